@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package that cohaptic's build, tests and benchmarks need.
+#
+# Idempotent: when everything is already installed it only checks and exits quickly.
+# Needs root (or passwordless sudo) to install; otherwise it lists what is missing
+# and exits non-zero.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake pkg-config git ca-certificates
+  # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it
+  libeigen3-dev libsuitesparse-dev libopenblas-dev
+  # networking and the wire format
+  libasio-dev libprotobuf-dev protobuf-compiler libsodium-dev
+  # configuration, command line, logging, JSON output
+  libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$p")
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "install-deps: missing ${#missing[@]} package(s): ${missing[*]}"
+
+if [[ $(id -u) -eq 0 ]]; then
+  as_root=()
+elif command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
+  as_root=(sudo -n)
+else
+  echo "install-deps: cannot install: not root and no passwordless sudo." >&2
+  echo "install-deps: run as root:  apt-get install -y ${missing[*]}" >&2
+  exit 1
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -q
+"${as_root[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+echo "install-deps: done"
