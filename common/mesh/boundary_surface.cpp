@@ -99,7 +99,30 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
   for (int t = 0; t < surface.triangle_count(); ++t)
     for (int v : surface.triangles[t])
       surface.node_triangle_list[static_cast<std::size_t>(fill[v]++)] = t;
+  surface.triangle_neighbours = triangle_edge_neighbours(surface.triangles);
   return surface;
+}
+
+std::vector<std::array<int, 3>> triangle_edge_neighbours(const std::vector<Triangle>& triangles) {
+  const auto edge_key = [](int from, int to) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(from)) << 32) | static_cast<std::uint32_t>(to);
+  };
+  // Directed edge -> owning triangle; -1 once the same directed edge is seen twice.
+  std::unordered_map<std::uint64_t, int> owner;
+  owner.reserve(triangles.size() * 3);
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const auto [it, inserted] = owner.emplace(edge_key(triangles[t][k], triangles[t][(k + 1) % 3]), t);
+      if (!inserted) it->second = -1;
+    }
+  std::vector<std::array<int, 3>> neighbours(triangles.size(), {-1, -1, -1});
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const auto forward = owner.find(edge_key(triangles[t][k], triangles[t][(k + 1) % 3]));
+      const auto reverse = owner.find(edge_key(triangles[t][(k + 1) % 3], triangles[t][k]));
+      if (forward->second >= 0 && reverse != owner.end() && reverse->second >= 0) neighbours[t][k] = reverse->second;
+    }
+  return neighbours;
 }
 
 Eigen::Vector3d triangle_normal(const TetMesh& mesh, const Triangle& tri) {

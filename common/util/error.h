@@ -5,6 +5,7 @@
 // level print what() and exit non-zero; nothing below them swallows an error.
 #pragma once
 
+#include <fmt/format.h>
 #include <stdexcept>
 #include <string>
 
@@ -20,7 +21,7 @@ class Error : public std::runtime_error {
 class ParseError : public Error {
  public:
   ParseError(const std::string& file, long line, const std::string& what)
-      : Error(file + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + what),
+      : Error(line > 0 ? fmt::format("{}:{}: {}", file, line, what) : fmt::format("{}: {}", file, what)),
         file_(file),
         line_(line) {}
   const std::string& file() const { return file_; }

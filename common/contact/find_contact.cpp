@@ -1,0 +1,43 @@
+#include "common/contact/find_contact.h"
+
+#include <limits>
+
+namespace cohaptic {
+
+ContactQuery find_contact(const TetMesh& mesh, const BoundarySurface& surface, const SurfacePseudoNormals& normals,
+                          std::span<const int> touchable_triangles, const Eigen::Vector3d& tool_position,
+                          double tool_radius) {
+  ContactQuery query;
+  query.signed_distance = closest_surface_point(mesh, surface, normals, tool_position).signed_distance;
+  if (!(query.signed_distance < tool_radius) || touchable_triangles.empty()) return query;
+
+  // Closest touchable triangle; among ties (an edge or vertex shared by several), the one
+  // whose plane the tool is deepest below.
+  double best_distance2 = std::numeric_limits<double>::infinity();
+  double best_height = std::numeric_limits<double>::infinity();
+  ToolContact contact;
+  for (int t : touchable_triangles) {
+    const Triangle& tri = surface.triangles[t];
+    const TriangleClosestPoint q = closest_point_on_triangle(tool_position, mesh.nodes.col(tri[0]),
+                                                             mesh.nodes.col(tri[1]), mesh.nodes.col(tri[2]));
+    const double d2 = (tool_position - q.point).squaredNorm();
+    const double height = (tool_position - q.point).dot(normals.face[t]);
+    const double tie_tolerance = 1e-24 + 1e-12 * best_distance2;
+    const bool closer = d2 < best_distance2 - tie_tolerance;
+    const bool tie_but_deeper = std::abs(d2 - best_distance2) <= tie_tolerance && height < best_height;
+    if (closer || tie_but_deeper) {
+      best_distance2 = std::min(d2, best_distance2);
+      best_height = height;
+      contact.triangle = t;
+      contact.foot = q.point;
+      contact.weights = q.weights;
+    }
+  }
+  const Eigen::Vector3d contact_point = tool_position - tool_radius * normals.face[contact.triangle];
+  contact.displacement = contact_point - contact.foot;
+  contact.depth = tool_radius - query.signed_distance;
+  query.contact = contact;
+  return query;
+}
+
+}  // namespace cohaptic

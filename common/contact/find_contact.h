@@ -1,0 +1,38 @@
+// Finding the contact of a tool with a deformable object at rest, and the paper's node
+// translation of the contact triangle.
+//
+// A tool is a point, or a sphere of radius r. It is in contact when its point (centre)
+// is less than r from the surface on the inside side, i.e. signed distance < r; the
+// contact triangle is then the closest touchable surface triangle (ties at an edge or a
+// vertex go to the triangle whose plane the tool is deepest below). F is the closest
+// point of that rest triangle (the foot of the perpendicular when it falls inside), w its
+// area coordinates, and the node-translation displacement of each of the triangle's
+// three nodes is d = (p - r n) - F with n the triangle's outward normal. Units: m.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <span>
+
+#include "common/contact/surface_distance.h"
+
+namespace cohaptic {
+
+struct ToolContact {
+  int triangle = -1;             ///< surface triangle index
+  Eigen::Vector3d foot;          ///< F, on the rest triangle [m]
+  Eigen::Vector3d weights;       ///< area coordinates of F
+  Eigen::Vector3d displacement;  ///< d, the same for the three nodes [m]
+  double depth = 0;              ///< how far the tool is inside the surface [m], > 0
+};
+
+struct ContactQuery {
+  double signed_distance = 0;          ///< of the tool point to the whole surface [m]
+  std::optional<ToolContact> contact;  ///< empty if the tool does not press a touchable triangle
+};
+
+ContactQuery find_contact(const TetMesh& mesh, const BoundarySurface& surface, const SurfacePseudoNormals& normals,
+                          std::span<const int> touchable_triangles, const Eigen::Vector3d& tool_position,
+                          double tool_radius);
+
+}  // namespace cohaptic

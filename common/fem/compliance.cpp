@@ -1,0 +1,83 @@
+#include "common/fem/compliance.h"
+
+#include <fmt/format.h>
+
+#include "common/util/error.h"
+
+namespace cohaptic {
+
+ComplianceColumns::ComplianceColumns(const SparseCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes)
+    : factor_(factor), dofs_(dofs), row_nodes_(std::move(row_nodes)), row_position_(static_cast<std::size_t>(dofs.node_count()), -1) {
+  for (int i = 0; i < static_cast<int>(row_nodes_.size()); ++i) {
+    const int node = row_nodes_[i];
+    if (node < 0 || node >= dofs.node_count()) throw Error(fmt::format("compliance: row node {} out of range", node));
+    if (row_position_[node] >= 0) throw Error(fmt::format("compliance: row node {} listed twice", node));
+    row_position_[node] = i;
+  }
+}
+
+const ComplianceColumn& ComplianceColumns::column(int node) {
+  if (!has_column(node)) compute_columns({node});
+  return columns_.at(node);
+}
+
+void ComplianceColumns::compute_columns(const std::vector<int>& nodes) {
+  std::vector<int> missing;
+  for (int node : nodes) {
+    if (node < 0 || node >= dofs_.node_count()) throw Error(fmt::format("compliance: node {} out of range", node));
+    if (!has_column(node) && std::find(missing.begin(), missing.end(), node) == missing.end()) missing.push_back(node);
+  }
+  if (missing.empty()) return;
+  // One right-hand side per axis of every missing node: unit force on that dof.
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(factor_.size(), 3 * static_cast<Eigen::Index>(missing.size()));
+  for (int k = 0; k < static_cast<int>(missing.size()); ++k)
+    for (int axis = 0; axis < 3; ++axis) {
+      const int free = dofs_.free_index[3 * missing[k] + axis];
+      if (free >= 0) rhs(free, 3 * k + axis) = 1.0;
+    }
+  const Eigen::MatrixXd solution = factor_.solve(rhs);
+  const auto rows = static_cast<Eigen::Index>(3 * row_nodes_.size());
+  for (int k = 0; k < static_cast<int>(missing.size()); ++k) {
+    ComplianceColumn column = ComplianceColumn::Zero(rows, 3);
+    for (int r = 0; r < static_cast<int>(row_nodes_.size()); ++r)
+      for (int axis = 0; axis < 3; ++axis) {
+        const int free = dofs_.free_index[3 * row_nodes_[r] + axis];
+        if (free >= 0) column.row(3 * r + axis) = solution.block(free, 3 * k, 1, 3);
+      }
+    // A fixed axis of the column node carries no force: its column stays zero.
+    for (int axis = 0; axis < 3; ++axis)
+      if (dofs_.is_fixed(missing[k], axis)) column.col(axis).setZero();
+    columns_.emplace(missing[k], std::move(column));
+  }
+}
+
+Eigen::Matrix3d ComplianceColumns::block(int row_node, int column_node) {
+  const int position = row_position(row_node);
+  if (position < 0) throw Error(fmt::format("compliance: node {} is not a row node", row_node));
+  return column(column_node).middleRows<3>(3 * position);
+}
+
+Eigen::MatrixXd ComplianceColumns::gather(const std::vector<int>& nodes) {
+  compute_columns(nodes);
+  const auto n = static_cast<Eigen::Index>(nodes.size());
+  Eigen::MatrixXd l(3 * n, 3 * n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const ComplianceColumn& col = columns_.at(nodes[j]);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const int position = row_position(nodes[i]);
+      if (position < 0) throw Error(fmt::format("compliance: node {} is not a row node", nodes[i]));
+      l.block<3, 3>(3 * i, 3 * j) = col.middleRows<3>(3 * position);
+    }
+  }
+  // Solves are symmetric only to round-off; M = L^-1 must be exactly symmetric.
+  return 0.5 * (l + l.transpose());
+}
+
+void ComplianceColumns::insert_column(int node, ComplianceColumn column) {
+  if (column.rows() != static_cast<Eigen::Index>(3 * row_nodes_.size()))
+    throw Error(fmt::format("compliance: column for node {} has {} rows, expected {}", node, column.rows(),
+                            3 * row_nodes_.size()));
+  columns_[node] = std::move(column);
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,54 @@
+// ComplianceColumns: column blocks of the compliance L = K_ff^-1, computed on demand.
+//
+// L is dense and (3N)^2: never formed. The column block of node j (3 columns, one per
+// axis) costs one solve with 3 right-hand sides; only the rows of the `row_nodes` (the
+// nodes that can be touched or collide) are kept, in a cache keyed by node. Columns of a
+// fixed axis are zero. Units: m/N. L is symmetric: block(i, j) = block(j, i)^T.
+#pragma once
+
+#include <Eigen/Core>
+#include <unordered_map>
+#include <vector>
+
+#include "common/fem/dof_map.h"
+#include "common/fem/sparse_cholesky.h"
+
+namespace cohaptic {
+
+/// Rows: 3 per row node, in row_nodes order; columns: the node's x, y, z.
+using ComplianceColumn = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+
+class ComplianceColumns {
+ public:
+  /// `factor` and `dofs` must outlive this object; `row_nodes` are volume node indices.
+  ComplianceColumns(const SparseCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes);
+
+  const std::vector<int>& row_nodes() const { return row_nodes_; }
+  int node_count() const { return static_cast<int>(row_position_.size()); }
+  /// Position of `node` in row_nodes(), or -1.
+  int row_position(int node) const { return row_position_[node]; }
+  bool has_column(int node) const { return columns_.count(node) != 0; }
+  std::size_t column_count() const { return columns_.size(); }
+
+  /// L[row_nodes, node], solved on first use.
+  const ComplianceColumn& column(int node);
+  /// Computes every missing column of `nodes` in one multi-right-hand-side solve.
+  void compute_columns(const std::vector<int>& nodes);
+  /// The 3x3 block L_ij; i must be a row node.
+  Eigen::Matrix3d block(int row_node, int column_node);
+  /// L_AA (3|A| x 3|A|, symmetrised) for nodes A, all of them row nodes.
+  Eigen::MatrixXd gather(const std::vector<int>& nodes);
+
+  /// Cached columns, for persistence. insert_column() checks the row count.
+  const std::unordered_map<int, ComplianceColumn>& columns() const { return columns_; }
+  void insert_column(int node, ComplianceColumn column);
+
+ private:
+  const SparseCholesky& factor_;
+  const DofMap& dofs_;
+  std::vector<int> row_nodes_;
+  std::vector<int> row_position_;  // per volume node
+  std::unordered_map<int, ComplianceColumn> columns_;
+};
+
+}  // namespace cohaptic

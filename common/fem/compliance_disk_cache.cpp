@@ -1,0 +1,185 @@
+#include "common/fem/compliance_disk_cache.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fmt/format.h>
+#include <fstream>
+
+#include "common/util/error.h"
+
+namespace cohaptic {
+namespace {
+
+constexpr char kMagic[8] = {'C', 'H', 'C', 'O', 'M', 'P', 'L', '\0'};
+
+// Appends plain values to a byte buffer.
+struct Writer {
+  std::vector<char> buffer;
+  void bytes(const void* data, std::size_t size) {
+    const std::size_t offset = buffer.size();
+    buffer.resize(offset + size);
+    std::memcpy(buffer.data() + offset, data, size);
+  }
+  template <typename T>
+  void value(const T& v) { bytes(&v, sizeof v); }
+};
+
+// Reads plain values from a byte buffer; every read is bounds-checked.
+struct Reader {
+  const std::vector<char>& buffer;
+  std::size_t offset = 0;
+  bool bytes(void* out, std::size_t size) {
+    if (size > buffer.size() - offset) return false;
+    std::memcpy(out, buffer.data() + offset, size);
+    offset += size;
+    return true;
+  }
+  template <typename T>
+  bool value(T& v) { return bytes(&v, sizeof v); }
+};
+
+}  // namespace
+
+Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
+                            const std::vector<int>& row_nodes) {
+  ContentHasher h;
+  h.text("cohaptic compliance cache").value(kComplianceCacheFormatVersion);
+  h.matrix(mesh.nodes);
+  h.values(std::span<const Tet>(mesh.tets));
+  h.value(material.youngs_modulus).value(material.poisson_ratio);
+  h.values(std::span<const AxisMask>(dofs.fixed_axes));
+  h.values(std::span<const int>(row_nodes));
+  return h.finish();
+}
+
+std::filesystem::path compliance_cache_file(const std::filesystem::path& directory, const Digest& key) {
+  return directory / ("compliance-" + to_hex(key).substr(0, 32) + ".bin");
+}
+
+ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, const Digest& key,
+                                          ComplianceColumns& columns) {
+  ComplianceCacheLoad result;
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    result.problem = "no cache file";
+    return result;
+  }
+  const std::vector<char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) {
+    result.problem = fmt::format("read error: {}", std::strerror(errno));
+    return result;
+  }
+  Digest stored_checksum{};
+  if (data.size() < sizeof kMagic + stored_checksum.size()) {
+    result.problem = fmt::format("truncated ({} bytes)", data.size());
+    return result;
+  }
+  const std::size_t body_size = data.size() - stored_checksum.size();
+  std::memcpy(stored_checksum.data(), data.data() + body_size, stored_checksum.size());
+  if (digest_of(data.data(), body_size) != stored_checksum) {
+    result.problem = "checksum mismatch (truncated or corrupted)";
+    return result;
+  }
+
+  Reader r{data};
+  char magic[sizeof kMagic];
+  std::uint32_t version = 0;
+  Digest stored_key{};
+  r.bytes(magic, sizeof magic);
+  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0) {
+    result.problem = "not a cohaptic compliance cache";
+    return result;
+  }
+  if (!r.value(version) || version != kComplianceCacheFormatVersion) {
+    result.problem = fmt::format("format version {} (this build reads {})", version, kComplianceCacheFormatVersion);
+    return result;
+  }
+  if (!r.value(stored_key) || stored_key != key) {
+    result.problem = "computed for a different mesh, material or boundary conditions";
+    return result;
+  }
+  std::uint32_t row_count = 0;
+  if (!r.value(row_count) || row_count != columns.row_nodes().size()) {
+    result.problem = "row count differs";
+    return result;
+  }
+  std::vector<int> rows(row_count);
+  if (!r.bytes(rows.data(), rows.size() * sizeof(int)) || rows != columns.row_nodes()) {
+    result.problem = "row nodes differ";
+    return result;
+  }
+  std::uint32_t column_count = 0;
+  if (!r.value(column_count)) {
+    result.problem = "truncated column count";
+    return result;
+  }
+  std::vector<std::pair<int, ComplianceColumn>> loaded;
+  loaded.reserve(column_count);
+  for (std::uint32_t c = 0; c < column_count; ++c) {
+    int node = 0;
+    ComplianceColumn column(3 * static_cast<Eigen::Index>(row_count), 3);
+    if (!r.value(node) || !r.bytes(column.data(), static_cast<std::size_t>(column.size()) * sizeof(double))) {
+      result.problem = fmt::format("truncated at column {}", c);
+      return result;
+    }
+    if (node < 0 || node >= columns.node_count()) {
+      result.problem = fmt::format("column {} names node {}, outside the mesh", c, node);
+      return result;
+    }
+    loaded.emplace_back(node, std::move(column));
+  }
+  if (r.offset != body_size) {
+    result.problem = "trailing bytes after the last column";
+    return result;
+  }
+  for (auto& [node, column] : loaded) columns.insert_column(node, std::move(column));
+  result.loaded = true;
+  result.columns = static_cast<int>(loaded.size());
+  return result;
+}
+
+void save_compliance_cache(const std::filesystem::path& file, const Digest& key, const ComplianceColumns& columns) {
+  Writer w;
+  w.bytes(kMagic, sizeof kMagic);
+  w.value(kComplianceCacheFormatVersion);
+  w.value(key);
+  const auto& rows = columns.row_nodes();
+  w.value(static_cast<std::uint32_t>(rows.size()));
+  w.bytes(rows.data(), rows.size() * sizeof(int));
+  // Sorted by node so the same columns always give the same file.
+  std::vector<int> nodes;
+  for (const auto& entry : columns.columns()) nodes.push_back(entry.first);
+  std::sort(nodes.begin(), nodes.end());
+  w.value(static_cast<std::uint32_t>(nodes.size()));
+  for (int node : nodes) {
+    const ComplianceColumn& column = columns.columns().at(node);
+    w.value(node);
+    w.bytes(column.data(), static_cast<std::size_t>(column.size()) * sizeof(double));
+  }
+  const Digest checksum = digest_of(w.buffer.data(), w.buffer.size());
+  w.value(checksum);
+
+  std::error_code ec;
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
+  if (ec) throw Error(fmt::format("{}: cannot create the cache directory: {}", file.parent_path().string(), ec.message()));
+  const std::filesystem::path temporary = file.string() + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (out) out.write(w.buffer.data(), static_cast<std::streamsize>(w.buffer.size()));
+    if (out) out.flush();
+    if (!out) {
+      const std::string reason = std::strerror(errno);
+      out.close();
+      std::filesystem::remove(temporary, ec);
+      throw Error(fmt::format("{}: cannot write the compliance cache: {}", temporary.string(), reason));
+    }
+  }
+  std::filesystem::rename(temporary, file, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    throw Error(fmt::format("{}: cannot move the compliance cache into place: {}", file.string(), ec.message()));
+  }
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,26 @@
+// Isotropic linear elastic material and its elasticity matrix.
+//
+// Units: Young's modulus E in Pa; Poisson's ratio nu dimensionless, -1 < nu < 0.5 (the
+// displacement formulation has no solution at 0.5 and locks as nu approaches it).
+// Voigt order of strain and stress: xx, yy, zz, yz, xz, xy with engineering shear strains.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace cohaptic {
+
+struct LinearElasticMaterial {
+  double youngs_modulus = 0;  ///< E [Pa], > 0
+  double poisson_ratio = 0;   ///< nu, in (-1, 0.5)
+
+  double lame_lambda() const { return youngs_modulus * poisson_ratio / ((1 + poisson_ratio) * (1 - 2 * poisson_ratio)); }
+  double shear_modulus() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
+};
+
+/// Throws cohaptic::Error naming the bad parameter if E or nu is out of range or not finite.
+void validate(const LinearElasticMaterial& material);
+
+/// The 6x6 matrix D with sigma = D epsilon (Voigt order above).
+Eigen::Matrix<double, 6, 6> elasticity_matrix(const LinearElasticMaterial& material);
+
+}  // namespace cohaptic

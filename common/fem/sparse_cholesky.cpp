@@ -1,0 +1,111 @@
+#include "common/fem/sparse_cholesky.h"
+
+#include <cholmod.h>
+#include <fmt/format.h>
+
+#include "common/util/error.h"
+
+namespace cohaptic {
+
+struct SparseCholesky::Impl {
+  mutable cholmod_common common{};
+  cholmod_factor* factor = nullptr;
+  // Reused solve workspace (cholmod_solve2), so repeated solves do not reallocate.
+  mutable cholmod_dense* solution = nullptr;
+  mutable cholmod_dense* work_y = nullptr;
+  mutable cholmod_dense* work_e = nullptr;
+
+  Impl() {
+    cholmod_start(&common);
+    common.supernodal = CHOLMOD_SUPERNODAL;
+    common.print = 0;           // errors are reported through exceptions, not stdout
+    common.error_handler = nullptr;
+  }
+  ~Impl() {
+    cholmod_free_dense(&solution, &common);
+    cholmod_free_dense(&work_y, &common);
+    cholmod_free_dense(&work_e, &common);
+    cholmod_free_factor(&factor, &common);
+    cholmod_finish(&common);
+  }
+};
+
+namespace {
+
+// A read-only CHOLMOD view of an Eigen compressed column matrix (no copy).
+cholmod_sparse view_of(const SparseMatrix& matrix) {
+  cholmod_sparse view{};
+  view.nrow = static_cast<std::size_t>(matrix.rows());
+  view.ncol = static_cast<std::size_t>(matrix.cols());
+  view.nzmax = static_cast<std::size_t>(matrix.nonZeros());
+  view.p = const_cast<int*>(matrix.outerIndexPtr());
+  view.i = const_cast<int*>(matrix.innerIndexPtr());
+  view.x = const_cast<double*>(matrix.valuePtr());
+  view.stype = -1;  // symmetric, lower triangle used
+  view.itype = CHOLMOD_INT;
+  view.xtype = CHOLMOD_REAL;
+  view.dtype = CHOLMOD_DOUBLE;
+  view.sorted = 1;
+  view.packed = 1;
+  return view;
+}
+
+}  // namespace
+
+SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row)
+    : impl_(std::make_unique<Impl>()), size_(static_cast<int>(matrix.rows())) {
+  if (matrix.rows() != matrix.cols())
+    throw NumericalError(fmt::format("cannot factor a {}x{} matrix: not square", matrix.rows(), matrix.cols()));
+  if (!matrix.isCompressed()) throw NumericalError("cannot factor an uncompressed sparse matrix");
+  cholmod_sparse view = view_of(matrix);
+  cholmod_common& c = impl_->common;
+  impl_->factor = cholmod_analyze(&view, &c);
+  if (impl_->factor == nullptr || c.status < CHOLMOD_OK)
+    throw NumericalError(fmt::format("CHOLMOD analysis of a {0}x{0} matrix failed (status {1})", size_, c.status));
+  const int ok = cholmod_factorize(&view, impl_->factor, &c);
+  if (c.status == CHOLMOD_NOT_POSDEF) {
+    const auto failed_column = static_cast<std::size_t>(impl_->factor->minor);
+    const int row = failed_column < static_cast<std::size_t>(size_)
+                        ? static_cast<int*>(impl_->factor->Perm)[failed_column]
+                        : -1;
+    throw NumericalError(fmt::format(
+        "the stiffness matrix is not positive definite ({}): is every part of the object fixed "
+        "against rigid motion, and are the material and elements valid?",
+        row >= 0 && name_row ? "first failure at " + name_row(row) : fmt::format("row {}", row)));
+  }
+  if (!ok || c.status < CHOLMOD_OK)
+    throw NumericalError(fmt::format("CHOLMOD factorisation of a {0}x{0} matrix failed (status {1})", size_, c.status));
+}
+
+SparseCholesky::~SparseCholesky() = default;
+
+Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
+  if (rhs.rows() != size_)
+    throw NumericalError(fmt::format("solve: right-hand side has {} rows, the factor {}", rhs.rows(), size_));
+  Eigen::MatrixXd x(rhs.rows(), rhs.cols());
+  if (rhs.cols() == 0) return x;
+  cholmod_dense b{};
+  b.nrow = static_cast<std::size_t>(rhs.rows());
+  b.ncol = static_cast<std::size_t>(rhs.cols());
+  b.nzmax = b.nrow * b.ncol;
+  b.d = b.nrow;
+  b.x = const_cast<double*>(rhs.data());
+  b.xtype = CHOLMOD_REAL;
+  b.dtype = CHOLMOD_DOUBLE;
+  cholmod_common& c = impl_->common;
+  if (!cholmod_solve2(CHOLMOD_A, impl_->factor, &b, nullptr, &impl_->solution, nullptr, &impl_->work_y,
+                      &impl_->work_e, &c))
+    throw NumericalError(fmt::format("CHOLMOD solve failed (status {})", c.status));
+  const auto* values = static_cast<const double*>(impl_->solution->x);
+  const auto leading = static_cast<Eigen::Index>(impl_->solution->d);
+  for (Eigen::Index j = 0; j < x.cols(); ++j) x.col(j) = Eigen::Map<const Eigen::VectorXd>(values + j * leading, x.rows());
+  return x;
+}
+
+double SparseCholesky::reciprocal_condition_estimate() const { return cholmod_rcond(impl_->factor, &impl_->common); }
+
+double SparseCholesky::factor_nonzeros() const { return impl_->common.lnz; }
+
+bool SparseCholesky::is_supernodal() const { return impl_->factor->is_super != 0; }
+
+}  // namespace cohaptic

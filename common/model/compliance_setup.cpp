@@ -1,0 +1,67 @@
+#include "common/model/compliance_setup.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cstdlib>
+
+#include "common/fem/compliance_disk_cache.h"
+#include "common/util/error.h"
+#include "common/util/stopwatch.h"
+
+namespace cohaptic {
+
+std::vector<int> compliance_row_nodes(const Model& model) { return model.touchable_nodes; }
+
+std::filesystem::path default_cache_directory() {
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "cohaptic";
+  if (const char* home = std::getenv("HOME"); home && *home) return std::filesystem::path(home) / ".cache" / "cohaptic";
+  return ".cohaptic-cache";
+}
+
+namespace {
+
+Digest cache_key(const Model& model, const ComplianceColumns& columns) {
+  return compliance_cache_key(model.mesh, model.scene.object.material, model.dofs, columns.row_nodes());
+}
+
+}  // namespace
+
+ComplianceSetup prepare_compliance(const Model& model, ComplianceColumns& columns,
+                                   const std::optional<std::filesystem::path>& cache_directory) {
+  ComplianceSetup setup;
+  Stopwatch watch;
+  const bool use_disk = cache_directory.has_value() && model.scene.object.compliance.disk_cache;
+  if (use_disk) {
+    const Digest key = cache_key(model, columns);
+    setup.cache_file = compliance_cache_file(*cache_directory, key);
+    const ComplianceCacheLoad load = load_compliance_cache(setup.cache_file, key, columns);
+    setup.from_disk = load.loaded;
+    setup.note = load.loaded ? fmt::format("loaded {} columns from {}", load.columns, setup.cache_file.string())
+                             : fmt::format("cache {}: {}", setup.cache_file.string(), load.problem);
+    if (!load.loaded && load.problem != "no cache file")
+      spdlog::warn("compliance {}; rebuilding it", setup.note);
+  }
+  const bool want_all = model.scene.object.compliance.precompute_touchable;
+  const std::size_t before = columns.column_count();
+  if (want_all) columns.compute_columns(columns.row_nodes());
+  if (use_disk && columns.column_count() > before) {
+    save_compliance(model, columns, *cache_directory);
+    setup.note += fmt::format("; computed {} columns and saved them", columns.column_count() - before);
+  }
+  setup.columns = columns.column_count();
+  setup.ms = watch.elapsed_ms();
+  spdlog::info("compliance: {} columns of {} rows ready in {:.1f} ms{}", setup.columns, 3 * columns.row_nodes().size(),
+               setup.ms, setup.note.empty() ? "" : " (" + setup.note + ")");
+  return setup;
+}
+
+void save_compliance(const Model& model, const ComplianceColumns& columns, const std::filesystem::path& cache_directory) {
+  const Digest key = cache_key(model, columns);
+  try {
+    save_compliance_cache(compliance_cache_file(cache_directory, key), key, columns);
+  } catch (const Error& e) {
+    spdlog::warn("compliance cache not saved (the results are unaffected): {}", e.what());
+  }
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,364 @@
+#include "common/scene/load_scene.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fmt/format.h>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace cohaptic {
+namespace {
+
+// A YAML node together with where it is (file and key path), so that every complaint
+// about it can say exactly where to look.
+class Cursor {
+ public:
+  Cursor(YAML::Node node, std::string path, const std::string* file, int line)
+      : node_(std::move(node)), path_(std::move(path)), file_(file), line_(line) {
+    if (node_.IsDefined() && node_.Mark().line >= 0) line_ = node_.Mark().line + 1;
+  }
+
+  const std::string& path() const { return path_; }
+  bool is_map() const { return node_.IsMap(); }
+  bool is_sequence() const { return node_.IsSequence(); }
+  bool is_scalar() const { return node_.IsScalar(); }
+
+  [[noreturn]] void fail(const std::string& expected) const {
+    throw SceneError(fmt::format("{}:{}: {}: expected {}, found {}", *file_, line_, path_.empty() ? "(top level)" : path_,
+                                 expected, describe()));
+  }
+  [[noreturn]] void fail_message(const std::string& message) const {
+    throw SceneError(fmt::format("{}:{}: {}: {}", *file_, line_, path_.empty() ? "(top level)" : path_, message));
+  }
+
+  std::optional<Cursor> find(const std::string& key) const {
+    if (!node_.IsMap()) fail("a map");
+    const YAML::Node child = node_[key];
+    if (!child.IsDefined() || child.IsNull()) return std::nullopt;
+    return Cursor(child, join(key), file_, line_);
+  }
+  Cursor at(const std::string& key) const {
+    if (auto child = find(key)) return *child;
+    throw SceneError(fmt::format("{}:{}: {}: missing required key '{}'", *file_, line_,
+                                 path_.empty() ? "(top level)" : path_, key));
+  }
+  /// Rejects keys outside `allowed`, naming the first unknown one and the allowed set.
+  void only_keys(std::initializer_list<const char*> allowed) const {
+    if (!node_.IsMap()) fail("a map");
+    const std::set<std::string> known(allowed.begin(), allowed.end());
+    for (const auto& entry : node_) {
+      const auto key = entry.first.as<std::string>();
+      if (!known.count(key)) {
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        Cursor(entry.first, join(key), file_, line_).fail_message(fmt::format("unknown key (allowed here: {})", list));
+      }
+    }
+  }
+  std::vector<Cursor> items() const {
+    if (!node_.IsSequence()) fail("a list");
+    std::vector<Cursor> out;
+    for (std::size_t i = 0; i < node_.size(); ++i)
+      out.emplace_back(node_[i], fmt::format("{}[{}]", path_, i), file_, line_);
+    return out;
+  }
+
+  std::string text() const {
+    if (!node_.IsScalar()) fail("a string");
+    return node_.Scalar();
+  }
+  double number() const {
+    if (!node_.IsScalar()) fail("a number");
+    try {
+      const double v = node_.as<double>();
+      if (!std::isfinite(v)) fail("a finite number");
+      return v;
+    } catch (const YAML::Exception&) {
+      fail("a number");
+    }
+  }
+  double number_in(double low, double high, bool low_open, bool high_open, const std::string& expected) const {
+    const double v = number();
+    if ((low_open ? v <= low : v < low) || (high_open ? v >= high : v > high)) fail(expected);
+    return v;
+  }
+  std::int64_t integer() const {
+    if (!node_.IsScalar()) fail("an integer");
+    try {
+      return node_.as<std::int64_t>();
+    } catch (const YAML::Exception&) {
+      fail("an integer");
+    }
+  }
+  bool boolean() const {
+    if (!node_.IsScalar()) fail("true or false");
+    try {
+      return node_.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail("true or false");
+    }
+  }
+  Eigen::Vector3d vec3() const {
+    if (!node_.IsSequence() || node_.size() != 3) fail("a list of 3 numbers");
+    const auto parts = items();
+    return {parts[0].number(), parts[1].number(), parts[2].number()};
+  }
+  std::string choice(std::initializer_list<const char*> options) const {
+    const std::string v = text();
+    std::string list;
+    for (const char* o : options) {
+      if (v == o) return v;
+      list += (list.empty() ? "" : " | ") + std::string(o);
+    }
+    fail(list);
+  }
+
+ private:
+  std::string join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+  std::string describe() const {
+    if (!node_.IsDefined() || node_.IsNull()) return "nothing";
+    if (node_.IsScalar()) return "'" + node_.Scalar() + "'";
+    if (node_.IsSequence()) return fmt::format("a list of {}", node_.size());
+    return "a map";
+  }
+
+  YAML::Node node_;
+  std::string path_;
+  const std::string* file_;
+  int line_;
+};
+
+double metres_per(const Cursor& units) {
+  const std::string u = units.choice({"m", "cm", "mm"});
+  return u == "m" ? 1.0 : u == "cm" ? 0.01 : 0.001;
+}
+
+// The caller checks the keys allowed beside the selector (e.g. `axes` for a fixed region).
+NodeSelector parse_selector(const Cursor& c, double scale) {
+  if (!c.is_map()) c.fail("a map with one of surface, box, plane or nodes");
+  NodeSelector s;
+  s.where = c.path();
+  int kinds = 0;
+  if (auto surface = c.find("surface")) {
+    if (!surface->boolean()) surface->fail("true (select the whole surface)");
+    s.kind = NodeSelector::Kind::surface;
+    ++kinds;
+  }
+  if (auto box = c.find("box")) {
+    box->only_keys({"min", "max"});
+    s.kind = NodeSelector::Kind::box;
+    s.box_min = box->at("min").vec3() * scale;
+    s.box_max = box->at("max").vec3() * scale;
+    if ((s.box_max.array() < s.box_min.array()).any()) box->at("max").fail("a corner not below min on any axis");
+    ++kinds;
+  }
+  if (auto plane = c.find("plane")) {
+    plane->only_keys({"point", "normal", "tolerance"});
+    s.kind = NodeSelector::Kind::plane;
+    s.plane_point = plane->at("point").vec3() * scale;
+    const Cursor normal = plane->at("normal");
+    s.plane_normal = normal.vec3();
+    if (s.plane_normal.norm() < 1e-12) normal.fail("a non-zero normal vector");
+    s.plane_normal.normalize();
+    if (auto tolerance = plane->find("tolerance"))
+      s.tolerance = tolerance->number_in(0, INFINITY, true, false, "a positive length") * scale;
+    ++kinds;
+  }
+  if (auto nodes = c.find("nodes")) {
+    s.kind = NodeSelector::Kind::node_tags;
+    for (const Cursor& item : nodes->items()) s.node_tags.push_back(item.integer());
+    if (s.node_tags.empty()) nodes->fail("a non-empty list of node ids");
+    ++kinds;
+  }
+  if (kinds != 1) c.fail("exactly one of surface, box, plane or nodes");
+  return s;
+}
+
+AxisMask parse_axes(const Cursor& c) {
+  const std::string text = c.text();
+  AxisMask mask = 0;
+  for (char ch : text) {
+    const int axis = ch == 'x' ? 0 : ch == 'y' ? 1 : ch == 'z' ? 2 : -1;
+    if (axis < 0 || (mask >> axis) & 1u) c.fail("a combination of x, y and z, each at most once (e.g. xyz or z)");
+    mask = static_cast<AxisMask>(mask | (1u << axis));
+  }
+  if (mask == 0) c.fail("at least one axis");
+  return mask;
+}
+
+MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
+  c.only_keys({"file", "box"});
+  MeshSpec mesh;
+  const auto file = c.find("file");
+  const auto box = c.find("box");
+  if (static_cast<bool>(file) == static_cast<bool>(box)) c.fail("exactly one of file or box");
+  if (file) {
+    mesh.file = file->text();
+    if (mesh.file.is_relative()) mesh.file = scene_dir / mesh.file;
+    if (!std::filesystem::exists(mesh.file)) file->fail_message(fmt::format("mesh file {} does not exist", mesh.file.string()));
+  } else {
+    box->only_keys({"min", "size", "divisions"});
+    BoxMeshSpec spec;
+    spec.min_corner = box->at("min").vec3() * scale;
+    const Cursor size = box->at("size");
+    spec.size = size.vec3() * scale;
+    if (!(spec.size.array() > 0).all()) size.fail("three positive lengths");
+    const Cursor divisions = box->at("divisions");
+    if (!divisions.is_sequence() || divisions.items().size() != 3) divisions.fail("a list of 3 integers");
+    const auto parts = divisions.items();
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t d = parts[i].integer();
+      if (d < 1 || d > 400) parts[i].fail("an integer from 1 to 400");
+      spec.divisions[i] = static_cast<int>(d);
+    }
+    mesh.box = spec;
+  }
+  return mesh;
+}
+
+ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
+  c.only_keys({"name", "mesh", "material", "fixed", "touchable", "compliance"});
+  ObjectSpec object;
+  object.name = c.at("name").text();
+  object.mesh = parse_mesh(c.at("mesh"), scale, scene_dir);
+
+  const Cursor material = c.at("material");
+  material.only_keys({"model", "youngs_modulus", "poisson_ratio"});
+  if (auto model = material.find("model")) model->choice({"linear_elastic"});
+  object.material.youngs_modulus = material.at("youngs_modulus").number_in(0, INFINITY, true, true, "a positive modulus in Pa");
+  object.material.poisson_ratio =
+      material.at("poisson_ratio").number_in(-1, 0.5, true, true, "a number in (-1, 0.5): 0.5 is incompressible, which linear tetrahedra cannot represent");
+
+  const Cursor fixed = c.at("fixed");
+  for (const Cursor& item : fixed.items()) {
+    item.only_keys({"surface", "box", "plane", "nodes", "axes"});
+    FixedRegion region;
+    region.nodes = parse_selector(item, scale);
+    if (auto axes = item.find("axes")) region.axes = parse_axes(*axes);
+    object.fixed.push_back(region);
+  }
+  if (object.fixed.empty()) fixed.fail("at least one fixed region (an unfixed object has no static solution)");
+
+  if (auto touchable = c.find("touchable")) {
+    for (const Cursor& item : touchable->items()) {
+      item.only_keys({"surface", "box", "plane", "nodes"});
+      object.touchable.push_back(parse_selector(item, scale));
+    }
+  } else {
+    NodeSelector whole;
+    whole.where = c.path() + ".touchable (default: the whole surface)";
+    object.touchable.push_back(whole);
+  }
+
+  if (auto compliance = c.find("compliance")) {
+    compliance->only_keys({"precompute", "disk_cache"});
+    if (auto precompute = compliance->find("precompute"))
+      object.compliance.precompute_touchable = precompute->choice({"touchable", "on_demand"}) == "touchable";
+    if (auto disk_cache = compliance->find("disk_cache")) object.compliance.disk_cache = disk_cache->boolean();
+  }
+  return object;
+}
+
+ObstacleSpec parse_obstacle(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
+  c.only_keys({"name", "surface", "plane"});
+  ObstacleSpec obstacle;
+  obstacle.name = c.at("name").text();
+  const auto surface = c.find("surface");
+  const auto plane = c.find("plane");
+  if (static_cast<bool>(surface) == static_cast<bool>(plane)) c.fail("exactly one of surface (a file) or plane");
+  if (surface) {
+    obstacle.surface_file = surface->text();
+    if (obstacle.surface_file.is_relative()) obstacle.surface_file = scene_dir / obstacle.surface_file;
+    if (!std::filesystem::exists(obstacle.surface_file))
+      surface->fail_message(fmt::format("surface file {} does not exist", obstacle.surface_file.string()));
+  } else {
+    plane->only_keys({"point", "normal"});
+    const Cursor normal = plane->at("normal");
+    Eigen::Vector3d n = normal.vec3();
+    if (n.norm() < 1e-12) normal.fail("a non-zero normal vector");
+    obstacle.plane = std::make_pair(Eigen::Vector3d(plane->at("point").vec3() * scale), Eigen::Vector3d(n.normalized()));
+  }
+  return obstacle;
+}
+
+ToolSpec parse_tool(const Cursor& c, double scale) {
+  c.only_keys({"name", "shape", "radius"});
+  ToolSpec tool;
+  tool.name = c.at("name").text();
+  if (auto shape = c.find("shape")) tool.shape = shape->choice({"point", "sphere"}) == "point" ? ToolShape::point : ToolShape::sphere;
+  if (tool.shape == ToolShape::sphere)
+    tool.radius = c.at("radius").number_in(0, INFINITY, true, true, "a positive radius") * scale;
+  else if (auto radius = c.find("radius"))
+    radius->fail_message("a point tool has no radius (use shape: sphere)");
+  return tool;
+}
+
+HapticSettings parse_haptic(const Cursor& c) {
+  c.only_keys({"rate_hz", "force_limit", "contact_model"});
+  HapticSettings haptic;
+  if (auto rate = c.find("rate_hz")) haptic.rate_hz = rate->number_in(1, 100000, false, false, "a rate from 1 to 100000 Hz");
+  if (auto limit = c.find("force_limit")) haptic.force_limit_n = limit->number_in(0, 1000, true, false, "a force limit in N, in (0, 1000]");
+  if (auto model = c.find("contact_model"))
+    haptic.contact_model = model->choice({"translation", "point"}) == "translation" ? ContactModel::node_translation
+                                                                                     : ContactModel::point_constraint;
+  return haptic;
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file) {
+  const std::string file_name = file.string();
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml_text);
+  } catch (const YAML::ParserException& e) {
+    throw SceneError(fmt::format("{}:{}: YAML syntax error: {}", file_name, e.mark.line + 1, e.msg));
+  }
+  const Cursor top(root, "", &file_name, 1);
+  if (!top.is_map()) top.fail("a map of scene settings");
+  top.only_keys({"name", "units", "objects", "obstacles", "tools", "haptic"});
+
+  Scene scene;
+  scene.file = file;
+  scene.name = top.find("name") ? top.at("name").text() : file.stem().string();
+  if (auto units = top.find("units")) {
+    scene.metres_per_unit = metres_per(*units);
+    scene.units = units->text();
+  }
+  const double scale = scene.metres_per_unit;
+  const std::filesystem::path scene_dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+
+  const Cursor objects = top.at("objects");
+  const auto object_items = objects.items();
+  if (object_items.size() != 1)
+    objects.fail("exactly one object (scenes with several deformable objects are not supported yet)");
+  scene.object = parse_object(object_items[0], scale, scene_dir);
+
+  if (auto obstacles = top.find("obstacles"))
+    for (const Cursor& item : obstacles->items()) scene.obstacles.push_back(parse_obstacle(item, scale, scene_dir));
+
+  const Cursor tools = top.at("tools");
+  std::set<std::string> tool_names;
+  for (const Cursor& item : tools.items()) {
+    scene.tools.push_back(parse_tool(item, scale));
+    if (!tool_names.insert(scene.tools.back().name).second) item.at("name").fail("a tool name not used before");
+  }
+  if (scene.tools.empty()) tools.fail("at least one tool");
+
+  if (auto haptic = top.find("haptic")) scene.haptic = parse_haptic(*haptic);
+  return scene;
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw SceneError(fmt::format("{}: cannot open the scene file: {}", file.string(), std::strerror(errno)));
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), file);
+}
+
+}  // namespace cohaptic

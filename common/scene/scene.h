@@ -1,0 +1,97 @@
+// Scene: the plain description of what to simulate, as loaded from a YAML scene file.
+//
+// Everything here is in SI units (lengths converted from the file's `units` on load;
+// moduli in Pa, forces in N, rates in Hz). A Scene is validated when loaded (see
+// load_scene.h) and compiled into a Model (model.h); only what it lists is built.
+// The file format is documented in README.md, "Scene files".
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/fem/dof_map.h"
+#include "common/fem/linear_elastic_material.h"
+
+namespace cohaptic {
+
+enum class ToolShape { point, sphere };
+enum class ContactModel { node_translation, point_constraint };
+
+struct BoxMeshSpec {
+  Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();  ///< [m]
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();        ///< [m]
+  Eigen::Vector3i divisions = Eigen::Vector3i::Ones();
+};
+
+/// Exactly one of a mesh file (.msh 2.2/4.1, resolved against the scene's directory) or a generator.
+struct MeshSpec {
+  std::filesystem::path file;
+  std::optional<BoxMeshSpec> box;
+};
+
+/// Selects nodes of an object: on its whole surface, inside a box, on a plane, or by tag.
+struct NodeSelector {
+  enum class Kind { surface, box, plane, node_tags };
+  Kind kind = Kind::surface;
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();  ///< [m]
+  Eigen::Vector3d plane_point = Eigen::Vector3d::Zero();  ///< [m]
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();  ///< unit
+  std::optional<double> tolerance;   ///< [m]; default: 1e-6 of the mesh's bounding-box diagonal
+  std::vector<std::int64_t> node_tags;
+  std::string where;                 ///< the key path it came from, for messages
+};
+
+struct FixedRegion {
+  NodeSelector nodes;
+  AxisMask axes = kAllAxes;  ///< fixing only some axes expresses a sliding boundary
+};
+
+struct ComplianceSettings {
+  bool precompute_touchable = true;  ///< whole touchable block up front (small meshes) or per node on demand
+  bool disk_cache = true;            ///< persist computed columns, keyed by a content hash
+};
+
+struct ObjectSpec {
+  std::string name;
+  MeshSpec mesh;
+  LinearElasticMaterial material;
+  std::vector<FixedRegion> fixed;
+  std::vector<NodeSelector> touchable;  ///< surface nodes a tool may press; triangles with all three
+  ComplianceSettings compliance;
+};
+
+/// A rigid surface: a triangle surface file (FreeSurfer .asc) or an infinite plane.
+struct ObstacleSpec {
+  std::string name;
+  std::filesystem::path surface_file;
+  std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> plane;  ///< point [m], unit normal
+};
+
+struct ToolSpec {
+  std::string name;
+  ToolShape shape = ToolShape::point;
+  double radius = 0;  ///< [m], > 0 for a sphere
+};
+
+struct HapticSettings {
+  double rate_hz = 1000;
+  double force_limit_n = 3.3;  ///< the PHANToM Omni's peak force
+  ContactModel contact_model = ContactModel::node_translation;
+};
+
+struct Scene {
+  std::filesystem::path file;   ///< where it was loaded from (empty if built in code)
+  std::string name;
+  std::string units = "m";      ///< the length unit of the file
+  double metres_per_unit = 1;
+  ObjectSpec object;            ///< one deformable object per scene for now
+  std::vector<ObstacleSpec> obstacles;
+  std::vector<ToolSpec> tools;
+  HapticSettings haptic;
+};
+
+}  // namespace cohaptic
