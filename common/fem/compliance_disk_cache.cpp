@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fstream>
 
+#include "common/util/atomic_file.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -163,23 +164,9 @@ void save_compliance_cache(const std::filesystem::path& file, const Digest& key,
   std::error_code ec;
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
   if (ec) throw Error(fmt::format("{}: cannot create the cache directory: {}", file.parent_path().string(), ec.message()));
-  const std::filesystem::path temporary = file.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (out) out.write(w.buffer.data(), static_cast<std::streamsize>(w.buffer.size()));
-    if (out) out.flush();
-    if (!out) {
-      const std::string reason = std::strerror(errno);
-      out.close();
-      std::filesystem::remove(temporary, ec);
-      throw Error(fmt::format("{}: cannot write the compliance cache: {}", temporary.string(), reason));
-    }
-  }
-  std::filesystem::rename(temporary, file, ec);
-  if (ec) {
-    std::filesystem::remove(temporary, ec);
-    throw Error(fmt::format("{}: cannot move the compliance cache into place: {}", file.string(), ec.message()));
-  }
+  AtomicFile out(file);
+  out.write(std::string_view(w.buffer.data(), w.buffer.size()));
+  out.commit();
 }
 
 }  // namespace cohaptic
