@@ -17,8 +17,9 @@ std::string reason(int error_number) { return std::generic_category().message(er
 }  // namespace
 
 AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
+  // Unique per process, so concurrent writers of the same file never share a temporary.
   temp_path_ = path_;
-  temp_path_ += ".tmp";
+  temp_path_ += fmt::format(".{}.tmp", ::getpid());
   errno = 0;
   file_ = std::fopen(temp_path_.c_str(), "wb");
   if (file_ == nullptr) {

@@ -1,6 +1,6 @@
 // AtomicFile: writes a file so that it appears complete or not at all.
 //
-// Text goes to "<path>.tmp"; commit() flushes it to disk and renames it over <path>. Any
+// Text goes to "<path>.<pid>.tmp"; commit() flushes it to disk and renames it over <path>. Any
 // failure (bad directory, full disk, I/O error) throws Error naming <path> and the
 // system's reason, and the temporary file is removed, so no partial <path> is ever left.
 // A writer that throws before commit() also leaves nothing: the destructor cleans up.
