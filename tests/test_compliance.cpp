@@ -1,0 +1,187 @@
+// Compliance columns against direct dense inverses, and the on-disk cache's validity rules.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <filesystem>
+#include <fstream>
+
+#include "common/fem/compliance.h"
+#include "common/fem/compliance_disk_cache.h"
+#include "common/model/compliance_setup.h"
+#include "common/model/model.h"
+#include "common/scene/load_scene.h"
+
+namespace cohaptic {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string small_cube_yaml(double youngs_modulus = 1e6, int divisions = 4, const char* precompute = "touchable") {
+  return fmt::format(R"(
+units: mm
+objects:
+  - name: cube
+    mesh: {{box: {{min: [-65, -65, -130], size: [130, 130, 130], divisions: [{0}, {0}, {0}]}}}}
+    material: {{youngs_modulus: {1}, poisson_ratio: 0.4}}
+    fixed: [{{plane: {{point: [0, 0, -130], normal: [0, 0, 1]}}}}]
+    touchable: [{{plane: {{point: [0, 0, 0], normal: [0, 0, 1]}}}}]
+    compliance: {{precompute: {2}}}
+tools: [{{name: A}}]
+)",
+                     divisions, youngs_modulus, precompute);
+}
+
+struct ScratchDirectory {
+  fs::path path = fs::temp_directory_path() / ("cohaptic-test-" + std::to_string(::getpid()) + "-" +
+                                               ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  ScratchDirectory() { fs::create_directories(path); }
+  ~ScratchDirectory() { fs::remove_all(path); }
+};
+
+TEST(Compliance, ColumnsEqualTheDenseInverseAndAreSymmetric) {
+  const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
+  ComplianceColumns columns(*model.free_factor, model.dofs, model.touchable_nodes);
+  const Eigen::MatrixXd k_ff(restrict_to_dofs(model.stiffness, model.dofs.free_dofs));
+  const Eigen::MatrixXd inverse = k_ff.ldlt().solve(Eigen::MatrixXd::Identity(k_ff.rows(), k_ff.cols()));
+  for (int i : {0, 7, 24})
+    for (int j : {0, 3, 24}) {
+      const int a = model.touchable_nodes[i], b = model.touchable_nodes[j];
+      Eigen::Matrix3d expected;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          expected(r, c) = inverse(model.dofs.free_index[3 * a + r], model.dofs.free_index[3 * b + c]);
+      EXPECT_LE((columns.block(a, b) - expected).norm(), 1e-10 * expected.norm());
+      EXPECT_LE((columns.block(a, b) - columns.block(b, a).transpose()).norm(), 1e-12 * expected.norm());
+    }
+  // One at a time or all at once: the same numbers.
+  ComplianceColumns batch(*model.free_factor, model.dofs, model.touchable_nodes);
+  batch.compute_columns(model.touchable_nodes);
+  for (int node : model.touchable_nodes)
+    EXPECT_LE((batch.column(node) - columns.column(node)).norm(), 1e-13 * batch.column(node).norm());
+}
+
+TEST(ComplianceCache, KeyChangesWithMeshMaterialBoundaryConditionsAndRows) {
+  const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
+  const auto key = [&](const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
+                       const std::vector<int>& rows) { return compliance_cache_key(mesh, material, dofs, rows); };
+  const LinearElasticMaterial material = model.scene.object.material;
+  const Digest base = key(model.mesh, material, model.dofs, model.touchable_nodes);
+  EXPECT_EQ(base, key(model.mesh, material, model.dofs, model.touchable_nodes));
+
+  TetMesh moved = model.mesh;
+  moved.nodes(1, 40) += 1e-12;
+  EXPECT_NE(base, key(moved, material, model.dofs, model.touchable_nodes));
+  TetMesh renumbered = model.mesh;
+  std::swap(renumbered.tets[0][1], renumbered.tets[0][2]);
+  EXPECT_NE(base, key(renumbered, material, model.dofs, model.touchable_nodes));
+  EXPECT_NE(base, key(model.mesh, {material.youngs_modulus * 1.000001, material.poisson_ratio}, model.dofs, model.touchable_nodes));
+  EXPECT_NE(base, key(model.mesh, {material.youngs_modulus, 0.3}, model.dofs, model.touchable_nodes));
+  std::vector<AxisMask> fixed = model.dofs.fixed_axes;
+  fixed[model.touchable_nodes[0]] = 0b100;  // one more node sliding
+  EXPECT_NE(base, key(model.mesh, material, make_dof_map(fixed), model.touchable_nodes));
+  std::vector<int> fewer_rows(model.touchable_nodes.begin() + 1, model.touchable_nodes.end());
+  EXPECT_NE(base, key(model.mesh, material, model.dofs, fewer_rows));
+}
+
+TEST(ComplianceCache, RoundTripsBitExactlyAndIsUsedOnTheSecondRun) {
+  const ScratchDirectory dir;
+  const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
+  ComplianceColumns first(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  const ComplianceSetup computed = prepare_compliance(model, first, dir.path);
+  EXPECT_FALSE(computed.from_disk);
+  EXPECT_TRUE(fs::exists(computed.cache_file));
+
+  ComplianceColumns second(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  const ComplianceSetup loaded = prepare_compliance(model, second, dir.path);
+  EXPECT_TRUE(loaded.from_disk);
+  ASSERT_EQ(second.column_count(), first.column_count());
+  for (const auto& [node, column] : first.columns())
+    EXPECT_EQ(std::memcmp(column.data(), second.columns().at(node).data(), sizeof(double) * column.size()), 0);
+}
+
+TEST(ComplianceCache, TruncatedOrCorruptedFilesAreDetectedAndRebuilt) {
+  const ScratchDirectory dir;
+  const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
+  ComplianceColumns reference(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  const fs::path file = prepare_compliance(model, reference, dir.path).cache_file;
+  const auto size = fs::file_size(file);
+  const Digest key = compliance_cache_key(model.mesh, model.scene.object.material, model.dofs, reference.row_nodes());
+
+  const auto expect_rebuilt = [&](const std::string& what) {
+    ComplianceColumns probe(*model.free_factor, model.dofs, compliance_row_nodes(model));
+    const ComplianceCacheLoad load = load_compliance_cache(file, key, probe);
+    EXPECT_FALSE(load.loaded) << what;
+    EXPECT_EQ(probe.column_count(), 0u) << what << ": a bad file must insert nothing";
+    EXPECT_FALSE(load.problem.empty()) << what;
+    ComplianceColumns rebuilt(*model.free_factor, model.dofs, compliance_row_nodes(model));
+    const ComplianceSetup setup = prepare_compliance(model, rebuilt, dir.path);
+    EXPECT_FALSE(setup.from_disk) << what;
+    EXPECT_EQ(rebuilt.column_count(), reference.column_count()) << what;
+    EXPECT_EQ(fs::file_size(file), size) << what << ": the cache is written again in full";
+    ComplianceColumns reloaded(*model.free_factor, model.dofs, compliance_row_nodes(model));
+    EXPECT_TRUE(load_compliance_cache(file, key, reloaded).loaded) << what;
+  };
+
+  fs::resize_file(file, size / 2);
+  expect_rebuilt("truncated to half");
+  fs::resize_file(file, 10);
+  expect_rebuilt("truncated to 10 bytes");
+  {
+    std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+    io.seekp(static_cast<std::streamoff>(size / 3));
+    char byte = 0;
+    io.read(&byte, 1);
+    io.seekp(static_cast<std::streamoff>(size / 3));
+    byte = static_cast<char>(byte ^ 0x10);
+    io.write(&byte, 1);
+  }
+  expect_rebuilt("one bit flipped");
+}
+
+TEST(ComplianceCache, AFileForAnotherMaterialIsNotUsed) {
+  const ScratchDirectory dir;
+  const Model soft = build_model(parse_scene(small_cube_yaml(1e6), "cube.yaml"));
+  const Model stiff = build_model(parse_scene(small_cube_yaml(2e6), "cube.yaml"));
+  ComplianceColumns soft_columns(*soft.free_factor, soft.dofs, compliance_row_nodes(soft));
+  const fs::path soft_file = prepare_compliance(soft, soft_columns, dir.path).cache_file;
+  // Put the soft cache where the stiff one would be: its embedded key still tells them apart.
+  ComplianceColumns stiff_columns(*stiff.free_factor, stiff.dofs, compliance_row_nodes(stiff));
+  const Digest stiff_key = compliance_cache_key(stiff.mesh, stiff.scene.object.material, stiff.dofs, stiff_columns.row_nodes());
+  fs::copy_file(soft_file, compliance_cache_file(dir.path, stiff_key));
+  const ComplianceCacheLoad load = load_compliance_cache(compliance_cache_file(dir.path, stiff_key), stiff_key, stiff_columns);
+  EXPECT_FALSE(load.loaded);
+  EXPECT_NE(load.problem.find("different mesh, material or boundary conditions"), std::string::npos) << load.problem;
+  // And the stiff object's compliance is half the soft one's (linear in 1/E).
+  const int node = soft.touchable_nodes[5];
+  EXPECT_LE((stiff_columns.column(node) * 2 - soft_columns.column(node)).norm(), 1e-9 * soft_columns.column(node).norm());
+}
+
+TEST(ComplianceCache, AnUnwritableCacheDirectoryIsNotFatal) {
+  const ScratchDirectory dir;
+  const fs::path blocked = dir.path / "not-a-directory";
+  std::ofstream(blocked) << "a file where the cache directory should be";
+  const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
+  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  ComplianceSetup setup;
+  EXPECT_NO_THROW(setup = prepare_compliance(model, columns, blocked / "cache"));
+  EXPECT_EQ(columns.column_count(), model.touchable_nodes.size());
+  EXPECT_THROW(save_compliance_cache(blocked / "cache" / "x.bin", Digest{}, columns), Error);
+}
+
+TEST(ComplianceCache, OnDemandModeComputesNothingUpFrontAndSavesWhatItComputed) {
+  const ScratchDirectory dir;
+  const Model model = build_model(parse_scene(small_cube_yaml(1e6, 4, "on_demand"), "cube.yaml"));
+  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  EXPECT_EQ(prepare_compliance(model, columns, dir.path).columns, 0u);
+  columns.column(model.touchable_nodes[3]);
+  columns.column(model.touchable_nodes[9]);
+  save_compliance(model, columns, dir.path);
+  ComplianceColumns again(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  const ComplianceSetup setup = prepare_compliance(model, again, dir.path);
+  EXPECT_TRUE(setup.from_disk);
+  EXPECT_EQ(again.column_count(), 2u);
+  EXPECT_TRUE(again.has_column(model.touchable_nodes[9]));
+}
+
+}  // namespace
+}  // namespace cohaptic

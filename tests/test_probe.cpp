@@ -1,0 +1,191 @@
+// The probe's static contact forces on the paper's cube: condensation against the full
+// sparse solve and against an independent FEM, physical properties of the answer, and the
+// command-line program itself (its JSON, its exports, its errors).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "common/mesh/read_gmsh.h"
+#include "common/model/compliance_setup.h"
+#include "common/model/static_contact.h"
+#include "common/scene/load_scene.h"
+#include "support/independent_fem.h"
+#include "support/test_meshes.h"
+
+namespace cohaptic {
+namespace {
+
+namespace fs = std::filesystem;
+
+class CubeProbe : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    model_ = new Model(build_model(load_scene(testing::source_path("scenes/cube.yaml"))));
+    columns_ = new ComplianceColumns(*model_->free_factor, model_->dofs, compliance_row_nodes(*model_));
+  }
+  static void TearDownTestSuite() {
+    delete columns_;
+    delete model_;
+  }
+  static Eigen::Vector3d mm(double x, double y, double z) { return Eigen::Vector3d(x, y, z) * 1e-3; }
+  static std::vector<ToolReaction> condensed(const std::vector<PressedTool>& tools) {
+    return contact_reactions_condensed(*model_, *columns_, find_tool_contacts(*model_, tools));
+  }
+  static Model* model_;
+  static ComplianceColumns* columns_;
+};
+Model* CubeProbe::model_ = nullptr;
+ComplianceColumns* CubeProbe::columns_ = nullptr;
+
+// Random points under the front face, inside the touchable region.
+std::vector<PressedTool> random_presses(std::mt19937& rng, int count, double max_depth_mm) {
+  std::uniform_real_distribution<double> across(-60, 60), depth(0.2, max_depth_mm);
+  std::vector<PressedTool> tools;
+  for (int i = 0; i < count; ++i) tools.push_back({Eigen::Vector3d(across(rng), across(rng), -depth(rng)) * 1e-3, 0});
+  return tools;
+}
+
+TEST_F(CubeProbe, CondensedForcesEqualTheFullSparseSolve) {
+  std::mt19937 rng(42);
+  for (int trial = 0; trial < 20; ++trial) {
+    const auto tools = random_presses(rng, 1 + trial % 2, 10);
+    std::vector<ContactQuery> contacts;
+    try {
+      contacts = find_tool_contacts(*model_, tools);
+    } catch (const Error&) {
+      continue;  // two random tools on neighbouring triangles: not this test's subject
+    }
+    const auto fast = contact_reactions_condensed(*model_, *columns_, contacts);
+    const auto reference = contact_reactions_reference(*model_, contacts);
+    for (std::size_t t = 0; t < tools.size(); ++t) {
+      ASSERT_TRUE(fast[t].query.contact.has_value());
+      EXPECT_LE((fast[t].reaction - reference[t].reaction).norm(), 1e-9 * reference[t].reaction.norm());
+      EXPECT_LE((fast[t].nodal_forces - reference[t].nodal_forces).norm(), 1e-9 * reference[t].nodal_forces.norm());
+    }
+  }
+}
+
+TEST_F(CubeProbe, ForcesAgreeWithAnIndependentFemOfTheSameMesh) {
+  std::mt19937 rng(7);
+  const auto tools = random_presses(rng, 1, 8);
+  const auto contacts = find_tool_contacts(*model_, tools);
+  const auto fast = contact_reactions_condensed(*model_, *columns_, contacts);
+
+  std::vector<bool> fixed(static_cast<std::size_t>(3 * model_->mesh.node_count()));
+  for (int dof = 0; dof < 3 * model_->mesh.node_count(); ++dof) fixed[dof] = model_->dofs.free_index[dof] < 0;
+  std::map<int, double> prescribed;
+  const ToolContact& contact = *contacts[0].contact;
+  const Triangle& tri = model_->surface.triangles[contact.triangle];
+  for (int node : tri)
+    for (int a = 0; a < 3; ++a) prescribed[3 * node + a] = contact.displacement[a];
+  const auto independent = testing::independent_static_solve(model_->mesh, 1.0e6, 0.4, fixed, prescribed);
+  Eigen::Vector3d expected = Eigen::Vector3d::Zero();
+  for (int i = 0; i < 3; ++i) expected -= contact.weights[i] * independent.reaction.segment<3>(3 * tri[i]);
+  EXPECT_LE((fast[0].reaction - expected).norm(), 1e-8 * expected.norm())
+      << "probe " << fast[0].reaction.transpose() << " independent " << expected.transpose();
+}
+
+TEST_F(CubeProbe, TheForcePushesTheToolOutAndIsLinearInDepth) {
+  const auto shallow = condensed({{mm(1, 2, -2), 0}});
+  const auto deep = condensed({{mm(1, 2, -6), 0}});
+  ASSERT_TRUE(shallow[0].query.contact && deep[0].query.contact);
+  EXPECT_EQ(shallow[0].query.contact->triangle, deep[0].query.contact->triangle);
+  EXPECT_GT(shallow[0].reaction.z(), 0);  // out of the front face, towards +z
+  EXPECT_GT(shallow[0].reaction.z(), 5 * shallow[0].reaction.head<2>().norm());
+  EXPECT_LE((deep[0].reaction - 3 * shallow[0].reaction).norm(), 1e-10 * deep[0].reaction.norm());
+  EXPECT_NEAR(shallow[0].query.contact->depth, 2e-3, 1e-15);
+}
+
+TEST_F(CubeProbe, TwoToolsCoupleThroughTheObject) {
+  const PressedTool a{mm(-20, 0, -5), 0}, b{mm(20, 0, -5), 0};
+  const auto alone = condensed({a});
+  const auto together = condensed({a, b});
+  // Pressing the same way next to it makes the surface around A sink: A needs less force.
+  EXPECT_LT(together[0].reaction.z(), alone[0].reaction.z());
+  EXPECT_GT(alone[0].reaction.z() - together[0].reaction.z(), 0.01 * alone[0].reaction.z());
+  EXPECT_THROW(condensed({a, {mm(-20, 0.5, -5), 0}}), Error);  // same triangle: cannot both hold it
+}
+
+TEST_F(CubeProbe, AToolOutsideOrBesideTheTouchableFaceHasNoForce) {
+  const auto reactions = condensed({{mm(0, 0, 3), 0}, {mm(80, 0, -50), 0}});
+  EXPECT_FALSE(reactions[0].query.contact);
+  EXPECT_NEAR(reactions[0].query.signed_distance, 3e-3, 1e-12);
+  EXPECT_FALSE(reactions[1].query.contact);
+  EXPECT_EQ(reactions[1].reaction, Eigen::Vector3d::Zero());
+}
+
+// --- the program ---
+
+struct ProgramRun {
+  int exit_code = -1;
+  std::string out;
+};
+
+ProgramRun run(const std::string& arguments) {
+  const std::string command = std::string(COHAPTIC_SERVER_EXE) + " " + arguments + " 2>/dev/null";
+  ProgramRun result;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buffer{};
+  std::size_t n = 0;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.out.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+TEST_F(CubeProbe, TheProgramPrintsOneJsonObjectWithTheSameForces) {
+  const fs::path dir = fs::temp_directory_path() / ("cohaptic-probe-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const ProgramRun result = run("probe --scene " + testing::source_path("scenes/cube.yaml") +
+                                " --tool 5,-7,-4 --tool -30,40,-2 --tool 0,0,10 --json --no-disk-cache --export-msh " +
+                                (dir / "cube.msh").string() + " --export-vtu " + (dir / "cube.vtu").string());
+  ASSERT_EQ(result.exit_code, 0) << result.out;
+  const nlohmann::json json = nlohmann::json::parse(result.out);  // throws if stdout holds anything else
+  EXPECT_EQ(json["nodes"], 1728);
+  EXPECT_EQ(json["tets"], 7986);
+  EXPECT_EQ(json["fixed_nodes"].size(), 144u);
+  ASSERT_EQ(json["tools"].size(), 3u);
+  EXPECT_TRUE(json["timings_ms"].contains("load") && json["timings_ms"].contains("precompute") &&
+              json["timings_ms"].contains("solve"));
+
+  const auto expected = condensed({{mm(5, -7, -4), 0}, {mm(-30, 40, -2), 0}, {mm(0, 0, 10), 0}});
+  const GmshMesh exported = read_gmsh(dir / "cube.msh");
+  for (int t = 0; t < 2; ++t) {
+    const nlohmann::json& tool = json["tools"][t];
+    Eigen::Vector3d force(tool["force"][0], tool["force"][1], tool["force"][2]);
+    EXPECT_LE((force - expected[t].reaction).norm(), 1e-12 * expected[t].reaction.norm());
+    // The ids name the same nodes in the exported mesh, whose coordinates are in mm.
+    const Triangle& tri = model_->surface.triangles[expected[t].query.contact->triangle];
+    for (int i = 0; i < 3; ++i) {
+      const std::int64_t id = tool["contact"]["triangle"][i];
+      EXPECT_EQ(id, model_->mesh.node_tags[tri[i]]);
+      const int index = node_index_from_tag(exported.mesh, id);
+      ASSERT_GE(index, 0);
+      EXPECT_LE((exported.mesh.nodes.col(index) * 1e-3 - model_->mesh.nodes.col(tri[i])).norm(), 1e-15);
+      const double dz = tool["contact"]["displacement"][i][2];
+      EXPECT_NEAR(dz, t == 0 ? -4.0 : -2.0, 1e-9);
+    }
+  }
+  EXPECT_TRUE(json["tools"][2]["contact"].is_null());
+  EXPECT_GT(fs::file_size(dir / "cube.vtu"), 100000u);
+  fs::remove_all(dir);
+}
+
+TEST(ProbeProgram, BadInputGivesAClearErrorAndANonZeroExit) {
+  const std::string cube = testing::source_path("scenes/cube.yaml");
+  EXPECT_EQ(run("probe --scene " + cube + " --tool 1,2").exit_code, 2);
+  EXPECT_NE(run("probe --scene /no/such/scene.yaml --tool 1,2,3").exit_code, 0);
+  EXPECT_NE(run("probe --scene " + cube + " --tool nan,0,0").exit_code, 0);
+  const std::string usage = run("probe --help").out;
+  EXPECT_NE(usage.find("--export-vtu"), std::string::npos);
+  EXPECT_NE(usage.find("--separately"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cohaptic
