@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -27,17 +29,25 @@ void ComplianceColumns::compute_columns(const std::vector<int>& nodes) {
     if (node < 0 || node >= dofs_.node_count()) throw Error(fmt::format("compliance: node {} out of range", node));
     if (!has_column(node) && std::find(missing.begin(), missing.end(), node) == missing.end()) missing.push_back(node);
   }
-  if (missing.empty()) return;
-  // One right-hand side per axis of every missing node: unit force on that dof.
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(factor_.size(), 3 * static_cast<Eigen::Index>(missing.size()));
-  for (int k = 0; k < static_cast<int>(missing.size()); ++k)
+  // Solve in chunks whose dense right-hand side stays near 64 MB: batching amortises the
+  // pass over the factor, chunking bounds memory on large meshes.
+  const std::size_t chunk = std::max<std::size_t>(1, (std::size_t{8} << 20) / (3 * static_cast<std::size_t>(factor_.size()) + 1));
+  for (std::size_t first = 0; first < missing.size(); first += chunk)
+    solve_chunk(std::span<const int>(missing).subspan(first, std::min(chunk, missing.size() - first)));
+}
+
+void ComplianceColumns::solve_chunk(std::span<const int> nodes) {
+  // One right-hand side per axis of every node: a unit force on that dof.
+  const auto count = static_cast<Eigen::Index>(nodes.size());
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(factor_.size(), 3 * count);
+  for (Eigen::Index k = 0; k < count; ++k)
     for (int axis = 0; axis < 3; ++axis) {
-      const int free = dofs_.free_index[3 * missing[k] + axis];
+      const int free = dofs_.free_index[3 * nodes[k] + axis];
       if (free >= 0) rhs(free, 3 * k + axis) = 1.0;
     }
   const Eigen::MatrixXd solution = factor_.solve(rhs);
   const auto rows = static_cast<Eigen::Index>(3 * row_nodes_.size());
-  for (int k = 0; k < static_cast<int>(missing.size()); ++k) {
+  for (Eigen::Index k = 0; k < count; ++k) {
     ComplianceColumn column = ComplianceColumn::Zero(rows, 3);
     for (int r = 0; r < static_cast<int>(row_nodes_.size()); ++r)
       for (int axis = 0; axis < 3; ++axis) {
@@ -46,8 +56,8 @@ void ComplianceColumns::compute_columns(const std::vector<int>& nodes) {
       }
     // A fixed axis of the column node carries no force: its column stays zero.
     for (int axis = 0; axis < 3; ++axis)
-      if (dofs_.is_fixed(missing[k], axis)) column.col(axis).setZero();
-    columns_.emplace(missing[k], std::move(column));
+      if (dofs_.is_fixed(nodes[k], axis)) column.col(axis).setZero();
+    columns_.emplace(nodes[k], std::move(column));
   }
 }
 

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -44,6 +45,8 @@ class ComplianceColumns {
   void insert_column(int node, ComplianceColumn column);
 
  private:
+  void solve_chunk(std::span<const int> nodes);
+
   const SparseCholesky& factor_;
   const DofMap& dofs_;
   std::vector<int> row_nodes_;
