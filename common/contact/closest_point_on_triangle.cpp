@@ -1,13 +1,44 @@
 #include "common/contact/closest_point_on_triangle.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 
 namespace cohaptic {
 
 // Voronoi-region walk after Ericson, "Real-Time Collision Detection", 5.1.5.
+namespace {
+
+// Zero-area triangle: its closest point lies on one of its edges; take the best of the three.
+TriangleClosestPoint closest_point_on_edges(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  TriangleClosestPoint best{a, {1, 0, 0}};
+  double best_distance = (p - a).squaredNorm();
+  const Eigen::Vector3d corners[3] = {a, b, c};
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d& s = corners[i];
+    const Eigen::Vector3d& e = corners[(i + 1) % 3];
+    const double length2 = (e - s).squaredNorm();
+    const double t = length2 > 0 ? std::clamp((p - s).dot(e - s) / length2, 0.0, 1.0) : 0.0;
+    const Eigen::Vector3d q = s + t * (e - s);
+    if ((p - q).squaredNorm() < best_distance) {
+      best_distance = (p - q).squaredNorm();
+      best.point = q;
+      best.weights.setZero();
+      best.weights[i] = 1 - t;
+      best.weights[(i + 1) % 3] = t;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
 TriangleClosestPoint closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                                const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  // Degenerate (sine of the angle at a below 1e-12): the face formula below would divide
+  // rounding noise by rounding noise, so use the edges instead.
+  if (ab.cross(ac).squaredNorm() <= 1e-24 * ab.squaredNorm() * ac.squaredNorm()) return closest_point_on_edges(p, a, b, c);
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return {a, {1, 0, 0}};
 
@@ -38,28 +69,7 @@ TriangleClosestPoint closest_point_on_triangle(const Eigen::Vector3d& p, const E
   }
 
   const double sum = va + vb + vc;
-  if (!(sum > 0)) {
-    // Zero-area triangle: the closest point lies on its longest edge (the others are
-    // contained in it); fall back to the best of the three edges.
-    TriangleClosestPoint best{a, {1, 0, 0}};
-    double best_distance = (p - a).squaredNorm();
-    const Eigen::Vector3d corners[3] = {a, b, c};
-    for (int i = 0; i < 3; ++i) {
-      const Eigen::Vector3d& s = corners[i];
-      const Eigen::Vector3d& e = corners[(i + 1) % 3];
-      const double length2 = (e - s).squaredNorm();
-      const double t = length2 > 0 ? std::clamp((p - s).dot(e - s) / length2, 0.0, 1.0) : 0.0;
-      const Eigen::Vector3d q = s + t * (e - s);
-      if ((p - q).squaredNorm() < best_distance) {
-        best_distance = (p - q).squaredNorm();
-        best.point = q;
-        best.weights.setZero();
-        best.weights[i] = 1 - t;
-        best.weights[(i + 1) % 3] = t;
-      }
-    }
-    return best;
-  }
+  if (!(sum > 0)) return closest_point_on_edges(p, a, b, c);
   const double v = vb / sum, w = vc / sum;
   return {a + v * ab + w * ac, {1 - v - w, v, w}};
 }

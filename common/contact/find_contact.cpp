@@ -35,7 +35,8 @@ ContactQuery find_contact(const TetMesh& mesh, const BoundarySurface& surface, c
   }
   const Eigen::Vector3d contact_point = tool_position - tool_radius * normals.face[contact.triangle];
   contact.displacement = contact_point - contact.foot;
-  contact.depth = tool_radius - query.signed_distance;
+  // Penetration below the contact triangle's plane, consistent with the displacement.
+  contact.depth = -contact.displacement.dot(normals.face[contact.triangle]);
   query.contact = contact;
   return query;
 }

@@ -23,7 +23,7 @@ struct ToolContact {
   Eigen::Vector3d foot;          ///< F, on the rest triangle [m]
   Eigen::Vector3d weights;       ///< area coordinates of F
   Eigen::Vector3d displacement;  ///< d, the same for the three nodes [m]
-  double depth = 0;              ///< how far the tool is inside the surface [m], > 0
+  double depth = 0;              ///< -d . n: penetration below the contact triangle's plane [m]
 };
 
 struct ContactQuery {

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <map>
 #include <numeric>
+#include <set>
 #include <unordered_map>
 
 #include "common/util/error.h"
@@ -43,24 +44,28 @@ struct UnionFind {
 void check_duplicate_nodes(const TetMesh& mesh, double tolerance, MeshCheckReport& report) {
   if (mesh.node_count() == 0) return;
   // Bucket nodes on a grid of cell `tolerance`; coincident nodes share a bucket or a neighbour.
+  // Cells are relative to the bounding box's corner, so coordinates far from the origin
+  // cannot overflow the cell index.
+  const Eigen::Vector3d origin = mesh.nodes.rowwise().minCoeff();
+  using Cell = Eigen::Matrix<std::int64_t, 3, 1>;
   const auto cell_of = [&](const Eigen::Vector3d& x) {
-    return Eigen::Vector3i((x / tolerance).array().floor().cast<int>());
+    return Cell(((x - origin) / tolerance).array().floor().cast<std::int64_t>());
   };
-  const auto key = [](const Eigen::Vector3i& c) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.x()) & 0x1fffff) << 42) ^
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.y()) & 0x1fffff) << 21) ^
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.z()) & 0x1fffff));
+  const auto key = [](const Cell& c) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (int i = 0; i < 3; ++i) h = (h ^ static_cast<std::uint64_t>(c[i])) * 1099511628211ull;
+    return h;
   };
   std::unordered_multimap<std::uint64_t, int> buckets;
   buckets.reserve(static_cast<std::size_t>(mesh.node_count()));
   std::vector<std::string> pairs;
   for (int n = 0; n < mesh.node_count(); ++n) {
     const Eigen::Vector3d x = mesh.nodes.col(n);
-    const Eigen::Vector3i c = cell_of(x);
+    const Cell c = cell_of(x);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
-          const auto range = buckets.equal_range(key(c + Eigen::Vector3i(dx, dy, dz)));
+          const auto range = buckets.equal_range(key(c + Cell(std::int64_t{dx}, std::int64_t{dy}, std::int64_t{dz})));
           for (auto it = range.first; it != range.second; ++it)
             if ((mesh.nodes.col(it->second) - x).norm() <= tolerance)
               pairs.push_back(fmt::format("{} and {}", mesh.node_tags[it->second], mesh.node_tags[n]));
@@ -177,13 +182,14 @@ MeshCheckReport check_tet_mesh(TetMesh& mesh, const MeshCheckOptions& options) {
 
 std::vector<std::string> check_boundary_surface(const TetMesh& mesh, const BoundarySurface& surface) {
   std::vector<std::string> findings;
-  std::vector<std::string> edges;
+  std::set<std::pair<int, int>> non_manifold_edges;
   for (int t = 0; t < surface.triangle_count(); ++t)
     for (int k = 0; k < 3; ++k) {
       const int a = surface.triangles[t][k], b = surface.triangles[t][(k + 1) % 3];
-      if (surface.triangle_neighbours[t][k] < 0 && a < b)
-        edges.push_back(fmt::format("{}-{}", mesh.node_tags[a], mesh.node_tags[b]));
+      if (surface.triangle_neighbours[t][k] < 0) non_manifold_edges.emplace(std::min(a, b), std::max(a, b));
     }
+  std::vector<std::string> edges;
+  for (const auto& [a, b] : non_manifold_edges) edges.push_back(fmt::format("{}-{}", mesh.node_tags[a], mesh.node_tags[b]));
   if (!edges.empty())
     findings.push_back(fmt::format("{} non-manifold surface edge(s) (more than two surface triangles meet): {}",
                                    edges.size(), name_some(edges)));

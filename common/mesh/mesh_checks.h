@@ -1,8 +1,8 @@
 // Checks a tetrahedral mesh before it is used, naming the offending element or node.
 //
 // Errors (thrown as MeshError): a mix of positively and negatively oriented tetrahedra
-// (tangled or inverted elements), zero-volume elements, a face shared by more than two
-// tetrahedra. Findings that still give a usable model are returned as warnings:
+// (tangled or inverted elements), zero-volume elements. (A face shared by more than two
+// tetrahedra is caught by extract_boundary_surface, which runs next.) Findings that still give a usable model are returned as warnings:
 // coincident (duplicate) nodes, disconnected parts, non-manifold surface edges or
 // vertices, sliver elements (smallest dihedral angle below a threshold). A mesh whose
 // elements are all negatively oriented is a convention, not an error: it is reoriented.

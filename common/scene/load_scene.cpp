@@ -23,6 +23,8 @@ class Cursor {
   }
 
   const std::string& path() const { return path_; }
+  /// "file:line: key.path", for messages raised after loading (e.g. a selector that selects nothing).
+  std::string location() const { return fmt::format("{}:{}: {}", *file_, line_, path_); }
   bool is_map() const { return node_.IsMap(); }
   bool is_sequence() const { return node_.IsSequence(); }
   bool is_scalar() const { return node_.IsScalar(); }
@@ -141,7 +143,7 @@ double metres_per(const Cursor& units) {
 NodeSelector parse_selector(const Cursor& c, double scale) {
   if (!c.is_map()) c.fail("a map with one of surface, box, plane or nodes");
   NodeSelector s;
-  s.where = c.path();
+  s.where = c.location();
   int kinds = 0;
   if (auto surface = c.find("surface")) {
     if (!surface->boolean()) surface->fail("true (select the whole surface)");
@@ -250,7 +252,7 @@ ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::pa
     }
   } else {
     NodeSelector whole;
-    whole.where = c.path() + ".touchable (default: the whole surface)";
+    whole.where = c.location() + ".touchable (default: the whole surface)";
     object.touchable.push_back(whole);
   }
 

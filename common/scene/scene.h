@@ -42,7 +42,7 @@ struct NodeSelector {
   Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();  ///< unit
   std::optional<double> tolerance;   ///< [m]; default: 1e-6 of the mesh's bounding-box diagonal
   std::vector<std::int64_t> node_tags;
-  std::string where;                 ///< the key path it came from, for messages
+  std::string where;                 ///< "file:line: key.path" it came from, for messages
 };
 
 struct FixedRegion {

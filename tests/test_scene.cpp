@@ -1,0 +1,410 @@
+// Scene loading and validation (common/scene/load_scene.h) and compiling a scene into a
+// Model (common/model/model.h): the shipped cube scene, error messages that name the
+// file, line and key path, per-axis fixing and selectors that select nothing.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/mesh/box_mesher.h"
+#include "common/model/model.h"
+#include "common/scene/load_scene.h"
+#include "support/test_meshes.h"
+
+namespace cohaptic {
+namespace {
+
+// A valid scene in block style, so that every value sits on its own line. Tests derive
+// malformed scenes from it by replacing one line (or block) and expect the message to
+// name the line the replacement is on, counted here independently of the parser.
+const std::string kBaseScene = R"(name: block_scene
+units: mm
+objects:
+  - name: block
+    mesh:
+      box:
+        min: [0, 0, 0]
+        size: [10, 10, 10]
+        divisions: [2, 2, 2]
+    material:
+      model: linear_elastic
+      youngs_modulus: 1000
+      poisson_ratio: 0.3
+    fixed:
+      - plane:
+          point: [0, 0, 0]
+          normal: [0, 0, 1]
+        axes: xyz
+    touchable:
+      - plane:
+          point: [0, 0, 10]
+          normal: [0, 0, 1]
+tools:
+  - name: A
+    shape: point
+haptic:
+  rate_hz: 1000
+)";
+
+// Not created: parse_scene only names it (and resolves relative mesh paths against it).
+const std::string kSceneFile = "/nonexistent-cohaptic-test/scenes/bad_scene.yaml";
+
+/// `text` with the first occurrence of `from` replaced by `to` (which must exist).
+std::string replaced(const std::string& text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << "test setup: '" << from << "' is not in the scene";
+  if (at == std::string::npos) return text;
+  std::string out = text;
+  out.replace(at, from.size(), to);
+  return out;
+}
+
+/// 1-based number of the line holding the first occurrence of `needle`.
+int line_of(const std::string& text, const std::string& needle) {
+  const auto at = text.find(needle);
+  EXPECT_NE(at, std::string::npos) << "test setup: '" << needle << "' is not in the scene";
+  if (at == std::string::npos) return -1;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+}
+
+std::optional<std::string> parse_error(const std::string& text) {
+  try {
+    parse_scene(text, kSceneFile);
+  } catch (const SceneError& e) {
+    return std::string(e.what());
+  }
+  return std::nullopt;
+}
+
+struct BadScene {
+  const char* what;
+  std::string text;
+  std::string line_needle;               // the line the message must name
+  std::vector<std::string> fragments;    // all must appear in the message
+};
+
+void expect_scene_error(const BadScene& bad) {
+  SCOPED_TRACE(bad.what);
+  const auto message = parse_error(bad.text);
+  ASSERT_TRUE(message.has_value()) << "no SceneError for:\n" << bad.text;
+  const std::string location = kSceneFile + ":" + std::to_string(line_of(bad.text, bad.line_needle)) + ":";
+  EXPECT_EQ(message->rfind(location, 0), 0u) << "message: " << *message << "\nexpected it to start with " << location;
+  for (const std::string& fragment : bad.fragments)
+    EXPECT_NE(message->find(fragment), std::string::npos) << "message: " << *message << "\nlacks: " << fragment;
+}
+
+bool near(double a, double b) { return std::abs(a - b) <= 1e-12 * std::max(1.0, std::abs(b)); }
+
+TEST(SceneLoad, BaseSceneOfTheseTestsIsValid) {
+  // Guards the error tests below: each of them differs from this scene in one place only.
+  const Scene scene = parse_scene(kBaseScene, kSceneFile);
+  EXPECT_EQ(scene.name, "block_scene");
+  EXPECT_DOUBLE_EQ(scene.object.mesh.box->size.x(), 0.010);
+  const Model model = build_model(scene);
+  EXPECT_EQ(model.mesh.node_count(), 27);
+}
+
+TEST(SceneLoad, CubeSceneFieldsInSIUnits) {
+  const Scene scene = load_scene(testing::source_path("scenes/cube.yaml"));
+  EXPECT_EQ(scene.name, "cube");
+  EXPECT_EQ(scene.units, "mm");
+  EXPECT_DOUBLE_EQ(scene.metres_per_unit, 0.001);
+
+  ASSERT_TRUE(scene.object.mesh.box.has_value());
+  EXPECT_TRUE(scene.object.mesh.file.empty());
+  const BoxMeshSpec& box = *scene.object.mesh.box;
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_TRUE(near(box.size[a], 0.13)) << "axis " << a << ": " << box.size[a];
+    EXPECT_EQ(box.divisions[a], 11);
+  }
+  EXPECT_TRUE(near(box.min_corner.x(), -0.065));
+  EXPECT_TRUE(near(box.min_corner.y(), -0.065));
+  EXPECT_TRUE(near(box.min_corner.z(), -0.13));
+
+  EXPECT_DOUBLE_EQ(scene.object.material.youngs_modulus, 1.0e6);
+  EXPECT_DOUBLE_EQ(scene.object.material.poisson_ratio, 0.4);
+
+  ASSERT_EQ(scene.object.fixed.size(), 1u);
+  const FixedRegion& fixed = scene.object.fixed[0];
+  EXPECT_EQ(fixed.axes, kAllAxes);
+  EXPECT_EQ(fixed.nodes.kind, NodeSelector::Kind::plane);
+  EXPECT_TRUE(near(fixed.nodes.plane_point.z(), -0.13));
+  EXPECT_TRUE(fixed.nodes.plane_normal.isApprox(Eigen::Vector3d::UnitZ(), 1e-15));
+  EXPECT_EQ(fixed.nodes.where, testing::source_path("scenes/cube.yaml") + ":14: objects[0].fixed[0]");
+
+  ASSERT_EQ(scene.object.touchable.size(), 1u);
+  EXPECT_EQ(scene.object.touchable[0].kind, NodeSelector::Kind::plane);
+  EXPECT_TRUE(near(scene.object.touchable[0].plane_point.z(), 0.0));
+  EXPECT_TRUE(scene.object.compliance.precompute_touchable);
+  EXPECT_TRUE(scene.object.compliance.disk_cache);
+
+  ASSERT_EQ(scene.tools.size(), 1u);
+  EXPECT_EQ(scene.tools[0].name, "A");
+  EXPECT_EQ(scene.tools[0].shape, ToolShape::point);
+  EXPECT_EQ(scene.tools[0].radius, 0.0);
+  EXPECT_TRUE(scene.obstacles.empty());
+
+  EXPECT_DOUBLE_EQ(scene.haptic.rate_hz, 1000);
+  EXPECT_DOUBLE_EQ(scene.haptic.force_limit_n, 3.3);
+  EXPECT_EQ(scene.haptic.contact_model, ContactModel::node_translation);
+}
+
+TEST(SceneModel, CubeModelFixedAndTouchableNodesAreTheTwoFaces) {
+  const Model model = build_model(load_scene(testing::source_path("scenes/cube.yaml")));
+  EXPECT_EQ(model.mesh.node_count(), 1728);
+  EXPECT_EQ(model.mesh.tet_count(), 7986);
+  ASSERT_EQ(model.dofs.node_count(), 1728);
+
+  // By hand from the coordinates: the rear face z = -0.13 m and the front face z = 0.
+  std::vector<int> rear, front;
+  for (int n = 0; n < model.mesh.node_count(); ++n) {
+    const double z = model.mesh.nodes(2, n);
+    if (std::abs(z + 0.13) < 1e-9) rear.push_back(n);
+    if (std::abs(z) < 1e-9) front.push_back(n);
+  }
+  ASSERT_EQ(rear.size(), 144u);
+  ASSERT_EQ(front.size(), 144u);
+
+  std::vector<int> fixed;
+  for (int n = 0; n < model.dofs.node_count(); ++n) {
+    const AxisMask mask = model.dofs.fixed_axes[n];
+    EXPECT_TRUE(mask == 0 || mask == kAllAxes) << "node " << n << " mask " << int(mask);
+    if (mask != 0) fixed.push_back(n);
+  }
+  EXPECT_EQ(fixed, rear);
+  EXPECT_EQ(model.dofs.free_count(), 3 * (1728 - 144));
+  EXPECT_EQ(model.touchable_nodes, front);
+
+  // 11 x 11 cells, two triangles each, all on the front face, all facing +z.
+  EXPECT_EQ(model.touchable_triangles.size(), 2u * 11 * 11);
+  for (int t : model.touchable_triangles) {
+    const Triangle& tri = model.surface.triangles[t];
+    for (int v : tri) EXPECT_NEAR(model.mesh.nodes(2, v), 0.0, 1e-12) << "triangle " << t;
+    const Eigen::Vector3d normal = triangle_normal(model.mesh, tri);
+    EXPECT_LT((normal - Eigen::Vector3d::UnitZ()).norm(), 1e-12) << "triangle " << t << " normal " << normal.transpose();
+  }
+}
+
+TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
+  const std::string& base = kBaseScene;
+  std::vector<BadScene> cases;
+
+  {
+    const auto text = replaced(base, "poisson_ratio: 0.3", "poisson_ratio: 0.5");
+    cases.push_back({"poisson ratio 0.5", text, "poisson_ratio: 0.5",
+                     {"objects[0].material.poisson_ratio", "(-1, 0.5)", "found '0.5'"}});
+  }
+  {
+    const auto text = replaced(base, "youngs_modulus: 1000", "youngs_modulus: -3");
+    cases.push_back({"negative modulus", text, "youngs_modulus: -3",
+                     {"objects[0].material.youngs_modulus", "positive modulus", "found '-3'"}});
+  }
+  {
+    const auto text = replaced(base, "youngs_modulus: 1000", "youngs_modulos: 1000");
+    cases.push_back({"misspelt key", text, "youngs_modulos",
+                     {"objects[0].material.youngs_modulos", "unknown key", "model, poisson_ratio, youngs_modulus"}});
+  }
+  {
+    const auto text = replaced(base,
+                               "    material:\n      model: linear_elastic\n      youngs_modulus: 1000\n"
+                               "      poisson_ratio: 0.3\n",
+                               "");
+    // Reported at the object that lacks it; its map starts on the "- name: block" line.
+    cases.push_back({"missing material", text, "- name: block", {"objects[0]", "missing required key 'material'"}});
+  }
+  {
+    const auto text = replaced(base, "size: [10, 10, 10]", "size: [10, 10]");
+    cases.push_back({"vector of two", text, "size: [10, 10]",
+                     {"objects[0].mesh.box.size", "a list of 3 numbers", "found a list of 2"}});
+  }
+  {
+    const auto text = replaced(base, "units: mm", "units: inch");
+    cases.push_back({"units inch", text, "units: inch", {"units", "m | cm | mm", "found 'inch'"}});
+  }
+  {
+    const auto text = replaced(base, "divisions: [2, 2, 2]", "divisions: [2, 0, 2]");
+    cases.push_back({"zero divisions", text, "divisions: [2, 0, 2]",
+                     {"objects[0].mesh.box.divisions[1]", "an integer from 1 to 400", "found '0'"}});
+  }
+  {
+    const auto text = replaced(base, "  rate_hz: 1000", "  rate_hz: 1000: 2");
+    cases.push_back({"YAML syntax error", text, "rate_hz: 1000: 2", {"YAML syntax error"}});
+  }
+  {
+    // A second object, a copy of the first.
+    const auto object_begin = base.find("  - name: block");
+    const auto object_end = base.find("tools:");
+    const std::string object = base.substr(object_begin, object_end - object_begin);
+    const auto text = replaced(base, "tools:", object + "tools:");
+    // The list itself is the offender: yaml-cpp places it at its first item.
+    cases.push_back({"two objects", text, "  - name: block", {"objects", "exactly one object", "found a list of 2"}});
+  }
+  {
+    const auto text = replaced(base, "tools:\n  - name: A\n    shape: point\n", "tools: []\n");
+    cases.push_back({"no tools", text, "tools: []", {"tools", "at least one tool", "found a list of 0"}});
+  }
+  {
+    const auto text = replaced(base, "    shape: point\n", "    shape: point\n  - name: A\n    shape: point\n");
+    // The second tool's name is the duplicate: the item starts three lines below "tools:".
+    const int second_line = line_of(text, "tools:") + 3;
+    const auto message = parse_error(text);
+    ASSERT_TRUE(message.has_value());
+    EXPECT_EQ(message->rfind(kSceneFile + ":" + std::to_string(second_line) + ":", 0), 0u) << *message;
+    EXPECT_NE(message->find("tools[1].name"), std::string::npos) << *message;
+    EXPECT_NE(message->find("a tool name not used before"), std::string::npos) << *message;
+    EXPECT_NE(message->find("found 'A'"), std::string::npos) << *message;
+  }
+  {
+    const auto text = replaced(base, "    shape: point\n", "    shape: sphere\n");
+    cases.push_back({"sphere without radius", text, "- name: A", {"tools[0]", "missing required key 'radius'"}});
+  }
+  {
+    const auto text = replaced(base, "    shape: point\n", "    shape: point\n    radius: 2\n");
+    cases.push_back({"point with radius", text, "radius: 2", {"tools[0].radius", "a point tool has no radius"}});
+  }
+  {
+    const auto text = replaced(base,
+                               "    fixed:\n      - plane:\n          point: [0, 0, 0]\n          normal: [0, 0, 1]\n"
+                               "        axes: xyz\n",
+                               "    fixed: []\n");
+    cases.push_back({"empty fixed list", text, "fixed: []",
+                     {"objects[0].fixed", "at least one fixed region", "found a list of 0"}});
+  }
+  {
+    const auto text = replaced(base, "        axes: xyz\n", "        box: {min: [0, 0, 0], max: [1, 1, 1]}\n        axes: xyz\n");
+    // The offender is the fixed region's map, which starts on its "- plane:" line.
+    cases.push_back({"plane and box", text, "      - plane:\n          point: [0, 0, 0]",
+                     {"objects[0].fixed[0]", "exactly one of surface, box, plane or nodes"}});
+  }
+  {
+    const auto text = replaced(base,
+                               "      box:\n        min: [0, 0, 0]\n        size: [10, 10, 10]\n"
+                               "        divisions: [2, 2, 2]\n",
+                               "      file: no_such_mesh.msh\n");
+    cases.push_back({"missing mesh file", text, "file: no_such_mesh.msh",
+                     {"objects[0].mesh.file", "/nonexistent-cohaptic-test/scenes/no_such_mesh.msh", "does not exist"}});
+  }
+
+  for (const BadScene& bad : cases) expect_scene_error(bad);
+}
+
+TEST(SceneErrors, MissingSceneFileNamesIt) {
+  const std::string file = "/nonexistent-cohaptic-test/missing.yaml";
+  try {
+    load_scene(file);
+    FAIL() << "no SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneModel, PerAxisFixingMatchesMasksComputedFromCoordinates) {
+  // Sliding (symmetry) boundaries on three planes: each removes one rigid mode family,
+  // together they make K_ff positive definite.
+  const std::string text = R"(units: m
+objects:
+  - name: block
+    mesh:
+      box: {min: [0, 0, 0], size: [1, 1, 1], divisions: [2, 2, 2]}
+    material: {youngs_modulus: 1000, poisson_ratio: 0.3}
+    fixed:
+      - plane: {point: [0, 0, 0], normal: [0, 0, 1]}
+        axes: z
+      - plane: {point: [0, 0, 0], normal: [1, 0, 0]}
+        axes: x
+      - plane: {point: [0, 0, 0], normal: [0, 1, 0]}
+        axes: y
+tools:
+  - {name: A}
+)";
+  const Model model = build_model(parse_scene(text, "per_axis.yaml"));
+  ASSERT_EQ(model.mesh.node_count(), 27);
+  int fixed_dofs = 0;
+  int x_and_z_only = 0;
+  for (int n = 0; n < model.mesh.node_count(); ++n) {
+    const Eigen::Vector3d x = model.mesh.nodes.col(n);
+    int expected = 0;
+    if (std::abs(x.x()) < 1e-12) expected |= 0b001;
+    if (std::abs(x.y()) < 1e-12) expected |= 0b010;
+    if (std::abs(x.z()) < 1e-12) expected |= 0b100;
+    EXPECT_EQ(int(model.dofs.fixed_axes[n]), int(expected)) << "node at " << x.transpose();
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_EQ(model.dofs.is_fixed(n, a), ((expected >> a) & 1) != 0);
+      fixed_dofs += (expected >> a) & 1;
+      if (((expected >> a) & 1) == 0) {
+        ASSERT_GE(model.dofs.free_index[3 * n + a], 0);
+        EXPECT_EQ(model.dofs.free_dofs[model.dofs.free_index[3 * n + a]], 3 * n + a);
+      } else {
+        EXPECT_EQ(model.dofs.free_index[3 * n + a], -1);
+      }
+    }
+    if (expected == 0b101) ++x_and_z_only;
+  }
+  EXPECT_EQ(x_and_z_only, 2);  // the line x = z = 0 without the origin: y = 0.5 and 1
+  EXPECT_EQ(fixed_dofs, 3 * 9);
+  EXPECT_EQ(model.dofs.free_count(), 3 * 27 - fixed_dofs);
+}
+
+std::string build_error(const std::string& text) {
+  try {
+    build_model(parse_scene(text, "selectors.yaml"));
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "(no SceneError)";
+}
+
+TEST(SceneModel, SelectorThatSelectsNothingNamesItsKeyPath) {
+  const std::string outside = replaced(kBaseScene, "        axes: xyz\n",
+                                       "        axes: xyz\n      - plane:\n          point: [0, 0, 50]\n"
+                                       "          normal: [0, 0, 1]\n        axes: z\n");
+  ASSERT_TRUE(parse_error(outside) == std::nullopt) << *parse_error(outside);
+  const std::string message = build_error(outside);
+  EXPECT_NE(message.find("objects[0].fixed[1]"), std::string::npos) << message;
+  EXPECT_NE(message.find("selects no"), std::string::npos) << message;
+
+  // The same through select_nodes directly, with a box selector that misses the mesh.
+  const TetMesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones(), Eigen::Vector3i::Constant(2));
+  const BoundarySurface surface = extract_boundary_surface(mesh);
+  NodeSelector box;
+  box.kind = NodeSelector::Kind::box;
+  box.box_min = Eigen::Vector3d::Constant(2);
+  box.box_max = Eigen::Vector3d::Constant(3);
+  box.where = "objects[0].touchable[3]";
+  try {
+    select_nodes(box, mesh, surface, true);
+    ADD_FAILURE() << "no SceneError";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("objects[0].touchable[3]"), std::string::npos) << e.what();
+  }
+  // A box around the top face selects exactly the 9 nodes with z = 1.
+  box.box_min = Eigen::Vector3d(-1, -1, 0.9);
+  box.box_max = Eigen::Vector3d(2, 2, 1.1);
+  std::vector<int> top;
+  for (int n = 0; n < mesh.node_count(); ++n)
+    if (mesh.nodes(2, n) == 1.0) top.push_back(n);
+  EXPECT_EQ(select_nodes(box, mesh, surface, true), top);
+}
+
+TEST(SceneModel, UnknownOrInteriorNodeIdIsNamed) {
+  const std::string unknown = replaced(kBaseScene, "      - plane:\n          point: [0, 0, 0]\n          normal: [0, 0, 1]\n",
+                                       "      - nodes: [1, 98765]\n");
+  const std::string message = build_error(unknown);
+  EXPECT_NE(message.find("objects[0].fixed[0]"), std::string::npos) << message;
+  EXPECT_NE(message.find("98765"), std::string::npos) << message;
+
+  // Node tags are index + 1; node index 13 is the centre of the 2x2x2 box, not on the surface.
+  const std::string interior = replaced(kBaseScene, "          point: [0, 0, 10]\n          normal: [0, 0, 1]\n",
+                                        "          point: [0, 0, 10]\n          normal: [0, 0, 1]\n      - nodes: [14]\n");
+  const std::string interior_message = build_error(interior);
+  EXPECT_NE(interior_message.find("objects[0].touchable[1]"), std::string::npos) << interior_message;
+  EXPECT_NE(interior_message.find("node 14"), std::string::npos) << interior_message;
+  EXPECT_NE(interior_message.find("not on the surface"), std::string::npos) << interior_message;
+}
+
+}  // namespace
+}  // namespace cohaptic
