@@ -44,8 +44,9 @@ int main(int argc, char** argv) {
   bool no_disk_cache = false;
   CLI::App* probe_cmd = app.add_subcommand(
       "probe",
-      "Static reaction force at tool positions pressed into the scene's object (node translation, "
-      "condensed on the compliance). Prints a table, or JSON with --json.");
+      "Static reaction force at tool positions pressed into the scene's object, through the intermediate "
+      "representation (condensed M~) and the haptic force evaluator, or the full FEM solve. Prints a table, "
+      "or JSON with --json.");
   probe_cmd->add_option("--scene", probe.scene, "Scene file (YAML)")->required()->check(CLI::ExistingFile);
   probe_cmd
       ->add_option("--tool", tool_texts,
@@ -54,6 +55,23 @@ int main(int argc, char** argv) {
       ->required();
   probe_cmd->add_flag("--separately", probe.separately,
                      "Press each tool alone (one solve per tool) instead of all tools at once");
+  std::string contact_model, precision = "f64";
+  probe_cmd->add_option("--boundary-nodes", probe.boundary_nodes,
+                        "Hold the N surface nodes nearest the tools at rest (the paper's step-delay T150/T300 sets)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  probe_cmd->add_option("--contact-model", contact_model,
+                        "translation (the paper's: the triangle's nodes follow the tool) or point (the contact point "
+                        "follows it with least energy); default: the scene's")
+      ->check(CLI::IsMember({"translation", "point"}));
+  probe_cmd->add_option("--ir-precision", precision, "Storage of M~ and u_B in the IR: f64 or f32 (inversion is always double)")
+      ->check(CLI::IsMember({"f64", "f32"}))
+      ->capture_default_str();
+  probe_cmd->add_option("--patch-rings", probe.patch_rings, "Rings of neighbouring triangles in each IR's contact patch")
+      ->check(CLI::Range(0, 4))
+      ->capture_default_str();
+  probe_cmd->add_flag("--reference", probe.reference,
+                      "Full sparse FEM solve instead of the condensed IR (slow; the answer the IR is checked against)");
   probe_cmd->add_flag("--json", probe.json, "Print one JSON object on stdout instead of the table");
   probe_cmd->add_option("--export-vtu", probe.export_vtu, "Write the mesh with the displacement field (.vtu, for ParaView)");
   probe_cmd->add_option("--export-msh", probe.export_msh, "Write the mesh as Gmsh 4.1 ASCII (its node ids are the ones reported)");
@@ -74,6 +92,10 @@ int main(int argc, char** argv) {
         probe.tools.push_back(point);
       }
       if (!no_disk_cache) probe.cache_directory = cache_dir;
+      if (!contact_model.empty())
+        probe.contact_model =
+            contact_model == "translation" ? cohaptic::ContactModel::node_translation : cohaptic::ContactModel::point_constraint;
+      probe.precision = precision == "f32" ? cohaptic::IrPrecision::f32 : cohaptic::IrPrecision::f64;
       return cohaptic::run_probe(probe);
     }
   } catch (const cohaptic::Error& e) {

@@ -4,11 +4,14 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include <limits>
+
 #include "common/mesh/write_gmsh.h"
 #include "common/mesh/write_vtu.h"
 #include "common/model/compliance_setup.h"
 #include "common/model/static_contact.h"
 #include "common/scene/load_scene.h"
+#include "common/sim/simulation.h"
 #include "common/util/stopwatch.h"
 
 namespace cohaptic {
@@ -17,13 +20,66 @@ namespace {
 struct ProbeTimings {
   double load_ms = 0;        // scene, mesh, checks, surface
   double precompute_ms = 0;  // assembly, factorisation, compliance columns
-  double solve_ms = 0;       // contacts and condensed forces
+  double ir_build_ms = 0;    // active sets and M~ (IR path)
+  double solve_ms = 0;       // force evaluation, or the full sparse solve with --reference
 };
+
+// One probed tool: its contact (from the full-surface search) and the answer.
+struct ProbedTool {
+  PressedTool tool;
+  ContactQuery query;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  // reaction on the tool [N]
+  std::size_t ir_bytes = 0;
+  int boundary_nodes = 0;
+  double condition_estimate = 0;
+};
+
+const char* model_name(ContactModel model) {
+  return model == ContactModel::node_translation ? "translation" : "point";
+}
+
+// Presses `tools` at once (every other scene tool absent) and fills in their answers.
+void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& options, ContactModel contact_model,
+           std::vector<ProbedTool>& tools, const std::vector<int>& users, ProbeTimings& timings) {
+  SimulationOptions sim_options;
+  sim_options.ir.patch_rings = options.patch_rings;
+  sim_options.ir.precision = options.precision;
+  sim_options.ir.contact_model = contact_model;
+  sim_options.ir.force_limit = std::numeric_limits<double>::infinity();  // the probe reports physics
+  sim_options.step_delay_nodes = options.boundary_nodes;
+  Simulation simulation(model, columns, model.scene.tools, sim_options);
+  std::vector<PressedTool> pressed;
+  for (int u : users) {
+    simulation.set_tool(u, tools[u].tool.position);
+    pressed.push_back(tools[u].tool);
+  }
+  const std::vector<ContactQuery> contacts = find_tool_contacts(model, pressed);
+  for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].query = contacts[i];
+
+  Stopwatch watch;
+  const StepReport report = simulation.step(0.0);
+  timings.ir_build_ms += watch.lap_ms();
+  for (int u : users) {
+    tools[u].boundary_nodes = report.boundary_nodes;
+    if (const auto ir = simulation.ir(u)) {
+      tools[u].ir_bytes = ir->ir.size_bytes();
+      tools[u].condition_estimate = ir->condition_estimate;
+    }
+  }
+  if (options.reference) {
+    HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
+    const std::vector<ToolReaction> reactions = contact_reactions_reference(model, contacts, held, contact_model);
+    for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].force = reactions[i].reaction;
+  } else {
+    for (int u : users) tools[u].force = simulation.force(u).force;
+  }
+  timings.solve_ms += watch.lap_ms();
+}
 
 nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-nlohmann::json probe_json(const Model& model, const std::vector<PressedTool>& tools,
-                          const std::vector<ToolReaction>& reactions, bool separately, const ProbeTimings& timings) {
+nlohmann::json probe_json(const Model& model, const ProbeOptions& options, ContactModel contact_model,
+                          const std::vector<ProbedTool>& tools, const ProbeTimings& timings) {
   const double unit = model.scene.metres_per_unit;
   nlohmann::json out;
   out["scene"] = model.scene.file.string();
@@ -35,15 +91,18 @@ nlohmann::json probe_json(const Model& model, const std::vector<PressedTool>& to
   out["touchable_nodes"] = model.touchable_nodes.size();
   out["material"] = {{"youngs_modulus_pa", model.scene.object.material.youngs_modulus},
                      {"poisson_ratio", model.scene.object.material.poisson_ratio}};
-  out["tools_pressed"] = separately ? "separately" : "together";
+  out["method"] = options.reference ? "reference" : "ir";
+  out["contact_model"] = model_name(contact_model);
+  out["ir_precision"] = options.precision == IrPrecision::f32 ? "f32" : "f64";
+  out["patch_rings"] = options.patch_rings;
+  out["tools_pressed"] = options.separately ? "separately" : "together";
   out["tools"] = nlohmann::json::array();
-  for (std::size_t t = 0; t < tools.size(); ++t) {
-    const ToolReaction& r = reactions[t];
+  for (const ProbedTool& probed : tools) {
     nlohmann::json tool;
-    tool["position"] = vector_json(tools[t].position / unit);
-    tool["signed_distance"] = r.query.signed_distance / unit;
-    if (r.query.contact) {
-      const ToolContact& c = *r.query.contact;
+    tool["position"] = vector_json(probed.tool.position / unit);
+    tool["signed_distance"] = probed.query.signed_distance / unit;
+    if (probed.query.contact) {
+      const ToolContact& c = *probed.query.contact;
       const Triangle& tri = model.surface.triangles[c.triangle];
       nlohmann::json contact;
       contact["triangle"] = {model.mesh.node_tags[tri[0]], model.mesh.node_tags[tri[1]], model.mesh.node_tags[tri[2]]};
@@ -52,16 +111,20 @@ nlohmann::json probe_json(const Model& model, const std::vector<PressedTool>& to
       contact["depth"] = c.depth / unit;
       contact["displacement"] = {vector_json(c.displacement / unit), vector_json(c.displacement / unit),
                                  vector_json(c.displacement / unit)};
-      contact["nodal_forces"] = {vector_json(r.nodal_forces.col(0)), vector_json(r.nodal_forces.col(1)),
-                                 vector_json(r.nodal_forces.col(2))};
       tool["contact"] = contact;
     } else {
       tool["contact"] = nullptr;
     }
-    tool["force"] = vector_json(r.reaction);
+    tool["force"] = vector_json(probed.force);
+    tool["ir"] = {{"bytes", probed.ir_bytes},
+                  {"boundary_nodes", probed.boundary_nodes},
+                  {"condition_estimate", probed.condition_estimate}};
     out["tools"].push_back(tool);
   }
-  out["timings_ms"] = {{"load", timings.load_ms}, {"precompute", timings.precompute_ms}, {"solve", timings.solve_ms}};
+  out["timings_ms"] = {{"load", timings.load_ms},
+                       {"precompute", timings.precompute_ms},
+                       {"ir_build", timings.ir_build_ms},
+                       {"solve", timings.solve_ms}};
   return out;
 }
 
@@ -69,8 +132,8 @@ std::string vec(const Eigen::Vector3d& v, int precision) {
   return fmt::format("({:.{}f}, {:.{}f}, {:.{}f})", v.x(), precision, v.y(), precision, v.z(), precision);
 }
 
-void print_table(const Model& model, const std::vector<PressedTool>& tools, const std::vector<ToolReaction>& reactions,
-                 bool separately, const ProbeTimings& timings, const std::string& compliance_note) {
+void print_table(const Model& model, const ProbeOptions& options, ContactModel contact_model,
+                 const std::vector<ProbedTool>& tools, const ProbeTimings& timings, const std::string& compliance_note) {
   const double unit = model.scene.metres_per_unit;
   const std::string& u = model.scene.units;
   const LinearElasticMaterial& material = model.scene.object.material;
@@ -78,29 +141,42 @@ void print_table(const Model& model, const std::vector<PressedTool>& tools, cons
   fmt::print("mesh      {} nodes, {} tetrahedra, {} surface triangles; {} fixed nodes; {} touchable nodes\n",
              model.mesh.node_count(), model.mesh.tet_count(), model.surface.triangle_count(),
              fixed_node_tags(model).size(), model.touchable_nodes.size());
-  fmt::print("material  E = {:g} Pa, nu = {:g}; contact model: node translation; tools pressed {}\n\n",
-             material.youngs_modulus, material.poisson_ratio, separately ? "one at a time" : "together");
-  fmt::print("{:<4} {:<28} {:>10} {:<20} {:<28} {:<30} {:>9}\n", "tool", fmt::format("position ({})", u),
+  fmt::print("material  E = {:g} Pa, nu = {:g}\n", material.youngs_modulus, material.poisson_ratio);
+  fmt::print("method    {}; contact model {}; tools pressed {}; {} boundary nodes held\n",
+             options.reference ? "full sparse solve (--reference)"
+                               : fmt::format("IR ({}, patch rings {})", options.precision == IrPrecision::f32 ? "f32" : "f64",
+                                             options.patch_rings),
+             model_name(contact_model), options.separately ? "one at a time" : "together",
+             tools.empty() ? 0 : tools.front().boundary_nodes);
+  fmt::print("\n{:<4} {:<28} {:>10} {:<20} {:<28} {:<30} {:>9} {:>9}\n", "tool", fmt::format("position ({})", u),
              fmt::format("depth ({})", u), "triangle (node ids)", fmt::format("node displacement ({})", u),
-             "reaction force on tool (N)", "|F| (N)");
+             "reaction force on tool (N)", "|F| (N)", "IR bytes");
+  const double limit = model.scene.haptic.force_limit_n;
+  bool over_limit = false;
   for (std::size_t t = 0; t < tools.size(); ++t) {
-    const ToolReaction& r = reactions[t];
-    if (!r.query.contact) {
-      fmt::print("{:<4} {:<28} {:>10} no contact ({} {:.3f} {} from the surface)\n", t + 1, vec(tools[t].position / unit, 3),
-                 "-", r.query.signed_distance < 0 ? "inside, but no touchable triangle;" : "outside,",
-                 std::abs(r.query.signed_distance) / unit, u);
+    const ProbedTool& probed = tools[t];
+    if (!probed.query.contact) {
+      fmt::print("{:<4} {:<28} {:>10} no contact ({} {:.3f} {} from the surface)\n", t + 1,
+                 vec(probed.tool.position / unit, 3), "-",
+                 probed.query.signed_distance < 0 ? "inside, but no touchable triangle;" : "outside,",
+                 std::abs(probed.query.signed_distance) / unit, u);
       continue;
     }
-    const ToolContact& c = *r.query.contact;
+    const ToolContact& c = *probed.query.contact;
     const Triangle& tri = model.surface.triangles[c.triangle];
-    fmt::print("{:<4} {:<28} {:>10.3f} {:<20} {:<28} {:<30} {:>9.4f}\n", t + 1, vec(tools[t].position / unit, 3),
+    const bool over = probed.force.norm() > limit;
+    over_limit |= over;
+    fmt::print("{:<4} {:<28} {:>10.3f} {:<20} {:<28} {:<30} {:>8.4f}{} {:>9}\n", t + 1, vec(probed.tool.position / unit, 3),
                c.depth / unit,
                fmt::format("{} {} {}", model.mesh.node_tags[tri[0]], model.mesh.node_tags[tri[1]], model.mesh.node_tags[tri[2]]),
-               vec(c.displacement / unit, 3), vec(r.reaction, 4), r.reaction.norm());
+               vec(c.displacement / unit, 3), vec(probed.force, 4), probed.force.norm(), over ? "*" : " ", probed.ir_bytes);
   }
-  fmt::print("\ntimings (ms): load {:.1f}, precompute {:.1f} (assemble {:.1f}, factor {:.1f}, compliance {:.1f}), solve {:.3f}\n",
+  if (over_limit) fmt::print("* above the scene's haptic force limit of {:g} N (a haptic client would clamp it)\n", limit);
+  fmt::print("\ntimings (ms): load {:.1f}, precompute {:.1f} (assemble {:.1f}, factor {:.1f}, compliance {:.1f}), "
+             "IR build {:.3f}, {} {:.3f}\n",
              timings.load_ms, timings.precompute_ms, model.timings.assemble_ms, model.timings.factor_ms,
-             timings.precompute_ms - model.timings.assemble_ms - model.timings.factor_ms, timings.solve_ms);
+             timings.precompute_ms - model.timings.assemble_ms - model.timings.factor_ms, timings.ir_build_ms,
+             options.reference ? "full solve" : "force evaluation", timings.solve_ms);
   if (!compliance_note.empty()) fmt::print("compliance cache: {}\n", compliance_note);
 }
 
@@ -109,29 +185,35 @@ void print_table(const Model& model, const std::vector<PressedTool>& tools, cons
 int run_probe(const ProbeOptions& options) {
   ProbeTimings timings;
   Stopwatch watch;
-  const Scene scene = load_scene(options.scene);
+  Scene scene = load_scene(options.scene);
+  // One user per --tool; tool k takes the shape of the scene's k-th tool, or of its last.
+  while (scene.tools.size() < options.tools.size()) {
+    scene.tools.push_back(scene.tools.back());
+    scene.tools.back().name += "'";
+  }
+  const ContactModel contact_model = options.contact_model.value_or(scene.haptic.contact_model);
   const Model model = build_model(scene);
   const double elapsed_build = watch.lap_ms();
   timings.load_ms = elapsed_build - model.timings.assemble_ms - model.timings.factor_ms;
   timings.precompute_ms = model.timings.assemble_ms + model.timings.factor_ms;
 
-  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, options.boundary_nodes > 0));
   const ComplianceSetup setup = prepare_compliance(model, columns, options.cache_directory);
   timings.precompute_ms += watch.lap_ms();
 
-  std::vector<PressedTool> tools;
-  for (std::size_t t = 0; t < options.tools.size(); ++t) {
-    const ToolSpec& spec = scene.tools[std::min(t, scene.tools.size() - 1)];
-    tools.push_back({options.tools[t] * scene.metres_per_unit, spec.radius});
+  std::vector<ProbedTool> tools;
+  for (const Eigen::Vector3d& position : options.tools) {
+    ProbedTool probed;
+    probed.tool = {position * scene.metres_per_unit, scene.tools[tools.size()].radius};
+    tools.push_back(probed);
   }
-  std::vector<ToolReaction> reactions;
   if (options.separately) {
-    for (const PressedTool& tool : tools)
-      reactions.push_back(contact_reactions_condensed(model, columns, find_tool_contacts(model, {tool})).front());
+    for (int u = 0; u < static_cast<int>(tools.size()); ++u) press(model, columns, options, contact_model, tools, {u}, timings);
   } else {
-    reactions = contact_reactions_condensed(model, columns, find_tool_contacts(model, tools));
+    std::vector<int> all(tools.size());
+    for (std::size_t u = 0; u < all.size(); ++u) all[u] = static_cast<int>(u);
+    press(model, columns, options, contact_model, tools, all, timings);
   }
-  timings.solve_ms = watch.lap_ms();
 
   if (!options.export_vtu.empty() || !options.export_msh.empty()) {
     TetMesh in_scene_units = model.mesh;
@@ -142,18 +224,22 @@ int run_probe(const ProbeOptions& options) {
     }
     if (!options.export_vtu.empty()) {
       if (options.separately && tools.size() > 1)
-        spdlog::warn("--export-vtu with --separately: the field shows all tools' forces superposed");
-      const Eigen::VectorXd u = displacement_under_reactions(model, reactions) / scene.metres_per_unit;
+        spdlog::warn("--export-vtu with --separately: the field shows all tools pressing together");
+      std::vector<PressedTool> pressed;
+      for (const ProbedTool& probed : tools) pressed.push_back(probed.tool);
+      Eigen::VectorXd u;
+      contact_reactions_reference(model, find_tool_contacts(model, pressed), {}, contact_model, &u);
+      u /= scene.metres_per_unit;
       write_vtu(options.export_vtu, in_scene_units,
                 {{"displacement", Eigen::Map<const Eigen::Matrix3Xd>(u.data(), 3, model.mesh.node_count())}});
-      spdlog::info("wrote {} (displacement in {})", options.export_vtu.string(), scene.units);
+      spdlog::info("wrote {} (displacement in {}, without held boundary nodes)", options.export_vtu.string(), scene.units);
     }
   }
 
   if (options.json)
-    fmt::print("{}\n", probe_json(model, tools, reactions, options.separately, timings).dump());
+    fmt::print("{}\n", probe_json(model, options, contact_model, tools, timings).dump());
   else
-    print_table(model, tools, reactions, options.separately, timings, setup.note);
+    print_table(model, options, contact_model, tools, timings, setup.note);
   return 0;
 }
 

@@ -1,5 +1,7 @@
 // `cohaptic-server probe`: the static reaction force at given tool positions, from the
-// command line, with the contact it came from and how long each stage took.
+// command line, through the same intermediate representation and force evaluator the
+// haptic loop uses (or the full sparse solve with --reference), with the contact it came
+// from, the IR's size and how long each stage took.
 #pragma once
 
 #include <Eigen/Core>
@@ -8,6 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "common/ir/intermediate_representation.h"
+#include "common/scene/scene.h"
+
 namespace cohaptic {
 
 struct ProbeOptions {
@@ -15,6 +20,11 @@ struct ProbeOptions {
   std::vector<Eigen::Vector3d> tools;  ///< in the scene's units
   bool separately = false;             ///< press each tool alone instead of all at once
   bool json = false;
+  bool reference = false;              ///< full sparse solve instead of the IR
+  int boundary_nodes = 0;              ///< step-delay boundary nodes held at rest
+  int patch_rings = 1;
+  std::optional<ContactModel> contact_model;  ///< default: the scene's
+  IrPrecision precision = IrPrecision::f64;
   std::filesystem::path export_vtu;    ///< empty: no export
   std::filesystem::path export_msh;
   std::optional<std::filesystem::path> cache_directory;  ///< empty: no disk cache

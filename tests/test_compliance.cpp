@@ -86,12 +86,12 @@ TEST(ComplianceCache, KeyChangesWithMeshMaterialBoundaryConditionsAndRows) {
 TEST(ComplianceCache, RoundTripsBitExactlyAndIsUsedOnTheSecondRun) {
   const ScratchDirectory dir;
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
-  ComplianceColumns first(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  ComplianceColumns first(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
   const ComplianceSetup computed = prepare_compliance(model, first, dir.path);
   EXPECT_FALSE(computed.from_disk);
   EXPECT_TRUE(fs::exists(computed.cache_file));
 
-  ComplianceColumns second(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  ComplianceColumns second(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
   const ComplianceSetup loaded = prepare_compliance(model, second, dir.path);
   EXPECT_TRUE(loaded.from_disk);
   ASSERT_EQ(second.column_count(), first.column_count());
@@ -102,23 +102,23 @@ TEST(ComplianceCache, RoundTripsBitExactlyAndIsUsedOnTheSecondRun) {
 TEST(ComplianceCache, TruncatedOrCorruptedFilesAreDetectedAndRebuilt) {
   const ScratchDirectory dir;
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
-  ComplianceColumns reference(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  ComplianceColumns reference(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
   const fs::path file = prepare_compliance(model, reference, dir.path).cache_file;
   const auto size = fs::file_size(file);
   const Digest key = compliance_cache_key(model.mesh, model.scene.object.material, model.dofs, reference.row_nodes());
 
   const auto expect_rebuilt = [&](const std::string& what) {
-    ComplianceColumns probe(*model.free_factor, model.dofs, compliance_row_nodes(model));
+    ComplianceColumns probe(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
     const ComplianceCacheLoad load = load_compliance_cache(file, key, probe);
     EXPECT_FALSE(load.loaded) << what;
     EXPECT_EQ(probe.column_count(), 0u) << what << ": a bad file must insert nothing";
     EXPECT_FALSE(load.problem.empty()) << what;
-    ComplianceColumns rebuilt(*model.free_factor, model.dofs, compliance_row_nodes(model));
+    ComplianceColumns rebuilt(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
     const ComplianceSetup setup = prepare_compliance(model, rebuilt, dir.path);
     EXPECT_FALSE(setup.from_disk) << what;
     EXPECT_EQ(rebuilt.column_count(), reference.column_count()) << what;
     EXPECT_EQ(fs::file_size(file), size) << what << ": the cache is written again in full";
-    ComplianceColumns reloaded(*model.free_factor, model.dofs, compliance_row_nodes(model));
+    ComplianceColumns reloaded(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
     EXPECT_TRUE(load_compliance_cache(file, key, reloaded).loaded) << what;
   };
 
@@ -142,10 +142,10 @@ TEST(ComplianceCache, AFileForAnotherMaterialIsNotUsed) {
   const ScratchDirectory dir;
   const Model soft = build_model(parse_scene(small_cube_yaml(1e6), "cube.yaml"));
   const Model stiff = build_model(parse_scene(small_cube_yaml(2e6), "cube.yaml"));
-  ComplianceColumns soft_columns(*soft.free_factor, soft.dofs, compliance_row_nodes(soft));
+  ComplianceColumns soft_columns(*soft.free_factor, soft.dofs, compliance_row_nodes(soft, false));
   const fs::path soft_file = prepare_compliance(soft, soft_columns, dir.path).cache_file;
   // Put the soft cache where the stiff one would be: its embedded key still tells them apart.
-  ComplianceColumns stiff_columns(*stiff.free_factor, stiff.dofs, compliance_row_nodes(stiff));
+  ComplianceColumns stiff_columns(*stiff.free_factor, stiff.dofs, compliance_row_nodes(stiff, false));
   const Digest stiff_key = compliance_cache_key(stiff.mesh, stiff.scene.object.material, stiff.dofs, stiff_columns.row_nodes());
   fs::copy_file(soft_file, compliance_cache_file(dir.path, stiff_key));
   const ComplianceCacheLoad load = load_compliance_cache(compliance_cache_file(dir.path, stiff_key), stiff_key, stiff_columns);
@@ -161,7 +161,7 @@ TEST(ComplianceCache, AnUnwritableCacheDirectoryIsNotFatal) {
   const fs::path blocked = dir.path / "not-a-directory";
   std::ofstream(blocked) << "a file where the cache directory should be";
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
-  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
   ComplianceSetup setup;
   EXPECT_NO_THROW(setup = prepare_compliance(model, columns, blocked / "cache"));
   EXPECT_EQ(columns.column_count(), model.touchable_nodes.size());
@@ -171,12 +171,12 @@ TEST(ComplianceCache, AnUnwritableCacheDirectoryIsNotFatal) {
 TEST(ComplianceCache, OnDemandModeComputesNothingUpFrontAndSavesWhatItComputed) {
   const ScratchDirectory dir;
   const Model model = build_model(parse_scene(small_cube_yaml(1e6, 4, "on_demand"), "cube.yaml"));
-  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
   EXPECT_EQ(prepare_compliance(model, columns, dir.path).columns, 0u);
   columns.column(model.touchable_nodes[3]);
   columns.column(model.touchable_nodes[9]);
   save_compliance(model, columns, dir.path);
-  ComplianceColumns again(*model.free_factor, model.dofs, compliance_row_nodes(model));
+  ComplianceColumns again(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
   const ComplianceSetup setup = prepare_compliance(model, again, dir.path);
   EXPECT_TRUE(setup.from_disk);
   EXPECT_EQ(again.column_count(), 2u);

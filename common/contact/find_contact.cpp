@@ -4,6 +4,33 @@
 
 namespace cohaptic {
 
+SurfacePoint nearest_triangle(const TetMesh& mesh, const BoundarySurface& surface, const SurfacePseudoNormals& normals,
+                              std::span<const int> triangles, const Eigen::Vector3d& p) {
+  // Closest triangle; among ties (an edge or vertex shared by several), the one whose
+  // plane p is deepest below.
+  SurfacePoint best;
+  double best_distance2 = std::numeric_limits<double>::infinity();
+  double best_height = std::numeric_limits<double>::infinity();
+  for (int t : triangles) {
+    const Triangle& tri = surface.triangles[t];
+    const TriangleClosestPoint q =
+        closest_point_on_triangle(p, mesh.nodes.col(tri[0]), mesh.nodes.col(tri[1]), mesh.nodes.col(tri[2]));
+    const double d2 = (p - q.point).squaredNorm();
+    const double height = (p - q.point).dot(normals.face[t]);
+    const double tie_tolerance = 1e-24 + 1e-12 * best_distance2;
+    const bool closer = d2 < best_distance2 - tie_tolerance;
+    const bool tie_but_deeper = std::abs(d2 - best_distance2) <= tie_tolerance && height < best_height;
+    if (closer || tie_but_deeper) {
+      best_distance2 = std::min(d2, best_distance2);
+      best_height = height;
+      best.triangle = t;
+      best.closest = q;
+    }
+  }
+  if (best.triangle >= 0) best.signed_distance = best_height;
+  return best;
+}
+
 ContactQuery find_contact(const TetMesh& mesh, const BoundarySurface& surface, const SurfacePseudoNormals& normals,
                           std::span<const int> touchable_triangles, const Eigen::Vector3d& tool_position,
                           double tool_radius) {
@@ -11,28 +38,11 @@ ContactQuery find_contact(const TetMesh& mesh, const BoundarySurface& surface, c
   query.signed_distance = closest_surface_point(mesh, surface, normals, tool_position).signed_distance;
   if (!(query.signed_distance < tool_radius) || touchable_triangles.empty()) return query;
 
-  // Closest touchable triangle; among ties (an edge or vertex shared by several), the one
-  // whose plane the tool is deepest below.
-  double best_distance2 = std::numeric_limits<double>::infinity();
-  double best_height = std::numeric_limits<double>::infinity();
+  const SurfacePoint nearest = nearest_triangle(mesh, surface, normals, touchable_triangles, tool_position);
   ToolContact contact;
-  for (int t : touchable_triangles) {
-    const Triangle& tri = surface.triangles[t];
-    const TriangleClosestPoint q = closest_point_on_triangle(tool_position, mesh.nodes.col(tri[0]),
-                                                             mesh.nodes.col(tri[1]), mesh.nodes.col(tri[2]));
-    const double d2 = (tool_position - q.point).squaredNorm();
-    const double height = (tool_position - q.point).dot(normals.face[t]);
-    const double tie_tolerance = 1e-24 + 1e-12 * best_distance2;
-    const bool closer = d2 < best_distance2 - tie_tolerance;
-    const bool tie_but_deeper = std::abs(d2 - best_distance2) <= tie_tolerance && height < best_height;
-    if (closer || tie_but_deeper) {
-      best_distance2 = std::min(d2, best_distance2);
-      best_height = height;
-      contact.triangle = t;
-      contact.foot = q.point;
-      contact.weights = q.weights;
-    }
-  }
+  contact.triangle = nearest.triangle;
+  contact.foot = nearest.closest.point;
+  contact.weights = nearest.closest.weights;
   const Eigen::Vector3d contact_point = tool_position - tool_radius * normals.face[contact.triangle];
   contact.displacement = contact_point - contact.foot;
   // Penetration below the contact triangle's plane, consistent with the displacement.

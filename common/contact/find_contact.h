@@ -31,6 +31,11 @@ struct ContactQuery {
   std::optional<ToolContact> contact;  ///< empty if the tool does not press a touchable triangle
 };
 
+/// The triangle of `triangles` nearest p (ties as above). Its signed_distance is the
+/// height of p above that triangle's plane, not a surface distance.
+SurfacePoint nearest_triangle(const TetMesh& mesh, const BoundarySurface& surface, const SurfacePseudoNormals& normals,
+                              std::span<const int> triangles, const Eigen::Vector3d& p);
+
 ContactQuery find_contact(const TetMesh& mesh, const BoundarySurface& surface, const SurfacePseudoNormals& normals,
                           std::span<const int> touchable_triangles, const Eigen::Vector3d& tool_position,
                           double tool_radius);

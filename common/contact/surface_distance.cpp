@@ -25,23 +25,26 @@ SurfacePseudoNormals compute_pseudo_normals(const TetMesh& mesh, const BoundaryS
   return normals;
 }
 
+TriangleFeature feature_of(const Eigen::Vector3d& weights) {
+  const int zeros = (weights[0] == 0) + (weights[1] == 0) + (weights[2] == 0);
+  if (zeros == 1) return {TriangleFeature::Kind::edge, ((weights[0] == 0 ? 0 : weights[1] == 0 ? 1 : 2) + 1) % 3};
+  if (zeros == 2) return {TriangleFeature::Kind::vertex, weights[0] != 0 ? 0 : weights[1] != 0 ? 1 : 2};
+  return {};
+}
+
+Eigen::Vector3d edge_pseudo_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals, int triangle, int k) {
+  const int neighbour = surface.triangle_neighbours[triangle][k];
+  return neighbour >= 0 ? Eigen::Vector3d((normals.face[triangle] + normals.face[neighbour]).normalized())
+                        : normals.face[triangle];
+}
+
 Eigen::Vector3d feature_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals, int triangle,
                                const Eigen::Vector3d& weights) {
-  const Triangle& tri = surface.triangles[triangle];
-  int zeros = 0, nonzero_vertex = 0, zero_vertex = 0;
-  for (int k = 0; k < 3; ++k) {
-    if (weights[k] == 0) {
-      ++zeros;
-      zero_vertex = k;
-    } else {
-      nonzero_vertex = k;
-    }
-  }
-  if (zeros == 2) return normals.vertex.col(tri[nonzero_vertex]);
-  if (zeros == 1) {
-    // The edge opposite the zero-weight vertex is edge (zero_vertex + 1, zero_vertex + 2).
-    const int neighbour = surface.triangle_neighbours[triangle][(zero_vertex + 1) % 3];
-    if (neighbour >= 0) return (normals.face[triangle] + normals.face[neighbour]).normalized();
+  const TriangleFeature feature = feature_of(weights);
+  switch (feature.kind) {
+    case TriangleFeature::Kind::vertex: return normals.vertex.col(surface.triangles[triangle][feature.index]);
+    case TriangleFeature::Kind::edge: return edge_pseudo_normal(surface, normals, triangle, feature.index);
+    case TriangleFeature::Kind::face: break;
   }
   return normals.face[triangle];
 }

@@ -27,6 +27,19 @@ struct SurfacePoint {
   double signed_distance = 0;     ///< [m], negative inside
 };
 
+/// The feature of a triangle that a point with area coordinates `weights` lies on: its
+/// face, edge (k, k+1) or vertex k, read from the exact zeros of the weights.
+struct TriangleFeature {
+  enum class Kind { face, edge, vertex };
+  Kind kind = Kind::face;
+  int index = 0;  ///< k for an edge (k, k+1) or a vertex k
+};
+TriangleFeature feature_of(const Eigen::Vector3d& weights);
+
+/// Normalised sum of the normals of `triangle` and the triangle across its edge (k, k+1)
+/// (the face normal alone where the edge has no single neighbour).
+Eigen::Vector3d edge_pseudo_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals, int triangle, int k);
+
 /// The pseudo-normal at the feature of `triangle` that `weights` lies on.
 Eigen::Vector3d feature_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals, int triangle,
                                const Eigen::Vector3d& weights);

@@ -2,51 +2,71 @@
 
 #include <fmt/format.h>
 
-#include "common/fem/sparse_cholesky.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
 
-StaticSolution solve_static(const SparseMatrix& stiffness, const DofMap& dofs,
-                            const std::vector<PrescribedDisplacement>& prescribed,
-                            const Eigen::VectorXd& applied_forces) {
+ConstrainedStaticSolver::ConstrainedStaticSolver(const SparseMatrix& stiffness, const DofMap& dofs,
+                                                 std::vector<int> prescribed_dofs)
+    : stiffness_(stiffness), prescribed_(std::move(prescribed_dofs)) {
   const auto n = static_cast<int>(stiffness.rows());
   if (n != 3 * dofs.node_count())
     throw Error(fmt::format("static solve: stiffness has {} rows but the dof map {} nodes", n, dofs.node_count()));
-  if (applied_forces.size() != 0 && applied_forces.size() != n)
-    throw Error(fmt::format("static solve: {} applied force components for {} dofs", applied_forces.size(), n));
-
-  StaticSolution solution;
-  solution.displacement = Eigen::VectorXd::Zero(n);
   std::vector<bool> constrained(static_cast<std::size_t>(n), false);
   for (int dof = 0; dof < n; ++dof) constrained[dof] = dofs.free_index[dof] < 0;
-  for (const PrescribedDisplacement& p : prescribed) {
-    if (p.dof < 0 || p.dof >= n) throw Error(fmt::format("static solve: prescribed dof {} out of range", p.dof));
-    if (dofs.free_index[p.dof] < 0)
-      throw Error(fmt::format("static solve: node {} axis {} is fixed and cannot be prescribed", p.dof / 3, p.dof % 3));
-    if (constrained[p.dof])
-      throw Error(fmt::format("static solve: node {} axis {} is prescribed twice", p.dof / 3, p.dof % 3));
-    constrained[p.dof] = true;
-    solution.displacement[p.dof] = p.value;
+  for (int dof : prescribed_) {
+    if (dof < 0 || dof >= n) throw Error(fmt::format("static solve: prescribed dof {} out of range", dof));
+    if (dofs.free_index[dof] < 0)
+      throw Error(fmt::format("static solve: node {} axis {} is fixed and cannot be prescribed", dof / 3, dof % 3));
+    if (constrained[dof]) throw Error(fmt::format("static solve: node {} axis {} is prescribed twice", dof / 3, dof % 3));
+    constrained[dof] = true;
   }
-
-  std::vector<int> unknown;
   for (int dof = 0; dof < n; ++dof)
-    if (!constrained[dof]) unknown.push_back(dof);
-  if (!unknown.empty()) {
+    if (!constrained[dof]) unknown_.push_back(dof);
+  if (!unknown_.empty())
+    factor_ = std::make_unique<SparseCholesky>(restrict_to_dofs(stiffness, unknown_), [this](int row) {
+      return fmt::format("node {} axis {}", unknown_[row] / 3, unknown_[row] % 3);
+    });
+}
+
+ConstrainedStaticSolver::~ConstrainedStaticSolver() = default;
+
+StaticSolution ConstrainedStaticSolver::solve(const Eigen::VectorXd& prescribed_values,
+                                              const Eigen::VectorXd& applied_forces) const {
+  const auto n = stiffness_.rows();
+  if (prescribed_values.size() != static_cast<Eigen::Index>(prescribed_.size()))
+    throw Error(fmt::format("static solve: {} prescribed values for {} prescribed dofs", prescribed_values.size(),
+                            prescribed_.size()));
+  if (applied_forces.size() != 0 && applied_forces.size() != n)
+    throw Error(fmt::format("static solve: {} applied force components for {} dofs", applied_forces.size(), n));
+  StaticSolution solution;
+  solution.displacement = Eigen::VectorXd::Zero(n);
+  for (std::size_t i = 0; i < prescribed_.size(); ++i)
+    solution.displacement[prescribed_[i]] = prescribed_values[static_cast<Eigen::Index>(i)];
+  if (factor_) {
     // rhs = f_U - K_UC u_C, computed as (f - K u_C-only)_U.
-    Eigen::VectorXd full_rhs = -(stiffness * solution.displacement);
+    Eigen::VectorXd full_rhs = -(stiffness_ * solution.displacement);
     if (applied_forces.size() == n) full_rhs += applied_forces;
-    Eigen::VectorXd rhs(static_cast<Eigen::Index>(unknown.size()));
-    for (std::size_t i = 0; i < unknown.size(); ++i) rhs[static_cast<Eigen::Index>(i)] = full_rhs[unknown[i]];
-    const SparseCholesky factor(restrict_to_dofs(stiffness, unknown),
-                                [&](int row) { return fmt::format("node {} axis {}", unknown[row] / 3, unknown[row] % 3); });
-    const Eigen::VectorXd u_unknown = factor.solve(rhs);
-    for (std::size_t i = 0; i < unknown.size(); ++i) solution.displacement[unknown[i]] = u_unknown[static_cast<Eigen::Index>(i)];
+    Eigen::VectorXd rhs(static_cast<Eigen::Index>(unknown_.size()));
+    for (std::size_t i = 0; i < unknown_.size(); ++i) rhs[static_cast<Eigen::Index>(i)] = full_rhs[unknown_[i]];
+    const Eigen::VectorXd u_unknown = factor_->solve(rhs);
+    for (std::size_t i = 0; i < unknown_.size(); ++i) solution.displacement[unknown_[i]] = u_unknown[static_cast<Eigen::Index>(i)];
   }
-  solution.reaction = stiffness * solution.displacement;
+  solution.reaction = stiffness_ * solution.displacement;
   if (applied_forces.size() == n) solution.reaction -= applied_forces;
   return solution;
+}
+
+StaticSolution solve_static(const SparseMatrix& stiffness, const DofMap& dofs,
+                            const std::vector<PrescribedDisplacement>& prescribed,
+                            const Eigen::VectorXd& applied_forces) {
+  std::vector<int> prescribed_dofs;
+  Eigen::VectorXd values(static_cast<Eigen::Index>(prescribed.size()));
+  for (std::size_t i = 0; i < prescribed.size(); ++i) {
+    prescribed_dofs.push_back(prescribed[i].dof);
+    values[static_cast<Eigen::Index>(i)] = prescribed[i].value;
+  }
+  return ConstrainedStaticSolver(stiffness, dofs, std::move(prescribed_dofs)).solve(values, applied_forces);
 }
 
 }  // namespace cohaptic

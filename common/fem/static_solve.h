@@ -1,15 +1,18 @@
 // The reference path: a full sparse static solve with prescribed displacements and loads.
 //
 // Every dof is one of: fixed (u = 0), prescribed (u = given value) or unknown. The
-// unknowns solve K_UU u_U = f_U - K_UC u_C with a fresh CHOLMOD factorisation, so this is
-// the slow, independent answer that condensation is checked against. Units: m, N, N/m.
+// unknowns solve K_UU u_U = f_U - K_UC u_C with a CHOLMOD factorisation of K_UU made for
+// the set of prescribed dofs, so this is the slow, independent answer that condensation
+// is checked against. One solver serves any number of load cases. Units: m, N, N/m.
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "common/fem/assemble_stiffness.h"
 #include "common/fem/dof_map.h"
+#include "common/fem/sparse_cholesky.h"
 
 namespace cohaptic {
 
@@ -25,8 +28,25 @@ struct StaticSolution {
   Eigen::VectorXd reaction;
 };
 
-/// `applied_forces` is 3N [N] or empty (no loads); loads on constrained dofs are carried
-/// by the constraint. Throws Error for a prescribed dof that is fixed or given twice.
+class ConstrainedStaticSolver {
+ public:
+  /// Factors K_UU for the given prescribed dofs. Throws Error for a prescribed dof that is
+  /// fixed, out of range or given twice; NumericalError if K_UU is not positive definite.
+  ConstrainedStaticSolver(const SparseMatrix& stiffness, const DofMap& dofs, std::vector<int> prescribed_dofs);
+  ~ConstrainedStaticSolver();
+
+  /// `prescribed_values` aligned with the constructor's dofs [m]; `applied_forces` 3N [N]
+  /// or empty. Loads on constrained dofs are carried by the constraint.
+  StaticSolution solve(const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& applied_forces = {}) const;
+
+ private:
+  const SparseMatrix& stiffness_;
+  std::vector<int> prescribed_;
+  std::vector<int> unknown_;
+  std::unique_ptr<SparseCholesky> factor_;
+};
+
+/// One solve: ConstrainedStaticSolver for the prescribed dofs, then solve().
 StaticSolution solve_static(const SparseMatrix& stiffness, const DofMap& dofs,
                             const std::vector<PrescribedDisplacement>& prescribed,
                             const Eigen::VectorXd& applied_forces = {});

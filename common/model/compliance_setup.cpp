@@ -10,7 +10,9 @@
 
 namespace cohaptic {
 
-std::vector<int> compliance_row_nodes(const Model& model) { return model.touchable_nodes; }
+std::vector<int> compliance_row_nodes(const Model& model, bool whole_surface) {
+  return whole_surface || !model.obstacles.empty() ? model.surface.nodes : model.touchable_nodes;
+}
 
 std::filesystem::path default_cache_directory() {
   if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "cohaptic";
@@ -43,7 +45,7 @@ ComplianceSetup prepare_compliance(const Model& model, ComplianceColumns& column
   }
   const bool want_all = model.scene.object.compliance.precompute_touchable;
   const std::size_t before = columns.column_count();
-  if (want_all) columns.compute_columns(columns.row_nodes());
+  if (want_all) columns.compute_columns(model.touchable_nodes);
   if (use_disk && columns.column_count() > before) {
     save_compliance(model, columns, *cache_directory);
     setup.note += fmt::format("; computed {} columns and saved them", columns.column_count() - before);

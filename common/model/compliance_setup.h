@@ -12,8 +12,10 @@
 
 namespace cohaptic {
 
-/// The nodes whose compliance rows are kept: the touchable surface nodes.
-std::vector<int> compliance_row_nodes(const Model& model);
+/// The nodes whose compliance rows are kept: the touchable surface nodes, or the whole
+/// surface when nodes outside the touchable region can be held (obstacles, step-delay
+/// boundary nodes).
+std::vector<int> compliance_row_nodes(const Model& model, bool whole_surface);
 
 struct ComplianceSetup {
   bool from_disk = false;
@@ -26,7 +28,8 @@ struct ComplianceSetup {
 /// $XDG_CACHE_HOME/cohaptic, else $HOME/.cache/cohaptic, else ./.cohaptic-cache.
 std::filesystem::path default_cache_directory();
 
-/// Fills `columns` for `model` per its scene's compliance settings. `cache_directory`
+/// Fills `columns` for `model` per its scene's compliance settings (precompute: the
+/// touchable nodes' columns). `cache_directory`
 /// empty disables the disk cache. A cache that cannot be written is logged, not fatal.
 ComplianceSetup prepare_compliance(const Model& model, ComplianceColumns& columns,
                                    const std::optional<std::filesystem::path>& cache_directory);

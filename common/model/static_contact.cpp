@@ -1,6 +1,6 @@
 #include "common/model/static_contact.h"
 
-#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <fmt/format.h>
 
 #include "common/fem/static_solve.h"
@@ -9,45 +9,19 @@
 namespace cohaptic {
 namespace {
 
-// The prescribed free dofs of all contact nodes, in tool-node-axis order.
-struct PrescribedSet {
-  std::vector<int> nodes;       ///< contact nodes, three per touching tool
-  std::vector<int> dofs;        ///< free global dofs of those nodes
-  std::vector<double> values;   ///< prescribed displacement per dof [m]
-};
-
-PrescribedSet prescribed_set(const Model& model, const std::vector<ContactQuery>& contacts) {
-  PrescribedSet set;
-  for (const ContactQuery& query : contacts) {
-    if (!query.contact) continue;
-    for (int node : model.surface.triangles[query.contact->triangle]) {
-      set.nodes.push_back(node);
-      for (int axis = 0; axis < 3; ++axis)
-        if (!model.dofs.is_fixed(node, axis)) {
-          set.dofs.push_back(3 * node + axis);
-          set.values.push_back(query.contact->displacement[axis]);
-        }
-    }
-  }
-  return set;
+const Triangle& contact_triangle(const Model& model, const ContactQuery& query) {
+  return model.surface.triangles[query.contact->triangle];
 }
 
-// Tool reactions from a per-dof force lookup (global dof -> force on that dof).
-template <typename ForceOfDof>
-std::vector<ToolReaction> reactions_from(const Model& model, const std::vector<ContactQuery>& contacts,
-                                         const ForceOfDof& force_of_dof) {
-  std::vector<ToolReaction> reactions(contacts.size());
-  for (std::size_t t = 0; t < contacts.size(); ++t) {
-    reactions[t].query = contacts[t];
-    if (!contacts[t].contact) continue;
-    const ToolContact& contact = *contacts[t].contact;
-    const Triangle& tri = model.surface.triangles[contact.triangle];
-    for (int i = 0; i < 3; ++i)
-      for (int axis = 0; axis < 3; ++axis)
-        reactions[t].nodal_forces(axis, i) = model.dofs.is_fixed(tri[i], axis) ? 0.0 : force_of_dof(3 * tri[i] + axis);
-    reactions[t].reaction = -(reactions[t].nodal_forces * contact.weights);
-  }
-  return reactions;
+// Prescribed dofs and values for the held nodes, and (node translation) the contact nodes.
+void prescribe(const Model& model, const std::vector<int>& nodes, const std::vector<Eigen::Vector3d>& values,
+               std::vector<int>& dofs, std::vector<double>& prescribed) {
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!model.dofs.is_fixed(nodes[i], axis)) {
+        dofs.push_back(3 * nodes[i] + axis);
+        prescribed.push_back(values[i][axis]);
+      }
 }
 
 }  // namespace
@@ -59,7 +33,7 @@ std::vector<ContactQuery> find_tool_contacts(const Model& model, const std::vect
     contacts.push_back(find_contact(model.mesh, model.surface, model.normals, model.touchable_triangles,
                                     tools[t].position, tools[t].radius));
     if (!contacts.back().contact) continue;
-    for (int node : model.surface.triangles[contacts.back().contact->triangle]) {
+    for (int node : contact_triangle(model, contacts.back())) {
       if (owner[node] >= 0)
         throw Error(fmt::format("tools {} and {} press triangles that share node {}: move them apart", owner[node] + 1,
                                 t + 1, model.mesh.node_tags[node]));
@@ -69,57 +43,89 @@ std::vector<ContactQuery> find_tool_contacts(const Model& model, const std::vect
   return contacts;
 }
 
-std::vector<ToolReaction> contact_reactions_condensed(const Model& model, ComplianceColumns& columns,
-                                                      const std::vector<ContactQuery>& contacts) {
-  const PrescribedSet set = prescribed_set(model, contacts);
-  Eigen::VectorXd force_by_dof = Eigen::VectorXd::Zero(3 * model.mesh.node_count());
-  if (!set.dofs.empty()) {
-    // L_AA over the free dofs of the contact nodes.
-    const Eigen::MatrixXd l_nodes = columns.gather(set.nodes);
-    std::vector<int> local;  // position of each prescribed dof inside l_nodes
-    for (int dof : set.dofs) {
-      const auto it = std::find(set.nodes.begin(), set.nodes.end(), dof / 3);
-      local.push_back(3 * static_cast<int>(it - set.nodes.begin()) + dof % 3);
-    }
-    const auto m = static_cast<Eigen::Index>(local.size());
-    Eigen::MatrixXd l_aa(m, m);
-    for (Eigen::Index i = 0; i < m; ++i)
-      for (Eigen::Index j = 0; j < m; ++j) l_aa(i, j) = l_nodes(local[i], local[j]);
-    const Eigen::LLT<Eigen::MatrixXd> llt(l_aa);
-    if (llt.info() != Eigen::Success)
-      throw NumericalError(fmt::format("the condensed compliance of {} contact dofs is not positive definite", m));
-    const Eigen::VectorXd u = Eigen::Map<const Eigen::VectorXd>(set.values.data(), m);
-    const Eigen::VectorXd f = llt.solve(u);
-    for (Eigen::Index i = 0; i < m; ++i) force_by_dof[set.dofs[i]] = f[i];
-  }
-  return reactions_from(model, contacts, [&](int dof) { return force_by_dof[dof]; });
-}
-
 std::vector<ToolReaction> contact_reactions_reference(const Model& model, const std::vector<ContactQuery>& contacts,
+                                                      const HeldNodes& held, ContactModel contact_model,
                                                       Eigen::VectorXd* displacement) {
-  const PrescribedSet set = prescribed_set(model, contacts);
-  std::vector<PrescribedDisplacement> prescribed;
-  for (std::size_t i = 0; i < set.dofs.size(); ++i) prescribed.push_back({set.dofs[i], set.values[i]});
-  const StaticSolution solution = solve_static(model.stiffness, model.dofs, prescribed);
-  if (displacement) *displacement = solution.displacement;
-  return reactions_from(model, contacts, [&](int dof) { return solution.reaction[dof]; });
-}
-
-Eigen::VectorXd displacement_under_reactions(const Model& model, const std::vector<ToolReaction>& reactions) {
-  Eigen::VectorXd free_forces = Eigen::VectorXd::Zero(model.dofs.free_count());
-  for (const ToolReaction& r : reactions) {
-    if (!r.query.contact) continue;
-    const Triangle& tri = model.surface.triangles[r.query.contact->triangle];
-    for (int i = 0; i < 3; ++i)
-      for (int axis = 0; axis < 3; ++axis) {
-        const int free = model.dofs.free_index[3 * tri[i] + axis];
-        if (free >= 0) free_forces[free] += r.nodal_forces(axis, i);
-      }
+  std::vector<bool> is_held(static_cast<std::size_t>(model.mesh.node_count()), false);
+  for (int node : held.nodes) is_held[node] = true;
+  std::vector<std::size_t> pressing;
+  for (std::size_t t = 0; t < contacts.size(); ++t) {
+    if (!contacts[t].contact) continue;
+    pressing.push_back(t);
+    for (int node : contact_triangle(model, contacts[t]))
+      if (is_held[node])
+        throw Error(fmt::format("node {} is both held and under tool {}", model.mesh.node_tags[node], t + 1));
   }
-  const Eigen::VectorXd free_u = model.free_factor->solve(free_forces);
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * model.mesh.node_count());
-  for (int i = 0; i < model.dofs.free_count(); ++i) u[model.dofs.free_dofs[i]] = free_u[i];
-  return u;
+
+  std::vector<int> dofs;
+  std::vector<double> values;
+  prescribe(model, held.nodes, held.displacement, dofs, values);
+  std::vector<ToolReaction> reactions(contacts.size());
+  for (std::size_t t = 0; t < contacts.size(); ++t) reactions[t].query = contacts[t];
+
+  if (contact_model == ContactModel::node_translation) {
+    for (std::size_t t : pressing) {
+      const Triangle& tri = contact_triangle(model, contacts[t]);
+      const Eigen::Vector3d d = contacts[t].contact->displacement;
+      prescribe(model, {tri.begin(), tri.end()}, {d, d, d}, dofs, values);
+    }
+    const StaticSolution solution = solve_static(model.stiffness, model.dofs, [&] {
+      std::vector<PrescribedDisplacement> list;
+      for (std::size_t i = 0; i < dofs.size(); ++i) list.push_back({dofs[i], values[i]});
+      return list;
+    }());
+    for (std::size_t t : pressing) {
+      const Triangle& tri = contact_triangle(model, contacts[t]);
+      for (int i = 0; i < 3; ++i)
+        for (int axis = 0; axis < 3; ++axis)
+          reactions[t].nodal_forces(axis, i) = model.dofs.is_fixed(tri[i], axis) ? 0.0 : solution.reaction[3 * tri[i] + axis];
+      reactions[t].reaction = -(reactions[t].nodal_forces * contacts[t].contact->weights);
+    }
+    if (displacement) *displacement = solution.displacement;
+    return reactions;
+  }
+
+  // Point constraint: superpose the held-nodes case and a unit load per tool and axis.
+  const ConstrainedStaticSolver solver(model.stiffness, model.dofs, dofs);
+  const Eigen::VectorXd held_values = Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  const StaticSolution base = solver.solve(held_values);
+  const auto m = static_cast<Eigen::Index>(3 * pressing.size());
+  const auto contact_point_displacement = [&](const Eigen::VectorXd& u, std::size_t t) {
+    const Triangle& tri = contact_triangle(model, contacts[t]);
+    const Eigen::Vector3d& w = contacts[t].contact->weights;
+    return Eigen::Vector3d(w[0] * u.segment<3>(3 * tri[0]) + w[1] * u.segment<3>(3 * tri[1]) + w[2] * u.segment<3>(3 * tri[2]));
+  };
+  std::vector<StaticSolution> unit(static_cast<std::size_t>(m));
+  Eigen::MatrixXd a(m, m);
+  Eigen::VectorXd rhs(m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    const std::size_t t = pressing[static_cast<std::size_t>(k / 3)];
+    Eigen::VectorXd load = Eigen::VectorXd::Zero(3 * model.mesh.node_count());
+    const Triangle& tri = contact_triangle(model, contacts[t]);
+    for (int i = 0; i < 3; ++i) load[3 * tri[i] + k % 3] = contacts[t].contact->weights[i];
+    unit[static_cast<std::size_t>(k)] = solver.solve(Eigen::VectorXd::Zero(held_values.size()), load);
+    for (std::size_t j = 0; j < pressing.size(); ++j)
+      a.block<3, 1>(3 * static_cast<Eigen::Index>(j), k) = contact_point_displacement(unit[static_cast<std::size_t>(k)].displacement, pressing[j]);
+  }
+  for (std::size_t j = 0; j < pressing.size(); ++j)
+    rhs.segment<3>(3 * static_cast<Eigen::Index>(j)) =
+        contacts[pressing[j]].contact->displacement - contact_point_displacement(base.displacement, pressing[j]);
+  const Eigen::VectorXd lambda = a.partialPivLu().solve(rhs);
+  for (std::size_t j = 0; j < pressing.size(); ++j) {
+    const Eigen::Vector3d force = lambda.segment<3>(3 * static_cast<Eigen::Index>(j));
+    const std::size_t t = pressing[j];
+    const Triangle& tri = contact_triangle(model, contacts[t]);
+    for (int i = 0; i < 3; ++i)
+      for (int axis = 0; axis < 3; ++axis)
+        reactions[t].nodal_forces(axis, i) =
+            model.dofs.is_fixed(tri[i], axis) ? 0.0 : contacts[t].contact->weights[i] * force[axis];
+    reactions[t].reaction = -force;
+  }
+  if (displacement) {
+    *displacement = base.displacement;
+    for (Eigen::Index k = 0; k < m; ++k) *displacement += lambda[k] * unit[static_cast<std::size_t>(k)].displacement;
+  }
+  return reactions;
 }
 
 }  // namespace cohaptic

@@ -1,0 +1,145 @@
+#include "common/contact/aabb_tree.h"
+
+#include <algorithm>
+#include <array>
+#include <fmt/format.h>
+#include <numeric>
+
+#include "common/util/error.h"
+
+namespace cohaptic {
+namespace {
+
+/// Squared distance from p to the box [lo, hi] (zero inside).
+double box_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double below = lo[k] - p[k], above = p[k] - hi[k];
+    const double d = std::max({below, above, 0.0});
+    d2 += d * d;
+  }
+  return d2;
+}
+
+}  // namespace
+
+AabbTree::AabbTree(const TriangleSurface& surface) : AabbTree(surface.vertices, surface.triangles) {}
+
+AabbTree::AabbTree(const Eigen::Matrix3Xd& vertices, std::span<const Triangle> triangles) {
+  const int n = static_cast<int>(triangles.size());
+  if (n == 0) return;
+  corners_.resize(triangles.size());
+  std::vector<Eigen::Vector3d> centroids(triangles.size());
+  for (int t = 0; t < n; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const int v = triangles[t][k];
+      if (v < 0 || v >= vertices.cols())
+        throw Error(fmt::format("AABB tree: triangle {} refers to vertex {}, but there are {} vertices", t, v,
+                                vertices.cols()));
+      if (!vertices.col(v).allFinite())
+        throw Error(fmt::format("AABB tree: vertex {} (used by triangle {}) is not finite", v, t));
+    }
+    // Kept in input order for now; permuted into leaf order once the tree is built.
+    corners_[t] = {vertices.col(triangles[t][0]), vertices.col(triangles[t][1]), vertices.col(triangles[t][2])};
+    centroids[t] = (corners_[t].a + corners_[t].b + corners_[t].c) / 3;
+  }
+  std::vector<int> order(triangles.size());
+  std::iota(order.begin(), order.end(), 0);
+  // A median split halves the count at every level: about 2n / kLeafSize nodes.
+  nodes_.reserve(static_cast<std::size_t>(2 * (n / kLeafSize) + 2));
+  build(order, centroids, 0, n, 1);
+  if (depth_ > kMaxDepth)  // cannot happen below 2^60 triangles; guards the query stack
+    throw Error(fmt::format("AABB tree: depth {} exceeds {}", depth_, kMaxDepth));
+
+  std::vector<Corners> leaf_corners(corners_.size());
+  for (int slot = 0; slot < n; ++slot) leaf_corners[slot] = corners_[order[slot]];
+  corners_ = std::move(leaf_corners);
+  triangle_index_ = std::move(order);
+}
+
+int AabbTree::build(std::vector<int>& order, const std::vector<Eigen::Vector3d>& centroids, int begin, int end,
+                    int level) {
+  depth_ = std::max(depth_, level);
+  const int index = static_cast<int>(nodes_.size());
+  nodes_.emplace_back();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  Eigen::Vector3d centroid_lo = lo, centroid_hi = hi;
+  for (int i = begin; i < end; ++i) {
+    const Corners& c = corners_[order[i]];
+    lo = lo.cwiseMin(c.a).cwiseMin(c.b).cwiseMin(c.c);
+    hi = hi.cwiseMax(c.a).cwiseMax(c.b).cwiseMax(c.c);
+    centroid_lo = centroid_lo.cwiseMin(centroids[order[i]]);
+    centroid_hi = centroid_hi.cwiseMax(centroids[order[i]]);
+  }
+  nodes_[index].lo = lo;
+  nodes_[index].hi = hi;
+  if (end - begin <= kLeafSize) {
+    nodes_[index].first_or_right = begin;
+    nodes_[index].count = end - begin;
+    return index;
+  }
+  int axis = 0;
+  (centroid_hi - centroid_lo).maxCoeff(&axis);
+  const int middle = begin + (end - begin) / 2;
+  std::nth_element(order.begin() + begin, order.begin() + middle, order.begin() + end,
+                   [&](int x, int y) { return centroids[x][axis] < centroids[y][axis]; });
+  build(order, centroids, begin, middle, level + 1);  // left child: index + 1
+  const int right = build(order, centroids, middle, end, level + 1);
+  nodes_[index].first_or_right = right;
+  nodes_[index].count = 0;
+  return index;
+}
+
+AabbHit AabbTree::closest_triangle(const Eigen::Vector3d& p, double max_distance) const {
+  AabbHit hit;
+  if (nodes_.empty() || !(max_distance >= 0)) return hit;
+  double best2 = max_distance * max_distance;
+
+  struct Pending {
+    int node;
+    double distance2;
+  };
+  std::array<Pending, kMaxDepth> stack;
+  int top = 0;
+  int node = 0;
+  if (box_distance2(p, nodes_[0].lo, nodes_[0].hi) > best2) return hit;
+  for (;;) {
+    // Descend towards the nearer child, leaving the farther one for later.
+    for (;;) {
+      const Node& current = nodes_[node];
+      if (current.count > 0) {
+        for (int slot = current.first_or_right; slot < current.first_or_right + current.count; ++slot) {
+          const Corners& c = corners_[slot];
+          const TriangleClosestPoint q = closest_point_on_triangle(p, c.a, c.b, c.c);
+          const double d2 = (p - q.point).squaredNorm();
+          const int t = triangle_index_[slot];
+          if (d2 < best2 || (d2 == best2 && (hit.triangle < 0 || t < hit.triangle))) {
+            best2 = d2;
+            hit.triangle = t;
+            hit.closest = q;
+          }
+        }
+        break;
+      }
+      int near = node + 1, far = current.first_or_right;
+      double near2 = box_distance2(p, nodes_[near].lo, nodes_[near].hi);
+      double far2 = box_distance2(p, nodes_[far].lo, nodes_[far].hi);
+      if (far2 < near2) {
+        std::swap(near, far);
+        std::swap(near2, far2);
+      }
+      if (near2 > best2) break;
+      if (far2 <= best2) stack[top++] = {far, far2};
+      node = near;
+    }
+    // Resume at the nearest-pushed box that can still hold something closer.
+    while (top > 0 && stack[top - 1].distance2 > best2) --top;
+    if (top == 0) break;
+    node = stack[--top].node;
+  }
+  if (hit.triangle >= 0) hit.distance2 = best2;
+  return hit;
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,19 @@
+// The step-delay boundary set of the paper's T150/T300 conditions: the N surface nodes
+// nearest the contact region, to be held at their current displacement.
+#pragma once
+
+#include <Eigen/Core>
+#include <span>
+#include <vector>
+
+#include "common/model/model.h"
+
+namespace cohaptic {
+
+/// The `count` surface nodes nearest any of `points` [m], nearest first, skipping fully
+/// fixed nodes and nodes marked in `excluded` (per volume node; may be empty). Throws
+/// Error if the surface has fewer such nodes.
+std::vector<int> nearest_surface_nodes(const Model& model, std::span<const Eigen::Vector3d> points, int count,
+                                       const std::vector<bool>& excluded);
+
+}  // namespace cohaptic

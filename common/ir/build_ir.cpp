@@ -1,0 +1,128 @@
+#include "common/ir/build_ir.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "common/contact/contact_patch.h"
+#include "common/contact/find_contact.h"
+#include "common/util/error.h"
+
+namespace cohaptic {
+
+int nearest_touchable_triangle(const Model& model, const Eigen::Vector3d& position) {
+  return nearest_triangle(model.mesh, model.surface, model.normals, model.touchable_triangles, position).triangle;
+}
+
+IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation& condensation,
+                                    std::span<const UserTool> users, std::size_t user_index,
+                                    std::span<const Eigen::Vector3d> boundary_displacement,
+                                    const IrBuildOptions& options, std::uint64_t epoch, double simulation_time) {
+  const UserTool& own = users[user_index];
+  const std::vector<int>& boundary = condensation.boundary_nodes();
+  if (boundary_displacement.size() != boundary.size())
+    throw Error(fmt::format("build_ir: {} boundary displacements for {} boundary nodes", boundary_displacement.size(),
+                            boundary.size()));
+  if (own.nearest_triangle < 0 || own.nearest_triangle >= model.surface.triangle_count())
+    throw Error(fmt::format("build_ir: user {} has no nearest triangle", own.user));
+
+  std::vector<bool> held(static_cast<std::size_t>(model.mesh.node_count()), false);
+  for (int node : boundary) held[node] = true;
+  const auto holds_node = [&](int triangle) {
+    const Triangle& tri = model.surface.triangles[triangle];
+    return held[tri[0]] || held[tri[1]] || held[tri[2]];
+  };
+  if (holds_node(own.nearest_triangle))
+    throw Error(fmt::format("build_ir: user {}'s contact triangle has a node held as a boundary node", own.user));
+
+  std::vector<bool> allowed(model.surface.triangles.size(), false);
+  for (int t : model.touchable_triangles) allowed[t] = !holds_node(t);
+  const std::vector<int> patch = contact_patch(model.surface, own.nearest_triangle, options.patch_rings, allowed);
+
+  IntermediateRepresentation ir;
+  ir.epoch = epoch;
+  ir.simulation_time = simulation_time;
+  ir.user = own.user;
+  ir.contact_model = options.contact_model;
+  ir.precision = options.precision;
+  ir.tool_radius = own.radius;
+  ir.force_limit = options.force_limit;
+
+  // Local numbering: patch nodes, remote contact nodes not in the patch, then B.
+  std::vector<int> nodes;
+  std::unordered_map<int, int> local;
+  const auto add_node = [&](int node) {
+    const auto [it, inserted] = local.emplace(node, static_cast<int>(nodes.size()));
+    if (inserted) nodes.push_back(node);
+    return it->second;
+  };
+  std::unordered_map<int, int> patch_index;
+  for (int t : patch) {
+    patch_index.emplace(t, static_cast<int>(ir.patch.size()));
+    IrTriangle tri;
+    for (int k = 0; k < 3; ++k) tri.nodes[k] = add_node(model.surface.triangles[t][k]);
+    tri.normal = model.normals.face[t];
+    ir.patch.push_back(tri);
+  }
+  std::vector<bool> in_guard(model.surface.triangles.size(), false);
+  for (std::size_t i = 0; i < patch.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const auto it = patch_index.find(model.surface.triangle_neighbours[patch[i]][k]);
+      ir.patch[i].neighbours[k] = it == patch_index.end() ? -1 : it->second;
+      ir.patch[i].edge_normals[k] = edge_pseudo_normal(model.surface, model.normals, patch[i], k);
+    }
+  ir.patch_node_count = static_cast<int>(nodes.size());
+  ir.patch_vertex_normals.resize(3, ir.patch_node_count);
+  for (int i = 0; i < ir.patch_node_count; ++i) ir.patch_vertex_normals.col(i) = model.normals.vertex.col(nodes[i]);
+  // The guard ring: every surface triangle sharing a vertex with the patch, not in it.
+  for (int i = 0; i < ir.patch_node_count; ++i)
+    for (int t : model.surface.node_triangles(nodes[i]))
+      if (!patch_index.count(t) && !in_guard[t]) {
+        in_guard[t] = true;
+        IrGuardTriangle guard;
+        for (int k = 0; k < 3; ++k) guard.corners[k] = model.mesh.nodes.col(model.surface.triangles[t][k]);
+        guard.normal = model.normals.face[t];
+        ir.guard.push_back(guard);
+      }
+  for (std::size_t j = 0; j < users.size(); ++j) {
+    if (j == user_index || users[j].nearest_triangle < 0 || holds_node(users[j].nearest_triangle)) continue;
+    IrRemoteContact remote;
+    remote.user = users[j].user;
+    for (int k = 0; k < 3; ++k) remote.nodes[k] = add_node(model.surface.triangles[users[j].nearest_triangle][k]);
+    const int t = users[j].nearest_triangle;
+    remote.normal = model.normals.face[t];
+    for (int k = 0; k < 3; ++k) {
+      remote.edge_normals[k] = edge_pseudo_normal(model.surface, model.normals, t, k);
+      remote.vertex_normals[k] = model.normals.vertex.col(model.surface.triangles[t][k]);
+    }
+    remote.tool_radius = users[j].radius;
+    ir.remotes.push_back(remote);
+  }
+  ir.row_node_count = static_cast<int>(nodes.size());
+  const std::vector<int> contact_nodes = nodes;
+  for (int node : boundary) add_node(node);
+
+  for (int node : nodes) {
+    ir.node_ids.push_back(model.mesh.node_tags[node]);
+    ir.fixed_axes.push_back(model.dofs.fixed_axes[node]);
+  }
+  ir.rest_positions.resize(3, ir.row_node_count);
+  for (int i = 0; i < ir.row_node_count; ++i) ir.rest_positions.col(i) = model.mesh.nodes.col(nodes[i]);
+
+  const CondensedOperator op = condensation.condense(contact_nodes);
+  ir.m_tilde.resize(op.m_cc.rows(), op.m_cc.cols() + op.m_cb.cols());
+  ir.m_tilde << op.m_cc, op.m_cb;
+  ir.boundary_displacement.resize(static_cast<Eigen::Index>(op.boundary_dofs.size()));
+  Eigen::Index row = 0;
+  for (std::size_t b = 0; b < boundary.size(); ++b)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!model.dofs.is_fixed(boundary[b], axis)) ir.boundary_displacement[row++] = boundary_displacement[b][axis];
+  if (options.precision == IrPrecision::f32) {
+    ir.m_tilde = ir.m_tilde.cast<float>().cast<double>();
+    ir.boundary_displacement = ir.boundary_displacement.cast<float>().cast<double>();
+  }
+  return ir;
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,45 @@
+// Building one user's intermediate representation from the simulation state.
+//
+// The patch is centred on the touchable triangle nearest the user's tool (in contact or
+// not, so the client can detect contact itself); the other users' nearest triangles are
+// included as remote contacts; M~ comes from the incremental condensation for
+// C = patch nodes + remote contact nodes and the current boundary set B.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+
+#include "common/condense/incremental_condensation.h"
+#include "common/ir/intermediate_representation.h"
+#include "common/model/model.h"
+
+namespace cohaptic {
+
+/// One user's tool as the server knows it.
+struct UserTool {
+  int user = 0;                                          ///< slot
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();    ///< [m]
+  double radius = 0;                                     ///< [m]
+  int nearest_triangle = -1;  ///< touchable surface triangle nearest the tool (see nearest_touchable_triangle)
+};
+
+struct IrBuildOptions {
+  int patch_rings = 1;  ///< 0: the nearest triangle only; each ring adds the triangles around it
+  IrPrecision precision = IrPrecision::f64;
+  ContactModel contact_model = ContactModel::node_translation;
+  double force_limit = 3.3;  ///< [N]
+};
+
+/// The touchable triangle nearest `position` (ties to the one it is deepest below).
+int nearest_touchable_triangle(const Model& model, const Eigen::Vector3d& position);
+
+/// IR for users[user_index]. `boundary_displacement` gives u for each node of
+/// condensation.boundary_nodes(), in that order. Throws Error if the user's nearest
+/// triangle is unknown or holds a boundary node.
+IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation& condensation,
+                                    std::span<const UserTool> users, std::size_t user_index,
+                                    std::span<const Eigen::Vector3d> boundary_displacement,
+                                    const IrBuildOptions& options, std::uint64_t epoch, double simulation_time);
+
+}  // namespace cohaptic

@@ -1,0 +1,246 @@
+#include "common/ir/evaluate_force.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+
+#include "common/condense/naive_condensation.h"
+#include "common/contact/closest_point_on_triangle.h"
+#include "common/contact/surface_distance.h"
+#include "common/util/error.h"
+
+namespace cohaptic {
+namespace {
+
+using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxContactDofs, kMaxContactDofs>;
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxContactDofs, 1>;
+
+// One pressing tool during a tick.
+struct PressingTool {
+  std::array<int, 3> nodes{};  // local node indices
+  Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
+};
+
+// Nearest patch triangle to p, and the signed height of p above the surface there: the
+// pseudo-normal of the nearest feature of the patch and its guard ring.
+struct PatchPoint {
+  int triangle = -1;
+  TriangleClosestPoint closest;
+  double height = 0;       // > 0 outside the object
+  bool on_border = false;  // nearest the patch's rim or beyond it
+};
+
+PatchPoint nearest_on_patch(const PreparedIR& prepared, const Eigen::Vector3d& p) {
+  const IntermediateRepresentation& ir = prepared.ir;
+  PatchPoint best;
+  double best_distance2 = std::numeric_limits<double>::infinity();
+  double best_height = std::numeric_limits<double>::infinity();
+  for (int t = 0; t < static_cast<int>(ir.patch.size()); ++t) {
+    const IrTriangle& tri = ir.patch[t];
+    const TriangleClosestPoint q = closest_point_on_triangle(p, ir.rest_positions.col(tri.nodes[0]),
+                                                             ir.rest_positions.col(tri.nodes[1]),
+                                                             ir.rest_positions.col(tri.nodes[2]));
+    const double d2 = (p - q.point).squaredNorm();
+    const double height = (p - q.point).dot(tri.normal);
+    const double tie = 1e-24 + 1e-12 * best_distance2;
+    if (d2 < best_distance2 - tie || (std::abs(d2 - best_distance2) <= tie && height < best_height)) {
+      best_distance2 = std::min(d2, best_distance2);
+      best_height = height;
+      best.triangle = t;
+      best.closest = q;
+    }
+  }
+  const IrTriangle& tri = ir.patch[best.triangle];
+  const TriangleFeature feature = feature_of(best.closest.weights);
+  Eigen::Vector3d normal = tri.normal;
+  if (feature.kind == TriangleFeature::Kind::edge) {
+    normal = tri.edge_normals[feature.index];
+    best.on_border = tri.neighbours[feature.index] < 0;
+  } else if (feature.kind == TriangleFeature::Kind::vertex) {
+    normal = ir.patch_vertex_normals.col(tri.nodes[feature.index]);
+    best.on_border = prepared.on_patch_border[tri.nodes[feature.index]];
+  }
+  best.height = (p - best.closest.point).dot(normal);
+
+  // Beyond the rim the guard ring decides the side, with its faces' normals.
+  double guard_distance2 = best_distance2;
+  for (const IrGuardTriangle& guard : ir.guard) {
+    const TriangleClosestPoint q = closest_point_on_triangle(p, guard.corners[0], guard.corners[1], guard.corners[2]);
+    const double d2 = (p - q.point).squaredNorm();
+    if (d2 < guard_distance2 * (1 - 1e-12) - 1e-24) {
+      guard_distance2 = d2;
+      best.height = (p - q.point).dot(guard.normal);
+      best.on_border = true;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+PreparedIR prepare_ir(IntermediateRepresentation ir) {
+  PreparedIR prepared;
+  const int rows = ir.row_node_count;
+  if (ir.node_count() < rows || rows < ir.patch_node_count || ir.patch.empty() ||
+      static_cast<int>(ir.fixed_axes.size()) != ir.node_count() || ir.rest_positions.cols() != rows)
+    throw Error("intermediate representation: inconsistent node counts");
+  const std::vector<int> row_dofs = ir_dofs(ir, 0, rows);
+  const std::vector<int> boundary_dofs = ir_dofs(ir, rows, ir.node_count());
+  const auto x = static_cast<Eigen::Index>(row_dofs.size());
+  const auto b = static_cast<Eigen::Index>(boundary_dofs.size());
+  if (ir.m_tilde.rows() != x || ir.m_tilde.cols() != x + b || ir.boundary_displacement.size() != b)
+    throw Error(fmt::format("intermediate representation: M~ is {}x{} and u_B {} long, expected {}x{} and {}",
+                            ir.m_tilde.rows(), ir.m_tilde.cols(), ir.boundary_displacement.size(), x, x + b, b));
+  if (!ir.m_tilde.allFinite() || !ir.boundary_displacement.allFinite() || !ir.rest_positions.allFinite())
+    throw Error("intermediate representation: non-finite values");
+  for (const IrTriangle& tri : ir.patch)
+    for (int k = 0; k < 3; ++k)
+      if (tri.nodes[k] < 0 || tri.nodes[k] >= ir.patch_node_count || tri.neighbours[k] >= static_cast<int>(ir.patch.size()))
+        throw Error("intermediate representation: a patch triangle refers to a node or triangle outside the patch");
+  if (static_cast<int>(ir.remotes.size()) >= kMaxUsers)
+    throw Error(fmt::format("intermediate representation: {} remote users, at most {} supported", ir.remotes.size(), kMaxUsers - 1));
+  for (const IrRemoteContact& remote : ir.remotes)
+    for (int node : remote.nodes)
+      if (node < 0 || node >= rows) throw Error("intermediate representation: a remote contact refers to a non-contact node");
+
+  const Eigen::MatrixXd m_cc = 0.5 * (ir.m_tilde.leftCols(x) + ir.m_tilde.leftCols(x).transpose());
+  const Eigen::LLT<Eigen::MatrixXd> llt(m_cc);
+  if (llt.info() != Eigen::Success) throw Error("intermediate representation: M_CC is not positive definite");
+  prepared.compliance = llt.solve(Eigen::MatrixXd::Identity(x, x));
+  prepared.compliance = 0.5 * (prepared.compliance + prepared.compliance.transpose()).eval();
+  prepared.free_displacement = -prepared.compliance * (ir.m_tilde.rightCols(b) * ir.boundary_displacement);
+  prepared.condition_estimate = cholesky_condition_estimate(llt.matrixL());
+
+  prepared.dof_index.assign(static_cast<std::size_t>(rows), {-1, -1, -1});
+  for (int i = 0; i < static_cast<int>(row_dofs.size()); ++i) prepared.dof_index[row_dofs[i] / 3][row_dofs[i] % 3] = i;
+
+  if (ir.patch_vertex_normals.cols() != ir.patch_node_count || !ir.patch_vertex_normals.allFinite())
+    throw Error("intermediate representation: patch vertex normals missing or not finite");
+  prepared.on_patch_border.assign(static_cast<std::size_t>(ir.patch_node_count), false);
+  for (const IrTriangle& tri : ir.patch)
+    for (int k = 0; k < 3; ++k)
+      if (tri.neighbours[k] < 0) prepared.on_patch_border[tri.nodes[k]] = prepared.on_patch_border[tri.nodes[(k + 1) % 3]] = true;
+  prepared.ir = std::move(ir);
+  return prepared;
+}
+
+ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
+                           std::span<const Eigen::Vector3d> remote_tools) noexcept {
+  ForceSample sample;
+  const IntermediateRepresentation& ir = prepared.ir;
+  if (!own_tool.allFinite()) {
+    sample.flags |= kNonFinite;
+    return sample;
+  }
+
+  // 1. The own tool against its patch.
+  const PatchPoint own = nearest_on_patch(prepared, own_tool);
+  const IrTriangle& own_triangle = ir.patch[own.triangle];
+  sample.triangle = own.triangle;
+  if (own.on_border) sample.flags |= kOutsidePatch;
+  if (!(own.height < ir.tool_radius)) return sample;
+  sample.flags |= kInContact;
+
+  std::array<PressingTool, kMaxUsers> pressing;
+  int pressing_count = 1;
+  pressing[0].nodes = own_triangle.nodes;
+  pressing[0].weights = own.closest.weights;
+  pressing[0].displacement = own_tool - ir.tool_radius * own_triangle.normal - own.closest.point;
+  sample.depth = -pressing[0].displacement.dot(own_triangle.normal);
+
+  // 2. Remote tools against their triangles; an unpressed remote's nodes stay unloaded.
+  for (std::size_t r = 0; r < ir.remotes.size() && r < remote_tools.size(); ++r) {
+    const IrRemoteContact& remote = ir.remotes[r];
+    const Eigen::Vector3d& p = remote_tools[r];
+    if (!p.allFinite()) continue;
+    const TriangleClosestPoint q = closest_point_on_triangle(p, ir.rest_positions.col(remote.nodes[0]),
+                                                             ir.rest_positions.col(remote.nodes[1]),
+                                                             ir.rest_positions.col(remote.nodes[2]));
+    const TriangleFeature feature = feature_of(q.weights);
+    const Eigen::Vector3d& sign_normal = feature.kind == TriangleFeature::Kind::edge     ? remote.edge_normals[feature.index]
+                                         : feature.kind == TriangleFeature::Kind::vertex ? remote.vertex_normals[feature.index]
+                                                                                          : remote.normal;
+    if (!((p - q.point).dot(sign_normal) < remote.tool_radius)) continue;
+    bool overlaps = false;
+    for (int node : remote.nodes)
+      for (int own_node : own_triangle.nodes) overlaps |= node == own_node;
+    if (overlaps) {
+      sample.flags |= kRemoteOverlap;
+      continue;
+    }
+    if (pressing_count == kMaxUsers) {
+      sample.flags |= kTooManyRemotes;
+      break;
+    }
+    pressing[pressing_count].nodes = remote.nodes;
+    pressing[pressing_count].weights = q.weights;
+    pressing[pressing_count].displacement = p - remote.tool_radius * remote.normal - q.point;
+    ++pressing_count;
+  }
+
+  // 3. The system over Z, the free dofs of the pressing tools' triangles.
+  std::array<int, kMaxContactDofs> z_dof{};     // row in L~
+  std::array<int, kMaxContactDofs> z_tool{};    // which pressing tool
+  std::array<int, kMaxContactDofs> z_axis{};
+  std::array<double, kMaxContactDofs> z_weight{};
+  int z = 0;
+  for (int t = 0; t < pressing_count; ++t)
+    for (int i = 0; i < 3; ++i)
+      for (int axis = 0; axis < 3; ++axis) {
+        const int dof = prepared.dof_index[pressing[t].nodes[i]][axis];
+        if (dof < 0) continue;
+        z_dof[z] = dof;
+        z_tool[z] = t;
+        z_axis[z] = axis;
+        z_weight[z] = pressing[t].weights[i];
+        ++z;
+      }
+  SmallMatrix l_zz(z, z);
+  SmallVector u0(z);
+  for (int i = 0; i < z; ++i) {
+    u0[i] = prepared.free_displacement[z_dof[i]];
+    for (int j = 0; j < z; ++j) l_zz(i, j) = prepared.compliance(z_dof[i], z_dof[j]);
+  }
+
+  Eigen::Vector3d contact_force = Eigen::Vector3d::Zero();
+  bool solved = true;
+  if (ir.contact_model == ContactModel::node_translation) {
+    SmallVector rhs(z);
+    for (int i = 0; i < z; ++i) rhs[i] = pressing[z_tool[i]].displacement[z_axis[i]] - u0[i];
+    const Eigen::LLT<SmallMatrix> llt(l_zz);
+    solved = llt.info() == Eigen::Success;
+    const SmallVector f = llt.solve(rhs);
+    for (int i = 0; i < z; ++i)
+      if (z_tool[i] == 0) contact_force[z_axis[i]] += z_weight[i] * f[i];
+  } else {
+    // W: dof i carries w_i of its tool's force component along its axis.
+    const int m = 3 * pressing_count;
+    SmallMatrix w = SmallMatrix::Zero(z, m);
+    for (int i = 0; i < z; ++i) w(i, 3 * z_tool[i] + z_axis[i]) = z_weight[i];
+    const SmallMatrix a = w.transpose() * l_zz * w;
+    SmallVector rhs(m);
+    for (int t = 0; t < pressing_count; ++t) rhs.segment<3>(3 * t) = pressing[t].displacement;
+    rhs -= w.transpose() * u0;
+    const Eigen::LLT<SmallMatrix> llt(a);
+    solved = llt.info() == Eigen::Success;
+    const SmallVector lambda = llt.solve(rhs);
+    contact_force = lambda.head<3>();
+  }
+
+  // 4. Safety: never a non-finite or unbounded force.
+  sample.force = -contact_force;
+  if (!solved || !sample.force.allFinite()) {
+    sample.force.setZero();
+    sample.flags |= kNonFinite;
+  } else if (const double magnitude = sample.force.norm(); magnitude > ir.force_limit) {
+    sample.force *= ir.force_limit / magnitude;
+    sample.flags |= kClamped;
+  }
+  return sample;
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,69 @@
+// The force evaluator: the reaction force on a user's tool from an intermediate
+// representation, its own tool position and the other users' tool positions.
+//
+// The same function serves the client's haptic loop (P1) and the server (P0). It is
+// noexcept, takes no lock and allocates nothing: all working storage has a fixed maximum
+// size (kMaxUsers users, each contributing at most 3 contact nodes).
+//
+// prepare_ir() runs once per IR, off the haptic thread: it checks the IR and inverts the
+// contact block of M~ (in double) to the condensed compliance L~ = M_CC^-1 of the contact
+// nodes with B held, and u0 = -L~ M_CB u_B, their displacement when they carry no force.
+// Per tick the evaluator then:
+//   1. finds the patch triangle nearest the own tool and whether it presses: signed
+//      distance below the tool radius, the sign from the whole surface's pseudo-normals
+//      at the patch and from the guard ring of triangles around it;
+//   2. does the same for every remote tool against its contact triangle;
+//   3. with Z the nodes of the pressing tools' triangles (all other contact nodes unloaded):
+//      node translation: u_Z = d per tool, f_Z = L~_ZZ^-1 (u_Z - u0_Z), F = sum w_i f_i;
+//      point constraint: f_Z = W lambda with W^T u_Z = d, (W^T L~_ZZ W) lambda = d - W^T u0_Z,
+//      F = lambda (a 3x3 system per pressing user);
+//   4. returns -F, set to zero if not finite and scaled down to the IR's force limit.
+// Exactly the full FEM solve's answer for the same tool positions, as long as every tool
+// stays on its IR triangles (the own tool within its patch).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "common/ir/intermediate_representation.h"
+
+namespace cohaptic {
+
+constexpr int kMaxUsers = 4;
+constexpr int kMaxContactDofs = 9 * kMaxUsers;
+
+struct PreparedIR {
+  IntermediateRepresentation ir;
+  Eigen::MatrixXd compliance;         ///< L~ over the free dofs of the contact nodes [m/N]
+  Eigen::VectorXd free_displacement;  ///< u0 over the same dofs [m]
+  std::vector<std::array<int, 3>> dof_index;  ///< per contact node and axis: row in L~, or -1 if fixed
+  std::vector<bool> on_patch_border;  ///< per patch node
+  double condition_estimate = 1;      ///< of L~
+};
+
+/// Checks sizes, finiteness and positive definiteness; throws Error naming the problem.
+PreparedIR prepare_ir(IntermediateRepresentation ir);
+
+enum ForceFlag : std::uint8_t {
+  kInContact = 1,         ///< the own tool presses the surface
+  kClamped = 2,           ///< scaled down to the force limit
+  kNonFinite = 4,         ///< a non-finite input or result: force set to zero
+  kOutsidePatch = 8,      ///< the tool is past the patch border: held on it until the next IR
+  kRemoteOverlap = 16,    ///< a remote triangle shares a node with the own one: that remote ignored
+  kTooManyRemotes = 32,   ///< remotes beyond kMaxUsers - 1 ignored
+};
+
+struct ForceSample {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< reaction on the own tool [N]
+  int triangle = -1;     ///< patch triangle nearest the tool
+  double depth = 0;      ///< penetration below that triangle's plane [m]
+  std::uint8_t flags = 0;
+};
+
+/// remote_tools[i] is the position of ir.remotes[i]'s tool [m] (NaN: unknown, ignored).
+ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
+                           std::span<const Eigen::Vector3d> remote_tools) noexcept;
+
+}  // namespace cohaptic

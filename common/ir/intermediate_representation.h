@@ -1,0 +1,91 @@
+// IntermediateRepresentation (IR): what the simulation exports to one user's haptic loop
+// (the paper's Sec. II-C): the local contact geometry and M~ = (M_CC M_CB).
+//
+// Nodes are numbered locally: first the user's own contact patch (the triangle nearest its
+// tool and `patch_rings` rings of neighbours), then the other users' contact triangles
+// (nodes not already in the patch), then the colliding boundary nodes B. The first
+// `row_node_count` nodes (patch and remote contacts) are the contact nodes C: M~ has a row
+// per free dof of C and a column per free dof of every node, node-major, axes x, y, z,
+// fixed axes left out. With f = M~ (u_C, u_B): the forces on C for prescribed displacements
+// of C and B, every other node unloaded. u_B is where the boundary nodes are held.
+//
+// Units: m, N, N/m, s. A plain value type: the wire format (next layer) mirrors it field by
+// field. With precision f32 the M~ and u_B values are rounded to float (as they travel);
+// the server always inverts in double.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "common/fem/dof_map.h"
+#include "common/mesh/tet_mesh.h"
+#include "common/scene/scene.h"
+
+namespace cohaptic {
+
+enum class IrPrecision { f64, f32 };
+
+struct IrTriangle {
+  std::array<int, 3> nodes{};          ///< local node indices, counter-clockwise seen from outside
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit outward normal at rest
+  std::array<int, 3> neighbours{-1, -1, -1};  ///< patch triangle across edge (k, k+1), or -1
+  /// The whole surface's pseudo-normal at edge (k, k+1), inside the patch or at its rim:
+  /// with it the sign of a point nearest an edge is the whole surface's.
+  std::array<Eigen::Vector3d, 3> edge_normals{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+};
+
+/// A surface triangle bordering the patch: geometry only (no force), so that the client can
+/// tell a tool beyond the patch's rim (beside the object, or over an untouchable region).
+struct IrGuardTriangle {
+  std::array<Eigen::Vector3d, 3> corners{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+};
+
+struct IrRemoteContact {
+  int user = 0;                         ///< the other user's slot
+  std::array<int, 3> nodes{};           ///< local node indices of their nearest triangle
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  /// The whole surface's pseudo-normals at the triangle's edges (k, k+1) and vertices,
+  /// to tell whether the remote tool presses.
+  std::array<Eigen::Vector3d, 3> edge_normals{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<Eigen::Vector3d, 3> vertex_normals{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  double tool_radius = 0;               ///< [m]
+};
+
+struct IntermediateRepresentation {
+  static constexpr std::uint32_t kFormatVersion = 1;
+
+  std::uint64_t epoch = 0;         ///< increases with every IR built for this user
+  double simulation_time = 0;      ///< [s] of the state it was built from
+  int user = 0;
+  ContactModel contact_model = ContactModel::node_translation;
+  IrPrecision precision = IrPrecision::f64;
+  double tool_radius = 0;          ///< own tool [m], 0 for a point
+  double force_limit = 0;          ///< [N], the scene's haptic limit
+
+  std::vector<std::int64_t> node_ids;  ///< mesh node tags, per local node
+  std::vector<AxisMask> fixed_axes;    ///< per local node
+  Eigen::Matrix3Xd rest_positions;     ///< [m], per contact (row) node
+  int patch_node_count = 0;
+  int row_node_count = 0;
+
+  std::vector<IrTriangle> patch;   ///< own patch; patch[0] is the triangle nearest the tool
+  Eigen::Matrix3Xd patch_vertex_normals;  ///< per patch node: the whole surface's angle-weighted normal
+  std::vector<IrGuardTriangle> guard;     ///< the ring of surface triangles around the patch
+  std::vector<IrRemoteContact> remotes;
+
+  Eigen::MatrixXd m_tilde;                ///< rows: free dofs of C; columns: free dofs of all nodes [N/m]
+  Eigen::VectorXd boundary_displacement;  ///< u_B, free dofs of B [m]
+
+  int node_count() const { return static_cast<int>(node_ids.size()); }
+  /// Bytes of the content as sent: header, geometry, M~ and u_B at the stored precision.
+  std::size_t size_bytes() const;
+};
+
+/// Free dofs of local nodes [first, last) of `ir`, as (local node, axis) pairs flattened
+/// to 3 * node + axis.
+std::vector<int> ir_dofs(const IntermediateRepresentation& ir, int first_node, int last_node);
+
+}  // namespace cohaptic
