@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "support/test_meshes.h"
 #include "common/contact/aabb_tree.h"
 #include "common/contact/closest_point_on_triangle.h"
 #include "common/mesh/boundary_surface.h"
@@ -25,37 +26,6 @@ namespace cohaptic {
 namespace {
 
 using Eigen::Vector3d;
-
-/// Icosahedron subdivided `level` times (each triangle into four), vertices on the sphere
-/// of `radius`, triangles counter-clockwise seen from outside: 20 * 4^level triangles.
-TriangleSurface make_icosphere(int level, double radius) {
-  const double g = (1 + std::sqrt(5.0)) / 2;
-  std::vector<Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                             {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  std::vector<Triangle> t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                             {11, 10, 2}, {10, 7, 6}, {7, 1, 8},   {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                             {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-  for (int l = 0; l < level; ++l) {
-    std::map<std::pair<int, int>, int> midpoint;
-    const auto middle = [&](int a, int b) {
-      const auto key = std::minmax(a, b);
-      const auto [it, inserted] = midpoint.emplace(key, static_cast<int>(v.size()));
-      if (inserted) v.push_back((v[a] + v[b]) / 2);
-      return it->second;
-    };
-    std::vector<Triangle> finer;
-    for (const Triangle& f : t) {
-      const int ab = middle(f[0], f[1]), bc = middle(f[1], f[2]), ca = middle(f[2], f[0]);
-      finer.insert(finer.end(), {{f[0], ab, ca}, {f[1], bc, ab}, {f[2], ca, bc}, {ab, bc, ca}});
-    }
-    t = std::move(finer);
-  }
-  TriangleSurface s;
-  s.vertices.resize(3, static_cast<Eigen::Index>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i) s.vertices.col(static_cast<Eigen::Index>(i)) = radius * v[i].normalized();
-  s.triangles = std::move(t);
-  return s;
-}
 
 struct Scan {
   int triangle = -1;
@@ -120,7 +90,7 @@ Vector3d random_direction(std::mt19937& rng) {
 }
 
 TEST(AabbTree, MatchesLinearScanOnPerturbedIcosphere) {
-  TriangleSurface surface = make_icosphere(3, 1.0);
+  TriangleSurface surface = testing::make_icosphere(3, 1.0);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> bump(0.85, 1.15);
   for (Eigen::Index v = 0; v < surface.vertices.cols(); ++v) surface.vertices.col(v) *= bump(rng);
@@ -187,7 +157,7 @@ TEST(AabbTree, MatchesLinearScanOnTriangleSoupWithDegenerateTriangles) {
 }
 
 TEST(AabbTree, FindsNothingBeyondMaxDistance) {
-  const TriangleSurface surface = make_icosphere(2, 1.0);
+  const TriangleSurface surface = testing::make_icosphere(2, 1.0);
   const AabbTree tree(surface);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> radius(0.2, 4);
@@ -232,7 +202,7 @@ TEST(AabbTree, SingleTriangleIsOneLeaf) {
 
 TEST(AabbTree, DepthIsLogarithmic) {
   for (int level = 0; level <= 5; ++level) {
-    const TriangleSurface surface = make_icosphere(level, 1.0);
+    const TriangleSurface surface = testing::make_icosphere(level, 1.0);
     const AabbTree tree(surface);
     const int n = surface.triangle_count();
     // Median split: level L holds ranges of at most ceil(n / 2^L) triangles.

@@ -32,36 +32,6 @@ namespace {
 
 using Eigen::Vector3d;
 
-/// Icosahedron subdivided `level` times, vertices on the sphere of `radius`, triangles
-/// counter-clockwise seen from outside.
-TriangleSurface make_icosphere(int level, double radius) {
-  const double g = (1 + std::sqrt(5.0)) / 2;
-  std::vector<Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                             {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  std::vector<Triangle> t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                             {11, 10, 2}, {10, 7, 6}, {7, 1, 8},   {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                             {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
-  for (int l = 0; l < level; ++l) {
-    std::map<std::pair<int, int>, int> midpoint;
-    const auto middle = [&](int a, int b) {
-      const auto [it, inserted] = midpoint.emplace(std::minmax(a, b), static_cast<int>(v.size()));
-      if (inserted) v.push_back((v[a] + v[b]) / 2);
-      return it->second;
-    };
-    std::vector<Triangle> finer;
-    for (const Triangle& f : t) {
-      const int ab = middle(f[0], f[1]), bc = middle(f[1], f[2]), ca = middle(f[2], f[0]);
-      finer.insert(finer.end(), {{f[0], ab, ca}, {f[1], bc, ab}, {f[2], ca, bc}, {ab, bc, ca}});
-    }
-    t = std::move(finer);
-  }
-  TriangleSurface s;
-  s.vertices.resize(3, static_cast<Eigen::Index>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i) s.vertices.col(static_cast<Eigen::Index>(i)) = radius * v[i].normalized();
-  s.triangles = std::move(t);
-  return s;
-}
-
 /// Smallest distance from the origin to a triangle's plane: the faceted sphere lies in the
 /// shell r_min <= |x| <= 1, so |signed distance - (1 - |p|)| <= 1 - r_min for every p.
 double smallest_plane_distance(const TriangleSurface& s) {
@@ -162,7 +132,7 @@ void expect_sphere_distances(const ObstacleDistance& sphere, double r_min, bool 
 }
 
 TEST(ObstacleDistance, ClosedSurfaceWithObjectInsideAllowsInside) {
-  const TriangleSurface sphere = make_icosphere(3, 1.0);
+  const TriangleSurface sphere = testing::make_icosphere(3, 1.0);
   const double r_min = smallest_plane_distance(sphere);
   ASSERT_GT(r_min, 0.99);  // level 3: the faceting error is a few thousandths
   const ObstacleDistance obstacle(surface_obstacle("ball", sphere), points_in_shell(200, 0.1, 0.9, 1));
@@ -174,7 +144,7 @@ TEST(ObstacleDistance, ClosedSurfaceWithObjectInsideAllowsInside) {
 }
 
 TEST(ObstacleDistance, ClosedSurfaceWithObjectOutsideAllowsOutside) {
-  const TriangleSurface sphere = make_icosphere(3, 1.0);
+  const TriangleSurface sphere = testing::make_icosphere(3, 1.0);
   const double r_min = smallest_plane_distance(sphere);
   const ObstacleDistance obstacle(surface_obstacle("ball", sphere), points_in_shell(200, 1.5, 3.0, 2));
   EXPECT_FALSE(obstacle.allowed_inside());
@@ -183,7 +153,7 @@ TEST(ObstacleDistance, ClosedSurfaceWithObjectOutsideAllowsOutside) {
 }
 
 TEST(ObstacleDistance, TriangleOrientationDoesNotMatter) {
-  const TriangleSurface outward = make_icosphere(2, 1.0);
+  const TriangleSurface outward = testing::make_icosphere(2, 1.0);
   TriangleSurface inward = outward;
   for (Triangle& tri : inward.triangles) std::swap(tri[1], tri[2]);
   const Eigen::Matrix3Xd inside = points_in_shell(100, 0.0, 0.8, 3);
@@ -205,7 +175,7 @@ TEST(ObstacleDistance, ObjectOnBothSidesIsAnErrorNamingTheSplit) {
   reference.leftCols(62) = points_in_shell(62, 0.2, 0.8, 5);
   reference.rightCols(38) = points_in_shell(38, 1.5, 2.0, 6);
   try {
-    const ObstacleDistance obstacle(surface_obstacle("skull", make_icosphere(2, 1.0)), reference);
+    const ObstacleDistance obstacle(surface_obstacle("skull", testing::make_icosphere(2, 1.0)), reference);
     FAIL() << "no error";
   } catch (const Error& e) {
     EXPECT_STREQ(e.what(), "the object is not on one side of obstacle 'skull': 62 % inside, 38 % outside");
@@ -213,7 +183,7 @@ TEST(ObstacleDistance, ObjectOnBothSidesIsAnErrorNamingTheSplit) {
   // 90 % on one side is enough.
   reference.leftCols(90) = points_in_shell(90, 1.5, 2.0, 7);
   reference.rightCols(10) = points_in_shell(10, 0.2, 0.8, 8);
-  EXPECT_FALSE(ObstacleDistance(surface_obstacle("skull", make_icosphere(2, 1.0)), reference).allowed_inside());
+  EXPECT_FALSE(ObstacleDistance(surface_obstacle("skull", testing::make_icosphere(2, 1.0)), reference).allowed_inside());
 }
 
 TEST(ObstacleDistance, ConstructionErrorsNameTheObstacle) {
@@ -229,7 +199,7 @@ TEST(ObstacleDistance, ConstructionErrorsNameTheObstacle) {
   EXPECT_THAT(message(Obstacle{"nothing", {}, std::nullopt}, one), ::testing::HasSubstr("'nothing'"));
   EXPECT_THAT(message(Obstacle{"flat", {}, std::make_pair(Vector3d::Zero(), Vector3d::Zero())}, one),
               ::testing::HasSubstr("'flat'"));
-  EXPECT_THAT(message(surface_obstacle("ball", make_icosphere(1, 1.0)), Eigen::Matrix3Xd()),
+  EXPECT_THAT(message(surface_obstacle("ball", testing::make_icosphere(1, 1.0)), Eigen::Matrix3Xd()),
               ::testing::HasSubstr("'ball': no reference points"));
 }
 
