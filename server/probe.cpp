@@ -67,7 +67,7 @@ void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& o
     }
   }
   if (options.reference) {
-    HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
+    const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
     const std::vector<ToolReaction> reactions = contact_reactions_reference(model, contacts, held, contact_model);
     for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].force = reactions[i].reaction;
   } else {

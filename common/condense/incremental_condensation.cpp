@@ -230,6 +230,17 @@ CondensedOperator IncrementalCondensation::condense(std::span<const int> contact
   return op;
 }
 
+Eigen::MatrixXd IncrementalCondensation::solve_boundary(const Eigen::MatrixXd& rhs) const {
+  if (rhs.rows() != n_) throw Error(fmt::format("solve_boundary: {} rows for {} boundary dofs", rhs.rows(), n_));
+  Eigen::MatrixXd x = rhs;
+  if (n_ > 0) {
+    const auto r = r_.topLeftCorner(n_, n_);
+    r.triangularView<Eigen::Upper>().transpose().solveInPlace(x);
+    r.triangularView<Eigen::Upper>().solveInPlace(x);
+  }
+  return x;
+}
+
 void IncrementalCondensation::after_update() {
   if (++updates_since_check_ < options_.check_interval) return;
   updates_since_check_ = 0;

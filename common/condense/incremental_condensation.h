@@ -57,6 +57,9 @@ class IncrementalCondensation {
   /// Schur complement is not positive definite.
   CondensedOperator condense(std::span<const int> contact_nodes);
 
+  /// L_BB^-1 rhs (two triangular solves with R), rhs over the free dofs of B.
+  Eigen::MatrixXd solve_boundary(const Eigen::MatrixXd& rhs) const;
+
   /// Recomputes R and every cached Z from L_BB.
   void refactor();
   const Statistics& statistics() const { return stats_; }

@@ -1,6 +1,7 @@
 #include "common/ir/evaluate_force.h"
 
 #include <Eigen/Cholesky>
+#include "common/ir/contact_solve.h"
 #include <Eigen/Geometry>
 #include <fmt/format.h>
 
@@ -14,9 +15,6 @@
 
 namespace cohaptic {
 namespace {
-
-using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxContactDofs, kMaxContactDofs>;
-using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxContactDofs, 1>;
 
 // One pressing tool during a tick.
 struct PressingTool {
@@ -183,53 +181,33 @@ ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& ow
   }
 
   // 3. The system over Z, the free dofs of the pressing tools' triangles.
-  std::array<int, kMaxContactDofs> z_dof{};     // row in L~
-  std::array<int, kMaxContactDofs> z_tool{};    // which pressing tool
-  std::array<int, kMaxContactDofs> z_axis{};
-  std::array<double, kMaxContactDofs> z_weight{};
+  std::array<int, kMaxContactDofs> z_row{};  // row in L~
+  std::array<ContactDof, kMaxContactDofs> z_dofs{};
+  std::array<Eigen::Vector3d, kMaxUsers> displacement{};
   int z = 0;
-  for (int t = 0; t < pressing_count; ++t)
+  for (int t = 0; t < pressing_count; ++t) {
+    displacement[t] = pressing[t].displacement;
     for (int i = 0; i < 3; ++i)
       for (int axis = 0; axis < 3; ++axis) {
-        const int dof = prepared.dof_index[pressing[t].nodes[i]][axis];
-        if (dof < 0) continue;
-        z_dof[z] = dof;
-        z_tool[z] = t;
-        z_axis[z] = axis;
-        z_weight[z] = pressing[t].weights[i];
+        const int row = prepared.dof_index[pressing[t].nodes[i]][axis];
+        if (row < 0) continue;
+        z_row[z] = row;
+        z_dofs[z] = {t, axis, pressing[t].weights[i]};
         ++z;
       }
+  }
   SmallMatrix l_zz(z, z);
   SmallVector u0(z);
   for (int i = 0; i < z; ++i) {
-    u0[i] = prepared.free_displacement[z_dof[i]];
-    for (int j = 0; j < z; ++j) l_zz(i, j) = prepared.compliance(z_dof[i], z_dof[j]);
+    u0[i] = prepared.free_displacement[z_row[i]];
+    for (int j = 0; j < z; ++j) l_zz(i, j) = prepared.compliance(z_row[i], z_row[j]);
   }
-
-  Eigen::Vector3d contact_force = Eigen::Vector3d::Zero();
-  bool solved = true;
-  if (ir.contact_model == ContactModel::node_translation) {
-    SmallVector rhs(z);
-    for (int i = 0; i < z; ++i) rhs[i] = pressing[z_tool[i]].displacement[z_axis[i]] - u0[i];
-    const Eigen::LLT<SmallMatrix> llt(l_zz);
-    solved = llt.info() == Eigen::Success;
-    const SmallVector f = llt.solve(rhs);
-    for (int i = 0; i < z; ++i)
-      if (z_tool[i] == 0) contact_force[z_axis[i]] += z_weight[i] * f[i];
-  } else {
-    // W: dof i carries w_i of its tool's force component along its axis.
-    const int m = 3 * pressing_count;
-    SmallMatrix w = SmallMatrix::Zero(z, m);
-    for (int i = 0; i < z; ++i) w(i, 3 * z_tool[i] + z_axis[i]) = z_weight[i];
-    const SmallMatrix a = w.transpose() * l_zz * w;
-    SmallVector rhs(m);
-    for (int t = 0; t < pressing_count; ++t) rhs.segment<3>(3 * t) = pressing[t].displacement;
-    rhs -= w.transpose() * u0;
-    const Eigen::LLT<SmallMatrix> llt(a);
-    solved = llt.info() == Eigen::Success;
-    const SmallVector lambda = llt.solve(rhs);
-    contact_force = lambda.head<3>();
-  }
+  SmallVector nodal_forces;
+  std::array<Eigen::Vector3d, kMaxUsers> tool_forces{};
+  const bool solved = solve_contact_forces(ir.contact_model, l_zz, u0, std::span(z_dofs.data(), static_cast<std::size_t>(z)),
+                                           std::span(displacement.data(), static_cast<std::size_t>(pressing_count)),
+                                           nodal_forces, std::span(tool_forces.data(), static_cast<std::size_t>(pressing_count)));
+  const Eigen::Vector3d contact_force = tool_forces[0];
 
   // 4. Safety: never a non-finite or unbounded force.
   sample.force = -contact_force;

@@ -27,12 +27,10 @@
 #include <span>
 #include <vector>
 
+#include "common/ir/contact_solve.h"
 #include "common/ir/intermediate_representation.h"
 
 namespace cohaptic {
-
-constexpr int kMaxUsers = 4;
-constexpr int kMaxContactDofs = 9 * kMaxUsers;
 
 struct PreparedIR {
   IntermediateRepresentation ir;

@@ -1,5 +1,6 @@
 #include "common/sim/simulation.h"
 
+#include <algorithm>
 #include <limits>
 
 #include "common/contact/find_contact.h"
@@ -10,9 +11,19 @@ namespace cohaptic {
 
 Simulation::Simulation(const Model& model, ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
                        SimulationOptions options)
-    : model_(model), options_(options), condensation_(columns, model.dofs) {
+    : model_(model), columns_(columns), options_(options), condensation_(columns, model.dofs) {
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
+  if (!model.obstacles.empty()) {
+    Eigen::Matrix3Xd surface_points(3, static_cast<Eigen::Index>(model.surface.nodes.size()));
+    for (std::size_t i = 0; i < model.surface.nodes.size(); ++i)
+      surface_points.col(static_cast<Eigen::Index>(i)) = model.mesh.nodes.col(model.surface.nodes[i]);
+    for (const Obstacle& obstacle : model.obstacles) obstacles_.emplace_back(obstacle, surface_points);
+    rest_clearance_.assign(model.surface.nodes.size(), std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < model.surface.nodes.size(); ++i)
+      for (const ObstacleDistance& obstacle : obstacles_)
+        rest_clearance_[i] = std::min(rest_clearance_[i], obstacle.signed_distance(surface_points.col(static_cast<Eigen::Index>(i))));
+  }
 }
 
 void Simulation::set_tool(int user, const Eigen::Vector3d& position) {
@@ -22,58 +33,153 @@ void Simulation::set_tool(int user, const Eigen::Vector3d& position) {
 
 void Simulation::clear_tool(int user) { users_[user].known = false; }
 
-bool Simulation::update_boundary() {
-  std::vector<Eigen::Vector3d> contact_points;
-  std::vector<bool> excluded(static_cast<std::size_t>(model_.mesh.node_count()), false);
-  for (const UserState& user : users_) {
-    if (!user.known) continue;
-    for (int node : model_.surface.triangles[user.nearest]) excluded[node] = true;
-    if (user.pressing) contact_points.push_back(user.position);
-  }
-  // A held node under a tool is released: the tool's triangle wins.
-  std::vector<int> kept;
-  for (int node : condensation_.boundary_nodes())
-    if (!excluded[node]) kept.push_back(node);
+void Simulation::hold(int node, const HeldNode& held) {
+  condensation_.add_boundary_node(node);
+  held_[node] = held;
+  boundary_dirty_ = true;
+}
 
-  std::vector<int> wanted;
-  if (options_.step_delay_nodes > 0 && !contact_points.empty())
-    wanted = condensation_.boundary_nodes().empty()
-                 ? nearest_surface_nodes(model_, contact_points, options_.step_delay_nodes, excluded)
-                 : kept;
-  if (wanted == condensation_.boundary_nodes()) return false;
-  condensation_.set_boundary_nodes(wanted);
-  // Held where they are when they join: at rest (every stroke starts from rest).
-  boundary_displacement_.assign(condensation_.boundary_nodes().size(), Eigen::Vector3d::Zero());
-  return true;
+void Simulation::release(int node) {
+  condensation_.remove_boundary_node(node);
+  held_.erase(node);
+  boundary_dirty_ = true;
+}
+
+std::vector<Eigen::Vector3d> Simulation::boundary_displacement() const {
+  std::vector<Eigen::Vector3d> out;
+  for (int node : condensation_.boundary_nodes()) out.push_back(held_.at(node).displacement);
+  return out;
+}
+
+Eigen::VectorXd Simulation::boundary_dof_displacement() const {
+  std::vector<double> values;
+  for (int node : condensation_.boundary_nodes())
+    for (int axis = 0; axis < 3; ++axis)
+      if (!model_.dofs.is_fixed(node, axis)) values.push_back(held_.at(node).displacement[axis]);
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+std::vector<PressingContact> Simulation::pressing_contacts() const {
+  std::vector<PressingContact> contacts;
+  for (const UserState& user : users_)
+    if (user.pressing) {
+      const Triangle& tri = model_.surface.triangles[user.contact->triangle];
+      contacts.push_back({{tri[0], tri[1], tri[2]}, user.contact->weights, user.contact->displacement});
+    }
+  return contacts;
+}
+
+StateSolution Simulation::solve(std::span<const PressingContact> contacts) const {
+  return solve_state(columns_, condensation_, model_.dofs, contacts, boundary_dof_displacement(),
+                     options_.ir.contact_model);
+}
+
+StateSolution Simulation::solve() const { return solve(pressing_contacts()); }
+
+Eigen::Matrix3Xd Simulation::displacement_of(std::span<const int> nodes) const {
+  return displacement_of_nodes(columns_, solve(), nodes);
+}
+
+bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
+  // Only nodes that can reach an obstacle are checked: rest clearance below the largest
+  // displacement of the surface.
+  const StateSolution state = solve();
+  const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, model_.surface.nodes);
+  const double reach = u.colwise().norm().maxCoeff();
+  bool changed = false;
+  for (std::size_t i = 0; i < model_.surface.nodes.size(); ++i) {
+    const int node = model_.surface.nodes[i];
+    if (rest_clearance_[i] > reach || held_.count(node) || under_tool[node] || model_.dofs.fixed_axes[node] == kAllAxes)
+      continue;
+    const Eigen::Vector3d rest = model_.mesh.nodes.col(node);
+    const Eigen::Vector3d moved = rest + u.col(static_cast<Eigen::Index>(i));
+    for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
+      const ObstaclePoint hit = obstacles_[o].closest_point(moved);
+      if (hit.signed_distance >= 0) continue;
+      hold(node, {hit.point - rest, o});
+      changed = true;
+      break;
+    }
+  }
+  // Release held nodes whose obstacle would have to pull (holding force into the obstacle).
+  std::vector<int> pulling;
+  for (std::size_t b = 0, dof = 0; b < condensation_.boundary_nodes().size(); ++b) {
+    const int node = condensation_.boundary_nodes()[b];
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();
+    for (int axis = 0; axis < 3; ++axis)
+      if (!model_.dofs.is_fixed(node, axis)) force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
+    const HeldNode& held = held_.at(node);
+    if (held.obstacle < 0) continue;
+    const Eigen::Vector3d at = model_.mesh.nodes.col(node) + held.displacement;
+    if (force.dot(obstacles_[held.obstacle].closest_point(at).normal) < 0) pulling.push_back(node);
+  }
+  for (int node : pulling) release(node);
+  return changed || !pulling.empty();
+}
+
+bool Simulation::update_boundary(const std::vector<bool>& under_tool) {
+  boundary_dirty_ = false;
+  const std::vector<int> current = condensation_.boundary_nodes();
+  for (int node : current)
+    if (under_tool[node]) release(node);  // the tool's triangle wins
+
+  // Step delay: hold the N nodes nearest the pressing tools while any presses.
+  std::vector<Eigen::Vector3d> contact_points;
+  for (const UserState& user : users_)
+    if (user.pressing) contact_points.push_back(user.position);
+  bool step_delay_held = false;
+  for (const auto& [node, held] : held_) step_delay_held |= held.obstacle < 0;
+  if (options_.step_delay_nodes > 0 && !contact_points.empty() && !step_delay_held) {
+    const std::vector<int> nodes = nearest_surface_nodes(model_, contact_points, options_.step_delay_nodes, under_tool);
+    std::vector<int> fresh;
+    for (int node : nodes)
+      if (!held_.count(node)) fresh.push_back(node);
+    // Held where they were before the touch: the previous step's state.
+    const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, solve(previous_contacts_), fresh);
+    for (std::size_t i = 0; i < fresh.size(); ++i) hold(fresh[i], {u.col(static_cast<Eigen::Index>(i)), -1});
+  } else if (contact_points.empty() && step_delay_held) {
+    std::vector<int> step_nodes;
+    for (const auto& [node, held] : held_)
+      if (held.obstacle < 0) step_nodes.push_back(node);
+    for (int node : step_nodes) release(node);
+  }
+
+  for (int pass = 0; pass < options_.obstacle_iterations && !obstacles_.empty(); ++pass)
+    if (!update_obstacle_contacts(under_tool)) break;
+  return boundary_dirty_;
 }
 
 StepReport Simulation::step(double time) {
   StepReport report;
   std::vector<UserTool> tools;
+  std::vector<bool> under_tool(static_cast<std::size_t>(model_.mesh.node_count()), false);
   for (std::size_t u = 0; u < users_.size(); ++u) {
     UserState& user = users_[u];
     if (!user.known) {
       user.pressing = false;
+      user.contact.reset();
       user.ir.reset();
       continue;
     }
-    const ContactQuery query = find_contact(model_.mesh, model_.surface, model_.normals, model_.touchable_triangles,
-                                            user.position, user.radius);
-    user.pressing = query.contact.has_value();
+    user.contact = find_contact(model_.mesh, model_.surface, model_.normals, model_.touchable_triangles, user.position,
+                                user.radius)
+                       .contact;
+    user.pressing = user.contact.has_value();
     user.nearest = nearest_triangle(model_.mesh, model_.surface, model_.normals, model_.touchable_triangles, user.position)
                        .triangle;
+    for (int node : model_.surface.triangles[user.nearest]) under_tool[node] = true;
     tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest});
   }
   std::vector<int> nearest;
   for (const UserState& user : users_) nearest.push_back(user.known ? user.nearest : -1);
 
   Stopwatch watch;
-  const bool boundary_changed = update_boundary();
+  const bool boundary_changed = update_boundary(under_tool);
   if (boundary_changed || nearest != built_nearest_) {
+    const std::vector<Eigen::Vector3d> held = boundary_displacement();
     for (std::size_t i = 0; i < tools.size(); ++i) {
       UserState& user = users_[tools[i].user];
-      IntermediateRepresentation ir =
-          build_ir(model_, condensation_, tools, i, boundary_displacement_, options_.ir, ++user.epoch, time);
+      IntermediateRepresentation ir = build_ir(model_, condensation_, tools, i, held, options_.ir, ++user.epoch, time);
       report.ir_bytes += ir.size_bytes();
       user.ir = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
     }
@@ -81,7 +187,9 @@ StepReport Simulation::step(double time) {
     report.rebuilt = true;
   }
   report.rebuild_ms = watch.elapsed_ms();
+  previous_contacts_ = pressing_contacts();
   report.boundary_nodes = static_cast<int>(condensation_.boundary_nodes().size());
+  for (const auto& [node, held] : held_) report.obstacle_nodes += held.obstacle >= 0;
   return report;
 }
 

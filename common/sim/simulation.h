@@ -2,30 +2,42 @@
 //
 // Each step takes the users' latest tool positions and
 //   1. finds every tool's nearest touchable triangle and whether it presses;
-//   2. updates the colliding boundary set B: with `step_delay_nodes` = N (the paper's
-//      T150/T300), the N surface nodes nearest the pressing tools join B when contact
-//      begins, held where they are (at rest), and leave when no tool presses;
+//   2. updates the colliding boundary set B, the nodes held at a prescribed displacement:
+//      - step delay (the paper's T150/T300): with `step_delay_nodes` = N, the N surface
+//        nodes nearest the pressing tools join B when contact begins, held where they were
+//        at the previous step (before the touch), and leave when no tool presses;
+//      - rigid obstacles: a surface node whose displaced position penetrates an obstacle
+//        joins B, held at its closest point on the obstacle; a held node whose holding
+//        force would pull it into the obstacle is released. The active set is iterated up
+//        to `obstacle_iterations` times per step (and keeps converging over steps);
+//      - a node of a tool's nearest triangle is never held: the tool wins;
 //   3. rebuilds every user's IR when a set changed (nearest triangles or B): M~ depends
 //      only on the sets, so it is not rebuilt otherwise.
 // force() evaluates a user's force from its IR and the current tool positions: the P0
-// protocol's server-side force, the same function the P1 client runs.
-// Owns the incremental condensation; reads the Model. Units: SI.
+// protocol's server-side force, the same function the P1 client runs. surface
+// displacement() solves the whole state for display. Units: SI.
 #pragma once
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
+#include <unordered_map>
 #include <vector>
 
 #include "common/condense/incremental_condensation.h"
+#include "common/contact/find_contact.h"
+#include "common/contact/obstacle_distance.h"
 #include "common/ir/build_ir.h"
 #include "common/ir/evaluate_force.h"
 #include "common/model/model.h"
+#include "common/sim/state_solve.h"
 
 namespace cohaptic {
 
 struct SimulationOptions {
   IrBuildOptions ir;
-  int step_delay_nodes = 0;  ///< N surface nodes held while any tool presses (0: none)
+  int step_delay_nodes = 0;     ///< N surface nodes held while any tool presses (0: none)
+  int obstacle_iterations = 4;  ///< active-set passes per step
 };
 
 struct StepReport {
@@ -33,11 +45,13 @@ struct StepReport {
   double rebuild_ms = 0;      ///< time to update B and rebuild every IR
   std::size_t ir_bytes = 0;   ///< total size of the IRs rebuilt
   int boundary_nodes = 0;     ///< |B| after the step
+  int obstacle_nodes = 0;     ///< of which held by obstacles
 };
 
 class Simulation {
  public:
-  /// One user per tool (usually the scene's tools). `model` and `columns` must outlive it.
+  /// One user per tool (usually the scene's tools). `model` and `columns` (whose rows
+  /// must include every node that can be held) must outlive it.
   Simulation(const Model& model, ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
              SimulationOptions options);
 
@@ -56,8 +70,14 @@ class Simulation {
   std::vector<Eigen::Vector3d> remote_positions(const IntermediateRepresentation& ir) const;
   bool pressing(int user) const { return users_[user].pressing; }
 
+  /// The whole state solved at the current tool positions.
+  StateSolution solve() const;
+  /// Displacement of `nodes` (row nodes) in the current state [m].
+  Eigen::Matrix3Xd displacement_of(std::span<const int> nodes) const;
+
   const IncrementalCondensation& condensation() const { return condensation_; }
-  const std::vector<Eigen::Vector3d>& boundary_displacement() const { return boundary_displacement_; }
+  /// u of each node of condensation().boundary_nodes(), in that order [m].
+  std::vector<Eigen::Vector3d> boundary_displacement() const;
 
  private:
   struct UserState {
@@ -65,19 +85,34 @@ class Simulation {
     Eigen::Vector3d position = Eigen::Vector3d::Zero();
     double radius = 0;
     int nearest = -1;
+    std::optional<ToolContact> contact;
     bool pressing = false;
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
   };
-  bool update_boundary();
+  struct HeldNode {
+    Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
+    int obstacle = -1;  ///< the obstacle holding it, or -1 for a step-delay node
+  };
+  std::vector<PressingContact> pressing_contacts() const;
+  StateSolution solve(std::span<const PressingContact> contacts) const;
+  bool update_boundary(const std::vector<bool>& under_tool);
+  bool update_obstacle_contacts(const std::vector<bool>& under_tool);
+  void hold(int node, const HeldNode& held);
+  void release(int node);
+  Eigen::VectorXd boundary_dof_displacement() const;
 
   const Model& model_;
+  ComplianceColumns& columns_;
   SimulationOptions options_;
-  IncrementalCondensation condensation_;
-  std::vector<Eigen::Vector3d> boundary_displacement_;  // per B node, in condensation order
+  mutable IncrementalCondensation condensation_;  // its Z cache changes on const queries
+  std::vector<ObstacleDistance> obstacles_;
+  std::vector<double> rest_clearance_;            // per surface node: distance to the nearest obstacle at rest
+  std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
-  std::vector<int> built_nearest_;                     // nearest triangles the IRs were built for
-  std::vector<int> built_boundary_;
+  std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
+  std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
+  bool boundary_dirty_ = false;
 };
 
 }  // namespace cohaptic

@@ -1,0 +1,66 @@
+#include "common/sim/state_solve.h"
+
+#include <Eigen/Cholesky>
+#include <fmt/format.h>
+
+#include "common/condense/dof_blocks.h"
+#include "common/ir/contact_solve.h"
+#include "common/util/error.h"
+
+namespace cohaptic {
+
+StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& condensation, const DofMap& dofs,
+                          std::span<const PressingContact> contacts, const Eigen::VectorXd& boundary_displacement,
+                          ContactModel contact_model) {
+  if (static_cast<int>(contacts.size()) > kMaxUsers)
+    throw Error(fmt::format("solve_state: {} pressing tools, at most {}", contacts.size(), kMaxUsers));
+  StateSolution state;
+  state.boundary_dofs = free_dofs_of_nodes(dofs, condensation.boundary_nodes());
+  state.tool_forces.assign(contacts.size(), Eigen::Vector3d::Zero());
+
+  std::vector<int> nodes;
+  std::vector<ContactDof> contact_dofs;
+  std::vector<Eigen::Vector3d> displacement;
+  for (std::size_t t = 0; t < contacts.size(); ++t) {
+    displacement.push_back(contacts[t].displacement);
+    for (int i = 0; i < 3; ++i) {
+      nodes.push_back(contacts[t].nodes[i]);
+      for (int axis = 0; axis < 3; ++axis)
+        if (!dofs.is_fixed(contacts[t].nodes[i], axis)) {
+          state.contact_dofs.push_back(3 * contacts[t].nodes[i] + axis);
+          contact_dofs.push_back({static_cast<int>(t), axis, contacts[t].weights[i]});
+        }
+    }
+  }
+  state.contact_forces = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(state.contact_dofs.size()));
+  if (!nodes.empty()) {
+    const CondensedOperator op = condensation.condense(nodes);
+    const Eigen::LLT<Eigen::MatrixXd> llt(op.m_cc);
+    const SmallMatrix compliance = llt.solve(Eigen::MatrixXd::Identity(op.m_cc.rows(), op.m_cc.cols()));
+    const SmallVector free_displacement = -compliance * (op.m_cb * boundary_displacement);
+    SmallVector nodal;
+    if (!solve_contact_forces(contact_model, compliance, free_displacement, contact_dofs, displacement, nodal,
+                              state.tool_forces))
+      throw NumericalError("the state's contact system is not positive definite");
+    state.contact_forces = nodal;
+  }
+  // The holding forces on B: L_BB f_B = u_B - L_BZ f_Z.
+  Eigen::VectorXd rhs = boundary_displacement;
+  if (!state.contact_dofs.empty())
+    rhs -= gather_compliance(columns, state.boundary_dofs, state.contact_dofs) * state.contact_forces;
+  state.boundary_forces = condensation.solve_boundary(rhs);
+  return state;
+}
+
+Eigen::Matrix3Xd displacement_of_nodes(ComplianceColumns& columns, const StateSolution& state, std::span<const int> nodes) {
+  std::vector<int> rows;
+  for (int node : nodes)
+    for (int axis = 0; axis < 3; ++axis) rows.push_back(3 * node + axis);
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows.size()));
+  // Fixed rows of L are zero: gathering them is harmless and keeps the layout simple.
+  if (!state.contact_dofs.empty()) u += gather_compliance(columns, rows, state.contact_dofs) * state.contact_forces;
+  if (!state.boundary_dofs.empty()) u += gather_compliance(columns, rows, state.boundary_dofs) * state.boundary_forces;
+  return Eigen::Map<const Eigen::Matrix3Xd>(u.data(), 3, static_cast<Eigen::Index>(nodes.size()));
+}
+
+}  // namespace cohaptic

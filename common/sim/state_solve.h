@@ -1,0 +1,44 @@
+// The simulation's own solve of the current state: every pressing tool at once with the
+// boundary nodes held, giving the nodal forces on the contact and boundary nodes and,
+// from them, the displacement of any row node (for obstacle collisions and display).
+//
+// f_Z follows from the condensed compliance of the pressing triangles' dofs Z with B
+// held (contact_solve.h), then f_B = L_BB^-1 (u_B - L_BZ f_Z), and u_N = L_NZ f_Z + L_NB f_B.
+// Units: m, N.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <span>
+#include <vector>
+
+#include "common/condense/incremental_condensation.h"
+#include "common/fem/compliance.h"
+#include "common/scene/scene.h"
+
+namespace cohaptic {
+
+struct PressingContact {
+  std::array<int, 3> nodes{};                      ///< volume node indices of the triangle
+  Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();  ///< d [m]
+};
+
+struct StateSolution {
+  std::vector<int> contact_dofs;    ///< global free dofs of the pressing triangles
+  Eigen::VectorXd contact_forces;   ///< tools' forces on those dofs [N]
+  std::vector<int> boundary_dofs;   ///< global free dofs of B
+  Eigen::VectorXd boundary_forces;  ///< holding forces on those dofs [N]
+  std::vector<Eigen::Vector3d> tool_forces;  ///< force each tool applies to the object [N]
+};
+
+/// At most kMaxUsers contacts, sharing no node. u_B over the free dofs of B in the
+/// condensation's order. Throws NumericalError if a system is not positive definite.
+StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& condensation, const DofMap& dofs,
+                          std::span<const PressingContact> contacts, const Eigen::VectorXd& boundary_displacement,
+                          ContactModel contact_model);
+
+/// Displacement [m] of `nodes` (row nodes of `columns`) in the solved state, one column each.
+Eigen::Matrix3Xd displacement_of_nodes(ComplianceColumns& columns, const StateSolution& state, std::span<const int> nodes);
+
+}  // namespace cohaptic
