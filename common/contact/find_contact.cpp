@@ -19,8 +19,10 @@ SurfacePoint nearest_triangle(const TetMesh& mesh, const BoundarySurface& surfac
     const double height = (p - q.point).dot(normals.face[t]);
     const double tie_tolerance = 1e-24 + 1e-12 * best_distance2;
     const bool closer = d2 < best_distance2 - tie_tolerance;
-    const bool tie_but_deeper = std::abs(d2 - best_distance2) <= tie_tolerance && height < best_height;
-    if (closer || tie_but_deeper) {
+    const bool same_distance = std::abs(d2 - best_distance2) <= tie_tolerance;
+    const bool deeper = height < best_height - 1e-15 * std::abs(best_height);
+    const bool same_height = !deeper && height <= best_height + 1e-15 * std::abs(best_height);
+    if (best.triangle < 0 || closer || (same_distance && (deeper || (same_height && t < best.triangle)))) {
       best_distance2 = std::min(d2, best_distance2);
       best_height = height;
       best.triangle = t;

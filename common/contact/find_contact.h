@@ -4,7 +4,8 @@
 // A tool is a point, or a sphere of radius r. It is in contact when its point (centre)
 // is less than r from the surface on the inside side, i.e. signed distance < r; the
 // contact triangle is then the closest touchable surface triangle (ties at an edge or a
-// vertex go to the triangle whose plane the tool is deepest below). F is the closest
+// vertex go to the triangle whose plane the tool is deepest below, then to the lower
+// surface index). F is the closest
 // point of that rest triangle (the foot of the perpendicular when it falls inside), w its
 // area coordinates, and the node-translation displacement of each of the triangle's
 // three nodes is d = (p - r n) - F with n the triangle's outward normal. Units: m.

@@ -61,6 +61,7 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   for (int t : patch) {
     patch_index.emplace(t, static_cast<int>(ir.patch.size()));
     IrTriangle tri;
+    tri.surface_index = t;
     for (int k = 0; k < 3; ++k) tri.nodes[k] = add_node(model.surface.triangles[t][k]);
     tri.normal = model.normals.face[t];
     ir.patch.push_back(tri);

@@ -44,8 +44,14 @@ PatchPoint nearest_on_patch(const PreparedIR& prepared, const Eigen::Vector3d& p
                                                              ir.rest_positions.col(tri.nodes[2]));
     const double d2 = (p - q.point).squaredNorm();
     const double height = (p - q.point).dot(tri.normal);
+    // Ties (an edge or vertex shared by several triangles) go to the triangle the tool is
+    // deepest below, then to the lower surface index: the server's rule (find_contact.h).
     const double tie = 1e-24 + 1e-12 * best_distance2;
-    if (d2 < best_distance2 - tie || (std::abs(d2 - best_distance2) <= tie && height < best_height)) {
+    const bool same_distance = std::abs(d2 - best_distance2) <= tie;
+    const bool deeper = height < best_height - 1e-15 * std::abs(best_height);
+    const bool same_height = !deeper && height <= best_height + 1e-15 * std::abs(best_height);
+    if (best.triangle < 0 || d2 < best_distance2 - tie ||
+        (same_distance && (deeper || (same_height && tri.surface_index < ir.patch[best.triangle].surface_index)))) {
       best_distance2 = std::min(d2, best_distance2);
       best_height = height;
       best.triangle = t;

@@ -7,7 +7,7 @@ std::size_t IntermediateRepresentation::size_bytes() const {
   constexpr std::size_t kHeader = 4 + 8 + 8 + 4 + 1 + 1 + 8 + 8 + 4 + 4;  // version .. row_node_count
   const std::size_t nodes = node_ids.size() * (sizeof(std::int64_t) + sizeof(AxisMask)) +
                             static_cast<std::size_t>(rest_positions.size()) * sizeof(double);
-  const std::size_t triangles = patch.size() * (3 * sizeof(std::int32_t) * 2 + 4 * 3 * sizeof(double)) +
+  const std::size_t triangles = patch.size() * (7 * sizeof(std::int32_t) + 4 * 3 * sizeof(double)) +
                                static_cast<std::size_t>(patch_vertex_normals.size()) * sizeof(double) +
                                guard.size() * 4 * 3 * sizeof(double);
   const std::size_t remote = remotes.size() * (sizeof(std::int32_t) * 4 + (1 + 7 * 3) * sizeof(double));

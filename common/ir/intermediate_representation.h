@@ -29,6 +29,7 @@ enum class IrPrecision { f64, f32 };
 
 struct IrTriangle {
   std::array<int, 3> nodes{};          ///< local node indices, counter-clockwise seen from outside
+  int surface_index = 0;               ///< index on the server's surface: ties at edges go to the lower
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit outward normal at rest
   std::array<int, 3> neighbours{-1, -1, -1};  ///< patch triangle across edge (k, k+1), or -1
   /// The whole surface's pseudo-normal at edge (k, k+1), inside the patch or at its rim:

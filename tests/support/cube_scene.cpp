@@ -1,0 +1,24 @@
+#include "support/cube_scene.h"
+
+#include <fmt/format.h>
+
+namespace cohaptic::testing {
+
+std::string cube_scene_yaml(const CubeSceneOptions& o) {
+  return fmt::format(R"(
+units: mm
+objects:
+  - name: cube
+    mesh: {{box: {{min: [-65, -65, -130], size: [130, 130, 130], divisions: [{0}, {0}, {0}]}}}}
+    material: {{youngs_modulus: {1}, poisson_ratio: {2}}}
+    fixed: [{{plane: {{point: [0, 0, -130], normal: [0, 0, 1]}}}}]
+    touchable: [{3}]
+    compliance: {{precompute: on_demand, disk_cache: false}}
+obstacles: [{4}]
+tools: {5}
+haptic: {{force_limit: {6}}}
+)",
+                     o.divisions, o.youngs_modulus, o.poisson_ratio, o.touchable, o.obstacles, o.tools, o.force_limit);
+}
+
+}  // namespace cohaptic::testing

@@ -1,0 +1,21 @@
+// The paper's cube as scene text, with the knobs tests and benchmarks turn.
+#pragma once
+
+#include <string>
+
+namespace cohaptic::testing {
+
+struct CubeSceneOptions {
+  int divisions = 11;
+  double youngs_modulus = 1.0e6;
+  double poisson_ratio = 0.4;
+  std::string touchable = "{plane: {point: [0, 0, 0], normal: [0, 0, 1]}}";
+  std::string obstacles;      ///< YAML list items, e.g. "- {name: wall, plane: {...}}"
+  std::string tools = "[{name: A}, {name: B}]";
+  double force_limit = 3.3;
+};
+
+/// A 130 mm cube (z from -130 to 0 mm), rear face fixed, in millimetres.
+std::string cube_scene_yaml(const CubeSceneOptions& options = {});
+
+}  // namespace cohaptic::testing
