@@ -1,0 +1,311 @@
+// The intermediate representation and its force evaluator against the full sparse FEM
+// solve: one and two users, both contact models, sliding within the patch, held boundary
+// nodes, float32 storage, and what happens at edges, past the patch and with bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <random>
+
+#include "common/model/static_contact.h"
+#include "common/scene/load_scene.h"
+#include "common/sim/simulation.h"
+#include "support/cube_scene.h"
+
+namespace cohaptic {
+namespace {
+
+// A cube model with compliance rows over its whole surface (any node may be held).
+struct Rig {
+  std::unique_ptr<Model> model;
+  std::unique_ptr<ComplianceColumns> columns;
+  explicit Rig(const testing::CubeSceneOptions& options = {})
+      : model(std::make_unique<Model>(build_model(parse_scene(testing::cube_scene_yaml(options), "cube.yaml")))),
+        columns(std::make_unique<ComplianceColumns>(*model->free_factor, model->dofs, model->surface.nodes)) {}
+};
+
+Rig& shared_cube() {
+  static Rig rig;
+  return rig;
+}
+
+Eigen::Vector3d mm(double x, double y, double z) { return Eigen::Vector3d(x, y, z) * 1e-3; }
+
+SimulationOptions unlimited(ContactModel model, int step_delay_nodes = 0, int patch_rings = 1,
+                            IrPrecision precision = IrPrecision::f64) {
+  SimulationOptions options;
+  options.ir.contact_model = model;
+  options.ir.patch_rings = patch_rings;
+  options.ir.precision = precision;
+  options.ir.force_limit = std::numeric_limits<double>::infinity();
+  options.step_delay_nodes = step_delay_nodes;
+  return options;
+}
+
+// The full sparse solve with all `tools` pressing and the simulation's held nodes.
+std::vector<Eigen::Vector3d> reference_forces(const Model& model, const Simulation& simulation,
+                                              const std::vector<Eigen::Vector3d>& tools, ContactModel contact_model) {
+  std::vector<PressedTool> pressed;
+  for (const Eigen::Vector3d& p : tools) pressed.push_back({p, 0});
+  const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
+  std::vector<Eigen::Vector3d> forces;
+  for (const ToolReaction& r : contact_reactions_reference(model, find_tool_contacts(model, pressed), held, contact_model))
+    forces.push_back(r.reaction);
+  return forces;
+}
+
+double relative_error(const Eigen::Vector3d& value, const Eigen::Vector3d& expected) {
+  return (value - expected).norm() / std::max(expected.norm(), 1e-300);
+}
+
+// Whether the IR of `user` holds the triangles the tools now press (own within the patch,
+// remote on its IR triangle): then the evaluator must be exact.
+bool ir_covers(const Model& model, const PreparedIR& prepared, const std::vector<Eigen::Vector3d>& tools, int user) {
+  const auto surface_triangle = [&](const Eigen::Vector3d& p) {
+    return nearest_triangle(model.mesh, model.surface, model.normals, model.touchable_triangles, p).triangle;
+  };
+  bool own = false;
+  for (const IrTriangle& tri : prepared.ir.patch) own |= tri.surface_index == surface_triangle(tools[user]);
+  for (const IrRemoteContact& remote : prepared.ir.remotes) {
+    const Triangle& t = model.surface.triangles[surface_triangle(tools[remote.user])];
+    for (int k = 0; k < 3; ++k)
+      if (model.mesh.node_tags[t[k]] != prepared.ir.node_ids[remote.nodes[k]]) return false;
+  }
+  return own;
+}
+
+void two_users_match_the_full_solve(ContactModel contact_model, int step_delay_nodes) {
+  Rig& rig = shared_cube();
+  const Model& model = *rig.model;
+  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(2), unlimited(contact_model, step_delay_nodes));
+  const std::vector<Eigen::Vector3d> start = {mm(-20, 5, -4), mm(25, -5, -3)};
+  simulation.set_tool(0, start[0]);
+  simulation.set_tool(1, start[1]);
+  simulation.step(0);
+  ASSERT_TRUE(simulation.pressing(0) && simulation.pressing(1));
+
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> jitter(-3, 3), depth(0.5, 6);
+  int checked = 0;
+  double worst = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const std::vector<Eigen::Vector3d> tools = {start[0] + mm(jitter(rng), jitter(rng), 0),
+                                                start[1] + mm(jitter(rng), jitter(rng), 0)};
+    std::vector<Eigen::Vector3d> pressed = tools;
+    pressed[0].z() = -depth(rng) * 1e-3;
+    pressed[1].z() = -depth(rng) * 1e-3;
+    // A tool moved onto a held node, or outside its IR's triangles: not this test's subject.
+    if (!ir_covers(model, *simulation.ir(0), pressed, 0) && !ir_covers(model, *simulation.ir(1), pressed, 1)) continue;
+    std::vector<Eigen::Vector3d> expected;
+    try {
+      expected = reference_forces(model, simulation, pressed, contact_model);
+    } catch (const Error&) {
+      continue;
+    }
+    for (int user = 0; user < 2; ++user) {
+      const PreparedIR& prepared = *simulation.ir(user);
+      if (!ir_covers(model, prepared, pressed, user)) continue;
+      const Eigen::Vector3d remote = pressed[1 - user];
+      const ForceSample sample = evaluate_force(prepared, pressed[user], std::span(&remote, 1));
+      ASSERT_TRUE(sample.flags & kInContact);
+      worst = std::max(worst, relative_error(sample.force, expected[user]));
+      EXPECT_LE(relative_error(sample.force, expected[user]), 1e-9) << "trial " << trial << " user " << user;
+      ++checked;
+    }
+  }
+  std::printf("  %s, %d held nodes: %d evaluations checked, worst relative error %.2e\n",
+              contact_model == ContactModel::node_translation ? "translation" : "point", step_delay_nodes, checked, worst);
+  EXPECT_GE(checked, 10);
+}
+
+TEST(IntermediateRepresentation, TwoUsersEqualTheFullSolveWithBothTools) {
+  two_users_match_the_full_solve(ContactModel::node_translation, 0);
+}
+TEST(IntermediateRepresentation, TwoUsersEqualTheFullSolveWithThePointModel) {
+  two_users_match_the_full_solve(ContactModel::point_constraint, 0);
+}
+TEST(IntermediateRepresentation, TwoUsersEqualTheFullSolveWithHeldBoundaryNodes) {
+  two_users_match_the_full_solve(ContactModel::node_translation, 150);
+  two_users_match_the_full_solve(ContactModel::point_constraint, 150);
+}
+
+TEST(IntermediateRepresentation, EachUserFeelsTheOther) {
+  Rig& rig = shared_cube();
+  const auto force_alone_and_together = [&](int user) {
+    Simulation alone(*rig.model, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
+    Simulation together(*rig.model, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
+    alone.set_tool(user, user == 0 ? mm(-12, 0, -5) : mm(12, 0, -5));
+    together.set_tool(0, mm(-12, 0, -5));
+    together.set_tool(1, mm(12, 0, -5));
+    alone.step(0);
+    together.step(0);
+    return std::make_pair(alone.force(user).force, together.force(user).force);
+  };
+  for (int user = 0; user < 2; ++user) {
+    const auto [alone, together] = force_alone_and_together(user);
+    // The other tool sinks the surface nearby: this one needs less force for the same depth.
+    EXPECT_LT(together.z(), alone.z());
+    EXPECT_GT((alone - together).norm(), 0.05 * alone.norm()) << "user " << user;
+  }
+}
+
+TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
+  Rig& rig = shared_cube();
+  const Model& model = *rig.model;
+  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::node_translation, 0, 2));
+  simulation.set_tool(0, mm(1, 2, -3));
+  simulation.step(0);
+  const PreparedIR& prepared = *simulation.ir(0);
+  int triangles_visited = 0, previous = -1;
+  for (double x = 1; x <= 20; x += 0.5) {
+    const std::vector<Eigen::Vector3d> tool = {mm(x, 2 + 0.3 * x, -3)};
+    if (!ir_covers(model, prepared, tool, 0)) break;
+    const ForceSample sample = evaluate_force(prepared, tool[0], {});
+    EXPECT_LE(relative_error(sample.force, reference_forces(model, simulation, tool, ContactModel::node_translation)[0]), 1e-9)
+        << "x = " << x;
+    if (sample.triangle != previous) ++triangles_visited;
+    previous = sample.triangle;
+  }
+  EXPECT_GE(triangles_visited, 3) << "the slide should cross several patch triangles";
+}
+
+TEST(IntermediateRepresentation, Float32StorageStaysCloseToFloat64) {
+  Rig& rig = shared_cube();
+  for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
+    Simulation f64(*rig.model, *rig.columns, std::vector<ToolSpec>(2), unlimited(contact_model, 300));
+    Simulation f32(*rig.model, *rig.columns, std::vector<ToolSpec>(2),
+                   unlimited(contact_model, 300, 1, IrPrecision::f32));
+    for (Simulation* s : {&f64, &f32}) {
+      s->set_tool(0, mm(-20, 5, -4));
+      s->set_tool(1, mm(25, -5, -3));
+      s->step(0);
+    }
+    EXPECT_LT(static_cast<double>(f32.ir(0)->ir.size_bytes()), 0.6 * static_cast<double>(f64.ir(0)->ir.size_bytes()));
+    for (int user = 0; user < 2; ++user) {
+      const double error = relative_error(f32.force(user).force, f64.force(user).force);
+      std::printf("  f32 vs f64 (%s, |B| 300): relative force difference %.2e\n",
+                  contact_model == ContactModel::node_translation ? "translation" : "point", error);
+      EXPECT_LE(error, 1e-4);
+      EXPECT_GT(error, 0.0) << "float32 storage that changes nothing is not float32";
+    }
+  }
+}
+
+// Largest change of the force between consecutive samples of a slide across the front
+// face, 3 mm deep, with samples `step` mm apart, staying inside the IR's patch.
+double largest_change_along_slide(const PreparedIR& prepared, double step, double& peak) {
+  double largest = 0;
+  peak = 0;
+  Eigen::Vector3d previous = evaluate_force(prepared, mm(0.5, 0.4, -3), {}).force;
+  for (double x = 0.5 + step; x <= 12; x += step) {
+    const ForceSample sample = evaluate_force(prepared, mm(x, 0.4 + 0.4 * x, -3), {});
+    if (sample.flags & kOutsidePatch) break;
+    largest = std::max(largest, (sample.force - previous).norm());
+    peak = std::max(peak, sample.force.norm());
+    previous = sample.force;
+  }
+  return largest;
+}
+
+TEST(IntermediateRepresentation, NodeTranslationJumpsAtEdgesThePointModelDoesNot) {
+  // A continuous force's largest step-to-step change shrinks with the step; a jump does not.
+  Rig& rig = shared_cube();
+  std::printf("  tool sliding 3 mm deep across several triangles (patch rings 2), largest change between samples:\n");
+  for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
+    Simulation simulation(*rig.model, *rig.columns, std::vector<ToolSpec>(1), unlimited(contact_model, 0, 2));
+    simulation.set_tool(0, mm(0.5, 0.4, -3));
+    simulation.step(0);
+    double peak = 0;
+    const double coarse = largest_change_along_slide(*simulation.ir(0), 0.2, peak);
+    const double fine = largest_change_along_slide(*simulation.ir(0), 0.02, peak);
+    std::printf("    %-11s %.3f N with 0.2 mm steps, %.3f N with 0.02 mm steps (peak force %.2f N)\n",
+                contact_model == ContactModel::node_translation ? "translation" : "point", coarse, fine, peak);
+    if (contact_model == ContactModel::node_translation) {
+      EXPECT_GT(fine, 0.5 * coarse) << "node translation switches nodes at an edge: a jump";
+      EXPECT_LT(fine, 0.25 * peak) << "but the jump is bounded";
+    } else {
+      EXPECT_LT(fine, 0.5 * coarse) << "the point model is continuous across edges";
+    }
+  }
+}
+
+TEST(IntermediateRepresentation, PastThePatchTheForceIsHeldAndTheNextIrCatchesUp) {
+  Rig& rig = shared_cube();
+  const Model& model = *rig.model;
+  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::point_constraint, 0, 0));
+  simulation.set_tool(0, mm(1, 1, -3));
+  simulation.step(0);
+  const std::shared_ptr<const PreparedIR> old_ir = simulation.ir(0);
+  Eigen::Vector3d previous = evaluate_force(*old_ir, mm(1, 1, -3), {}).force;
+  double largest_jump = 0;
+  bool left = false;
+  Eigen::Vector3d p;
+  double beyond = 0;  // how far past the rim [mm]
+  for (double x = 1; x < 30 && beyond < 1.0; x += 0.05) {
+    p = mm(x, 1, -3);
+    const ForceSample sample = evaluate_force(*old_ir, p, {});
+    if (sample.flags & kOutsidePatch) {
+      left = true;
+      beyond += 0.05;
+    }
+    ASSERT_TRUE(sample.force.allFinite());
+    largest_jump = std::max(largest_jump, (sample.force - previous).norm());
+    previous = sample.force;
+  }
+  ASSERT_TRUE(left) << "the slide should leave a one-triangle patch";
+  // Held on the patch's rim: still continuous.
+  EXPECT_LT(largest_jump, 0.01 * previous.norm());
+  // The next IR is centred on the new triangle: its force is the exact one there.
+  simulation.set_tool(0, p);
+  simulation.step(0.01);
+  const Eigen::Vector3d exact = simulation.force(0).force;
+  EXPECT_LE(relative_error(exact, reference_forces(model, simulation, {p}, ContactModel::point_constraint)[0]), 1e-9);
+  std::printf("  1 mm past a one-triangle patch: force held on the rim %.3f N, exact at the new triangle %.3f N "
+              "(jump %.3f N when the next IR arrives)\n",
+              previous.norm(), exact.norm(), (exact - previous).norm());
+  EXPECT_LT((exact - previous).norm(), 0.25 * exact.norm());
+}
+
+TEST(IntermediateRepresentation, NonFiniteToolsGiveZeroOrAreIgnored) {
+  Rig& rig = shared_cube();
+  const Model& model = *rig.model;
+  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
+  simulation.set_tool(0, mm(-20, 5, -4));
+  simulation.set_tool(1, mm(25, -5, -3));
+  simulation.step(0);
+  const PreparedIR& prepared = *simulation.ir(0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const ForceSample own_nan = evaluate_force(prepared, Eigen::Vector3d(nan, 0, 0), {});
+  EXPECT_EQ(own_nan.force, Eigen::Vector3d::Zero());
+  EXPECT_TRUE(own_nan.flags & kNonFinite);
+  // An unknown remote leaves its nodes unloaded: the force of the own tool alone.
+  const Eigen::Vector3d unknown(nan, nan, nan);
+  const ForceSample alone = evaluate_force(prepared, mm(-20, 5, -4), std::span(&unknown, 1));
+  EXPECT_LE(relative_error(alone.force, reference_forces(model, simulation, {mm(-20, 5, -4)}, ContactModel::node_translation)[0]),
+            1e-9);
+}
+
+TEST(IntermediateRepresentation, PrepareRejectsMalformedIrs) {
+  Rig& rig = shared_cube();
+  Simulation simulation(*rig.model, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::node_translation));
+  simulation.set_tool(0, mm(0, 0, -2));
+  simulation.step(0);
+  const IntermediateRepresentation good = simulation.ir(0)->ir;
+  IntermediateRepresentation bad = good;
+  bad.m_tilde(0, 0) = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(prepare_ir(bad), Error);
+  bad = good;
+  bad.m_tilde.conservativeResize(bad.m_tilde.rows() - 1, Eigen::NoChange);
+  EXPECT_THROW(prepare_ir(bad), Error);
+  bad = good;
+  bad.m_tilde.leftCols(bad.m_tilde.rows()) *= -1;  // not positive definite
+  EXPECT_THROW(prepare_ir(bad), Error);
+  bad = good;
+  bad.patch[0].nodes[1] = bad.node_count() + 5;
+  EXPECT_THROW(prepare_ir(bad), Error);
+  EXPECT_NO_THROW(prepare_ir(good));
+}
+
+}  // namespace
+}  // namespace cohaptic
