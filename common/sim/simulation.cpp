@@ -81,27 +81,8 @@ Eigen::Matrix3Xd Simulation::displacement_of(std::span<const int> nodes) const {
 }
 
 bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
-  // Only nodes that can reach an obstacle are checked: rest clearance below the largest
-  // displacement of the surface.
   const StateSolution state = solve();
-  const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, model_.surface.nodes);
-  const double reach = u.colwise().norm().maxCoeff();
-  bool changed = false;
-  for (std::size_t i = 0; i < model_.surface.nodes.size(); ++i) {
-    const int node = model_.surface.nodes[i];
-    if (rest_clearance_[i] > reach || held_.count(node) || under_tool[node] || model_.dofs.fixed_axes[node] == kAllAxes)
-      continue;
-    const Eigen::Vector3d rest = model_.mesh.nodes.col(node);
-    const Eigen::Vector3d moved = rest + u.col(static_cast<Eigen::Index>(i));
-    for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
-      const ObstaclePoint hit = obstacles_[o].closest_point(moved);
-      if (hit.signed_distance >= 0) continue;
-      hold(node, {hit.point - rest, o});
-      changed = true;
-      break;
-    }
-  }
-  // Release held nodes whose obstacle would have to pull (holding force into the obstacle).
+  // Held nodes whose obstacle would have to pull (holding force into the obstacle) go free.
   std::vector<int> pulling;
   for (std::size_t b = 0, dof = 0; b < condensation_.boundary_nodes().size(); ++b) {
     const int node = condensation_.boundary_nodes()[b];
@@ -113,8 +94,27 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
     const Eigen::Vector3d at = model_.mesh.nodes.col(node) + held.displacement;
     if (force.dot(obstacles_[held.obstacle].closest_point(at).normal) < 0) pulling.push_back(node);
   }
+  // Free nodes whose displaced position penetrates an obstacle are held on it. Only nodes
+  // that can reach one are checked: rest clearance below the largest surface displacement.
+  const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, model_.surface.nodes);
+  const double reach = u.colwise().norm().maxCoeff();
+  std::vector<std::pair<int, HeldNode>> penetrating;
+  for (std::size_t i = 0; i < model_.surface.nodes.size(); ++i) {
+    const int node = model_.surface.nodes[i];
+    if (rest_clearance_[i] > reach || held_.count(node) || under_tool[node] || model_.dofs.fixed_axes[node] == kAllAxes)
+      continue;
+    const Eigen::Vector3d rest = model_.mesh.nodes.col(node);
+    const Eigen::Vector3d moved = rest + u.col(static_cast<Eigen::Index>(i));
+    for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
+      const ObstaclePoint hit = obstacles_[o].closest_point(moved);
+      if (hit.signed_distance >= 0) continue;
+      penetrating.push_back({node, {hit.point - rest, o}});
+      break;
+    }
+  }
   for (int node : pulling) release(node);
-  return changed || !pulling.empty();
+  for (const auto& [node, held] : penetrating) hold(node, held);
+  return !pulling.empty() || !penetrating.empty();
 }
 
 bool Simulation::update_boundary(const std::vector<bool>& under_tool) {
