@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "common/contact/contact_patch.h"
 #include "common/contact/find_contact.h"
 #include "common/contact/nearest_surface_nodes.h"
 #include "common/util/stopwatch.h"
@@ -117,7 +118,7 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
   return !pulling.empty() || !penetrating.empty();
 }
 
-bool Simulation::update_boundary(const std::vector<bool>& under_tool) {
+bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch) {
   boundary_dirty_ = false;
   const std::vector<int> current = condensation_.boundary_nodes();
   for (int node : current)
@@ -130,7 +131,8 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool) {
   bool step_delay_held = false;
   for (const auto& [node, held] : held_) step_delay_held |= held.obstacle < 0;
   if (options_.step_delay_nodes > 0 && !contact_points.empty() && !step_delay_held) {
-    const std::vector<int> nodes = nearest_surface_nodes(model_, contact_points, options_.step_delay_nodes, under_tool);
+    // Chosen outside every user's patch, so that the patches keep their triangles.
+    const std::vector<int> nodes = nearest_surface_nodes(model_, contact_points, options_.step_delay_nodes, in_patch);
     std::vector<int> fresh;
     for (int node : nodes)
       if (!held_.count(node)) fresh.push_back(node);
@@ -153,6 +155,9 @@ StepReport Simulation::step(double time) {
   StepReport report;
   std::vector<UserTool> tools;
   std::vector<bool> under_tool(static_cast<std::size_t>(model_.mesh.node_count()), false);
+  std::vector<bool> in_patch(under_tool.size(), false);
+  std::vector<bool> touchable(model_.surface.triangles.size(), false);
+  for (int t : model_.touchable_triangles) touchable[t] = true;
   for (std::size_t u = 0; u < users_.size(); ++u) {
     UserState& user = users_[u];
     if (!user.known) {
@@ -168,13 +173,15 @@ StepReport Simulation::step(double time) {
     user.nearest = nearest_triangle(model_.mesh, model_.surface, model_.normals, model_.touchable_triangles, user.position)
                        .triangle;
     for (int node : model_.surface.triangles[user.nearest]) under_tool[node] = true;
+    for (int t : contact_patch(model_.surface, user.nearest, options_.ir.patch_rings, touchable))
+      for (int node : model_.surface.triangles[t]) in_patch[node] = true;
     tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest});
   }
   std::vector<int> nearest;
   for (const UserState& user : users_) nearest.push_back(user.known ? user.nearest : -1);
 
   Stopwatch watch;
-  const bool boundary_changed = update_boundary(under_tool);
+  const bool boundary_changed = update_boundary(under_tool, in_patch);
   if (boundary_changed || nearest != built_nearest_) {
     const std::vector<Eigen::Vector3d> held = boundary_displacement();
     for (std::size_t i = 0; i < tools.size(); ++i) {

@@ -4,8 +4,9 @@
 //   1. finds every tool's nearest touchable triangle and whether it presses;
 //   2. updates the colliding boundary set B, the nodes held at a prescribed displacement:
 //      - step delay (the paper's T150/T300): with `step_delay_nodes` = N, the N surface
-//        nodes nearest the pressing tools join B when contact begins, held where they were
-//        at the previous step (before the touch), and leave when no tool presses;
+//        nodes nearest the pressing tools, outside every user's patch, join B when contact
+//        begins, held where they were at the previous step (before the touch), and leave
+//        when no tool presses;
 //      - rigid obstacles: a surface node whose displaced position penetrates an obstacle
 //        joins B, held at its closest point on the obstacle; a held node whose holding
 //        force would pull it into the obstacle is released. The active set is iterated up
@@ -96,7 +97,7 @@ class Simulation {
   };
   std::vector<PressingContact> pressing_contacts() const;
   StateSolution solve(std::span<const PressingContact> contacts) const;
-  bool update_boundary(const std::vector<bool>& under_tool);
+  bool update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch);
   bool update_obstacle_contacts(const std::vector<bool>& under_tool);
   void hold(int node, const HeldNode& held);
   void release(int node);
