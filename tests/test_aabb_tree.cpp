@@ -81,14 +81,6 @@ int expect_matches_linear_scan(const AabbTree& tree, const Eigen::Matrix3Xd& ver
   return ties;
 }
 
-Vector3d random_direction(std::mt19937& rng) {
-  std::normal_distribution<double> normal;
-  for (;;) {
-    const Vector3d d(normal(rng), normal(rng), normal(rng));
-    if (d.norm() > 1e-6) return d.normalized();
-  }
-}
-
 TEST(AabbTree, MatchesLinearScanOnPerturbedIcosphere) {
   TriangleSurface surface = testing::make_icosphere(3, 1.0);
   std::mt19937 rng(7);
@@ -100,8 +92,8 @@ TEST(AabbTree, MatchesLinearScanOnPerturbedIcosphere) {
   std::vector<Vector3d> points;
   std::uniform_real_distribution<double> box(-2, 2), shell(0.8, 1.2), far(2, 20);
   for (int i = 0; i < 1000; ++i) points.emplace_back(box(rng), box(rng), box(rng));
-  for (int i = 0; i < 1000; ++i) points.push_back(shell(rng) * random_direction(rng));
-  for (int i = 0; i < 300; ++i) points.push_back(far(rng) * random_direction(rng));
+  for (int i = 0; i < 1000; ++i) points.push_back(shell(rng) * testing::random_direction(rng));
+  for (int i = 0; i < 300; ++i) points.push_back(far(rng) * testing::random_direction(rng));
   // Exactly at vertices and edge midpoints, where several triangles tie.
   for (Eigen::Index v = 0; v < surface.vertices.cols(); v += 7) points.push_back(surface.vertices.col(v));
   for (int t = 0; t < surface.triangle_count(); t += 11) {
@@ -162,7 +154,7 @@ TEST(AabbTree, FindsNothingBeyondMaxDistance) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> radius(0.2, 4);
   for (int i = 0; i < 500; ++i) {
-    const Vector3d p = radius(rng) * random_direction(rng);
+    const Vector3d p = radius(rng) * testing::random_direction(rng);
     const Scan reference = linear_scan(surface.vertices, surface.triangles, p);
     const double d = std::sqrt(reference.distance2);
     const AabbHit short_reach = tree.closest_triangle(p, 0.999 * d);

@@ -26,13 +26,7 @@
 namespace cohaptic {
 namespace {
 
-struct Rig {
-  std::unique_ptr<Model> model;
-  std::unique_ptr<ComplianceColumns> columns;
-  explicit Rig(const testing::CubeSceneOptions& options)
-      : model(std::make_unique<Model>(build_model(parse_scene(testing::cube_scene_yaml(options), "cube.yaml")))),
-        columns(std::make_unique<ComplianceColumns>(*model->free_factor, model->dofs, model->surface.nodes)) {}
-};
+using Rig = testing::CubeRig;
 
 testing::CubeSceneOptions cube(int divisions) {
   testing::CubeSceneOptions options;

@@ -16,14 +16,7 @@
 namespace cohaptic {
 namespace {
 
-// A cube model with compliance rows over its whole surface (any node may be held).
-struct Rig {
-  std::unique_ptr<Model> model;
-  std::unique_ptr<ComplianceColumns> columns;
-  explicit Rig(const testing::CubeSceneOptions& options = {})
-      : model(std::make_unique<Model>(build_model(parse_scene(testing::cube_scene_yaml(options), "cube.yaml")))),
-        columns(std::make_unique<ComplianceColumns>(*model->free_factor, model->dofs, model->surface.nodes)) {}
-};
+using Rig = testing::CubeRig;
 
 Rig& shared_cube() {
   static Rig rig;

@@ -44,20 +44,12 @@ double smallest_plane_distance(const TriangleSurface& s) {
   return r_min;
 }
 
-Vector3d random_direction(std::mt19937& rng) {
-  std::normal_distribution<double> normal;
-  for (;;) {
-    const Vector3d d(normal(rng), normal(rng), normal(rng));
-    if (d.norm() > 1e-6) return d.normalized();
-  }
-}
-
 /// `count` points at radii drawn uniformly from [r0, r1], in random directions.
 Eigen::Matrix3Xd points_in_shell(int count, double r0, double r1, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> radius(r0, r1);
   Eigen::Matrix3Xd points(3, count);
-  for (int i = 0; i < count; ++i) points.col(i) = radius(rng) * random_direction(rng);
+  for (int i = 0; i < count; ++i) points.col(i) = radius(rng) * testing::random_direction(rng);
   return points;
 }
 

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "common/scene/load_scene.h"
+
 namespace cohaptic::testing {
 
 std::string cube_scene_yaml(const CubeSceneOptions& o) {
@@ -20,5 +22,9 @@ haptic: {{force_limit: {6}}}
 )",
                      o.divisions, o.youngs_modulus, o.poisson_ratio, o.touchable, o.obstacles, o.tools, o.force_limit);
 }
+
+CubeRig::CubeRig(const CubeSceneOptions& options)
+    : model(std::make_unique<Model>(build_model(parse_scene(cube_scene_yaml(options), "cube.yaml")))),
+      columns(std::make_unique<ComplianceColumns>(*model->free_factor, model->dofs, model->surface.nodes)) {}
 
 }  // namespace cohaptic::testing

@@ -1,7 +1,11 @@
 // The paper's cube as scene text, with the knobs tests and benchmarks turn.
 #pragma once
 
+#include <memory>
 #include <string>
+
+#include "common/fem/compliance.h"
+#include "common/model/model.h"
 
 namespace cohaptic::testing {
 
@@ -17,5 +21,12 @@ struct CubeSceneOptions {
 
 /// A 130 mm cube (z from -130 to 0 mm), rear face fixed, in millimetres.
 std::string cube_scene_yaml(const CubeSceneOptions& options = {});
+
+/// The cube's model and its compliance columns over the whole surface (any node may be held).
+struct CubeRig {
+  std::unique_ptr<Model> model;
+  std::unique_ptr<ComplianceColumns> columns;
+  explicit CubeRig(const CubeSceneOptions& options = {});
+};
 
 }  // namespace cohaptic::testing

@@ -55,6 +55,14 @@ TriangleSurface make_icosphere(int level, double radius) {
   return s;
 }
 
+Eigen::Vector3d random_direction(std::mt19937& rng) {
+  std::normal_distribution<double> normal;
+  for (;;) {
+    const Eigen::Vector3d d(normal(rng), normal(rng), normal(rng));
+    if (d.norm() > 1e-6) return d.normalized();
+  }
+}
+
 std::string source_path(const std::string& relative) { return std::string(COHAPTIC_SOURCE_DIR) + "/" + relative; }
 
 }  // namespace cohaptic::testing

@@ -1,6 +1,7 @@
 // Meshes shared by tests and benchmarks.
 #pragma once
 
+#include <random>
 #include <string>
 
 #include "common/mesh/tet_mesh.h"
@@ -16,6 +17,9 @@ TetMesh distorted_box_mesh(double size, int divisions, double jitter, unsigned s
 /// Icosahedron subdivided `level` times (each triangle into four), vertices on the sphere
 /// of `radius`, triangles counter-clockwise seen from outside: 20 * 4^level triangles.
 TriangleSurface make_icosphere(int level, double radius);
+
+/// A uniformly distributed unit vector.
+Eigen::Vector3d random_direction(std::mt19937& rng);
 
 /// Path of a file under the source tree (tests read their data from tests/data).
 std::string source_path(const std::string& relative);
