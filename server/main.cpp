@@ -67,9 +67,9 @@ int main(int argc, char** argv) {
   probe_cmd->add_option("--ir-precision", precision, "Storage of M~ and u_B in the IR: f64 or f32 (inversion is always double)")
       ->check(CLI::IsMember({"f64", "f32"}))
       ->capture_default_str();
-  probe_cmd->add_option("--patch-rings", probe.patch_rings, "Rings of neighbouring triangles in each IR's contact patch")
-      ->check(CLI::Range(0, 4))
-      ->capture_default_str();
+  probe_cmd->add_option("--patch-rings", probe.patch_rings,
+                        "Rings of neighbouring triangles in each IR's contact patch (0-4); default: the scene's")
+      ->check(CLI::Range(0, 4));
   probe_cmd->add_flag("--reference", probe.reference,
                       "Full sparse FEM solve instead of the condensed IR (slow; the answer the IR is checked against)");
   probe_cmd->add_flag("--json", probe.json, "Print one JSON object on stdout instead of the table");

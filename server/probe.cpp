@@ -42,7 +42,7 @@ const char* model_name(ContactModel model) {
 void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& options, ContactModel contact_model,
            std::vector<ProbedTool>& tools, const std::vector<int>& users, ProbeTimings& timings) {
   SimulationOptions sim_options;
-  sim_options.ir.patch_rings = options.patch_rings;
+  sim_options.ir.patch_rings = options.patch_rings.value_or(model.scene.haptic.patch_rings);
   sim_options.ir.precision = options.precision;
   sim_options.ir.contact_model = contact_model;
   sim_options.ir.force_limit = std::numeric_limits<double>::infinity();  // the probe reports physics
@@ -94,7 +94,7 @@ nlohmann::json probe_json(const Model& model, const ProbeOptions& options, Conta
   out["method"] = options.reference ? "reference" : "ir";
   out["contact_model"] = model_name(contact_model);
   out["ir_precision"] = options.precision == IrPrecision::f32 ? "f32" : "f64";
-  out["patch_rings"] = options.patch_rings;
+  out["patch_rings"] = options.patch_rings.value_or(model.scene.haptic.patch_rings);
   out["tools_pressed"] = options.separately ? "separately" : "together";
   out["tools"] = nlohmann::json::array();
   for (const ProbedTool& probed : tools) {
@@ -145,7 +145,7 @@ void print_table(const Model& model, const ProbeOptions& options, ContactModel c
   fmt::print("method    {}; contact model {}; tools pressed {}; {} boundary nodes held\n",
              options.reference ? "full sparse solve (--reference)"
                                : fmt::format("IR ({}, patch rings {})", options.precision == IrPrecision::f32 ? "f32" : "f64",
-                                             options.patch_rings),
+                                             options.patch_rings.value_or(model.scene.haptic.patch_rings)),
              model_name(contact_model), options.separately ? "one at a time" : "together",
              tools.empty() ? 0 : tools.front().boundary_nodes);
   fmt::print("\n{:<4} {:<28} {:>10} {:<20} {:<28} {:<30} {:>9} {:>9}\n", "tool", fmt::format("position ({})", u),

@@ -22,7 +22,7 @@ struct ProbeOptions {
   bool json = false;
   bool reference = false;              ///< full sparse solve instead of the IR
   int boundary_nodes = 0;              ///< step-delay boundary nodes held at rest
-  int patch_rings = 1;
+  std::optional<int> patch_rings;      ///< default: the scene's
   std::optional<ContactModel> contact_model;  ///< default: the scene's
   IrPrecision precision = IrPrecision::f64;
   std::filesystem::path export_vtu;    ///< empty: no export

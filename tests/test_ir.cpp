@@ -260,6 +260,33 @@ TEST(IntermediateRepresentation, PastThePatchTheForceIsHeldAndTheNextIrCatchesUp
   EXPECT_LT((exact - previous).norm(), 0.25 * exact.norm());
 }
 
+TEST(IntermediateRepresentation, SphereToolsEqualTheFullSolve) {
+  Rig& rig = shared_cube();
+  const Model& model = *rig.model;
+  const double radius = 4e-3;
+  for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
+    std::vector<ToolSpec> tools(2);
+    for (ToolSpec& tool : tools) {
+      tool.shape = ToolShape::sphere;
+      tool.radius = radius;
+    }
+    Simulation simulation(model, *rig.columns, tools, unlimited(contact_model));
+    // Centres outside the surface (1 mm above it) and inside (2 mm below): both press.
+    const std::vector<Eigen::Vector3d> centres = {mm(-20, 5, 1), mm(25, -5, -2)};
+    simulation.set_tool(0, centres[0]);
+    simulation.set_tool(1, centres[1]);
+    simulation.step(0);
+    std::vector<PressedTool> pressed = {{centres[0], radius}, {centres[1], radius}};
+    const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
+    const auto reference = contact_reactions_reference(model, find_tool_contacts(model, pressed), held, contact_model);
+    for (int user = 0; user < 2; ++user) {
+      ASSERT_TRUE(reference[user].query.contact.has_value());
+      EXPECT_NEAR(reference[user].query.contact->depth, user == 0 ? 3e-3 : 6e-3, 1e-12);
+      EXPECT_LE(relative_error(simulation.force(user).force, reference[user].reaction), 1e-9) << "user " << user;
+    }
+  }
+}
+
 TEST(IntermediateRepresentation, NonFiniteToolsGiveZeroOrAreIgnored) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;

@@ -50,7 +50,8 @@ class IncrementalCondensation {
   void add_boundary_node(int node);
   /// A node leaves B. Throws Error if it is not in B.
   void remove_boundary_node(int node);
-  /// Adds and removes nodes so that B equals `nodes` (order of new joins as given).
+  /// Adds and removes nodes so that B equals `nodes` (order of new joins as given). More
+  /// than kBulkJoin new nodes are appended at once and factored from scratch.
   void set_boundary_nodes(std::span<const int> nodes);
 
   /// M~ for contact nodes `contact_nodes` (none of them in B). Throws NumericalError if the
@@ -65,11 +66,13 @@ class IncrementalCondensation {
   const Statistics& statistics() const { return stats_; }
 
  private:
+  static constexpr std::size_t kBulkJoin = 16;
   struct CachedZ {
     Eigen::MatrixXd z;  ///< n x (free dofs of the node)
     long last_used = 0;
   };
   void ensure_capacity(int size);
+  void factor_from_scratch(const char* failure);
   void after_update();
   double check_residuals();
   void compute_z(std::span<const int> nodes);

@@ -81,6 +81,7 @@ struct HapticSettings {
   double rate_hz = 1000;
   double force_limit_n = 3.3;  ///< the PHANToM Omni's peak force
   ContactModel contact_model = ContactModel::node_translation;
+  int patch_rings = 1;  ///< rings of neighbouring triangles in each IR's contact patch
 };
 
 struct Scene {
