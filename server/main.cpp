@@ -1,5 +1,9 @@
-// cohaptic-server: the simulation server's command line. Subcommands:
-//   probe  static reaction forces at tool positions on a scene (see README.md).
+// cohaptic-server: the simulation server.
+//   cohaptic-server --scene FILE --listen HOST:PORT [...]   serve a scene to haptic clients
+//   cohaptic-server probe ...                               static forces at tool positions
+//   cohaptic-server keygen FILE                             a new session key file
+//   cohaptic-server summarize ...                           merge reports, judge a session
+// See README.md for every option.
 #include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -8,7 +12,10 @@
 
 #include "common/model/compliance_setup.h"
 #include "common/util/error.h"
+#include "proto/wire/session_key.h"
 #include "server/probe.h"
+#include "server/session_summary.h"
+#include "server/simulation_server.h"
 
 namespace {
 
@@ -23,6 +30,21 @@ std::string parse_point(const std::string& text, Eigen::Vector3d& point) {
   return {};
 }
 
+// Parses "HOST:PORT".
+std::string parse_listen(const std::string& text, std::string& host, std::uint16_t& port) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0) return "expected HOST:PORT, got '" + text + "'";
+  try {
+    const int value = std::stoi(text.substr(colon + 1));
+    if (value < 0 || value > 65535) return "port out of range in '" + text + "'";
+    port = static_cast<std::uint16_t>(value);
+  } catch (const std::exception&) {
+    return "expected a port number after ':' in '" + text + "'";
+  }
+  host = text.substr(0, colon);
+  return {};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -30,14 +52,56 @@ int main(int argc, char** argv) {
   spdlog::set_default_logger(logger);
   spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
 
-  CLI::App app{"cohaptic-server: FEM simulation server for networked haptic collaboration"};
-  app.require_subcommand(1);
-  app.fallthrough();  // --log-level may follow the subcommand
+  CLI::App app{"cohaptic-server: FEM simulation server for networked haptic collaboration. Serves a scene to "
+               "haptic clients (--scene, --listen), or runs a subcommand."};
+  app.require_subcommand(0, 1);
+  app.fallthrough();  // --log-level may follow a subcommand
   std::string log_level = "info";
   app.add_option("--log-level", log_level, "Log verbosity on stderr: trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
       ->capture_default_str();
 
+  // Serving.
+  cohaptic::ServeOptions serve;
+  std::string listen = "127.0.0.1:7400", protocol = "P1", condensation = "incremental", serve_precision = "f64";
+  std::string serve_cache_dir = cohaptic::default_cache_directory().string();
+  bool serve_no_disk_cache = false;
+  app.add_option("--scene", serve.scene, "Scene file (YAML) to serve")->check(CLI::ExistingFile);
+  app.add_option("--listen", listen, "HOST:PORT for TCP control and UDP samples (port 0: any free port)")->capture_default_str();
+  app.add_option("--protocol", protocol, "P0: the server computes the force, the client holds it; P1: the server "
+                                         "sends the IR, the client computes the force at its haptic rate")
+      ->check(CLI::IsMember({"P0", "P1"}))
+      ->capture_default_str();
+  app.add_option("--key-file", serve.key_file, "Session key (64 hex characters); without it the public development key")
+      ->check(CLI::ExistingFile);
+  app.add_option("--shift-delay-ms", serve.shift.delay_ms, "Injected one-way delay on every link, each direction [ms]")
+      ->capture_default_str();
+  app.add_option("--jitter-ms", serve.shift.jitter_ms, "Injected jitter: extra delay drawn from U(0, J) ms")->capture_default_str();
+  app.add_option("--loss", serve.shift.loss, "Injected loss probability of UDP datagrams")->capture_default_str();
+  app.add_option("--reorder", serve.shift.reorder, "Probability that a datagram is held back past later ones")->capture_default_str();
+  app.add_option("--seed", serve.shift.seed, "Seed of the injected delays")->capture_default_str();
+  app.add_option("--step-nodes", serve.step_nodes,
+                 "Step delay, the natural kind: hold this many surface nodes near the contact (the paper's T150/T300)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--sim-rate-hz", serve.sim_rate_hz, "Step delay, the capped kind: simulation loop rate (0: up to 1 kHz)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--condensation", condensation,
+                 "incremental (M~ updated when a set changes) or naive (rebuilt from scratch every step, as the "
+                 "paper's conventional loop)")
+      ->check(CLI::IsMember({"incremental", "naive"}))
+      ->capture_default_str();
+  app.add_option("--ir-precision", serve_precision, "Storage of M~ and u_B in the IRs sent: f64 or f32")
+      ->check(CLI::IsMember({"f64", "f32"}))
+      ->capture_default_str();
+  app.add_option("--duration", serve.duration_s, "Stop after S seconds (0: until SIGINT/SIGTERM)")->capture_default_str();
+  app.add_option("--report", serve.report, "Write a JSON report here at exit");
+  app.add_option("--client-timeout", serve.client_timeout_s, "Release a tool after S seconds without samples")->capture_default_str();
+  app.add_option("--cache-dir", serve_cache_dir, "Directory of the on-disk compliance cache")->capture_default_str();
+  app.add_flag("--no-disk-cache", serve_no_disk_cache, "Neither read nor write the on-disk compliance cache");
+
+  // probe
   cohaptic::ProbeOptions probe;
   std::vector<std::string> tool_texts;
   std::string cache_dir = cohaptic::default_cache_directory().string();
@@ -54,7 +118,7 @@ int main(int argc, char** argv) {
                    "Tool k takes the shape of the scene's k-th tool (the last one if there are fewer)")
       ->required();
   probe_cmd->add_flag("--separately", probe.separately,
-                     "Press each tool alone (one solve per tool) instead of all tools at once");
+                      "Press each tool alone (one solve per tool) instead of all tools at once");
   std::string contact_model, precision = "f64";
   probe_cmd->add_option("--boundary-nodes", probe.boundary_nodes,
                         "Hold the N surface nodes nearest the tools at rest (the paper's step-delay T150/T300 sets)")
@@ -78,6 +142,20 @@ int main(int argc, char** argv) {
   probe_cmd->add_option("--cache-dir", cache_dir, "Directory of the on-disk compliance cache")->capture_default_str();
   probe_cmd->add_flag("--no-disk-cache", no_disk_cache, "Neither read nor write the on-disk compliance cache");
 
+  // keygen
+  std::string key_path;
+  CLI::App* keygen_cmd = app.add_subcommand("keygen", "Write a new random session key file (mode 0600)");
+  keygen_cmd->add_option("file", key_path, "Where to write it")->required();
+
+  // summarize
+  std::filesystem::path summary_server, summary_out;
+  std::vector<std::filesystem::path> summary_clients;
+  CLI::App* summarize_cmd = app.add_subcommand(
+      "summarize", "Merge a session's server and client reports, print a table and judge its health (exit 3 if unhealthy)");
+  summarize_cmd->add_option("--server-report", summary_server, "The server's --report")->required()->check(CLI::ExistingFile);
+  summarize_cmd->add_option("--client-report", summary_clients, "A client's --report (repeat)")->required()->check(CLI::ExistingFile);
+  summarize_cmd->add_option("--out", summary_out, "Write the merged report here");
+
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));
 
@@ -98,6 +176,27 @@ int main(int argc, char** argv) {
       probe.precision = precision == "f32" ? cohaptic::IrPrecision::f32 : cohaptic::IrPrecision::f64;
       return cohaptic::run_probe(probe);
     }
+    if (summarize_cmd->parsed()) return cohaptic::run_summarize(summary_server, summary_clients, summary_out);
+    if (keygen_cmd->parsed()) {
+      cohaptic::wire::write_session_key(key_path);
+      spdlog::info("wrote a new session key to {}", key_path);
+      return 0;
+    }
+    if (serve.scene.empty()) {
+      fmt::print(stderr, "cohaptic-server: --scene is required to serve (or give a subcommand; see --help)\n");
+      return 2;
+    }
+    if (const std::string problem = parse_listen(listen, serve.host, serve.port); !problem.empty()) {
+      fmt::print(stderr, "cohaptic-server: --listen: {}\n", problem);
+      return 2;
+    }
+    serve.protocol = protocol == "P0" ? cohaptic::ServeProtocol::p0 : cohaptic::ServeProtocol::p1;
+    serve.naive_condensation = condensation == "naive";
+    serve.precision = serve_precision == "f32" ? cohaptic::IrPrecision::f32 : cohaptic::IrPrecision::f64;
+    if (!serve_no_disk_cache) serve.cache_directory = serve_cache_dir;
+    cohaptic::SimulationServer server(serve);
+    server.run();
+    return 0;
   } catch (const cohaptic::Error& e) {
     spdlog::error("{}", e.what());
     return 1;
@@ -105,5 +204,4 @@ int main(int argc, char** argv) {
     spdlog::error("unexpected failure: {}", e.what());
     return 1;
   }
-  return 0;
 }

@@ -222,6 +222,7 @@ CondensedOperator IncrementalCondensation::condense(std::span<const int> contact
   ++clock_;
   for (int node : contact_nodes)
     if (in_boundary(node)) throw Error(fmt::format("node {} is both a contact and a boundary node", node));
+  if (options_.naive) return naive_condensation(columns_, dofs_, contact_nodes, b_nodes_);
   compute_z(contact_nodes);
 
   CondensedOperator op;

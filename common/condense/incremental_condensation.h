@@ -30,6 +30,9 @@ class IncrementalCondensation {
     double drift_tolerance = 1e-12;  ///< normwise backward error that triggers a refactorisation
     int check_interval = 32;         ///< updates between residual checks
     std::size_t z_cache_nodes = 64;  ///< contact nodes whose Z columns are kept and updated
+    /// condense() refactors L_AA from scratch instead (the paper's conventional loop; makes
+    /// the step delay of large boundary sets appear naturally).
+    bool naive = false;
   };
   struct Statistics {
     long joins = 0, leaves = 0, residual_checks = 0, refactorizations = 0;

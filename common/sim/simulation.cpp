@@ -12,7 +12,14 @@ namespace cohaptic {
 
 Simulation::Simulation(const Model& model, ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
                        SimulationOptions options)
-    : model_(model), columns_(columns), options_(options), condensation_(columns, model.dofs) {
+    : model_(model),
+      columns_(columns),
+      options_(options),
+      condensation_(columns, model.dofs, [&] {
+        IncrementalCondensation::Options condensation;
+        condensation.naive = options.naive_every_step;
+        return condensation;
+      }()) {
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
   if (!model.obstacles.empty()) {
@@ -114,6 +121,9 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
     }
   }
   for (int node : pulling) release(node);
+  std::vector<int> joining;
+  for (const auto& entry : penetrating) joining.push_back(entry.first);
+  columns_.compute_columns(joining);  // one multi-right-hand-side solve for all that join
   for (const auto& [node, held] : penetrating) hold(node, held);
   return !pulling.empty() || !penetrating.empty();
 }
@@ -182,7 +192,7 @@ StepReport Simulation::step(double time) {
 
   Stopwatch watch;
   const bool boundary_changed = update_boundary(under_tool, in_patch);
-  if (boundary_changed || nearest != built_nearest_) {
+  if (boundary_changed || nearest != built_nearest_ || options_.naive_every_step) {
     const std::vector<Eigen::Vector3d> held = boundary_displacement();
     for (std::size_t i = 0; i < tools.size(); ++i) {
       UserState& user = users_[tools[i].user];

@@ -1,0 +1,71 @@
+// ClientNetwork: the haptic client's I/O thread (DESIGN.md §4-§5).
+//
+// It owns the sockets and an asio io_context run on one thread:
+//   - TCP control: join, the server's welcome, IRs (converted, checked and prepared here,
+//     then handed to the haptic thread through a TripleBuffer), events, goodbye;
+//   - UDP: own tool samples (drained from the haptic thread's ring every millisecond and
+//     stamped with the server's clock), remote tool samples and P0 forces (validated, then
+//     handed over), clock pings every 100 ms (NTP-style offset, smallest round trip wins);
+//   - when the server goes away it keeps trying to reconnect every 500 ms; meanwhile no IR
+//     or force arrives, so the haptic loop fades the force to zero.
+// All authentication and validation is done here: nothing unchecked reaches the haptic
+// thread. Units: ns of CLOCK_MONOTONIC, m, N.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "client/haptic_loop.h"
+
+namespace cohaptic {
+
+struct ClientOptions {
+  std::string host = "127.0.0.1";
+  std::uint16_t port = 7400;
+  std::string user_name;
+  std::optional<std::filesystem::path> key_file;  ///< empty: the public development key
+  int requested_slot = -1;                        ///< -1: any free slot
+  std::filesystem::path trace_directory;          ///< empty: no trace (per-tick CSV and the IRs received)
+};
+
+/// What the server told us when we joined.
+struct WelcomeInfo {
+  int slot = 0;
+  std::string scene_name;
+  std::string scene_yaml;
+  HapticProtocol protocol = HapticProtocol::p1;
+  double force_limit = 0;
+  double haptic_rate_hz = 1000;
+  double ir_max_age_s = 0.5;
+  int user_count = 0;
+};
+
+class ClientNetwork {
+ public:
+  ClientNetwork(ClientOptions options, HapticChannels& channels);
+  ~ClientNetwork();
+  ClientNetwork(const ClientNetwork&) = delete;
+  ClientNetwork& operator=(const ClientNetwork&) = delete;
+
+  /// Starts the I/O thread and joins the session; returns the welcome, or throws Error
+  /// if none arrives within `timeout_s`.
+  WelcomeInfo start(double timeout_s);
+  /// Stops the I/O thread (after a last drain of the haptic thread's rings).
+  void stop();
+  /// Set by SIGINT/SIGTERM, or when the server says goodbye and never comes back.
+  const std::atomic<bool>& stop_requested() const { return stop_requested_; }
+
+  nlohmann::json report() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::atomic<bool> stop_requested_{false};
+};
+
+}  // namespace cohaptic

@@ -1,0 +1,85 @@
+#include "client/device/make_device.h"
+
+#include <charconv>
+#include <fmt/format.h>
+#include <functional>
+
+#include "client/device/bridge_device.h"
+#include "client/device/hand_model.h"
+#include "client/device/scripted_device.h"
+#include "client/device/trajectory.h"
+#include "common/util/error.h"
+
+namespace cohaptic {
+namespace {
+
+struct DeviceKind {
+  const char* prefix;  // before the first ':'
+  const char* usage;   // the whole form, for messages
+  std::function<std::unique_ptr<HapticDevice>(const std::string& args, double force_limit)> make;
+};
+
+std::uint16_t parse_port(const std::string& text, const std::string& spec) {
+  unsigned value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end || value < 1 || value > 65535)
+    throw Error(fmt::format("device '{}': expected a port from 1 to 65535, found '{}'", spec, text));
+  return static_cast<std::uint16_t>(value);
+}
+
+std::unique_ptr<HapticDevice> make_bridge(const std::string& args, double force_limit, const std::string& spec) {
+  BridgeOptions options;
+  const auto colon = args.rfind(':');
+  if (colon == std::string::npos) {
+    options.port = parse_port(args, spec);
+  } else {
+    std::string host = args.substr(0, colon);
+    if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+    if (host.empty()) throw Error(fmt::format("device '{}': expected a host before ':PORT'", spec));
+    options.host = host;
+    options.port = parse_port(args.substr(colon + 1), spec);
+  }
+  return std::make_unique<BridgeDevice>(options, force_limit);
+}
+
+// One entry per kind; a new kind (e.g. replay:FILE[:user]) is one more entry.
+const std::vector<DeviceKind>& kinds() {
+  static const std::vector<DeviceKind> table{
+      {"script", "script:FILE        play the trajectory in FILE (open loop)",
+       [](const std::string& file, double limit) -> std::unique_ptr<HapticDevice> {
+         return std::make_unique<ScriptedDevice>(load_trajectory(file), limit);
+       }},
+      {"hand", "hand:FILE          a mass-spring-damper hand tracking the trajectory in FILE (closed loop)",
+       [](const std::string& file, double limit) -> std::unique_ptr<HapticDevice> {
+         Trajectory reference = load_trajectory(file);
+         const HandParameters parameters = load_hand_parameters(file).value_or(HandParameters{});
+         return std::make_unique<HandModelDevice>(std::move(reference), parameters, limit);
+       }},
+      {"bridge", "bridge:[HOST:]PORT an external program sending poses to UDP HOST:PORT (default host 127.0.0.1)",
+       [](const std::string& args, double limit) { return make_bridge(args, limit, "bridge:" + args); }},
+  };
+  return table;
+}
+
+}  // namespace
+
+std::vector<std::string> device_spec_forms() {
+  std::vector<std::string> out;
+  for (const DeviceKind& kind : kinds()) out.emplace_back(kind.usage);
+  return out;
+}
+
+std::unique_ptr<HapticDevice> make_device(const std::string& spec, double force_limit) {
+  const auto colon = spec.find(':');
+  if (colon != std::string::npos && colon + 1 < spec.size()) {
+    const std::string prefix = spec.substr(0, colon);
+    for (const DeviceKind& kind : kinds())
+      if (prefix == kind.prefix) return kind.make(spec.substr(colon + 1), force_limit);
+  }
+  std::string forms;
+  for (const DeviceKind& kind : kinds()) forms += fmt::format("\n  {}", kind.usage);
+  throw Error(fmt::format("unknown device '{}'; accepted forms:{}", spec, forms));
+}
+
+}  // namespace cohaptic

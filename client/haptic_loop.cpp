@@ -1,0 +1,175 @@
+#include "client/haptic_loop.h"
+
+#include <pthread.h>
+#include <sched.h>
+#include <sys/mman.h>
+#include <time.h>
+
+#include <cmath>
+#include <limits>
+
+namespace cohaptic {
+namespace {
+
+std::int64_t now_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+void sleep_until(std::int64_t deadline_ns) {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(deadline_ns / 1'000'000'000);
+  ts.tv_nsec = static_cast<long>(deadline_ns % 1'000'000'000);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) != 0) {
+  }
+}
+
+// Advances `deadline` past `woke`, returning how many whole periods were missed.
+std::uint64_t skip_missed(std::int64_t& deadline, std::int64_t woke, std::int64_t period) {
+  if (woke < deadline + period) return 0;
+  const auto missed = static_cast<std::uint64_t>((woke - deadline) / period);
+  deadline += static_cast<std::int64_t>(missed) * period;
+  return missed;
+}
+
+}  // namespace
+
+bool enter_realtime(int priority) {
+  sched_param param{};
+  param.sched_priority = priority;
+  const bool fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+  const bool locked = mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+  return fifo && locked;
+}
+
+void TimerFloor::run(double rate_hz, const std::atomic<bool>& stop, bool realtime) {
+  if (realtime) enter_realtime(79);
+  const auto period = static_cast<std::int64_t>(1e9 / rate_hz);
+  std::int64_t deadline = now_ns() + period;
+  std::int64_t last = 0;
+  while (!stop.load(std::memory_order_relaxed)) {
+    sleep_until(deadline);
+    const std::int64_t woke = now_ns();
+    if (last) period_ns.record(woke - last);
+    last = woke;
+    missed_deadlines += skip_missed(deadline, woke, period);
+    deadline += period;
+  }
+}
+
+HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings)
+    : device_(device),
+      channels_(channels),
+      settings_(settings),
+      remote_buffers_{RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
+                      RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
+                      RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
+                      RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9))} {}
+
+Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record) {
+  std::int64_t age = std::numeric_limits<std::int64_t>::max();
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  record.remotes.fill(Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  if (settings_.protocol == HapticProtocol::p1) {
+    const IrSlot& slot = channels_.ir.front();
+    if (slot.ir) {
+      const IrConfirmation& confirmed = channels_.confirmation.front();
+      const bool fresh = confirmed.epoch == slot.ir->ir.epoch && confirmed.arrival_ns > slot.arrival_ns;
+      age = now - (fresh ? confirmed.arrival_ns : slot.arrival_ns);
+      const IntermediateRepresentation& ir = slot.ir->ir;
+      std::array<Eigen::Vector3d, kMaxUsers - 1> remotes;
+      const std::size_t count = std::min<std::size_t>(ir.remotes.size(), remotes.size());
+      for (std::size_t r = 0; r < count; ++r) {
+        const PlayoutQuery remote = remote_buffers_[ir.remotes[r].user % kMaxUsers].at(now);
+        remotes[r] = remote.valid ? remote.position : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+        record.remotes[r] = remotes[r];
+      }
+      const ForceSample sample = evaluate_force(*slot.ir, own, std::span(remotes.data(), count));
+      force = sample.force;
+      record.flags = sample.flags;
+      record.ir_epoch = ir.epoch;
+      if (count > 0 && (sample.flags & kInContact)) {
+        const ForceSample alone = evaluate_force(*slot.ir, own, {});
+        metrics_.peak_coupling = std::max(metrics_.peak_coupling, (sample.force - alone.force).norm());
+      }
+    }
+  } else {
+    const ForceSlot& slot = channels_.force.front();
+    if (slot.valid) {
+      age = now - slot.arrival_ns;
+      force = slot.force;
+      record.ir_epoch = slot.epoch;
+    }
+  }
+  if (age != std::numeric_limits<std::int64_t>::max()) metrics_.ir_age_ns.record(age);
+  record.evaluated = force;
+
+  // Stale data fades out.
+  const double age_s = static_cast<double>(age) * 1e-9;
+  float fade = 1;
+  if (age_s > settings_.max_age_s) fade = static_cast<float>(std::max(0.0, 1.0 - (age_s - settings_.max_age_s) / settings_.fade_s));
+  record.fade = fade;
+  force *= static_cast<double>(fade);
+  return force;
+}
+
+void HapticLoop::run(const std::atomic<bool>& stop) {
+  if (settings_.realtime) {
+    metrics_.realtime = enter_realtime(80);
+    channels_.events.push({metrics_.realtime ? HapticEventKind::started_realtime : HapticEventKind::realtime_refused, now_ns(), 0});
+  }
+  const auto period = static_cast<std::int64_t>(1e9 / settings_.rate_hz);
+  const std::int64_t start = now_ns();
+  std::int64_t deadline = start + period;
+  std::int64_t last_woke = 0;
+  std::uint64_t epoch_in_use = 0;
+  while (!stop.load(std::memory_order_relaxed)) {
+    sleep_until(deadline);
+    const std::int64_t woke = now_ns();
+    if (last_woke) metrics_.period_ns.record(woke - last_woke);
+    last_woke = woke;
+    metrics_.missed_deadlines += skip_missed(deadline, woke, period);
+    deadline += period;
+    const double time_s = static_cast<double>(woke - start) * 1e-9;
+    if ((settings_.duration_s > 0 && time_s >= settings_.duration_s) || device_.finished(time_s)) break;
+
+    const DeviceState state = device_.read(time_s);
+    channels_.own_samples.push({woke, state.position, state.buttons, state.valid});
+    while (const auto remote = channels_.remote_samples.pop())
+      remote_buffers_[remote->user % kMaxUsers].add(remote->sample_time_ns, remote->arrival_ns, remote->position, remote->valid);
+    if (settings_.protocol == HapticProtocol::p1 ? channels_.ir.update() : channels_.force.update()) {
+      ++metrics_.ir_switches;
+    }
+    channels_.confirmation.update();
+
+    TickRecord record;
+    record.time_ns = woke;
+    record.own = state.position;
+    Eigen::Vector3d force = state.valid ? compute_force(woke, state.position, record) : Eigen::Vector3d::Zero();
+    if (settings_.protocol == HapticProtocol::p1 && record.ir_epoch != epoch_in_use) {
+      if (epoch_in_use != 0) metrics_.largest_step_on_ir_switch = std::max(metrics_.largest_step_on_ir_switch, (force - last_force_).norm());
+      epoch_in_use = record.ir_epoch;
+    }
+    if (!force.allFinite()) {
+      force.setZero();
+      ++metrics_.non_finite;
+      channels_.events.push({HapticEventKind::non_finite, woke, record.ir_epoch});
+    }
+    const double magnitude = force.norm();
+    if (magnitude > settings_.force_limit) {
+      force *= settings_.force_limit / magnitude;
+      ++metrics_.clamped;
+    }
+    device_.write_force(force, time_s);
+    last_force_ = force;
+    metrics_.peak_force = std::max(metrics_.peak_force, force.norm());
+    record.force = force;
+    if (channels_.tracing.load(std::memory_order_relaxed)) channels_.trace.push(record);
+    ++metrics_.ticks;
+  }
+  device_.write_force(Eigen::Vector3d::Zero(), static_cast<double>(now_ns() - start) * 1e-9);
+  metrics_.elapsed_s = static_cast<double>(now_ns() - start) * 1e-9;
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,152 @@
+// HapticLoop: the client's real-time loop (DESIGN.md §4).
+//
+// Every period, at an absolute deadline (clock_nanosleep on CLOCK_MONOTONIC), it reads the
+// device, hands the own tool sample to the I/O thread, takes in remote tool samples and the
+// newest IR (P1) or force (P0), computes the force, makes it safe and writes it to the
+// device. It takes no lock, allocates nothing and makes no system call but the device's
+// and the sleep: everything crosses threads through SpscRing and TripleBuffer.
+//
+// Late ticks: if it wakes after the next deadline, the missed ticks are skipped and counted
+// and the schedule keeps its phase (no catch-up burst, no drift).
+// Safety: the force is limited to min(device, scene) limit; an IR the server has not
+// confirmed (P1), or a force (P0), older than `max_age` fades the force to zero over
+// `fade`; any non-finite value gives zero and an event. Units: s, m, N; times are CLOCK_MONOTONIC ns.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+#include "client/device/haptic_device.h"
+#include "common/ir/evaluate_force.h"
+#include "common/sync/remote_tool_buffer.h"
+#include "common/util/histogram.h"
+#include "common/util/spsc_ring.h"
+#include "common/util/triple_buffer.h"
+#include "proto/wire/header.h"
+
+namespace cohaptic {
+
+enum class HapticProtocol { p0, p1 };
+
+struct HapticLoopSettings {
+  double rate_hz = 1000;
+  HapticProtocol protocol = HapticProtocol::p1;
+  double force_limit = 3.3;     ///< [N], min of the device's and the scene's
+  double max_age_s = 0.25;      ///< IR (P1) or force (P0) older than this starts to fade
+  double fade_s = 0.1;          ///< time to fade to zero
+  PlayoutPolicy playout = PlayoutPolicy::fixed;
+  double playout_delay_s = 0.005;
+  double duration_s = 0;        ///< 0: until stopped
+  bool realtime = true;         ///< try SCHED_FIFO and mlockall
+};
+
+/// An IR handed to the haptic thread, with when it arrived.
+struct IrSlot {
+  std::unique_ptr<const PreparedIR> ir;
+  std::int64_t arrival_ns = 0;
+};
+
+/// The server's latest confirmation that an IR is still valid (P1), with when it arrived.
+struct IrConfirmation {
+  std::uint64_t epoch = 0;
+  std::int64_t arrival_ns = 0;
+};
+
+/// A P0 force from the server, with when it arrived.
+struct ForceSlot {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  std::int64_t arrival_ns = 0;
+  std::uint64_t epoch = 0;
+  bool valid = false;
+};
+
+struct RemoteSample {
+  std::uint32_t user = 0;
+  std::int64_t sample_time_ns = 0;  ///< local clock
+  std::int64_t arrival_ns = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  bool valid = false;
+};
+
+struct OwnSample {
+  std::int64_t sample_time_ns = 0;  ///< local clock
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  std::uint32_t buttons = 0;
+  bool valid = false;
+};
+
+/// One tick, for traces and offline checks.
+struct TickRecord {
+  std::int64_t time_ns = 0;
+  Eigen::Vector3d own = Eigen::Vector3d::Zero();
+  std::array<Eigen::Vector3d, kMaxUsers - 1> remotes{};  ///< in the IR's remotes order (NaN unused)
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();       ///< as written to the device
+  Eigen::Vector3d evaluated = Eigen::Vector3d::Zero();   ///< before fading and limiting
+  std::uint64_t ir_epoch = 0;
+  std::uint8_t flags = 0;
+  float fade = 1;
+};
+
+enum class HapticEventKind : std::uint8_t { non_finite, ir_switched, fading, started_realtime, realtime_refused };
+struct HapticEvent {
+  HapticEventKind kind = HapticEventKind::non_finite;
+  std::int64_t time_ns = 0;
+  std::uint64_t value = 0;
+};
+
+/// Lock-free channels between the I/O thread and the haptic thread.
+struct HapticChannels {
+  TripleBuffer<IrSlot> ir;                     // I/O -> haptic (P1)
+  TripleBuffer<IrConfirmation> confirmation;   // I/O -> haptic (P1)
+  TripleBuffer<ForceSlot> force;               // I/O -> haptic (P0)
+  SpscRing<RemoteSample, 4096> remote_samples; // I/O -> haptic
+  SpscRing<OwnSample, 4096> own_samples;       // haptic -> I/O
+  SpscRing<TickRecord, 8192> trace;            // haptic -> I/O (only if tracing)
+  SpscRing<HapticEvent, 1024> events;          // haptic -> I/O
+  std::atomic<bool> tracing{false};
+};
+
+struct HapticMetrics {
+  Histogram period_ns{1000, 50000};   ///< 1 us bins up to 50 ms
+  Histogram ir_age_ns{100000, 20000}; ///< 0.1 ms bins up to 2 s
+  std::uint64_t ticks = 0, missed_deadlines = 0, non_finite = 0, clamped = 0, ir_switches = 0;
+  double peak_force = 0;      ///< [N]
+  double peak_coupling = 0;   ///< [N], |F - F without the remote tools|
+  double largest_step_on_ir_switch = 0;  ///< [N]
+  double elapsed_s = 0;
+  bool realtime = false;      ///< SCHED_FIFO and mlockall in effect
+};
+
+class HapticLoop {
+ public:
+  HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings);
+
+  /// Runs until `stop` is set, the duration is over or a scripted device finishes.
+  void run(const std::atomic<bool>& stop);
+  const HapticMetrics& metrics() const { return metrics_; }
+
+ private:
+  Eigen::Vector3d compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record);
+
+  HapticDevice& device_;
+  HapticChannels& channels_;
+  HapticLoopSettings settings_;
+  HapticMetrics metrics_;
+  std::array<RemoteToolBuffer, kMaxUsers> remote_buffers_;
+  Eigen::Vector3d last_force_ = Eigen::Vector3d::Zero();
+};
+
+/// A loop that does nothing but sleep to absolute deadlines at `rate_hz`: the timer floor
+/// the haptic loop is judged against, measured at the same time on the same machine.
+struct TimerFloor {
+  Histogram period_ns{1000, 50000};
+  std::uint64_t missed_deadlines = 0;
+  void run(double rate_hz, const std::atomic<bool>& stop, bool realtime);
+};
+
+/// Tries SCHED_FIFO (priority `priority`) and mlockall for the calling thread; returns
+/// whether both took effect. Never throws.
+bool enter_realtime(int priority);
+
+}  // namespace cohaptic

@@ -1,0 +1,153 @@
+// cohaptic-client: a haptic client. Joins a cohaptic-server session, runs the haptic loop
+// against a device at its rate, and writes a report at the end. See README.md.
+#include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <fstream>
+#include <thread>
+
+#include "client/client_network.h"
+#include "client/device/make_device.h"
+#include "client/haptic_loop.h"
+#include "common/util/atomic_file.h"
+#include "common/util/error.h"
+
+namespace {
+
+std::string parse_server(const std::string& text, std::string& host, std::uint16_t& port) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0) return "expected HOST:PORT, got '" + text + "'";
+  try {
+    const int value = std::stoi(text.substr(colon + 1));
+    if (value <= 0 || value > 65535) return "port out of range in '" + text + "'";
+    port = static_cast<std::uint16_t>(value);
+  } catch (const std::exception&) {
+    return "expected a port number after ':' in '" + text + "'";
+  }
+  host = text.substr(0, colon);
+  return {};
+}
+
+nlohmann::json quantiles_us(const cohaptic::Histogram& h) {
+  return {{"p50", static_cast<double>(h.quantile(0.5)) * 1e-3},
+          {"p99", static_cast<double>(h.quantile(0.99)) * 1e-3},
+          {"max", static_cast<double>(h.max()) * 1e-3}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  auto logger = spdlog::stderr_color_mt("cohaptic");
+  spdlog::set_default_logger(logger);
+  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+
+  CLI::App app{"cohaptic-client: a haptic client of a cohaptic-server session"};
+  std::string server = "127.0.0.1:7400", device_spec, log_level = "info", playout = "fixed";
+  cohaptic::ClientOptions options;
+  cohaptic::HapticLoopSettings settings;
+  std::filesystem::path report_path;
+  double rate_hz = 0, join_timeout_s = 10;
+  bool best_effort = false;
+  int slot = -1;
+  app.add_option("--server", server, "HOST:PORT of the server")->capture_default_str();
+  app.add_option("--user", options.user_name, "Your name, shown to the other users")->required();
+  app.add_option("--device", device_spec,
+                 "script:FILE (scripted trajectory), hand:FILE (hand model tracking the trajectory), "
+                 "bridge:PORT or bridge:HOST:PORT (an external device program over UDP; see client/device/BRIDGE.md)")
+      ->required();
+  app.add_option("--key-file", options.key_file, "Session key (64 hex characters), the server's")->check(CLI::ExistingFile);
+  app.add_option("--slot", slot, "Ask for this user slot (tool) instead of the first free one");
+  app.add_option("--rate-hz", rate_hz, "Haptic loop rate (default: the scene's, usually 1000)");
+  app.add_option("--duration", settings.duration_s, "Stop after S seconds (0: when the device's script ends, or SIGINT)")
+      ->capture_default_str();
+  app.add_option("--playout", playout, "Remote tool playout: newest, fixed or adaptive")
+      ->check(CLI::IsMember({"newest", "fixed", "adaptive"}))
+      ->capture_default_str();
+  app.add_option("--playout-delay-ms", settings.playout_delay_s, "Fixed playout delay [ms] (also the adaptive start)")
+      ->transform([](const std::string& ms) { return std::to_string(std::stod(ms) * 1e-3); });
+  app.add_option("--fade-ms", settings.fade_s, "Time to fade the force out once the IR is too old [ms]")
+      ->transform([](const std::string& ms) { return std::to_string(std::stod(ms) * 1e-3); });
+  app.add_flag("--best-effort", best_effort, "Do not try SCHED_FIFO and mlockall");
+  app.add_option("--report", report_path, "Write a JSON report here at exit");
+  app.add_option("--trace", options.trace_directory, "Write every tick (ticks.csv) and every IR received (ir-*.pb) here");
+  app.add_option("--join-timeout", join_timeout_s, "Give up if the server does not welcome us within S seconds")
+      ->capture_default_str();
+  app.add_option("--log-level", log_level, "Log verbosity: trace, debug, info, warn, error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
+      ->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_level(spdlog::level::from_str(log_level));
+
+  try {
+    if (const std::string problem = parse_server(server, options.host, options.port); !problem.empty()) {
+      fmt::print(stderr, "cohaptic-client: --server: {}\n", problem);
+      return 2;
+    }
+    options.requested_slot = slot;
+    auto channels = std::make_unique<cohaptic::HapticChannels>();
+    cohaptic::ClientNetwork network(options, *channels);
+    const cohaptic::WelcomeInfo welcome = network.start(join_timeout_s);
+
+    std::unique_ptr<cohaptic::HapticDevice> device = cohaptic::make_device(device_spec, welcome.force_limit);
+    device->start();
+    settings.rate_hz = rate_hz > 0 ? rate_hz : welcome.haptic_rate_hz;
+    settings.protocol = welcome.protocol;
+    settings.force_limit = std::min(welcome.force_limit, device->force_limit());
+    settings.max_age_s = welcome.ir_max_age_s;
+    settings.playout = cohaptic::parse_playout_policy(playout);
+    settings.realtime = !best_effort;
+    spdlog::info("haptic loop at {:g} Hz with {} (force limit {:g} N)", settings.rate_hz, device->describe(),
+                 settings.force_limit);
+
+    cohaptic::HapticLoop loop(*device, *channels, settings);
+    std::atomic<bool> floor_stop{false};
+    cohaptic::TimerFloor floor;
+    std::thread floor_thread([&] { floor.run(settings.rate_hz, floor_stop, settings.realtime); });
+    std::thread haptic_thread([&] { loop.run(network.stop_requested()); });
+    haptic_thread.join();
+    floor_stop = true;
+    floor_thread.join();
+    device->stop();
+    network.stop();
+
+    const cohaptic::HapticMetrics& m = loop.metrics();
+    nlohmann::json report;
+    report["user"] = options.user_name;
+    report["slot"] = welcome.slot;
+    report["device"] = device->describe();
+    report["protocol"] = welcome.protocol == cohaptic::HapticProtocol::p1 ? "P1" : "P0";
+    report["rate_setting_hz"] = settings.rate_hz;
+    report["haptic_rate_hz"] = m.elapsed_s > 0 ? static_cast<double>(m.ticks) / m.elapsed_s : 0.0;
+    report["ticks"] = m.ticks;
+    report["period_us"] = quantiles_us(m.period_ns);
+    report["missed_deadlines"] = m.missed_deadlines;
+    report["timer_floor"] = {{"period_us", quantiles_us(floor.period_ns)}, {"missed_deadlines", floor.missed_deadlines}};
+    report["realtime"] = m.realtime;
+    report["ir_age_ms"] = {{"p50", static_cast<double>(m.ir_age_ns.quantile(0.5)) * 1e-6},
+                           {"p99", static_cast<double>(m.ir_age_ns.quantile(0.99)) * 1e-6}};
+    report["force_n"] = {{"peak", m.peak_force}, {"clamped_ticks", m.clamped}};
+    report["coupling_n"] = {{"peak", m.peak_coupling}};
+    report["force_step_on_ir_switch_n"] = m.largest_step_on_ir_switch;
+    report["non_finite_ticks"] = m.non_finite;
+    report["elapsed_s"] = m.elapsed_s;
+    report.update(network.report());
+    spdlog::info("done: {} ticks at {:.1f} Hz, period p99 {:.0f} us (timer floor p99 {:.0f} us), peak force {:.3f} N, "
+                 "coupling {:.3f} N",
+                 m.ticks, report["haptic_rate_hz"].get<double>(), report["period_us"]["p99"].get<double>(),
+                 report["timer_floor"]["period_us"]["p99"].get<double>(), m.peak_force, m.peak_coupling);
+    if (!report_path.empty()) {
+      if (report_path.has_parent_path()) std::filesystem::create_directories(report_path.parent_path());
+      cohaptic::AtomicFile out(report_path);
+      out.write(report.dump(2));
+      out.commit();
+    }
+    return 0;
+  } catch (const cohaptic::Error& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    spdlog::error("unexpected failure: {}", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,273 @@
+#include "proto/wire/ir_convert.h"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "common/util/error.h"
+
+namespace cohaptic::wire {
+namespace {
+
+using CommonIr = cohaptic::IntermediateRepresentation;
+using WireIr = IntermediateRepresentation;
+
+template <typename... Args>
+[[noreturn]] void invalid(fmt::format_string<Args...> format, Args&&... args) {
+  throw cohaptic::Error("intermediate representation: " + fmt::format(format, std::forward<Args>(args)...));
+}
+
+template <typename Field>
+void add_xyz(const Eigen::Matrix3Xd& m, Field* out) {
+  out->Reserve(static_cast<int>(m.size()));
+  for (Eigen::Index i = 0; i < m.size(); ++i) out->AddAlreadyReserved(m.data()[i]);
+}
+
+/// `count` doubles from `values` (column-major for a matrix), as Scalar.
+template <typename Scalar, typename Field>
+void add_values(const double* values, Eigen::Index count, Field* out) {
+  out->Reserve(static_cast<int>(count));
+  for (Eigen::Index i = 0; i < count; ++i) out->AddAlreadyReserved(static_cast<Scalar>(values[i]));
+}
+
+template <typename Triples>
+void add_triple(const std::array<Eigen::Vector3d, 3>& vectors, Triples* out) {
+  for (const Eigen::Vector3d& v : vectors) to_wire(v, out->Add());
+}
+
+// ---- from_wire checks ----
+
+void check_vec3(const Vec3& v, const std::string& what) {
+  if (!is_finite(v)) invalid("{} has a non-finite component ({}, {}, {})", what, v.x(), v.y(), v.z());
+}
+
+template <typename Triples>
+std::array<Eigen::Vector3d, 3> read_triple(const Triples& vectors, const std::string& what) {
+  if (vectors.size() != 3) invalid("{} has {} entries, expected 3", what, vectors.size());
+  std::array<Eigen::Vector3d, 3> out;
+  for (int k = 0; k < 3; ++k) {
+    check_vec3(vectors[k], fmt::format("{}[{}]", what, k));
+    out[k] = from_wire(vectors[k]);
+  }
+  return out;
+}
+
+Eigen::Vector3d read_vec3(const Vec3& v, const std::string& what) {
+  check_vec3(v, what);
+  return from_wire(v);
+}
+
+/// Three node indices, each in [0, limit).
+std::array<int, 3> read_nodes(const google::protobuf::RepeatedField<std::uint32_t>& nodes, std::uint32_t limit,
+                              const std::string& what, const char* range) {
+  if (nodes.size() != 3) invalid("{}.nodes has {} entries, expected 3", what, nodes.size());
+  std::array<int, 3> out{};
+  for (int k = 0; k < 3; ++k) {
+    if (nodes[k] >= limit) invalid("{}.nodes[{}] = {} is outside the {} ({} nodes)", what, k, nodes[k], range, limit);
+    out[k] = static_cast<int>(nodes[k]);
+  }
+  return out;
+}
+
+Eigen::Matrix3Xd read_xyz(const google::protobuf::RepeatedField<double>& values, std::uint32_t count, const char* what) {
+  if (static_cast<std::uint64_t>(values.size()) != 3ull * count)
+    invalid("{} has {} values, expected 3 x {}", what, values.size(), count);
+  Eigen::Matrix3Xd out(3, static_cast<Eigen::Index>(count));
+  for (int i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i])) invalid("{}[{}] is not finite ({})", what, i, values[i]);
+    out.data()[i] = values[i];
+  }
+  return out;
+}
+
+int to_int(std::uint32_t value, const char* what) {
+  if (value > static_cast<std::uint32_t>(INT_MAX)) invalid("{} = {} is out of range", what, value);
+  return static_cast<int>(value);
+}
+
+std::size_t free_dofs(const std::string& fixed_axes, std::size_t first, std::size_t last) {
+  std::size_t count = 0;
+  for (std::size_t i = first; i < last; ++i)
+    for (int axis = 0; axis < 3; ++axis) count += ((static_cast<unsigned char>(fixed_axes[i]) >> axis) & 1u) ? 0 : 1;
+  return count;
+}
+
+/// `values` (f64 or f32 on the wire) into doubles, each finite.
+template <typename Field, typename Target>
+void read_values(const Field& values, Target& out, const char* what) {
+  for (int i = 0; i < values.size(); ++i) {
+    const double v = static_cast<double>(values[i]);
+    if (!std::isfinite(v)) invalid("{}[{}] is not finite ({})", what, i, v);
+    out.data()[i] = v;
+  }
+}
+
+}  // namespace
+
+void to_wire(const CommonIr& ir, WireIr* out) {
+  out->Clear();
+  out->set_format_version(CommonIr::kFormatVersion);
+  out->set_epoch(ir.epoch);
+  out->set_simulation_time(ir.simulation_time);
+  out->set_user(static_cast<std::uint32_t>(ir.user));
+  out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? WireIr::POINT : WireIr::TRANSLATION);
+  out->set_tool_radius(ir.tool_radius);
+  out->set_force_limit(ir.force_limit);
+  out->mutable_node_ids()->Reserve(static_cast<int>(ir.node_ids.size()));
+  for (std::int64_t id : ir.node_ids) out->mutable_node_ids()->AddAlreadyReserved(id);
+  out->set_fixed_axes(std::string(ir.fixed_axes.begin(), ir.fixed_axes.end()));
+  add_xyz(ir.rest_positions, out->mutable_rest_positions());
+  out->set_patch_node_count(static_cast<std::uint32_t>(ir.patch_node_count));
+  out->set_row_node_count(static_cast<std::uint32_t>(ir.row_node_count));
+  for (const cohaptic::IrTriangle& tri : ir.patch) {
+    wire::IrTriangle* t = out->add_patch();
+    for (int node : tri.nodes) t->add_nodes(static_cast<std::uint32_t>(node));
+    t->set_surface_index(tri.surface_index);
+    to_wire(tri.normal, t->mutable_normal());
+    for (int neighbour : tri.neighbours) t->add_neighbours(neighbour);
+    add_triple(tri.edge_normals, t->mutable_edge_normals());
+  }
+  add_xyz(ir.patch_vertex_normals, out->mutable_patch_vertex_normals());
+  for (const cohaptic::IrGuardTriangle& guard : ir.guard) {
+    wire::IrGuardTriangle* g = out->add_guard();
+    add_triple(guard.corners, g->mutable_corners());
+    to_wire(guard.normal, g->mutable_normal());
+  }
+  for (const cohaptic::IrRemoteContact& remote : ir.remotes) {
+    wire::IrRemoteContact* r = out->add_remotes();
+    r->set_user(static_cast<std::uint32_t>(remote.user));
+    for (int node : remote.nodes) r->add_nodes(static_cast<std::uint32_t>(node));
+    to_wire(remote.normal, r->mutable_normal());
+    add_triple(remote.edge_normals, r->mutable_edge_normals());
+    add_triple(remote.vertex_normals, r->mutable_vertex_normals());
+    r->set_tool_radius(remote.tool_radius);
+  }
+  out->set_m_rows(static_cast<std::uint32_t>(ir.m_tilde.rows()));
+  out->set_m_cols(static_cast<std::uint32_t>(ir.m_tilde.cols()));
+  if (ir.precision == IrPrecision::f32) {
+    add_values<float>(ir.m_tilde.data(), ir.m_tilde.size(), out->mutable_m_tilde_f32());
+    add_values<float>(ir.boundary_displacement.data(), ir.boundary_displacement.size(),
+                      out->mutable_boundary_displacement_f32());
+  } else {
+    add_values<double>(ir.m_tilde.data(), ir.m_tilde.size(), out->mutable_m_tilde_f64());
+    add_values<double>(ir.boundary_displacement.data(), ir.boundary_displacement.size(),
+                       out->mutable_boundary_displacement_f64());
+  }
+}
+
+WireIr to_wire(const CommonIr& ir) {
+  WireIr out;
+  to_wire(ir, &out);
+  return out;
+}
+
+CommonIr from_wire(const WireIr& w) {
+  if (w.format_version() != CommonIr::kFormatVersion)
+    invalid("format version {}, expected {}", w.format_version(), CommonIr::kFormatVersion);
+  CommonIr ir;
+  ir.epoch = w.epoch();
+  if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());
+  ir.simulation_time = w.simulation_time();
+  ir.user = to_int(w.user(), "user");
+  switch (w.contact_model()) {
+    case WireIr::TRANSLATION: ir.contact_model = ContactModel::node_translation; break;
+    case WireIr::POINT: ir.contact_model = ContactModel::point_constraint; break;
+    default: invalid("unknown contact model {}", static_cast<int>(w.contact_model()));
+  }
+  if (!(std::isfinite(w.tool_radius()) && w.tool_radius() >= 0)) invalid("tool_radius {} is not a finite length >= 0", w.tool_radius());
+  ir.tool_radius = w.tool_radius();
+  // +inf is a legitimate "no limit".
+  if (!(w.force_limit() >= 0)) invalid("force_limit {} is not >= 0", w.force_limit());
+  ir.force_limit = w.force_limit();
+
+  // Nodes.
+  const auto nodes = static_cast<std::uint32_t>(w.node_ids_size());
+  if (w.fixed_axes().size() != nodes) invalid("{} fixed_axes bytes for {} nodes", w.fixed_axes().size(), nodes);
+  if (w.row_node_count() > nodes) invalid("row_node_count {} exceeds the {} nodes", w.row_node_count(), nodes);
+  if (w.patch_node_count() > w.row_node_count())
+    invalid("patch_node_count {} exceeds row_node_count {}", w.patch_node_count(), w.row_node_count());
+  ir.node_ids.assign(w.node_ids().begin(), w.node_ids().end());
+  ir.fixed_axes.reserve(nodes);
+  for (std::uint32_t i = 0; i < nodes; ++i) {
+    const auto mask = static_cast<AxisMask>(w.fixed_axes()[i]);
+    if (mask & ~kAllAxes) invalid("fixed_axes of node {} is 0x{:02x}, not a mask of x, y, z", i, static_cast<unsigned>(mask));
+    ir.fixed_axes.push_back(mask);
+  }
+  ir.row_node_count = static_cast<int>(w.row_node_count());
+  ir.patch_node_count = static_cast<int>(w.patch_node_count());
+  ir.rest_positions = read_xyz(w.rest_positions(), w.row_node_count(), "rest_positions");
+
+  // Patch.
+  if (w.patch_size() == 0) invalid("the patch has no triangle");
+  for (int i = 0; i < w.patch_size(); ++i) {
+    const wire::IrTriangle& t = w.patch(i);
+    const std::string what = fmt::format("patch[{}]", i);
+    cohaptic::IrTriangle tri;
+    tri.nodes = read_nodes(t.nodes(), w.patch_node_count(), what, "patch");
+    if (t.surface_index() < 0) invalid("{}.surface_index is negative ({})", what, t.surface_index());
+    tri.surface_index = t.surface_index();
+    tri.normal = read_vec3(t.normal(), what + ".normal");
+    if (t.neighbours_size() != 3) invalid("{}.neighbours has {} entries, expected 3", what, t.neighbours_size());
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t n = t.neighbours(k);
+      if (n < -1 || n >= w.patch_size())
+        invalid("{}.neighbours[{}] = {} is neither -1 nor one of the {} patch triangles", what, k, n, w.patch_size());
+      tri.neighbours[k] = n;
+    }
+    tri.edge_normals = read_triple(t.edge_normals(), what + ".edge_normals");
+    ir.patch.push_back(tri);
+  }
+  ir.patch_vertex_normals = read_xyz(w.patch_vertex_normals(), w.patch_node_count(), "patch_vertex_normals");
+  for (int i = 0; i < w.guard_size(); ++i) {
+    const std::string what = fmt::format("guard[{}]", i);
+    cohaptic::IrGuardTriangle guard;
+    guard.corners = read_triple(w.guard(i).corners(), what + ".corners");
+    guard.normal = read_vec3(w.guard(i).normal(), what + ".normal");
+    ir.guard.push_back(guard);
+  }
+  for (int i = 0; i < w.remotes_size(); ++i) {
+    const wire::IrRemoteContact& r = w.remotes(i);
+    const std::string what = fmt::format("remotes[{}]", i);
+    cohaptic::IrRemoteContact remote;
+    remote.user = to_int(r.user(), "remote user");
+    remote.nodes = read_nodes(r.nodes(), w.row_node_count(), what, "contact nodes");
+    remote.normal = read_vec3(r.normal(), what + ".normal");
+    remote.edge_normals = read_triple(r.edge_normals(), what + ".edge_normals");
+    remote.vertex_normals = read_triple(r.vertex_normals(), what + ".vertex_normals");
+    if (!(std::isfinite(r.tool_radius()) && r.tool_radius() >= 0))
+      invalid("{}.tool_radius {} is not a finite length >= 0", what, r.tool_radius());
+    remote.tool_radius = r.tool_radius();
+    ir.remotes.push_back(remote);
+  }
+
+  // M~ and u_B: sizes follow from the free dofs of the contact and boundary nodes.
+  const bool f64 = w.m_tilde_f64_size() > 0 || w.boundary_displacement_f64_size() > 0;
+  const bool f32 = w.m_tilde_f32_size() > 0 || w.boundary_displacement_f32_size() > 0;
+  if (f64 && f32) invalid("M~ and u_B mix f64 and f32 fields");
+  ir.precision = f32 ? IrPrecision::f32 : IrPrecision::f64;
+  const std::size_t row_dofs = free_dofs(w.fixed_axes(), 0, w.row_node_count());
+  const std::size_t boundary_dofs = free_dofs(w.fixed_axes(), w.row_node_count(), nodes);
+  if (w.m_rows() != row_dofs) invalid("m_rows {} differs from the {} free dofs of the contact nodes", w.m_rows(), row_dofs);
+  if (w.m_cols() != row_dofs + boundary_dofs)
+    invalid("m_cols {} differs from the {} free dofs of all nodes", w.m_cols(), row_dofs + boundary_dofs);
+  const std::uint64_t entries = std::uint64_t{w.m_rows()} * w.m_cols();
+  const auto m_length = static_cast<std::uint64_t>(f32 ? w.m_tilde_f32_size() : w.m_tilde_f64_size());
+  if (m_length != entries) invalid("M~ has {} values, expected m_rows x m_cols = {} x {}", m_length, w.m_rows(), w.m_cols());
+  const auto u_length =
+      static_cast<std::uint64_t>(f32 ? w.boundary_displacement_f32_size() : w.boundary_displacement_f64_size());
+  if (u_length != boundary_dofs) invalid("u_B has {} values, expected {} (free boundary dofs)", u_length, boundary_dofs);
+  ir.m_tilde.resize(static_cast<Eigen::Index>(w.m_rows()), static_cast<Eigen::Index>(w.m_cols()));
+  ir.boundary_displacement.resize(static_cast<Eigen::Index>(boundary_dofs));
+  if (f32) {
+    read_values(w.m_tilde_f32(), ir.m_tilde, "m_tilde_f32");
+    read_values(w.boundary_displacement_f32(), ir.boundary_displacement, "boundary_displacement_f32");
+  } else {
+    read_values(w.m_tilde_f64(), ir.m_tilde, "m_tilde_f64");
+    read_values(w.boundary_displacement_f64(), ir.boundary_displacement, "boundary_displacement_f64");
+  }
+  return ir;
+}
+
+}  // namespace cohaptic::wire

@@ -1,0 +1,53 @@
+#include "proto/wire/surface_mesh_message.h"
+
+#include <cmath>
+
+#include "common/util/error.h"
+
+namespace cohaptic::wire {
+
+SurfaceMesh surface_mesh_message(const Model& model) {
+  const std::vector<int>& nodes = model.surface.nodes;
+  std::vector<int> compact(static_cast<std::size_t>(model.mesh.node_count()), -1);
+  SurfaceMesh message;
+  message.mutable_vertices()->Reserve(3 * static_cast<int>(nodes.size()));
+  message.mutable_node_ids()->Reserve(static_cast<int>(nodes.size()));
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    compact[nodes[i]] = static_cast<int>(i);
+    for (int axis = 0; axis < 3; ++axis) message.add_vertices(model.mesh.nodes(axis, nodes[i]));
+    message.add_node_ids(model.mesh.node_tags[nodes[i]]);
+  }
+  message.mutable_triangles()->Reserve(3 * model.surface.triangle_count());
+  for (const Triangle& tri : model.surface.triangles)
+    for (int node : tri) {
+      if (compact[node] < 0)
+        throw cohaptic::Error(fmt::format("surface mesh: triangle node {} is not a surface node", model.mesh.node_tags[node]));
+      message.add_triangles(static_cast<std::uint32_t>(compact[node]));
+    }
+  return message;
+}
+
+ReceivedSurface from_wire(const SurfaceMesh& mesh) {
+  const auto fail = [](const std::string& what) { throw cohaptic::Error("surface mesh: " + what); };
+  if (mesh.vertices_size() % 3 != 0) fail(fmt::format("{} vertex coordinates, not a multiple of 3", mesh.vertices_size()));
+  const int vertices = mesh.vertices_size() / 3;
+  if (mesh.node_ids_size() != vertices) fail(fmt::format("{} node ids for {} vertices", mesh.node_ids_size(), vertices));
+  if (mesh.triangles_size() % 3 != 0) fail(fmt::format("{} triangle indices, not a multiple of 3", mesh.triangles_size()));
+  ReceivedSurface received;
+  received.surface.vertices.resize(3, vertices);
+  for (int i = 0; i < mesh.vertices_size(); ++i) {
+    if (!std::isfinite(mesh.vertices(i))) fail(fmt::format("vertex {} has a non-finite coordinate", i / 3));
+    received.surface.vertices.data()[i] = mesh.vertices(i);
+  }
+  received.node_ids.assign(mesh.node_ids().begin(), mesh.node_ids().end());
+  received.surface.triangles.resize(static_cast<std::size_t>(mesh.triangles_size() / 3));
+  for (int i = 0; i < mesh.triangles_size(); ++i) {
+    const std::uint32_t v = mesh.triangles(i);
+    if (v >= static_cast<std::uint32_t>(vertices))
+      fail(fmt::format("triangle {} refers to vertex {}, there are {}", i / 3, v, vertices));
+    received.surface.triangles[static_cast<std::size_t>(i / 3)][static_cast<std::size_t>(i % 3)] = static_cast<int>(v);
+  }
+  return received;
+}
+
+}  // namespace cohaptic::wire

@@ -1,0 +1,35 @@
+// ServeOptions: everything `cohaptic-server --scene ... --listen ...` is told.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "common/ir/intermediate_representation.h"
+#include "common/net/link_delay.h"
+
+namespace cohaptic {
+
+enum class ServeProtocol { p0, p1 };
+
+struct ServeOptions {
+  std::filesystem::path scene;
+  std::string host = "127.0.0.1";
+  std::uint16_t port = 7400;            ///< TCP and UDP; 0: any free port (tests)
+  ServeProtocol protocol = ServeProtocol::p1;
+  std::optional<std::filesystem::path> key_file;  ///< empty: the public development key
+  LinkDelaySettings shift;              ///< injected on every link, each direction
+  int step_nodes = 0;                   ///< step-delay boundary nodes (the paper's T150/T300)
+  double sim_rate_hz = 0;               ///< cap of the simulation loop; 0: up to 1 kHz
+  bool naive_condensation = false;      ///< rebuild M~ from scratch every step (the paper's loop)
+  IrPrecision precision = IrPrecision::f64;
+  double duration_s = 0;                ///< 0: until SIGINT/SIGTERM
+  std::filesystem::path report;         ///< JSON report at exit; empty: none
+  double client_timeout_s = 0.5;        ///< no tool sample for this long: the tool is released
+  double status_interval_s = 5;
+  double ir_max_age_s = 0.5;            ///< told to clients: older IRs fade out
+  std::optional<std::filesystem::path> cache_directory;
+};
+
+}  // namespace cohaptic

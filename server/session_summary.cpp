@@ -1,0 +1,128 @@
+#include "server/session_summary.h"
+
+#include <fmt/format.h>
+
+#include <fstream>
+
+#include "common/util/atomic_file.h"
+#include "common/util/error.h"
+
+namespace cohaptic {
+namespace {
+
+nlohmann::json read_json(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw Error(fmt::format("{}: cannot read the report", file.string()));
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(fmt::format("{}: not a JSON report: {}", file.string(), e.what()));
+  }
+}
+
+double number(const nlohmann::json& j, const std::vector<std::string>& path) {
+  const nlohmann::json* node = &j;
+  for (const std::string& key : path) {
+    if (!node->contains(key)) return 0;
+    node = &(*node)[key];
+  }
+  return node->is_number() ? node->get<double>() : 0;
+}
+
+}  // namespace
+
+SessionVerdict summarize_session(const nlohmann::json& server, const std::vector<nlohmann::json>& clients) {
+  SessionVerdict verdict;
+  verdict.report["server"] = server.contains("server") ? server["server"] : server;
+  verdict.report["clients"] = clients;
+  const auto problem = [&](std::string text) { verdict.problems.push_back(std::move(text)); };
+  const nlohmann::json& s = verdict.report["server"];
+  if (number(s, {"steps"}) <= 0) problem("server: the simulation loop never ran");
+  if (number(s, {"datagrams", "rejected"}) > 0)
+    problem(fmt::format("server: {} datagrams rejected", number(s, {"datagrams", "rejected"})));
+  if (number(s, {"control_frames", "rejected"}) > 0) problem("server: control frames rejected");
+  if (clients.empty()) problem("no client report");
+
+  for (const nlohmann::json& c : clients) {
+    const std::string user = c.value("user", "?");
+    const double ticks = number(c, {"ticks"});
+    const double rate = number(c, {"haptic_rate_hz"});
+    const double rate_setting = std::max(1.0, number(c, {"rate_setting_hz"}));
+    const double nominal = 1e6 / rate_setting;  // the period asked for [us]
+    if (ticks <= 0) {
+      problem(user + ": the haptic loop never ran");
+      continue;
+    }
+    if (rate < 0.95 * rate_setting)
+      problem(fmt::format("{}: haptic rate {:.1f} Hz, below 95 % of {:g} Hz", user, rate, rate_setting));
+    if (c.value("protocol", "P1") == "P1" ? number(c, {"ir", "received"}) < 1 : number(c, {"forces_received"}) < 1)
+      problem(user + ": nothing to compute forces from (no IR or force received)");
+    if (number(c, {"force_n", "peak"}) <= 0) problem(user + ": never touched the object");
+    if (number(c, {"non_finite_ticks"}) > 0) problem(user + ": non-finite forces (zeroed)");
+    if (number(c, {"datagrams", "rejected"}) > 0)
+      problem(fmt::format("{}: {} datagrams rejected", user, number(c, {"datagrams", "rejected"})));
+    const double p99 = number(c, {"period_us", "p99"});
+    const double floor_p99 = number(c, {"timer_floor", "period_us", "p99"});
+    if (p99 > nominal + 100 && p99 > floor_p99 + 100)
+      problem(fmt::format("{}: haptic period p99 {:.0f} us, more than 100 us above both {:.0f} us and the timer floor "
+                          "({:.0f} us)",
+                          user, p99, nominal, floor_p99));
+    else if (p99 > nominal + 100)
+      verdict.notes.push_back(fmt::format("{}: period p99 {:.0f} us exceeds {:.0f} + 100 us, but so does this machine's "
+                                          "bare timer (p99 {:.0f} us)",
+                                          user, p99, nominal, floor_p99));
+    const double missed = number(c, {"missed_deadlines"});
+    if (missed > 0.001 * ticks) problem(fmt::format("{}: {:.0f} missed deadlines ({:.2f} %)", user, missed, 100 * missed / ticks));
+    else if (missed > 0)
+      verdict.notes.push_back(fmt::format("{}: {:.0f} missed deadlines (timer floor missed {:.0f})", user, missed,
+                                          number(c, {"timer_floor", "missed_deadlines"})));
+    if (clients.size() > 1 && number(c, {"coupling_n", "peak"}) <= 0.1 * number(c, {"force_n", "peak"}))
+      problem(fmt::format("{}: coupling peak {:.3f} N is not above 10 % of its peak force {:.3f} N", user,
+                          number(c, {"coupling_n", "peak"}), number(c, {"force_n", "peak"})));
+  }
+  verdict.report["healthy"] = verdict.problems.empty();
+  verdict.report["problems"] = verdict.problems;
+  verdict.report["notes"] = verdict.notes;
+  return verdict;
+}
+
+int run_summarize(const std::filesystem::path& server_report, const std::vector<std::filesystem::path>& client_reports,
+                  const std::filesystem::path& out) {
+  std::vector<nlohmann::json> clients;
+  for (const auto& file : client_reports) clients.push_back(read_json(file));
+  const SessionVerdict verdict = summarize_session(read_json(server_report), clients);
+  const nlohmann::json& s = verdict.report["server"];
+  fmt::print("server   {} {}, sim {:.0f} Hz, IR build p50 {:.2f} ms p99 {:.2f} ms, |B| max {:.0f}, IRs {:.0f} ({:.0f} kB)\n",
+             s.value("scene", "?"), s.value("protocol", "?"), number(s, {"sim_rate_hz"}), number(s, {"ir_build_ms", "p50"}),
+             number(s, {"ir_build_ms", "p99"}), number(s, {"boundary_nodes", "max"}), number(s, {"ir_build_ms", "count"}),
+             number(s, {"ir_bytes_sent"}) / 1000);
+  fmt::print("\n{:<10} {:>8} {:>22} {:>8} {:>18} {:>12} {:>12} {:>10} {:>12}\n", "user", "rate Hz", "period us p50/p99/max",
+             "missed", "floor p50/p99 us", "IR age p99", "peak F (N)", "coupling", "IR kB/s");
+  for (const nlohmann::json& c : clients)
+    fmt::print("{:<10} {:>8.1f} {:>22} {:>8.0f} {:>18} {:>9.2f} ms {:>12.3f} {:>10.3f} {:>12.1f}\n", c.value("user", "?"),
+               number(c, {"haptic_rate_hz"}),
+               fmt::format("{:.0f}/{:.0f}/{:.0f}", number(c, {"period_us", "p50"}), number(c, {"period_us", "p99"}),
+                           number(c, {"period_us", "max"})),
+               number(c, {"missed_deadlines"}),
+               fmt::format("{:.0f}/{:.0f}", number(c, {"timer_floor", "period_us", "p50"}),
+                           number(c, {"timer_floor", "period_us", "p99"})),
+               number(c, {"ir_age_ms", "p99"}), number(c, {"force_n", "peak"}), number(c, {"coupling_n", "peak"}),
+               number(c, {"ir", "bytes_per_s"}) / 1000);
+  for (const std::string& note : verdict.notes) fmt::print("note: {}\n", note);
+  if (verdict.problems.empty()) {
+    fmt::print("\nhealthy\n");
+  } else {
+    fmt::print("\nUNHEALTHY:\n");
+    for (const std::string& p : verdict.problems) fmt::print("  - {}\n", p);
+  }
+  if (!out.empty()) {
+    if (out.has_parent_path()) std::filesystem::create_directories(out.parent_path());
+    AtomicFile file(out);
+    file.write(verdict.report.dump(2));
+    file.commit();
+    fmt::print("report: {}\n", out.string());
+  }
+  return verdict.problems.empty() ? 0 : 3;
+}
+
+}  // namespace cohaptic
