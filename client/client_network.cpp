@@ -95,6 +95,7 @@ struct ClientNetwork::Impl {
     inspector.allow_sender(wire::kServerSender);
     udp_socket.open(udp::v4());
     udp_socket.bind(udp::endpoint(asio::ip::make_address("0.0.0.0"), 0));
+    spdlog::info("receiving datagrams on UDP port {}", udp_socket.local_endpoint().port());
   }
 
   // ---- connection ----

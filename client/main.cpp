@@ -52,10 +52,9 @@ int main(int argc, char** argv) {
   int slot = -1;
   app.add_option("--server", server, "HOST:PORT of the server")->capture_default_str();
   app.add_option("--user", options.user_name, "Your name, shown to the other users")->required();
-  app.add_option("--device", device_spec,
-                 "script:FILE (scripted trajectory), hand:FILE (hand model tracking the trajectory), "
-                 "bridge:PORT or bridge:HOST:PORT (an external device program over UDP; see client/device/BRIDGE.md)")
-      ->required();
+  std::string device_forms;
+  for (const std::string& form : cohaptic::device_spec_forms()) device_forms += (device_forms.empty() ? "" : "; ") + form;
+  app.add_option("--device", device_spec, "The device: " + device_forms)->required();
   app.add_option("--key-file", options.key_file, "Session key (64 hex characters), the server's")->check(CLI::ExistingFile);
   app.add_option("--slot", slot, "Ask for this user slot (tool) instead of the first free one");
   app.add_option("--rate-hz", rate_hz, "Haptic loop rate (default: the scene's, usually 1000)");

@@ -38,7 +38,7 @@ wire::Vec3 vec3(const Eigen::Vector3d& v) { return wire::to_wire(v); }
 struct LoopStats {
   Histogram step_ns{10'000, 100'000};      // 10 us bins up to 1 s
   Histogram ir_build_ns{10'000, 100'000};  // steps that rebuilt the IRs
-  std::uint64_t steps = 0, rebuilds = 0, ir_bytes = 0, forces_sent = 0;
+  std::uint64_t steps = 0, rebuilds = 0, ir_bytes = 0, irs_sent = 0, forces_sent = 0;
   int max_boundary_nodes = 0, max_obstacle_nodes = 0;
   double elapsed_s = 0;
 };
@@ -92,6 +92,7 @@ struct SimulationServer::Impl {
   std::vector<std::shared_ptr<Session>> sessions;           // all connections
   std::vector<std::shared_ptr<Session>> slots;              // joined users by slot
   std::uint64_t datagrams_sent = 0, datagrams_relayed = 0, frames_sent = 0, frames_rejected = 0;
+  std::uint64_t dropped_to_clients = 0, dropped_from_clients = 0;  // by the injected loss
 
   std::mutex tools_mutex;
   std::vector<LatestTool> tools;
@@ -343,6 +344,7 @@ struct SimulationServer::Impl {
         const int slot = static_cast<int>(datagram->header().sender()) - 1;
         const auto& session = slots[static_cast<std::size_t>(slot)];
         const std::optional<std::int64_t> delay = session ? session->from_client_udp->delay_ns(arrival) : std::int64_t{0};
+        if (!delay) ++dropped_from_clients;
         if (delay && *delay > 0) {
           auto timer = std::make_shared<asio::steady_timer>(io, std::chrono::nanoseconds(*delay));
           timer->async_wait([this, timer, d = std::move(*datagram), slot](std::error_code e) {
@@ -391,7 +393,10 @@ struct SimulationServer::Impl {
     udp_stamp.stamp(*datagram.mutable_header());
     auto bytes = std::make_shared<std::vector<std::uint8_t>>(wire::encode_datagram(datagram, key));
     const std::optional<std::int64_t> delay = session->to_client_udp->delay_ns(now_ns());
-    if (!delay) return;  // lost on the injected link
+    if (!delay) {  // lost on the injected link
+      ++dropped_to_clients;
+      return;
+    }
     const udp::endpoint to = session->udp_endpoint;
     const auto send = [this, bytes, to] {
       udp_socket.async_send_to(asio::buffer(*bytes), to, [bytes](std::error_code, std::size_t) {});
@@ -445,9 +450,11 @@ struct SimulationServer::Impl {
         for (std::size_t u = 0; u < latest.size(); ++u) simulation.clear_tool(static_cast<int>(u));
         continue;
       }
+      std::uint64_t irs = 0;
       if (report.rebuilt && options.protocol == ServeProtocol::p1) {
         for (std::size_t u = 0; u < latest.size(); ++u)
           if (const auto prepared = simulation.ir(static_cast<int>(u))) {
+            ++irs;
             auto control = std::make_shared<wire::Control>();
             *control->mutable_ir() = wire::to_wire(prepared->ir);
             asio::post(io, [this, u, control] {
@@ -499,6 +506,7 @@ struct SimulationServer::Impl {
         }
         ++stats.steps;
         stats.forces_sent += forces;
+        stats.irs_sent += irs;
         stats.max_boundary_nodes = std::max(stats.max_boundary_nodes, report.boundary_nodes);
         stats.max_obstacle_nodes = std::max(stats.max_obstacle_nodes, report.obstacle_nodes);
         stats.elapsed_s = static_cast<double>(step_end - start_ns) * 1e-9;
@@ -564,6 +572,7 @@ struct SimulationServer::Impl {
     server["ir_build_ms"] = {{"p50", static_cast<double>(stats.ir_build_ns.quantile(0.5)) * 1e-6},
                              {"p99", static_cast<double>(stats.ir_build_ns.quantile(0.99)) * 1e-6},
                              {"count", stats.rebuilds}};
+    server["irs_sent"] = stats.irs_sent;
     server["ir_bytes_sent"] = stats.ir_bytes;
     server["boundary_nodes"] = {{"max", stats.max_boundary_nodes}, {"obstacle_max", stats.max_obstacle_nodes}};
     server["forces_sent"] = stats.forces_sent;
@@ -581,7 +590,9 @@ struct SimulationServer::Impl {
                           {"seed", options.shift.seed},
                           {"step_nodes", options.step_nodes},
                           {"sim_rate_hz", options.sim_rate_hz},
-                          {"condensation", options.naive_condensation ? "naive" : "incremental"}};
+                          {"condensation", options.naive_condensation ? "naive" : "incremental"},
+                          {"datagrams_dropped_to_clients", dropped_to_clients},
+                          {"datagrams_dropped_from_clients", dropped_from_clients}};
     server["elapsed_s"] = stats.elapsed_s;
     return server;
   }

@@ -1,0 +1,380 @@
+// End-to-end tests with the real programs on loopback: a cohaptic-server process and
+// cohaptic-client processes with scripted devices, on a soft two-tool cube.
+//   - the forces each client output equal an offline evaluation of the IRs it received
+//     for the tool positions it used, and the full FEM solve for those positions;
+//   - P0 is stepwise and P1 smooth when the simulation rate is capped;
+//   - an injected shift delay is measured back within 1 ms;
+//   - hostile datagrams are rejected and counted by reason, and a flood of them does not
+//     move the haptic period beyond the machine's timer floor;
+//   - killing the server fades the clients' force to zero; a restarted server takes them back.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <asio.hpp>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "common/model/static_contact.h"
+#include "common/scene/load_scene.h"
+#include "common/ir/evaluate_force.h"
+#include "proto/wire/datagram_codec.h"
+#include "proto/wire/ir_convert.h"
+#include "proto/wire/session_key.h"
+#include "support/process.h"
+
+namespace cohaptic {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using testing::ChildProcess;
+
+// A soft cube (forces well under the 3.3 N limit) with two point tools.
+void write_scene(const fs::path& dir) {
+  std::ofstream(dir / "cube.yaml") << R"(
+name: soft-cube
+units: mm
+objects:
+  - name: cube
+    mesh: {box: {min: [-65, -65, -130], size: [130, 130, 130], divisions: [8, 8, 8]}}
+    material: {youngs_modulus: 2.0e4, poisson_ratio: 0.4}
+    fixed: [{plane: {point: [0, 0, -130], normal: [0, 0, 1]}}]
+    touchable: [{plane: {point: [0, 0, 0], normal: [0, 0, 1]}}]
+    compliance: {precompute: touchable, disk_cache: false}
+tools: [{name: A}, {name: B}]
+haptic: {rate_hz: 1000, force_limit: 3.3, contact_model: translation, patch_rings: 1}
+)";
+}
+
+// Press `depth` mm at (x, y), hold, release: about 0.4 + 2 * depth / 5 + hold seconds.
+fs::path write_press(const fs::path& dir, const std::string& name, double x, double y, double depth, double hold) {
+  const fs::path file = dir / (name + ".yaml");
+  std::ofstream(file) << fmt::format(R"(
+units: mm
+start: [{0}, {1}, 6]
+segments:
+  - {{move_to: [{0}, {1}, 0.5], speed: 20}}
+  - {{press: {2}, speed: 5, direction: [0, 0, -1]}}
+  - {{hold: {3}}}
+  - {{release: {2}, speed: 5}}
+)",
+                                     x, y, depth, hold);
+  return file;
+}
+
+struct Session {
+  fs::path dir;
+  std::unique_ptr<ChildProcess> server;
+  int port = -1;
+  Session(const std::string& name, const std::vector<std::string>& server_arguments) : dir(testing::scratch_directory(name)) {
+    write_scene(dir);
+    std::vector<std::string> arguments = {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0",
+                                          "--report", (dir / "server.json").string(), "--no-disk-cache"};
+    arguments.insert(arguments.end(), server_arguments.begin(), server_arguments.end());
+    server = std::make_unique<ChildProcess>(testing::server_program(), arguments, dir / "server.log");
+    EXPECT_TRUE(server->wait_for_log("listening on", 20s)) << server->log_text();
+    port = testing::listening_port(server->log_text());
+  }
+  std::unique_ptr<ChildProcess> client(const std::string& user, int slot, const fs::path& trajectory,
+                                       const std::vector<std::string>& extra = {}) const {
+    std::vector<std::string> arguments = {"--server", fmt::format("127.0.0.1:{}", port), "--user", user,
+                                          "--slot", std::to_string(slot), "--device", "script:" + trajectory.string(),
+                                          "--report", (dir / (user + ".json")).string(), "--trace", (dir / user).string()};
+    arguments.insert(arguments.end(), extra.begin(), extra.end());
+    return std::make_unique<ChildProcess>(testing::client_program(), arguments, dir / (user + ".log"));
+  }
+  nlohmann::json report(const std::string& name) const {
+    std::ifstream in(dir / (name + ".json"));
+    return nlohmann::json::parse(in);
+  }
+  void stop_server() {
+    server->signal(SIGINT);
+    EXPECT_EQ(server->wait(10s), 0) << server->log_text();
+  }
+};
+
+struct Tick {
+  double time = 0;
+  Eigen::Vector3d own, remote, force, evaluated;
+  std::uint64_t epoch = 0;
+  int flags = 0;
+  double fade = 1;
+};
+
+std::vector<Tick> read_ticks(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);  // header
+  std::vector<Tick> ticks;
+  while (std::getline(in, line)) {
+    std::stringstream fields(line);
+    std::vector<double> v;
+    std::string field;
+    while (std::getline(fields, field, ',')) v.push_back(field == "nan" || field == "-nan" ? NAN : std::stod(field));
+    if (v.size() < 16) continue;
+    Tick t;
+    t.time = v[0];
+    t.own = {v[1], v[2], v[3]};
+    t.remote = {v[4], v[5], v[6]};
+    t.force = {v[7], v[8], v[9]};
+    t.evaluated = {v[10], v[11], v[12]};
+    t.epoch = static_cast<std::uint64_t>(v[13]);
+    t.flags = static_cast<int>(v[14]);
+    t.fade = v[15];
+    ticks.push_back(t);
+  }
+  return ticks;
+}
+
+PreparedIR load_ir(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  wire::IntermediateRepresentation message;
+  EXPECT_TRUE(message.ParseFromIstream(&in)) << file;
+  return prepare_ir(wire::from_wire(message));
+}
+
+TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
+  Session session("e2e-forces", {"--duration", "30"});
+  const auto a = session.client("alice", 0, write_press(session.dir, "a", -20, 2, 4, 0.6));
+  const auto b = session.client("bob", 1, write_press(session.dir, "b", 20, -2, 4, 0.6));
+  ASSERT_EQ(a->wait(30s), 0) << a->log_text();
+  ASSERT_EQ(b->wait(30s), 0) << b->log_text();
+  session.stop_server();
+
+  const Model model = build_model(load_scene(session.dir / "cube.yaml"));
+  for (const std::string user : {"alice", "bob"}) {
+    const std::vector<Tick> ticks = read_ticks(session.dir / user / "ticks.csv");
+    ASSERT_GT(ticks.size(), 1500u) << user;
+    std::map<std::uint64_t, std::unique_ptr<PreparedIR>> irs;
+    int contact_ticks = 0, offline_checked = 0, reference_checked = 0;
+    for (std::size_t i = 0; i < ticks.size(); ++i) {
+      const Tick& t = ticks[i];
+      if (!(t.flags & kInContact) || t.epoch == 0) continue;
+      ++contact_ticks;
+      auto& ir = irs[t.epoch];
+      if (!ir) ir = std::make_unique<PreparedIR>(load_ir(session.dir / user / fmt::format("ir-{:06d}.pb", t.epoch)));
+      // The same IR and positions give the same force, bit for bit.
+      const Eigen::Vector3d remote = t.remote;
+      const ForceSample offline = evaluate_force(*ir, t.own, std::span(&remote, ir->ir.remotes.empty() ? 0 : 1));
+      ASSERT_EQ(offline.force, t.evaluated) << user << " tick " << i;
+      ++offline_checked;
+      // And the full FEM solve with both tools at those positions, where both sit on the
+      // IR's triangles (every 50th contact tick; a full solve takes a while).
+      if (contact_ticks % 50 != 0 || !remote.allFinite()) continue;
+      std::vector<PressedTool> pressed = {{t.own, 0}, {remote, 0}};
+      const std::vector<ContactQuery> contacts = find_tool_contacts(model, pressed);
+      bool covered = contacts[0].contact.has_value();
+      if (covered) {
+        bool in_patch = false;
+        for (const IrTriangle& tri : ir->ir.patch) in_patch |= tri.surface_index == contacts[0].contact->triangle;
+        covered = in_patch && (!contacts[1].contact || [&] {
+          const Triangle& tri = model.surface.triangles[contacts[1].contact->triangle];
+          for (int k = 0; k < 3; ++k)
+            if (ir->ir.remotes.empty() || model.mesh.node_tags[tri[k]] != ir->ir.node_ids[ir->ir.remotes[0].nodes[k]]) return false;
+          return true;
+        }());
+      }
+      if (!covered) continue;
+      const Eigen::Vector3d expected =
+          contact_reactions_reference(model, contacts, {}, ContactModel::node_translation)[0].reaction;
+      EXPECT_LE((t.evaluated - expected).norm(), 1e-9 * expected.norm()) << user << " tick " << i;
+      ++reference_checked;
+    }
+    std::printf("  %s: %zu ticks, %d in contact, %d re-evaluated offline, %d checked against the full solve\n",
+                user.c_str(), ticks.size(), contact_ticks, offline_checked, reference_checked);
+    EXPECT_GT(contact_ticks, 300);
+    EXPECT_GE(reference_checked, 5);
+    const nlohmann::json report = session.report(user);
+    EXPECT_GT(report["coupling_n"]["peak"].get<double>(), 0.1 * report["force_n"]["peak"].get<double>());
+  }
+}
+
+// Distinct force values per second while pressing.
+double force_updates_per_second(const std::vector<Tick>& ticks) {
+  std::set<std::tuple<double, double, double>> distinct;
+  double first = -1, last = 0;
+  for (const Tick& t : ticks) {
+    if (t.force.norm() < 1e-6) continue;
+    distinct.emplace(t.force.x(), t.force.y(), t.force.z());
+    if (first < 0) first = t.time;
+    last = t.time;
+  }
+  return last > first ? static_cast<double>(distinct.size()) / (last - first) : 0;
+}
+
+TEST(EndToEnd, P0IsStepwiseAndP1SmoothAtACappedSimulationRate) {
+  std::map<std::string, double> rate;
+  for (const std::string protocol : {"P0", "P1"}) {
+    Session session("e2e-" + protocol, {"--protocol", protocol, "--sim-rate-hz", "40", "--duration", "30"});
+    const auto a = session.client("alice", 0, write_press(session.dir, "a", 3, 2, 5, 0.2));
+    ASSERT_EQ(a->wait(30s), 0) << a->log_text();
+    session.stop_server();
+    rate[protocol] = force_updates_per_second(read_ticks(session.dir / "alice" / "ticks.csv"));
+    std::printf("  %s at a 40 Hz simulation: %.0f distinct forces per second\n", protocol.c_str(), rate[protocol]);
+  }
+  EXPECT_LE(rate["P0"], 45);   // one force per simulation step, held in between
+  EXPECT_GE(rate["P1"], 500);  // a new force every haptic tick
+}
+
+TEST(EndToEnd, AnInjectedShiftDelayIsMeasuredBack) {
+  Session session("e2e-delay", {"--shift-delay-ms", "20", "--duration", "30"});
+  const auto a = session.client("alice", 0, write_press(session.dir, "a", 3, 2, 3, 0.2));
+  ASSERT_EQ(a->wait(30s), 0) << a->log_text();
+  session.stop_server();
+  const nlohmann::json client = session.report("alice");
+  const double one_way = client["one_way_delay_ms"]["p50"].get<double>();
+  const double round_trip = client["clock"]["round_trip_ms"].get<double>();
+  std::printf("  injected 20 ms each way: measured one-way %.2f ms (p50), clock round trip %.2f ms\n", one_way, round_trip);
+  EXPECT_NEAR(one_way, 20.0, 1.0);
+  EXPECT_NEAR(round_trip, 40.0, 2.0);
+  EXPECT_EQ(session.report("server")["server"]["injected"]["shift_delay_ms"], 20.0);
+}
+
+TEST(EndToEnd, HostileDatagramsAreRejectedByReasonAndDoNotMoveTheHapticPeriod) {
+  Session session("e2e-hostile", {"--duration", "30"});
+  const auto a = session.client("alice", 0, write_press(session.dir, "a", 3, 2, 3, 2.0));
+  ASSERT_TRUE(a->wait_for_log("joined", 20s)) << a->log_text();
+  std::smatch match;
+  const std::string log = a->log_text();
+  ASSERT_TRUE(std::regex_search(log, match, std::regex(R"(UDP port (\d+))")));
+  const auto client_port = static_cast<std::uint16_t>(std::stoi(match[1]));
+
+  asio::io_context io;
+  asio::ip::udp::socket socket(io, asio::ip::udp::endpoint(asio::ip::udp::v4(), 0));
+  const asio::ip::udp::endpoint server(asio::ip::make_address("127.0.0.1"), static_cast<std::uint16_t>(session.port));
+  const asio::ip::udp::endpoint client(asio::ip::make_address("127.0.0.1"), client_port);
+  const wire::SessionKey key = wire::development_key();
+  const auto send = [&](const std::vector<std::uint8_t>& bytes, const asio::ip::udp::endpoint& to) {
+    socket.send_to(asio::buffer(bytes), to);
+  };
+  const auto datagram = [&](std::uint32_t version, std::uint64_t sequence, double x) {
+    wire::Datagram d;
+    d.mutable_header()->set_protocol_version(version);
+    d.mutable_header()->set_sender(1);
+    d.mutable_header()->set_sequence(sequence);
+    d.mutable_tool()->set_user(0);
+    d.mutable_tool()->mutable_position()->set_x(x);
+    return wire::encode_datagram(d, key);
+  };
+  // One of each kind to the server (its session id is unknown to us: wrong_session, except
+  // where an earlier check fires first).
+  send({1, 2, 3}, server);                                          // truncated
+  send(std::vector<std::uint8_t>(2000, 7), server);                 // oversized
+  std::vector<std::uint8_t> forged = datagram(1, 5, 0.0);
+  forged[3] ^= 0x40;
+  send(forged, server);                                             // bad_tag
+  send(datagram(2, 5, 0.0), server);                                // bad_version
+  send(datagram(1, 5, 0.0), server);                                // wrong_session
+  // A flood at the client while its haptic loop runs: random bytes and forged datagrams.
+  std::mt19937 rng(3);
+  for (int i = 0; i < 20000; ++i) {
+    std::vector<std::uint8_t> junk(16 + rng() % 200);
+    for (auto& byte : junk) byte = static_cast<std::uint8_t>(rng());
+    send(i % 2 ? junk : datagram(1, 1000 + static_cast<std::uint64_t>(i), std::nan("")), client);
+    if (i % 1000 == 999) std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_EQ(a->wait(30s), 0) << a->log_text();
+  session.stop_server();
+
+  const nlohmann::json server_reasons = session.report("server")["server"]["datagrams"]["rejected_by_reason"];
+  for (const char* reason : {"truncated", "oversized", "bad_tag", "bad_version", "wrong_session"})
+    EXPECT_GE(server_reasons[reason].get<int>(), 1) << reason << ": " << server_reasons.dump();
+  const nlohmann::json report = session.report("alice");
+  const nlohmann::json& reasons = report["datagrams"]["rejected_by_reason"];
+  EXPECT_GE(reasons["bad_tag"].get<int>() + reasons["truncated"].get<int>(), 9000) << reasons.dump();
+  EXPECT_GE(reasons["wrong_session"].get<int>(), 9000) << reasons.dump();  // forged with no session: checked before NaN
+  const double p99 = report["period_us"]["p99"].get<double>();
+  const double floor_p99 = report["timer_floor"]["period_us"]["p99"].get<double>();
+  std::printf("  under a flood of 20,000 hostile datagrams: haptic period p99 %.0f us, timer floor p99 %.0f us\n", p99,
+              floor_p99);
+  EXPECT_LE(p99, std::max(1100.0, floor_p99 + 150));
+  EXPECT_EQ(report["non_finite_ticks"], 0);
+}
+
+// Why IRs travel over TCP: on a lossy link every IR still arrives, whereas an IR sent as
+// UDP fragments would be lost whenever any one of its fragments is.
+TEST(EndToEnd, OnALossyLinkEveryIrArrivesOverTcp) {
+  Session session("e2e-loss", {"--loss", "0.2", "--seed", "7", "--duration", "30"});
+  // Press, then slide across the face: every triangle change is a new IR.
+  const fs::path slide = session.dir / "slide.yaml";
+  std::ofstream(slide) << R"(
+units: mm
+start: [-40, 2, 6]
+segments:
+  - {move_to: [-40, 2, -2], speed: 20}
+  - {move_by: [80, 0, 0], speed: 40}
+  - {move_to: [40, 2, 6], speed: 20}
+)";
+  const auto a = session.client("alice", 0, slide);
+  ASSERT_EQ(a->wait(30s), 0) << a->log_text();
+  session.stop_server();
+  const nlohmann::json server = session.report("server")["server"];
+  const nlohmann::json client = session.report("alice");
+  const auto sent = server["irs_sent"].get<std::uint64_t>();
+  const auto received = client["ir"]["received"].get<std::uint64_t>();
+  const double mean_bytes = static_cast<double>(client["ir"]["bytes"].get<std::uint64_t>()) / static_cast<double>(received);
+  const double fragments = std::ceil(mean_bytes / static_cast<double>(wire::kMaxDatagramBytes - 100));
+  const double udp_survival = std::pow(0.8, fragments);
+  std::printf("  20 %% datagram loss: %lu of %lu IRs arrived over TCP; as UDP, an IR of %.0f bytes (%.0f fragments) "
+              "would arrive with probability %.2g\n",
+              static_cast<unsigned long>(received), static_cast<unsigned long>(sent), mean_bytes, fragments, udp_survival);
+  EXPECT_EQ(received, sent);
+  EXPECT_GE(received, 5u);
+  EXPECT_GT(client["remote_samples_received"].get<int>() + client["datagrams"]["received"].get<int>(), 0);
+  EXPECT_LT(udp_survival, 0.1);
+  // The datagrams did suffer: about 20 % lost each way.
+  const double to_lost = server["injected"]["datagrams_dropped_to_clients"].get<double>();
+  const double from_lost = server["injected"]["datagrams_dropped_from_clients"].get<double>();
+  EXPECT_NEAR(to_lost / (to_lost + server["datagrams"]["sent"].get<double>()), 0.2, 0.05);
+  EXPECT_NEAR(from_lost / server["datagrams"]["accepted"].get<double>(), 0.2, 0.05);
+}
+
+TEST(EndToEnd, AServerRestartFadesTheForceOutAndTheClientReconnects) {
+  auto session = std::make_unique<Session>("e2e-restart", std::vector<std::string>{"--duration", "60"});
+  const int port = session->port;
+  const auto a = session->client("alice", 0, write_press(session->dir, "a", 3, 2, 3, 5.0));
+  ASSERT_TRUE(a->wait_for_log("haptic loop", 20s));
+  std::this_thread::sleep_for(1500ms);  // pressing by now
+  session->server->signal(SIGKILL);
+  ASSERT_TRUE(session->server->wait(5s).has_value());
+  std::this_thread::sleep_for(1500ms);
+  ChildProcess restarted(testing::server_program(),
+                         {"--scene", (session->dir / "cube.yaml").string(), "--listen", fmt::format("127.0.0.1:{}", port),
+                          "--duration", "60", "--no-disk-cache"},
+                         session->dir / "server2.log");
+  ASSERT_TRUE(restarted.wait_for_log("listening on", 20s)) << restarted.log_text();
+  ASSERT_EQ(a->wait(30s), 0) << a->log_text();
+  restarted.signal(SIGINT);
+  restarted.wait(10s);
+
+  const std::vector<Tick> ticks = read_ticks(session->dir / "alice" / "ticks.csv");
+  ASSERT_FALSE(ticks.empty());
+  const double start = ticks.front().time;
+  // Find the kill from the log-free trace: the first tick after which confirmations stop is
+  // where the force starts to fade. Check the shape: force before, zero within max age +
+  // fade (0.5 + 0.1 s) of the fade's start, force again after the reconnect.
+  double fade_started = -1, zero_at = -1, back_at = -1;
+  for (const Tick& t : ticks) {
+    const double s = t.time - start;
+    if (fade_started < 0 && t.fade < 1 && t.evaluated.norm() > 0) fade_started = s;
+    if (fade_started >= 0 && zero_at < 0 && t.fade == 0) zero_at = s;
+    if (zero_at >= 0 && back_at < 0 && t.fade == 1 && t.force.norm() > 0) back_at = s;
+  }
+  std::printf("  force fading from %.3f s, zero at %.3f s, back at %.3f s\n", fade_started, zero_at, back_at);
+  ASSERT_GT(fade_started, 0) << "the force never faded";
+  ASSERT_GT(zero_at, 0) << "the force never reached zero";
+  EXPECT_LE(zero_at - fade_started, 0.1 + 0.02);  // the fade time, plus a tick or two
+  EXPECT_GT(back_at, zero_at) << "the force did not come back after the restart";
+  EXPECT_GE(session->report("alice")["reconnects"].get<int>(), 1);
+  for (const Tick& t : ticks) EXPECT_TRUE(t.force.allFinite());
+}
+
+}  // namespace
+}  // namespace cohaptic
