@@ -8,7 +8,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BENCH_ARGS ?=
 SERVER := $(BUILD_DIR)/server/cohaptic-server
 
-.PHONY: all deps configure build test demo bench clean
+.PHONY: all deps configure build test demo probe-demo bench clean
 
 all: build
 
@@ -26,15 +26,16 @@ build: configure
 test: build
 	ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS)
 
-# Until the networked system exists, the main job is the probe on the paper's cube,
-# through the intermediate representation: a tool pressed 1, 2, 5 and 10 mm into the
-# front face's centre (one at a time); two tools pressing together; and the same two
-# with the point-constraint model, 300 held boundary nodes (the paper's T300) and float32
-# storage.
+# The main job: the two-surgeon brain demo. A server and two haptic clients (hand models
+# following the surgeons' scripted motions) on loopback, P1, about 20 s; prints a summary
+# table, writes out/demo/report.json, and fails if the session was unhealthy.
 demo: build
+	@BUILD_DIR=$(BUILD_DIR) ./deploy/run-demo.sh
+
+# The probe on the paper's cube, through the intermediate representation: a tool pressed
+# 1, 2, 5 and 10 mm into the front face's centre, then two tools together.
+probe-demo: build
 	@$(SERVER) probe --scene scenes/cube.yaml --separately --tool 0,0,-1 --tool 0,0,-2 --tool 0,0,-5 --tool 0,0,-10
-	@echo
-	@$(SERVER) probe --scene scenes/cube.yaml --tool 30,-20,-5 --tool -60,60,-3 --log-level warn
 	@echo
 	@$(SERVER) probe --scene scenes/cube.yaml --tool 30,-20,-5 --tool -60,60,-3 --contact-model point \
 	  --boundary-nodes 300 --ir-precision f32 --log-level warn
