@@ -2,8 +2,9 @@
 # The two-surgeon demo on loopback: a cohaptic-server serving the brain scene (P1) and two
 # cohaptic-client processes whose hand models follow the surgeons' scripted motions (A
 # retracts the cerebellum downward, B the occipital lobe upward). About 20 s. Writes
-# every report under out/demo/ and prints the summary; exits non-zero if the session was
-# unhealthy (see README.md, "The demo report").
+# every report under out/demo/, the deformed brain surface for ParaView under
+# out/demo/display/ (open surface.pvd), prints the summary, and exits non-zero if the
+# session was unhealthy (see README.md, "Reports and the demo report").
 #
 # Environment: BUILD_DIR (default build), DEMO_PORT (default 7431), DEMO_DURATION (s, default
 # 20), DEMO_PROTOCOL (P1), DEMO_DEVICE (hand or script), DEMO_OUT (out/demo).
@@ -18,7 +19,7 @@ out=${DEMO_OUT:-out/demo}
 server_bin=$build/server/cohaptic-server
 client_bin=$build/client/cohaptic-client
 mkdir -p "$out"
-rm -f "$out"/*.json "$out"/*.log
+rm -rf "$out"/*.json "$out"/*.log "$out/display"
 
 pids=()
 cleanup() { for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done; }
@@ -26,7 +27,8 @@ trap cleanup EXIT
 
 # The server outlives the clients by a few seconds so that both can say goodbye.
 "$server_bin" --scene scenes/brain.yaml --listen "127.0.0.1:$port" --protocol "$protocol" \
-  --duration $((duration + 6)) --report "$out/server.json" >"$out/server.log" 2>&1 &
+  --duration $((duration + 6)) --report "$out/server.json" --display "$out/display" --display-rate-hz 5 \
+  >"$out/server.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 1 300); do
   grep -q "listening on" "$out/server.log" 2>/dev/null && break

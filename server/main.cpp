@@ -98,6 +98,11 @@ int main(int argc, char** argv) {
   app.add_option("--duration", serve.duration_s, "Stop after S seconds (0: until SIGINT/SIGTERM)")->capture_default_str();
   app.add_option("--report", serve.report, "Write a JSON report here at exit");
   app.add_option("--client-timeout", serve.client_timeout_s, "Release a tool after S seconds without samples")->capture_default_str();
+  app.add_option("--display", serve.display,
+                 "Write the deformed surface here (surface-*.vtu and surface.pvd, for ParaView) at --display-rate-hz");
+  app.add_option("--display-rate-hz", serve.display_rate_hz, "Frames per second of --display")
+      ->check(CLI::Range(0.1, 100.0))
+      ->capture_default_str();
   app.add_option("--cache-dir", serve_cache_dir, "Directory of the on-disk compliance cache")->capture_default_str();
   app.add_flag("--no-disk-cache", serve_no_disk_cache, "Neither read nor write the on-disk compliance cache");
 

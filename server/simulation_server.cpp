@@ -4,12 +4,14 @@
 
 #include <asio.hpp>
 #include <chrono>
+#include <condition_variable>
 #include <deque>
 #include <fstream>
 #include <mutex>
 #include <random>
 #include <thread>
 
+#include "common/mesh/write_vtu.h"
 #include "common/model/compliance_setup.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
@@ -98,7 +100,20 @@ struct SimulationServer::Impl {
   std::vector<LatestTool> tools;
 
   std::atomic<bool> running{true};
-  std::thread io_thread, sim_thread;
+  std::thread io_thread, sim_thread, display_thread;
+
+  // Deformation for display: frames from the simulation thread, written by the display thread.
+  struct DisplayFrame {
+    double time = 0;
+    Eigen::Matrix3Xd displacement;  // [m], per display node
+  };
+  std::vector<int> display_nodes;         // row nodes shown
+  std::vector<Triangle> display_triangles;  // in display_nodes numbering
+  std::mutex display_mutex;
+  std::condition_variable display_ready;
+  std::deque<DisplayFrame> display_queue;
+  std::vector<std::pair<double, std::string>> display_written;  // for the .pvd index
+  double max_displacement = 0;
   mutable std::mutex stats_mutex;
   LoopStats stats;
   std::int64_t start_ns = now_ns();
@@ -119,6 +134,18 @@ struct SimulationServer::Impl {
                                                   compliance_row_nodes(*model, options.step_nodes > 0));
     prepare_compliance(*model, *columns, options.cache_directory);
     surface = wire::surface_mesh_message(*model);
+    if (!options.display.empty()) {
+      // The surface triangles whose nodes all have compliance rows can be shown.
+      std::vector<int> local(static_cast<std::size_t>(model->mesh.node_count()), -1);
+      for (int node : columns->row_nodes()) {
+        local[node] = static_cast<int>(display_nodes.size());
+        display_nodes.push_back(node);
+      }
+      for (const Triangle& tri : model->surface.triangles)
+        if (local[tri[0]] >= 0 && local[tri[1]] >= 0 && local[tri[2]] >= 0)
+          display_triangles.push_back({local[tri[0]], local[tri[1]], local[tri[2]]});
+      std::filesystem::create_directories(options.display);
+    }
     tools.resize(model->scene.tools.size());
     slots.resize(model->scene.tools.size());
     spdlog::info("scene '{}' ready in {:.0f} ms: {} user slots", scene.name, watch.elapsed_ms(), slots.size());
@@ -429,7 +456,7 @@ struct SimulationServer::Impl {
     const auto timeout = static_cast<std::int64_t>(options.client_timeout_s * 1e9);
     std::vector<std::int64_t> answered(tools.size(), 0);
     std::int64_t next = now_ns();
-    std::int64_t last_keep_alive = 0;
+    std::int64_t last_keep_alive = 0, last_display = 0;
     while (running.load()) {
       const std::int64_t step_start = now_ns();
       std::vector<LatestTool> latest;
@@ -495,6 +522,14 @@ struct SimulationServer::Impl {
           ++forces;
         }
       }
+      if (!options.display.empty() && step_start - last_display >= static_cast<std::int64_t>(1e9 / options.display_rate_hz)) {
+        last_display = step_start;
+        DisplayFrame frame{static_cast<double>(step_start - start_ns) * 1e-9, simulation.displacement_of(display_nodes)};
+        max_displacement = std::max(max_displacement, frame.displacement.colwise().norm().maxCoeff());
+        std::lock_guard lock(display_mutex);
+        if (display_queue.size() < 16) display_queue.push_back(std::move(frame));  // never hold the loop up
+        display_ready.notify_one();
+      }
       const std::int64_t step_end = now_ns();
       {
         std::lock_guard lock(stats_mutex);
@@ -514,6 +549,49 @@ struct SimulationServer::Impl {
       next += period;
       if (next < step_end) next = step_end;  // behind: no catch-up burst
       std::this_thread::sleep_for(std::chrono::nanoseconds(next - step_end));
+    }
+  }
+
+  // ---- deformation for display ----
+
+  void write_display_frames() {
+    const double unit = model->scene.metres_per_unit;
+    Eigen::Matrix3Xd rest(3, static_cast<Eigen::Index>(display_nodes.size()));
+    std::vector<std::int64_t> tags;
+    for (std::size_t i = 0; i < display_nodes.size(); ++i) {
+      rest.col(static_cast<Eigen::Index>(i)) = model->mesh.nodes.col(display_nodes[i]) / unit;
+      tags.push_back(model->mesh.node_tags[display_nodes[i]]);
+    }
+    for (;;) {
+      DisplayFrame frame;
+      {
+        std::unique_lock lock(display_mutex);
+        display_ready.wait(lock, [this] { return !display_queue.empty() || !running.load(); });
+        if (display_queue.empty()) break;
+        frame = std::move(display_queue.front());
+        display_queue.pop_front();
+      }
+      const std::string name = fmt::format("surface-{:06d}.vtu", display_written.size());
+      try {
+        write_surface_vtu(options.display / name, rest, display_triangles, tags,
+                          {{"displacement", Eigen::MatrixXd(frame.displacement / unit)}});
+        display_written.emplace_back(frame.time, name);
+      } catch (const Error& e) {
+        spdlog::warn("display frame not written: {}", e.what());
+      }
+    }
+    // The ParaView collection: open surface.pvd to play the deformation over time.
+    try {
+      AtomicFile index(options.display / "surface.pvd");
+      index.write("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
+      for (const auto& [time, name] : display_written)
+        index.print("    <DataSet timestep=\"{:.6f}\" file=\"{}\"/>\n", time, name);
+      index.write("  </Collection>\n</VTKFile>\n");
+      index.commit();
+      spdlog::info("{} display frames in {} (open surface.pvd in ParaView; lengths in {})", display_written.size(),
+                   options.display.string(), model->scene.units);
+    } catch (const Error& e) {
+      spdlog::warn("display index not written: {}", e.what());
     }
   }
 
@@ -576,6 +654,7 @@ struct SimulationServer::Impl {
     server["ir_bytes_sent"] = stats.ir_bytes;
     server["boundary_nodes"] = {{"max", stats.max_boundary_nodes}, {"obstacle_max", stats.max_obstacle_nodes}};
     server["forces_sent"] = stats.forces_sent;
+    server["max_surface_displacement_mm"] = max_displacement * 1e3;
     server["datagrams"] = {{"received", inspector->counters().accepted() + inspector->counters().rejected()},
                            {"accepted", inspector->counters().accepted()},
                            {"rejected", inspector->counters().rejected()},
@@ -606,6 +685,9 @@ SimulationServer::SimulationServer(ServeOptions options) : impl_(std::make_uniqu
 
 SimulationServer::~SimulationServer() {
   stop();
+  impl_->running = false;
+  impl_->display_ready.notify_all();
+  if (impl_->display_thread.joinable()) impl_->display_thread.join();
   if (impl_->sim_thread.joinable()) impl_->sim_thread.join();
   if (impl_->io_thread.joinable()) impl_->io_thread.join();
 }
@@ -635,10 +717,15 @@ void SimulationServer::run() {
   }
   s.print_status();
   s.sim_thread = std::thread([&s] { s.simulate(); });
+  if (!s.options.display.empty()) s.display_thread = std::thread([&s] { s.write_display_frames(); });
   s.io_thread = std::thread([&s] { s.io.run(); });
   s.io_thread.join();
   s.running = false;
   s.sim_thread.join();
+  if (s.display_thread.joinable()) {
+    s.display_ready.notify_all();
+    s.display_thread.join();
+  }
   // Compliance columns computed on demand during the session serve the next one.
   if (s.options.cache_directory && s.model->scene.object.compliance.disk_cache)
     save_compliance(*s.model, *s.columns, *s.options.cache_directory);

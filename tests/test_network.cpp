@@ -11,6 +11,7 @@
 #include <signal.h>
 
 #include <asio.hpp>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -77,7 +78,8 @@ struct Session {
     write_scene(dir);
     std::vector<std::string> arguments = {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0",
                                           "--report", (dir / "server.json").string(), "--no-disk-cache"};
-    arguments.insert(arguments.end(), server_arguments.begin(), server_arguments.end());
+    for (const std::string& argument : server_arguments)  // paths after --display are in the session's directory
+      arguments.push_back(arguments.back() == "--display" ? (dir / argument).string() : argument);
     server = std::make_unique<ChildProcess>(testing::server_program(), arguments, dir / "server.log");
     EXPECT_TRUE(server->wait_for_log("listening on", 20s)) << server->log_text();
     port = testing::listening_port(server->log_text());
@@ -141,12 +143,22 @@ PreparedIR load_ir(const fs::path& file) {
 }
 
 TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
-  Session session("e2e-forces", {"--duration", "30"});
+  Session session("e2e-forces", {"--duration", "30", "--display", "display", "--display-rate-hz", "20"});
   const auto a = session.client("alice", 0, write_press(session.dir, "a", -20, 2, 4, 0.6));
   const auto b = session.client("bob", 1, write_press(session.dir, "b", 20, -2, 4, 0.6));
   ASSERT_EQ(a->wait(30s), 0) << a->log_text();
   ASSERT_EQ(b->wait(30s), 0) << b->log_text();
   session.stop_server();
+
+  // The deformation for display: under node translation the contact nodes follow the
+  // tool, so the largest surface displacement is the depth reached: 4 mm pressed from
+  // 0.5 mm above the surface.
+  const nlohmann::json server_report = session.report("server")["server"];
+  EXPECT_NEAR(server_report["max_surface_displacement_mm"].get<double>(), 3.5, 0.05);
+  std::ifstream index(session.dir / "display" / "surface.pvd");
+  const std::string pvd((std::istreambuf_iterator<char>(index)), std::istreambuf_iterator<char>());
+  EXPECT_GT(std::count(pvd.begin(), pvd.end(), '\n'), 20) << "display frames listed in surface.pvd";
+  EXPECT_TRUE(fs::exists(session.dir / "display" / "surface-000010.vtu"));
 
   const Model model = build_model(load_scene(session.dir / "cube.yaml"));
   for (const std::string user : {"alice", "bob"}) {

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cstdint>
 #include <set>
 #include <string_view>
@@ -13,6 +14,7 @@ namespace cohaptic {
 
 namespace {
 
+constexpr int kVtkTriangle = 5;
 constexpr int kVtkTetra = 10;
 
 /// Text safe inside a double-quoted XML attribute.
@@ -34,24 +36,26 @@ std::string xml_escaped(std::string_view text) {
 /// The tag of item i: tags[i], or i + 1 when the mesh has no tags.
 std::int64_t tag_of(const std::vector<std::int64_t>& tags, int i) { return tags.empty() ? i + 1 : tags[i]; }
 
-void check_input(const std::filesystem::path& path, const TetMesh& mesh,
-                 const std::vector<VtuPointField>& point_fields) {
+template <std::size_t N>
+void check_input(const std::filesystem::path& path, const Eigen::Matrix3Xd& points,
+                 const std::vector<std::array<int, N>>& cells, const std::vector<std::int64_t>& point_tags,
+                 const std::vector<std::int64_t>& cell_tags, const std::vector<VtuPointField>& point_fields) {
   const std::string file = path.string();
-  const int node_count = mesh.node_count();
-  if (!mesh.node_tags.empty() && static_cast<int>(mesh.node_tags.size()) != node_count)
+  const auto node_count = static_cast<int>(points.cols());
+  if (!point_tags.empty() && static_cast<int>(point_tags.size()) != node_count)
     throw Error(fmt::format("cannot write {}: the mesh has {} nodes but {} node tags", file, node_count,
-                            mesh.node_tags.size()));
-  if (!mesh.tet_tags.empty() && mesh.tet_tags.size() != mesh.tets.size())
-    throw Error(fmt::format("cannot write {}: the mesh has {} tetrahedra but {} element tags", file,
-                            mesh.tets.size(), mesh.tet_tags.size()));
+                            point_tags.size()));
+  if (!cell_tags.empty() && cell_tags.size() != cells.size())
+    throw Error(fmt::format("cannot write {}: the mesh has {} elements but {} element tags", file, cells.size(),
+                            cell_tags.size()));
   for (int n = 0; n < node_count; ++n)
-    if (!mesh.nodes.col(n).allFinite())
-      throw Error(fmt::format("cannot write {}: node {} has a non-finite coordinate", file, tag_of(mesh.node_tags, n)));
-  for (int t = 0; t < mesh.tet_count(); ++t)
-    for (const int node : mesh.tets[t])
+    if (!points.col(n).allFinite())
+      throw Error(fmt::format("cannot write {}: node {} has a non-finite coordinate", file, tag_of(point_tags, n)));
+  for (std::size_t t = 0; t < cells.size(); ++t)
+    for (const int node : cells[t])
       if (node < 0 || node >= node_count)
         throw Error(fmt::format("cannot write {}: element {} refers to node index {}, but the mesh has {} nodes", file,
-                                tag_of(mesh.tet_tags, t), node, node_count));
+                                tag_of(cell_tags, static_cast<int>(t)), node, node_count));
   std::set<std::string, std::less<>> names = {"node_tag"};
   for (const VtuPointField& field : point_fields) {
     if (field.name.empty()) throw Error(fmt::format("cannot write {}: a point field has no name", file));
@@ -66,7 +70,7 @@ void check_input(const std::filesystem::path& path, const TetMesh& mesh,
     for (int n = 0; n < node_count; ++n)
       if (!field.values.col(n).allFinite())
         throw Error(fmt::format("cannot write {}: point field '{}' is not finite at node {}", file, field.name,
-                                tag_of(mesh.node_tags, n)));
+                                tag_of(point_tags, n)));
   }
 }
 
@@ -78,12 +82,14 @@ void write_doubles(AtomicFile& file, const Eigen::Ref<const Eigen::MatrixXd>& va
   }
 }
 
-}  // namespace
-
-void write_vtu(const std::filesystem::path& path, const TetMesh& mesh, const std::vector<VtuPointField>& point_fields) {
-  check_input(path, mesh, point_fields);
-  const int node_count = mesh.node_count();
-  const int tet_count = mesh.tet_count();
+// An UnstructuredGrid of cells of one kind (N nodes each, VTK type `vtk_type`).
+template <std::size_t N>
+void write_grid(const std::filesystem::path& path, const Eigen::Matrix3Xd& points,
+                const std::vector<std::array<int, N>>& cells, int vtk_type, const std::vector<std::int64_t>& point_tags,
+                const std::vector<std::int64_t>& cell_tags, const std::vector<VtuPointField>& point_fields) {
+  check_input(path, points, cells, point_tags, cell_tags, point_fields);
+  const auto node_count = static_cast<int>(points.cols());
+  const auto tet_count = static_cast<int>(cells.size());
 
   // The first scalar and the first vector field become ParaView's active ones.
   std::string active;
@@ -108,31 +114,35 @@ void write_vtu(const std::filesystem::path& path, const TetMesh& mesh, const std
     file.write("        </DataArray>\n");
   }
   file.write("        <DataArray type=\"Int64\" Name=\"node_tag\" format=\"ascii\">\n");
-  for (int n = 0; n < node_count; ++n) file.print("          {}\n", tag_of(mesh.node_tags, n));
+  for (int n = 0; n < node_count; ++n) file.print("          {}\n", tag_of(point_tags, n));
   file.write("        </DataArray>\n");
   file.write("      </PointData>\n");
 
   file.write("      <CellData Scalars=\"element_tag\">\n");
   file.write("        <DataArray type=\"Int64\" Name=\"element_tag\" format=\"ascii\">\n");
-  for (int t = 0; t < tet_count; ++t) file.print("          {}\n", tag_of(mesh.tet_tags, t));
+  for (int t = 0; t < tet_count; ++t) file.print("          {}\n", tag_of(cell_tags, t));
   file.write("        </DataArray>\n");
   file.write("      </CellData>\n");
 
   file.write("      <Points>\n");
   file.write("        <DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-  write_doubles(file, mesh.nodes);
+  write_doubles(file, points);
   file.write("        </DataArray>\n");
   file.write("      </Points>\n");
 
   file.write("      <Cells>\n");
   file.write("        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
-  for (const Tet& tet : mesh.tets) file.print("          {} {} {} {}\n", tet[0], tet[1], tet[2], tet[3]);
+  for (const auto& cell : cells) {
+    file.write("         ");
+    for (const int node : cell) file.print(" {}", node);
+    file.write("\n");
+  }
   file.write("        </DataArray>\n");
   file.write("        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
-  for (int t = 0; t < tet_count; ++t) file.print("          {}\n", 4 * (static_cast<std::int64_t>(t) + 1));
+  for (int t = 0; t < tet_count; ++t) file.print("          {}\n", static_cast<std::int64_t>(N) * (t + 1));
   file.write("        </DataArray>\n");
   file.write("        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-  for (int t = 0; t < tet_count; ++t) file.print("          {}\n", kVtkTetra);
+  for (int t = 0; t < tet_count; ++t) file.print("          {}\n", vtk_type);
   file.write("        </DataArray>\n");
   file.write("      </Cells>\n");
 
@@ -140,6 +150,18 @@ void write_vtu(const std::filesystem::path& path, const TetMesh& mesh, const std
   file.write("  </UnstructuredGrid>\n");
   file.write("</VTKFile>\n");
   file.commit();
+}
+
+}  // namespace
+
+void write_vtu(const std::filesystem::path& path, const TetMesh& mesh, const std::vector<VtuPointField>& point_fields) {
+  write_grid(path, mesh.nodes, mesh.tets, kVtkTetra, mesh.node_tags, mesh.tet_tags, point_fields);
+}
+
+void write_surface_vtu(const std::filesystem::path& path, const Eigen::Matrix3Xd& vertices,
+                       const std::vector<Triangle>& triangles, const std::vector<std::int64_t>& vertex_tags,
+                       const std::vector<VtuPointField>& point_fields) {
+  write_grid(path, vertices, triangles, kVtkTriangle, vertex_tags, {}, point_fields);
 }
 
 }  // namespace cohaptic

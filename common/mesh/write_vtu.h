@@ -1,5 +1,5 @@
-// Writer for VTK XML UnstructuredGrid files (.vtu) of a TetMesh and fields on its nodes,
-// for looking at meshes and results in ParaView.
+// Writer for VTK XML UnstructuredGrid files (.vtu) of a TetMesh (or a triangle surface)
+// and fields on its nodes, for looking at meshes and results in ParaView.
 //
 // Data arrays are ASCII with 17 significant digits (exact doubles); cells are VTK_TETRA
 // (type 10) in the mesh's node order. Besides the caller's point fields the file always
@@ -29,5 +29,11 @@ struct VtuPointField {
 /// repeated name, or the reserved name "node_tag"; throws Error naming the path and the
 /// system's reason if the file cannot be written.
 void write_vtu(const std::filesystem::path& path, const TetMesh& mesh, const std::vector<VtuPointField>& point_fields);
+
+/// The same for a triangle surface (VTK_TRIANGLE cells, no element tags): e.g. a deformed
+/// boundary surface for display.
+void write_surface_vtu(const std::filesystem::path& path, const Eigen::Matrix3Xd& vertices,
+                       const std::vector<Triangle>& triangles, const std::vector<std::int64_t>& vertex_tags,
+                       const std::vector<VtuPointField>& point_fields);
 
 }  // namespace cohaptic
