@@ -10,24 +10,11 @@
 #include "client/client_network.h"
 #include "client/device/make_device.h"
 #include "client/haptic_loop.h"
+#include "common/net/host_port.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
 
 namespace {
-
-std::string parse_server(const std::string& text, std::string& host, std::uint16_t& port) {
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0) return "expected HOST:PORT, got '" + text + "'";
-  try {
-    const int value = std::stoi(text.substr(colon + 1));
-    if (value <= 0 || value > 65535) return "port out of range in '" + text + "'";
-    port = static_cast<std::uint16_t>(value);
-  } catch (const std::exception&) {
-    return "expected a port number after ':' in '" + text + "'";
-  }
-  host = text.substr(0, colon);
-  return {};
-}
 
 nlohmann::json quantiles_us(const cohaptic::Histogram& h) {
   return {{"p50", static_cast<double>(h.quantile(0.5)) * 1e-3},
@@ -79,7 +66,7 @@ int main(int argc, char** argv) {
   spdlog::set_level(spdlog::level::from_str(log_level));
 
   try {
-    if (const std::string problem = parse_server(server, options.host, options.port); !problem.empty()) {
+    if (const std::string problem = cohaptic::parse_host_port(server, options.host, options.port, false); !problem.empty()) {
       fmt::print(stderr, "cohaptic-client: --server: {}\n", problem);
       return 2;
     }

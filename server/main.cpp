@@ -11,6 +11,7 @@
 #include <cstdio>
 
 #include "common/model/compliance_setup.h"
+#include "common/net/host_port.h"
 #include "common/util/error.h"
 #include "proto/wire/session_key.h"
 #include "server/probe.h"
@@ -27,21 +28,6 @@ std::string parse_point(const std::string& text, Eigen::Vector3d& point) {
       !std::isfinite(v[1]) || !std::isfinite(v[2]))
     return "expected x,y,z (three numbers separated by commas), got '" + text + "'";
   point = {v[0], v[1], v[2]};
-  return {};
-}
-
-// Parses "HOST:PORT".
-std::string parse_listen(const std::string& text, std::string& host, std::uint16_t& port) {
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0) return "expected HOST:PORT, got '" + text + "'";
-  try {
-    const int value = std::stoi(text.substr(colon + 1));
-    if (value < 0 || value > 65535) return "port out of range in '" + text + "'";
-    port = static_cast<std::uint16_t>(value);
-  } catch (const std::exception&) {
-    return "expected a port number after ':' in '" + text + "'";
-  }
-  host = text.substr(0, colon);
   return {};
 }
 
@@ -191,7 +177,7 @@ int main(int argc, char** argv) {
       fmt::print(stderr, "cohaptic-server: --scene is required to serve (or give a subcommand; see --help)\n");
       return 2;
     }
-    if (const std::string problem = parse_listen(listen, serve.host, serve.port); !problem.empty()) {
+    if (const std::string problem = cohaptic::parse_host_port(listen, serve.host, serve.port, true); !problem.empty()) {
       fmt::print(stderr, "cohaptic-server: --listen: {}\n", problem);
       return 2;
     }

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <fmt/format.h>
 
-#include "client/device/yaml_cursor.h"
+#include "common/util/yaml_cursor.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -93,8 +93,8 @@ void HandModelDevice::write_force(const Eigen::Vector3d& force, double /*time_s*
 }
 
 std::optional<HandParameters> parse_hand_parameters(const std::string& yaml, const std::string& name) {
-  using device_yaml::Cursor;
-  const Cursor top(device_yaml::load_yaml(yaml, name), "", &name, 1);
+  using Cursor = YamlCursor;
+  const Cursor top(load_yaml(yaml, name), "", &name, 1);
   if (!top.is_map()) top.fail("a map");
   const auto hand = top.find("hand");
   if (!hand) return std::nullopt;
@@ -111,7 +111,7 @@ std::optional<HandParameters> parse_hand_parameters(const std::string& yaml, con
 
 std::optional<HandParameters> load_hand_parameters(const std::filesystem::path& file) {
   const std::string name = file.string();
-  return parse_hand_parameters(device_yaml::read_text_file(name), name);
+  return parse_hand_parameters(read_text_file(name), name);
 }
 
 }  // namespace cohaptic

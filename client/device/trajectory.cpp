@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 #include <optional>
 
-#include "client/device/yaml_cursor.h"
+#include "common/util/yaml_cursor.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -46,7 +46,7 @@ Eigen::Vector3d Trajectory::velocity(double t) const {
 
 namespace {
 
-using device_yaml::Cursor;
+using Cursor = YamlCursor;
 
 constexpr std::int64_t kMaxRepeat = 100000;
 
@@ -118,7 +118,7 @@ Segment parse_segment(const Cursor& c, double scale) {
 }  // namespace
 
 Trajectory parse_trajectory(const std::string& yaml, const std::string& name) {
-  const Cursor top(device_yaml::load_yaml(yaml, name), "", &name, 1);
+  const Cursor top(load_yaml(yaml, name), "", &name, 1);
   if (!top.is_map()) top.fail("a map with start and segments");
   top.only_keys({"units", "start", "segments", "repeat", "hand"});
 
@@ -185,7 +185,7 @@ Trajectory parse_trajectory(const std::string& yaml, const std::string& name) {
 
 Trajectory load_trajectory(const std::filesystem::path& file) {
   const std::string name = file.string();
-  return parse_trajectory(device_yaml::read_text_file(name), name);
+  return parse_trajectory(read_text_file(name), name);
 }
 
 }  // namespace cohaptic

@@ -1,6 +1,7 @@
 #include "common/scene/load_scene.h"
 
-#include <yaml-cpp/yaml.h>
+#include "common/util/yaml_cursor.h"
+
 
 #include <cerrno>
 #include <cmath>
@@ -13,126 +14,11 @@
 namespace cohaptic {
 namespace {
 
-// A YAML node together with where it is (file and key path), so that every complaint
-// about it can say exactly where to look.
-class Cursor {
- public:
-  Cursor(YAML::Node node, std::string path, const std::string* file, int line)
-      : node_(std::move(node)), path_(std::move(path)), file_(file), line_(line) {
-    if (node_.IsDefined() && node_.Mark().line >= 0) line_ = node_.Mark().line + 1;
-  }
+[[noreturn]] void raise_scene_error(const std::string& file, int line, const std::string& message) {
+  throw SceneError(line > 0 ? fmt::format("{}:{}: {}", file, line, message) : fmt::format("{}: {}", file, message));
+}
 
-  const std::string& path() const { return path_; }
-  /// "file:line: key.path", for messages raised after loading (e.g. a selector that selects nothing).
-  std::string location() const { return fmt::format("{}:{}: {}", *file_, line_, path_); }
-  bool is_map() const { return node_.IsMap(); }
-  bool is_sequence() const { return node_.IsSequence(); }
-  bool is_scalar() const { return node_.IsScalar(); }
-
-  [[noreturn]] void fail(const std::string& expected) const {
-    throw SceneError(fmt::format("{}:{}: {}: expected {}, found {}", *file_, line_, path_.empty() ? "(top level)" : path_,
-                                 expected, describe()));
-  }
-  [[noreturn]] void fail_message(const std::string& message) const {
-    throw SceneError(fmt::format("{}:{}: {}: {}", *file_, line_, path_.empty() ? "(top level)" : path_, message));
-  }
-
-  std::optional<Cursor> find(const std::string& key) const {
-    if (!node_.IsMap()) fail("a map");
-    const YAML::Node child = node_[key];
-    if (!child.IsDefined() || child.IsNull()) return std::nullopt;
-    return Cursor(child, join(key), file_, line_);
-  }
-  Cursor at(const std::string& key) const {
-    if (auto child = find(key)) return *child;
-    throw SceneError(fmt::format("{}:{}: {}: missing required key '{}'", *file_, line_,
-                                 path_.empty() ? "(top level)" : path_, key));
-  }
-  /// Rejects keys outside `allowed`, naming the first unknown one and the allowed set.
-  void only_keys(std::initializer_list<const char*> allowed) const {
-    if (!node_.IsMap()) fail("a map");
-    const std::set<std::string> known(allowed.begin(), allowed.end());
-    for (const auto& entry : node_) {
-      const auto key = entry.first.as<std::string>();
-      if (!known.count(key)) {
-        std::string list;
-        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-        Cursor(entry.first, join(key), file_, line_).fail_message(fmt::format("unknown key (allowed here: {})", list));
-      }
-    }
-  }
-  std::vector<Cursor> items() const {
-    if (!node_.IsSequence()) fail("a list");
-    std::vector<Cursor> out;
-    for (std::size_t i = 0; i < node_.size(); ++i)
-      out.emplace_back(node_[i], fmt::format("{}[{}]", path_, i), file_, line_);
-    return out;
-  }
-
-  std::string text() const {
-    if (!node_.IsScalar()) fail("a string");
-    return node_.Scalar();
-  }
-  double number() const {
-    if (!node_.IsScalar()) fail("a number");
-    try {
-      const double v = node_.as<double>();
-      if (!std::isfinite(v)) fail("a finite number");
-      return v;
-    } catch (const YAML::Exception&) {
-      fail("a number");
-    }
-  }
-  double number_in(double low, double high, bool low_open, bool high_open, const std::string& expected) const {
-    const double v = number();
-    if ((low_open ? v <= low : v < low) || (high_open ? v >= high : v > high)) fail(expected);
-    return v;
-  }
-  std::int64_t integer() const {
-    if (!node_.IsScalar()) fail("an integer");
-    try {
-      return node_.as<std::int64_t>();
-    } catch (const YAML::Exception&) {
-      fail("an integer");
-    }
-  }
-  bool boolean() const {
-    if (!node_.IsScalar()) fail("true or false");
-    try {
-      return node_.as<bool>();
-    } catch (const YAML::Exception&) {
-      fail("true or false");
-    }
-  }
-  Eigen::Vector3d vec3() const {
-    if (!node_.IsSequence() || node_.size() != 3) fail("a list of 3 numbers");
-    const auto parts = items();
-    return {parts[0].number(), parts[1].number(), parts[2].number()};
-  }
-  std::string choice(std::initializer_list<const char*> options) const {
-    const std::string v = text();
-    std::string list;
-    for (const char* o : options) {
-      if (v == o) return v;
-      list += (list.empty() ? "" : " | ") + std::string(o);
-    }
-    fail(list);
-  }
-
- private:
-  std::string join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-  std::string describe() const {
-    if (!node_.IsDefined() || node_.IsNull()) return "nothing";
-    if (node_.IsScalar()) return "'" + node_.Scalar() + "'";
-    if (node_.IsSequence()) return fmt::format("a list of {}", node_.size());
-    return "a map";
-  }
-
-  YAML::Node node_;
-  std::string path_;
-  const std::string* file_;
-  int line_;
-};
+using Cursor = YamlCursor;
 
 double metres_per(const Cursor& units) {
   const std::string u = units.choice({"m", "cm", "mm"});
@@ -319,13 +205,7 @@ HapticSettings parse_haptic(const Cursor& c) {
 
 Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file) {
   const std::string file_name = file.string();
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::ParserException& e) {
-    throw SceneError(fmt::format("{}:{}: YAML syntax error: {}", file_name, e.mark.line + 1, e.msg));
-  }
-  const Cursor top(root, "", &file_name, 1);
+  const Cursor top(load_yaml(yaml_text, file_name, raise_scene_error), "", &file_name, 1, raise_scene_error);
   if (!top.is_map()) top.fail("a map of scene settings");
   top.only_keys({"name", "units", "objects", "obstacles", "tools", "haptic"});
 
