@@ -12,6 +12,7 @@
 
 #include "common/model/compliance_setup.h"
 #include "common/net/host_port.h"
+#include "common/util/blas_threads.h"
 #include "common/util/error.h"
 #include "proto/wire/session_key.h"
 #include "server/probe.h"
@@ -149,6 +150,7 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));
+  cohaptic::use_single_blas_thread();
 
   try {
     if (probe_cmd->parsed()) {

@@ -60,6 +60,21 @@ TEST(Compliance, ColumnsEqualTheDenseInverseAndAreSymmetric) {
     EXPECT_LE((batch.column(node) - columns.column(node)).norm(), 1e-13 * batch.column(node).norm());
 }
 
+TEST(Compliance, AColumnsBitsDoNotDependOnWhatElseWasAskedFor) {
+  // Replays rebuild M~ bit for bit only if they do: a solve's rounding depends on how many
+  // right-hand sides it has, so columns are always solved in the same groups.
+  const Model model = build_model(parse_scene(small_cube_yaml(1e6, 8), "cube.yaml"));
+  ComplianceColumns one_by_one(*model.free_factor, model.dofs, model.surface.nodes);
+  ComplianceColumns all_at_once(*model.free_factor, model.dofs, model.surface.nodes);
+  all_at_once.compute_columns(model.surface.nodes);
+  for (std::size_t i = 0; i < model.surface.nodes.size(); i += 7) {
+    const int node = model.surface.nodes[i];
+    const ComplianceColumn& a = one_by_one.column(node);
+    const ComplianceColumn& b = all_at_once.column(node);
+    ASSERT_EQ(std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())), 0) << "node " << node;
+  }
+}
+
 TEST(ComplianceCache, KeyChangesWithMeshMaterialBoundaryConditionsAndRows) {
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
   const auto key = [&](const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
@@ -179,7 +194,8 @@ TEST(ComplianceCache, OnDemandModeComputesNothingUpFrontAndSavesWhatItComputed) 
   ComplianceColumns again(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
   const ComplianceSetup setup = prepare_compliance(model, again, dir.path);
   EXPECT_TRUE(setup.from_disk);
-  EXPECT_EQ(again.column_count(), 2u);
+  EXPECT_EQ(again.column_count(), columns.column_count());  // the group the two columns belong to
+  EXPECT_LT(again.column_count(), model.touchable_nodes.size());
   EXPECT_TRUE(again.has_column(model.touchable_nodes[9]));
 }
 

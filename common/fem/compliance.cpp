@@ -24,16 +24,27 @@ const ComplianceColumn& ComplianceColumns::column(int node) {
 }
 
 void ComplianceColumns::compute_columns(const std::vector<int>& nodes) {
-  std::vector<int> missing;
+  // Columns are solved in fixed groups of kGroupSize consecutive row nodes, always the
+  // whole group in one solve: the numbers of a column then never depend on which other
+  // columns were asked for with it (a solve's rounding depends on its right-hand sides'
+  // count), so a replayed session rebuilds the same M~ bit for bit. A node that is not a
+  // row node is solved alone.
+  std::vector<int> groups, singles;
   for (int node : nodes) {
     if (node < 0 || node >= dofs_.node_count()) throw Error(fmt::format("compliance: node {} out of range", node));
-    if (!has_column(node) && std::find(missing.begin(), missing.end(), node) == missing.end()) missing.push_back(node);
+    if (has_column(node)) continue;
+    const int position = row_position(node);
+    std::vector<int>& list = position >= 0 ? groups : singles;
+    const int key = position >= 0 ? position / kGroupSize : node;
+    if (std::find(list.begin(), list.end(), key) == list.end()) list.push_back(key);
   }
-  // Solve in chunks whose dense right-hand side stays near 64 MB: batching amortises the
-  // pass over the factor, chunking bounds memory on large meshes.
-  const std::size_t chunk = std::max<std::size_t>(1, (std::size_t{8} << 20) / (3 * static_cast<std::size_t>(factor_.size()) + 1));
-  for (std::size_t first = 0; first < missing.size(); first += chunk)
-    solve_chunk(std::span<const int>(missing).subspan(first, std::min(chunk, missing.size() - first)));
+  std::sort(groups.begin(), groups.end());
+  for (int group : groups) {
+    const std::size_t first = static_cast<std::size_t>(group) * kGroupSize;
+    const std::size_t count = std::min<std::size_t>(kGroupSize, row_nodes_.size() - first);
+    solve_chunk(std::span<const int>(row_nodes_).subspan(first, count));
+  }
+  for (int node : singles) solve_chunk(std::span<const int>(&node, 1));
 }
 
 void ComplianceColumns::solve_chunk(std::span<const int> nodes) {
@@ -57,7 +68,7 @@ void ComplianceColumns::solve_chunk(std::span<const int> nodes) {
     // A fixed axis of the column node carries no force: its column stays zero.
     for (int axis = 0; axis < 3; ++axis)
       if (dofs_.is_fixed(nodes[k], axis)) column.col(axis).setZero();
-    columns_.emplace(nodes[k], std::move(column));
+    columns_.try_emplace(nodes[k], std::move(column));  // a group may hold columns already known
   }
 }
 

@@ -21,6 +21,9 @@ using ComplianceColumn = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 
 class ComplianceColumns {
  public:
+  /// Row nodes solved together (see compute_columns): 48 right-hand sides per solve.
+  static constexpr int kGroupSize = 16;
+
   /// `factor` and `dofs` must outlive this object; `row_nodes` are volume node indices.
   ComplianceColumns(const SparseCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes);
 
@@ -33,7 +36,8 @@ class ComplianceColumns {
 
   /// L[row_nodes, node], solved on first use.
   const ComplianceColumn& column(int node);
-  /// Computes every missing column of `nodes` in one multi-right-hand-side solve.
+  /// Computes every missing column of `nodes`, in fixed groups of row nodes (so that a
+  /// column's bits never depend on what was asked for with it).
   void compute_columns(const std::vector<int>& nodes);
   /// The 3x3 block L_ij; i must be a row node.
   Eigen::Matrix3d block(int row_node, int column_node);

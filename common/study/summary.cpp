@@ -1,0 +1,83 @@
+#include "common/study/summary.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "common/util/atomic_file.h"
+
+namespace cohaptic {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string csv_field(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"') quoted += '"';
+    quoted += c;
+  }
+  return quoted + '"';
+}
+
+}  // namespace
+
+Statistics describe(std::span<const double> values) {
+  Statistics s;
+  double sum = 0;
+  for (double v : values)
+    if (std::isfinite(v)) {
+      sum += v;
+      ++s.n;
+    }
+  if (s.n == 0) return {kNaN, kNaN, 0};
+  s.mean = sum / static_cast<double>(s.n);
+  if (s.n < 2) {
+    s.sd = kNaN;
+    return s;
+  }
+  double sum_sq = 0;
+  for (double v : values)
+    if (std::isfinite(v)) sum_sq += (v - s.mean) * (v - s.mean);
+  s.sd = std::sqrt(sum_sq / static_cast<double>(s.n - 1));
+  return s;
+}
+
+std::vector<ConditionSummary> summarize(const std::vector<ConditionTrial>& trials) {
+  // Conditions in order of first appearance; values[c][m] = measure m over the trials of c.
+  std::vector<std::string> conditions;
+  std::map<std::string, std::size_t> index;
+  std::vector<std::vector<std::vector<double>>> values;
+  std::vector<std::string> names;
+  for (const NamedMeasure& named : named_measures(TrialMeasures{})) names.emplace_back(named.name);
+  for (const ConditionTrial& trial : trials) {
+    const auto [it, inserted] = index.try_emplace(trial.condition, conditions.size());
+    if (inserted) {
+      conditions.push_back(trial.condition);
+      values.emplace_back(names.size());
+    }
+    const std::vector<NamedMeasure> measures = named_measures(trial.measures);
+    for (std::size_t m = 0; m < measures.size(); ++m) values[it->second][m].push_back(measures[m].value);
+  }
+  std::vector<ConditionSummary> summary;
+  summary.reserve(conditions.size() * names.size());
+  for (std::size_t c = 0; c < conditions.size(); ++c)
+    for (std::size_t m = 0; m < names.size(); ++m) {
+      const Statistics s = describe(values[c][m]);
+      summary.push_back({conditions[c], names[m], s.mean, s.sd, s.n});
+    }
+  return summary;
+}
+
+void write_summary_csv(const std::filesystem::path& path, const std::vector<ConditionSummary>& summary) {
+  AtomicFile file(path);
+  file.write("condition,measure,mean,sd,n\n");
+  for (const ConditionSummary& row : summary)
+    file.print("{},{},{:.9g},{:.9g},{}\n", csv_field(row.condition), csv_field(row.measure), row.mean, row.sd, row.n);
+  file.commit();
+}
+
+}  // namespace cohaptic
