@@ -7,10 +7,12 @@
 #include <condition_variable>
 #include <deque>
 #include <fstream>
+#include <future>
 #include <mutex>
 #include <thread>
 
 #include "common/sync/clock_offset.h"
+#include "proto/record/session_recorder.h"
 #include "proto/wire/datagram_codec.h"
 #include "proto/wire/frame_codec.h"
 #include "proto/wire/ir_convert.h"
@@ -74,7 +76,9 @@ struct ClientNetwork::Impl {
   std::uint64_t remote_samples = 0, events_logged = 0, non_finite_events = 0;
   Histogram one_way_ns{10'000, 100'000};  // server -> client, 10 us bins up to 1 s
   std::int64_t first_ir_ns = 0, last_ir_ns = 0;
-  std::ofstream trace;
+  std::unique_ptr<record::SessionRecorder> recorder;  // from record_session() on
+  std::optional<WelcomeInfo> welcomed;                 // the last welcome, for the recording
+  std::uint64_t session_id = 0;
 
   Impl(ClientOptions o, HapticChannels& c, std::atomic<bool>& stop)
       : options(std::move(o)),
@@ -83,15 +87,6 @@ struct ClientNetwork::Impl {
         key(options.key_file ? wire::load_session_key(*options.key_file) : wire::development_key()),
         inspector(key) {
     if (!options.key_file) spdlog::warn("no --key-file: using the public development key");
-    if (!options.trace_directory.empty()) {
-      std::filesystem::create_directories(options.trace_directory);
-      trace.open(options.trace_directory / "ticks.csv");
-      if (!trace) throw Error(fmt::format("cannot write {}", (options.trace_directory / "ticks.csv").string()));
-      trace << "time_s,own_x,own_y,own_z,remote_x,remote_y,remote_z,force_x,force_y,force_z,"
-               "evaluated_x,evaluated_y,evaluated_z,ir_epoch,flags,fade\n";
-      trace.precision(17);
-      channels.tracing = true;
-    }
     inspector.allow_sender(wire::kServerSender);
     udp_socket.open(udp::v4());
     udp_socket.bind(udp::endpoint(asio::ip::make_address("0.0.0.0"), 0));
@@ -138,6 +133,7 @@ struct ClientNetwork::Impl {
 
   void lost(const std::string& why) {
     if (stop_requested.load()) return;  // our own goodbye
+    if (recorder && connected) recorder->event(now_ns(), "lost", why);
     if (connected) {
       spdlog::warn("lost the server ({}); zero force until it is back, reconnecting", why);
       connected = false;
@@ -209,6 +205,9 @@ struct ClientNetwork::Impl {
       spdlog::info("joined '{}' as slot {} ({} protocol, force limit {:g} N)", info.scene_name, info.slot,
                    info.protocol == HapticProtocol::p1 ? "P1" : "P0", info.force_limit);
       send_ping();
+      session_id = session;
+      welcomed = info;
+      if (recorder) recorder->event(now_ns(), "joined", fmt::format("session {:016x}, slot {}", session, info.slot));
       std::lock_guard lock(welcome_mutex);
       welcome = info;
       welcome_ready.notify_all();
@@ -230,10 +229,7 @@ struct ClientNetwork::Impl {
     const std::int64_t arrival = now_ns();
     try {
       auto prepared = std::make_unique<const PreparedIR>(prepare_ir(wire::from_wire(message)));
-      if (trace.is_open()) {
-        std::ofstream out(options.trace_directory / fmt::format("ir-{:06d}.pb", prepared->ir.epoch), std::ios::binary);
-        message.SerializeToOstream(&out);
-      }
+      if (recorder) recorder->ir(arrival, message);
       channels.ir.back() = IrSlot{std::move(prepared), arrival};
       channels.ir.publish();
       ++irs_received;
@@ -255,8 +251,10 @@ struct ClientNetwork::Impl {
         return;
       }
       const std::int64_t arrival = now_ns();
-      if (const std::optional<wire::Datagram> datagram = inspector.inspect(std::span(udp_buffer.data(), n)))
+      if (const std::optional<wire::Datagram> datagram = inspector.inspect(std::span(udp_buffer.data(), n))) {
+        if (recorder) recorder->datagram_in(arrival, *datagram);
         handle_datagram(*datagram, arrival);
+      }
       receive_datagram();
     });
   }
@@ -318,6 +316,7 @@ struct ClientNetwork::Impl {
     }
     while (const auto event = channels.events.pop()) {
       ++events_logged;
+      if (recorder) recorder->event(event->time_ns, "haptic", event_name(event->kind));
       if (event->kind == HapticEventKind::non_finite) ++non_finite_events;
       if (event->kind == HapticEventKind::realtime_refused || event->kind == HapticEventKind::non_finite)
         spdlog::warn("haptic: {}", event_name(event->kind));
@@ -325,13 +324,20 @@ struct ClientNetwork::Impl {
         spdlog::info("haptic: {}", event_name(event->kind));
     }
     while (const auto tick = channels.trace.pop()) {
-      if (!trace.is_open()) continue;
-      trace << static_cast<double>(tick->time_ns) * 1e-9 << ',' << tick->own.x() << ',' << tick->own.y() << ',' << tick->own.z()
-            << ',' << tick->remotes[0].x() << ',' << tick->remotes[0].y() << ',' << tick->remotes[0].z() << ','
-            << tick->force.x() << ',' << tick->force.y() << ',' << tick->force.z() << ',' << tick->evaluated.x() << ','
-            << tick->evaluated.y() << ',' << tick->evaluated.z() << ',' << tick->ir_epoch << ',' << int{tick->flags} << ','
-            << tick->fade << '\n';
+      if (!recorder) continue;
+      record::HapticTick record;
+      record.set_time_ns(tick->time_ns);
+      wire::to_wire(tick->own, record.mutable_own());
+      for (int r = 0; r < tick->remote_count; ++r) wire::to_wire(tick->remotes[r], record.add_remotes());
+      wire::to_wire(tick->force, record.mutable_force());
+      wire::to_wire(tick->evaluated, record.mutable_evaluated());
+      record.set_ir_epoch(tick->ir_epoch);
+      record.set_flags(tick->flags);
+      record.set_fade(tick->fade);
+      record.set_own_valid(tick->own_valid);
+      recorder->tick(record);
     }
+    if (recorder) recorder->flush_if_due();
   }
 
   void tick() {
@@ -380,12 +386,40 @@ WelcomeInfo ClientNetwork::start(double timeout_s) {
   return *s.welcome;
 }
 
+void ClientNetwork::record_session(const std::filesystem::path& file, const std::string& device, double force_limit) {
+  Impl& s = *impl_;
+  auto recorder = std::make_unique<record::SessionRecorder>(file);
+  std::promise<void> done;
+  asio::post(s.io, [&s, &recorder, &done, device, force_limit] {
+    record::SessionConfig config;
+    config.set_role("client");
+    config.set_user(s.options.user_name);
+    config.set_device(device);
+    config.set_force_limit(force_limit);
+    config.set_session(s.session_id);
+    config.set_start_time_ns(now_ns());
+    if (s.welcomed) {
+      config.set_scene_name(s.welcomed->scene_name);
+      config.set_scene_yaml(s.welcomed->scene_yaml);
+      config.set_slot(static_cast<std::uint32_t>(s.welcomed->slot));
+      config.set_protocol(s.welcomed->protocol == HapticProtocol::p1 ? wire::P1 : wire::P0);
+    }
+    recorder->config(config);
+    s.recorder = std::move(recorder);
+    s.channels.tracing = true;
+    done.set_value();
+  });
+  done.get_future().wait();
+  spdlog::info("recording to {}", file.string());
+}
+
 void ClientNetwork::stop() {
   Impl& s = *impl_;
   if (!s.thread.joinable()) return;
   stop_requested_ = true;
   asio::post(s.io, [&s] {
     s.drain();
+    if (s.recorder) s.recorder->close();
     if (s.connected) {
       wire::Control control;
       control.mutable_bye()->set_reason("client finished");

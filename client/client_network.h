@@ -7,7 +7,8 @@
 //     stamped with the server's clock), remote tool samples and P0 forces (validated, then
 //     handed over), clock pings every 100 ms (NTP-style offset, smallest round trip wins);
 //   - when the server goes away it keeps trying to reconnect every 500 ms; meanwhile no IR
-//     or force arrives, so the haptic loop fades the force to zero.
+//     or force arrives, so the haptic loop fades the force to zero;
+//   - optionally it records the session (record_session).
 // All authentication and validation is done here: nothing unchecked reaches the haptic
 // thread. Units: ns of CLOCK_MONOTONIC, m, N.
 #pragma once
@@ -30,7 +31,6 @@ struct ClientOptions {
   std::string user_name;
   std::optional<std::filesystem::path> key_file;  ///< empty: the public development key
   int requested_slot = -1;                        ///< -1: any free slot
-  std::filesystem::path trace_directory;          ///< empty: no trace (per-tick CSV and the IRs received)
 };
 
 /// What the server told us when we joined.
@@ -55,6 +55,10 @@ class ClientNetwork {
   /// Starts the I/O thread and joins the session; returns the welcome, or throws Error
   /// if none arrives within `timeout_s`.
   WelcomeInfo start(double timeout_s);
+  /// Records the session from now on (MCAP, see proto/record/session_recorder.h): the
+  /// configuration, every datagram and IR received, every haptic tick, every event.
+  /// Throws Error if the file cannot be created.
+  void record_session(const std::filesystem::path& file, const std::string& device, double force_limit);
   /// Stops the I/O thread (after a last drain of the haptic thread's rings).
   void stop();
   /// Set by SIGINT/SIGTERM, or when the server says goodbye and never comes back.

@@ -85,6 +85,7 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
         remotes[r] = remote.valid ? remote.position : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
         record.remotes[r] = remotes[r];
       }
+      record.remote_count = static_cast<std::uint8_t>(count);
       const ForceSample sample = evaluate_force(*slot.ir, own, std::span(remotes.data(), count));
       force = sample.force;
       record.flags = sample.flags;
@@ -146,6 +147,7 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     TickRecord record;
     record.time_ns = woke;
     record.own = state.position;
+    record.own_valid = state.valid;
     Eigen::Vector3d force = state.valid ? compute_force(woke, state.position, record) : Eigen::Vector3d::Zero();
     if (settings_.protocol == HapticProtocol::p1 && record.ir_epoch != epoch_in_use) {
       if (epoch_in_use != 0) metrics_.largest_step_on_ir_switch = std::max(metrics_.largest_step_on_ir_switch, (force - last_force_).norm());

@@ -76,11 +76,13 @@ struct OwnSample {
   bool valid = false;
 };
 
-/// One tick, for traces and offline checks.
+/// One tick, for the recording and offline checks.
 struct TickRecord {
   std::int64_t time_ns = 0;
   Eigen::Vector3d own = Eigen::Vector3d::Zero();
-  std::array<Eigen::Vector3d, kMaxUsers - 1> remotes{};  ///< in the IR's remotes order (NaN unused)
+  bool own_valid = false;
+  std::uint8_t remote_count = 0;                         ///< remote positions used
+  std::array<Eigen::Vector3d, kMaxUsers - 1> remotes{};  ///< in the IR's remotes order (NaN: unknown)
   Eigen::Vector3d force = Eigen::Vector3d::Zero();       ///< as written to the device
   Eigen::Vector3d evaluated = Eigen::Vector3d::Zero();   ///< before fading and limiting
   std::uint64_t ir_epoch = 0;
@@ -102,7 +104,7 @@ struct HapticChannels {
   TripleBuffer<ForceSlot> force;               // I/O -> haptic (P0)
   SpscRing<RemoteSample, 4096> remote_samples; // I/O -> haptic
   SpscRing<OwnSample, 4096> own_samples;       // haptic -> I/O
-  SpscRing<TickRecord, 8192> trace;            // haptic -> I/O (only if tracing)
+  SpscRing<TickRecord, 8192> trace;            // haptic -> I/O (only if tracing: recording)
   SpscRing<HapticEvent, 1024> events;          // haptic -> I/O
   std::atomic<bool> tracing{false};
 };

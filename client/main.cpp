@@ -56,7 +56,9 @@ int main(int argc, char** argv) {
       ->transform([](const std::string& ms) { return std::to_string(std::stod(ms) * 1e-3); });
   app.add_flag("--best-effort", best_effort, "Do not try SCHED_FIFO and mlockall");
   app.add_option("--report", report_path, "Write a JSON report here at exit");
-  app.add_option("--trace", options.trace_directory, "Write every tick (ticks.csv) and every IR received (ir-*.pb) here");
+  std::filesystem::path record_path;
+  app.add_option("--record", record_path,
+                 "Record the session here (MCAP: configuration, datagrams, IRs, every haptic tick, events)");
   app.add_option("--join-timeout", join_timeout_s, "Give up if the server does not welcome us within S seconds")
       ->capture_default_str();
   app.add_option("--log-level", log_level, "Log verbosity: trace, debug, info, warn, error, off")
@@ -86,6 +88,7 @@ int main(int argc, char** argv) {
     spdlog::info("haptic loop at {:g} Hz with {} (force limit {:g} N)", settings.rate_hz, device->describe(),
                  settings.force_limit);
 
+    if (!record_path.empty()) network.record_session(record_path, device->describe(), settings.force_limit);
     cohaptic::HapticLoop loop(*device, *channels, settings);
     std::atomic<bool> floor_stop{false};
     cohaptic::TimerFloor floor;

@@ -84,6 +84,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--duration", serve.duration_s, "Stop after S seconds (0: until SIGINT/SIGTERM)")->capture_default_str();
   app.add_option("--report", serve.report, "Write a JSON report here at exit");
+  app.add_option("--record", serve.record,
+                 "Record the session here (MCAP: configuration, datagrams, every simulation step, IRs, forces, events)");
   app.add_option("--client-timeout", serve.client_timeout_s, "Release a tool after S seconds without samples")->capture_default_str();
   app.add_option("--display", serve.display,
                  "Write the deformed surface here (surface-*.vtu and surface.pvd, for ParaView) at --display-rate-hz");
@@ -187,6 +189,7 @@ int main(int argc, char** argv) {
     serve.naive_condensation = condensation == "naive";
     serve.precision = serve_precision == "f32" ? cohaptic::IrPrecision::f32 : cohaptic::IrPrecision::f64;
     if (!serve_no_disk_cache) serve.cache_directory = serve_cache_dir;
+    serve.options_json = app.config_to_str(true, false);
     cohaptic::SimulationServer server(serve);
     server.run();
     return 0;

@@ -21,6 +21,7 @@
 #include "proto/wire/datagram_codec.h"
 #include "proto/wire/frame_codec.h"
 #include "proto/wire/ir_convert.h"
+#include "proto/record/session_recorder.h"
 #include "proto/wire/session_key.h"
 #include "proto/wire/surface_mesh_message.h"
 #include "proto/wire/vec3_convert.h"
@@ -99,6 +100,7 @@ struct SimulationServer::Impl {
   std::mutex tools_mutex;
   std::vector<LatestTool> tools;
 
+  std::unique_ptr<record::SessionRecorder> recorder;  // with --record
   std::atomic<bool> running{true};
   std::thread io_thread, sim_thread, display_thread;
 
@@ -161,6 +163,28 @@ struct SimulationServer::Impl {
     if (session_id == 0) session_id = 1;
     inspector.emplace(key, session_id);
     udp_stamp.set_session(session_id);
+    if (!options.record.empty()) {
+      recorder = std::make_unique<record::SessionRecorder>(options.record);
+      record::SessionConfig config;
+      config.set_role("server");
+      config.set_scene_name(scene.name);
+      config.set_scene_yaml(scene_yaml);
+      config.set_options_json(options.options_json);
+      config.set_session(session_id);
+      config.set_protocol(options.protocol == ServeProtocol::p1 ? wire::P1 : wire::P0);
+      auto* injected = config.mutable_injected();
+      injected->set_shift_delay_ms(options.shift.delay_ms);
+      injected->set_jitter_ms(options.shift.jitter_ms);
+      injected->set_loss(options.shift.loss);
+      injected->set_reorder(options.shift.reorder);
+      injected->set_seed(options.shift.seed);
+      injected->set_step_nodes(static_cast<std::uint32_t>(options.step_nodes));
+      injected->set_sim_rate_hz(options.sim_rate_hz);
+      injected->set_condensation(options.naive_condensation ? "naive" : "incremental");
+      config.set_start_time_ns(now_ns());
+      recorder->config(config);
+      spdlog::info("recording to {}", options.record.string());
+    }
   }
 
   void bind() {
@@ -349,6 +373,7 @@ struct SimulationServer::Impl {
   }
 
   void broadcast_event(const std::string& kind, const std::string& text) {
+    if (recorder) recorder->event(now_ns(), kind, text);
     for (const auto& session : slots) {
       if (!session) continue;
       wire::Control control;
@@ -387,6 +412,7 @@ struct SimulationServer::Impl {
 
   void handle_datagram(const wire::Datagram& datagram, int slot, std::int64_t arrival) {
     if (slot < 0 || slot >= static_cast<int>(slots.size()) || !slots[slot]) return;
+    if (recorder) recorder->datagram_in(arrival, datagram);
     if (datagram.has_tool()) {
       const wire::ToolSample& sample = datagram.tool();
       if (static_cast<int>(sample.user()) != slot) return;  // a user speaks for its own tool only
@@ -454,7 +480,6 @@ struct SimulationServer::Impl {
     const double rate = options.sim_rate_hz > 0 ? options.sim_rate_hz : 1000.0;
     const auto period = static_cast<std::int64_t>(1e9 / rate);
     const auto timeout = static_cast<std::int64_t>(options.client_timeout_s * 1e9);
-    std::vector<std::int64_t> answered(tools.size(), 0);
     std::int64_t next = now_ns();
     std::int64_t last_keep_alive = 0, last_display = 0;
     while (running.load()) {
@@ -464,9 +489,10 @@ struct SimulationServer::Impl {
         std::lock_guard lock(tools_mutex);
         latest = tools;
       }
+      std::vector<bool> fresh_tools(latest.size(), false);
       for (std::size_t u = 0; u < latest.size(); ++u) {
-        const bool fresh = latest[u].joined && latest[u].valid && step_start - latest[u].received_ns < timeout;
-        if (fresh) simulation.set_tool(static_cast<int>(u), latest[u].position);
+        fresh_tools[u] = latest[u].joined && latest[u].valid && step_start - latest[u].received_ns < timeout;
+        if (fresh_tools[u]) simulation.set_tool(static_cast<int>(u), latest[u].position);
         else simulation.clear_tool(static_cast<int>(u));
       }
       StepReport report;
@@ -478,12 +504,14 @@ struct SimulationServer::Impl {
         continue;
       }
       std::uint64_t irs = 0;
-      if (report.rebuilt && options.protocol == ServeProtocol::p1) {
+      if (report.rebuilt && (options.protocol == ServeProtocol::p1 || recorder)) {
         for (std::size_t u = 0; u < latest.size(); ++u)
           if (const auto prepared = simulation.ir(static_cast<int>(u))) {
-            ++irs;
             auto control = std::make_shared<wire::Control>();
             *control->mutable_ir() = wire::to_wire(prepared->ir);
+            if (recorder) recorder->ir(step_start, control->ir());
+            if (options.protocol != ServeProtocol::p1) continue;
+            ++irs;
             asio::post(io, [this, u, control] {
               if (slots[u]) send_control(slots[u], *control);
             });
@@ -504,6 +532,7 @@ struct SimulationServer::Impl {
           }
       }
       std::uint64_t forces = 0;
+      std::vector<record::ServerForce> forces_this_step;
       if (options.protocol == ServeProtocol::p0) {
         for (std::size_t u = 0; u < latest.size(); ++u) {
           if (!simulation.ir(static_cast<int>(u))) continue;
@@ -515,7 +544,14 @@ struct SimulationServer::Impl {
           sample->set_tool_time_ns(latest[u].sample_time_ns);
           sample->set_ir_epoch(simulation.ir(static_cast<int>(u))->ir.epoch);
           sample->set_flags(force.flags);
-          answered[u] = latest[u].sample_time_ns;
+          if (recorder) {
+            record::ServerForce recorded;
+            recorded.set_slot(static_cast<std::uint32_t>(u));
+            wire::to_wire(force.force, recorded.mutable_force());
+            recorded.set_ir_epoch(sample->ir_epoch());
+            recorded.set_flags(force.flags);
+            forces_this_step.push_back(recorded);
+          }
           asio::post(io, [this, u, datagram] {
             if (slots[u]) send_datagram(slots[u], *datagram);
           });
@@ -529,6 +565,23 @@ struct SimulationServer::Impl {
         std::lock_guard lock(display_mutex);
         if (display_queue.size() < 16) display_queue.push_back(std::move(frame));  // never hold the loop up
         display_ready.notify_one();
+      }
+      if (recorder) {
+        record::SimulationStep step;
+        step.set_time_ns(step_start);
+        step.set_simulation_time(static_cast<double>(step_start - start_ns) * 1e-9);
+        for (std::size_t u = 0; u < latest.size(); ++u) {
+          auto* tool = step.add_tools();
+          tool->set_slot(static_cast<std::uint32_t>(u));
+          tool->set_known(fresh_tools[u]);
+          wire::to_wire(latest[u].position, tool->mutable_position());
+          tool->set_sample_time_ns(latest[u].sample_time_ns);
+        }
+        step.set_rebuilt(report.rebuilt);
+        step.set_boundary_nodes(static_cast<std::uint32_t>(report.boundary_nodes));
+        for (const record::ServerForce& force : forces_this_step) *step.add_forces() = force;
+        recorder->step(step);
+        recorder->flush_if_due();
       }
       const std::int64_t step_end = now_ns();
       {
@@ -726,6 +779,7 @@ void SimulationServer::run() {
     s.display_ready.notify_all();
     s.display_thread.join();
   }
+  if (s.recorder) s.recorder->close();
   // Compliance columns computed on demand during the session serve the next one.
   if (s.options.cache_directory && s.model->scene.object.compliance.disk_cache)
     save_compliance(*s.model, *s.columns, *s.options.cache_directory);

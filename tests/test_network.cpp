@@ -25,6 +25,7 @@
 #include "common/model/static_contact.h"
 #include "common/scene/load_scene.h"
 #include "common/ir/evaluate_force.h"
+#include "proto/record/recording.h"
 #include "proto/wire/datagram_codec.h"
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/session_key.h"
@@ -88,7 +89,7 @@ struct Session {
                                        const std::vector<std::string>& extra = {}) const {
     std::vector<std::string> arguments = {"--server", fmt::format("127.0.0.1:{}", port), "--user", user,
                                           "--slot", std::to_string(slot), "--device", "script:" + trajectory.string(),
-                                          "--report", (dir / (user + ".json")).string(), "--trace", (dir / user).string()};
+                                          "--report", (dir / (user + ".json")).string(), "--record", (dir / (user + ".mcap")).string()};
     arguments.insert(arguments.end(), extra.begin(), extra.end());
     return std::make_unique<ChildProcess>(testing::client_program(), arguments, dir / (user + ".log"));
   }
@@ -110,36 +111,31 @@ struct Tick {
   double fade = 1;
 };
 
+// The haptic ticks of a client's recording.
 std::vector<Tick> read_ticks(const fs::path& file) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);  // header
+  const record::Recording recording = record::read_recording(file);
   std::vector<Tick> ticks;
-  while (std::getline(in, line)) {
-    std::stringstream fields(line);
-    std::vector<double> v;
-    std::string field;
-    while (std::getline(fields, field, ',')) v.push_back(field == "nan" || field == "-nan" ? NAN : std::stod(field));
-    if (v.size() < 16) continue;
-    Tick t;
-    t.time = v[0];
-    t.own = {v[1], v[2], v[3]};
-    t.remote = {v[4], v[5], v[6]};
-    t.force = {v[7], v[8], v[9]};
-    t.evaluated = {v[10], v[11], v[12]};
-    t.epoch = static_cast<std::uint64_t>(v[13]);
-    t.flags = static_cast<int>(v[14]);
-    t.fade = v[15];
-    ticks.push_back(t);
+  for (const record::HapticTick& t : recording.ticks) {
+    Tick tick;
+    tick.time = static_cast<double>(t.time_ns()) * 1e-9;
+    tick.own = wire::from_wire(t.own());
+    tick.remote = t.remotes_size() > 0 ? wire::from_wire(t.remotes(0)) : Eigen::Vector3d::Constant(NAN);
+    tick.force = wire::from_wire(t.force());
+    tick.evaluated = wire::from_wire(t.evaluated());
+    tick.epoch = t.ir_epoch();
+    tick.flags = static_cast<int>(t.flags());
+    tick.fade = t.fade();
+    ticks.push_back(tick);
   }
   return ticks;
 }
 
-PreparedIR load_ir(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  wire::IntermediateRepresentation message;
-  EXPECT_TRUE(message.ParseFromIstream(&in)) << file;
-  return prepare_ir(wire::from_wire(message));
+// The IRs of a client's recording, by epoch.
+std::map<std::uint64_t, std::unique_ptr<PreparedIR>> read_irs(const fs::path& file) {
+  std::map<std::uint64_t, std::unique_ptr<PreparedIR>> irs;
+  for (const record::RecordedIr& recorded : record::read_recording(file).irs)
+    irs[recorded.ir().epoch()] = std::make_unique<PreparedIR>(prepare_ir(wire::from_wire(recorded.ir())));
+  return irs;
 }
 
 TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
@@ -162,16 +158,16 @@ TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
 
   const Model model = build_model(load_scene(session.dir / "cube.yaml"));
   for (const std::string user : {"alice", "bob"}) {
-    const std::vector<Tick> ticks = read_ticks(session.dir / user / "ticks.csv");
+    const std::vector<Tick> ticks = read_ticks(session.dir / (user + ".mcap"));
     ASSERT_GT(ticks.size(), 1500u) << user;
-    std::map<std::uint64_t, std::unique_ptr<PreparedIR>> irs;
+    const std::map<std::uint64_t, std::unique_ptr<PreparedIR>> irs = read_irs(session.dir / (user + ".mcap"));
     int contact_ticks = 0, offline_checked = 0, reference_checked = 0;
     for (std::size_t i = 0; i < ticks.size(); ++i) {
       const Tick& t = ticks[i];
       if (!(t.flags & kInContact) || t.epoch == 0) continue;
       ++contact_ticks;
-      auto& ir = irs[t.epoch];
-      if (!ir) ir = std::make_unique<PreparedIR>(load_ir(session.dir / user / fmt::format("ir-{:06d}.pb", t.epoch)));
+      ASSERT_TRUE(irs.count(t.epoch)) << "IR " << t.epoch << " not recorded";
+      const auto& ir = irs.at(t.epoch);
       // The same IR and positions give the same force, bit for bit.
       const Eigen::Vector3d remote = t.remote;
       const ForceSample offline = evaluate_force(*ir, t.own, std::span(&remote, ir->ir.remotes.empty() ? 0 : 1));
@@ -228,7 +224,7 @@ TEST(EndToEnd, P0IsStepwiseAndP1SmoothAtACappedSimulationRate) {
     const auto a = session.client("alice", 0, write_press(session.dir, "a", 3, 2, 5, 0.2));
     ASSERT_EQ(a->wait(30s), 0) << a->log_text();
     session.stop_server();
-    rate[protocol] = force_updates_per_second(read_ticks(session.dir / "alice" / "ticks.csv"));
+    rate[protocol] = force_updates_per_second(read_ticks(session.dir / "alice.mcap"));
     std::printf("  %s at a 40 Hz simulation: %.0f distinct forces per second\n", protocol.c_str(), rate[protocol]);
   }
   EXPECT_LE(rate["P0"], 45);   // one force per simulation step, held in between
@@ -300,8 +296,11 @@ TEST(EndToEnd, HostileDatagramsAreRejectedByReasonAndDoNotMoveTheHapticPeriod) {
     EXPECT_GE(server_reasons[reason].get<int>(), 1) << reason << ": " << server_reasons.dump();
   const nlohmann::json report = session.report("alice");
   const nlohmann::json& reasons = report["datagrams"]["rejected_by_reason"];
-  EXPECT_GE(reasons["bad_tag"].get<int>() + reasons["truncated"].get<int>(), 9000) << reasons.dump();
-  EXPECT_GE(reasons["wrong_session"].get<int>(), 9000) << reasons.dump();  // forged with no session: checked before NaN
+  // 10,000 of each kind were sent; the kernel may drop some of a flood before the client
+  // reads them, but most must be seen and every one seen must be rejected.
+  EXPECT_GE(reasons["bad_tag"].get<int>() + reasons["truncated"].get<int>(), 7500) << reasons.dump();
+  EXPECT_GE(reasons["wrong_session"].get<int>(), 7500) << reasons.dump();  // forged with no session: checked before NaN
+  EXPECT_LE(reasons["accepted"].get<int>(), report["datagrams"]["received"].get<int>() - 15000);
   const double p99 = report["period_us"]["p99"].get<double>();
   const double floor_p99 = report["timer_floor"]["period_us"]["p99"].get<double>();
   std::printf("  under a flood of 20,000 hostile datagrams: haptic period p99 %.0f us, timer floor p99 %.0f us\n", p99,
@@ -366,7 +365,7 @@ TEST(EndToEnd, AServerRestartFadesTheForceOutAndTheClientReconnects) {
   restarted.signal(SIGINT);
   restarted.wait(10s);
 
-  const std::vector<Tick> ticks = read_ticks(session->dir / "alice" / "ticks.csv");
+  const std::vector<Tick> ticks = read_ticks(session->dir / "alice.mcap");
   ASSERT_FALSE(ticks.empty());
   const double start = ticks.front().time;
   // Find the kill from the log-free trace: the first tick after which confirmations stop is

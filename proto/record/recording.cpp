@@ -1,0 +1,46 @@
+#include "proto/record/recording.h"
+
+#include <fmt/format.h>
+
+#include "common/util/error.h"
+#include "proto/record/mcap_reader.h"
+#include "proto/record/session_recorder.h"
+
+namespace cohaptic::record {
+namespace {
+
+template <typename Message>
+void add(const McapReader& reader, const McapMessage& message, std::vector<Message>& to, std::size_t& unknown) {
+  if (auto parsed = reader.parse<Message>(message)) to.push_back(std::move(*parsed));
+  else ++unknown;
+}
+
+}  // namespace
+
+Recording read_recording(const std::filesystem::path& file) {
+  McapReader reader(file);
+  Recording recording;
+  recording.file = file;
+  std::vector<SessionConfig> configs;
+  while (const auto message = reader.next()) {
+    const std::string& topic = reader.channel_of(*message).topic;
+    if (topic == topic::kConfig) add(reader, *message, configs, recording.unknown_messages);
+    else if (topic == topic::kDatagramsIn) add(reader, *message, recording.datagrams, recording.unknown_messages);
+    else if (topic == topic::kIr) add(reader, *message, recording.irs, recording.unknown_messages);
+    else if (topic == topic::kHaptic) add(reader, *message, recording.ticks, recording.unknown_messages);
+    else if (topic == topic::kSteps) add(reader, *message, recording.steps, recording.unknown_messages);
+    else if (topic == topic::kEvents) add(reader, *message, recording.events, recording.unknown_messages);
+    else ++recording.unknown_messages;
+  }
+  if (configs.empty() && recording.ticks.empty() && recording.steps.empty())
+    throw Error(fmt::format("{}: not a cohaptic session recording (no /config, /haptic or /steps messages)", file.string()));
+  if (!configs.empty()) {
+    recording.config = configs.front();
+    recording.has_config = true;
+  }
+  recording.truncated = reader.truncated();
+  recording.truncation = reader.truncation();
+  return recording;
+}
+
+}  // namespace cohaptic::record
