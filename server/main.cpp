@@ -1,6 +1,7 @@
 // cohaptic-server: the simulation server.
 //   cohaptic-server --scene FILE --listen HOST:PORT [...]   serve a scene to haptic clients
 //   cohaptic-server probe ...                               static forces at tool positions
+//   cohaptic-server replay FILE [--summary|--verify|--export-csv DIR]  a recorded session
 //   cohaptic-server keygen FILE                             a new session key file
 //   cohaptic-server summarize ...                           merge reports, judge a session
 // See README.md for every option.
@@ -16,6 +17,7 @@
 #include "common/util/error.h"
 #include "proto/wire/session_key.h"
 #include "server/probe.h"
+#include "server/replay.h"
 #include "server/session_summary.h"
 #include "server/simulation_server.h"
 
@@ -136,6 +138,16 @@ int main(int argc, char** argv) {
   probe_cmd->add_option("--cache-dir", cache_dir, "Directory of the on-disk compliance cache")->capture_default_str();
   probe_cmd->add_flag("--no-disk-cache", no_disk_cache, "Neither read nor write the on-disk compliance cache");
 
+  // replay
+  cohaptic::ReplayOptions replay;
+  CLI::App* replay_cmd = app.add_subcommand("replay", "Look at a recorded session, re-run it bit for bit, or export it");
+  replay_cmd->add_option("file", replay.file, "A recording (.mcap) of a server or a client")->required()->check(CLI::ExistingFile);
+  replay_cmd->add_flag("--summary", replay.summary, "What is in it (the default)");
+  replay_cmd->add_flag("--verify", replay.verify,
+                       "Re-run the recorded inputs through the same computations and compare every force (and IR) bit "
+                       "for bit; exit 1 naming the first difference");
+  replay_cmd->add_option("--export-csv", replay.export_csv, "Write its records as CSV files in this directory");
+
   // keygen
   std::string key_path;
   CLI::App* keygen_cmd = app.add_subcommand("keygen", "Write a new random session key file (mode 0600)");
@@ -171,6 +183,7 @@ int main(int argc, char** argv) {
       probe.precision = precision == "f32" ? cohaptic::IrPrecision::f32 : cohaptic::IrPrecision::f64;
       return cohaptic::run_probe(probe);
     }
+    if (replay_cmd->parsed()) return cohaptic::run_replay(replay);
     if (summarize_cmd->parsed()) return cohaptic::run_summarize(summary_server, summary_clients, summary_out);
     if (keygen_cmd->parsed()) {
       cohaptic::wire::write_session_key(key_path);
@@ -189,7 +202,7 @@ int main(int argc, char** argv) {
     serve.naive_condensation = condensation == "naive";
     serve.precision = serve_precision == "f32" ? cohaptic::IrPrecision::f32 : cohaptic::IrPrecision::f64;
     if (!serve_no_disk_cache) serve.cache_directory = serve_cache_dir;
-    serve.options_json = app.config_to_str(true, false);
+    serve.options_text = app.config_to_str(true, false);
     cohaptic::SimulationServer server(serve);
     server.run();
     return 0;

@@ -31,7 +31,7 @@ struct ServeOptions {
   double ir_max_age_s = 0.5;            ///< told to clients: older IRs fade out
   std::optional<std::filesystem::path> cache_directory;
   std::filesystem::path record;         ///< MCAP recording of the session; empty: none
-  std::string options_json;             ///< the command line's options, for the recording
+  std::string options_text;             ///< the command line options (CLI11 config format), for the recording
   std::filesystem::path display;        ///< deformed-surface frames (.vtu + .pvd) here; empty: none
   double display_rate_hz = 10;
 };

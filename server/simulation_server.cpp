@@ -169,7 +169,10 @@ struct SimulationServer::Impl {
       config.set_role("server");
       config.set_scene_name(scene.name);
       config.set_scene_yaml(scene_yaml);
-      config.set_options_json(options.options_json);
+      config.set_options(options.options_text);
+      config.set_scene_file(std::filesystem::absolute(options.scene).string());
+      config.set_patch_rings(static_cast<std::uint32_t>(model->scene.haptic.patch_rings));
+      config.set_ir_f32(options.precision == IrPrecision::f32);
       config.set_session(session_id);
       config.set_protocol(options.protocol == ServeProtocol::p1 ? wire::P1 : wire::P0);
       auto* injected = config.mutable_injected();
@@ -558,8 +561,10 @@ struct SimulationServer::Impl {
           ++forces;
         }
       }
+      bool display_frame = false;
       if (!options.display.empty() && step_start - last_display >= static_cast<std::int64_t>(1e9 / options.display_rate_hz)) {
         last_display = step_start;
+        display_frame = true;
         DisplayFrame frame{static_cast<double>(step_start - start_ns) * 1e-9, simulation.displacement_of(display_nodes)};
         max_displacement = std::max(max_displacement, frame.displacement.colwise().norm().maxCoeff());
         std::lock_guard lock(display_mutex);
@@ -578,6 +583,7 @@ struct SimulationServer::Impl {
           tool->set_sample_time_ns(latest[u].sample_time_ns);
         }
         step.set_rebuilt(report.rebuilt);
+        step.set_display_frame(display_frame);
         step.set_boundary_nodes(static_cast<std::uint32_t>(report.boundary_nodes));
         for (const record::ServerForce& force : forces_this_step) *step.add_forces() = force;
         recorder->step(step);

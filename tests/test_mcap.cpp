@@ -602,15 +602,17 @@ TEST(McapTruncation, EveryCutYieldsExactlyTheMessagesCompleteBeforeIt) {
     ++checked;
   }
   EXPECT_GT(checked, 3000u);
+  std::printf("checked %zu cut points of a %zu-byte file\n", checked, b.size());
 
   // The descriptions say where the file ends.
-  fs::resize_file(cut_file, message_ends[499] + 12);
+  const auto cut_copy = [&](std::size_t n) { write_bytes(cut_file, Bytes(b.begin(), b.begin() + static_cast<long>(n))); };
+  cut_copy(message_ends[499] + 12);
   McapReader mid(cut_file);
   EXPECT_EQ(read_all(mid).size(), 500u);
   EXPECT_EQ(mid.truncation(), "file ends 3 bytes into the content of a " +
                                   std::to_string(records[7 + 500].length) + "-byte Message record at offset " +
                                   std::to_string(message_ends[499]));
-  fs::resize_file(cut_file, message_ends[499]);
+  cut_copy(message_ends[499]);
   McapReader boundary(cut_file);
   EXPECT_EQ(read_all(boundary).size(), 500u);
   EXPECT_EQ(boundary.truncation(), "file ends after the complete record ending at offset " +

@@ -43,18 +43,24 @@ Eigen::Vector3d still(std::size_t, double) { return Eigen::Vector3d::Zero(); }
 
 // 1 s at 1 kHz of 2 + 3 sin(pi t) N, recomputed every sample (smooth) or every 25 ms (steps).
 ForceTrace press(std::size_t hold_samples) {
-  return sample(1000, 1e-3, [&](std::size_t k, double) {
-    const double held_t = static_cast<double>(k / hold_samples * hold_samples) * 1e-3;
-    return Eigen::Vector3d((2 + 3 * std::sin(kPi * held_t)) * kAxis);
-  }, still);
+  return sample(
+      1000, 1e-3,
+      [&](std::size_t k, double) {
+        const double held_t = static_cast<double>(k / hold_samples * hold_samples) * 1e-3;
+        return Eigen::Vector3d((2 + 3 * std::sin(kPi * held_t)) * kAxis);
+      },
+      still);
 }
 
 // 1 s at 1 kHz of a ramp 1 + 4 t N, recomputed every sample or held for hold_samples.
 ForceTrace ramp(std::size_t hold_samples) {
-  return sample(1001, 1e-3, [&](std::size_t k, double) {
-    const double held_t = static_cast<double>(k / hold_samples * hold_samples) * 1e-3;
-    return Eigen::Vector3d((1 + 4 * held_t) * kAxis);
-  }, still);
+  return sample(
+      1001, 1e-3,
+      [&](std::size_t k, double) {
+        const double held_t = static_cast<double>(k / hold_samples * hold_samples) * 1e-3;
+        return Eigen::Vector3d((1 + 4 * held_t) * kAxis);
+      },
+      still);
 }
 
 TEST(MeasureTrace, StrokesAreTheRunsAboveTheThreshold) {
@@ -93,7 +99,9 @@ TEST(MeasureTrace, StrokesAreTheRunsAboveTheThreshold) {
 
 TEST(MeasureLowpass, KeepsLinesAndConstantsAndFiltersAtTwentyHertz) {
   const auto signal = [](double hz) {
-    return sample(2001, 1e-3, [hz](std::size_t, double t) { return Eigen::Vector3d(std::sin(2 * kPi * hz * t), 3, 2 + 5 * t); }, still);
+    return sample(
+        2001, 1e-3, [hz](std::size_t, double t) { return Eigen::Vector3d(std::sin(2 * kPi * hz * t), 3, 2 + 5 * t); },
+        still);
   };
   for (double hz : {5.0, 20.0, 100.0}) {
     const ForceTrace trace = signal(hz);
@@ -158,15 +166,16 @@ TEST(MeasureFineness, NoContactGivesNaN) {
 constexpr double kA = 0.01, kK = 500, kOmega = 2 * kPi;
 ForceTrace delayed_press(double tau, double start_s = 0, std::size_t n = 0) {
   if (n == 0) n = static_cast<std::size_t>(std::lround((0.5 + tau) / 1e-3)) + 2;
-  return sample(n, 1e-3,
-                [=](std::size_t, double t) {
-                  const double u = t - start_s - tau;
-                  return Eigen::Vector3d(0, 0, u > 0 && u < 0.5 ? kK * kA * std::sin(kOmega * u) : 0);
-                },
-                [=](std::size_t, double t) {
-                  const double u = t - start_s;
-                  return Eigen::Vector3d(0, 0, u > 0 && u < 0.5 ? -kA * std::sin(kOmega * u) : 0);
-                });
+  return sample(
+      n, 1e-3,
+      [=](std::size_t, double t) {
+        const double u = t - start_s - tau;
+        return Eigen::Vector3d(0, 0, u > 0 && u < 0.5 ? kK * kA * std::sin(kOmega * u) : 0);
+      },
+      [=](std::size_t, double t) {
+        const double u = t - start_s;
+        return Eigen::Vector3d(0, 0, u > 0 && u < 0.5 ? -kA * std::sin(kOmega * u) : 0);
+      });
 }
 
 TEST(MeasureHardness, TerminalForceRatioOfAShiftDelayedPressIsCosOmegaTau) {
@@ -259,12 +268,15 @@ TEST(MeasureStability, NegativeDampingGivesTheHandItsWork) {
 
 // A half-sine press of 1 s and 5 N along kAxis, plus decaying 30 Hz bursts starting at `bursts`.
 ForceTrace press_with_bursts(const std::vector<double>& bursts, double burst_hz = 30) {
-  return sample(1000, 1e-3, [=](std::size_t, double t) {
-    double f = 5 * std::sin(kPi * t);
-    for (double t0 : bursts)
-      if (t >= t0) f += std::exp(-(t - t0) / 0.05) * std::sin(2 * kPi * burst_hz * (t - t0));
-    return Eigen::Vector3d(f * kAxis);
-  }, still);
+  return sample(
+      1000, 1e-3,
+      [=](std::size_t, double t) {
+        double f = 5 * std::sin(kPi * t);
+        for (double t0 : bursts)
+          if (t >= t0) f += std::exp(-(t - t0) / 0.05) * std::sin(2 * kPi * burst_hz * (t - t0));
+        return Eigen::Vector3d(f * kAxis);
+      },
+      still);
 }
 
 TEST(MeasureStability, DecayingThirtyHertzOscillationIsOneEpisodeAndASmoothPressNone) {
@@ -295,8 +307,10 @@ TEST(MeasureTrial, HardnessIsTheMeanOverStrokesAndShortBlipsAreLeftOut) {
   EXPECT_NEAR(m.terminal_force_ratio, (std::cos(kOmega * 0.1) + 1) / 2, 1e-3);
   EXPECT_NEAR(m.peak_force_n, kK * kA, 1e-9);
   EXPECT_NEAR(m.duration_s, 1.999, 1e-12);
-  EXPECT_NEAR(m.effective_stiffness_n_per_m, effective_stiffness(trace, find_strokes(trace)[1]) / 2 +
-                                                 effective_stiffness(trace, find_strokes(trace)[0]) / 2, 1e-9);
+  EXPECT_NEAR(
+      m.effective_stiffness_n_per_m,
+      effective_stiffness(trace, find_strokes(trace)[1]) / 2 + effective_stiffness(trace, find_strokes(trace)[0]) / 2,
+      1e-9);
   EXPECT_GT(m.force_update_rate_hz, 980);  // the blip holds one value for 10 ms
   EXPECT_LT(m.force_update_rate_hz, 1000);
   const std::vector<NamedMeasure> named = named_measures(m);

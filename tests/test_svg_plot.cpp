@@ -130,14 +130,17 @@ TEST(SvgPlot, BarChartHasOneRectPerFiniteBarAndErrorBars) {
   BarChart chart;
   chart.title = "Roughness";
   chart.y_label = "roughness";
-  chart.bars = {{"T0", 0.01, 0.002, ""}, {"T150", 0.05, 0.01, "#ff0000"}, {"T300", -0.02, 0.005, ""},
-                {"none", kNaN, kNaN, ""}, {"no sd", 0.03, kNaN, ""}};
+  chart.bars = {{"T0", 0.01, 0.002, ""},
+                {"T150", 0.05, 0.01, "#ff0000"},
+                {"T300", -0.02, 0.005, ""},
+                {"none", kNaN, kNaN, ""},
+                {"no sd", 0.03, kNaN, ""}};
   const std::string svg = render_svg(chart);
   EXPECT_EQ(xml_problem(svg), "") << svg;
   EXPECT_EQ(count(svg, "<rect class=\"bar\""), 4);
   EXPECT_EQ(count(svg, "<rect"), 4);
   EXPECT_EQ(count(svg, "<polyline"), 0);
-  EXPECT_EQ(count(svg, ">none</text>"), 1);  // the category is still labelled
+  EXPECT_EQ(count(svg, ">none</text>"), 1);              // the category is still labelled
   EXPECT_EQ(count(svg, "stroke-width=\"1.5\""), 3 * 3);  // three error bars of three lines each
   EXPECT_EQ(count(svg, "fill=\"#ff0000\""), 1);
   check_coordinates(svg);
@@ -173,12 +176,13 @@ TEST(SvgPlot, NanEmptyConstantAndSinglePointSeriesDoNotCrash) {
   plot.series.push_back({"empty", {}, {}, "", false});
   plot.series.push_back({"all NaN", {kNaN, kNaN}, {1, kNaN}, "", false});
   plot.series.push_back({"constant", {0, 1, 2, 3}, {2, 2, 2, 2}, "", false});
-  plot.series.push_back({"with gaps", {0, kNaN, 2, 3, std::numeric_limits<double>::infinity()}, {1, 5, kNaN, 3, 4}, "", true});
+  plot.series.push_back(
+      {"with gaps", {0, kNaN, 2, 3, std::numeric_limits<double>::infinity()}, {1, 5, kNaN, 3, 4}, "", true});
   plot.series.push_back({"single", {1.5}, {2.5}, "", false});
   plot.series.push_back({"uneven", {0, 1, 2}, {1, 2}, "", false});
   const std::string svg = render_svg(plot);
   EXPECT_EQ(xml_problem(svg), "") << svg;
-  EXPECT_EQ(count(svg, "<polyline"), 4);  // not "empty" nor "all NaN"
+  EXPECT_EQ(count(svg, "<polyline"), 4);    // not "empty" nor "all NaN"
   EXPECT_EQ(count(svg, "<circle"), 2 + 1);  // markers of "with gaps" (2 finite points) + "single"
   check_coordinates(svg);
   EXPECT_EQ(svg.find("nan"), std::string::npos);

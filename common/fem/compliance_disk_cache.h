@@ -21,7 +21,7 @@
 
 namespace cohaptic {
 
-constexpr std::uint32_t kComplianceCacheFormatVersion = 1;
+constexpr std::uint32_t kComplianceCacheFormatVersion = 2;  // 2: columns solved in fixed groups
 
 Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
                             const std::vector<int>& row_nodes);

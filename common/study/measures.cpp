@@ -106,8 +106,8 @@ Eigen::Vector3d press_direction(const ForceTrace& trace, const Stroke& stroke) {
 
 std::vector<double> displacement_m(const ForceTrace& trace, const Stroke& stroke) {
   if (stroke.begin > stroke.end || stroke.end > trace.size())
-    throw Error(fmt::format("stroke [{}, {}) is outside the trace of {} samples", stroke.begin, stroke.end,
-                            trace.size()));
+    throw Error(
+        fmt::format("stroke [{}, {}) is outside the trace of {} samples", stroke.begin, stroke.end, trace.size()));
   const Eigen::Vector3d d = press_direction(trace, stroke);
   std::vector<double> s;
   s.reserve(stroke.size());
@@ -146,8 +146,8 @@ double effective_stiffness(const ForceTrace& trace, const Stroke& stroke) {
 
 double hysteresis_energy(const ForceTrace& trace, const Stroke& stroke) {
   if (stroke.begin > stroke.end || stroke.end > trace.size())
-    throw Error(fmt::format("stroke [{}, {}) is outside the trace of {} samples", stroke.begin, stroke.end,
-                            trace.size()));
+    throw Error(
+        fmt::format("stroke [{}, {}) is outside the trace of {} samples", stroke.begin, stroke.end, trace.size()));
   if (stroke.size() < 2) return kNaN;
   double work = 0;
   for (std::size_t k = stroke.begin; k + 1 < stroke.end; ++k)
@@ -173,8 +173,9 @@ std::vector<OscillationEpisode> find_oscillations(const ForceTrace& trace, const
   if (axis.norm() > 1e-12 * peak) {
     axis.normalize();
   } else {  // forces cancel out: take the direction of the peak
-    const auto it = std::max_element(trace.force.begin(), trace.force.end(),
-                                     [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.norm() < b.norm(); });
+    const auto it =
+        std::max_element(trace.force.begin(), trace.force.end(),
+                         [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.norm() < b.norm(); });
     axis = it->normalized();
   }
   const double swing = settings.oscillation_swing_fraction * peak;

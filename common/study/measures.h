@@ -70,9 +70,9 @@ namespace cohaptic {
 struct MeasureSettings {
   double contact_fraction = kDefaultContactFraction;  ///< stroke threshold as a fraction of P
   double lowpass_hz = 20;                             ///< roughness low-pass cut-off [Hz]
-  double min_stroke_s = 0.05;  ///< shorter strokes are left out of the trial's hardness means [s]
-  int oscillation_reversals = 4;       ///< N
-  double oscillation_window_s = 0.1;   ///< [s]
+  double min_stroke_s = 0.05;                ///< shorter strokes are left out of the trial's hardness means [s]
+  int oscillation_reversals = 4;             ///< N
+  double oscillation_window_s = 0.1;         ///< [s]
   double oscillation_swing_fraction = 0.05;  ///< delta / P
 };
 
@@ -85,7 +85,7 @@ double p99_force_step_ratio(const ForceTrace& trace, const MeasureSettings& sett
 double roughness(const ForceTrace& trace, const MeasureSettings& settings = {});
 
 // Hardness of one stroke of the trace.
-Eigen::Vector3d press_direction(const ForceTrace& trace, const Stroke& stroke);  ///< d; zero if no force
+Eigen::Vector3d press_direction(const ForceTrace& trace, const Stroke& stroke);     ///< d; zero if no force
 std::vector<double> displacement_m(const ForceTrace& trace, const Stroke& stroke);  ///< s(b..e-1)
 double terminal_force_ratio(const ForceTrace& trace, const Stroke& stroke);
 double effective_stiffness(const ForceTrace& trace, const Stroke& stroke);  ///< [N/m]

@@ -157,9 +157,10 @@ std::string render(const LinePlot& plot) {
       pixels.emplace_back(px, py);
     }
     if (!pixels.empty()) {
-      c.raw(fmt::format("<polyline class=\"series\" fill=\"none\" stroke=\"{}\" stroke-width=\"1.5\" "
-                        "stroke-linejoin=\"round\" points=\"{}\"/>\n",
-                        colour, points));
+      c.raw(
+          fmt::format("<polyline class=\"series\" fill=\"none\" stroke=\"{}\" stroke-width=\"1.5\" "
+                      "stroke-linejoin=\"round\" points=\"{}\"/>\n",
+                      colour, points));
       if (s.markers || pixels.size() == 1)
         for (const auto& [px, py] : pixels)
           c.raw(fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"3\" fill=\"{}\"/>\n", px, py, colour));
@@ -191,6 +192,7 @@ std::string render(const BarChart& chart) {
 
   const double slot = (x1 - x0) / static_cast<double>(std::max<std::size_t>(chart.bars.size(), 1));
   const double zero_y = y1 - y_axis.frac(0) * (y1 - y0);
+  if (zero_y < y1) c.line(x0, zero_y, x1, zero_y, "#000000");  // the bars' base line
   for (std::size_t i = 0; i < chart.bars.size(); ++i) {
     const Bar& bar = chart.bars[i];
     const double centre = x0 + (static_cast<double>(i) + 0.5) * slot;
@@ -199,9 +201,9 @@ std::string render(const BarChart& chart) {
     if (!std::isfinite(bar.mean)) continue;
     const double top = y1 - y_axis.frac(bar.mean) * (y1 - y0);
     const double half = 0.3 * slot;
-    c.raw(fmt::format("<rect class=\"bar\" x=\"{:.2f}\" y=\"{:.2f}\" width=\"{:.2f}\" height=\"{:.2f}\" fill=\"{}\"/>\n",
-                      centre - half, std::min(top, zero_y), 2 * half, std::abs(zero_y - top),
-                      xml_escape(colour_of(bar.colour, i))));
+    c.raw(fmt::format(
+        "<rect class=\"bar\" x=\"{:.2f}\" y=\"{:.2f}\" width=\"{:.2f}\" height=\"{:.2f}\" fill=\"{}\"/>\n",
+        centre - half, std::min(top, zero_y), 2 * half, std::abs(zero_y - top), xml_escape(colour_of(bar.colour, i))));
     if (std::isfinite(bar.sd) && bar.sd != 0) {
       const double sd = std::abs(bar.sd);
       const double hi = y1 - y_axis.frac(bar.mean + sd) * (y1 - y0), lo = y1 - y_axis.frac(bar.mean - sd) * (y1 - y0);
@@ -221,11 +223,21 @@ std::string xml_escape(std::string_view text) {
   out.reserve(text.size());
   for (char ch : text) {
     switch (ch) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
       default:
         if (static_cast<unsigned char>(ch) < 0x20 && ch != '\t' && ch != '\n' && ch != '\r') break;
         out += ch;

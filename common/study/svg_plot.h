@@ -24,10 +24,10 @@
 namespace cohaptic {
 
 struct Series {
-  std::string label;   ///< legend text; empty = not in the legend
+  std::string label;         ///< legend text; empty = not in the legend
   std::vector<double> x, y;  ///< same length (the shorter length is used otherwise)
-  std::string colour;  ///< any SVG colour; empty = the next of a 10-colour palette
-  bool markers = false;  ///< a circle at every point
+  std::string colour;        ///< any SVG colour; empty = the next of a 10-colour palette
+  bool markers = false;      ///< a circle at every point
 };
 
 struct LinePlot {

@@ -1,0 +1,281 @@
+#include "server/replay.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <cstring>
+#include <fstream>
+#include <map>
+
+#include "common/model/compliance_setup.h"
+#include "common/scene/load_scene.h"
+#include "common/sim/simulation.h"
+#include "common/util/atomic_file.h"
+#include "common/util/error.h"
+#include "proto/record/recording.h"
+#include "proto/wire/ir_convert.h"
+#include "proto/wire/vec3_convert.h"
+
+namespace cohaptic {
+namespace {
+
+using record::Recording;
+
+bool same_bits(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::memcmp(a.data(), b.data(), sizeof(double) * 3) == 0; }
+
+std::string vec(const Eigen::Vector3d& v) { return fmt::format("({:.17g}, {:.17g}, {:.17g})", v.x(), v.y(), v.z()); }
+
+double seconds(std::int64_t ns, std::int64_t start) { return static_cast<double>(ns - start) * 1e-9; }
+
+// What the haptic loop does after evaluating: fade, drop non-finite, limit.
+Eigen::Vector3d output_force(const Eigen::Vector3d& evaluated, float fade, double limit) {
+  Eigen::Vector3d force = evaluated * static_cast<double>(fade);
+  if (!force.allFinite()) force.setZero();
+  const double magnitude = force.norm();
+  if (magnitude > limit) force *= limit / magnitude;
+  return force;
+}
+
+VerifyResult verify_client(const Recording& rec) {
+  VerifyResult result;
+  const std::int64_t start = rec.config.start_time_ns();
+  const bool p1 = rec.config.protocol() != wire::P0;
+  // IRs by epoch, in arrival order (epochs restart when the server does).
+  std::multimap<std::uint64_t, std::pair<std::int64_t, std::shared_ptr<const PreparedIR>>> irs;
+  for (const record::RecordedIr& recorded : rec.irs)
+    irs.emplace(recorded.ir().epoch(), std::make_pair(recorded.time_ns(), std::make_shared<const PreparedIR>(
+                                                                              prepare_ir(wire::from_wire(recorded.ir())))));
+  std::vector<std::tuple<std::int64_t, std::uint64_t, Eigen::Vector3d>> forces;  // P0: arrival, epoch, force
+  for (const record::ReceivedDatagram& d : rec.datagrams)
+    if (d.datagram().has_force())
+      forces.emplace_back(d.receive_time_ns(), d.datagram().force().ir_epoch(), wire::from_wire(d.datagram().force().force()));
+
+  const auto fail = [&](std::size_t i, const record::HapticTick& tick, const std::string& what) {
+    result.ok = false;
+    result.first_difference =
+        fmt::format("haptic tick {} (t = {:.6f} s, IR epoch {}): {}", i, seconds(tick.time_ns(), start), tick.ir_epoch(), what);
+  };
+  for (std::size_t i = 0; i < rec.ticks.size() && result.ok; ++i) {
+    const record::HapticTick& tick = rec.ticks[i];
+    const Eigen::Vector3d evaluated = wire::from_wire(tick.evaluated());
+    Eigen::Vector3d expected = Eigen::Vector3d::Zero();
+    if (tick.own_valid() && tick.ir_epoch() != 0) {
+      if (p1) {
+        // The newest IR of that epoch received by then.
+        std::shared_ptr<const PreparedIR> ir;
+        const auto [first, last] = irs.equal_range(tick.ir_epoch());
+        for (auto it = first; it != last; ++it)
+          if (it->second.first <= tick.time_ns() || !ir) ir = it->second.second;
+        if (!ir) {
+          fail(i, tick, "the IR it used was not recorded");
+          break;
+        }
+        std::vector<Eigen::Vector3d> remotes;
+        for (const wire::Vec3& r : tick.remotes()) remotes.push_back(wire::from_wire(r));
+        expected = evaluate_force(*ir, wire::from_wire(tick.own()), remotes).force;
+      } else {
+        // P0: the force held is one the server sent under that epoch and had arrived.
+        expected = Eigen::Vector3d::Constant(std::nan(""));
+        for (const auto& [arrival, epoch, force] : forces)
+          if (epoch == tick.ir_epoch() && arrival <= tick.time_ns() && same_bits(force, evaluated)) expected = force;
+      }
+    }
+    if (!same_bits(expected, evaluated)) {
+      fail(i, tick, fmt::format("recorded evaluated force {}, replayed {}", vec(evaluated), vec(expected)));
+      break;
+    }
+    const Eigen::Vector3d force = output_force(evaluated, tick.fade(), rec.config.force_limit());
+    if (!same_bits(force, wire::from_wire(tick.force()))) {
+      fail(i, tick, fmt::format("recorded output force {}, replayed {}", vec(wire::from_wire(tick.force())), vec(force)));
+      break;
+    }
+    result.checked += 2;
+  }
+  return result;
+}
+
+VerifyResult verify_server(const Recording& rec) {
+  VerifyResult result;
+  const record::SessionConfig& config = rec.config;
+  const std::int64_t start = config.start_time_ns();
+  const Scene scene = parse_scene(config.scene_yaml(), config.scene_file());
+  const Model model = build_model(scene);
+  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, config.injected().step_nodes() > 0));
+  prepare_compliance(model, columns, std::nullopt);
+  SimulationOptions options;
+  options.ir.patch_rings = scene.haptic.patch_rings;
+  options.ir.precision = config.ir_f32() ? IrPrecision::f32 : IrPrecision::f64;
+  options.ir.contact_model = scene.haptic.contact_model;
+  options.ir.force_limit = scene.haptic.force_limit_n;
+  options.step_delay_nodes = static_cast<int>(config.injected().step_nodes());
+  options.naive_every_step = config.injected().condensation() == "naive";
+  Simulation simulation(model, columns, scene.tools, options);
+
+  std::size_t next_ir = 0;
+  std::string expected_bytes, replayed_bytes;
+  for (std::size_t i = 0; i < rec.steps.size() && result.ok; ++i) {
+    const record::SimulationStep& step = rec.steps[i];
+    const auto fail = [&](const std::string& what) {
+      result.ok = false;
+      result.first_difference = fmt::format("simulation step {} (t = {:.6f} s): {}", i, seconds(step.time_ns(), start), what);
+    };
+    for (const record::ToolInput& tool : step.tools()) {
+      if (tool.known()) simulation.set_tool(static_cast<int>(tool.slot()), wire::from_wire(tool.position()));
+      else simulation.clear_tool(static_cast<int>(tool.slot()));
+    }
+    const StepReport report = simulation.step(step.simulation_time());
+    if (report.rebuilt != step.rebuilt()) {
+      fail(fmt::format("recorded {} the IRs, the replay {}", step.rebuilt() ? "rebuilt" : "kept",
+                       report.rebuilt ? "rebuilt them" : "kept them"));
+      break;
+    }
+    if (report.rebuilt) {
+      for (int user = 0; user < simulation.user_count() && result.ok; ++user) {
+        const auto prepared = simulation.ir(user);
+        if (!prepared) continue;
+        if (next_ir >= rec.irs.size()) {
+          fail(fmt::format("the replay built an IR for user {} that was not recorded", user));
+          break;
+        }
+        rec.irs[next_ir].ir().SerializeToString(&expected_bytes);
+        wire::to_wire(prepared->ir).SerializeToString(&replayed_bytes);
+        if (expected_bytes != replayed_bytes)
+          fail(fmt::format("the IR for user {} (epoch {}) differs from the recorded one", user, prepared->ir.epoch));
+        ++next_ir;
+        ++result.checked;
+      }
+    }
+    for (const record::ServerForce& recorded : step.forces()) {
+      const Eigen::Vector3d force = simulation.force(static_cast<int>(recorded.slot())).force;
+      if (!same_bits(force, wire::from_wire(recorded.force()))) {
+        fail(fmt::format("P0 force for user {}: recorded {}, replayed {}", recorded.slot(),
+                         vec(wire::from_wire(recorded.force())), vec(force)));
+        break;
+      }
+      ++result.checked;
+    }
+    if (step.display_frame()) simulation.displacement_of(columns.row_nodes());  // same side effects as live
+  }
+  return result;
+}
+
+void print_summary(const Recording& rec) {
+  const record::SessionConfig& c = rec.config;
+  const auto span = [&](auto first, auto last) { return seconds(last, first); };
+  std::int64_t first = std::numeric_limits<std::int64_t>::max(), last = 0;
+  const auto see = [&](std::int64_t t) {
+    first = std::min(first, t);
+    last = std::max(last, t);
+  };
+  for (const auto& t : rec.ticks) see(t.time_ns());
+  for (const auto& s : rec.steps) see(s.time_ns());
+  for (const auto& d : rec.datagrams) see(d.receive_time_ns());
+  fmt::print("recording   {}{}\n", rec.file.string(), rec.truncated ? fmt::format(" (TRUNCATED: {})", rec.truncation) : "");
+  fmt::print("role        {}{}\n", c.role(), c.role() == "client" ? fmt::format(", user '{}' in slot {}, device {}", c.user(), c.slot(), c.device()) : "");
+  fmt::print("scene       {} ({})\n", c.scene_name(), c.scene_file().empty() ? "as served" : c.scene_file());
+  fmt::print("protocol    {}; session {:016x}\n", c.protocol() == wire::P0 ? "P0" : "P1", c.session());
+  const record::InjectedDelays& d = c.injected();
+  if (c.role() == "server")
+    fmt::print("injected    shift {:g} ms + U(0, {:g}) ms, loss {:g}, reorder {:g}, seed {}; step nodes {}, sim rate {:g} Hz, "
+               "{} condensation\n",
+               d.shift_delay_ms(), d.jitter_ms(), d.loss(), d.reorder(), d.seed(), d.step_nodes(), d.sim_rate_hz(),
+               d.condensation());
+  fmt::print("duration    {:.3f} s\n", first <= last ? span(first, last) : 0.0);
+  fmt::print("records     {} haptic ticks, {} simulation steps, {} IRs, {} datagrams, {} events\n", rec.ticks.size(),
+             rec.steps.size(), rec.irs.size(), rec.datagrams.size(), rec.events.size());
+  if (!rec.ticks.empty()) {
+    double peak = 0;
+    for (const auto& t : rec.ticks) peak = std::max(peak, wire::from_wire(t.force()).norm());
+    fmt::print("force       peak {:.4f} N\n", peak);
+  }
+  for (const auto& e : rec.events) fmt::print("event       {:9.3f} s  {}: {}\n", seconds(e.time_ns(), c.start_time_ns()), e.kind(), e.text());
+}
+
+void export_csv(const Recording& rec, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  const std::int64_t start = rec.config.start_time_ns();
+  if (!rec.ticks.empty()) {
+    AtomicFile out(dir / "haptic.csv");
+    out.write("time_s,own_x,own_y,own_z,own_valid,force_x,force_y,force_z,evaluated_x,evaluated_y,evaluated_z,ir_epoch,flags,fade");
+    out.write(",remote_x,remote_y,remote_z\n");
+    for (const auto& t : rec.ticks) {
+      const Eigen::Vector3d o = wire::from_wire(t.own()), f = wire::from_wire(t.force()), e = wire::from_wire(t.evaluated());
+      const Eigen::Vector3d r = t.remotes_size() ? wire::from_wire(t.remotes(0)) : Eigen::Vector3d::Constant(std::nan(""));
+      out.print("{:.9f},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{},{:.17g},{:.17g},{:.17g}\n",
+                seconds(t.time_ns(), start), o.x(), o.y(), o.z(), t.own_valid() ? 1 : 0, f.x(), f.y(), f.z(), e.x(), e.y(),
+                e.z(), t.ir_epoch(), t.flags(), t.fade(), r.x(), r.y(), r.z());
+    }
+    out.commit();
+  }
+  if (!rec.steps.empty()) {
+    AtomicFile out(dir / "steps.csv");
+    out.write("time_s,simulation_time_s,slot,known,x,y,z,rebuilt,boundary_nodes\n");
+    for (const auto& s : rec.steps)
+      for (const auto& tool : s.tools()) {
+        const Eigen::Vector3d p = wire::from_wire(tool.position());
+        out.print("{:.9f},{:.9f},{},{},{:.17g},{:.17g},{:.17g},{},{}\n", seconds(s.time_ns(), start), s.simulation_time(),
+                  tool.slot(), tool.known() ? 1 : 0, p.x(), p.y(), p.z(), s.rebuilt() ? 1 : 0, s.boundary_nodes());
+      }
+    out.commit();
+  }
+  {
+    AtomicFile out(dir / "tool_samples.csv");
+    out.write("receive_time_s,sender,sequence,sender_time_ns,user,sample_time_ns,x,y,z,valid\n");
+    for (const auto& d : rec.datagrams) {
+      if (!d.datagram().has_tool()) continue;
+      const wire::ToolSample& t = d.datagram().tool();
+      const Eigen::Vector3d p = wire::from_wire(t.position());
+      out.print("{:.9f},{},{},{},{},{},{:.17g},{:.17g},{:.17g},{}\n", seconds(d.receive_time_ns(), start),
+                d.datagram().header().sender(), d.datagram().header().sequence(), d.datagram().header().sender_time_ns(),
+                t.user(), t.sample_time_ns(), p.x(), p.y(), p.z(), t.valid() ? 1 : 0);
+    }
+    out.commit();
+  }
+  {
+    AtomicFile out(dir / "irs.csv");
+    out.write("time_s,user,epoch,simulation_time_s,contact_nodes,boundary_dofs,bytes\n");
+    for (const auto& r : rec.irs)
+      out.print("{:.9f},{},{},{:.9f},{},{},{}\n", seconds(r.time_ns(), start), r.ir().user(), r.ir().epoch(),
+                r.ir().simulation_time(), r.ir().row_node_count(),
+                r.ir().boundary_displacement_f64_size() + r.ir().boundary_displacement_f32_size(), r.ir().ByteSizeLong());
+    out.commit();
+  }
+  {
+    AtomicFile out(dir / "events.csv");
+    out.write("time_s,kind,text\n");
+    for (const auto& e : rec.events) {
+      std::string text = e.text();
+      std::replace(text.begin(), text.end(), '"', '\'');
+      out.print("{:.9f},{},\"{}\"\n", seconds(e.time_ns(), start), e.kind(), text);
+    }
+    out.commit();
+  }
+  spdlog::info("exported CSV files to {}", dir.string());
+}
+
+}  // namespace
+
+VerifyResult verify_recording(const std::filesystem::path& file) {
+  const Recording rec = record::read_recording(file);
+  if (!rec.has_config) throw Error(fmt::format("{}: the recording has no configuration: it cannot be verified", file.string()));
+  return rec.config.role() == "server" ? verify_server(rec) : verify_client(rec);
+}
+
+int run_replay(const ReplayOptions& options) {
+  const Recording rec = record::read_recording(options.file);
+  const bool summary = options.summary || (!options.verify && options.export_csv.empty());
+  if (summary) print_summary(rec);
+  if (!options.export_csv.empty()) export_csv(rec, options.export_csv);
+  if (options.verify) {
+    const VerifyResult result = verify_recording(options.file);
+    if (!result.ok) {
+      fmt::print("verify: DIFFERENT after {} identical values: {}\n", result.checked, result.first_difference);
+      return 1;
+    }
+    fmt::print("verify: identical: {} {} re-run and compared bit for bit{}\n", result.checked,
+               rec.config.role() == "server" ? "IRs and forces" : "forces", rec.truncated ? " (recording truncated)" : "");
+  }
+  return 0;
+}
+
+}  // namespace cohaptic

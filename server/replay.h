@@ -1,0 +1,40 @@
+// `cohaptic-server replay FILE`: looking at a recorded session, re-running it, exporting it.
+//
+//   --summary     what is in the recording (the default)
+//   --verify      re-run the recorded inputs through the same computations and compare
+//                 every force bit for bit:
+//                   a client recording: each haptic tick's force from the IR it used (or the
+//                   P0 force it held) and the positions it used, then faded and limited as
+//                   the loop does;
+//                   a server recording: the simulation re-run step by step from the recorded
+//                   tool inputs (same model, same compliance), every IR it built and every
+//                   P0 force it sent;
+//                 exits non-zero and names the first difference;
+//   --export-csv  every kind of record as a CSV file in DIR.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace cohaptic {
+
+struct ReplayOptions {
+  std::filesystem::path file;
+  bool summary = false;
+  bool verify = false;
+  std::filesystem::path export_csv;  ///< empty: no export
+};
+
+/// Returns the process exit code: 0, or 1 if verification found a difference.
+int run_replay(const ReplayOptions& options);
+
+/// The outcome of verifying one recording.
+struct VerifyResult {
+  bool ok = true;
+  std::size_t checked = 0;     ///< forces (and IRs) compared
+  std::string first_difference;
+};
+
+VerifyResult verify_recording(const std::filesystem::path& file);
+
+}  // namespace cohaptic
