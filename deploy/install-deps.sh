@@ -25,7 +25,21 @@ for p in "${packages[@]}"; do
   [[ "$status" == "install ok installed" ]] || missing+=("$p")
 done
 
+# The official MCAP reader (@mcap/core), used by a test to check our recordings. Optional:
+# only where Node.js and npm already are; the test says how to get it when it is missing.
+install_node_tools() {
+  local here
+  here="$(cd "$(dirname "$0")" && pwd)"
+  if [[ -d "$here/node/node_modules/@mcap/core" ]]; then return 0; fi
+  if command -v npm >/dev/null 2>&1; then
+    echo "install-deps: npm install @mcap/core into deploy/node (for the recording-format test)"
+    npm ci --prefix "$here/node" --no-audit --no-fund --loglevel=error >/dev/null 2>&1 ||
+      echo "install-deps: npm install failed; the official-reader test will be skipped"
+  fi
+}
+
 if [[ ${#missing[@]} -eq 0 ]]; then
+  install_node_tools
   echo "install-deps: all ${#packages[@]} packages present"
   exit 0
 fi
@@ -45,4 +59,5 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 "${as_root[@]}" apt-get update -q
 "${as_root[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
+install_node_tools
 echo "install-deps: done"

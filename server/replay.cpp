@@ -11,6 +11,7 @@
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "common/util/atomic_file.h"
+#include "common/util/blas_threads.h"
 #include "common/util/error.h"
 #include "proto/record/recording.h"
 #include "proto/wire/ir_convert.h"
@@ -95,6 +96,7 @@ VerifyResult verify_client(const Recording& rec) {
 }
 
 VerifyResult verify_server(const Recording& rec) {
+  use_single_blas_thread();  // as the server ran: the same rounding in every solve
   VerifyResult result;
   const record::SessionConfig& config = rec.config;
   const std::int64_t start = config.start_time_ns();

@@ -289,7 +289,7 @@ const McapSchema* McapReader::schema_of(const McapMessage& message) const {
   return it == schemas_.end() ? nullptr : &it->second;
 }
 
-bool McapReader::carries_protobuf(const McapMessage& message, const std::string& full_name) const {
+bool McapReader::carries_protobuf(const McapMessage& message, std::string_view full_name) const {
   const auto channel = channels_.find(message.channel_id);
   if (channel == channels_.end() || channel->second.message_encoding != "protobuf") return false;
   const auto schema = schemas_.find(channel->second.schema_id);

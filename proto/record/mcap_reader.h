@@ -30,6 +30,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "proto/record/crc32.h"
@@ -87,7 +88,7 @@ class McapReader {
     void operator()(std::FILE* file) const;
   };
 
-  bool carries_protobuf(const McapMessage& message, const std::string& full_name) const;
+  bool carries_protobuf(const McapMessage& message, std::string_view full_name) const;
   void read_magic();
   /// Reads the next record into prefix_/content_; false (and the reader ended, truncated)
   /// if the file ends before the record is complete.
