@@ -6,6 +6,7 @@
 
 #include "client/device/bridge_device.h"
 #include "client/device/hand_model.h"
+#include "client/device/recorded_motion.h"
 #include "client/device/scripted_device.h"
 #include "client/device/trajectory.h"
 #include "common/util/error.h"
@@ -43,7 +44,7 @@ std::unique_ptr<HapticDevice> make_bridge(const std::string& args, double force_
   return std::make_unique<BridgeDevice>(options, force_limit);
 }
 
-// One entry per kind; a new kind (e.g. replay:FILE[:user]) is one more entry.
+// One entry per kind.
 const std::vector<DeviceKind>& kinds() {
   static const std::vector<DeviceKind> table{
       {"script", "script:FILE        play the trajectory in FILE (open loop)",
@@ -58,6 +59,15 @@ const std::vector<DeviceKind>& kinds() {
        }},
       {"bridge", "bridge:[HOST:]PORT an external program sending poses to UDP HOST:PORT (default host 127.0.0.1)",
        [](const std::string& args, double limit) { return make_bridge(args, limit, "bridge:" + args); }},
+      {"replay", "replay:FILE[:SLOT] the hand motion of a recording: a client's own, or a server's user SLOT (open loop)",
+       [](const std::string& args, double limit) -> std::unique_ptr<HapticDevice> {
+         // FILE may contain ':' itself; a trailing ":digits" is the slot.
+         const auto colon = args.rfind(':');
+         const bool has_slot = colon != std::string::npos && colon + 1 < args.size() &&
+                               args.find_first_not_of("0123456789", colon + 1) == std::string::npos;
+         const std::string file = has_slot ? args.substr(0, colon) : args;
+         return std::make_unique<ScriptedDevice>(recorded_motion(file, has_slot ? args.substr(colon + 1) : ""), limit);
+       }},
   };
   return table;
 }
