@@ -19,14 +19,19 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 
+# Node.js and npm, for the official MCAP reader (@mcap/core) a test checks our recordings
+# with: Debian's packages, unless some Node.js is already there (NodeSource's brings its
+# own npm and conflicts with Debian's).
+if ! command -v node >/dev/null 2>&1 && ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi
+
 missing=()
 for p in "${packages[@]}"; do
   status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
   [[ "$status" == "install ok installed" ]] || missing+=("$p")
 done
 
-# The official MCAP reader (@mcap/core), used by a test to check our recordings. Optional:
-# only where Node.js and npm already are; the test says how to get it when it is missing.
+# @mcap/core into deploy/node/node_modules, from the lock file. If npm cannot reach its
+# registry, the test that needs it is skipped and says how to get it.
 install_node_tools() {
   local here
   here="$(cd "$(dirname "$0")" && pwd)"

@@ -2,9 +2,12 @@
 # The two-surgeon demo on loopback: a cohaptic-server serving the brain scene (P1) and two
 # cohaptic-client processes whose hand models follow the surgeons' scripted motions (A
 # retracts the cerebellum downward, B the occipital lobe upward). About 20 s. Writes
-# every report under out/demo/, the deformed brain surface for ParaView under
-# out/demo/display/ (open surface.pvd), prints the summary, and exits non-zero if the
-# session was unhealthy (see README.md, "Reports and the demo report").
+# every report under out/demo/, the three processes' recordings (server.mcap,
+# client_a.mcap, client_b.mcap), the deformed brain surface for ParaView under
+# out/demo/display/ (open surface.pvd), prints the summary, verifies the clients'
+# recordings bit for bit (cohaptic-server replay --verify), and exits non-zero if the
+# session was unhealthy (see README.md, "Reports and the demo report") or a verification
+# failed.
 #
 # Environment: BUILD_DIR (default build), DEMO_PORT (default 7431), DEMO_DURATION (s, default
 # 20), DEMO_PROTOCOL (P1), DEMO_DEVICE (hand or script), DEMO_OUT (out/demo).
@@ -19,7 +22,7 @@ out=${DEMO_OUT:-out/demo}
 server_bin=$build/server/cohaptic-server
 client_bin=$build/client/cohaptic-client
 mkdir -p "$out"
-rm -rf "$out"/*.json "$out"/*.log "$out/display"
+rm -rf "$out"/*.json "$out"/*.log "$out"/*.mcap "$out/display"
 
 pids=()
 cleanup() { for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done; }
@@ -27,7 +30,7 @@ trap cleanup EXIT
 
 # The server outlives the clients by a few seconds so that both can say goodbye.
 "$server_bin" --scene scenes/brain.yaml --listen "127.0.0.1:$port" --protocol "$protocol" \
-  --duration $((duration + 6)) --report "$out/server.json" --display "$out/display" --display-rate-hz 5 \
+  --duration $((duration + 6)) --report "$out/server.json" --record "$out/server.mcap" --display "$out/display" --display-rate-hz 5 \
   >"$out/server.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 1 300); do
@@ -39,10 +42,10 @@ grep -q "listening on" "$out/server.log" || { echo "demo: the server did not sta
 echo "demo: server up on 127.0.0.1:$port ($protocol); two surgeons for ${duration} s ..."
 
 "$client_bin" --server "127.0.0.1:$port" --user surgeon-A --slot 0 --device "$device:scenes/brain/surgeon_a.yaml" \
-  --duration "$duration" --report "$out/client_a.json" >"$out/client_a.log" 2>&1 &
+  --duration "$duration" --report "$out/client_a.json" --record "$out/client_a.mcap" >"$out/client_a.log" 2>&1 &
 pids+=($!)
 "$client_bin" --server "127.0.0.1:$port" --user surgeon-B --slot 1 --device "$device:scenes/brain/surgeon_b.yaml" \
-  --duration "$duration" --report "$out/client_b.json" >"$out/client_b.log" 2>&1 &
+  --duration "$duration" --report "$out/client_b.json" --record "$out/client_b.mcap" >"$out/client_b.log" 2>&1 &
 pids+=($!)
 status=0
 wait "${pids[1]}" || status=$?
@@ -53,5 +56,15 @@ if [[ $status -ne 0 ]]; then
   tail -n 5 "$out"/*.log >&2
   echo "demo: a process failed (exit $status)" >&2
 fi
+healthy=0
 "$server_bin" summarize --server-report "$out/server.json" --client-report "$out/client_a.json" \
-  --client-report "$out/client_b.json" --out "$out/report.json"
+  --client-report "$out/client_b.json" --out "$out/report.json" || healthy=$?
+# Every force each surgeon felt, recomputed from the recorded inputs, must be bit-identical.
+# (The server's recording verifies too, re-running every simulation step: cohaptic-server
+# replay out/demo/server.mcap --verify; it takes about as long as the session.)
+verified=0
+for client in client_a client_b; do
+  "$server_bin" replay "$out/$client.mcap" --verify --log-level warn || verified=1
+done
+[[ $healthy -eq 0 ]] || exit "$healthy"
+exit "$verified"

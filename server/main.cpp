@@ -2,6 +2,7 @@
 //   cohaptic-server --scene FILE --listen HOST:PORT [...]   serve a scene to haptic clients
 //   cohaptic-server probe ...                               static forces at tool positions
 //   cohaptic-server replay FILE [--summary|--verify|--export-csv DIR]  a recorded session
+//   cohaptic-server study FILE --out DIR                    a lab study, trial by trial
 //   cohaptic-server keygen FILE                             a new session key file
 //   cohaptic-server summarize ...                           merge reports, judge a session
 // See README.md for every option.
@@ -18,6 +19,7 @@
 #include "proto/wire/session_key.h"
 #include "server/probe.h"
 #include "server/replay.h"
+#include "server/study.h"
 #include "server/session_summary.h"
 #include "server/simulation_server.h"
 
@@ -77,8 +79,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--condensation", condensation,
-                 "incremental (M~ updated when a set changes) or naive (rebuilt from scratch every step, as the "
-                 "paper's conventional loop)")
+                 "incremental (M~ updated when a set changes) or naive (M~ computed from scratch every step, as the "
+                 "paper's conventional loop; a new IR is still sent only when a set changes)")
       ->check(CLI::IsMember({"incremental", "naive"}))
       ->capture_default_str();
   app.add_option("--ir-precision", serve_precision, "Storage of M~ and u_B in the IRs sent: f64 or f32")
@@ -148,6 +150,16 @@ int main(int argc, char** argv) {
                        "for bit; exit 1 naming the first difference");
   replay_cmd->add_option("--export-csv", replay.export_csv, "Write its records as CSV files in this directory");
 
+  // study
+  std::filesystem::path study_file;
+  cohaptic::StudyRunOptions study;
+  CLI::App* study_cmd = app.add_subcommand(
+      "study", "Run a lab study: every trial with real server and client processes, recorded; trials.csv, summary.csv "
+               "and figures in --out (re-run to continue an interrupted study)");
+  study_cmd->add_option("file", study_file, "The study file (YAML)")->required()->check(CLI::ExistingFile);
+  study_cmd->add_option("--out", study.out, "Output directory")->required();
+  study_cmd->add_option("--client-program", study.client_program, "cohaptic-client to run (default: the one of this build)");
+
   // keygen
   std::string key_path;
   CLI::App* keygen_cmd = app.add_subcommand("keygen", "Write a new random session key file (mode 0600)");
@@ -184,6 +196,7 @@ int main(int argc, char** argv) {
       return cohaptic::run_probe(probe);
     }
     if (replay_cmd->parsed()) return cohaptic::run_replay(replay);
+    if (study_cmd->parsed()) return cohaptic::run_study(study_file, study);
     if (summarize_cmd->parsed()) return cohaptic::run_summarize(summary_server, summary_clients, summary_out);
     if (keygen_cmd->parsed()) {
       cohaptic::wire::write_session_key(key_path);

@@ -131,6 +131,13 @@ VerifyResult verify_server(const Recording& rec) {
                        report.rebuilt ? "rebuilt them" : "kept them"));
       break;
     }
+    std::vector<std::uint32_t> pressing;
+    for (int user = 0; user < simulation.user_count(); ++user)
+      if (simulation.pressing(user)) pressing.push_back(static_cast<std::uint32_t>(user));
+    if (!std::equal(pressing.begin(), pressing.end(), step.pressing_slots().begin(), step.pressing_slots().end())) {
+      fail(fmt::format("recorded {} users pressing, the replay {}", step.pressing_slots_size(), pressing.size()));
+      break;
+    }
     if (report.rebuilt) {
       for (int user = 0; user < simulation.user_count() && result.ok; ++user) {
         const auto prepared = simulation.ir(user);

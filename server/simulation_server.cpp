@@ -583,6 +583,8 @@ struct SimulationServer::Impl {
           tool->set_sample_time_ns(latest[u].sample_time_ns);
         }
         step.set_rebuilt(report.rebuilt);
+        for (std::size_t u = 0; u < latest.size(); ++u)
+          if (simulation.pressing(static_cast<int>(u))) step.add_pressing_slots(static_cast<std::uint32_t>(u));
         step.set_display_frame(display_frame);
         step.set_boundary_nodes(static_cast<std::uint32_t>(report.boundary_nodes));
         for (const record::ServerForce& force : forces_this_step) *step.add_forces() = force;
@@ -593,8 +595,8 @@ struct SimulationServer::Impl {
       {
         std::lock_guard lock(stats_mutex);
         stats.step_ns.record(step_end - step_start);
+        if (report.recomputed) stats.ir_build_ns.record(static_cast<std::int64_t>(report.rebuild_ms * 1e6));
         if (report.rebuilt) {
-          stats.ir_build_ns.record(static_cast<std::int64_t>(report.rebuild_ms * 1e6));
           ++stats.rebuilds;
           stats.ir_bytes += report.ir_bytes;
         }
@@ -708,7 +710,7 @@ struct SimulationServer::Impl {
                          {"max", static_cast<double>(stats.step_ns.max()) * 1e-6}};
     server["ir_build_ms"] = {{"p50", static_cast<double>(stats.ir_build_ns.quantile(0.5)) * 1e-6},
                              {"p99", static_cast<double>(stats.ir_build_ns.quantile(0.99)) * 1e-6},
-                             {"count", stats.rebuilds}};
+                             {"count", stats.ir_build_ns.count()}};
     server["irs_sent"] = stats.irs_sent;
     server["ir_bytes_sent"] = stats.ir_bytes;
     server["boundary_nodes"] = {{"max", stats.max_boundary_nodes}, {"obstacle_max", stats.max_obstacle_nodes}};

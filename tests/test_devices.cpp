@@ -415,13 +415,13 @@ TEST(Device, MakeDeviceFromSpecs) {
       const std::string message = e.what();
       EXPECT_NE(message.find(std::string("'") + bad + "'"), std::string::npos) << message;
       if (message.find("unknown device") != std::string::npos) {
-        for (const char* form : {"script:FILE", "hand:FILE", "bridge:[HOST:]PORT"})
+        for (const char* form : {"script:FILE", "hand:FILE", "bridge:[HOST:]PORT", "replay:FILE[:SLOT]"})
           EXPECT_NE(message.find(form), std::string::npos) << "'" << bad << "': " << message;
       }
     }
   }
   EXPECT_THROW(make_device("script:" + kDataDir + "no-such-file.yaml", 3.0), ParseError);
-  EXPECT_EQ(device_spec_forms().size(), 3u);
+  EXPECT_EQ(device_spec_forms().size(), 4u);
 }
 
 // ---------------------------------------------------------------------------------------

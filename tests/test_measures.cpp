@@ -335,17 +335,16 @@ TEST(MeasureSummary, MeanSdAndNMatchAHandComputation) {
   EXPECT_TRUE(std::isnan(describe(one).sd));
   EXPECT_EQ(describe(std::span<const double>{}).n, 0u);
 
-  std::vector<ConditionTrial> trials(4);
-  trials[0].condition = "S30-T150-P0";
-  trials[0].measures.roughness = 0.1;
-  trials[1].condition = "S0, \"fast\"";
-  trials[1].measures.roughness = 0.5;
-  trials[2].condition = "S30-T150-P0";
-  trials[2].measures.roughness = 0.3;
-  trials[3].condition = "S30-T150-P0";
-  trials[3].measures.roughness = kNaN;
+  const auto with_roughness = [](const char* condition, double roughness) {
+    TrialMeasures measures;
+    measures.roughness = roughness;
+    return condition_trial(condition, measures);
+  };
+  std::vector<ConditionTrial> trials = {with_roughness("S30-T150-P0", 0.1), with_roughness("S0, \"fast\"", 0.5),
+                                        with_roughness("S30-T150-P0", 0.3), with_roughness("S30-T150-P0", kNaN)};
+  trials[1].values.push_back({"server_rate_hz", 400});  // a value only some trials have
   const std::vector<ConditionSummary> summary = summarize(trials);
-  ASSERT_EQ(summary.size(), 2 * named_measures(TrialMeasures{}).size());
+  ASSERT_EQ(summary.size(), 2 * (named_measures(TrialMeasures{}).size() + 1));
   const auto find = [&](const std::string& condition, const std::string& measure) {
     for (const ConditionSummary& row : summary)
       if (row.condition == condition && row.measure == measure) return row;
@@ -362,6 +361,9 @@ TEST(MeasureSummary, MeanSdAndNMatchAHandComputation) {
   EXPECT_DOUBLE_EQ(b.mean, 0.5);
   EXPECT_TRUE(std::isnan(b.sd));
   EXPECT_EQ(find("S30-T150-P0", "n_strokes").n, 3u);
+  EXPECT_EQ(find("S30-T150-P0", "server_rate_hz").n, 0u);
+  EXPECT_DOUBLE_EQ(find("S0, \"fast\"", "server_rate_hz").mean, 400);
+  EXPECT_EQ(summary.back().measure, "server_rate_hz");  // after the measures
 
   const std::filesystem::path path = testing::scratch_directory("summary") / "summary.csv";
   write_summary_csv(path, summary);

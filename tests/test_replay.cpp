@@ -10,7 +10,10 @@
 #include <fstream>
 #include <thread>
 
+#include "client/device/recorded_motion.h"
+#include "common/util/error.h"
 #include "proto/record/recording.h"
+#include "proto/wire/vec3_convert.h"
 #include "proto/record/session_recorder.h"
 #include "server/replay.h"
 #include "support/process.h"
@@ -61,17 +64,24 @@ struct RecordedSession {
     EXPECT_TRUE(server->wait_for_log("listening on", 20s)) << server->log_text();
     port = testing::listening_port(server->log_text());
   }
-  std::unique_ptr<ChildProcess> client(const std::string& user, int slot) const {
+  // A client playing `device` (default: the user's script), recording to <user>.mcap.
+  std::unique_ptr<ChildProcess> client(const std::string& user, int slot, const std::string& device = "") const {
     return std::make_unique<ChildProcess>(
         testing::client_program(),
         std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot", std::to_string(slot),
-                                 "--device", "script:" + (dir / (user + ".yaml")).string(), "--record",
-                                 (dir / (user + ".mcap")).string()},
+                                 "--device", device.empty() ? "script:" + (dir / (user + ".yaml")).string() : device,
+                                 "--record", (dir / (user + ".mcap")).string()},
         dir / (user + ".log"));
   }
   void stop() {
     server->signal(SIGINT);
     EXPECT_EQ(server->wait(20s), 0) << server->log_text();
+  }
+  // One user's session: its client in slot 0 runs its script to the end, then the server stops.
+  void run_one_user(const std::string& user) {
+    const auto c = client(user, 0);
+    EXPECT_EQ(c->wait(30s), 0) << c->log_text();
+    stop();
   }
   std::unique_ptr<ChildProcess> server;
   int port = -1;
@@ -100,9 +110,7 @@ TEST(Replay, ATwoUserSessionVerifiesBitForBit) {
 
 TEST(Replay, AChangedForceIsFoundAndNamed) {
   RecordedSession session("replay-tamper", {"--protocol", "P1"});
-  const auto a = session.client("a", 0);
-  ASSERT_EQ(a->wait(30s), 0) << a->log_text();
-  session.stop();
+  session.run_one_user("a");
   // Copy the client's recording with one output force one ulp off.
   const record::Recording original = record::read_recording(session.dir / "a.mcap");
   std::size_t changed = 0;
@@ -142,6 +150,48 @@ TEST(Replay, AClientKilledMidSessionLeavesARecordingThatReadsAndVerifies) {
   EXPECT_TRUE(result.ok) << result.first_difference;
   std::printf("  killed after ~1.5 s: %zu ticks readable (%s), all verified\n", recording.ticks.size(),
               recording.truncation.c_str());
+}
+
+// The deepest point (smallest z) of the own tool and the peak force of a client recording.
+std::pair<double, double> deepest_and_peak(const record::Recording& recording) {
+  double deepest = 1e9, peak = 0;
+  for (const auto& tick : recording.ticks) {
+    if (tick.own_valid()) deepest = std::min(deepest, tick.own().z());
+    peak = std::max(peak, wire::from_wire(tick.force()).norm());
+  }
+  return {deepest, peak};
+}
+
+TEST(Replay, ARecordedHandMotionDrivesANewSession) {
+  RecordedSession first("replay-motion-source", {"--protocol", "P1"});
+  first.run_one_user("a");
+  const record::Recording source = record::read_recording(first.dir / "a.mcap");
+
+  // From a client recording: the own positions, from t = 0 at the first valid one.
+  const Trajectory motion = recorded_motion(first.dir / "a.mcap", "");
+  EXPECT_EQ(motion.knot_times().front(), 0.0);
+  const auto& last_tick = source.ticks.back();
+  EXPECT_EQ(motion.knot_points().back(), wire::from_wire(last_tick.own()));
+  EXPECT_GT(motion.knot_times().size(), source.ticks.size() / 2);
+  // From the server's recording: the positions the server used for slot 0, the same path.
+  const Trajectory served = recorded_motion(first.dir / "server.mcap", "0");
+  EXPECT_NEAR(served.knot_points().back().z(), motion.knot_points().back().z(), 1e-12);
+  EXPECT_THROW(recorded_motion(first.dir / "server.mcap", "a"), Error);
+  EXPECT_THROW(recorded_motion(first.dir / "server.mcap", "1"), Error) << "slot 1 never had a tool";
+
+  // A new session driven by the recorded motion (open loop) reaches the same depth and
+  // feels the same peak force.
+  RecordedSession second("replay-motion-target", {"--protocol", "P1"});
+  const auto replayed = second.client("r", 0, "replay:" + (first.dir / "a.mcap").string());
+  ASSERT_EQ(replayed->wait(30s), 0) << replayed->log_text();
+  second.stop();
+  const auto [source_depth, source_peak] = deepest_and_peak(source);
+  const auto [replay_depth, replay_peak] = deepest_and_peak(record::read_recording(second.dir / "r.mcap"));
+  std::printf("  deepest z %.4f mm vs %.4f mm; peak force %.4f N vs %.4f N\n", source_depth * 1e3, replay_depth * 1e3,
+              source_peak, replay_peak);
+  EXPECT_NEAR(replay_depth, source_depth, 2e-6);
+  EXPECT_NEAR(replay_peak, source_peak, 0.02 * source_peak);
+  EXPECT_GT(source_peak, 0.05);
 }
 
 }  // namespace

@@ -31,9 +31,12 @@ Trajectory recorded_motion(const std::filesystem::path& file, const std::string&
   std::vector<double> times;
   std::vector<Eigen::Vector3d> points;
   if (!rec.ticks.empty()) {
-    const std::int64_t start = rec.ticks.front().time_ns();
+    std::int64_t start = -1;
     for (const record::HapticTick& tick : rec.ticks)
-      if (tick.own_valid()) add_knot(times, points, static_cast<double>(tick.time_ns() - start) * 1e-9, wire::from_wire(tick.own()));
+      if (tick.own_valid()) {
+        if (start < 0) start = tick.time_ns();
+        add_knot(times, points, static_cast<double>(tick.time_ns() - start) * 1e-9, wire::from_wire(tick.own()));
+      }
   } else {
     const int slot = slot_of(rec, user);
     std::int64_t start = -1;

@@ -13,7 +13,8 @@
 //        to `obstacle_iterations` times per step (and keeps converging over steps);
 //      - a node of a tool's nearest triangle is never held: the tool wins;
 //   3. rebuilds every user's IR when a set changed (nearest triangles or B): M~ depends
-//      only on the sets, so it is not rebuilt otherwise (unless `naive_every_step`).
+//      only on the sets, so it is not rebuilt otherwise (`naive_every_step` computes it
+//      every step all the same, for its cost, and publishes it only when a set changed).
 // force() evaluates a user's force from its IR and the current tool positions: the P0
 // protocol's server-side force, the same function the P1 client runs. surface
 // displacement() solves the whole state for display. Units: SI.
@@ -39,14 +40,15 @@ struct SimulationOptions {
   IrBuildOptions ir;
   int step_delay_nodes = 0;     ///< N surface nodes held while any tool presses (0: none)
   int obstacle_iterations = 4;  ///< active-set passes per step
-  /// Rebuild every IR from scratch (naive condensation) at every step, as the paper's
+  /// Compute every M~ from scratch (naive condensation) at every step, as the paper's
   /// conventional simulation loop did: the step delay of large boundary sets then shows.
   bool naive_every_step = false;
 };
 
 struct StepReport {
-  bool rebuilt = false;       ///< the IRs were rebuilt this step
-  double rebuild_ms = 0;      ///< time to update B and rebuild every IR
+  bool rebuilt = false;       ///< new IRs were built this step (a set changed)
+  bool recomputed = false;    ///< M~ was computed this step (rebuilt, or naive_every_step)
+  double rebuild_ms = 0;      ///< time to update B and compute every M~
   std::size_t ir_bytes = 0;   ///< total size of the IRs rebuilt
   int boundary_nodes = 0;     ///< |B| after the step
   int obstacle_nodes = 0;     ///< of which held by obstacles

@@ -7,21 +7,12 @@
 #include <map>
 
 #include "common/util/atomic_file.h"
+#include "common/util/csv.h"
 
 namespace cohaptic {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (char c : text) {
-    if (c == '"') quoted += '"';
-    quoted += c;
-  }
-  return quoted + '"';
-}
 
 }  // namespace
 
@@ -46,21 +37,28 @@ Statistics describe(std::span<const double> values) {
   return s;
 }
 
+ConditionTrial condition_trial(std::string condition, const TrialMeasures& measures) {
+  ConditionTrial trial{std::move(condition), {}};
+  for (const NamedMeasure& named : named_measures(measures)) trial.values.push_back({std::string(named.name), named.value});
+  return trial;
+}
+
 std::vector<ConditionSummary> summarize(const std::vector<ConditionTrial>& trials) {
-  // Conditions in order of first appearance; values[c][m] = measure m over the trials of c.
-  std::vector<std::string> conditions;
-  std::map<std::string, std::size_t> index;
+  // Conditions and names in order of first appearance; values[c][m] = value m over the
+  // trials of condition c.
+  std::vector<std::string> conditions, names;
+  std::map<std::string, std::size_t> condition_index, name_index;
   std::vector<std::vector<std::vector<double>>> values;
-  std::vector<std::string> names;
-  for (const NamedMeasure& named : named_measures(TrialMeasures{})) names.emplace_back(named.name);
+  for (const ConditionTrial& trial : trials)
+    for (const TrialValue& value : trial.values)
+      if (name_index.try_emplace(value.name, names.size()).second) names.push_back(value.name);
   for (const ConditionTrial& trial : trials) {
-    const auto [it, inserted] = index.try_emplace(trial.condition, conditions.size());
+    const auto [it, inserted] = condition_index.try_emplace(trial.condition, conditions.size());
     if (inserted) {
       conditions.push_back(trial.condition);
       values.emplace_back(names.size());
     }
-    const std::vector<NamedMeasure> measures = named_measures(trial.measures);
-    for (std::size_t m = 0; m < measures.size(); ++m) values[it->second][m].push_back(measures[m].value);
+    for (const TrialValue& value : trial.values) values[it->second][name_index.at(value.name)].push_back(value.value);
   }
   std::vector<ConditionSummary> summary;
   summary.reserve(conditions.size() * names.size());

@@ -8,8 +8,9 @@
 //   mean = (1/n) sum v_i                        (NaN if n = 0)
 //   sd   = sqrt(sum (v_i - mean)^2 / (n - 1))   (sample sd; NaN if n < 2)
 // Order: conditions in order of first appearance among the trials, and within a condition the
-// measures in the order of named_measures() (measures.h); every (condition, measure) pair
-// appears, even with n = 0.
+// measures in order of first appearance among the trials' values (for condition_trial():
+// named_measures() order, measures.h); every (condition, measure) pair appears, even with
+// n = 0.
 #pragma once
 
 #include <cstddef>
@@ -31,15 +32,24 @@ struct Statistics {
 /// mean, sd, n of the finite values, as defined above.
 Statistics describe(std::span<const double> values);
 
+/// One named value of a trial: a measure, or another per-trial number (e.g. a rate).
+struct TrialValue {
+  std::string name;
+  double value = 0;
+};
+
 /// One trial and the condition it was run in.
 struct ConditionTrial {
   std::string condition;
-  TrialMeasures measures;
+  std::vector<TrialValue> values;
 };
+
+/// A trial's measures, in the order of named_measures().
+ConditionTrial condition_trial(std::string condition, const TrialMeasures& measures);
 
 struct ConditionSummary {
   std::string condition;
-  std::string measure;  ///< a name from named_measures()
+  std::string measure;  ///< a TrialValue name
   double mean = 0;
   double sd = 0;
   std::size_t n = 0;

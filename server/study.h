@@ -1,0 +1,74 @@
+// `cohaptic-server study FILE --out DIR`: a lab study with simulated participants.
+//
+// The study file (YAML, README "Study files") names a scene, the participants (each a
+// scripted or hand-model device following a trajectory), the factors (shift_ms,
+// step_nodes, sim_rate_hz, protocol, jitter_ms, loss; every combination is a condition),
+// the repetitions and the order (random with a seed, a balanced Latin square, or
+// sequential). Every trial runs a real cohaptic-server and one cohaptic-client per
+// participant on loopback, each recording (MCAP) under DIR/trials/NNN/. After each trial
+// the measures (common/study/measures.h) of every participant's forces go into
+// DIR/trials.csv; at the end DIR/summary.csv (mean, sd, n per condition and measure) and
+// the figures: DIR/figures/fig4.svg (normalised force against time under step delay, P0
+// and P1, the paper's Fig. 4) and DIR/figures/<measure>.svg (each measure per condition).
+// Interrupted and run again with the same study file and DIR, it continues where it
+// stopped: trials already in trials.csv are not run again.
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace cohaptic {
+
+struct StudyParticipant {
+  std::string name;
+  std::string device;  ///< "script" or "hand"
+  std::filesystem::path trajectory;
+  int slot = 0;        ///< the scene tool it holds (its position in the list)
+};
+
+/// One combination of factor levels.
+struct StudyCondition {
+  double shift_ms = 0, jitter_ms = 0, loss = 0, sim_rate_hz = 0;
+  int step_nodes = 0;
+  std::string protocol = "P1";
+  std::string name() const;  ///< e.g. "S30-T150-P1" (+ "-J5", "-L0.1", "-R40" when set)
+};
+
+struct StudyTrial {
+  int index = 0;        ///< 1-based, in run order
+  int repetition = 1;
+  StudyCondition condition;
+};
+
+struct Study {
+  std::filesystem::path file;
+  std::string name;
+  std::filesystem::path scene;
+  double trial_duration_s = 12;
+  std::string condensation = "naive";  ///< how the server builds M~: naive shows the step delay
+  std::vector<StudyParticipant> participants;
+  std::vector<StudyCondition> conditions;
+  int repetitions = 1;
+  std::string order = "random";  ///< random | latin_square | sequential
+  unsigned seed = 1;
+  std::map<std::string, std::string> session;  ///< participant/session fields, copied to every row
+  std::vector<StudyTrial> trials;              ///< in run order
+};
+
+/// Parses and validates a study file (errors name the file, line and key). Trials are
+/// generated in the file's order.
+Study load_study(const std::filesystem::path& file);
+
+struct StudyRunOptions {
+  std::filesystem::path out;
+  std::string server_program;  ///< empty: this program
+  std::string client_program;  ///< empty: cohaptic-client beside this program's build
+};
+
+/// Runs the trials not yet in out/trials.csv (and those that failed), then writes the
+/// summary and the figures. Returns the exit code: 0, or 1 if a trial failed.
+int run_study(const std::filesystem::path& file, const StudyRunOptions& options);
+
+}  // namespace cohaptic

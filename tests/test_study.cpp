@@ -1,0 +1,231 @@
+// The study runner: study files are parsed and checked (errors name the key), the trial
+// order is what the file asks for (a seeded shuffle, or a balanced Latin square), and a
+// two-condition study runs with the real programs: P0 renders at the rate of the slowed
+// simulation, P1 at its haptic rate; an interrupted study continues where it stopped.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "common/util/csv.h"
+#include "common/util/error.h"
+#include "server/study.h"
+#include "support/process.h"
+
+namespace cohaptic {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small cube pressed open loop (a scripted device), so every trial presses the same.
+void write_study_files(const fs::path& dir, const std::string& study_body) {
+  std::ofstream(dir / "cube.yaml") << R"(
+name: study-cube
+units: mm
+objects:
+  - name: cube
+    mesh: {box: {min: [-65, -65, -130], size: [130, 130, 130], divisions: [7, 7, 7]}}
+    material: {youngs_modulus: 2.0e5, poisson_ratio: 0.4}
+    fixed: [{plane: {point: [0, 0, -130], normal: [0, 0, 1]}}]
+    touchable: [{plane: {point: [0, 0, 0], normal: [0, 0, 1]}}]
+    compliance: {precompute: touchable, disk_cache: false}
+tools: [{name: A}]
+haptic: {force_limit: 3.3}
+)";
+  std::ofstream(dir / "press.yaml") << R"(
+units: mm
+start: [4, 3, 4]
+segments:
+  - {move_to: [4, 3, 0.5], speed: 20}
+  - {press: 0.75, speed: 0.75, direction: [0, 0, -1]}
+  - {release: 0.75, speed: 0.75}
+)";
+  std::ofstream(dir / "study.yaml") << study_body;
+}
+
+std::string study_text(const std::string& factors, const std::string& order = "{kind: sequential}",
+                       int repetitions = 1) {
+  return fmt::format(R"(name: test-study
+scene: cube.yaml
+trial_duration: 2.8
+condensation: naive
+participants:
+  - {{name: s1, device: script, trajectory: press.yaml}}
+factors:
+{}
+repetitions: {}
+order: {}
+session: {{site: ci}}
+)",
+                     factors, repetitions, order);
+}
+
+std::vector<std::map<std::string, std::string>> read_table(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> header = split_csv_line(line);
+  std::vector<std::map<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> fields = split_csv_line(line);
+    EXPECT_EQ(fields.size(), header.size()) << line;
+    std::map<std::string, std::string>& row = rows.emplace_back();
+    for (std::size_t i = 0; i < header.size() && i < fields.size(); ++i) row[header[i]] = fields[i];
+  }
+  return rows;
+}
+
+TEST(StudyFile, CrossesTheFactorsAndOrdersTheTrialsAsAsked) {
+  const fs::path dir = testing::scratch_directory("study-file");
+  write_study_files(dir, study_text("  shift_ms: [0, 30]\n  step_nodes: [0, 150]\n  protocol: [P0, P1]",
+                                    "{kind: random, seed: 7}", 2));
+  const Study study = load_study(dir / "study.yaml");
+  ASSERT_EQ(study.conditions.size(), 8u);
+  ASSERT_EQ(study.trials.size(), 16u);
+  std::set<std::string> names;
+  for (const StudyCondition& c : study.conditions) names.insert(c.name());
+  EXPECT_EQ(names.size(), 8u);
+  EXPECT_TRUE(names.count("S30-T150-P1"));
+  // Each repetition runs every condition once; the seed makes the order reproducible and
+  // the two repetitions differ.
+  std::vector<std::string> first, second;
+  for (const StudyTrial& t : study.trials) (t.repetition == 1 ? first : second).push_back(t.condition.name());
+  EXPECT_EQ(std::set<std::string>(first.begin(), first.end()), names);
+  EXPECT_EQ(std::set<std::string>(second.begin(), second.end()), names);
+  EXPECT_NE(first, second);
+  const Study again = load_study(dir / "study.yaml");
+  for (std::size_t i = 0; i < study.trials.size(); ++i)
+    EXPECT_EQ(again.trials[i].condition.name(), study.trials[i].condition.name());
+}
+
+TEST(StudyFile, ALatinSquareBalancesPositionsAndSuccessions) {
+  const fs::path dir = testing::scratch_directory("study-latin");
+  write_study_files(dir, study_text("  step_nodes: [0, 150]\n  protocol: [P0, P1]", "{kind: latin_square}", 4));
+  const Study study = load_study(dir / "study.yaml");
+  ASSERT_EQ(study.trials.size(), 16u);
+  // Every condition once in every position, and every ordered pair of conditions once as
+  // neighbours (Williams design, n = 4): order and carry-over effects are balanced.
+  std::map<std::pair<std::size_t, std::string>, int> position_count;
+  std::map<std::pair<std::string, std::string>, int> succession_count;
+  for (std::size_t k = 0; k < study.trials.size(); ++k) {
+    position_count[{k % 4, study.trials[k].condition.name()}]++;
+    if (k % 4 != 3) succession_count[{study.trials[k].condition.name(), study.trials[k + 1].condition.name()}]++;
+  }
+  EXPECT_EQ(position_count.size(), 16u);
+  for (const auto& [key, count] : position_count) EXPECT_EQ(count, 1) << key.second << " at " << key.first;
+  EXPECT_EQ(succession_count.size(), 12u);
+  for (const auto& [pair, count] : succession_count) EXPECT_EQ(count, 1) << pair.first << " -> " << pair.second;
+}
+
+TEST(StudyFile, MistakesAreNamedWithTheirKey) {
+  const fs::path dir = testing::scratch_directory("study-errors");
+  const auto error_of = [&](const std::string& body) {
+    write_study_files(dir, body);
+    try {
+      load_study(dir / "study.yaml");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::string e = error_of(study_text("  shift_ms: [0, -5]"));
+  EXPECT_NE(e.find("study.yaml"), std::string::npos) << e;
+  EXPECT_NE(e.find("factors.shift_ms"), std::string::npos) << e;
+  e = error_of(study_text("  shift_ms: [0]\n  stepnodes: [150]"));
+  EXPECT_NE(e.find("stepnodes"), std::string::npos) << e;
+  e = error_of(study_text("  protocol: [P2]"));
+  EXPECT_NE(e.find("P2"), std::string::npos) << e;
+  e = error_of(study_text("  shift_ms: [0]", "{kind: shuffled}"));
+  EXPECT_NE(e.find("order.kind"), std::string::npos) << e;
+  std::string body = study_text("  shift_ms: [0]");
+  e = error_of(body.replace(body.find("{site: ci}"), 10, "{protocol: x}"));
+  EXPECT_NE(e.find("column of trials.csv"), std::string::npos) << e;
+  body = study_text("  shift_ms: [0]");
+  const std::string one = "  - {name: s1, device: script, trajectory: press.yaml}\n";
+  e = error_of(body.insert(body.find(one) + one.size(), "  - {name: s2, device: script, trajectory: press.yaml}\n"));
+  EXPECT_NE(e.find("2 participants, but the scene"), std::string::npos) << e;
+  e = error_of("scene: nowhere.yaml\nparticipants: []\nfactors: {}\n");
+  EXPECT_NE(e.find("nowhere.yaml"), std::string::npos) << e;
+}
+
+TEST(Study, TwoConditionsRunWithTheRealProgramsAndAnInterruptedStudyContinues) {
+  const fs::path dir = testing::scratch_directory("study-run");
+  write_study_files(dir, study_text("  step_nodes: [150]\n  protocol: [P0, P1]"));
+  StudyRunOptions options;
+  options.out = dir / "out";
+  options.server_program = testing::server_program();
+  options.client_program = testing::client_program();
+  ASSERT_EQ(run_study(dir / "study.yaml", options), 0);
+
+  auto rows = read_table(options.out / "trials.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  std::map<std::string, std::map<std::string, std::string>> by_protocol;
+  for (const auto& row : rows) {
+    EXPECT_EQ(row.at("status"), "ok");
+    EXPECT_EQ(row.at("site"), "ci");
+    EXPECT_EQ(row.at("step_nodes"), "150");
+    by_protocol[row.at("protocol")] = row;
+  }
+  const auto value = [&](const char* protocol, const char* column) { return std::stod(by_protocol[protocol].at(column)); };
+  // P0: the hand meets each simulation step once, so the force changes at the simulation's
+  // rate in contact (within 25 %: the client's stroke leaves out the slow first step of a
+  // contact, when the held nodes join); P1: the client re-evaluates the IR every tick.
+  const double p0_rate = value("P0", "force_update_rate_hz");
+  const double p0_sim = value("P0", "contact_sim_rate_hz");
+  const double p1_rate = value("P1", "force_update_rate_hz");
+  std::printf("  P0: force updates %.0f/s, simulation %.0f/s in contact; P1: force updates %.0f/s (simulation %.0f/s)\n",
+              p0_rate, p0_sim, p1_rate, value("P1", "contact_sim_rate_hz"));
+  EXPECT_GT(p0_rate, 0);
+  EXPECT_LE(p0_rate, p0_sim * 1.25);
+  EXPECT_GE(p0_rate, p0_sim * 0.75);
+  EXPECT_GT(p1_rate, 2 * p0_rate);
+  EXPECT_GT(p1_rate, 300);
+  for (const char* protocol : {"P0", "P1"}) {
+    EXPECT_GT(value(protocol, "peak_force_n"), 0.1) << protocol;
+    EXPECT_LT(value(protocol, "peak_force_n"), 3.3) << protocol << ": below the force limit, not clamped";
+    EXPECT_EQ(value(protocol, "n_strokes"), 1) << protocol;
+  }
+
+  // summary.csv: mean of one trial = its value, n = 1, for every measure.
+  const auto summary = read_table(options.out / "summary.csv");
+  bool found = false;
+  for (const auto& row : summary)
+    if (row.at("condition") == "S0-T150-P1" && row.at("measure") == "force_update_rate_hz") {
+      EXPECT_NEAR(std::stod(row.at("mean")), p1_rate, 1e-6 * p1_rate);
+      EXPECT_EQ(row.at("n"), "1");
+      found = true;
+    }
+  EXPECT_TRUE(found);
+  for (const char* figure : {"fig4.svg", "force_update_rate_hz.svg", "terminal_force_ratio.svg"})
+    EXPECT_GT(fs::file_size(options.out / "figures" / figure), 1000u) << figure;
+  for (const char* recording : {"server.mcap", "s1.mcap"})
+    EXPECT_GT(fs::file_size(options.out / "trials" / "001" / recording), 1000u) << recording;
+
+  // Interrupted after the first trial: drop the second row; a re-run runs only that trial
+  // and leaves the first one's recording alone.
+  {
+    std::ifstream in(options.out / "trials.csv");
+    std::string header, first;
+    std::getline(in, header);
+    std::getline(in, first);
+    std::ofstream(options.out / "trials.csv") << header << "\n" << first << "\n";
+  }
+  const auto first_recording_time = fs::last_write_time(options.out / "trials" / "001" / "s1.mcap");
+  ASSERT_EQ(run_study(dir / "study.yaml", options), 0);
+  rows = read_table(options.out / "trials.csv");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].at("trial"), "1");
+  EXPECT_EQ(rows[1].at("trial"), "2");
+  EXPECT_EQ(fs::last_write_time(options.out / "trials" / "001" / "s1.mcap"), first_recording_time);
+
+  // The same output directory with a different plan is refused.
+  write_study_files(dir, study_text("  step_nodes: [150]\n  protocol: [P1, P0]"));
+  EXPECT_THROW(run_study(dir / "study.yaml", options), Error);
+}
+
+}  // namespace
+}  // namespace cohaptic
