@@ -61,7 +61,7 @@ healthy=0
   --client-report "$out/client_b.json" --out "$out/report.json" || healthy=$?
 # Every force each surgeon felt, recomputed from the recorded inputs, must be bit-identical.
 # (The server's recording verifies too, re-running every simulation step: cohaptic-server
-# replay out/demo/server.mcap --verify; it takes about as long as the session.)
+# replay out/demo/server.mcap --verify; about 13 s for this 20 s session on 2 cores.)
 verified=0
 for client in client_a client_b; do
   "$server_bin" replay "$out/$client.mcap" --verify --log-level warn || verified=1

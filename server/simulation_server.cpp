@@ -8,6 +8,7 @@
 #include <deque>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <thread>
 
@@ -315,7 +316,8 @@ struct SimulationServer::Impl {
     send_control(session, control);
     spdlog::info("user '{}' joined from {} as slot {} (tool {})", session->user_name, peer(session), slot,
                  model->scene.tools[slot].name);
-    broadcast_event("user_joined", fmt::format("{} took tool {}", session->user_name, model->scene.tools[slot].name));
+    broadcast_event("user_joined", fmt::format("{} took tool {}", session->user_name, model->scene.tools[slot].name),
+                    record::EventUser{session->user_name, static_cast<std::uint32_t>(slot)});
   }
 
   void close(const std::shared_ptr<Session>& session, const std::string& why) {
@@ -338,7 +340,8 @@ struct SimulationServer::Impl {
         tools[session->slot] = LatestTool{};
       }
       spdlog::info("user '{}' (slot {}) left: {}; its tool is released", session->user_name, session->slot, why);
-      broadcast_event("user_left", fmt::format("{} left ({})", session->user_name, why));
+      broadcast_event("user_left", fmt::format("{} left ({})", session->user_name, why),
+                      record::EventUser{session->user_name, static_cast<std::uint32_t>(slot)});
     }
   }
 
@@ -375,8 +378,9 @@ struct SimulationServer::Impl {
     });
   }
 
-  void broadcast_event(const std::string& kind, const std::string& text) {
-    if (recorder) recorder->event(now_ns(), kind, text);
+  void broadcast_event(const std::string& kind, const std::string& text,
+                       const std::optional<record::EventUser>& user = std::nullopt) {
+    if (recorder) recorder->event(now_ns(), kind, text, user);
     for (const auto& session : slots) {
       if (!session) continue;
       wire::Control control;

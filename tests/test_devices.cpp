@@ -415,7 +415,7 @@ TEST(Device, MakeDeviceFromSpecs) {
       const std::string message = e.what();
       EXPECT_NE(message.find(std::string("'") + bad + "'"), std::string::npos) << message;
       if (message.find("unknown device") != std::string::npos) {
-        for (const char* form : {"script:FILE", "hand:FILE", "bridge:[HOST:]PORT", "replay:FILE[:SLOT]"})
+        for (const char* form : {"script:FILE", "hand:FILE", "bridge:[HOST:]PORT", "replay:FILE[:USER]"})
           EXPECT_NE(message.find(form), std::string::npos) << "'" << bad << "': " << message;
       }
     }

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <thread>
 
+#include "client/device/make_device.h"
 #include "client/device/recorded_motion.h"
 #include "common/util/error.h"
 #include "proto/record/recording.h"
@@ -176,7 +177,19 @@ TEST(Replay, ARecordedHandMotionDrivesANewSession) {
   // From the server's recording: the positions the server used for slot 0, the same path.
   const Trajectory served = recorded_motion(first.dir / "server.mcap", "0");
   EXPECT_NEAR(served.knot_points().back().z(), motion.knot_points().back().z(), 1e-12);
-  EXPECT_THROW(recorded_motion(first.dir / "server.mcap", "a"), Error);
+  // By the name the user joined with, too; an unknown name lists the users there were.
+  const Trajectory by_name = recorded_motion(first.dir / "server.mcap", "a");
+  EXPECT_EQ(by_name.knot_points().back(), served.knot_points().back());
+  try {
+    recorded_motion(first.dir / "server.mcap", "nobody");
+    ADD_FAILURE() << "no error for an unknown user";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'a' (slot 0)"), std::string::npos) << e.what();
+  }
+  // The device spec splits FILE from USER at the last ':'.
+  const auto device = make_device("replay:" + (first.dir / "server.mcap").string() + ":a", 3.0);
+  EXPECT_NE(device->describe().find("server.mcap"), std::string::npos) << device->describe();
+  EXPECT_THROW(make_device("replay:" + (first.dir / "server.mcap").string() + ":nobody", 3.0), Error);
   EXPECT_THROW(recorded_motion(first.dir / "server.mcap", "1"), Error) << "slot 1 never had a tool";
 
   // A new session driven by the recorded motion (open loop) reaches the same depth and

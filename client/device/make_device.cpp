@@ -1,6 +1,7 @@
 #include "client/device/make_device.h"
 
 #include <charconv>
+#include <filesystem>
 #include <fmt/format.h>
 #include <functional>
 
@@ -59,14 +60,15 @@ const std::vector<DeviceKind>& kinds() {
        }},
       {"bridge", "bridge:[HOST:]PORT an external program sending poses to UDP HOST:PORT (default host 127.0.0.1)",
        [](const std::string& args, double limit) { return make_bridge(args, limit, "bridge:" + args); }},
-      {"replay", "replay:FILE[:SLOT] the hand motion of a recording: a client's own, or a server's user SLOT (open loop)",
+      {"replay", "replay:FILE[:USER] the hand motion of a recording: a client's own, or a server's USER (slot or name; open loop)",
        [](const std::string& args, double limit) -> std::unique_ptr<HapticDevice> {
-         // FILE may contain ':' itself; a trailing ":digits" is the slot.
+         // FILE may contain ':' itself: the whole is the file if there is one by that name,
+         // otherwise the text after the last ':' is the user.
          const auto colon = args.rfind(':');
-         const bool has_slot = colon != std::string::npos && colon + 1 < args.size() &&
-                               args.find_first_not_of("0123456789", colon + 1) == std::string::npos;
-         const std::string file = has_slot ? args.substr(0, colon) : args;
-         return std::make_unique<ScriptedDevice>(recorded_motion(file, has_slot ? args.substr(colon + 1) : ""), limit);
+         std::error_code ignored;
+         const bool has_user = colon != std::string::npos && colon + 1 < args.size() && !std::filesystem::exists(args, ignored);
+         const std::string file = has_user ? args.substr(0, colon) : args;
+         return std::make_unique<ScriptedDevice>(recorded_motion(file, has_user ? args.substr(colon + 1) : ""), limit);
        }},
   };
   return table;

@@ -1,6 +1,10 @@
 #include "client/device/recorded_motion.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <string>
+#include <vector>
 
 #include "common/util/error.h"
 #include "proto/record/recording.h"
@@ -16,12 +20,19 @@ void add_knot(std::vector<double>& times, std::vector<Eigen::Vector3d>& points, 
   points.push_back(p);
 }
 
-// The slot of `user` in a server recording: a slot number (0 if none is given).
+// The slot of `user` in a server recording: a slot number, or the name a user joined with
+// (0 if none is given).
 int slot_of(const record::Recording& rec, const std::string& user) {
   if (user.empty()) return 0;
   if (user.find_first_not_of("0123456789") == std::string::npos && user.size() < 4) return std::stoi(user);
-  throw Error(fmt::format("{}: give the user of a server recording as its slot number (0, 1, ...), not '{}'",
-                          rec.file.string(), user));
+  std::vector<std::string> names;
+  for (const record::SessionEvent& event : rec.events) {
+    if (event.kind() != "user_joined" || !event.has_slot()) continue;
+    if (event.user() == user) return static_cast<int>(event.slot());
+    names.push_back(fmt::format("'{}' (slot {})", event.user(), event.slot()));
+  }
+  throw Error(fmt::format("{}: no user '{}' joined this session; give a slot number or one of: {}", rec.file.string(),
+                          user, names.empty() ? "(no joins recorded)" : fmt::format("{}", fmt::join(names, ", "))));
 }
 
 }  // namespace

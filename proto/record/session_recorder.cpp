@@ -60,11 +60,16 @@ void SessionRecorder::tick(const HapticTick& tick) { write(haptic_, tick.time_ns
 
 void SessionRecorder::step(const SimulationStep& step) { write(steps_, step.time_ns(), step); }
 
-void SessionRecorder::event(std::int64_t time_ns, const std::string& kind, const std::string& text) {
+void SessionRecorder::event(std::int64_t time_ns, const std::string& kind, const std::string& text,
+                            const std::optional<EventUser>& user) {
   SessionEvent record;
   record.set_time_ns(time_ns);
   record.set_kind(kind);
   record.set_text(text);
+  if (user) {
+    record.set_user(user->name);
+    record.set_slot(user->slot);
+  }
   write(events_, time_ns, record);
 }
 

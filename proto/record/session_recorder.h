@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 
 #include "cohaptic/recording.pb.h"
@@ -31,6 +32,12 @@ inline constexpr const char* kSteps = "/steps";
 inline constexpr const char* kEvents = "/events";
 }  // namespace topic
 
+/// The user an event is about.
+struct EventUser {
+  std::string name;
+  std::uint32_t slot = 0;
+};
+
 class SessionRecorder {
  public:
   /// Creates the file (throws cohaptic::Error naming it if it cannot).
@@ -44,7 +51,9 @@ class SessionRecorder {
   void ir(std::int64_t time_ns, const wire::IntermediateRepresentation& ir);
   void tick(const HapticTick& tick);
   void step(const SimulationStep& step);
-  void event(std::int64_t time_ns, const std::string& kind, const std::string& text);
+  /// An event; joins and leaves name their user and slot, so a user can be found by name.
+  void event(std::int64_t time_ns, const std::string& kind, const std::string& text,
+             const std::optional<EventUser>& user = std::nullopt);
   /// Hands buffered records to the file if the flush interval has passed.
   void flush_if_due();
   /// Writes the summary and footer; later records are dropped.
