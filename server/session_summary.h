@@ -6,7 +6,8 @@
 //   - no datagram or control frame was rejected (nobody else is on the demo's loopback);
 //   - the haptic period's p99 is within 100 us of the period, or, on a machine whose bare
 //     timer cannot do that, within 100 us of that timer floor measured at the same time;
-//   - at most 0.1 % of the ticks missed their deadline;
+//   - at most 0.1 % of the ticks missed their deadline, or, when the bare timer missed
+//     deadlines too (the machine stalled), at most 0.1 % more than it did;
 //   - with two or more users, each one's coupling (the part of its force due to the
 //     others) peaks above 10 % of its own peak force.
 // Every failed criterion is listed by name.

@@ -1,0 +1,92 @@
+// The demo's verdict (cohaptic-server summarize): each criterion on hand-made reports.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "server/session_summary.h"
+
+namespace cohaptic {
+namespace {
+
+nlohmann::json healthy_server() {
+  return {{"server", {{"steps", 5000}, {"datagrams", {{"rejected", 0}}}, {"control_frames", {{"rejected", 0}}}}}};
+}
+
+// A client that did everything right: 16,000 ticks at 1 kHz, IRs received, coupled.
+nlohmann::json healthy_client(const std::string& user) {
+  return {{"user", user},
+          {"ticks", 16000},
+          {"haptic_rate_hz", 999.9},
+          {"rate_setting_hz", 1000.0},
+          {"protocol", "P1"},
+          {"ir", {{"received", 100}}},
+          {"force_n", {{"peak", 0.5}}},
+          {"coupling_n", {{"peak", 0.4}}},
+          {"non_finite_ticks", 0},
+          {"datagrams", {{"rejected", 0}}},
+          {"period_us", {{"p50", 1000.0}, {"p99", 1030.0}}},
+          {"missed_deadlines", 0},
+          {"timer_floor", {{"missed_deadlines", 0}, {"period_us", {{"p99", 1025.0}}}}}};
+}
+
+bool mentions(const std::vector<std::string>& lines, const std::string& text) {
+  return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(text) != std::string::npos; });
+}
+
+TEST(SessionSummary, TwoGoodClientsAreHealthy) {
+  const SessionVerdict verdict = summarize_session(healthy_server(), {healthy_client("a"), healthy_client("b")});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.problems.front();
+  EXPECT_TRUE(verdict.report["healthy"].get<bool>());
+}
+
+TEST(SessionSummary, MissedDeadlinesAreTheLoopsOnlyBeyondWhatTheBareTimerMissed) {
+  // 40 of 16,000 (0.25 %) with a floor that missed nothing: the loop's fault.
+  nlohmann::json late = healthy_client("a");
+  late["missed_deadlines"] = 40;
+  SessionVerdict verdict = summarize_session(healthy_server(), {late, healthy_client("b")});
+  EXPECT_TRUE(mentions(verdict.problems, "a: 40 missed deadlines")) << verdict.report["problems"].dump();
+
+  // The same 40 while the bare timer missed 30: the machine stalled; a note, not a failure.
+  late["timer_floor"]["missed_deadlines"] = 30;
+  verdict = summarize_session(healthy_server(), {late, healthy_client("b")});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
+  EXPECT_TRUE(mentions(verdict.notes, "timer floor missed 30"));
+
+  // 60 against a floor of 30: 30 (0.19 %) are the loop's own.
+  late["missed_deadlines"] = 60;
+  verdict = summarize_session(healthy_server(), {late, healthy_client("b")});
+  EXPECT_TRUE(mentions(verdict.problems, "a: 60 missed deadlines"));
+}
+
+TEST(SessionSummary, SlowPeriodIsAProblemUnlessTheTimerFloorIsAsSlow) {
+  nlohmann::json slow = healthy_client("a");
+  slow["period_us"]["p99"] = 1300.0;
+  SessionVerdict verdict = summarize_session(healthy_server(), {slow, healthy_client("b")});
+  EXPECT_TRUE(mentions(verdict.problems, "haptic period p99 1300 us"));
+  slow["timer_floor"]["period_us"]["p99"] = 1250.0;
+  verdict = summarize_session(healthy_server(), {slow, healthy_client("b")});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
+  EXPECT_TRUE(mentions(verdict.notes, "bare timer"));
+}
+
+TEST(SessionSummary, EachFailedCriterionIsNamed) {
+  nlohmann::json bad = healthy_client("a");
+  bad["non_finite_ticks"] = 3;
+  bad["haptic_rate_hz"] = 800.0;
+  bad["coupling_n"]["peak"] = 0.01;
+  bad["ir"]["received"] = 0;
+  nlohmann::json server = healthy_server();
+  server["server"]["datagrams"]["rejected"] = 7;
+  const SessionVerdict verdict = summarize_session(server, {bad, healthy_client("b")});
+  EXPECT_FALSE(verdict.report["healthy"].get<bool>());
+  for (const char* text : {"a: non-finite forces", "a: haptic rate 800.0 Hz", "a: coupling peak 0.010 N",
+                           "a: nothing to compute forces from", "server: 7 datagrams rejected"})
+    EXPECT_TRUE(mentions(verdict.problems, text)) << text << " in " << verdict.report["problems"].dump();
+  EXPECT_EQ(verdict.problems.size(), 5u) << verdict.report["problems"].dump();
+  EXPECT_TRUE(summarize_session(healthy_server(), {}).problems.size() == 1);
+}
+
+}  // namespace
+}  // namespace cohaptic
