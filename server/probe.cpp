@@ -90,7 +90,8 @@ nlohmann::json probe_json(const Model& model, const ProbeOptions& options, Conta
   out["fixed_nodes"] = fixed_node_tags(model);
   out["touchable_nodes"] = model.touchable_nodes.size();
   out["material"] = {{"youngs_modulus_pa", model.scene.object.material.youngs_modulus},
-                     {"poisson_ratio", model.scene.object.material.poisson_ratio}};
+                     {"poisson_ratio", model.scene.object.material.poisson_ratio},
+                     {"element", formulation_name(model.scene.object.material.formulation)}};
   out["method"] = options.reference ? "reference" : "ir";
   out["contact_model"] = model_name(contact_model);
   out["ir_precision"] = options.precision == IrPrecision::f32 ? "f32" : "f64";
@@ -141,7 +142,8 @@ void print_table(const Model& model, const ProbeOptions& options, ContactModel c
   fmt::print("mesh      {} nodes, {} tetrahedra, {} surface triangles; {} fixed nodes; {} touchable nodes\n",
              model.mesh.node_count(), model.mesh.tet_count(), model.surface.triangle_count(),
              fixed_node_tags(model).size(), model.touchable_nodes.size());
-  fmt::print("material  E = {:g} Pa, nu = {:g}\n", material.youngs_modulus, material.poisson_ratio);
+  fmt::print("material  E = {:g} Pa, nu = {:g}, {}\n", material.youngs_modulus, material.poisson_ratio,
+             formulation_name(material.formulation));
   fmt::print("method    {}; contact model {}; tools pressed {}; {} boundary nodes held\n",
              options.reference ? "full sparse solve (--reference)"
                                : fmt::format("IR ({}, patch rings {})", options.precision == IrPrecision::f32 ? "f32" : "f64",

@@ -199,6 +199,11 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
                      {"objects[0].material.poisson_ratio", "(-1, 0.5)", "found '0.5'"}});
   }
   {
+    const auto text = replaced(base, "poisson_ratio: 0.3", "poisson_ratio: 0.3\n      element: quadratic_tet");
+    cases.push_back({"unknown element", text, "element: quadratic_tet",
+                     {"objects[0].material.element", "linear_tet", "nodal_pressure_tet", "found 'quadratic_tet'"}});
+  }
+  {
     const auto text = replaced(base, "youngs_modulus: 1000", "youngs_modulus: -3");
     cases.push_back({"negative modulus", text, "youngs_modulus: -3",
                      {"objects[0].material.youngs_modulus", "positive modulus", "found '-3'"}});

@@ -1,4 +1,5 @@
-// Assembly of the global stiffness matrix of a linear elastic tetrahedral mesh.
+// Assembly of the global stiffness matrix of a linear elastic tetrahedral mesh, in the
+// material's element formulation (plain linear or average-nodal-pressure tetrahedra).
 //
 // K is 3N x 3N, symmetric, in N/m; before any dof is fixed its null space holds the six
 // rigid-body modes. restrict_to_free_dofs gives K_ff, positive definite when the fixed

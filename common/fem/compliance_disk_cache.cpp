@@ -48,7 +48,7 @@ Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& ma
   h.text("cohaptic compliance cache").value(kComplianceCacheFormatVersion);
   h.matrix(mesh.nodes);
   h.values(std::span<const Tet>(mesh.tets));
-  h.value(material.youngs_modulus).value(material.poisson_ratio);
+  h.value(material.youngs_modulus).value(material.poisson_ratio).value(static_cast<int>(material.formulation));
   h.values(std::span<const AxisMask>(dofs.fixed_axes));
   h.values(std::span<const int>(row_nodes));
   return h.finish();

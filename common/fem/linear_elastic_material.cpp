@@ -24,4 +24,20 @@ Eigen::Matrix<double, 6, 6> elasticity_matrix(const LinearElasticMaterial& mater
   return d;
 }
 
+Eigen::Matrix<double, 6, 6> deviatoric_elasticity_matrix(const LinearElasticMaterial& material) {
+  Eigen::Matrix<double, 6, 6> d = elasticity_matrix(material);
+  d.topLeftCorner<3, 3>().array() -= material.bulk_modulus();
+  return d;
+}
+
+const char* formulation_name(ElementFormulation formulation) {
+  switch (formulation) {
+    case ElementFormulation::linear_tet:
+      return "linear_tet";
+    case ElementFormulation::nodal_pressure_tet:
+      return "nodal_pressure_tet";
+  }
+  return "?";
+}
+
 }  // namespace cohaptic

@@ -115,8 +115,12 @@ ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::pa
   object.mesh = parse_mesh(c.at("mesh"), scale, scene_dir);
 
   const Cursor material = c.at("material");
-  material.only_keys({"model", "youngs_modulus", "poisson_ratio"});
+  material.only_keys({"model", "youngs_modulus", "poisson_ratio", "element"});
   if (auto model = material.find("model")) model->choice({"linear_elastic"});
+  if (auto element = material.find("element"))
+    object.material.formulation = element->choice({"linear_tet", "nodal_pressure_tet"}) == "linear_tet"
+                                      ? ElementFormulation::linear_tet
+                                      : ElementFormulation::nodal_pressure_tet;
   object.material.youngs_modulus = material.at("youngs_modulus").number_in(0, INFINITY, true, true, "a positive modulus in Pa");
   object.material.poisson_ratio =
       material.at("poisson_ratio").number_in(-1, 0.5, true, true, "a number in (-1, 0.5): 0.5 is incompressible, which linear tetrahedra cannot represent");
