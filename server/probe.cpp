@@ -42,6 +42,7 @@ const char* model_name(ContactModel model) {
 void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& options, ContactModel contact_model,
            std::vector<ProbedTool>& tools, const std::vector<int>& users, ProbeTimings& timings) {
   SimulationOptions sim_options;
+  sim_options.ir = ir_build_options(model.scene.haptic);
   sim_options.ir.patch_rings = options.patch_rings.value_or(model.scene.haptic.patch_rings);
   sim_options.ir.precision = options.precision;
   sim_options.ir.contact_model = contact_model;

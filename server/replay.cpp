@@ -105,10 +105,8 @@ VerifyResult verify_server(const Recording& rec) {
   ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, config.injected().step_nodes() > 0));
   prepare_compliance(model, columns, std::nullopt);
   SimulationOptions options;
-  options.ir.patch_rings = scene.haptic.patch_rings;
+  options.ir = ir_build_options(scene.haptic);
   options.ir.precision = config.ir_f32() ? IrPrecision::f32 : IrPrecision::f64;
-  options.ir.contact_model = scene.haptic.contact_model;
-  options.ir.force_limit = scene.haptic.force_limit_n;
   options.step_delay_nodes = static_cast<int>(config.injected().step_nodes());
   options.naive_every_step = config.injected().condensation() == "naive";
   Simulation simulation(model, columns, scene.tools, options);

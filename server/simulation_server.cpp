@@ -476,10 +476,8 @@ struct SimulationServer::Impl {
 
   void simulate() {
     SimulationOptions sim_options;
-    sim_options.ir.patch_rings = model->scene.haptic.patch_rings;
+    sim_options.ir = ir_build_options(model->scene.haptic);
     sim_options.ir.precision = options.precision;
-    sim_options.ir.contact_model = model->scene.haptic.contact_model;
-    sim_options.ir.force_limit = model->scene.haptic.force_limit_n;
     sim_options.step_delay_nodes = options.step_nodes;
     sim_options.naive_every_step = options.naive_condensation;
     Simulation simulation(*model, *columns, model->scene.tools, sim_options);

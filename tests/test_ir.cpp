@@ -8,6 +8,8 @@
 #include <memory>
 #include <random>
 
+#include "common/contact/nearest_surface_nodes.h"
+#include "common/ir/build_ir.h"
 #include "common/model/static_contact.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
@@ -121,6 +123,78 @@ TEST(IntermediateRepresentation, TwoUsersEqualTheFullSolveWithThePointModel) {
 TEST(IntermediateRepresentation, TwoUsersEqualTheFullSolveWithHeldBoundaryNodes) {
   two_users_match_the_full_solve(ContactModel::node_translation, 150);
   two_users_match_the_full_solve(ContactModel::point_constraint, 150);
+}
+
+// B truncation drops the held nodes whose columns of M_CB are weak: at threshold 0 the IR is
+// the untruncated one bit for bit; above it the kept columns are the same numbers, the
+// dropped nodes are exactly those below the threshold, and the force changes by exactly
+// the dropped columns times their displacements.
+TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
+  Rig& rig = shared_cube();
+  const Model& model = *rig.model;
+  const Eigen::Vector3d tool = mm(4, -1, -2);
+  const UserTool user{0, tool, 0, nearest_touchable_triangle(model, tool)};
+  std::vector<bool> under_tool(static_cast<std::size_t>(model.mesh.node_count()), false);
+  for (int v : model.surface.triangles[user.nearest_triangle]) under_tool[v] = true;
+  IncrementalCondensation condensation(*rig.columns, model.dofs);
+  const std::vector<Eigen::Vector3d> around = {tool};
+  std::vector<int> held = nearest_surface_nodes(model, around, 200, under_tool);
+  held.erase(held.begin(), held.begin() + 20);  // leave the patch's neighbourhood free
+  condensation.set_boundary_nodes(held);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> uniform(-1e-3, 1e-3);
+  std::vector<Eigen::Vector3d> held_displacement;
+  for (std::size_t i = 0; i < held.size(); ++i) held_displacement.emplace_back(uniform(rng), uniform(rng), uniform(rng));
+  const std::vector<UserTool> users = {user};
+
+  const auto build = [&](double threshold) {
+    IrBuildOptions options;
+    options.boundary_truncation = threshold;
+    return build_ir(model, condensation, users, 0, held_displacement, options, 1, 0.0);
+  };
+  const IntermediateRepresentation full = build(0.0);
+  EXPECT_EQ(full.node_count(), full.row_node_count + static_cast<int>(held.size()));
+  const IntermediateRepresentation zero = build(0.0);
+  EXPECT_EQ(zero.m_tilde, full.m_tilde);
+  EXPECT_EQ(zero.node_ids, full.node_ids);
+
+  const double threshold = 0.05;
+  const IntermediateRepresentation cut = build(threshold);
+  ASSERT_LT(cut.node_count(), full.node_count());
+  ASSERT_GT(cut.node_count(), full.row_node_count);
+  EXPECT_LT(cut.size_bytes(), full.size_bytes());
+  const Eigen::Index contact = full.m_tilde.rows();
+  EXPECT_EQ(cut.m_tilde.leftCols(contact), full.m_tilde.leftCols(contact));
+
+  // Each held node's coupling (norm of its three columns), kept or not.
+  std::vector<double> coupling;
+  for (std::size_t b = 0; b < held.size(); ++b)
+    coupling.push_back(full.m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3).norm());
+  const double strongest = *std::max_element(coupling.begin(), coupling.end());
+  const Eigen::VectorXd u_c = Eigen::VectorXd::NullaryExpr(contact, [&] { return uniform(rng); });
+  Eigen::VectorXd dropped_force = Eigen::VectorXd::Zero(contact);
+  std::size_t next_kept = static_cast<std::size_t>(cut.row_node_count);
+  for (std::size_t b = 0; b < held.size(); ++b) {
+    const std::int64_t tag = model.mesh.node_tags[held[b]];
+    const bool kept = next_kept < cut.node_ids.size() && cut.node_ids[next_kept] == tag;
+    EXPECT_EQ(kept, coupling[b] >= threshold * strongest) << "node " << tag;
+    if (kept) {
+      ++next_kept;
+    } else {
+      dropped_force += full.m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3) *
+                       full.boundary_displacement.segment<3>(3 * static_cast<Eigen::Index>(b));
+    }
+  }
+  EXPECT_EQ(next_kept, cut.node_ids.size());
+  Eigen::VectorXd full_u(full.m_tilde.cols()), cut_u(cut.m_tilde.cols());
+  full_u << u_c, full.boundary_displacement;
+  cut_u << u_c, cut.boundary_displacement;
+  const Eigen::VectorXd difference = full.m_tilde * full_u - cut.m_tilde * cut_u;
+  EXPECT_LE((difference - dropped_force).norm(), 1e-12 * (full.m_tilde * full_u).norm());
+  EXPECT_GT(dropped_force.norm(), 0.0);
+  std::printf("  B truncation at %.2f keeps %d of %zu held nodes: %zu -> %zu bytes, dropped force %.3g of %.3g N\n",
+              threshold, cut.node_count() - cut.row_node_count, held.size(), full.size_bytes(), cut.size_bytes(),
+              dropped_force.norm(), (full.m_tilde * full_u).norm());
 }
 
 TEST(IntermediateRepresentation, EachUserFeelsTheOther) {

@@ -11,6 +11,29 @@
 
 namespace cohaptic {
 
+IrBuildOptions ir_build_options(const HapticSettings& haptic) {
+  IrBuildOptions options;
+  options.patch_rings = haptic.patch_rings;
+  options.contact_model = haptic.contact_model;
+  options.force_limit = haptic.force_limit_n;
+  options.boundary_truncation = haptic.boundary_truncation;
+  return options;
+}
+
+std::vector<bool> kept_boundary_nodes(const DofMap& dofs, std::span<const int> boundary, const Eigen::MatrixXd& m_cb,
+                                      double threshold) {
+  std::vector<bool> kept(boundary.size(), true);
+  if (threshold <= 0) return kept;
+  std::vector<double> coupling(boundary.size(), 0.0);
+  Eigen::Index column = 0;
+  for (std::size_t b = 0; b < boundary.size(); ++b)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!dofs.is_fixed(boundary[b], axis)) coupling[b] += m_cb.col(column++).squaredNorm();
+  const double strongest = coupling.empty() ? 0 : *std::max_element(coupling.begin(), coupling.end());
+  for (std::size_t b = 0; b < boundary.size(); ++b) kept[b] = coupling[b] >= threshold * threshold * strongest;
+  return kept;
+}
+
 int nearest_touchable_triangle(const Model& model, const Eigen::Vector3d& position) {
   return nearest_triangle(model.mesh, model.surface, model.normals, model.touchable_triangles, position).triangle;
 }
@@ -102,7 +125,25 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   }
   ir.row_node_count = static_cast<int>(nodes.size());
   const std::vector<int> contact_nodes = nodes;
-  for (int node : boundary) add_node(node);
+  const CondensedOperator op = condensation.condense(contact_nodes);
+
+  // The held nodes the IR carries, with their columns of M_CB: all of them, or with B
+  // truncation only those whose coupling to the contact rows is not negligible.
+  std::vector<Eigen::Index> kept_columns;
+  std::vector<double> kept_displacement;
+  const std::vector<bool> kept = kept_boundary_nodes(model.dofs, boundary, op.m_cb, options.boundary_truncation);
+  Eigen::Index column = 0;
+  for (std::size_t b = 0; b < boundary.size(); ++b) {
+    if (kept[b]) add_node(boundary[b]);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (model.dofs.is_fixed(boundary[b], axis)) continue;
+      if (kept[b]) {
+        kept_columns.push_back(column);
+        kept_displacement.push_back(boundary_displacement[b][axis]);
+      }
+      ++column;
+    }
+  }
 
   for (int node : nodes) {
     ir.node_ids.push_back(model.mesh.node_tags[node]);
@@ -111,14 +152,11 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   ir.rest_positions.resize(3, ir.row_node_count);
   for (int i = 0; i < ir.row_node_count; ++i) ir.rest_positions.col(i) = model.mesh.nodes.col(nodes[i]);
 
-  const CondensedOperator op = condensation.condense(contact_nodes);
-  ir.m_tilde.resize(op.m_cc.rows(), op.m_cc.cols() + op.m_cb.cols());
-  ir.m_tilde << op.m_cc, op.m_cb;
-  ir.boundary_displacement.resize(static_cast<Eigen::Index>(op.boundary_dofs.size()));
-  Eigen::Index row = 0;
-  for (std::size_t b = 0; b < boundary.size(); ++b)
-    for (int axis = 0; axis < 3; ++axis)
-      if (!model.dofs.is_fixed(boundary[b], axis)) ir.boundary_displacement[row++] = boundary_displacement[b][axis];
+  const auto kept_count = static_cast<Eigen::Index>(kept_columns.size());
+  ir.m_tilde.resize(op.m_cc.rows(), op.m_cc.cols() + kept_count);
+  ir.m_tilde.leftCols(op.m_cc.cols()) = op.m_cc;
+  for (Eigen::Index k = 0; k < kept_count; ++k) ir.m_tilde.col(op.m_cc.cols() + k) = op.m_cb.col(kept_columns[k]);
+  ir.boundary_displacement = Eigen::Map<const Eigen::VectorXd>(kept_displacement.data(), kept_count);
   if (options.precision == IrPrecision::f32) {
     ir.m_tilde = ir.m_tilde.cast<float>().cast<double>();
     ir.boundary_displacement = ir.boundary_displacement.cast<float>().cast<double>();

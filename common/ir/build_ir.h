@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "common/condense/incremental_condensation.h"
 #include "common/ir/intermediate_representation.h"
@@ -29,7 +30,20 @@ struct IrBuildOptions {
   IrPrecision precision = IrPrecision::f64;
   ContactModel contact_model = ContactModel::node_translation;
   double force_limit = 3.3;  ///< [N]
+  /// B truncation: a held node is left out of the IR (its columns of M_CB and its u_B) when
+  /// the norm of its columns is below this fraction of the largest node's. 0 keeps all;
+  /// M_CC is unchanged either way (the node stays held, only its displacement's effect on
+  /// the contact forces is dropped).
+  double boundary_truncation = 0;
 };
+
+/// The IR settings `haptic` (a scene's) asks for, at f64 (the precision is the server's choice).
+IrBuildOptions ir_build_options(const HapticSettings& haptic);
+
+/// Which nodes of `boundary` B truncation keeps: those whose columns of `m_cb` (free dofs
+/// of B, node by node) have a norm of at least `threshold` times the largest node's.
+std::vector<bool> kept_boundary_nodes(const DofMap& dofs, std::span<const int> boundary, const Eigen::MatrixXd& m_cb,
+                                      double threshold);
 
 /// The touchable triangle nearest `position` (ties to the one it is deepest below).
 int nearest_touchable_triangle(const Model& model, const Eigen::Vector3d& position);

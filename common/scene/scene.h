@@ -82,6 +82,9 @@ struct HapticSettings {
   double force_limit_n = 3.3;  ///< the PHANToM Omni's peak force
   ContactModel contact_model = ContactModel::node_translation;
   int patch_rings = 1;  ///< rings of neighbouring triangles in each IR's contact patch
+  /// B truncation threshold in [0, 1): held nodes coupled to the contact rows more weakly
+  /// than this fraction of the strongest are left out of the IR (0: none).
+  double boundary_truncation = 0;
 };
 
 struct Scene {
