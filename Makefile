@@ -1,6 +1,7 @@
 # cohaptic: the two commands (see README.md).
 #   make test   install missing packages, configure, build (Release), run every test
 #   make demo   the same set-up, then the main job
+#   make tradeoff  the same set-up, then the speed/accuracy grid on the cube
 #   make bench  the same set-up, then the benchmarks (BENCH_ARGS passes arguments through)
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
@@ -8,7 +9,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BENCH_ARGS ?=
 SERVER := $(BUILD_DIR)/server/cohaptic-server
 
-.PHONY: all deps configure build test demo probe-demo bench clean
+.PHONY: all deps configure build test demo probe-demo tradeoff bench clean
 
 all: build
 
@@ -39,6 +40,12 @@ probe-demo: build
 	@echo
 	@$(SERVER) probe --scene scenes/cube.yaml --tool 30,-20,-5 --tool -60,60,-3 --contact-model point \
 	  --boundary-nodes 300 --ir-precision f32 --log-level warn
+
+# Speed against accuracy on the paper's cube (README "Speed versus accuracy"): every
+# setting against the full solve on an 18-division mesh; about a minute.
+tradeoff: build
+	$(SERVER) tradeoff --scene scenes/tradeoff/cube_two_users.yaml --motion scenes/tradeoff/cube_press_slide.yaml \
+	  --motion scenes/tradeoff/cube_press_hold.yaml --out out/tradeoff/cube
 
 bench: build
 	$(BUILD_DIR)/tests/cohaptic_bench $(BENCH_ARGS)

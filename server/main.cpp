@@ -3,6 +3,7 @@
 //   cohaptic-server probe ...                               static forces at tool positions
 //   cohaptic-server replay FILE [--summary|--verify|--export-csv DIR]  a recorded session
 //   cohaptic-server study FILE --out DIR                    a lab study, trial by trial
+//   cohaptic-server tradeoff --scene F --motion M... --out D speed against accuracy, per setting
 //   cohaptic-server keygen FILE                             a new session key file
 //   cohaptic-server summarize ...                           merge reports, judge a session
 // See README.md for every option.
@@ -20,6 +21,7 @@
 #include "server/probe.h"
 #include "server/replay.h"
 #include "server/study.h"
+#include "server/tradeoff.h"
 #include "server/session_summary.h"
 #include "server/simulation_server.h"
 
@@ -160,6 +162,23 @@ int main(int argc, char** argv) {
   study_cmd->add_option("--out", study.out, "Output directory")->required();
   study_cmd->add_option("--client-program", study.client_program, "cohaptic-client to run (default: the one of this build)");
 
+  // tradeoff
+  cohaptic::TradeoffOptions tradeoff;
+  CLI::App* tradeoff_cmd = app.add_subcommand(
+      "tradeoff", "Measure what each speed/accuracy setting costs and buys on a scene, against the full solve on its "
+                  "finest mesh: tradeoff.csv, tradeoff.md and Pareto plots in --out");
+  tradeoff_cmd->add_option("--scene", tradeoff.scene, "Scene file (YAML)")->required()->check(CLI::ExistingFile);
+  tradeoff_cmd->add_option("--motion", tradeoff.motions, "Trajectory file for each scene tool, in order (repeat)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  tradeoff_cmd->add_option("--out", tradeoff.out, "Output directory")->required();
+  tradeoff_cmd->add_option("--divisions", tradeoff.divisions, "Mesh resolutions to measure (box scenes)")
+      ->capture_default_str();
+  tradeoff_cmd->add_option("--reference-divisions", tradeoff.reference_divisions,
+                           "Resolution of the reference mesh (box scenes; a mesh file is its own reference)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 60));
+
   // keygen
   std::string key_path;
   CLI::App* keygen_cmd = app.add_subcommand("keygen", "Write a new random session key file (mode 0600)");
@@ -197,6 +216,7 @@ int main(int argc, char** argv) {
     }
     if (replay_cmd->parsed()) return cohaptic::run_replay(replay);
     if (study_cmd->parsed()) return cohaptic::run_study(study_file, study);
+    if (tradeoff_cmd->parsed()) return cohaptic::run_tradeoff(tradeoff);
     if (summarize_cmd->parsed()) return cohaptic::run_summarize(summary_server, summary_clients, summary_out);
     if (keygen_cmd->parsed()) {
       cohaptic::wire::write_session_key(key_path);

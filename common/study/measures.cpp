@@ -8,6 +8,7 @@
 
 #include "common/study/zero_phase_lowpass.h"
 #include "common/util/error.h"
+#include "common/util/percentile.h"
 
 namespace cohaptic {
 namespace {
@@ -17,17 +18,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 std::vector<Stroke> contact_strokes(const ForceTrace& trace, const MeasureSettings& settings) {
   validate(settings);
   return find_strokes(trace, settings.contact_fraction * peak_force_n(trace));
-}
-
-// Linear interpolation between order statistics at rank p (m - 1); NaN if empty.
-double percentile(std::vector<double> values, double p) {
-  if (values.empty()) return kNaN;
-  std::sort(values.begin(), values.end());
-  const double rank = p * static_cast<double>(values.size() - 1);
-  const auto lo = static_cast<std::size_t>(std::floor(rank));
-  const std::size_t hi = std::min(lo + 1, values.size() - 1);
-  const double w = rank - static_cast<double>(lo);
-  return values[lo] + w * (values[hi] - values[lo]);
 }
 
 double mean_of_finite(const std::vector<double>& values) {

@@ -1,0 +1,64 @@
+#include "common/model/contact_reference.h"
+
+#include "common/fem/static_solve.h"
+
+namespace cohaptic {
+
+ContactReference::ContactReference(const Model& model) : model_(model) {}
+
+const ContactReference::ContactSet& ContactReference::contact_set(const std::vector<ContactQuery>& contacts) {
+  std::vector<int> key;
+  for (const ContactQuery& query : contacts) key.push_back(query.contact ? query.contact->triangle : -1);
+  if (const auto found = sets_.find(key); found != sets_.end()) return found->second;
+
+  ContactSet set;
+  std::vector<int> prescribed;  // free dofs of the pressing triangles' nodes
+  std::vector<std::pair<std::size_t, int>> owner;  // per prescribed dof: (pressing index, axis)
+  for (std::size_t t = 0; t < contacts.size(); ++t) {
+    if (!contacts[t].contact) continue;
+    for (int node : model_.surface.triangles[contacts[t].contact->triangle])
+      for (int axis = 0; axis < 3; ++axis)
+        if (!model_.dofs.is_fixed(node, axis)) {
+          prescribed.push_back(3 * node + axis);
+          owner.emplace_back(set.pressing.size(), axis);
+        }
+    set.pressing.push_back(t);
+  }
+  const auto m = static_cast<Eigen::Index>(set.pressing.size());
+  set.nodal_per_displacement = Eigen::MatrixXd::Zero(9 * m, 3 * m);
+  if (m > 0) {
+    const ConstrainedStaticSolver solver(model_.stiffness, model_.dofs, prescribed);
+    for (Eigen::Index unit = 0; unit < 3 * m; ++unit) {
+      Eigen::VectorXd values(static_cast<Eigen::Index>(prescribed.size()));
+      for (std::size_t i = 0; i < prescribed.size(); ++i)
+        values[static_cast<Eigen::Index>(i)] =
+            static_cast<Eigen::Index>(owner[i].first) == unit / 3 && owner[i].second == unit % 3 ? 1.0 : 0.0;
+      const StaticSolution solution = solver.solve(values);
+      for (Eigen::Index p = 0; p < m; ++p) {
+        const Triangle& tri = model_.surface.triangles[contacts[set.pressing[p]].contact->triangle];
+        for (int i = 0; i < 3; ++i)
+          for (int axis = 0; axis < 3; ++axis)
+            if (!model_.dofs.is_fixed(tri[i], axis))
+              set.nodal_per_displacement(9 * p + 3 * i + axis, unit) = solution.reaction[3 * tri[i] + axis];
+      }
+    }
+  }
+  return sets_.emplace(std::move(key), std::move(set)).first->second;
+}
+
+std::vector<Eigen::Vector3d> ContactReference::forces(const std::vector<PressedTool>& tools) {
+  const std::vector<ContactQuery> contacts = find_tool_contacts(model_, tools);
+  const ContactSet& set = contact_set(contacts);
+  const auto m = static_cast<Eigen::Index>(set.pressing.size());
+  Eigen::VectorXd displacement(3 * m);
+  for (Eigen::Index p = 0; p < m; ++p) displacement.segment<3>(3 * p) = contacts[set.pressing[p]].contact->displacement;
+  const Eigen::VectorXd nodal = set.nodal_per_displacement * displacement;
+  std::vector<Eigen::Vector3d> out(tools.size(), Eigen::Vector3d::Zero());
+  for (Eigen::Index p = 0; p < m; ++p) {
+    const Eigen::Vector3d& w = contacts[set.pressing[p]].contact->weights;
+    for (int i = 0; i < 3; ++i) out[set.pressing[p]] -= w[i] * nodal.segment<3>(9 * p + 3 * i);
+  }
+  return out;
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,45 @@
+// ContactReference: the full sparse solve's reaction forces on a model's tools under node
+// translation, for many tool positions in a row (a recorded or scripted motion).
+//
+// For a fixed set of contact triangles the solve is linear in the prescribed node
+// displacements, so the reference factors K with those nodes' dofs prescribed once per
+// distinct set (CHOLMOD), solves one unit case per pressing tool and axis, and answers
+// every later position with the same set exactly (to round-off) by superposition: the
+// answer of contact_reactions_reference() with nothing held, at a fraction of the cost.
+// Units: m, N. Not thread-safe (the per-set cache grows).
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <vector>
+
+#include "common/model/static_contact.h"
+
+namespace cohaptic {
+
+class ContactReference {
+ public:
+  /// `model` must outlive the reference.
+  explicit ContactReference(const Model& model);
+
+  /// Force on each tool [N] (zero for a tool that presses nothing). Throws Error if two
+  /// tools press triangles sharing a node.
+  std::vector<Eigen::Vector3d> forces(const std::vector<PressedTool>& tools);
+
+  /// Contact sets factored so far.
+  std::size_t factorisations() const { return sets_.size(); }
+
+ private:
+  // Reactions at the pressing triangles' nodes (3 x 3 per tool, column-major per node)
+  // for a unit displacement of each pressing tool and axis: 9m x 3m.
+  struct ContactSet {
+    std::vector<std::size_t> pressing;  // tool indices
+    Eigen::MatrixXd nodal_per_displacement;
+  };
+  const ContactSet& contact_set(const std::vector<ContactQuery>& contacts);
+
+  const Model& model_;
+  std::map<std::vector<int>, ContactSet> sets_;  // keyed by contact triangle per tool (-1: none)
+};
+
+}  // namespace cohaptic

@@ -1,0 +1,370 @@
+#include "server/tradeoff.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "common/fem/compliance.h"
+#include "common/ir/build_ir.h"
+#include "common/ir/evaluate_force.h"
+#include "common/model/compliance_setup.h"
+#include "common/model/contact_reference.h"
+#include "common/scene/load_scene.h"
+#include "common/sim/simulation.h"
+#include "common/study/svg_plot.h"
+#include "common/util/atomic_file.h"
+#include "common/util/error.h"
+#include "common/util/percentile.h"
+#include "common/util/stopwatch.h"
+
+namespace cohaptic {
+namespace {
+
+constexpr double kSampleRateHz = 10000;  // the comparison grid: every haptic rate divides it
+constexpr double kSimulationRateHz = 1000;
+
+const char* contact_model_name(ContactModel model) {
+  return model == ContactModel::node_translation ? "translation" : "point";
+}
+
+int samples_per(double sample_rate_hz, double rate_hz, const std::string& what) {
+  const double ratio = sample_rate_hz / rate_hz;
+  if (!(rate_hz > 0) || std::abs(ratio - std::round(ratio)) > 1e-9 || ratio < 1)
+    throw Error(fmt::format("tradeoff: the {} ({:g} Hz) must divide {:g} Hz", what, rate_hz, sample_rate_hz));
+  return static_cast<int>(std::lround(ratio));
+}
+
+double model_memory_mb(const Model& model, const ComplianceColumns& columns) {
+  const double stiffness = static_cast<double>(model.stiffness.nonZeros()) * (sizeof(double) + sizeof(int));
+  const double factor = model.free_factor->factor_nonzeros() * (sizeof(double) + sizeof(int));
+  const double compliance = static_cast<double>(columns.column_count()) * columns.node_count() * 9 * sizeof(double);
+  return (stiffness + factor + compliance) / 1e6;
+}
+
+}  // namespace
+
+std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector<int>& divisions) {
+  TradeoffSetting base;
+  base.formulation = scene.object.material.formulation;
+  base.contact_model = scene.haptic.contact_model;
+  base.patch_rings = scene.haptic.patch_rings;
+  base.haptic_rate_hz = scene.haptic.rate_hz;
+  std::vector<TradeoffSetting> grid = {base};
+  const auto vary = [&](const std::string& knob, const std::string& value, auto&& change) {
+    TradeoffSetting setting = base;
+    setting.knob = knob;
+    setting.value = value;
+    change(setting);
+    grid.push_back(setting);
+  };
+  if (scene.object.mesh.box) {
+    const int own = scene.object.mesh.box->divisions.maxCoeff();
+    for (int d : divisions)
+      if (d != own) vary("divisions", std::to_string(d), [d](TradeoffSetting& s) { s.divisions = d; });
+  }
+  const ElementFormulation other_element = base.formulation == ElementFormulation::linear_tet
+                                               ? ElementFormulation::nodal_pressure_tet
+                                               : ElementFormulation::linear_tet;
+  vary("element", formulation_name(other_element), [&](TradeoffSetting& s) { s.formulation = other_element; });
+  const ContactModel other_contact = base.contact_model == ContactModel::node_translation
+                                         ? ContactModel::point_constraint
+                                         : ContactModel::node_translation;
+  vary("contact_model", contact_model_name(other_contact), [&](TradeoffSetting& s) { s.contact_model = other_contact; });
+  for (int rings : {0, 2})
+    if (rings != base.patch_rings)
+      vary("patch_rings", std::to_string(rings), [rings](TradeoffSetting& s) { s.patch_rings = rings; });
+  vary("precision", "f32", [](TradeoffSetting& s) { s.precision = IrPrecision::f32; });
+  for (double rate : {100.0, 25.0})
+    vary("ir_rate_hz", fmt::format("{:g}", rate), [rate](TradeoffSetting& s) { s.ir_rate_hz = rate; });
+  for (double rate : {500.0, 1000.0, 2000.0, 5000.0})
+    if (rate != base.haptic_rate_hz)
+      vary("haptic_rate_hz", fmt::format("{:g}", rate), [rate](TradeoffSetting& s) { s.haptic_rate_hz = rate; });
+  return grid;
+}
+
+Scene scene_with(const Scene& scene, const TradeoffSetting& setting) {
+  Scene out = scene;
+  if (setting.divisions > 0) {
+    if (!out.object.mesh.box) throw Error(fmt::format("{}: mesh divisions can only be varied for a box mesh", scene.file.string()));
+    BoxMeshSpec& box = *out.object.mesh.box;
+    const double longest = box.size.maxCoeff();
+    for (int axis = 0; axis < 3; ++axis)
+      box.divisions[axis] = std::max(1, static_cast<int>(std::lround(setting.divisions * box.size[axis] / longest)));
+  }
+  out.object.material.formulation = setting.formulation;
+  out.object.compliance.disk_cache = false;
+  out.haptic.contact_model = setting.contact_model;
+  out.haptic.patch_rings = setting.patch_rings;
+  out.haptic.rate_hz = setting.haptic_rate_hz;
+  return out;
+}
+
+ReferenceTrace reference_trace(const Scene& reference, const std::vector<Trajectory>& motions, double sample_rate_hz) {
+  if (motions.size() != reference.tools.size())
+    throw Error(fmt::format("tradeoff: {} motions for the scene's {} tools (give one --motion per tool)", motions.size(),
+                            reference.tools.size()));
+  const Stopwatch watch;
+  const Model model = build_model(reference);
+  ContactReference solver(model);
+  ReferenceTrace trace;
+  trace.sample_rate_hz = sample_rate_hz;
+  trace.nodes = model.mesh.node_count();
+  trace.tets = model.mesh.tet_count();
+  double duration = 0;
+  for (const Trajectory& motion : motions) duration = std::max(duration, motion.duration());
+  const auto samples = static_cast<std::size_t>(std::floor(duration * sample_rate_hz)) + 1;
+  std::vector<PressedTool> tools(motions.size());
+  for (std::size_t j = 0; j < samples; ++j) {
+    const double t = static_cast<double>(j) / sample_rate_hz;
+    for (std::size_t u = 0; u < motions.size(); ++u) tools[u] = {motions[u].position(t), reference.tools[u].radius};
+    std::vector<Eigen::Vector3d> positions;
+    for (const PressedTool& tool : tools) positions.push_back(tool.position);
+    trace.positions.push_back(std::move(positions));
+    trace.forces.push_back(solver.forces(tools));
+    for (const Eigen::Vector3d& f : trace.forces.back()) trace.peak_force = std::max(trace.peak_force, f.norm());
+  }
+  trace.factorisations = solver.factorisations();
+  trace.seconds = watch.elapsed_ms() / 1000;
+  return trace;
+}
+
+TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, const std::vector<Trajectory>& motions,
+                        const ReferenceTrace& reference) {
+  const Scene varied = scene_with(scene, setting);
+  if (motions.size() != varied.tools.size() || reference.positions.empty() ||
+      reference.positions.front().size() != varied.tools.size())
+    throw Error("tradeoff: the reference, the motions and the scene's tools do not match");
+  TradeoffRow row;
+  row.setting = setting;
+
+  const Stopwatch precompute;
+  const Model model = build_model(varied);
+  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, !varied.obstacles.empty()));
+  prepare_compliance(model, columns, std::nullopt);
+  row.precompute_s = precompute.elapsed_ms() / 1000;
+  row.nodes = model.mesh.node_count();
+  row.tets = model.mesh.tet_count();
+
+  SimulationOptions options;
+  options.ir = ir_build_options(varied.haptic);
+  options.ir.precision = setting.precision;
+  options.ir.force_limit = std::numeric_limits<double>::infinity();  // compare the physics, not the limiter
+  Simulation simulation(model, columns, varied.tools, options);
+  ContactReference own_mesh(model);
+  std::vector<PressedTool> pressed(varied.tools.size());
+
+  const int per_step = samples_per(reference.sample_rate_hz, kSimulationRateHz, "simulation rate");
+  const int per_tick = samples_per(reference.sample_rate_hz, setting.haptic_rate_hz, "haptic rate");
+  const std::size_t users = varied.tools.size();
+  std::vector<std::shared_ptr<const PreparedIR>> published(users);
+  std::vector<double> last_published(users, -INFINITY);
+  std::vector<Eigen::Vector3d> held(users, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Vector3d> remotes;
+  std::vector<double> mtilde_ms;
+  double step_ms = 0, evaluation_ms = 0, bytes = 0, sum_squared = 0, worst = 0, own_sum_squared = 0, own_worst = 0;
+  std::size_t evaluations = 0;
+  const std::size_t samples = reference.positions.size();
+  for (std::size_t j = 0; j < samples; ++j) {
+    const double t = static_cast<double>(j) / reference.sample_rate_hz;
+    const std::vector<Eigen::Vector3d>& positions = reference.positions[j];
+    if (j % static_cast<std::size_t>(per_step) == 0) {
+      for (std::size_t u = 0; u < users; ++u) simulation.set_tool(static_cast<int>(u), positions[u]);
+      const Stopwatch step;
+      const StepReport report = simulation.step(t);
+      step_ms += step.elapsed_ms();
+      if (report.rebuilt) mtilde_ms.push_back(report.rebuild_ms);
+      for (std::size_t u = 0; u < users; ++u) {
+        const std::shared_ptr<const PreparedIR> ir = simulation.ir(static_cast<int>(u));
+        const bool due = setting.ir_rate_hz <= 0 || t - last_published[u] >= 1 / setting.ir_rate_hz - 1e-9;
+        if (ir && ir != published[u] && due) {
+          published[u] = ir;
+          last_published[u] = t;
+          bytes += static_cast<double>(ir->ir.size_bytes());
+          ++row.irs_sent;
+        }
+      }
+    }
+    if (j % static_cast<std::size_t>(per_tick) == 0)
+      for (std::size_t u = 0; u < users; ++u) {
+        if (!published[u]) continue;
+        remotes.clear();
+        for (const IrRemoteContact& remote : published[u]->ir.remotes) remotes.push_back(positions[remote.user]);
+        const Stopwatch evaluation;
+        held[u] = evaluate_force(*published[u], positions[u], remotes).force;
+        evaluation_ms += evaluation.elapsed_ms();
+        ++evaluations;
+      }
+    for (std::size_t u = 0; u < users; ++u) pressed[u] = {positions[u], varied.tools[u].radius};
+    const std::vector<Eigen::Vector3d> own_forces = own_mesh.forces(pressed);
+    for (std::size_t u = 0; u < users; ++u) {
+      const double error = (held[u] - reference.forces[j][u]).norm();
+      sum_squared += error * error;
+      worst = std::max(worst, error);
+      const double own_error = (held[u] - own_forces[u]).norm();
+      own_sum_squared += own_error * own_error;
+      own_worst = std::max(own_worst, own_error);
+    }
+  }
+  const double duration = static_cast<double>(samples) / reference.sample_rate_hz;
+  const double peak = std::max(reference.peak_force, 1e-300);
+  row.error_rms = std::sqrt(sum_squared / static_cast<double>(samples * users)) / peak;
+  row.error_max = worst / peak;
+  row.own_mesh_error_rms = std::sqrt(own_sum_squared / static_cast<double>(samples * users)) / peak;
+  row.own_mesh_error_max = own_worst / peak;
+  row.mtilde_ms_p50 = mtilde_ms.empty() ? 0 : percentile(mtilde_ms, 0.5);
+  row.mtilde_ms_p99 = mtilde_ms.empty() ? 0 : percentile(mtilde_ms, 0.99);
+  row.evaluation_us = evaluations ? 1000 * evaluation_ms / static_cast<double>(evaluations) : 0;
+  row.ir_bytes_per_s = bytes / duration;
+  row.memory_mb = model_memory_mb(model, columns);
+  row.cpu_ms_per_s = (step_ms + evaluation_ms) / duration;
+  return row;
+}
+
+std::vector<bool> pareto_front(const std::vector<double>& error, const std::vector<double>& cost) {
+  std::vector<bool> front(error.size(), true);
+  for (std::size_t i = 0; i < error.size(); ++i)
+    for (std::size_t j = 0; j < error.size() && front[i]; ++j)
+      if (j != i && error[j] <= error[i] && cost[j] <= cost[i] && (error[j] < error[i] || cost[j] < cost[i]))
+        front[i] = false;
+  return front;
+}
+
+namespace {
+
+std::string front_names(const std::vector<TradeoffRow>& rows, const std::vector<bool>& front) {
+  std::string names;
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    if (front[i]) names += (names.empty() ? "" : ", ") + rows[i].setting.name();
+  return names;
+}
+
+void write_csv(const std::filesystem::path& file, const std::vector<TradeoffRow>& rows, const std::vector<bool>& cpu_front,
+               const std::vector<bool>& bytes_front) {
+  AtomicFile out(file);
+  out.write(
+      "setting,knob,value,nodes,tets,error_rms_pct,error_max_pct,own_mesh_error_rms_pct,own_mesh_error_max_pct,"
+      "precompute_s,mtilde_ms_p50,mtilde_ms_p99,evaluation_us,ir_bytes_per_s,memory_mb,cpu_ms_per_s,irs_sent,front_cpu,"
+      "front_bytes\n");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const TradeoffRow& r = rows[i];
+    out.print("{},{},{},{},{},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.4g},{:.6g},{:.4g},{:.4g},{},{},{}\n",
+              r.setting.name(), r.setting.knob, r.setting.value, r.nodes, r.tets, 100 * r.error_rms, 100 * r.error_max,
+              100 * r.own_mesh_error_rms, 100 * r.own_mesh_error_max, r.precompute_s,
+              r.mtilde_ms_p50, r.mtilde_ms_p99, r.evaluation_us, r.ir_bytes_per_s, r.memory_mb, r.cpu_ms_per_s,
+              r.irs_sent, cpu_front[i] ? 1 : 0, bytes_front[i] ? 1 : 0);
+  }
+  out.commit();
+}
+
+void write_markdown(const std::filesystem::path& file, const std::string& heading, const std::vector<TradeoffRow>& rows,
+                    const std::vector<bool>& cpu_front, const std::vector<bool>& bytes_front) {
+  AtomicFile out(file);
+  out.write(heading);
+  out.write(
+      "\n| setting | nodes | error RMS % | error max % | own-mesh error RMS / max % | precompute s | M~ ms p50 / p99 "
+      "| eval µs | IR kB/s | memory MB | CPU ms/s | front |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const TradeoffRow& r = rows[i];
+    std::string front = cpu_front[i] ? "CPU" : "";
+    if (bytes_front[i]) front += front.empty() ? "bytes" : ", bytes";
+    out.print("| {} | {} | {:.2f} | {:.2f} | {:.3g} / {:.3g} | {:.2f} | {:.2f} / {:.2f} | {:.2f} | {:.1f} | {:.1f} | {:.1f} | {} |\n",
+              r.setting.name(), r.nodes, 100 * r.error_rms, 100 * r.error_max, 100 * r.own_mesh_error_rms,
+              100 * r.own_mesh_error_max, r.precompute_s, r.mtilde_ms_p50,
+              r.mtilde_ms_p99, r.evaluation_us, r.ir_bytes_per_s / 1000, r.memory_mb, r.cpu_ms_per_s, front);
+  }
+  out.print("\nOn the front of error against CPU: {}.\n\nOn the front of error against IR bytes: {}.\n",
+            front_names(rows, cpu_front), front_names(rows, bytes_front));
+  out.commit();
+}
+
+void write_pareto_plot(const std::filesystem::path& file, const std::vector<TradeoffRow>& rows, const std::string& x_label,
+                       double (*cost)(const TradeoffRow&), const std::vector<bool>& front) {
+  LinePlot plot;
+  plot.title = "Force error against cost (one point per setting; the front joined)";
+  plot.x_label = x_label;
+  plot.y_label = "force error RMS, % of peak";
+  std::vector<std::pair<double, double>> front_points;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    plot.series.push_back({rows[i].setting.name(), {cost(rows[i])}, {100 * rows[i].error_rms}, "", true});
+    if (front[i]) front_points.emplace_back(cost(rows[i]), 100 * rows[i].error_rms);
+  }
+  std::sort(front_points.begin(), front_points.end());
+  Series line{"Pareto front", {}, {}, "black", false};
+  for (const auto& [x, y] : front_points) {
+    line.x.push_back(x);
+    line.y.push_back(y);
+  }
+  plot.series.push_back(line);
+  write_svg(file, plot);
+}
+
+}  // namespace
+
+int run_tradeoff(const TradeoffOptions& options) {
+  const Scene scene = load_scene(options.scene);
+  if (!scene.obstacles.empty())
+    throw Error(fmt::format("{}: the scene has obstacles, but the trade-off's reference solve does not hold nodes on "
+                            "obstacles (yet); use a scene without them",
+                            options.scene.string()));
+  std::vector<Trajectory> motions;
+  for (const auto& file : options.motions) motions.push_back(load_trajectory(file));
+  if (motions.size() != scene.tools.size())
+    throw Error(fmt::format("{}: the scene has {} tools; give one --motion per tool (got {})", options.scene.string(),
+                            scene.tools.size(), motions.size()));
+  std::filesystem::create_directories(options.out);
+
+  TradeoffSetting reference_setting = tradeoff_grid(scene, {}).front();
+  if (scene.object.mesh.box) reference_setting.divisions = options.reference_divisions;
+  spdlog::info("reference: {}, solved in full at {:g} Hz over the motions ...",
+               scene.object.mesh.box ? fmt::format("{} divisions", options.reference_divisions) : "the scene's own mesh",
+               kSampleRateHz);
+  const ReferenceTrace reference = reference_trace(scene_with(scene, reference_setting), motions, kSampleRateHz);
+  spdlog::info("reference: {} nodes, {} tetrahedra, {} samples, {} contact sets factored, peak force {:.3f} N, {:.1f} s",
+               reference.nodes, reference.tets, reference.positions.size(), reference.factorisations,
+               reference.peak_force, reference.seconds);
+
+  const std::vector<TradeoffSetting> grid = tradeoff_grid(scene, options.divisions);
+  std::vector<TradeoffRow> rows;
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    const Stopwatch watch;
+    rows.push_back(run_setting(scene, grid[i], motions, reference));
+    const TradeoffRow& r = rows.back();
+    spdlog::info("[{}/{}] {}: error RMS {:.2f} % (max {:.2f} %; own mesh {:.3g} %), M~ p99 {:.2f} ms, {:.1f} kB/s, "
+                 "CPU {:.1f} ms/s ({:.1f} s)",
+                 i + 1, grid.size(), r.setting.name(), 100 * r.error_rms, 100 * r.error_max, 100 * r.own_mesh_error_rms,
+                 r.mtilde_ms_p99,
+                 r.ir_bytes_per_s / 1000, r.cpu_ms_per_s, watch.elapsed_ms() / 1000);
+  }
+
+  std::vector<double> error, cpu, bytes;
+  for (const TradeoffRow& r : rows) {
+    error.push_back(r.error_rms);
+    cpu.push_back(r.cpu_ms_per_s);
+    bytes.push_back(r.ir_bytes_per_s);
+  }
+  const std::vector<bool> cpu_front = pareto_front(error, cpu);
+  const std::vector<bool> bytes_front = pareto_front(error, bytes);
+  const std::string heading = fmt::format(
+      "# Speed against accuracy: {}\n\nReference: {} nodes, {} tetrahedra, full sparse solve at {:g} Hz; peak force "
+      "{:.3f} N. Workload: {}.\n",
+      scene.name, reference.nodes, reference.tets, kSampleRateHz, reference.peak_force, [&] {
+        std::string names;
+        for (const auto& file : options.motions) names += (names.empty() ? "" : ", ") + file.filename().string();
+        return names;
+      }());
+  write_csv(options.out / "tradeoff.csv", rows, cpu_front, bytes_front);
+  write_markdown(options.out / "tradeoff.md", heading, rows, cpu_front, bytes_front);
+  write_pareto_plot(options.out / "pareto_cpu.svg", rows, "CPU per second of session, ms",
+                    [](const TradeoffRow& r) { return r.cpu_ms_per_s; }, cpu_front);
+  write_pareto_plot(options.out / "pareto_bytes.svg", rows, "IR traffic, bytes per second",
+                    [](const TradeoffRow& r) { return r.ir_bytes_per_s; }, bytes_front);
+  spdlog::info("front (error against CPU): {}", front_names(rows, cpu_front));
+  spdlog::info("front (error against IR bytes): {}", front_names(rows, bytes_front));
+  spdlog::info("wrote {}/tradeoff.csv, tradeoff.md, pareto_cpu.svg, pareto_bytes.svg", options.out.string());
+  return 0;
+}
+
+}  // namespace cohaptic
