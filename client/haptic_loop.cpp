@@ -158,6 +158,11 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
       ++metrics_.non_finite;
       channels_.events.push({HapticEventKind::non_finite, woke, record.ir_epoch});
     }
+    if (settings_.passivity_control && state.valid && state.position.allFinite()) {
+      force = passivity_.filter(time_s, state.position, force);
+      metrics_.passivity_ticks = static_cast<std::uint64_t>(passivity_.active_ticks());
+      metrics_.passivity_dissipated_j = passivity_.dissipated_energy();
+    }
     const double magnitude = force.norm();
     if (magnitude > settings_.force_limit) {
       force *= settings_.force_limit / magnitude;

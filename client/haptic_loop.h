@@ -18,6 +18,7 @@
 #include <memory>
 
 #include "client/device/haptic_device.h"
+#include "client/passivity_controller.h"
 #include "common/ir/evaluate_force.h"
 #include "common/sync/remote_tool_buffer.h"
 #include "common/util/histogram.h"
@@ -39,6 +40,9 @@ struct HapticLoopSettings {
   double playout_delay_s = 0.005;
   double duration_s = 0;        ///< 0: until stopped
   bool realtime = true;         ///< try SCHED_FIFO and mlockall
+  /// Filter the output through a passivity observer/controller (passivity_controller.h)
+  /// before the force limit: keeps a stiff, delayed or stepwise force passive for the hand.
+  bool passivity_control = false;
 };
 
 /// An IR handed to the haptic thread, with when it arrived.
@@ -118,6 +122,8 @@ struct HapticMetrics {
   double largest_step_on_ir_switch = 0;  ///< [N]
   double elapsed_s = 0;
   bool realtime = false;      ///< SCHED_FIFO and mlockall in effect
+  std::uint64_t passivity_ticks = 0;  ///< ticks on which the passivity controller acted
+  double passivity_dissipated_j = 0;  ///< energy its damping took out [J]
 };
 
 class HapticLoop {
@@ -137,6 +143,7 @@ class HapticLoop {
   HapticMetrics metrics_;
   std::array<RemoteToolBuffer, kMaxUsers> remote_buffers_;
   Eigen::Vector3d last_force_ = Eigen::Vector3d::Zero();
+  PassivityController passivity_;
 };
 
 /// A loop that does nothing but sleep to absolute deadlines at `rate_hz`: the timer floor

@@ -55,6 +55,9 @@ int main(int argc, char** argv) {
   app.add_option("--fade-ms", settings.fade_s, "Time to fade the force out once the IR is too old [ms]")
       ->transform([](const std::string& ms) { return std::to_string(std::stod(ms) * 1e-3); });
   app.add_flag("--best-effort", best_effort, "Do not try SCHED_FIFO and mlockall");
+  app.add_flag("--passivity-control", settings.passivity_control,
+               "Filter the force through a passivity observer/controller (stable against stiff, delayed or stepwise "
+               "forces, at some cost in transparency; README \"Stability\")");
   app.add_option("--report", report_path, "Write a JSON report here at exit");
   std::filesystem::path record_path;
   app.add_option("--record", record_path,
@@ -118,6 +121,8 @@ int main(int argc, char** argv) {
     report["force_n"] = {{"peak", m.peak_force}, {"clamped_ticks", m.clamped}};
     report["coupling_n"] = {{"peak", m.peak_coupling}};
     report["force_step_on_ir_switch_n"] = m.largest_step_on_ir_switch;
+    if (settings.passivity_control)
+      report["passivity_controller"] = {{"active_ticks", m.passivity_ticks}, {"dissipated_j", m.passivity_dissipated_j}};
     report["non_finite_ticks"] = m.non_finite;
     report["elapsed_s"] = m.elapsed_s;
     report.update(network.report());

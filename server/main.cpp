@@ -4,6 +4,7 @@
 //   cohaptic-server replay FILE [--summary|--verify|--export-csv DIR]  a recorded session
 //   cohaptic-server study FILE --out DIR                    a lab study, trial by trial
 //   cohaptic-server tradeoff --scene F --motion M... --out D speed against accuracy, per setting
+//   cohaptic-server stability --out DIR                     the stability map of a virtual wall
 //   cohaptic-server keygen FILE                             a new session key file
 //   cohaptic-server summarize ...                           merge reports, judge a session
 // See README.md for every option.
@@ -20,6 +21,7 @@
 #include "proto/wire/session_key.h"
 #include "server/probe.h"
 #include "server/replay.h"
+#include "server/stability.h"
 #include "server/study.h"
 #include "server/tradeoff.h"
 #include "server/session_summary.h"
@@ -179,6 +181,18 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(2, 60));
 
+  // stability
+  cohaptic::StabilityOptions stability;
+  CLI::App* stability_cmd = app.add_subcommand(
+      "stability", "Map where a virtual wall stays stable under the hand model (stiffness x haptic rate x delay), with "
+                   "and without the passivity controller: stability.csv, stability.md, stability.svg in --out");
+  stability_cmd->add_option("--out", stability.out, "Output directory")->required();
+  stability_cmd->add_option("--hand-mass", stability.hand.mass_kg, "Hand model mass [kg]")->capture_default_str();
+  stability_cmd->add_option("--hand-stiffness", stability.hand.stiffness_n_per_m, "Hand model stiffness [N/m]")
+      ->capture_default_str();
+  stability_cmd->add_option("--hand-damping", stability.hand.damping_ns_per_m, "Hand model damping [N s/m]")
+      ->capture_default_str();
+
   // keygen
   std::string key_path;
   CLI::App* keygen_cmd = app.add_subcommand("keygen", "Write a new random session key file (mode 0600)");
@@ -217,6 +231,7 @@ int main(int argc, char** argv) {
     if (replay_cmd->parsed()) return cohaptic::run_replay(replay);
     if (study_cmd->parsed()) return cohaptic::run_study(study_file, study);
     if (tradeoff_cmd->parsed()) return cohaptic::run_tradeoff(tradeoff);
+    if (stability_cmd->parsed()) return cohaptic::run_stability(stability);
     if (summarize_cmd->parsed()) return cohaptic::run_summarize(summary_server, summary_clients, summary_out);
     if (keygen_cmd->parsed()) {
       cohaptic::wire::write_session_key(key_path);

@@ -79,10 +79,12 @@ struct TradeoffRow {
   double own_mesh_error_rms = 0, own_mesh_error_max = 0;
   double precompute_s = 0;        ///< model build (assembly, factorisation) + compliance precompute
   double mtilde_ms_p50 = 0, mtilde_ms_p99 = 0;  ///< per step that rebuilt the IRs (all users)
-  double evaluation_us = 0;       ///< per haptic tick and user
+  double evaluation_us = 0;       ///< per haptic tick and user (median)
   double ir_bytes_per_s = 0;      ///< IRs sent to all users, per second of workload
   double memory_mb = 0;           ///< K + factor of K_ff + compliance columns
-  double cpu_ms_per_s = 0;        ///< simulation steps + evaluations, per second of workload
+  /// Simulation steps + evaluations per second of workload: steps that rebuilt IRs as timed,
+  /// the others and the evaluations at their median time (robust to scheduler hiccups).
+  double cpu_ms_per_s = 0;
   int irs_sent = 0;
 };
 

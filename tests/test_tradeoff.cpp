@@ -103,6 +103,17 @@ TEST(Tradeoff, ErrorIsMeasuredAgainstTheReferenceNotAgainstItself) {
   TradeoffSetting slow = baseline;
   slow.haptic_rate_hz = 500;
   EXPECT_GT(run_setting(scene, slow, motions, own).own_mesh_error_rms, self.own_mesh_error_rms);
+
+  // With a one-triangle patch, IRs at most 5 per second leave the sliding tool past its
+  // patch for up to 0.2 s (force held on the rim), and fewer IRs are sent.
+  TradeoffSetting small_patch = baseline;
+  small_patch.patch_rings = 0;
+  TradeoffSetting rare = small_patch;
+  rare.ir_rate_hz = 5;
+  const TradeoffRow every_change = run_setting(scene, small_patch, motions, own);
+  const TradeoffRow rate_limited = run_setting(scene, rare, motions, own);
+  EXPECT_GT(rate_limited.own_mesh_error_rms, 2 * every_change.own_mesh_error_rms);
+  EXPECT_LT(rate_limited.irs_sent, every_change.irs_sent);
 }
 
 }  // namespace

@@ -1,0 +1,40 @@
+#include "client/passivity_controller.h"
+
+#include <cmath>
+
+namespace cohaptic {
+
+Eigen::Vector3d PassivityController::filter(double time_s, const Eigen::Vector3d& position,
+                                            const Eigen::Vector3d& environment_force) {
+  if (!started_ || !(time_s > last_time_) || !position.allFinite()) {
+    started_ = started_ || position.allFinite();
+    last_time_ = time_s;
+    if (position.allFinite()) last_position_ = position;
+    last_output_ = environment_force;
+    last_damping_.setZero();
+    return environment_force;
+  }
+  const double period = time_s - last_time_;
+  const Eigen::Vector3d step = position - last_position_;
+  // The force held over the last interval did work last_output . step on the hand; the
+  // damping part of it dissipated -last_damping . step.
+  energy_ -= last_output_.dot(step);
+  dissipated_ -= last_damping_.dot(step);
+  Eigen::Vector3d output = environment_force;
+  last_damping_.setZero();
+  const double speed_squared = step.squaredNorm() / (period * period);
+  if (energy_ < -energy_tolerance_ && speed_squared > 0) {
+    // A damper b applied for one period T changes the velocity of a mass m by at most the
+    // fraction b T / m: kept at 1/2, it slows the hand and never reverses it.
+    const double alpha = std::min(-(energy_ + energy_tolerance_) / (period * speed_squared), 0.5 * moving_mass_ / period);
+    last_damping_ = -alpha * step / period;
+    output += last_damping_;
+    ++active_ticks_;
+  }
+  last_time_ = time_s;
+  last_position_ = position;
+  last_output_ = output;
+  return output;
+}
+
+}  // namespace cohaptic
