@@ -21,7 +21,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A small cube pressed open loop (a scripted device), so every trial presses the same.
+// A small cube pressed open loop (a scripted device), so every trial presses the same. The
+// whole surface is touchable, so its compliance is computed when the scene loads: the
+// nodes that step delay holds need no columns computed at the first contact, which on a
+// loaded machine could stall the server past the client's fade age and split the stroke.
 void write_study_files(const fs::path& dir, const std::string& study_body) {
   std::ofstream(dir / "cube.yaml") << R"(
 name: study-cube
@@ -31,7 +34,7 @@ objects:
     mesh: {box: {min: [-65, -65, -130], size: [130, 130, 130], divisions: [7, 7, 7]}}
     material: {youngs_modulus: 2.0e5, poisson_ratio: 0.4}
     fixed: [{plane: {point: [0, 0, -130], normal: [0, 0, 1]}}]
-    touchable: [{plane: {point: [0, 0, 0], normal: [0, 0, 1]}}]
+    touchable: [{surface: true}]
     compliance: {precompute: touchable, disk_cache: false}
 tools: [{name: A}]
 haptic: {force_limit: 3.3}
