@@ -176,10 +176,16 @@ int main(int argc, char** argv) {
   tradeoff_cmd->add_option("--out", tradeoff.out, "Output directory")->required();
   tradeoff_cmd->add_option("--divisions", tradeoff.divisions, "Mesh resolutions to measure (box scenes)")
       ->capture_default_str();
-  tradeoff_cmd->add_option("--reference-divisions", tradeoff.reference_divisions,
-                           "Resolution of the reference mesh (box scenes; a mesh file is its own reference)")
+  tradeoff_cmd->add_option("--reference-divisions", tradeoff.reference_divisions, "Resolution of the reference mesh (box scenes)")
       ->capture_default_str()
       ->check(CLI::Range(2, 60));
+  tradeoff_cmd->add_option("--reference-scene", tradeoff.reference_scene,
+                           "Mesh-file scenes: the same scene on a finer mesh, the reference (default: the scene itself)")
+      ->check(CLI::ExistingFile);
+  tradeoff_cmd->add_option("--sample-rate-hz", tradeoff.sample_rate_hz,
+                           "The comparison grid; haptic rates that do not divide it are left out")
+      ->capture_default_str()
+      ->check(CLI::Range(1000.0, 100000.0));
 
   // stability
   cohaptic::StabilityOptions stability;

@@ -23,11 +23,14 @@
 namespace cohaptic {
 namespace {
 
-constexpr double kSampleRateHz = 10000;  // the comparison grid: every haptic rate divides it
 constexpr double kSimulationRateHz = 1000;
 
 const char* contact_model_name(ContactModel model) {
   return model == ContactModel::node_translation ? "translation" : "point";
+}
+
+HeldNodes held_nodes(const Simulation& simulation) {
+  return {simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
 }
 
 int samples_per(double sample_rate_hz, double rate_hz, const std::string& what) {
@@ -46,12 +49,14 @@ double model_memory_mb(const Model& model, const ComplianceColumns& columns) {
 
 }  // namespace
 
-std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector<int>& divisions) {
+std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector<int>& divisions,
+                                           double sample_rate_hz) {
   TradeoffSetting base;
   base.formulation = scene.object.material.formulation;
   base.contact_model = scene.haptic.contact_model;
   base.patch_rings = scene.haptic.patch_rings;
   base.haptic_rate_hz = scene.haptic.rate_hz;
+  base.boundary_truncation = scene.haptic.boundary_truncation;
   std::vector<TradeoffSetting> grid = {base};
   const auto vary = [&](const std::string& knob, const std::string& value, auto&& change) {
     TradeoffSetting setting = base;
@@ -77,10 +82,14 @@ std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector
     if (rings != base.patch_rings)
       vary("patch_rings", std::to_string(rings), [rings](TradeoffSetting& s) { s.patch_rings = rings; });
   vary("precision", "f32", [](TradeoffSetting& s) { s.precision = IrPrecision::f32; });
+  if (!scene.obstacles.empty())
+    for (double threshold : {0.01, 0.05, 0.2})
+      vary("boundary_truncation", fmt::format("{:g}", threshold),
+           [threshold](TradeoffSetting& s) { s.boundary_truncation = threshold; });
   for (double rate : {20.0, 5.0})
     vary("ir_rate_hz", fmt::format("{:g}", rate), [rate](TradeoffSetting& s) { s.ir_rate_hz = rate; });
   for (double rate : {500.0, 1000.0, 2000.0, 5000.0})
-    if (rate != base.haptic_rate_hz)
+    if (rate != base.haptic_rate_hz && std::fmod(sample_rate_hz, rate) == 0)
       vary("haptic_rate_hz", fmt::format("{:g}", rate), [rate](TradeoffSetting& s) { s.haptic_rate_hz = rate; });
   return grid;
 }
@@ -99,6 +108,7 @@ Scene scene_with(const Scene& scene, const TradeoffSetting& setting) {
   out.haptic.contact_model = setting.contact_model;
   out.haptic.patch_rings = setting.patch_rings;
   out.haptic.rate_hz = setting.haptic_rate_hz;
+  out.haptic.boundary_truncation = setting.boundary_truncation;
   return out;
 }
 
@@ -109,6 +119,18 @@ ReferenceTrace reference_trace(const Scene& reference, const std::vector<Traject
   const Stopwatch watch;
   const Model model = build_model(reference);
   ContactReference solver(model);
+  // With obstacles, which nodes rest on them at each moment comes from the simulation's
+  // active set on this mesh; the forces then from the full solve with those nodes held.
+  std::unique_ptr<ComplianceColumns> columns;
+  std::unique_ptr<Simulation> active_set;
+  if (!reference.obstacles.empty()) {
+    columns = std::make_unique<ComplianceColumns>(*model.free_factor, model.dofs, compliance_row_nodes(model, true));
+    prepare_compliance(model, *columns, std::nullopt);
+    SimulationOptions options;
+    options.ir = ir_build_options(reference.haptic);
+    options.ir.force_limit = std::numeric_limits<double>::infinity();
+    active_set = std::make_unique<Simulation>(model, *columns, reference.tools, options);
+  }
   ReferenceTrace trace;
   trace.sample_rate_hz = sample_rate_hz;
   trace.nodes = model.mesh.node_count();
@@ -117,13 +139,25 @@ ReferenceTrace reference_trace(const Scene& reference, const std::vector<Traject
   for (const Trajectory& motion : motions) duration = std::max(duration, motion.duration());
   const auto samples = static_cast<std::size_t>(std::floor(duration * sample_rate_hz)) + 1;
   std::vector<PressedTool> tools(motions.size());
+  Stopwatch progress;
   for (std::size_t j = 0; j < samples; ++j) {
     const double t = static_cast<double>(j) / sample_rate_hz;
+    if (progress.elapsed_ms() > 10000) {
+      spdlog::info("reference: {:.0f} % ({} of {} samples, {} factorisations)", 100.0 * static_cast<double>(j) / static_cast<double>(samples), j,
+                   samples, solver.factorisations());
+      progress.lap_ms();
+    }
     for (std::size_t u = 0; u < motions.size(); ++u) tools[u] = {motions[u].position(t), reference.tools[u].radius};
     std::vector<Eigen::Vector3d> positions;
     for (const PressedTool& tool : tools) positions.push_back(tool.position);
     trace.positions.push_back(std::move(positions));
-    trace.forces.push_back(solver.forces(tools));
+    if (active_set) {
+      for (std::size_t u = 0; u < tools.size(); ++u) active_set->set_tool(static_cast<int>(u), tools[u].position);
+      active_set->step(t);
+      trace.forces.push_back(solver.forces(tools, held_nodes(*active_set)));
+    } else {
+      trace.forces.push_back(solver.forces(tools));
+    }
     for (const Eigen::Vector3d& f : trace.forces.back()) trace.peak_force = std::max(trace.peak_force, f.norm());
   }
   trace.factorisations = solver.factorisations();
@@ -201,7 +235,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
         evaluation_us.push_back(1000 * evaluation.elapsed_ms());
       }
     for (std::size_t u = 0; u < users; ++u) pressed[u] = {positions[u], varied.tools[u].radius};
-    const std::vector<Eigen::Vector3d> own_forces = own_mesh.forces(pressed);
+    const std::vector<Eigen::Vector3d> own_forces = own_mesh.forces(pressed, held_nodes(simulation));
     for (std::size_t u = 0; u < users; ++u) {
       const double error = (held[u] - reference.forces[j][u]).norm();
       sum_squared += error * error;
@@ -313,9 +347,9 @@ void write_pareto_plot(const std::filesystem::path& file, const std::vector<Trad
 
 int run_tradeoff(const TradeoffOptions& options) {
   const Scene scene = load_scene(options.scene);
-  if (!scene.obstacles.empty())
-    throw Error(fmt::format("{}: the scene has obstacles, but the trade-off's reference solve does not hold nodes on "
-                            "obstacles (yet); use a scene without them",
+  if (!options.reference_scene.empty() && scene.object.mesh.box)
+    throw Error(fmt::format("{}: a box scene's reference is its own box at --reference-divisions; --reference-scene is "
+                            "for mesh files",
                             options.scene.string()));
   std::vector<Trajectory> motions;
   for (const auto& file : options.motions) motions.push_back(load_trajectory(file));
@@ -326,15 +360,23 @@ int run_tradeoff(const TradeoffOptions& options) {
 
   TradeoffSetting reference_setting = tradeoff_grid(scene, {}).front();
   if (scene.object.mesh.box) reference_setting.divisions = options.reference_divisions;
+  const Scene reference_scene =
+      options.reference_scene.empty() ? scene_with(scene, reference_setting)
+                                      : scene_with(load_scene(options.reference_scene), reference_setting);
+  if (reference_scene.tools.size() != scene.tools.size())
+    throw Error(fmt::format("{}: the reference scene has {} tools, the scene {}", options.reference_scene.string(),
+                            reference_scene.tools.size(), scene.tools.size()));
   spdlog::info("reference: {}, solved in full at {:g} Hz over the motions ...",
-               scene.object.mesh.box ? fmt::format("{} divisions", options.reference_divisions) : "the scene's own mesh",
-               kSampleRateHz);
-  const ReferenceTrace reference = reference_trace(scene_with(scene, reference_setting), motions, kSampleRateHz);
+               scene.object.mesh.box      ? fmt::format("{} divisions", options.reference_divisions)
+               : options.reference_scene.empty() ? std::string("the scene's own mesh")
+                                                 : options.reference_scene.string(),
+               options.sample_rate_hz);
+  const ReferenceTrace reference = reference_trace(reference_scene, motions, options.sample_rate_hz);
   spdlog::info("reference: {} nodes, {} tetrahedra, {} samples, {} contact sets factored, peak force {:.3f} N, {:.1f} s",
                reference.nodes, reference.tets, reference.positions.size(), reference.factorisations,
                reference.peak_force, reference.seconds);
 
-  const std::vector<TradeoffSetting> grid = tradeoff_grid(scene, options.divisions);
+  const std::vector<TradeoffSetting> grid = tradeoff_grid(scene, options.divisions, options.sample_rate_hz);
   std::vector<TradeoffRow> rows;
   for (std::size_t i = 0; i < grid.size(); ++i) {
     const Stopwatch watch;
@@ -358,7 +400,7 @@ int run_tradeoff(const TradeoffOptions& options) {
   const std::string heading = fmt::format(
       "# Speed against accuracy: {}\n\nReference: {} nodes, {} tetrahedra, full sparse solve at {:g} Hz; peak force "
       "{:.3f} N. Workload: {}.\n",
-      scene.name, reference.nodes, reference.tets, kSampleRateHz, reference.peak_force, [&] {
+      scene.name, reference.nodes, reference.tets, options.sample_rate_hz, reference.peak_force, [&] {
         std::string names;
         for (const auto& file : options.motions) names += (names.empty() ? "" : ", ") + file.filename().string();
         return names;

@@ -11,9 +11,9 @@
 //
 // One knob at a time is varied from the scene's own settings (the baseline): mesh
 // divisions (box scenes), element formulation, contact model, patch rings, IR precision,
-// IR update policy (every set change, or at most R per second), haptic rate. Scenes with
-// obstacles are refused: the reference does not hold nodes on obstacles, so B truncation
-// (which only matters with held nodes) is not in the grid either. Costs per setting: precompute time, M~ build time (p50/p99 of
+// B truncation (scenes with obstacles, the only ones with held nodes here), IR update
+// policy (every set change, or at most R per second), haptic rate. With obstacles the
+// references hold the nodes that the simulation's active set puts on them. Costs per setting: precompute time, M~ build time (p50/p99 of
 // the steps that rebuilt IRs), evaluation time per tick, IR bytes per second sent, memory
 // (K, its factor, compliance columns) and CPU per second of session (simulation steps +
 // evaluations). Units as the column names say.
@@ -39,6 +39,7 @@ struct TradeoffSetting {
   ContactModel contact_model = ContactModel::node_translation;
   int patch_rings = 1;
   IrPrecision precision = IrPrecision::f64;
+  double boundary_truncation = 0;
   double ir_rate_hz = 0;          ///< 0: a new IR on every set change; else at most this many per second
   double haptic_rate_hz = 1000;
 
@@ -46,11 +47,13 @@ struct TradeoffSetting {
 };
 
 /// The baseline (the scene's settings) and one variation per other value of each knob.
-/// `divisions` lists mesh resolutions for box scenes (ignored for mesh files).
-std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector<int>& divisions);
+/// `divisions` lists mesh resolutions for box scenes (ignored for mesh files); haptic
+/// rates that do not divide `sample_rate_hz` (the comparison grid) are left out.
+std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector<int>& divisions,
+                                           double sample_rate_hz = 10000);
 
 /// The scene with a setting applied (mesh divisions, element, contact model, patch rings,
-/// haptic rate; the disk cache off, so precompute is measured).
+/// B truncation, haptic rate; the disk cache off, so precompute is measured).
 Scene scene_with(const Scene& scene, const TradeoffSetting& setting);
 
 /// The workload's reference: tool positions and forces on a regular time grid.
@@ -75,7 +78,7 @@ struct TradeoffRow {
   double error_max = 0;           ///< max of the same, over the peak
   /// The same against the full solve (node translation) on the setting's own mesh: what the
   /// IR pipeline itself costs in accuracy (patch, update policy, precision, haptic rate,
-  /// contact model), without the discretisation.
+  /// truncation, contact model), without the discretisation.
   double own_mesh_error_rms = 0, own_mesh_error_max = 0;
   double precompute_s = 0;        ///< model build (assembly, factorisation) + compliance precompute
   double mtilde_ms_p50 = 0, mtilde_ms_p99 = 0;  ///< per step that rebuilt the IRs (all users)
@@ -101,7 +104,10 @@ struct TradeoffOptions {
   std::vector<std::filesystem::path> motions;  ///< one trajectory file per scene tool
   std::filesystem::path out;
   std::vector<int> divisions = {6, 8, 11, 14};  ///< box scenes
-  int reference_divisions = 18;                 ///< box scenes; a mesh file is its own reference
+  int reference_divisions = 18;                 ///< box scenes
+  /// Mesh-file scenes: the same geometry on a finer mesh (empty: the scene itself).
+  std::filesystem::path reference_scene;
+  double sample_rate_hz = 10000;  ///< the comparison grid; every haptic rate measured divides it
 };
 
 /// Writes DIR/tradeoff.csv, DIR/tradeoff.md and DIR/pareto_cpu.svg, DIR/pareto_bytes.svg;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "client/device/trajectory.h"
 #include "common/mesh/box_mesher.h"
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
@@ -151,6 +152,26 @@ TEST(SceneLoad, CubeSceneFieldsInSIUnits) {
   EXPECT_DOUBLE_EQ(scene.haptic.rate_hz, 1000);
   EXPECT_DOUBLE_EQ(scene.haptic.force_limit_n, 3.3);
   EXPECT_EQ(scene.haptic.contact_model, ContactModel::node_translation);
+}
+
+// Every scene and motion the project ships loads and builds; the tools of a scene and the
+// motions written for it fit (the trade-off's motions press inside the touchable surface).
+TEST(SceneModel, EveryShippedSceneAndMotionLoads) {
+  for (const char* file : {"scenes/cube.yaml", "scenes/brain.yaml", "scenes/tradeoff/cube_two_users.yaml",
+                           "scenes/tradeoff/brain_fine.yaml"}) {
+    const Model model = build_model(load_scene(testing::source_path(file)));
+    EXPECT_GT(model.touchable_nodes.size(), 10u) << file;
+  }
+  const Model fine = build_model(load_scene(testing::source_path("scenes/tradeoff/brain_fine.yaml")));
+  EXPECT_EQ(fine.mesh.node_count(), 9015);
+  for (const char* file : {"scenes/brain/surgeon_a.yaml", "scenes/brain/surgeon_b.yaml", "scenes/studies/press_front.yaml",
+                           "scenes/tradeoff/cube_press_slide.yaml", "scenes/tradeoff/cube_press_hold.yaml",
+                           "scenes/tradeoff/brain_press_slide.yaml", "scenes/tradeoff/brain_press_hold.yaml"}) {
+    const Trajectory motion = load_trajectory(testing::source_path(file));
+    EXPECT_GT(motion.duration(), 1.0) << file;
+  }
+  EXPECT_DOUBLE_EQ(load_trajectory(testing::source_path("scenes/tradeoff/cube_press_slide.yaml")).duration(), 3.0);
+  EXPECT_DOUBLE_EQ(load_trajectory(testing::source_path("scenes/tradeoff/cube_press_hold.yaml")).duration(), 3.0);
 }
 
 TEST(SceneModel, CubeModelFixedAndTouchableNodesAreTheTwoFaces) {

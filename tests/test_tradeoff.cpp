@@ -8,6 +8,7 @@
 #include "common/model/contact_reference.h"
 #include "common/model/static_contact.h"
 #include "common/scene/load_scene.h"
+#include "common/util/error.h"
 #include "server/tradeoff.h"
 #include "support/cube_scene.h"
 
@@ -45,6 +46,39 @@ TEST(ContactReference, EqualsTheOneShotFullSolveAndFactorsEachContactSetOnce) {
   EXPECT_GT(reference.factorisations(), 1u);
 }
 
+TEST(ContactReference, WithHeldNodesEqualsTheOneShotFullSolve) {
+  const Model model = build_model(two_user_cube(7));
+  ContactReference reference(model);
+  // The front face's nodes at its left and right edges and its lower two rows, held at small
+  // displacements, as an obstacle would hold them.
+  HeldNodes held;
+  for (int node : model.surface.nodes) {
+    const Eigen::Vector3d x = model.mesh.nodes.col(node);
+    if (std::abs(x.z()) < 1e-9 && (std::abs(x.x()) > 0.05 || x.y() < -0.04)) {
+      held.nodes.push_back(node);
+      held.displacement.emplace_back(1e-4, -2e-4, -3e-4 * static_cast<double>(held.nodes.size() % 3));
+    }
+  }
+  ASSERT_EQ(held.nodes.size(), 28u);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> along(-8, 8), depth(0.2, 3);
+  for (int trial = 0; trial < 8; ++trial) {
+    const std::vector<PressedTool> tools = {{mm(-20 + along(rng), along(rng), -depth(rng)), 0},
+                                            {mm(20 + along(rng), 20 + along(rng), -depth(rng)), 0}};
+    const std::vector<Eigen::Vector3d> cached = reference.forces(tools, held);
+    const std::vector<ToolReaction> direct =
+        contact_reactions_reference(model, find_tool_contacts(model, tools), held, ContactModel::node_translation);
+    for (std::size_t u = 0; u < tools.size(); ++u)
+      EXPECT_LE((cached[u] - direct[u].reaction).norm(), 1e-9 * direct[u].reaction.norm()) << "trial " << trial;
+  }
+  // A held node under a tool is refused.
+  HeldNodes under = held;
+  const std::vector<PressedTool> one = {{mm(-20, 0, -1), 0}, {mm(20, 20, 1), 0}};
+  under.nodes.push_back(model.surface.triangles[find_tool_contacts(model, one)[0].contact->triangle][0]);
+  under.displacement.emplace_back(0, 0, 0);
+  EXPECT_THROW(reference.forces(one, under), Error);
+}
+
 TEST(Tradeoff, ParetoFrontKeepsOnlyTheUndominated) {
   //            a    b    c    d    e (= b)
   const std::vector<double> error = {1.0, 0.5, 0.8, 0.2, 0.5};
@@ -64,12 +98,25 @@ TEST(Tradeoff, GridVariesOneKnobAtATimeFromTheScenesOwnSettings) {
     int differences = (s.divisions != 0) + (s.formulation != grid.front().formulation) +
                       (s.contact_model != grid.front().contact_model) + (s.patch_rings != grid.front().patch_rings) +
                       (s.precision != grid.front().precision) + (s.ir_rate_hz != grid.front().ir_rate_hz) +
+                      (s.boundary_truncation != grid.front().boundary_truncation) +
                       (s.haptic_rate_hz != grid.front().haptic_rate_hz);
     EXPECT_EQ(differences, s.knob == "baseline" ? 0 : 1) << s.name();
   }
   EXPECT_EQ(per_knob["divisions"], 2) << "8 is the scene's own";
   EXPECT_EQ(per_knob["haptic_rate_hz"], 3);
+  EXPECT_EQ(per_knob.count("boundary_truncation"), 0u) << "no obstacle, nothing held";
   EXPECT_EQ(scene_with(scene, grid[1]).object.mesh.box->divisions, Eigen::Vector3i(6, 6, 6));
+  // A 1 kHz comparison grid leaves out the haptic rates it cannot sample.
+  per_knob.clear();
+  for (const TradeoffSetting& s : tradeoff_grid(scene, {}, 1000)) ++per_knob[s.knob];
+  EXPECT_EQ(per_knob["haptic_rate_hz"], 1) << "500 Hz only";
+  // With an obstacle, B truncation joins the grid.
+  testing::CubeSceneOptions walled;
+  walled.obstacles = "{name: wall, plane: {point: [0, 0, 5], normal: [0, 0, -1]}}";
+  per_knob.clear();
+  for (const TradeoffSetting& s : tradeoff_grid(parse_scene(testing::cube_scene_yaml(walled), "cube.yaml"), {}))
+    ++per_knob[s.knob];
+  EXPECT_EQ(per_knob["boundary_truncation"], 3);
 }
 
 TEST(Tradeoff, ErrorIsMeasuredAgainstTheReferenceNotAgainstItself) {

@@ -46,8 +46,49 @@ const ContactReference::ContactSet& ContactReference::contact_set(const std::vec
   return sets_.emplace(std::move(key), std::move(set)).first->second;
 }
 
-std::vector<Eigen::Vector3d> ContactReference::forces(const std::vector<PressedTool>& tools) {
+std::vector<Eigen::Vector3d> ContactReference::forces_with_held(const std::vector<ContactQuery>& contacts,
+                                                               const HeldNodes& held) {
+  std::vector<int> key;
+  for (const ContactQuery& query : contacts) key.push_back(query.contact ? query.contact->triangle : -1);
+  key.push_back(-2);  // between the triangles and the held nodes
+  key.insert(key.end(), held.nodes.begin(), held.nodes.end());
+  std::vector<std::pair<int, double>> values;  // (prescribed dof, value), in solver order
+  for (const ContactQuery& query : contacts) {
+    if (!query.contact) continue;
+    for (int node : model_.surface.triangles[query.contact->triangle])
+      for (int axis = 0; axis < 3; ++axis)
+        if (!model_.dofs.is_fixed(node, axis)) values.emplace_back(3 * node + axis, query.contact->displacement[axis]);
+  }
+  for (std::size_t h = 0; h < held.nodes.size(); ++h)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!model_.dofs.is_fixed(held.nodes[h], axis))
+        values.emplace_back(3 * held.nodes[h] + axis, held.displacement[h][axis]);
+  if (!held_solver_ || key != held_key_) {
+    held_prescribed_.clear();
+    for (const auto& [dof, value] : values) held_prescribed_.push_back(dof);
+    // Throws Error for a dof given twice: a held node under a tool.
+    held_solver_ = std::make_unique<ConstrainedStaticSolver>(model_.stiffness, model_.dofs, held_prescribed_);
+    held_key_ = std::move(key);
+    ++held_factorisations_;
+  }
+  Eigen::VectorXd prescribed(static_cast<Eigen::Index>(values.size()));
+  for (std::size_t i = 0; i < values.size(); ++i) prescribed[static_cast<Eigen::Index>(i)] = values[i].second;
+  const StaticSolution solution = held_solver_->solve(prescribed);
+  std::vector<Eigen::Vector3d> out(contacts.size(), Eigen::Vector3d::Zero());
+  for (std::size_t t = 0; t < contacts.size(); ++t) {
+    if (!contacts[t].contact) continue;
+    const Triangle& tri = model_.surface.triangles[contacts[t].contact->triangle];
+    for (int i = 0; i < 3; ++i)
+      for (int axis = 0; axis < 3; ++axis)
+        if (!model_.dofs.is_fixed(tri[i], axis))
+          out[t][axis] -= contacts[t].contact->weights[i] * solution.reaction[3 * tri[i] + axis];
+  }
+  return out;
+}
+
+std::vector<Eigen::Vector3d> ContactReference::forces(const std::vector<PressedTool>& tools, const HeldNodes& held) {
   const std::vector<ContactQuery> contacts = find_tool_contacts(model_, tools);
+  if (!held.nodes.empty()) return forces_with_held(contacts, held);
   const ContactSet& set = contact_set(contacts);
   const auto m = static_cast<Eigen::Index>(set.pressing.size());
   Eigen::VectorXd displacement(3 * m);

@@ -6,13 +6,18 @@
 // distinct set (CHOLMOD), solves one unit case per pressing tool and axis, and answers
 // every later position with the same set exactly (to round-off) by superposition: the
 // answer of contact_reactions_reference() with nothing held, at a fraction of the cost.
-// Units: m, N. Not thread-safe (the per-set cache grows).
+// With held nodes (obstacles, step delay) their displacements are prescribed too; the
+// factorisation for the latest set of contact triangles and held nodes is kept, and each
+// call solves once with the actual values.
+// Units: m, N. Not thread-safe (the caches grow).
 #pragma once
 
 #include <Eigen/Core>
 #include <map>
+#include <memory>
 #include <vector>
 
+#include "common/fem/static_solve.h"
 #include "common/model/static_contact.h"
 
 namespace cohaptic {
@@ -22,12 +27,13 @@ class ContactReference {
   /// `model` must outlive the reference.
   explicit ContactReference(const Model& model);
 
-  /// Force on each tool [N] (zero for a tool that presses nothing). Throws Error if two
-  /// tools press triangles sharing a node.
-  std::vector<Eigen::Vector3d> forces(const std::vector<PressedTool>& tools);
+  /// Force on each tool [N] (zero for a tool that presses nothing), with `held` nodes at
+  /// their displacements. Throws Error if two tools press triangles sharing a node, or a
+  /// held node is under a tool.
+  std::vector<Eigen::Vector3d> forces(const std::vector<PressedTool>& tools, const HeldNodes& held = {});
 
-  /// Contact sets factored so far.
-  std::size_t factorisations() const { return sets_.size(); }
+  /// Factorisations so far (contact sets, and contact-and-held sets).
+  std::size_t factorisations() const { return sets_.size() + held_factorisations_; }
 
  private:
   // Reactions at the pressing triangles' nodes (3 x 3 per tool, column-major per node)
@@ -37,9 +43,15 @@ class ContactReference {
     Eigen::MatrixXd nodal_per_displacement;
   };
   const ContactSet& contact_set(const std::vector<ContactQuery>& contacts);
+  std::vector<Eigen::Vector3d> forces_with_held(const std::vector<ContactQuery>& contacts, const HeldNodes& held);
 
   const Model& model_;
   std::map<std::vector<int>, ContactSet> sets_;  // keyed by contact triangle per tool (-1: none)
+  // The latest contact-and-held set: its key, prescribed dofs and factorisation.
+  std::vector<int> held_key_;
+  std::vector<int> held_prescribed_;
+  std::unique_ptr<ConstrainedStaticSolver> held_solver_;
+  std::size_t held_factorisations_ = 0;
 };
 
 }  // namespace cohaptic
