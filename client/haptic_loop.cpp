@@ -65,7 +65,8 @@ HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoo
       remote_buffers_{RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
-                      RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9))} {}
+                      RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9))},
+      passivity_(settings.passivity_mass_kg) {}
 
 Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record) {
   std::int64_t age = std::numeric_limits<std::int64_t>::max();

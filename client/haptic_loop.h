@@ -43,6 +43,7 @@ struct HapticLoopSettings {
   /// Filter the output through a passivity observer/controller (passivity_controller.h)
   /// before the force limit: keeps a stiff, delayed or stepwise force passive for the hand.
   bool passivity_control = false;
+  double passivity_mass_kg = 0.2;  ///< the lightest mass expected at the tool (caps its damping)
 };
 
 /// An IR handed to the haptic thread, with when it arrived.

@@ -58,6 +58,10 @@ int main(int argc, char** argv) {
   app.add_flag("--passivity-control", settings.passivity_control,
                "Filter the force through a passivity observer/controller (stable against stiff, delayed or stepwise "
                "forces, at some cost in transparency; README \"Stability\")");
+  app.add_option("--passivity-mass", settings.passivity_mass_kg,
+                 "The lightest mass expected at the tool [kg]: caps the controller's damping at m / (2 T)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--report", report_path, "Write a JSON report here at exit");
   std::filesystem::path record_path;
   app.add_option("--record", record_path,
