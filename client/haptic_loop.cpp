@@ -66,7 +66,7 @@ HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoo
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9))},
-      passivity_(settings.passivity_mass_kg) {}
+      passivity_(settings.passivity_mass_kg, settings.force_limit) {}
 
 Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record) {
   std::int64_t age = std::numeric_limits<std::int64_t>::max();
@@ -159,10 +159,14 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
       ++metrics_.non_finite;
       channels_.events.push({HapticEventKind::non_finite, woke, record.ir_epoch});
     }
-    if (settings_.passivity_control && state.valid && state.position.allFinite()) {
-      force = passivity_.filter(time_s, state.position, force);
-      metrics_.passivity_ticks = static_cast<std::uint64_t>(passivity_.active_ticks());
-      metrics_.passivity_dissipated_j = passivity_.dissipated_energy();
+    if (settings_.passivity_control) {
+      if (state.valid && state.position.allFinite()) {
+        force = passivity_.filter(time_s, state.position, force);  // limited inside
+        metrics_.passivity_ticks = static_cast<std::uint64_t>(passivity_.active_ticks());
+        metrics_.passivity_dissipated_j = passivity_.dissipated_energy();
+      } else {
+        passivity_.interrupt();  // this tick outputs zero, not what the controller last booked
+      }
     }
     const double magnitude = force.norm();
     if (magnitude > settings_.force_limit) {

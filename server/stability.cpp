@@ -36,7 +36,8 @@ WallLoopResult run_wall_loop(const WallLoopSettings& settings) {
     throw Error("run_wall_loop: stiffness and haptic rate must be positive, delays non-negative");
   const Trajectory motion = wall_press();
   HandModelDevice hand(motion, settings.hand, settings.force_limit_n);
-  PassivityController controller(settings.hand.mass_kg);  // the hand is the only mass at the tool
+  // The hand is the only mass at the tool; the controller limits its own output.
+  PassivityController controller(settings.hand.mass_kg, settings.force_limit_n);
   const double period = 1 / settings.haptic_rate_hz;
   const auto ticks = static_cast<std::size_t>(std::ceil(motion.duration() / period)) + 1;
   WallLoopResult result;

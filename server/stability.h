@@ -10,7 +10,10 @@
 //   - step delay T_s: the environment takes a position at the start of each step of length
 //     T_s and answers at its end (a slow simulation): the position is up to 2 T_s old and
 //     the force changes only every T_s.
-// With the passivity controller (client/passivity_controller.h) the output is filtered.
+// Positions exist only at ticks: a delay that is not a whole number of ticks uses the
+// latest tick at or before the moment (at 500 Hz, tau = 5 ms acts as 6 ms; the bound uses
+// 5 ms). With the passivity controller (client/passivity_controller.h) the output is
+// filtered, and limited inside it.
 // A run is passive when the energy the wall gave the hand is at most 1 mJ (a sampled spring
 // leaks a few µJ; an unstable loop gives tenths of a joule), and oscillating when a force
 // oscillation episode (common/study/measures.h) is still going in the last 0.5 s of the

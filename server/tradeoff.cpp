@@ -358,6 +358,10 @@ int run_tradeoff(const TradeoffOptions& options) {
                             scene.tools.size(), motions.size()));
   std::filesystem::create_directories(options.out);
 
+  // Check the rates before the (long) reference: the simulation's and the scene's haptic
+  // rate must divide the comparison grid.
+  samples_per(options.sample_rate_hz, kSimulationRateHz, "simulation rate");
+  samples_per(options.sample_rate_hz, scene.haptic.rate_hz, "scene's haptic rate");
   TradeoffSetting reference_setting = tradeoff_grid(scene, {}).front();
   if (scene.object.mesh.box) reference_setting.divisions = options.reference_divisions;
   const Scene reference_scene =

@@ -76,7 +76,8 @@ struct TradeoffRow {
   int nodes = 0, tets = 0;
   double error_rms = 0;           ///< RMS over samples and tools of |F - F_ref|, over the reference's peak
   double error_max = 0;           ///< max of the same, over the peak
-  /// The same against the full solve (node translation) on the setting's own mesh: what the
+  /// The same against the full solve (node translation) on the setting's own mesh, over the
+  /// same (the reference's) peak, so that both columns share a scale: what the
   /// IR pipeline itself costs in accuracy (patch, update policy, precision, haptic rate,
   /// truncation, contact model), without the discretisation.
   double own_mesh_error_rms = 0, own_mesh_error_max = 0;

@@ -59,6 +59,26 @@ TEST(PassivityController, BoundsWhatAnActiveEnvironmentGivesTheHand) {
   EXPECT_GT(controller.dissipated_energy(), 0.9 * uncontrolled);
 }
 
+TEST(PassivityController, LimitsItsOwnOutputAndBooksWhatTheDeviceReceived) {
+  // A 1 N limit against an environment pushing 3 N along a steady 10 mm/s motion: every
+  // output is within the limit, and the energy observed is the work the limited output did.
+  PassivityController controller(0.2, 1.0);
+  double work_on_hand = 0;
+  Eigen::Vector3d last_x = Eigen::Vector3d::Zero(), last_f = Eigen::Vector3d::Zero();
+  for (int k = 0; k <= 500; ++k) {
+    const double t = k * 1e-3;
+    const Eigen::Vector3d x(0.01 * t, 0, 0);
+    const Eigen::Vector3d out = controller.filter(t, x, Eigen::Vector3d(3, 0, 0));
+    EXPECT_LE(out.norm(), 1.0 + 1e-12);
+    work_on_hand += last_f.dot(x - last_x);
+    last_x = x;
+    last_f = out;
+  }
+  EXPECT_NEAR(controller.observed_energy(), -work_on_hand, 1e-12);
+  EXPECT_LE(work_on_hand, 1e-4 + 1e-5 + 1e-12) << "the tolerance and one tick's work (1 N x 10 um)";
+  EXPECT_GT(controller.active_ticks(), 0);
+}
+
 TEST(WallLoop, StaysStableBelowTheSampledDataBoundAndNotAboveIt) {
   // Colgate and Schenkel: against damping b a wall sampled with period T is passive for
   // K < 2 b / T. The hand's b is 8 N s/m: 16,000 N/m at 1 kHz, 8,000 N/m at 500 Hz.

@@ -25,8 +25,13 @@ Eigen::Matrix<double, 6, 6> elasticity_matrix(const LinearElasticMaterial& mater
 }
 
 Eigen::Matrix<double, 6, 6> deviatoric_elasticity_matrix(const LinearElasticMaterial& material) {
-  Eigen::Matrix<double, 6, 6> d = elasticity_matrix(material);
-  d.topLeftCorner<3, 3>().array() -= material.bulk_modulus();
+  // 2 mu (I - m m^T / 3) on the normal block, mu on the (engineering) shears: built
+  // directly, since (lambda + 2 mu) - kappa would cancel badly as nu approaches 0.5.
+  const double mu = material.shear_modulus();
+  Eigen::Matrix<double, 6, 6> d = Eigen::Matrix<double, 6, 6>::Zero();
+  d.topLeftCorner<3, 3>().setConstant(-2 * mu / 3);
+  d.topLeftCorner<3, 3>().diagonal().array() += 2 * mu;
+  d.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
   return d;
 }
 

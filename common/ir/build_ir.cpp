@@ -24,6 +24,11 @@ std::vector<bool> kept_boundary_nodes(const DofMap& dofs, std::span<const int> b
                                       double threshold) {
   std::vector<bool> kept(boundary.size(), true);
   if (threshold <= 0) return kept;
+  Eigen::Index free_dofs = 0;
+  for (int node : boundary)
+    for (int axis = 0; axis < 3; ++axis) free_dofs += dofs.is_fixed(node, axis) ? 0 : 1;
+  if (free_dofs != m_cb.cols())
+    throw Error(fmt::format("kept_boundary_nodes: {} free boundary dofs for {} columns of M_CB", free_dofs, m_cb.cols()));
   std::vector<double> coupling(boundary.size(), 0.0);
   Eigen::Index column = 0;
   for (std::size_t b = 0; b < boundary.size(); ++b)

@@ -27,6 +27,7 @@ const ContactReference::ContactSet& ContactReference::contact_set(const std::vec
   const auto m = static_cast<Eigen::Index>(set.pressing.size());
   set.nodal_per_displacement = Eigen::MatrixXd::Zero(9 * m, 3 * m);
   if (m > 0) {
+    ++factorisations_;
     const ConstrainedStaticSolver solver(model_.stiffness, model_.dofs, prescribed);
     for (Eigen::Index unit = 0; unit < 3 * m; ++unit) {
       Eigen::VectorXd values(static_cast<Eigen::Index>(prescribed.size()));
@@ -59,17 +60,22 @@ std::vector<Eigen::Vector3d> ContactReference::forces_with_held(const std::vecto
       for (int axis = 0; axis < 3; ++axis)
         if (!model_.dofs.is_fixed(node, axis)) values.emplace_back(3 * node + axis, query.contact->displacement[axis]);
   }
-  for (std::size_t h = 0; h < held.nodes.size(); ++h)
+  std::vector<bool> under_tool(static_cast<std::size_t>(model_.mesh.node_count()), false);
+  for (const ContactQuery& query : contacts)
+    if (query.contact)
+      for (int node : model_.surface.triangles[query.contact->triangle]) under_tool[node] = true;
+  for (std::size_t h = 0; h < held.nodes.size(); ++h) {
+    if (under_tool[held.nodes[h]]) continue;  // the tool wins, as in the simulation
     for (int axis = 0; axis < 3; ++axis)
       if (!model_.dofs.is_fixed(held.nodes[h], axis))
         values.emplace_back(3 * held.nodes[h] + axis, held.displacement[h][axis]);
+  }
   if (!held_solver_ || key != held_key_) {
-    held_prescribed_.clear();
-    for (const auto& [dof, value] : values) held_prescribed_.push_back(dof);
-    // Throws Error for a dof given twice: a held node under a tool.
-    held_solver_ = std::make_unique<ConstrainedStaticSolver>(model_.stiffness, model_.dofs, held_prescribed_);
+    std::vector<int> prescribed;
+    for (const auto& [dof, value] : values) prescribed.push_back(dof);
+    held_solver_ = std::make_unique<ConstrainedStaticSolver>(model_.stiffness, model_.dofs, std::move(prescribed));
     held_key_ = std::move(key);
-    ++held_factorisations_;
+    ++factorisations_;
   }
   Eigen::VectorXd prescribed(static_cast<Eigen::Index>(values.size()));
   for (std::size_t i = 0; i < values.size(); ++i) prescribed[static_cast<Eigen::Index>(i)] = values[i].second;

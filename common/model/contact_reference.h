@@ -8,7 +8,8 @@
 // answer of contact_reactions_reference() with nothing held, at a fraction of the cost.
 // With held nodes (obstacles, step delay) their displacements are prescribed too; the
 // factorisation for the latest set of contact triangles and held nodes is kept, and each
-// call solves once with the actual values.
+// call solves once with the actual values. A held node under a tool is not held: the tool
+// wins, as in the simulation (whose held set may be a step older than the tools).
 // Units: m, N. Not thread-safe (the caches grow).
 #pragma once
 
@@ -28,12 +29,12 @@ class ContactReference {
   explicit ContactReference(const Model& model);
 
   /// Force on each tool [N] (zero for a tool that presses nothing), with `held` nodes at
-  /// their displacements. Throws Error if two tools press triangles sharing a node, or a
-  /// held node is under a tool.
+  /// their displacements (but those under a tool). Throws Error if two tools press
+  /// triangles sharing a node.
   std::vector<Eigen::Vector3d> forces(const std::vector<PressedTool>& tools, const HeldNodes& held = {});
 
   /// Factorisations so far (contact sets, and contact-and-held sets).
-  std::size_t factorisations() const { return sets_.size() + held_factorisations_; }
+  std::size_t factorisations() const { return factorisations_; }
 
  private:
   // Reactions at the pressing triangles' nodes (3 x 3 per tool, column-major per node)
@@ -49,9 +50,8 @@ class ContactReference {
   std::map<std::vector<int>, ContactSet> sets_;  // keyed by contact triangle per tool (-1: none)
   // The latest contact-and-held set: its key, prescribed dofs and factorisation.
   std::vector<int> held_key_;
-  std::vector<int> held_prescribed_;
   std::unique_ptr<ConstrainedStaticSolver> held_solver_;
-  std::size_t held_factorisations_ = 0;
+  std::size_t factorisations_ = 0;
 };
 
 }  // namespace cohaptic
