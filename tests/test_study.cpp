@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <set>
@@ -175,16 +176,19 @@ TEST(Study, TwoConditionsRunWithTheRealProgramsAndAnInterruptedStudyContinues) {
   }
   const auto value = [&](const char* protocol, const char* column) { return std::stod(by_protocol[protocol].at(column)); };
   // P0: the hand meets each simulation step once, so the force changes at the simulation's
-  // rate in contact (within 25 %: the client's stroke leaves out the slow first step of a
-  // contact, when the held nodes join); P1: the client re-evaluates the IR every tick.
+  // rate in contact: within 25 %, or 3 steps over the contact time when the simulation is
+  // slow (a loaded machine), since the client's stroke and the server's pressing steps
+  // differ at their edges (the slow first step of a contact, when the held nodes join);
+  // P1: the client re-evaluates the IR every tick.
   const double p0_rate = value("P0", "force_update_rate_hz");
   const double p0_sim = value("P0", "contact_sim_rate_hz");
+  const double edge_margin = std::max(0.25 * p0_sim, 3 / value("P0", "contact_time_s"));
   const double p1_rate = value("P1", "force_update_rate_hz");
   std::printf("  P0: force updates %.0f/s, simulation %.0f/s in contact; P1: force updates %.0f/s (simulation %.0f/s)\n",
               p0_rate, p0_sim, p1_rate, value("P1", "contact_sim_rate_hz"));
   EXPECT_GT(p0_rate, 0);
-  EXPECT_LE(p0_rate, p0_sim * 1.25);
-  EXPECT_GE(p0_rate, p0_sim * 0.75);
+  EXPECT_LE(p0_rate, p0_sim + edge_margin);
+  EXPECT_GE(p0_rate, p0_sim - edge_margin);
   EXPECT_GT(p1_rate, 2 * p0_rate);
   EXPECT_GT(p1_rate, 300);
   for (const char* protocol : {"P0", "P1"}) {
