@@ -162,8 +162,6 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     if (settings_.passivity_control) {
       if (state.valid && state.position.allFinite()) {
         force = passivity_.filter(time_s, state.position, force);  // limited inside
-        metrics_.passivity_ticks = static_cast<std::uint64_t>(passivity_.active_ticks());
-        metrics_.passivity_dissipated_j = passivity_.dissipated_energy();
       } else {
         passivity_.interrupt();  // this tick outputs zero, not what the controller last booked
       }

@@ -123,8 +123,6 @@ struct HapticMetrics {
   double largest_step_on_ir_switch = 0;  ///< [N]
   double elapsed_s = 0;
   bool realtime = false;      ///< SCHED_FIFO and mlockall in effect
-  std::uint64_t passivity_ticks = 0;  ///< ticks on which the passivity controller acted
-  double passivity_dissipated_j = 0;  ///< energy its damping took out [J]
 };
 
 class HapticLoop {
@@ -134,6 +132,8 @@ class HapticLoop {
   /// Runs until `stop` is set, the duration is over or a scripted device finishes.
   void run(const std::atomic<bool>& stop);
   const HapticMetrics& metrics() const { return metrics_; }
+  /// The passivity controller (idle unless settings.passivity_control): what it did.
+  const PassivityController& passivity() const { return passivity_; }
 
  private:
   Eigen::Vector3d compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record);

@@ -126,7 +126,8 @@ int main(int argc, char** argv) {
     report["coupling_n"] = {{"peak", m.peak_coupling}};
     report["force_step_on_ir_switch_n"] = m.largest_step_on_ir_switch;
     if (settings.passivity_control)
-      report["passivity_controller"] = {{"active_ticks", m.passivity_ticks}, {"dissipated_j", m.passivity_dissipated_j}};
+      report["passivity_controller"] = {{"active_ticks", loop.passivity().active_ticks()},
+                                        {"dissipated_j", loop.passivity().dissipated_energy()}};
     report["non_finite_ticks"] = m.non_finite;
     report["elapsed_s"] = m.elapsed_s;
     report.update(network.report());

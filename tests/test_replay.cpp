@@ -17,6 +17,7 @@
 #include "proto/wire/vec3_convert.h"
 #include "proto/record/session_recorder.h"
 #include "server/replay.h"
+#include "support/cube_scene.h"
 #include "support/process.h"
 
 namespace cohaptic {
@@ -27,19 +28,11 @@ using namespace std::chrono_literals;
 using testing::ChildProcess;
 
 void write_files(const fs::path& dir) {
-  std::ofstream(dir / "cube.yaml") << R"(
-name: soft-cube
-units: mm
-objects:
-  - name: cube
-    mesh: {box: {min: [-65, -65, -130], size: [130, 130, 130], divisions: [8, 8, 8]}}
-    material: {youngs_modulus: 2.0e4, poisson_ratio: 0.4}
-    fixed: [{plane: {point: [0, 0, -130], normal: [0, 0, 1]}}]
-    touchable: [{surface: true}]
-    compliance: {precompute: on_demand, disk_cache: false}
-tools: [{name: A}, {name: B}]
-haptic: {force_limit: 3.3}
-)";
+  testing::CubeSceneOptions soft;  // forces well under the 3.3 N limit
+  soft.divisions = 8;
+  soft.youngs_modulus = 2.0e4;
+  soft.touchable = "{surface: true}";
+  std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(soft);
   for (const auto& [name, x] : {std::pair{"a", -20}, std::pair{"b", 20}})
     std::ofstream(dir / (std::string(name) + ".yaml")) << fmt::format(R"(
 units: mm

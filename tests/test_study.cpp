@@ -15,6 +15,7 @@
 #include "common/util/csv.h"
 #include "common/util/error.h"
 #include "server/study.h"
+#include "support/cube_scene.h"
 #include "support/process.h"
 
 namespace cohaptic {
@@ -27,19 +28,13 @@ namespace fs = std::filesystem;
 // nodes that step delay holds need no columns computed at the first contact, which on a
 // loaded machine could stall the server past the client's fade age and split the stroke.
 void write_study_files(const fs::path& dir, const std::string& study_body) {
-  std::ofstream(dir / "cube.yaml") << R"(
-name: study-cube
-units: mm
-objects:
-  - name: cube
-    mesh: {box: {min: [-65, -65, -130], size: [130, 130, 130], divisions: [7, 7, 7]}}
-    material: {youngs_modulus: 2.0e5, poisson_ratio: 0.4}
-    fixed: [{plane: {point: [0, 0, -130], normal: [0, 0, 1]}}]
-    touchable: [{surface: true}]
-    compliance: {precompute: touchable, disk_cache: false}
-tools: [{name: A}]
-haptic: {force_limit: 3.3}
-)";
+  testing::CubeSceneOptions cube;
+  cube.divisions = 7;
+  cube.youngs_modulus = 2.0e5;
+  cube.touchable = "{surface: true}";
+  cube.compliance = "{precompute: touchable, disk_cache: false}";
+  cube.tools = "[{name: A}]";
+  std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(cube);
   std::ofstream(dir / "press.yaml") << R"(
 units: mm
 start: [4, 3, 4]

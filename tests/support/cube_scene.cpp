@@ -15,12 +15,13 @@ objects:
     material: {{youngs_modulus: {1}, poisson_ratio: {2}}}
     fixed: [{{plane: {{point: [0, 0, -130], normal: [0, 0, 1]}}}}]
     touchable: [{3}]
-    compliance: {{precompute: on_demand, disk_cache: false}}
+    compliance: {7}
 obstacles: [{4}]
 tools: {5}
 haptic: {{force_limit: {6}}}
 )",
-                     o.divisions, o.youngs_modulus, o.poisson_ratio, o.touchable, o.obstacles, o.tools, o.force_limit);
+                     o.divisions, o.youngs_modulus, o.poisson_ratio, o.touchable, o.obstacles, o.tools, o.force_limit,
+                     o.compliance);
 }
 
 CubeRig::CubeRig(const CubeSceneOptions& options)

@@ -16,6 +16,7 @@ struct CubeSceneOptions {
   std::string touchable = "{plane: {point: [0, 0, 0], normal: [0, 0, 1]}}";
   std::string obstacles;      ///< YAML list items, e.g. "- {name: wall, plane: {...}}"
   std::string tools = "[{name: A}, {name: B}]";
+  std::string compliance = "{precompute: on_demand, disk_cache: false}";
   double force_limit = 3.3;
 };
 
