@@ -60,6 +60,8 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
   asio::ip::address peer_address() const { return peer_address_; }
   /// The reader, for a codec change within the stream (e.g. a key derived after the join).
   wire::FrameReader& reader() { return reader_; }
+  /// Frames waiting behind the one being written (at most kMaxWaitingFrames).
+  std::size_t frames_waiting() const { return queue_.waiting(); }
   /// Newest-wins frames dropped by the write queue.
   std::uint64_t frames_dropped() const { return queue_.dropped(); }
 
