@@ -27,7 +27,7 @@ enum class FrameKind : std::uint8_t { must_arrive, newest_wins };
 
 /// Frames allowed to wait behind the one being written. A control connection carries a
 /// few frames a second at most (IRs on a change of contact, events), so a peer with this
-/// many waiting has stopped reading; IRs (10-400 kB each) bound the memory to a few MB.
+/// many waiting has stopped reading; with IRs of 10-400 kB that bounds a connection to 13 MB.
 inline constexpr std::size_t kMaxWaitingFrames = 32;
 
 class BoundedWriteQueue {
