@@ -5,26 +5,31 @@
 #include <asio.hpp>
 #include <chrono>
 #include <condition_variable>
-#include <deque>
-#include <fstream>
 #include <future>
 #include <mutex>
 #include <thread>
 
-#include "common/sync/clock_offset.h"
+#include "client/client_recording.h"
+#include "client/clock_sync.h"
+#include "client/ir_intake.h"
+#include "client/server_connection.h"
+#include "net/datagram_endpoint.h"
 #include "proto/record/session_recorder.h"
-#include "proto/wire/datagram_codec.h"
-#include "proto/wire/frame_codec.h"
-#include "proto/wire/ir_convert.h"
+#include "proto/wire/header.h"
+#include "proto/wire/sealer.h"
 #include "proto/wire/session_key.h"
 #include "proto/wire/vec3_convert.h"
 
 namespace cohaptic {
 
-using asio::ip::tcp;
 using asio::ip::udp;
 
 namespace {
+
+/// How often the haptic thread's rings are drained: its own samples leave within a tick or two.
+constexpr std::chrono::milliseconds kDrainPeriod{1};
+/// Time the goodbye gets to leave before the I/O stops.
+constexpr std::chrono::milliseconds kGoodbyeGrace{50};
 
 std::int64_t now_ns() { return wire::monotonic_now_ns(); }
 
@@ -39,6 +44,26 @@ const char* event_name(HapticEventKind kind) {
   return "?";
 }
 
+// Datagrams are accepted from the server only; its session is learnt from the Welcome.
+std::unique_ptr<wire::DatagramInspector> server_only_inspector(const wire::SessionKey& key) {
+  auto inspector = std::make_unique<wire::DatagramInspector>(key);
+  inspector->allow_sender(wire::kServerSender);
+  return inspector;
+}
+
+WelcomeInfo welcome_info(const wire::Welcome& welcome) {
+  WelcomeInfo info;
+  info.slot = static_cast<int>(welcome.slot());
+  info.scene_name = welcome.scene_name();
+  info.scene_yaml = welcome.scene_yaml();
+  info.protocol = welcome.protocol() == wire::P0 ? HapticProtocol::p0 : HapticProtocol::p1;
+  info.force_limit = welcome.force_limit();
+  info.haptic_rate_hz = welcome.haptic_rate_hz();
+  info.ir_max_age_s = welcome.ir_max_age_s();
+  info.user_count = welcome.users_size();
+  return info;
+}
+
 }  // namespace
 
 struct ClientNetwork::Impl {
@@ -48,19 +73,14 @@ struct ClientNetwork::Impl {
   wire::SessionKey key;
 
   asio::io_context io;
-  tcp::socket tcp_socket{io};
-  udp::socket udp_socket{io};
+  net::DatagramEndpoint udp;
+  wire::DatagramSealer udp_sealer;
   udp::endpoint server_udp;
-  asio::steady_timer tick_timer{io}, ping_timer{io}, reconnect_timer{io};
+  ServerConnection connection;
+  ClockSync clock;
+  IrIntake irs;
+  asio::steady_timer drain_timer{io};
   asio::signal_set signals{io, SIGINT, SIGTERM};
-  std::array<std::uint8_t, 64 * 1024> tcp_buffer{};
-  std::array<std::uint8_t, 2048> udp_buffer{};
-  udp::endpoint udp_from;
-  std::unique_ptr<wire::FrameReader> reader;
-  wire::DatagramInspector inspector;
-  wire::HeaderStamp udp_stamp{0, 0}, control_stamp{0, 0};
-  std::deque<std::vector<std::uint8_t>> writes;
-  ClockOffsetEstimator clock;
   std::thread thread;
 
   // Welcome hand-off to start().
@@ -68,14 +88,11 @@ struct ClientNetwork::Impl {
   std::condition_variable welcome_ready;
   std::optional<WelcomeInfo> welcome;
   std::string refusal;
-  bool connected = false;
+  bool connected = false;  // welcomed, and not lost since
   bool ever_connected = false;
 
   // Counters (I/O thread; read after stop()).
-  std::uint64_t datagrams_sent = 0, irs_received = 0, ir_bytes = 0, irs_rejected = 0, reconnects = 0, forces_received = 0;
-  std::uint64_t remote_samples = 0, events_logged = 0, non_finite_events = 0;
-  Histogram one_way_ns{10'000, 100'000};  // server -> client, 10 us bins up to 1 s
-  std::int64_t first_ir_ns = 0, last_ir_ns = 0;
+  std::uint64_t reconnects = 0, forces_received = 0, remote_samples = 0, non_finite_events = 0;
   std::unique_ptr<record::SessionRecorder> recorder;  // from record_session() on
   std::optional<WelcomeInfo> welcomed;                 // the last welcome, for the recording
   std::uint64_t session_id = 0;
@@ -85,134 +102,40 @@ struct ClientNetwork::Impl {
         channels(c),
         stop_requested(stop),
         key(options.key_file ? wire::load_session_key(*options.key_file) : wire::development_key()),
-        inspector(key) {
+        udp(io, udp::endpoint(asio::ip::make_address("0.0.0.0"), 0), server_only_inspector(key)),
+        udp_sealer(key, 0, 0),
+        connection(io, options.host, options.port, key,
+                   {[this] { return join_request(); }, [this](const wire::Control& control) { handle_control(control); },
+                    [this](const std::string& why) { lost(why); }}),
+        clock(io, [this](wire::Datagram& ping) { send_datagram(ping); }),
+        irs(channels.ir) {
     if (!options.key_file) spdlog::warn("no --key-file: using the public development key");
-    inspector.allow_sender(wire::kServerSender);
-    udp_socket.open(udp::v4());
-    udp_socket.bind(udp::endpoint(asio::ip::make_address("0.0.0.0"), 0));
-    spdlog::info("receiving datagrams on UDP port {}", udp_socket.local_endpoint().port());
+    spdlog::info("receiving datagrams on UDP port {}", udp.port());
   }
 
-  // ---- connection ----
+  // ---- control ----
 
-  void connect() {
-    std::error_code error;
-    tcp_socket.close(error);
-    tcp_socket = tcp::socket(io);
-    tcp::resolver resolver(io);
-    const auto endpoints = resolver.resolve(options.host, std::to_string(options.port), error);
-    if (error) {
-      spdlog::warn("cannot resolve {}: {}", options.host, error.message());
-      schedule_reconnect();
-      return;
-    }
-    asio::async_connect(tcp_socket, endpoints, [this](std::error_code e, const tcp::endpoint&) {
-      if (e) {
-        schedule_reconnect();
-        return;
-      }
-      tcp_socket.set_option(tcp::no_delay(true));
-      reader = std::make_unique<wire::FrameReader>(key);
-      writes.clear();
-      wire::Control control;
-      control.mutable_join()->set_user_name(options.user_name);
-      control.mutable_join()->set_udp_port(udp_socket.local_endpoint().port());
-      control.mutable_join()->set_requested_slot(options.requested_slot >= 0 ? static_cast<std::uint32_t>(options.requested_slot + 1) : 0);
-      send_control(control);
-      read_control();
-    });
-  }
-
-  void schedule_reconnect() {
-    if (stop_requested.load()) return;
-    reconnect_timer.expires_after(std::chrono::milliseconds(500));
-    reconnect_timer.async_wait([this](std::error_code e) {
-      if (!e) connect();
-    });
+  wire::Control join_request() const {
+    wire::Control control;
+    control.mutable_join()->set_user_name(options.user_name);
+    control.mutable_join()->set_udp_port(udp.port());
+    control.mutable_join()->set_requested_slot(options.requested_slot >= 0 ? static_cast<std::uint32_t>(options.requested_slot + 1) : 0);
+    return control;
   }
 
   void lost(const std::string& why) {
-    if (stop_requested.load()) return;  // our own goodbye
-    if (recorder && connected) recorder->event(now_ns(), "lost", why);
-    if (connected) {
-      spdlog::warn("lost the server ({}); zero force until it is back, reconnecting", why);
-      connected = false;
-    }
-    std::error_code ignored;
-    tcp_socket.close(ignored);
-    schedule_reconnect();
+    if (!connected) return;
+    if (recorder) recorder->event(now_ns(), "lost", why);
+    spdlog::warn("lost the server ({}); zero force until it is back, reconnecting", why);
+    connected = false;
   }
 
-  void send_control(wire::Control& control) {
-    control_stamp.stamp(*control.mutable_header());
-    writes.push_back(wire::encode_frame(control, key));
-    if (writes.size() == 1) write_next();
-  }
-
-  void write_next() {
-    asio::async_write(tcp_socket, asio::buffer(writes.front()), [this](std::error_code error, std::size_t) {
-      if (error) {
-        writes.clear();
-        return;  // the read side notices and reconnects
-      }
-      writes.pop_front();
-      if (!writes.empty()) write_next();
-    });
-  }
-
-  void read_control() {
-    tcp_socket.async_read_some(asio::buffer(tcp_buffer), [this](std::error_code error, std::size_t n) {
-      if (error) {
-        if (error != asio::error::operation_aborted) lost(error == asio::error::eof ? "closed" : error.message());
-        return;
-      }
-      try {
-        reader->feed(std::span(tcp_buffer.data(), n));
-        while (auto control = reader->next()) handle_control(*control, n);
-      } catch (const Error& e) {
-        spdlog::error("control channel: {}", e.what());
-        lost("protocol error");
-        return;
-      }
-      read_control();
-    });
-  }
-
-  void handle_control(const wire::Control& control, std::size_t) {
+  void handle_control(const wire::Control& control) {
     if (control.has_welcome()) {
-      const wire::Welcome& w = control.welcome();
-      WelcomeInfo info;
-      info.slot = static_cast<int>(w.slot());
-      info.scene_name = w.scene_name();
-      info.scene_yaml = w.scene_yaml();
-      info.protocol = w.protocol() == wire::P0 ? HapticProtocol::p0 : HapticProtocol::p1;
-      info.force_limit = w.force_limit();
-      info.haptic_rate_hz = w.haptic_rate_hz();
-      info.ir_max_age_s = w.ir_max_age_s();
-      info.user_count = w.users_size();
-      server_udp = udp::endpoint(tcp_socket.remote_endpoint().address(), static_cast<std::uint16_t>(w.server_udp_port()));
-      const std::uint64_t session = control.header().session();
-      inspector.set_expected_session(session);
-      inspector.allow_sender(wire::kServerSender);  // fresh replay window for a new session
-      // Sequence numbers keep increasing across sessions: a fresh replay window accepts them.
-      udp_stamp.set_session(session);
-      udp_stamp.set_sender(wire::sender_of_slot(w.slot()));
-      control_stamp.set_session(session);
-      control_stamp.set_sender(wire::sender_of_slot(w.slot()));
-      clock = ClockOffsetEstimator();
-      if (ever_connected) ++reconnects;
-      ever_connected = connected = true;
-      spdlog::info("joined '{}' as slot {} ({} protocol, force limit {:g} N)", info.scene_name, info.slot,
-                   info.protocol == HapticProtocol::p1 ? "P1" : "P0", info.force_limit);
-      send_ping();
-      session_id = session;
-      welcomed = info;
-      if (recorder) recorder->event(now_ns(), "joined", fmt::format("session {:016x}, slot {}", session, info.slot));
-      std::lock_guard lock(welcome_mutex);
-      welcome = info;
-      welcome_ready.notify_all();
+      joined(control.welcome(), control.header().session());
     } else if (control.has_ir()) {
-      receive_ir(control.ir(), control.ByteSizeLong());
+      const std::int64_t arrival = now_ns();
+      if (irs.receive(control.ir(), control.ByteSizeLong(), arrival) && recorder) recorder->ir(arrival, control.ir());
     } else if (control.has_event()) {
       spdlog::info("server: {}", control.event().text());
     } else if (control.has_error()) {
@@ -221,49 +144,41 @@ struct ClientNetwork::Impl {
       refusal = control.error().text();
       welcome_ready.notify_all();
     } else if (control.has_bye()) {
-      lost("server said goodbye: " + control.bye().reason());
+      connection.drop("server said goodbye: " + control.bye().reason());
     }
   }
 
-  void receive_ir(const wire::IntermediateRepresentation& message, std::size_t bytes) {
-    const std::int64_t arrival = now_ns();
-    try {
-      auto prepared = std::make_unique<const PreparedIR>(prepare_ir(wire::from_wire(message)));
-      if (recorder) recorder->ir(arrival, message);
-      channels.ir.back() = IrSlot{std::move(prepared), arrival};
-      channels.ir.publish();
-      ++irs_received;
-      ir_bytes += bytes;
-      if (!first_ir_ns) first_ir_ns = arrival;
-      last_ir_ns = arrival;
-    } catch (const Error& e) {
-      ++irs_rejected;
-      spdlog::warn("IR rejected: {}", e.what());
+  void joined(const wire::Welcome& message, std::uint64_t session) {
+    const WelcomeInfo info = welcome_info(message);
+    server_udp = udp::endpoint(connection.server_address(), static_cast<std::uint16_t>(message.server_udp_port()));
+    udp.inspector().set_expected_session(session);
+    // A fresh replay window for a new session: our sequence numbers keep increasing across
+    // sessions, the server's start again.
+    udp.inspector().allow_sender(wire::kServerSender);
+    for (wire::HeaderStamp* stamp : {&udp_sealer.stamp(), &connection.stamp()}) {
+      stamp->set_session(session);
+      stamp->set_sender(wire::sender_of_slot(message.slot()));
     }
+    if (ever_connected) ++reconnects;
+    ever_connected = connected = true;
+    spdlog::info("joined '{}' as slot {} ({} protocol, force limit {:g} N)", info.scene_name, info.slot,
+                 info.protocol == HapticProtocol::p1 ? "P1" : "P0", info.force_limit);
+    clock.restart();
+    session_id = session;
+    welcomed = info;
+    if (recorder) recorder->event(now_ns(), "joined", fmt::format("session {:016x}, slot {}", session, info.slot));
+    std::lock_guard lock(welcome_mutex);
+    welcome = info;
+    welcome_ready.notify_all();
   }
 
-  // ---- UDP ----
-
-  void receive_datagram() {
-    udp_socket.async_receive_from(asio::buffer(udp_buffer), udp_from, [this](std::error_code error, std::size_t n) {
-      if (error) {
-        if (error != asio::error::operation_aborted) receive_datagram();
-        return;
-      }
-      const std::int64_t arrival = now_ns();
-      if (const std::optional<wire::Datagram> datagram = inspector.inspect(std::span(udp_buffer.data(), n))) {
-        if (recorder) recorder->datagram_in(arrival, *datagram);
-        handle_datagram(*datagram, arrival);
-      }
-      receive_datagram();
-    });
-  }
+  // ---- datagrams ----
 
   void handle_datagram(const wire::Datagram& datagram, std::int64_t arrival) {
-    if (clock.valid()) one_way_ns.record(arrival - clock.to_client(datagram.header().sender_time_ns()));
+    if (recorder) recorder->datagram_in(arrival, datagram);
+    clock.observe(datagram.header().sender_time_ns(), arrival);
     if (datagram.has_pong()) {
-      const wire::ClockPong& pong = datagram.pong();
-      clock.add(pong.client_send_ns(), pong.server_receive_ns(), pong.server_send_ns(), arrival);
+      clock.on_pong(datagram.pong(), arrival);
     } else if (datagram.has_tool()) {
       const wire::ToolSample& sample = datagram.tool();
       RemoteSample remote;
@@ -290,24 +205,17 @@ struct ClientNetwork::Impl {
 
   void send_datagram(wire::Datagram& datagram) {
     if (!connected) return;
-    udp_stamp.stamp(*datagram.mutable_header());
-    auto bytes = std::make_shared<std::vector<std::uint8_t>>(wire::encode_datagram(datagram, key));
-    udp_socket.async_send_to(asio::buffer(*bytes), server_udp, [bytes](std::error_code, std::size_t) {});
-    ++datagrams_sent;
+    udp.send(udp_sealer.seal(datagram), server_udp);
   }
 
-  void send_ping() {
-    wire::Datagram ping;
-    ping.mutable_ping()->set_client_send_ns(now_ns());
-    send_datagram(ping);
-  }
+  // ---- the haptic thread's rings: own samples out, events logged, ticks recorded ----
 
-  // Every millisecond: own samples out, events logged, trace written.
   void drain() {
     while (const auto own = channels.own_samples.pop()) {
       wire::Datagram datagram;
       auto* sample = datagram.mutable_tool();
-      sample->set_user(udp_stamp.sender() > 0 ? udp_stamp.sender() - 1 : 0);
+      const std::uint32_t sender = udp_sealer.stamp().sender();
+      sample->set_user(sender > 0 ? sender - 1 : 0);
       sample->set_sample_time_ns(clock.to_server(own->sample_time_ns));
       *sample->mutable_position() = wire::to_wire(own->valid ? own->position : Eigen::Vector3d::Zero());
       sample->set_valid(own->valid);
@@ -315,7 +223,6 @@ struct ClientNetwork::Impl {
       send_datagram(datagram);
     }
     while (const auto event = channels.events.pop()) {
-      ++events_logged;
       if (recorder) recorder->event(event->time_ns, "haptic", event_name(event->kind));
       if (event->kind == HapticEventKind::non_finite) ++non_finite_events;
       if (event->kind == HapticEventKind::realtime_refused || event->kind == HapticEventKind::non_finite)
@@ -323,38 +230,17 @@ struct ClientNetwork::Impl {
       else
         spdlog::info("haptic: {}", event_name(event->kind));
     }
-    while (const auto tick = channels.trace.pop()) {
-      if (!recorder) continue;
-      record::HapticTick record;
-      record.set_time_ns(tick->time_ns);
-      wire::to_wire(tick->own, record.mutable_own());
-      for (int r = 0; r < tick->remote_count; ++r) wire::to_wire(tick->remotes[r], record.add_remotes());
-      wire::to_wire(tick->force, record.mutable_force());
-      wire::to_wire(tick->evaluated, record.mutable_evaluated());
-      record.set_ir_epoch(tick->ir_epoch);
-      record.set_flags(tick->flags);
-      record.set_fade(tick->fade);
-      record.set_own_valid(tick->own_valid);
-      recorder->tick(record);
-    }
+    while (const auto tick = channels.trace.pop())
+      if (recorder) recorder->tick(haptic_tick_record(*tick));
     if (recorder) recorder->flush_if_due();
   }
 
-  void tick() {
-    tick_timer.expires_after(std::chrono::milliseconds(1));
-    tick_timer.async_wait([this](std::error_code error) {
+  void schedule_drain() {
+    drain_timer.expires_after(kDrainPeriod);
+    drain_timer.async_wait([this](std::error_code error) {
       if (error) return;
       drain();
-      tick();
-    });
-  }
-
-  void pinger() {
-    ping_timer.expires_after(std::chrono::milliseconds(100));
-    ping_timer.async_wait([this](std::error_code error) {
-      if (error) return;
-      send_ping();
-      pinger();
+      schedule_drain();
     });
   }
 };
@@ -366,16 +252,16 @@ ClientNetwork::~ClientNetwork() { stop(); }
 
 WelcomeInfo ClientNetwork::start(double timeout_s) {
   Impl& s = *impl_;
-  s.signals.async_wait([this](std::error_code error, int signal) {
-    if (!error) {
-      spdlog::info("signal {} received: stopping", signal);
-      stop_requested_ = true;
-    }
+  s.signals.async_wait([this, &s](std::error_code error, int signal) {
+    if (error) return;
+    spdlog::info("signal {} received: stopping", signal);
+    stop_requested_ = true;
+    s.connection.stop();
   });
-  s.connect();
-  s.receive_datagram();
-  s.tick();
-  s.pinger();
+  s.connection.start();
+  s.udp.start([&s](wire::Datagram&& datagram, const udp::endpoint&, std::int64_t arrival) { s.handle_datagram(datagram, arrival); });
+  s.schedule_drain();
+  s.clock.start();
   s.thread = std::thread([&s] { s.io.run(); });
   std::unique_lock lock(s.welcome_mutex);
   s.welcome_ready.wait_for(lock, std::chrono::duration<double>(timeout_s), [&s] { return s.welcome || !s.refusal.empty(); });
@@ -390,21 +276,8 @@ void ClientNetwork::record_session(const std::filesystem::path& file, const std:
   Impl& s = *impl_;
   auto recorder = std::make_unique<record::SessionRecorder>(file);
   std::promise<void> done;
-  asio::post(s.io, [&s, &recorder, &done, device, force_limit] {
-    record::SessionConfig config;
-    config.set_role("client");
-    config.set_user(s.options.user_name);
-    config.set_device(device);
-    config.set_force_limit(force_limit);
-    config.set_session(s.session_id);
-    config.set_start_time_ns(now_ns());
-    if (s.welcomed) {
-      config.set_scene_name(s.welcomed->scene_name);
-      config.set_scene_yaml(s.welcomed->scene_yaml);
-      config.set_slot(static_cast<std::uint32_t>(s.welcomed->slot));
-      config.set_protocol(s.welcomed->protocol == HapticProtocol::p1 ? wire::P1 : wire::P0);
-    }
-    recorder->config(config);
+  asio::post(s.io, [&s, &recorder, &done, &device, force_limit] {
+    recorder->config(client_session_config(s.options.user_name, device, force_limit, s.session_id, s.welcomed, now_ns()));
     s.recorder = std::move(recorder);
     s.channels.tracing = true;
     done.set_value();
@@ -418,14 +291,15 @@ void ClientNetwork::stop() {
   if (!s.thread.joinable()) return;
   stop_requested_ = true;
   asio::post(s.io, [&s] {
+    s.connection.stop();
     s.drain();
     if (s.recorder) s.recorder->close();
     if (s.connected) {
       wire::Control control;
       control.mutable_bye()->set_reason("client finished");
-      s.send_control(control);
+      s.connection.send(control);
     }
-    auto timer = std::make_shared<asio::steady_timer>(s.io, std::chrono::milliseconds(50));
+    auto timer = std::make_shared<asio::steady_timer>(s.io, kGoodbyeGrace);
     timer->async_wait([&s, timer](std::error_code) { s.io.stop(); });
   });
   s.thread.join();
@@ -433,23 +307,16 @@ void ClientNetwork::stop() {
 
 nlohmann::json ClientNetwork::report() const {
   const Impl& s = *impl_;
-  const double ir_span_s = static_cast<double>(s.last_ir_ns - s.first_ir_ns) * 1e-9;
+  const wire::RejectionCounters& rejections = s.udp.inspector().counters();
   nlohmann::json out;
-  out["datagrams"] = {{"sent", s.datagrams_sent},
-                      {"received", s.inspector.counters().accepted() + s.inspector.counters().rejected()},
-                      {"rejected", s.inspector.counters().rejected()},
-                      {"rejected_by_reason", s.inspector.counters().snapshot()}};
-  out["ir"] = {{"received", s.irs_received},
-               {"rejected", s.irs_rejected},
-               {"bytes", s.ir_bytes},
-               {"bytes_per_s", ir_span_s > 0 ? static_cast<double>(s.ir_bytes) / ir_span_s : 0.0}};
+  out["datagrams"] = {{"sent", s.udp.sent()},
+                      {"received", rejections.accepted() + rejections.rejected()},
+                      {"rejected", rejections.rejected()},
+                      {"rejected_by_reason", rejections.snapshot()}};
+  out["ir"] = s.irs.report();
   out["forces_received"] = s.forces_received;
   out["remote_samples_received"] = s.remote_samples;
-  out["clock"] = {{"offset_ms", static_cast<double>(s.clock.offset_ns()) * 1e-6},
-                  {"round_trip_ms", static_cast<double>(s.clock.round_trip_ns()) * 1e-6}};
-  out["one_way_delay_ms"] = {{"p50", static_cast<double>(s.one_way_ns.quantile(0.5)) * 1e-6},
-                             {"p99", static_cast<double>(s.one_way_ns.quantile(0.99)) * 1e-6},
-                             {"samples", s.one_way_ns.count()}};
+  s.clock.add_to_report(out);
   out["reconnects"] = s.reconnects;
   out["non_finite_events"] = s.non_finite_events;
   return out;

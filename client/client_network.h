@@ -1,14 +1,16 @@
-// ClientNetwork: the haptic client's I/O thread (DESIGN.md §4-§5).
-//
-// It owns the sockets and an asio io_context run on one thread:
-//   - TCP control: join, the server's welcome, IRs (converted, checked and prepared here,
-//     then handed to the haptic thread through a TripleBuffer), events, goodbye;
-//   - UDP: own tool samples (drained from the haptic thread's ring every millisecond and
-//     stamped with the server's clock), remote tool samples and P0 forces (validated, then
-//     handed over), clock pings every 100 ms (NTP-style offset, smallest round trip wins);
-//   - when the server goes away it keeps trying to reconnect every 500 ms; meanwhile no IR
-//     or force arrives, so the haptic loop fades the force to zero;
-//   - optionally it records the session (record_session).
+// ClientNetwork: the haptic client's I/O thread (README.md, "cohaptic-client"). It runs
+// an asio io_context on one thread and wires together the parts that each do one job:
+//   - ServerConnection (server_connection.h): the TCP control channel to the server (join,
+//     welcome, IRs, events, goodbye), reconnecting every 500 ms while the server is away;
+//     meanwhile no IR or force arrives, so the haptic loop fades the force to zero;
+//   - IrIntake (ir_intake.h): each IR converted, checked and prepared here, then handed
+//     to the haptic thread through a TripleBuffer;
+//   - ClockSync (clock_sync.h): clock pings every 100 ms, the server's clock estimated
+//     NTP-style (smallest round trip wins), the one-way delay measured;
+//   - the UDP endpoint (net/datagram_endpoint.h): own tool samples out (drained from the
+//     haptic thread's ring every millisecond and stamped with the server's clock), remote
+//     tool samples, IR keep-alives and P0 forces in (validated, then handed over);
+//   - optionally the recording (record_session, client_recording.h).
 // All authentication and validation is done here: nothing unchecked reaches the haptic
 // thread. Units: ns of CLOCK_MONOTONIC, m, N.
 #pragma once

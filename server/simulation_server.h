@@ -1,16 +1,19 @@
-// SimulationServer: the networked simulation server (DESIGN.md §4-§6).
-//
-// Threads, each with one job:
-//   - the I/O thread runs an asio io_context: it accepts TCP control connections (join,
-//     welcome, IRs, events), receives and relays UDP tool samples, answers clock pings,
-//     and applies the injected shift delay to every link, each direction;
-//   - the simulation thread runs the loop: latest tool samples in -> active sets and M~
-//     (Simulation) -> IRs out (P1) or forces out (P0), at up to `sim_rate_hz`;
-//   - the thread that calls run() waits for SIGINT/SIGTERM, stop() or the duration,
-//     then shuts the others down cleanly and writes the report.
-// The simulation thread never blocks on a client: it hands messages to the I/O thread
-// with asio::post; tool samples cross the other way under a small mutex.
-// One user slot per tool of the scene; a vanished client's tool is released.
+// SimulationServer: the networked simulation server, `cohaptic-server --scene ...`
+// (README.md, "cohaptic-server"). It loads the scene, builds the model and its compliance,
+// and wires together the parts that each do one job:
+//   - ConnectionHandler (connection_handler.h), on the I/O thread: connections, user slots,
+//     tool samples in and relayed, clock pongs, the injected shift delay, each step's
+//     messages out;
+//   - SimulationLoop (simulation_loop.h), on the simulation thread: latest tool samples
+//     in -> Simulation step -> an Outbox of IRs (P1) or forces (P0) per step, posted to
+//     the I/O thread in one piece;
+//   - DisplayWriter (display_writer.h), on its own thread, with --display;
+//   - the recording (server_recording.h, with --record), the statistics
+//     (loop_statistics.h) and the report (server_report.h).
+// Tool samples cross from the I/O thread to the simulation thread through ToolInputs
+// (tool_inputs.h), the one lock between them; the simulation thread never blocks on a
+// client. The thread that calls run() runs the I/O context; it also handles SIGINT and
+// SIGTERM, stop() and the duration, then shuts the others down and writes the report.
 #pragma once
 
 #include <atomic>
@@ -30,13 +33,17 @@ class SimulationServer {
   SimulationServer(const SimulationServer&) = delete;
   SimulationServer& operator=(const SimulationServer&) = delete;
 
-  /// Serves until stop(), a signal or the duration; then writes the report. Blocks.
+  /// Serves until stop(), a signal or the duration; then says goodbye to the clients,
+  /// closes the recording and writes the report. Blocks. Throws Error, after all of that,
+  /// if the session ended because kMaxConsecutiveStepFailures simulation steps failed in
+  /// a row (simulation_loop.h): the message names the last error.
   void run();
   /// Asks run() to finish; callable from any thread.
   void stop();
 
   std::uint16_t tcp_port() const;
   std::uint16_t udp_port() const;
+  /// The report (README.md, "Reports"); complete once run() has returned.
   nlohmann::json report() const;
 
  private:

@@ -1,0 +1,35 @@
+#include "client/ir_intake.h"
+
+#include <spdlog/spdlog.h>
+
+#include "common/util/error.h"
+#include "proto/wire/ir_convert.h"
+
+namespace cohaptic {
+
+bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::size_t bytes, std::int64_t arrival_ns) {
+  try {
+    auto prepared = std::make_unique<const PreparedIR>(prepare_ir(wire::from_wire(message)));
+    to_haptic_.back() = IrSlot{std::move(prepared), arrival_ns};
+    to_haptic_.publish();
+  } catch (const Error& e) {
+    ++rejected_;
+    spdlog::warn("IR rejected: {}", e.what());
+    return false;
+  }
+  ++received_;
+  bytes_ += bytes;
+  if (!first_ns_) first_ns_ = arrival_ns;
+  last_ns_ = arrival_ns;
+  return true;
+}
+
+nlohmann::json IrIntake::report() const {
+  const double span_s = static_cast<double>(last_ns_ - first_ns_) * 1e-9;
+  return {{"received", received_},
+          {"rejected", rejected_},
+          {"bytes", bytes_},
+          {"bytes_per_s", span_s > 0 ? static_cast<double>(bytes_) / span_s : 0.0}};
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,34 @@
+// IrIntake: the IRs the server sends, on the client's I/O thread. Each is converted from
+// the wire, checked and prepared (prepare_ir: the factorisations the haptic loop needs,
+// done here so the haptic thread never does them), then handed to the haptic thread
+// through its TripleBuffer with the time it arrived. An IR that fails its checks is
+// counted and logged, and never reaches the haptic thread.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+
+#include "cohaptic/messages.pb.h"
+#include "client/haptic_loop.h"
+#include "common/util/triple_buffer.h"
+
+namespace cohaptic {
+
+class IrIntake {
+ public:
+  explicit IrIntake(TripleBuffer<IrSlot>& to_haptic) : to_haptic_(to_haptic) {}
+
+  /// Prepares and hands over `message` (`bytes` on the wire). False if it was rejected.
+  bool receive(const wire::IntermediateRepresentation& message, std::size_t bytes, std::int64_t arrival_ns);
+
+  /// The report's "ir": received, rejected, bytes, bytes_per_s (from the first IR to the last).
+  nlohmann::json report() const;
+
+ private:
+  TripleBuffer<IrSlot>& to_haptic_;
+  std::uint64_t received_ = 0, rejected_ = 0, bytes_ = 0;
+  std::int64_t first_ns_ = 0, last_ns_ = 0;
+};
+
+}  // namespace cohaptic

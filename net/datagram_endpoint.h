@@ -1,0 +1,63 @@
+// DatagramEndpoint: one UDP socket and its receive loop, run by the thread of its
+// io_context. Each packet received (into a kDatagramBufferBytes buffer, larger than any
+// valid datagram, so that an oversized one is seen whole and rejected as such) goes
+// through the endpoint's wire::DatagramInspector, which checks it and counts each
+// rejection by reason; an accepted datagram goes to the handler with its sender's address
+// and its arrival time. send() sends sealed bytes (wire::DatagramSealer) and counts them.
+// It holds no keys and decides nothing about messages: the inspector (with its key and
+// allowed senders) is given, the datagrams come sealed. Counters: read them on the I/O
+// thread, or after it stopped; the inspector's rejection counters from any thread.
+#pragma once
+
+#include <array>
+#include <asio.hpp>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "cohaptic/messages.pb.h"
+#include "proto/wire/authenticated.h"
+#include "proto/wire/datagram_codec.h"
+
+namespace cohaptic::net {
+
+/// The receive buffer: every valid datagram (at most wire::kMaxDatagramBytes) fits with room to spare.
+inline constexpr std::size_t kDatagramBufferBytes = 2048;
+static_assert(kDatagramBufferBytes > wire::kMaxDatagramBytes);
+
+class DatagramEndpoint {
+ public:
+  using Handler =
+      std::function<void(wire::Datagram&& datagram, const asio::ip::udp::endpoint& from, std::int64_t arrival_ns)>;
+
+  /// Opens and binds the socket (port 0: any free port). Throws std::system_error if it cannot.
+  DatagramEndpoint(asio::io_context& io, const asio::ip::udp::endpoint& local,
+                   std::unique_ptr<wire::DatagramInspector> inspector);
+
+  /// Starts the receive loop; it runs until close().
+  void start(Handler on_datagram);
+  /// Sends `datagram` (sealed bytes) to `to`, without waiting; a send error is not reported
+  /// (UDP: the datagram is simply lost).
+  void send(std::vector<std::uint8_t> datagram, const asio::ip::udp::endpoint& to);
+  void close();
+
+  std::uint16_t port() const { return port_; }
+  wire::DatagramInspector& inspector() { return *inspector_; }
+  const wire::DatagramInspector& inspector() const { return *inspector_; }
+  std::uint64_t sent() const { return sent_; }
+
+ private:
+  void receive_next();
+
+  asio::ip::udp::socket socket_;
+  std::unique_ptr<wire::DatagramInspector> inspector_;
+  Handler on_datagram_;
+  std::array<std::uint8_t, kDatagramBufferBytes> buffer_{};
+  asio::ip::udp::endpoint from_;
+  std::uint16_t port_ = 0;
+  std::uint64_t sent_ = 0;
+};
+
+}  // namespace cohaptic::net

@@ -1,0 +1,37 @@
+// Delivery across a link with an injected shift delay (common/net/link_delay.h): a
+// message handed over now is delivered at once, after its delay by a timer on the I/O
+// thread, or never (lost on the link). The caller keeps one LinkDelay per link and
+// direction, and applies it where the message enters or leaves the process, so that the
+// delay is the link's and nothing else's. Times: ns of wire::monotonic_now_ns().
+#pragma once
+
+#include <asio.hpp>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "common/net/link_delay.h"
+#include "proto/wire/header.h"
+
+namespace cohaptic::net {
+
+/// Calls `deliver(delivered_ns)` after `link`'s delay for a message sent at `now_ns`:
+/// inline if the delay is zero (delivered_ns = now_ns), else from a timer on `io`'s thread.
+/// Returns false, without calling it, if the link loses the message.
+template <class Deliver>
+bool deliver_over(LinkDelay& link, asio::io_context& io, std::int64_t now_ns, Deliver deliver) {
+  const std::optional<std::int64_t> delay = link.delay_ns(now_ns);
+  if (!delay) return false;
+  if (*delay <= 0) {
+    deliver(now_ns);
+    return true;
+  }
+  auto timer = std::make_shared<asio::steady_timer>(io, std::chrono::nanoseconds(*delay));
+  timer->async_wait([timer, deliver = std::move(deliver)](std::error_code error) mutable {
+    if (!error) deliver(wire::monotonic_now_ns());
+  });
+  return true;
+}
+
+}  // namespace cohaptic::net

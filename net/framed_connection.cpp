@@ -1,0 +1,95 @@
+#include "net/framed_connection.h"
+
+#include <fmt/format.h>
+
+#include <span>
+
+namespace cohaptic::net {
+
+using asio::ip::tcp;
+
+FramedConnection::FramedConnection(Passkey, tcp::socket socket, wire::FrameReader reader, Handlers handlers)
+    : socket_(std::move(socket)),
+      reader_(std::move(reader)),
+      handlers_(std::make_shared<const Handlers>(std::move(handlers))) {
+  std::error_code error;
+  const tcp::endpoint remote = socket_.remote_endpoint(error);
+  peer_ = error ? "?" : fmt::format("{}:{}", remote.address().to_string(), remote.port());
+  if (!error) peer_address_ = remote.address();
+}
+
+std::shared_ptr<FramedConnection> FramedConnection::start(tcp::socket socket, wire::FrameReader reader,
+                                                          Handlers handlers) {
+  auto connection = std::make_shared<FramedConnection>(Passkey{}, std::move(socket), std::move(reader), std::move(handlers));
+  connection->read_next();
+  return connection;
+}
+
+void FramedConnection::read_next() {
+  socket_.async_read_some(asio::buffer(buffer_), [self = shared_from_this()](std::error_code error, std::size_t n) {
+    if (self->closed_) return;
+    if (error) {
+      if (error == asio::error::eof) self->fail(CloseCause::peer_closed, "closed by the peer");
+      else self->fail(CloseCause::io_error, error.message());
+      return;
+    }
+    try {
+      self->reader_.feed(std::span(self->buffer_.data(), n));
+      const std::shared_ptr<const Handlers> handlers = self->handlers_;
+      while (auto control = self->reader_.next()) {
+        handlers->on_control(*control);
+        if (self->closed_) return;  // the owner closed it while handling the frame
+      }
+    } catch (const wire::FrameError& e) {
+      self->fail(CloseCause::rejected_frame, e.what());
+      return;
+    }
+    self->read_next();
+  });
+}
+
+FramedConnection::Sent FramedConnection::send(std::vector<std::uint8_t> frame, FrameKind kind) {
+  if (closed_) return Sent::closed;
+  const BoundedWriteQueue::Push pushed = queue_.push(std::move(frame), kind);
+  if (pushed == BoundedWriteQueue::Push::refused) {
+    fail(CloseCause::write_queue_full,
+         fmt::format("the peer stopped reading: {} frames that must arrive are waiting", queue_.waiting()));
+    return Sent::closed;
+  }
+  write_next();
+  return pushed == BoundedWriteQueue::Push::queued ? Sent::queued : Sent::queued_after_drop;
+}
+
+void FramedConnection::write_next() {
+  const std::vector<std::uint8_t>* frame = queue_.begin_write();
+  if (!frame) return;
+  asio::async_write(socket_, asio::buffer(*frame), [self = shared_from_this()](std::error_code error, std::size_t) {
+    self->queue_.end_write();
+    if (self->closed_) return;
+    if (error) {
+      self->fail(CloseCause::io_error, error.message());
+      return;
+    }
+    self->write_next();
+  });
+}
+
+void FramedConnection::close() {
+  if (closed_) return;
+  closed_ = true;
+  std::error_code ignored;
+  socket_.close(ignored);
+  handlers_.reset();
+}
+
+void FramedConnection::fail(CloseCause cause, std::string why) {
+  if (closed_) return;
+  std::shared_ptr<const Handlers> handlers = handlers_;
+  close();
+  asio::post(socket_.get_executor(), [self = shared_from_this(), handlers = std::move(handlers), cause,
+                                      why = std::move(why)] {
+    if (handlers->on_close) handlers->on_close(cause, why);
+  });
+}
+
+}  // namespace cohaptic::net

@@ -1,0 +1,110 @@
+// ConnectionHandler: the server's side of the network, run by the I/O thread. It owns
+//   - the TCP acceptor and one participant per control connection (net::FramedConnection):
+//     join (a free user slot, the Welcome), leave (the slot and its tool released),
+//     events to every user;
+//   - the UDP endpoint (net::DatagramEndpoint): tool samples in (the newest of each slot
+//     to ToolInputs, and relayed to the other users), clock pings answered with pongs;
+//   - the sending of each step's Outbox (IRs over TCP, keep-alives and forces over UDP);
+//   - the injected shift delay: per participant, one LinkDelay per link and direction (to
+//     the client over UDP and over TCP, from the client over UDP), applied where a message
+//     leaves or enters the process;
+//   - its counters, for the status line and the report.
+// It decides slots and what to relay; sealing is the codec's (wire::FrameSealer,
+// wire::DatagramSealer), the sockets are net/'s. With --record it records the datagrams
+// it accepts and the joins and leaves. Everything here runs on the I/O thread, except
+// the counters' readers noted below.
+#pragma once
+
+#include <asio.hpp>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cohaptic/messages.pb.h"
+#include "net/datagram_endpoint.h"
+#include "proto/record/session_recorder.h"
+#include "proto/wire/rejection.h"
+#include "proto/wire/sealer.h"
+#include "proto/wire/session_key.h"
+#include "server/outbox.h"
+#include "server/serve_options.h"
+#include "server/tool_inputs.h"
+
+namespace cohaptic {
+
+/// How long a slot's sender stays allowed after its user left: samples sent just before
+/// the goodbye may still be in flight, and are accepted and ignored rather than counted
+/// as hostile.
+inline constexpr std::int64_t kLeftSenderGrace_ms = 500;
+
+struct ConnectionCounters {
+  std::uint64_t datagrams_sent = 0, datagrams_relayed = 0;
+  std::uint64_t frames_sent = 0, frames_rejected = 0, frames_dropped = 0;
+  std::uint64_t dropped_to_clients = 0, dropped_from_clients = 0;  ///< by the injected loss
+};
+
+class ConnectionHandler {
+ public:
+  /// Binds TCP and UDP on `options.host`:`options.port` (the UDP port is the TCP one).
+  /// `welcome` carries everything a joining user is told but its slot and the users' names
+  /// (one entry per slot, with tool names). `recorder` may be null. Throws
+  /// std::system_error if a socket cannot be bound.
+  ConnectionHandler(asio::io_context& io, const ServeOptions& options, wire::Welcome welcome,
+                    const wire::SessionKey& key, std::uint64_t session, ToolInputs& tools,
+                    record::SessionRecorder* recorder);
+  ~ConnectionHandler();
+  ConnectionHandler(const ConnectionHandler&) = delete;
+  ConnectionHandler& operator=(const ConnectionHandler&) = delete;
+
+  /// Starts accepting connections and receiving datagrams.
+  void start();
+  /// Sends a step's messages (stamped and sealed now) to the users now in their slots.
+  void send(Outbox outbox);
+  /// Tells every user goodbye with `reason`, and accepts no more connections.
+  void say_goodbye(const std::string& reason);
+  /// Closes every connection and the UDP socket.
+  void close_all(const std::string& why);
+
+  std::uint16_t tcp_port() const { return tcp_port_; }
+  std::uint16_t udp_port() const { return udp_.port(); }
+  int users() const;
+  int slots() const { return static_cast<int>(slots_.size()); }
+  /// On the I/O thread, or after it stopped.
+  ConnectionCounters counters() const;
+  /// From any thread.
+  const wire::RejectionCounters& datagram_counters() const { return udp_.inspector().counters(); }
+
+ private:
+  struct Participant;
+  using ParticipantPtr = std::shared_ptr<Participant>;
+
+  void accept();
+  void handle_control(const ParticipantPtr& participant, const wire::Control& control);
+  void join(const ParticipantPtr& participant, const wire::Join& request);
+  void leave(const ParticipantPtr& participant, const std::string& why);
+  void broadcast_event(const std::string& kind, const std::string& text, const record::EventUser& user);
+  void send_control(const ParticipantPtr& participant, wire::Control& control, bool newest_wins = false);
+  void send_error(const ParticipantPtr& participant, const std::string& code, const std::string& text);
+  void send_datagram(Participant& participant, wire::Datagram& datagram);
+  void receive_datagram(wire::Datagram&& datagram, std::int64_t arrival_ns);
+  void handle_datagram(const wire::Datagram& datagram, int slot, std::int64_t arrival_ns);
+
+  asio::io_context& io_;
+  const ServeOptions& options_;
+  wire::Welcome welcome_;
+  wire::SessionKey key_;
+  std::uint64_t session_;
+  ToolInputs& tools_;
+  record::SessionRecorder* recorder_;
+  asio::ip::tcp::acceptor acceptor_;
+  std::uint16_t tcp_port_ = 0;
+  net::DatagramEndpoint udp_;
+  wire::DatagramSealer udp_sealer_;
+  std::vector<ParticipantPtr> participants_;  // every connection
+  std::vector<ParticipantPtr> slots_;         // joined users, by slot
+  ConnectionCounters counters_;
+};
+
+}  // namespace cohaptic

@@ -1,0 +1,54 @@
+// LoopStatistics: the simulation loop's figures for the status line and the report:
+// step durations, M~ build times, IRs and forces sent, |B|, surface displacement, failed
+// steps. The simulation thread records; the I/O thread (status line) and the main thread
+// (report) read a summary. A mutex guards them (held for a few additions per step).
+// Units: the histograms record ns; the summary gives ms, s and m.
+#pragma once
+
+#include <cstdint>
+#include <mutex>
+#include <string>
+
+#include "common/sim/simulation.h"
+#include "common/util/histogram.h"
+
+namespace cohaptic {
+
+/// What one successful step adds.
+struct StepFigures {
+  std::int64_t duration_ns = 0;
+  StepReport report;
+  std::uint64_t irs_sent = 0;     ///< IRs put in the outbox
+  std::uint64_t forces_sent = 0;  ///< P0 forces put in the outbox
+};
+
+/// The figures so far.
+struct LoopSummary {
+  std::uint64_t steps = 0, rebuilds = 0, ir_bytes = 0, irs_sent = 0, forces_sent = 0;
+  double step_p50_ms = 0, step_p99_ms = 0, step_max_ms = 0;
+  double ir_build_p50_ms = 0, ir_build_p99_ms = 0;
+  std::uint64_t ir_builds = 0;  ///< steps that computed M~
+  int max_boundary_nodes = 0, max_obstacle_nodes = 0;
+  double max_surface_displacement_m = 0;  ///< in the display frames
+  std::uint64_t failed_steps = 0;
+  int max_consecutive_failures = 0;
+  std::string last_failure;
+  double elapsed_s = 0;  ///< from the server's start to the end of the last step
+  double rate_hz() const { return elapsed_s > 0 ? static_cast<double>(steps) / elapsed_s : 0.0; }
+};
+
+class LoopStatistics {
+ public:
+  void record_step(const StepFigures& step, double elapsed_s);
+  void record_failure(int consecutive, const std::string& what, double elapsed_s);
+  void record_display_frame(double max_displacement_m);
+  LoopSummary summary() const;
+
+ private:
+  mutable std::mutex mutex_;
+  Histogram step_ns_{10'000, 100'000};      // 10 us bins up to 1 s
+  Histogram ir_build_ns_{10'000, 100'000};  // steps that computed M~
+  LoopSummary totals_;                      // the counts and maxima (quantiles filled in by summary())
+};
+
+}  // namespace cohaptic

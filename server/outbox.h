@@ -1,0 +1,26 @@
+// Outbox: what one simulation step has to send, and to whom. The simulation thread fills
+// one per step and hands it to the I/O thread in one piece (the only thing it posts
+// there); ConnectionHandler::send() stamps, seals and sends each message to the user now
+// in its slot (a slot left empty in the meantime gets nothing).
+#pragma once
+
+#include <vector>
+
+#include "cohaptic/messages.pb.h"
+
+namespace cohaptic {
+
+template <class Message>
+struct ToSlot {
+  int slot = 0;
+  Message message;
+};
+
+struct Outbox {
+  std::vector<ToSlot<wire::Control>> irs;         ///< P1: new IRs, over TCP (newest wins)
+  std::vector<ToSlot<wire::Datagram>> datagrams;  ///< P1: IR keep-alives; P0: forces (UDP)
+
+  bool empty() const { return irs.empty() && datagrams.empty(); }
+};
+
+}  // namespace cohaptic

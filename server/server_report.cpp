@@ -1,0 +1,60 @@
+#include "server/server_report.h"
+
+#include <fmt/format.h>
+
+namespace cohaptic {
+
+nlohmann::json server_report(const ServerFigures& figures) {
+  const LoopSummary& loop = figures.loop;
+  const ConnectionCounters& connections = figures.connections;
+  const ServeOptions& options = figures.options;
+  nlohmann::json server;
+  server["scene"] = figures.scene_name;
+  server["protocol"] = options.protocol == ServeProtocol::p1 ? "P1" : "P0";
+  server["sim_rate_hz"] = loop.rate_hz();
+  server["steps"] = loop.steps;
+  server["step_ms"] = {{"p50", loop.step_p50_ms}, {"p99", loop.step_p99_ms}, {"max", loop.step_max_ms}};
+  server["ir_build_ms"] = {{"p50", loop.ir_build_p50_ms}, {"p99", loop.ir_build_p99_ms}, {"count", loop.ir_builds}};
+  server["irs_sent"] = loop.irs_sent;
+  server["ir_bytes_sent"] = loop.ir_bytes;
+  server["boundary_nodes"] = {{"max", loop.max_boundary_nodes}, {"obstacle_max", loop.max_obstacle_nodes}};
+  server["forces_sent"] = loop.forces_sent;
+  server["max_surface_displacement_mm"] = loop.max_surface_displacement_m * 1e3;
+  server["failed_steps"] = {{"count", loop.failed_steps},
+                            {"max_in_a_row", loop.max_consecutive_failures},
+                            {"last_error", loop.last_failure}};
+  server["datagrams"] = {{"received", figures.datagrams.accepted() + figures.datagrams.rejected()},
+                         {"accepted", figures.datagrams.accepted()},
+                         {"rejected", figures.datagrams.rejected()},
+                         {"rejected_by_reason", figures.datagrams.snapshot()},
+                         {"sent", connections.datagrams_sent},
+                         {"relayed", connections.datagrams_relayed}};
+  server["control_frames"] = {{"sent", connections.frames_sent},
+                              {"rejected", connections.frames_rejected},
+                              {"dropped", connections.frames_dropped}};
+  server["injected"] = {{"shift_delay_ms", options.shift.delay_ms},
+                        {"jitter_ms", options.shift.jitter_ms},
+                        {"loss", options.shift.loss},
+                        {"reorder", options.shift.reorder},
+                        {"seed", options.shift.seed},
+                        {"step_nodes", options.step_nodes},
+                        {"sim_rate_hz", options.sim_rate_hz},
+                        {"condensation", options.naive_condensation ? "naive" : "incremental"},
+                        {"datagrams_dropped_to_clients", connections.dropped_to_clients},
+                        {"datagrams_dropped_from_clients", connections.dropped_from_clients}};
+  server["elapsed_s"] = loop.elapsed_s;
+  return server;
+}
+
+std::string status_line(const ServerFigures& figures, int users, int slots) {
+  const LoopSummary& loop = figures.loop;
+  std::string line = fmt::format(
+      "t {:.0f} s | users {}/{} | sim {:.0f} Hz, step p99 {:.2f} ms | |B| max {} | IRs {} | datagrams in {} (rejected {}), "
+      "out {}",
+      loop.elapsed_s, users, slots, loop.rate_hz(), loop.step_p99_ms, loop.max_boundary_nodes, loop.rebuilds,
+      figures.datagrams.accepted(), figures.datagrams.rejected(), figures.connections.datagrams_sent);
+  if (loop.failed_steps > 0) line += fmt::format(" | failed steps {}", loop.failed_steps);
+  return line;
+}
+
+}  // namespace cohaptic

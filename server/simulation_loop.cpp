@@ -1,0 +1,164 @@
+#include "server/simulation_loop.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <thread>
+
+#include "proto/wire/header.h"
+#include "proto/wire/ir_convert.h"
+#include "proto/wire/vec3_convert.h"
+#include "server/server_recording.h"
+
+namespace cohaptic {
+namespace {
+
+SimulationOptions simulation_options(const Model& model, const ServeOptions& options) {
+  SimulationOptions sim;
+  sim.ir = ir_build_options(model.scene.haptic);
+  sim.ir.precision = options.precision;
+  sim.step_delay_nodes = options.step_nodes;
+  sim.naive_every_step = options.naive_condensation;
+  return sim;
+}
+
+}  // namespace
+
+SimulationLoop::SimulationLoop(const Model& model, ComplianceColumns& columns, const ServeOptions& options,
+                               const ToolInputs& tools, LoopStatistics& statistics, DisplayWriter* display,
+                               record::SessionRecorder* recorder, std::int64_t start_ns)
+    : options_(options),
+      tools_(tools),
+      statistics_(statistics),
+      display_(display),
+      recorder_(recorder),
+      start_ns_(start_ns),
+      simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {}
+
+Outbox SimulationLoop::step(std::int64_t now_ns) {
+  take_tools(now_ns);
+  const StepReport report = simulation_.step(seconds_since_start(now_ns));
+  Outbox outbox;
+  const std::uint64_t irs = report.rebuilt ? add_irs(now_ns, outbox) : 0;
+  if (options_.protocol == ServeProtocol::p1 && now_ns - last_keep_alive_ns_ >= kKeepAlivePeriod_ns) {
+    last_keep_alive_ns_ = now_ns;
+    add_keep_alives(outbox);
+  }
+  const std::vector<record::ServerForce> forces =
+      options_.protocol == ServeProtocol::p0 ? add_forces(outbox) : std::vector<record::ServerForce>{};
+  const bool display_frame = solve_display_frame(now_ns);
+  if (recorder_) {
+    recorder_->step(simulation_step_record(now_ns, seconds_since_start(now_ns), latest_, used_, simulation_, report,
+                                           display_frame, forces));
+    recorder_->flush_if_due();
+  }
+  const std::int64_t end_ns = wire::monotonic_now_ns();
+  statistics_.record_step({end_ns - now_ns, report, irs, forces.size()}, seconds_since_start(end_ns));
+  return outbox;
+}
+
+void SimulationLoop::take_tools(std::int64_t now_ns) {
+  tools_.copy_to(latest_);
+  used_.assign(latest_.size(), false);
+  const auto timeout = static_cast<std::int64_t>(options_.client_timeout_s * 1e9);
+  for (std::size_t slot = 0; slot < latest_.size(); ++slot) {
+    const ToolInput& tool = latest_[slot];
+    used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
+    if (used_[slot]) simulation_.set_tool(static_cast<int>(slot), tool.position);
+    else simulation_.clear_tool(static_cast<int>(slot));
+  }
+}
+
+// The new IRs: sent to their users (P1), and recorded (either protocol).
+std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox) {
+  const bool send = options_.protocol == ServeProtocol::p1;
+  if (!send && !recorder_) return 0;
+  std::uint64_t sent = 0;
+  for (int user = 0; user < simulation_.user_count(); ++user) {
+    const auto prepared = simulation_.ir(user);
+    if (!prepared) continue;
+    wire::Control control;
+    *control.mutable_ir() = wire::to_wire(prepared->ir);
+    if (recorder_) recorder_->ir(now_ns, control.ir());
+    if (!send) continue;
+    outbox.irs.push_back({user, std::move(control)});
+    ++sent;
+  }
+  return sent;
+}
+
+void SimulationLoop::add_keep_alives(Outbox& outbox) {
+  for (int user = 0; user < simulation_.user_count(); ++user) {
+    const auto prepared = simulation_.ir(user);
+    if (!prepared) continue;
+    wire::Datagram datagram;
+    auto* keep_alive = datagram.mutable_keep_alive();
+    keep_alive->set_user(static_cast<std::uint32_t>(user));
+    keep_alive->set_ir_epoch(prepared->ir.epoch);
+    keep_alive->set_simulation_time(prepared->ir.simulation_time);
+    outbox.datagrams.push_back({user, std::move(datagram)});
+  }
+}
+
+// P0: each user's force, from its IR at the current tool positions; recorded with the step.
+std::vector<record::ServerForce> SimulationLoop::add_forces(Outbox& outbox) {
+  std::vector<record::ServerForce> forces;
+  for (int user = 0; user < simulation_.user_count(); ++user) {
+    const auto prepared = simulation_.ir(user);
+    if (!prepared) continue;
+    const ForceSample force = simulation_.force(user);
+    wire::Datagram datagram;
+    auto* sample = datagram.mutable_force();
+    sample->set_user(static_cast<std::uint32_t>(user));
+    *sample->mutable_force() = wire::to_wire(force.force);
+    sample->set_tool_time_ns(latest_[static_cast<std::size_t>(user)].sample_time_ns);
+    sample->set_ir_epoch(prepared->ir.epoch);
+    sample->set_flags(force.flags);
+    record::ServerForce& recorded = forces.emplace_back();
+    recorded.set_slot(static_cast<std::uint32_t>(user));
+    wire::to_wire(force.force, recorded.mutable_force());
+    recorded.set_ir_epoch(prepared->ir.epoch);
+    recorded.set_flags(force.flags);
+    outbox.datagrams.push_back({user, std::move(datagram)});
+  }
+  return forces;
+}
+
+bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
+  if (!display_ || now_ns - last_display_ns_ < static_cast<std::int64_t>(1e9 / options_.display_rate_hz)) return false;
+  last_display_ns_ = now_ns;
+  Eigen::Matrix3Xd displacement = simulation_.displacement_of(display_->nodes());
+  statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
+  display_->offer(seconds_since_start(now_ns), std::move(displacement));  // dropped if the writer is behind
+  return true;
+}
+
+std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,
+                                               const std::function<void(Outbox&&)>& send) {
+  const double rate = options_.sim_rate_hz > 0 ? options_.sim_rate_hz : kDefaultSimulationRate_hz;
+  const auto period = static_cast<std::int64_t>(1e9 / rate);
+  std::int64_t next = wire::monotonic_now_ns();
+  while (running.load()) {
+    const std::int64_t step_start = wire::monotonic_now_ns();
+    try {
+      Outbox outbox = step(step_start);
+      failures_.succeeded();
+      if (!outbox.empty()) send(std::move(outbox));
+    } catch (const std::exception& e) {
+      for (int user = 0; user < simulation_.user_count(); ++user) simulation_.clear_tool(user);
+      const std::optional<std::string> line = failures_.failed(step_start, e.what());
+      if (line) spdlog::error("{}", *line);
+      statistics_.record_failure(failures_.consecutive(), e.what(), seconds_since_start(wire::monotonic_now_ns()));
+      if (failures_.limit_reached())
+        return fmt::format("the simulation failed {} steps in a row, the last with: {}", failures_.consecutive(),
+                           e.what());
+    }
+    next += period;
+    const std::int64_t step_end = wire::monotonic_now_ns();
+    if (next < step_end) next = step_end;  // behind: no catch-up burst
+    std::this_thread::sleep_for(std::chrono::nanoseconds(next - step_end));
+  }
+  return std::nullopt;
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,84 @@
+// SimulationLoop: the server's simulation thread. Each step
+//   1. copies the latest tool samples (ToolInputs) and gives the simulation those that
+//      are fresh (a tool silent for --client-timeout is released);
+//   2. steps the Simulation: contacts, active sets, M~ when a set changed;
+//   3. fills the step's Outbox: the new IRs (P1), the IR keep-alives (P1, every
+//      kKeepAlivePeriod_ns), the forces (P0);
+//   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter;
+//   5. records the step and the IRs it built (--record), and its figures (LoopStatistics).
+// run() paces the steps at the loop's rate with absolute deadlines (when behind, the next
+// step starts at once, with no catch-up burst) and hands each non-empty outbox to the I/O
+// side. It sleeps to the next deadline after every step, failed or not: a step that
+// throws releases every tool and is counted, and logged at a paced rate (StepFailures);
+// kMaxConsecutiveStepFailures in a row end the loop with the reason.
+// The loop owns the Simulation (the mutable state); the model is shared read-only, the
+// compliance columns are filled in on demand by this thread alone. Times: ns of
+// wire::monotonic_now_ns(); simulation time in s from the server's start.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/fem/compliance.h"
+#include "common/model/model.h"
+#include "common/sim/simulation.h"
+#include "proto/record/session_recorder.h"
+#include "server/display_writer.h"
+#include "server/loop_statistics.h"
+#include "server/outbox.h"
+#include "server/serve_options.h"
+#include "server/step_failures.h"
+#include "server/tool_inputs.h"
+
+namespace cohaptic {
+
+/// P1: how often the server tells each client that its IR still stands. A client fades its
+/// force out when these stop for its IR's max age (--ir-max-age, 0.5 s by default).
+inline constexpr std::int64_t kKeepAlivePeriod_ns = 10'000'000;
+/// The loop's rate when --sim-rate-hz is not given.
+inline constexpr double kDefaultSimulationRate_hz = 1000;
+
+class SimulationLoop {
+ public:
+  /// `display` and `recorder` may be null (no --display, no --record). Everything given
+  /// must outlive the loop.
+  SimulationLoop(const Model& model, ComplianceColumns& columns, const ServeOptions& options, const ToolInputs& tools,
+                 LoopStatistics& statistics, DisplayWriter* display, record::SessionRecorder* recorder,
+                 std::int64_t start_ns);
+
+  /// One step at `now_ns`: returns what to send. Throws whatever Simulation::step throws.
+  Outbox step(std::int64_t now_ns);
+
+  /// Steps until `running` turns false, handing each step's outbox to `send` (which must
+  /// not block). Returns why it stopped early: the last error after
+  /// kMaxConsecutiveStepFailures failed steps in a row; nullopt when `running` ended it.
+  std::optional<std::string> run(const std::atomic<bool>& running, const std::function<void(Outbox&&)>& send);
+
+  const StepFailures& failures() const { return failures_; }
+
+ private:
+  void take_tools(std::int64_t now_ns);
+  std::uint64_t add_irs(std::int64_t now_ns, Outbox& outbox);
+  void add_keep_alives(Outbox& outbox);
+  std::vector<record::ServerForce> add_forces(Outbox& outbox);
+  bool solve_display_frame(std::int64_t now_ns);
+  double seconds_since_start(std::int64_t ns) const { return static_cast<double>(ns - start_ns_) * 1e-9; }
+
+  const ServeOptions& options_;
+  const ToolInputs& tools_;
+  LoopStatistics& statistics_;
+  DisplayWriter* display_;
+  record::SessionRecorder* recorder_;
+  std::int64_t start_ns_;
+  Simulation simulation_;
+  StepFailures failures_;
+  std::vector<ToolInput> latest_;  // this step's copy of the tool inputs
+  std::vector<bool> used_;         // per slot: fresh, given to the simulation
+  std::int64_t last_keep_alive_ns_ = 0, last_display_ns_ = 0;
+};
+
+}  // namespace cohaptic

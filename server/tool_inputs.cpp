@@ -1,0 +1,33 @@
+#include "server/tool_inputs.h"
+
+namespace cohaptic {
+
+void ToolInputs::join(int slot) {
+  std::lock_guard lock(mutex_);
+  tools_[static_cast<std::size_t>(slot)] = ToolInput{};
+  tools_[static_cast<std::size_t>(slot)].joined = true;
+}
+
+void ToolInputs::release(int slot) {
+  std::lock_guard lock(mutex_);
+  tools_[static_cast<std::size_t>(slot)] = ToolInput{};
+}
+
+bool ToolInputs::update(int slot, bool valid, const Eigen::Vector3d& position, std::int64_t sample_time_ns,
+                        std::int64_t received_ns) {
+  std::lock_guard lock(mutex_);
+  ToolInput& tool = tools_[static_cast<std::size_t>(slot)];
+  if (sample_time_ns <= tool.sample_time_ns) return false;
+  tool.valid = valid;
+  tool.position = position;
+  tool.sample_time_ns = sample_time_ns;
+  tool.received_ns = received_ns;
+  return true;
+}
+
+void ToolInputs::copy_to(std::vector<ToolInput>& out) const {
+  std::lock_guard lock(mutex_);
+  out = tools_;
+}
+
+}  // namespace cohaptic

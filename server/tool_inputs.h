@@ -1,0 +1,45 @@
+// ToolInputs: the newest tool sample of each user slot, the one piece of state the
+// server's I/O thread and simulation thread share. The I/O thread (ConnectionHandler)
+// writes a slot as its user joins, sends samples and leaves; the simulation thread
+// (SimulationLoop) copies all of them once per step. A small mutex guards them: both
+// sides hold it only to copy a few numbers. Units: m; ns of wire::monotonic_now_ns().
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+namespace cohaptic {
+
+struct ToolInput {
+  bool joined = false;  ///< a user holds the slot
+  bool valid = false;   ///< the device reported a position
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  std::int64_t sample_time_ns = 0;  ///< the server's clock, as stamped by the client
+  std::int64_t received_ns = 0;     ///< when the server took it in
+};
+
+class ToolInputs {
+ public:
+  explicit ToolInputs(std::size_t slots) : tools_(slots) {}
+
+  /// A user took `slot`: no sample yet.
+  void join(int slot);
+  /// The user of `slot` left: its tool is released.
+  void release(int slot);
+  /// Takes a sample of `slot`'s tool; false (and nothing changes) if it is not newer than
+  /// the one held, as a reordered datagram would be.
+  bool update(int slot, bool valid, const Eigen::Vector3d& position, std::int64_t sample_time_ns,
+              std::int64_t received_ns);
+  /// Copies every slot into `out` (resized to the number of slots).
+  void copy_to(std::vector<ToolInput>& out) const;
+
+  std::size_t size() const { return tools_.size(); }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<ToolInput> tools_;
+};
+
+}  // namespace cohaptic

@@ -1,0 +1,244 @@
+// The server's simulation loop (server/simulation_loop.h) and what it does about failing
+// steps, with the real Simulation on a cube.
+//
+// How a step is made to fail: --step-nodes asks the loop to hold the N surface nodes
+// nearest a pressing tool outside every user's patch. With N equal to the number of
+// movable surface nodes, the patch's nodes leave fewer than N to choose from, and every
+// step in which a tool presses throws (nearest_surface_nodes: "N boundary nodes asked for,
+// but the surface has only M"). No load-time check can refuse this N, since the patch
+// depends on where the tool touches: it is a real failure a user can cause, with the real
+// Simulation, not a mock.
+//   - StepFailures logs the first failure and then at most one line a second, whose counts
+//     add up to every failure; it ends the session at the 100th failure in a row;
+//   - the loop in process: a pressing tool makes it fail 100 steps in a row and stop with
+//     the cause; it slept to each deadline meanwhile (100 steps take >= 99 periods); it
+//     released the tools; with fewer step nodes the same loop steps on and fills each
+//     step's outbox (P0: one force per step for the known tool; P1: its IRs, keep-alives);
+//   - the real server program: a client pressing makes the server end the session on its
+//     own, with a clear message, a goodbye to the client, a report, few log lines and
+//     exit status 1.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <thread>
+
+#include "common/fem/dof_map.h"
+#include "proto/wire/header.h"
+#include "server/simulation_loop.h"
+#include "server/step_failures.h"
+#include "support/cube_scene.h"
+#include "support/process.h"
+
+namespace cohaptic {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+int movable_surface_nodes(const Model& model) {
+  int count = 0;
+  for (int node : model.surface.nodes) count += model.dofs.fixed_axes[static_cast<std::size_t>(node)] != kAllAxes;
+  return count;
+}
+
+// ---- pacing ----
+
+TEST(StepFailures, LogsTheFirstThenOneLineASecondWhoseCountsAddUpAndEndsAfterAHundredInARow) {
+  StepFailures failures;
+  std::vector<std::string> lines;
+  std::int64_t now = 5'000'000'000;
+  // A flapping error: 3 s of one failure every 2 ms, with a success in between.
+  for (int i = 0; i < 1500; ++i, now += 2'000'000) {
+    if (auto line = failures.failed(now, "degenerate contact")) lines.push_back(*line);
+    failures.succeeded();
+  }
+  EXPECT_FALSE(failures.limit_reached());
+  EXPECT_EQ(failures.total(), 1500u);
+  ASSERT_EQ(lines.size(), 3u);  // at 0 s, 1 s and 2 s
+  EXPECT_EQ(lines[0], "simulation step failed, tools released: degenerate contact");
+  std::uint64_t logged = 1;
+  const std::regex counted(R"(failed (\d+) times since the last report \(1 in a row\))");
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    std::smatch match;
+    ASSERT_TRUE(std::regex_search(lines[i], match, counted)) << lines[i];
+    logged += std::stoull(match[1]);
+  }
+  // The failures after the last line are counted for the next one: 499 of them.
+  EXPECT_EQ(logged + 499, failures.total());
+
+  // A run of failures in a row ends the session at the limit.
+  for (int i = 0; i < kMaxConsecutiveStepFailures - 1; ++i, now += 1'000'000) {
+    failures.failed(now, "stuck");
+    EXPECT_FALSE(failures.limit_reached());
+  }
+  failures.failed(now, "stuck");
+  EXPECT_TRUE(failures.limit_reached());
+  EXPECT_EQ(failures.consecutive(), kMaxConsecutiveStepFailures);
+  EXPECT_EQ(failures.last_error(), "stuck");
+}
+
+// ---- the loop, in process ----
+
+struct LoopRig {
+  testing::CubeRig cube;
+  ServeOptions options;
+  ToolInputs tools{2};
+  LoopStatistics statistics;
+  explicit LoopRig(int step_nodes, ServeProtocol protocol = ServeProtocol::p1) : cube(soft_cube()) {
+    options.step_nodes = step_nodes;
+    options.protocol = protocol;
+    options.sim_rate_hz = 200;
+    options.client_timeout_s = 3600;  // the one sample below stays fresh
+    tools.join(0);
+    // Slot 0 presses 2 mm into the top face; slot 1 stays away.
+    tools.update(0, true, Eigen::Vector3d(0.003, 0.002, -0.002), 1, wire::monotonic_now_ns());
+  }
+  static testing::CubeSceneOptions soft_cube() {
+    testing::CubeSceneOptions options;
+    options.divisions = 6;
+    options.youngs_modulus = 2.0e4;
+    return options;
+  }
+};
+
+// Runs `loop` until it stops itself or `limit` passes; returns its result and the outboxes.
+std::pair<std::optional<std::string>, std::vector<Outbox>> run_for(SimulationLoop& loop, std::chrono::milliseconds limit) {
+  std::atomic<bool> running{true};
+  std::thread watchdog([&] {
+    const auto end = std::chrono::steady_clock::now() + limit;
+    while (running && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(5ms);
+    running = false;
+  });
+  std::vector<Outbox> outboxes;
+  std::optional<std::string> stopped = loop.run(running, [&](Outbox&& outbox) { outboxes.push_back(std::move(outbox)); });
+  running = false;
+  watchdog.join();
+  return {stopped, outboxes};
+}
+
+TEST(SimulationLoop, AStepThatKeepsFailingEndsTheLoopAfterAHundredPacedSteps) {
+  LoopRig rig(0);
+  rig.options.step_nodes = movable_surface_nodes(*rig.cube.model);
+  SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr,
+                      wire::monotonic_now_ns());
+  const auto start = std::chrono::steady_clock::now();
+  const auto [stopped, outboxes] = run_for(loop, 20s);
+  const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(stopped.has_value()) << "the loop did not stop on its own";
+  EXPECT_NE(stopped->find("failed 100 steps in a row"), std::string::npos) << *stopped;
+  EXPECT_NE(stopped->find("boundary nodes asked for"), std::string::npos) << *stopped;
+  EXPECT_TRUE(outboxes.empty());
+  const LoopSummary summary = rig.statistics.summary();
+  EXPECT_EQ(summary.failed_steps, static_cast<std::uint64_t>(kMaxConsecutiveStepFailures));
+  EXPECT_EQ(summary.max_consecutive_failures, kMaxConsecutiveStepFailures);
+  EXPECT_EQ(summary.steps, 0u);
+  // Each failed step slept to its deadline: 100 steps at 200 Hz span at least 99 periods.
+  // (A loop that skipped its sleep would fail them all within a few milliseconds.)
+  std::printf("  100 failing steps at 200 Hz took %.3f s\n", elapsed_s);
+  EXPECT_GE(elapsed_s, 99 / rig.options.sim_rate_hz);
+}
+
+TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
+  // P0: every step sends the known tool's force, and only to its slot.
+  {
+    LoopRig rig(10, ServeProtocol::p0);
+    SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr,
+                        wire::monotonic_now_ns());
+    const auto [stopped, outboxes] = run_for(loop, 400ms);
+    EXPECT_FALSE(stopped.has_value()) << *stopped;
+    const LoopSummary summary = rig.statistics.summary();
+    EXPECT_EQ(summary.failed_steps, 0u);
+    EXPECT_GT(summary.steps, 5u);
+    ASSERT_EQ(outboxes.size(), summary.steps);
+    for (const Outbox& outbox : outboxes) {
+      EXPECT_TRUE(outbox.irs.empty());
+      ASSERT_EQ(outbox.datagrams.size(), 1u);
+      EXPECT_EQ(outbox.datagrams[0].slot, 0);
+      EXPECT_TRUE(outbox.datagrams[0].message.has_force());
+    }
+    EXPECT_EQ(summary.forces_sent, summary.steps);
+    EXPECT_GT(outboxes.back().datagrams[0].message.force().force().z(), 0) << "the pressed surface pushes back up";
+  }
+  // P1: the first step builds slot 0's IR; keep-alives follow.
+  {
+    LoopRig rig(10, ServeProtocol::p1);
+    SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr,
+                        wire::monotonic_now_ns());
+    const auto [stopped, outboxes] = run_for(loop, 400ms);
+    EXPECT_FALSE(stopped.has_value());
+    ASSERT_FALSE(outboxes.empty());
+    ASSERT_EQ(outboxes.front().irs.size(), 1u);
+    EXPECT_EQ(outboxes.front().irs[0].slot, 0);
+    EXPECT_TRUE(outboxes.front().irs[0].message.has_ir());
+    std::size_t keep_alives = 0, irs = 0;
+    for (const Outbox& outbox : outboxes) {
+      irs += outbox.irs.size();
+      for (const auto& datagram : outbox.datagrams) {
+        EXPECT_EQ(datagram.slot, 0);
+        keep_alives += datagram.message.has_keep_alive();
+      }
+    }
+    EXPECT_EQ(irs, rig.statistics.summary().irs_sent);
+    EXPECT_GE(keep_alives, 2u);
+  }
+}
+
+// ---- the real server program ----
+
+TEST(ServerProgram, EndsTheSessionWithAnErrorWhenEveryStepFails) {
+  const fs::path dir = testing::scratch_directory("server-step-failures");
+  testing::CubeSceneOptions scene = LoopRig::soft_cube();
+  scene.divisions = 8;
+  std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(scene);
+  const int step_nodes = movable_surface_nodes(*testing::CubeRig(scene).model);
+  std::ofstream(dir / "press.yaml") << R"(
+units: mm
+start: [3, 2, 6]
+segments:
+  - {move_to: [3, 2, 0.5], speed: 20}
+  - {press: 3, speed: 5, direction: [0, 0, -1]}
+  - {hold: 4}
+  - {release: 3, speed: 5}
+)";
+  testing::ChildProcess server(testing::server_program(),
+                               {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--step-nodes",
+                                std::to_string(step_nodes), "--sim-rate-hz", "100", "--duration", "60", "--report",
+                                (dir / "server.json").string(), "--no-disk-cache"},
+                               dir / "server.log");
+  ASSERT_TRUE(server.wait_for_log("listening on", 20s)) << server.log_text();
+  testing::ChildProcess client(testing::client_program(),
+                               {"--server", fmt::format("127.0.0.1:{}", testing::listening_port(server.log_text())),
+                                "--user", "alice", "--device", "script:" + (dir / "press.yaml").string()},
+                               dir / "client.log");
+  const std::optional<int> status = server.wait(30s);
+  ASSERT_TRUE(status.has_value()) << "the server did not end the session\n" << server.log_text();
+  EXPECT_EQ(*status, 1) << server.log_text();
+  const std::string log = server.log_text();
+  EXPECT_NE(log.find("the simulation failed 100 steps in a row, the last with: "), std::string::npos) << log;
+  EXPECT_NE(log.find("boundary nodes asked for"), std::string::npos) << log;
+  // About a second of failures at 100 Hz: the first line, perhaps one more.
+  std::size_t lines = 0;
+  for (std::size_t at = log.find("simulation step failed"); at != std::string::npos;
+       at = log.find("simulation step failed", at + 1))
+    ++lines;
+  EXPECT_GE(lines, 1u);
+  EXPECT_LE(lines, 3u) << log;
+  std::ifstream in(dir / "server.json");
+  const nlohmann::json report = nlohmann::json::parse(in)["server"];
+  EXPECT_EQ(report["failed_steps"]["count"], kMaxConsecutiveStepFailures);
+  EXPECT_EQ(report["failed_steps"]["max_in_a_row"], kMaxConsecutiveStepFailures);
+  EXPECT_NE(report["failed_steps"]["last_error"].get<std::string>().find("boundary nodes asked for"), std::string::npos);
+  // The client was told why, and is on its own again (it keeps trying to reconnect).
+  EXPECT_TRUE(client.wait_for_log("server said goodbye: the server's simulation failed", 10s)) << client.log_text();
+  client.signal(SIGINT);
+  EXPECT_TRUE(client.wait(10s).has_value());
+}
+
+}  // namespace
+}  // namespace cohaptic

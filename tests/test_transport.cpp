@@ -1,0 +1,333 @@
+// The transport layer (net/) on real loopback sockets:
+//   - the bounded write queue keeps its policy under any sequence of pushes and writes:
+//     never more than its limit waiting, never a must-arrive frame lost, the newest
+//     newest-wins frame always kept, frames written in the order pushed;
+//   - a framed connection carries sealed frames in order both ways, and closes on a frame
+//     whose tag does not verify;
+//   - against a peer that stops reading, it stays bounded: it drops superseded newest-wins
+//     frames, and when it has read again every must-arrive frame and the newest
+//     newest-wins frame arrived; with nothing it may drop, it closes the connection;
+//   - the UDP endpoint hands over the datagrams that pass the inspector and counts every
+//     other by its reason.
+#include <gtest/gtest.h>
+
+#include <asio.hpp>
+#include <chrono>
+#include <map>
+#include <random>
+#include <set>
+#include <string>
+
+#include "net/bounded_write_queue.h"
+#include "net/datagram_endpoint.h"
+#include "net/framed_connection.h"
+#include "proto/wire/frame_codec.h"
+#include "proto/wire/sealer.h"
+#include "proto/wire/session_key.h"
+
+namespace cohaptic::net {
+namespace {
+
+using asio::ip::tcp;
+using asio::ip::udp;
+using namespace std::chrono_literals;
+using Bytes = std::vector<std::uint8_t>;
+
+constexpr std::uint64_t kSession = 0x7e57'0001;
+
+// ---- the write queue's policy ----
+
+// Frame i is i as 4 bytes: the tests can tell frames apart after they went through the queue.
+Bytes frame_of(std::uint32_t i) {
+  return {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8), static_cast<std::uint8_t>(i >> 16),
+          static_cast<std::uint8_t>(i >> 24)};
+}
+std::uint32_t index_of(const Bytes& frame) {
+  return frame[0] | static_cast<std::uint32_t>(frame[1]) << 8 | static_cast<std::uint32_t>(frame[2]) << 16 |
+         static_cast<std::uint32_t>(frame[3]) << 24;
+}
+
+TEST(BoundedWriteQueue, DropsTheOldestSupersededNewestWinsFrameAndRefusesWhenNothingCanGo) {
+  BoundedWriteQueue queue(3);
+  EXPECT_EQ(queue.push(frame_of(0), FrameKind::newest_wins), BoundedWriteQueue::Push::queued);
+  EXPECT_EQ(index_of(*queue.begin_write()), 0u);  // in flight from now on
+  EXPECT_EQ(queue.push(frame_of(1), FrameKind::must_arrive), BoundedWriteQueue::Push::queued);
+  EXPECT_EQ(queue.push(frame_of(2), FrameKind::newest_wins), BoundedWriteQueue::Push::queued);
+  EXPECT_EQ(queue.push(frame_of(3), FrameKind::must_arrive), BoundedWriteQueue::Push::queued);
+  // Full. A must-arrive frame: the only newest-wins frame waiting is the newest, so it stays.
+  EXPECT_EQ(queue.push(frame_of(4), FrameKind::must_arrive), BoundedWriteQueue::Push::refused);
+  // A newest-wins frame supersedes frame 2 (not frame 0, which is being written).
+  EXPECT_EQ(queue.push(frame_of(5), FrameKind::newest_wins), BoundedWriteQueue::Push::queued_after_drop);
+  EXPECT_EQ(queue.dropped(), 1u);
+  EXPECT_EQ(queue.waiting(), 3u);
+  EXPECT_EQ(queue.begin_write(), nullptr);  // one at a time
+  std::vector<std::uint32_t> written;
+  queue.end_write();
+  while (const Bytes* frame = queue.begin_write()) {
+    written.push_back(index_of(*frame));
+    queue.end_write();
+  }
+  EXPECT_EQ(written, (std::vector<std::uint32_t>{1, 3, 5}));
+}
+
+// Random pushes and writes against the policy's promises.
+TEST(BoundedWriteQueue, UnderRandomTrafficKeepsEveryMustArriveFrameAndTheNewestNewestWinsFrame) {
+  std::mt19937 random(11);
+  for (int trial = 0; trial < 50; ++trial) {
+    const std::size_t limit = 1 + random() % 6;
+    BoundedWriteQueue queue(limit);
+    std::set<std::uint32_t> must_arrive, refused;
+    std::vector<std::uint32_t> written;
+    std::uint32_t newest = 0;
+    bool any_newest_wins = false, in_flight = false;
+    for (std::uint32_t i = 0; i < 400; ++i) {
+      const bool newest_wins = random() % 3 != 0;
+      const auto pushed = queue.push(frame_of(i), newest_wins ? FrameKind::newest_wins : FrameKind::must_arrive);
+      if (pushed == BoundedWriteQueue::Push::refused) {
+        refused.insert(i);
+      } else if (newest_wins) {
+        newest = i;
+        any_newest_wins = true;
+      } else {
+        must_arrive.insert(i);
+      }
+      ASSERT_LE(queue.waiting(), limit);
+      // The socket writes now and then.
+      if (random() % 4 == 0) {
+        if (in_flight) {
+          queue.end_write();
+          in_flight = false;
+        }
+        if (const Bytes* frame = queue.begin_write()) {
+          written.push_back(index_of(*frame));
+          in_flight = true;
+        }
+      }
+    }
+    if (in_flight) queue.end_write();
+    while (const Bytes* frame = queue.begin_write()) {
+      written.push_back(index_of(*frame));
+      queue.end_write();
+    }
+    EXPECT_TRUE(std::is_sorted(written.begin(), written.end())) << "frames left out of order";
+    const std::set<std::uint32_t> arrived(written.begin(), written.end());
+    for (std::uint32_t i : must_arrive) EXPECT_TRUE(arrived.count(i)) << "must-arrive frame " << i << " was lost";
+    if (any_newest_wins) {
+      EXPECT_TRUE(arrived.count(newest)) << "the newest newest-wins frame was lost";
+    }
+    EXPECT_EQ(arrived.size() + queue.dropped() + refused.size(), 400u);
+  }
+}
+
+// ---- the framed connection ----
+
+// A loopback TCP pair: `client` connected to `server`.
+struct TcpPair {
+  asio::io_context io;
+  tcp::socket server{io}, client{io};
+  explicit TcpPair(int receive_buffer_bytes = 0) {
+    tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+    client.open(tcp::v4());
+    if (receive_buffer_bytes > 0) client.set_option(asio::socket_base::receive_buffer_size(receive_buffer_bytes));
+    client.connect(acceptor.local_endpoint());
+    acceptor.accept(server);
+  }
+  // Runs the I/O until `done` or the timeout.
+  template <class Done>
+  bool run_until(Done done, std::chrono::seconds timeout = 10s) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (!done() && std::chrono::steady_clock::now() < end) {
+      io.restart();
+      io.run_for(5ms);
+    }
+    return done();
+  }
+};
+
+wire::Control event(const std::string& kind, const std::string& text) {
+  wire::Control control;
+  control.mutable_event()->set_kind(kind);
+  control.mutable_event()->set_text(text);
+  return control;
+}
+
+TEST(FramedConnection, CarriesSealedFramesInOrderBothWaysAndClosesOnABadTag) {
+  const wire::SessionKey key = wire::development_key();
+  TcpPair pair;
+  std::vector<std::string> at_server, at_client;
+  std::map<std::string, CloseCause> closed;
+  const auto handlers = [&](std::vector<std::string>& received, const std::string& side) {
+    FramedConnection::Handlers h;
+    h.on_control = [&received](const wire::Control& control) { received.push_back(control.event().text()); };
+    h.on_close = [&closed, side](CloseCause cause, const std::string&) { closed[side] = cause; };
+    return h;
+  };
+  auto server = FramedConnection::start(std::move(pair.server), wire::FrameReader(key), handlers(at_server, "server"));
+  auto client = FramedConnection::start(std::move(pair.client), wire::FrameReader(key), handlers(at_client, "client"));
+  wire::FrameSealer server_sealer(key, kSession, 0), client_sealer(key, kSession, 1);
+  for (int i = 0; i < 100; ++i) {
+    wire::Control to_client = event("count", std::to_string(i)), to_server = event("count", std::to_string(-i));
+    server->send(server_sealer.seal(to_client), FrameKind::must_arrive);
+    client->send(client_sealer.seal(to_server), FrameKind::must_arrive);
+    pair.io.restart();
+    pair.io.poll();  // the sockets write as the frames come, as on an I/O thread
+  }
+  ASSERT_TRUE(pair.run_until([&] { return at_client.size() == 100 && at_server.size() == 100; }));
+  for (int i = 0; i < 100; ++i) {
+    EXPECT_EQ(at_client[static_cast<std::size_t>(i)], std::to_string(i));
+    EXPECT_EQ(at_server[static_cast<std::size_t>(i)], std::to_string(-i));
+  }
+  // A frame with one bit of its tag flipped: the client's reader rejects it and closes.
+  wire::Control forged = event("forged", "x");
+  Bytes bytes = server_sealer.seal(forged);
+  bytes.back() ^= 1;
+  server->send(std::move(bytes), FrameKind::must_arrive);
+  ASSERT_TRUE(pair.run_until([&] { return closed.size() == 2; }));
+  EXPECT_EQ(closed["client"], CloseCause::rejected_frame);
+  EXPECT_EQ(closed["server"], CloseCause::peer_closed);
+  EXPECT_EQ(at_client.size(), 100u);  // the forged frame never reached its handler
+  EXPECT_TRUE(client->closed());
+}
+
+TEST(FramedConnection, AgainstAPeerThatStopsReadingItStaysBoundedAndTheFramesThatMustArriveDo) {
+  const wire::SessionKey key = wire::development_key();
+  TcpPair pair(64 * 1024);  // a small receive window: the peer's kernel takes few frames
+  bool sender_closed = false;
+  FramedConnection::Handlers handlers;
+  handlers.on_control = [](const wire::Control&) {};
+  handlers.on_close = [&](CloseCause, const std::string&) { sender_closed = true; };
+  pair.server.set_option(asio::socket_base::send_buffer_size(64 * 1024));
+  auto sender = FramedConnection::start(std::move(pair.server), wire::FrameReader(key), std::move(handlers));
+  wire::FrameSealer sealer(key, kSession, 0);
+  // 200 frames of 100 kB, every 20th a must-arrive event, the rest newest-wins "IRs".
+  const std::string payload(100'000, 'p');
+  constexpr int kFrames = 200;
+  std::size_t most_waiting = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    const bool must_arrive = i % 20 == 0;
+    wire::Control control = event(must_arrive ? "event" : "ir", std::to_string(i) + " " + payload);
+    EXPECT_NE(sender->send(sealer.seal(control), must_arrive ? FrameKind::must_arrive : FrameKind::newest_wins),
+              FramedConnection::Sent::closed);
+    pair.io.restart();
+    pair.io.poll();  // the socket takes what it can
+    most_waiting = std::max(most_waiting, sender->frames_waiting());
+  }
+  EXPECT_LE(most_waiting, kMaxWaitingFrames);
+  EXPECT_GT(sender->frames_dropped(), 50u) << "the peer's kernel buffers took more than expected";
+  EXPECT_FALSE(sender_closed);
+
+  // The peer reads again: everything still queued arrives, in order.
+  std::vector<std::pair<std::string, int>> received;
+  FramedConnection::Handlers receiving;
+  receiving.on_control = [&](const wire::Control& control) {
+    received.emplace_back(control.event().kind(), std::stoi(control.event().text()));
+  };
+  receiving.on_close = [](CloseCause, const std::string&) {};
+  auto reader = FramedConnection::start(std::move(pair.client), wire::FrameReader(key), std::move(receiving));
+  ASSERT_TRUE(pair.run_until([&] { return !received.empty() && received.back().second == kFrames - 1; }));
+  int irs = 0;
+  std::vector<int> events;
+  for (std::size_t i = 0; i < received.size(); ++i) {
+    if (i > 0) {
+      EXPECT_LT(received[i - 1].second, received[i].second);
+    }
+    if (received[i].first == "event") events.push_back(received[i].second);
+    else ++irs;
+  }
+  EXPECT_EQ(events.size(), static_cast<std::size_t>(kFrames / 20)) << "a must-arrive frame was lost";
+  EXPECT_EQ(static_cast<std::uint64_t>(irs) + sender->frames_dropped(), static_cast<std::uint64_t>(kFrames - kFrames / 20));
+  std::printf("  %d frames to a peer that stopped reading: %lu newest-wins frames dropped, at most %zu waiting\n", kFrames,
+              static_cast<unsigned long>(sender->frames_dropped()), most_waiting);
+}
+
+TEST(FramedConnection, ClosesWhenFramesThatMustArrivePileUpUnread) {
+  const wire::SessionKey key = wire::development_key();
+  TcpPair pair(64 * 1024);
+  pair.server.set_option(asio::socket_base::send_buffer_size(64 * 1024));
+  std::optional<CloseCause> cause;
+  FramedConnection::Handlers handlers;
+  handlers.on_control = [](const wire::Control&) {};
+  handlers.on_close = [&](CloseCause c, const std::string&) { cause = c; };
+  auto sender = FramedConnection::start(std::move(pair.server), wire::FrameReader(key), std::move(handlers));
+  wire::FrameSealer sealer(key, kSession, 0);
+  const std::string payload(100'000, 'e');
+  int sent = 0;
+  for (; sent < 1000 && !sender->closed(); ++sent) {
+    wire::Control control = event("event", payload);
+    sender->send(sealer.seal(control), FrameKind::must_arrive);
+    pair.io.restart();
+    pair.io.poll();
+  }
+  ASSERT_TRUE(pair.run_until([&] { return cause.has_value(); }));
+  EXPECT_EQ(*cause, CloseCause::write_queue_full);
+  EXPECT_LT(sent, 1000);
+  EXPECT_EQ(sender->send(Bytes(10), FrameKind::must_arrive), FramedConnection::Sent::closed);
+}
+
+// ---- the UDP endpoint ----
+
+TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) {
+  const wire::SessionKey key = wire::development_key();
+  asio::io_context io;
+  auto inspector = std::make_unique<wire::DatagramInspector>(key, kSession);
+  inspector->allow_sender(1);
+  DatagramEndpoint endpoint(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0), std::move(inspector));
+  std::vector<std::pair<double, udp::endpoint>> received;
+  endpoint.start([&](wire::Datagram&& datagram, const udp::endpoint& from, std::int64_t) {
+    received.emplace_back(datagram.tool().position().x(), from);
+  });
+  udp::socket peer(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  const udp::endpoint to(asio::ip::make_address("127.0.0.1"), endpoint.port());
+  wire::DatagramSealer user(key, kSession, 1), stranger(key, kSession, 2);
+  const auto tool_sample = [](double x) {
+    wire::Datagram datagram;
+    datagram.mutable_tool()->mutable_position()->set_x(x);
+    datagram.mutable_tool()->mutable_position()->set_y(0);
+    datagram.mutable_tool()->mutable_position()->set_z(0);
+    return datagram;
+  };
+  Bytes first;
+  for (int i = 0; i < 5; ++i) {
+    wire::Datagram datagram = tool_sample(i);
+    const Bytes bytes = user.seal(datagram);
+    if (i == 0) first = bytes;
+    peer.send_to(asio::buffer(bytes), to);
+  }
+  wire::Datagram forged_datagram = tool_sample(9);
+  Bytes forged = user.seal(forged_datagram);
+  forged[3] ^= 0x10;
+  peer.send_to(asio::buffer(forged), to);                               // bad_tag
+  peer.send_to(asio::buffer(Bytes(wire::kMaxDatagramBytes + 100)), to);  // oversized, seen whole
+  peer.send_to(asio::buffer(Bytes(3000)), to);                           // oversized, larger than the buffer
+  wire::Datagram from_stranger = tool_sample(8);
+  peer.send_to(asio::buffer(stranger.seal(from_stranger)), to);  // unknown_sender
+  peer.send_to(asio::buffer(first), to);                         // replayed
+  const wire::RejectionCounters& counters = endpoint.inspector().counters();
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (counters.accepted() + counters.rejected() < 10 && std::chrono::steady_clock::now() < end) {
+    io.restart();
+    io.run_for(5ms);
+  }
+  ASSERT_EQ(received.size(), 5u);
+  for (std::size_t i = 0; i < received.size(); ++i) {
+    EXPECT_EQ(received[i].first, static_cast<double>(i));
+    EXPECT_EQ(received[i].second, peer.local_endpoint());
+  }
+  EXPECT_EQ(counters.accepted(), 5u);
+  EXPECT_EQ(counters.count(wire::Rejection::bad_tag), 1u);
+  EXPECT_EQ(counters.count(wire::Rejection::oversized), 2u);
+  EXPECT_EQ(counters.count(wire::Rejection::unknown_sender), 1u);
+  EXPECT_EQ(counters.count(wire::Rejection::replayed), 1u);
+  EXPECT_EQ(counters.rejected(), 5u);
+
+  // And the other way: sealed bytes out, as given.
+  endpoint.send(first, peer.local_endpoint());
+  Bytes echo(wire::kMaxDatagramBytes);
+  const std::size_t n = peer.receive(asio::buffer(echo));
+  echo.resize(n);
+  EXPECT_EQ(echo, first);
+  EXPECT_EQ(endpoint.sent(), 1u);
+}
+
+}  // namespace
+}  // namespace cohaptic::net
