@@ -11,13 +11,13 @@
 namespace cohaptic {
 namespace {
 
-std::int64_t now_ns() {
+std::int64_t monotonic_now() {
   timespec ts{};
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
-void sleep_until(std::int64_t deadline_ns) {
+void sleep_until_monotonic(std::int64_t deadline_ns) {
   timespec ts{};
   ts.tv_sec = static_cast<time_t>(deadline_ns / 1'000'000'000);
   ts.tv_nsec = static_cast<long>(deadline_ns % 1'000'000'000);
@@ -35,6 +35,10 @@ std::uint64_t skip_missed(std::int64_t& deadline, std::int64_t woke, std::int64_
 
 }  // namespace
 
+HapticClock HapticClock::monotonic() {
+  return {[](void*) { return monotonic_now(); }, [](void*, std::int64_t deadline_ns) { sleep_until_monotonic(deadline_ns); }, nullptr};
+}
+
 bool enter_realtime(int priority) {
   sched_param param{};
   param.sched_priority = priority;
@@ -46,11 +50,11 @@ bool enter_realtime(int priority) {
 void TimerFloor::run(double rate_hz, const std::atomic<bool>& stop, bool realtime) {
   if (realtime) enter_realtime(79);
   const auto period = static_cast<std::int64_t>(1e9 / rate_hz);
-  std::int64_t deadline = now_ns() + period;
+  std::int64_t deadline = monotonic_now() + period;
   std::int64_t last = 0;
   while (!stop.load(std::memory_order_relaxed)) {
-    sleep_until(deadline);
-    const std::int64_t woke = now_ns();
+    sleep_until_monotonic(deadline);
+    const std::int64_t woke = monotonic_now();
     if (last) period_ns.record(woke - last);
     last = woke;
     missed_deadlines += skip_missed(deadline, woke, period);
@@ -58,7 +62,7 @@ void TimerFloor::run(double rate_hz, const std::atomic<bool>& stop, bool realtim
   }
 }
 
-HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings)
+HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings, HapticClock clock)
     : device_(device),
       channels_(channels),
       settings_(settings),
@@ -66,7 +70,8 @@ HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoo
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9))},
-      passivity_(settings.passivity_mass_kg, settings.force_limit) {}
+      passivity_(settings.passivity_mass_kg, settings.force_limit),
+      clock_(clock) {}
 
 Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record) {
   std::int64_t age = std::numeric_limits<std::int64_t>::max();
@@ -119,16 +124,16 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
 void HapticLoop::run(const std::atomic<bool>& stop) {
   if (settings_.realtime) {
     metrics_.realtime = enter_realtime(80);
-    channels_.events.push({metrics_.realtime ? HapticEventKind::started_realtime : HapticEventKind::realtime_refused, now_ns(), 0});
+    channels_.events.push({metrics_.realtime ? HapticEventKind::started_realtime : HapticEventKind::realtime_refused, now(), 0});
   }
   const auto period = static_cast<std::int64_t>(1e9 / settings_.rate_hz);
-  const std::int64_t start = now_ns();
+  const std::int64_t start = now();
   std::int64_t deadline = start + period;
   std::int64_t last_woke = 0;
   std::uint64_t epoch_in_use = 0;
   while (!stop.load(std::memory_order_relaxed)) {
-    sleep_until(deadline);
-    const std::int64_t woke = now_ns();
+    clock_.sleep_until_ns(clock_.context, deadline);
+    const std::int64_t woke = now();
     if (last_woke) metrics_.period_ns.record(woke - last_woke);
     last_woke = woke;
     metrics_.missed_deadlines += skip_missed(deadline, woke, period);
@@ -178,8 +183,8 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     if (channels_.tracing.load(std::memory_order_relaxed)) channels_.trace.push(record);
     ++metrics_.ticks;
   }
-  device_.write_force(Eigen::Vector3d::Zero(), static_cast<double>(now_ns() - start) * 1e-9);
-  metrics_.elapsed_s = static_cast<double>(now_ns() - start) * 1e-9;
+  device_.write_force(Eigen::Vector3d::Zero(), static_cast<double>(now() - start) * 1e-9);
+  metrics_.elapsed_s = static_cast<double>(now() - start) * 1e-9;
 }
 
 }  // namespace cohaptic

@@ -10,7 +10,8 @@
 // and the schedule keeps its phase (no catch-up burst, no drift).
 // Safety: the force is limited to min(device, scene) limit; an IR the server has not
 // confirmed (P1), or a force (P0), older than `max_age` fades the force to zero over
-// `fade`; any non-finite value gives zero and an event. Units: s, m, N; times are CLOCK_MONOTONIC ns.
+// `fade`; any non-finite value gives zero and an event. Units: s, m, N; times are CLOCK_MONOTONIC ns
+// (HapticClock::monotonic(); a test may give the loop a clock it drives instead).
 #pragma once
 
 #include <atomic>
@@ -125,9 +126,21 @@ struct HapticMetrics {
   bool realtime = false;      ///< SCHED_FIFO and mlockall in effect
 };
 
+/// Where the loop reads the time and sleeps to its deadlines, in ns. The real clock,
+/// monotonic(), is CLOCK_MONOTONIC, on which the I/O thread stamps arrivals. A test passes
+/// a clock it drives (`context` is its state) to put every tick at an exact time. Plain
+/// function pointers fixed at construction: two indirect calls a tick, no allocation, no lock.
+struct HapticClock {
+  std::int64_t (*now_ns)(void* context);
+  void (*sleep_until_ns)(void* context, std::int64_t deadline_ns);  ///< returns at or after the deadline
+  void* context = nullptr;
+  static HapticClock monotonic();
+};
+
 class HapticLoop {
  public:
-  HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings);
+  HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings,
+             HapticClock clock = HapticClock::monotonic());
 
   /// Runs until `stop` is set, the duration is over or a scripted device finishes.
   void run(const std::atomic<bool>& stop);
@@ -137,6 +150,7 @@ class HapticLoop {
 
  private:
   Eigen::Vector3d compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record);
+  std::int64_t now() const { return clock_.now_ns(clock_.context); }
 
   HapticDevice& device_;
   HapticChannels& channels_;
@@ -145,6 +159,7 @@ class HapticLoop {
   std::array<RemoteToolBuffer, kMaxUsers> remote_buffers_;
   Eigen::Vector3d last_force_ = Eigen::Vector3d::Zero();
   PassivityController passivity_;
+  HapticClock clock_;
 };
 
 /// A loop that does nothing but sleep to absolute deadlines at `rate_hz`: the timer floor

@@ -8,7 +8,6 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -18,7 +17,6 @@
 #include <numbers>
 #include <cstdio>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "client/device/bridge_device.h"
@@ -29,6 +27,7 @@
 #include "client/device/scripted_device.h"
 #include "client/device/trajectory.h"
 #include "common/util/error.h"
+#include "support/wait.h"
 
 // Counting operator new, for the "no allocation in the haptic thread" checks. Weak, so that
 // another test file's replacement (if one appears) wins without a link error; the tests
@@ -627,22 +626,20 @@ TEST(HandModel, ReadAndWriteAllocateNothing) {
 // ---------------------------------------------------------------------------------------
 // Bridge
 
-/// Polls `ready` every 0.2 ms for up to 2 s.
-bool eventually(const std::function<bool()>& ready) {
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (ready()) return true;
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
-  return ready();
+/// Waits until `device` has read `datagrams` datagrams in total, reading at loop time t.
+::testing::AssertionResult read_until(BridgeDevice& device, std::uint64_t datagrams, double t) {
+  return testing::wait_until(
+      [&] {
+        device.read(t);
+        return device.counters().received >= datagrams;
+      },
+      std::to_string(datagrams) + " datagrams read by the bridge device");
 }
 
-/// Waits until `device` has read `datagrams` datagrams in total, reading at loop time t.
-bool read_until(BridgeDevice& device, std::uint64_t datagrams, double t) {
-  return eventually([&] {
-    device.read(t);
-    return device.counters().received >= datagrams;
-  });
+/// Waits until a force packet from the device has reached `peer`.
+::testing::AssertionResult force_arrives(BridgePeer& peer) {
+  return testing::wait_until([&] { return peer.poll_forces() > 0 || peer.newest_force().has_value(); },
+                             "a force packet at the bridge peer");
 }
 
 TEST(Bridge, PacketLayoutIsLittleEndianAndFixed) {
@@ -724,7 +721,7 @@ TEST(Bridge, PoseAndForceRoundTripOnLoopback) {
   EXPECT_EQ(device.peer(), "127.0.0.1:" + std::to_string(peer.local_port()));
 
   device.write_force(Eigen::Vector3d(0.25, -0.5, 1.75), 1.0);
-  ASSERT_TRUE(eventually([&] { return peer.poll_forces() > 0 || peer.newest_force().has_value(); }));
+  ASSERT_TRUE(force_arrives(peer));
   const auto& f = *peer.newest_force();
   EXPECT_EQ(f.sequence, 0u);
   EXPECT_EQ(f.device_time_s, 12.5);
@@ -742,7 +739,6 @@ TEST(Bridge, NewestPoseWinsAndOlderOnesAreStale) {
   device.start();
   BridgePeer peer("127.0.0.1", device.local_port());
   for (int i = 0; i < 10; ++i) peer.send_pose(Eigen::Vector3d(i * 1e-3, 0, 0), i * 1e-3);
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));  // all ten in the socket's queue
   ASSERT_TRUE(read_until(device, 10, 1.0));
   EXPECT_EQ(device.read(1.0).position.x(), 9 * 1e-3) << "the newest of the ten";
   EXPECT_EQ(device.newest_pose().sequence, 9u);
@@ -835,7 +831,7 @@ TEST(Bridge, TimeoutMakesThePoseInvalid) {
 
   // The force packet says the client had no valid pose.
   device.write_force(Eigen::Vector3d::Zero(), 2.0501);
-  ASSERT_TRUE(eventually([&] { return peer.poll_forces() > 0 || peer.newest_force().has_value(); }));
+  ASSERT_TRUE(force_arrives(peer));
   EXPECT_EQ(peer.newest_force()->flags & bridge::kClientValid, 0u);
 
   // After a timeout, a restarted program (sequence from 0 again) is taken at once.

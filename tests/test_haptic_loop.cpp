@@ -1,9 +1,12 @@
 // The client's haptic loop in process, with a scripted device and an IR from the
 // simulation: the force it outputs is the evaluator's, limited and faded as specified,
-// zero for non-finite input, and its schedule keeps its phase.
+// zero for non-finite input, and its schedule keeps its phase. Most tests drive the loop's
+// clock (DrivenClock), so each tick happens at an exact time whatever the machine's load;
+// one fade test and one late-tick test run on the real clock.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <thread>
 
@@ -52,6 +55,22 @@ struct Fixture {
     simulation.step(0);
     return simulation.ir(0);
   }
+  // A tool pressed 2 mm in, its IR and the force the evaluator gives there.
+  const Eigen::Vector3d pressed{0.001, 0.002, -0.002};
+  const std::shared_ptr<const PreparedIR> ir = ir_for(pressed);
+  const Eigen::Vector3d pressed_force = evaluate_force(*ir, pressed, {}).force;
+  /// Channels with tracing on, holding the pressed IR as arrived at `arrival_ns`.
+  std::unique_ptr<HapticChannels> channels_with_ir(std::int64_t arrival_ns) const {
+    auto channels = std::make_unique<HapticChannels>();
+    channels->tracing = true;
+    channels->ir.back() = IrSlot{std::make_unique<const PreparedIR>(*ir), arrival_ns};
+    channels->ir.publish();
+    return channels;
+  }
+  /// A scripted device holding the tool where it is pressed.
+  static ScriptedDevice holding_device() {
+    return ScriptedDevice(parse_trajectory("units: m\nstart: [0.001, 0.002, -0.002]\nsegments: [{hold: 10}]\n", "hold"), 10);
+  }
 };
 
 std::vector<TickRecord> drain(HapticChannels& channels) {
@@ -60,80 +79,155 @@ std::vector<TickRecord> drain(HapticChannels& channels) {
   return ticks;
 }
 
-TEST(HapticLoop, OutputsTheEvaluatorsForceLimitedAndFadedWhenConfirmationsStop) {
-  Fixture fixture;
-  const Eigen::Vector3d pressed(0.001, 0.002, -0.002);
-  const std::shared_ptr<const PreparedIR> ir = fixture.ir_for(pressed);
-  const Eigen::Vector3d expected = evaluate_force(*ir, pressed, {}).force;
-  ASSERT_GT(expected.norm(), 0.2);
+// Runs `loop` to its end (its duration, or its device's) and returns the ticks it traced.
+std::vector<TickRecord> run_to_end(HapticLoop& loop, HapticChannels& channels) {
+  const std::atomic<bool> stop{false};
+  loop.run(stop);
+  return drain(channels);
+}
 
-  auto channels = std::make_unique<HapticChannels>();
-  channels->tracing = true;
-  const std::int64_t now = wire::monotonic_now_ns();
-  channels->ir.back() = IrSlot{std::make_unique<const PreparedIR>(*ir), now};
-  channels->ir.publish();
-  ScriptedDevice device(parse_trajectory("units: m\nstart: [0.001, 0.002, -0.002]\nsegments: [{hold: 10}]\n", "hold"), 10);
+constexpr std::int64_t kMs = 1'000'000;  // [ns]
+
+// A clock the test drives: a sleep returns at once with the time set to its deadline (or
+// left where it is, if a stall already took it past), then calls `at` with the new time,
+// so a stimulus (a confirmation arriving) happens at an exact time on the loop's thread.
+struct DrivenClock {
+  std::int64_t now = 1'000'000'000;  // [ns]
+  std::function<void(std::int64_t now)> at;
+  HapticClock haptic() {
+    return {[](void* self) { return static_cast<DrivenClock*>(self)->now; },
+            [](void* self, std::int64_t deadline_ns) {
+              DrivenClock& clock = *static_cast<DrivenClock*>(self);
+              clock.now = std::max(clock.now, deadline_ns);
+              if (clock.at) clock.at(clock.now);
+            },
+            this};
+  }
+};
+
+// On a driven clock: confirmations every 10 ms until 200 ms, then none. The force is the
+// evaluator's times a fade of exactly 1 up to an age of max_age (100 ms), then falling on a
+// straight line to 0 at max_age + fade (150 ms), and 0 after.
+TEST(HapticLoop, FadesTheForceLinearlyFromMaxAgeToZeroOnADrivenClock) {
+  const Fixture fixture;
+  const Eigen::Vector3d& expected = fixture.pressed_force;
+  ASSERT_GT(expected.norm(), 0.2);
+  DrivenClock clock;
+  const std::int64_t start = clock.now;
+  const std::unique_ptr<HapticChannels> channels = fixture.channels_with_ir(start);
+  clock.at = [&](std::int64_t now) {
+    if ((now - start) % (10 * kMs) == 0 && now - start <= 200 * kMs) {
+      channels->confirmation.back() = {fixture.ir->ir.epoch, now};
+      channels->confirmation.publish();
+    }
+  };
+  ScriptedDevice device = Fixture::holding_device();
   HapticLoopSettings settings;
-  settings.force_limit = 0.2;  // below the evaluated force: clamped
+  settings.force_limit = 10;  // above the evaluated force: what comes out is the fade alone
   settings.max_age_s = 0.1;
   settings.fade_s = 0.05;
   settings.duration_s = 0.5;
   settings.realtime = false;
+  HapticLoop loop(device, *channels, settings, clock.haptic());
+  const std::vector<TickRecord> ticks = run_to_end(loop, *channels);
+  ASSERT_EQ(ticks.size(), 499u) << "a tick every 1 ms from 1 ms, until 0.5 s";
+  EXPECT_EQ(loop.metrics().missed_deadlines, 0u);
+  int fading = 0;
+  for (const TickRecord& t : ticks) {
+    const std::int64_t ms = (t.time_ns - start) / kMs;
+    ASSERT_EQ(t.time_ns, start + ms * kMs) << "on the 1 ms grid";
+    const std::int64_t age_ms = ms - std::min<std::int64_t>(ms / 10 * 10, 200);
+    const double fade = age_ms <= 100 ? 1.0 : std::max(0.0, static_cast<double>(150 - age_ms) / 50.0);
+    EXPECT_EQ(t.evaluated, expected) << "at " << ms << " ms";
+    EXPECT_FLOAT_EQ(t.fade, static_cast<float>(fade)) << "at " << ms << " ms, " << age_ms << " ms after the last confirmation";
+    EXPECT_EQ(t.force, expected * static_cast<double>(t.fade)) << "at " << ms << " ms";
+    if (fade > 0 && fade < 1) ++fading;
+  }
+  EXPECT_EQ(fading, 49) << "ages 101 to 149 ms";
+  // By hand: the last confirmation came at 200 ms; the fade is 0.8, 0.5 and 0.2 at 10, 25
+  // and 40 ms into its 50 ms.
+  for (const auto& [ms, fade] : {std::pair{300, 1.0f}, {310, 0.8f}, {325, 0.5f}, {340, 0.2f}, {350, 0.0f}})
+    EXPECT_FLOAT_EQ(ticks[static_cast<std::size_t>(ms - 1)].fade, fade) << ms << " ms";
+  EXPECT_EQ(device.last_force(), Eigen::Vector3d::Zero()) << "the loop leaves the device at zero force";
+}
+
+// On the real clock (CLOCK_MONOTONIC, a thread confirming), with the force limited. The
+// confirmations come when the machine lets them, so each tick is judged by the ones it
+// surely saw: full force within max_age of a confirmation published before the tick woke,
+// zero once max_age + fade have passed since the last one.
+TEST(HapticLoop, OutputsTheEvaluatorsForceLimitedAndFadedWhenConfirmationsStop) {
+  const Fixture fixture;
+  const Eigen::Vector3d& expected = fixture.pressed_force;
+  ASSERT_GT(expected.norm(), 0.2);
+  const std::unique_ptr<HapticChannels> channels = fixture.channels_with_ir(wire::monotonic_now_ns());
+  ScriptedDevice device = Fixture::holding_device();
+  HapticLoopSettings settings;
+  settings.force_limit = 0.2;  // below the evaluated force: clamped
+  settings.max_age_s = 0.1;
+  settings.fade_s = 0.05;
+  settings.duration_s = 1.0;  // long after the confirmations stop, however late a loaded machine sends them
+  settings.realtime = false;
   HapticLoop loop(device, *channels, settings);
-  std::atomic<bool> stop{false};
-  // Confirm the IR every 10 ms for 0.2 s, then go silent (as a dead server would).
+  // Confirm the IR 20 times, every 10 ms, then go silent (as a dead server would): the
+  // sleeps are the stimulus, a server's pace. Each confirmation's stamp and the time by
+  // which it was published.
+  struct Confirmed {
+    std::int64_t stamp_ns = 0, published_ns = 0;
+  };
+  std::vector<Confirmed> confirmed(20);
   std::thread server([&] {
-    for (int i = 0; i < 20; ++i) {
-      channels->confirmation.back() = {ir->ir.epoch, wire::monotonic_now_ns()};
+    for (Confirmed& c : confirmed) {
+      c.stamp_ns = wire::monotonic_now_ns();
+      channels->confirmation.back() = {fixture.ir->ir.epoch, c.stamp_ns};
       channels->confirmation.publish();
+      c.published_ns = wire::monotonic_now_ns();
       std::this_thread::sleep_for(10ms);
     }
   });
-  // Drain the trace while the loop runs (it holds 8192 ticks).
-  std::vector<TickRecord> ticks;
-  std::thread loop_thread([&] { loop.run(stop); });
-  loop_thread.join();
+  const std::vector<TickRecord> ticks = run_to_end(loop, *channels);
   server.join();
-  ticks = drain(*channels);
   ASSERT_GT(ticks.size(), 400u);
 
-  const std::int64_t start = ticks.front().time_ns;
+  const std::int64_t max_age_ns = 100 * kMs, faded_out_ns = 150 * kMs + 1000;  // + 1 us of rounding
+  int full = 0, zero = 0;
   for (const TickRecord& t : ticks) {
-    const double s = static_cast<double>(t.time_ns - start) * 1e-9;
     EXPECT_EQ(t.evaluated, expected);
     EXPECT_LE(t.force.norm(), 0.2 + 1e-12);
-    if (s < 0.25) {
-      EXPECT_EQ(t.fade, 1.0f) << "confirmed at " << s << " s";
+    const auto seen = std::find_if(confirmed.rbegin(), confirmed.rend(),
+                                   [&](const Confirmed& c) { return c.published_ns <= t.time_ns; });
+    if (seen != confirmed.rend() && t.time_ns - seen->stamp_ns <= max_age_ns) {
+      EXPECT_EQ(t.fade, 1.0f) << static_cast<double>(t.time_ns - seen->stamp_ns) * 1e-6 << " ms after a confirmation it saw";
+      ++full;
     }
-    if (s > 0.2 + 0.1 + 0.05 + 0.02) {
-      EXPECT_EQ(t.force.norm(), 0.0) << "faded out at " << s << " s";
+    if (t.time_ns - confirmed.back().stamp_ns > faded_out_ns) {
+      EXPECT_EQ(t.force.norm(), 0.0) << static_cast<double>(t.time_ns - confirmed.back().stamp_ns) * 1e-6
+                                     << " ms after the last confirmation";
+      ++zero;
     }
   }
+  std::printf("  %zu ticks: %d at full force after a confirmation, %d at zero after the fade\n", ticks.size(), full, zero);
+  EXPECT_GT(full, 100);
+  EXPECT_GT(zero, 100);
   EXPECT_NEAR(ticks.front().force.norm(), 0.2, 1e-12);
   EXPECT_GT(loop.metrics().clamped, 0u);
-  // Every 1 ms period of the 0.5 s run is either a tick or a skipped deadline (a loaded
+  // Every 1 ms period of the 1 s run is either a tick or a skipped deadline (a loaded
   // machine skips some), so together they account for the duration.
-  EXPECT_NEAR(static_cast<double>(loop.metrics().ticks + loop.metrics().missed_deadlines), 500, 25);
+  EXPECT_NEAR(static_cast<double>(loop.metrics().ticks + loop.metrics().missed_deadlines), 1000, 25);
   EXPECT_EQ(device.last_force(), Eigen::Vector3d::Zero()) << "the loop leaves the device at zero force";
 }
 
 TEST(HapticLoop, NonFiniteInputGivesZeroForceAndAnEvent) {
-  Fixture fixture;
-  const std::shared_ptr<const PreparedIR> ir = fixture.ir_for(Eigen::Vector3d(0.001, 0.002, -0.002));
-  auto channels = std::make_unique<HapticChannels>();
-  channels->tracing = true;
-  channels->ir.back() = IrSlot{std::make_unique<const PreparedIR>(*ir), wire::monotonic_now_ns()};
-  channels->ir.publish();
-  NanDevice device(0.1);
+  const Fixture fixture;
+  DrivenClock clock;
+  const std::unique_ptr<HapticChannels> channels = fixture.channels_with_ir(clock.now);
+  NanDevice device(0.1005);
   HapticLoopSettings settings;
   settings.duration_s = 0.2;
   settings.realtime = false;
   settings.max_age_s = 10;
-  HapticLoop loop(device, *channels, settings);
-  std::atomic<bool> stop{false};
-  loop.run(stop);
+  HapticLoop loop(device, *channels, settings, clock.haptic());
   int zero_after = 0;
-  for (const TickRecord& t : drain(*channels)) {
+  for (const TickRecord& t : run_to_end(loop, *channels)) {
     ASSERT_TRUE(t.force.allFinite());
     if (!t.own.allFinite()) {
       EXPECT_EQ(t.force, Eigen::Vector3d::Zero());
@@ -141,34 +235,38 @@ TEST(HapticLoop, NonFiniteInputGivesZeroForceAndAnEvent) {
       ++zero_after;
     }
   }
-  EXPECT_GT(zero_after, 50);
+  EXPECT_EQ(zero_after, 99) << "the ticks at 101 to 199 ms";
 }
 
-TEST(HapticLoop, ALateTickSkipsTheMissedDeadlinesAndKeepsThePhase) {
-  // A device that stalls once for 5.5 ms, like a host preempting the VM.
-  class StallingDevice final : public HapticDevice {
-   public:
-    std::string describe() const override { return "stall"; }
-    DeviceState read(double t) override {
-      if (!stalled && t > 0.05) {
-        stalled = true;
-        std::this_thread::sleep_for(5500us);
-      }
-      return {};
+// A device that stalls once, at its first read after 50 ms, like a host preempting the VM.
+class StallingDevice final : public HapticDevice {
+ public:
+  explicit StallingDevice(std::function<void()> stall) : stall_(std::move(stall)) {}
+  std::string describe() const override { return "stall"; }
+  DeviceState read(double t) override {
+    if (!stalled_ && t > 0.05) {
+      stalled_ = true;
+      stall_();
     }
-    void write_force(const Eigen::Vector3d&, double) override {}
-    double force_limit() const override { return 1; }
-    bool stalled = false;
-  } device;
+    return {};
+  }
+  void write_force(const Eigen::Vector3d&, double) override {}
+  double force_limit() const override { return 1; }
+
+ private:
+  std::function<void()> stall_;
+  bool stalled_ = false;
+};
+
+TEST(HapticLoop, ALateTickSkipsTheMissedDeadlinesAndKeepsThePhase) {
+  StallingDevice device([] { std::this_thread::sleep_for(5500us); });  // stimulus: the stall
   auto channels = std::make_unique<HapticChannels>();
   channels->tracing = true;
   HapticLoopSettings settings;
   settings.duration_s = 0.2;
   settings.realtime = false;
   HapticLoop loop(device, *channels, settings);
-  std::atomic<bool> stop{false};
-  loop.run(stop);
-  const std::vector<TickRecord> ticks = drain(*channels);
+  const std::vector<TickRecord> ticks = run_to_end(loop, *channels);
   EXPECT_GE(loop.metrics().missed_deadlines, 4u);
   // The ticks after the stall are on the same 1 ms grid as those before it: their median
   // offset from the first tick's grid is the same (wake-up latency, which a loaded machine
@@ -190,6 +288,31 @@ TEST(HapticLoop, ALateTickSkipsTheMissedDeadlinesAndKeepsThePhase) {
   EXPECT_LT(std::abs(after - before), 300'000) << "median offset from the 1 ms grid: " << before << " ns before the stall, "
                                                << after << " ns after";
   EXPECT_LT(ticks.size(), 200u - 3u) << "missed ticks are skipped, not caught up";
+}
+
+// The same on a driven clock, exactly: the read at 51 ms stalls 5.5 ms, so the loop wakes
+// at 56.5 ms for its 52 ms deadline. The deadlines 52 to 55 ms are skipped (4), the late
+// tick runs at once, and every tick after it is back on the 1 ms grid at 57, 58, ... ms.
+TEST(HapticLoop, ALateTickSkipsExactlyTheMissedDeadlinesOnADrivenClock) {
+  DrivenClock clock;
+  const std::int64_t start = clock.now;
+  StallingDevice device([&clock] { clock.now += 5 * kMs + kMs / 2; });
+  auto channels = std::make_unique<HapticChannels>();
+  channels->tracing = true;
+  HapticLoopSettings settings;
+  settings.duration_s = 0.2;
+  settings.realtime = false;
+  HapticLoop loop(device, *channels, settings, clock.haptic());
+  const std::vector<TickRecord> ticks = run_to_end(loop, *channels);
+  EXPECT_EQ(loop.metrics().missed_deadlines, 4u);
+  std::vector<std::int64_t> expected;  // tick times from the start [ns]
+  for (std::int64_t ms = 1; ms <= 51; ++ms) expected.push_back(ms * kMs);
+  expected.push_back(56 * kMs + kMs / 2);
+  for (std::int64_t ms = 57; ms < 200; ++ms) expected.push_back(ms * kMs);
+  std::vector<std::int64_t> times;
+  for (const TickRecord& t : ticks) times.push_back(t.time_ns - start);
+  EXPECT_EQ(times, expected);
+  EXPECT_EQ(loop.metrics().ticks + loop.metrics().missed_deadlines, 199u) << "every period a tick or a skipped deadline";
 }
 
 }  // namespace

@@ -705,11 +705,11 @@ TEST(McapWriter, FlushesWhenTheBufferFillsWhenTimeIsUpAndOnRequest) {
     if (std::chrono::steady_clock::now() - flushed_at < kInterval) {
       EXPECT_LT(on_disk(file), writer.size()) << "buffered before the interval is up";
     }
-    std::this_thread::sleep_for(kInterval + 20ms);
+    std::this_thread::sleep_for(kInterval + 20ms);  // stimulus: the flush interval passing
     write_messages(writer, c, 1, 1);
     EXPECT_EQ(on_disk(file), writer.size()) << "a write after the interval flushes";
     write_messages(writer, c, 2, 1);
-    std::this_thread::sleep_for(kInterval + 20ms);
+    std::this_thread::sleep_for(kInterval + 20ms);  // stimulus: the flush interval passing
     writer.flush_if_due();
     EXPECT_EQ(on_disk(file), writer.size()) << "flush_if_due after the interval flushes";
     writer.close();

@@ -8,7 +8,6 @@
 
 #include <cmath>
 #include <fstream>
-#include <thread>
 
 #include "client/device/make_device.h"
 #include "client/device/recorded_motion.h"
@@ -24,7 +23,6 @@ namespace cohaptic {
 namespace {
 
 namespace fs = std::filesystem;
-using namespace std::chrono_literals;
 using testing::ChildProcess;
 
 void write_files(const fs::path& dir) {
@@ -55,7 +53,7 @@ struct RecordedSession {
                                      "--record", (dir / "server.mcap").string(), "--step-nodes", "40", "--no-disk-cache"};
     args.insert(args.end(), server_extra.begin(), server_extra.end());
     server = std::make_unique<ChildProcess>(testing::server_program(), args, dir / "server.log");
-    EXPECT_TRUE(server->wait_for_log("listening on", 20s)) << server->log_text();
+    EXPECT_TRUE(testing::wait_for_output(*server, "listening on"));
     port = testing::listening_port(server->log_text());
   }
   // A client playing `device` (default: the user's script), recording to <user>.mcap.
@@ -69,12 +67,12 @@ struct RecordedSession {
   }
   void stop() {
     server->signal(SIGINT);
-    EXPECT_EQ(server->wait(20s), 0) << server->log_text();
+    EXPECT_EQ(server->wait(testing::kPatience), 0) << server->log_text();
   }
   // One user's session: its client in slot 0 runs its script to the end, then the server stops.
   void run_one_user(const std::string& user) {
     const auto c = client(user, 0);
-    EXPECT_EQ(c->wait(30s), 0) << c->log_text();
+    EXPECT_EQ(c->wait(testing::kPatience), 0) << c->log_text();
     stop();
   }
   std::unique_ptr<ChildProcess> server;
@@ -85,8 +83,8 @@ TEST(Replay, ATwoUserSessionVerifiesBitForBit) {
   RecordedSession session("replay-two", {"--protocol", "P1"});
   const auto a = session.client("a", 0);
   const auto b = session.client("b", 1);
-  ASSERT_EQ(a->wait(30s), 0) << a->log_text();
-  ASSERT_EQ(b->wait(30s), 0) << b->log_text();
+  ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
+  ASSERT_EQ(b->wait(testing::kPatience), 0) << b->log_text();
   session.stop();
   for (const char* file : {"server.mcap", "a.mcap", "b.mcap"}) {
     const VerifyResult result = verify_recording(session.dir / file);
@@ -131,19 +129,39 @@ TEST(Replay, AChangedForceIsFoundAndNamed) {
 
 TEST(Replay, AClientKilledMidSessionLeavesARecordingThatReadsAndVerifies) {
   RecordedSession session("replay-killed");
-  const auto a = session.client("a", 0);
-  ASSERT_TRUE(a->wait_for_log("recording to", 20s)) << a->log_text();
-  std::this_thread::sleep_for(1500ms);
+  // A press, then a slide far slower than the test waits for, so the kill comes mid-session.
+  std::ofstream(session.dir / "hold.yaml") << R"(
+units: mm
+start: [-20, 2, 6]
+segments:
+  - {move_to: [-20, 2, 0.5], speed: 20}
+  - {press: 4, speed: 5, direction: [0, 0, -1]}
+  - {move_by: [8, 0, 0], speed: 0.1}
+)";
+  const auto a = session.client("a", 0, "script:" + (session.dir / "hold.yaml").string());
+  // The recorder flushes while the session runs (at least every 100 ms), not only at the
+  // end: a second's ticks reach the disk while the client is still running.
+  std::size_t on_disk_before_kill = 0;
+  ASSERT_TRUE(testing::wait_until(
+      [&] {
+        try {
+          on_disk_before_kill = record::read_recording(session.dir / "a.mcap").ticks.size();
+        } catch (const Error&) {  // not yet flushed
+        }
+        return on_disk_before_kill > 1000;
+      },
+      "more than 1000 haptic ticks flushed to the running client's recording"))
+      << a->log_text();
   a->signal(SIGKILL);
-  a->wait(5s);
+  ASSERT_EQ(a->wait(testing::kPatience), 128 + SIGKILL);
   session.stop();
   const record::Recording recording = record::read_recording(session.dir / "a.mcap");
   EXPECT_TRUE(recording.truncated) << "a killed writer cannot have written the footer";
-  EXPECT_GT(recording.ticks.size(), 1000u) << "flushed at least every 100 ms";
+  EXPECT_GE(recording.ticks.size(), on_disk_before_kill) << "every tick flushed before the kill is still readable";
   const VerifyResult result = verify_recording(session.dir / "a.mcap");
   EXPECT_TRUE(result.ok) << result.first_difference;
-  std::printf("  killed after ~1.5 s: %zu ticks readable (%s), all verified\n", recording.ticks.size(),
-              recording.truncation.c_str());
+  std::printf("  killed with %zu ticks on disk: %zu ticks readable (%s), all verified\n", on_disk_before_kill,
+              recording.ticks.size(), recording.truncation.c_str());
 }
 
 // The deepest point (smallest z) of the own tool and the peak force of a client recording.
@@ -197,7 +215,7 @@ TEST(Replay, ARecordedHandMotionDrivesANewSession) {
   // feels the same peak force.
   RecordedSession second("replay-motion-target", {"--protocol", "P1"});
   const auto replayed = second.client("r", 0, "replay:" + (first.dir / "a.mcap").string());
-  ASSERT_EQ(replayed->wait(30s), 0) << replayed->log_text();
+  ASSERT_EQ(replayed->wait(testing::kPatience), 0) << replayed->log_text();
   second.stop();
   const auto [source_depth, source_peak] = deepest_and_peak(source);
   const auto [replay_depth, replay_peak] = deepest_and_peak(record::read_recording(second.dir / "r.mcap"));

@@ -1,11 +1,15 @@
-// Helpers for end-to-end tests: the built programs, scratch directories, and the
-// ChildProcess of the server library.
+// Helpers for end-to-end tests: the built programs, scratch directories, the ChildProcess
+// of the server library, and waiting for a line in a child's output.
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <chrono>
 #include <filesystem>
 #include <string>
 
 #include "server/child_process.h"
+#include "support/wait.h"
 
 namespace cohaptic::testing {
 
@@ -18,5 +22,10 @@ std::filesystem::path scratch_directory(const std::string& name);
 /// Path of a built program (server or client).
 std::string server_program();
 std::string client_program();
+
+/// Waits (wait_until) until `process`'s output (stdout and stderr) contains `text`. The
+/// failure says what was awaited, whether the process ended first, and its output.
+::testing::AssertionResult wait_for_output(ChildProcess& process, const std::string& text,
+                                           std::chrono::milliseconds timeout = kPatience);
 
 }  // namespace cohaptic::testing
