@@ -119,32 +119,27 @@ CBLAS_TRANSPOSE blas_transpose(Transposed transposed) {
   return transposed == Transposed::yes ? CblasTrans : CblasNoTrans;
 }
 
-void check_triangle(const ConstMatrixRef& g, const MatrixRef& x, const char* name) {
+// x <- G^-1 x or G^-T x.
+void solve_lower(const ConstMatrixRef& g, MatrixRef x, Transposed transposed) {
   if (g.rows() != g.cols() || g.rows() != x.rows())
-    throw Error(fmt::format("{}: a {} x {} triangle against {} rows", name, g.rows(), g.cols(), x.rows()));
+    throw Error(fmt::format("{}: a {} x {} triangle against {} rows",
+                            transposed == Transposed::yes ? "solve_lower_transposed_in_place" : "solve_lower_in_place",
+                            g.rows(), g.cols(), x.rows()));
+  if (x.rows() == 0 || x.cols() == 0) return;
+  if (x.cols() <= kNarrowColumns) {
+    const auto narrow = transposed == Transposed::yes ? narrow_backward_substitution : narrow_forward_substitution;
+    narrow(x.rows(), g.data(), g.outerStride(), x.data(), x.outerStride(), x.cols());
+  } else {
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, blas_transpose(transposed), CblasNonUnit, blas_size(x.rows()),
+                blas_size(x.cols()), 1.0, g.data(), leading_dimension(g), x.data(), leading_dimension(x));
+  }
 }
 
 }  // namespace
 
-void solve_lower_in_place(const ConstMatrixRef& g, MatrixRef x) {
-  check_triangle(g, x, "solve_lower_in_place");
-  if (x.rows() == 0 || x.cols() == 0) return;
-  if (x.cols() <= kNarrowColumns)
-    narrow_forward_substitution(x.rows(), g.data(), g.outerStride(), x.data(), x.outerStride(), x.cols());
-  else
-    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, blas_size(x.rows()),
-                blas_size(x.cols()), 1.0, g.data(), leading_dimension(g), x.data(), leading_dimension(x));
-}
+void solve_lower_in_place(const ConstMatrixRef& g, MatrixRef x) { solve_lower(g, x, Transposed::no); }
 
-void solve_lower_transposed_in_place(const ConstMatrixRef& g, MatrixRef x) {
-  check_triangle(g, x, "solve_lower_transposed_in_place");
-  if (x.rows() == 0 || x.cols() == 0) return;
-  if (x.cols() <= kNarrowColumns)
-    narrow_backward_substitution(x.rows(), g.data(), g.outerStride(), x.data(), x.outerStride(), x.cols());
-  else
-    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasTrans, CblasNonUnit, blas_size(x.rows()),
-                blas_size(x.cols()), 1.0, g.data(), leading_dimension(g), x.data(), leading_dimension(x));
-}
+void solve_lower_transposed_in_place(const ConstMatrixRef& g, MatrixRef x) { solve_lower(g, x, Transposed::yes); }
 
 void multiply(double alpha, const ConstMatrixRef& a, Transposed transposed_a, const ConstMatrixRef& b,
               Transposed transposed_b, double beta, MatrixRef c) {
