@@ -48,7 +48,6 @@ Fixture& fixture(int boundary_nodes) {
   static std::map<int, std::unique_ptr<Fixture>> fixtures;
   auto& slot = fixtures[boundary_nodes];
   if (slot) return *slot;
-  use_single_blas_thread();
   slot = std::make_unique<Fixture>();
   Fixture& f = *slot;
   testing::CubeSceneOptions scene;
@@ -190,6 +189,8 @@ void BM_PrepareIr(benchmark::State& state) {
 const std::vector<std::int64_t> kBoundarySizes = {0, 150, 300, 1000};
 
 void register_all() {
+  // For the whole program, whatever runs first: the server's setting (server/main.cpp).
+  use_single_blas_thread();
   const auto add = [](const char* name, void (*fn)(benchmark::State&), benchmark::TimeUnit unit) {
     auto* b = benchmark::RegisterBenchmark(name, fn)->Unit(unit);
     for (std::int64_t size : kBoundarySizes) b->Arg(size);
