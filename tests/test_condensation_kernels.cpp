@@ -1,15 +1,16 @@
 // The dense kernels of the incremental condensation against Eigen's own (a second
 // implementation): triangular solves with the own narrow kernel (1-3 right-hand sides,
 // every panel remainder) and with BLAS (more), products in every transposition, and the
-// rank-k Cholesky update. Operands are blocks inside larger buffers, as in the
-// condensation, with NaN wherever a kernel must not read or write.
+// rank-k Cholesky update (in place, and into the place of removed rows and columns).
+// Operands are blocks inside larger buffers, as in the condensation, with NaN wherever a
+// kernel must not read or write.
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <limits>
+#include <vector>
 
-#include "common/condense/cholesky_rank_update.h"
 #include "common/condense/dense_kernels.h"
 #include "common/util/error.h"
 
@@ -84,20 +85,40 @@ TEST(CondensationKernels, ProductsEqualEigensInEveryTransposition) {
 
 TEST(CondensationKernels, RankUpdateGivesTheFactorOfTheUpdatedMatrix) {
   for (Eigen::Index n : {1, 5, 40})
-    for (Eigen::Index k : {1, 3}) {
+    for (Eigen::Index k : {1, 2, 3}) {
       Eigen::MatrixXd buffer = factor_in_buffer(n, static_cast<unsigned>(n + k));
       const Eigen::MatrixXd g = buffer.block(2, 3, n, n).triangularView<Eigen::Lower>();
       const Eigen::MatrixXd w = Eigen::MatrixXd::Random(n, k);
       const Eigen::MatrixXd expected = g * g.transpose() + w * w.transpose();
       Eigen::MatrixXd scratch = w;
-      cholesky_rank_update(buffer.block(2, 3, n, n), scratch);
-      const auto updated = buffer.block(2, 3, n, n);
-      const Eigen::MatrixXd lower = updated.triangularView<Eigen::Lower>();
+      cholesky_rank_update(buffer.block(2, 3, n, n), scratch, buffer.block(2, 3, n, n));
+      const Eigen::MatrixXd lower = buffer.block(2, 3, n, n).triangularView<Eigen::Lower>();
       EXPECT_LE((lower * lower.transpose() - expected).norm(), 1e-14 * expected.norm()) << "n " << n << ", k " << k;
       EXPECT_GT(lower.diagonal().minCoeff(), 0) << "n " << n;
       // Nothing outside the lower triangle was touched: it is all still NaN.
       EXPECT_EQ(buffer.array().isNaN().count(), buffer.size() - n * (n + 1) / 2) << "n " << n;
     }
+}
+
+// As when a node leaves: the factor of the matrix without rows and columns [2, 5), its
+// lower right block written straight to its new place, 3 rows and columns up.
+TEST(CondensationKernels, RankUpdateIntoTheRemovedRowsPlaceGivesTheReducedFactor) {
+  const Eigen::Index n = 30, first = 2, k = 3, below = n - first - k;
+  Eigen::MatrixXd buffer = factor_in_buffer(n, 17);
+  const Eigen::MatrixXd g = buffer.block(2, 3, n, n).triangularView<Eigen::Lower>();
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (i < first || i >= first + k) kept.push_back(i);
+  const Eigen::MatrixXd l = g * g.transpose();
+  const Eigen::MatrixXd reduced = l(kept, kept);
+  auto factor = buffer.block(2, 3, n, n);
+  Eigen::MatrixXd dropped = factor.block(first + k, first, below, k);
+  cholesky_rank_update(factor.block(first + k, first + k, below, below), dropped, factor.block(first, first, below, below));
+  // Rows below the node in the columns before it move up by k, as the condensation does.
+  for (Eigen::Index col = 0; col < first; ++col)
+    factor.col(col).segment(first, below) = factor.col(col).segment(first + k, below).eval();
+  const Eigen::MatrixXd moved = factor.topLeftCorner(n - k, n - k).triangularView<Eigen::Lower>();
+  EXPECT_LE((moved * moved.transpose() - reduced).norm(), 1e-14 * reduced.norm());
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "common/util/error.h"
 
@@ -96,6 +97,46 @@ void backward_substitution(Eigen::Index n, const double* __restrict g, Eigen::In
   }
 }
 
+// G' G'^T = G G^T + W W^T for K update columns: per column of G, the K rotations' cosines
+// and sines from its diagonal, then one sweep down the column applying all K to each row
+// of G and of W. Reads column j of g, writes column j of out (which may alias g, see
+// cholesky_rank_update).
+template <int K>
+void rank_update(Eigen::Index n, const double* g, Eigen::Index ld, double* out, Eigen::Index ld_out,
+                 double* __restrict w, Eigen::Index ldw) {
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double* column = g + j * ld;
+    double* target = out + j * ld_out;
+    double sine[K], cosine[K], inverse_cosine[K];
+    double diagonal = column[j];
+    for (int r = 0; r < K; ++r) {
+      const double w_j = w[r * ldw + j];
+      const double radius = std::hypot(diagonal, w_j);
+      sine[r] = w_j / diagonal;
+      cosine[r] = radius / diagonal;
+      inverse_cosine[r] = diagonal / radius;
+      diagonal = radius;
+    }
+    target[j] = diagonal;
+    for (Eigen::Index i = j + 1; i < n; ++i) {
+      double value = column[i];
+      for (int r = 0; r < K; ++r) {
+        double& update = w[r * ldw + i];
+        value = (value + sine[r] * update) * inverse_cosine[r];
+        update = update * cosine[r] - sine[r] * value;
+      }
+      target[i] = value;
+    }
+  }
+}
+
+COHAPTIC_CPU_CLONES void narrow_rank_update(Eigen::Index n, const double* g, Eigen::Index ld, double* out,
+                                            Eigen::Index ld_out, double* w, Eigen::Index ldw, Eigen::Index k) {
+  if (k == 1) rank_update<1>(n, g, ld, out, ld_out, w, ldw);
+  if (k == 2) rank_update<2>(n, g, ld, out, ld_out, w, ldw);
+  if (k == 3) rank_update<3>(n, g, ld, out, ld_out, w, ldw);
+}
+
 COHAPTIC_CPU_CLONES void narrow_forward_substitution(Eigen::Index n, const double* g, Eigen::Index ld, double* x,
                                                      Eigen::Index ldx, Eigen::Index columns) {
   if (columns == 1) forward_substitution<1>(n, g, ld, x, ldx);
@@ -161,6 +202,16 @@ void multiply(double alpha, const ConstMatrixRef& a, Transposed transposed_a, co
   cblas_dgemm(CblasColMajor, blas_transpose(transposed_a), blas_transpose(transposed_b), blas_size(rows),
               blas_size(cols), blas_size(inner), alpha, a.data(), leading_dimension(a), b.data(),
               leading_dimension(b), beta, c.data(), leading_dimension(c));
+}
+
+void cholesky_rank_update(const ConstMatrixRef& g, MatrixRef w, MatrixRef updated) {
+  const Eigen::Index n = g.rows();
+  if (g.cols() != n || updated.rows() != n || updated.cols() != n || w.rows() != n || w.cols() > 3)
+    throw Error(fmt::format("cholesky_rank_update: a {} x {} factor, {} x {} updates (at most 3 columns), into {} x {}",
+                            n, g.cols(), w.rows(), w.cols(), updated.rows(), updated.cols()));
+  if (n == 0) return;
+  narrow_rank_update(n, g.data(), g.outerStride(), updated.data(), updated.outerStride(), w.data(), w.outerStride(),
+                     w.cols());
 }
 
 }  // namespace cohaptic

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 
-#include "common/condense/cholesky_rank_update.h"
 #include "common/condense/dense_kernels.h"
 #include "common/condense/dof_blocks.h"
 #include "common/condense/naive_condensation.h"
@@ -56,7 +55,9 @@ bool IncrementalCondensation::in_boundary(int node) const {
 
 void IncrementalCondensation::ensure_row_capacity(int rows) {
   if (rows <= g_.rows()) return;
-  const Eigen::Index capacity = std::max<Eigen::Index>(rows, 2 * g_.rows() + 12);
+  // A quarter more each time: amortised O(n) per dof added, and at |B| = 1000 about 110 MB
+  // per buffer instead of the 290 MB of doubling.
+  const Eigen::Index capacity = std::max<Eigen::Index>(rows, g_.rows() + g_.rows() / 4 + 12);
   l_bb_.conservativeResize(capacity, capacity);
   g_.conservativeResize(capacity, capacity);
   z_.conservativeResize(capacity, z_.cols());
@@ -172,13 +173,14 @@ void IncrementalCondensation::remove_boundary_node(int node) {
     update_cached_z_for_leave(first, k);
     stats_.z_ms += watch.lap_ms();
   }
-  // G without the node: the block below absorbs the dropped rows below the diagonal,
-  // G33' G33'^T = G33 G33^T + G32 G32^T.
+  // G without the node: the block below it absorbs the rows dropped from under the node,
+  // G33' G33'^T = G33 G33^T + G32 G32^T, written straight to its place k rows and columns
+  // up; the columns before the node only lose k rows.
   if (below > 0) {
     Eigen::MatrixXd dropped = g_.block(first + k, first, below, k);
-    cholesky_rank_update(g_.block(first + k, first + k, below, below), dropped);
+    cholesky_rank_update(g_.block(first + k, first + k, below, below), dropped, g_.block(first, first, below, below));
   }
-  remove_from_lower_triangle(g_, n, first, k);
+  remove_rows(g_, n, first, first, k);
   remove_from_lower_triangle(l_bb_, n, first, k);
 
   b_dofs_.erase(b_dofs_.begin() + first, b_dofs_.begin() + first + k);

@@ -5,7 +5,7 @@
 //   - L_BB (lower triangle; B in join order) and its Cholesky factor L_BB = G G^T (G lower,
 //     the R^T of R^T R). A join borders G: one solve g = G^-1 l with the new columns l. A
 //     leave drops the node's rows and columns and updates the block below by rank k with
-//     the rows it drops (cholesky_rank_update). Each O(n^2), never O(n^3).
+//     the rows it drops (dense_kernels.h). Each O(n^2), never O(n^3).
 //   - Z_c = L_BB^-1 L_Bc and L_Bc for recently used contact nodes c. A join appends k rows
 //     and corrects the old ones by rank k (one more solve, q = G^-T g = L_BB^-1 l); a leave
 //     drops k rows and corrects the rest by rank k (the node's columns of L_BB^-1, two
