@@ -1,6 +1,12 @@
 // Benchmarks of the intermediate representation, naive against incremental in one run:
 //   BM_MtildeUpdate/<method>/<|B|>    one boundary node joins (or, next iteration, leaves)
-//                                      and M~ is rebuilt for the same contact set
+//                                      and M~ is rebuilt for the same contact set; the
+//                                      node joins last and leaves from there
+//   BM_MtildeUpdate/incremental_oldest/<|B|>  the same, but the node that leaves is the
+//                                      oldest of B (first position: the whole factor below
+//                                      it is updated), and it joins again at the end
+//   (incremental counters: ms per iteration spent on the factor G, the cached Z, S and
+//   M_CC, and M_CB; see IncrementalCondensation::Statistics)
 //   BM_TriangleChange/<method>/<|B|>  the tool moves to another triangle: M~ for a new C
 //   BM_Evaluate/<|B|>                 one haptic tick: the force from a prepared IR with a
 //                                      remote tool (counters: IR bytes in f64 and f32)
@@ -8,7 +14,7 @@
 // C is a user's patch (one ring around its triangle) plus a remote user's triangle. B is
 // the step-delay set nearest the contact. |B| = 0, 150, 300 on the paper's cube (11
 // divisions, 584 movable surface nodes); |B| = 1000 on a 16-division cube, the smallest
-// whose surface has that many movable nodes.
+// whose surface has that many movable nodes. BLAS runs on one thread, as in the server.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -20,6 +26,7 @@
 #include "common/contact/nearest_surface_nodes.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
+#include "common/util/blas_threads.h"
 #include "support/cube_scene.h"
 
 namespace cohaptic {
@@ -99,20 +106,44 @@ void BM_MtildeUpdate_naive(benchmark::State& state) {
   state.counters["contact_dofs"] = static_cast<double>(f.ir_f64->ir.m_tilde.rows());
 }
 
-void BM_MtildeUpdate_incremental(benchmark::State& state) {
+// Per-iteration counters: where an incremental update's time goes, and how often the
+// drift monitor refactored.
+void report_phases(benchmark::State& state, const IncrementalCondensation::Statistics& before,
+                   const IncrementalCondensation::Statistics& after) {
+  const auto per_iteration = [](double ms) { return benchmark::Counter(ms, benchmark::Counter::kAvgIterations); };
+  state.counters["factor_ms"] = per_iteration(after.factor_ms - before.factor_ms);
+  state.counters["z_ms"] = per_iteration(after.z_ms - before.z_ms);
+  state.counters["schur_ms"] = per_iteration(after.schur_ms - before.schur_ms);
+  state.counters["m_cb_ms"] = per_iteration(after.m_cb_ms - before.m_cb_ms);
+  state.counters["refactorizations"] = static_cast<double>(after.refactorizations - before.refactorizations);
+}
+
+// Odd iterations: `spare` joins B (last). Even ones: the newest node (the spare) leaves,
+// or with `oldest` the first node of B leaves and becomes the next spare.
+void mtilde_update_incremental(benchmark::State& state, bool oldest) {
   Fixture& f = fixture(static_cast<int>(state.range(0)));
   IncrementalCondensation condensation(*f.columns, f.model->dofs);
   condensation.set_boundary_nodes(f.boundary);
   condensation.condense(f.contact);
+  const IncrementalCondensation::Statistics before = condensation.statistics();
+  int spare = f.spare[0];
   bool joined = false;
   for (auto _ : state) {
-    if (joined) condensation.remove_boundary_node(f.spare[0]); else condensation.add_boundary_node(f.spare[0]);
+    if (!joined) {
+      condensation.add_boundary_node(spare);
+    } else {
+      if (oldest) spare = condensation.boundary_nodes().front();
+      condensation.remove_boundary_node(spare);
+    }
     joined = !joined;
     benchmark::DoNotOptimize(condensation.condense(f.contact).m_cb.data());
   }
-  state.counters["refactorizations"] = static_cast<double>(condensation.statistics().refactorizations);
+  report_phases(state, before, condensation.statistics());
   state.counters["contact_dofs"] = static_cast<double>(f.ir_f64->ir.m_tilde.rows());
 }
+
+void BM_MtildeUpdate_incremental(benchmark::State& state) { mtilde_update_incremental(state, false); }
+void BM_MtildeUpdate_incremental_oldest(benchmark::State& state) { mtilde_update_incremental(state, true); }
 
 void BM_TriangleChange_naive(benchmark::State& state) {
   Fixture& f = fixture(static_cast<int>(state.range(0)));
@@ -129,11 +160,13 @@ void BM_TriangleChange_incremental(benchmark::State& state) {
   options.z_cache_nodes = 16;  // smaller than the 120 nodes cycled: every change is a miss
   IncrementalCondensation condensation(*f.columns, f.model->dofs, options);
   condensation.set_boundary_nodes(f.boundary);
+  const IncrementalCondensation::Statistics before = condensation.statistics();
   std::size_t next = 0;
   for (auto _ : state) {
     const std::vector<int>& contact = f.other_contacts[next++ % f.other_contacts.size()];
     benchmark::DoNotOptimize(condensation.condense(contact).m_cb.data());
   }
+  report_phases(state, before, condensation.statistics());
 }
 
 void BM_Evaluate(benchmark::State& state) {
@@ -156,12 +189,15 @@ void BM_PrepareIr(benchmark::State& state) {
 const std::vector<std::int64_t> kBoundarySizes = {0, 150, 300, 1000};
 
 void register_all() {
+  // For the whole program, whatever runs first: the server's setting (server/main.cpp).
+  use_single_blas_thread();
   const auto add = [](const char* name, void (*fn)(benchmark::State&), benchmark::TimeUnit unit) {
     auto* b = benchmark::RegisterBenchmark(name, fn)->Unit(unit);
     for (std::int64_t size : kBoundarySizes) b->Arg(size);
   };
   add("BM_MtildeUpdate/naive", BM_MtildeUpdate_naive, benchmark::kMillisecond);
   add("BM_MtildeUpdate/incremental", BM_MtildeUpdate_incremental, benchmark::kMillisecond);
+  add("BM_MtildeUpdate/incremental_oldest", BM_MtildeUpdate_incremental_oldest, benchmark::kMillisecond);
   add("BM_TriangleChange/naive", BM_TriangleChange_naive, benchmark::kMillisecond);
   add("BM_TriangleChange/incremental", BM_TriangleChange_incremental, benchmark::kMillisecond);
   add("BM_Evaluate", BM_Evaluate, benchmark::kMicrosecond);

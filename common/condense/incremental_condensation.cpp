@@ -7,41 +7,41 @@
 #include <cmath>
 #include <cstring>
 
+#include "common/condense/dense_kernels.h"
 #include "common/condense/dof_blocks.h"
 #include "common/condense/naive_condensation.h"
 #include "common/util/error.h"
+#include "common/util/stopwatch.h"
 
 namespace cohaptic {
 namespace {
 
-// Removes rows and columns [first, first + count) from the leading size x size block of
-// `buffer`, shifting the rest up and left in place.
-void remove_rows_and_columns(Eigen::MatrixXd& buffer, int size, int first, int count) {
-  const Eigen::Index stride = buffer.rows();
-  double* data = buffer.data();
-  for (int col = first + count; col < size; ++col)
-    std::memmove(data + (col - count) * stride, data + col * stride, sizeof(double) * static_cast<std::size_t>(size));
-  for (int col = 0; col < size - count; ++col) {
-    double* column = data + col * stride;
-    std::memmove(column + first, column + first + count, sizeof(double) * static_cast<std::size_t>(size - first - count));
+// Deletes rows [first, first + count) from the leading `rows` rows of columns [0, cols)
+// of `buffer`, moving the rows below up, in place.
+void remove_rows(Eigen::MatrixXd& buffer, int rows, Eigen::Index cols, int first, int count) {
+  const auto moved = static_cast<std::size_t>(rows - first - count);
+  for (Eigen::Index col = 0; col < cols; ++col) {
+    double* column = buffer.data() + col * buffer.rows();
+    std::memmove(column + first, column + first + count, sizeof(double) * moved);
   }
 }
 
-// R^T R + v v^T for upper triangular R (m x m), in place; v is overwritten.
-template <typename Block>
-void cholesky_rank_one_update(Block r, Eigen::VectorXd& v) {
-  const Eigen::Index m = r.rows();
-  for (Eigen::Index j = 0; j < m; ++j) {
-    const double rjj = r(j, j);
-    const double radius = std::hypot(rjj, v[j]);
-    const double c = radius / rjj, s = v[j] / rjj;
-    r(j, j) = radius;
-    if (j + 1 < m) {
-      const Eigen::Index rest = m - j - 1;
-      r.row(j).tail(rest) = (r.row(j).tail(rest) + s * v.tail(rest).transpose()) / c;
-      v.tail(rest) = c * v.tail(rest) - s * r.row(j).tail(rest).transpose();
-    }
-  }
+// Deletes rows and columns [first, first + count) from the lower triangle of the leading
+// size x size block of `buffer`, in place; only the lower triangle is moved.
+void remove_from_lower_triangle(Eigen::MatrixXd& buffer, int size, int first, int count) {
+  remove_rows(buffer, size, first, first, count);
+  const Eigen::Index stride = buffer.rows();
+  for (int col = first + count; col < size; ++col)
+    std::memmove(buffer.data() + (col - count) * stride + (col - count), buffer.data() + col * stride + col,
+                 sizeof(double) * static_cast<std::size_t>(size - col));
+}
+
+// Frobenius norm of the symmetric matrix whose lower triangle `lower` holds.
+double symmetric_frobenius_norm(const Eigen::Ref<const Eigen::MatrixXd>& lower) {
+  double squared = 0;
+  for (Eigen::Index j = 0; j < lower.cols(); ++j)
+    squared += lower(j, j) * lower(j, j) + 2 * lower.col(j).tail(lower.rows() - j - 1).squaredNorm();
+  return std::sqrt(squared);
 }
 
 }  // namespace
@@ -53,15 +53,49 @@ bool IncrementalCondensation::in_boundary(int node) const {
   return std::find(b_nodes_.begin(), b_nodes_.end(), node) != b_nodes_.end();
 }
 
-void IncrementalCondensation::ensure_capacity(int size) {
-  if (size <= l_bb_.rows()) return;
-  const Eigen::Index capacity = std::max<Eigen::Index>(size, 2 * l_bb_.rows() + 12);
+void IncrementalCondensation::ensure_row_capacity(int rows) {
+  if (rows <= g_.rows()) return;
+  // A quarter more each time: amortised O(n) per dof added, and at |B| = 1000 about 110 MB
+  // per buffer instead of the 290 MB of doubling.
+  const Eigen::Index capacity = std::max<Eigen::Index>(rows, g_.rows() + g_.rows() / 4 + 12);
   l_bb_.conservativeResize(capacity, capacity);
-  r_.conservativeResize(capacity, capacity);
+  g_.conservativeResize(capacity, capacity);
+  z_.conservativeResize(capacity, z_.cols());
+  l_bz_.conservativeResize(capacity, l_bz_.cols());
+}
+
+void IncrementalCondensation::ensure_slot_capacity(std::size_t slots) {
+  const auto columns = 3 * static_cast<Eigen::Index>(slots);
+  if (columns <= z_.cols()) return;
+  const Eigen::Index capacity = std::max(columns, 2 * z_.cols());
+  z_.conservativeResize(g_.rows(), capacity);
+  l_bz_.conservativeResize(g_.rows(), capacity);
+}
+
+int IncrementalCondensation::slot_of(int node) const {
+  for (std::size_t s = 0; s < cached_.size(); ++s)
+    if (cached_[s].node == node) return static_cast<int>(s);
+  return -1;
 }
 
 Eigen::MatrixXd IncrementalCondensation::column_rows_at_boundary(int node) {
   return gather_compliance(columns_, b_dofs_, free_dofs_of_nodes(dofs_, std::span<const int>(&node, 1)));
+}
+
+Eigen::MatrixXd IncrementalCondensation::compliance_to_slots(std::span<const int> row_dofs, std::size_t first_slot) {
+  std::vector<int> dofs;
+  std::vector<Eigen::Index> column_of;
+  for (std::size_t s = first_slot; s < cached_.size(); ++s) {
+    const std::vector<int> node_dofs = free_dofs_of_nodes(dofs_, std::span<const int>(&cached_[s].node, 1));
+    for (std::size_t axis = 0; axis < node_dofs.size(); ++axis) {
+      dofs.push_back(node_dofs[axis]);
+      column_of.push_back(3 * static_cast<Eigen::Index>(s - first_slot) + static_cast<Eigen::Index>(axis));
+    }
+  }
+  const Eigen::MatrixXd gathered = gather_compliance(columns_, row_dofs, dofs);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(gathered.rows(), 3 * static_cast<Eigen::Index>(cached_.size() - first_slot));
+  for (std::size_t j = 0; j < column_of.size(); ++j) out.col(column_of[j]) = gathered.col(static_cast<Eigen::Index>(j));
+  return out;
 }
 
 void IncrementalCondensation::add_boundary_node(int node) {
@@ -70,47 +104,59 @@ void IncrementalCondensation::add_boundary_node(int node) {
   const auto k = static_cast<int>(new_dofs.size());
   if (k == 0) return;  // a fully fixed node carries no unknown: nothing to hold
 
-  const Eigen::MatrixXd l = column_rows_at_boundary(node);                      // n x k
-  Eigen::MatrixXd lambda = gather_compliance(columns_, new_dofs, new_dofs);     // k x k
+  Stopwatch watch;
+  const int n = n_;
+  const Eigen::MatrixXd l = column_rows_at_boundary(node);                   // n x k
+  Eigen::MatrixXd lambda = gather_compliance(columns_, new_dofs, new_dofs);  // k x k
   lambda = 0.5 * (lambda + lambda.transpose()).eval();
-  const auto n = n_;
-  auto r_old = r_.topLeftCorner(n, n);
-  const Eigen::MatrixXd r_col = n > 0 ? Eigen::MatrixXd(r_old.triangularView<Eigen::Upper>().transpose().solve(l))
-                                      : Eigen::MatrixXd(0, k);
-  const Eigen::MatrixXd schur = lambda - r_col.transpose() * r_col;
-  const Eigen::LLT<Eigen::MatrixXd> rho(schur);
+  ensure_row_capacity(n + k);
+  const auto g_old = g_.topLeftCorner(n, n);
+  // The new rows of G: [G 0; g^T rho] with g = G^-1 l and rho rho^T = lambda - g^T g.
+  Eigen::MatrixXd g = l;
+  solve_lower_in_place(g_old, g);
+  const Eigen::LLT<Eigen::MatrixXd> rho(lambda - g.transpose() * g);
   if (rho.info() != Eigen::Success)
     throw NumericalError(fmt::format(
         "node {} cannot join the boundary set: L_BB would not be positive definite (the node duplicates "
         "others, or the set is numerically singular; condition estimate of L_BB {:.3g})",
-        node, n > 0 ? cholesky_condition_estimate(r_old) : 1.0));
-  const Eigen::MatrixXd q = n > 0 ? Eigen::MatrixXd(r_old.triangularView<Eigen::Upper>().solve(r_col))
-                                  : Eigen::MatrixXd(0, k);
+        node, n > 0 ? cholesky_condition_estimate(g_old) : 1.0));
+  const Eigen::MatrixXd rho_lower = rho.matrixL();
+  stats_.factor_ms += watch.lap_ms();
 
-  // Z_c for cached contact nodes: [Z - q t; t] with t = S^-1 (L_bc - l^T Z).
-  for (auto& [c, cached] : z_) {
-    const std::vector<int> c_dofs = free_dofs_of_nodes(dofs_, std::span<const int>(&c, 1));
-    const Eigen::MatrixXd l_bc = gather_compliance(columns_, new_dofs, c_dofs);
-    const Eigen::MatrixXd t = rho.solve(l_bc - l.transpose() * cached.z);
-    Eigen::MatrixXd z(n + k, cached.z.cols());
-    z.topRows(n) = cached.z - q * t;
-    z.bottomRows(k) = t;
-    cached.z = std::move(z);
+  if (!cached_.empty()) {
+    update_cached_z_for_join(new_dofs, l, g, rho_lower);
+    stats_.z_ms += watch.lap_ms();
   }
 
-  ensure_capacity(n + k);
-  l_bb_.block(0, n, n, k) = l;
+  g_.block(n, 0, k, n) = g.transpose();
+  g_.block(n, n, k, k) = rho_lower;
   l_bb_.block(n, 0, k, n) = l.transpose();
   l_bb_.block(n, n, k, k) = lambda;
-  r_.block(0, n, n, k) = r_col;
-  r_.block(n, 0, k, n).setZero();
-  r_.block(n, n, k, k) = rho.matrixU();
   b_node_offset_.push_back(n);
   b_nodes_.push_back(node);
   b_dofs_.insert(b_dofs_.end(), new_dofs.begin(), new_dofs.end());
   n_ = n + k;
   ++stats_.joins;
+  stats_.factor_ms += watch.lap_ms();
   after_update();
+}
+
+void IncrementalCondensation::update_cached_z_for_join(std::span<const int> new_dofs, const Eigen::MatrixXd& l,
+                                                       const Eigen::MatrixXd& g, const Eigen::MatrixXd& rho_lower) {
+  // Z' = [Z - q t; t] with q = L_BB^-1 l and t = (rho rho^T)^-1 (L_bc - l^T Z).
+  const int n = n_;
+  const auto k = static_cast<Eigen::Index>(new_dofs.size());
+  const Eigen::Index columns = cached_columns();
+  Eigen::MatrixXd q = g;
+  solve_lower_transposed_in_place(g_.topLeftCorner(n, n), q);
+  Eigen::MatrixXd t = compliance_to_slots(new_dofs, 0);
+  l_bz_.block(n, 0, k, columns) = t;
+  auto z = z_.block(0, 0, n, columns);
+  multiply(-1, l, Transposed::yes, z, Transposed::no, 1, t);
+  solve_lower_in_place(rho_lower, t);
+  solve_lower_transposed_in_place(rho_lower, t);
+  multiply(-1, q, Transposed::no, t, Transposed::no, 1, z);
+  z_.block(n, 0, k, columns) = t;
 }
 
 void IncrementalCondensation::remove_boundary_node(int node) {
@@ -120,37 +166,22 @@ void IncrementalCondensation::remove_boundary_node(int node) {
   const int first = b_node_offset_[position];
   const int k = (position + 1 < b_nodes_.size() ? b_node_offset_[position + 1] : n_) - first;
   const int n = n_;
-  auto r = r_.topLeftCorner(n, n);
+  const int below = n - first - k;
 
-  // The node's columns of L_BB^-1: N_ab and N_bb; then Z_c <- Z_a - N_ab N_bb^-1 Z_b.
-  Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(n, k);
-  unit.middleRows(first, k).setIdentity();
-  Eigen::MatrixXd inverse_columns = r.triangularView<Eigen::Upper>().transpose().solve(unit);
-  r.triangularView<Eigen::Upper>().solveInPlace(inverse_columns);
-  const Eigen::LLT<Eigen::MatrixXd> n_bb(inverse_columns.middleRows(first, k));
-  const auto remove_rows = [&](const Eigen::MatrixXd& m) {
-    Eigen::MatrixXd out(n - k, m.cols());
-    out.topRows(first) = m.topRows(first);
-    out.bottomRows(n - k - first) = m.bottomRows(n - k - first);
-    return out;
-  };
-  const Eigen::MatrixXd n_ab = remove_rows(inverse_columns);
-  for (auto& [c, cached] : z_)
-    cached.z = remove_rows(cached.z) - n_ab * n_bb.solve(cached.z.middleRows(first, k));
-
-  // R: drop the node's rows and columns; the trailing block absorbs the dropped rows by
-  // rank-one updates, R33'^T R33' = R33^T R33 + R23^T R23.
-  const int trailing = n - first - k;
-  if (trailing > 0) {
-    for (int row = 0; row < k; ++row) {
-      Eigen::VectorXd v = r.block(first + row, first + k, 1, trailing).transpose();
-      cholesky_rank_one_update(r.block(first + k, first + k, trailing, trailing), v);
-    }
+  Stopwatch watch;
+  if (!cached_.empty()) {
+    update_cached_z_for_leave(first, k);
+    stats_.z_ms += watch.lap_ms();
   }
-  remove_rows_and_columns(r_, n, first, k);
-  remove_rows_and_columns(l_bb_, n, first, k);
-  // Rows [first, first + trailing) of the moved columns below the diagonal must be zero.
-  r_.topLeftCorner(n - k, n - k).triangularView<Eigen::StrictlyLower>().setZero();
+  // G without the node: the block below it absorbs the rows dropped from under the node,
+  // G33' G33'^T = G33 G33^T + G32 G32^T, written straight to its place k rows and columns
+  // up; the columns before the node only lose k rows.
+  if (below > 0) {
+    Eigen::MatrixXd dropped = g_.block(first + k, first, below, k);
+    cholesky_rank_update(g_.block(first + k, first + k, below, below), dropped, g_.block(first, first, below, below));
+  }
+  remove_rows(g_, n, first, first, k);
+  remove_from_lower_triangle(l_bb_, n, first, k);
 
   b_dofs_.erase(b_dofs_.begin() + first, b_dofs_.begin() + first + k);
   b_nodes_.erase(it);
@@ -158,7 +189,30 @@ void IncrementalCondensation::remove_boundary_node(int node) {
   for (std::size_t i = position; i < b_node_offset_.size(); ++i) b_node_offset_[i] -= k;
   n_ = n - k;
   ++stats_.leaves;
+  stats_.factor_ms += watch.lap_ms();
   after_update();
+}
+
+void IncrementalCondensation::update_cached_z_for_leave(int first, int k) {
+  // With N = L_BB^-1 restricted to the node's columns, Z_a' = Z_a - N_a N_bb^-1 Z_b.
+  const int n = n_;
+  const int below = n - first - k;
+  const Eigen::Index columns = cached_columns();
+  Eigen::MatrixXd inverse_columns = Eigen::MatrixXd::Zero(n, k);
+  inverse_columns.middleRows(first, k).setIdentity();
+  // G^-1 E_b is zero above the node's rows: the forward solve starts there.
+  solve_lower_in_place(g_.block(first, first, n - first, n - first), inverse_columns.bottomRows(n - first));
+  solve_lower_transposed_in_place(g_.topLeftCorner(n, n), inverse_columns);
+  const Eigen::LLT<Eigen::MatrixXd> n_bb(inverse_columns.middleRows(first, k));
+  if (n_bb.info() != Eigen::Success)
+    throw NumericalError(fmt::format("boundary node at dof {} cannot leave: L_BB^-1 has lost positive definiteness "
+                                     "({} boundary dofs)", first, n));
+  const Eigen::MatrixXd h = n_bb.solve(z_.block(first, 0, k, columns));
+  multiply(-1, inverse_columns.topRows(first), Transposed::no, h, Transposed::no, 1, z_.block(0, 0, first, columns));
+  multiply(-1, inverse_columns.bottomRows(below), Transposed::no, h, Transposed::no, 1,
+           z_.block(first + k, 0, below, columns));
+  remove_rows(z_, n, columns, first, k);
+  remove_rows(l_bz_, n, columns, first, k);
 }
 
 void IncrementalCondensation::set_boundary_nodes(std::span<const int> nodes) {
@@ -175,6 +229,7 @@ void IncrementalCondensation::set_boundary_nodes(std::span<const int> nodes) {
     for (int node : joining) add_boundary_node(node);
     return;
   }
+  Stopwatch watch;
   std::vector<int> new_dofs;
   for (int node : joining) {
     const std::vector<int> node_dofs = free_dofs_of_nodes(dofs_, std::span<const int>(&node, 1));
@@ -184,10 +239,9 @@ void IncrementalCondensation::set_boundary_nodes(std::span<const int> nodes) {
     new_dofs.insert(new_dofs.end(), node_dofs.begin(), node_dofs.end());
   }
   const auto k = static_cast<int>(new_dofs.size());
-  ensure_capacity(n_ + k);
+  ensure_row_capacity(n_ + k);
   const Eigen::MatrixXd l_new = gather_compliance(columns_, b_dofs_, new_dofs);
-  Eigen::MatrixXd lambda = gather_compliance(columns_, new_dofs, new_dofs);
-  l_bb_.block(0, n_, n_, k) = l_new;
+  const Eigen::MatrixXd lambda = gather_compliance(columns_, new_dofs, new_dofs);
   l_bb_.block(n_, 0, k, n_) = l_new.transpose();
   l_bb_.block(n_, n_, k, k) = 0.5 * (lambda + lambda.transpose());
   b_dofs_.insert(b_dofs_.end(), new_dofs.begin(), new_dofs.end());
@@ -196,26 +250,23 @@ void IncrementalCondensation::set_boundary_nodes(std::span<const int> nodes) {
   factor_from_scratch(
       "the boundary nodes cannot be held together: L_BB is not positive definite (duplicate nodes, or a numerically "
       "singular set)");
+  stats_.factor_ms += watch.lap_ms();
 }
 
 void IncrementalCondensation::compute_z(std::span<const int> nodes) {
-  std::vector<int> missing;
+  const std::size_t first_new = cached_.size();
   for (int node : nodes)
-    if (!z_.count(node) && std::find(missing.begin(), missing.end(), node) == missing.end()) missing.push_back(node);
-  if (missing.empty()) return;
-  const std::vector<int> dofs = free_dofs_of_nodes(dofs_, missing);
-  Eigen::MatrixXd z = gather_compliance(columns_, b_dofs_, dofs);
-  if (n_ > 0) {
-    const auto r = r_.topLeftCorner(n_, n_);
-    r.triangularView<Eigen::Upper>().transpose().solveInPlace(z);
-    r.triangularView<Eigen::Upper>().solveInPlace(z);
-  }
-  Eigen::Index col = 0;
-  for (int node : missing) {
-    const auto width = static_cast<Eigen::Index>(free_dofs_of_nodes(dofs_, std::span<const int>(&node, 1)).size());
-    z_[node] = CachedZ{z.middleCols(col, width), clock_};
-    col += width;
-  }
+    if (slot_of(node) < 0)
+      cached_.push_back({node, static_cast<int>(free_dofs_of_nodes(dofs_, std::span<const int>(&node, 1)).size()), clock_});
+  if (cached_.size() == first_new) return;
+  ensure_slot_capacity(cached_.size());
+  const auto first_column = 3 * static_cast<Eigen::Index>(first_new);
+  const Eigen::Index columns = cached_columns() - first_column;
+  l_bz_.block(0, first_column, n_, columns) = compliance_to_slots(b_dofs_, first_new);
+  auto z = z_.block(0, first_column, n_, columns);
+  z = l_bz_.block(0, first_column, n_, columns);
+  solve_lower_in_place(g_.topLeftCorner(n_, n_), z);
+  solve_lower_transposed_in_place(g_.topLeftCorner(n_, n_), z);
 }
 
 CondensedOperator IncrementalCondensation::condense(std::span<const int> contact_nodes) {
@@ -223,22 +274,26 @@ CondensedOperator IncrementalCondensation::condense(std::span<const int> contact
   for (int node : contact_nodes)
     if (in_boundary(node)) throw Error(fmt::format("node {} is both a contact and a boundary node", node));
   if (options_.naive) return naive_condensation(columns_, dofs_, contact_nodes, b_nodes_);
+  Stopwatch watch;
   compute_z(contact_nodes);
+  stats_.z_ms += watch.lap_ms();
 
   CondensedOperator op;
   op.contact_dofs = free_dofs_of_nodes(dofs_, contact_nodes);
   op.boundary_dofs = b_dofs_;
   const auto m = static_cast<Eigen::Index>(op.contact_dofs.size());
-  Eigen::MatrixXd z_c(n_, m);
+  Eigen::MatrixXd z_c(n_, m), l_bc(n_, m);
   Eigen::Index col = 0;
   for (int node : contact_nodes) {
-    CachedZ& cached = z_.at(node);
+    const int slot = slot_of(node);
+    CachedNode& cached = cached_[static_cast<std::size_t>(slot)];
     cached.last_used = clock_;
-    z_c.middleCols(col, cached.z.cols()) = cached.z;
-    col += cached.z.cols();
+    z_c.middleCols(col, cached.width) = z_.block(0, 3 * slot, n_, cached.width);
+    l_bc.middleCols(col, cached.width) = l_bz_.block(0, 3 * slot, n_, cached.width);
+    col += cached.width;
   }
-  const Eigen::MatrixXd l_bc = gather_compliance(columns_, b_dofs_, op.contact_dofs);
-  Eigen::MatrixXd s = gather_compliance(columns_, op.contact_dofs, op.contact_dofs) - l_bc.transpose() * z_c;
+  Eigen::MatrixXd s = gather_compliance(columns_, op.contact_dofs, op.contact_dofs);
+  multiply(-1, l_bc, Transposed::yes, z_c, Transposed::no, 1, s);
   s = 0.5 * (s + s.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(s);
   if (llt.info() != Eigen::Success)
@@ -248,33 +303,45 @@ CondensedOperator IncrementalCondensation::condense(std::span<const int> contact
   op.condition_estimate = cholesky_condition_estimate(llt.matrixL());
   op.m_cc = llt.solve(Eigen::MatrixXd::Identity(m, m));
   op.m_cc = 0.5 * (op.m_cc + op.m_cc.transpose()).eval();
-  op.m_cb = -op.m_cc * z_c.transpose();
-
-  // Keep the cache bounded: forget the least recently used nodes beyond the limit.
-  while (z_.size() > options_.z_cache_nodes) {
-    auto oldest = std::min_element(z_.begin(), z_.end(),
-                                   [](const auto& a, const auto& b) { return a.second.last_used < b.second.last_used; });
-    if (oldest->second.last_used == clock_) break;
-    z_.erase(oldest);
-  }
+  stats_.schur_ms += watch.lap_ms();
+  op.m_cb.resize(m, n_);
+  multiply(-1, op.m_cc, Transposed::no, z_c, Transposed::yes, 0, op.m_cb);
+  stats_.m_cb_ms += watch.lap_ms();
+  forget_least_recently_used();
   return op;
+}
+
+void IncrementalCondensation::forget_least_recently_used() {
+  // Keep the cache bounded: the last slot fills the one freed, so slots stay contiguous.
+  while (cached_.size() > options_.z_cache_nodes) {
+    const auto oldest = std::min_element(cached_.begin(), cached_.end(),
+                                         [](const CachedNode& a, const CachedNode& b) { return a.last_used < b.last_used; });
+    if (oldest->last_used == clock_) break;
+    const auto slot = static_cast<Eigen::Index>(oldest - cached_.begin());
+    const auto last = static_cast<Eigen::Index>(cached_.size()) - 1;
+    if (slot != last) {
+      z_.block(0, 3 * slot, n_, 3) = z_.block(0, 3 * last, n_, 3);
+      l_bz_.block(0, 3 * slot, n_, 3) = l_bz_.block(0, 3 * last, n_, 3);
+      *oldest = cached_.back();
+    }
+    cached_.pop_back();
+  }
 }
 
 Eigen::MatrixXd IncrementalCondensation::solve_boundary(const Eigen::MatrixXd& rhs) const {
   if (rhs.rows() != n_) throw Error(fmt::format("solve_boundary: {} rows for {} boundary dofs", rhs.rows(), n_));
   Eigen::MatrixXd x = rhs;
-  if (n_ > 0) {
-    const auto r = r_.topLeftCorner(n_, n_);
-    r.triangularView<Eigen::Upper>().transpose().solveInPlace(x);
-    r.triangularView<Eigen::Upper>().solveInPlace(x);
-  }
+  solve_lower_in_place(g_.topLeftCorner(n_, n_), x);
+  solve_lower_transposed_in_place(g_.topLeftCorner(n_, n_), x);
   return x;
 }
 
 void IncrementalCondensation::after_update() {
   if (++updates_since_check_ < options_.check_interval) return;
   updates_since_check_ = 0;
+  Stopwatch watch;
   if (check_residuals() > options_.drift_tolerance) refactor();
+  stats_.factor_ms += watch.elapsed_ms();
 }
 
 double IncrementalCondensation::check_residuals() {
@@ -282,21 +349,23 @@ double IncrementalCondensation::check_residuals() {
   double worst = 0;
   if (n_ > 0) {
     const auto l = l_bb_.topLeftCorner(n_, n_);
-    const auto r = r_.topLeftCorner(n_, n_);
+    const auto g = g_.topLeftCorner(n_, n_);
+    const double l_norm = symmetric_frobenius_norm(l);
     // A deterministic probe vector: the factor must reproduce L_BB on it.
     Eigen::VectorXd x(n_);
     for (int i = 0; i < n_; ++i) x[i] = std::sin(1.0 + 0.7 * i + 0.013 * static_cast<double>(stats_.residual_checks));
-    const double scale = l.norm() * x.norm();
-    const Eigen::VectorXd rx = r.triangularView<Eigen::Upper>() * x;
-    const Eigen::VectorXd lx = l * x;
-    worst = (r.triangularView<Eigen::Upper>().transpose() * rx - lx).norm() / scale;
+    const Eigen::VectorXd gx = g.triangularView<Eigen::Lower>().transpose() * x;
+    const Eigen::VectorXd ggx = g.triangularView<Eigen::Lower>() * gx;
+    const Eigen::VectorXd lx = l.selfadjointView<Eigen::Lower>() * x;
+    worst = (ggx - lx).norm() / (l_norm * x.norm());
     // And one cached Z, in turn: L_BB Z_c must equal L_Bc.
-    if (!z_.empty()) {
-      auto entry = z_.begin();
-      std::advance(entry, stats_.residual_checks % static_cast<long>(z_.size()));
-      const Eigen::MatrixXd l_bc = column_rows_at_boundary(entry->first);
-      const double z_scale = l.norm() * entry->second.z.norm() + l_bc.norm();
-      worst = std::max(worst, (l * entry->second.z - l_bc).norm() / z_scale);
+    if (!cached_.empty()) {
+      const auto slot = static_cast<std::size_t>(stats_.residual_checks) % cached_.size();
+      const CachedNode& cached = cached_[slot];
+      const Eigen::MatrixXd l_bc = column_rows_at_boundary(cached.node);
+      const auto z = z_.block(0, 3 * static_cast<Eigen::Index>(slot), n_, cached.width);
+      const Eigen::MatrixXd lz = l.selfadjointView<Eigen::Lower>() * z;
+      worst = std::max(worst, (lz - l_bc).norm() / (l_norm * z.norm() + l_bc.norm()));
     }
   }
   stats_.last_residual = worst;
@@ -310,14 +379,19 @@ void IncrementalCondensation::refactor() {
 
 void IncrementalCondensation::factor_from_scratch(const char* failure) {
   if (n_ > 0) {
-    const Eigen::LLT<Eigen::MatrixXd> llt(l_bb_.topLeftCorner(n_, n_));
+    Eigen::Ref<Eigen::MatrixXd> g = g_.topLeftCorner(n_, n_);
+    g.triangularView<Eigen::Lower>() = l_bb_.topLeftCorner(n_, n_);
+    const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> llt(g);  // in place, lower triangle
     if (llt.info() != Eigen::Success) throw NumericalError(fmt::format("{} ({} boundary dofs)", failure, n_));
-    r_.topLeftCorner(n_, n_) = llt.matrixU();
   }
-  std::vector<int> cached;
-  for (const auto& entry : z_) cached.push_back(entry.first);
-  z_.clear();
-  compute_z(cached);
+  // Every cached Z again, from the compliance itself.
+  if (cached_.empty()) return;
+  const Eigen::Index columns = cached_columns();
+  l_bz_.block(0, 0, n_, columns) = compliance_to_slots(b_dofs_, 0);
+  auto z = z_.block(0, 0, n_, columns);
+  z = l_bz_.block(0, 0, n_, columns);
+  solve_lower_in_place(g_.topLeftCorner(n_, n_), z);
+  solve_lower_transposed_in_place(g_.topLeftCorner(n_, n_), z);
 }
 
 }  // namespace cohaptic
