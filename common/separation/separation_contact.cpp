@@ -4,14 +4,11 @@
 #include <limits>
 
 #include "common/separation/bracketed_root.h"
-#include "common/separation/crack_growth.h"
-#include "common/separation/normal_fracture.h"
+#include "common/separation/fracture_step.h"
 #include "common/separation/patch_walk.h"
 
 namespace cohaptic {
 namespace {
-
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 struct Evaluation {
   FieldValue value;
@@ -43,58 +40,69 @@ struct Slide {
   PatchWalk walk;
 };
 
-// Moves c along the tangential deflection until the tangential force is down to `limit`
-// (or as far as the walk goes, when it stops first with the force still above).
-Slide slide_to_limit(const SeparationPatch& patch, const SeparationState& state, const SeparationContact& contact,
-                     const Eigen::Vector3d& tool, double limit, bool stop_at_crack_edges) noexcept {
-  const Eigen::Vector3d n = patch.normals[contact.point.triangle];
-  const Eigen::Vector3d delta = contact_deflection(contact, tool);
-  const Eigen::Vector3d tangential = delta - delta.dot(n) * n;
-  const double reach = tangential.norm();
+// Moves c along the tangential force on the body, d = F_t / |F_t|, until excess(evaluation)
+// is down to zero — or, when it stays positive, only as far as the tangential force still
+// points along d (or the walk stops first). Moving c by ds along d changes the fields'
+// energy by -F_t . d ds plus what the interpolation between nodal fields adds (c moving
+// towards stiffer nodes at the same deflection): the slip is cut short where the energy
+// would rise above its value before it, so that a slip never feeds the hand.
+template <typename Excess>
+Slide slide_until(const SeparationPatch& patch, const SeparationState& state, const SeparationContact& contact,
+                  const Eigen::Vector3d& tool, bool stop_at_crack_edges, const Excess& excess) noexcept {
   Slide slide{contact, PatchWalk{}};
   slide.walk.triangle = contact.point.triangle;
   slide.walk.weights = contact.point.weights;
   slide.walk.point = contact.position;
-  if (!(reach > 0)) return slide;
-  const Eigen::Vector3d direction = tangential / reach;
+  const Evaluation start = evaluate(patch, state, contact, tool);
+  const double start_excess = excess(start);
+  const double tangential = start.tangential.norm();
+  if (!(tangential > 0) || !(start_excess > 0)) return slide;
+  const Eigen::Vector3d direction = start.tangential / tangential;
   const auto walk = [&](double distance) {
     return walk_on_patch(patch, state, contact.point.triangle, contact.point.weights, direction, distance,
                          stop_at_crack_edges);
   };
-  const auto excess_at = [&](const PatchWalk& w) {
-    return evaluate(patch, state, moved_to(contact, w), tool).tangential.norm() - limit;
+  const auto along_at = [&](const PatchWalk& w) {
+    return evaluate(patch, state, moved_to(contact, w), tool).tangential.dot(direction);
   };
-  const PatchWalk full = walk(reach);
-  const double full_excess = excess_at(full);
-  if (full_excess >= 0) {
-    slide.walk = full;
-  } else {
-    const double start_excess = evaluate(patch, state, contact, tool).tangential.norm() - limit;
-    const double distance = bracketed_root([&](double s) { return excess_at(walk(s)); }, 0.0, full.travelled,
-                                           start_excess, full_excess, 1e-12 * std::max(limit, 1e-9));
-    slide.walk = walk(distance);
+  const auto excess_at = [&](const PatchWalk& w) { return excess(evaluate(patch, state, moved_to(contact, w), tool)); };
+  // How far F_t . d stays positive: from the deflection's own length, doubled a few times.
+  const Eigen::Vector3d n = patch.normals[contact.point.triangle];
+  const Eigen::Vector3d delta = contact_deflection(contact, tool);
+  double distance = std::max((delta - delta.dot(n) * n).norm(), 1e-9);
+  PatchWalk end = walk(distance);
+  for (int doubling = 0; doubling < 8 && end.stop == PatchWalk::Stop::none && along_at(end) > 0; ++doubling)
+    end = walk(distance *= 2);
+  double along_end = along_at(end);
+  if (along_end < 0) {
+    end = walk(bracketed_root([&](double s) { return along_at(walk(s)); }, 0.0, end.travelled, tangential, along_end,
+                              1e-12 * tangential));
   }
+  const double end_excess = excess_at(end);
+  double length = end.travelled;
+  if (end_excess < 0)
+    length = bracketed_root([&](double s) { return excess_at(walk(s)); }, 0.0, end.travelled, start_excess, end_excess,
+                            1e-12 * start_excess);
+  // The energy guard: the last of 16 even steps up to `length` whose energy is no higher
+  // than at the start, then the crossing between it and the next step.
+  const auto energy_rise = [&](double s) {
+    return evaluate(patch, state, moved_to(contact, walk(s)), tool).value.energy - start.value.energy;
+  };
+  constexpr int kSteps = 16;
+  double allowed = 0;
+  for (int i = 1; i <= kSteps; ++i) {
+    const double s = length * i / kSteps;
+    const double rise = energy_rise(s);
+    if (rise > 0) {
+      allowed = bracketed_root(energy_rise, allowed, s, energy_rise(allowed), rise, 1e-12 * std::abs(start.value.energy));
+      if (energy_rise(allowed) > 0) allowed = length * (i - 1) / kSteps;
+      break;
+    }
+    allowed = s;
+  }
+  slide.walk = walk(allowed);
   slide.contact = moved_to(contact, slide.walk);
   return slide;
-}
-
-bool crack_front_in_reach(const SeparationPatch& patch, const SeparationState& state, const ContactPoint& point) noexcept {
-  const ContactRegion region = contact_region(patch, point);
-  for (int i = 0; i < region.count; ++i)
-    if (can_grow(patch, state, region.triangles[i])) return true;
-  return false;
-}
-
-// Pushed at the tangential threshold: c moves with the crack edge, l_t per metre separates.
-void tangential_fracture(const SeparationPatch& patch, SeparationState& state, SeparationContact& contact,
-                         const Eigen::Vector3d& tool, SeparationSample& sample) noexcept {
-  const Slide slide = slide_to_limit(patch, state, contact, tool, patch.tangential_threshold, false);
-  contact = slide.contact;
-  const double separated =
-      grow_nearest(patch, state, contact.position, patch.tangential_length * slide.walk.travelled, nullptr);
-  if (separated > 0) sample.flags |= kSeparationTangentialFracture;
-  sample.separated += separated;
-  sample.fracture_motion += separated / patch.tangential_length;
 }
 
 }  // namespace
@@ -129,13 +137,25 @@ SeparationSample step_contact(const SeparationPatch& patch, SeparationState& sta
   }
   sample.flags |= kSeparationInContact;
 
-  const NormalFracture normal = normal_fracture(patch, state, contact.point, contact.position,
-                                                contact_deflection(contact, contact.last_tool),
-                                                contact_deflection(contact, tool));
-  if (normal.separated > 0) sample.flags |= kSeparationNormalFracture;
-  if (!normal.held) sample.flags |= kSeparationAboveThreshold;
-  sample.separated += normal.separated;
-  sample.fracture_motion += normal.fracture_motion;
+  const FractureStep fracture = fracture_step(patch, state, contact.point, contact.position,
+                                              contact_deflection(contact, contact.last_tool),
+                                              contact_deflection(contact, tool));
+  if (fracture.separated > 0) sample.flags |= kSeparationFracture;
+  sample.separated = fracture.separated;
+  sample.fracture_motion = fracture.fracture_motion;
+  if (fracture.in_reach && !fracture.held) {
+    // The contact's region is used up: pushed along the interface, c moves on with the
+    // crack edge at the threshold (Fig. 3); pulled straight away, the force rises.
+    const Eigen::Vector3d n = patch.normals[contact.point.triangle];
+    const Slide slide = slide_until(patch, state, contact, tool, false, [&](const Evaluation& at) {
+      return opening_force(at.value.force, n, fracture.direction) - fracture.threshold;
+    });
+    contact = slide.contact;
+    if (slide.walk.travelled > 0) sample.flags |= kSeparationSliding;
+    if (opening_force(evaluate(patch, state, contact, tool).value.force, n, fracture.direction) >
+        fracture.threshold * (1 + 1e-9))
+      sample.flags |= kSeparationAboveThreshold;
+  }
 
   Evaluation e = evaluate(patch, state, contact, tool);
   if (contact.mode == ContactMode::push && e.normal < 0) {
@@ -143,26 +163,13 @@ SeparationSample step_contact(const SeparationPatch& patch, SeparationState& sta
     sample.flags = static_cast<std::uint16_t>((sample.flags & ~kSeparationInContact) | kSeparationReleased);
     return sample;
   }
-  const double friction_limit = contact.mode == ContactMode::push ? patch.friction * e.normal : kInfinity;
-  const double tangential = e.tangential.norm();
-  if (tangential > friction_limit || tangential > patch.tangential_threshold) {
-    const double fracture_limit =
-        crack_front_in_reach(patch, state, contact.point) ? patch.tangential_threshold : kInfinity;
-    if (tangential > std::min(friction_limit, fracture_limit)) {
-      if (friction_limit < fracture_limit) {
-        const Slide slide = slide_to_limit(patch, state, contact, tool, friction_limit, true);
-        contact = slide.contact;
-        if (slide.walk.travelled > 0) sample.flags |= kSeparationSliding;
-        if (slide.walk.stop == PatchWalk::Stop::crack_edge) {
-          sample.flags |= kSeparationStoppedAtCrackEdge;
-          if (evaluate(patch, state, contact, tool).tangential.norm() > patch.tangential_threshold &&
-              crack_front_in_reach(patch, state, contact.point))
-            tangential_fracture(patch, state, contact, tool, sample);
-        }
-      } else {
-        tangential_fracture(patch, state, contact, tool, sample);
-      }
-    }
+  if (contact.mode == ContactMode::push && e.tangential.norm() > patch.friction * e.normal) {
+    const double limit = patch.friction * e.normal;
+    const Slide slide =
+        slide_until(patch, state, contact, tool, true, [&](const Evaluation& at) { return at.tangential.norm() - limit; });
+    contact = slide.contact;
+    if (slide.walk.travelled > 0) sample.flags |= kSeparationSliding;
+    if (slide.walk.stop == PatchWalk::Stop::crack_edge) sample.flags |= kSeparationStoppedAtCrackEdge;
   }
 
   e = evaluate(patch, state, contact, tool);

@@ -6,15 +6,18 @@
 // A contact holds c, the contact point on the patch (at rest), the tool triangle's
 // weights, and the tool's offset when it began, so that the deflection delta = x - offset
 // - c starts at zero. Each tick, with the tool's contact point x:
-//   1. normal fracture (normal_fracture.h), c fixed;
-//   2. tangential: with n the normal of c's triangle and F_t the tangential force, the
-//      limit is mu (F . n) for a pushing tool (it slides by friction; a grasp does not)
-//      and F_t = J_c l_t where a crack front lies in the contact's region. Above the
-//      limit, c moves along the tangential deflection until |F_t| is back at it. A
-//      sliding c stops at a crack edge (and at the rim); pushed on past it at F_t, the
-//      crack edge moves with the tool and l_t times the distance separates (Eqs. 4–11).
-//   3. the force on the hand is -F, scaled down to the force limit, zero if not finite.
-// A pushing tool lets go when its normal force would pull (F . n < 0).
+//   1. fracture (fracture_step.h): where a crack front lies in the contact's region, the
+//      force that opens it is held at J_c l — F_n = J_c l_n pulling away, F_t = J_c l_t
+//      pushing along — while the crack grows by l per metre of the move. When the
+//      contact's region is used up, a push along the interface carries c on with the crack
+//      edge at the threshold (Fig. 3); a straight pull loads the separated flap;
+//   2. a pushing tool lets go if its normal force would pull (F . n < 0);
+//   3. a pushing tool slides by friction, c moving along the tangential deflection until
+//      |F_t| = mu (F . n); sliding, c stops at a crack edge (an edge between an open and a
+//      closed triangle: "the contact point c stops sliding if it reaches a crack edge",
+//      Sec. V.D) and at the rim. A grasp does not slide;
+//   4. the force on the hand is -F, scaled down to the force limit, zero if not finite.
+// c only moves forward, by slips that dissipate: the contact is passive.
 // noexcept, lock-free, no allocation. Units: m, N, J.
 #pragma once
 
@@ -41,14 +44,13 @@ struct SeparationContact {
 
 enum SeparationFlag : std::uint16_t {
   kSeparationInContact = 1,
-  kSeparationNormalFracture = 2,
-  kSeparationTangentialFracture = 4,
-  kSeparationSliding = 8,
-  kSeparationStoppedAtCrackEdge = 16,
-  kSeparationReleased = 32,
-  kSeparationClamped = 64,
-  kSeparationNonFinite = 128,
-  kSeparationAboveThreshold = 256,  ///< fracture could not hold the force at its threshold
+  kSeparationFracture = 2,
+  kSeparationSliding = 4,
+  kSeparationStoppedAtCrackEdge = 8,
+  kSeparationReleased = 16,
+  kSeparationClamped = 32,
+  kSeparationNonFinite = 64,
+  kSeparationAboveThreshold = 128,  ///< fracture could not hold the force at its threshold
 };
 
 struct SeparationSample {
@@ -57,7 +59,7 @@ struct SeparationSample {
   Eigen::Vector3d deflection = Eigen::Vector3d::Zero();  ///< delta [m]
   double energy = 0;           ///< the fields' potential at delta [J]
   double separated = 0;        ///< area separated by fracture this tick [m^2]
-  double fracture_motion = 0;  ///< the tool's travel that fractured: dz_f + tangential [m]
+  double fracture_motion = 0;  ///< the part of the tool's move that fractured [m]
   std::uint16_t flags = 0;
 };
 

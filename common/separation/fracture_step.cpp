@@ -1,4 +1,4 @@
-#include "common/separation/normal_fracture.h"
+#include "common/separation/fracture_step.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,20 +10,36 @@
 
 namespace cohaptic {
 
-NormalFracture normal_fracture(const SeparationPatch& patch, SeparationState& state, const ContactPoint& contact,
-                               const Eigen::Vector3d& contact_position, const Eigen::Vector3d& delta_old,
-                               const Eigen::Vector3d& delta_new) noexcept {
-  NormalFracture result;
-  const Eigen::Vector3d n = patch.normals[contact.triangle];
-  const double motion = (delta_new - delta_old).dot(n);
+double opening_length(const SeparationPatch& patch, const Eigen::Vector3d& n, const Eigen::Vector3d& v) noexcept {
+  const double along_normal = v.dot(n);
+  return patch.normal_length * std::max(0.0, along_normal) + patch.tangential_length * (v - along_normal * n).norm();
+}
+
+double opening_force(const Eigen::Vector3d& force, const Eigen::Vector3d& n, const Eigen::Vector3d& v) noexcept {
+  const double normal_force = force.dot(n), along_normal = v.dot(n);
+  return std::max(0.0, normal_force) * std::max(0.0, along_normal) + (force - normal_force * n).dot(v - along_normal * n);
+}
+
+FractureStep fracture_step(const SeparationPatch& patch, SeparationState& state, const ContactPoint& contact,
+                           const Eigen::Vector3d& contact_position, const Eigen::Vector3d& delta_old,
+                           const Eigen::Vector3d& delta_new) noexcept {
+  FractureStep result;
+  const Eigen::Vector3d move = delta_new - delta_old;
+  const double motion = move.norm();
   if (!(motion > 0)) return result;
-  const double threshold = patch.normal_threshold;
+  const Eigen::Vector3d n = patch.normals[contact.triangle];
+  const Eigen::Vector3d v = move / motion;
+  const double crack_length = opening_length(patch, n, v);
+  if (!(crack_length > 0)) return result;  // pressing straight towards the base
+  const double threshold = patch.toughness * crack_length;
   const double tolerance = 1e-12 * threshold;
-  const ContactAreas now = contact_areas(patch, state, contact.triangle);
-  const auto normal_force = [&](const ContactAreas& areas, const Eigen::Vector3d& delta) {
-    return contact_field(patch, contact, areas, delta).force.dot(n);
+  result.direction = v;
+  result.threshold = threshold;
+  const auto drive = [&](const ContactAreas& areas, const Eigen::Vector3d& delta) {
+    return opening_force(contact_field(patch, contact, areas, delta).force, n, v);
   };
-  const double trial = normal_force(now, delta_new);
+  const ContactAreas now = contact_areas(patch, state, contact.triangle);
+  const double trial = drive(now, delta_new);
   if (!(trial > threshold)) return result;
   const ContactRegion region = contact_region(patch, contact);
   const LocalGrowth order = local_growth_order(patch, state, region, contact_position);
@@ -32,20 +48,22 @@ NormalFracture normal_fracture(const SeparationPatch& patch, SeparationState& st
     result.held = false;  // no crack edge in reach: the force just rises
     return result;
   }
+  result.in_reach = true;
 
-  // The elastic part of the move: up to where the normal force reaches F_n.
+  // The elastic part of the move: up to where the opening force reaches the threshold.
   double elastic = 0;
-  const double before = normal_force(now, delta_old);
+  const double before = drive(now, delta_old);
   if (before < threshold) {
-    const auto excess = [&](double tau) { return normal_force(now, delta_old + tau * (delta_new - delta_old)) - threshold; };
+    const auto excess = [&](double tau) { return drive(now, delta_old + tau * move) - threshold; };
     elastic = bracketed_root(excess, 0.0, 1.0, before - threshold, trial - threshold, tolerance);
   }
   const double far_room = front_room(patch, state, &region);
-  const double total = std::min(patch.normal_length * (1 - elastic) * motion, local_room + far_room);
+  const double total = std::min(crack_length * (1 - elastic) * motion, local_room + far_room);
 
-  // Normal force minus F_n after `local` in the region and the rest of `amount` elsewhere.
+  // The opening force minus the threshold after `local` in the region and the rest of
+  // `amount` elsewhere.
   const auto excess_after = [&](double local, double amount) {
-    return normal_force(areas_after_growth(patch, state, contact, order, local, amount - local), delta_new) - threshold;
+    return drive(areas_after_growth(patch, state, contact, order, local, amount - local), delta_new) - threshold;
   };
   const auto least_local = [&](double amount) { return std::max(0.0, amount - far_room); };
   double amount = total;
@@ -69,7 +87,7 @@ NormalFracture normal_fracture(const SeparationPatch& patch, SeparationState& st
   }
   result.separated = apply_local_growth(patch, state, order, local);
   result.separated += grow_nearest(patch, state, contact_position, amount - local, &region);
-  result.fracture_motion = result.separated / patch.normal_length;
+  result.fracture_motion = result.separated / crack_length;
   return result;
 }
 
