@@ -100,7 +100,7 @@ Slide slide_until(const SeparationPatch& patch, const SeparationState& state, co
     }
     allowed = s;
   }
-  slide.walk = walk(allowed);
+  slide.walk = allowed < end.travelled ? walk(allowed) : end;  // `end` knows where it stopped
   slide.contact = moved_to(contact, slide.walk);
   return slide;
 }
@@ -164,9 +164,9 @@ SeparationSample step_contact(const SeparationPatch& patch, SeparationState& sta
     return sample;
   }
   if (contact.mode == ContactMode::push && e.tangential.norm() > patch.friction * e.normal) {
-    const double limit = patch.friction * e.normal;
-    const Slide slide =
-        slide_until(patch, state, contact, tool, true, [&](const Evaluation& at) { return at.tangential.norm() - limit; });
+    const Slide slide = slide_until(patch, state, contact, tool, true, [&](const Evaluation& at) {
+      return at.tangential.norm() - patch.friction * at.normal;
+    });
     contact = slide.contact;
     if (slide.walk.travelled > 0) sample.flags |= kSeparationSliding;
     if (slide.walk.stop == PatchWalk::Stop::crack_edge) sample.flags |= kSeparationStoppedAtCrackEdge;
