@@ -11,7 +11,7 @@
 
 #include "common/separation/laser_groove.h"
 #include "common/separation/fracture_step.h"
-#include "common/separation/pull_loop.h"
+#include "common/separation/pull_loop_figure.h"
 #include "common/separation/two_layer_setup.h"
 
 namespace cohaptic {
@@ -83,6 +83,20 @@ TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
   EXPECT_NEAR(loop.samples.back().force, 0, 1e-12);
   EXPECT_GT(loop.net_work, 0);
   EXPECT_LT(loop.net_work, patch.toughness * grown);
+  // The figure: one line per phase, joined, and the threshold.
+  const LinePlot figure = pull_loop_force_plot(loop);
+  ASSERT_EQ(figure.series.size(), 4u);
+  EXPECT_EQ(figure.series[0].x.size(), static_cast<std::size_t>(loading));
+  EXPECT_EQ(figure.series[1].x.size(), static_cast<std::size_t>(fracture) + 1);
+  EXPECT_EQ(figure.series[2].x.size(), static_cast<std::size_t>(unloading) + 1);
+  EXPECT_EQ(figure.series[1].x.front(), figure.series[0].x.back());
+  EXPECT_EQ(figure.series[3].y.front(), f_n);
+  const std::string svg = render_svg(figure);
+  std::size_t polylines = 0;
+  for (std::size_t at = svg.find("<polyline"); at != std::string::npos; at = svg.find("<polyline", at + 1)) ++polylines;
+  EXPECT_EQ(polylines, 4u);
+  const LinePlot shares = pull_loop_area_plot(loop, patch.interface_area);
+  EXPECT_EQ(shares.series[0].y.back(), 1.0);
   RecordProperty("threshold_N", std::to_string(f_n));
   RecordProperty("fracture_work_J", std::to_string(loop.fracture_work));
   RecordProperty("Jc_dLambda_J", std::to_string(patch.toughness * grown));
