@@ -3,11 +3,8 @@
 #include <algorithm>
 #include <cstring>
 #include <fmt/format.h>
-#include <fstream>
-#include <iterator>
 
-#include "common/util/atomic_file.h"
-#include "common/util/error.h"
+#include "common/util/checksummed_file.h"
 
 namespace cohaptic {
 namespace {
@@ -55,25 +52,13 @@ std::filesystem::path separation_fields_file(const std::filesystem::path& direct
 
 SeparationFieldsLoad load_separation_fields(const std::filesystem::path& file, const Digest& key) {
   SeparationFieldsLoad result;
-  std::ifstream in(file, std::ios::binary);
-  if (!in) {
-    result.problem = "no cache file";
-    return result;
-  }
-  const std::vector<char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   Header header{};
-  Digest stored_checksum{};
-  if (data.size() < sizeof header + stored_checksum.size()) {
-    result.problem = fmt::format("truncated ({} bytes)", data.size());
+  const ChecksummedRead read = read_checksummed_file(file, sizeof header);
+  if (!read.problem.empty()) {
+    result.problem = read.problem;
     return result;
   }
-  const std::size_t body_size = data.size() - stored_checksum.size();
-  std::memcpy(stored_checksum.data(), data.data() + body_size, stored_checksum.size());
-  if (digest_of(data.data(), body_size) != stored_checksum) {
-    result.problem = "checksum mismatch (truncated or corrupted)";
-    return result;
-  }
-  std::memcpy(&header, data.data(), sizeof header);
+  std::memcpy(&header, read.body.data(), sizeof header);
   if (std::memcmp(header.magic, kMagic, sizeof kMagic) != 0) {
     result.problem = "not a cohaptic separation-fields cache";
     return result;
@@ -90,16 +75,17 @@ SeparationFieldsLoad load_separation_fields(const std::filesystem::path& file, c
                                  static_cast<std::uint64_t>(std::max(header.tool_node_count, 0)) * kFieldStates *
                                  SeparationFields::block_size(std::max(header.degree, 0));
   if (header.degree < 1 || header.node_count < 1 || header.tool_node_count < 1 || header.value_count != expected ||
-      body_size != sizeof header + expected * sizeof(double)) {
+      read.body.size() != sizeof header + expected * sizeof(double)) {
     result.problem = fmt::format("inconsistent sizes (degree {}, {} nodes, {} tool nodes, {} values, {} bytes)",
-                                 header.degree, header.node_count, header.tool_node_count, header.value_count, body_size);
+                                 header.degree, header.node_count, header.tool_node_count, header.value_count,
+                                 read.body.size());
     return result;
   }
   result.fields.degree = header.degree;
   result.fields.node_count = header.node_count;
   result.fields.tool_node_count = header.tool_node_count;
   result.fields.values.resize(expected);
-  std::memcpy(result.fields.values.data(), data.data() + sizeof header, expected * sizeof(double));
+  std::memcpy(result.fields.values.data(), read.body.data() + sizeof header, expected * sizeof(double));
   result.loaded = true;
   return result;
 }
@@ -116,15 +102,7 @@ void save_separation_fields(const std::filesystem::path& file, const Digest& key
   std::vector<char> bytes(sizeof header + fields.values.size() * sizeof(double));
   std::memcpy(bytes.data(), &header, sizeof header);
   std::memcpy(bytes.data() + sizeof header, fields.values.data(), fields.values.size() * sizeof(double));
-  const Digest checksum = digest_of(bytes.data(), bytes.size());
-
-  std::error_code ec;
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
-  if (ec) throw Error(fmt::format("{}: cannot create the cache directory: {}", file.parent_path().string(), ec.message()));
-  AtomicFile out(file);
-  out.write(std::string_view(bytes.data(), bytes.size()));
-  out.write(std::string_view(reinterpret_cast<const char*>(checksum.data()), checksum.size()));
-  out.commit();
+  write_checksummed_file(file, std::string_view(bytes.data(), bytes.size()));
 }
 
 CachedSeparationFields cached_separation_fields(const std::filesystem::path& directory, const SeparationBodies& bodies,
