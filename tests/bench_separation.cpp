@@ -1,5 +1,5 @@
 // Benchmarks of the separation body (issue 12, deliverable 7): the haptic tick against the
-// number of patch nodes — an elastic tick, a tick that tears, a laser tick — beside the
+// number of patch nodes — elastic, tearing, sliding and laser ticks — beside the
 // naive way (a live sparse FEM solve of the two layers per tick), and the precomputation
 // per field. The argument is the divisions of the 40 mm square interface: 10, 20 and 30
 // give 121, 441 and 961 patch nodes.
@@ -87,6 +87,29 @@ void BM_SeparationTick_tearing(benchmark::State& state) {
   state.counters["tearing_share"] = static_cast<double>(tears) / static_cast<double>(state.iterations());
 }
 
+// A tool under an opened flap (the strip x < 10 mm separated) pressing it up and dragged to
+// and fro along y: it slides by friction every tick (a walk over the patch, an energy check).
+void BM_SeparationTick_sliding(benchmark::State& state) {
+  const SeparationPatch& patch = layers(static_cast<int>(state.range(0))).patch;
+  SeparationState separation = make_separation_state(patch);
+  std::vector<int> strip;
+  for (int t = 0; t < patch.triangle_count(); ++t)
+    if (patch.centroids[t].x() < 0.010) strip.push_back(t);
+  separate_triangles(patch, separation, strip);
+  const int node = nearest_patch_node(patch, Eigen::Vector3d(0.006, 0.02, 0));
+  const Eigen::Vector3d start = patch.positions.col(node);
+  SeparationContact contact = begin_contact(patch, ContactMode::push, contact_at_node(patch, node), start);
+  int i = 0;
+  long slides = 0;
+  for (auto _ : state) {
+    const double t = 1e-3 * i++;
+    const Eigen::Vector3d tool = start + Eigen::Vector3d(0, 0.005 * std::sin(2 * t), 0.001);
+    slides += (step_contact(patch, separation, contact, tool).flags & kSeparationSliding) != 0;
+  }
+  set_counters(state, patch);
+  state.counters["sliding_share"] = static_cast<double>(slides) / static_cast<double>(state.iterations());
+}
+
 // A laser sweep at half the vaporisation speed across the interface.
 void BM_SeparationTick_laser(benchmark::State& state) {
   const SeparationPatch& patch = layers(static_cast<int>(state.range(0))).patch;
@@ -138,6 +161,7 @@ void BM_SeparationPrecompute(benchmark::State& state) {
 
 BENCHMARK(BM_SeparationTick_elastic)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeparationTick_tearing)->Arg(10)->Arg(20)->Arg(30)->UseManualTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SeparationTick_sliding)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeparationTick_laser)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeparationTick_naive_full_solve)->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SeparationPrecompute)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMillisecond)->Iterations(1);

@@ -16,7 +16,6 @@
 #include <vector>
 
 #include "common/separation/separation_contact.h"
-#include "common/separation/separation_force.h"
 
 namespace cohaptic {
 

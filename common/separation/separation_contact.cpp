@@ -1,7 +1,6 @@
 #include "common/separation/separation_contact.h"
 
 #include <cmath>
-#include <limits>
 
 #include "common/separation/bracketed_root.h"
 #include "common/separation/fracture_step.h"
