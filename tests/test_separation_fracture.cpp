@@ -1,0 +1,238 @@
+// Fracture at the separating interface (issue 12, deliverables 3 and 6): the paper's
+// Fig. 10 normal pull with its three phases, the energy balance at other speeds and angles,
+// the tangential threshold, and that no crack means no fracture until a laser groove.
+// The answers they are checked against: the fitted fields themselves (AB, CA), the
+// thresholds J_c l from the paper's energy balance, the work the hand does (integrated
+// from the forces) against J_c times the separated area, and passivity.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "common/separation/laser_groove.h"
+#include "common/separation/fracture_step.h"
+#include "common/separation/pull_loop_figure.h"
+#include "common/separation/two_layer_setup.h"
+
+namespace cohaptic {
+namespace {
+
+// The default scene: two 40 x 40 mm layers (4 mm flap on a 10 mm bed), 2 mm cells, J_c =
+// 75 J/m^2, l_n = l_t = 5 mm. Built once per test program.
+const TwoLayerSetup& layers() {
+  static const TwoLayerSetup setup = make_two_layer_setup(TwoLayerBoxes{}, FieldSettings{}, SeparationSettings{});
+  return setup;
+}
+
+int rim_node() { return nearest_patch_node(layers().patch, Eigen::Vector3d(0, 0.02, 0)); }
+int centre_node() { return nearest_patch_node(layers().patch, Eigen::Vector3d(0.02, 0.02, 0)); }
+
+TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
+  const SeparationPatch& patch = layers().patch;
+  const int node = rim_node();
+  // The precondition for a flat BC: l_n is long enough for these fields at this node.
+  ASSERT_LT(holding_normal_length(patch, node), patch.normal_length);
+  PullLoopSettings settings;
+  settings.node = node;
+  const PullLoop loop = run_pull_loop(patch, make_separation_state(patch), settings);
+  const Eigen::Vector3d n = patch.normals[patch.regions.of(node).front()];
+  const double f_n = patch.toughness * patch.normal_length;
+  ASSERT_DOUBLE_EQ(loop.threshold, f_n);
+
+  int loading = 0, fracture = 0, unloading = 0;
+  const PullLoopSample* b = nullptr;
+  const PullLoopSample* c = nullptr;
+  for (const PullLoopSample& s : loop.samples) {
+    const Eigen::Vector3d delta = s.travel * n;
+    switch (s.phase) {
+      case PullPhase::loading:  // AB: the connected field F, nothing separated
+        ++loading;
+        EXPECT_NEAR(s.force, field_value(patch, node, 0, FieldState::connected, delta).force.dot(n), 1e-12 * f_n);
+        EXPECT_EQ(s.separated_area, 0);
+        b = &s;
+        break;
+      case PullPhase::fracture:  // BC: held at J_c l_n
+        ++fracture;
+        EXPECT_NEAR(s.force, f_n, 0.02 * f_n) << "at " << s.travel * 1e3 << " mm";
+        c = &s;
+        break;
+      case PullPhase::unloading: {  // CA: D_n separated, F-bar (and the global share's F^e)
+        ++unloading;
+        EXPECT_EQ(s.local_separated, 1.0);
+        const double f_bar = field_value(patch, node, 0, FieldState::locally_separated, delta).force.dot(n);
+        const double f_e = field_value(patch, node, 0, FieldState::separated, delta).force.dot(n);
+        const double global = s.separated_area / patch.interface_area;
+        EXPECT_NEAR(s.force, (1 - global) * f_bar + global * f_e, 1e-12 * f_n);
+        EXPECT_NEAR(s.force, f_bar, 0.01 * f_bar) << "at " << s.travel * 1e3 << " mm";
+        break;
+      }
+    }
+  }
+  EXPECT_GT(loading, 100);
+  EXPECT_GT(fracture, 100);
+  EXPECT_GT(unloading, 100);
+  ASSERT_TRUE(b && c);
+  EXPECT_NEAR(b->force, f_n, 1e-9 * f_n);  // B: where F reaches the threshold
+  // BC: the separated area grew by l_n dz, and the hand's work paid for it at J_c.
+  const double grown = c->separated_area - b->separated_area;
+  EXPECT_NEAR(grown, patch.normal_length * (c->travel - b->travel), 1e-9 * grown);
+  EXPECT_NEAR(loop.fracture_area, grown, 1e-15);
+  EXPECT_NEAR(loop.fracture_work, patch.toughness * grown, 0.01 * patch.toughness * grown);
+  // The loop: back to A with no force; the hand lost energy (passive), at most J_c dLambda.
+  EXPECT_EQ(loop.samples.back().travel, 0);
+  EXPECT_NEAR(loop.samples.back().force, 0, 1e-12);
+  EXPECT_GT(loop.net_work, 0);
+  EXPECT_LT(loop.net_work, patch.toughness * grown);
+  // The figure: one line per phase, joined, and the threshold.
+  const LinePlot figure = pull_loop_force_plot(loop);
+  ASSERT_EQ(figure.series.size(), 4u);
+  EXPECT_EQ(figure.series[0].x.size(), static_cast<std::size_t>(loading));
+  EXPECT_EQ(figure.series[1].x.size(), static_cast<std::size_t>(fracture) + 1);
+  EXPECT_EQ(figure.series[2].x.size(), static_cast<std::size_t>(unloading) + 1);
+  EXPECT_EQ(figure.series[1].x.front(), figure.series[0].x.back());
+  EXPECT_EQ(figure.series[3].y.front(), f_n);
+  const std::string svg = render_svg(figure);
+  std::size_t polylines = 0;
+  for (std::size_t at = svg.find("<polyline"); at != std::string::npos; at = svg.find("<polyline", at + 1)) ++polylines;
+  EXPECT_EQ(polylines, 4u);
+  const LinePlot shares = pull_loop_area_plot(loop, patch.interface_area);
+  EXPECT_EQ(shares.series[0].y.back(), 1.0);
+  RecordProperty("threshold_N", std::to_string(f_n));
+  RecordProperty("fracture_work_J", std::to_string(loop.fracture_work));
+  RecordProperty("Jc_dLambda_J", std::to_string(patch.toughness * grown));
+}
+
+// The energy balance holds whatever the speed (tick length) and the direction of the pull
+// (Eq. 10, F . dx = J_c dLambda with dLambda = l_n dz + l_t dx_t): over BC the hand's work,
+// integrated from the forces it feels, is J_c times the separated area, and the force
+// along the pull stays at J_c l(direction). The loop is passive: the hand's work exceeds
+// what the fields still store at the end.
+TEST(SeparationFracture, EnergyBalanceAtOtherSpeedsAndAngles) {
+  const SeparationPatch& patch = layers().patch;
+  for (double speed : {0.002, 0.01, 0.05, 0.2})
+    for (double tilt_deg : {0.0, 20.0, 40.0, 60.0})
+      for (const Eigen::Vector3d& towards : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)}) {
+        if (tilt_deg == 0 && towards.y() == 1) continue;
+        const double tilt = tilt_deg * std::numbers::pi / 180;
+        PullLoopSettings settings;
+        settings.node = rim_node();
+        settings.speed = speed;
+        settings.direction = std::cos(tilt) * Eigen::Vector3d::UnitZ() + std::sin(tilt) * towards;
+        const PullLoop loop = run_pull_loop(patch, make_separation_state(patch), settings);
+        const std::string where = "speed " + std::to_string(speed) + " m/s, tilt " + std::to_string(tilt_deg) +
+                                  " deg towards " + (towards.x() == 1 ? "x" : "y");
+        ASSERT_GT(loop.fracture_area, 0) << where;
+        EXPECT_NEAR(loop.threshold, patch.toughness * (patch.normal_length * std::cos(tilt) + patch.tangential_length * std::sin(tilt)),
+                    1e-12)
+            << where;
+        EXPECT_NEAR(loop.fracture_work, patch.toughness * loop.fracture_area, 0.01 * patch.toughness * loop.fracture_area)
+            << where;
+        for (const PullLoopSample& s : loop.samples)
+          if (s.phase == PullPhase::fracture) {
+            EXPECT_NEAR(s.force, loop.threshold, 0.02 * loop.threshold) << where << " at " << s.travel * 1e3 << " mm";
+          }
+        EXPECT_GE(loop.net_work - loop.final_energy, 0) << where;
+        EXPECT_GE(loop.final_energy, 0) << where;
+      }
+}
+
+// Drives a grasp at `node` along `direction` by `step` per tick until `stop` says so.
+struct Push {
+  SeparationState state;
+  SeparationContact contact;
+  std::vector<SeparationSample> samples;
+  std::vector<double> travel;
+};
+
+template <typename Stop>
+Push push(const SeparationPatch& patch, SeparationState state, int node, const Eigen::Vector3d& direction, double step,
+          int max_ticks, const Stop& stop) {
+  Push p{std::move(state), {}, {}, {}};
+  const Eigen::Vector3d start = patch.positions.col(node);
+  p.contact = begin_contact(patch, ContactMode::grasp, contact_at_node(patch, node), start);
+  for (int i = 1; i <= max_ticks; ++i) {
+    p.samples.push_back(step_contact(patch, p.state, p.contact, start + i * step * direction));
+    p.travel.push_back(i * step);
+    if (stop(p.samples.back())) break;
+  }
+  return p;
+}
+
+double tangential(const SeparationPatch& patch, const SeparationSample& s, int node) {
+  const Eigen::Vector3d n = patch.normals[patch.regions.of(node).front()];
+  return (s.body_force - s.body_force.dot(n) * n).norm();
+}
+
+// Pushed along the interface at a crack edge (the rim), the flap tears at F_t = J_c l_t:
+// the force along the push holds there and l_t of area separates per metre the tool moves
+// (Eqs. 4–11).
+TEST(SeparationFracture, TangentialThresholdIsJcLt) {
+  const SeparationPatch& patch = layers().patch;
+  const int node = rim_node();
+  const double f_t = patch.toughness * patch.tangential_length;
+  const Push p = push(patch, make_separation_state(patch), node, Eigen::Vector3d::UnitX(), 1e-5, 800,
+                      [](const SeparationSample&) { return false; });
+  std::size_t first = p.samples.size();
+  for (std::size_t i = 0; i < p.samples.size(); ++i)
+    if (p.samples[i].flags & kSeparationFracture) {
+      first = i;
+      break;
+    }
+  ASSERT_LT(first, p.samples.size() / 2) << "the push never tore the flap";
+  for (std::size_t i = 0; i < first; ++i) {
+    EXPECT_LT(p.samples[i].body_force.x(), f_t * (1 + 1e-9));
+    EXPECT_EQ(p.samples[i].separated, 0);
+  }
+  double area = 0, work = 0;
+  for (std::size_t i = first; i < p.samples.size(); ++i) {
+    EXPECT_NEAR(p.samples[i].body_force.x(), f_t, 0.02 * f_t) << "tick " << i;
+    area += p.samples[i].separated;
+    if (i > first) work += 0.5 * (p.samples[i - 1].body_force + p.samples[i].body_force).dot(1e-5 * Eigen::Vector3d::UnitX());
+  }
+  const double travel = p.travel.back() - p.travel[first];
+  EXPECT_NEAR(area - p.samples[first].separated, patch.tangential_length * travel, 0.02 * patch.tangential_length * travel);
+  EXPECT_NEAR(work, patch.toughness * (area - p.samples[first].separated), 0.01 * work);
+  RecordProperty("tangential_plateau_N", std::to_string(p.samples.back().body_force.x()));
+}
+
+// "When there is no initial crack between bodies, the tool cannot cause fracture" (Sec.
+// VI.C): away from the rim a push of ten times the thresholds separates nothing; after a
+// laser groove through the contact's region the same push does.
+TEST(SeparationFracture, NoCrackNoFractureUntilALaserGroove) {
+  const SeparationPatch& patch = layers().patch;
+  const int node = centre_node();
+  const double f_t = patch.toughness * patch.tangential_length;
+  const auto ten_times = [&](const SeparationSample& s) { return tangential(patch, s, node) >= 10 * f_t; };
+  const Push intact = push(patch, make_separation_state(patch), node, Eigen::Vector3d::UnitX(), 2e-5, 5000, ten_times);
+  ASSERT_TRUE(ten_times(intact.samples.back())) << "did not reach 10 F_t";
+  EXPECT_EQ(intact.state.separated_area, 0);
+  const Eigen::Vector3d n = patch.normals[patch.regions.of(node).front()];
+  const Push pulled = push(patch, make_separation_state(patch), node, n, 2e-5, 5000, [&](const SeparationSample& s) {
+    return s.body_force.dot(n) >= 10 * patch.normal_threshold;
+  });
+  ASSERT_GE(pulled.samples.back().body_force.dot(n), 10 * patch.normal_threshold);
+  EXPECT_EQ(pulled.state.separated_area, 0);
+
+  // A groove across the interface at x = 20.5 mm, through the node's region, at half v_s.
+  SeparationState grooved = make_separation_state(patch);
+  LaserFibre fibre;
+  const double dt = 1e-3, speed = 0.5 * patch.vaporisation_speed;
+  const Eigen::Vector3d from(0.0205, 0.012, 0), to(0.0205, 0.028, 0);
+  const int ticks = static_cast<int>(std::ceil((to - from).norm() / (speed * dt)));
+  for (int i = 0; i <= ticks; ++i)
+    step_laser(patch, grooved, fibre, from + (to - from) * std::min(1.0, double(i) / ticks), true, dt);
+  const double groove = grooved.separated_area;
+  ASSERT_GT(groove, 0);
+  // The same push, 6 mm on from the node: it tears at F_t and goes on tearing, the
+  // contact point carried along with the crack edge (Fig. 3).
+  const Push opened = push(patch, grooved, node, Eigen::Vector3d::UnitX(), 2e-5, 300, ten_times);
+  EXPECT_GT(opened.state.separated_area, groove + 1e-6) << "the push did not open the groove";
+  double largest = 0;
+  for (const SeparationSample& s : opened.samples) largest = std::max(largest, s.body_force.x());
+  EXPECT_LT(largest, 1.02 * f_t);
+  EXPECT_NEAR(opened.samples.back().body_force.x(), f_t, 0.02 * f_t);
+  EXPECT_GT(opened.contact.position.x(), patch.positions(0, node) + 0.002) << "the contact point did not move on";
+}
+
+}  // namespace
+}  // namespace cohaptic
