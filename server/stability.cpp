@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "client/passivity_controller.h"
+#include "common/haptics/passivity_controller.h"
 #include "common/study/measures.h"
 #include "common/study/svg_plot.h"
 #include "common/util/atomic_file.h"

@@ -28,7 +28,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "client/device/hand_model.h"
+#include "common/haptics/hand_model.h"
 #include "common/study/force_trace.h"
 
 namespace cohaptic {

@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "client/device/trajectory.h"
+#include "common/haptics/trajectory.h"
 #include "common/ir/intermediate_representation.h"
 #include "common/scene/scene.h"
 

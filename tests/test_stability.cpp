@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "client/device/scripted_device.h"
 #include "client/haptic_loop.h"
-#include "client/passivity_controller.h"
+#include "common/haptics/passivity_controller.h"
+#include "common/haptics/scripted_device.h"
 #include "common/study/measures.h"
 #include "proto/wire/header.h"
 #include "server/stability.h"
