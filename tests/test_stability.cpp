@@ -9,8 +9,8 @@
 #include "common/haptics/passivity_controller.h"
 #include "common/haptics/scripted_device.h"
 #include "common/study/measures.h"
+#include "lab/stability.h"
 #include "proto/wire/header.h"
-#include "server/stability.h"
 
 namespace cohaptic {
 namespace {

@@ -1,11 +1,11 @@
 // Helpers for end-to-end tests: the built programs, scratch directories, and the
-// ChildProcess of the server library.
+// ChildProcess of the lab library.
 #pragma once
 
 #include <filesystem>
 #include <string>
 
-#include "server/child_process.h"
+#include "lab/child_process.h"
 
 namespace cohaptic::testing {
 
