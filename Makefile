@@ -7,7 +7,7 @@ BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BENCH_ARGS ?=
-SERVER := $(BUILD_DIR)/server/cohaptic-server
+LAB := $(BUILD_DIR)/lab/cohaptic-lab
 
 .PHONY: all deps configure build test demo probe-demo tradeoff bench clean
 
@@ -36,15 +36,15 @@ demo: build
 # The probe on the paper's cube, through the intermediate representation: a tool pressed
 # 1, 2, 5 and 10 mm into the front face's centre, then two tools together.
 probe-demo: build
-	@$(SERVER) probe --scene scenes/cube.yaml --separately --tool 0,0,-1 --tool 0,0,-2 --tool 0,0,-5 --tool 0,0,-10
+	@$(LAB) probe --scene scenes/cube.yaml --separately --tool 0,0,-1 --tool 0,0,-2 --tool 0,0,-5 --tool 0,0,-10
 	@echo
-	@$(SERVER) probe --scene scenes/cube.yaml --tool 30,-20,-5 --tool -60,60,-3 --contact-model point \
+	@$(LAB) probe --scene scenes/cube.yaml --tool 30,-20,-5 --tool -60,60,-3 --contact-model point \
 	  --boundary-nodes 300 --ir-precision f32 --log-level warn
 
 # Speed against accuracy on the paper's cube (README "Speed versus accuracy"): every
 # setting against the full solve on an 18-division mesh; about a minute.
 tradeoff: build
-	$(SERVER) tradeoff --scene scenes/tradeoff/cube_two_users.yaml --motion scenes/tradeoff/cube_press_slide.yaml \
+	$(LAB) tradeoff --scene scenes/tradeoff/cube_two_users.yaml --motion scenes/tradeoff/cube_press_slide.yaml \
 	  --motion scenes/tradeoff/cube_press_hold.yaml --out out/tradeoff/cube
 
 bench: build

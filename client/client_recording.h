@@ -2,7 +2,7 @@
 // (proto/record/session_recorder.h): the configuration first (who, with what device,
 // in which session and slot), then from the I/O thread every datagram and IR received,
 // every event, and every haptic tick the haptic thread traced (TickRecord ->
-// HapticTick). `cohaptic-server replay --verify` re-computes the ticks' forces.
+// HapticTick). `cohaptic-lab replay --verify` re-computes the ticks' forces.
 #pragma once
 
 #include <cstdint>

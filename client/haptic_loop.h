@@ -18,8 +18,8 @@
 #include <cstdint>
 #include <memory>
 
-#include "client/device/haptic_device.h"
-#include "client/passivity_controller.h"
+#include "common/haptics/haptic_device.h"
+#include "common/haptics/passivity_controller.h"
 #include "common/ir/evaluate_force.h"
 #include "common/sync/remote_tool_buffer.h"
 #include "common/util/histogram.h"

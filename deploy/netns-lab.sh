@@ -15,6 +15,8 @@
 #        run a command on one host, e.g.
 #          deploy/netns-lab.sh run server build/server/cohaptic-server --scene scenes/cube.yaml --listen 10.77.0.1:7400
 #          deploy/netns-lab.sh run client build/client/cohaptic-client --server 10.77.0.1:7400 --user A --device script:tests/data/devices/press.yaml
+#        (give both a --key-file made by `build/lab/cohaptic-lab keygen FILE` off a trusted
+#        network; the lab tools themselves, cohaptic-lab, need no namespace)
 #   deploy/netns-lab.sh status      the namespaces, addresses, queueing disciplines and a ping
 #   deploy/netns-lab.sh down        remove the lab (also what `up` does first)
 #

@@ -5,7 +5,7 @@
 # every report under out/demo/, the three processes' recordings (server.mcap,
 # client_a.mcap, client_b.mcap), the deformed brain surface for ParaView under
 # out/demo/display/ (open surface.pvd), prints the summary, verifies the clients'
-# recordings bit for bit (cohaptic-server replay --verify), and exits non-zero if the
+# recordings bit for bit (cohaptic-lab replay --verify), and exits non-zero if the
 # session was unhealthy (see README.md, "Reports and the demo report") or a verification
 # failed.
 #
@@ -21,6 +21,7 @@ device=${DEMO_DEVICE:-hand}
 out=${DEMO_OUT:-out/demo}
 server_bin=$build/server/cohaptic-server
 client_bin=$build/client/cohaptic-client
+lab_bin=$build/lab/cohaptic-lab
 mkdir -p "$out"
 rm -rf "$out"/*.json "$out"/*.log "$out"/*.mcap "$out/display"
 
@@ -57,14 +58,14 @@ if [[ $status -ne 0 ]]; then
   echo "demo: a process failed (exit $status)" >&2
 fi
 healthy=0
-"$server_bin" summarize --server-report "$out/server.json" --client-report "$out/client_a.json" \
+"$lab_bin" summarize --server-report "$out/server.json" --client-report "$out/client_a.json" \
   --client-report "$out/client_b.json" --out "$out/report.json" || healthy=$?
 # Every force each surgeon felt, recomputed from the recorded inputs, must be bit-identical.
-# (The server's recording verifies too, re-running every simulation step: cohaptic-server
+# (The server's recording verifies too, re-running every simulation step: cohaptic-lab
 # replay out/demo/server.mcap --verify; about 13 s for this 20 s session on 2 cores.)
 verified=0
 for client in client_a client_b; do
-  "$server_bin" replay "$out/$client.mcap" --verify --log-level warn || verified=1
+  "$lab_bin" replay "$out/$client.mcap" --verify --log-level warn || verified=1
 done
 [[ $healthy -eq 0 ]] || exit "$healthy"
 exit "$verified"

@@ -2,7 +2,7 @@
 // (proto/record/session_recorder.h): the configuration first, then one SimulationStep
 // per successful step, built here from what the simulation loop used and produced. The
 // simulation thread records steps and IRs, the I/O thread datagrams and events (the
-// recorder is thread-safe). `cohaptic-server replay --verify` re-runs these steps.
+// recorder is thread-safe). `cohaptic-lab replay --verify` re-runs these steps.
 #pragma once
 
 #include <cstdint>

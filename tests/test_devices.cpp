@@ -22,10 +22,10 @@
 #include "client/device/bridge_device.h"
 #include "client/device/bridge_peer.h"
 #include "client/device/bridge_protocol.h"
-#include "client/device/hand_model.h"
 #include "client/device/make_device.h"
-#include "client/device/scripted_device.h"
-#include "client/device/trajectory.h"
+#include "common/haptics/hand_model.h"
+#include "common/haptics/scripted_device.h"
+#include "common/haptics/trajectory.h"
 #include "common/util/error.h"
 #include "support/wait.h"
 

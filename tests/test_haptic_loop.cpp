@@ -10,9 +10,9 @@
 #include <limits>
 #include <thread>
 
-#include "client/device/scripted_device.h"
-#include "client/device/trajectory.h"
 #include "client/haptic_loop.h"
+#include "common/haptics/scripted_device.h"
+#include "common/haptics/trajectory.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"

@@ -2,10 +2,8 @@
 // sparse solve and against an independent FEM, physical properties of the answer, and the
 // command-line program itself (its JSON, its exports, its errors).
 #include <gtest/gtest.h>
-#include <sys/wait.h>
+#include <unistd.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <limits>
@@ -17,6 +15,7 @@
 #include "common/sim/simulation.h"
 #include "common/scene/load_scene.h"
 #include "support/independent_fem.h"
+#include "support/run_program.h"
 #include "support/test_meshes.h"
 
 namespace cohaptic {
@@ -134,28 +133,12 @@ TEST_F(CubeProbe, AToolOutsideOrBesideTheTouchableFaceHasNoForce) {
 
 // --- the program ---
 
-struct ProgramRun {
-  int exit_code = -1;
-  std::string out;
-};
-
-ProgramRun run(const std::string& arguments) {
-  const std::string command = std::string(COHAPTIC_SERVER_EXE) + " " + arguments + " 2>/dev/null";
-  ProgramRun result;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (!pipe) return result;
-  std::array<char, 4096> buffer{};
-  std::size_t n = 0;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.out.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+testing::ProgramRun run(const std::string& arguments) { return testing::run_program(COHAPTIC_LAB_EXE, arguments); }
 
 TEST_F(CubeProbe, TheProgramPrintsOneJsonObjectWithTheSameForces) {
   const fs::path dir = fs::temp_directory_path() / ("cohaptic-probe-" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  const ProgramRun result = run("probe --scene " + testing::source_path("scenes/cube.yaml") +
+  const testing::ProgramRun result = run("probe --scene " + testing::source_path("scenes/cube.yaml") +
                                 " --tool 5,-7,-4 --tool -30,40,-2 --tool 0,0,10 --json --no-disk-cache --export-msh " +
                                 (dir / "cube.msh").string() + " --export-vtu " + (dir / "cube.vtu").string());
   ASSERT_EQ(result.exit_code, 0) << result.out;

@@ -12,10 +12,10 @@
 #include "client/device/make_device.h"
 #include "client/device/recorded_motion.h"
 #include "common/util/error.h"
+#include "lab/replay.h"
 #include "proto/record/recording.h"
-#include "proto/wire/vec3_convert.h"
 #include "proto/record/session_recorder.h"
-#include "server/replay.h"
+#include "proto/wire/vec3_convert.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
 

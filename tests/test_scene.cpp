@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "client/device/trajectory.h"
+#include "common/haptics/trajectory.h"
 #include "common/mesh/box_mesher.h"
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"

@@ -1,11 +1,11 @@
-// The demo's verdict (cohaptic-server summarize): each criterion on hand-made reports.
+// The demo's verdict (cohaptic-lab summarize): each criterion on hand-made reports.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "server/session_summary.h"
+#include "lab/session_summary.h"
 
 namespace cohaptic {
 namespace {
@@ -86,6 +86,20 @@ TEST(SessionSummary, EachFailedCriterionIsNamed) {
     EXPECT_TRUE(mentions(verdict.problems, text)) << text << " in " << verdict.report["problems"].dump();
   EXPECT_EQ(verdict.problems.size(), 5u) << verdict.report["problems"].dump();
   EXPECT_TRUE(summarize_session(healthy_server(), {}).problems.size() == 1);
+}
+
+TEST(SessionSummary, FailedSimulationStepsMakeTheSessionUnhealthyNamingCountAndLastError) {
+  nlohmann::json server = healthy_server();
+  server["server"]["failed_steps"] = {{"count", 0}, {"max_in_a_row", 0}, {"last_error", ""}};
+  EXPECT_TRUE(summarize_session(server, {healthy_client("a")}).problems.empty());
+
+  server["server"]["failed_steps"] = {{"count", 12}, {"max_in_a_row", 4}, {"last_error", "contact solve: singular"}};
+  const SessionVerdict verdict = summarize_session(server, {healthy_client("a")});
+  EXPECT_FALSE(verdict.report["healthy"].get<bool>());
+  ASSERT_EQ(verdict.problems.size(), 1u) << verdict.report["problems"].dump();
+  EXPECT_TRUE(mentions(verdict.problems, "server: 12 simulation steps failed (4 in a row at most)"))
+      << verdict.problems.front();
+  EXPECT_TRUE(mentions(verdict.problems, "contact solve: singular")) << verdict.problems.front();
 }
 
 }  // namespace

@@ -5,12 +5,12 @@
 
 #include <cmath>
 
-#include "client/device/scripted_device.h"
 #include "client/haptic_loop.h"
-#include "client/passivity_controller.h"
+#include "common/haptics/passivity_controller.h"
+#include "common/haptics/scripted_device.h"
 #include "common/study/measures.h"
+#include "lab/stability.h"
 #include "proto/wire/header.h"
-#include "server/stability.h"
 
 namespace cohaptic {
 namespace {

@@ -14,7 +14,7 @@
 
 #include "common/util/csv.h"
 #include "common/util/error.h"
-#include "server/study.h"
+#include "lab/study.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
 

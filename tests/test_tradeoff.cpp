@@ -9,7 +9,7 @@
 #include "common/model/static_contact.h"
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
-#include "server/tradeoff.h"
+#include "lab/tradeoff.h"
 #include "support/cube_scene.h"
 
 namespace cohaptic {

@@ -32,7 +32,7 @@
 #include <string>
 
 #include "client/device/bridge_protocol.h"
-#include "client/device/haptic_device.h"
+#include "common/haptics/haptic_device.h"
 
 namespace cohaptic {
 

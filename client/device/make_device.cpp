@@ -6,10 +6,10 @@
 #include <functional>
 
 #include "client/device/bridge_device.h"
-#include "client/device/hand_model.h"
 #include "client/device/recorded_motion.h"
-#include "client/device/scripted_device.h"
-#include "client/device/trajectory.h"
+#include "common/haptics/hand_model.h"
+#include "common/haptics/scripted_device.h"
+#include "common/haptics/trajectory.h"
 #include "common/util/error.h"
 
 namespace cohaptic {

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "client/device/haptic_device.h"
+#include "common/haptics/haptic_device.h"
 
 namespace cohaptic {
 

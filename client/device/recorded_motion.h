@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include "client/device/trajectory.h"
+#include "common/haptics/trajectory.h"
 
 namespace cohaptic {
 

@@ -1,5 +1,5 @@
 // Helpers for end-to-end tests: the built programs, scratch directories, the ChildProcess
-// of the server library, and waiting for a line in a child's output.
+// of the lab library, and waiting for a line in a child's output.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <string>
 
-#include "server/child_process.h"
+#include "lab/child_process.h"
 #include "support/wait.h"
 
 namespace cohaptic::testing {

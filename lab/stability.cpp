@@ -1,12 +1,14 @@
-#include "server/stability.h"
+#include "lab/stability.h"
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
-#include "client/passivity_controller.h"
+#include "common/haptics/passivity_controller.h"
 #include "common/study/measures.h"
 #include "common/study/svg_plot.h"
 #include "common/util/atomic_file.h"
@@ -211,6 +213,18 @@ int run_stability(const StabilityOptions& options) {
                rescued, unstable, costs.empty() ? 0.0 : 100 * costs[costs.size() / 2]);
   spdlog::info("wrote {}/stability.csv, stability.md, stability.svg", options.out.string());
   return 0;
+}
+
+LabCommand add_stability_command(CLI::App& lab) {
+  auto options = std::make_shared<StabilityOptions>();
+  CLI::App* command = lab.add_subcommand(
+      "stability", "Map where a virtual wall stays stable under the hand model (stiffness x haptic rate x delay), with "
+                   "and without the passivity controller: stability.csv, stability.md, stability.svg in --out");
+  command->add_option("--out", options->out, "Output directory")->required();
+  command->add_option("--hand-mass", options->hand.mass_kg, "Hand model mass [kg]")->capture_default_str();
+  command->add_option("--hand-stiffness", options->hand.stiffness_n_per_m, "Hand model stiffness [N/m]")->capture_default_str();
+  command->add_option("--hand-damping", options->hand.damping_ns_per_m, "Hand model damping [N s/m]")->capture_default_str();
+  return {command, [options] { return run_stability(*options); }};
 }
 
 }  // namespace cohaptic

@@ -1,4 +1,4 @@
-#include "client/device/hand_model.h"
+#include "common/haptics/hand_model.h"
 
 #include <cmath>
 #include <fmt/format.h>

@@ -1,10 +1,13 @@
-#include "server/probe.h"
+#include "lab/probe.h"
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include <cstdio>
 #include <limits>
+#include <memory>
 
 #include "common/mesh/write_gmsh.h"
 #include "common/mesh/write_vtu.h"
@@ -37,6 +40,27 @@ struct ProbedTool {
 const char* model_name(ContactModel model) {
   return model == ContactModel::node_translation ? "translation" : "point";
 }
+
+// Parses "x,y,z" (three finite numbers separated by commas).
+std::string parse_point(const std::string& text, Eigen::Vector3d& point) {
+  double v[3];
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 || !std::isfinite(v[0]) ||
+      !std::isfinite(v[1]) || !std::isfinite(v[2]))
+    return "expected x,y,z (three numbers separated by commas), got '" + text + "'";
+  point = {v[0], v[1], v[2]};
+  return {};
+}
+
+// What the command line gives, before it becomes ProbeOptions.
+struct ProbeCommandLine {
+  ProbeOptions options;
+  std::vector<std::string> tools;
+  std::string contact_model;
+  std::string precision = "f64";
+  std::string cache_dir = default_cache_directory().string();
+  bool no_disk_cache = false;
+};
 
 // Presses `tools` at once (every other scene tool absent) and fills in their answers.
 void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& options, ContactModel contact_model,
@@ -244,6 +268,62 @@ int run_probe(const ProbeOptions& options) {
   else
     print_table(model, options, contact_model, tools, timings, setup.note);
   return 0;
+}
+
+LabCommand add_probe_command(CLI::App& lab) {
+  auto line = std::make_shared<ProbeCommandLine>();
+  ProbeOptions& probe = line->options;
+  CLI::App* command = lab.add_subcommand(
+      "probe",
+      "Static reaction force at tool positions pressed into the scene's object, through the intermediate "
+      "representation (condensed M~) and the haptic force evaluator, or the full FEM solve. Prints a table, "
+      "or JSON with --json.");
+  command->add_option("--scene", probe.scene, "Scene file (YAML)")->required()->check(CLI::ExistingFile);
+  command
+      ->add_option("--tool", line->tools,
+                   "Tool position x,y,z in the scene's units; repeat for several tools pressing at once. "
+                   "Tool k takes the shape of the scene's k-th tool (the last one if there are fewer)")
+      ->required();
+  command->add_flag("--separately", probe.separately, "Press each tool alone (one solve per tool) instead of all tools at once");
+  command->add_option("--boundary-nodes", probe.boundary_nodes,
+                      "Hold the N surface nodes nearest the tools at rest (the paper's step-delay T150/T300 sets)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command->add_option("--contact-model", line->contact_model,
+                      "translation (the paper's: the triangle's nodes follow the tool) or point (the contact point "
+                      "follows it with least energy); default: the scene's")
+      ->check(CLI::IsMember({"translation", "point"}));
+  command->add_option("--ir-precision", line->precision, "Storage of M~ and u_B in the IR: f64 or f32 (inversion is always double)")
+      ->check(CLI::IsMember({"f64", "f32"}))
+      ->capture_default_str();
+  command->add_option("--patch-rings", probe.patch_rings,
+                      "Rings of neighbouring triangles in each IR's contact patch (0-4); default: the scene's")
+      ->check(CLI::Range(0, 4));
+  command->add_flag("--reference", probe.reference,
+                    "Full sparse FEM solve instead of the condensed IR (slow; the answer the IR is checked against)");
+  command->add_flag("--json", probe.json, "Print one JSON object on stdout instead of the table");
+  command->add_option("--export-vtu", probe.export_vtu, "Write the mesh with the displacement field (.vtu, for ParaView)");
+  command->add_option("--export-msh", probe.export_msh, "Write the mesh as Gmsh 4.1 ASCII (its node ids are the ones reported)");
+  command->add_option("--cache-dir", line->cache_dir, "Directory of the on-disk compliance cache")->capture_default_str();
+  command->add_flag("--no-disk-cache", line->no_disk_cache, "Neither read nor write the on-disk compliance cache");
+
+  return {command, [line] {
+            ProbeOptions options = line->options;
+            for (const std::string& text : line->tools) {
+              Eigen::Vector3d point;
+              if (const std::string problem = parse_point(text, point); !problem.empty()) {
+                fmt::print(stderr, "cohaptic-lab probe: --tool: {}\n", problem);
+                return 2;
+              }
+              options.tools.push_back(point);
+            }
+            if (!line->no_disk_cache) options.cache_directory = line->cache_dir;
+            if (!line->contact_model.empty())
+              options.contact_model = line->contact_model == "translation" ? ContactModel::node_translation
+                                                                           : ContactModel::point_constraint;
+            options.precision = line->precision == "f32" ? IrPrecision::f32 : IrPrecision::f64;
+            return run_probe(options);
+          }};
 }
 
 }  // namespace cohaptic

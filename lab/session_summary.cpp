@@ -1,8 +1,10 @@
-#include "server/session_summary.h"
+#include "lab/session_summary.h"
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include <fstream>
+#include <memory>
 
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
@@ -41,6 +43,9 @@ SessionVerdict summarize_session(const nlohmann::json& server, const std::vector
   if (number(s, {"datagrams", "rejected"}) > 0)
     problem(fmt::format("server: {} datagrams rejected", number(s, {"datagrams", "rejected"})));
   if (number(s, {"control_frames", "rejected"}) > 0) problem("server: control frames rejected");
+  if (const double failed = number(s, {"failed_steps", "count"}); failed > 0)
+    problem(fmt::format("server: {:.0f} simulation steps failed ({:.0f} in a row at most), the last with: {}", failed,
+                        number(s, {"failed_steps", "max_in_a_row"}), s["failed_steps"].value("last_error", "?")));
   if (clients.empty()) problem("no client report");
 
   for (const nlohmann::json& c : clients) {
@@ -128,6 +133,20 @@ int run_summarize(const std::filesystem::path& server_report, const std::vector<
     fmt::print("report: {}\n", out.string());
   }
   return verdict.problems.empty() ? 0 : 3;
+}
+
+LabCommand add_summarize_command(CLI::App& lab) {
+  struct SummarizeCommandLine {
+    std::filesystem::path server, out;
+    std::vector<std::filesystem::path> clients;
+  };
+  auto line = std::make_shared<SummarizeCommandLine>();
+  CLI::App* command = lab.add_subcommand(
+      "summarize", "Merge a session's server and client reports, print a table and judge its health (exit 3 if unhealthy)");
+  command->add_option("--server-report", line->server, "The server's --report")->required()->check(CLI::ExistingFile);
+  command->add_option("--client-report", line->clients, "A client's --report (repeat)")->required()->check(CLI::ExistingFile);
+  command->add_option("--out", line->out, "Write the merged report here");
+  return {command, [line] { return run_summarize(line->server, line->clients, line->out); }};
 }
 
 }  // namespace cohaptic

@@ -36,8 +36,8 @@
 #include <optional>
 #include <string>
 
-#include "client/device/haptic_device.h"
-#include "client/device/trajectory.h"
+#include "common/haptics/haptic_device.h"
+#include "common/haptics/trajectory.h"
 
 namespace cohaptic {
 

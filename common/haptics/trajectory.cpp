@@ -1,4 +1,4 @@
-#include "client/device/trajectory.h"
+#include "common/haptics/trajectory.h"
 
 #include <algorithm>
 #include <cmath>

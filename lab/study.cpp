@@ -1,5 +1,6 @@
-#include "server/study.h"
+#include "lab/study.h"
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <signal.h>
@@ -7,6 +8,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <memory>
 #include <optional>
 #include <random>
 #include <set>
@@ -20,9 +22,9 @@
 #include "common/util/error.h"
 #include "common/util/stopwatch.h"
 #include "common/util/yaml_cursor.h"
+#include "lab/child_process.h"
 #include "proto/record/recording.h"
 #include "proto/wire/vec3_convert.h"
-#include "server/child_process.h"
 
 namespace cohaptic {
 namespace {
@@ -372,10 +374,12 @@ void write_figures(const Study& study, const std::filesystem::path& out, const s
 int run_study(const std::filesystem::path& file, const StudyRunOptions& given) {
   const Study study = load_study(file);
   StudyRunOptions options = given;
-  if (options.server_program.empty()) options.server_program = std::filesystem::read_symlink("/proc/self/exe").string();
+  if (options.server_program.empty()) options.server_program = program_beside("../server/cohaptic-server").string();
   if (options.client_program.empty()) options.client_program = program_beside("../client/cohaptic-client").string();
-  if (!std::filesystem::exists(options.client_program))
-    throw Error(fmt::format("the client program {} does not exist (build it, or give --client-program)", options.client_program));
+  for (const auto& [program, option] : {std::pair{options.server_program, "--server-program"},
+                                        std::pair{options.client_program, "--client-program"}})
+    if (!std::filesystem::exists(program))
+      throw Error(fmt::format("the program {} does not exist (build it, or give {})", program, option));
   std::filesystem::create_directories(options.out);
 
   // The plan: the trials in run order; a re-run must find the same plan.
@@ -468,6 +472,24 @@ int run_study(const std::filesystem::path& file, const StudyRunOptions& given) {
   fmt::print(stderr, "{} trial(s) failed (their status in {} says why): run the study again to retry them\n",
              failed_now.size(), trials_file.string());
   return 1;
+}
+
+LabCommand add_study_command(CLI::App& lab) {
+  struct StudyCommandLine {
+    std::filesystem::path file;
+    StudyRunOptions options;
+  };
+  auto line = std::make_shared<StudyCommandLine>();
+  CLI::App* command = lab.add_subcommand(
+      "study", "Run a lab study: every trial with real server and client processes, recorded; trials.csv, summary.csv "
+               "and figures in --out (re-run to continue an interrupted study)");
+  command->add_option("file", line->file, "The study file (YAML)")->required()->check(CLI::ExistingFile);
+  command->add_option("--out", line->options.out, "Output directory")->required();
+  command->add_option("--server-program", line->options.server_program,
+                      "cohaptic-server to run (default: the one of this build)");
+  command->add_option("--client-program", line->options.client_program,
+                      "cohaptic-client to run (default: the one of this build)");
+  return {command, [line] { return run_study(line->file, line->options); }};
 }
 
 }  // namespace cohaptic

@@ -1,5 +1,7 @@
-// HapticDevice: what the haptic loop needs of a device, and how devices are named on the
-// command line.
+// HapticDevice: what a haptic loop needs of a device: the client's real-time loop
+// (client/haptic_loop.h), or an offline simulation of one (lab/stability.h). The devices
+// that are pure computation live beside it (scripted_device.h, hand_model.h); those with
+// sockets or files of a session, and their command-line names, in client/device/.
 //
 // The loop calls read() then write_force() once per tick, from the haptic thread only. An
 // implementation must return in bounded time and must not allocate or take a lock there

@@ -1,8 +1,8 @@
-// `cohaptic-server stability`: where haptic rendering stays stable, and what the
+// `cohaptic-lab stability`: where haptic rendering stays stable, and what the
 // stabilising option costs.
 //
 // The closed loop of one haptic client, in process and in model time: the hand model
-// (client/device/hand_model.h) presses a virtual wall (the plane z = 0, solid below) of
+// (common/haptics/hand_model.h) presses a virtual wall (the plane z = 0, solid below) of
 // stiffness K, 10 mm deep at 10 mm/s, holds 1.5 s and comes back. Each haptic tick (period
 // T) outputs the wall's force, zero-order held, computed from the tool position of an
 // earlier moment:
@@ -12,7 +12,7 @@
 //     the force changes only every T_s.
 // Positions exist only at ticks: a delay that is not a whole number of ticks uses the
 // latest tick at or before the moment (at 500 Hz, tau = 5 ms acts as 6 ms; the bound uses
-// 5 ms). With the passivity controller (client/passivity_controller.h) the output is
+// 5 ms). With the passivity controller (common/haptics/passivity_controller.h) the output is
 // filtered, and limited inside it.
 // A run is passive when the energy the wall gave the hand is at most 1 mJ (a sampled spring
 // leaks a few µJ; an unstable loop gives tenths of a joule), and oscillating when a force
@@ -28,8 +28,9 @@
 #include <filesystem>
 #include <vector>
 
-#include "client/device/hand_model.h"
+#include "common/haptics/hand_model.h"
 #include "common/study/force_trace.h"
+#include "lab/lab_command.h"
 
 namespace cohaptic {
 
@@ -69,5 +70,8 @@ struct StabilityOptions {
 /// Runs the map (stiffness x haptic rate x shift delay, and x step delay), with and without
 /// the passivity controller; writes DIR/stability.csv, DIR/stability.md, DIR/stability.svg.
 int run_stability(const StabilityOptions& options);
+
+/// `cohaptic-lab stability --out DIR [--hand-mass KG ...]`.
+LabCommand add_stability_command(CLI::App& lab);
 
 }  // namespace cohaptic

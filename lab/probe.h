@@ -1,4 +1,4 @@
-// `cohaptic-server probe`: the static reaction force at given tool positions, from the
+// `cohaptic-lab probe`: the static reaction force at given tool positions, from the
 // command line, through the same intermediate representation and force evaluator the
 // haptic loop uses (or the full sparse solve with --reference), with the contact it came
 // from, the IR's size and how long each stage took.
@@ -12,6 +12,7 @@
 
 #include "common/ir/intermediate_representation.h"
 #include "common/scene/scene.h"
+#include "lab/lab_command.h"
 
 namespace cohaptic {
 
@@ -32,5 +33,8 @@ struct ProbeOptions {
 
 /// Runs the probe, printing a table (or JSON) on stdout. Returns the process exit code.
 int run_probe(const ProbeOptions& options);
+
+/// `cohaptic-lab probe --scene FILE --tool X,Y,Z [...]` (README "cohaptic-lab probe").
+LabCommand add_probe_command(CLI::App& lab);
 
 }  // namespace cohaptic

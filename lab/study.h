@@ -1,4 +1,4 @@
-// `cohaptic-server study FILE --out DIR`: a lab study with simulated participants.
+// `cohaptic-lab study FILE --out DIR`: a lab study with simulated participants.
 //
 // The study file (YAML, README "Study files") names a scene, the participants (each a
 // scripted or hand-model device following a trajectory), the factors (shift_ms,
@@ -18,6 +18,8 @@
 #include <map>
 #include <string>
 #include <vector>
+
+#include "lab/lab_command.h"
 
 namespace cohaptic {
 
@@ -63,12 +65,15 @@ Study load_study(const std::filesystem::path& file);
 
 struct StudyRunOptions {
   std::filesystem::path out;
-  std::string server_program;  ///< empty: this program
+  std::string server_program;  ///< empty: cohaptic-server beside this program's build
   std::string client_program;  ///< empty: cohaptic-client beside this program's build
 };
 
 /// Runs the trials not yet in out/trials.csv (and those that failed), then writes the
 /// summary and the figures. Returns the exit code: 0, or 1 if a trial failed.
 int run_study(const std::filesystem::path& file, const StudyRunOptions& options);
+
+/// `cohaptic-lab study FILE --out DIR [--server-program P] [--client-program P]`.
+LabCommand add_study_command(CLI::App& lab);
 
 }  // namespace cohaptic

@@ -1,5 +1,6 @@
-#include "server/tradeoff.h"
+#include "lab/tradeoff.h"
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -419,6 +420,30 @@ int run_tradeoff(const TradeoffOptions& options) {
   spdlog::info("front (error against IR bytes): {}", front_names(rows, bytes_front));
   spdlog::info("wrote {}/tradeoff.csv, tradeoff.md, pareto_cpu.svg, pareto_bytes.svg", options.out.string());
   return 0;
+}
+
+LabCommand add_tradeoff_command(CLI::App& lab) {
+  auto options = std::make_shared<TradeoffOptions>();
+  CLI::App* command = lab.add_subcommand(
+      "tradeoff", "Measure what each speed/accuracy setting costs and buys on a scene, against the full solve on its "
+                  "finest mesh: tradeoff.csv, tradeoff.md and Pareto plots in --out");
+  command->add_option("--scene", options->scene, "Scene file (YAML)")->required()->check(CLI::ExistingFile);
+  command->add_option("--motion", options->motions, "Trajectory file for each scene tool, in order (repeat)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--out", options->out, "Output directory")->required();
+  command->add_option("--divisions", options->divisions, "Mesh resolutions to measure (box scenes)")->capture_default_str();
+  command->add_option("--reference-divisions", options->reference_divisions, "Resolution of the reference mesh (box scenes)")
+      ->capture_default_str()
+      ->check(CLI::Range(2, 60));
+  command->add_option("--reference-scene", options->reference_scene,
+                      "Mesh-file scenes: the same scene on a finer mesh, the reference (default: the scene itself)")
+      ->check(CLI::ExistingFile);
+  command->add_option("--sample-rate-hz", options->sample_rate_hz,
+                      "The comparison grid; haptic rates that do not divide it are left out")
+      ->capture_default_str()
+      ->check(CLI::Range(1000.0, 100000.0));
+  return {command, [options] { return run_tradeoff(*options); }};
 }
 
 }  // namespace cohaptic

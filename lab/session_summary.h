@@ -1,6 +1,8 @@
 // The summary of a networked session: the server's and the clients' JSON reports merged
-// into one, a table on stdout, and a verdict (`cohaptic-server summarize`, used by
+// into one, a table on stdout, and a verdict (`cohaptic-lab summarize`, used by
 // `make demo`). Healthy means:
+//   - the server's simulation loop ran and none of its steps failed (the report's
+//     failed_steps: the problem names the count and the last error);
 //   - every client joined, ran its haptic loop at >= 95 % of its rate, received IRs (P1)
 //     or forces (P0), touched the object, and never output a non-finite force;
 //   - no datagram or control frame was rejected (nobody else is on the demo's loopback);
@@ -18,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "lab/lab_command.h"
+
 namespace cohaptic {
 
 struct SessionVerdict {
@@ -31,5 +35,8 @@ SessionVerdict summarize_session(const nlohmann::json& server, const std::vector
 /// Reads the reports, prints the table, writes `out` (if not empty); exit code 0 if healthy.
 int run_summarize(const std::filesystem::path& server_report, const std::vector<std::filesystem::path>& client_reports,
                   const std::filesystem::path& out);
+
+/// `cohaptic-lab summarize --server-report FILE --client-report FILE... [--out FILE]`.
+LabCommand add_summarize_command(CLI::App& lab);
 
 }  // namespace cohaptic

@@ -1,4 +1,4 @@
-// `cohaptic-server replay FILE`: looking at a recorded session, re-running it, exporting it.
+// `cohaptic-lab replay FILE`: looking at a recorded session, re-running it, exporting it.
 //
 //   --summary     what is in the recording (the default)
 //   --verify      re-run the recorded inputs through the same computations and compare
@@ -15,6 +15,8 @@
 
 #include <filesystem>
 #include <string>
+
+#include "lab/lab_command.h"
 
 namespace cohaptic {
 
@@ -36,5 +38,8 @@ struct VerifyResult {
 };
 
 VerifyResult verify_recording(const std::filesystem::path& file);
+
+/// `cohaptic-lab replay FILE [--summary|--verify|--export-csv DIR]`.
+LabCommand add_replay_command(CLI::App& lab);
 
 }  // namespace cohaptic

@@ -1,4 +1,4 @@
-#include "server/child_process.h"
+#include "lab/child_process.h"
 
 #include <fcntl.h>
 #include <fmt/format.h>

@@ -9,8 +9,8 @@
 #include <Eigen/Core>
 #include <string>
 
-#include "client/device/haptic_device.h"
-#include "client/device/trajectory.h"
+#include "common/haptics/haptic_device.h"
+#include "common/haptics/trajectory.h"
 
 namespace cohaptic {
 

@@ -1,4 +1,4 @@
-#include "client/passivity_controller.h"
+#include "common/haptics/passivity_controller.h"
 
 #include <cmath>
 

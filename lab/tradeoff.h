@@ -1,4 +1,4 @@
-// `cohaptic-server tradeoff`: what each speed/accuracy setting costs and what it buys.
+// `cohaptic-lab tradeoff`: what each speed/accuracy setting costs and what it buys.
 //
 // Every setting replays one fixed workload (a scripted motion per scene tool: press, slide
 // across several triangles, release, with a second user pressing nearby) through the same
@@ -25,9 +25,10 @@
 #include <string>
 #include <vector>
 
-#include "client/device/trajectory.h"
+#include "common/haptics/trajectory.h"
 #include "common/ir/intermediate_representation.h"
 #include "common/scene/scene.h"
+#include "lab/lab_command.h"
 
 namespace cohaptic {
 
@@ -114,5 +115,8 @@ struct TradeoffOptions {
 /// Writes DIR/tradeoff.csv, DIR/tradeoff.md and DIR/pareto_cpu.svg, DIR/pareto_bytes.svg;
 /// logs a progress line per setting. Returns the exit code.
 int run_tradeoff(const TradeoffOptions& options);
+
+/// `cohaptic-lab tradeoff --scene FILE --motion FILE... --out DIR [...]`.
+LabCommand add_tradeoff_command(CLI::App& lab);
 
 }  // namespace cohaptic

@@ -1,4 +1,4 @@
-#include "client/device/scripted_device.h"
+#include "common/haptics/scripted_device.h"
 
 #include <cmath>
 #include <fmt/format.h>

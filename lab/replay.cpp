@@ -1,11 +1,13 @@
-#include "server/replay.h"
+#include "lab/replay.h"
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
 
 #include "common/model/compliance_setup.h"
 #include "common/scene/load_scene.h"
@@ -283,6 +285,18 @@ int run_replay(const ReplayOptions& options) {
                rec.config.role() == "server" ? "IRs and forces" : "forces", rec.truncated ? " (recording truncated)" : "");
   }
   return 0;
+}
+
+LabCommand add_replay_command(CLI::App& lab) {
+  auto options = std::make_shared<ReplayOptions>();
+  CLI::App* command = lab.add_subcommand("replay", "Look at a recorded session, re-run it bit for bit, or export it");
+  command->add_option("file", options->file, "A recording (.mcap) of a server or a client")->required()->check(CLI::ExistingFile);
+  command->add_flag("--summary", options->summary, "What is in it (the default)");
+  command->add_flag("--verify", options->verify,
+                    "Re-run the recorded inputs through the same computations and compare every force (and IR) bit "
+                    "for bit; exit 1 naming the first difference");
+  command->add_option("--export-csv", options->export_csv, "Write its records as CSV files in this directory");
+  return {command, [options] { return run_replay(*options); }};
 }
 
 }  // namespace cohaptic
