@@ -27,10 +27,7 @@ Simulation::Simulation(const Model& model, ComplianceColumns& columns, const std
     for (std::size_t i = 0; i < model.surface.nodes.size(); ++i)
       surface_points.col(static_cast<Eigen::Index>(i)) = model.mesh.nodes.col(model.surface.nodes[i]);
     for (const Obstacle& obstacle : model.obstacles) obstacles_.emplace_back(obstacle, surface_points);
-    rest_clearance_.assign(model.surface.nodes.size(), std::numeric_limits<double>::infinity());
-    for (std::size_t i = 0; i < model.surface.nodes.size(); ++i)
-      for (const ObstacleDistance& obstacle : obstacles_)
-        rest_clearance_[i] = std::min(rest_clearance_[i], obstacle.signed_distance(surface_points.col(static_cast<Eigen::Index>(i))));
+    clearance_ = ObstacleClearance(obstacles_, surface_points);
   }
 }
 
@@ -103,22 +100,24 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
     if (force.dot(obstacles_[held.obstacle].closest_point(at).normal) < 0) pulling.push_back(node);
   }
   // Free nodes whose displaced position penetrates an obstacle are held on it. Only nodes
-  // that can reach one are checked: rest clearance below the largest surface displacement.
+  // that may have reached one since their last query are queried (ObstacleClearance).
   const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, model_.surface.nodes);
-  const double reach = u.colwise().norm().maxCoeff();
   std::vector<std::pair<int, HeldNode>> penetrating;
   for (std::size_t i = 0; i < model_.surface.nodes.size(); ++i) {
     const int node = model_.surface.nodes[i];
-    if (rest_clearance_[i] > reach || held_.count(node) || under_tool[node] || model_.dofs.fixed_axes[node] == kAllAxes)
-      continue;
+    if (held_.count(node) || under_tool[node] || model_.dofs.fixed_axes[node] == kAllAxes) continue;
     const Eigen::Vector3d rest = model_.mesh.nodes.col(node);
     const Eigen::Vector3d moved = rest + u.col(static_cast<Eigen::Index>(i));
+    if (clearance_.certainly_clear(i, moved)) continue;
+    double clearance = std::numeric_limits<double>::infinity();
     for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
       const ObstaclePoint hit = obstacles_[o].closest_point(moved);
+      clearance = std::min(clearance, hit.signed_distance);
       if (hit.signed_distance >= 0) continue;
       penetrating.push_back({node, {hit.point - rest, o}});
       break;
     }
+    clearance_.record(i, moved, clearance);
   }
   for (int node : pulling) release(node);
   std::vector<int> joining;

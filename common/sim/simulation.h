@@ -28,6 +28,7 @@
 
 #include "common/condense/incremental_condensation.h"
 #include "common/contact/find_contact.h"
+#include "common/contact/obstacle_clearance.h"
 #include "common/contact/obstacle_distance.h"
 #include "common/ir/build_ir.h"
 #include "common/ir/evaluate_force.h"
@@ -113,7 +114,7 @@ class Simulation {
   SimulationOptions options_;
   mutable IncrementalCondensation condensation_;  // its Z cache changes on const queries
   std::vector<ObstacleDistance> obstacles_;
-  std::vector<double> rest_clearance_;            // per surface node: distance to the nearest obstacle at rest
+  ObstacleClearance clearance_;                   // per surface node: where it was last found clear of the obstacles
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
