@@ -19,7 +19,8 @@ Simulation::Simulation(const Model& model, ComplianceColumns& columns, const std
         IncrementalCondensation::Options condensation;
         condensation.naive = options.naive_every_step;
         return condensation;
-      }()) {
+      }()),
+      candidates_(model.mesh, model.surface, model.touchable_triangles) {
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
   if (!model.obstacles.empty()) {
@@ -175,12 +176,16 @@ StepReport Simulation::step(double time) {
       user.ir.reset();
       continue;
     }
-    user.contact = find_contact(model_.mesh, model_.surface, model_.normals, model_.touchable_triangles, user.position,
-                                user.radius)
+    candidates_.find(user.position, surface_candidates_, touchable_candidates_);
+    user.contact = find_contact(model_.mesh, model_.surface, model_.normals, touchable_candidates_, user.position,
+                                user.radius, surface_candidates_)
                        .contact;
     user.pressing = user.contact.has_value();
-    user.nearest = nearest_triangle(model_.mesh, model_.surface, model_.normals, model_.touchable_triangles, user.position)
-                       .triangle;
+    // A contact's triangle is the nearest touchable one, found by the same rule.
+    user.nearest = user.pressing ? user.contact->triangle
+                                 : nearest_triangle(model_.mesh, model_.surface, model_.normals, touchable_candidates_,
+                                                    user.position)
+                                       .triangle;
     for (int node : model_.surface.triangles[user.nearest]) under_tool[node] = true;
     for (int t : contact_patch(model_.surface, user.nearest, options_.ir.patch_rings, touchable))
       for (int node : model_.surface.triangles[t]) in_patch[node] = true;

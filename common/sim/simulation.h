@@ -28,6 +28,7 @@
 
 #include "common/condense/incremental_condensation.h"
 #include "common/contact/find_contact.h"
+#include "common/contact/nearest_triangle_candidates.h"
 #include "common/contact/obstacle_clearance.h"
 #include "common/contact/obstacle_distance.h"
 #include "common/ir/build_ir.h"
@@ -114,6 +115,8 @@ class Simulation {
   SimulationOptions options_;
   mutable IncrementalCondensation condensation_;  // its Z cache changes on const queries
   std::vector<ObstacleDistance> obstacles_;
+  NearestTriangleCandidates candidates_;          // the few triangles each tool's nearest-triangle scans visit
+  std::vector<int> surface_candidates_, touchable_candidates_;  // their scratch, reused step to step
   ObstacleClearance clearance_;                   // per surface node: where it was last found clear of the obstacles
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
