@@ -14,7 +14,7 @@ namespace cohaptic {
 
 /// The nodes whose compliance rows are kept: the touchable surface nodes, or the whole
 /// surface when nodes outside the touchable region can be held (obstacles, step-delay
-/// boundary nodes).
+/// boundary nodes); ordered in spatially compact solve groups (compact_groups.h).
 std::vector<int> compliance_row_nodes(const Model& model, bool whole_surface);
 
 struct ComplianceSetup {
