@@ -27,13 +27,15 @@ SimulationOptions simulation_options(const Model& model, const ServeOptions& opt
 SimulationLoop::SimulationLoop(const Model& model, ComplianceColumns& columns, const ServeOptions& options,
                                const ToolInputs& tools, LoopStatistics& statistics, DisplayWriter* display,
                                record::SessionRecorder* recorder, std::int64_t start_ns)
-    : options_(options),
+    : columns_(columns),
+      options_(options),
       tools_(tools),
       statistics_(statistics),
       display_(display),
       recorder_(recorder),
       start_ns_(start_ns),
-      simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {}
+      simulation_(model, columns, model.scene.tools, simulation_options(model, options)),
+      prefetch_(*model.free_factor, model.dofs, columns.row_nodes(), model.mesh.nodes) {}
 
 Outbox SimulationLoop::step(std::int64_t now_ns) {
   take_tools(now_ns);
@@ -58,15 +60,21 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
 }
 
 void SimulationLoop::take_tools(std::int64_t now_ns) {
+  prefetch_.deliver(columns_);
   tools_.copy_to(latest_);
   used_.assign(latest_.size(), false);
   const auto timeout = static_cast<std::int64_t>(options_.client_timeout_s * 1e9);
   for (std::size_t slot = 0; slot < latest_.size(); ++slot) {
     const ToolInput& tool = latest_[slot];
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
-    if (used_[slot]) simulation_.set_tool(static_cast<int>(slot), tool.position);
-    else simulation_.clear_tool(static_cast<int>(slot));
+    if (used_[slot]) {
+      simulation_.set_tool(static_cast<int>(slot), tool.position);
+      prefetch_.request_near(tool.position, columns_);
+    } else {
+      simulation_.clear_tool(static_cast<int>(slot));
+    }
   }
+  prefetch_.request(simulation_.nodes_near_obstacles());  // as of the previous step
 }
 
 // The new IRs: sent to their users (P1), and recorded (either protocol).
@@ -158,6 +166,7 @@ std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,
     if (next < step_end) next = step_end;  // behind: no catch-up burst
     std::this_thread::sleep_for(std::chrono::nanoseconds(next - step_end));
   }
+  prefetch_.deliver(columns_);  // so that the disk cache keeps them too
   return std::nullopt;
 }
 

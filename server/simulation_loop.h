@@ -1,6 +1,8 @@
 // SimulationLoop: the server's simulation thread. Each step
 //   1. copies the latest tool samples (ToolInputs) and gives the simulation those that
-//      are fresh (a tool silent for --client-timeout is released);
+//      are fresh (a tool silent for --client-timeout is released); takes in the compliance
+//      columns solved ahead, and asks for those near the tools and the obstacles
+//      (CompliancePrefetch);
 //   2. steps the Simulation: contacts, active sets, M~ when a set changed;
 //   3. fills the step's Outbox: the new IRs (P1), the IR keep-alives (P1, every
 //      kKeepAlivePeriod_ns), the forces (P0);
@@ -12,7 +14,8 @@
 // throws releases every tool and is counted, and logged at a paced rate (StepFailures);
 // kMaxConsecutiveStepFailures in a row end the loop with the reason.
 // The loop owns the Simulation (the mutable state); the model is shared read-only, the
-// compliance columns are filled in on demand by this thread alone. Times: ns of
+// compliance columns are filled in by this thread alone (the prefetch worker solves into
+// its own, handed over at the start of a step). Times: ns of
 // wire::monotonic_now_ns(); simulation time in s from the server's start.
 #pragma once
 
@@ -27,6 +30,7 @@
 #include "common/model/model.h"
 #include "common/sim/simulation.h"
 #include "proto/record/session_recorder.h"
+#include "server/compliance_prefetch.h"
 #include "server/display_writer.h"
 #include "server/loop_statistics.h"
 #include "server/outbox.h"
@@ -68,6 +72,7 @@ class SimulationLoop {
   bool solve_display_frame(std::int64_t now_ns);
   double seconds_since_start(std::int64_t ns) const { return static_cast<double>(ns - start_ns_) * 1e-9; }
 
+  ComplianceColumns& columns_;
   const ServeOptions& options_;
   const ToolInputs& tools_;
   LoopStatistics& statistics_;
@@ -78,6 +83,7 @@ class SimulationLoop {
   StepFailures failures_;
   std::vector<ToolInput> latest_;  // this step's copy of the tool inputs
   std::vector<bool> used_;         // per slot: fresh, given to the simulation
+  CompliancePrefetch prefetch_;
   std::int64_t last_keep_alive_ns_ = 0, last_display_ns_ = 0;
 };
 

@@ -55,7 +55,7 @@ TEST(ObstacleClearance, PointsItSkipsAreClearOfEveryObstacleAndItSkipsMost) {
       } else {
         ++queried;
         penetrating += truth < 0;
-        clearance.record(slot, next, truth);
+        clearance.record(slot, next, truth, Vector3d::UnitZ());
       }
     }
   }
@@ -72,10 +72,30 @@ TEST(ObstacleClearance, APenetratingOrTouchingPointIsAlwaysQueried) {
   ObstacleClearance clearance(obstacles, rest);
   EXPECT_TRUE(clearance.certainly_clear(0, Vector3d(0, 0, 0.5)));
   EXPECT_FALSE(clearance.certainly_clear(0, Vector3d(0, 0, 0)));  // moved by the whole radius
-  clearance.record(0, Vector3d(0, 0, -0.1), -0.1);
+  clearance.record(0, Vector3d(0, 0, -0.1), -0.1, Vector3d::UnitZ());
   EXPECT_FALSE(clearance.certainly_clear(0, Vector3d(0, 0, -0.1)));
-  clearance.record(0, Vector3d(0, 0, 0), 0.0);
+  clearance.record(0, Vector3d(0, 0, 0), 0.0, Vector3d::UnitZ());
   EXPECT_FALSE(clearance.certainly_clear(0, Vector3d(0, 0, 0)));
+}
+
+TEST(ObstacleClearance, EstimatesThePlanesDistanceExactlyAndTheSpheresToSecondOrder) {
+  const Eigen::Matrix3Xd rest = (Eigen::Matrix3Xd(3, 2) << 0, 0, 0, 0, 0.5, 0.6).finished();  // (0, 0, 0.5), (0, 0, 0.6)
+  std::vector<ObstacleDistance> plane;
+  plane.emplace_back(Obstacle{"floor", {}, std::pair{Vector3d(0, 0, 0.2), Vector3d(0, 0, 1)}}, rest);
+  const ObstacleClearance flat(plane, rest);
+  for (const Vector3d& p : {Vector3d(0.3, -0.1, 0.25), Vector3d(-1, 2, 0.9), Vector3d(0, 0, 0.1)})
+    EXPECT_NEAR(flat.estimate(0, p), p.z() - 0.2, 1e-15);
+
+  // Inside a unit ball (finely faceted): d = 1 - |p|, so moving sideways by s from the
+  // anchor overestimates d by about s^2 / (2 |p|), under s^2 here.
+  std::vector<ObstacleDistance> ball;
+  ball.emplace_back(Obstacle{"ball", testing::make_icosphere(5, 1.0), std::nullopt}, rest);
+  const ObstacleClearance round(ball, rest);
+  for (double s : {0.01, 0.05, 0.1}) {
+    const Vector3d p(s, 0, 0.6 - s);  // sideways and towards the wall
+    const double truth = ball[0].signed_distance(p);
+    EXPECT_NEAR(round.estimate(1, p), truth, s * s + 3e-3) << "step " << s;  // 3e-3: the faceting
+  }
 }
 
 }  // namespace

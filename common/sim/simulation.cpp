@@ -103,22 +103,26 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
   // Free nodes whose displaced position penetrates an obstacle are held on it. Only nodes
   // that may have reached one since their last query are queried (ObstacleClearance).
   const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, model_.surface.nodes);
+  near_obstacles_.clear();  // as of this pass's state
   std::vector<std::pair<int, HeldNode>> penetrating;
   for (std::size_t i = 0; i < model_.surface.nodes.size(); ++i) {
     const int node = model_.surface.nodes[i];
     if (held_.count(node) || under_tool[node] || model_.dofs.fixed_axes[node] == kAllAxes) continue;
     const Eigen::Vector3d rest = model_.mesh.nodes.col(node);
     const Eigen::Vector3d moved = rest + u.col(static_cast<Eigen::Index>(i));
+    if (const double estimate = clearance_.estimate(i, moved);
+        estimate < options_.near_obstacle_distance && !columns_.has_column(node))
+      near_obstacles_.push_back({node, estimate});
     if (clearance_.certainly_clear(i, moved)) continue;
-    double clearance = std::numeric_limits<double>::infinity();
+    ObstaclePoint nearest{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), std::numeric_limits<double>::infinity(), -1};
     for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
       const ObstaclePoint hit = obstacles_[o].closest_point(moved);
-      clearance = std::min(clearance, hit.signed_distance);
+      if (hit.signed_distance < nearest.signed_distance) nearest = hit;
       if (hit.signed_distance >= 0) continue;
       penetrating.push_back({node, {hit.point - rest, o}});
       break;
     }
-    clearance_.record(i, moved, clearance);
+    clearance_.record(i, moved, nearest.signed_distance, nearest.normal);
   }
   for (int node : pulling) release(node);
   std::vector<int> joining;

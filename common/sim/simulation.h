@@ -42,9 +42,18 @@ struct SimulationOptions {
   IrBuildOptions ir;
   int step_delay_nodes = 0;     ///< N surface nodes held while any tool presses (0: none)
   int obstacle_iterations = 4;  ///< active-set passes per step
+  /// Free surface nodes about this close to an obstacle are listed by
+  /// nodes_near_obstacles() [m].
+  double near_obstacle_distance = 0.001;
   /// Compute every M~ from scratch (naive condensation) at every step, as the paper's
   /// conventional simulation loop did: the step delay of large boundary sets then shows.
   bool naive_every_step = false;
+};
+
+/// A node and an estimate of its distance to something [m].
+struct NodeDistance {
+  int node = -1;
+  double distance = 0;
 };
 
 struct StepReport {
@@ -83,6 +92,13 @@ class Simulation {
   /// Displacement of `nodes` (row nodes) in the current state [m].
   Eigen::Matrix3Xd displacement_of(std::span<const int> nodes) const;
 
+  /// Free surface nodes without compliance columns yet that were about (to first order,
+  /// ObstacleClearance::estimate) options.near_obstacle_distance or less from an obstacle
+  /// in the last step's last obstacle pass, with that estimate: should one reach the
+  /// obstacle, the step that holds it solves its columns first. A caller may have them
+  /// solved ahead (the server's CompliancePrefetch).
+  const std::vector<NodeDistance>& nodes_near_obstacles() const { return near_obstacles_; }
+
   const IncrementalCondensation& condensation() const { return condensation_; }
   /// u of each node of condensation().boundary_nodes(), in that order [m].
   std::vector<Eigen::Vector3d> boundary_displacement() const;
@@ -118,6 +134,7 @@ class Simulation {
   NearestTriangleCandidates candidates_;          // the few triangles each tool's nearest-triangle scans visit
   std::vector<int> surface_candidates_, touchable_candidates_;  // their scratch, reused step to step
   ObstacleClearance clearance_;                   // per surface node: where it was last found clear of the obstacles
+  std::vector<NodeDistance> near_obstacles_;      // see nodes_near_obstacles()
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
