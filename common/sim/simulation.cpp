@@ -20,7 +20,9 @@ Simulation::Simulation(const Model& model, ComplianceColumns& columns, const std
         condensation.naive = options.naive_every_step;
         return condensation;
       }()),
-      candidates_(model.mesh, model.surface, model.touchable_triangles) {
+      candidates_(model.mesh, model.surface, model.touchable_triangles),
+      touchable_triangle_(model.surface.triangles.size(), false) {
+  for (int t : model.touchable_triangles) touchable_triangle_[t] = true;
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
   if (!model.obstacles.empty()) {
@@ -167,11 +169,14 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
 
 StepReport Simulation::step(double time) {
   StepReport report;
-  std::vector<UserTool> tools;
-  std::vector<bool> under_tool(static_cast<std::size_t>(model_.mesh.node_count()), false);
-  std::vector<bool> in_patch(under_tool.size(), false);
-  std::vector<bool> touchable(model_.surface.triangles.size(), false);
-  for (int t : model_.touchable_triangles) touchable[t] = true;
+  // The step's scratch lives in the simulation, so that a step allocates no more than its
+  // mathematics does.
+  std::vector<UserTool>& tools = step_tools_;
+  std::vector<bool>& under_tool = under_tool_;
+  std::vector<bool>& in_patch = in_patch_;
+  tools.clear();
+  under_tool.assign(static_cast<std::size_t>(model_.mesh.node_count()), false);
+  in_patch.assign(under_tool.size(), false);
   for (std::size_t u = 0; u < users_.size(); ++u) {
     UserState& user = users_[u];
     if (!user.known) {
@@ -191,11 +196,13 @@ StepReport Simulation::step(double time) {
                                                     user.position)
                                        .triangle;
     for (int node : model_.surface.triangles[user.nearest]) under_tool[node] = true;
-    for (int t : contact_patch(model_.surface, user.nearest, options_.ir.patch_rings, touchable))
-      for (int node : model_.surface.triangles[t]) in_patch[node] = true;
+    if (options_.step_delay_nodes > 0)  // only step-delay nodes are chosen outside the patches
+      for (int t : contact_patch(model_.surface, user.nearest, options_.ir.patch_rings, touchable_triangle_))
+        for (int node : model_.surface.triangles[t]) in_patch[node] = true;
     tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest});
   }
-  std::vector<int> nearest;
+  std::vector<int>& nearest = step_nearest_;
+  nearest.clear();
   for (const UserState& user : users_) nearest.push_back(user.known ? user.nearest : -1);
 
   Stopwatch watch;

@@ -133,12 +133,17 @@ class Simulation {
   std::vector<ObstacleDistance> obstacles_;
   NearestTriangleCandidates candidates_;          // the few triangles each tool's nearest-triangle scans visit
   std::vector<int> surface_candidates_, touchable_candidates_;  // their scratch, reused step to step
+  std::vector<bool> touchable_triangle_;          // per surface triangle
   ObstacleClearance clearance_;                   // per surface node: where it was last found clear of the obstacles
   std::vector<NodeDistance> near_obstacles_;      // see nodes_near_obstacles()
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
   std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
+  // step()'s scratch: the known tools, their nearest triangles, the nodes under them and in their patches.
+  std::vector<UserTool> step_tools_;
+  std::vector<int> step_nearest_;
+  std::vector<bool> under_tool_, in_patch_;
   bool boundary_dirty_ = false;
 };
 
