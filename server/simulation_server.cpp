@@ -107,7 +107,7 @@ struct SimulationServer::Impl {
     }
     if (!options.record.empty()) {
       recorder = std::make_unique<record::SessionRecorder>(options.record);
-      recorder->config(server_session_config(options, *model, scene_yaml, session_id, wire::monotonic_now_ns()));
+      recorder->config(server_session_config(options, *model, scene_yaml, session_id, start_ns));
       spdlog::info("recording to {}", options.record.string());
     }
     if (options.view) {
