@@ -50,7 +50,8 @@ bool same_secret(const std::string& a, const std::string& b) {
 
 struct ViewServer::Impl {
   struct Browser {
-    std::array<std::uint64_t, kChannels> sent{};  // newest sequence sent, per channel
+    std::array<std::uint64_t, kChannels> sent{};       // newest sequence sent, per channel
+    std::array<std::uint64_t, kChannels> accounted{};  // sent or counted as dropped up to here
   };
 
   ViewServerOptions options;
@@ -137,7 +138,12 @@ struct ViewServer::Impl {
   }
 
   void opened(connection_hdl hdl) {
-    browsers[hdl] = Browser{};
+    Browser& browser = browsers[hdl];
+    {
+      std::lock_guard lock(mutex);  // what was published before it came is not its loss
+      for (std::size_t channel = 0; channel < kChannels; ++channel)
+        browser.accounted[channel] = sequence[channel] > 0 ? sequence[channel] - 1 : 0;
+    }
     count([this](ViewCounters& c) {
       ++c.connections;
       c.browsers = static_cast<int>(browsers.size());
@@ -184,13 +190,16 @@ struct ViewServer::Impl {
       if (error) continue;
       for (std::size_t channel = 0; channel < kChannels; ++channel) {
         if (!messages[channel] || browser.sent[channel] == sequences[channel]) continue;
-        const bool first = browser.sent[channel] == 0;
+        // Everything older than the newest that it has not had, it never will.
+        if (sequences[channel] - 1 > browser.accounted[channel]) {
+          dropped += sequences[channel] - 1 - browser.accounted[channel];
+          browser.accounted[channel] = sequences[channel] - 1;
+        }
         if (channel != static_cast<std::size_t>(Channel::scene) && connection->get_buffered_amount() > options.max_buffered_bytes)
           continue;  // caught up later, with whatever is newest then
-        if (!first) dropped += sequences[channel] - browser.sent[channel] - 1;
         error = connection->send(*messages[channel], websocketpp::frame::opcode::binary);
         if (error) break;
-        browser.sent[channel] = sequences[channel];
+        browser.sent[channel] = browser.accounted[channel] = sequences[channel];
         ++sent;
         bytes += messages[channel]->size();
       }

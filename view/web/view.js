@@ -42,6 +42,8 @@ function colourOf(t, out, offset) {
   for (let c = 0; c < 3; ++c) out[offset + c] = (COLOUR_STOPS[i][c] * (1 - f) + COLOUR_STOPS[i + 1][c] * f) / 255;
 }
 
+// protobufjs gives 64-bit integers as {low, high} objects.
+const num = (x) => (typeof x === 'object' && x !== null ? x.high * 4294967296 + (x.low >>> 0) : Number(x));
 const norm3 = (v) => (v && v.length === 3 ? Math.hypot(v[0], v[1], v[2]) : 0);
 const fmt = (x, digits) => (Number.isFinite(x) ? x.toFixed(digits) : '–');
 
@@ -51,7 +53,7 @@ class View {
   constructor(schema) {
     this.schema = schema;
     this.state = {
-      connected: false, scene: null, replay: false, framesReceived: 0, framesDrawn: 0, frame: null,
+      connected: false, frozen: false, softwareRenderer: false, scene: null, replay: false, framesReceived: 0, framesDrawn: 0, frame: null,
       status: {}, timeline: null, drawFps: 0, messageBytes: 0, displacementScaleMm: 0.1, closedReason: '',
     };
     this.history = new Map();  // slot -> [{t, f}] (live: from frames)
@@ -65,13 +67,20 @@ class View {
 
   setUpRenderer() {
     this.canvas = $('canvas');
-    this.renderer = new THREE.WebGLRenderer({ canvas: this.canvas, antialias: true, preserveDrawingBuffer: true });
+    // Multisampling is nearly free on a graphics card but costs a software renderer (a headless
+    // browser's SwiftShader) most of its time: only with a card.
+    const probe = document.createElement('canvas').getContext('webgl2');
+    const info = probe && probe.getExtension('WEBGL_debug_renderer_info');
+    this.state.softwareRenderer = !!(info && /swiftshader|llvmpipe/i.test(probe.getParameter(info.UNMASKED_RENDERER_WEBGL)));
+    this.renderer = new THREE.WebGLRenderer({ canvas: this.canvas, antialias: !this.state.softwareRenderer, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(window.devicePixelRatio);
     this.scene3d = new THREE.Scene();
     this.scene3d.background = new THREE.Color(0x15171c);
     this.camera = new THREE.PerspectiveCamera(40, 1, 0.1, 1e5);
     this.camera.up.set(0, 0, 1);
     this.orbit = new OrbitControls(this.camera, this.canvas);
+    // Drawn only when something changed (a frame, the camera, the window): an idle page costs nothing.
+    this.orbit.addEventListener('change', () => { this.needsRender = true; });
     this.scene3d.add(new THREE.HemisphereLight(0xffffff, 0x404050, 1.6));
     this.light = new THREE.DirectionalLight(0xffffff, 1.4);
     this.scene3d.add(this.light);
@@ -85,6 +94,7 @@ class View {
     this.renderer.setSize(w, h, false);
     this.camera.aspect = w / Math.max(h, 1);
     this.camera.updateProjectionMatrix();
+    this.needsRender = true;
   }
 
   setUpControls() {
@@ -100,6 +110,7 @@ class View {
       const key = e.key.toLowerCase();
       if (key === 'r') this.resetCamera();
       else if (key === 'o') this.toggleObstacles();
+      else if (key === 'f') this.frozen = !this.frozen;
       else if (!this.state.replay || !t) return;
       else if (e.key === ' ') send(t.playing ? { pause: {} } : { play: {} });
       else if (e.key === 'ArrowLeft' || e.key === 'ArrowRight')
@@ -255,11 +266,13 @@ class View {
     this.camera.updateProjectionMatrix();
     this.orbit.target.copy(centre);
     this.orbit.update();
+    this.needsRender = true;
   }
 
   toggleObstacles() {
     this.showObstacles = !this.showObstacles;
     if (this.obstacleGroup) this.obstacleGroup.visible = this.showObstacles;
+    this.needsRender = true;
   }
 
   buildPanel() {
@@ -298,7 +311,10 @@ class View {
   }
 
   setStatus(status) {
-    for (const s of status.users) this.state.status[s.slot] = { user: s.user, receivedTime: s.received_time, ...s.figures };
+    for (const s of status.users) {
+      const f = s.figures || {};
+      this.state.status[s.slot] = { user: s.user, receivedTime: s.received_time, ...f, missed_deadlines: num(f.missed_deadlines), ticks: num(f.ticks) };
+    }
     for (const user of this.users || []) this.showStatus(user);
   }
 
@@ -312,7 +328,7 @@ class View {
     if (!s) return;
     cell('haptic_rate_hz').textContent = `${fmt(s.haptic_rate_hz, 1)} Hz`;
     cell('period_p99_us').textContent = `${fmt(s.period_p99_us, 0)} µs (${fmt(s.timer_floor_p99_us, 0)} µs)`;
-    cell('missed_deadlines').textContent = `${Number(s.missed_deadlines)}`;
+    cell('missed_deadlines').textContent = `${num(s.missed_deadlines)}`;
     cell('ir_age_p99_ms').textContent = `${fmt(s.ir_age_p99_ms, 1)} ms`;
     cell('one_way_delay_p99_ms').textContent = `${fmt(s.one_way_delay_p99_ms, 2)} ms`;
     cell('peak_force').textContent = `${fmt(s.peak_force, 3)} N${s.final ? ' (final)' : ''}`;
@@ -401,7 +417,7 @@ class View {
     const boundary = frame.boundary_nodes;
     $('frame-info').textContent = `t = ${fmt(frame.time, 2)} s · simulation ${fmt(frame.sim_rate_hz, 0)} steps/s · |B| = ${boundary}`;
     this.state.frame = {
-      time: frame.time, sequence: Number(frame.sequence), boundaryNodes: boundary, heldShown: frame.held_nodes.length,
+      time: frame.time, sequence: num(frame.sequence), boundaryNodes: boundary, heldShown: frame.held_nodes.length,
       simRateHz: frame.sim_rate_hz, maxDisplacementMm: largest * 1e3,
     };
   }
@@ -485,7 +501,7 @@ class View {
   draw(time) {
     requestAnimationFrame((t) => this.draw(t));
     if (!this.surface) return;
-    if (this.pendingFrame) {
+    if (this.pendingFrame && !this.frozen) {
       const frame = this.pendingFrame;
       this.pendingFrame = null;
       this.applyFrame(frame);
@@ -493,10 +509,12 @@ class View {
       this.drawTimes = (this.drawTimes || []).filter((t) => t > time - 2000).concat([time]);
       this.state.drawFps = this.drawTimes.length > 1 ? (this.drawTimes.length - 1) / ((time - this.drawTimes[0]) / 1000) : 0;
       for (const user of this.users) this.drawChart(user, frame.time);
+      this.needsRender = true;
     }
+    if (!this.needsRender) return;
+    this.needsRender = false;
     this.light.position.copy(this.camera.position);
     this.light.target.position.copy(this.orbit.target);
-    this.orbit.update();
     this.renderer.render(this.scene3d, this.camera);
     this.placeLabels();
   }
@@ -521,6 +539,7 @@ class View {
     const rect = this.canvas.getBoundingClientRect();
     return {
       ...this.state,
+      frozen: !!this.frozen,
       canvas: { x: rect.left, y: rect.top, width: rect.width, height: rect.height },
       meshScreenBox: box ? this.screenBox(corners) : null,
       meshTriangles: this.surface ? this.surface.geometry.index.count / 3 : 0,
@@ -542,4 +561,5 @@ const view = new View(schema);
 window.cohapticView = {
   snapshot: () => view.snapshot(),
   command: (body) => view.send(body),
+  freeze: (on) => { view.frozen = on; },
 };
