@@ -39,7 +39,7 @@ ReplayPlayer::ReplayPlayer(const record::Recording& recording)
     for (const Frame& frame : frames_)
       for (const UserFrame& user : frame.users())
         if (user.slot() == tool.slot()) {
-          series->add_times(static_cast<float>(frame.time()));
+          series->add_times(frame.time());
           series->add_magnitudes(static_cast<float>(force_norm(user)));
         }
   }

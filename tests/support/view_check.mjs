@@ -68,7 +68,7 @@ try {
     await page.evaluate((t) => window.cohapticView.command({ seek: t }), target);
     result.after = await waitFor(`the frame at ${target} s`,
       (s) => s.timeline && Math.abs(s.timeline.time - target) < 1e-6 && s.frame && s.frame.time <= target + 1e-6 &&
-        s.users.every((u) => u.chart));
+        target - s.frame.time < 1.5 / s.scene.frameRateHz && s.users.every((u) => u.chart));
   }
   await page.evaluate(() => window.cohapticView.freeze(true));
   await page.waitForTimeout(300);  // the frame being drawn lands

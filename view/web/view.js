@@ -258,9 +258,13 @@ class View {
 
   resetCamera() {
     if (!this.box) return;
+    // From behind, to the left and above (the brain's surgeons work at its back), far enough
+    // for the object's bounding sphere to fit the narrower of the two fields of view.
     const centre = this.box.getCenter(new THREE.Vector3());
-    const distance = this.size * 1.25;
-    this.camera.position.copy(centre).add(new THREE.Vector3(-0.6, -1, 0.25).normalize().multiplyScalar(distance));
+    const halfFov = THREE.MathUtils.degToRad(this.camera.fov / 2);
+    const narrowest = Math.min(halfFov, Math.atan(Math.tan(halfFov) * this.camera.aspect));
+    const distance = (this.size / 2 / Math.sin(narrowest)) * 1.05;
+    this.camera.position.copy(centre).add(new THREE.Vector3(-0.5, -1, 0.55).normalize().multiplyScalar(distance));
     this.camera.near = this.size / 200;
     this.camera.far = this.size * 20;
     this.camera.updateProjectionMatrix();
