@@ -54,6 +54,7 @@ class LiveView {
   void start() { server_.start(); }
   void stop() { server_.stop(); }
   std::string url() const { return server_.url(); }
+  std::uint16_t port() const { return server_.port(); }
   ViewCounters counters() const { return server_.counters(); }
 
   /// The nodes whose displacement publish_frame() expects, in order.

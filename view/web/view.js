@@ -485,7 +485,8 @@ class View {
       ctx.lineWidth = devicePixelRatio;
       ctx.beginPath();
       s.times.forEach((t, i) => {
-        const x = ((t - start) / span) * canvas.width, y = canvas.height * (1 - 0.9 * (s.magnitudes[i] / top)) - 12 * devicePixelRatio;
+        // Above the slider's track, which takes the lowest 16 px.
+        const x = ((t - start) / span) * canvas.width, y = 2 + (canvas.height - 18 * devicePixelRatio) * (1 - s.magnitudes[i] / top);
         if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y);
       });
       ctx.stroke();
