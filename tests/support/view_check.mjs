@@ -3,13 +3,16 @@
 // and what a screenshot of it holds. tests/test_view.cpp runs it and judges the result.
 //
 //   node view_check.mjs --url URL --screenshot FILE.png [--seek SECONDS | --jump peak | --final 1]
-//                       [--width W --height H]
+//                       [--min-force N] [--stay SECONDS] [--focus-tools 1] [--width W --height H]
 //
 // Live: waits for frames with every tool present, takes the page's state, waits 1.5 s and
 // takes it again (the strip chart must have moved on), freezes the drawing, takes a third
 // state and a screenshot of that same picture. With --seek (a recording): asks the page to
 // seek there and waits until the frame shown is the one at that time; with --jump peak, to
-// jump to the largest force. With --final: waits until every user's status panel shows its
+// jump to the largest force. Live with --min-force (instead of the two looks): the
+// screenshot waits until every tool presses with at least N newtons; --stay keeps the page open and drawing that long after
+// the screenshot (make demo's watching browser); --focus-tools moves the camera close to
+// the tools first (the page's T key). With --final: waits until every user's status panel shows its
 // final report (its client has finished).
 // Pixels: the screenshot is decoded by the browser itself (an <img> drawn on a 2-D canvas)
 // and counted: non-background pixels inside the projected box of the mesh, pixels of each
@@ -58,6 +61,9 @@ try {
     await page.evaluate(() => window.cohapticView.command({ jump: 1 }));
     result.after = await waitFor('the frame of the largest force',
       (s) => s.timeline && s.timeline.time === s.timeline.peakForceTime && s.frame && s.frame.time === s.timeline.time);
+  } else if (args['min-force'] !== undefined) {
+    result.after = await waitFor(`every tool pressing with at least ${args['min-force']} N`,
+      (s) => everyToolPresent(s) && s.users.every((u) => u.pressing && u.forceMagnitude >= Number(args['min-force'])), 120);
   } else if (args.seek === undefined) {
     result.before = await waitFor('frames with every tool present', (s) => everyToolPresent(s) && s.users.every((u) => u.chart));
     await page.waitForTimeout(1500);
@@ -70,6 +76,7 @@ try {
       (s) => s.timeline && Math.abs(s.timeline.time - target) < 1e-6 && s.frame && s.frame.time <= target + 1e-6 &&
         target - s.frame.time < 1.5 / s.scene.frameRateHz && s.users.every((u) => u.chart));
   }
+  if (args['focus-tools'] !== undefined) await page.keyboard.press('t');
   await page.evaluate(() => window.cohapticView.freeze(true));
   await page.waitForTimeout(300);  // the frame being drawn lands
   result.shown = await snapshot();
@@ -124,6 +131,12 @@ try {
     });
     return { mesh, corner: outside, users };
   }, { data: png.toString('base64'), shown: result.shown });
+  if (args.stay !== undefined) {
+    // Watching on, drawing every frame, for as long as asked (the demo's browser).
+    await page.evaluate(() => window.cohapticView.freeze(false));
+    await page.waitForTimeout(Number(args.stay) * 1000);
+    result.stayed = await snapshot();
+  }
 } catch (e) {
   result.error = e.message;
 }

@@ -111,6 +111,7 @@ class View {
       if (key === 'r') this.resetCamera();
       else if (key === 'o') this.toggleObstacles();
       else if (key === 'f') this.frozen = !this.frozen;
+      else if (key === 't') this.focusTools();
       else if (!this.state.replay || !t) return;
       else if (e.key === ' ') send(t.playing ? { pause: {} } : { play: {} });
       else if (e.key === 'ArrowLeft' || e.key === 'ArrowRight')
@@ -269,6 +270,18 @@ class View {
     this.camera.far = this.size * 20;
     this.camera.updateProjectionMatrix();
     this.orbit.target.copy(centre);
+    this.orbit.update();
+    this.needsRender = true;
+  }
+
+  // Closer, at the present tools' midpoint, looking from where the camera is.
+  focusTools() {
+    const present = (this.users || []).filter((u) => u.present && u.position);
+    if (!present.length) return;
+    const middle = present.reduce((sum, u) => sum.add(u.position), new THREE.Vector3()).multiplyScalar(1 / present.length);
+    const direction = this.camera.position.clone().sub(this.orbit.target).normalize();
+    this.orbit.target.copy(middle);
+    this.camera.position.copy(middle).add(direction.multiplyScalar(this.size * 0.45));
     this.orbit.update();
     this.needsRender = true;
   }
