@@ -76,9 +76,9 @@ Fixture& fixture(int boundary_nodes) {
       {1, f.remote, 0, nearest_touchable_triangle(model, f.remote)}};
   for (const UserTool& tool : tools)
     for (int node : model.surface.triangles[tool.nearest_triangle]) reserved[node] = true;
-  f.boundary = nearest_surface_nodes(model, std::vector<Eigen::Vector3d>{f.own}, boundary_nodes, reserved);
+  f.boundary = nearest_surface_nodes(model.mesh, model.surface, model.dofs, std::vector<Eigen::Vector3d>{f.own}, boundary_nodes, reserved);
   for (int node : f.boundary) reserved[node] = true;
-  f.spare = nearest_surface_nodes(model, std::vector<Eigen::Vector3d>{f.own}, 8, reserved);
+  f.spare = nearest_surface_nodes(model.mesh, model.surface, model.dofs, std::vector<Eigen::Vector3d>{f.own}, 8, reserved);
 
   IncrementalCondensation condensation(*f.columns, model.dofs);
   condensation.set_boundary_nodes(f.boundary);

@@ -138,7 +138,7 @@ TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
   for (int v : model.surface.triangles[user.nearest_triangle]) under_tool[v] = true;
   IncrementalCondensation condensation(*rig.columns, model.dofs);
   const std::vector<Eigen::Vector3d> around = {tool};
-  std::vector<int> held = nearest_surface_nodes(model, around, 200, under_tool);
+  std::vector<int> held = nearest_surface_nodes(model.mesh, model.surface, model.dofs, around, 200, under_tool);
   held.erase(held.begin(), held.begin() + 20);  // leave the patch's neighbourhood free
   condensation.set_boundary_nodes(held);
   std::mt19937 rng(3);

@@ -6,10 +6,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <limits>
 
 #include "common/condense/naive_condensation.h"
 #include "common/contact/closest_point_on_triangle.h"
+#include "common/contact/nearest_triangle_rule.h"
 #include "common/contact/surface_distance.h"
 #include "common/util/error.h"
 
@@ -35,25 +35,13 @@ struct PatchPoint {
 PatchPoint nearest_on_patch(const PreparedIR& prepared, const Eigen::Vector3d& p) {
   const IntermediateRepresentation& ir = prepared.ir;
   PatchPoint best;
-  double best_distance2 = std::numeric_limits<double>::infinity();
-  double best_height = std::numeric_limits<double>::infinity();
+  NearestTriangleRule rule;  // on the patch's surface indices: the server's choice (find_contact.h)
   for (int t = 0; t < static_cast<int>(ir.patch.size()); ++t) {
     const IrTriangle& tri = ir.patch[t];
     const TriangleClosestPoint q = closest_point_on_triangle(p, ir.rest_positions.col(tri.nodes[0]),
                                                              ir.rest_positions.col(tri.nodes[1]),
                                                              ir.rest_positions.col(tri.nodes[2]));
-    const double d2 = (p - q.point).squaredNorm();
-    const double height = (p - q.point).dot(tri.normal);
-    // Ties (an edge or vertex shared by several triangles) go to the triangle the tool is
-    // deepest below, then to the lower surface index: the server's rule (find_contact.h).
-    const double tie = 1e-24 + 1e-12 * best_distance2;
-    const bool same_distance = std::abs(d2 - best_distance2) <= tie;
-    const bool deeper = height < best_height - 1e-15 * std::abs(best_height);
-    const bool same_height = !deeper && height <= best_height + 1e-15 * std::abs(best_height);
-    if (best.triangle < 0 || d2 < best_distance2 - tie ||
-        (same_distance && (deeper || (same_height && tri.surface_index < ir.patch[best.triangle].surface_index)))) {
-      best_distance2 = std::min(d2, best_distance2);
-      best_height = height;
+    if (rule.offer((p - q.point).squaredNorm(), (p - q.point).dot(tri.normal), tri.surface_index)) {
       best.triangle = t;
       best.closest = q;
     }
@@ -71,11 +59,11 @@ PatchPoint nearest_on_patch(const PreparedIR& prepared, const Eigen::Vector3d& p
   best.height = (p - best.closest.point).dot(normal);
 
   // Beyond the rim the guard ring decides the side, with its faces' normals.
-  double guard_distance2 = best_distance2;
+  double guard_distance2 = rule.distance2();
   for (const IrGuardTriangle& guard : ir.guard) {
     const TriangleClosestPoint q = closest_point_on_triangle(p, guard.corners[0], guard.corners[1], guard.corners[2]);
     const double d2 = (p - q.point).squaredNorm();
-    if (d2 < guard_distance2 * (1 - 1e-12) - 1e-24) {
+    if (strictly_nearer(d2, guard_distance2)) {
       guard_distance2 = d2;
       best.height = (p - q.point).dot(guard.normal);
       best.on_border = true;

@@ -9,26 +9,19 @@
 #pragma once
 
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
+#include "common/contact/obstacle.h"
 #include "common/contact/surface_distance.h"
 #include "common/fem/assemble_stiffness.h"
 #include "common/fem/dof_map.h"
 #include "common/fem/sparse_cholesky.h"
 #include "common/mesh/boundary_surface.h"
 #include "common/mesh/mesh_checks.h"
-#include "common/mesh/triangle_surface.h"
 #include "common/scene/scene.h"
 
 namespace cohaptic {
-
-struct Obstacle {
-  std::string name;
-  TriangleSurface surface;  ///< [m]; empty for a plane
-  std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> plane;  ///< point [m], unit normal
-};
 
 struct ModelBuildTimings {
   double mesh_ms = 0;      ///< read or generate, check, extract the surface

@@ -142,7 +142,7 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
   for (const auto& [node, held] : held_) step_delay_held |= held.obstacle < 0;
   if (options_.step_delay_nodes > 0 && !contact_points.empty() && !step_delay_held) {
     // Chosen outside every user's patch, so that the patches keep their triangles.
-    const std::vector<int> nodes = nearest_surface_nodes(model_, contact_points, options_.step_delay_nodes, in_patch);
+    const std::vector<int> nodes = nearest_surface_nodes(model_.mesh, model_.surface, model_.dofs, contact_points, options_.step_delay_nodes, in_patch);
     std::vector<int> fresh;
     for (int node : nodes)
       if (!held_.count(node)) fresh.push_back(node);
