@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cstdio>
 #include <random>
+#include <thread>
 
 #include "common/fem/assemble_stiffness.h"
 #include "common/fem/sparse_cholesky.h"
@@ -86,6 +87,19 @@ TEST(Stiffness, PositiveDefiniteOnceFixedAndCholmodAgreesWithADenseSolve) {
   const Eigen::MatrixXd x = factor.solve(rhs);
   const Eigen::MatrixXd expected = dense.ldlt().solve(rhs);
   EXPECT_LE((x - expected).norm(), 1e-9 * expected.norm());
+
+  // The factor is immutable: threads solving at once, each with its own workspace reused
+  // over many solves, get the single-threaded answer bit for bit.
+  std::vector<Eigen::MatrixXd> answers(4);
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < answers.size(); ++t)
+    threads.emplace_back([&, t] {
+      CholeskyWorkspace workspace;
+      for (int repeat = 0; repeat < 50; ++repeat) answers[t] = factor.solve(rhs * double(t + 1), workspace);
+    });
+  for (std::thread& thread : threads) thread.join();
+  for (std::size_t t = 0; t < answers.size(); ++t)
+    EXPECT_EQ(answers[t], factor.solve(rhs * double(t + 1))) << "thread " << t;
 }
 
 TEST(SparseCholesky, AnIndefiniteMatrixIsATypedErrorNamingTheRow) {

@@ -52,6 +52,7 @@ class ComplianceColumns {
   void solve_chunk(std::span<const int> nodes);
 
   const SparseCholesky& factor_;
+  CholeskyWorkspace workspace_;  // the solves' scratch: the factor itself stays immutable
   const DofMap& dofs_;
   std::vector<int> row_nodes_;
   std::vector<int> row_position_;  // per volume node
