@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "common/model/compliance_setup.h"
+#include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "common/util/atomic_file.h"
@@ -104,14 +105,16 @@ VerifyResult verify_server(const Recording& rec) {
   const std::int64_t start = config.start_time_ns();
   const Scene scene = parse_scene(config.scene_yaml(), config.scene_file());
   const Model model = build_model(scene);
-  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, config.injected().step_nodes() > 0));
-  prepare_compliance(model, columns, std::nullopt);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs,
+                            compliance_row_nodes(body, config.injected().step_nodes() > 0 || !model.obstacles.empty()));
+  prepare_compliance(body, columns, std::nullopt);
   SimulationOptions options;
   options.ir = ir_build_options(scene.haptic);
   options.ir.precision = config.ir_f32() ? IrPrecision::f32 : IrPrecision::f64;
   options.step_delay_nodes = static_cast<int>(config.injected().step_nodes());
   options.naive_every_step = config.injected().condensation() == "naive";
-  Simulation simulation(model, columns, scene.tools, options);
+  Simulation simulation(body, model.obstacles, columns, scene.tools, options);
 
   std::size_t next_ir = 0;
   std::string expected_bytes, replayed_bytes;

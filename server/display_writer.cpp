@@ -10,14 +10,14 @@
 namespace cohaptic {
 
 DisplayWriter::DisplayWriter(const Model& model, const ComplianceColumns& columns, std::filesystem::path directory)
-    : model_(model), directory_(std::move(directory)) {
-  std::vector<int> local(static_cast<std::size_t>(model.mesh.node_count()), -1);
+    : model_(model), body_(single_elastic_body(model)), directory_(std::move(directory)) {
+  std::vector<int> local(static_cast<std::size_t>(body_.mesh.node_count()), -1);
   for (int node : columns.row_nodes()) {
     local[static_cast<std::size_t>(node)] = static_cast<int>(nodes_.size());
     nodes_.push_back(node);
   }
   const auto shown = [&](int node) { return local[static_cast<std::size_t>(node)]; };
-  for (const Triangle& tri : model.surface.triangles)
+  for (const Triangle& tri : body_.surface.triangles)
     if (shown(tri[0]) >= 0 && shown(tri[1]) >= 0 && shown(tri[2]) >= 0)
       triangles_.push_back({shown(tri[0]), shown(tri[1]), shown(tri[2])});
   std::filesystem::create_directories(directory_);
@@ -49,8 +49,8 @@ void DisplayWriter::write_frames() {
   Eigen::Matrix3Xd rest(3, static_cast<Eigen::Index>(nodes_.size()));
   std::vector<std::int64_t> tags;
   for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    rest.col(static_cast<Eigen::Index>(i)) = model_.mesh.nodes.col(nodes_[i]) / unit;
-    tags.push_back(model_.mesh.node_tags[static_cast<std::size_t>(nodes_[i])]);
+    rest.col(static_cast<Eigen::Index>(i)) = body_.mesh.nodes.col(nodes_[i]) / unit;
+    tags.push_back(body_.mesh.node_tags[static_cast<std::size_t>(nodes_[i])]);
   }
   for (;;) {
     Frame frame;

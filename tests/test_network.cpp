@@ -23,6 +23,7 @@
 #include <thread>
 
 #include "common/model/static_contact.h"
+#include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
 #include "common/ir/evaluate_force.h"
@@ -158,6 +159,7 @@ TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
   EXPECT_TRUE(fs::exists(session.dir / "display" / "surface-000010.vtu"));
 
   const Model model = build_model(load_scene(session.dir / "cube.yaml"));
+  const ElasticBody& body = single_elastic_body(model);
   for (const std::string user : {"alice", "bob"}) {
     const std::vector<Tick> ticks = read_ticks(session.dir / (user + ".mcap"));
     ASSERT_GT(ticks.size(), 1500u) << user;
@@ -178,21 +180,21 @@ TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
       // IR's triangles (every 50th contact tick; a full solve takes a while).
       if (contact_ticks % 50 != 0 || !remote.allFinite()) continue;
       std::vector<PressedTool> pressed = {{t.own, 0}, {remote, 0}};
-      const std::vector<ContactQuery> contacts = find_tool_contacts(model, pressed);
+      const std::vector<ContactQuery> contacts = find_tool_contacts(body, pressed);
       bool covered = contacts[0].contact.has_value();
       if (covered) {
         bool in_patch = false;
         for (const IrTriangle& tri : ir->ir.patch) in_patch |= tri.surface_index == contacts[0].contact->triangle;
         covered = in_patch && (!contacts[1].contact || [&] {
-          const Triangle& tri = model.surface.triangles[contacts[1].contact->triangle];
+          const Triangle& tri = body.surface.triangles[contacts[1].contact->triangle];
           for (int k = 0; k < 3; ++k)
-            if (ir->ir.remotes.empty() || model.mesh.node_tags[tri[k]] != ir->ir.node_ids[ir->ir.remotes[0].nodes[k]]) return false;
+            if (ir->ir.remotes.empty() || body.mesh.node_tags[tri[k]] != ir->ir.node_ids[ir->ir.remotes[0].nodes[k]]) return false;
           return true;
         }());
       }
       if (!covered) continue;
       const Eigen::Vector3d expected =
-          contact_reactions_reference(model, contacts, {}, ContactModel::node_translation)[0].reaction;
+          contact_reactions_reference(body, contacts, {}, ContactModel::node_translation)[0].reaction;
       EXPECT_LE((t.evaluated - expected).norm(), 1e-9 * expected.norm()) << user << " tick " << i;
       ++reference_checked;
     }

@@ -706,7 +706,7 @@ struct IrRig {
   explicit IrRig(IrPrecision precision) : rig(small_cube()) {
     SimulationOptions options;
     options.ir.precision = precision;
-    Simulation simulation(*rig.model, *rig.columns, std::vector<ToolSpec>(2), options);
+    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), options);
     simulation.set_tool(0, {0, 0, -0.002});
     simulation.set_tool(1, {0.03, 0, -0.002});
     simulation.step(0);
@@ -900,7 +900,8 @@ TEST(WireIr, FromWireSurvivesMutatedBytes) {
 
 TEST(WireSurfaceMesh, BoxSurfaceInCompactNumbering) {
   const Model model = build_model(parse_scene(testing::cube_scene_yaml(small_cube()), "cube.yaml"));
-  const SurfaceMesh message = surface_mesh_message(model);
+  const ElasticBody& body = single_elastic_body(model);
+  const SurfaceMesh message = surface_mesh_message(body);
   // A 3 x 3 x 3 grid of cells: 4^3 - 2^3 surface nodes, 6 faces x 9 squares x 2 triangles.
   ASSERT_EQ(message.vertices_size(), 3 * 56);
   ASSERT_EQ(message.node_ids_size(), 56);
@@ -911,9 +912,9 @@ TEST(WireSurfaceMesh, BoxSurfaceInCompactNumbering) {
     const Eigen::Vector3d v(message.vertices(3 * i), message.vertices(3 * i + 1), message.vertices(3 * i + 2));
     EXPECT_NEAR((v - centre).lpNorm<Eigen::Infinity>(), 0.065, 1e-12) << "vertex " << i << " is not on the cube's faces";
     ids.insert(message.node_ids(i));
-    const int node = node_index_from_tag(model.mesh, message.node_ids(i));
+    const int node = node_index_from_tag(body.mesh, message.node_ids(i));
     ASSERT_GE(node, 0);
-    EXPECT_EQ(model.mesh.nodes.col(node), v);  // the id names the node at that position
+    EXPECT_EQ(body.mesh.nodes.col(node), v);  // the id names the node at that position
   }
   EXPECT_EQ(ids.size(), 56u);
   std::set<std::pair<std::uint32_t, std::uint32_t>> edges;

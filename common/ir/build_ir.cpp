@@ -39,11 +39,11 @@ std::vector<bool> kept_boundary_nodes(const DofMap& dofs, std::span<const int> b
   return kept;
 }
 
-int nearest_touchable_triangle(const Model& model, const Eigen::Vector3d& position) {
-  return nearest_triangle(model.mesh, model.surface, model.normals, model.touchable_triangles, position).triangle;
+int nearest_touchable_triangle(const ElasticBody& body, const Eigen::Vector3d& position) {
+  return nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, position).triangle;
 }
 
-IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation& condensation,
+IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensation& condensation,
                                     std::span<const UserTool> users, std::size_t user_index,
                                     std::span<const Eigen::Vector3d> boundary_displacement,
                                     const IrBuildOptions& options, std::uint64_t epoch, double simulation_time) {
@@ -52,21 +52,21 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   if (boundary_displacement.size() != boundary.size())
     throw Error(fmt::format("build_ir: {} boundary displacements for {} boundary nodes", boundary_displacement.size(),
                             boundary.size()));
-  if (own.nearest_triangle < 0 || own.nearest_triangle >= model.surface.triangle_count())
+  if (own.nearest_triangle < 0 || own.nearest_triangle >= body.surface.triangle_count())
     throw Error(fmt::format("build_ir: user {} has no nearest triangle", own.user));
 
-  std::vector<bool> held(static_cast<std::size_t>(model.mesh.node_count()), false);
+  std::vector<bool> held(static_cast<std::size_t>(body.mesh.node_count()), false);
   for (int node : boundary) held[node] = true;
   const auto holds_node = [&](int triangle) {
-    const Triangle& tri = model.surface.triangles[triangle];
+    const Triangle& tri = body.surface.triangles[triangle];
     return held[tri[0]] || held[tri[1]] || held[tri[2]];
   };
   if (holds_node(own.nearest_triangle))
     throw Error(fmt::format("build_ir: user {}'s contact triangle has a node held as a boundary node", own.user));
 
-  std::vector<bool> allowed(model.surface.triangles.size(), false);
-  for (int t : model.touchable_triangles) allowed[t] = !holds_node(t);
-  const std::vector<int> patch = contact_patch(model.surface, own.nearest_triangle, options.patch_rings, allowed);
+  std::vector<bool> allowed(body.surface.triangles.size(), false);
+  for (int t : body.touchable_triangles) allowed[t] = !holds_node(t);
+  const std::vector<int> patch = contact_patch(body.surface, own.nearest_triangle, options.patch_rings, allowed);
 
   IntermediateRepresentation ir;
   ir.epoch = epoch;
@@ -90,40 +90,40 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
     patch_index.emplace(t, static_cast<int>(ir.patch.size()));
     IrTriangle tri;
     tri.surface_index = t;
-    for (int k = 0; k < 3; ++k) tri.nodes[k] = add_node(model.surface.triangles[t][k]);
-    tri.normal = model.normals.face[t];
+    for (int k = 0; k < 3; ++k) tri.nodes[k] = add_node(body.surface.triangles[t][k]);
+    tri.normal = body.normals.face[t];
     ir.patch.push_back(tri);
   }
-  std::vector<bool> in_guard(model.surface.triangles.size(), false);
+  std::vector<bool> in_guard(body.surface.triangles.size(), false);
   for (std::size_t i = 0; i < patch.size(); ++i)
     for (int k = 0; k < 3; ++k) {
-      const auto it = patch_index.find(model.surface.triangle_neighbours[patch[i]][k]);
+      const auto it = patch_index.find(body.surface.triangle_neighbours[patch[i]][k]);
       ir.patch[i].neighbours[k] = it == patch_index.end() ? -1 : it->second;
-      ir.patch[i].edge_normals[k] = edge_pseudo_normal(model.surface, model.normals, patch[i], k);
+      ir.patch[i].edge_normals[k] = edge_pseudo_normal(body.surface, body.normals, patch[i], k);
     }
   ir.patch_node_count = static_cast<int>(nodes.size());
   ir.patch_vertex_normals.resize(3, ir.patch_node_count);
-  for (int i = 0; i < ir.patch_node_count; ++i) ir.patch_vertex_normals.col(i) = model.normals.vertex.col(nodes[i]);
+  for (int i = 0; i < ir.patch_node_count; ++i) ir.patch_vertex_normals.col(i) = body.normals.vertex.col(nodes[i]);
   // The guard ring: every surface triangle sharing a vertex with the patch, not in it.
   for (int i = 0; i < ir.patch_node_count; ++i)
-    for (int t : model.surface.node_triangles(nodes[i]))
+    for (int t : body.surface.node_triangles(nodes[i]))
       if (!patch_index.count(t) && !in_guard[t]) {
         in_guard[t] = true;
         IrGuardTriangle guard;
-        for (int k = 0; k < 3; ++k) guard.corners[k] = model.mesh.nodes.col(model.surface.triangles[t][k]);
-        guard.normal = model.normals.face[t];
+        for (int k = 0; k < 3; ++k) guard.corners[k] = body.mesh.nodes.col(body.surface.triangles[t][k]);
+        guard.normal = body.normals.face[t];
         ir.guard.push_back(guard);
       }
   for (std::size_t j = 0; j < users.size(); ++j) {
     if (j == user_index || users[j].nearest_triangle < 0 || holds_node(users[j].nearest_triangle)) continue;
     IrRemoteContact remote;
     remote.user = users[j].user;
-    for (int k = 0; k < 3; ++k) remote.nodes[k] = add_node(model.surface.triangles[users[j].nearest_triangle][k]);
+    for (int k = 0; k < 3; ++k) remote.nodes[k] = add_node(body.surface.triangles[users[j].nearest_triangle][k]);
     const int t = users[j].nearest_triangle;
-    remote.normal = model.normals.face[t];
+    remote.normal = body.normals.face[t];
     for (int k = 0; k < 3; ++k) {
-      remote.edge_normals[k] = edge_pseudo_normal(model.surface, model.normals, t, k);
-      remote.vertex_normals[k] = model.normals.vertex.col(model.surface.triangles[t][k]);
+      remote.edge_normals[k] = edge_pseudo_normal(body.surface, body.normals, t, k);
+      remote.vertex_normals[k] = body.normals.vertex.col(body.surface.triangles[t][k]);
     }
     remote.tool_radius = users[j].radius;
     ir.remotes.push_back(remote);
@@ -136,12 +136,12 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   // truncation only those whose coupling to the contact rows is not negligible.
   std::vector<Eigen::Index> kept_columns;
   std::vector<double> kept_displacement;
-  const std::vector<bool> kept = kept_boundary_nodes(model.dofs, boundary, op.m_cb, options.boundary_truncation);
+  const std::vector<bool> kept = kept_boundary_nodes(body.dofs, boundary, op.m_cb, options.boundary_truncation);
   Eigen::Index column = 0;
   for (std::size_t b = 0; b < boundary.size(); ++b) {
     if (kept[b]) add_node(boundary[b]);
     for (int axis = 0; axis < 3; ++axis) {
-      if (model.dofs.is_fixed(boundary[b], axis)) continue;
+      if (body.dofs.is_fixed(boundary[b], axis)) continue;
       if (kept[b]) {
         kept_columns.push_back(column);
         kept_displacement.push_back(boundary_displacement[b][axis]);
@@ -151,11 +151,11 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   }
 
   for (int node : nodes) {
-    ir.node_ids.push_back(model.mesh.node_tags[node]);
-    ir.fixed_axes.push_back(model.dofs.fixed_axes[node]);
+    ir.node_ids.push_back(body.mesh.node_tags[node]);
+    ir.fixed_axes.push_back(body.dofs.fixed_axes[node]);
   }
   ir.rest_positions.resize(3, ir.row_node_count);
-  for (int i = 0; i < ir.row_node_count; ++i) ir.rest_positions.col(i) = model.mesh.nodes.col(nodes[i]);
+  for (int i = 0; i < ir.row_node_count; ++i) ir.rest_positions.col(i) = body.mesh.nodes.col(nodes[i]);
 
   const auto kept_count = static_cast<Eigen::Index>(kept_columns.size());
   ir.m_tilde.resize(op.m_cc.rows(), op.m_cc.cols() + kept_count);
