@@ -248,8 +248,9 @@ void export_csv(const Recording& rec, const std::filesystem::path& dir) {
     out.write("time_s,user,epoch,simulation_time_s,contact_nodes,boundary_dofs,bytes\n");
     for (const auto& r : rec.irs)
       out.print("{:.9f},{},{},{:.9f},{},{},{}\n", seconds(r.time_ns(), start), r.ir().user(), r.ir().epoch(),
-                r.ir().simulation_time(), r.ir().row_node_count(),
-                r.ir().boundary_displacement_f64_size() + r.ir().boundary_displacement_f32_size(), r.ir().ByteSizeLong());
+                r.ir().simulation_time(), r.ir().fem().row_node_count(),
+                r.ir().fem().boundary_displacement_f64_size() + r.ir().fem().boundary_displacement_f32_size(),
+                r.ir().ByteSizeLong());
     out.commit();
   }
   {
@@ -270,6 +271,12 @@ void export_csv(const Recording& rec, const std::filesystem::path& dir) {
 VerifyResult verify_recording(const std::filesystem::path& file) {
   const Recording rec = record::read_recording(file);
   if (!rec.has_config) throw Error(fmt::format("{}: the recording has no configuration: it cannot be verified", file.string()));
+  // Re-running needs this build's IR format; a recording of another is refused, never misread.
+  for (const record::RecordedIr& recorded : rec.irs)
+    if (recorded.ir().format_version() != IntermediateRepresentation::kFormatVersion)
+      throw Error(fmt::format("{}: its IRs are in format version {}, and this build re-runs format version {}: verify it "
+                              "with the cohaptic build that recorded it (format 1: builds before scenes had several bodies)",
+                              file.string(), recorded.ir().format_version(), IntermediateRepresentation::kFormatVersion));
   return rec.config.role() == "server" ? verify_server(rec) : verify_client(rec);
 }
 

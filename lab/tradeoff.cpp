@@ -234,7 +234,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
       for (std::size_t u = 0; u < users; ++u) {
         if (!published[u]) continue;
         remotes.clear();
-        for (const IrRemoteContact& remote : published[u]->ir.remotes) remotes.push_back(positions[remote.user]);
+        for (int r = 0; r < remote_count(published[u]->ir); ++r) remotes.push_back(positions[remote_user(published[u]->ir, r)]);
         const Stopwatch evaluation;
         held[u] = evaluate_force(*published[u], positions[u], remotes).force;
         evaluation_us.push_back(1000 * evaluation.elapsed_ms());

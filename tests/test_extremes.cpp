@@ -194,9 +194,9 @@ TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
   }
   // Exactly under a patch vertex and an edge midpoint: finite, deterministic, and the
   // same triangle as the server picks (ties go to the lower surface index on both sides).
-  const IrTriangle& tri = prepared.ir.patch[0];
-  const Eigen::Vector3d vertex = prepared.ir.rest_positions.col(tri.nodes[0]);
-  const Eigen::Vector3d edge = (vertex + prepared.ir.rest_positions.col(tri.nodes[1])) / 2;
+  const IrTriangle& tri = condensed_fem(prepared.ir).patch[0];
+  const Eigen::Vector3d vertex = condensed_fem(prepared.ir).rest_positions.col(tri.nodes[0]);
+  const Eigen::Vector3d edge = (vertex + condensed_fem(prepared.ir).rest_positions.col(tri.nodes[1])) / 2;
   for (const Eigen::Vector3d& on : {vertex, edge}) {
     const Eigen::Vector3d tool = on - 2e-3 * tri.normal;
     const ForceSample a = evaluate_force(prepared, tool, {});
@@ -206,7 +206,7 @@ TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
     EXPECT_EQ(a.triangle, b.triangle);
     const int server_triangle =
         nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, tool).triangle;
-    EXPECT_EQ(prepared.ir.patch[a.triangle].surface_index, server_triangle);
+    EXPECT_EQ(condensed_fem(prepared.ir).patch[a.triangle].surface_index, server_triangle);
   }
 }
 

@@ -63,11 +63,11 @@ bool ir_covers(const Model& model, const PreparedIR& prepared, const std::vector
     return nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, p).triangle;
   };
   bool own = false;
-  for (const IrTriangle& tri : prepared.ir.patch) own |= tri.surface_index == surface_triangle(tools[user]);
-  for (const IrRemoteContact& remote : prepared.ir.remotes) {
+  for (const IrTriangle& tri : condensed_fem(prepared.ir).patch) own |= tri.surface_index == surface_triangle(tools[user]);
+  for (const IrRemoteContact& remote : condensed_fem(prepared.ir).remotes) {
     const Triangle& t = body.surface.triangles[surface_triangle(tools[remote.user])];
     for (int k = 0; k < 3; ++k)
-      if (body.mesh.node_tags[t[k]] != prepared.ir.node_ids[remote.nodes[k]]) return false;
+      if (body.mesh.node_tags[t[k]] != condensed_fem(prepared.ir).node_ids[remote.nodes[k]]) return false;
   }
   return own;
 }
@@ -156,48 +156,48 @@ TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
     return build_ir(body, condensation, users, 0, held_displacement, options, 1, 0.0);
   };
   const IntermediateRepresentation full = build(0.0);
-  EXPECT_EQ(full.node_count(), full.row_node_count + static_cast<int>(held.size()));
+  EXPECT_EQ(condensed_fem(full).node_count(), condensed_fem(full).row_node_count + static_cast<int>(held.size()));
   const IntermediateRepresentation zero = build(0.0);
-  EXPECT_EQ(zero.m_tilde, full.m_tilde);
-  EXPECT_EQ(zero.node_ids, full.node_ids);
+  EXPECT_EQ(condensed_fem(zero).m_tilde, condensed_fem(full).m_tilde);
+  EXPECT_EQ(condensed_fem(zero).node_ids, condensed_fem(full).node_ids);
 
   const double threshold = 0.05;
   const IntermediateRepresentation cut = build(threshold);
-  ASSERT_LT(cut.node_count(), full.node_count());
-  ASSERT_GT(cut.node_count(), full.row_node_count);
+  ASSERT_LT(condensed_fem(cut).node_count(), condensed_fem(full).node_count());
+  ASSERT_GT(condensed_fem(cut).node_count(), condensed_fem(full).row_node_count);
   EXPECT_LT(cut.size_bytes(), full.size_bytes());
-  const Eigen::Index contact = full.m_tilde.rows();
-  EXPECT_EQ(cut.m_tilde.leftCols(contact), full.m_tilde.leftCols(contact));
+  const Eigen::Index contact = condensed_fem(full).m_tilde.rows();
+  EXPECT_EQ(condensed_fem(cut).m_tilde.leftCols(contact), condensed_fem(full).m_tilde.leftCols(contact));
 
   // Each held node's coupling (norm of its three columns), kept or not.
   std::vector<double> coupling;
   for (std::size_t b = 0; b < held.size(); ++b)
-    coupling.push_back(full.m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3).norm());
+    coupling.push_back(condensed_fem(full).m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3).norm());
   const double strongest = *std::max_element(coupling.begin(), coupling.end());
   const Eigen::VectorXd u_c = Eigen::VectorXd::NullaryExpr(contact, [&] { return uniform(rng); });
   Eigen::VectorXd dropped_force = Eigen::VectorXd::Zero(contact);
-  std::size_t next_kept = static_cast<std::size_t>(cut.row_node_count);
+  std::size_t next_kept = static_cast<std::size_t>(condensed_fem(cut).row_node_count);
   for (std::size_t b = 0; b < held.size(); ++b) {
     const std::int64_t tag = body.mesh.node_tags[held[b]];
-    const bool kept = next_kept < cut.node_ids.size() && cut.node_ids[next_kept] == tag;
+    const bool kept = next_kept < condensed_fem(cut).node_ids.size() && condensed_fem(cut).node_ids[next_kept] == tag;
     EXPECT_EQ(kept, coupling[b] >= threshold * strongest) << "node " << tag;
     if (kept) {
       ++next_kept;
     } else {
-      dropped_force += full.m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3) *
-                       full.boundary_displacement.segment<3>(3 * static_cast<Eigen::Index>(b));
+      dropped_force += condensed_fem(full).m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3) *
+                       condensed_fem(full).boundary_displacement.segment<3>(3 * static_cast<Eigen::Index>(b));
     }
   }
-  EXPECT_EQ(next_kept, cut.node_ids.size());
-  Eigen::VectorXd full_u(full.m_tilde.cols()), cut_u(cut.m_tilde.cols());
-  full_u << u_c, full.boundary_displacement;
-  cut_u << u_c, cut.boundary_displacement;
-  const Eigen::VectorXd difference = full.m_tilde * full_u - cut.m_tilde * cut_u;
-  EXPECT_LE((difference - dropped_force).norm(), 1e-12 * (full.m_tilde * full_u).norm());
+  EXPECT_EQ(next_kept, condensed_fem(cut).node_ids.size());
+  Eigen::VectorXd full_u(condensed_fem(full).m_tilde.cols()), cut_u(condensed_fem(cut).m_tilde.cols());
+  full_u << u_c, condensed_fem(full).boundary_displacement;
+  cut_u << u_c, condensed_fem(cut).boundary_displacement;
+  const Eigen::VectorXd difference = condensed_fem(full).m_tilde * full_u - condensed_fem(cut).m_tilde * cut_u;
+  EXPECT_LE((difference - dropped_force).norm(), 1e-12 * (condensed_fem(full).m_tilde * full_u).norm());
   EXPECT_GT(dropped_force.norm(), 0.0);
   std::printf("  B truncation at %.2f keeps %d of %zu held nodes: %zu -> %zu bytes, dropped force %.3g of %.3g N\n",
-              threshold, cut.node_count() - cut.row_node_count, held.size(), full.size_bytes(), cut.size_bytes(),
-              dropped_force.norm(), (full.m_tilde * full_u).norm());
+              threshold, condensed_fem(cut).node_count() - condensed_fem(cut).row_node_count, held.size(), full.size_bytes(), cut.size_bytes(),
+              dropped_force.norm(), (condensed_fem(full).m_tilde * full_u).norm());
 }
 
 TEST(IntermediateRepresentation, EachUserFeelsTheOther) {
@@ -391,16 +391,16 @@ TEST(IntermediateRepresentation, PrepareRejectsMalformedIrs) {
   simulation.step(0);
   const IntermediateRepresentation good = simulation.ir(0)->ir;
   IntermediateRepresentation bad = good;
-  bad.m_tilde(0, 0) = std::numeric_limits<double>::infinity();
+  condensed_fem(bad).m_tilde(0, 0) = std::numeric_limits<double>::infinity();
   EXPECT_THROW(prepare_ir(bad), Error);
   bad = good;
-  bad.m_tilde.conservativeResize(bad.m_tilde.rows() - 1, Eigen::NoChange);
+  condensed_fem(bad).m_tilde.conservativeResize(condensed_fem(bad).m_tilde.rows() - 1, Eigen::NoChange);
   EXPECT_THROW(prepare_ir(bad), Error);
   bad = good;
-  bad.m_tilde.leftCols(bad.m_tilde.rows()) *= -1;  // not positive definite
+  condensed_fem(bad).m_tilde.leftCols(condensed_fem(bad).m_tilde.rows()) *= -1;  // not positive definite
   EXPECT_THROW(prepare_ir(bad), Error);
   bad = good;
-  bad.patch[0].nodes[1] = bad.node_count() + 5;
+  condensed_fem(bad).patch[0].nodes[1] = condensed_fem(bad).node_count() + 5;
   EXPECT_THROW(prepare_ir(bad), Error);
   EXPECT_NO_THROW(prepare_ir(good));
 }

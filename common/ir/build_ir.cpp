@@ -72,10 +72,11 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
   ir.epoch = epoch;
   ir.simulation_time = simulation_time;
   ir.user = own.user;
-  ir.contact_model = options.contact_model;
-  ir.precision = options.precision;
   ir.tool_radius = own.radius;
   ir.force_limit = options.force_limit;
+  CondensedFemIr& fem = std::get<CondensedFemIr>(ir.body);
+  fem.contact_model = options.contact_model;
+  fem.precision = options.precision;
 
   // Local numbering: patch nodes, remote contact nodes not in the patch, then B.
   std::vector<int> nodes;
@@ -87,32 +88,32 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
   };
   std::unordered_map<int, int> patch_index;
   for (int t : patch) {
-    patch_index.emplace(t, static_cast<int>(ir.patch.size()));
+    patch_index.emplace(t, static_cast<int>(fem.patch.size()));
     IrTriangle tri;
     tri.surface_index = t;
     for (int k = 0; k < 3; ++k) tri.nodes[k] = add_node(body.surface.triangles[t][k]);
     tri.normal = body.normals.face[t];
-    ir.patch.push_back(tri);
+    fem.patch.push_back(tri);
   }
   std::vector<bool> in_guard(body.surface.triangles.size(), false);
   for (std::size_t i = 0; i < patch.size(); ++i)
     for (int k = 0; k < 3; ++k) {
       const auto it = patch_index.find(body.surface.triangle_neighbours[patch[i]][k]);
-      ir.patch[i].neighbours[k] = it == patch_index.end() ? -1 : it->second;
-      ir.patch[i].edge_normals[k] = edge_pseudo_normal(body.surface, body.normals, patch[i], k);
+      fem.patch[i].neighbours[k] = it == patch_index.end() ? -1 : it->second;
+      fem.patch[i].edge_normals[k] = edge_pseudo_normal(body.surface, body.normals, patch[i], k);
     }
-  ir.patch_node_count = static_cast<int>(nodes.size());
-  ir.patch_vertex_normals.resize(3, ir.patch_node_count);
-  for (int i = 0; i < ir.patch_node_count; ++i) ir.patch_vertex_normals.col(i) = body.normals.vertex.col(nodes[i]);
+  fem.patch_node_count = static_cast<int>(nodes.size());
+  fem.patch_vertex_normals.resize(3, fem.patch_node_count);
+  for (int i = 0; i < fem.patch_node_count; ++i) fem.patch_vertex_normals.col(i) = body.normals.vertex.col(nodes[i]);
   // The guard ring: every surface triangle sharing a vertex with the patch, not in it.
-  for (int i = 0; i < ir.patch_node_count; ++i)
+  for (int i = 0; i < fem.patch_node_count; ++i)
     for (int t : body.surface.node_triangles(nodes[i]))
       if (!patch_index.count(t) && !in_guard[t]) {
         in_guard[t] = true;
         IrGuardTriangle guard;
         for (int k = 0; k < 3; ++k) guard.corners[k] = body.mesh.nodes.col(body.surface.triangles[t][k]);
         guard.normal = body.normals.face[t];
-        ir.guard.push_back(guard);
+        fem.guard.push_back(guard);
       }
   for (std::size_t j = 0; j < users.size(); ++j) {
     if (j == user_index || users[j].nearest_triangle < 0 || holds_node(users[j].nearest_triangle)) continue;
@@ -126,9 +127,9 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
       remote.vertex_normals[k] = body.normals.vertex.col(body.surface.triangles[t][k]);
     }
     remote.tool_radius = users[j].radius;
-    ir.remotes.push_back(remote);
+    fem.remotes.push_back(remote);
   }
-  ir.row_node_count = static_cast<int>(nodes.size());
+  fem.row_node_count = static_cast<int>(nodes.size());
   const std::vector<int> contact_nodes = nodes;
   const CondensedOperator op = condensation.condense(contact_nodes);
 
@@ -151,20 +152,20 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
   }
 
   for (int node : nodes) {
-    ir.node_ids.push_back(body.mesh.node_tags[node]);
-    ir.fixed_axes.push_back(body.dofs.fixed_axes[node]);
+    fem.node_ids.push_back(body.mesh.node_tags[node]);
+    fem.fixed_axes.push_back(body.dofs.fixed_axes[node]);
   }
-  ir.rest_positions.resize(3, ir.row_node_count);
-  for (int i = 0; i < ir.row_node_count; ++i) ir.rest_positions.col(i) = body.mesh.nodes.col(nodes[i]);
+  fem.rest_positions.resize(3, fem.row_node_count);
+  for (int i = 0; i < fem.row_node_count; ++i) fem.rest_positions.col(i) = body.mesh.nodes.col(nodes[i]);
 
   const auto kept_count = static_cast<Eigen::Index>(kept_columns.size());
-  ir.m_tilde.resize(op.m_cc.rows(), op.m_cc.cols() + kept_count);
-  ir.m_tilde.leftCols(op.m_cc.cols()) = op.m_cc;
-  for (Eigen::Index k = 0; k < kept_count; ++k) ir.m_tilde.col(op.m_cc.cols() + k) = op.m_cb.col(kept_columns[k]);
-  ir.boundary_displacement = Eigen::Map<const Eigen::VectorXd>(kept_displacement.data(), kept_count);
+  fem.m_tilde.resize(op.m_cc.rows(), op.m_cc.cols() + kept_count);
+  fem.m_tilde.leftCols(op.m_cc.cols()) = op.m_cc;
+  for (Eigen::Index k = 0; k < kept_count; ++k) fem.m_tilde.col(op.m_cc.cols() + k) = op.m_cb.col(kept_columns[k]);
+  fem.boundary_displacement = Eigen::Map<const Eigen::VectorXd>(kept_displacement.data(), kept_count);
   if (options.precision == IrPrecision::f32) {
-    ir.m_tilde = ir.m_tilde.cast<float>().cast<double>();
-    ir.boundary_displacement = ir.boundary_displacement.cast<float>().cast<double>();
+    fem.m_tilde = fem.m_tilde.cast<float>().cast<double>();
+    fem.boundary_displacement = fem.boundary_displacement.cast<float>().cast<double>();
   }
   return ir;
 }

@@ -219,8 +219,8 @@ StepReport Simulation::step(double time) {
 
 std::vector<Eigen::Vector3d> Simulation::remote_positions(const IntermediateRepresentation& ir) const {
   std::vector<Eigen::Vector3d> positions;
-  for (const IrRemoteContact& remote : ir.remotes) {
-    const UserState& user = users_[remote.user];
+  for (int r = 0; r < remote_count(ir); ++r) {
+    const UserState& user = users_[remote_user(ir, r)];
     positions.push_back(user.known ? user.position : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   }
   return positions;

@@ -106,15 +106,11 @@ void read_values(const Field& values, Target& out, const char* what) {
 
 }  // namespace
 
-void to_wire(const CommonIr& ir, WireIr* out) {
-  out->Clear();
-  out->set_format_version(CommonIr::kFormatVersion);
-  out->set_epoch(ir.epoch);
-  out->set_simulation_time(ir.simulation_time);
-  out->set_user(static_cast<std::uint32_t>(ir.user));
-  out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? WireIr::POINT : WireIr::TRANSLATION);
-  out->set_tool_radius(ir.tool_radius);
-  out->set_force_limit(ir.force_limit);
+namespace {
+
+void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
+  out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? CondensedFem::POINT
+                                                                              : CondensedFem::TRANSLATION);
   out->mutable_node_ids()->Reserve(static_cast<int>(ir.node_ids.size()));
   for (std::int64_t id : ir.node_ids) out->mutable_node_ids()->AddAlreadyReserved(id);
   out->set_fixed_axes(std::string(ir.fixed_axes.begin(), ir.fixed_axes.end()));
@@ -157,30 +153,41 @@ void to_wire(const CommonIr& ir, WireIr* out) {
   }
 }
 
+// Writes the IR's body into the wire's oneof, by kind.
+struct BodyToWire {
+  WireIr* out;
+  void operator()(const CondensedFemIr& fem) const { fem_to_wire(fem, out->mutable_fem()); }
+};
+
+}  // namespace
+
+void to_wire(const CommonIr& ir, WireIr* out) {
+  out->Clear();
+  out->set_format_version(CommonIr::kFormatVersion);
+  out->set_epoch(ir.epoch);
+  out->set_simulation_time(ir.simulation_time);
+  out->set_user(static_cast<std::uint32_t>(ir.user));
+  out->set_object(static_cast<std::uint32_t>(ir.object));
+  out->set_tool_radius(ir.tool_radius);
+  out->set_force_limit(ir.force_limit);
+  std::visit(BodyToWire{out}, ir.body);
+}
+
 WireIr to_wire(const CommonIr& ir) {
   WireIr out;
   to_wire(ir, &out);
   return out;
 }
 
-CommonIr from_wire(const WireIr& w) {
-  if (w.format_version() != CommonIr::kFormatVersion)
-    invalid("format version {}, expected {}", w.format_version(), CommonIr::kFormatVersion);
-  CommonIr ir;
-  ir.epoch = w.epoch();
-  if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());
-  ir.simulation_time = w.simulation_time();
-  ir.user = to_int(w.user(), "user");
+namespace {
+
+CondensedFemIr fem_from_wire(const CondensedFem& w) {
+  CondensedFemIr ir;
   switch (w.contact_model()) {
-    case WireIr::TRANSLATION: ir.contact_model = ContactModel::node_translation; break;
-    case WireIr::POINT: ir.contact_model = ContactModel::point_constraint; break;
+    case CondensedFem::TRANSLATION: ir.contact_model = ContactModel::node_translation; break;
+    case CondensedFem::POINT: ir.contact_model = ContactModel::point_constraint; break;
     default: invalid("unknown contact model {}", static_cast<int>(w.contact_model()));
   }
-  if (!(std::isfinite(w.tool_radius()) && w.tool_radius() >= 0)) invalid("tool_radius {} is not a finite length >= 0", w.tool_radius());
-  ir.tool_radius = w.tool_radius();
-  // +inf is a legitimate "no limit".
-  if (!(w.force_limit() >= 0)) invalid("force_limit {} is not >= 0", w.force_limit());
-  ir.force_limit = w.force_limit();
 
   // Nodes.
   const auto nodes = static_cast<std::uint32_t>(w.node_ids_size());
@@ -266,6 +273,30 @@ CommonIr from_wire(const WireIr& w) {
   } else {
     read_values(w.m_tilde_f64(), ir.m_tilde, "m_tilde_f64");
     read_values(w.boundary_displacement_f64(), ir.boundary_displacement, "boundary_displacement_f64");
+  }
+  return ir;
+}
+
+}  // namespace
+
+CommonIr from_wire(const WireIr& w) {
+  if (w.format_version() != CommonIr::kFormatVersion)
+    invalid("format version {}, expected {}{}", w.format_version(), CommonIr::kFormatVersion,
+            w.format_version() == 1 ? " (version 1 is read by cohaptic builds before the body framework)" : "");
+  CommonIr ir;
+  ir.epoch = w.epoch();
+  if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());
+  ir.simulation_time = w.simulation_time();
+  ir.user = to_int(w.user(), "user");
+  ir.object = to_int(w.object(), "object");
+  if (!(std::isfinite(w.tool_radius()) && w.tool_radius() >= 0)) invalid("tool_radius {} is not a finite length >= 0", w.tool_radius());
+  ir.tool_radius = w.tool_radius();
+  // +inf is a legitimate "no limit".
+  if (!(w.force_limit() >= 0)) invalid("force_limit {} is not >= 0", w.force_limit());
+  ir.force_limit = w.force_limit();
+  switch (w.body_case()) {
+    case WireIr::kFem: ir.body = fem_from_wire(w.fem()); break;
+    case WireIr::BODY_NOT_SET: invalid("no body of a kind this build knows");
   }
   return ir;
 }
