@@ -85,9 +85,9 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       age = now - (fresh ? confirmed.arrival_ns : slot.arrival_ns);
       const IntermediateRepresentation& ir = slot.ir->ir;
       std::array<Eigen::Vector3d, kMaxUsers - 1> remotes;
-      const std::size_t count = std::min<std::size_t>(ir.remotes.size(), remotes.size());
+      const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(remote_count(ir)), remotes.size());
       for (std::size_t r = 0; r < count; ++r) {
-        const PlayoutQuery remote = remote_buffers_[ir.remotes[r].user % kMaxUsers].at(now);
+        const PlayoutQuery remote = remote_buffers_[static_cast<std::size_t>(remote_user(ir, static_cast<int>(r)) % kMaxUsers)].at(now);
         remotes[r] = remote.valid ? remote.position : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
         record.remotes[r] = remotes[r];
       }

@@ -1,4 +1,4 @@
-// HapticLoop: the client's real-time loop (DESIGN.md §4).
+// HapticLoop: the client's real-time loop (docs/architecture.md, "Threads").
 //
 // Every period, at an absolute deadline (clock_nanosleep on CLOCK_MONOTONIC), it reads the
 // device, hands the own tool sample to the I/O thread, takes in remote tool samples and the

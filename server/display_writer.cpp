@@ -11,8 +11,8 @@
 namespace cohaptic {
 
 DisplayWriter::DisplayWriter(const Model& model, const ComplianceColumns& columns, std::filesystem::path directory)
-    : model_(model), directory_(std::move(directory)) {
-  ShownSurface shown = shown_surface(model, columns.row_nodes());
+    : model_(model), body_(single_elastic_body(model)), directory_(std::move(directory)) {
+  ShownSurface shown = shown_surface(body_, columns.row_nodes());
   nodes_ = std::move(shown.nodes);
   triangles_ = std::move(shown.triangles);
   std::filesystem::create_directories(directory_);
@@ -44,8 +44,8 @@ void DisplayWriter::write_frames() {
   Eigen::Matrix3Xd rest(3, static_cast<Eigen::Index>(nodes_.size()));
   std::vector<std::int64_t> tags;
   for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    rest.col(static_cast<Eigen::Index>(i)) = model_.mesh.nodes.col(nodes_[i]) / unit;
-    tags.push_back(model_.mesh.node_tags[static_cast<std::size_t>(nodes_[i])]);
+    rest.col(static_cast<Eigen::Index>(i)) = body_.mesh.nodes.col(nodes_[i]) / unit;
+    tags.push_back(body_.mesh.node_tags[static_cast<std::size_t>(nodes_[i])]);
   }
   for (;;) {
     Frame frame;

@@ -55,6 +55,7 @@ class DisplayWriter {
   void write_index() const;
 
   const Model& model_;
+  const ElasticBody& body_;  // the body drawn (the scene's only one)
   std::filesystem::path directory_;
   std::vector<int> nodes_;            // row nodes shown
   std::vector<Triangle> triangles_;   // in nodes_ numbering

@@ -34,7 +34,8 @@ SimulationLoop::SimulationLoop(const Model& model, ComplianceColumns& columns, c
       view_(view),
       recorder_(recorder),
       start_ns_(start_ns),
-      simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {}
+      simulation_(single_elastic_body(model), model.obstacles, columns, model.scene.tools,
+                  simulation_options(model, options)) {}
 
 Outbox SimulationLoop::step(std::int64_t now_ns) {
   take_tools(now_ns);

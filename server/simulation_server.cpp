@@ -44,7 +44,7 @@ wire::Welcome welcome_template(const ServeOptions& options, const Model& model, 
   wire::Welcome welcome;
   welcome.set_scene_name(model.scene.name);
   welcome.set_scene_yaml(scene_yaml);
-  *welcome.mutable_surface() = wire::surface_mesh_message(model);
+  *welcome.mutable_surface() = wire::surface_mesh_message(single_elastic_body(model));
   welcome.set_protocol(wire_protocol(options));
   welcome.set_force_limit(model.scene.haptic.force_limit_n);
   welcome.set_haptic_rate_hz(model.scene.haptic.rate_hz);
@@ -92,9 +92,10 @@ struct SimulationServer::Impl {
       scene_yaml.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
     model = std::make_unique<Model>(build_model(scene));
-    columns = std::make_unique<ComplianceColumns>(*model->free_factor, model->dofs,
-                                                  compliance_row_nodes(*model, options.step_nodes > 0));
-    prepare_compliance(*model, *columns, options.cache_directory);
+    const ElasticBody& body = single_elastic_body(*model);
+    columns = std::make_unique<ComplianceColumns>(
+        *body.free_factor, body.dofs, compliance_row_nodes(body, options.step_nodes > 0 || !model->obstacles.empty()));
+    prepare_compliance(body, *columns, options.cache_directory);
     if (!options.display.empty()) display = std::make_unique<DisplayWriter>(*model, *columns, options.display);
     tools = std::make_unique<ToolInputs>(model->scene.tools.size());
     spdlog::info("scene '{}' ready in {:.0f} ms: {} user slots", scene.name, watch.elapsed_ms(), tools->size());
@@ -233,8 +234,8 @@ void SimulationServer::run() {
   if (s.view) s.view->stop();
   if (s.recorder) s.recorder->close();
   // Compliance columns computed on demand during the session serve the next one.
-  if (s.options.cache_directory && s.model->scene.object.compliance.disk_cache)
-    save_compliance(*s.model, *s.columns, *s.options.cache_directory);
+  const ElasticBody& body = single_elastic_body(*s.model);
+  if (s.options.cache_directory && body.spec.compliance.disk_cache) save_compliance(body, *s.columns, *s.options.cache_directory);
   if (!s.options.report.empty()) s.write_report();
   if (s.failure) throw Error(*s.failure + "; the session ended");
 }

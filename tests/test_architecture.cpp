@@ -159,5 +159,30 @@ TEST(Architecture, CommonsSubdirectoriesIncludeEachOtherWithoutACycle) {
   if (const auto cycle = find_cycle(graph)) ADD_FAILURE() << "common/ includes itself in a circle: " << describe_cycle(graph, *cycle);
 }
 
+TEST(Architecture, NoFileCitesAPlanOutsideTheRepository) {
+  // The project documents itself (docs/architecture.md); a comment pointing at a plan a
+  // clone does not have is a dead end for its reader.
+  const std::string outside = std::string("DESIGN") + ".md";
+  std::vector<std::string> citations;
+  for (const char* floor : {"common", "proto", "net", "server", "client", "lab", "tests", "docs", "scenes", "deploy", "cmake"}) {
+    if (!fs::exists(kSourceDir / floor)) continue;
+    for (const fs::directory_entry& entry : fs::recursive_directory_iterator(kSourceDir / floor)) {
+      if (!entry.is_regular_file() || entry.file_size() > 1'000'000) continue;
+      std::ifstream in(entry.path());
+      std::string text;
+      for (int line = 1; std::getline(in, text); ++line)
+        if (text.find(outside) != std::string::npos)
+          citations.push_back(fs::relative(entry.path(), kSourceDir).string() + ":" + std::to_string(line));
+    }
+  }
+  for (const char* file : {"README.md", "CMakeLists.txt", "Makefile"}) {
+    std::ifstream in(kSourceDir / file);
+    std::string text;
+    for (int line = 1; std::getline(in, text); ++line)
+      if (text.find(outside) != std::string::npos) citations.push_back(std::string(file) + ":" + std::to_string(line));
+  }
+  EXPECT_TRUE(citations.empty()) << "cite docs/architecture.md instead at: " << ::testing::PrintToString(citations);
+}
+
 }  // namespace
 }  // namespace cohaptic

@@ -42,8 +42,9 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
 int movable_surface_nodes(const Model& model) {
+  const ElasticBody& body = single_elastic_body(model);
   int count = 0;
-  for (int node : model.surface.nodes) count += model.dofs.fixed_axes[static_cast<std::size_t>(node)] != kAllAxes;
+  for (int node : body.surface.nodes) count += body.dofs.fixed_axes[static_cast<std::size_t>(node)] != kAllAxes;
   return count;
 }
 

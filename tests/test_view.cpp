@@ -305,15 +305,15 @@ TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes)
   SimulationOptions options;
   options.ir = ir_build_options(cube.model->scene.haptic);
   options.step_delay_nodes = 12;
-  Simulation simulation(*cube.model, *cube.columns, cube.model->scene.tools, options);
+  Simulation simulation(cube.body, cube.model->obstacles, *cube.columns, cube.model->scene.tools, options);
   const Eigen::Vector3d pressing(0.003, 0.002, -0.002);  // 2 mm into the top face
   simulation.set_tool(0, pressing);
   simulation.step(0);
   simulation.step(0.001);
   ASSERT_TRUE(simulation.pressing(0));
 
-  const ShownSurface shown = shown_surface(*cube.model, cube.columns->row_nodes());
-  const view::ShownIndex index(*cube.model, shown);
+  const ShownSurface shown = shown_surface(cube.body, cube.columns->row_nodes());
+  const view::ShownIndex index(cube.body, shown);
   const Eigen::Matrix3Xd displacement = simulation.displacement_of(shown.nodes);
   const std::vector<view::ToolState> tools = {{true, pressing}, {false, Eigen::Vector3d::Zero()}};
   const view::Frame frame = view::view_frame(simulation, index, 7, 0.001, displacement, tools, 999);
@@ -333,12 +333,12 @@ TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes)
   }
   // The contact triangle is the IR's first patch triangle, its nodes mapped to the shown
   // surface's; every patch node is shown (the whole surface has rows).
-  const IntermediateRepresentation& ir = simulation.ir(0)->ir;
+  const CondensedFemIr& ir = condensed_fem(simulation.ir(0)->ir);
   ASSERT_EQ(user.contact_nodes_size(), 3);
   for (int corner = 0; corner < 3; ++corner) {
     const int shown_node = static_cast<int>(user.contact_nodes(corner));
     const int volume_node = shown.nodes[static_cast<std::size_t>(shown_node)];
-    EXPECT_EQ(cube.model->mesh.node_tags[static_cast<std::size_t>(volume_node)],
+    EXPECT_EQ(cube.body.mesh.node_tags[static_cast<std::size_t>(volume_node)],
               ir.node_ids[static_cast<std::size_t>(ir.patch.front().nodes[static_cast<std::size_t>(corner)])]);
   }
   EXPECT_EQ(user.patch_nodes_size(), ir.patch_node_count);

@@ -9,12 +9,12 @@ namespace cohaptic::view {
 
 LiveView::LiveView(const Model& model, const ComplianceColumns& columns, wire::Protocol protocol,
                    const record::InjectedDelays& injected, LiveViewOptions options, record::SessionRecorder* recorder)
-    : shown_(shown_surface(model, columns.row_nodes())),
-      index_(model, shown_),
+    : shown_(shown_surface(single_elastic_body(model), columns.row_nodes())),
+      index_(single_elastic_body(model), shown_),
       recorder_(recorder),
       period_ns_(static_cast<std::int64_t>(1e9 / options.rate_hz)),
       server_({options.host, options.port, access_token(options.host, options.token_file), options.assets, options.proto}) {
-  const Scene scene = view_scene(model, shown_, protocol, injected, options.rate_hz, "live");
+  const Scene scene = view_scene(model, single_elastic_body(model), shown_, protocol, injected, options.rate_hz, "live");
   if (recorder_) recorder_->view_scene(wire::monotonic_now_ns(), scene);
   server_.publish(Channel::scene, server_message(scene));
 }

@@ -22,13 +22,13 @@ void add_plane(Obstacle& out, const Eigen::Vector3d& point, const Eigen::Vector3
 
 }  // namespace
 
-Scene view_scene(const Model& model, const ShownSurface& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
+Scene view_scene(const Model& model, const ElasticBody& body, const ShownSurface& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
                  double frame_rate_hz, const std::string& source) {
   Scene scene;
   scene.set_scene_name(model.scene.name);
   scene.set_units(model.scene.units);
   scene.set_metres_per_unit(model.scene.metres_per_unit);
-  for (int node : shown.nodes) add_point(*scene.mutable_rest_positions(), model.mesh.nodes.col(node));
+  for (int node : shown.nodes) add_point(*scene.mutable_rest_positions(), body.mesh.nodes.col(node));
   for (const Triangle& tri : shown.triangles)
     for (int corner : tri) scene.add_triangles(static_cast<std::uint32_t>(corner));
   for (std::size_t slot = 0; slot < model.scene.tools.size(); ++slot) {
@@ -41,7 +41,7 @@ Scene view_scene(const Model& model, const ShownSurface& shown, wire::Protocol p
     Obstacle* out = scene.add_obstacles();
     out->set_name(obstacle.name);
     if (obstacle.plane) {
-      add_plane(*out, obstacle.plane->first, obstacle.plane->second, model.mesh.nodes);
+      add_plane(*out, obstacle.plane->first, obstacle.plane->second, body.mesh.nodes);
       continue;
     }
     for (Eigen::Index v = 0; v < obstacle.surface.vertices.cols(); ++v)
@@ -57,8 +57,8 @@ Scene view_scene(const Model& model, const ShownSurface& shown, wire::Protocol p
   return scene;
 }
 
-ShownIndex::ShownIndex(const Model& model, const ShownSurface& shown) : shown_(shown) {
-  for (int node : shown.nodes) node_of_tag_[model.mesh.node_tags[static_cast<std::size_t>(node)]] = node;
+ShownIndex::ShownIndex(const ElasticBody& body, const ShownSurface& shown) : shown_(shown) {
+  for (int node : shown.nodes) node_of_tag_[body.mesh.node_tags[static_cast<std::size_t>(node)]] = node;
 }
 
 int ShownIndex::of_tag(std::int64_t tag) const {
@@ -88,11 +88,12 @@ Frame view_frame(const Simulation& simulation, const ShownIndex& index, std::uin
     add_point(*out->mutable_force(), simulation.force(user).force);
     out->set_pressing(simulation.pressing(user));
     const auto ir = simulation.ir(user);
-    if (!ir) continue;
-    for (int node = 0; node < ir->ir.patch_node_count; ++node)
-      add_tagged(*out->mutable_patch_nodes(), ir->ir.node_ids[static_cast<std::size_t>(node)]);
-    if (simulation.pressing(user) && !ir->ir.patch.empty())
-      for (int node : ir->ir.patch.front().nodes) add_tagged(*out->mutable_contact_nodes(), ir->ir.node_ids[static_cast<std::size_t>(node)]);
+    const CondensedFemIr* fem = ir ? std::get_if<CondensedFemIr>(&ir->ir.body) : nullptr;
+    if (!fem) continue;
+    for (int node = 0; node < fem->patch_node_count; ++node)
+      add_tagged(*out->mutable_patch_nodes(), fem->node_ids[static_cast<std::size_t>(node)]);
+    if (simulation.pressing(user) && !fem->patch.empty())
+      for (int node : fem->patch.front().nodes) add_tagged(*out->mutable_contact_nodes(), fem->node_ids[static_cast<std::size_t>(node)]);
   }
   const std::vector<int>& held = simulation.condensation().boundary_nodes();
   frame.set_boundary_nodes(static_cast<std::uint32_t>(held.size()));

@@ -22,16 +22,16 @@ struct ToolState {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< [m]
 };
 
-/// The scene: the shown surface at rest, the tools, the obstacles (a plane as a square of
+/// The scene: the shown surface of `body` (one of `model`'s) at rest, the tools, the obstacles (a plane as a square of
 /// twice the object's size around the object's projection), and the session's settings.
-Scene view_scene(const Model& model, const ShownSurface& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
+Scene view_scene(const Model& model, const ElasticBody& body, const ShownSurface& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
                  double frame_rate_hz, const std::string& source);
 
 /// Maps the simulation's nodes to the shown surface's: by volume index, or by mesh tag
 /// (as IRs name their nodes).
 class ShownIndex {
  public:
-  ShownIndex(const Model& model, const ShownSurface& shown);
+  ShownIndex(const ElasticBody& body, const ShownSurface& shown);
   /// The shown index of volume node `node`, or -1.
   int of_node(int node) const { return shown_.index_of[static_cast<std::size_t>(node)]; }
   /// The shown index of the node with mesh tag `tag`, or -1.

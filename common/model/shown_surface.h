@@ -7,7 +7,7 @@
 #include <span>
 #include <vector>
 
-#include "common/model/model.h"
+#include "common/model/elastic_body.h"
 
 namespace cohaptic {
 
@@ -18,6 +18,6 @@ struct ShownSurface {
 };
 
 /// The surface over `row_nodes` (a ComplianceColumns' row nodes).
-ShownSurface shown_surface(const Model& model, std::span<const int> row_nodes);
+ShownSurface shown_surface(const ElasticBody& body, std::span<const int> row_nodes);
 
 }  // namespace cohaptic
