@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "common/fem/compliance.h"
+#include "common/model/elastic_body.h"
 #include "common/sim/simulation.h"
 
 namespace cohaptic {
@@ -42,10 +43,9 @@ class CompliancePrefetch {
   /// ... those within this one first: about the extent of a one-ring patch [m].
   static constexpr double kPatchRadius = 0.010;
 
-  /// `factor` and `dofs` must outlive it; `row_nodes` as the simulation's columns have
-  /// them; `node_positions` one column per volume node [m].
-  CompliancePrefetch(const SparseCholesky& factor, const DofMap& dofs, const std::vector<int>& row_nodes,
-                     const Eigen::Matrix3Xd& node_positions);
+  /// `body` (its factor, dofs and rest positions) must outlive it; `row_nodes` as the
+  /// simulation's columns have them.
+  CompliancePrefetch(const ElasticBody& body, const std::vector<int>& row_nodes);
   /// Stops the worker (after the group it is solving) and joins it.
   ~CompliancePrefetch();
   CompliancePrefetch(const CompliancePrefetch&) = delete;

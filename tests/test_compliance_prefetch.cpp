@@ -25,12 +25,12 @@ void deliver_until(CompliancePrefetch& prefetch, ComplianceColumns& columns, std
 }
 
 // The row nodes whose groups hold a row node within `reach` of `point`.
-std::set<int> nodes_of_groups_near(const Model& model, const ComplianceColumns& columns, const Eigen::Vector3d& point,
+std::set<int> nodes_of_groups_near(const ElasticBody& body, const ComplianceColumns& columns, const Eigen::Vector3d& point,
                                    double reach) {
   std::set<int> groups, nodes;
   const std::vector<int>& rows = columns.row_nodes();
   for (std::size_t r = 0; r < rows.size(); ++r)
-    if ((model.mesh.nodes.col(rows[r]) - point).norm() < reach)
+    if ((body.mesh.nodes.col(rows[r]) - point).norm() < reach)
       groups.insert(ComplianceColumns::group_of(static_cast<int>(r)));
   for (std::size_t r = 0; r < rows.size(); ++r)
     if (groups.count(ComplianceColumns::group_of(static_cast<int>(r)))) nodes.insert(rows[r]);
@@ -39,11 +39,11 @@ std::set<int> nodes_of_groups_near(const Model& model, const ComplianceColumns& 
 
 TEST(CompliancePrefetch, SolvesTheGroupsNearAToolBitForBitAsTheSimulationWould) {
   const testing::CubeRig rig;
-  const Model& model = *rig.model;
-  ComplianceColumns columns(*model.free_factor, model.dofs, rig.columns->row_nodes());
-  CompliancePrefetch prefetch(*model.free_factor, model.dofs, columns.row_nodes(), model.mesh.nodes);
+  const ElasticBody& body = rig.body;
+  ComplianceColumns columns(*body.free_factor, body.dofs, rig.columns->row_nodes());
+  CompliancePrefetch prefetch(body, columns.row_nodes());
   const Eigen::Vector3d tool(0.01, -0.02, 0.004);  // 4 mm above the front face
-  const std::set<int> expected = nodes_of_groups_near(model, columns, tool, CompliancePrefetch::kToolReach);
+  const std::set<int> expected = nodes_of_groups_near(body, columns, tool, CompliancePrefetch::kToolReach);
   ASSERT_GT(expected.size(), 8u);
   ASSERT_LT(expected.size(), columns.row_nodes().size() / 4);
 
@@ -54,7 +54,7 @@ TEST(CompliancePrefetch, SolvesTheGroupsNearAToolBitForBitAsTheSimulationWould) 
   EXPECT_EQ(delivered, expected);
 
   // The same columns solved here, on this thread, as the simulation solves a node it needs.
-  ComplianceColumns here(*model.free_factor, model.dofs, columns.row_nodes());
+  ComplianceColumns here(*body.free_factor, body.dofs, columns.row_nodes());
   for (int node : expected) {
     const ComplianceColumn& mine = here.column(node);
     const ComplianceColumn& prefetched = columns.columns().at(node);
@@ -65,9 +65,9 @@ TEST(CompliancePrefetch, SolvesTheGroupsNearAToolBitForBitAsTheSimulationWould) 
 
 TEST(CompliancePrefetch, NeverReplacesAColumnTheCallerHasAndSkipsWhatItHas) {
   const testing::CubeRig rig;
-  const Model& model = *rig.model;
-  ComplianceColumns columns(*model.free_factor, model.dofs, rig.columns->row_nodes());
-  CompliancePrefetch prefetch(*model.free_factor, model.dofs, columns.row_nodes(), model.mesh.nodes);
+  const ElasticBody& body = rig.body;
+  ComplianceColumns columns(*body.free_factor, body.dofs, rig.columns->row_nodes());
+  CompliancePrefetch prefetch(body, columns.row_nodes());
   const int first = columns.row_nodes()[0];
   const ComplianceColumn* held = &columns.column(first);  // the caller solved the first group itself
   const std::size_t group = columns.column_count();
