@@ -34,6 +34,28 @@ ForcibleDisplacement forcible_displacement(std::span<const PolygonCollision> col
   const auto collision_count = static_cast<Eigen::Index>(collisions.size());
   result.map = Eigen::MatrixXd::Zero(3 * node_count, 3 * collision_count);
 
+  if (node_count == 3 * collision_count) {
+    // Disjoint polygons: each condition alone, the balance rule w_k / sum w^2 over the
+    // polygon's nodes free along the axis (the least-norm solution below, without the
+    // decomposition).
+    for (Eigen::Index k = 0; k < collision_count; ++k) {
+      const PolygonCollision& collision = collisions[static_cast<std::size_t>(k)];
+      for (int axis = 0; axis < 3; ++axis) {
+        Eigen::Vector3d free_weights = collision.weights;
+        for (std::size_t corner = 0; corner < 3; ++corner)
+          if ((passive_fixed_axes[static_cast<std::size_t>(collision.polygon[corner])] >> axis) & 1u)
+            free_weights[static_cast<Eigen::Index>(corner)] = 0;
+        if (free_weights.norm() <= kRankThreshold) continue;
+        const Eigen::Vector3d share = free_weights / free_weights.squaredNorm();
+        for (std::size_t corner = 0; corner < 3; ++corner)
+          result.map(3 * position(collision.polygon[corner]) + axis, 3 * k + axis) =
+              share[static_cast<Eigen::Index>(corner)];
+      }
+    }
+    result.displacement = result.map * stacked_gaps(collisions);
+    return result;
+  }
+
   Eigen::MatrixXd conditions(collision_count, node_count);  // row k: w of collision k over the nodes
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> decomposition;
   decomposition.setThreshold(kRankThreshold);

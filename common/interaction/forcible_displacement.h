@@ -35,6 +35,7 @@ struct PolygonCollision {
   Eigen::Vector3d weights = Eigen::Vector3d::Zero();  ///< the target's, sum one
   Eigen::Vector3d target = Eigen::Vector3d::Zero();   ///< T on the undisplaced polygon [m]
   Eigen::Vector3d gap = Eigen::Vector3d::Zero();      ///< P - T [m]
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();   ///< the polygon's unit outward normal
 };
 
 struct ForcibleDisplacement {

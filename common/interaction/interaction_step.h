@@ -7,7 +7,11 @@
 // virtual work the reaction on the active nodes is -map^T f_c (f_c the forces holding the
 // displaced nodes, condensed_response.h): for one polygon, each node's force weighted by
 // w_k / sum w^2 and summed onto the active node. The active body uses it in its next
-// deformation.
+// deformation. A contact cannot pull: a collision whose reaction would pull its active
+// node into the behind body (against the polygon's outward normal; e.g. a node that
+// barely penetrates beside a deep one, where the behind body sinks further by itself) is
+// released and the rest solved again, until none pulls (as rigid obstacles release held
+// nodes). The paper keeps every collision; releasing is ours.
 // Two workflows (Sec. 2.2, Fig. 2): the naive one deforms the behind body once per
 // colliding pair (each pair's procedure carried out in full and its own reaction conveyed),
 // the improved one once per step for all pairs. Both see the same displaced set, so their
@@ -45,6 +49,7 @@ struct InteractingBodies {
 struct InteractionStep {
   int pairs_updated = 0;
   int pairs_added = 0;
+  int released = 0;  ///< collisions released because their reaction pulled
   std::vector<PolygonCollision> collisions;
   ForcibleDisplacement displacement;
   Eigen::VectorXd passive_forces;       ///< f_c, 3 per displaced node [N]

@@ -55,7 +55,7 @@ std::optional<PolygonTarget> detailed_collision_test(const Eigen::Vector3d& acti
                                   doubled_area(foot, a, b, normal));
     if (weights.minCoeff() < 0) continue;
     nearest_distance = distance;
-    nearest = PolygonTarget{t, weights / doubled_triangle_area, foot};
+    nearest = PolygonTarget{t, weights / doubled_triangle_area, foot, normal};
   }
   return nearest;
 }

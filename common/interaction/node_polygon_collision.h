@@ -30,6 +30,7 @@ struct PolygonTarget {
   int triangle = -1;                                  ///< index into SurfaceAdjacency::triangles
   Eigen::Vector3d weights = Eigen::Vector3d::Zero();  ///< T = sum_k weights[k] x(triangle[k])
   Eigen::Vector3d point = Eigen::Vector3d::Zero();    ///< T [m]
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();   ///< the polygon's unit outward normal
 };
 
 /// Eq. (0) for `active` against the polygons around `passive_node`; false when the node is
