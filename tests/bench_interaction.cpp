@@ -12,7 +12,9 @@
 //   BM_InteractionStep/<workflow>/<pairs>  one step (update of pairs, collision tests,
 //                             forcible displacement, deformation, conveyance, addition of
 //                             pairs) with 1..16 colliding pairs, naive (a deformation per
-//                             pair) and improved (one per step) workflow (Sec. 2.2)
+//                             pair) and improved (one per step) workflow (Sec. 2.2); counters:
+//                             the collisions kept (a pulling one is released) and the
+//                             displaced nodes
 //   BM_UpdatePairs/<pairs>, BM_InstantCollision, BM_DetailedCollision,
 //   BM_ForcibleDisplacement/<pairs>, BM_Conveyance/<pairs>, BM_AddPairs: Table 1's rows
 //                             (update of pairs 0.0120 ms, instant collision detection
