@@ -71,12 +71,12 @@ class Simulation {
   StepReport step(double time);
 
   /// Latest IR of `user`; null until its tool position is known.
-  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[user].ir; }
+  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
   /// Reaction force on `user`'s tool now (zero if it has no IR).
   ForceSample force(int user) const;
   /// Positions of the remote tools of `ir`, in its remotes' order (NaN where unknown).
   std::vector<Eigen::Vector3d> remote_positions(const IntermediateRepresentation& ir) const;
-  bool pressing(int user) const { return users_[user].pressing; }
+  bool pressing(int user) const { return users_[static_cast<std::size_t>(user)].pressing; }
 
   /// The whole state solved at the current tool positions.
   StateSolution solve() const;

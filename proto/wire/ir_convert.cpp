@@ -49,7 +49,7 @@ std::array<Eigen::Vector3d, 3> read_triple(const Triples& vectors, const std::st
   std::array<Eigen::Vector3d, 3> out;
   for (int k = 0; k < 3; ++k) {
     check_vec3(vectors[k], fmt::format("{}[{}]", what, k));
-    out[k] = from_wire(vectors[k]);
+    out[static_cast<std::size_t>(k)] = from_wire(vectors[k]);
   }
   return out;
 }
@@ -66,7 +66,7 @@ std::array<int, 3> read_nodes(const google::protobuf::RepeatedField<std::uint32_
   std::array<int, 3> out{};
   for (int k = 0; k < 3; ++k) {
     if (nodes[k] >= limit) invalid("{}.nodes[{}] = {} is outside the {} ({} nodes)", what, k, nodes[k], range, limit);
-    out[k] = static_cast<int>(nodes[k]);
+    out[static_cast<std::size_t>(k)] = static_cast<int>(nodes[k]);
   }
   return out;
 }
@@ -90,7 +90,7 @@ int to_int(std::uint32_t value, const char* what) {
 std::size_t free_dofs(const std::string& fixed_axes, std::size_t first, std::size_t last) {
   std::size_t count = 0;
   for (std::size_t i = first; i < last; ++i)
-    for (int axis = 0; axis < 3; ++axis) count += ((static_cast<unsigned char>(fixed_axes[i]) >> axis) & 1u) ? 0 : 1;
+    for (int axis = 0; axis < 3; ++axis) count += ((static_cast<unsigned char>(fixed_axes[i]) >> axis) & 1u) ? 0u : 1u;
   return count;
 }
 
@@ -258,7 +258,7 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
       const std::int32_t n = t.neighbours(k);
       if (n < -1 || n >= w.patch_size())
         invalid("{}.neighbours[{}] = {} is neither -1 nor one of the {} patch triangles", what, k, n, w.patch_size());
-      tri.neighbours[k] = n;
+      tri.neighbours[static_cast<std::size_t>(k)] = n;
     }
     tri.edge_normals = read_triple(t.edge_normals(), what + ".edge_normals");
     ir.patch.push_back(tri);
