@@ -7,6 +7,8 @@ BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BENCH_ARGS ?=
+# As typed, '$' included (make would expand it): the bench recipe reads it from the environment.
+export COHAPTIC_BENCH_ARGS = $(value BENCH_ARGS)
 # Extra CMake settings for the first configure, e.g. CMAKE_ARGS=-DCOHAPTIC_WARNINGS_AS_ERRORS=ON (CI).
 CMAKE_ARGS ?=
 LAB := $(BUILD_DIR)/lab/cohaptic-lab
@@ -49,8 +51,12 @@ tradeoff: build
 	$(LAB) tradeoff --scene scenes/tradeoff/cube_two_users.yaml --motion scenes/tradeoff/cube_press_slide.yaml \
 	  --motion scenes/tradeoff/cube_press_hold.yaml --out out/tradeoff/cube
 
-bench: build
-	$(BUILD_DIR)/tests/cohaptic_bench $(BENCH_ARGS)
+# BENCH_ARGS reaches the program through the environment, split at spaces and otherwise as
+# typed (no globbing, no pipes): BENCH_ARGS="--benchmark_filter=naive|incremental" works.
+# The set-up's output goes to stderr, so that stdout is only the table, JSON or CSV asked for.
+bench:
+	@$(MAKE) --no-print-directory build >&2
+	@set -f; exec $(BUILD_DIR)/tests/cohaptic_bench $$COHAPTIC_BENCH_ARGS
 
 clean:
 	rm -rf $(BUILD_DIR)

@@ -1,7 +1,6 @@
 // cohaptic-client: a haptic client. Joins a cohaptic-server session, runs the haptic loop
 // against a device at its rate, and writes a report at the end. See README.md.
 #include <CLI/CLI.hpp>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <fstream>
@@ -13,6 +12,7 @@
 #include "common/net/host_port.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
+#include "common/util/log_to_stderr.h"
 
 namespace {
 
@@ -25,9 +25,7 @@ nlohmann::json quantiles_us(const cohaptic::Histogram& h) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  auto logger = spdlog::stderr_color_mt("cohaptic");
-  spdlog::set_default_logger(logger);
-  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+  cohaptic::log_to_stderr();
 
   CLI::App app{"cohaptic-client: a haptic client of a cohaptic-server session"};
   std::string server = "127.0.0.1:7400", device_spec, log_level = "info", playout = "fixed";

@@ -2,7 +2,6 @@
 //   cohaptic-server --scene FILE --listen HOST:PORT [...]   serve a scene to haptic clients
 // The offline tools (probe, replay, study, ...) are cohaptic-lab's. See README.md for every option.
 #include <CLI/CLI.hpp>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <string>
@@ -12,12 +11,11 @@
 #include "common/net/host_port.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
+#include "common/util/log_to_stderr.h"
 #include "server/simulation_server.h"
 
 int main(int argc, char** argv) {
-  auto logger = spdlog::stderr_color_mt("cohaptic");
-  spdlog::set_default_logger(logger);
-  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+  cohaptic::log_to_stderr();
 
   CLI::App app{"cohaptic-server: FEM simulation server for networked haptic collaboration. Serves a scene to "
                "haptic clients (--scene, --listen). The offline tools are cohaptic-lab's."};
