@@ -24,20 +24,25 @@ SimulationOptions simulation_options(const Model& model, const ServeOptions& opt
 
 }  // namespace
 
-SimulationLoop::SimulationLoop(const Model& model, ComplianceColumns& columns, const ServeOptions& options,
-                               const ToolInputs& tools, LoopStatistics& statistics, DisplayWriter* display,
+SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns,
+                               const ServeOptions& options, const ToolInputs& tools, LoopStatistics& statistics, DisplayWriter* display,
                                view::LiveView* view, record::SessionRecorder* recorder, std::int64_t start_ns)
-    : columns_(columns),
-      options_(options),
+    : options_(options),
       tools_(tools),
       statistics_(statistics),
       display_(display),
       view_(view),
       recorder_(recorder),
       start_ns_(start_ns),
-      simulation_(single_elastic_body(model), model.obstacles, columns, model.scene.tools,
-                  simulation_options(model, options)),
-      prefetch_(single_elastic_body(model), columns.row_nodes()) {}
+      simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {
+  for (std::size_t i = 0; i < model.bodies.size(); ++i)
+    if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i]); body && columns[i])
+      prefetch_.push_back({columns[i], static_cast<int>(i), std::make_unique<CompliancePrefetch>(*body, columns[i]->row_nodes())});
+}
+
+void SimulationLoop::deliver_prefetched() {
+  for (BodyPrefetch& prefetch : prefetch_) prefetch.worker->deliver(*prefetch.columns);
+}
 
 Outbox SimulationLoop::step(std::int64_t now_ns) {
   take_tools(now_ns);
@@ -63,7 +68,7 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
 }
 
 void SimulationLoop::take_tools(std::int64_t now_ns) {
-  prefetch_.deliver(columns_);
+  deliver_prefetched();
   tools_.copy_to(latest_);
   used_.assign(latest_.size(), false);
   const auto timeout = static_cast<std::int64_t>(options_.client_timeout_s * 1e9);
@@ -72,12 +77,13 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
     if (used_[slot]) {
       simulation_.set_tool(static_cast<int>(slot), tool.position);
-      prefetch_.request_near(tool.position, columns_);
+      for (BodyPrefetch& prefetch : prefetch_) prefetch.worker->request_near(tool.position, *prefetch.columns);
     } else {
       simulation_.clear_tool(static_cast<int>(slot));
     }
   }
-  prefetch_.request(simulation_.nodes_near_obstacles());  // as of the previous step
+  for (BodyPrefetch& prefetch : prefetch_)  // as of the previous step
+    prefetch.worker->request(std::get<Simulation>(simulation_.body(prefetch.body)).nodes_near_obstacles());
 }
 
 // The new IRs: sent to their users (P1), and recorded (either protocol).
@@ -87,7 +93,7 @@ std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox) {
   std::uint64_t sent = 0;
   for (int user = 0; user < simulation_.user_count(); ++user) {
     const auto prepared = simulation_.ir(user);
-    if (!prepared) continue;
+    if (!prepared || !simulation_.ir_changed(user)) continue;
     wire::Control control;
     *control.mutable_ir() = wire::to_wire(prepared->ir);
     if (recorder_) recorder_->ir(now_ns, control.ir());
@@ -141,12 +147,13 @@ bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
   const bool view_due = view_ && view_->frame_due(now_ns);
   if (!display_due && !view_due) return false;
   // Both show the row nodes' surface (common/model/shown_surface.h): one solve serves both.
-  Eigen::Matrix3Xd displacement = simulation_.displacement_of(display_ ? display_->nodes() : view_->nodes());
+  const Simulation& shown = simulation_.single_elastic();
+  Eigen::Matrix3Xd displacement = shown.displacement_of(display_ ? display_->nodes() : view_->nodes());
   statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
   if (view_due) {
     view_tools_.resize(latest_.size());
     for (std::size_t slot = 0; slot < latest_.size(); ++slot) view_tools_[slot] = {used_[slot], latest_[slot].position};
-    view_->publish_frame(now_ns, seconds_since_start(now_ns), simulation_, displacement, view_tools_, steps_);
+    view_->publish_frame(now_ns, seconds_since_start(now_ns), shown, displacement, view_tools_, steps_);
   }
   if (display_due) {
     last_display_ns_ = now_ns;
@@ -180,7 +187,7 @@ std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,
     if (next < step_end) next = step_end;  // behind: no catch-up burst
     std::this_thread::sleep_for(std::chrono::nanoseconds(next - step_end));
   }
-  prefetch_.deliver(columns_);  // so that the disk cache keeps them too
+  deliver_prefetched();  // so that the disk cache keeps them too
   return std::nullopt;
 }
 
