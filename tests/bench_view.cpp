@@ -4,14 +4,25 @@
 //   - no view (BM_SimulationSteps/no_view), the reference;
 //   - the live view at 30 frames/s and 0, 1 or 50 browsers (WebSocket clients in this
 //     process, reading everything) connected: BM_SimulationSteps/view_browsers/N.
-// items_per_second is the simulation's step rate; the counters give, per browser, the
-// frames and bytes it received per second. The browsers and the view server's thread share
-// the machine's cores with the simulation, as they would on a server with local browsers.
+// A browser runs on another machine in real use. Here the browsers share this one, and the
+// kernel charges a loopback receive to whichever thread happens to run, so the benchmark
+// pins the simulation (this thread) to CPU 0 and the view's thread and the browsers to
+// CPU 1 (on a machine with both): it then measures what the view costs the simulation
+// thread itself, as on a server whose browsers are elsewhere.
+// Time: real time per step; CPU: the simulation thread's own CPU time per step
+// (CLOCK_THREAD_CPUTIME_ID); items_per_second: the step rate. Counters: others_cpu_us_per_step,
+// the CPU of every other thread of the process (the view's, the browsers') per step; per
+// browser, the frames and kB it received per second; the frames the view built and dropped.
 #include <array>
 #include <benchmark/benchmark.h>
 
+#include <pthread.h>
+#include <sched.h>
+#include <time.h>
+
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <spdlog/spdlog.h>
 #include <thread>
 
@@ -66,8 +77,39 @@ void set_tools(ToolInputs& tools, const BrainRig& rig, double t) {
   }
 }
 
+// Pins the calling thread (and the threads it starts from now on) to `cpu`, if this process
+// may run on CPUs 0 and 1; restores the thread's CPUs when it goes.
+class PinnedThread {
+ public:
+  static bool possible() {
+    cpu_set_t allowed;
+    return sched_getaffinity(0, sizeof allowed, &allowed) == 0 && CPU_ISSET(0, &allowed) && CPU_ISSET(1, &allowed);
+  }
+  explicit PinnedThread(int cpu) {
+    pthread_getaffinity_np(pthread_self(), sizeof before_, &before_);
+    cpu_set_t only;
+    CPU_ZERO(&only);
+    CPU_SET(cpu, &only);
+    pthread_setaffinity_np(pthread_self(), sizeof only, &only);
+  }
+  ~PinnedThread() { pthread_setaffinity_np(pthread_self(), sizeof before_, &before_); }
+  PinnedThread(const PinnedThread&) = delete;
+  PinnedThread& operator=(const PinnedThread&) = delete;
+
+ private:
+  cpu_set_t before_;
+};
+
+double cpu_seconds(clockid_t clock) {
+  timespec now{};
+  clock_gettime(clock, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
 void run_steps(benchmark::State& state, bool with_view, int browsers) {
   BrainRig& rig = BrainRig::get();
+  const bool pin = PinnedThread::possible();
+  if (!pin) state.SetLabel("not pinned: CPUs 0 and 1 are not both available");
   ServeOptions options;
   options.client_timeout_s = 3600;
   ToolInputs tools(rig.motions.size());
@@ -87,6 +129,8 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
   }
   std::vector<std::unique_ptr<testing::WebSocketClient>> clients;
   if (live) {
+    std::optional<PinnedThread> on_cpu1;  // the view's thread and the browsers' start there
+    if (pin) on_cpu1.emplace(1);
     live->start();
     const std::string url = "ws://127.0.0.1:" + std::to_string(live->port()) + "/ws";
     for (int k = 0; k < browsers; ++k) {
@@ -95,11 +139,16 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
       clients.back()->count_only();
     }
   }
+  std::optional<PinnedThread> on_cpu0;  // the simulation
+  if (pin) on_cpu0.emplace(0);
+  std::this_thread::yield();  // on CPU 0 from here
   std::vector<std::uint64_t> frames_before, bytes_before;
   for (const auto& client : clients) {
     frames_before.push_back(client->message_count());
     bytes_before.push_back(client->bytes_received());
   }
+  const std::uint64_t built_before = live ? live->frames_built() : 0;
+  const double process_cpu_before = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID), thread_cpu_before = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
   const auto start = std::chrono::steady_clock::now();
   double t = kWindowStart_s;
   for (auto _ : state) {
@@ -108,7 +157,11 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
     t += kWindowStride_s;  // the motion at a fixed stride, whatever the steps cost
   }
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double others_cpu = (cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - process_cpu_before) -
+                            (cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - thread_cpu_before);
   state.SetItemsProcessed(state.iterations());
+  state.counters["others_cpu_us_per_step"] = 1e6 * others_cpu / static_cast<double>(state.iterations());
+  if (live) state.counters["frames_built_per_s"] = static_cast<double>(live->frames_built() - built_before) / elapsed;
   if (!clients.empty()) {
     double frames = 0, bytes = 0;
     for (std::size_t k = 0; k < clients.size(); ++k) {
