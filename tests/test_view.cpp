@@ -495,10 +495,11 @@ TEST(LiveView, ARecordedSessionGetsItsFramesWithoutABrowser) {
   {
     record::SessionRecorder recorder(file);
     ViewedLoop session(&recorder);
-    // A frame period (34 steps of 1 ms) at a time, each frame built before the next is due:
-    // stepped faster than real time, a state not yet taken would be replaced by the newer.
+    // A frame period at a time (33 steps of 1 ms, one frame due in each), each frame built
+    // before the next is due: stepped faster than real time, a state the view's thread has
+    // not taken yet would be replaced by the newer.
     for (std::uint64_t frame = 1; frame <= 15; ++frame) {
-      session.run(0.034);
+      session.run(0.033);
       ASSERT_TRUE(testing::wait_until([&] { return session.live.frames_built() == frame; }, "the period's frame"));
     }
     session.live.stop();

@@ -25,6 +25,8 @@ void LiveView::publish_frame(std::int64_t now_ns, double time, FrameState state,
   const double rate = last_frame_ns_ > 0 && interval_s > 0 ? static_cast<double>(steps - last_steps_) / interval_s : 0.0;
   last_frame_ns_ = now_ns;
   last_steps_ = steps;
+  next_frame_ns_ += period_ns_;
+  if (next_frame_ns_ <= now_ns) next_frame_ns_ = now_ns + period_ns_;
   bool waiting = false;
   {
     std::lock_guard lock(pending_mutex_);

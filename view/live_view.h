@@ -63,9 +63,10 @@ class LiveView {
   ViewCounters counters() const { return server_.counters(); }
 
   /// True when a frame is due at `now_ns` and someone will have it: a browser is connected,
-  /// or the session is recorded (simulation thread).
+  /// or the session is recorded (simulation thread). Frames are due every 1/rate s on
+  /// average, whatever the steps' length (none to catch up after a gap).
   bool frame_due(std::int64_t now_ns) const {
-    return now_ns - last_frame_ns_ >= period_ns_ && (recorder_ || server_.watched());
+    return now_ns >= next_frame_ns_ && (recorder_ || server_.watched());
   }
   /// Hands over the state after a step at `now_ns` (simulation thread; `steps`: the loop's
   /// count so far, for the rate shown). The frame is built, recorded and sent on the view's
@@ -91,7 +92,7 @@ class LiveView {
   record::SessionRecorder* recorder_;
   std::int64_t period_ns_;
   // Simulation thread.
-  std::int64_t last_frame_ns_ = 0;
+  std::int64_t last_frame_ns_ = 0, next_frame_ns_ = 0;
   std::uint64_t last_steps_ = 0;
   // Handed from the simulation thread to the view's.
   std::mutex pending_mutex_;
