@@ -13,6 +13,18 @@
 // (CLOCK_THREAD_CPUTIME_ID); items_per_second: the step rate. Counters: others_cpu_us_per_step,
 // the CPU of every other thread of the process (the view's, the browsers') per step; per
 // browser, the frames and kB it received per second; the frames the view built and dropped.
+//
+// What one frame costs each thread, at one state of the same motions (both surgeons
+// pressing, 3 s in), CPU time per frame:
+//   - BM_ViewFrame_simulation_thread: the simulation thread's part, the state solve, its
+//     loads (LoadedColumn) and the FrameState handed over;
+//   - BM_ViewFrame_view_thread: the view's thread's part, the shown surface's displacement
+//     from those loads, the Frame and its encoding;
+//   - BM_ViewFrame_displacement_from_loads: of which the displacement;
+//   - BM_ViewFrame_displacement_gathered: the displacement as the display solves it
+//     (Simulation::displacement_of: the state solve and a gathered block of L), which the
+//     simulation thread solved for every view frame, and encoded, before the view's thread
+//     took the frame over.
 #include <array>
 #include <benchmark/benchmark.h>
 
@@ -28,7 +40,10 @@
 
 #include "common/haptics/trajectory.h"
 #include "common/model/compliance_setup.h"
+#include "common/model/shown_surface.h"
 #include "common/scene/load_scene.h"
+#include "common/sim/loaded_columns.h"
+#include "common/sim/simulation.h"
 #include "common/util/blas_threads.h"
 #include "proto/wire/header.h"
 #include "server/server_recording.h"
@@ -178,6 +193,78 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
   clients.clear();
   if (live) live->stop();
 }
+
+// The brain with both surgeons pressing, 3 s into their motions, and what a frame of it needs.
+struct PressedBrain {
+  BrainRig& rig = BrainRig::get();
+  Simulation simulation;
+  ShownSurface shown;
+  view::ShownIndex index;
+  std::vector<int> positions;
+  std::vector<view::ToolState> tools;
+  static SimulationOptions options(const Model& model) {
+    SimulationOptions options;
+    options.ir = ir_build_options(model.scene.haptic);
+    return options;
+  }
+  PressedBrain()
+      : simulation(single_elastic_body(*rig.model), rig.model->obstacles, *rig.columns, rig.model->scene.tools,
+                   options(*rig.model)),
+        shown(shown_surface(single_elastic_body(*rig.model), rig.columns->row_nodes())),
+        index(single_elastic_body(*rig.model), shown) {
+    for (double t = 0; t < 3.0; t += 0.005) {
+      for (std::size_t slot = 0; slot < rig.motions.size(); ++slot)
+        simulation.set_tool(static_cast<int>(slot), rig.motions[slot].position(t));
+      simulation.step(t);
+    }
+    for (int node : shown.nodes) positions.push_back(rig.columns->row_position(node));
+    for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) tools.push_back({true, rig.motions[slot].position(3.0)});
+  }
+  static PressedBrain& get() {
+    static PressedBrain brain;
+    return brain;
+  }
+  view::FrameState frame_state() { return view::frame_state(simulation, loaded_columns(*rig.columns, simulation.solve()), tools); }
+  void describe(benchmark::State& state) {
+    state.counters["pressing"] = simulation.pressing(0) + simulation.pressing(1);
+    state.counters["boundary_nodes"] = static_cast<double>(simulation.condensation().boundary_nodes().size());
+    state.counters["shown_nodes"] = static_cast<double>(shown.nodes.size());
+  }
+};
+
+void BM_ViewFrame_simulation_thread(benchmark::State& state) {
+  PressedBrain& brain = PressedBrain::get();
+  for (auto _ : state) benchmark::DoNotOptimize(brain.frame_state());
+  brain.describe(state);
+}
+
+void BM_ViewFrame_view_thread(benchmark::State& state) {
+  PressedBrain& brain = PressedBrain::get();
+  const view::FrameState frame = brain.frame_state();
+  std::size_t bytes = 0;
+  for (auto _ : state) {
+    const std::string message = view::server_message(view::view_frame(frame, brain.index, brain.positions, 1, 3.0, 400));
+    bytes = message.size();
+    benchmark::DoNotOptimize(message.data());
+  }
+  state.counters["frame_kB"] = static_cast<double>(bytes) / 1e3;
+}
+
+void BM_ViewFrame_displacement_from_loads(benchmark::State& state) {
+  PressedBrain& brain = PressedBrain::get();
+  const view::FrameState frame = brain.frame_state();
+  for (auto _ : state) benchmark::DoNotOptimize(displacement_of_rows(frame.loads, brain.positions));
+}
+
+void BM_ViewFrame_displacement_gathered(benchmark::State& state) {
+  PressedBrain& brain = PressedBrain::get();
+  for (auto _ : state) benchmark::DoNotOptimize(brain.simulation.displacement_of(brain.shown.nodes));
+}
+
+BENCHMARK(BM_ViewFrame_simulation_thread)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ViewFrame_view_thread)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ViewFrame_displacement_from_loads)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ViewFrame_displacement_gathered)->Unit(benchmark::kMicrosecond);
 
 void BM_SimulationSteps_no_view(benchmark::State& state) { run_steps(state, false, 0); }
 void BM_SimulationSteps_view_browsers(benchmark::State& state) { run_steps(state, true, static_cast<int>(state.range(0))); }
