@@ -5,6 +5,7 @@
 #include <chrono>
 #include <thread>
 
+#include "common/sim/loaded_columns.h"
 #include "proto/wire/header.h"
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/vec3_convert.h"
@@ -33,6 +34,7 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       display_(display),
       view_(view),
       recorder_(recorder),
+      shown_columns_(display || view ? columns.front() : nullptr),
       start_ns_(start_ns),
       simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
@@ -146,16 +148,19 @@ bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
       display_ && now_ns - last_display_ns_ >= static_cast<std::int64_t>(1e9 / options_.display_rate_hz);
   const bool view_due = view_ && view_->frame_due(now_ns);
   if (!display_due && !view_due) return false;
-  // Both show the row nodes' surface (common/model/shown_surface.h): one solve serves both.
+  // Both show the row nodes' surface (common/model/shown_surface.h): one state solve serves both.
   const Simulation& shown = simulation_.single_elastic();
-  Eigen::Matrix3Xd displacement = shown.displacement_of(display_ ? display_->nodes() : view_->nodes());
-  statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
+  const StateSolution state = shown.solve();
   if (view_due) {
     view_tools_.resize(latest_.size());
     for (std::size_t slot = 0; slot < latest_.size(); ++slot) view_tools_[slot] = {used_[slot], latest_[slot].position};
-    view_->publish_frame(now_ns, seconds_since_start(now_ns), shown, displacement, view_tools_, steps_);
+    // The displacement and the encoding are the view's thread's work.
+    view_->publish_frame(now_ns, seconds_since_start(now_ns),
+                         view::frame_state(shown, loaded_columns(*shown_columns_, state), view_tools_), steps_);
   }
   if (display_due) {
+    Eigen::Matrix3Xd displacement = displacement_of_nodes(*shown_columns_, state, display_->nodes());
+    statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
     last_display_ns_ = now_ns;
     display_->offer(seconds_since_start(now_ns), std::move(displacement));  // dropped if the writer is behind
   }

@@ -7,8 +7,10 @@
 //      changed; mass-spring: the whole network, and the IRs that are due);
 //   3. fills the step's Outbox: each user's new IR (P1), the IR keep-alives (P1, every
 //      kKeepAlivePeriod_ns), the forces (P0);
-//   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter,
-//      and every 1/--view-rate-hz for the live view (one solve when both are due);
+//   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter;
+//      every 1/--view-rate-hz, while a browser watches or the session is recorded, hands the
+//      live view the state it draws (its loads, not its displacement: the view's thread
+//      computes that); one state solve when both are due;
 //   5. records the step and the IRs it built (--record), and its figures (LoopStatistics).
 // run() paces the steps at the loop's rate with absolute deadlines (when behind, the next
 // step starts at once, with no catch-up burst) and hands each non-empty outbox to the I/O
@@ -94,6 +96,7 @@ class SimulationLoop {
   DisplayWriter* display_;
   view::LiveView* view_;
   record::SessionRecorder* recorder_;
+  ComplianceColumns* shown_columns_;  // the displayed body's, with a display or a view
   std::int64_t start_ns_;
   SceneSimulation simulation_;
   StepFailures failures_;

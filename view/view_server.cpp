@@ -68,6 +68,7 @@ struct ViewServer::Impl {
   std::array<std::shared_ptr<const std::string>, kChannels> newest;
   std::array<std::uint64_t, kChannels> sequence{};
   std::atomic<bool> flush_pending{false};
+  std::atomic<int> connected{0};  // browsers, for watched()
 
   // The server's thread only.
   std::map<connection_hdl, Browser, std::owner_less<connection_hdl>> browsers;
@@ -144,6 +145,7 @@ struct ViewServer::Impl {
       for (std::size_t channel = 0; channel < kChannels; ++channel)
         browser.accounted[channel] = sequence[channel] > 0 ? sequence[channel] - 1 : 0;
     }
+    connected = static_cast<int>(browsers.size());
     count([this](ViewCounters& c) {
       ++c.connections;
       c.browsers = static_cast<int>(browsers.size());
@@ -155,6 +157,7 @@ struct ViewServer::Impl {
 
   void closed(connection_hdl hdl) {
     if (browsers.erase(hdl) == 0) return;
+    connected = static_cast<int>(browsers.size());
     count([this](ViewCounters& c) { c.browsers = static_cast<int>(browsers.size()); });
   }
 
@@ -255,6 +258,10 @@ void ViewServer::publish(Channel channel, std::string message) {
   }
   if (!s.flush_pending.exchange(true)) asio::post(s.io, [&s] { s.flush(); });
 }
+
+bool ViewServer::watched() const { return impl_->connected.load() > 0; }
+
+void ViewServer::post(std::function<void()> task) { asio::post(impl_->io, std::move(task)); }
 
 ViewCounters ViewServer::counters() const {
   std::lock_guard lock(impl_->counters_mutex);
