@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
     report["ir_age_ms"] = {{"p50", static_cast<double>(m.ir_age_ns.quantile(0.5)) * 1e-6},
                            {"p99", static_cast<double>(m.ir_age_ns.quantile(0.99)) * 1e-6}};
     report["force_n"] = {{"peak", m.peak_force}, {"clamped_ticks", m.clamped}};
-    report["coupling_n"] = {{"peak", m.peak_coupling}};
+    report["coupling_n"] = {{"peak", m.peak_coupling}, {"measured", m.coupling_measured}};
     report["force_step_on_ir_switch_n"] = m.largest_step_on_ir_switch;
     if (settings.passivity_control)
       report["passivity_controller"] = {{"active_ticks", loop.passivity().active_ticks()},
