@@ -5,6 +5,7 @@
 
 #include "common/condense/dof_blocks.h"
 #include "common/ir/contact_solve.h"
+#include "common/sim/loaded_columns.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -52,32 +53,14 @@ StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& c
   return state;
 }
 
-namespace {
-
-// u += L[row nodes, dofs] f, in the row nodes' layout: one column of L per loaded dof.
-void add_compliance_times(ComplianceColumns& columns, const std::vector<int>& dofs, const Eigen::VectorXd& forces,
-                          Eigen::VectorXd& u) {
-  columns.compute_columns(nodes_of_dofs(dofs));
-  for (std::size_t j = 0; j < dofs.size(); ++j)
-    u.noalias() += forces[static_cast<Eigen::Index>(j)] * columns.column(dofs[j] / 3).col(dofs[j] % 3);
-}
-
-}  // namespace
-
 Eigen::Matrix3Xd displacement_of_nodes(ComplianceColumns& columns, const StateSolution& state, std::span<const int> nodes) {
-  // Every row node's displacement at once (the columns are laid out by row node), then the
-  // nodes asked for: no gathered block of L.
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(columns.row_nodes().size()));
-  add_compliance_times(columns, state.contact_dofs, state.contact_forces, u);
-  add_compliance_times(columns, state.boundary_dofs, state.boundary_forces, u);
-  Eigen::Matrix3Xd out(3, static_cast<Eigen::Index>(nodes.size()));
+  std::vector<int> positions(nodes.size());
   for (std::size_t k = 0; k < nodes.size(); ++k) {
-    const int position = columns.row_position(nodes[k]);
-    if (position < 0)
+    positions[k] = columns.row_position(nodes[k]);
+    if (positions[k] < 0)
       throw Error(fmt::format("compliance rows are not kept for node {} (not touchable or on the surface)", nodes[k]));
-    out.col(static_cast<Eigen::Index>(k)) = u.segment<3>(3 * static_cast<Eigen::Index>(position));
   }
-  return out;
+  return displacement_of_rows(loaded_columns(columns, state), positions);
 }
 
 }  // namespace cohaptic
