@@ -31,8 +31,9 @@ struct ClientOptions {
   std::string host = "127.0.0.1";
   std::uint16_t port = 7400;
   std::string user_name;
-  std::optional<std::filesystem::path> key_file;  ///< empty: the public development key
-  int requested_slot = -1;                        ///< -1: any free slot
+  std::optional<std::filesystem::path> key_file;  ///< session or participant key; empty: the public development key
+  bool encrypt = true;                            ///< false: send in clear (authenticated), and accept the server's so
+  int requested_slot = -1;                        ///< -1: any free slot (a participant key: its own)
 };
 
 /// What the server told us when we joined.
@@ -49,6 +50,8 @@ struct WelcomeInfo {
 
 class ClientNetwork {
  public:
+  /// Throws Error if the key file cannot be used (see wire/session_key.h), or names
+  /// another slot than --slot.
   ClientNetwork(ClientOptions options, HapticChannels& channels);
   ~ClientNetwork();
   ClientNetwork(const ClientNetwork&) = delete;

@@ -315,7 +315,24 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
                      {"objects[0].mesh.file", "/nonexistent-cohaptic-test/scenes/no_such_mesh.msh", "does not exist"}});
   }
 
+  {
+    const auto text = replaced(base, "haptic:\n", "network:\n  max_participants: 2\nhaptic:\n");
+    cases.push_back({"more participants than tools", text, "max_participants: 2",
+                     {"network.max_participants", "an integer from 1 to the number of tools (1)", "found '2'"}});
+  }
+  {
+    const auto text = replaced(base, "haptic:\n", "network:\n  max_users: 1\nhaptic:\n");
+    cases.push_back({"unknown network key", text, "max_users: 1", {"network.max_users", "unknown key", "max_participants"}});
+  }
+
   for (const BadScene& bad : cases) expect_scene_error(bad);
+}
+
+TEST(SceneLoad, MaxParticipantsDefaultsToOnePerToolAndMayBeFewer) {
+  const std::string two_tools = replaced(kBaseScene, "    shape: point\n", "    shape: point\n  - name: B\n");
+  EXPECT_EQ(parse_scene(two_tools, kSceneFile).network.max_participants, 2);
+  const std::string one_at_a_time = replaced(two_tools, "haptic:\n", "network: {max_participants: 1}\nhaptic:\n");
+  EXPECT_EQ(parse_scene(one_at_a_time, kSceneFile).network.max_participants, 1);
 }
 
 TEST(SceneErrors, MissingSceneFileNamesIt) {

@@ -207,13 +207,26 @@ HapticSettings parse_haptic(const Cursor& c) {
   return haptic;
 }
 
+NetworkSettings parse_network(const Cursor& c, std::size_t tools) {
+  c.only_keys({"max_participants"});
+  NetworkSettings network;
+  network.max_participants = static_cast<int>(tools);
+  if (auto max = c.find("max_participants")) {
+    const std::int64_t value = max->integer();
+    if (value < 1 || value > static_cast<std::int64_t>(tools))
+      max->fail(fmt::format("an integer from 1 to the number of tools ({})", tools));
+    network.max_participants = static_cast<int>(value);
+  }
+  return network;
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file) {
   const std::string file_name = file.string();
   const Cursor top(load_yaml(yaml_text, file_name, raise_scene_error), "", &file_name, 1, raise_scene_error);
   if (!top.is_map()) top.fail("a map of scene settings");
-  top.only_keys({"name", "units", "objects", "obstacles", "tools", "haptic"});
+  top.only_keys({"name", "units", "objects", "obstacles", "tools", "haptic", "network"});
 
   Scene scene;
   scene.file = file;
@@ -243,6 +256,8 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
   if (scene.tools.empty()) tools.fail("at least one tool");
 
   if (auto haptic = top.find("haptic")) scene.haptic = parse_haptic(*haptic);
+  scene.network.max_participants = static_cast<int>(scene.tools.size());
+  if (auto network = top.find("network")) scene.network = parse_network(*network, scene.tools.size());
   return scene;
 }
 
