@@ -31,6 +31,7 @@
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/session_key.h"
 #include "proto/wire/traffic_keys.h"
+#include "support/cube_session.h"
 #include "support/process.h"
 
 namespace cohaptic {
@@ -39,71 +40,8 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using testing::ChildProcess;
-
-// A soft cube (forces well under the 3.3 N limit) with two point tools.
-void write_scene(const fs::path& dir) {
-  std::ofstream(dir / "cube.yaml") << R"(
-name: soft-cube
-units: mm
-objects:
-  - name: cube
-    mesh: {box: {min: [-65, -65, -130], size: [130, 130, 130], divisions: [8, 8, 8]}}
-    material: {youngs_modulus: 2.0e4, poisson_ratio: 0.4}
-    fixed: [{plane: {point: [0, 0, -130], normal: [0, 0, 1]}}]
-    touchable: [{plane: {point: [0, 0, 0], normal: [0, 0, 1]}}]
-    compliance: {precompute: touchable, disk_cache: false}
-tools: [{name: A}, {name: B}]
-haptic: {rate_hz: 1000, force_limit: 3.3, contact_model: translation, patch_rings: 1}
-)";
-}
-
-// Press `depth` mm at (x, y), hold, release: about 0.4 + 2 * depth / 5 + hold seconds.
-fs::path write_press(const fs::path& dir, const std::string& name, double x, double y, double depth, double hold) {
-  const fs::path file = dir / (name + ".yaml");
-  std::ofstream(file) << fmt::format(R"(
-units: mm
-start: [{0}, {1}, 6]
-segments:
-  - {{move_to: [{0}, {1}, 0.5], speed: 20}}
-  - {{press: {2}, speed: 5, direction: [0, 0, -1]}}
-  - {{hold: {3}}}
-  - {{release: {2}, speed: 5}}
-)",
-                                     x, y, depth, hold);
-  return file;
-}
-
-struct Session {
-  fs::path dir;
-  std::unique_ptr<ChildProcess> server;
-  int port = -1;
-  Session(const std::string& name, const std::vector<std::string>& server_arguments) : dir(testing::scratch_directory(name)) {
-    write_scene(dir);
-    std::vector<std::string> arguments = {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0",
-                                          "--report", (dir / "server.json").string(), "--no-disk-cache"};
-    for (const std::string& argument : server_arguments)  // paths after --display are in the session's directory
-      arguments.push_back(arguments.back() == "--display" ? (dir / argument).string() : argument);
-    server = std::make_unique<ChildProcess>(testing::server_program(), arguments, dir / "server.log");
-    EXPECT_TRUE(testing::wait_for_output(*server, "listening on"));
-    port = testing::listening_port(server->log_text());
-  }
-  std::unique_ptr<ChildProcess> client(const std::string& user, int slot, const fs::path& trajectory,
-                                       const std::vector<std::string>& extra = {}) const {
-    std::vector<std::string> arguments = {"--server", fmt::format("127.0.0.1:{}", port), "--user", user,
-                                          "--slot", std::to_string(slot), "--device", "script:" + trajectory.string(),
-                                          "--report", (dir / (user + ".json")).string(), "--record", (dir / (user + ".mcap")).string()};
-    arguments.insert(arguments.end(), extra.begin(), extra.end());
-    return std::make_unique<ChildProcess>(testing::client_program(), arguments, dir / (user + ".log"));
-  }
-  nlohmann::json report(const std::string& name) const {
-    std::ifstream in(dir / (name + ".json"));
-    return nlohmann::json::parse(in);
-  }
-  void stop_server() {
-    server->signal(SIGINT);
-    EXPECT_EQ(server->wait(testing::kPatience), 0) << server->log_text();
-  }
-};
+using testing::write_press;
+using Session = testing::CubeSession;
 
 struct Tick {
   double time = 0;
