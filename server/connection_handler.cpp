@@ -129,6 +129,7 @@ void ConnectionHandler::accept() {
       return;
     }
     socket.set_option(tcp::no_delay(true));
+    socket.set_option(asio::socket_base::send_buffer_size(kControlSendBufferBytes));
     auto participant = std::make_shared<Participant>(io_, session_, options_.shift, options_.encrypt);
     const std::weak_ptr<Participant> weak = participant;
     net::FramedConnection::Handlers handlers;

@@ -53,6 +53,10 @@ inline constexpr std::int64_t kLeftSenderGrace_ms = 500;
 inline constexpr std::chrono::seconds kJoinTimeout{10};
 /// Connections that have not joined, at most; more are closed as they come.
 inline constexpr std::size_t kMaxUnjoinedConnections = 16;
+/// The kernel's send buffer of a control connection, fixed rather than grown without a
+/// say: with kMaxWaitingFrames, what a user that stops reading can hold up is bounded, and
+/// its writes stall (net::kWriteTimeout) within seconds. A few IRs' worth at any link speed.
+inline constexpr int kControlSendBufferBytes = 1 << 20;
 
 struct ConnectionCounters {
   std::uint64_t datagrams_sent = 0, datagrams_relayed = 0;
