@@ -77,7 +77,7 @@ const wire::Control& ir_control(int held) {
   static const testing::CubeRig rig;
   SimulationOptions options;
   options.step_delay_nodes = held;
-  Simulation simulation(*rig.model, *rig.columns, std::vector<ToolSpec>(2), options);
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), options);
   simulation.set_tool(0, {0, 0, -0.002});
   simulation.set_tool(1, {0.03, 0, -0.002});
   simulation.step(0);
@@ -102,13 +102,13 @@ void BM_IrFrame(benchmark::State& state, Mode mode) {
       received.assign(bytes.begin(), bytes.end());
       wire::Control parsed;
       if (!parsed.ParseFromArray(received.data(), static_cast<int>(received.size()))) state.SkipWithError("parse");
-      benchmark::DoNotOptimize(parsed.ir().m_rows());
+      benchmark::DoNotOptimize(parsed.ir().fem().m_rows());
     } else {
       bytes = sealer.seal(control);
       reader.feed(bytes);
       const std::optional<wire::Control> opened = reader.next();
       if (!opened) state.SkipWithError("incomplete");
-      benchmark::DoNotOptimize(opened->ir().m_rows());
+      benchmark::DoNotOptimize(opened->ir().fem().m_rows());
     }
     size = bytes.size();
   }

@@ -1,4 +1,4 @@
-// UDP datagrams on the wire (protocol 2): [envelope (envelope.h)][body: one serialized
+// UDP datagrams on the wire (protocol 3): [envelope (envelope.h)][body: one serialized
 // Datagram, encrypted or in clear][16-byte tag (aead.h)], at most kMaxDatagramBytes.
 //
 // Receiving runs these checks in this order, the first failure naming the Rejection:

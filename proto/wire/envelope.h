@@ -1,4 +1,4 @@
-// The envelope: the clear bytes in front of every sealed datagram and frame (protocol 2).
+// The envelope: the clear bytes in front of every sealed datagram and frame (protocol 3).
 //
 //   offset  size  field
 //        0     1  protocol version (kProtocolVersion)

@@ -81,7 +81,7 @@ std::optional<Control> FrameReader::next_greeting() {
   if (buffered() < kGreetingBytes) return std::nullopt;
   const std::uint8_t* greeting = buffer_.data() + begin_;
   if (!std::equal(kGreetingMagic.begin(), kGreetingMagic.end(), greeting))
-    fail(Rejection::bad_version, "the peer did not open with a cohaptic greeting (an older cohaptic, protocol 1, "
+    fail(Rejection::bad_version, "the peer did not open with a cohaptic greeting (an older cohaptic, protocol 1 or 2, "
                                  "opens with nothing; or not cohaptic at all)");
   if (greeting[kGreetingMagic.size()] != kProtocolVersion)
     fail(Rejection::bad_version, fmt::format("the peer speaks protocol version {}, this program {}",
@@ -107,7 +107,7 @@ std::optional<Control> FrameReader::next() {
   if (buffered() < kFrameClearBytes) return std::nullopt;
   const Envelope envelope = *read_envelope(std::span(frame + kFrameLengthBytes, kEnvelopeBytes));
   if (envelope.version != kProtocolVersion)
-    fail(Rejection::bad_version, fmt::format("envelope version byte {}, expected protocol version {} (a protocol 1 "
+    fail(Rejection::bad_version, fmt::format("envelope version byte {}, expected protocol version {} (a protocol 1 or 2 "
                                              "peer, an older cohaptic, sends no envelope)",
                                              envelope.version, kProtocolVersion));
   if (!envelope.known_format()) fail(Rejection::bad_version, fmt::format("unknown envelope flags 0x{:02x}", envelope.flags));

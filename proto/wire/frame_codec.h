@@ -1,4 +1,4 @@
-// Framing of the TCP control channel (protocol 2). Each Control message travels as
+// Framing of the TCP control channel (protocol 3). Each Control message travels as
 //   [u32 little-endian body length][envelope (envelope.h)][body: serialized Control][16-byte tag]
 // sealed under the sender's traffic key (aead.h); length and envelope are the clear part.
 // The server opens every connection with a greeting before any frame:

@@ -14,9 +14,10 @@
 
 namespace cohaptic::wire {
 
-/// 2: every frame and datagram sealed with its sender's traffic key (XChaCha20-Poly1305
-/// behind a clear envelope); 1 was the shared session key's HMAC tag on clear messages.
-constexpr std::uint32_t kProtocolVersion = 2;
+/// 3: every frame and datagram sealed with its sender's traffic key (XChaCha20-Poly1305
+/// behind a clear envelope); 2: IR format 2 (an envelope around a body), and like 1 the
+/// shared session key's HMAC tag on clear messages.
+constexpr std::uint32_t kProtocolVersion = 3;
 
 /// Sender ids in Header.sender: 0 the server, k + 1 the user in slot k, kJoiningSender a
 /// client that holds the session key and has no slot yet (its Join; traffic_keys.h).

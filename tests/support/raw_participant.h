@@ -1,4 +1,4 @@
-// RawParticipant: a participant made by hand over plain sockets, speaking protocol 2 through
+// RawParticipant: a participant made by hand over plain sockets, speaking protocol 3 through
 // the codec alone (no ServerConnection, no ClientNetwork), so that a test can make it do
 // what a real client never does: stop reading its control connection while it presses,
 // replay its join on another connection, claim another slot. Blocking sockets with a
