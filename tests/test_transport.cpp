@@ -13,7 +13,9 @@
 //     other by its reason;
 //   - the per-source rate limit against a token-bucket model on a driven clock, and on a
 //     real socket: a flooding source is heard only at the refill rate, while an admitted
-//     peer on the same address loses nothing.
+//     peer on the same address loses nothing;
+//   - delivery over an ordered link with jitter (the server's injected delay on TCP) keeps
+//     the order of a burst: timers due at one instant, or run late, never swap two frames.
 #include <gtest/gtest.h>
 
 #include <asio.hpp>
@@ -25,6 +27,7 @@
 
 #include "net/bounded_write_queue.h"
 #include "net/datagram_endpoint.h"
+#include "net/delayed_delivery.h"
 #include "net/framed_connection.h"
 #include "net/source_rate_limiter.h"
 #include "proto/wire/frame_codec.h"
@@ -461,6 +464,22 @@ TEST(DatagramEndpoint, AFloodingSourceIsRateLimitedAndAnAdmittedPeerOnItsAddress
               static_cast<unsigned long>(counters.count(wire::Rejection::rate_limited)), received);
   EXPECT_LE(static_cast<double>(inspected_garbage), limit.burst + limit.refill_per_s * seconds + 1);
   EXPECT_GE(counters.count(wire::Rejection::rate_limited), static_cast<std::uint64_t>(kGarbage) - inspected_garbage);
+}
+
+// What the soak found: frames sent in a burst over the server's jittered TCP link were
+// delivered by timers that could expire out of order (each deadline was counted from its
+// own reading of the clock, and equal deadlines fire in any order), so a client received
+// an event sealed with its slot's key before the Welcome that gave it the slot.
+TEST(DelayedDelivery, AnOrderedLinkWithJitterDeliversABurstInOrder) {
+  asio::io_context io;
+  LinkDelay link({.delay_ms = 0, .jitter_ms = 10, .seed = 16}, true);
+  std::vector<int> delivered;
+  constexpr int kMessages = 5000;  // sent as fast as the loop goes: a burst, many within one jitter
+  for (int i = 0; i < kMessages; ++i)
+    ASSERT_TRUE(deliver_over(link, io, wire::monotonic_now_ns(), [&delivered, i](std::int64_t) { delivered.push_back(i); }));
+  io.run();
+  ASSERT_EQ(delivered.size(), static_cast<std::size_t>(kMessages));
+  for (int i = 0; i < kMessages; ++i) ASSERT_EQ(delivered[static_cast<std::size_t>(i)], i) << "delivered out of order";
 }
 
 }  // namespace
