@@ -145,7 +145,7 @@ void ConnectionHandler::accept() {
           const ParticipantPtr p = weak.lock();
           return p ? key_for(*p, sender) : nullptr;
         },
-        {.expect_greeting = false, .allow_cleartext = !options_.encrypt});
+        {.expect_greeting = false, .allow_cleartext = !options_.encrypt, .max_body_bytes = kMaxClientFrameBytes});
     participant->connection = net::FramedConnection::start(std::move(socket), std::move(reader), std::move(handlers));
     participants_.push_back(participant);
     send_bytes(participant, wire::encode_greeting(participant->challenge), net::FrameKind::must_arrive, false);

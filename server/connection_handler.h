@@ -59,6 +59,10 @@ inline constexpr std::size_t kMaxUnjoinedConnections = 16;
 /// say: with kMaxWaitingFrames, what a user that stops reading can hold up is bounded, and
 /// its writes stall (net::kWriteTimeout) within seconds. A few IRs' worth at any link speed.
 inline constexpr int kControlSendBufferBytes = 1 << 20;
+/// The largest frame body a client may send: its frames (Join, Event, Bye, ClientStatus) are
+/// small, and a frame declared larger is refused (oversized) before its body is buffered,
+/// so that a connection that has not even joined cannot make the server hold megabytes.
+inline constexpr std::size_t kMaxClientFrameBytes = std::size_t{64} << 10;
 
 struct ConnectionCounters {
   std::uint64_t datagrams_sent = 0, datagrams_relayed = 0;

@@ -3,13 +3,18 @@
 #include <fmt/format.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <fstream>
+#include <stdexcept>
 
 namespace cohaptic::testing {
 
 namespace fs = std::filesystem;
 
-void write_cube_scene(const fs::path& dir, const std::string& extra) {
+void write_cube_scene(const fs::path& dir, const std::string& extra, int tools) {
+  if (tools < 1 || tools > 4) throw std::invalid_argument(fmt::format("write_cube_scene: {} tools, not 1 to 4", tools));
+  std::string tool_list;
+  for (int k = 0; k < tools; ++k) tool_list += fmt::format("{}{{name: {}}}", k ? ", " : "", static_cast<char>('A' + k));
   std::ofstream(dir / "cube.yaml") << R"(
 name: soft-cube
 units: mm
@@ -20,7 +25,7 @@ objects:
     fixed: [{plane: {point: [0, 0, -130], normal: [0, 0, 1]}}]
     touchable: [{plane: {point: [0, 0, 0], normal: [0, 0, 1]}}]
     compliance: {precompute: touchable, disk_cache: false}
-tools: [{name: A}, {name: B}]
+tools: [)" << tool_list << R"(]
 haptic: {rate_hz: 1000, force_limit: 3.3, contact_model: translation, patch_rings: 1}
 )" << extra;
 }
@@ -40,10 +45,14 @@ segments:
   return file;
 }
 
+double period_p99_allowance_us(const nlohmann::json& client_report) {
+  return std::max(1100.0, client_report.at("timer_floor").at("period_us").at("p99").get<double>() + 150);
+}
+
 CubeSession::CubeSession(const std::string& name, const std::vector<std::string>& server_arguments,
-                         const std::string& scene_extra)
+                         const std::string& scene_extra, int tools)
     : dir(scratch_directory(name)) {
-  write_cube_scene(dir, scene_extra);
+  write_cube_scene(dir, scene_extra, tools);
   std::vector<std::string> arguments = {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0",
                                         "--report", (dir / "server.json").string(), "--no-disk-cache"};
   for (const std::string& argument : server_arguments) {  // paths after --display and --record are the session directory's
