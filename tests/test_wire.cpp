@@ -250,7 +250,7 @@ TEST(WireAead, SealIsXChaCha20Poly1305OverTheDocumentedNonce) {
 
   // The documented layout of the envelope and the nonce, byte by byte.
   EXPECT_EQ(Bytes(message.begin(), message.begin() + kEnvelopeBytes),
-            (Bytes{2, 1, 7, 0, 0, 0, 8, 7, 6, 5, 4, 3, 2, 1, 0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11}));
+            (Bytes{3, 1, 7, 0, 0, 0, 8, 7, 6, 5, 4, 3, 2, 1, 0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11}));
   const Bytes nonce = {8, 7, 6, 5, 4, 3, 2, 1, 7, 0, 0, 0, 1, 0, 0, 0, 0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11};
   // Independently: libsodium's combined decryption with that nonce and the envelope as associated data.
   Bytes plain(body.size());
@@ -853,14 +853,14 @@ TEST(WireFrame, TheClientsReaderTakesTheGreetingFirst) {
 
   // A peer of another version, or none at all.
   Bytes other_version = greeting;
-  other_version[8] = 3;
+  other_version[8] = 4;
   FrameReader newer = reader_for(key, {.expect_greeting = true});
   newer.feed(other_version);
   const auto [newer_error, newer_reason] = frame_error(newer);
   EXPECT_EQ(newer_reason, Rejection::bad_version);
-  EXPECT_NE(newer_error.find("speaks protocol version 3, this program 2"), std::string::npos) << newer_error;
+  EXPECT_NE(newer_error.find("speaks protocol version 4, this program 3"), std::string::npos) << newer_error;
   FrameReader silent = reader_for(key, {.expect_greeting = true});
-  silent.feed(frame);  // a server that sends a frame first is no cohaptic 2 server
+  silent.feed(frame);  // a server that sends a frame first is no cohaptic 3 server
   EXPECT_EQ(frame_error(silent).second, Rejection::bad_version);
   // The server's reader takes no greeting: one is garbage to it.
   FrameReader server = reader_for(key);
