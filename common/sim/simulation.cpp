@@ -41,6 +41,8 @@ void Simulation::set_tool(int user, const Eigen::Vector3d& position) {
 
 void Simulation::clear_tool(int user) { users_[user].known = false; }
 
+void Simulation::continue_epochs(int user, std::uint64_t epoch) { users_[user].epoch = std::max(users_[user].epoch, epoch); }
+
 void Simulation::hold(int node, const HeldNode& held) {
   condensation_.add_boundary_node(node);
   held_[node] = held;
