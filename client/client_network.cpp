@@ -13,6 +13,7 @@
 #include "client/clock_sync.h"
 #include "client/ir_intake.h"
 #include "client/server_connection.h"
+#include "client/welcome.h"
 #include "net/datagram_endpoint.h"
 #include "proto/record/session_recorder.h"
 #include "proto/wire/header.h"
@@ -49,19 +50,6 @@ std::unique_ptr<wire::DatagramInspector> server_only_inspector(const wire::Sessi
   auto inspector = std::make_unique<wire::DatagramInspector>(key);
   inspector->allow_sender(wire::kServerSender);
   return inspector;
-}
-
-WelcomeInfo welcome_info(const wire::Welcome& welcome) {
-  WelcomeInfo info;
-  info.slot = static_cast<int>(welcome.slot());
-  info.scene_name = welcome.scene_name();
-  info.scene_yaml = welcome.scene_yaml();
-  info.protocol = welcome.protocol() == wire::P0 ? HapticProtocol::p0 : HapticProtocol::p1;
-  info.force_limit = welcome.force_limit();
-  info.haptic_rate_hz = welcome.haptic_rate_hz();
-  info.ir_max_age_s = welcome.ir_max_age_s();
-  info.user_count = welcome.users_size();
-  return info;
 }
 
 }  // namespace
@@ -149,7 +137,18 @@ struct ClientNetwork::Impl {
   }
 
   void joined(const wire::Welcome& message, std::uint64_t session) {
-    const WelcomeInfo info = welcome_info(message);
+    WelcomeInfo info;
+    try {
+      info = welcome_info(message);
+    } catch (const Error& error) {
+      // Nothing of a welcome we cannot use reaches the haptic loop: start() fails with why.
+      spdlog::error("{}", error.what());
+      connection.drop(error.what());
+      std::lock_guard lock(welcome_mutex);
+      refusal = error.what();
+      welcome_ready.notify_all();
+      return;
+    }
     server_udp = udp::endpoint(connection.server_address(), static_cast<std::uint16_t>(message.server_udp_port()));
     udp.inspector().set_expected_session(session);
     // A fresh replay window for a new session: our sequence numbers keep increasing across

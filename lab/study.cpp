@@ -117,9 +117,11 @@ std::string StudyCondition::name() const {
   return out;
 }
 
-Study load_study(const std::filesystem::path& file) {
+Study load_study(const std::filesystem::path& file) { return parse_study(read_text_file(file.string()), file); }
+
+Study parse_study(const std::string& yaml_text, const std::filesystem::path& file) {
   const std::string name = file.string();
-  const YamlCursor top(load_yaml(read_text_file(name), name), "", &name, 1);
+  const YamlCursor top(load_yaml(yaml_text, name), "", &name, 1);
   top.only_keys({"name", "scene", "trial_duration", "condensation", "participants", "factors", "repetitions", "order", "session"});
   const std::filesystem::path base = file.has_parent_path() ? file.parent_path() : ".";
   Study study;
