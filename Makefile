@@ -3,13 +3,31 @@
 #   make demo   the same set-up, then the main job
 #   make tradeoff  the same set-up, then the speed/accuracy grid on the cube
 #   make bench  the same set-up, then the benchmarks (BENCH_ARGS passes arguments through)
+#   make fuzz       build the fuzz targets with clang (libFuzzer, ASan, UBSan) in build-fuzz
+#                   and run each for FUZZ_SECONDS (default 20; 0 builds only)
+#   make test-asan  the whole suite built with ASan + UBSan (GCC) in build-asan
+#   make test-tsan  the threaded tests (TSAN_TESTS) built with ThreadSanitizer in build-tsan
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BENCH_ARGS ?=
 LAB := $(BUILD_DIR)/lab/cohaptic-lab
 
-.PHONY: all deps configure build test demo probe-demo tradeoff bench clean
+FUZZ_BUILD_DIR ?= build-fuzz
+ASAN_BUILD_DIR ?= build-asan
+TSAN_BUILD_DIR ?= build-tsan
+FUZZ_SECONDS ?= 20
+# The tests that run threads: the haptic loop, the hand-overs between threads, the
+# transport, the server's loop and program, and the end-to-end sessions of real server and
+# client processes (whose programs are built with TSan too).
+TSAN_TESTS ?= HapticLoop|ThreadHandOver|FramedConnection|DatagramEndpoint|SimulationLoop|ServerProgram|EndToEnd|Replay\.
+# Sanitizer and fuzz builds: -O1 with line tables only (file:line in every report, half the
+# compile time of -O2 -g), and assertions on (Eigen's index checks too); no benchmarks.
+SANITIZER_CMAKE = -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g1" -DCOHAPTIC_BUILD_BENCHMARKS=OFF
+SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
+
+.PHONY: all deps configure build test demo probe-demo tradeoff bench fuzz test-asan test-tsan clean
 
 all: build
 
@@ -50,5 +68,21 @@ tradeoff: build
 bench: build
 	$(BUILD_DIR)/tests/cohaptic_bench $(BENCH_ARGS)
 
+fuzz: deps
+	CC=clang CXX=clang++ cmake -S . -B $(FUZZ_BUILD_DIR) -DCMAKE_BUILD_TYPE=Debug \
+	  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DCOHAPTIC_FUZZ=ON -DCOHAPTIC_BUILD_TESTS=OFF -DCOHAPTIC_BUILD_BENCHMARKS=OFF
+	cmake --build $(FUZZ_BUILD_DIR) -j $(JOBS) --target fuzz_targets
+	@if [ "$(FUZZ_SECONDS)" != 0 ]; then FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run_fuzzers.sh $(FUZZ_BUILD_DIR); fi
+
+test-asan: deps
+	cmake -S . -B $(ASAN_BUILD_DIR) $(SANITIZER_CMAKE) -DCOHAPTIC_SANITIZE=address,undefined
+	cmake --build $(ASAN_BUILD_DIR) -j $(JOBS)
+	$(SANITIZER_ENV) ctest --test-dir $(ASAN_BUILD_DIR) --output-on-failure -j $(JOBS)
+
+test-tsan: deps
+	cmake -S . -B $(TSAN_BUILD_DIR) $(SANITIZER_CMAKE) -DCOHAPTIC_SANITIZE=thread
+	cmake --build $(TSAN_BUILD_DIR) -j $(JOBS) --target cohaptic_tests cohaptic_e2e_tests
+	$(SANITIZER_ENV) ctest --test-dir $(TSAN_BUILD_DIR) --output-on-failure -j $(JOBS) -R '$(TSAN_TESTS)'
+
 clean:
-	rm -rf $(BUILD_DIR)
+	rm -rf $(BUILD_DIR) $(FUZZ_BUILD_DIR) $(ASAN_BUILD_DIR) $(TSAN_BUILD_DIR)

@@ -17,6 +17,8 @@ packages=(
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # fuzzing (libFuzzer) and sanitizer reports: make fuzz, make test-asan, make test-tsan
+  clang libclang-rt-14-dev llvm
 )
 
 # Node.js and npm, for the official MCAP reader (@mcap/core) a test checks our recordings

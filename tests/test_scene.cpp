@@ -315,6 +315,13 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
                      {"objects[0].mesh.file", "/nonexistent-cohaptic-test/scenes/no_such_mesh.msh", "does not exist"}});
   }
 
+  {
+    // Found by fuzzing: a list as a map key escaped as a YAML library exception.
+    const auto text = replaced(base, "      youngs_modulus: 1000\n", "      ? [youngs, modulus]\n      : 1000\n");
+    cases.push_back({"list as a key", text, "? [youngs, modulus]",
+                     {"objects[0].material", "a map whose keys are names", "found a list of 2"}});
+  }
+
   for (const BadScene& bad : cases) expect_scene_error(bad);
 }
 

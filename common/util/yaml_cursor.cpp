@@ -57,7 +57,7 @@ void YamlCursor::only_keys(std::initializer_list<const char*> allowed) const {
   if (!node_.IsMap()) fail("a map");
   const std::set<std::string> known(allowed.begin(), allowed.end());
   for (const auto& entry : node_) {
-    const auto key = entry.first.as<std::string>();
+    const std::string key = key_text(entry.first);
     if (!known.count(key)) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
@@ -69,7 +69,7 @@ void YamlCursor::only_keys(std::initializer_list<const char*> allowed) const {
 std::vector<std::string> YamlCursor::keys() const {
   if (!node_.IsMap()) fail("a map");
   std::vector<std::string> out;
-  for (const auto& entry : node_) out.push_back(entry.first.as<std::string>());
+  for (const auto& entry : node_) out.push_back(key_text(entry.first));
   return out;
 }
 
@@ -142,6 +142,11 @@ Eigen::Vector3d YamlCursor::vec3() const {
   if (!node_.IsSequence() || node_.size() != 3) fail("a list of 3 numbers");
   const auto parts = items();
   return {parts[0].number(), parts[1].number(), parts[2].number()};
+}
+
+std::string YamlCursor::key_text(const YAML::Node& key) const {
+  if (!key.IsScalar()) YamlCursor(key, path_, file_, line_, raise_).fail("a map whose keys are names");
+  return key.Scalar();
 }
 
 std::string YamlCursor::join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }

@@ -70,6 +70,8 @@ class YamlCursor {
 
  private:
   std::string join(const std::string& key) const;
+  /// The map key `key` as text; a key that is a list or a map fails, naming where.
+  std::string key_text(const YAML::Node& key) const;
   std::string describe() const;
 
   YAML::Node node_;
