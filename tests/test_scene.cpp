@@ -322,6 +322,23 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
                      {"objects[0].material", "a map whose keys are names", "found a list of 2"}});
   }
 
+  {
+    // Found by fuzzing: a name the system refuses (too long) threw std::filesystem's error.
+    const std::string long_name(5000, 'm');
+    const auto text = replaced(base,
+                               "      box:\n        min: [0, 0, 0]\n        size: [10, 10, 10]\n"
+                               "        divisions: [2, 2, 2]\n",
+                               "      file: " + long_name + ".msh\n");
+    cases.push_back({"file name too long", text, "file: mmm", {"objects[0].mesh.file", "cannot be examined: File name too long"}});
+  }
+  {
+    const auto text = replaced(base,
+                               "      box:\n        min: [0, 0, 0]\n        size: [10, 10, 10]\n"
+                               "        divisions: [2, 2, 2]\n",
+                               "      file: /tmp\n");
+    cases.push_back({"directory as mesh", text, "file: /tmp", {"objects[0].mesh.file", "mesh file /tmp is a directory"}});
+  }
+
   for (const BadScene& bad : cases) expect_scene_error(bad);
 }
 
