@@ -5,7 +5,8 @@
 //   size (oversized; truncated if shorter than a tag), tag (bad_tag), parse (truncated),
 //   header version (bad_version), session (wrong_session, if one is expected),
 //   sender (unknown_sender; inspector only), body present (empty), every double finite
-//   (non_finite), replay (replayed; inspector only).
+//   (non_finite), every clock reading in [0, kMaxClockNs) (bad_time), replay (replayed;
+//   inspector only).
 // Replay comes last so that a packet failing any other check never moves a replay window.
 // decode_datagram() is the stateless part; DatagramInspector adds the allowed senders,
 // one ReplayWindow per sender and counters per reason. Neither throws on any input.
@@ -37,8 +38,14 @@ void encode_datagram(const Datagram& datagram, const SessionKey& key, std::vecto
 std::variant<Datagram, Rejection> decode_datagram(std::span<const std::uint8_t> bytes, const SessionKey& key,
                                                   std::optional<std::uint64_t> expected_session = std::nullopt);
 
+/// The bound of every clock reading a datagram carries (header.sender_time_ns and the
+/// body's times): 2^61 ns, 73 years of a monotonic clock. Within it, the receivers' clock
+/// arithmetic (offsets, conversions between clocks, ages, intervals) cannot overflow.
+constexpr std::int64_t kMaxClockNs = std::int64_t{1} << 61;
+
 /// empty if `datagram` has no body, non_finite if a double in its body is NaN or infinite
-/// (a ToolSample's position is checked even when it is marked invalid: send zeros).
+/// (a ToolSample's position is checked even when it is marked invalid: send zeros),
+/// bad_time if a clock reading in its header or body is outside [0, kMaxClockNs).
 std::optional<Rejection> body_rejection(const Datagram& datagram);
 
 /// The receiving side of a UDP socket: validates, counts, and keeps a replay window per

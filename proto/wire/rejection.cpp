@@ -13,6 +13,7 @@ std::string_view to_string(Rejection reason) {
     case Rejection::replayed: return "replayed";
     case Rejection::non_finite: return "non_finite";
     case Rejection::empty: return "empty";
+    case Rejection::bad_time: return "bad_time";
   }
   return "unknown";
 }

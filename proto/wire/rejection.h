@@ -1,7 +1,7 @@
 // Why a received datagram was dropped, and how many were, per reason.
 //
 // Reasons in the order the checks run (datagram_codec.h): size, tag, parse, version,
-// session, sender, body present, finite values, replay. The counters are atomics so a
+// session, sender, body present, finite values, clock readings in range, replay. The counters are atomics so a
 // monitoring thread may read them while the receiving thread counts.
 #pragma once
 
@@ -25,13 +25,14 @@ enum class Rejection : std::uint8_t {
   replayed,        ///< sequence already seen, or older than the replay window
   non_finite,      ///< a NaN or infinite value in the body
   empty,           ///< no body
+  bad_time,        ///< a clock reading (header or body) outside [0, kMaxClockNs)
 };
 
-constexpr std::size_t kRejectionCount = 9;
+constexpr std::size_t kRejectionCount = 10;
 
 constexpr std::array<Rejection, kRejectionCount> kAllRejections = {
     Rejection::oversized,      Rejection::truncated, Rejection::bad_tag,    Rejection::bad_version, Rejection::wrong_session,
-    Rejection::unknown_sender, Rejection::replayed,  Rejection::non_finite, Rejection::empty};
+    Rejection::unknown_sender, Rejection::replayed,  Rejection::non_finite, Rejection::empty,       Rejection::bad_time};
 
 /// "oversized", "truncated", "bad_tag", ...: the enumerator's name.
 std::string_view to_string(Rejection reason);

@@ -81,7 +81,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const wire::Rejection reason = *inspector.last_rejection();
       if (std::holds_alternative<wire::Rejection>(decoded)) {
         const wire::Rejection decode_reason = std::get<wire::Rejection>(decoded);
-        const bool body_reason = decode_reason == wire::Rejection::empty || decode_reason == wire::Rejection::non_finite;
+        const bool body_reason = decode_reason == wire::Rejection::empty || decode_reason == wire::Rejection::non_finite ||
+                                 decode_reason == wire::Rejection::bad_time;
         require(reason == decode_reason || (body_reason && reason == wire::Rejection::unknown_sender),
                 "the inspector names decode_datagram()'s reason, or the sender checked before the body");
       } else

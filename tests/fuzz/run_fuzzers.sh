@@ -5,7 +5,8 @@
 # features ("ft"), and the new inputs found.
 #   tests/fuzz/run_fuzzers.sh BUILD_DIR [TARGET...]      (default: every target)
 # Environment: FUZZ_SECONDS per target (default 20), FUZZ_OUT (default out/fuzz).
-# Each target starts from its seed corpus (tests/fuzz/corpus/NAME, read only) and from what
+# Each target starts from its seed corpus (tests/fuzz/corpus/NAME, read only; with the
+# dictionary tests/fuzz/NAME.dict if there is one) and from what
 # earlier runs found (FUZZ_OUT/NAME/corpus, where new inputs go). An input that crashes,
 # breaks a property, leaks, runs longer than 10 s or needs more than 2 GB is written to
 # FUZZ_OUT/NAME/ and fails the run (exit 1) after every target has run; fix the bug and
@@ -35,7 +36,9 @@ for target in "${targets[@]}"; do
   fi
   mkdir -p "$out/$target/corpus"
   log="$out/$target/fuzz.log"
-  "$program" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  dictionary=()
+  [[ -f "tests/fuzz/$target.dict" ]] && dictionary=(-dict="tests/fuzz/$target.dict")
+  "$program" "${dictionary[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
     -artifact_prefix="$out/$target/" "$out/$target/corpus" "tests/fuzz/corpus/$target" >"$log" 2>&1
   status=$?
   final_stat() { sed -n "s/^stat::$1: *//p" "$log" | tail -n 1; }
