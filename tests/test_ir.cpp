@@ -398,6 +398,9 @@ TEST(IntermediateRepresentation, PrepareRejectsMalformedIrs) {
   bad = good;
   bad.patch[0].nodes[1] = bad.node_count() + 5;
   EXPECT_THROW(prepare_ir(bad), Error);
+  bad = good;  // a lying server: M_CC not symmetric (its symmetric part is still definite)
+  bad.m_tilde(0, 1) += 1e-3 * bad.m_tilde.leftCols(bad.m_tilde.rows()).cwiseAbs().maxCoeff();
+  EXPECT_THROW(prepare_ir(bad), Error);
   EXPECT_NO_THROW(prepare_ir(good));
 }
 

@@ -41,7 +41,8 @@ struct PreparedIR {
   double condition_estimate = 1;      ///< of L~
 };
 
-/// Checks sizes, finiteness and positive definiteness; throws Error naming the problem.
+/// Checks sizes, finiteness, symmetry (to 1e-9 of the largest entry) and positive
+/// definiteness of M_CC; throws Error naming the problem.
 PreparedIR prepare_ir(IntermediateRepresentation ir);
 
 enum ForceFlag : std::uint8_t {

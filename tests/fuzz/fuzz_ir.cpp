@@ -4,7 +4,8 @@
 // lie: sizes, indices, NaN and infinities, asymmetric or indefinite M~, huge values.
 //
 // Input: a serialized wire::IntermediateRepresentation. Properties:
-//   - from_wire() and prepare_ir() either accept or throw cohaptic::Error;
+//   - from_wire() and prepare_ir() either accept or throw cohaptic::Error; an M_CC
+//     accepted is symmetric to 1e-9 of its largest entry;
 //   - for an IR they accept, evaluate_force() at probe positions around every patch
 //     triangle and node (outside, on the surface, pressed in by up to the patch's size),
 //     with the remote tools pressed into their triangles, returns a finite force no larger
@@ -49,6 +50,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;  // refused with a message: what a lying IR should get
   }
   const IntermediateRepresentation& ir = prepared.ir;
+  const auto m_cc = ir.m_tilde.leftCols(ir.m_tilde.rows());
+  if (m_cc.size() > 0)
+    require((m_cc - m_cc.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * m_cc.cwiseAbs().maxCoeff(), "an accepted M_CC is symmetric");
 
   // The patch's size sets the probe depths.
   const Eigen::Vector3d low = ir.rest_positions.rowwise().minCoeff(), high = ir.rest_positions.rowwise().maxCoeff();
