@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <span>
+#include <variant>
 #include <vector>
 
 #include "common/ir/contact_solve.h"
@@ -32,13 +33,23 @@
 
 namespace cohaptic {
 
-struct PreparedIR {
-  IntermediateRepresentation ir;
+/// What prepare_ir derives from a CondensedFemIr.
+struct PreparedFem {
   Eigen::MatrixXd compliance;         ///< L~ over the free dofs of the contact nodes [m/N]
   Eigen::VectorXd free_displacement;  ///< u0 over the same dofs [m]
   std::vector<std::array<int, 3>> dof_index;  ///< per contact node and axis: row in L~, or -1 if fixed
   std::vector<bool> on_patch_border;  ///< per patch node
-  double condition_estimate = 1;      ///< of L~
+};
+
+/// One alternative per IrBody alternative, in the same order.
+using PreparedBody = std::variant<PreparedFem>;
+
+/// An IR and what its evaluation needs, computed once: `body` holds the alternative that
+/// matches ir.body's kind (PreparedFem for CondensedFemIr).
+struct PreparedIR {
+  IntermediateRepresentation ir;
+  PreparedBody body;
+  double condition_estimate = 1;      ///< of the body's operator (L~ for FEM)
 };
 
 /// Checks sizes, finiteness, symmetry (to 1e-9 of the largest entry) and positive
@@ -61,7 +72,8 @@ struct ForceSample {
   std::uint8_t flags = 0;
 };
 
-/// remote_tools[i] is the position of ir.remotes[i]'s tool [m] (NaN: unknown, ignored).
+/// Dispatches on the body kind. remote_tools[i] is the position of the tool of the body's
+/// i-th remote contact [m] (NaN: unknown, ignored).
 ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
                            std::span<const Eigen::Vector3d> remote_tools) noexcept;
 

@@ -5,13 +5,14 @@
 // Input: the YAML text. Properties:
 //   - parse_scene() either returns a scene or throws cohaptic::Error (SceneError) naming
 //     the file: no exception of the YAML library, or anything else, escapes;
-//   - a scene accepted holds what the format promises: a unit scale, a finite positive
-//     modulus and a Poisson ratio in (-1, 0.5), tools, plane normals of unit length, box
-//     meshes of positive size, a haptic rate in [1, 100000] Hz and a force limit in
-//     (0, 1000] N.
+//   - a scene accepted holds what the format promises: a unit scale; objects, each body
+//     checked by its kind (linear_elastic: a finite positive modulus, a Poisson ratio in
+//     (-1, 0.5), box meshes of positive size); tools; plane normals of unit length; a
+//     haptic rate in [1, 100000] Hz and a force limit in (0, 1000] N.
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <variant>
 
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
@@ -26,22 +27,27 @@ void require_unit(const Eigen::Vector3d& normal) {
   require(normal.allFinite() && std::abs(normal.norm() - 1) < 1e-9, "an accepted plane normal is a unit vector");
 }
 
-void require_valid(const Scene& scene) {
-  require(std::isfinite(scene.metres_per_unit) && scene.metres_per_unit > 0, "the unit scale is positive");
-  const LinearElasticMaterial& material = scene.object.material;
+void require_valid(const ElasticObjectSpec& object) {
+  const LinearElasticMaterial& material = object.material;
   require(std::isfinite(material.youngs_modulus) && material.youngs_modulus > 0, "the modulus is positive and finite");
   require(material.poisson_ratio > -1 && material.poisson_ratio < 0.5, "the Poisson ratio is in (-1, 0.5)");
+  if (object.mesh.box) {
+    require(object.mesh.box->size.allFinite() && (object.mesh.box->size.array() > 0).all(), "a box has a size");
+    require(object.mesh.box->min_corner.allFinite(), "a box has a corner");
+  }
+  for (const FixedRegion& region : object.fixed)
+    if (region.nodes.kind == NodeSelector::Kind::plane) require_unit(region.nodes.plane_normal);
+  for (const NodeSelector& selector : object.touchable)
+    if (selector.kind == NodeSelector::Kind::plane) require_unit(selector.plane_normal);
+}
+
+void require_valid(const Scene& scene) {
+  require(std::isfinite(scene.metres_per_unit) && scene.metres_per_unit > 0, "the unit scale is positive");
+  require(!scene.objects.empty(), "a scene has objects");
+  for (const ObjectSpec& object : scene.objects) std::visit([](const auto& body) { require_valid(body); }, object.body);
   require(!scene.tools.empty(), "a scene has tools");
   for (const ToolSpec& tool : scene.tools)
     require(tool.shape == ToolShape::point || (std::isfinite(tool.radius) && tool.radius > 0), "a sphere has a radius");
-  if (scene.object.mesh.box) {
-    require(scene.object.mesh.box->size.allFinite() && (scene.object.mesh.box->size.array() > 0).all(), "a box has a size");
-    require(scene.object.mesh.box->min_corner.allFinite(), "a box has a corner");
-  }
-  for (const FixedRegion& region : scene.object.fixed)
-    if (region.nodes.kind == NodeSelector::Kind::plane) require_unit(region.nodes.plane_normal);
-  for (const NodeSelector& selector : scene.object.touchable)
-    if (selector.kind == NodeSelector::Kind::plane) require_unit(selector.plane_normal);
   for (const ObstacleSpec& obstacle : scene.obstacles)
     if (obstacle.plane) require_unit(obstacle.plane->second);
   require(scene.haptic.rate_hz >= 1 && scene.haptic.rate_hz <= 100000, "the haptic rate is in range");
