@@ -1,5 +1,5 @@
 // fuzz_make_seeds: writes the seed corpora of the wire and recording targets
-// (corpus/{datagram,control_frames,ir,mcap,bridge}/) from real session recordings:
+// (corpus/{datagram,control_frames,ir,mcap,bridge,view}/) from real session recordings:
 //   fuzz_make_seeds SERVER.mcap CLIENT.mcap OUT_DIR
 // make_seeds.sh records a short two-user session on the cube and runs this on it. The
 // file-format targets (scene, study, gmsh, freesurfer) take their seeds straight from the
@@ -19,8 +19,10 @@
 #include <vector>
 
 #include "client/device/bridge_protocol.h"
+#include "cohaptic/view.pb.h"
 #include "common/mesh/boundary_surface.h"
 #include "common/mesh/read_gmsh.h"
+#include "common/util/error.h"
 #include "proto/record/mcap_writer.h"
 #include "proto/record/recording.h"
 #include "proto/record/session_recorder.h"
@@ -174,14 +176,15 @@ void control_seeds(const record::Recording& client, const std::vector<wire::Inte
 
 void ir_seeds(const std::vector<wire::IntermediateRepresentation>& irs, const fs::path& out) {
   write_seed(out, "smallest", bytes_of(irs.front()));
-  const auto with_remote = std::find_if(irs.begin(), irs.end(), [](const auto& ir) { return ir.remotes_size() > 0; });
+  const auto with_remote = std::find_if(irs.begin(), irs.end(), [](const auto& ir) { return ir.fem().remotes_size() > 0; });
   if (with_remote != irs.end()) write_seed(out, "with_remote", bytes_of(*with_remote));
   // The smallest as a server with --ir-precision f32 sends it: M~ and u_B rounded to float.
   wire::IntermediateRepresentation f32 = irs.front();
-  f32.clear_m_tilde_f64();
-  f32.clear_boundary_displacement_f64();
-  for (double v : irs.front().m_tilde_f64()) f32.add_m_tilde_f32(static_cast<float>(v));
-  for (double v : irs.front().boundary_displacement_f64()) f32.add_boundary_displacement_f32(static_cast<float>(v));
+  wire::CondensedFem& fem = *f32.mutable_fem();
+  fem.clear_m_tilde_f64();
+  fem.clear_boundary_displacement_f64();
+  for (double v : irs.front().fem().m_tilde_f64()) fem.add_m_tilde_f32(static_cast<float>(v));
+  for (double v : irs.front().fem().boundary_displacement_f64()) fem.add_boundary_displacement_f32(static_cast<float>(v));
   write_seed(out, "smallest_f32", bytes_of(f32));
 }
 
@@ -222,6 +225,62 @@ void mcap_seeds(const record::Recording& server, const record::Recording& client
   std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   bytes.resize(bytes.size() * 2 / 3);
   write_seed(out, "killed_writer", bytes);
+}
+
+// The view target's input: a recording of the live view (its scene, four frames while the
+// users press, two status reports; schemas named only, as in the mcap seed events_only) as
+// the first piece, then browsers' Commands, wall time passing and a handshake.
+void view_seeds(const record::Recording& server, const fs::path& out) {
+  if (server.view_scenes.empty() || server.view_frames.empty()) throw Error("the server recording has no view frames (--view)");
+  const fs::path file = out / "recording.mcap";
+  fs::create_directories(out);
+  {
+    record::McapWriter writer(file);
+    const auto channel = [&writer](const google::protobuf::Descriptor* descriptor, const char* topic) {
+      return writer.add_channel(writer.add_schema(descriptor->full_name(), "protobuf", ""), topic);
+    };
+    const std::uint16_t config = channel(record::SessionConfig::descriptor(), record::topic::kConfig);
+    const std::uint16_t scene = channel(view::Scene::descriptor(), record::topic::kViewScene);
+    const std::uint16_t frames = channel(view::Frame::descriptor(), record::topic::kViewFrames);
+    const std::uint16_t statuses = channel(record::ReceivedClientStatus::descriptor(), record::topic::kClientStatus);
+    const auto start = static_cast<std::uint64_t>(server.config.start_time_ns());
+    std::uint32_t sequence = 0;
+    writer.write(config, ++sequence, start, start, server.config);
+    writer.write(scene, ++sequence, start, start, server.view_scenes.front());
+    const std::size_t count = std::min<std::size_t>(4, server.view_frames.size());
+    const std::size_t first = (server.view_frames.size() - count) / 2;  // mid-session: while pressing
+    for (std::size_t i = first; i < first + count; ++i) {
+      const auto time = start + static_cast<std::uint64_t>(server.view_frames[i].time() * 1e9);
+      writer.write(frames, ++sequence, time, time, server.view_frames[i]);
+    }
+    for (std::size_t i = 0; i < std::min<std::size_t>(2, server.client_statuses.size()); ++i) {
+      const auto time = static_cast<std::uint64_t>(server.client_statuses[i].receive_time_ns());
+      writer.write(statuses, ++sequence, time, time, server.client_statuses[i]);
+    }
+    writer.close();
+  }
+  std::ifstream in(file, std::ios::binary);
+  const std::vector<std::uint8_t> recording{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  fs::remove(file);
+  if (recording.size() > 65535) throw Error("the view's seed recording exceeds a piece (64 kB)");
+
+  const auto command_bytes = [](auto set) {
+    view::Command command;
+    set(command);
+    return bytes_of(command);
+  };
+  std::vector<std::uint8_t> input;
+  fuzz::append_piece(input, 0, recording);
+  fuzz::append_piece(input, 0, command_bytes([](view::Command& c) { c.mutable_play(); }));
+  const double half_second = 0.5;
+  fuzz::append_piece(input, 1, {reinterpret_cast<const std::uint8_t*>(&half_second), sizeof half_second});
+  fuzz::append_piece(input, 0, command_bytes([](view::Command& c) { c.set_speed(4); }));
+  fuzz::append_piece(input, 0, command_bytes([&server](view::Command& c) { c.set_seek(server.view_frames.front().time()); }));
+  fuzz::append_piece(input, 0, command_bytes([](view::Command& c) { c.set_jump(view::Command::PEAK_FORCE); }));
+  fuzz::append_piece(input, 0, command_bytes([](view::Command& c) { c.mutable_pause(); }));
+  const std::string handshake = "/ws?token=fuzz-token-0123456789";
+  fuzz::append_piece(input, 2, {reinterpret_cast<const std::uint8_t*>(handshake.data()), handshake.size()});
+  write_seed(out, "replay_session", input);
 }
 
 void bridge_seeds(const record::Recording& client, const fs::path& out) {
@@ -266,5 +325,6 @@ int main(int argc, char** argv) {
   ir_seeds(irs, out / "ir");
   mcap_seeds(server, client, out / "mcap");
   bridge_seeds(client, out / "bridge");
+  view_seeds(server, out / "view");
   return 0;
 }

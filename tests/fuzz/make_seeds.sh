@@ -2,7 +2,7 @@
 # Rewrites the seed corpora under tests/fuzz/corpus/ from real files and a real session:
 #   - scene, study, gmsh, freesurfer: copies of the repository's scene and study files and
 #     of the small test meshes (tests/data/mesh_io);
-#   - datagram, control_frames, ir, mcap, bridge: taken by fuzz_make_seeds from the
+#   - datagram, control_frames, ir, mcap, bridge, view: taken by fuzz_make_seeds from the
 #     recordings of a 4 s, two-user session on the cube (scenes/tradeoff/cube_two_users.yaml,
 #     P1, both users pressing) run here with the real server and clients on loopback.
 # Seeds that fuzzing found (crash-*, regression-*) are kept. Run from a configured build:
@@ -29,7 +29,7 @@ copy_seeds gmsh tests/data/mesh_io/*.msh
 copy_seeds freesurfer tests/data/mesh_io/*.asc
 
 "$build/server/cohaptic-server" --scene scenes/tradeoff/cube_two_users.yaml --listen "127.0.0.1:$port" --protocol P1 \
-  --duration 12 --no-disk-cache --record "$work/server.mcap" --log-level warn &
+  --duration 12 --no-disk-cache --view 127.0.0.1:0 --record "$work/server.mcap" --log-level warn &
 server=$!
 sleep 6  # the compliance block of the cube's front face
 "$build/client/cohaptic-client" --server "127.0.0.1:$port" --user alice --slot 0 --best-effort --duration 4 \
@@ -40,7 +40,7 @@ client_a=$!
 wait "$client_a"
 wait "$server"
 
-for target in datagram control_frames ir mcap bridge; do
+for target in datagram control_frames ir mcap bridge view; do
   mkdir -p "$corpus/$target"
   find "$corpus/$target" -type f ! -name 'crash-*' ! -name 'regression-*' -delete
 done
