@@ -1,5 +1,6 @@
 #include "common/scene/load_scene.h"
 
+#include "common/scene/parse_mass_spring.h"
 #include "common/util/regular_file.h"
 #include "common/util/yaml_cursor.h"
 
@@ -49,10 +50,7 @@ NodeSelector parse_selector(const Cursor& c, double scale) {
     plane->only_keys({"point", "normal", "tolerance"});
     s.kind = NodeSelector::Kind::plane;
     s.plane_point = plane->at("point").vec3() * scale;
-    const Cursor normal = plane->at("normal");
-    s.plane_normal = normal.vec3();
-    if (s.plane_normal.norm() < 1e-12) normal.fail("a non-zero normal vector");
-    s.plane_normal.normalize();
+    s.plane_normal = plane->at("normal").direction("a non-zero normal vector");
     if (auto tolerance = plane->find("tolerance"))
       s.tolerance = tolerance->number_in(0, INFINITY, true, false, "a positive length") * scale;
     ++kinds;
@@ -161,8 +159,9 @@ ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::pa
   ObjectSpec object;
   object.where = c.location();
   object.name = c.at("name").text();
-  const std::string model = c.find("model") ? c.at("model").choice({"linear_elastic"}) : "linear_elastic";
+  const std::string model = c.find("model") ? c.at("model").choice({"linear_elastic", "mass_spring"}) : "linear_elastic";
   if (model == "linear_elastic") object.body = parse_elastic_object(c, scale, scene_dir);
+  else object.body = parse_mass_spring_object(c, scale);
   return object;
 }
 

@@ -144,6 +144,15 @@ Eigen::Vector3d YamlCursor::vec3() const {
   return {parts[0].number(), parts[1].number(), parts[2].number()};
 }
 
+Eigen::Vector3d YamlCursor::direction(const std::string& expected) const {
+  // stableNorm, not norm: (1e200, 1e200, 0) has a finite length, but its squared norm
+  // overflows, and normalize() would then return the zero vector.
+  const Eigen::Vector3d v = vec3();
+  const double length = v.stableNorm();
+  if (!(length >= 1e-12)) fail(expected);
+  return v / length;
+}
+
 std::string YamlCursor::key_text(const YAML::Node& key) const {
   if (!key.IsScalar()) YamlCursor(key, path_, file_, line_, raise_).fail("a map whose keys are names");
   return key.Scalar();

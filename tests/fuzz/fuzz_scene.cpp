@@ -7,13 +7,15 @@
 //     the file: no exception of the YAML library, or anything else, escapes;
 //   - a scene accepted holds what the format promises: a unit scale; objects, each body
 //     checked by its kind (linear_elastic: a finite positive modulus, a Poisson ratio in
-//     (-1, 0.5), box meshes of positive size); tools; plane normals of unit length; a
+//     (-1, 0.5), box meshes of positive size; mass_spring: a finite tube of positive radius,
+//     two sections or more, a unit `up`, finite positive modulus and density); tools; plane normals of unit length; a
 //     haptic rate in [1, 100000] Hz and a force limit in (0, 1000] N.
 #include <cmath>
 #include <cstdint>
 #include <string>
 #include <variant>
 
+#include "common/mass_spring/mass_spring_spec.h"
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
 #include "tests/fuzz/fuzz_support.h"
@@ -24,7 +26,7 @@ using namespace cohaptic;
 using fuzz::require;
 
 void require_unit(const Eigen::Vector3d& normal) {
-  require(normal.allFinite() && std::abs(normal.norm() - 1) < 1e-9, "an accepted plane normal is a unit vector");
+  require(normal.allFinite() && std::abs(normal.norm() - 1) < 1e-9, "an accepted direction is a unit vector");
 }
 
 void require_valid(const ElasticObjectSpec& object) {
@@ -39,6 +41,16 @@ void require_valid(const ElasticObjectSpec& object) {
     if (region.nodes.kind == NodeSelector::Kind::plane) require_unit(region.nodes.plane_normal);
   for (const NodeSelector& selector : object.touchable)
     if (selector.kind == NodeSelector::Kind::plane) require_unit(selector.plane_normal);
+}
+
+void require_valid(const MassSpringObjectSpec& object) {
+  require(object.tube.centre_line.size() >= 2, "a tube has a centre line");
+  for (const Eigen::Vector3d& point : object.tube.centre_line) require(point.allFinite(), "the centre line is finite");
+  require(std::isfinite(object.tube.radius) && object.tube.radius > 0, "a tube has a radius");
+  require(object.tube.sections >= 2, "a tube has two sections or more");
+  require_unit(object.tube.up);
+  require(std::isfinite(object.material.youngs_modulus) && object.material.youngs_modulus > 0, "the modulus is positive and finite");
+  require(std::isfinite(object.material.density) && object.material.density > 0, "the density is positive and finite");
 }
 
 void require_valid(const Scene& scene) {
