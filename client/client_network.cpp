@@ -14,6 +14,7 @@
 #include "client/clock_sync.h"
 #include "client/ir_intake.h"
 #include "client/server_connection.h"
+#include "client/welcome.h"
 #include "net/datagram_endpoint.h"
 #include "proto/record/session_recorder.h"
 #include "proto/wire/header.h"
@@ -63,19 +64,6 @@ int requested_slot(const ClientOptions& options, const wire::ClientKeys& keys) {
     throw Error(fmt::format("--slot {}, but the key file is participant {}'s: it can only join slot {}",
                             options.requested_slot, *fixed, *fixed));
   return static_cast<int>(*fixed);
-}
-
-WelcomeInfo welcome_info(const wire::Welcome& welcome) {
-  WelcomeInfo info;
-  info.slot = static_cast<int>(welcome.slot());
-  info.scene_name = welcome.scene_name();
-  info.scene_yaml = welcome.scene_yaml();
-  info.protocol = welcome.protocol() == wire::P0 ? HapticProtocol::p0 : HapticProtocol::p1;
-  info.force_limit = welcome.force_limit();
-  info.haptic_rate_hz = welcome.haptic_rate_hz();
-  info.ir_max_age_s = welcome.ir_max_age_s();
-  info.user_count = welcome.users_size();
-  return info;
 }
 
 }  // namespace
@@ -172,7 +160,18 @@ struct ClientNetwork::Impl {
   }
 
   void joined(const wire::Welcome& message, std::uint64_t session) {
-    const WelcomeInfo info = welcome_info(message);
+    WelcomeInfo info;
+    try {
+      info = welcome_info(message);
+    } catch (const Error& error) {
+      // Nothing of a welcome we cannot use reaches the haptic loop: start() fails with why.
+      spdlog::error("{}", error.what());
+      connection.drop(error.what());
+      std::lock_guard lock(welcome_mutex);
+      refusal = error.what();
+      welcome_ready.notify_all();
+      return;
+    }
     udp.distrust(server_udp);
     server_udp = udp::endpoint(connection.server_address(), static_cast<std::uint16_t>(message.server_udp_port()));
     udp.trust(server_udp);

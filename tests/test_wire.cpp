@@ -384,7 +384,7 @@ Datagram tool_datagram(std::uint64_t sequence, std::uint32_t sender = 1, std::ui
   h->set_sender_time_ns(123456789);
   ToolSample* tool = d.mutable_tool();
   tool->set_user(sender - 1);
-  tool->set_sample_time_ns(-42);
+  tool->set_sample_time_ns(42);
   tool->mutable_position()->set_x(0.01);
   tool->mutable_position()->set_y(-0.02);
   tool->mutable_position()->set_z(-0.003);
@@ -449,7 +449,7 @@ TEST(WireDatagram, RoundTripsEveryBodyBehindTheDocumentedEnvelope) {
   EXPECT_EQ(d.header().sequence(), 7u);
   EXPECT_EQ(d.header().sender_time_ns(), 123456789);
   EXPECT_EQ(d.tool().position().y(), -0.02);
-  EXPECT_EQ(d.tool().sample_time_ns(), -42);
+  EXPECT_EQ(d.tool().sample_time_ns(), 42);
   EXPECT_EQ(d.tool().buttons(), 5u);
   EXPECT_TRUE(d.tool().valid());
 
@@ -467,11 +467,11 @@ TEST(WireDatagram, RoundTripsEveryBodyBehindTheDocumentedEnvelope) {
   Datagram pong;
   *pong.mutable_header() = tool.header();
   pong.mutable_pong()->set_client_send_ns(1);
-  pong.mutable_pong()->set_server_receive_ns(std::numeric_limits<std::int64_t>::max());
-  pong.mutable_pong()->set_server_send_ns(-3);
+  pong.mutable_pong()->set_server_receive_ns(kMaxClockNs - 1);
+  pong.mutable_pong()->set_server_send_ns(0);
   decoded = decode_datagram(encode_datagram(pong, {key, kSalt}), key);
   ASSERT_TRUE(std::holds_alternative<Datagram>(decoded));
-  EXPECT_EQ(std::get<Datagram>(decoded).pong().server_receive_ns(), std::numeric_limits<std::int64_t>::max());
+  EXPECT_EQ(std::get<Datagram>(decoded).pong().server_receive_ns(), kMaxClockNs - 1);
 
   // The in-place encoder produces the same bytes.
   Bytes reused;
@@ -584,6 +584,32 @@ TEST(WireDatagramInspector, RejectsEachHostileDatagramForItsReason) {
   Datagram empty = tool_datagram(14);
   empty.clear_body();
   expect_outcome(rig.inspector, rig.encode(empty), Rejection::empty, "no body");
+
+  // Clock readings outside [0, 2^61) ns: found by review while fuzzing, a pong's INT64_MIN
+  // overflowed the client's clock offset arithmetic (undefined behaviour).
+  constexpr std::int64_t kMin = std::numeric_limits<std::int64_t>::min(), kMax = std::numeric_limits<std::int64_t>::max();
+  Datagram early = tool_datagram(15);
+  early.mutable_header()->set_sender_time_ns(-1);
+  expect_outcome(rig.inspector, rig.encode(early), Rejection::bad_time, "negative sender time");
+  Datagram sample = tool_datagram(15);
+  sample.mutable_tool()->set_sample_time_ns(kMaxClockNs);
+  expect_outcome(rig.inspector, rig.encode(sample), Rejection::bad_time, "sample time at 2^61");
+  Datagram ping;
+  *ping.mutable_header() = tool_datagram(15).header();
+  ping.mutable_ping()->set_client_send_ns(kMin);
+  expect_outcome(rig.inspector, rig.encode(ping), Rejection::bad_time, "ping at INT64_MIN");
+  for (int field = 0; field < 3; ++field) {
+    Datagram pong;
+    *pong.mutable_header() = tool_datagram(15).header();
+    pong.mutable_pong()->set_client_send_ns(field == 0 ? kMin : 1);
+    pong.mutable_pong()->set_server_receive_ns(field == 1 ? kMax : 2);
+    pong.mutable_pong()->set_server_send_ns(field == 2 ? -3 : 3);
+    expect_outcome(rig.inspector, rig.encode(pong), Rejection::bad_time, "pong field " + std::to_string(field));
+  }
+  Datagram answer;
+  *answer.mutable_header() = tool_datagram(15).header();
+  answer.mutable_force()->set_tool_time_ns(kMax);
+  expect_outcome(rig.inspector, rig.encode(answer), Rejection::bad_time, "force answering INT64_MAX");
 
   // None of the rejected packets moved the window: the valid one is still fresh, once.
   expect_outcome(rig.inspector, valid, std::nullopt, "valid");
@@ -724,7 +750,7 @@ TEST(WireDatagramInspector, RejectionNamesAreTheEnumerators) {
   for (Rejection r : kAllRejections) names.insert(std::string(to_string(r)));
   EXPECT_EQ(names, (std::set<std::string>{"oversized", "truncated", "bad_tag", "bad_version", "wrong_session",
                                           "unknown_sender", "replayed", "non_finite", "empty", "cleartext",
-                                          "rate_limited"}));
+                                          "rate_limited", "bad_time"}));
 }
 
 // ---- TCP frames ----

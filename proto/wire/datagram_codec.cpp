@@ -56,20 +56,30 @@ std::vector<std::uint8_t> encode_datagram(const Datagram& datagram, const SealWi
 }
 
 std::optional<Rejection> body_rejection(const Datagram& datagram) {
+  const auto clock = [](std::int64_t ns) { return ns >= 0 && ns < kMaxClockNs; };
+  bool times_in_range = clock(datagram.header().sender_time_ns());
   switch (datagram.body_case()) {
     case Datagram::BODY_NOT_SET: return Rejection::empty;
     case Datagram::kTool:
       if (!is_finite(datagram.tool().position())) return Rejection::non_finite;
+      times_in_range = times_in_range && clock(datagram.tool().sample_time_ns());
       break;
     case Datagram::kForce:
       if (!is_finite(datagram.force().force())) return Rejection::non_finite;
+      times_in_range = times_in_range && clock(datagram.force().tool_time_ns());
       break;
     case Datagram::kKeepAlive:
       if (!std::isfinite(datagram.keep_alive().simulation_time())) return Rejection::non_finite;
       break;
-    case Datagram::kPing:
-    case Datagram::kPong: break;  // integers only
+    case Datagram::kPing: times_in_range = times_in_range && clock(datagram.ping().client_send_ns()); break;
+    case Datagram::kPong: {
+      const ClockPong& pong = datagram.pong();
+      times_in_range = times_in_range && clock(pong.client_send_ns()) && clock(pong.server_receive_ns()) &&
+                       clock(pong.server_send_ns());
+      break;
+    }
   }
+  if (!times_in_range) return Rejection::bad_time;
   return std::nullopt;
 }
 

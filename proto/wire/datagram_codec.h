@@ -8,7 +8,8 @@
 //   parse (truncated), header version (bad_version), header sender and sequence equal to
 //   the envelope's (bad_tag), session (wrong_session, if one is expected), salt (replayed,
 //   the inspector only: sealed by another sealer than the sender's current one), body
-//   present (empty), every double finite (non_finite), replay window (replayed; inspector).
+//   present (empty), every double finite (non_finite), every clock reading in
+//   [0, kMaxClockNs) (bad_time), replay window (replayed; inspector).
 // The sender is checked before the tag, so that a datagram from no one costs no
 // cryptography; the replay window comes last, so that a datagram failing any other check
 // never moves it. decode_datagram() is the stateless part; DatagramInspector adds the
@@ -54,8 +55,14 @@ std::variant<Datagram, Rejection> decode_datagram(std::span<const std::uint8_t> 
                                                   std::optional<std::uint64_t> expected_session = std::nullopt,
                                                   bool allow_cleartext = false);
 
+/// The bound of every clock reading a datagram carries (header.sender_time_ns and the
+/// body's times): 2^61 ns, 73 years of a monotonic clock. Within it, the receivers' clock
+/// arithmetic (offsets, conversions between clocks, ages, intervals) cannot overflow.
+constexpr std::int64_t kMaxClockNs = std::int64_t{1} << 61;
+
 /// empty if `datagram` has no body, non_finite if a double in its body is NaN or infinite
-/// (a ToolSample's position is checked even when it is marked invalid: send zeros).
+/// (a ToolSample's position is checked even when it is marked invalid: send zeros),
+/// bad_time if a clock reading in its header or body is outside [0, kMaxClockNs).
 std::optional<Rejection> body_rejection(const Datagram& datagram);
 
 /// The receiving side of a UDP socket: validates, counts, and keeps for each allowed

@@ -31,14 +31,15 @@ enum class Rejection : std::uint8_t {
   empty,           ///< no body
   cleartext,       ///< not encrypted, and this receiver requires encryption
   rate_limited,    ///< from a source whose datagrams keep failing: dropped unread (net/)
+  bad_time,        ///< a clock reading (header or body) outside [0, kMaxClockNs)
 };
 
-constexpr std::size_t kRejectionCount = 11;
+constexpr std::size_t kRejectionCount = 12;
 
 constexpr std::array<Rejection, kRejectionCount> kAllRejections = {
-    Rejection::oversized,      Rejection::truncated, Rejection::bad_tag,    Rejection::bad_version,
-    Rejection::wrong_session,  Rejection::unknown_sender, Rejection::replayed, Rejection::non_finite,
-    Rejection::empty,          Rejection::cleartext, Rejection::rate_limited};
+    Rejection::oversized,     Rejection::truncated,      Rejection::bad_tag,  Rejection::bad_version,
+    Rejection::wrong_session, Rejection::unknown_sender, Rejection::replayed, Rejection::non_finite,
+    Rejection::empty,         Rejection::cleartext,      Rejection::rate_limited, Rejection::bad_time};
 
 /// "oversized", "truncated", "bad_tag", ...: the enumerator's name.
 std::string_view to_string(Rejection reason);
