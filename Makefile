@@ -27,9 +27,10 @@ ASAN_TESTS ?=
 # with TSan too) run every thread the system has: the haptic loop and its hand-overs, the
 # transport's I/O threads, the server's simulation loop. These ones check behaviour, not
 # timing (TSan slows a program 5 to 15 times): two users' forces against the offline
-# evaluation, a recording verified bit for bit, a server restart and reconnection, the
-# participant keys, and a client that stops reading.
-TSAN_TESTS ?= EndToEnd\.ClientForcesEqualOfflineEvaluationAndTheFullSolve|Replay\.ATwoUserSessionVerifiesBitForBit|EndToEnd\.AServerRestartFadesTheForceOutAndTheClientReconnects|Security\.EachParticipantKeyOpensItsOwnSlotOnly
+# evaluation, IRs over a lossy link, a server restart and reconnection, a recording
+# verified bit for bit, and the security tests (participant keys, no plaintext, stale and
+# old peers, the participant limit).
+TSAN_TESTS ?= EndToEnd\.ClientForcesEqualOfflineEvaluationAndTheFullSolve|EndToEnd\.OnALossyLinkEveryIrArrivesOverTcp|EndToEnd\.AServerRestartFadesTheForceOutAndTheClientReconnects|Replay\.ATwoUserSessionVerifiesBitForBit|Security\.
 # Sanitizer and fuzz builds: clang, -O1 with line tables only (file:line in every report,
 # half the compile time of -O2 -g), and assertions on (Eigen's index checks too); no
 # benchmarks. The ASan build is also the fuzzing build (COHAPTIC_FUZZ: coverage
