@@ -40,8 +40,14 @@ int main(int argc, char** argv) {
   std::string device_forms;
   for (const std::string& form : cohaptic::device_spec_forms()) device_forms += (device_forms.empty() ? "" : "; ") + form;
   app.add_option("--device", device_spec, "The device: " + device_forms)->required();
-  app.add_option("--key-file", options.key_file, "Session key (64 hex characters), the server's")->check(CLI::ExistingFile);
-  app.add_option("--slot", slot, "Ask for this user slot (tool) instead of the first free one");
+  app.add_option("--key-file", options.key_file,
+                 "Key file (mode 0600): your participant key (cohaptic-lab keygen --participant), or the session key")
+      ->check(CLI::ExistingFile);
+  app.add_option("--slot", slot, "Ask for this user slot (tool) instead of the first free one (a participant key: its own)");
+  bool no_encryption = false;
+  app.add_flag("--no-encryption", no_encryption,
+               "Send frames and datagrams in clear (still authenticated), and accept the server's in clear; the server "
+               "must be run with --no-encryption too");
   app.add_option("--rate-hz", rate_hz, "Haptic loop rate (default: the scene's, usually 1000)");
   app.add_option("--duration", settings.duration_s, "Stop after S seconds (0: when the device's script ends, or SIGINT)")
       ->capture_default_str();
@@ -78,6 +84,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     options.requested_slot = slot;
+    options.encrypt = !no_encryption;
     auto channels = std::make_unique<cohaptic::HapticChannels>();
     cohaptic::ClientNetwork network(options, *channels);
     const cohaptic::WelcomeInfo welcome = network.start(join_timeout_s);

@@ -2,7 +2,7 @@
 //   probe      static forces at tool positions          tradeoff   speed against accuracy
 //   replay     look at, re-run or export a recording    stability  the stability map of a wall
 //   study      a lab study, trial by trial              summarize  merge reports, judge a session
-//   keygen     a new session key file
+//   keygen     a new session key file, or a participant key file
 // Each tool adds its own subcommand (lab/lab_command.h). A tool that needs the server or the
 // client (study) starts them as processes; cohaptic-lab links neither.
 #include <CLI/CLI.hpp>

@@ -35,8 +35,13 @@ int main(int argc, char** argv) {
                                          "sends the IR, the client computes the force at its haptic rate")
       ->check(CLI::IsMember({"P0", "P1"}))
       ->capture_default_str();
-  app.add_option("--key-file", serve.key_file, "Session key (64 hex characters); without it the public development key")
+  app.add_option("--key-file", serve.key_file,
+                 "Session key file (cohaptic-lab keygen; mode 0600); without it the public development key")
       ->check(CLI::ExistingFile);
+  bool no_encryption = false;
+  app.add_flag("--no-encryption", no_encryption,
+               "Send frames and datagrams in clear (still authenticated), and accept clients that do; for debugging "
+               "with a packet capture");
   app.add_option("--shift-delay-ms", serve.shift.delay_ms, "Injected one-way delay on every link, each direction [ms]")
       ->capture_default_str();
   app.add_option("--jitter-ms", serve.shift.jitter_ms, "Injected jitter: extra delay drawn from U(0, J) ms")->capture_default_str();
@@ -108,6 +113,7 @@ int main(int argc, char** argv) {
       fmt::print(stderr, "cohaptic-server: --listen: {}\n", problem);
       return 2;
     }
+    serve.encrypt = !no_encryption;
     if (!view_address.empty()) {
       if (const std::string problem = cohaptic::parse_host_port(view_address, serve.view_host, serve.view_port, true);
           !problem.empty()) {
