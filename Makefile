@@ -1,8 +1,9 @@
 # cohaptic: the two commands (see README.md).
 #   make test   install missing packages, configure, build (Release), run every test
-#   make demo   the same set-up, then the main job
+#   make demo   the same set-up, then the main job (SCENE=scenes/thin/noodle.yaml: the noodle's)
 #   make tradeoff  the same set-up, then the speed/accuracy grid on the cube
 #   make bench  the same set-up, then the benchmarks (BENCH_ARGS passes arguments through)
+#   make bench-thin  the mass-spring benchmarks beside the thin-objects paper's Table 2
 #   make fuzz       build the fuzz targets with clang (libFuzzer, ASan, UBSan) in build-asan
 #                   and run each for FUZZ_SECONDS (default 15; 0 builds only), FUZZ_JOBS at once
 #   make test-asan  the suite (ASAN_TESTS: all by default) built with clang, ASan + UBSan, in
@@ -12,6 +13,8 @@ BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BENCH_ARGS ?=
+# The demo's scene (empty: the brain).
+SCENE ?=
 # As typed, '$' included (make would expand it): the bench recipe reads it from the environment.
 export COHAPTIC_BENCH_ARGS = $(value BENCH_ARGS)
 # Extra CMake settings for the first configure, e.g. CMAKE_ARGS=-DCOHAPTIC_WARNINGS_AS_ERRORS=ON (CI).
@@ -43,7 +46,7 @@ SANITIZER_CMAKE = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
 SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
   TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
 
-.PHONY: all deps configure build test demo probe-demo tradeoff bench fuzz test-asan test-tsan clean
+.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin fuzz test-asan test-tsan clean
 
 all: build
 
@@ -63,9 +66,10 @@ test: build
 
 # The main job: the two-surgeon brain demo. A server and two haptic clients (hand models
 # following the surgeons' scripted motions) on loopback, P1, about 20 s; prints a summary
-# table, writes out/demo/report.json, and fails if the session was unhealthy.
+# table, writes out/demo/report.json, and fails if the session was unhealthy. SCENE names
+# another scene with surgeons' scripts beside it (scenes/thin/noodle.yaml: the noodle's demo).
 demo: build
-	@BUILD_DIR=$(BUILD_DIR) ./deploy/run-demo.sh
+	@BUILD_DIR=$(BUILD_DIR) ./deploy/run-demo.sh $(SCENE)
 
 # The probe on the paper's cube, through the intermediate representation: a tool pressed
 # 1, 2, 5 and 10 mm into the front face's centre, then two tools together.
@@ -87,6 +91,12 @@ tradeoff: build
 bench:
 	@$(MAKE) --no-print-directory build >&2
 	@set -f; exec $(BUILD_DIR)/tests/cohaptic_bench $$COHAPTIC_BENCH_ARGS
+
+# The mass-spring body's benchmarks beside the thin-objects paper's Table 2, its largest
+# stable steps and a client's tick against sections sent, as Markdown (about a minute).
+bench-thin:
+	@$(MAKE) --no-print-directory build >&2
+	@tests/mass_spring_tables.sh $(BUILD_DIR)/tests/cohaptic_bench
 
 $(ASAN_BUILD_DIR)/CMakeCache.txt: | deps
 	cmake -S . -B $(ASAN_BUILD_DIR) $(SANITIZER_CMAKE) -DCOHAPTIC_FUZZ=ON

@@ -15,6 +15,8 @@ packages=(
   libasio-dev libprotobuf-dev protobuf-compiler libsodium-dev libwebsocketpp-dev
   # configuration, command line, logging, JSON output
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
+  # the mass-spring benchmark tables (make bench-thin) read the benchmarks' JSON
+  jq
   # tests and benchmarks; the browser the live view's test opens the page in
   libgtest-dev libgmock-dev libbenchmark-dev chromium
   # fuzzing (libFuzzer) and sanitizer reports: make fuzz, make test-asan, make test-tsan
