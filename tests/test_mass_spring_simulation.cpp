@@ -2,8 +2,9 @@
 // (its sections, rim and springs against the body's), the client's force against the
 // server's whole network (bit for bit when the IR carries the whole network, within a
 // bound for a sub-network), the client's force through the wire against the server's P0
-// evaluation in lockstep (bit for bit), the IR rate, and SceneSimulation's assignment of
-// users to the nearest of two bodies with epochs that keep rising.
+// evaluation in lockstep (bit for bit), the IR rate, the scene's noodle dropped and slid on
+// its plane against a rigid body's closed forms, and SceneSimulation's assignment of users
+// to the nearest of two bodies with epochs that keep rising.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +13,9 @@
 #include <map>
 
 #include "common/ir/build_mass_spring_ir.h"
+#include "common/mass_spring/integrate_network.h"
+#include "common/mass_spring/plane_friction.h"
+#include "common/mass_spring/stable_time_step.h"
 #include "common/mass_spring/tube_network.h"
 #include "common/model/model.h"
 #include "common/model/scene_compliance.h"
@@ -219,6 +223,105 @@ TEST(MassSpringSimulation, SubNetworkForceFollowsTheWholeNetwork) {
     EXPECT_LT(worst, 0.1 * largest) << sections << " sections";
     std::printf("sections %d: largest force %.4g N, largest difference %.3g N\n", sections, largest, worst);
   }
+}
+
+// The noodle as its scene file makes it (scenes/thin/noodle.yaml, with the paper's nodal
+// damping beta = 0.007 N s/m) dropped onto its plane and slid along it, against the closed
+// forms of a rigid body of mass M under gravity, Coulomb friction mu_d M g and the damping
+// -beta N v of its N nodes (rate c = beta N / M), integrated by semi-implicit Euler at the
+// body's step h: v_n = v_inf (1 - r^n) with r = 1 - c h, so the fall after n steps is
+// h v_inf (n - r (1 - r^n) / (1 - r)) with v_inf = g / c; sliding from v0, the speed falls by
+// h (mu_d g + c v) a step until it stops.
+double rigid_fall(double g, double c, double h, int steps) {
+  const double r = 1 - c * h, v_inf = g / c;
+  return h * v_inf * (steps - r * (1 - std::pow(r, steps)) / (1 - r));
+}
+
+double rigid_slide(double v0, double friction_deceleration, double c, double h) {
+  double v = v0, distance = 0;
+  while (true) {
+    v -= h * (friction_deceleration + c * v);
+    if (v <= 0) return distance;
+    distance += h * v;
+  }
+}
+
+struct DropAndSlide {
+  double fall = 0, expected_fall = 0, lowest = 0, landed_lowest = 0, landed_speed = 0, rest_offset = 0, slide = 0, expected_slide = 0, speed_after = 0;
+};
+
+// Dropped from 20 mm for 50 ms, then left 1 s to land; set on the plane at rest, pushed
+// along it at v0 = 0.2 m/s and left 1 s.
+DropAndSlide drop_and_slide(const MassSpringNetwork& network) {
+  const double h = network.parameters.time_step, g = -network.parameters.gravity.z();
+  const double total_mass = network.mass.sum(), c = network.parameters.node_damping * network.node_count() / total_mass;
+  const auto centre_of_mass = [&](const MassSpringState& s) -> Eigen::Vector3d { return s.positions * network.mass / total_mass; };
+  const auto run = [&](MassSpringState& s, double seconds) {
+    for (int i = 0; i < static_cast<int>(std::round(seconds / h)); ++i) step_network(network, s, {}, {}, h);
+  };
+  DropAndSlide result;
+  MassSpringState resting = make_state(network);
+  run(resting, 0.5);
+  MassSpringState dropped = make_state(network);
+  dropped.positions.row(2).array() += 0.02;
+  const double start = centre_of_mass(dropped).z();
+  const int falling = static_cast<int>(std::round(0.05 / h));
+  for (int i = 0; i < falling; ++i) step_network(network, dropped, {}, {}, h);
+  result.fall = start - centre_of_mass(dropped).z();
+  result.expected_fall = rigid_fall(g, c, h, falling);
+  result.lowest = 1;
+  for (int i = 0; i < static_cast<int>(1.0 / h); ++i) {
+    step_network(network, dropped, {}, {}, h);
+    result.lowest = std::min(result.lowest, dropped.positions.row(2).minCoeff());
+  }
+  result.landed_lowest = dropped.positions.row(2).minCoeff();
+  result.landed_speed = dropped.velocities.cwiseAbs().maxCoeff();
+  result.rest_offset = centre_of_mass(dropped).z() - centre_of_mass(resting).z();
+
+  const double v0 = 0.2;
+  MassSpringState sliding = resting;
+  sliding.velocities.setZero();
+  sliding.velocities.row(0).setConstant(v0);
+  const double x0 = centre_of_mass(sliding).x();
+  run(sliding, 1.0);
+  result.slide = centre_of_mass(sliding).x() - x0;
+  result.expected_slide = rigid_slide(v0, network.parameters.plane->dynamic_friction * g, c, h);
+  result.speed_after = sliding.velocities.cwiseAbs().maxCoeff();
+  std::printf("fell %.4g mm in 50 ms (closed form %.4g); slid from %.2f m/s %.4g mm (closed form %.4g; without damping %.4g)\n",
+              result.fall * 1e3, result.expected_fall * 1e3, v0, result.slide * 1e3, result.expected_slide * 1e3,
+              v0 * v0 / (2 * network.parameters.plane->dynamic_friction * g) * 1e3);
+  return result;
+}
+
+// The scene's noodle falls as the rigid body does (its springs carry no load in free fall),
+// lands without a node below the plane and comes to rest on it (0.13 mm lower than the noodle
+// set down gently: the soft tube spreads on landing, and friction keeps its footprint). Sliding, the soft noodle
+// (E = 737 Pa: it sags to half its height under its own weight) goes 7 % further than a rigid
+// body, its upper part rolling on after its base stops; with its springs 100 times stiffer
+// (the step shortened to stay stable) it slides as the rigid body does.
+TEST(MassSpringSimulation, NoodleSceneDroppedAndSlidFollowsTheRigidClosedForms) {
+  const MassSpringNetwork& network = noodle().network;
+  ASSERT_GT(network.parameters.node_damping, 0);
+  const DropAndSlide soft = drop_and_slide(network);
+  EXPECT_NEAR(soft.fall, soft.expected_fall, 0.02 * soft.expected_fall);
+  EXPECT_GE(soft.lowest, 0.0) << "a node went below the plane";
+  EXPECT_LT(soft.landed_lowest, kPlaneTouchTolerance) << "it landed";
+  EXPECT_LT(soft.landed_speed, 1e-3) << "and came to rest";
+  EXPECT_LT(soft.speed_after, 1e-3);
+
+  MassSpringNetwork stiff = network;
+  for (Spring& s : stiff.springs) {
+    s.stiffness *= 100;
+    s.damping *= 100;
+  }
+  stiff.parameters.time_step = 0.8 * critical_time_step(stiff);
+  const DropAndSlide rigid = drop_and_slide(stiff);
+  EXPECT_NEAR(rigid.fall, rigid.expected_fall, 0.01 * rigid.expected_fall);
+  EXPECT_GE(rigid.lowest, 0.0) << "a node went below the plane";
+  EXPECT_LT(std::abs(rigid.rest_offset), 2e-5) << "it rests where it rested";
+  EXPECT_LT(rigid.landed_speed, 1e-3);
+  EXPECT_NEAR(rigid.slide, rigid.expected_slide, 0.03 * rigid.expected_slide);
+  EXPECT_LT(rigid.speed_after, 1e-3);
 }
 
 // Two noodles 5 cm apart; a user goes to the one its tool is nearest.
