@@ -1,16 +1,21 @@
 // The force evaluator allocates nothing: malloc is interposed for this test program and
 // counts the calls made while a flag is set, around thousands of evaluations with every
-// contact model, remote tools and held boundary nodes.
+// contact model, remote tools and held boundary nodes, and of a mass-spring body's
+// sub-network integrated tick by tick with two tools pressing it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstdlib>
 #include <limits>
 
 #include "common/scene/load_scene.h"
+#include "common/sim/mass_spring_simulation.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
 #include "support/evaluate_static.h"
+#include "support/test_meshes.h"
 
 extern "C" void* __libc_malloc(std::size_t size);  // glibc's own, behind the interposed one
 
@@ -28,13 +33,19 @@ extern "C" void* malloc(std::size_t size) {
 namespace cohaptic {
 namespace {
 
-TEST(ForceEvaluator, AllocatesNothing) {
-  // Check the counter works at all: a vector allocation inside the window is seen.
+// The counter works at all: a vector allocation inside the window is seen.
+bool interposition_counts() {
+  allocations = 0;
   counting = true;
   { volatile auto* probe = new std::vector<int>(100); delete probe; }
   counting = false;
-  ASSERT_GT(allocations.load(), 0) << "malloc interposition is not active";
+  const bool seen = allocations.load() > 0;
   allocations = 0;
+  return seen;
+}
+
+TEST(ForceEvaluator, AllocatesNothing) {
+  ASSERT_TRUE(interposition_counts()) << "malloc interposition is not active";
 
   const Model model = build_model(parse_scene(testing::cube_scene_yaml(), "cube.yaml"));
   const ElasticBody& body = single_elastic_body(model);
@@ -61,6 +72,40 @@ TEST(ForceEvaluator, AllocatesNothing) {
     EXPECT_TRUE(sum.allFinite());
     EXPECT_GT(sum.norm(), 0);
   }
+}
+
+// The noodle (scenes/thin/noodle.yaml) pressed by two tools 4 mm apart: the IR of the
+// first carries the second as a remote, and each tick integrates the sub-network.
+TEST(ForceEvaluator, MassSpringSubNetworkAllocatesNothing) {
+  const Model model = build_model(load_scene(testing::source_path("scenes/thin/noodle.yaml")));
+  const MassSpringModel& body = std::get<MassSpringModel>(model.bodies.front());
+  MassSpringSimulation simulation(body, 0, model.scene.tools, model.scene.haptic.force_limit_n);
+  const Eigen::Vector3d middle(0.0434, 0, 0.0092);
+  const Eigen::Vector3d own = middle + Eigen::Vector3d(0, 0, 0.0015), other = own + Eigen::Vector3d(0.004, 0, 0);
+  for (int i = 0; i < 20 && !simulation.ir(0); ++i) {
+    simulation.set_tool(0, own);
+    simulation.set_tool(1, other);
+    simulation.step(0.001 * i);
+  }
+  ASSERT_NE(simulation.ir(0), nullptr);
+  const PreparedIR& prepared = *simulation.ir(0);
+  ASSERT_EQ(remote_count(prepared.ir), 1);
+  EvaluationState state = make_evaluation_state(prepared);
+  const std::array<Eigen::Vector3d, 1> remotes{other - Eigen::Vector3d(0, 0, 0.002)};
+  ASSERT_TRUE(interposition_counts()) << "malloc interposition is not active";
+  double largest = 0;
+  bool finite = true;
+  counting = true;
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3d tool = own - Eigen::Vector3d(1e-6 * (i % 1000), 0, 2e-6 * (i % 1500));
+    const ForceSample sample = evaluate_force(prepared, state, tool, remotes, 0.001);
+    finite = finite && sample.force.allFinite();
+    largest = std::max(largest, sample.force.norm());
+  }
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0) << "evaluate_force allocated on a mass-spring body";
+  EXPECT_TRUE(finite);
+  EXPECT_GT(largest, 0) << "the tool pressed";
 }
 
 }  // namespace
