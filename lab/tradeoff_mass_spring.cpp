@@ -62,7 +62,7 @@ MassSpringTradeoffRow run_mass_spring_setting(const Scene& scene, const MassSpri
   row.whole = 2 * body.spec.ir.sections + 1 >= body.section_count;
 
   // No force limit: the physics is compared, not the limiter.
-  MassSpringSimulation server(body, 0, varied.tools, std::numeric_limits<double>::infinity());
+  MassSpringSimulation server(body, 0, varied.tools, std::numeric_limits<double>::infinity(), 1 / varied.haptic.rate_hz);
   const std::size_t users = varied.tools.size();
   std::vector<std::shared_ptr<const PreparedIR>> client_ir(users);
   std::vector<EvaluationState> client_state(users);

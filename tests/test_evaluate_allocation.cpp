@@ -79,7 +79,7 @@ TEST(ForceEvaluator, AllocatesNothing) {
 TEST(ForceEvaluator, MassSpringSubNetworkAllocatesNothing) {
   const Model model = build_model(load_scene(testing::source_path("scenes/thin/noodle.yaml")));
   const MassSpringModel& body = std::get<MassSpringModel>(model.bodies.front());
-  MassSpringSimulation simulation(body, 0, model.scene.tools, model.scene.haptic.force_limit_n);
+  MassSpringSimulation simulation(body, 0, model.scene.tools, model.scene.haptic.force_limit_n, 0.001);
   const Eigen::Vector3d middle(0.0434, 0, 0.0092);
   const Eigen::Vector3d own = middle + Eigen::Vector3d(0, 0, 0.0015), other = own + Eigen::Vector3d(0.004, 0, 0);
   for (int i = 0; i < 20 && !simulation.ir(0); ++i) {

@@ -135,7 +135,9 @@ Eigen::Vector3d pressing_tool(const MassSpringModel& body, double t, double dept
 // The server steps at 1 kHz; the client takes each new IR through the wire and evaluates
 // it every 1 ms with the same tool positions; the server's P0 evaluation runs beside it.
 struct Lockstep {
-  explicit Lockstep(const MassSpringModel& body) : simulation(body, 0, {ToolSpec{"A", ToolShape::sphere, 0.002}}, 3.3) {}
+  // The server advances by the test's tick, 1/1024 s: exact in binary, so its step times'
+  // differences are exactly one tick.
+  explicit Lockstep(const MassSpringModel& body) : simulation(body, 0, {ToolSpec{"A", ToolShape::sphere, 0.002}}, 3.3, 1.0 / 1024) {}
   MassSpringSimulation simulation;
   std::unique_ptr<PreparedIR> client;
   EvaluationState client_state;

@@ -1,7 +1,10 @@
 // MassSpringSimulation: the server's simulation of one mass–spring body (the thin-objects
-// paper's model), with no threads or sockets. The whole network is integrated in real time:
-// each step advances it by the time since the previous step (substepped at the body's
-// stable time step, tool_coupling.h) with every known user's tool pressing it.
+// paper's model), with no threads or sockets. The whole network is integrated in real time
+// in fixed periods (the haptic loop's, as each client integrates its sub-network): each
+// step advances it by as many whole periods as have passed since the previous step, with
+// every known user's tool pressing it, and carries the remainder. (Periods that follow the
+// server's uneven steps make Eq. (5)'s force kick: a node set moving at d/h by one period
+// is stopped in another.)
 //
 // IRs: while a user's tool is within the body's near_distance of the surface, the user gets
 // a fresh IR at the body's IR rate: the sub-network around its nearest surface node
@@ -35,8 +38,10 @@ inline constexpr double kMassSpringMaxStepPeriod = 0.05;
 class MassSpringSimulation {
  public:
   /// One user per tool; `body` must outlive it. `object` is the body's index in the scene
-  /// (the IRs' object); `force_limit` [N] goes into every IR.
-  MassSpringSimulation(const MassSpringModel& body, int object, const std::vector<ToolSpec>& tools, double force_limit);
+  /// (the IRs' object); `force_limit` [N] goes into every IR; `period` [s] > 0 is the fixed
+  /// period the network is advanced by (the haptic loop's nominal period).
+  MassSpringSimulation(const MassSpringModel& body, int object, const std::vector<ToolSpec>& tools, double force_limit,
+                       double period);
 
   // The members SceneSimulation visits, as Simulation has them (set_tool, clear_tool,
   // continue_epochs, step, ir, pressing), and force with the period to advance by.
@@ -77,6 +82,8 @@ class MassSpringSimulation {
   const MassSpringModel& body_;
   int object_;
   double force_limit_;
+  double period_;                               // of each advance [s]
+  double pending_ = 0;                          // time stepped but not yet advanced [s]
   MassSpringState state_;
   std::vector<UserState> users_;
   std::vector<ToolOnNetwork> tools_;            // per user, for each step

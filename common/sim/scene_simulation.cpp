@@ -23,7 +23,7 @@ struct SimulationMaker {
   }
   std::unique_ptr<BodySimulation> operator()(const MassSpringModel& body) const {
     return std::make_unique<BodySimulation>(std::in_place_type<MassSpringSimulation>, body, object, tools,
-                                            model.scene.haptic.force_limit_n);
+                                            model.scene.haptic.force_limit_n, 1 / model.scene.haptic.rate_hz);
   }
 };
 
