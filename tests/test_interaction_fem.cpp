@@ -17,6 +17,7 @@
 #include "common/interaction/interaction_step.h"
 #include "common/interaction/linear_backing.h"
 #include "support/paired_boxes.h"
+#include "support/prescribed_nodes_solve.h"
 
 namespace cohaptic {
 namespace {
@@ -67,42 +68,9 @@ struct Pushed {
   }
 };
 
-std::vector<int> displaced_free_dofs(const ElasticBody& body, const std::vector<int>& nodes) {
-  std::vector<int> dofs;
-  for (int node : nodes)
-    for (int axis = 0; axis < 3; ++axis)
-      if (!body.dofs.is_fixed(node, axis)) dofs.push_back(3 * node + axis);
-  return dofs;
-}
-
-// Full sparse solve of B with `nodes` prescribed at `displacement` (3 per node).
-StaticSolution full_solve(const ElasticBody& body, const std::vector<int>& nodes, const Eigen::VectorXd& displacement) {
-  const std::vector<int> dofs = displaced_free_dofs(body, nodes);
-  Eigen::VectorXd values(static_cast<Eigen::Index>(dofs.size()));
-  for (std::size_t i = 0; i < dofs.size(); ++i) {
-    const auto j = std::lower_bound(nodes.begin(), nodes.end(), dofs[i] / 3) - nodes.begin();
-    values[static_cast<Eigen::Index>(i)] = displacement[3 * j + dofs[i] % 3];
-  }
-  return ConstrainedStaticSolver(body.stiffness, body.dofs, dofs).solve(values);
-}
-
-Eigen::VectorXd nodal(const Eigen::VectorXd& global, const std::vector<int>& nodes) {
-  Eigen::VectorXd values(3 * static_cast<Eigen::Index>(nodes.size()));
-  for (std::size_t j = 0; j < nodes.size(); ++j)
-    values.segment<3>(3 * static_cast<Eigen::Index>(j)) = global.segment<3>(3 * nodes[j]);
-  return values;
-}
-
-// The full solve's reactions at `nodes` along their free axes (a fixed axis's reaction
-// is the support's, not the interaction's).
-Eigen::VectorXd free_reactions(const ElasticBody& body, const Eigen::VectorXd& reaction,
-                               const std::vector<int>& nodes) {
-  Eigen::VectorXd values = nodal(reaction, nodes);
-  for (std::size_t j = 0; j < nodes.size(); ++j)
-    for (int axis = 0; axis < 3; ++axis)
-      if (body.dofs.is_fixed(nodes[j], axis)) values[3 * static_cast<Eigen::Index>(j) + axis] = 0;
-  return values;
-}
+using testing::free_reactions;
+using testing::nodal;
+using testing::prescribed_nodes_solve;
 
 TEST(InteractionFem, PairsGrownFromOneReachEveryPenetratingNodeAndAreNearest) {
   Pushed pushed(0.006);
@@ -133,7 +101,7 @@ TEST(InteractionFem, ReactionAndDeformationEqualTheFullSparseSolveAndActiveNodes
   const InteractionStep step = pushed.settle();
   ASSERT_FALSE(step.collisions.empty());
   const ElasticBody& behind = pushed.rig.behind;
-  const StaticSolution solution = full_solve(behind, step.displacement.nodes, step.displacement.displacement);
+  const StaticSolution solution = prescribed_nodes_solve(behind, step.displacement.nodes, step.displacement.displacement);
   EXPECT_LT(
       relative_difference(step.passive_forces, free_reactions(behind, solution.reaction, step.displacement.nodes)),
       1e-9);
@@ -199,7 +167,7 @@ TEST(InteractionFem, LinearBackingEqualsTheFullSolveForOtherDisplacementsOfTheCo
           pushed.rig.front.mesh.nodes.col(backing.nodes[k]) + moved.segment<3>(at) - step.collisions[k].target;
     }
     const Eigen::VectorXd passive_displacement = step.displacement.map * gaps;
-    const StaticSolution solution = full_solve(behind, step.displacement.nodes, passive_displacement);
+    const StaticSolution solution = prescribed_nodes_solve(behind, step.displacement.nodes, passive_displacement);
     const Eigen::VectorXd expected =
         -step.displacement.map.transpose() * free_reactions(behind, solution.reaction, step.displacement.nodes);
     evaluate_linear_backing(backing, moved, force);

@@ -13,18 +13,12 @@
 #include "common/fem/compliance.h"
 #include "common/interaction/surface_adjacency.h"
 #include "common/model/model.h"
+#include "lab/objects_push.h"
 
 namespace cohaptic::testing {
 
-struct PairedBoxesOptions {
-  Eigen::Vector3i behind_divisions{4, 6, 5};
-  Eigen::Vector3i front_divisions{3, 5, 3};
-  double behind_youngs_modulus = 1.0e6;
-  double behind_poisson_ratio = 0.216;
-  double gap_mm = 1;
-};
-
-std::string paired_boxes_scene_yaml(const PairedBoxesOptions& options = {});
+using cohaptic::PairedBoxesOptions;
+using cohaptic::paired_boxes_scene_yaml;
 
 /// Both bodies compiled, their surfaces' adjacency, B's compliance over its surface nodes.
 struct PairedBoxesRig {
