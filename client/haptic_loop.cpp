@@ -121,6 +121,11 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
   return force;
 }
 
+void HapticLoop::publish_progress(double elapsed_s, bool finished) {
+  channels_.progress.back() = {metrics_.ticks, metrics_.missed_deadlines, elapsed_s, metrics_.peak_force, finished};
+  channels_.progress.publish();
+}
+
 void HapticLoop::run(const std::atomic<bool>& stop) {
   if (settings_.realtime) {
     metrics_.realtime = enter_realtime(80);
@@ -182,9 +187,11 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     record.force = force;
     if (channels_.tracing.load(std::memory_order_relaxed)) channels_.trace.push(record);
     ++metrics_.ticks;
+    publish_progress(time_s, false);
   }
   device_.write_force(Eigen::Vector3d::Zero(), static_cast<double>(now() - start) * 1e-9);
   metrics_.elapsed_s = static_cast<double>(now() - start) * 1e-9;
+  publish_progress(metrics_.elapsed_s, true);
 }
 
 }  // namespace cohaptic

@@ -11,6 +11,7 @@
 
 #include "common/model/compliance_setup.h"
 #include "common/model/model.h"
+#include "common/net/host_port.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "common/util/atomic_file.h"
@@ -19,6 +20,7 @@
 #include "proto/record/recording.h"
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/vec3_convert.h"
+#include "lab/replay_view.h"
 
 namespace cohaptic {
 namespace {
@@ -195,6 +197,9 @@ void print_summary(const Recording& rec) {
   fmt::print("duration    {:.3f} s\n", first <= last ? span(first, last) : 0.0);
   fmt::print("records     {} haptic ticks, {} simulation steps, {} IRs, {} datagrams, {} events\n", rec.ticks.size(),
              rec.steps.size(), rec.irs.size(), rec.datagrams.size(), rec.events.size());
+  if (c.role() == "server")
+    fmt::print("view        {} frames, {} client status reports{}\n", rec.view_frames.size(), rec.client_statuses.size(),
+               rec.view_frames.empty() ? " (recorded without --view: replay --view has no frames to show)" : "");
   if (!rec.ticks.empty()) {
     double peak = 0;
     for (const auto& t : rec.ticks) peak = std::max(peak, wire::from_wire(t.force()).norm());
@@ -285,6 +290,13 @@ int run_replay(const ReplayOptions& options) {
   const bool summary = options.summary || (!options.verify && options.export_csv.empty());
   if (summary) print_summary(rec);
   if (!options.export_csv.empty()) export_csv(rec, options.export_csv);
+  if (!options.view.empty()) {
+    ReplayViewOptions view;
+    if (const std::string problem = parse_host_port(options.view, view.host, view.port, true); !problem.empty())
+      throw Error("--view: " + problem);
+    view.token_file = options.view_token_file;
+    return serve_replay(rec, view);
+  }
   if (options.verify) {
     const VerifyResult result = verify_recording(options.file);
     if (!result.ok) {
@@ -306,6 +318,12 @@ LabCommand add_replay_command(CLI::App& lab) {
                     "Re-run the recorded inputs through the same computations and compare every force (and IR) bit "
                     "for bit; exit 1 naming the first difference");
   command->add_option("--export-csv", options->export_csv, "Write its records as CSV files in this directory");
+  command->add_option("--view", options->view,
+                      "Serve a server recording made with --view in the live view's page at HOST:PORT, with a "
+                      "timeline (play, pause, speed, scrub, jump to the largest force), until SIGINT");
+  command->add_option("--view-token-file", options->view_token_file,
+                      "The page's access token (required off loopback; without it a random one is printed)")
+      ->check(CLI::ExistingFile);
   return {command, [options] { return run_replay(*options); }};
 }
 

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/mesh/write_vtu.h"
+#include "common/model/shown_surface.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
 
@@ -11,15 +12,9 @@ namespace cohaptic {
 
 DisplayWriter::DisplayWriter(const Model& model, const ComplianceColumns& columns, std::filesystem::path directory)
     : model_(model), body_(single_elastic_body(model)), directory_(std::move(directory)) {
-  std::vector<int> local(static_cast<std::size_t>(body_.mesh.node_count()), -1);
-  for (int node : columns.row_nodes()) {
-    local[static_cast<std::size_t>(node)] = static_cast<int>(nodes_.size());
-    nodes_.push_back(node);
-  }
-  const auto shown = [&](int node) { return local[static_cast<std::size_t>(node)]; };
-  for (const Triangle& tri : body_.surface.triangles)
-    if (shown(tri[0]) >= 0 && shown(tri[1]) >= 0 && shown(tri[2]) >= 0)
-      triangles_.push_back({shown(tri[0]), shown(tri[1]), shown(tri[2])});
+  ShownSurface shown = shown_surface(body_, columns.row_nodes());
+  nodes_ = std::move(shown.nodes);
+  triangles_ = std::move(shown.triangles);
   std::filesystem::create_directories(directory_);
 }
 
