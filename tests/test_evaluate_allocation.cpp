@@ -1,15 +1,23 @@
-// The force evaluator allocates nothing: malloc is interposed for this test program and
-// counts the calls made while a flag is set, around thousands of evaluations with every
-// contact model, remote tools and held boundary nodes.
+// The haptic path allocates nothing: malloc is interposed for this test program and
+// counts the calls made while a flag is set, around thousands of evaluations of the FEM
+// body's force (every contact model, remote tools, held boundary nodes) and of the
+// laparoscopy model's per-tick functions (home-spring tick, forceps step, display
+// deformations).
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
 #include <limits>
 
+#include "common/laparoscopy/direct_manipulation.h"
+#include "common/laparoscopy/extract_home_spring_patch.h"
+#include "common/laparoscopy/forceps_jaws.h"
+#include "common/laparoscopy/home_spring_contact.h"
+#include "common/laparoscopy/polynomial_deformation.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
+#include "support/tissue_sheet.h"
 
 extern "C" void* __libc_malloc(std::size_t size);  // glibc's own, behind the interposed one
 
@@ -27,13 +35,18 @@ extern "C" void* malloc(std::size_t size) {
 namespace cohaptic {
 namespace {
 
-TEST(ForceEvaluator, AllocatesNothing) {
-  // Check the counter works at all: a vector allocation inside the window is seen.
+/// Checks the counter works at all (a vector allocation inside the window is seen), then
+/// zeroes it.
+void expect_counter_works() {
   counting = true;
   { volatile auto* probe = new std::vector<int>(100); delete probe; }
   counting = false;
   ASSERT_GT(allocations.load(), 0) << "malloc interposition is not active";
   allocations = 0;
+}
+
+TEST(ForceEvaluator, AllocatesNothing) {
+  expect_counter_works();
 
   const Model model = build_model(parse_scene(testing::cube_scene_yaml(), "cube.yaml"));
   const ElasticBody& body = single_elastic_body(model);
@@ -60,6 +73,42 @@ TEST(ForceEvaluator, AllocatesNothing) {
     EXPECT_TRUE(sum.allFinite());
     EXPECT_GT(sum.norm(), 0);
   }
+}
+
+TEST(LaparoscopyHapticPath, AllocatesNothing) {
+  expect_counter_works();
+  const TriangleSurface sheet = testing::equilateral_sheet(40, 40, 0.002);
+  const VertexRings rings = vertex_rings(sheet.triangles, sheet.vertex_count());
+  const Eigen::Vector3d pivot(0.01, 0.02, 0.15);
+  const PreparedHomeSpringPatch prepared = prepare_home_spring_patch(extract_home_spring_patch(
+      {sheet.vertices, sheet.triangles, rings}, Eigen::Vector3d::Zero(), 0.02, {300, 100}, pivot));
+  const AabbTree sheet_tree(sheet.vertices, sheet.triangles);
+  const ForcepsGeometry geometry{0.01, 0.5, 0.01};
+  ForcepsJaws jaws = open_forceps(geometry);
+  const BernsteinLattice lattice = identity_lattice(Eigen::Vector3d(-0.05, -0.05, -0.02), Eigen::Vector3d(0.05, 0.05, 0.02));
+  const LatticeBinding binding = bind_to_lattice(lattice, sheet.vertices);
+  Eigen::Matrix3Xd deformed(3, sheet.vertices.cols());
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int touching = 0;
+  counting = true;
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d tool(0.008 * std::cos(1e-2 * i), 0.008 * std::sin(1e-2 * i), 0.003 - 6e-6 * i);
+    const HomeSpringContact contact = evaluate_home_spring(prepared, tool);
+    sum += contact.force;
+    touching += contact.touching ? 1 : 0;
+    if (const auto shaft = shaft_frame(pivot, tool, Eigen::Vector3d::UnitX()))
+      step_forceps(geometry, *shaft, i % 500 < 400, sheet_tree, jaws);
+    if (i % 100 == 0) {  // a display frame every 100 ticks
+      deform_polynomial(sheet.vertices, {Eigen::Vector3d(tool.x(), tool.y(), 0), tool, 0.01}, deformed);
+      const LatticeControl control =
+          lattice.control + single_point_manipulation(lattice_basis(lattice, Eigen::Vector3d::Zero()), tool);
+      deform_ffd(binding, control, deformed);
+    }
+  }
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0) << "the laparoscopy haptic path allocated";
+  EXPECT_TRUE(sum.allFinite());
+  EXPECT_GT(touching, 500);  // the tool does go through the sheet
 }
 
 }  // namespace
