@@ -2,18 +2,17 @@
 // counts the calls made while a flag is set, around thousands of evaluations of the FEM
 // body's force (every contact model, remote tools, held boundary nodes) and of the
 // laparoscopy model's per-tick functions (home-spring tick, forceps step, display
-// deformations).
+// frames by both methods).
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cstdlib>
 #include <limits>
 
-#include "common/laparoscopy/direct_manipulation.h"
 #include "common/laparoscopy/extract_home_spring_patch.h"
 #include "common/laparoscopy/forceps_jaws.h"
 #include "common/laparoscopy/home_spring_contact.h"
-#include "common/laparoscopy/polynomial_deformation.h"
+#include "common/laparoscopy/tissue_display.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
@@ -85,8 +84,8 @@ TEST(LaparoscopyHapticPath, AllocatesNothing) {
   const AabbTree sheet_tree(sheet.vertices, sheet.triangles);
   const ForcepsGeometry geometry{0.01, 0.5, 0.01};
   ForcepsJaws jaws = open_forceps(geometry);
-  const BernsteinLattice lattice = identity_lattice(Eigen::Vector3d(-0.05, -0.05, -0.02), Eigen::Vector3d(0.05, 0.05, 0.02));
-  const LatticeBinding binding = bind_to_lattice(lattice, sheet.vertices);
+  const TissueDisplay polynomial = make_tissue_display(sheet.vertices, 0.01, DisplayDeformation::polynomial);
+  const TissueDisplay lattice = make_tissue_display(sheet.vertices, 0.01, DisplayDeformation::ffd_one_point);
   Eigen::Matrix3Xd deformed(3, sheet.vertices.cols());
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int touching = 0;
@@ -99,10 +98,8 @@ TEST(LaparoscopyHapticPath, AllocatesNothing) {
     if (const auto shaft = shaft_frame(pivot, tool, Eigen::Vector3d::UnitX()))
       step_forceps(geometry, *shaft, i % 500 < 400, sheet_tree, jaws);
     if (i % 100 == 0) {  // a display frame every 100 ticks
-      deform_polynomial(sheet.vertices, {Eigen::Vector3d(tool.x(), tool.y(), 0), tool, 0.01}, deformed);
-      const LatticeControl control =
-          lattice.control + single_point_manipulation(lattice_basis(lattice, Eigen::Vector3d::Zero()), tool);
-      deform_ffd(binding, control, deformed);
+      display_tissue(polynomial, contact.contact_point, tool, deformed);
+      display_tissue(lattice, contact.contact_point, tool, deformed);
     }
   }
   counting = false;

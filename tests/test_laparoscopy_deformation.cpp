@@ -3,15 +3,22 @@
 // with direct manipulation (Eqs. 6-7) against what must hold exactly: the identity
 // lattice maps every point to itself, the Bernstein basis is a partition of unity, Eq. 7
 // lands its point, and Eq. 6 equals the least-squares solution of an SVD (Eigen's
-// JacobiSVD, the independent method).
+// JacobiSVD, the independent method); and the two ways a tissue's display is dented,
+// compared on a sheet: both land P on A, the polynomial moves nothing beyond R, Eq. 7
+// moves the whole tissue, and Eq. 6 pinning a rim about P makes the far tissue swing more.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <map>
+#include <numbers>
 #include <random>
 
 #include "common/laparoscopy/direct_manipulation.h"
 #include "common/laparoscopy/polynomial_deformation.h"
+#include "common/laparoscopy/tissue_display.h"
 #include "common/util/error.h"
+#include "support/tissue_sheet.h"
 
 namespace cohaptic {
 namespace {
@@ -183,6 +190,61 @@ TEST(DirectManipulation, DependentPointsAreRefused) {
     EXPECT_NE(std::string(e.what()).find("given twice"), std::string::npos) << e.what();
   }
   EXPECT_THROW(least_squares_manipulation(bases, Eigen::Matrix3Xd::Zero(3, 3)), Error);
+}
+
+/// Largest displacement of the sheet's vertices farther than `beyond` from `centre`.
+double far_motion(const Eigen::Matrix3Xd& rest, const Eigen::Matrix3Xd& deformed, const Vector3d& centre,
+                  double beyond) {
+  double largest = 0;
+  for (Eigen::Index v = 0; v < rest.cols(); ++v)
+    if ((rest.col(v) - centre).norm() > beyond) largest = std::max(largest, (deformed.col(v) - rest.col(v)).norm());
+  return largest;
+}
+
+TEST(TissueDisplay, BothMethodsLandPOnAThePolynomialLocallyEq7Globally) {
+  const TriangleSurface sheet = testing::equilateral_sheet(30, 30, 0.002);  // 6 cm square
+  const double radius = 0.01;
+  Eigen::Index centre = 0;
+  for (Eigen::Index v = 1; v < sheet.vertices.cols(); ++v)
+    if (sheet.vertices.col(v).norm() < sheet.vertices.col(centre).norm()) centre = v;
+  const Vector3d p = sheet.vertices.col(centre);
+  const Vector3d a = p + Vector3d(0.001, -0.0005, 0.006);  // the forceps pull up and aside
+  std::map<DisplayDeformation, double> far;
+  for (const DisplayDeformation method : {DisplayDeformation::polynomial, DisplayDeformation::ffd_one_point}) {
+    const TissueDisplay display = make_tissue_display(sheet.vertices, radius, method);
+    Eigen::Matrix3Xd deformed(3, sheet.vertices.cols());
+    display_tissue(display, p, a, deformed);
+    EXPECT_LT((deformed.col(centre) - a).norm(), 1e-12) << static_cast<int>(method);
+    far[method] = far_motion(sheet.vertices, deformed, p, 2 * radius);
+    Eigen::Matrix3Xd at_rest(3, sheet.vertices.cols());
+    display_tissue(display, p, Vector3d(std::nan(""), 0, 0), at_rest);
+    EXPECT_EQ(at_rest, sheet.vertices);
+  }
+  EXPECT_EQ(far[DisplayDeformation::polynomial], 0.0);
+  EXPECT_GT(far[DisplayDeformation::ffd_one_point], 0.5 * (a - p).norm());  // Eq. 7 moves the whole tissue
+
+  // Why the display offers no Eq. 6 with a pinned rim: holding eight points on a circle of
+  // radius R about P (perpendicular to AP) still while P lands on A makes this coarse
+  // lattice swing the far tissue more than Eq. 7 alone does.
+  const TissueDisplay display = make_tissue_display(sheet.vertices, radius, DisplayDeformation::ffd_one_point);
+  constexpr int kRim = 8;
+  Eigen::Matrix<double, kLatticeControlPoints, Eigen::Dynamic> bases(kLatticeControlPoints, kRim + 1);
+  Eigen::Matrix3Xd wanted = Eigen::Matrix3Xd::Zero(3, kRim + 1);
+  bases.col(0) = lattice_basis(display.lattice, p);
+  wanted.col(0) = a - p;
+  const Vector3d axis = (a - p).normalized(), e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+  for (int i = 0; i < kRim; ++i) {
+    const double angle = 2 * std::numbers::pi * i / kRim;
+    bases.col(i + 1) = lattice_basis(display.lattice, p + radius * (std::cos(angle) * e1 + std::sin(angle) * e2));
+  }
+  const LatticeControl pinned = display.lattice.control + least_squares_manipulation(bases, wanted);
+  EXPECT_LT((pinned * bases - (display.lattice.control * bases + wanted)).norm(), 1e-12);  // all nine land
+  Eigen::Matrix3Xd deformed(3, sheet.vertices.cols());
+  deform_ffd(display.binding, pinned, deformed);
+  EXPECT_GT(far_motion(sheet.vertices, deformed, p, 2 * radius), 2 * far[DisplayDeformation::ffd_one_point]);
+
+  EXPECT_THROW(make_tissue_display(sheet.vertices, 0, DisplayDeformation::polynomial), Error);
+  EXPECT_THROW(make_tissue_display(Eigen::Matrix3Xd(3, 0), radius, DisplayDeformation::polynomial), Error);
 }
 
 }  // namespace
