@@ -56,6 +56,9 @@ VerifyResult verify_client(const Recording& rec) {
     if (d.datagram().has_force())
       forces.emplace_back(d.receive_time_ns(), d.datagram().force().ir_epoch(), wire::from_wire(d.datagram().force().force()));
 
+  // Each IR's evaluation state, made when a tick first uses the IR and advanced by every
+  // tick that uses it, as the haptic loop did (a dynamic body's force depends on it).
+  std::map<const PreparedIR*, EvaluationState> states;
   const auto fail = [&](std::size_t i, const record::HapticTick& tick, const std::string& what) {
     result.ok = false;
     result.first_difference =
@@ -78,7 +81,9 @@ VerifyResult verify_client(const Recording& rec) {
         }
         std::vector<Eigen::Vector3d> remotes;
         for (const wire::Vec3& r : tick.remotes()) remotes.push_back(wire::from_wire(r));
-        expected = evaluate_force(*ir, wire::from_wire(tick.own()), remotes).force;
+        auto state = states.find(ir.get());
+        if (state == states.end()) state = states.emplace(ir.get(), make_evaluation_state(*ir)).first;
+        expected = evaluate_force(*ir, state->second, wire::from_wire(tick.own()), remotes, tick.dt()).force;
       } else {
         // P0: the force held is one the server sent under that epoch and had arrived.
         expected = Eigen::Vector3d::Constant(std::nan(""));

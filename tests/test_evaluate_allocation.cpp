@@ -16,6 +16,7 @@
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
+#include "support/evaluate_static.h"
 #include "support/tissue_sheet.h"
 
 extern "C" void* __libc_malloc(std::size_t size);  // glibc's own, behind the interposed one
@@ -65,7 +66,7 @@ TEST(ForceEvaluator, AllocatesNothing) {
     counting = true;
     for (int i = 0; i < 5000; ++i) {
       const Eigen::Vector3d tool(-0.02 + 1e-6 * (i % 1000), 0.005, -0.004 + 1e-7 * (i % 300));
-      sum += evaluate_force(prepared, tool, remotes).force;
+      sum += testing::evaluate_static(prepared, tool, remotes).force;
     }
     counting = false;
     EXPECT_EQ(allocations.load(), 0) << "evaluate_force allocated";

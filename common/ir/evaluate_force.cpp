@@ -71,6 +71,18 @@ PatchPoint nearest_on_patch(const CondensedFemIr& ir, const PreparedFem& prepare
   return best;
 }
 
+// Never a non-finite or unbounded force: zero (flagged) if the evaluation failed or is not
+// finite, scaled down to the limit (flagged) if above it.
+void limit_force(ForceSample& sample, bool evaluated, double force_limit) noexcept {
+  if (!evaluated || !sample.force.allFinite()) {
+    sample.force.setZero();
+    sample.flags |= kNonFinite;
+  } else if (const double magnitude = sample.force.norm(); magnitude > force_limit) {
+    sample.force *= force_limit / magnitude;
+    sample.flags |= kClamped;
+  }
+}
+
 PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double& condition_estimate) {
   PreparedFem prepared;
   const int rows = ir.row_node_count;
@@ -202,13 +214,22 @@ ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, c
 
   // 4. Safety: never a non-finite or unbounded force.
   sample.force = -contact_force;
-  if (!solved || !sample.force.allFinite()) {
-    sample.force.setZero();
-    sample.flags |= kNonFinite;
-  } else if (const double magnitude = sample.force.norm(); magnitude > envelope.force_limit) {
-    sample.force *= envelope.force_limit / magnitude;
-    sample.flags |= kClamped;
-  }
+  limit_force(sample, solved, envelope.force_limit);
+  return sample;
+}
+
+ForceSample evaluate_mass_spring(const IntermediateRepresentation& envelope, const MassSpringIr& ir,
+                                 const PreparedMassSpring& prepared, MassSpringPatchState& state,
+                                 const Eigen::Vector3d& own_tool, std::span<const Eigen::Vector3d> remote_tools,
+                                 double dt) noexcept {
+  const NetworkToolReaction reaction =
+      advance_mass_spring(ir, prepared, state, own_tool, envelope.tool_radius, remote_tools, dt);
+  ForceSample sample;
+  sample.force = reaction.force;
+  sample.depth = reaction.depth;
+  if (reaction.colliding) sample.flags |= kInContact;
+  if (remote_tools.size() + 1 > static_cast<std::size_t>(kMaxNetworkTools)) sample.flags |= kTooManyRemotes;
+  limit_force(sample, state.network.positions.allFinite(), envelope.force_limit);
   return sample;
 }
 
@@ -216,6 +237,7 @@ ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, c
 struct BodyPreparer {
   double& condition_estimate;
   PreparedBody operator()(const CondensedFemIr& fem) const { return prepare_condensed_fem(fem, condition_estimate); }
+  PreparedBody operator()(const MassSpringIr& network) const { return prepare_mass_spring(network); }
 };
 
 }  // namespace
@@ -229,12 +251,23 @@ PreparedIR prepare_ir(IntermediateRepresentation ir) {
   return prepared;
 }
 
-ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
-                           std::span<const Eigen::Vector3d> remote_tools) noexcept {
+EvaluationState make_evaluation_state(const PreparedIR& prepared) {
+  EvaluationState state;
+  if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
+    state.body = make_mass_spring_state(*network, std::get<PreparedMassSpring>(prepared.body));
+  return state;
+}
+
+ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, const Eigen::Vector3d& own_tool,
+                           std::span<const Eigen::Vector3d> remote_tools, double dt) noexcept {
   // get_if, not visit: nothing on this path may throw. prepare_ir made the kinds match.
   if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body))
     if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body))
       return evaluate_condensed_fem(prepared.ir, *fem, *prepared_fem, own_tool, remote_tools);
+  if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
+    if (const auto* prepared_network = std::get_if<PreparedMassSpring>(&prepared.body))
+      if (auto* network_state = std::get_if<MassSpringPatchState>(&state.body))
+        return evaluate_mass_spring(prepared.ir, *network, *prepared_network, *network_state, own_tool, remote_tools, dt);
   ForceSample unknown;
   unknown.flags = kNonFinite;
   return unknown;

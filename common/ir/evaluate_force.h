@@ -3,8 +3,13 @@
 //
 // The same function serves the client's haptic loop (P1) and the server (P0). It is
 // noexcept, takes no lock and allocates nothing: all working storage has a fixed maximum
-// size (kMaxUsers users, each contributing at most 3 contact nodes).
+// size (kMaxUsers users, each contributing at most 3 contact nodes), and what a dynamic
+// body changes from tick to tick lives in the caller's EvaluationState, made with the
+// prepared IR (make_evaluation_state) and advanced by dt, the loop's nominal period, at
+// every call. The condensed FEM body is static: it ignores both. The mass-spring body
+// (mass_spring_evaluation.h) integrates its sub-network over dt.
 //
+// The condensed FEM body:
 // prepare_ir() runs once per IR, off the haptic thread: it checks the IR and inverts the
 // contact block of M~ (in double) to the condensed compliance L~ = M_CC^-1 of the contact
 // nodes with B held, and u0 = -L~ M_CB u_B, their displacement when they carry no force.
@@ -30,6 +35,7 @@
 
 #include "common/ir/contact_solve.h"
 #include "common/ir/intermediate_representation.h"
+#include "common/ir/mass_spring_evaluation.h"
 
 namespace cohaptic {
 
@@ -42,10 +48,11 @@ struct PreparedFem {
 };
 
 /// One alternative per IrBody alternative, in the same order.
-using PreparedBody = std::variant<PreparedFem>;
+using PreparedBody = std::variant<PreparedFem, PreparedMassSpring>;
 
 /// An IR and what its evaluation needs, computed once: `body` holds the alternative that
-/// matches ir.body's kind (PreparedFem for CondensedFemIr).
+/// matches ir.body's kind (PreparedFem for CondensedFemIr, PreparedMassSpring for
+/// MassSpringIr).
 struct PreparedIR {
   IntermediateRepresentation ir;
   PreparedBody body;
@@ -54,6 +61,15 @@ struct PreparedIR {
 
 /// Checks sizes, finiteness and positive definiteness; throws Error naming the problem.
 PreparedIR prepare_ir(IntermediateRepresentation ir);
+
+/// The mutable side of one evaluator of one prepared IR: nothing for a static body (FEM),
+/// the sub-network's state for a mass-spring body. Made off the haptic thread, sized there.
+struct EvaluationState {
+  std::variant<std::monostate, MassSpringPatchState> body;
+};
+
+/// The state an evaluator of `prepared` starts from (the server's state at the IR's time).
+EvaluationState make_evaluation_state(const PreparedIR& prepared);
 
 enum ForceFlag : std::uint8_t {
   kInContact = 1,         ///< the own tool presses the surface
@@ -72,8 +88,11 @@ struct ForceSample {
 };
 
 /// Dispatches on the body kind. remote_tools[i] is the position of the tool of the body's
-/// i-th remote contact [m] (NaN: unknown, ignored).
-ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
-                           std::span<const Eigen::Vector3d> remote_tools) noexcept;
+/// i-th remote contact [m] (NaN: unknown, ignored). `state` must come from
+/// make_evaluation_state(prepared) and be advanced by no other IR; dt [s] is the period
+/// since the previous call (the haptic loop's nominal period). A state of another kind
+/// than the body's gives a zero force flagged kNonFinite.
+ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, const Eigen::Vector3d& own_tool,
+                           std::span<const Eigen::Vector3d> remote_tools, double dt) noexcept;
 
 }  // namespace cohaptic

@@ -229,7 +229,8 @@ std::vector<Eigen::Vector3d> Simulation::remote_positions(const IntermediateRepr
 ForceSample Simulation::force(int user) const {
   const UserState& state = users_[user];
   if (!state.ir) return {};
-  return evaluate_force(*state.ir, state.position, remote_positions(state.ir->ir));
+  EvaluationState stateless;  // the condensed FEM body keeps no evaluation state and ignores dt
+  return evaluate_force(*state.ir, stateless, state.position, remote_positions(state.ir->ir), 0);
 }
 
 }  // namespace cohaptic
