@@ -107,6 +107,7 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       // The coupling figure (the force without the remote tools) needs a second evaluation,
       // which would advance a dynamic body's state a second time: static bodies only.
       const bool stateless = std::holds_alternative<std::monostate>(slot.state->body);
+      metrics_.coupling_measured = metrics_.coupling_measured || stateless;
       if (count > 0 && (sample.flags & kInContact) && stateless) {
         const ForceSample alone = evaluate_force(*slot.ir, *slot.state, own, {}, dt);
         metrics_.peak_coupling = std::max(metrics_.peak_coupling, (sample.force - alone.force).norm());

@@ -60,6 +60,11 @@ class AabbTree {
   /// for each triangle; triangle -1 if it crosses none.
   AabbCrossing first_crossing(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const noexcept;
 
+  /// Appends to `out` the input index of every triangle whose bounding box is within
+  /// `max_distance` of `p` (inclusive): a superset of the triangles within that distance, in
+  /// no particular order. Allocates only when `out` grows.
+  void triangles_near(const Eigen::Vector3d& p, double max_distance, std::vector<int>& out) const;
+
   int triangle_count() const { return static_cast<int>(triangle_index_.size()); }
   int node_count() const { return static_cast<int>(nodes_.size()); }
   /// Levels of nodes (1 for a single leaf, 0 for an empty tree).

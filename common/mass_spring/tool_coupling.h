@@ -44,7 +44,7 @@ struct NetworkToolReaction {
   double depth = 0;       ///< at the start of the period [m]
 };
 
-/// Advances `state` by `period` [s] with `tools` pressing; presses[i] and reactions[i]
+/// Advances `state` by `period` [s] (> 0) with `tools` pressing; presses[i] and reactions[i]
 /// belong to tools[i] (both at least as long as tools; at most kMaxNetworkTools used).
 void advance_with_tools(const MassSpringNetwork& network, MassSpringState& state, std::span<const ToolOnNetwork> tools,
                         std::span<ToolPress> presses, std::span<NetworkToolReaction> reactions, double period) noexcept;

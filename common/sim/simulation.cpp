@@ -19,7 +19,10 @@ Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstac
         IncrementalCondensation::Options condensation;
         condensation.naive = options.naive_every_step;
         return condensation;
-      }()) {
+      }()),
+      candidates_(body.mesh, body.surface, body.touchable_triangles),
+      touchable_triangle_(body.surface.triangles.size(), false) {
+  for (int t : body.touchable_triangles) touchable_triangle_[t] = true;
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
   if (!obstacles.empty()) {
@@ -27,10 +30,7 @@ Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstac
     for (std::size_t i = 0; i < body.surface.nodes.size(); ++i)
       surface_points.col(static_cast<Eigen::Index>(i)) = body.mesh.nodes.col(body.surface.nodes[i]);
     for (const Obstacle& obstacle : obstacles) obstacles_.emplace_back(obstacle, surface_points);
-    rest_clearance_.assign(body.surface.nodes.size(), std::numeric_limits<double>::infinity());
-    for (std::size_t i = 0; i < body.surface.nodes.size(); ++i)
-      for (const ObstacleDistance& obstacle : obstacles_)
-        rest_clearance_[i] = std::min(rest_clearance_[i], obstacle.signed_distance(surface_points.col(static_cast<Eigen::Index>(i))));
+    clearance_ = ObstacleClearance(obstacles_, surface_points);
   }
 }
 
@@ -40,6 +40,8 @@ void Simulation::set_tool(int user, const Eigen::Vector3d& position) {
 }
 
 void Simulation::clear_tool(int user) { users_[user].known = false; }
+
+void Simulation::continue_epochs(int user, std::uint64_t epoch) { users_[user].epoch = std::max(users_[user].epoch, epoch); }
 
 void Simulation::hold(int node, const HeldNode& held) {
   condensation_.add_boundary_node(node);
@@ -103,22 +105,28 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
     if (force.dot(obstacles_[held.obstacle].closest_point(at).normal) < 0) pulling.push_back(node);
   }
   // Free nodes whose displaced position penetrates an obstacle are held on it. Only nodes
-  // that can reach one are checked: rest clearance below the largest surface displacement.
+  // that may have reached one since their last query are queried (ObstacleClearance).
   const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, body_.surface.nodes);
-  const double reach = u.colwise().norm().maxCoeff();
+  near_obstacles_.clear();  // as of this pass's state
   std::vector<std::pair<int, HeldNode>> penetrating;
   for (std::size_t i = 0; i < body_.surface.nodes.size(); ++i) {
     const int node = body_.surface.nodes[i];
-    if (rest_clearance_[i] > reach || held_.count(node) || under_tool[node] || body_.dofs.fixed_axes[node] == kAllAxes)
-      continue;
+    if (held_.count(node) || under_tool[node] || body_.dofs.fixed_axes[node] == kAllAxes) continue;
     const Eigen::Vector3d rest = body_.mesh.nodes.col(node);
     const Eigen::Vector3d moved = rest + u.col(static_cast<Eigen::Index>(i));
+    if (const double estimate = clearance_.estimate(i, moved);
+        estimate < options_.near_obstacle_distance && !columns_.has_column(node))
+      near_obstacles_.push_back({node, estimate});
+    if (clearance_.certainly_clear(i, moved)) continue;
+    ObstaclePoint nearest{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), std::numeric_limits<double>::infinity(), -1};
     for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
       const ObstaclePoint hit = obstacles_[o].closest_point(moved);
+      if (hit.signed_distance < nearest.signed_distance) nearest = hit;
       if (hit.signed_distance >= 0) continue;
       penetrating.push_back({node, {hit.point - rest, o}});
       break;
     }
+    clearance_.record(i, moved, nearest.signed_distance, nearest.normal);
   }
   for (int node : pulling) release(node);
   std::vector<int> joining;
@@ -163,11 +171,14 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
 
 StepReport Simulation::step(double time) {
   StepReport report;
-  std::vector<UserTool> tools;
-  std::vector<bool> under_tool(static_cast<std::size_t>(body_.mesh.node_count()), false);
-  std::vector<bool> in_patch(under_tool.size(), false);
-  std::vector<bool> touchable(body_.surface.triangles.size(), false);
-  for (int t : body_.touchable_triangles) touchable[t] = true;
+  // The step's scratch lives in the simulation, so that a step allocates no more than its
+  // mathematics does.
+  std::vector<UserTool>& tools = step_tools_;
+  std::vector<bool>& under_tool = under_tool_;
+  std::vector<bool>& in_patch = in_patch_;
+  tools.clear();
+  under_tool.assign(static_cast<std::size_t>(body_.mesh.node_count()), false);
+  in_patch.assign(under_tool.size(), false);
   for (std::size_t u = 0; u < users_.size(); ++u) {
     UserState& user = users_[u];
     if (!user.known) {
@@ -176,18 +187,24 @@ StepReport Simulation::step(double time) {
       user.ir.reset();
       continue;
     }
-    user.contact = find_contact(body_.mesh, body_.surface, body_.normals, body_.touchable_triangles, user.position,
-                                user.radius)
+    candidates_.find(user.position, surface_candidates_, touchable_candidates_);
+    user.contact = find_contact(body_.mesh, body_.surface, body_.normals, touchable_candidates_, user.position,
+                                user.radius, surface_candidates_)
                        .contact;
     user.pressing = user.contact.has_value();
-    user.nearest = nearest_triangle(body_.mesh, body_.surface, body_.normals, body_.touchable_triangles, user.position)
-                       .triangle;
+    // A contact's triangle is the nearest touchable one, found by the same rule.
+    user.nearest = user.pressing ? user.contact->triangle
+                                 : nearest_triangle(body_.mesh, body_.surface, body_.normals, touchable_candidates_,
+                                                    user.position)
+                                       .triangle;
     for (int node : body_.surface.triangles[user.nearest]) under_tool[node] = true;
-    for (int t : contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable))
-      for (int node : body_.surface.triangles[t]) in_patch[node] = true;
+    if (options_.step_delay_nodes > 0)  // only step-delay nodes are chosen outside the patches
+      for (int t : contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable_triangle_))
+        for (int node : body_.surface.triangles[t]) in_patch[node] = true;
     tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest});
   }
-  std::vector<int> nearest;
+  std::vector<int>& nearest = step_nearest_;
+  nearest.clear();
   for (const UserState& user : users_) nearest.push_back(user.known ? user.nearest : -1);
 
   Stopwatch watch;

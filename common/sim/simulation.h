@@ -29,11 +29,14 @@
 
 #include "common/condense/incremental_condensation.h"
 #include "common/contact/find_contact.h"
+#include "common/contact/nearest_triangle_candidates.h"
+#include "common/contact/obstacle_clearance.h"
 #include "common/contact/obstacle_distance.h"
 #include "common/ir/build_ir.h"
 #include "common/ir/evaluate_force.h"
 #include "common/model/elastic_body.h"
 #include "common/sim/state_solve.h"
+#include "common/sim/step_report.h"
 
 namespace cohaptic {
 
@@ -41,18 +44,18 @@ struct SimulationOptions {
   IrBuildOptions ir;
   int step_delay_nodes = 0;     ///< N surface nodes held while any tool presses (0: none)
   int obstacle_iterations = 4;  ///< active-set passes per step
+  /// Free surface nodes about this close to an obstacle are listed by
+  /// nodes_near_obstacles() [m].
+  double near_obstacle_distance = 0.001;
   /// Compute every M~ from scratch (naive condensation) at every step, as the paper's
   /// conventional simulation loop did: the step delay of large boundary sets then shows.
   bool naive_every_step = false;
 };
 
-struct StepReport {
-  bool rebuilt = false;       ///< new IRs were built this step (a set changed)
-  bool recomputed = false;    ///< M~ was computed this step (rebuilt, or naive_every_step)
-  double rebuild_ms = 0;      ///< time to update B and compute every M~
-  std::size_t ir_bytes = 0;   ///< total size of the IRs rebuilt
-  int boundary_nodes = 0;     ///< |B| after the step
-  int obstacle_nodes = 0;     ///< of which held by obstacles
+/// A node and an estimate of its distance to something [m].
+struct NodeDistance {
+  int node = -1;
+  double distance = 0;
 };
 
 class Simulation {
@@ -67,6 +70,8 @@ class Simulation {
   void set_tool(int user, const Eigen::Vector3d& position);
   /// The user's tool is no longer known (disconnected): it presses nothing.
   void clear_tool(int user);
+  /// The user's next IR gets an epoch above `epoch` (a user coming from another body).
+  void continue_epochs(int user, std::uint64_t epoch);
 
   StepReport step(double time);
 
@@ -82,6 +87,13 @@ class Simulation {
   StateSolution solve() const;
   /// Displacement of `nodes` (row nodes) in the current state [m].
   Eigen::Matrix3Xd displacement_of(std::span<const int> nodes) const;
+
+  /// Free surface nodes without compliance columns yet that were about (to first order,
+  /// ObstacleClearance::estimate) options.near_obstacle_distance or less from an obstacle
+  /// in the last step's last obstacle pass, with that estimate: should one reach the
+  /// obstacle, the step that holds it solves its columns first. A caller may have them
+  /// solved ahead (the server's CompliancePrefetch).
+  const std::vector<NodeDistance>& nodes_near_obstacles() const { return near_obstacles_; }
 
   const IncrementalCondensation& condensation() const { return condensation_; }
   /// u of each node of condensation().boundary_nodes(), in that order [m].
@@ -115,11 +127,19 @@ class Simulation {
   SimulationOptions options_;
   mutable IncrementalCondensation condensation_;  // its Z cache changes on const queries
   std::vector<ObstacleDistance> obstacles_;
-  std::vector<double> rest_clearance_;            // per surface node: distance to the nearest obstacle at rest
+  NearestTriangleCandidates candidates_;          // the few triangles each tool's nearest-triangle scans visit
+  std::vector<int> surface_candidates_, touchable_candidates_;  // their scratch, reused step to step
+  std::vector<bool> touchable_triangle_;          // per surface triangle
+  ObstacleClearance clearance_;                   // per surface node: where it was last found clear of the obstacles
+  std::vector<NodeDistance> near_obstacles_;      // see nodes_near_obstacles()
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
   std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
+  // step()'s scratch: the known tools, their nearest triangles, the nodes under them and in their patches.
+  std::vector<UserTool> step_tools_;
+  std::vector<int> step_nearest_;
+  std::vector<bool> under_tool_, in_patch_;
   bool boundary_dirty_ = false;
 };
 
