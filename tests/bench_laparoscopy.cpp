@@ -2,7 +2,9 @@
 // 500 Hz - 2 kHz haptic loop (0.5 - 2 ms per tick) and >= 30 Hz graphics (33 ms per frame).
 //   HomeSpringTick/<radius mm>: one haptic tick (shaft collision through the patch's AABB
 //     tree, nearest vertex, Eq. 8) against the patch size, beside _scan, the same tick
-//     with the collision by a scan of every patch triangle (the naive way).
+//     with the collision by a scan of every patch triangle (the naive way), and
+//     HomeSpringIrTick, the tick as the client runs it (the patch as the IR's body, through
+//     evaluate_force, with the force limit).
 //   HomeSpringLoad: Eq. 8 alone for one vertex and its 1-ring.
 //   PolynomialDeformation/<columns>, FfdDeformation/<columns>: one display frame of a
 //     sheet of (columns + 1)^2 vertices; FFD beside _naive, Eq. 2's triple sum with the
@@ -15,6 +17,7 @@
 #include <map>
 #include <memory>
 
+#include "common/ir/evaluate_force.h"
 #include "common/laparoscopy/direct_manipulation.h"
 #include "common/laparoscopy/extract_home_spring_patch.h"
 #include "common/laparoscopy/home_spring_contact.h"
@@ -62,6 +65,20 @@ void BM_HomeSpringTick(benchmark::State& state) {
   set_patch_counters(state, prepared.patch);
 }
 BENCHMARK(BM_HomeSpringTick)->Arg(5)->Arg(10)->Arg(20)->Arg(40)->Unit(benchmark::kMicrosecond);
+
+/// The same tick as the client runs it: the patch as the IR's body, through evaluate_force.
+void BM_HomeSpringIrTick(benchmark::State& state) {
+  IntermediateRepresentation ir;
+  ir.force_limit = 10;
+  ir.body = patch_of_radius(1e-3 * static_cast<double>(state.range(0))).patch;
+  const PreparedIR prepared = prepare_ir(std::move(ir));
+  EvaluationState evaluation = make_evaluation_state(prepared);
+  int tick = 0;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(evaluate_force(prepared, evaluation, circling_tool(tick++), {}, 1.0 / 2000));
+  set_patch_counters(state, std::get<HomeSpringPatch>(prepared.ir.body));
+}
+BENCHMARK(BM_HomeSpringIrTick)->Arg(5)->Arg(40)->Unit(benchmark::kMicrosecond);
 
 /// The naive tick: every triangle tested for the shaft's crossing, then the same Eq. 8.
 HomeSpringContact scan_tick(const HomeSpringPatch& patch, const Vector3d& tool) {

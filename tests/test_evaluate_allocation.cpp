@@ -1,8 +1,8 @@
 // The haptic path allocates nothing: malloc is interposed for this test program and
 // counts the calls made while a flag is set, around thousands of evaluations of the FEM
 // body's force (every contact model, remote tools, held boundary nodes) and of the
-// laparoscopy model's per-tick functions (home-spring tick, forceps step, display
-// frames by both methods).
+// laparoscopy model's per-tick functions (home-spring tick, alone and as the IR's body
+// through evaluate_force, forceps step, display frames by both methods).
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -82,6 +82,11 @@ TEST(LaparoscopyHapticPath, AllocatesNothing) {
   const Eigen::Vector3d pivot(0.01, 0.02, 0.15);
   const PreparedHomeSpringPatch prepared = prepare_home_spring_patch(extract_home_spring_patch(
       {sheet.vertices, sheet.triangles, rings}, Eigen::Vector3d::Zero(), 0.02, {300, 100}, pivot));
+  IntermediateRepresentation ir;  // the same patch as the client receives it, as the IR's body
+  ir.force_limit = 5;
+  ir.body = prepared.patch;
+  const PreparedIR client = prepare_ir(std::move(ir));
+  EvaluationState client_state = make_evaluation_state(client);
   const AabbTree sheet_tree(sheet.vertices, sheet.triangles);
   const ForcepsGeometry geometry{0.01, 0.5, 0.01};
   ForcepsJaws jaws = open_forceps(geometry);
@@ -94,7 +99,7 @@ TEST(LaparoscopyHapticPath, AllocatesNothing) {
   for (int i = 0; i < 2000; ++i) {
     const Eigen::Vector3d tool(0.008 * std::cos(1e-2 * i), 0.008 * std::sin(1e-2 * i), 0.003 - 6e-6 * i);
     const HomeSpringContact contact = evaluate_home_spring(prepared, tool);
-    sum += contact.force;
+    sum += contact.force + evaluate_force(client, client_state, tool, {}, 1.0 / 2000).force;
     touching += contact.touching ? 1 : 0;
     if (const auto shaft = shaft_frame(pivot, tool, Eigen::Vector3d::UnitX()))
       step_forceps(geometry, *shaft, i % 500 < 400, sheet_tree, jaws);

@@ -253,6 +253,9 @@ TEST(HomeSprings, ValidationNamesWhatIsWrong) {
   p.ring_offsets.pop_back();
   expect_rejected(p, "ring_offsets has 7 entries, expected contact_vertex_count + 1 = 8");
   p = good;
+  p.ring_offsets[1] = 1000;  // a ring past ring_vertices, caught before it is read
+  expect_rejected(p, "ring_offsets decrease at vertex 1");
+  p = good;
   p.triangles[4] = {0, 5, 5};
   expect_rejected(p, "triangle 4 is degenerate");
   p = good;

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fmt/format.h>
 #include <unordered_set>
 
@@ -22,9 +23,12 @@ void check_rings(const HomeSpringPatch& patch) {
   if (patch.ring_offsets.back() != static_cast<int>(patch.ring_vertices.size()))
     fail(fmt::format("ring_offsets ends at {}, but ring_vertices has {} entries", patch.ring_offsets.back(),
                      patch.ring_vertices.size()));
-  for (int v = 0; v < n; ++v) {
+  // Every offset in order before any ring is read: a later decrease would let an earlier
+  // ring run past ring_vertices.
+  for (int v = 0; v < n; ++v)
     if (patch.ring_offsets[static_cast<std::size_t>(v) + 1] < patch.ring_offsets[static_cast<std::size_t>(v)])
       fail(fmt::format("ring_offsets decrease at vertex {}", v));
+  for (int v = 0; v < n; ++v) {
     const std::span<const int> ring = patch.ring(v);
     if (ring.empty()) fail(fmt::format("touchable vertex {} has an empty 1-ring", v));
     for (std::size_t i = 0; i < ring.size(); ++i) {
@@ -81,6 +85,13 @@ void validate_home_spring_patch(const HomeSpringPatch& patch) {
     fail(fmt::format("grasp names vertex {}, expected -1 (none) or a touchable vertex 0..{}", patch.grasp.vertex,
                      patch.contact_vertex_count - 1));
   if (!patch.grasp.tool_at_grasp.allFinite()) fail("grasp.tool_at_grasp is not finite");
+}
+
+std::size_t HomeSpringPatch::size_bytes() const {
+  constexpr std::size_t kScalars = (2 + 3 + 3) * sizeof(double) + 2 * sizeof(std::int32_t);  // k1, k2, pivot, grasp
+  const auto vertices = static_cast<std::size_t>(vertex_count());
+  return kScalars + vertices * (3 * sizeof(double) + sizeof(std::int32_t)) +
+         (triangles.size() * 3 + ring_offsets.size() + ring_vertices.size()) * sizeof(std::int32_t);
 }
 
 int nearest_touchable_vertex(const HomeSpringPatch& patch, const Eigen::Vector3d& point) noexcept {

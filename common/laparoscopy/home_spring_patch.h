@@ -47,6 +47,8 @@ struct HomeSpringPatch {
     const auto end = static_cast<std::size_t>(ring_offsets[static_cast<std::size_t>(vertex) + 1]);
     return std::span<const int>(ring_vertices).subspan(begin, end - begin);
   }
+  /// Bytes of the content as sent (the IR's size accounting).
+  std::size_t size_bytes() const;
 };
 
 /// Throws Error naming the first thing wrong: sizes that disagree, an index out of range,
