@@ -1,7 +1,9 @@
-// The force evaluator allocates nothing: malloc is interposed for this test program and
-// counts the calls made while a flag is set, around thousands of evaluations with every
-// contact model, remote tools and held boundary nodes, and of a mass-spring body's
-// sub-network integrated tick by tick with two tools pressing it.
+// The haptic path allocates nothing: malloc is interposed for this test program and
+// counts the calls made while a flag is set, around thousands of evaluations of the FEM
+// body's force (every contact model, remote tools, held boundary nodes), of a mass-spring
+// body's sub-network integrated tick by tick with two tools pressing it, and of the
+// laparoscopy model's per-tick functions (home-spring tick, alone and as the IR's body
+// through evaluate_force, forceps step, display frames by both methods).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,12 +12,17 @@
 #include <cstdlib>
 #include <limits>
 
+#include "common/laparoscopy/extract_home_spring_patch.h"
+#include "common/laparoscopy/forceps_jaws.h"
+#include "common/laparoscopy/home_spring_contact.h"
+#include "common/laparoscopy/tissue_display.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/mass_spring_simulation.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
 #include "support/evaluate_static.h"
 #include "support/test_meshes.h"
+#include "support/tissue_sheet.h"
 
 extern "C" void* __libc_malloc(std::size_t size);  // glibc's own, behind the interposed one
 
@@ -106,6 +113,45 @@ TEST(ForceEvaluator, MassSpringSubNetworkAllocatesNothing) {
   EXPECT_EQ(allocations.load(), 0) << "evaluate_force allocated on a mass-spring body";
   EXPECT_TRUE(finite);
   EXPECT_GT(largest, 0) << "the tool pressed";
+}
+
+TEST(LaparoscopyHapticPath, AllocatesNothing) {
+  ASSERT_TRUE(interposition_counts()) << "malloc interposition is not active";
+  const TriangleSurface sheet = testing::equilateral_sheet(40, 40, 0.002);
+  const VertexRings rings = vertex_rings(sheet.triangles, sheet.vertex_count());
+  const Eigen::Vector3d pivot(0.01, 0.02, 0.15);
+  const PreparedHomeSpringPatch prepared = prepare_home_spring_patch(extract_home_spring_patch(
+      {sheet.vertices, sheet.triangles, rings}, Eigen::Vector3d::Zero(), 0.02, {300, 100}, pivot));
+  IntermediateRepresentation ir;  // the same patch as the client receives it, as the IR's body
+  ir.force_limit = 5;
+  ir.body = prepared.patch;
+  const PreparedIR client = prepare_ir(std::move(ir));
+  EvaluationState client_state = make_evaluation_state(client);
+  const AabbTree sheet_tree(sheet.vertices, sheet.triangles);
+  const ForcepsGeometry geometry{0.01, 0.5, 0.01};
+  ForcepsJaws jaws = open_forceps(geometry);
+  const TissueDisplay polynomial = make_tissue_display(sheet.vertices, 0.01, DisplayDeformation::polynomial);
+  const TissueDisplay lattice = make_tissue_display(sheet.vertices, 0.01, DisplayDeformation::ffd_one_point);
+  Eigen::Matrix3Xd deformed(3, sheet.vertices.cols());
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int touching = 0;
+  counting = true;
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d tool(0.008 * std::cos(1e-2 * i), 0.008 * std::sin(1e-2 * i), 0.003 - 6e-6 * i);
+    const HomeSpringContact contact = evaluate_home_spring(prepared, tool);
+    sum += contact.force + evaluate_force(client, client_state, tool, {}, 1.0 / 2000).force;
+    touching += contact.touching ? 1 : 0;
+    if (const auto shaft = shaft_frame(pivot, tool, Eigen::Vector3d::UnitX()))
+      step_forceps(geometry, *shaft, i % 500 < 400, sheet_tree, jaws);
+    if (i % 100 == 0) {  // a display frame every 100 ticks
+      display_tissue(polynomial, contact.contact_point, tool, deformed);
+      display_tissue(lattice, contact.contact_point, tool, deformed);
+    }
+  }
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0) << "the laparoscopy haptic path allocated";
+  EXPECT_TRUE(sum.allFinite());
+  EXPECT_GT(touching, 500);  // the tool does go through the sheet
 }
 
 }  // namespace

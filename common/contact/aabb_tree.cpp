@@ -21,6 +21,30 @@ double box_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& lo, const 
   return d2;
 }
 
+/// Slack on segment parameters when a box is tested: a triangle's crossing, computed
+/// another way, may differ from its box's entry by rounding, and pruning must never lose it.
+constexpr double kSegmentSlack = 1e-12;
+
+/// Where the segment from + t d, 0 <= t <= t_max, enters the box [lo, hi] (with the
+/// slack above); false if it misses the box.
+bool segment_box_interval(const Eigen::Vector3d& from, const Eigen::Vector3d& d, double t_max,
+                          const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double& enter) {
+  double t0 = 0, t1 = t_max + kSegmentSlack;
+  for (int k = 0; k < 3; ++k) {
+    if (d[k] == 0) {
+      if (from[k] < lo[k] || from[k] > hi[k]) return false;
+      continue;
+    }
+    double a = (lo[k] - from[k]) / d[k], b = (hi[k] - from[k]) / d[k];
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+    if (t0 > t1 + kSegmentSlack) return false;
+  }
+  enter = t0;
+  return true;
+}
+
 }  // namespace
 
 AabbTree::AabbTree(const TriangleSurface& surface) : AabbTree(surface.vertices, surface.triangles) {}
@@ -139,6 +163,59 @@ AabbHit AabbTree::closest_triangle(const Eigen::Vector3d& p, double max_distance
     node = stack[--top].node;
   }
   if (hit.triangle >= 0) hit.distance2 = best2;
+  return hit;
+}
+
+AabbCrossing AabbTree::first_crossing(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const noexcept {
+  AabbCrossing hit;
+  const Eigen::Vector3d d = to - from;
+  if (nodes_.empty() || !from.allFinite() || !d.allFinite()) return hit;
+  // Boxes are tested against the segment up to the best crossing so far (inclusive: a box
+  // touched exactly there may still hold a tie with a lower index).
+  double best_t = 1;
+  struct Pending {
+    int node;
+    double enter;
+  };
+  std::array<Pending, kMaxDepth> stack;
+  int top = 0;
+  int node = 0;
+  double enter = 0;
+  if (!segment_box_interval(from, d, best_t, nodes_[0].lo, nodes_[0].hi, enter)) return hit;
+  for (;;) {
+    for (;;) {
+      const Node& current = nodes_[node];
+      if (current.count > 0) {
+        for (int slot = current.first_or_right; slot < current.first_or_right + current.count; ++slot) {
+          const Corners& c = corners_[slot];
+          const auto crossing = segment_triangle_crossing(from, to, c.a, c.b, c.c);
+          if (!crossing) continue;
+          const int t = triangle_index_[slot];
+          if (crossing->t < best_t || (crossing->t == best_t && (hit.triangle < 0 || t < hit.triangle))) {
+            best_t = crossing->t;
+            hit.triangle = t;
+            hit.crossing = *crossing;
+          }
+        }
+        break;
+      }
+      int near = node + 1, far = current.first_or_right;
+      double near_enter = 0, far_enter = 0;
+      const bool near_hit = segment_box_interval(from, d, best_t, nodes_[near].lo, nodes_[near].hi, near_enter);
+      const bool far_hit = segment_box_interval(from, d, best_t, nodes_[far].lo, nodes_[far].hi, far_enter);
+      if (!near_hit && !far_hit) break;
+      if (!near_hit || (far_hit && far_enter < near_enter)) {
+        std::swap(near, far);
+        std::swap(near_enter, far_enter);
+      }
+      if (near_hit && far_hit) stack[top++] = {far, far_enter};
+      node = near;
+    }
+    // Resume at the most recently pushed box the segment still reaches before best_t.
+    while (top > 0 && stack[top - 1].enter > best_t + kSegmentSlack) --top;
+    if (top == 0) break;
+    node = stack[--top].node;
+  }
   return hit;
 }
 

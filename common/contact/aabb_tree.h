@@ -9,7 +9,10 @@
 // first and skips every box farther than the best triangle found so far; it allocates
 // nothing (a fixed stack of kMaxDepth entries; the median split keeps the depth at about
 // log2(n / 4) + 1). Ties between triangles at exactly the same distance go to the lowest
-// index, as a linear scan would. Units: those of the vertices (m inside cohaptic).
+// index, as a linear scan would. The same tree answers which triangle a segment crosses
+// first (an instrument's shaft against a tissue surface), visiting only the boxes the
+// segment passes through before the best crossing found so far. Units: those of the
+// vertices (m inside cohaptic).
 #pragma once
 
 #include <Eigen/Core>
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "common/contact/closest_point_on_triangle.h"
+#include "common/contact/segment_triangle_crossing.h"
 #include "common/mesh/tet_mesh.h"
 #include "common/mesh/triangle_surface.h"
 
@@ -27,6 +31,11 @@ struct AabbHit {
   int triangle = -1;                                               ///< -1: none within reach
   TriangleClosestPoint closest{};                                  ///< point and area coordinates
   double distance2 = std::numeric_limits<double>::infinity();     ///< squared distance to p
+};
+
+struct AabbCrossing {
+  int triangle = -1;                 ///< -1: the segment crosses nothing
+  SegmentTriangleCrossing crossing{};  ///< where along the segment, and where on the triangle
 };
 
 class AabbTree {
@@ -45,6 +54,11 @@ class AabbTree {
   /// closest point on it; triangle -1 if there is none (or the tree is empty).
   AabbHit closest_triangle(const Eigen::Vector3d& p,
                            double max_distance = std::numeric_limits<double>::infinity()) const;
+
+  /// The triangle the segment from -> to crosses first (smallest segment parameter; ties
+  /// to the lowest index, as a linear scan would), as segment_triangle_crossing decides
+  /// for each triangle; triangle -1 if it crosses none.
+  AabbCrossing first_crossing(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const noexcept;
 
   /// Appends to `out` the input index of every triangle whose bounding box is within
   /// `max_distance` of `p` (inclusive): a superset of the triangles within that distance, in

@@ -245,11 +245,25 @@ ForceSample evaluate_mass_spring(const IntermediateRepresentation& envelope, con
   return sample;
 }
 
+ForceSample evaluate_home_spring_body(const IntermediateRepresentation& envelope,
+                                      const PreparedHomeSpringPatch& prepared, const Eigen::Vector3d& own_tool) noexcept {
+  const HomeSpringContact contact = evaluate_home_spring(prepared, own_tool);
+  ForceSample sample;
+  sample.force = contact.force;
+  if (contact.touching) {
+    sample.flags |= kInContact;
+    sample.depth = contact.displacement.norm();
+  }
+  limit_force(sample, own_tool.allFinite(), envelope.force_limit);
+  return sample;
+}
+
 // Prepares the IR's body by its kind.
 struct BodyPreparer {
   double& condition_estimate;
   PreparedBody operator()(const CondensedFemIr& fem) const { return prepare_condensed_fem(fem, condition_estimate); }
   PreparedBody operator()(const MassSpringIr& network) const { return prepare_mass_spring(network); }
+  PreparedBody operator()(const HomeSpringPatch& patch) const { return prepare_home_spring_patch(patch); }
 };
 
 }  // namespace
@@ -280,6 +294,9 @@ ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, c
     if (const auto* prepared_network = std::get_if<PreparedMassSpring>(&prepared.body))
       if (auto* network_state = std::get_if<MassSpringPatchState>(&state.body))
         return evaluate_mass_spring(prepared.ir, *network, *prepared_network, *network_state, own_tool, remote_tools, dt);
+  if (std::holds_alternative<HomeSpringPatch>(prepared.ir.body))
+    if (const auto* prepared_patch = std::get_if<PreparedHomeSpringPatch>(&prepared.body))
+      return evaluate_home_spring_body(prepared.ir, *prepared_patch, own_tool);
   ForceSample unknown;
   unknown.flags = kNonFinite;
   return unknown;

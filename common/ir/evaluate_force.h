@@ -7,7 +7,10 @@
 // body changes from tick to tick lives in the caller's EvaluationState, made with the
 // prepared IR (make_evaluation_state) and advanced by dt, the loop's nominal period, at
 // every call. The condensed FEM body is static: it ignores both. The mass-spring body
-// (mass_spring_evaluation.h) integrates its sub-network over dt.
+// (mass_spring_evaluation.h) integrates its sub-network over dt. The home-spring body is
+// static too (its grasp travels in the IR): home_spring_contact.h's tick, from the shaft
+// through the patch's trocar pivot; the sample's depth is then |u|, the contact vertex's
+// displacement, and its triangle -1.
 //
 // The condensed FEM body:
 // prepare_ir() runs once per IR, off the haptic thread: it checks the IR and inverts the
@@ -36,6 +39,7 @@
 #include "common/ir/contact_solve.h"
 #include "common/ir/intermediate_representation.h"
 #include "common/ir/mass_spring_evaluation.h"
+#include "common/laparoscopy/home_spring_contact.h"
 
 namespace cohaptic {
 
@@ -48,11 +52,11 @@ struct PreparedFem {
 };
 
 /// One alternative per IrBody alternative, in the same order.
-using PreparedBody = std::variant<PreparedFem, PreparedMassSpring>;
+using PreparedBody = std::variant<PreparedFem, PreparedMassSpring, PreparedHomeSpringPatch>;
 
 /// An IR and what its evaluation needs, computed once: `body` holds the alternative that
 /// matches ir.body's kind (PreparedFem for CondensedFemIr, PreparedMassSpring for
-/// MassSpringIr).
+/// MassSpringIr, PreparedHomeSpringPatch for HomeSpringPatch).
 struct PreparedIR {
   IntermediateRepresentation ir;
   PreparedBody body;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "common/util/error.h"
 
@@ -189,11 +190,29 @@ void mass_spring_to_wire(const MassSpringIr& ir, MassSpringPatch* out) {
   }
 }
 
+void home_spring_to_wire(const cohaptic::HomeSpringPatch& patch, HomeSpringPatch* out) {
+  add_xyz(patch.rest_positions, out->mutable_rest_positions());
+  out->set_contact_vertex_count(static_cast<std::uint32_t>(patch.contact_vertex_count));
+  for (const Triangle& triangle : patch.triangles)
+    for (int vertex : triangle) out->add_triangles(static_cast<std::uint32_t>(vertex));
+  for (int offset : patch.ring_offsets) out->add_ring_offsets(static_cast<std::uint32_t>(offset));
+  for (int vertex : patch.ring_vertices) out->add_ring_vertices(static_cast<std::uint32_t>(vertex));
+  for (int vertex : patch.surface_vertex) out->add_surface_vertex(static_cast<std::uint32_t>(vertex));
+  out->set_home_stiffness(patch.home_stiffness);
+  out->set_neighbour_stiffness(patch.neighbour_stiffness);
+  to_wire(patch.trocar_pivot, out->mutable_trocar_pivot());
+  if (patch.grasp.active()) {
+    out->mutable_grasp()->set_vertex(static_cast<std::uint32_t>(patch.grasp.vertex));
+    to_wire(patch.grasp.tool_at_grasp, out->mutable_grasp()->mutable_tool_at_grasp());
+  }
+}
+
 // Writes the IR's body into the wire's oneof, by kind.
 struct BodyToWire {
   WireIr* out;
   void operator()(const CondensedFemIr& fem) const { fem_to_wire(fem, out->mutable_fem()); }
   void operator()(const MassSpringIr& network) const { mass_spring_to_wire(network, out->mutable_mass_spring()); }
+  void operator()(const cohaptic::HomeSpringPatch& patch) const { home_spring_to_wire(patch, out->mutable_home_spring()); }
 };
 
 }  // namespace
@@ -379,6 +398,42 @@ MassSpringIr mass_spring_from_wire(const MassSpringPatch& w) {
   return ir;
 }
 
+template <typename Indices>
+std::vector<int> read_indices(const Indices& values, const char* what) {
+  std::vector<int> out;
+  out.reserve(static_cast<std::size_t>(values.size()));
+  for (std::uint32_t value : values) out.push_back(to_int(value, what));
+  return out;
+}
+
+// Sizes here; every index, sign and range by validate_home_spring_patch, before anything
+// reads through an index.
+cohaptic::HomeSpringPatch home_spring_from_wire(const HomeSpringPatch& w) {
+  cohaptic::HomeSpringPatch patch;
+  const auto vertices = static_cast<std::uint32_t>(w.surface_vertex_size());
+  patch.rest_positions = read_xyz(w.rest_positions(), vertices, "rest_positions");
+  patch.contact_vertex_count = to_int(w.contact_vertex_count(), "contact_vertex_count");
+  if (w.triangles_size() % 3 != 0) invalid("{} triangle indices, not a multiple of 3", w.triangles_size());
+  const std::vector<int> corners = read_indices(w.triangles(), "triangle corner");
+  for (std::size_t i = 0; i < corners.size(); i += 3) patch.triangles.push_back({corners[i], corners[i + 1], corners[i + 2]});
+  patch.ring_offsets = read_indices(w.ring_offsets(), "ring offset");
+  patch.ring_vertices = read_indices(w.ring_vertices(), "ring vertex");
+  patch.surface_vertex = read_indices(w.surface_vertex(), "surface vertex");
+  patch.home_stiffness = w.home_stiffness();
+  patch.neighbour_stiffness = w.neighbour_stiffness();
+  patch.trocar_pivot = read_vec3(w.trocar_pivot(), "trocar_pivot");
+  if (w.has_grasp()) {
+    patch.grasp.vertex = to_int(w.grasp().vertex(), "grasp vertex");
+    patch.grasp.tool_at_grasp = read_vec3(w.grasp().tool_at_grasp(), "grasp.tool_at_grasp");
+  }
+  try {
+    validate_home_spring_patch(patch);
+  } catch (const cohaptic::Error& e) {
+    invalid("{}", e.what());
+  }
+  return patch;
+}
+
 }  // namespace
 
 CommonIr from_wire(const WireIr& w) {
@@ -399,6 +454,7 @@ CommonIr from_wire(const WireIr& w) {
   switch (w.body_case()) {
     case WireIr::kFem: ir.body = fem_from_wire(w.fem()); break;
     case WireIr::kMassSpring: ir.body = mass_spring_from_wire(w.mass_spring()); break;
+    case WireIr::kHomeSpring: ir.body = home_spring_from_wire(w.home_spring()); break;
     case WireIr::BODY_NOT_SET: invalid("no body of a kind this build knows");
   }
   return ir;

@@ -14,6 +14,8 @@
 //       triangles;
 //       mass-spring: a tool moving through the sub-network's nodes, one haptic tick
 //       (1 ms) per position, the sub-network integrated all the while.
+//       home-spring: a tool on the shaft through each touchable vertex from the trocar
+//       pivot, short of it, on it and past it (and pulled aside while grasping).
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
@@ -87,6 +89,16 @@ void probe(const PreparedIR& prepared, const MassSpringIr& ir) {
   constexpr int kMaxProbedNodes = 16, kTicksPerNode = 4;
   for (int node = 0; node < std::min(ir.node_count(), kMaxProbedNodes); ++node)
     for (int tick = 0; tick < kTicksPerNode; ++tick) require_safe(prepared, state, ir.positions.col(node), remotes);
+}
+
+void probe(const PreparedIR& prepared, const HomeSpringPatch& patch) {
+  EvaluationState state = make_evaluation_state(prepared);
+  constexpr int kMaxProbedVertices = 16;
+  for (int v = 0; v < std::min(patch.contact_vertex_count, kMaxProbedVertices); ++v) {
+    const Eigen::Vector3d shaft = patch.rest_positions.col(v) - patch.trocar_pivot;
+    for (double along : {0.5, 1.0, 1.2, 3.0}) require_safe(prepared, state, patch.trocar_pivot + along * shaft, {});
+    require_safe(prepared, state, patch.rest_positions.col(v) + Eigen::Vector3d(shaft.norm(), 0, 0), {});
+  }
 }
 
 }  // namespace

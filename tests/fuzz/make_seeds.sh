@@ -6,7 +6,9 @@
 #     recordings of a 4 s, two-user session on the cube (scenes/tradeoff/cube_two_users.yaml,
 #     P1, both users pressing) and of a 4 s session of one user pressing the noodle
 #     (scenes/thin/noodle.yaml, a mass-spring body), run here with the real server and
-#     clients on loopback (protocol 3, the development key).
+#     clients on loopback (protocol 3, the development key);
+#   - ir also from text_seeds/ir/*.txtpb (protoc --encode): bodies no recorded session has
+#     yet (the home-spring body).
 # Seeds that fuzzing found (crash-*, regression-*) are kept. Run from a configured build:
 #   BUILD_DIR=build tests/fuzz/make_seeds.sh
 set -euo pipefail
@@ -55,3 +57,8 @@ for target in datagram control_frames ir mcap bridge view; do
   find "$corpus/$target" -type f ! -name 'crash-*' ! -name 'regression-*' -delete
 done
 "$build/tests/fuzz/fuzz_make_seeds" "$work/server.mcap" "$work/client_b.mcap" "$work/client_noodle.mcap" "$corpus"
+# Bodies no recorded session has yet, written by hand in protobuf text format.
+for seed in tests/fuzz/text_seeds/ir/*.txtpb; do
+  protoc -Iproto --encode=cohaptic.wire.IntermediateRepresentation proto/cohaptic/messages.proto \
+    <"$seed" >"$corpus/ir/$(basename "$seed" .txtpb)"
+done
