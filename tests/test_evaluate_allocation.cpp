@@ -1,6 +1,6 @@
 // The force evaluator allocates nothing: malloc is interposed for this test program and
 // counts the calls made while a flag is set, around thousands of evaluations with every
-// contact model, remote tools and held boundary nodes.
+// contact model (the sphere model's too), remote tools and held boundary nodes.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -59,6 +59,34 @@ TEST(ForceEvaluator, AllocatesNothing) {
     EXPECT_TRUE(sum.allFinite());
     EXPECT_GT(sum.norm(), 0);
   }
+}
+
+TEST(ForceEvaluator, AllocatesNothingUnderTheSphereModel) {
+  testing::CubeSceneOptions cube;
+  cube.tools = "[{name: A, shape: sphere, radius: 30}, {name: B, shape: sphere, radius: 30}]";
+  const Model model = build_model(parse_scene(testing::cube_scene_yaml(cube), "cube.yaml"));
+  ComplianceColumns columns(*model.free_factor, model.dofs, model.surface.nodes);
+  SimulationOptions options;
+  options.ir.contact_model = ContactModel::sphere;
+  options.ir.patch_rings = 2;
+  options.step_delay_nodes = 150;
+  Simulation simulation(model, columns, model.scene.tools, options);
+  simulation.set_tool(0, Eigen::Vector3d(-0.02, 0.005, 0.026));
+  simulation.set_tool(1, Eigen::Vector3d(0.025, -0.005, 0.027));
+  simulation.step(0);
+  const PreparedIR& prepared = *simulation.ir(0);
+  const std::vector<Eigen::Vector3d> remotes = simulation.remote_positions(prepared.ir);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  allocations = 0;
+  counting = true;
+  for (int i = 0; i < 5000; ++i) {
+    const Eigen::Vector3d tool(-0.02 + 1e-6 * (i % 1000), 0.005, 0.026 - 1e-7 * (i % 300));
+    sum += evaluate_force(prepared, tool, remotes).force;
+  }
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0) << "evaluate_force allocated";
+  EXPECT_TRUE(sum.allFinite());
+  EXPECT_GT(sum.norm(), 0);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "common/condense/naive_condensation.h"
 #include "common/contact/closest_point_on_triangle.h"
 #include "common/contact/surface_distance.h"
+#include "common/ir/evaluate_sphere_contact.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -128,12 +129,14 @@ PreparedIR prepare_ir(IntermediateRepresentation ir) {
   for (const IrTriangle& tri : ir.patch)
     for (int k = 0; k < 3; ++k)
       if (tri.neighbours[k] < 0) prepared.on_patch_border[tri.nodes[k]] = prepared.on_patch_border[tri.nodes[(k + 1) % 3]] = true;
+  if (ir.contact_model == ContactModel::sphere) prepared.sphere = prepare_sphere_contact(ir);
   prepared.ir = std::move(ir);
   return prepared;
 }
 
 ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
                            std::span<const Eigen::Vector3d> remote_tools) noexcept {
+  if (prepared.ir.contact_model == ContactModel::sphere) return evaluate_sphere_contact(prepared, own_tool, remote_tools);
   ForceSample sample;
   const IntermediateRepresentation& ir = prepared.ir;
   if (!own_tool.allFinite()) {
@@ -213,18 +216,21 @@ ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& ow
   const bool solved = solve_contact_forces(ir.contact_model, l_zz, u0, std::span(z_dofs.data(), static_cast<std::size_t>(z)),
                                            std::span(displacement.data(), static_cast<std::size_t>(pressing_count)),
                                            nodal_forces, std::span(tool_forces.data(), static_cast<std::size_t>(pressing_count)));
-  const Eigen::Vector3d contact_force = tool_forces[0];
 
   // 4. Safety: never a non-finite or unbounded force.
+  finish_force(sample, tool_forces[0], solved, ir.force_limit);
+  return sample;
+}
+
+void finish_force(ForceSample& sample, const Eigen::Vector3d& contact_force, bool solved, double force_limit) noexcept {
   sample.force = -contact_force;
   if (!solved || !sample.force.allFinite()) {
     sample.force.setZero();
     sample.flags |= kNonFinite;
-  } else if (const double magnitude = sample.force.norm(); magnitude > ir.force_limit) {
-    sample.force *= ir.force_limit / magnitude;
+  } else if (const double magnitude = sample.force.norm(); magnitude > force_limit) {
+    sample.force *= force_limit / magnitude;
     sample.flags |= kClamped;
   }
-  return sample;
 }
 
 }  // namespace cohaptic

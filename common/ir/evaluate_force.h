@@ -29,6 +29,7 @@
 
 #include "common/ir/contact_solve.h"
 #include "common/ir/intermediate_representation.h"
+#include "common/ir/prepared_sphere_contact.h"
 
 namespace cohaptic {
 
@@ -39,6 +40,7 @@ struct PreparedIR {
   std::vector<std::array<int, 3>> dof_index;  ///< per contact node and axis: row in L~, or -1 if fixed
   std::vector<bool> on_patch_border;  ///< per patch node
   double condition_estimate = 1;      ///< of L~
+  PreparedSphereContact sphere;       ///< the sphere contact model's (evaluate_sphere_contact.h)
 };
 
 /// Checks sizes, finiteness and positive definiteness; throws Error naming the problem.
@@ -51,6 +53,7 @@ enum ForceFlag : std::uint8_t {
   kOutsidePatch = 8,      ///< the tool is past the patch border: held on it until the next IR
   kRemoteOverlap = 16,    ///< a remote triangle shares a node with the own one: that remote ignored
   kTooManyRemotes = 32,   ///< remotes beyond kMaxUsers - 1 ignored
+  kContactUnresolved = 64,  ///< sphere model: the contact solve did not finish in its budget (zero force)
 };
 
 struct ForceSample {
@@ -60,7 +63,12 @@ struct ForceSample {
   std::uint8_t flags = 0;
 };
 
+/// Sets sample.force to -contact_force (the reaction on the tool), zero if not `solved` or
+/// not finite, and scaled down to `force_limit`; flags it.
+void finish_force(ForceSample& sample, const Eigen::Vector3d& contact_force, bool solved, double force_limit) noexcept;
+
 /// remote_tools[i] is the position of ir.remotes[i]'s tool [m] (NaN: unknown, ignored).
+/// The sphere contact model is evaluate_sphere_contact().
 ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
                            std::span<const Eigen::Vector3d> remote_tools) noexcept;
 

@@ -3,6 +3,7 @@
 #include "common/util/yaml_cursor.h"
 
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -201,9 +202,12 @@ HapticSettings parse_haptic(const Cursor& c) {
   }
   if (auto truncation = c.find("boundary_truncation"))
     haptic.boundary_truncation = truncation->number_in(0, 1, false, true, "a fraction in [0, 1)");
-  if (auto model = c.find("contact_model"))
-    haptic.contact_model = model->choice({"translation", "point"}) == "translation" ? ContactModel::node_translation
-                                                                                     : ContactModel::point_constraint;
+  if (auto model = c.find("contact_model")) {
+    const std::string name = model->choice({"translation", "point", "sphere"});
+    haptic.contact_model = name == "translation" ? ContactModel::node_translation
+                           : name == "point"     ? ContactModel::point_constraint
+                                                 : ContactModel::sphere;
+  }
   return haptic;
 }
 
@@ -242,7 +246,17 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
   }
   if (scene.tools.empty()) tools.fail("at least one tool");
 
-  if (auto haptic = top.find("haptic")) scene.haptic = parse_haptic(*haptic);
+  const std::optional<Cursor> haptic = top.find("haptic");
+  if (haptic) scene.haptic = parse_haptic(*haptic);
+  // The sphere model is the default when every tool is a sphere, and needs sphere tools.
+  const std::optional<Cursor> contact_model = haptic ? haptic->find("contact_model") : std::nullopt;
+  const auto point = std::find_if(scene.tools.begin(), scene.tools.end(),
+                                  [](const ToolSpec& tool) { return tool.shape != ToolShape::sphere; });
+  if (!contact_model && point == scene.tools.end()) scene.haptic.contact_model = ContactModel::sphere;
+  if (contact_model && scene.haptic.contact_model == ContactModel::sphere && point != scene.tools.end())
+    contact_model->fail_message(fmt::format("the sphere contact model needs sphere tools, and tool '{}' is a point "
+                                            "(give it shape: sphere and a radius, or use translation or point)",
+                                            point->name));
   return scene;
 }
 

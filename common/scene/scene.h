@@ -19,7 +19,10 @@
 namespace cohaptic {
 
 enum class ToolShape { point, sphere };
-enum class ContactModel { node_translation, point_constraint };
+/// How a tool holds the surface: the paper's two (node translation of the contact triangle, the
+/// contact point alone) and the sphere model (every node a sphere tool has passed, held on
+/// its surface; common/contact/sphere_contact.h), the default for sphere tools.
+enum class ContactModel { node_translation, point_constraint, sphere };
 
 struct BoxMeshSpec {
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();  ///< [m]

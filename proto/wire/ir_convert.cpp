@@ -112,7 +112,9 @@ void to_wire(const CommonIr& ir, WireIr* out) {
   out->set_epoch(ir.epoch);
   out->set_simulation_time(ir.simulation_time);
   out->set_user(static_cast<std::uint32_t>(ir.user));
-  out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? WireIr::POINT : WireIr::TRANSLATION);
+  out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? WireIr::POINT
+                         : ir.contact_model == ContactModel::sphere         ? WireIr::SPHERE
+                                                                            : WireIr::TRANSLATION);
   out->set_tool_radius(ir.tool_radius);
   out->set_force_limit(ir.force_limit);
   out->mutable_node_ids()->Reserve(static_cast<int>(ir.node_ids.size()));
@@ -174,6 +176,7 @@ CommonIr from_wire(const WireIr& w) {
   switch (w.contact_model()) {
     case WireIr::TRANSLATION: ir.contact_model = ContactModel::node_translation; break;
     case WireIr::POINT: ir.contact_model = ContactModel::point_constraint; break;
+    case WireIr::SPHERE: ir.contact_model = ContactModel::sphere; break;
     default: invalid("unknown contact model {}", static_cast<int>(w.contact_model()));
   }
   if (!(std::isfinite(w.tool_radius()) && w.tool_radius() >= 0)) invalid("tool_radius {} is not a finite length >= 0", w.tool_radius());
