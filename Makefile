@@ -7,6 +7,8 @@ BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BENCH_ARGS ?=
+# Extra CMake settings for the first configure, e.g. CMAKE_ARGS=-DCOHAPTIC_WARNINGS_AS_ERRORS=ON (CI).
+CMAKE_ARGS ?=
 LAB := $(BUILD_DIR)/lab/cohaptic-lab
 
 .PHONY: all deps configure build test demo probe-demo tradeoff bench clean
@@ -17,7 +19,7 @@ deps:
 	@./deploy/install-deps.sh
 
 $(BUILD_DIR)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE)
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) $(CMAKE_ARGS)
 
 configure: deps $(BUILD_DIR)/CMakeCache.txt
 

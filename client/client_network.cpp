@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "client/client_recording.h"
+#include "client/client_status.h"
 #include "client/clock_sync.h"
 #include "client/ir_intake.h"
 #include "client/server_connection.h"
@@ -80,6 +81,9 @@ struct ClientNetwork::Impl {
   ClockSync clock;
   IrIntake irs;
   asio::steady_timer drain_timer{io};
+  asio::steady_timer status_timer{io};
+  const HapticMetrics* haptic_metrics = nullptr;  // from report_status() on
+  const Histogram* floor_period = nullptr;
   asio::signal_set signals{io, SIGINT, SIGTERM};
   std::thread thread;
 
@@ -235,6 +239,26 @@ struct ClientNetwork::Impl {
     if (recorder) recorder->flush_if_due();
   }
 
+  // ---- status reports ----
+
+  void send_status() {
+    if (!haptic_metrics || !connected) return;
+    channels.progress.update();
+    wire::Control control;
+    *control.mutable_status() =
+        client_status(channels.progress.front(), *haptic_metrics, *floor_period, clock.one_way_delay());
+    connection.send(control);
+  }
+
+  void schedule_status() {
+    status_timer.expires_after(std::chrono::milliseconds(kStatusPeriod_ms));
+    status_timer.async_wait([this](std::error_code error) {
+      if (error) return;
+      send_status();
+      schedule_status();
+    });
+  }
+
   void schedule_drain() {
     drain_timer.expires_after(kDrainPeriod);
     drain_timer.async_wait([this](std::error_code error) {
@@ -286,6 +310,15 @@ void ClientNetwork::record_session(const std::filesystem::path& file, const std:
   spdlog::info("recording to {}", file.string());
 }
 
+void ClientNetwork::report_status(const HapticMetrics& metrics, const Histogram& floor_period_ns) {
+  Impl& s = *impl_;
+  asio::post(s.io, [&s, &metrics, &floor_period_ns] {
+    s.haptic_metrics = &metrics;
+    s.floor_period = &floor_period_ns;
+    s.schedule_status();
+  });
+}
+
 void ClientNetwork::stop() {
   Impl& s = *impl_;
   if (!s.thread.joinable()) return;
@@ -294,6 +327,9 @@ void ClientNetwork::stop() {
     s.connection.stop();
     s.drain();
     if (s.recorder) s.recorder->close();
+    s.status_timer.cancel();
+    s.udp.close();  // no more one-way delays: the final status has the report's figures
+    s.send_status();
     if (s.connected) {
       wire::Control control;
       control.mutable_bye()->set_reason("client finished");

@@ -10,7 +10,9 @@
 //   - the UDP endpoint (net/datagram_endpoint.h): own tool samples out (drained from the
 //     haptic thread's ring every millisecond and stamped with the server's clock), remote
 //     tool samples, IR keep-alives and P0 forces in (validated, then handed over);
-//   - optionally the recording (record_session, client_recording.h).
+//   - optionally the recording (record_session, client_recording.h);
+//   - the status reports (client_status.h): the haptic figures so far, every 200 ms and
+//     once more before the goodbye, for the server's live view.
 // All authentication and validation is done here: nothing unchecked reaches the haptic
 // thread. Units: ns of CLOCK_MONOTONIC, m, N.
 #pragma once
@@ -61,7 +63,13 @@ class ClientNetwork {
   /// configuration, every datagram and IR received, every haptic tick, every event.
   /// Throws Error if the file cannot be created.
   void record_session(const std::filesystem::path& file, const std::string& device, double force_limit);
-  /// Stops the I/O thread (after a last drain of the haptic thread's rings).
+  /// Reports the haptic loop's figures to the server from now on (status reports):
+  /// `metrics` are the loop's, `floor_period_ns` the timer floor's; both must outlive
+  /// stop(). The progress comes through the channels' `progress` buffer.
+  void report_status(const HapticMetrics& metrics, const Histogram& floor_period_ns);
+  /// Stops the I/O thread (after a last drain of the haptic thread's rings, the UDP
+  /// socket closed and a final status sent: call it after the haptic loop has ended, and
+  /// that status carries the report's figures).
   void stop();
   /// Set by SIGINT/SIGTERM, or when the server says goodbye and never comes back.
   const std::atomic<bool>& stop_requested() const { return stop_requested_; }

@@ -40,6 +40,8 @@ class ClockSync {
   std::int64_t to_server(std::int64_t client_ns) const { return estimate_.to_server(client_ns); }
   std::int64_t to_client(std::int64_t server_ns) const { return estimate_.to_client(server_ns); }
 
+  /// Server-to-client delays of the datagrams observed [ns] (read on the I/O thread).
+  const Histogram& one_way_delay() const { return one_way_ns_; }
   /// The report's "clock" (offset, round trip) and "one_way_delay_ms" (p50, p99, samples).
   void add_to_report(nlohmann::json& report) const;
 

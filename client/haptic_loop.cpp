@@ -85,9 +85,9 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       age = now - (fresh ? confirmed.arrival_ns : slot.arrival_ns);
       const IntermediateRepresentation& ir = slot.ir->ir;
       std::array<Eigen::Vector3d, kMaxUsers - 1> remotes;
-      const std::size_t count = std::min<std::size_t>(ir.remotes.size(), remotes.size());
+      const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(remote_count(ir)), remotes.size());
       for (std::size_t r = 0; r < count; ++r) {
-        const PlayoutQuery remote = remote_buffers_[ir.remotes[r].user % kMaxUsers].at(now);
+        const PlayoutQuery remote = remote_buffers_[static_cast<std::size_t>(remote_user(ir, static_cast<int>(r)) % kMaxUsers)].at(now);
         remotes[r] = remote.valid ? remote.position : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
         record.remotes[r] = remotes[r];
       }
@@ -119,6 +119,11 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
   record.fade = fade;
   force *= static_cast<double>(fade);
   return force;
+}
+
+void HapticLoop::publish_progress(double elapsed_s, bool finished) {
+  channels_.progress.back() = {metrics_.ticks, metrics_.missed_deadlines, elapsed_s, metrics_.peak_force, finished};
+  channels_.progress.publish();
 }
 
 void HapticLoop::run(const std::atomic<bool>& stop) {
@@ -182,9 +187,11 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     record.force = force;
     if (channels_.tracing.load(std::memory_order_relaxed)) channels_.trace.push(record);
     ++metrics_.ticks;
+    publish_progress(time_s, false);
   }
   device_.write_force(Eigen::Vector3d::Zero(), static_cast<double>(now() - start) * 1e-9);
   metrics_.elapsed_s = static_cast<double>(now() - start) * 1e-9;
+  publish_progress(metrics_.elapsed_s, true);
 }
 
 }  // namespace cohaptic

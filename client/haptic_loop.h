@@ -1,4 +1,4 @@
-// HapticLoop: the client's real-time loop (DESIGN.md §4).
+// HapticLoop: the client's real-time loop (docs/architecture.md, "Threads").
 //
 // Every period, at an absolute deadline (clock_nanosleep on CLOCK_MONOTONIC), it reads the
 // device, hands the own tool sample to the I/O thread, takes in remote tool samples and the
@@ -103,6 +103,16 @@ struct HapticEvent {
   std::uint64_t value = 0;
 };
 
+/// The loop's running totals, published every tick and once more when it ends (finished),
+/// for the status the I/O thread reports to the server (client_status.h). Its histograms
+/// are read from HapticLoop::metrics() directly (Histogram allows a concurrent reader).
+struct HapticProgress {
+  std::uint64_t ticks = 0, missed_deadlines = 0;
+  double elapsed_s = 0;    ///< since the loop started; when finished, HapticMetrics::elapsed_s
+  double peak_force = 0;   ///< [N]
+  bool finished = false;
+};
+
 /// Lock-free channels between the I/O thread and the haptic thread.
 struct HapticChannels {
   TripleBuffer<IrSlot> ir;                     // I/O -> haptic (P1)
@@ -112,6 +122,7 @@ struct HapticChannels {
   SpscRing<OwnSample, 4096> own_samples;       // haptic -> I/O
   SpscRing<TickRecord, 8192> trace;            // haptic -> I/O (only if tracing: recording)
   SpscRing<HapticEvent, 1024> events;          // haptic -> I/O
+  TripleBuffer<HapticProgress> progress;       // haptic -> I/O
   std::atomic<bool> tracing{false};
 };
 
@@ -150,6 +161,7 @@ class HapticLoop {
 
  private:
   Eigen::Vector3d compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record);
+  void publish_progress(double elapsed_s, bool finished);
   std::int64_t now() const { return clock_.now_ns(clock_.context); }
 
   HapticDevice& device_;

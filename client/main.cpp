@@ -99,6 +99,7 @@ int main(int argc, char** argv) {
     cohaptic::HapticLoop loop(*device, *channels, settings);
     std::atomic<bool> floor_stop{false};
     cohaptic::TimerFloor floor;
+    network.report_status(loop.metrics(), floor.period_ns);
     std::thread floor_thread([&] { floor.run(settings.rate_hz, floor_stop, settings.realtime); });
     std::thread haptic_thread([&] { loop.run(network.stop_requested()); });
     haptic_thread.join();

@@ -1,20 +1,23 @@
 # The one-way rule of the layout (README.md, "Layout"), checked when the build is
 # configured: every library and program of ours may link, directly or through another of
 # ours, only the libraries listed for it here. In particular the server and the client
-# never link each other or the lab, and common links nothing of ours. A lab tool that needs
+# never link each other or the lab, the live view (cohaptic_view, which both the server and
+# the lab's replay use) links neither, and common links nothing of ours. A lab tool that needs
 # the server or the client starts it as a process instead.
 # Reads LINK_LIBRARIES and INTERFACE_LINK_LIBRARIES (static libraries list their private
 # links there as $<LINK_ONLY:...>); a violation stops the configuration with the chain of
 # links that broke the rule.
 
-set(COHAPTIC_OUR_LIBRARIES cohaptic_common cohaptic_proto cohaptic_net cohaptic_server cohaptic_client cohaptic_lab)
+set(COHAPTIC_OUR_LIBRARIES cohaptic_common cohaptic_proto cohaptic_net cohaptic_view cohaptic_server cohaptic_client
+  cohaptic_lab)
 
 set(COHAPTIC_MAY_LINK_cohaptic_common "")
 set(COHAPTIC_MAY_LINK_cohaptic_proto cohaptic_common)
 set(COHAPTIC_MAY_LINK_cohaptic_net cohaptic_proto cohaptic_common)
-set(COHAPTIC_MAY_LINK_cohaptic_server cohaptic_net cohaptic_proto cohaptic_common)
+set(COHAPTIC_MAY_LINK_cohaptic_view cohaptic_net cohaptic_proto cohaptic_common)
+set(COHAPTIC_MAY_LINK_cohaptic_server cohaptic_view cohaptic_net cohaptic_proto cohaptic_common)
 set(COHAPTIC_MAY_LINK_cohaptic_client cohaptic_net cohaptic_proto cohaptic_common)
-set(COHAPTIC_MAY_LINK_cohaptic_lab cohaptic_net cohaptic_proto cohaptic_common)
+set(COHAPTIC_MAY_LINK_cohaptic_lab cohaptic_view cohaptic_net cohaptic_proto cohaptic_common)
 set(COHAPTIC_MAY_LINK_cohaptic-server cohaptic_server ${COHAPTIC_MAY_LINK_cohaptic_server})
 set(COHAPTIC_MAY_LINK_cohaptic-client cohaptic_client ${COHAPTIC_MAY_LINK_cohaptic_client})
 set(COHAPTIC_MAY_LINK_cohaptic-lab cohaptic_lab ${COHAPTIC_MAY_LINK_cohaptic_lab})
@@ -58,7 +61,8 @@ function(cohaptic_check_links target)
           set(allowed_text "nothing of ours")
         endif()
         message(FATAL_ERROR "cohaptic link check: ${target} links ${link} (${chain_${link}}), but it may link "
-                            "${allowed_text}. The server and the client never link each other or the lab, and "
+                            "${allowed_text}. The server and the client never link each other or the lab, the view "
+                            "links no program's library, and "
                             "common links nothing of ours (README.md, \"Layout\"; cmake/check_links.cmake).")
       endif()
       list(APPEND queue ${link})

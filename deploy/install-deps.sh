@@ -11,17 +11,18 @@ packages=(
   build-essential cmake pkg-config git ca-certificates
   # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it
   libeigen3-dev libsuitesparse-dev libopenblas-dev
-  # networking and the wire format
-  libasio-dev libprotobuf-dev protobuf-compiler libsodium-dev
+  # networking and the wire format; the live view's web server
+  libasio-dev libprotobuf-dev protobuf-compiler libsodium-dev libwebsocketpp-dev
   # configuration, command line, logging, JSON output
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks; the browser the live view's test opens the page in
+  libgtest-dev libgmock-dev libbenchmark-dev chromium
 )
 
-# Node.js and npm, for the official MCAP reader (@mcap/core) a test checks our recordings
-# with: Debian's packages, unless some Node.js is already there (NodeSource's brings its
-# own npm and conflicts with Debian's).
+# Node.js and npm, for the live view's page libraries (three.js, protobufjs), the official
+# MCAP reader (@mcap/core) a test checks our recordings with, and playwright-core, which
+# drives Chromium in the view's browser test: Debian's packages, unless some Node.js is
+# already there (NodeSource's brings its own npm and conflicts with Debian's).
 if ! command -v node >/dev/null 2>&1 && ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi
 
 missing=()
@@ -30,17 +31,33 @@ for p in "${packages[@]}"; do
   [[ "$status" == "install ok installed" ]] || missing+=("$p")
 done
 
-# @mcap/core into deploy/node/node_modules, from the lock file. If npm cannot reach its
-# registry, the test that needs it is skipped and says how to get it.
+# npm packages, each set from its lock file (npm ci), so every machine gets the same:
+#   view/web     three, protobufjs: the live view's page, served by cohaptic-server --view
+#                (no CDN at run time);
+#   deploy/node  @mcap/core (the recording-format test), playwright-core (the view's
+#                browser test).
+# If npm cannot reach its registry: the view cannot serve its page (it says so), and the
+# tests that need the others are skipped, saying how to get them.
 install_node_tools() {
-  local here
+  local here root
   here="$(cd "$(dirname "$0")" && pwd)"
-  if [[ -d "$here/node/node_modules/@mcap/core" ]]; then return 0; fi
-  if command -v npm >/dev/null 2>&1; then
-    echo "install-deps: npm install @mcap/core into deploy/node (for the recording-format test)"
-    npm ci --prefix "$here/node" --no-audit --no-fund --loglevel=error >/dev/null 2>&1 ||
-      echo "install-deps: npm install failed; the official-reader test will be skipped"
-  fi
+  root="$(dirname "$here")"
+  command -v npm >/dev/null 2>&1 || return 0
+  local -A wanted=(
+    ["$root/view/web"]="three protobufjs"
+    ["$here/node"]="@mcap/core playwright-core"
+  )
+  local dir package
+  for dir in "${!wanted[@]}"; do
+    for package in ${wanted[$dir]}; do
+      if [[ ! -d "$dir/node_modules/$package" ]]; then
+        echo "install-deps: npm ci in ${dir#"$root"/} (${wanted[$dir]})"
+        npm ci --prefix "$dir" --no-audit --no-fund --loglevel=error >/dev/null 2>&1 ||
+          echo "install-deps: npm ci in ${dir#"$root"/} failed: what needs ${wanted[$dir]} will say so"
+        break
+      fi
+    done
+  done
 }
 
 if [[ ${#missing[@]} -eq 0 ]]; then

@@ -9,8 +9,14 @@
 # session was unhealthy (see README.md, "Reports and the demo report") or a verification
 # failed.
 #
+# The server serves the live view (cohaptic-server --view) on 127.0.0.1:DEMO_VIEW_PORT and
+# the demo prints its address: open it in a browser to watch the session.
+#
 # Environment: BUILD_DIR (default build), DEMO_PORT (default 7431), DEMO_DURATION (s, default
-# 20), DEMO_PROTOCOL (P1), DEMO_DEVICE (hand or script), DEMO_OUT (out/demo).
+# 20), DEMO_PROTOCOL (P1), DEMO_DEVICE (hand or script), DEMO_OUT (out/demo), DEMO_VIEW_PORT
+# (default 7480; "off": no live view), DEMO_VIEW_SCREENSHOT (a PNG file: a headless Chromium
+# watches the whole session and takes this screenshot once both surgeons press with 0.2 N;
+# the README's picture is taken so).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${BUILD_DIR:-build}
@@ -19,6 +25,8 @@ duration=${DEMO_DURATION:-20}
 protocol=${DEMO_PROTOCOL:-P1}
 device=${DEMO_DEVICE:-hand}
 out=${DEMO_OUT:-out/demo}
+view_port=${DEMO_VIEW_PORT:-7480}
+screenshot=${DEMO_VIEW_SCREENSHOT:-}
 server_bin=$build/server/cohaptic-server
 client_bin=$build/client/cohaptic-client
 lab_bin=$build/lab/cohaptic-lab
@@ -29,10 +37,12 @@ pids=()
 cleanup() { for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done; }
 trap cleanup EXIT
 
+view=()
+[[ "$view_port" == off ]] || view=(--view "127.0.0.1:$view_port")
 # The server outlives the clients by a few seconds so that both can say goodbye.
 "$server_bin" --scene scenes/brain.yaml --listen "127.0.0.1:$port" --protocol "$protocol" \
   --duration $((duration + 6)) --report "$out/server.json" --record "$out/server.mcap" --display "$out/display" --display-rate-hz 5 \
-  >"$out/server.log" 2>&1 &
+  "${view[@]}" >"$out/server.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 1 300); do
   grep -q "listening on" "$out/server.log" 2>/dev/null && break
@@ -41,6 +51,17 @@ for _ in $(seq 1 300); do
 done
 grep -q "listening on" "$out/server.log" || { echo "demo: the server did not start listening" >&2; exit 1; }
 echo "demo: server up on 127.0.0.1:$port ($protocol); two surgeons for ${duration} s ..."
+if [[ ${#view[@]} -gt 0 ]]; then
+  url=$(sed -n 's/.*live view at \(http[^ ]*\).*/\1/p' "$out/server.log" | head -n 1)
+  echo "demo: live view at $url (open it in a browser; replay it afterwards with: $lab_bin replay $out/server.mcap --view 127.0.0.1:$view_port)"
+  if [[ -n "$screenshot" ]]; then
+    # Chromium draws in software here; at the lowest priority it takes what the haptic
+    # loops leave, as a browser on another machine would take nothing.
+    nice -n 19 node tests/support/view_check.mjs --url "$url" --screenshot "$screenshot" --min-force 0.2 --focus-tools 1 --stay "$duration" \
+      >"$out/view_check.json" 2>"$out/view_check.log" &
+    pids+=($!)
+  fi
+fi
 
 "$client_bin" --server "127.0.0.1:$port" --user surgeon-A --slot 0 --device "$device:scenes/brain/surgeon_a.yaml" \
   --duration "$duration" --report "$out/client_a.json" --record "$out/client_a.mcap" >"$out/client_a.log" 2>&1 &
@@ -49,9 +70,12 @@ pids+=($!)
   --duration "$duration" --report "$out/client_b.json" --record "$out/client_b.mcap" >"$out/client_b.log" 2>&1 &
 pids+=($!)
 status=0
-wait "${pids[1]}" || status=$?
-wait "${pids[2]}" || status=$?
+wait "${pids[-2]}" || status=$?
+wait "${pids[-1]}" || status=$?
 wait "${pids[0]}" || status=$?
+if [[ ${#pids[@]} -gt 3 ]]; then
+  wait "${pids[1]}" && echo "demo: screenshot of the live view in $screenshot" || echo "demo: no screenshot (see $out/view_check.json)"
+fi
 pids=()
 if [[ $status -ne 0 ]]; then
   tail -n 5 "$out"/*.log >&2

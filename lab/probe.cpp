@@ -12,6 +12,7 @@
 #include "common/mesh/write_gmsh.h"
 #include "common/mesh/write_vtu.h"
 #include "common/model/compliance_setup.h"
+#include "common/model/model.h"
 #include "common/model/static_contact.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
@@ -65,6 +66,7 @@ struct ProbeCommandLine {
 // Presses `tools` at once (every other scene tool absent) and fills in their answers.
 void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& options, ContactModel contact_model,
            std::vector<ProbedTool>& tools, const std::vector<int>& users, ProbeTimings& timings) {
+  const ElasticBody& body = single_elastic_body(model);
   SimulationOptions sim_options;
   sim_options.ir = ir_build_options(model.scene.haptic);
   sim_options.ir.patch_rings = options.patch_rings.value_or(model.scene.haptic.patch_rings);
@@ -72,13 +74,13 @@ void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& o
   sim_options.ir.contact_model = contact_model;
   sim_options.ir.force_limit = std::numeric_limits<double>::infinity();  // the probe reports physics
   sim_options.step_delay_nodes = options.boundary_nodes;
-  Simulation simulation(model, columns, model.scene.tools, sim_options);
+  Simulation simulation(body, model.obstacles, columns, model.scene.tools, sim_options);
   std::vector<PressedTool> pressed;
   for (int u : users) {
     simulation.set_tool(u, tools[u].tool.position);
     pressed.push_back(tools[u].tool);
   }
-  const std::vector<ContactQuery> contacts = find_tool_contacts(model, pressed);
+  const std::vector<ContactQuery> contacts = find_tool_contacts(body, pressed);
   for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].query = contacts[i];
 
   Stopwatch watch;
@@ -93,7 +95,7 @@ void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& o
   }
   if (options.reference) {
     const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
-    const std::vector<ToolReaction> reactions = contact_reactions_reference(model, contacts, held, contact_model);
+    const std::vector<ToolReaction> reactions = contact_reactions_reference(body, contacts, held, contact_model);
     for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].force = reactions[i].reaction;
   } else {
     for (int u : users) tools[u].force = simulation.force(u).force;
@@ -105,18 +107,19 @@ nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z
 
 nlohmann::json probe_json(const Model& model, const ProbeOptions& options, ContactModel contact_model,
                           const std::vector<ProbedTool>& tools, const ProbeTimings& timings) {
+  const ElasticBody& body = single_elastic_body(model);
   const double unit = model.scene.metres_per_unit;
   nlohmann::json out;
   out["scene"] = model.scene.file.string();
   out["units"] = model.scene.units;
-  out["nodes"] = model.mesh.node_count();
-  out["tets"] = model.mesh.tet_count();
-  out["surface_triangles"] = model.surface.triangle_count();
-  out["fixed_nodes"] = fixed_node_tags(model);
-  out["touchable_nodes"] = model.touchable_nodes.size();
-  out["material"] = {{"youngs_modulus_pa", model.scene.object.material.youngs_modulus},
-                     {"poisson_ratio", model.scene.object.material.poisson_ratio},
-                     {"element", formulation_name(model.scene.object.material.formulation)}};
+  out["nodes"] = body.mesh.node_count();
+  out["tets"] = body.mesh.tet_count();
+  out["surface_triangles"] = body.surface.triangle_count();
+  out["fixed_nodes"] = fixed_node_tags(body);
+  out["touchable_nodes"] = body.touchable_nodes.size();
+  out["material"] = {{"youngs_modulus_pa", body.spec.material.youngs_modulus},
+                     {"poisson_ratio", body.spec.material.poisson_ratio},
+                     {"element", formulation_name(body.spec.material.formulation)}};
   out["method"] = options.reference ? "reference" : "ir";
   out["contact_model"] = model_name(contact_model);
   out["ir_precision"] = options.precision == IrPrecision::f32 ? "f32" : "f64";
@@ -129,9 +132,9 @@ nlohmann::json probe_json(const Model& model, const ProbeOptions& options, Conta
     tool["signed_distance"] = probed.query.signed_distance / unit;
     if (probed.query.contact) {
       const ToolContact& c = *probed.query.contact;
-      const Triangle& tri = model.surface.triangles[c.triangle];
+      const Triangle& tri = body.surface.triangles[c.triangle];
       nlohmann::json contact;
-      contact["triangle"] = {model.mesh.node_tags[tri[0]], model.mesh.node_tags[tri[1]], model.mesh.node_tags[tri[2]]};
+      contact["triangle"] = {body.mesh.node_tags[tri[0]], body.mesh.node_tags[tri[1]], body.mesh.node_tags[tri[2]]};
       contact["foot"] = vector_json(c.foot / unit);
       contact["weights"] = vector_json(c.weights);
       contact["depth"] = c.depth / unit;
@@ -160,13 +163,14 @@ std::string vec(const Eigen::Vector3d& v, int precision) {
 
 void print_table(const Model& model, const ProbeOptions& options, ContactModel contact_model,
                  const std::vector<ProbedTool>& tools, const ProbeTimings& timings, const std::string& compliance_note) {
+  const ElasticBody& body = single_elastic_body(model);
   const double unit = model.scene.metres_per_unit;
   const std::string& u = model.scene.units;
-  const LinearElasticMaterial& material = model.scene.object.material;
+  const LinearElasticMaterial& material = body.spec.material;
   fmt::print("scene     {} ({})\n", model.scene.name, model.scene.file.string());
   fmt::print("mesh      {} nodes, {} tetrahedra, {} surface triangles; {} fixed nodes; {} touchable nodes\n",
-             model.mesh.node_count(), model.mesh.tet_count(), model.surface.triangle_count(),
-             fixed_node_tags(model).size(), model.touchable_nodes.size());
+             body.mesh.node_count(), body.mesh.tet_count(), body.surface.triangle_count(),
+             fixed_node_tags(body).size(), body.touchable_nodes.size());
   fmt::print("material  E = {:g} Pa, nu = {:g}, {}\n", material.youngs_modulus, material.poisson_ratio,
              formulation_name(material.formulation));
   fmt::print("method    {}; contact model {}; tools pressed {}; {} boundary nodes held\n",
@@ -190,19 +194,19 @@ void print_table(const Model& model, const ProbeOptions& options, ContactModel c
       continue;
     }
     const ToolContact& c = *probed.query.contact;
-    const Triangle& tri = model.surface.triangles[c.triangle];
+    const Triangle& tri = body.surface.triangles[c.triangle];
     const bool over = probed.force.norm() > limit;
     over_limit |= over;
     fmt::print("{:<4} {:<28} {:>10.3f} {:<20} {:<28} {:<30} {:>8.4f}{} {:>9}\n", t + 1, vec(probed.tool.position / unit, 3),
                c.depth / unit,
-               fmt::format("{} {} {}", model.mesh.node_tags[tri[0]], model.mesh.node_tags[tri[1]], model.mesh.node_tags[tri[2]]),
+               fmt::format("{} {} {}", body.mesh.node_tags[tri[0]], body.mesh.node_tags[tri[1]], body.mesh.node_tags[tri[2]]),
                vec(c.displacement / unit, 3), vec(probed.force, 4), probed.force.norm(), over ? "*" : " ", probed.ir_bytes);
   }
   if (over_limit) fmt::print("* above the scene's haptic force limit of {:g} N (a haptic client would clamp it)\n", limit);
   fmt::print("\ntimings (ms): load {:.1f}, precompute {:.1f} (assemble {:.1f}, factor {:.1f}, compliance {:.1f}), "
              "IR build {:.3f}, {} {:.3f}\n",
-             timings.load_ms, timings.precompute_ms, model.timings.assemble_ms, model.timings.factor_ms,
-             timings.precompute_ms - model.timings.assemble_ms - model.timings.factor_ms, timings.ir_build_ms,
+             timings.load_ms, timings.precompute_ms, body.timings.assemble_ms, body.timings.factor_ms,
+             timings.precompute_ms - body.timings.assemble_ms - body.timings.factor_ms, timings.ir_build_ms,
              options.reference ? "full solve" : "force evaluation", timings.solve_ms);
   if (!compliance_note.empty()) fmt::print("compliance cache: {}\n", compliance_note);
 }
@@ -220,12 +224,13 @@ int run_probe(const ProbeOptions& options) {
   }
   const ContactModel contact_model = options.contact_model.value_or(scene.haptic.contact_model);
   const Model model = build_model(scene);
+  const ElasticBody& body = single_elastic_body(model);
   const double elapsed_build = watch.lap_ms();
-  timings.load_ms = elapsed_build - model.timings.assemble_ms - model.timings.factor_ms;
-  timings.precompute_ms = model.timings.assemble_ms + model.timings.factor_ms;
+  timings.load_ms = elapsed_build - body.timings.assemble_ms - body.timings.factor_ms;
+  timings.precompute_ms = body.timings.assemble_ms + body.timings.factor_ms;
 
-  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, options.boundary_nodes > 0));
-  const ComplianceSetup setup = prepare_compliance(model, columns, options.cache_directory);
+  ComplianceColumns columns(*body.free_factor, body.dofs, compliance_row_nodes(body, options.boundary_nodes > 0 || !model.obstacles.empty()));
+  const ComplianceSetup setup = prepare_compliance(body, columns, options.cache_directory);
   timings.precompute_ms += watch.lap_ms();
 
   std::vector<ProbedTool> tools;
@@ -243,7 +248,7 @@ int run_probe(const ProbeOptions& options) {
   }
 
   if (!options.export_vtu.empty() || !options.export_msh.empty()) {
-    TetMesh in_scene_units = model.mesh;
+    TetMesh in_scene_units = body.mesh;
     in_scene_units.nodes /= scene.metres_per_unit;
     if (!options.export_msh.empty()) {
       write_gmsh41(options.export_msh, in_scene_units);
@@ -255,10 +260,10 @@ int run_probe(const ProbeOptions& options) {
       std::vector<PressedTool> pressed;
       for (const ProbedTool& probed : tools) pressed.push_back(probed.tool);
       Eigen::VectorXd u;
-      contact_reactions_reference(model, find_tool_contacts(model, pressed), {}, contact_model, &u);
+      contact_reactions_reference(body, find_tool_contacts(body, pressed), {}, contact_model, &u);
       u /= scene.metres_per_unit;
       write_vtu(options.export_vtu, in_scene_units,
-                {{"displacement", Eigen::Map<const Eigen::Matrix3Xd>(u.data(), 3, model.mesh.node_count())}});
+                {{"displacement", Eigen::Map<const Eigen::Matrix3Xd>(u.data(), 3, body.mesh.node_count())}});
       spdlog::info("wrote {} (displacement in {}, without held boundary nodes)", options.export_vtu.string(), scene.units);
     }
   }

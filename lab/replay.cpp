@@ -10,6 +10,8 @@
 #include <memory>
 
 #include "common/model/compliance_setup.h"
+#include "common/model/model.h"
+#include "common/net/host_port.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "common/util/atomic_file.h"
@@ -18,6 +20,7 @@
 #include "proto/record/recording.h"
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/vec3_convert.h"
+#include "lab/replay_view.h"
 
 namespace cohaptic {
 namespace {
@@ -104,14 +107,16 @@ VerifyResult verify_server(const Recording& rec) {
   const std::int64_t start = config.start_time_ns();
   const Scene scene = parse_scene(config.scene_yaml(), config.scene_file());
   const Model model = build_model(scene);
-  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, config.injected().step_nodes() > 0));
-  prepare_compliance(model, columns, std::nullopt);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs,
+                            compliance_row_nodes(body, config.injected().step_nodes() > 0 || !model.obstacles.empty()));
+  prepare_compliance(body, columns, std::nullopt);
   SimulationOptions options;
   options.ir = ir_build_options(scene.haptic);
   options.ir.precision = config.ir_f32() ? IrPrecision::f32 : IrPrecision::f64;
   options.step_delay_nodes = static_cast<int>(config.injected().step_nodes());
   options.naive_every_step = config.injected().condensation() == "naive";
-  Simulation simulation(model, columns, scene.tools, options);
+  Simulation simulation(body, model.obstacles, columns, scene.tools, options);
 
   std::size_t next_ir = 0;
   std::string expected_bytes, replayed_bytes;
@@ -192,6 +197,9 @@ void print_summary(const Recording& rec) {
   fmt::print("duration    {:.3f} s\n", first <= last ? span(first, last) : 0.0);
   fmt::print("records     {} haptic ticks, {} simulation steps, {} IRs, {} datagrams, {} events\n", rec.ticks.size(),
              rec.steps.size(), rec.irs.size(), rec.datagrams.size(), rec.events.size());
+  if (c.role() == "server")
+    fmt::print("view        {} frames, {} client status reports{}\n", rec.view_frames.size(), rec.client_statuses.size(),
+               rec.view_frames.empty() ? " (recorded without --view: replay --view has no frames to show)" : "");
   if (!rec.ticks.empty()) {
     double peak = 0;
     for (const auto& t : rec.ticks) peak = std::max(peak, wire::from_wire(t.force()).norm());
@@ -245,8 +253,9 @@ void export_csv(const Recording& rec, const std::filesystem::path& dir) {
     out.write("time_s,user,epoch,simulation_time_s,contact_nodes,boundary_dofs,bytes\n");
     for (const auto& r : rec.irs)
       out.print("{:.9f},{},{},{:.9f},{},{},{}\n", seconds(r.time_ns(), start), r.ir().user(), r.ir().epoch(),
-                r.ir().simulation_time(), r.ir().row_node_count(),
-                r.ir().boundary_displacement_f64_size() + r.ir().boundary_displacement_f32_size(), r.ir().ByteSizeLong());
+                r.ir().simulation_time(), r.ir().fem().row_node_count(),
+                r.ir().fem().boundary_displacement_f64_size() + r.ir().fem().boundary_displacement_f32_size(),
+                r.ir().ByteSizeLong());
     out.commit();
   }
   {
@@ -267,6 +276,12 @@ void export_csv(const Recording& rec, const std::filesystem::path& dir) {
 VerifyResult verify_recording(const std::filesystem::path& file) {
   const Recording rec = record::read_recording(file);
   if (!rec.has_config) throw Error(fmt::format("{}: the recording has no configuration: it cannot be verified", file.string()));
+  // Re-running needs this build's IR format; a recording of another is refused, never misread.
+  for (const record::RecordedIr& recorded : rec.irs)
+    if (recorded.ir().format_version() != IntermediateRepresentation::kFormatVersion)
+      throw Error(fmt::format("{}: its IRs are in format version {}, and this build re-runs format version {}: verify it "
+                              "with the cohaptic build that recorded it (format 1: builds before scenes had several bodies)",
+                              file.string(), recorded.ir().format_version(), IntermediateRepresentation::kFormatVersion));
   return rec.config.role() == "server" ? verify_server(rec) : verify_client(rec);
 }
 
@@ -275,6 +290,13 @@ int run_replay(const ReplayOptions& options) {
   const bool summary = options.summary || (!options.verify && options.export_csv.empty());
   if (summary) print_summary(rec);
   if (!options.export_csv.empty()) export_csv(rec, options.export_csv);
+  if (!options.view.empty()) {
+    ReplayViewOptions view;
+    if (const std::string problem = parse_host_port(options.view, view.host, view.port, true); !problem.empty())
+      throw Error("--view: " + problem);
+    view.token_file = options.view_token_file;
+    return serve_replay(rec, view);
+  }
   if (options.verify) {
     const VerifyResult result = verify_recording(options.file);
     if (!result.ok) {
@@ -296,6 +318,12 @@ LabCommand add_replay_command(CLI::App& lab) {
                     "Re-run the recorded inputs through the same computations and compare every force (and IR) bit "
                     "for bit; exit 1 naming the first difference");
   command->add_option("--export-csv", options->export_csv, "Write its records as CSV files in this directory");
+  command->add_option("--view", options->view,
+                      "Serve a server recording made with --view in the live view's page at HOST:PORT, with a "
+                      "timeline (play, pause, speed, scrub, jump to the largest force), until SIGINT");
+  command->add_option("--view-token-file", options->view_token_file,
+                      "The page's access token (required off loopback; without it a random one is printed)")
+      ->check(CLI::ExistingFile);
   return {command, [options] { return run_replay(*options); }};
 }
 

@@ -10,10 +10,13 @@
 //                   tool inputs (same model, same compliance), every IR it built and every
 //                   P0 force it sent;
 //                 exits non-zero and names the first difference;
-//   --export-csv  every kind of record as a CSV file in DIR.
+//   --export-csv  every kind of record as a CSV file in DIR;
+//   --view        a server recording made with --view, in the live view's page with a
+//                 timeline (lab/replay_view.h), until SIGINT.
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "lab/lab_command.h"
@@ -25,6 +28,8 @@ struct ReplayOptions {
   bool summary = false;
   bool verify = false;
   std::filesystem::path export_csv;  ///< empty: no export
+  std::string view;                  ///< HOST:PORT of the page; empty: none
+  std::optional<std::filesystem::path> view_token_file;
 };
 
 /// Returns the process exit code: 0, or 1 if verification found a difference.

@@ -12,6 +12,7 @@
 #include "common/ir/build_ir.h"
 #include "common/ir/evaluate_force.h"
 #include "common/model/compliance_setup.h"
+#include "common/model/model.h"
 #include "common/model/contact_reference.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
@@ -41,9 +42,9 @@ int samples_per(double sample_rate_hz, double rate_hz, const std::string& what) 
   return static_cast<int>(std::lround(ratio));
 }
 
-double model_memory_mb(const Model& model, const ComplianceColumns& columns) {
-  const double stiffness = static_cast<double>(model.stiffness.nonZeros()) * (sizeof(double) + sizeof(int));
-  const double factor = model.free_factor->factor_nonzeros() * (sizeof(double) + sizeof(int));
+double model_memory_mb(const ElasticBody& body, const ComplianceColumns& columns) {
+  const double stiffness = static_cast<double>(body.stiffness.nonZeros()) * (sizeof(double) + sizeof(int));
+  const double factor = body.free_factor->factor_nonzeros() * (sizeof(double) + sizeof(int));
   const double compliance = static_cast<double>(columns.column_count()) * columns.node_count() * 9 * sizeof(double);
   return (stiffness + factor + compliance) / 1e6;
 }
@@ -53,7 +54,7 @@ double model_memory_mb(const Model& model, const ComplianceColumns& columns) {
 std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector<int>& divisions,
                                            double sample_rate_hz) {
   TradeoffSetting base;
-  base.formulation = scene.object.material.formulation;
+  base.formulation = single_elastic_object(scene).material.formulation;
   base.contact_model = scene.haptic.contact_model;
   base.patch_rings = scene.haptic.patch_rings;
   base.haptic_rate_hz = scene.haptic.rate_hz;
@@ -66,8 +67,8 @@ std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector
     change(setting);
     grid.push_back(setting);
   };
-  if (scene.object.mesh.box) {
-    const int own = scene.object.mesh.box->divisions.maxCoeff();
+  if (single_elastic_object(scene).mesh.box) {
+    const int own = single_elastic_object(scene).mesh.box->divisions.maxCoeff();
     for (int d : divisions)
       if (d != own) vary("divisions", std::to_string(d), [d](TradeoffSetting& s) { s.divisions = d; });
   }
@@ -97,15 +98,16 @@ std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector
 
 Scene scene_with(const Scene& scene, const TradeoffSetting& setting) {
   Scene out = scene;
+  ElasticObjectSpec& object = single_elastic_object(out);
   if (setting.divisions > 0) {
-    if (!out.object.mesh.box) throw Error(fmt::format("{}: mesh divisions can only be varied for a box mesh", scene.file.string()));
-    BoxMeshSpec& box = *out.object.mesh.box;
+    if (!object.mesh.box) throw Error(fmt::format("{}: mesh divisions can only be varied for a box mesh", scene.file.string()));
+    BoxMeshSpec& box = *object.mesh.box;
     const double longest = box.size.maxCoeff();
     for (int axis = 0; axis < 3; ++axis)
       box.divisions[axis] = std::max(1, static_cast<int>(std::lround(setting.divisions * box.size[axis] / longest)));
   }
-  out.object.material.formulation = setting.formulation;
-  out.object.compliance.disk_cache = false;
+  object.material.formulation = setting.formulation;
+  object.compliance.disk_cache = false;
   out.haptic.contact_model = setting.contact_model;
   out.haptic.patch_rings = setting.patch_rings;
   out.haptic.rate_hz = setting.haptic_rate_hz;
@@ -119,23 +121,24 @@ ReferenceTrace reference_trace(const Scene& reference, const std::vector<Traject
                             reference.tools.size()));
   const Stopwatch watch;
   const Model model = build_model(reference);
-  ContactReference solver(model);
+  const ElasticBody& body = single_elastic_body(model);
+  ContactReference solver(body);
   // With obstacles, which nodes rest on them at each moment comes from the simulation's
   // active set on this mesh; the forces then from the full solve with those nodes held.
   std::unique_ptr<ComplianceColumns> columns;
   std::unique_ptr<Simulation> active_set;
   if (!reference.obstacles.empty()) {
-    columns = std::make_unique<ComplianceColumns>(*model.free_factor, model.dofs, compliance_row_nodes(model, true));
-    prepare_compliance(model, *columns, std::nullopt);
+    columns = std::make_unique<ComplianceColumns>(*body.free_factor, body.dofs, compliance_row_nodes(body, true));
+    prepare_compliance(body, *columns, std::nullopt);
     SimulationOptions options;
     options.ir = ir_build_options(reference.haptic);
     options.ir.force_limit = std::numeric_limits<double>::infinity();
-    active_set = std::make_unique<Simulation>(model, *columns, reference.tools, options);
+    active_set = std::make_unique<Simulation>(body, model.obstacles, *columns, reference.tools, options);
   }
   ReferenceTrace trace;
   trace.sample_rate_hz = sample_rate_hz;
-  trace.nodes = model.mesh.node_count();
-  trace.tets = model.mesh.tet_count();
+  trace.nodes = body.mesh.node_count();
+  trace.tets = body.mesh.tet_count();
   double duration = 0;
   for (const Trajectory& motion : motions) duration = std::max(duration, motion.duration());
   const auto samples = static_cast<std::size_t>(std::floor(duration * sample_rate_hz)) + 1;
@@ -177,18 +180,19 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
 
   const Stopwatch precompute;
   const Model model = build_model(varied);
-  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, !varied.obstacles.empty()));
-  prepare_compliance(model, columns, std::nullopt);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, compliance_row_nodes(body, !varied.obstacles.empty()));
+  prepare_compliance(body, columns, std::nullopt);
   row.precompute_s = precompute.elapsed_ms() / 1000;
-  row.nodes = model.mesh.node_count();
-  row.tets = model.mesh.tet_count();
+  row.nodes = body.mesh.node_count();
+  row.tets = body.mesh.tet_count();
 
   SimulationOptions options;
   options.ir = ir_build_options(varied.haptic);
   options.ir.precision = setting.precision;
   options.ir.force_limit = std::numeric_limits<double>::infinity();  // compare the physics, not the limiter
-  Simulation simulation(model, columns, varied.tools, options);
-  ContactReference own_mesh(model);
+  Simulation simulation(body, model.obstacles, columns, varied.tools, options);
+  ContactReference own_mesh(body);
   std::vector<PressedTool> pressed(varied.tools.size());
 
   const int per_step = samples_per(reference.sample_rate_hz, kSimulationRateHz, "simulation rate");
@@ -230,7 +234,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
       for (std::size_t u = 0; u < users; ++u) {
         if (!published[u]) continue;
         remotes.clear();
-        for (const IrRemoteContact& remote : published[u]->ir.remotes) remotes.push_back(positions[remote.user]);
+        for (int r = 0; r < remote_count(published[u]->ir); ++r) remotes.push_back(positions[remote_user(published[u]->ir, r)]);
         const Stopwatch evaluation;
         held[u] = evaluate_force(*published[u], positions[u], remotes).force;
         evaluation_us.push_back(1000 * evaluation.elapsed_ms());
@@ -258,7 +262,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
   // machine does not decide the front; the steps that rebuilt IRs count in full.
   row.evaluation_us = evaluation_us.empty() ? 0 : percentile(evaluation_us, 0.5);
   row.ir_bytes_per_s = bytes / duration;
-  row.memory_mb = model_memory_mb(model, columns);
+  row.memory_mb = model_memory_mb(body, columns);
   const double plain_steps_ms =
       plain_step_ms.empty() ? 0 : percentile(plain_step_ms, 0.5) * static_cast<double>(plain_step_ms.size());
   const double evaluations_ms = row.evaluation_us * static_cast<double>(evaluation_us.size()) / 1000;
@@ -348,7 +352,7 @@ void write_pareto_plot(const std::filesystem::path& file, const std::vector<Trad
 
 int run_tradeoff(const TradeoffOptions& options) {
   const Scene scene = load_scene(options.scene);
-  if (!options.reference_scene.empty() && scene.object.mesh.box)
+  if (!options.reference_scene.empty() && single_elastic_object(scene).mesh.box)
     throw Error(fmt::format("{}: a box scene's reference is its own box at --reference-divisions; --reference-scene is "
                             "for mesh files",
                             options.scene.string()));
@@ -364,7 +368,7 @@ int run_tradeoff(const TradeoffOptions& options) {
   samples_per(options.sample_rate_hz, kSimulationRateHz, "simulation rate");
   samples_per(options.sample_rate_hz, scene.haptic.rate_hz, "scene's haptic rate");
   TradeoffSetting reference_setting = tradeoff_grid(scene, {}).front();
-  if (scene.object.mesh.box) reference_setting.divisions = options.reference_divisions;
+  if (single_elastic_object(scene).mesh.box) reference_setting.divisions = options.reference_divisions;
   const Scene reference_scene =
       options.reference_scene.empty() ? scene_with(scene, reference_setting)
                                       : scene_with(load_scene(options.reference_scene), reference_setting);
@@ -372,7 +376,7 @@ int run_tradeoff(const TradeoffOptions& options) {
     throw Error(fmt::format("{}: the reference scene has {} tools, the scene {}", options.reference_scene.string(),
                             reference_scene.tools.size(), scene.tools.size()));
   spdlog::info("reference: {}, solved in full at {:g} Hz over the motions ...",
-               scene.object.mesh.box      ? fmt::format("{} divisions", options.reference_divisions)
+               single_elastic_object(scene).mesh.box      ? fmt::format("{} divisions", options.reference_divisions)
                : options.reference_scene.empty() ? std::string("the scene's own mesh")
                                                  : options.reference_scene.string(),
                options.sample_rate_hz);

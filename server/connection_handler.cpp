@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <cmath>
 
 #include "common/net/link_delay.h"
 #include "net/delayed_delivery.h"
@@ -126,6 +127,27 @@ void ConnectionHandler::accept() {
 void ConnectionHandler::handle_control(const ParticipantPtr& participant, const wire::Control& control) {
   if (control.has_join()) join(participant, control.join());
   else if (control.has_bye()) leave(participant, "left: " + control.bye().reason());
+  else if (control.has_status() && participant->slot >= 0) client_status(*participant, control.status());
+}
+
+void ConnectionHandler::client_status(const Participant& participant, const wire::ClientStatus& status) {
+  const auto& s = status;
+  for (double value : {s.haptic_rate_hz(), s.period_p99_us(), s.ir_age_p99_ms(), s.one_way_delay_p99_ms(),
+                       s.timer_floor_p99_us(), s.peak_force(), s.elapsed_s()})
+    if (!std::isfinite(value)) {
+      ++counters_.frames_rejected;
+      spdlog::warn("status of '{}' (slot {}) ignored: a value is not finite", participant.user_name, participant.slot);
+      return;
+    }
+  if (recorder_) {
+    record::ReceivedClientStatus received;
+    received.set_receive_time_ns(wire::monotonic_now_ns());
+    received.set_slot(static_cast<std::uint32_t>(participant.slot));
+    received.set_user(participant.user_name);
+    *received.mutable_status() = status;
+    recorder_->client_status(received);
+  }
+  if (on_status_) on_status_(participant.slot, participant.user_name, status);
 }
 
 void ConnectionHandler::join(const ParticipantPtr& participant, const wire::Join& request) {

@@ -11,12 +11,14 @@
 //   - its counters, for the status line and the report.
 // It decides slots and what to relay; sealing is the codec's (wire::FrameSealer,
 // wire::DatagramSealer), the sockets are net/'s. With --record it records the datagrams
-// it accepts and the joins and leaves. Everything here runs on the I/O thread, except
-// the counters' readers noted below.
+// it accepts, the joins and leaves and the users' status reports (ClientStatus, also handed
+// to on_client_status: the live view's panel). Everything here runs on the I/O thread,
+// except the counters' readers noted below.
 #pragma once
 
 #include <asio.hpp>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -58,6 +60,10 @@ class ConnectionHandler {
   ConnectionHandler(const ConnectionHandler&) = delete;
   ConnectionHandler& operator=(const ConnectionHandler&) = delete;
 
+  using StatusHandler = std::function<void(int slot, const std::string& user, const wire::ClientStatus& status)>;
+  /// Where the users' status reports go (on the I/O thread); set before start().
+  void on_client_status(StatusHandler handler) { on_status_ = std::move(handler); }
+
   /// Starts accepting connections and receiving datagrams.
   void start();
   /// Sends a step's messages (stamped and sealed now) to the users now in their slots.
@@ -83,6 +89,7 @@ class ConnectionHandler {
   void accept();
   void handle_control(const ParticipantPtr& participant, const wire::Control& control);
   void join(const ParticipantPtr& participant, const wire::Join& request);
+  void client_status(const Participant& participant, const wire::ClientStatus& status);
   void leave(const ParticipantPtr& participant, const std::string& why);
   void broadcast_event(const std::string& kind, const std::string& text, const record::EventUser& user);
   void send_control(const ParticipantPtr& participant, wire::Control& control, bool newest_wins = false);
@@ -105,6 +112,7 @@ class ConnectionHandler {
   std::vector<ParticipantPtr> participants_;  // every connection
   std::vector<ParticipantPtr> slots_;         // joined users, by slot
   ConnectionCounters counters_;
+  StatusHandler on_status_;
 };
 
 }  // namespace cohaptic

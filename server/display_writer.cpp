@@ -4,22 +4,17 @@
 #include <spdlog/spdlog.h>
 
 #include "common/mesh/write_vtu.h"
+#include "common/model/shown_surface.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
 
 DisplayWriter::DisplayWriter(const Model& model, const ComplianceColumns& columns, std::filesystem::path directory)
-    : model_(model), directory_(std::move(directory)) {
-  std::vector<int> local(static_cast<std::size_t>(model.mesh.node_count()), -1);
-  for (int node : columns.row_nodes()) {
-    local[static_cast<std::size_t>(node)] = static_cast<int>(nodes_.size());
-    nodes_.push_back(node);
-  }
-  const auto shown = [&](int node) { return local[static_cast<std::size_t>(node)]; };
-  for (const Triangle& tri : model.surface.triangles)
-    if (shown(tri[0]) >= 0 && shown(tri[1]) >= 0 && shown(tri[2]) >= 0)
-      triangles_.push_back({shown(tri[0]), shown(tri[1]), shown(tri[2])});
+    : model_(model), body_(single_elastic_body(model)), directory_(std::move(directory)) {
+  ShownSurface shown = shown_surface(body_, columns.row_nodes());
+  nodes_ = std::move(shown.nodes);
+  triangles_ = std::move(shown.triangles);
   std::filesystem::create_directories(directory_);
 }
 
@@ -49,8 +44,8 @@ void DisplayWriter::write_frames() {
   Eigen::Matrix3Xd rest(3, static_cast<Eigen::Index>(nodes_.size()));
   std::vector<std::int64_t> tags;
   for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    rest.col(static_cast<Eigen::Index>(i)) = model_.mesh.nodes.col(nodes_[i]) / unit;
-    tags.push_back(model_.mesh.node_tags[static_cast<std::size_t>(nodes_[i])]);
+    rest.col(static_cast<Eigen::Index>(i)) = body_.mesh.nodes.col(nodes_[i]) / unit;
+    tags.push_back(body_.mesh.node_tags[static_cast<std::size_t>(nodes_[i])]);
   }
   for (;;) {
     Frame frame;

@@ -2,7 +2,7 @@
 // offers frames (the displacement of the shown surface nodes at a time); the writer's own
 // thread writes each as DIR/surface-NNNNNN.vtu, and DIR/surface.pvd (the ParaView
 // collection of them all) when it stops. Shown: the surface triangles whose nodes all
-// have compliance rows. Its queue holds at most kMaxQueuedDisplayFrames: a frame offered
+// have compliance rows (common/model/shown_surface.h). Its queue holds at most kMaxQueuedDisplayFrames: a frame offered
 // while the writer is that far behind is dropped, so the simulation is never held up.
 // Units: offered in m and s; written in the scene's units.
 #pragma once
@@ -55,6 +55,7 @@ class DisplayWriter {
   void write_index() const;
 
   const Model& model_;
+  const ElasticBody& body_;  // the body drawn (the scene's only one)
   std::filesystem::path directory_;
   std::vector<int> nodes_;            // row nodes shown
   std::vector<Triangle> triangles_;   // in nodes_ numbering

@@ -70,6 +70,17 @@ int main(int argc, char** argv) {
   app.add_option("--display-rate-hz", serve.display_rate_hz, "Frames per second of --display")
       ->check(CLI::Range(0.1, 100.0))
       ->capture_default_str();
+  std::string view_address;
+  app.add_option("--view", view_address,
+                 "Serve the live view in a browser at HOST:PORT (HTTP page and WebSocket data; off loopback a token "
+                 "is required, see --view-token-file)");
+  app.add_option("--view-rate-hz", serve.view_rate_hz, "Frames per second of the live view")
+      ->check(CLI::Range(1.0, 60.0))
+      ->capture_default_str();
+  app.add_option("--view-token-file", serve.view_token_file,
+                 "The live view's access token (first line; at least 16 letters, digits, - or _). Without it: none on "
+                 "loopback, a random one (in the printed address) elsewhere")
+      ->check(CLI::ExistingFile);
   app.add_option("--cache-dir", serve_cache_dir, "Directory of the on-disk compliance cache")->capture_default_str();
   app.add_flag("--no-disk-cache", serve_no_disk_cache, "Neither read nor write the on-disk compliance cache");
 
@@ -98,6 +109,14 @@ int main(int argc, char** argv) {
     if (const std::string problem = cohaptic::parse_host_port(listen, serve.host, serve.port, true); !problem.empty()) {
       fmt::print(stderr, "cohaptic-server: --listen: {}\n", problem);
       return 2;
+    }
+    if (!view_address.empty()) {
+      if (const std::string problem = cohaptic::parse_host_port(view_address, serve.view_host, serve.view_port, true);
+          !problem.empty()) {
+        fmt::print(stderr, "cohaptic-server: --view: {}\n", problem);
+        return 2;
+      }
+      serve.view = true;
     }
     serve.protocol = protocol == "P0" ? cohaptic::ServeProtocol::p0 : cohaptic::ServeProtocol::p1;
     serve.naive_condensation = condensation == "naive";

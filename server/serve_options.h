@@ -34,6 +34,11 @@ struct ServeOptions {
   std::string options_text;             ///< the command line options (CLI11 config format), for the recording
   std::filesystem::path display;        ///< deformed-surface frames (.vtu + .pvd) here; empty: none
   double display_rate_hz = 10;
+  bool view = false;                    ///< the live view in the browser (view/live_view.h)
+  std::string view_host = "127.0.0.1";
+  std::uint16_t view_port = 0;
+  double view_rate_hz = 30;
+  std::optional<std::filesystem::path> view_token_file;  ///< required off loopback; empty: a random token
 };
 
 }  // namespace cohaptic

@@ -6,6 +6,23 @@
 
 namespace cohaptic {
 
+record::InjectedDelays injected_delays(const ServeOptions& options) {
+  record::InjectedDelays injected;
+  injected.set_shift_delay_ms(options.shift.delay_ms);
+  injected.set_jitter_ms(options.shift.jitter_ms);
+  injected.set_loss(options.shift.loss);
+  injected.set_reorder(options.shift.reorder);
+  injected.set_seed(options.shift.seed);
+  injected.set_step_nodes(static_cast<std::uint32_t>(options.step_nodes));
+  injected.set_sim_rate_hz(options.sim_rate_hz);
+  injected.set_condensation(options.naive_condensation ? "naive" : "incremental");
+  return injected;
+}
+
+wire::Protocol wire_protocol(const ServeOptions& options) {
+  return options.protocol == ServeProtocol::p1 ? wire::P1 : wire::P0;
+}
+
 record::SessionConfig server_session_config(const ServeOptions& options, const Model& model,
                                             const std::string& scene_yaml, std::uint64_t session,
                                             std::int64_t start_time_ns) {
@@ -18,16 +35,8 @@ record::SessionConfig server_session_config(const ServeOptions& options, const M
   config.set_patch_rings(static_cast<std::uint32_t>(model.scene.haptic.patch_rings));
   config.set_ir_f32(options.precision == IrPrecision::f32);
   config.set_session(session);
-  config.set_protocol(options.protocol == ServeProtocol::p1 ? wire::P1 : wire::P0);
-  auto* injected = config.mutable_injected();
-  injected->set_shift_delay_ms(options.shift.delay_ms);
-  injected->set_jitter_ms(options.shift.jitter_ms);
-  injected->set_loss(options.shift.loss);
-  injected->set_reorder(options.shift.reorder);
-  injected->set_seed(options.shift.seed);
-  injected->set_step_nodes(static_cast<std::uint32_t>(options.step_nodes));
-  injected->set_sim_rate_hz(options.sim_rate_hz);
-  injected->set_condensation(options.naive_condensation ? "naive" : "incremental");
+  config.set_protocol(wire_protocol(options));
+  *config.mutable_injected() = injected_delays(options);
   config.set_start_time_ns(start_time_ns);
   return config;
 }

@@ -17,6 +17,11 @@
 
 namespace cohaptic {
 
+/// The injected delays and the step-delay settings, as recorded and as the live view shows them.
+record::InjectedDelays injected_delays(const ServeOptions& options);
+/// The protocol served, as on the wire.
+wire::Protocol wire_protocol(const ServeOptions& options);
+
 /// The first record: the role, the scene as served, the options and the injected delays.
 record::SessionConfig server_session_config(const ServeOptions& options, const Model& model,
                                             const std::string& scene_yaml, std::uint64_t session,

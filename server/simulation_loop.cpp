@@ -26,14 +26,16 @@ SimulationOptions simulation_options(const Model& model, const ServeOptions& opt
 
 SimulationLoop::SimulationLoop(const Model& model, ComplianceColumns& columns, const ServeOptions& options,
                                const ToolInputs& tools, LoopStatistics& statistics, DisplayWriter* display,
-                               record::SessionRecorder* recorder, std::int64_t start_ns)
+                               view::LiveView* view, record::SessionRecorder* recorder, std::int64_t start_ns)
     : options_(options),
       tools_(tools),
       statistics_(statistics),
       display_(display),
+      view_(view),
       recorder_(recorder),
       start_ns_(start_ns),
-      simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {}
+      simulation_(single_elastic_body(model), model.obstacles, columns, model.scene.tools,
+                  simulation_options(model, options)) {}
 
 Outbox SimulationLoop::step(std::int64_t now_ns) {
   take_tools(now_ns);
@@ -52,6 +54,7 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
                                            display_frame, forces));
     recorder_->flush_if_due();
   }
+  ++steps_;
   const std::int64_t end_ns = wire::monotonic_now_ns();
   statistics_.record_step({end_ns - now_ns, report, irs, forces.size()}, seconds_since_start(end_ns));
   return outbox;
@@ -125,11 +128,22 @@ std::vector<record::ServerForce> SimulationLoop::add_forces(Outbox& outbox) {
 }
 
 bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
-  if (!display_ || now_ns - last_display_ns_ < static_cast<std::int64_t>(1e9 / options_.display_rate_hz)) return false;
-  last_display_ns_ = now_ns;
-  Eigen::Matrix3Xd displacement = simulation_.displacement_of(display_->nodes());
+  const bool display_due =
+      display_ && now_ns - last_display_ns_ >= static_cast<std::int64_t>(1e9 / options_.display_rate_hz);
+  const bool view_due = view_ && view_->frame_due(now_ns);
+  if (!display_due && !view_due) return false;
+  // Both show the row nodes' surface (common/model/shown_surface.h): one solve serves both.
+  Eigen::Matrix3Xd displacement = simulation_.displacement_of(display_ ? display_->nodes() : view_->nodes());
   statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
-  display_->offer(seconds_since_start(now_ns), std::move(displacement));  // dropped if the writer is behind
+  if (view_due) {
+    view_tools_.resize(latest_.size());
+    for (std::size_t slot = 0; slot < latest_.size(); ++slot) view_tools_[slot] = {used_[slot], latest_[slot].position};
+    view_->publish_frame(now_ns, seconds_since_start(now_ns), simulation_, displacement, view_tools_, steps_);
+  }
+  if (display_due) {
+    last_display_ns_ = now_ns;
+    display_->offer(seconds_since_start(now_ns), std::move(displacement));  // dropped if the writer is behind
+  }
   return true;
 }
 

@@ -4,7 +4,8 @@
 //   2. steps the Simulation: contacts, active sets, M~ when a set changed;
 //   3. fills the step's Outbox: the new IRs (P1), the IR keep-alives (P1, every
 //      kKeepAlivePeriod_ns), the forces (P0);
-//   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter;
+//   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter,
+//      and every 1/--view-rate-hz for the live view (one solve when both are due);
 //   5. records the step and the IRs it built (--record), and its figures (LoopStatistics).
 // run() paces the steps at the loop's rate with absolute deadlines (when behind, the next
 // step starts at once, with no catch-up burst) and hands each non-empty outbox to the I/O
@@ -28,6 +29,7 @@
 #include "common/sim/simulation.h"
 #include "proto/record/session_recorder.h"
 #include "server/display_writer.h"
+#include "view/live_view.h"
 #include "server/loop_statistics.h"
 #include "server/outbox.h"
 #include "server/serve_options.h"
@@ -44,11 +46,11 @@ inline constexpr double kDefaultSimulationRate_hz = 1000;
 
 class SimulationLoop {
  public:
-  /// `display` and `recorder` may be null (no --display, no --record). Everything given
-  /// must outlive the loop.
+  /// `display`, `view` and `recorder` may be null (no --display, --view, --record).
+  /// Everything given must outlive the loop.
   SimulationLoop(const Model& model, ComplianceColumns& columns, const ServeOptions& options, const ToolInputs& tools,
-                 LoopStatistics& statistics, DisplayWriter* display, record::SessionRecorder* recorder,
-                 std::int64_t start_ns);
+                 LoopStatistics& statistics, DisplayWriter* display, view::LiveView* view,
+                 record::SessionRecorder* recorder, std::int64_t start_ns);
 
   /// One step at `now_ns`: returns what to send. Throws whatever Simulation::step throws.
   Outbox step(std::int64_t now_ns);
@@ -72,6 +74,7 @@ class SimulationLoop {
   const ToolInputs& tools_;
   LoopStatistics& statistics_;
   DisplayWriter* display_;
+  view::LiveView* view_;
   record::SessionRecorder* recorder_;
   std::int64_t start_ns_;
   Simulation simulation_;
@@ -79,6 +82,8 @@ class SimulationLoop {
   std::vector<ToolInput> latest_;  // this step's copy of the tool inputs
   std::vector<bool> used_;         // per slot: fresh, given to the simulation
   std::int64_t last_keep_alive_ns_ = 0, last_display_ns_ = 0;
+  std::uint64_t steps_ = 0;                      // successful steps so far
+  std::vector<view::ToolState> view_tools_;      // this step's tools, for the view
 };
 
 }  // namespace cohaptic

@@ -25,6 +25,7 @@
 #include "server/server_report.h"
 #include "server/simulation_loop.h"
 #include "server/tool_inputs.h"
+#include "view/live_view.h"
 
 namespace cohaptic {
 namespace {
@@ -43,8 +44,8 @@ wire::Welcome welcome_template(const ServeOptions& options, const Model& model, 
   wire::Welcome welcome;
   welcome.set_scene_name(model.scene.name);
   welcome.set_scene_yaml(scene_yaml);
-  *welcome.mutable_surface() = wire::surface_mesh_message(model);
-  welcome.set_protocol(options.protocol == ServeProtocol::p1 ? wire::P1 : wire::P0);
+  *welcome.mutable_surface() = wire::surface_mesh_message(single_elastic_body(model));
+  welcome.set_protocol(wire_protocol(options));
   welcome.set_force_limit(model.scene.haptic.force_limit_n);
   welcome.set_haptic_rate_hz(model.scene.haptic.rate_hz);
   welcome.set_ir_max_age_s(options.ir_max_age_s);
@@ -71,6 +72,7 @@ struct SimulationServer::Impl {
   std::unique_ptr<ToolInputs> tools;
   LoopStatistics statistics;
   std::unique_ptr<DisplayWriter> display;  // with --display
+  std::unique_ptr<view::LiveView> view;    // with --view
   std::unique_ptr<SimulationLoop> loop;
   asio::io_context io;
   std::unique_ptr<ConnectionHandler> connections;
@@ -90,9 +92,10 @@ struct SimulationServer::Impl {
       scene_yaml.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
     model = std::make_unique<Model>(build_model(scene));
-    columns = std::make_unique<ComplianceColumns>(*model->free_factor, model->dofs,
-                                                  compliance_row_nodes(*model, options.step_nodes > 0));
-    prepare_compliance(*model, *columns, options.cache_directory);
+    const ElasticBody& body = single_elastic_body(*model);
+    columns = std::make_unique<ComplianceColumns>(
+        *body.free_factor, body.dofs, compliance_row_nodes(body, options.step_nodes > 0 || !model->obstacles.empty()));
+    prepare_compliance(body, *columns, options.cache_directory);
     if (!options.display.empty()) display = std::make_unique<DisplayWriter>(*model, *columns, options.display);
     tools = std::make_unique<ToolInputs>(model->scene.tools.size());
     spdlog::info("scene '{}' ready in {:.0f} ms: {} user slots", scene.name, watch.elapsed_ms(), tools->size());
@@ -105,11 +108,20 @@ struct SimulationServer::Impl {
     }
     if (!options.record.empty()) {
       recorder = std::make_unique<record::SessionRecorder>(options.record);
-      recorder->config(server_session_config(options, *model, scene_yaml, session_id, wire::monotonic_now_ns()));
+      recorder->config(server_session_config(options, *model, scene_yaml, session_id, start_ns));
       spdlog::info("recording to {}", options.record.string());
     }
-    loop = std::make_unique<SimulationLoop>(*model, *columns, options, *tools, statistics, display.get(), recorder.get(),
-                                            start_ns);
+    if (options.view) {
+      view::LiveViewOptions settings;
+      settings.host = options.view_host;
+      settings.port = options.view_port;
+      settings.token_file = options.view_token_file;
+      settings.rate_hz = options.view_rate_hz;
+      view = std::make_unique<view::LiveView>(*model, *columns, wire_protocol(options), injected_delays(options),
+                                              settings, recorder.get());
+    }
+    loop = std::make_unique<SimulationLoop>(*model, *columns, options, *tools, statistics, display.get(), view.get(),
+                                            recorder.get(), start_ns);
   }
 
   void bind() {
@@ -118,6 +130,12 @@ struct SimulationServer::Impl {
     spdlog::info("listening on {}:{} (TCP control, UDP samples), protocol {}, session {:016x}", options.host,
                  connections->tcp_port(), options.protocol == ServeProtocol::p1 ? "P1" : "P0", session_id);
     if (options.shift.active()) spdlog::info("injected shift delay on every link, each direction: {}", options.shift.describe());
+    if (view) {
+      connections->on_client_status([this](int slot, const std::string& user, const wire::ClientStatus& status) {
+        view->publish_status(slot, user, status, static_cast<double>(wire::monotonic_now_ns() - start_ns) * 1e-9);
+      });
+      spdlog::info("live view at {} (open it in a browser)", view->url());
+    }
   }
 
   ServerFigures figures() const {
@@ -181,6 +199,7 @@ SimulationServer::~SimulationServer() {
   impl_->running = false;
   if (impl_->sim_thread.joinable()) impl_->sim_thread.join();
   if (impl_->display) impl_->display->stop();
+  if (impl_->view) impl_->view->stop();
 }
 
 std::uint16_t SimulationServer::tcp_port() const { return impl_->connections->tcp_port(); }
@@ -206,15 +225,17 @@ void SimulationServer::run() {
   }
   s.print_status();
   if (s.display) s.display->start();
+  if (s.view) s.view->start();
   s.sim_thread = std::thread([&s] { s.simulate(); });
   s.io.run();  // until shutdown() stops it
   s.running = false;
   s.sim_thread.join();
   if (s.display) s.display->stop();
+  if (s.view) s.view->stop();
   if (s.recorder) s.recorder->close();
   // Compliance columns computed on demand during the session serve the next one.
-  if (s.options.cache_directory && s.model->scene.object.compliance.disk_cache)
-    save_compliance(*s.model, *s.columns, *s.options.cache_directory);
+  const ElasticBody& body = single_elastic_body(*s.model);
+  if (s.options.cache_directory && body.spec.compliance.disk_cache) save_compliance(body, *s.columns, *s.options.cache_directory);
   if (!s.options.report.empty()) s.write_report();
   if (s.failure) throw Error(*s.failure + "; the session ended");
 }

@@ -36,6 +36,7 @@ namespace {
 struct Fixture {
   std::unique_ptr<Model> model;
   std::unique_ptr<ComplianceColumns> columns;
+  const ElasticBody& body() const { return single_elastic_body(*model); }
   std::vector<int> contact;         // C: patch + remote triangle
   std::vector<int> boundary;        // B: |B| nodes nearest the contact
   std::vector<int> spare;           // nodes that join and leave B
@@ -53,44 +54,45 @@ Fixture& fixture(int boundary_nodes) {
   testing::CubeSceneOptions scene;
   scene.divisions = boundary_nodes > 500 ? 16 : 11;
   f.model = std::make_unique<Model>(build_model(parse_scene(testing::cube_scene_yaml(scene), "bench-cube.yaml")));
-  f.columns = std::make_unique<ComplianceColumns>(*f.model->free_factor, f.model->dofs, f.model->surface.nodes);
+  f.columns = std::make_unique<ComplianceColumns>(*f.body().free_factor, f.body().dofs, f.body().surface.nodes);
   const Model& model = *f.model;
+  const ElasticBody& body = single_elastic_body(model);
 
   // Reserved for contacts: the 40 touchable triangles nearest the own tool (the triangle
   // changes cycle through them) and the remote tool's triangle. B avoids them all.
   std::vector<std::pair<double, int>> by_distance;
-  for (int t : model.touchable_triangles) {
-    const Triangle& tri = model.surface.triangles[t];
-    const Eigen::Vector3d centre = (model.mesh.nodes.col(tri[0]) + model.mesh.nodes.col(tri[1]) + model.mesh.nodes.col(tri[2])) / 3;
+  for (int t : body.touchable_triangles) {
+    const Triangle& tri = body.surface.triangles[t];
+    const Eigen::Vector3d centre = (body.mesh.nodes.col(tri[0]) + body.mesh.nodes.col(tri[1]) + body.mesh.nodes.col(tri[2])) / 3;
     by_distance.emplace_back((centre - f.own).norm(), t);
   }
   std::sort(by_distance.begin(), by_distance.end());
-  std::vector<bool> reserved(static_cast<std::size_t>(model.mesh.node_count()), false);
+  std::vector<bool> reserved(static_cast<std::size_t>(body.mesh.node_count()), false);
   for (std::size_t i = 0; i < 40; ++i) {
-    const Triangle& tri = model.surface.triangles[by_distance[i].second];
+    const Triangle& tri = body.surface.triangles[by_distance[i].second];
     f.other_contacts.push_back({tri[0], tri[1], tri[2]});
     for (int node : tri) reserved[node] = true;
   }
   const std::vector<UserTool> tools = {
-      {0, f.own, 0, nearest_touchable_triangle(model, f.own)},
-      {1, f.remote, 0, nearest_touchable_triangle(model, f.remote)}};
+      {0, f.own, 0, nearest_touchable_triangle(body, f.own)},
+      {1, f.remote, 0, nearest_touchable_triangle(body, f.remote)}};
   for (const UserTool& tool : tools)
-    for (int node : model.surface.triangles[tool.nearest_triangle]) reserved[node] = true;
-  f.boundary = nearest_surface_nodes(model, std::vector<Eigen::Vector3d>{f.own}, boundary_nodes, reserved);
+    for (int node : body.surface.triangles[tool.nearest_triangle]) reserved[node] = true;
+  f.boundary = nearest_surface_nodes(body.mesh, body.surface, body.dofs, std::vector<Eigen::Vector3d>{f.own}, boundary_nodes, reserved);
   for (int node : f.boundary) reserved[node] = true;
-  f.spare = nearest_surface_nodes(model, std::vector<Eigen::Vector3d>{f.own}, 8, reserved);
+  f.spare = nearest_surface_nodes(body.mesh, body.surface, body.dofs, std::vector<Eigen::Vector3d>{f.own}, 8, reserved);
 
-  IncrementalCondensation condensation(*f.columns, model.dofs);
+  IncrementalCondensation condensation(*f.columns, body.dofs);
   condensation.set_boundary_nodes(f.boundary);
   const std::vector<Eigen::Vector3d> held(f.boundary.size(), Eigen::Vector3d::Zero());
   for (IrPrecision precision : {IrPrecision::f64, IrPrecision::f32}) {
     IrBuildOptions options;
     options.precision = precision;
-    auto prepared = std::make_shared<const PreparedIR>(prepare_ir(build_ir(model, condensation, tools, 0, held, options, 1, 0)));
+    auto prepared = std::make_shared<const PreparedIR>(prepare_ir(build_ir(body, condensation, tools, 0, held, options, 1, 0)));
     (precision == IrPrecision::f64 ? f.ir_f64 : f.ir_f32) = prepared;
   }
-  const IntermediateRepresentation& ir = f.ir_f64->ir;
-  for (int i = 0; i < ir.row_node_count; ++i) f.contact.push_back(node_index_from_tag(model.mesh, ir.node_ids[i]));
+  const CondensedFemIr& ir = condensed_fem(f.ir_f64->ir);
+  for (int i = 0; i < ir.row_node_count; ++i) f.contact.push_back(node_index_from_tag(body.mesh, ir.node_ids[i]));
   return f;
 }
 
@@ -101,9 +103,9 @@ void BM_MtildeUpdate_naive(benchmark::State& state) {
   for (auto _ : state) {
     if (joined) boundary.pop_back(); else boundary.push_back(f.spare[0]);
     joined = !joined;
-    benchmark::DoNotOptimize(naive_condensation(*f.columns, f.model->dofs, f.contact, boundary).m_cb.data());
+    benchmark::DoNotOptimize(naive_condensation(*f.columns, f.body().dofs, f.contact, boundary).m_cb.data());
   }
-  state.counters["contact_dofs"] = static_cast<double>(f.ir_f64->ir.m_tilde.rows());
+  state.counters["contact_dofs"] = static_cast<double>(condensed_fem(f.ir_f64->ir).m_tilde.rows());
 }
 
 // Per-iteration counters: where an incremental update's time goes, and how often the
@@ -122,7 +124,7 @@ void report_phases(benchmark::State& state, const IncrementalCondensation::Stati
 // or with `oldest` the first node of B leaves and becomes the next spare.
 void mtilde_update_incremental(benchmark::State& state, bool oldest) {
   Fixture& f = fixture(static_cast<int>(state.range(0)));
-  IncrementalCondensation condensation(*f.columns, f.model->dofs);
+  IncrementalCondensation condensation(*f.columns, f.body().dofs);
   condensation.set_boundary_nodes(f.boundary);
   condensation.condense(f.contact);
   const IncrementalCondensation::Statistics before = condensation.statistics();
@@ -139,7 +141,7 @@ void mtilde_update_incremental(benchmark::State& state, bool oldest) {
     benchmark::DoNotOptimize(condensation.condense(f.contact).m_cb.data());
   }
   report_phases(state, before, condensation.statistics());
-  state.counters["contact_dofs"] = static_cast<double>(f.ir_f64->ir.m_tilde.rows());
+  state.counters["contact_dofs"] = static_cast<double>(condensed_fem(f.ir_f64->ir).m_tilde.rows());
 }
 
 void BM_MtildeUpdate_incremental(benchmark::State& state) { mtilde_update_incremental(state, false); }
@@ -150,7 +152,7 @@ void BM_TriangleChange_naive(benchmark::State& state) {
   std::size_t next = 0;
   for (auto _ : state) {
     const std::vector<int>& contact = f.other_contacts[next++ % f.other_contacts.size()];
-    benchmark::DoNotOptimize(naive_condensation(*f.columns, f.model->dofs, contact, f.boundary).m_cb.data());
+    benchmark::DoNotOptimize(naive_condensation(*f.columns, f.body().dofs, contact, f.boundary).m_cb.data());
   }
 }
 
@@ -158,7 +160,7 @@ void BM_TriangleChange_incremental(benchmark::State& state) {
   Fixture& f = fixture(static_cast<int>(state.range(0)));
   IncrementalCondensation::Options options;
   options.z_cache_nodes = 16;  // smaller than the 120 nodes cycled: every change is a miss
-  IncrementalCondensation condensation(*f.columns, f.model->dofs, options);
+  IncrementalCondensation condensation(*f.columns, f.body().dofs, options);
   condensation.set_boundary_nodes(f.boundary);
   const IncrementalCondensation::Statistics before = condensation.statistics();
   std::size_t next = 0;
@@ -183,7 +185,7 @@ void BM_Evaluate(benchmark::State& state) {
 
 void BM_PrepareIr(benchmark::State& state) {
   Fixture& f = fixture(static_cast<int>(state.range(0)));
-  for (auto _ : state) benchmark::DoNotOptimize(prepare_ir(f.ir_f64->ir).compliance.data());
+  for (auto _ : state) benchmark::DoNotOptimize(std::get<PreparedFem>(prepare_ir(f.ir_f64->ir).body).compliance.data());
 }
 
 const std::vector<std::int64_t> kBoundarySizes = {0, 150, 300, 1000};

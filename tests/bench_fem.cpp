@@ -36,34 +36,38 @@ tools: [{{name: A}}]
 }
 
 void set_mesh_counters(benchmark::State& state, const Model& model) {
-  state.counters["nodes"] = model.mesh.node_count();
-  state.counters["tets"] = model.mesh.tet_count();
+  const ElasticBody& body = single_elastic_body(model);
+  state.counters["nodes"] = body.mesh.node_count();
+  state.counters["tets"] = body.mesh.tet_count();
 }
 
 void BM_Assemble(benchmark::State& state) {
   const Model& model = cube_model(static_cast<int>(state.range(0)));
-  for (auto _ : state) benchmark::DoNotOptimize(assemble_stiffness(model.mesh, model.scene.object.material));
+  const ElasticBody& body = single_elastic_body(model);
+  for (auto _ : state) benchmark::DoNotOptimize(assemble_stiffness(body.mesh, body.spec.material));
   set_mesh_counters(state, model);
 }
 
 void BM_Factor(benchmark::State& state) {
   const Model& model = cube_model(static_cast<int>(state.range(0)));
-  const SparseMatrix k_ff = restrict_to_dofs(model.stiffness, model.dofs.free_dofs);
+  const ElasticBody& body = single_elastic_body(model);
+  const SparseMatrix k_ff = restrict_to_dofs(body.stiffness, body.dofs.free_dofs);
   double nonzeros = 0;
   for (auto _ : state) {
     SparseCholesky factor(k_ff);
     nonzeros = factor.factor_nonzeros();
   }
   set_mesh_counters(state, model);
-  state.counters["free_dofs"] = model.dofs.free_count();
+  state.counters["free_dofs"] = body.dofs.free_count();
   state.counters["factor_nnz"] = nonzeros;
 }
 
 void BM_ComplianceColumn(benchmark::State& state) {
   const Model& model = cube_model(static_cast<int>(state.range(0)));
-  const int node = model.touchable_nodes[model.touchable_nodes.size() / 2];
+  const ElasticBody& body = single_elastic_body(model);
+  const int node = body.touchable_nodes[body.touchable_nodes.size() / 2];
   for (auto _ : state) {
-    ComplianceColumns columns(*model.free_factor, model.dofs, model.touchable_nodes);
+    ComplianceColumns columns(*body.free_factor, body.dofs, body.touchable_nodes);
     benchmark::DoNotOptimize(columns.column(node).data());
   }
   set_mesh_counters(state, model);
@@ -72,25 +76,27 @@ void BM_ComplianceColumn(benchmark::State& state) {
 // The whole touchable block: one solve with 3|T| right-hand sides ...
 void BM_ComplianceSurfaceBlock_batched(benchmark::State& state) {
   const Model& model = cube_model(static_cast<int>(state.range(0)));
+  const ElasticBody& body = single_elastic_body(model);
   for (auto _ : state) {
-    ComplianceColumns columns(*model.free_factor, model.dofs, model.touchable_nodes);
-    columns.compute_columns(model.touchable_nodes);
+    ComplianceColumns columns(*body.free_factor, body.dofs, body.touchable_nodes);
+    columns.compute_columns(body.touchable_nodes);
     benchmark::DoNotOptimize(columns.column_count());
   }
   set_mesh_counters(state, model);
-  state.counters["touchable_nodes"] = static_cast<double>(model.touchable_nodes.size());
+  state.counters["touchable_nodes"] = static_cast<double>(body.touchable_nodes.size());
 }
 
 // ... against the naive way, one 3-column solve per node.
 void BM_ComplianceSurfaceBlock_per_node(benchmark::State& state) {
   const Model& model = cube_model(static_cast<int>(state.range(0)));
+  const ElasticBody& body = single_elastic_body(model);
   for (auto _ : state) {
-    ComplianceColumns columns(*model.free_factor, model.dofs, model.touchable_nodes);
-    for (int node : model.touchable_nodes) columns.column(node);
+    ComplianceColumns columns(*body.free_factor, body.dofs, body.touchable_nodes);
+    for (int node : body.touchable_nodes) columns.column(node);
     benchmark::DoNotOptimize(columns.column_count());
   }
   set_mesh_counters(state, model);
-  state.counters["touchable_nodes"] = static_cast<double>(model.touchable_nodes.size());
+  state.counters["touchable_nodes"] = static_cast<double>(body.touchable_nodes.size());
 }
 
 BENCHMARK(BM_Assemble)->Arg(11)->Arg(22)->Unit(benchmark::kMillisecond);

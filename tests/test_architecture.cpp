@@ -1,8 +1,8 @@
 // The one-way rule of the layout (README.md, "Layout"), read from the sources: every
-// `#include "..."` of common/, proto/, net/, server/, client/ and lab/ is resolved to the
-// directory (the floor) it comes from, and each floor may include only the floors listed
-// for it: server/ and client/ never include each other or lab/, net/ no program's
-// directory, common/ nothing outside common/. The subdirectories of common/ (common/X
+// `#include "..."` of common/, proto/, net/, view/, server/, client/ and lab/ is resolved to
+// the directory (the floor) it comes from, and each floor may include only the floors listed
+// for it: server/ and client/ never include each other or lab/, net/ and view/ no program's
+// directory (the server and the lab both use the view), common/ nothing outside common/. The subdirectories of common/ (common/X
 // includes common/Y) must not include each other in a circle; a failure prints the cycle
 // with a file and line for each step. The link-level twin of this test is
 // cmake/check_links.cmake.
@@ -30,9 +30,10 @@ const std::map<std::string, std::set<std::string>> kMayInclude = {
     {"common", {"common"}},
     {"proto", {"proto", "common"}},
     {"net", {"net", "proto", "common"}},
-    {"server", {"server", "net", "proto", "common"}},
+    {"view", {"view", "net", "proto", "common"}},
+    {"server", {"server", "view", "net", "proto", "common"}},
     {"client", {"client", "net", "proto", "common"}},
-    {"lab", {"lab", "net", "proto", "common"}},
+    {"lab", {"lab", "view", "net", "proto", "common"}},
 };
 
 struct Include {
@@ -156,6 +157,31 @@ TEST(Architecture, CommonsSubdirectoriesIncludeEachOtherWithoutACycle) {
   }
   EXPECT_GE(graph.size(), 10u) << "the walk found too few subdirectories of common/";
   if (const auto cycle = find_cycle(graph)) ADD_FAILURE() << "common/ includes itself in a circle: " << describe_cycle(graph, *cycle);
+}
+
+TEST(Architecture, NoFileCitesAPlanOutsideTheRepository) {
+  // The project documents itself (docs/architecture.md); a comment pointing at a plan a
+  // clone does not have is a dead end for its reader.
+  const std::string outside = std::string("DESIGN") + ".md";
+  std::vector<std::string> citations;
+  for (const char* floor : {"common", "proto", "net", "server", "client", "lab", "tests", "docs", "scenes", "deploy", "cmake"}) {
+    if (!fs::exists(kSourceDir / floor)) continue;
+    for (const fs::directory_entry& entry : fs::recursive_directory_iterator(kSourceDir / floor)) {
+      if (!entry.is_regular_file() || entry.file_size() > 1'000'000) continue;
+      std::ifstream in(entry.path());
+      std::string text;
+      for (int line = 1; std::getline(in, text); ++line)
+        if (text.find(outside) != std::string::npos)
+          citations.push_back(fs::relative(entry.path(), kSourceDir).string() + ":" + std::to_string(line));
+    }
+  }
+  for (const char* file : {"README.md", "CMakeLists.txt", "Makefile"}) {
+    std::ifstream in(kSourceDir / file);
+    std::string text;
+    for (int line = 1; std::getline(in, text); ++line)
+      if (text.find(outside) != std::string::npos) citations.push_back(std::string(file) + ":" + std::to_string(line));
+  }
+  EXPECT_TRUE(citations.empty()) << "cite docs/architecture.md instead at: " << ::testing::PrintToString(citations);
 }
 
 }  // namespace

@@ -40,23 +40,24 @@ struct ScratchDirectory {
 
 TEST(Compliance, ColumnsEqualTheDenseInverseAndAreSymmetric) {
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
-  ComplianceColumns columns(*model.free_factor, model.dofs, model.touchable_nodes);
-  const Eigen::MatrixXd k_ff(restrict_to_dofs(model.stiffness, model.dofs.free_dofs));
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.touchable_nodes);
+  const Eigen::MatrixXd k_ff(restrict_to_dofs(body.stiffness, body.dofs.free_dofs));
   const Eigen::MatrixXd inverse = k_ff.ldlt().solve(Eigen::MatrixXd::Identity(k_ff.rows(), k_ff.cols()));
   for (int i : {0, 7, 24})
     for (int j : {0, 3, 24}) {
-      const int a = model.touchable_nodes[i], b = model.touchable_nodes[j];
+      const int a = body.touchable_nodes[i], b = body.touchable_nodes[j];
       Eigen::Matrix3d expected;
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
-          expected(r, c) = inverse(model.dofs.free_index[3 * a + r], model.dofs.free_index[3 * b + c]);
+          expected(r, c) = inverse(body.dofs.free_index[3 * a + r], body.dofs.free_index[3 * b + c]);
       EXPECT_LE((columns.block(a, b) - expected).norm(), 1e-10 * expected.norm());
       EXPECT_LE((columns.block(a, b) - columns.block(b, a).transpose()).norm(), 1e-12 * expected.norm());
     }
   // One at a time or all at once: the same numbers.
-  ComplianceColumns batch(*model.free_factor, model.dofs, model.touchable_nodes);
-  batch.compute_columns(model.touchable_nodes);
-  for (int node : model.touchable_nodes)
+  ComplianceColumns batch(*body.free_factor, body.dofs, body.touchable_nodes);
+  batch.compute_columns(body.touchable_nodes);
+  for (int node : body.touchable_nodes)
     EXPECT_LE((batch.column(node) - columns.column(node)).norm(), 1e-13 * batch.column(node).norm());
 }
 
@@ -64,11 +65,12 @@ TEST(Compliance, AColumnsBitsDoNotDependOnWhatElseWasAskedFor) {
   // Replays rebuild M~ bit for bit only if they do: a solve's rounding depends on how many
   // right-hand sides it has, so columns are always solved in the same groups.
   const Model model = build_model(parse_scene(small_cube_yaml(1e6, 8), "cube.yaml"));
-  ComplianceColumns one_by_one(*model.free_factor, model.dofs, model.surface.nodes);
-  ComplianceColumns all_at_once(*model.free_factor, model.dofs, model.surface.nodes);
-  all_at_once.compute_columns(model.surface.nodes);
-  for (std::size_t i = 0; i < model.surface.nodes.size(); i += 7) {
-    const int node = model.surface.nodes[i];
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns one_by_one(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns all_at_once(*body.free_factor, body.dofs, body.surface.nodes);
+  all_at_once.compute_columns(body.surface.nodes);
+  for (std::size_t i = 0; i < body.surface.nodes.size(); i += 7) {
+    const int node = body.surface.nodes[i];
     const ComplianceColumn& a = one_by_one.column(node);
     const ComplianceColumn& b = all_at_once.column(node);
     ASSERT_EQ(std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())), 0) << "node " << node;
@@ -77,37 +79,39 @@ TEST(Compliance, AColumnsBitsDoNotDependOnWhatElseWasAskedFor) {
 
 TEST(ComplianceCache, KeyChangesWithMeshMaterialBoundaryConditionsAndRows) {
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
+  const ElasticBody& body = single_elastic_body(model);
   const auto key = [&](const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
                        const std::vector<int>& rows) { return compliance_cache_key(mesh, material, dofs, rows); };
-  const LinearElasticMaterial material = model.scene.object.material;
-  const Digest base = key(model.mesh, material, model.dofs, model.touchable_nodes);
-  EXPECT_EQ(base, key(model.mesh, material, model.dofs, model.touchable_nodes));
+  const LinearElasticMaterial material = body.spec.material;
+  const Digest base = key(body.mesh, material, body.dofs, body.touchable_nodes);
+  EXPECT_EQ(base, key(body.mesh, material, body.dofs, body.touchable_nodes));
 
-  TetMesh moved = model.mesh;
+  TetMesh moved = body.mesh;
   moved.nodes(1, 40) += 1e-12;
-  EXPECT_NE(base, key(moved, material, model.dofs, model.touchable_nodes));
-  TetMesh renumbered = model.mesh;
+  EXPECT_NE(base, key(moved, material, body.dofs, body.touchable_nodes));
+  TetMesh renumbered = body.mesh;
   std::swap(renumbered.tets[0][1], renumbered.tets[0][2]);
-  EXPECT_NE(base, key(renumbered, material, model.dofs, model.touchable_nodes));
-  EXPECT_NE(base, key(model.mesh, {material.youngs_modulus * 1.000001, material.poisson_ratio}, model.dofs, model.touchable_nodes));
-  EXPECT_NE(base, key(model.mesh, {material.youngs_modulus, 0.3}, model.dofs, model.touchable_nodes));
-  std::vector<AxisMask> fixed = model.dofs.fixed_axes;
-  fixed[model.touchable_nodes[0]] = 0b100;  // one more node sliding
-  EXPECT_NE(base, key(model.mesh, material, make_dof_map(fixed), model.touchable_nodes));
-  std::vector<int> fewer_rows(model.touchable_nodes.begin() + 1, model.touchable_nodes.end());
-  EXPECT_NE(base, key(model.mesh, material, model.dofs, fewer_rows));
+  EXPECT_NE(base, key(renumbered, material, body.dofs, body.touchable_nodes));
+  EXPECT_NE(base, key(body.mesh, {material.youngs_modulus * 1.000001, material.poisson_ratio}, body.dofs, body.touchable_nodes));
+  EXPECT_NE(base, key(body.mesh, {material.youngs_modulus, 0.3}, body.dofs, body.touchable_nodes));
+  std::vector<AxisMask> fixed = body.dofs.fixed_axes;
+  fixed[body.touchable_nodes[0]] = 0b100;  // one more node sliding
+  EXPECT_NE(base, key(body.mesh, material, make_dof_map(fixed), body.touchable_nodes));
+  std::vector<int> fewer_rows(body.touchable_nodes.begin() + 1, body.touchable_nodes.end());
+  EXPECT_NE(base, key(body.mesh, material, body.dofs, fewer_rows));
 }
 
 TEST(ComplianceCache, RoundTripsBitExactlyAndIsUsedOnTheSecondRun) {
   const ScratchDirectory dir;
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
-  ComplianceColumns first(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
-  const ComplianceSetup computed = prepare_compliance(model, first, dir.path);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns first(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
+  const ComplianceSetup computed = prepare_compliance(body, first, dir.path);
   EXPECT_FALSE(computed.from_disk);
   EXPECT_TRUE(fs::exists(computed.cache_file));
 
-  ComplianceColumns second(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
-  const ComplianceSetup loaded = prepare_compliance(model, second, dir.path);
+  ComplianceColumns second(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
+  const ComplianceSetup loaded = prepare_compliance(body, second, dir.path);
   EXPECT_TRUE(loaded.from_disk);
   ASSERT_EQ(second.column_count(), first.column_count());
   for (const auto& [node, column] : first.columns())
@@ -117,23 +121,24 @@ TEST(ComplianceCache, RoundTripsBitExactlyAndIsUsedOnTheSecondRun) {
 TEST(ComplianceCache, TruncatedOrCorruptedFilesAreDetectedAndRebuilt) {
   const ScratchDirectory dir;
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
-  ComplianceColumns reference(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
-  const fs::path file = prepare_compliance(model, reference, dir.path).cache_file;
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns reference(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
+  const fs::path file = prepare_compliance(body, reference, dir.path).cache_file;
   const auto size = fs::file_size(file);
-  const Digest key = compliance_cache_key(model.mesh, model.scene.object.material, model.dofs, reference.row_nodes());
+  const Digest key = compliance_cache_key(body.mesh, body.spec.material, body.dofs, reference.row_nodes());
 
   const auto expect_rebuilt = [&](const std::string& what) {
-    ComplianceColumns probe(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
+    ComplianceColumns probe(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
     const ComplianceCacheLoad load = load_compliance_cache(file, key, probe);
     EXPECT_FALSE(load.loaded) << what;
     EXPECT_EQ(probe.column_count(), 0u) << what << ": a bad file must insert nothing";
     EXPECT_FALSE(load.problem.empty()) << what;
-    ComplianceColumns rebuilt(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
-    const ComplianceSetup setup = prepare_compliance(model, rebuilt, dir.path);
+    ComplianceColumns rebuilt(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
+    const ComplianceSetup setup = prepare_compliance(body, rebuilt, dir.path);
     EXPECT_FALSE(setup.from_disk) << what;
     EXPECT_EQ(rebuilt.column_count(), reference.column_count()) << what;
     EXPECT_EQ(fs::file_size(file), size) << what << ": the cache is written again in full";
-    ComplianceColumns reloaded(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
+    ComplianceColumns reloaded(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
     EXPECT_TRUE(load_compliance_cache(file, key, reloaded).loaded) << what;
   };
 
@@ -155,13 +160,15 @@ TEST(ComplianceCache, TruncatedOrCorruptedFilesAreDetectedAndRebuilt) {
 
 TEST(ComplianceCache, AFileForAnotherMaterialIsNotUsed) {
   const ScratchDirectory dir;
-  const Model soft = build_model(parse_scene(small_cube_yaml(1e6), "cube.yaml"));
-  const Model stiff = build_model(parse_scene(small_cube_yaml(2e6), "cube.yaml"));
+  const Model soft_model = build_model(parse_scene(small_cube_yaml(1e6), "cube.yaml"));
+  const Model stiff_model = build_model(parse_scene(small_cube_yaml(2e6), "cube.yaml"));
+  const ElasticBody& soft = single_elastic_body(soft_model);
+  const ElasticBody& stiff = single_elastic_body(stiff_model);
   ComplianceColumns soft_columns(*soft.free_factor, soft.dofs, compliance_row_nodes(soft, false));
   const fs::path soft_file = prepare_compliance(soft, soft_columns, dir.path).cache_file;
   // Put the soft cache where the stiff one would be: its embedded key still tells them apart.
   ComplianceColumns stiff_columns(*stiff.free_factor, stiff.dofs, compliance_row_nodes(stiff, false));
-  const Digest stiff_key = compliance_cache_key(stiff.mesh, stiff.scene.object.material, stiff.dofs, stiff_columns.row_nodes());
+  const Digest stiff_key = compliance_cache_key(stiff.mesh, stiff.spec.material, stiff.dofs, stiff_columns.row_nodes());
   fs::copy_file(soft_file, compliance_cache_file(dir.path, stiff_key));
   const ComplianceCacheLoad load = load_compliance_cache(compliance_cache_file(dir.path, stiff_key), stiff_key, stiff_columns);
   EXPECT_FALSE(load.loaded);
@@ -176,27 +183,29 @@ TEST(ComplianceCache, AnUnwritableCacheDirectoryIsNotFatal) {
   const fs::path blocked = dir.path / "not-a-directory";
   std::ofstream(blocked) << "a file where the cache directory should be";
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
-  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
   ComplianceSetup setup;
-  EXPECT_NO_THROW(setup = prepare_compliance(model, columns, blocked / "cache"));
-  EXPECT_EQ(columns.column_count(), model.touchable_nodes.size());
+  EXPECT_NO_THROW(setup = prepare_compliance(body, columns, blocked / "cache"));
+  EXPECT_EQ(columns.column_count(), body.touchable_nodes.size());
   EXPECT_THROW(save_compliance_cache(blocked / "cache" / "x.bin", Digest{}, columns), Error);
 }
 
 TEST(ComplianceCache, OnDemandModeComputesNothingUpFrontAndSavesWhatItComputed) {
   const ScratchDirectory dir;
   const Model model = build_model(parse_scene(small_cube_yaml(1e6, 4, "on_demand"), "cube.yaml"));
-  ComplianceColumns columns(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
-  EXPECT_EQ(prepare_compliance(model, columns, dir.path).columns, 0u);
-  columns.column(model.touchable_nodes[3]);
-  columns.column(model.touchable_nodes[9]);
-  save_compliance(model, columns, dir.path);
-  ComplianceColumns again(*model.free_factor, model.dofs, compliance_row_nodes(model, false));
-  const ComplianceSetup setup = prepare_compliance(model, again, dir.path);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
+  EXPECT_EQ(prepare_compliance(body, columns, dir.path).columns, 0u);
+  columns.column(body.touchable_nodes[3]);
+  columns.column(body.touchable_nodes[9]);
+  save_compliance(body, columns, dir.path);
+  ComplianceColumns again(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
+  const ComplianceSetup setup = prepare_compliance(body, again, dir.path);
   EXPECT_TRUE(setup.from_disk);
   EXPECT_EQ(again.column_count(), columns.column_count());  // the group the two columns belong to
-  EXPECT_LT(again.column_count(), model.touchable_nodes.size());
-  EXPECT_TRUE(again.has_column(model.touchable_nodes[9]));
+  EXPECT_LT(again.column_count(), body.touchable_nodes.size());
+  EXPECT_TRUE(again.has_column(body.touchable_nodes[9]));
 }
 
 }  // namespace

@@ -41,9 +41,10 @@ tools: [{{name: A}}]
 
 // Surface nodes that can move (not on the fixed rear face).
 std::vector<int> movable_surface_nodes(const Model& model) {
+  const ElasticBody& body = single_elastic_body(model);
   std::vector<int> nodes;
-  for (int node : model.surface.nodes)
-    if (model.dofs.fixed_axes[node] != kAllAxes) nodes.push_back(node);
+  for (int node : body.surface.nodes)
+    if (body.dofs.fixed_axes[node] != kAllAxes) nodes.push_back(node);
   return nodes;
 }
 
@@ -66,7 +67,8 @@ double expect_equals_naive(IncrementalCondensation& incremental, ComplianceColum
 
 TEST(Condensation, ForcesEqualTheFullSparseSolveForRandomActiveSets) {
   const Model model = cube_model(8, 0.4);
-  ComplianceColumns columns(*model.free_factor, model.dofs, model.surface.nodes);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
   const std::vector<int> candidates = movable_surface_nodes(model);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> displacement(-2e-3, 2e-3);
@@ -75,7 +77,7 @@ TEST(Condensation, ForcesEqualTheFullSparseSolveForRandomActiveSets) {
     std::shuffle(shuffled.begin(), shuffled.end(), rng);
     const std::vector<int> contact(shuffled.begin(), shuffled.begin() + 3 + trial % 4);
     const std::vector<int> boundary(shuffled.begin() + 10, shuffled.begin() + 10 + 20 * trial);
-    IncrementalCondensation incremental(columns, model.dofs);
+    IncrementalCondensation incremental(columns, body.dofs);
     incremental.set_boundary_nodes(boundary);
     const CondensedOperator op = incremental.condense(contact);
 
@@ -84,7 +86,7 @@ TEST(Condensation, ForcesEqualTheFullSparseSolveForRandomActiveSets) {
     std::vector<PrescribedDisplacement> prescribed;
     for (Eigen::Index i = 0; i < u_c.size(); ++i) prescribed.push_back({op.contact_dofs[i], u_c[i] = displacement(rng)});
     for (Eigen::Index i = 0; i < u_b.size(); ++i) prescribed.push_back({op.boundary_dofs[i], u_b[i] = displacement(rng)});
-    const StaticSolution full = solve_static(model.stiffness, model.dofs, prescribed);
+    const StaticSolution full = solve_static(body.stiffness, body.dofs, prescribed);
 
     const Eigen::VectorXd f_c = op.m_cc * u_c + op.m_cb * u_b;
     Eigen::VectorXd expected(f_c.size());
@@ -95,9 +97,10 @@ TEST(Condensation, ForcesEqualTheFullSparseSolveForRandomActiveSets) {
 
 void incremental_matches_naive_after_random_updates(double nu) {
   const Model model = cube_model(6, nu);
-  ComplianceColumns columns(*model.free_factor, model.dofs, model.surface.nodes);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
   const std::vector<int> candidates = movable_surface_nodes(model);
-  IncrementalCondensation incremental(columns, model.dofs);
+  IncrementalCondensation incremental(columns, body.dofs);
   std::mt19937 rng(nu < 0.4 ? 17 : 29);
   std::vector<int> boundary;
   std::vector<int> contact;
@@ -129,7 +132,7 @@ void incremental_matches_naive_after_random_updates(double nu) {
       for (auto it = contact.begin(); it != contact.end();)
         it = std::find(boundary.begin(), boundary.end(), *it) != boundary.end() ? contact.erase(it) : it + 1;
       if (contact.empty()) continue;
-      worst = std::max(worst, expect_equals_naive(incremental, columns, model.dofs, contact,
+      worst = std::max(worst, expect_equals_naive(incremental, columns, body.dofs, contact,
                                                   fmt::format("after {} updates", op)));
       ASSERT_FALSE(::testing::Test::HasFailure());
     }
@@ -153,24 +156,25 @@ TEST(Condensation, IncrementalEqualsNaiveNearIncompressibility) { incremental_ma
 TEST(Condensation, JoinsAndLeavesAtTheFirstMiddleAndLastPositionEqualNaive) {
   for (double nu : {0.3, 0.499}) {
     const Model model = cube_model(6, nu, true);
-    ComplianceColumns columns(*model.free_factor, model.dofs, model.surface.nodes);
+    const ElasticBody& body = single_elastic_body(model);
+    ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
     const std::vector<int> candidates = movable_surface_nodes(model);
     std::vector<int> shuffled = candidates;
     std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(5));
     const std::vector<int> contact(shuffled.begin(), shuffled.begin() + 4);
     const std::vector<int> initial(shuffled.begin() + 4, shuffled.begin() + 34);
     for (bool cached : {true, false}) {
-      IncrementalCondensation incremental(columns, model.dofs);
+      IncrementalCondensation incremental(columns, body.dofs);
       for (int node : initial) incremental.add_boundary_node(node);  // one by one: bordering
-      if (cached) expect_equals_naive(incremental, columns, model.dofs, contact, "before any leave");
+      if (cached) expect_equals_naive(incremental, columns, body.dofs, contact, "before any leave");
       const std::size_t size = incremental.boundary_nodes().size();
       for (std::size_t position : {std::size_t{0}, size / 2, size - 1}) {
         const int node = incremental.boundary_nodes()[position];
         const std::string where = fmt::format("nu {}, cached {}, position {}", nu, cached, position);
         incremental.remove_boundary_node(node);
-        if (cached) expect_equals_naive(incremental, columns, model.dofs, contact, where + " left");
+        if (cached) expect_equals_naive(incremental, columns, body.dofs, contact, where + " left");
 
-        const std::vector<int> b_dofs = free_dofs_of_nodes(model.dofs, incremental.boundary_nodes());
+        const std::vector<int> b_dofs = free_dofs_of_nodes(body.dofs, incremental.boundary_nodes());
         const Eigen::MatrixXd l_bb = gather_compliance(columns, b_dofs, b_dofs);
         const Eigen::MatrixXd rhs = Eigen::MatrixXd::Random(l_bb.rows(), 2);
         const Eigen::MatrixXd expected = l_bb.llt().solve(rhs);
@@ -178,7 +182,7 @@ TEST(Condensation, JoinsAndLeavesAtTheFirstMiddleAndLastPositionEqualNaive) {
 
         incremental.add_boundary_node(node);
         EXPECT_EQ(incremental.boundary_nodes().back(), node);
-        expect_equals_naive(incremental, columns, model.dofs, contact, where + " joined again");
+        expect_equals_naive(incremental, columns, body.dofs, contact, where + " joined again");
       }
     }
   }
@@ -189,17 +193,18 @@ TEST(Condensation, JoinsAndLeavesAtTheFirstMiddleAndLastPositionEqualNaive) {
 // free axes (the sliding face) in both C and B.
 TEST(Condensation, ContactSetChangesEqualNaive) {
   const Model model = cube_model(6, 0.45, true);
-  ComplianceColumns columns(*model.free_factor, model.dofs, model.surface.nodes);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
   std::vector<int> candidates = movable_surface_nodes(model);
   std::vector<int> sliding;
   for (int node : candidates)
-    if (model.dofs.fixed_axes[node] != 0) sliding.push_back(node);
+    if (body.dofs.fixed_axes[node] != 0) sliding.push_back(node);
   ASSERT_GE(sliding.size(), 10u);
   std::mt19937 rng(11);
   std::shuffle(candidates.begin(), candidates.end(), rng);
   IncrementalCondensation::Options options;
   options.z_cache_nodes = 5;
-  IncrementalCondensation incremental(columns, model.dofs, options);
+  IncrementalCondensation incremental(columns, body.dofs, options);
   std::vector<int> boundary = {sliding[0], sliding[1]};
   for (auto it = candidates.begin(); boundary.size() < 25; ++it)
     if (std::find(sliding.begin(), sliding.end(), *it) == sliding.end()) boundary.push_back(*it);
@@ -226,13 +231,13 @@ TEST(Condensation, ContactSetChangesEqualNaive) {
   spare.push_back(sliding[6]);
   for (int round = 0; round < 3; ++round)
     for (std::size_t i = 0; i < contacts.size(); ++i) {
-      expect_equals_naive(incremental, columns, model.dofs, contacts[i], fmt::format("round {}, contact set {}", round, i));
+      expect_equals_naive(incremental, columns, body.dofs, contacts[i], fmt::format("round {}, contact set {}", round, i));
       // One join and one leave from a random position before the next contact set.
       const int joining = spare[(round * contacts.size() + i) % spare.size()];
       if (incremental.in_boundary(joining)) incremental.remove_boundary_node(joining); else incremental.add_boundary_node(joining);
       const auto& b = incremental.boundary_nodes();
       incremental.remove_boundary_node(b[std::uniform_int_distribution<std::size_t>(0, b.size() - 2)(rng)]);
-      expect_equals_naive(incremental, columns, model.dofs, contacts[i], fmt::format("round {}, after B changed", round));
+      expect_equals_naive(incremental, columns, body.dofs, contacts[i], fmt::format("round {}, after B changed", round));
     }
 }
 
@@ -241,18 +246,19 @@ TEST(Condensation, ContactSetChangesEqualNaive) {
 // while Z is cached, which gives every Z new rows.
 TEST(Condensation, RefactoringKeepsTheCondensationExact) {
   const Model model = cube_model(5, 0.4);
-  ComplianceColumns columns(*model.free_factor, model.dofs, model.surface.nodes);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
   const std::vector<int> candidates = movable_surface_nodes(model);
   IncrementalCondensation::Options options;
   options.drift_tolerance = -1;
   options.check_interval = 3;
-  IncrementalCondensation incremental(columns, model.dofs, options);
+  IncrementalCondensation incremental(columns, body.dofs, options);
   const std::vector<int> contact = {candidates[0], candidates[1], candidates[2]};
   std::mt19937 rng(7);
   for (int op = 0; op < 60; ++op) {
     const int node = candidates[std::uniform_int_distribution<std::size_t>(3, candidates.size() - 1)(rng)];
     if (incremental.in_boundary(node)) incremental.remove_boundary_node(node); else incremental.add_boundary_node(node);
-    if (op % 4 == 0) expect_equals_naive(incremental, columns, model.dofs, contact, fmt::format("after {} updates", op));
+    if (op % 4 == 0) expect_equals_naive(incremental, columns, body.dofs, contact, fmt::format("after {} updates", op));
   }
   EXPECT_EQ(incremental.statistics().refactorizations, incremental.statistics().residual_checks);
   EXPECT_GE(incremental.statistics().refactorizations, 15);
@@ -261,20 +267,21 @@ TEST(Condensation, RefactoringKeepsTheCondensationExact) {
   for (std::size_t i = 3; i < candidates.size() && more.size() < incremental.boundary_nodes().size() + 20; ++i)
     if (!incremental.in_boundary(candidates[i])) more.push_back(candidates[i]);
   incremental.set_boundary_nodes(more);
-  expect_equals_naive(incremental, columns, model.dofs, contact, "after a bulk join");
+  expect_equals_naive(incremental, columns, body.dofs, contact, "after a bulk join");
 }
 
 TEST(Condensation, ANodeInBothSetsOrTwiceInBIsAClearError) {
   const Model model = cube_model(4, 0.4);
-  ComplianceColumns columns(*model.free_factor, model.dofs, model.surface.nodes);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
   const std::vector<int> nodes = movable_surface_nodes(model);
-  IncrementalCondensation incremental(columns, model.dofs);
+  IncrementalCondensation incremental(columns, body.dofs);
   incremental.add_boundary_node(nodes[0]);
   EXPECT_THROW(incremental.add_boundary_node(nodes[0]), Error);
   EXPECT_THROW(incremental.remove_boundary_node(nodes[1]), Error);
   const std::vector<int> contact = {nodes[0], nodes[2]};
   EXPECT_THROW(incremental.condense(contact), Error);
-  EXPECT_THROW(naive_condensation(columns, model.dofs, contact, incremental.boundary_nodes()), NumericalError);
+  EXPECT_THROW(naive_condensation(columns, body.dofs, contact, incremental.boundary_nodes()), NumericalError);
 }
 
 }  // namespace

@@ -26,15 +26,16 @@ TEST(ContactModels, ForcesFallWithTheElementSizeAndTranslationTransmitsAtLeastTh
     testing::CubeSceneOptions scene;
     scene.divisions = divisions;
     const Model model = build_model(parse_scene(testing::cube_scene_yaml(scene), "cube.yaml"));
+    const ElasticBody& body = single_elastic_body(model);
     std::mt19937 rng(static_cast<unsigned>(divisions));
     std::uniform_real_distribution<double> across(-20e-3, 20e-3);
     double reaction = 0, transmitted = 0, point = 0;
     const int presses = 6;
     for (int i = 0; i < presses; ++i) {
       const Eigen::Vector3d tool(across(rng), across(rng), -1e-3);
-      const std::vector<ContactQuery> contacts = find_tool_contacts(model, {{tool, 0}});
-      const ToolReaction translation = contact_reactions_reference(model, contacts, {}, ContactModel::node_translation)[0];
-      const ToolReaction constraint = contact_reactions_reference(model, contacts, {}, ContactModel::point_constraint)[0];
+      const std::vector<ContactQuery> contacts = find_tool_contacts(body, {{tool, 0}});
+      const ToolReaction translation = contact_reactions_reference(body, contacts, {}, ContactModel::node_translation)[0];
+      const ToolReaction constraint = contact_reactions_reference(body, contacts, {}, ContactModel::point_constraint)[0];
       const Eigen::Vector3d d = contacts[0].contact->displacement;
       const Eigen::Vector3d total = translation.nodal_forces.rowwise().sum();
       // Minimum energy: more constraint, more work for the same contact-point displacement.

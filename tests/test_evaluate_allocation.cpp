@@ -36,13 +36,14 @@ TEST(ForceEvaluator, AllocatesNothing) {
   allocations = 0;
 
   const Model model = build_model(parse_scene(testing::cube_scene_yaml(), "cube.yaml"));
-  ComplianceColumns columns(*model.free_factor, model.dofs, model.surface.nodes);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
   for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
     SimulationOptions options;
     options.ir.contact_model = contact_model;
     options.ir.patch_rings = 2;
     options.step_delay_nodes = 150;
-    Simulation simulation(model, columns, std::vector<ToolSpec>(2), options);
+    Simulation simulation(body, model.obstacles, columns, std::vector<ToolSpec>(2), options);
     simulation.set_tool(0, Eigen::Vector3d(-0.02, 0.005, -0.004));
     simulation.set_tool(1, Eigen::Vector3d(0.025, -0.005, -0.003));
     simulation.step(0);
@@ -65,12 +66,13 @@ TEST(ForceEvaluator, AllocatesNothingUnderTheSphereModel) {
   testing::CubeSceneOptions cube;
   cube.tools = "[{name: A, shape: sphere, radius: 30}, {name: B, shape: sphere, radius: 30}]";
   const Model model = build_model(parse_scene(testing::cube_scene_yaml(cube), "cube.yaml"));
-  ComplianceColumns columns(*model.free_factor, model.dofs, model.surface.nodes);
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
   SimulationOptions options;
   options.ir.contact_model = ContactModel::sphere;
   options.ir.patch_rings = 2;
   options.step_delay_nodes = 150;
-  Simulation simulation(model, columns, model.scene.tools, options);
+  Simulation simulation(body, model.obstacles, columns, model.scene.tools, options);
   simulation.set_tool(0, Eigen::Vector3d(-0.02, 0.005, 0.026));
   simulation.set_tool(1, Eigen::Vector3d(0.025, -0.005, 0.027));
   simulation.step(0);

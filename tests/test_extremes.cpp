@@ -55,7 +55,7 @@ struct Comparison {
 
 // One tool at `tool`: the IR's force against the full solve with the same held nodes.
 Comparison compare(Rig& rig, const Eigen::Vector3d& tool, const SimulationOptions& o) {
-  Simulation simulation(*rig.model, *rig.columns, std::vector<ToolSpec>(1), o);
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), o);
   simulation.set_tool(0, tool);
   const StepReport report = simulation.step(0);
   Comparison c;
@@ -63,7 +63,7 @@ Comparison compare(Rig& rig, const Eigen::Vector3d& tool, const SimulationOption
   c.condition = simulation.ir(0)->condition_estimate;
   c.boundary_nodes = report.boundary_nodes;
   const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
-  c.reference = contact_reactions_reference(*rig.model, find_tool_contacts(*rig.model, {{tool, 0}}), held,
+  c.reference = contact_reactions_reference(rig.body, find_tool_contacts(rig.body, {{tool, 0}}), held,
                                             o.ir.contact_model)[0]
                     .reaction;
   c.relative_error = (c.ir - c.reference).norm() / c.reference.norm();
@@ -101,7 +101,7 @@ TEST(Extremes, VerySoftAndVeryStiffTissueScaleExactlyAndRespectTheLimit) {
     const Eigen::Vector3d force = compare(rig, mm(2, 3, -5), options(kUnlimited)).ir;
     EXPECT_LE((force / modulus - reference / 1e6).norm(), 1e-9 * (reference / 1e6).norm()) << "E = " << modulus;
     // With the haptic limit the magnitude never exceeds it, whatever E.
-    Simulation limited(*rig.model, *rig.columns, std::vector<ToolSpec>(1), options(3.3));
+    Simulation limited(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), options(3.3));
     limited.set_tool(0, mm(2, 3, -5));
     limited.step(0);
     const ForceSample sample = limited.force(0);
@@ -114,9 +114,9 @@ TEST(Extremes, ASliverAndANearlyDegenerateContactTriangleAtTheSurface) {
   // A front-face node moved within the face, most of the way across one of its
   // triangles: that triangle becomes a thin needle and its tetrahedron a sliver.
   const std::string yaml = testing::cube_scene_yaml(cube(4));
-  Scene scene = parse_scene(yaml, "cube.yaml");
-  TetMesh mesh = make_box_mesh(scene.object.mesh.box->min_corner, scene.object.mesh.box->size,
-                               scene.object.mesh.box->divisions);
+  const Scene scene = parse_scene(yaml, "cube.yaml");
+  const BoxMeshSpec& box = *single_elastic_object(scene).mesh.box;
+  TetMesh mesh = make_box_mesh(box.min_corner, box.size, box.divisions);
   const int moved = 2 + 5 * (2 + 5 * 4);  // node (2, 2, 4): centre of the front face z = 0
   const Eigen::Vector3d target = mesh.nodes.col(3 + 5 * (3 + 5 * 4));  // node (3, 3, 4)
   mesh.nodes.col(moved) += 0.9995 * (target - mesh.nodes.col(moved)).cwiseProduct(Eigen::Vector3d(1, 0, 0));
@@ -137,10 +137,7 @@ TEST(Extremes, ASliverAndANearlyDegenerateContactTriangleAtTheSurface) {
   const std::size_t mesh_line = yaml.find("mesh: {box:");
   const std::string file_yaml =
       yaml.substr(0, mesh_line) + "mesh: {file: " + path + "}" + yaml.substr(yaml.find('\n', mesh_line));
-  Rig rig(cube(4));
-  rig.columns.reset();
-  rig.model = std::make_unique<Model>(build_model(parse_scene(file_yaml, "sliver.yaml")));
-  rig.columns = std::make_unique<ComplianceColumns>(*rig.model->free_factor, rig.model->dofs, rig.model->surface.nodes);
+  Rig rig(file_yaml);
   // Press on the needle triangle and around it.
   const Eigen::Vector3d needle_point = (mesh.nodes.col(moved) + target.cwiseProduct(Eigen::Vector3d(1, 0, 0)) +
                                         Eigen::Vector3d(0, target.y(), 0)) / 2;
@@ -157,7 +154,7 @@ TEST(Extremes, ASliverAndANearlyDegenerateContactTriangleAtTheSurface) {
 TEST(Extremes, FromNoHeldNodesToTheWholeSurface) {
   Rig rig(testing::CubeSceneOptions{});
   int movable = 0;
-  for (int node : rig.model->surface.nodes) movable += rig.model->dofs.fixed_axes[node] != kAllAxes;
+  for (int node : rig.body.surface.nodes) movable += rig.body.dofs.fixed_axes[node] != kAllAxes;
   const int whole_surface = movable - 3;  // all but the contact triangle
   std::printf("  |B|     |F| (N)    IR vs full solve   condition of L~\n");
   double previous = 0;
@@ -183,7 +180,8 @@ TEST(Extremes, FromNoHeldNodesToTheWholeSurface) {
 TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
   Rig rig(testing::CubeSceneOptions{});
   const Model& model = *rig.model;
-  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(1), options(3.3));
+  const ElasticBody& body = single_elastic_body(model);
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), options(3.3));
   simulation.set_tool(0, mm(1, 2, -1));
   simulation.step(0);
   const PreparedIR& prepared = *simulation.ir(0);
@@ -196,9 +194,9 @@ TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
   }
   // Exactly under a patch vertex and an edge midpoint: finite, deterministic, and the
   // same triangle as the server picks (ties go to the lower surface index on both sides).
-  const IrTriangle& tri = prepared.ir.patch[0];
-  const Eigen::Vector3d vertex = prepared.ir.rest_positions.col(tri.nodes[0]);
-  const Eigen::Vector3d edge = (vertex + prepared.ir.rest_positions.col(tri.nodes[1])) / 2;
+  const IrTriangle& tri = condensed_fem(prepared.ir).patch[0];
+  const Eigen::Vector3d vertex = condensed_fem(prepared.ir).rest_positions.col(tri.nodes[0]);
+  const Eigen::Vector3d edge = (vertex + condensed_fem(prepared.ir).rest_positions.col(tri.nodes[1])) / 2;
   for (const Eigen::Vector3d& on : {vertex, edge}) {
     const Eigen::Vector3d tool = on - 2e-3 * tri.normal;
     const ForceSample a = evaluate_force(prepared, tool, {});
@@ -207,8 +205,8 @@ TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
     EXPECT_EQ(a.force, b.force);
     EXPECT_EQ(a.triangle, b.triangle);
     const int server_triangle =
-        nearest_triangle(model.mesh, model.surface, model.normals, model.touchable_triangles, tool).triangle;
-    EXPECT_EQ(prepared.ir.patch[a.triangle].surface_index, server_triangle);
+        nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, tool).triangle;
+    EXPECT_EQ(condensed_fem(prepared.ir).patch[a.triangle].surface_index, server_triangle);
   }
 }
 
@@ -220,10 +218,11 @@ TEST(Extremes, ARigidWallCatchesTheBulge) {
   scene.obstacles = "{name: wall, plane: {point: [65.005, 0, 0], normal: [-1, 0, 0]}}";
   Rig rig(scene);
   const Model& model = *rig.model;
+  const ElasticBody& body = single_elastic_body(model);
   Rig free_rig(cube(8));
   const Eigen::Vector3d tool = mm(40, 0, -8);
   for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
-    Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(1), options(kUnlimited, 0, contact_model));
+    Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), options(kUnlimited, 0, contact_model));
     simulation.set_tool(0, tool);
     StepReport report;
     for (int step = 0; step < 6; ++step) report = simulation.step(0.001 * step);
@@ -232,22 +231,22 @@ TEST(Extremes, ARigidWallCatchesTheBulge) {
     const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
     Eigen::VectorXd u;
     const Eigen::Vector3d reference =
-        contact_reactions_reference(model, find_tool_contacts(model, {{tool, 0}}), held, contact_model, &u)[0].reaction;
+        contact_reactions_reference(body, find_tool_contacts(body, {{tool, 0}}), held, contact_model, &u)[0].reaction;
     EXPECT_LE((ir_force - reference).norm(), 1e-9 * reference.norm());
     // Free surface nodes stay on the allowed side; held nodes sit on the wall and are pushed.
     const StateSolution state = simulation.solve();
-    for (int node : model.surface.nodes)
-      EXPECT_LE(model.mesh.nodes(0, node) + u[3 * node], 65.005e-3 + 1e-9) << "node " << node;
+    for (int node : body.surface.nodes)
+      EXPECT_LE(body.mesh.nodes(0, node) + u[3 * node], 65.005e-3 + 1e-9) << "node " << node;
     for (std::size_t b = 0, dof = 0; b < held.nodes.size(); ++b) {
       const int node = held.nodes[b];
-      EXPECT_NEAR(model.mesh.nodes(0, node) + held.displacement[b].x(), 65.005e-3, 1e-12);
+      EXPECT_NEAR(body.mesh.nodes(0, node) + held.displacement[b].x(), 65.005e-3, 1e-12);
       Eigen::Vector3d force = Eigen::Vector3d::Zero();
       for (int axis = 0; axis < 3; ++axis)
-        if (!model.dofs.is_fixed(node, axis)) force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
+        if (!body.dofs.is_fixed(node, axis)) force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
       EXPECT_LE(force.x(), 1e-12) << "the wall pushes (towards -x), it never pulls";
     }
     // The wall stiffens the object.
-    Simulation free(*free_rig.model, *free_rig.columns, std::vector<ToolSpec>(1), options(kUnlimited, 0, contact_model));
+    Simulation free(free_rig.body, free_rig.model->obstacles, *free_rig.columns, std::vector<ToolSpec>(1), options(kUnlimited, 0, contact_model));
     free.set_tool(0, tool);
     free.step(0);
     EXPECT_GT(ir_force.norm(), free.force(0).force.norm());

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cstdio>
 #include <random>
+#include <thread>
 
 #include "common/fem/assemble_stiffness.h"
 #include "common/fem/sparse_cholesky.h"
@@ -86,6 +87,19 @@ TEST(Stiffness, PositiveDefiniteOnceFixedAndCholmodAgreesWithADenseSolve) {
   const Eigen::MatrixXd x = factor.solve(rhs);
   const Eigen::MatrixXd expected = dense.ldlt().solve(rhs);
   EXPECT_LE((x - expected).norm(), 1e-9 * expected.norm());
+
+  // The factor is immutable: threads solving at once, each with its own workspace reused
+  // over many solves, get the single-threaded answer bit for bit.
+  std::vector<Eigen::MatrixXd> answers(4);
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < answers.size(); ++t)
+    threads.emplace_back([&, t] {
+      CholeskyWorkspace workspace;
+      for (int repeat = 0; repeat < 50; ++repeat) answers[t] = factor.solve(rhs * double(t + 1), workspace);
+    });
+  for (std::thread& thread : threads) thread.join();
+  for (std::size_t t = 0; t < answers.size(); ++t)
+    EXPECT_EQ(answers[t], factor.solve(rhs * double(t + 1))) << "thread " << t;
 }
 
 TEST(SparseCholesky, AnIndefiniteMatrixIsATypedErrorNamingTheRow) {
@@ -152,21 +166,22 @@ objects:
 tools: [{name: A}]
 )";
   const Model model = build_model(parse_scene(yaml, "uniaxial.yaml"));
+  const ElasticBody& body = single_elastic_body(model);
   const double strain = 0.01, height = 0.05, area = 0.02 * 0.03, modulus = 2.5e4, nu = 0.45;
   std::vector<PrescribedDisplacement> prescribed;
   std::vector<int> top;
-  for (int node = 0; node < model.mesh.node_count(); ++node)
-    if (std::abs(model.mesh.nodes(2, node) - height) < 1e-12) {
+  for (int node = 0; node < body.mesh.node_count(); ++node)
+    if (std::abs(body.mesh.nodes(2, node) - height) < 1e-12) {
       top.push_back(node);
       prescribed.push_back({3 * node + 2, -strain * height});
     }
   ASSERT_EQ(top.size(), 4u * 5u);
-  const StaticSolution solution = solve_static(model.stiffness, model.dofs, prescribed);
+  const StaticSolution solution = solve_static(body.stiffness, body.dofs, prescribed);
   double force = 0;
   for (int node : top) force += solution.reaction[3 * node + 2];
   EXPECT_NEAR(force, -modulus * area * strain, 1e-8 * modulus * area * strain);
-  for (int node = 0; node < model.mesh.node_count(); ++node) {
-    const Eigen::Vector3d x = model.mesh.nodes.col(node);
+  for (int node = 0; node < body.mesh.node_count(); ++node) {
+    const Eigen::Vector3d x = body.mesh.nodes.col(node);
     const Eigen::Vector3d expected(nu * strain * x.x(), nu * strain * x.y(), -strain * x.z());
     EXPECT_LE((solution.displacement.segment<3>(3 * node) - expected).norm(), 1e-10 * strain * height);
   }

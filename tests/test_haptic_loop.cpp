@@ -50,7 +50,7 @@ struct Fixture {
   std::shared_ptr<const PreparedIR> ir_for(const Eigen::Vector3d& tool) {
     SimulationOptions options;
     options.ir.force_limit = std::numeric_limits<double>::infinity();
-    Simulation simulation(*rig.model, *rig.columns, std::vector<ToolSpec>(1), options);
+    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), options);
     simulation.set_tool(0, tool);
     simulation.step(0);
     return simulation.ir(0);

@@ -41,11 +41,12 @@ SimulationOptions unlimited(ContactModel model, int step_delay_nodes = 0, int pa
 // The full sparse solve with all `tools` pressing and the simulation's held nodes.
 std::vector<Eigen::Vector3d> reference_forces(const Model& model, const Simulation& simulation,
                                               const std::vector<Eigen::Vector3d>& tools, ContactModel contact_model) {
+  const ElasticBody& body = single_elastic_body(model);
   std::vector<PressedTool> pressed;
   for (const Eigen::Vector3d& p : tools) pressed.push_back({p, 0});
   const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
   std::vector<Eigen::Vector3d> forces;
-  for (const ToolReaction& r : contact_reactions_reference(model, find_tool_contacts(model, pressed), held, contact_model))
+  for (const ToolReaction& r : contact_reactions_reference(body, find_tool_contacts(body, pressed), held, contact_model))
     forces.push_back(r.reaction);
   return forces;
 }
@@ -57,15 +58,16 @@ double relative_error(const Eigen::Vector3d& value, const Eigen::Vector3d& expec
 // Whether the IR of `user` holds the triangles the tools now press (own within the patch,
 // remote on its IR triangle): then the evaluator must be exact.
 bool ir_covers(const Model& model, const PreparedIR& prepared, const std::vector<Eigen::Vector3d>& tools, int user) {
+  const ElasticBody& body = single_elastic_body(model);
   const auto surface_triangle = [&](const Eigen::Vector3d& p) {
-    return nearest_triangle(model.mesh, model.surface, model.normals, model.touchable_triangles, p).triangle;
+    return nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, p).triangle;
   };
   bool own = false;
-  for (const IrTriangle& tri : prepared.ir.patch) own |= tri.surface_index == surface_triangle(tools[user]);
-  for (const IrRemoteContact& remote : prepared.ir.remotes) {
-    const Triangle& t = model.surface.triangles[surface_triangle(tools[remote.user])];
+  for (const IrTriangle& tri : condensed_fem(prepared.ir).patch) own |= tri.surface_index == surface_triangle(tools[user]);
+  for (const IrRemoteContact& remote : condensed_fem(prepared.ir).remotes) {
+    const Triangle& t = body.surface.triangles[surface_triangle(tools[remote.user])];
     for (int k = 0; k < 3; ++k)
-      if (model.mesh.node_tags[t[k]] != prepared.ir.node_ids[remote.nodes[k]]) return false;
+      if (body.mesh.node_tags[t[k]] != condensed_fem(prepared.ir).node_ids[remote.nodes[k]]) return false;
   }
   return own;
 }
@@ -73,7 +75,7 @@ bool ir_covers(const Model& model, const PreparedIR& prepared, const std::vector
 void two_users_match_the_full_solve(ContactModel contact_model, int step_delay_nodes) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(2), unlimited(contact_model, step_delay_nodes));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(contact_model, step_delay_nodes));
   const std::vector<Eigen::Vector3d> start = {mm(-20, 5, -4), mm(25, -5, -3)};
   simulation.set_tool(0, start[0]);
   simulation.set_tool(1, start[1]);
@@ -132,13 +134,14 @@ TEST(IntermediateRepresentation, TwoUsersEqualTheFullSolveWithHeldBoundaryNodes)
 TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
+  const ElasticBody& body = single_elastic_body(model);
   const Eigen::Vector3d tool = mm(4, -1, -2);
-  const UserTool user{0, tool, 0, nearest_touchable_triangle(model, tool)};
-  std::vector<bool> under_tool(static_cast<std::size_t>(model.mesh.node_count()), false);
-  for (int v : model.surface.triangles[user.nearest_triangle]) under_tool[v] = true;
-  IncrementalCondensation condensation(*rig.columns, model.dofs);
+  const UserTool user{0, tool, 0, nearest_touchable_triangle(body, tool)};
+  std::vector<bool> under_tool(static_cast<std::size_t>(body.mesh.node_count()), false);
+  for (int v : body.surface.triangles[user.nearest_triangle]) under_tool[v] = true;
+  IncrementalCondensation condensation(*rig.columns, body.dofs);
   const std::vector<Eigen::Vector3d> around = {tool};
-  std::vector<int> held = nearest_surface_nodes(model, around, 200, under_tool);
+  std::vector<int> held = nearest_surface_nodes(body.mesh, body.surface, body.dofs, around, 200, under_tool);
   held.erase(held.begin(), held.begin() + 20);  // leave the patch's neighbourhood free
   condensation.set_boundary_nodes(held);
   std::mt19937 rng(3);
@@ -150,58 +153,58 @@ TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
   const auto build = [&](double threshold) {
     IrBuildOptions options;
     options.boundary_truncation = threshold;
-    return build_ir(model, condensation, users, 0, held_displacement, options, 1, 0.0);
+    return build_ir(body, condensation, users, 0, held_displacement, options, 1, 0.0);
   };
   const IntermediateRepresentation full = build(0.0);
-  EXPECT_EQ(full.node_count(), full.row_node_count + static_cast<int>(held.size()));
+  EXPECT_EQ(condensed_fem(full).node_count(), condensed_fem(full).row_node_count + static_cast<int>(held.size()));
   const IntermediateRepresentation zero = build(0.0);
-  EXPECT_EQ(zero.m_tilde, full.m_tilde);
-  EXPECT_EQ(zero.node_ids, full.node_ids);
+  EXPECT_EQ(condensed_fem(zero).m_tilde, condensed_fem(full).m_tilde);
+  EXPECT_EQ(condensed_fem(zero).node_ids, condensed_fem(full).node_ids);
 
   const double threshold = 0.05;
   const IntermediateRepresentation cut = build(threshold);
-  ASSERT_LT(cut.node_count(), full.node_count());
-  ASSERT_GT(cut.node_count(), full.row_node_count);
+  ASSERT_LT(condensed_fem(cut).node_count(), condensed_fem(full).node_count());
+  ASSERT_GT(condensed_fem(cut).node_count(), condensed_fem(full).row_node_count);
   EXPECT_LT(cut.size_bytes(), full.size_bytes());
-  const Eigen::Index contact = full.m_tilde.rows();
-  EXPECT_EQ(cut.m_tilde.leftCols(contact), full.m_tilde.leftCols(contact));
+  const Eigen::Index contact = condensed_fem(full).m_tilde.rows();
+  EXPECT_EQ(condensed_fem(cut).m_tilde.leftCols(contact), condensed_fem(full).m_tilde.leftCols(contact));
 
   // Each held node's coupling (norm of its three columns), kept or not.
   std::vector<double> coupling;
   for (std::size_t b = 0; b < held.size(); ++b)
-    coupling.push_back(full.m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3).norm());
+    coupling.push_back(condensed_fem(full).m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3).norm());
   const double strongest = *std::max_element(coupling.begin(), coupling.end());
   const Eigen::VectorXd u_c = Eigen::VectorXd::NullaryExpr(contact, [&] { return uniform(rng); });
   Eigen::VectorXd dropped_force = Eigen::VectorXd::Zero(contact);
-  std::size_t next_kept = static_cast<std::size_t>(cut.row_node_count);
+  std::size_t next_kept = static_cast<std::size_t>(condensed_fem(cut).row_node_count);
   for (std::size_t b = 0; b < held.size(); ++b) {
-    const std::int64_t tag = model.mesh.node_tags[held[b]];
-    const bool kept = next_kept < cut.node_ids.size() && cut.node_ids[next_kept] == tag;
+    const std::int64_t tag = body.mesh.node_tags[held[b]];
+    const bool kept = next_kept < condensed_fem(cut).node_ids.size() && condensed_fem(cut).node_ids[next_kept] == tag;
     EXPECT_EQ(kept, coupling[b] >= threshold * strongest) << "node " << tag;
     if (kept) {
       ++next_kept;
     } else {
-      dropped_force += full.m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3) *
-                       full.boundary_displacement.segment<3>(3 * static_cast<Eigen::Index>(b));
+      dropped_force += condensed_fem(full).m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3) *
+                       condensed_fem(full).boundary_displacement.segment<3>(3 * static_cast<Eigen::Index>(b));
     }
   }
-  EXPECT_EQ(next_kept, cut.node_ids.size());
-  Eigen::VectorXd full_u(full.m_tilde.cols()), cut_u(cut.m_tilde.cols());
-  full_u << u_c, full.boundary_displacement;
-  cut_u << u_c, cut.boundary_displacement;
-  const Eigen::VectorXd difference = full.m_tilde * full_u - cut.m_tilde * cut_u;
-  EXPECT_LE((difference - dropped_force).norm(), 1e-12 * (full.m_tilde * full_u).norm());
+  EXPECT_EQ(next_kept, condensed_fem(cut).node_ids.size());
+  Eigen::VectorXd full_u(condensed_fem(full).m_tilde.cols()), cut_u(condensed_fem(cut).m_tilde.cols());
+  full_u << u_c, condensed_fem(full).boundary_displacement;
+  cut_u << u_c, condensed_fem(cut).boundary_displacement;
+  const Eigen::VectorXd difference = condensed_fem(full).m_tilde * full_u - condensed_fem(cut).m_tilde * cut_u;
+  EXPECT_LE((difference - dropped_force).norm(), 1e-12 * (condensed_fem(full).m_tilde * full_u).norm());
   EXPECT_GT(dropped_force.norm(), 0.0);
   std::printf("  B truncation at %.2f keeps %d of %zu held nodes: %zu -> %zu bytes, dropped force %.3g of %.3g N\n",
-              threshold, cut.node_count() - cut.row_node_count, held.size(), full.size_bytes(), cut.size_bytes(),
-              dropped_force.norm(), (full.m_tilde * full_u).norm());
+              threshold, condensed_fem(cut).node_count() - condensed_fem(cut).row_node_count, held.size(), full.size_bytes(), cut.size_bytes(),
+              dropped_force.norm(), (condensed_fem(full).m_tilde * full_u).norm());
 }
 
 TEST(IntermediateRepresentation, EachUserFeelsTheOther) {
   Rig& rig = shared_cube();
   const auto force_alone_and_together = [&](int user) {
-    Simulation alone(*rig.model, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
-    Simulation together(*rig.model, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
+    Simulation alone(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
+    Simulation together(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
     alone.set_tool(user, user == 0 ? mm(-12, 0, -5) : mm(12, 0, -5));
     together.set_tool(0, mm(-12, 0, -5));
     together.set_tool(1, mm(12, 0, -5));
@@ -220,7 +223,7 @@ TEST(IntermediateRepresentation, EachUserFeelsTheOther) {
 TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::node_translation, 0, 2));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::node_translation, 0, 2));
   simulation.set_tool(0, mm(1, 2, -3));
   simulation.step(0);
   const PreparedIR& prepared = *simulation.ir(0);
@@ -240,8 +243,8 @@ TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
 TEST(IntermediateRepresentation, Float32StorageStaysCloseToFloat64) {
   Rig& rig = shared_cube();
   for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
-    Simulation f64(*rig.model, *rig.columns, std::vector<ToolSpec>(2), unlimited(contact_model, 300));
-    Simulation f32(*rig.model, *rig.columns, std::vector<ToolSpec>(2),
+    Simulation f64(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(contact_model, 300));
+    Simulation f32(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
                    unlimited(contact_model, 300, 1, IrPrecision::f32));
     for (Simulation* s : {&f64, &f32}) {
       s->set_tool(0, mm(-20, 5, -4));
@@ -280,7 +283,7 @@ TEST(IntermediateRepresentation, NodeTranslationJumpsAtEdgesThePointModelDoesNot
   Rig& rig = shared_cube();
   std::printf("  tool sliding 3 mm deep across several triangles (patch rings 2), largest change between samples:\n");
   for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
-    Simulation simulation(*rig.model, *rig.columns, std::vector<ToolSpec>(1), unlimited(contact_model, 0, 2));
+    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited(contact_model, 0, 2));
     simulation.set_tool(0, mm(0.5, 0.4, -3));
     simulation.step(0);
     double peak = 0;
@@ -300,7 +303,7 @@ TEST(IntermediateRepresentation, NodeTranslationJumpsAtEdgesThePointModelDoesNot
 TEST(IntermediateRepresentation, PastThePatchTheForceIsHeldAndTheNextIrCatchesUp) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::point_constraint, 0, 0));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::point_constraint, 0, 0));
   simulation.set_tool(0, mm(1, 1, -3));
   simulation.step(0);
   const std::shared_ptr<const PreparedIR> old_ir = simulation.ir(0);
@@ -337,6 +340,7 @@ TEST(IntermediateRepresentation, PastThePatchTheForceIsHeldAndTheNextIrCatchesUp
 TEST(IntermediateRepresentation, SphereToolsEqualTheFullSolve) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
+  const ElasticBody& body = single_elastic_body(model);
   const double radius = 4e-3;
   for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
     std::vector<ToolSpec> tools(2);
@@ -344,7 +348,7 @@ TEST(IntermediateRepresentation, SphereToolsEqualTheFullSolve) {
       tool.shape = ToolShape::sphere;
       tool.radius = radius;
     }
-    Simulation simulation(model, *rig.columns, tools, unlimited(contact_model));
+    Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, tools, unlimited(contact_model));
     // Centres outside the surface (1 mm above it) and inside (2 mm below): both press.
     const std::vector<Eigen::Vector3d> centres = {mm(-20, 5, 1), mm(25, -5, -2)};
     simulation.set_tool(0, centres[0]);
@@ -352,7 +356,7 @@ TEST(IntermediateRepresentation, SphereToolsEqualTheFullSolve) {
     simulation.step(0);
     std::vector<PressedTool> pressed = {{centres[0], radius}, {centres[1], radius}};
     const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
-    const auto reference = contact_reactions_reference(model, find_tool_contacts(model, pressed), held, contact_model);
+    const auto reference = contact_reactions_reference(body, find_tool_contacts(body, pressed), held, contact_model);
     for (int user = 0; user < 2; ++user) {
       ASSERT_TRUE(reference[user].query.contact.has_value());
       EXPECT_NEAR(reference[user].query.contact->depth, user == 0 ? 3e-3 : 6e-3, 1e-12);
@@ -364,7 +368,7 @@ TEST(IntermediateRepresentation, SphereToolsEqualTheFullSolve) {
 TEST(IntermediateRepresentation, NonFiniteToolsGiveZeroOrAreIgnored) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
   simulation.set_tool(0, mm(-20, 5, -4));
   simulation.set_tool(1, mm(25, -5, -3));
   simulation.step(0);
@@ -382,21 +386,21 @@ TEST(IntermediateRepresentation, NonFiniteToolsGiveZeroOrAreIgnored) {
 
 TEST(IntermediateRepresentation, PrepareRejectsMalformedIrs) {
   Rig& rig = shared_cube();
-  Simulation simulation(*rig.model, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::node_translation));
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::node_translation));
   simulation.set_tool(0, mm(0, 0, -2));
   simulation.step(0);
   const IntermediateRepresentation good = simulation.ir(0)->ir;
   IntermediateRepresentation bad = good;
-  bad.m_tilde(0, 0) = std::numeric_limits<double>::infinity();
+  condensed_fem(bad).m_tilde(0, 0) = std::numeric_limits<double>::infinity();
   EXPECT_THROW(prepare_ir(bad), Error);
   bad = good;
-  bad.m_tilde.conservativeResize(bad.m_tilde.rows() - 1, Eigen::NoChange);
+  condensed_fem(bad).m_tilde.conservativeResize(condensed_fem(bad).m_tilde.rows() - 1, Eigen::NoChange);
   EXPECT_THROW(prepare_ir(bad), Error);
   bad = good;
-  bad.m_tilde.leftCols(bad.m_tilde.rows()) *= -1;  // not positive definite
+  condensed_fem(bad).m_tilde.leftCols(condensed_fem(bad).m_tilde.rows()) *= -1;  // not positive definite
   EXPECT_THROW(prepare_ir(bad), Error);
   bad = good;
-  bad.patch[0].nodes[1] = bad.node_count() + 5;
+  condensed_fem(bad).patch[0].nodes[1] = condensed_fem(bad).node_count() + 5;
   EXPECT_THROW(prepare_ir(bad), Error);
   EXPECT_NO_THROW(prepare_ir(good));
 }

@@ -23,6 +23,7 @@
 #include <thread>
 
 #include "common/model/static_contact.h"
+#include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
 #include "common/ir/evaluate_force.h"
@@ -158,6 +159,7 @@ TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
   EXPECT_TRUE(fs::exists(session.dir / "display" / "surface-000010.vtu"));
 
   const Model model = build_model(load_scene(session.dir / "cube.yaml"));
+  const ElasticBody& body = single_elastic_body(model);
   for (const std::string user : {"alice", "bob"}) {
     const std::vector<Tick> ticks = read_ticks(session.dir / (user + ".mcap"));
     ASSERT_GT(ticks.size(), 1500u) << user;
@@ -171,28 +173,28 @@ TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
       const auto& ir = irs.at(t.epoch);
       // The same IR and positions give the same force, bit for bit.
       const Eigen::Vector3d remote = t.remote;
-      const ForceSample offline = evaluate_force(*ir, t.own, std::span(&remote, ir->ir.remotes.empty() ? 0 : 1));
+      const ForceSample offline = evaluate_force(*ir, t.own, std::span(&remote, condensed_fem(ir->ir).remotes.empty() ? 0 : 1));
       ASSERT_EQ(offline.force, t.evaluated) << user << " tick " << i;
       ++offline_checked;
       // And the full FEM solve with both tools at those positions, where both sit on the
       // IR's triangles (every 50th contact tick; a full solve takes a while).
       if (contact_ticks % 50 != 0 || !remote.allFinite()) continue;
       std::vector<PressedTool> pressed = {{t.own, 0}, {remote, 0}};
-      const std::vector<ContactQuery> contacts = find_tool_contacts(model, pressed);
+      const std::vector<ContactQuery> contacts = find_tool_contacts(body, pressed);
       bool covered = contacts[0].contact.has_value();
       if (covered) {
         bool in_patch = false;
-        for (const IrTriangle& tri : ir->ir.patch) in_patch |= tri.surface_index == contacts[0].contact->triangle;
+        for (const IrTriangle& tri : condensed_fem(ir->ir).patch) in_patch |= tri.surface_index == contacts[0].contact->triangle;
         covered = in_patch && (!contacts[1].contact || [&] {
-          const Triangle& tri = model.surface.triangles[contacts[1].contact->triangle];
+          const Triangle& tri = body.surface.triangles[contacts[1].contact->triangle];
           for (int k = 0; k < 3; ++k)
-            if (ir->ir.remotes.empty() || model.mesh.node_tags[tri[k]] != ir->ir.node_ids[ir->ir.remotes[0].nodes[k]]) return false;
+            if (condensed_fem(ir->ir).remotes.empty() || body.mesh.node_tags[tri[k]] != condensed_fem(ir->ir).node_ids[condensed_fem(ir->ir).remotes[0].nodes[k]]) return false;
           return true;
         }());
       }
       if (!covered) continue;
       const Eigen::Vector3d expected =
-          contact_reactions_reference(model, contacts, {}, ContactModel::node_translation)[0].reaction;
+          contact_reactions_reference(body, contacts, {}, ContactModel::node_translation)[0].reaction;
       EXPECT_LE((t.evaluated - expected).norm(), 1e-9 * expected.norm()) << user << " tick " << i;
       ++reference_checked;
     }
@@ -277,17 +279,17 @@ TEST(EndToEnd, HostileDatagramsAreRejectedByReasonAndDoNotMoveTheHapticPeriod) {
   // where an earlier check fires first).
   send({1, 2, 3}, server);                                          // truncated
   send(std::vector<std::uint8_t>(2000, 7), server);                 // oversized
-  std::vector<std::uint8_t> forged = datagram(1, 5, 0.0);
+  std::vector<std::uint8_t> forged = datagram(wire::kProtocolVersion, 5, 0.0);
   forged[3] ^= 0x40;
   send(forged, server);                                             // bad_tag
-  send(datagram(2, 5, 0.0), server);                                // bad_version
-  send(datagram(1, 5, 0.0), server);                                // wrong_session
+  send(datagram(wire::kProtocolVersion - 1, 5, 0.0), server);  // bad_version: an older peer
+  send(datagram(wire::kProtocolVersion, 5, 0.0), server);      // wrong_session
   // A flood at the client while its haptic loop runs: random bytes and forged datagrams.
   std::mt19937 rng(3);
   for (int i = 0; i < 20000; ++i) {
     std::vector<std::uint8_t> junk(16 + rng() % 200);
     for (auto& byte : junk) byte = static_cast<std::uint8_t>(rng());
-    send(i % 2 ? junk : datagram(1, 1000 + static_cast<std::uint64_t>(i), std::nan("")), client);
+    send(i % 2 ? junk : datagram(wire::kProtocolVersion, 1000 + static_cast<std::uint64_t>(i), std::nan("")), client);
     if (i % 1000 == 999) std::this_thread::sleep_for(5ms);  // stimulus: a flood in bursts the kernel can take
   }
   ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();

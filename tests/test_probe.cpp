@@ -11,6 +11,7 @@
 
 #include "common/mesh/read_gmsh.h"
 #include "common/model/compliance_setup.h"
+#include "common/model/model.h"
 #include "common/model/static_contact.h"
 #include "common/sim/simulation.h"
 #include "common/scene/load_scene.h"
@@ -27,7 +28,8 @@ class CubeProbe : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     model_ = new Model(build_model(load_scene(testing::source_path("scenes/cube.yaml"))));
-    columns_ = new ComplianceColumns(*model_->free_factor, model_->dofs, compliance_row_nodes(*model_, false));
+    const ElasticBody& body = single_elastic_body(*model_);
+    columns_ = new ComplianceColumns(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
   }
   static void TearDownTestSuite() {
     delete columns_;
@@ -36,10 +38,10 @@ class CubeProbe : public ::testing::Test {
   static Eigen::Vector3d mm(double x, double y, double z) { return Eigen::Vector3d(x, y, z) * 1e-3; }
   // The IR path: one simulation step with these tools, each user's force from its IR.
   static std::vector<ToolReaction> condensed(const std::vector<PressedTool>& tools) {
-    const std::vector<ContactQuery> contacts = find_tool_contacts(*model_, tools);
+    const std::vector<ContactQuery> contacts = find_tool_contacts(body(), tools);
     SimulationOptions options;
     options.ir.force_limit = std::numeric_limits<double>::infinity();
-    Simulation simulation(*model_, *columns_, std::vector<ToolSpec>(tools.size()), options);
+    Simulation simulation(body(), model_->obstacles, *columns_, std::vector<ToolSpec>(tools.size()), options);
     for (std::size_t t = 0; t < tools.size(); ++t) simulation.set_tool(static_cast<int>(t), tools[t].position);
     simulation.step(0);
     std::vector<ToolReaction> reactions(tools.size());
@@ -49,6 +51,7 @@ class CubeProbe : public ::testing::Test {
     }
     return reactions;
   }
+  static const ElasticBody& body() { return single_elastic_body(*model_); }
   static Model* model_;
   static ComplianceColumns* columns_;
 };
@@ -69,12 +72,12 @@ TEST_F(CubeProbe, CondensedForcesEqualTheFullSparseSolve) {
     const auto tools = random_presses(rng, 1 + trial % 2, 10);
     std::vector<ContactQuery> contacts;
     try {
-      contacts = find_tool_contacts(*model_, tools);
+      contacts = find_tool_contacts(body(), tools);
     } catch (const Error&) {
       continue;  // two random tools on neighbouring triangles: not this test's subject
     }
     const auto fast = condensed(tools);
-    const auto reference = contact_reactions_reference(*model_, contacts, {}, ContactModel::node_translation);
+    const auto reference = contact_reactions_reference(body(), contacts, {}, ContactModel::node_translation);
     for (std::size_t t = 0; t < tools.size(); ++t) {
       ASSERT_TRUE(fast[t].query.contact.has_value());
       EXPECT_LE((fast[t].reaction - reference[t].reaction).norm(), 1e-9 * reference[t].reaction.norm());
@@ -85,17 +88,17 @@ TEST_F(CubeProbe, CondensedForcesEqualTheFullSparseSolve) {
 TEST_F(CubeProbe, ForcesAgreeWithAnIndependentFemOfTheSameMesh) {
   std::mt19937 rng(7);
   const auto tools = random_presses(rng, 1, 8);
-  const auto contacts = find_tool_contacts(*model_, tools);
+  const auto contacts = find_tool_contacts(body(), tools);
   const auto fast = condensed(tools);
 
-  std::vector<bool> fixed(static_cast<std::size_t>(3 * model_->mesh.node_count()));
-  for (int dof = 0; dof < 3 * model_->mesh.node_count(); ++dof) fixed[dof] = model_->dofs.free_index[dof] < 0;
+  std::vector<bool> fixed(static_cast<std::size_t>(3 * body().mesh.node_count()));
+  for (int dof = 0; dof < 3 * body().mesh.node_count(); ++dof) fixed[dof] = body().dofs.free_index[dof] < 0;
   std::map<int, double> prescribed;
   const ToolContact& contact = *contacts[0].contact;
-  const Triangle& tri = model_->surface.triangles[contact.triangle];
+  const Triangle& tri = body().surface.triangles[contact.triangle];
   for (int node : tri)
     for (int a = 0; a < 3; ++a) prescribed[3 * node + a] = contact.displacement[a];
-  const auto independent = testing::independent_static_solve(model_->mesh, 1.0e6, 0.4, fixed, prescribed);
+  const auto independent = testing::independent_static_solve(body().mesh, 1.0e6, 0.4, fixed, prescribed);
   Eigen::Vector3d expected = Eigen::Vector3d::Zero();
   for (int i = 0; i < 3; ++i) expected -= contact.weights[i] * independent.reaction.segment<3>(3 * tri[i]);
   EXPECT_LE((fast[0].reaction - expected).norm(), 1e-8 * expected.norm())
@@ -157,13 +160,13 @@ TEST_F(CubeProbe, TheProgramPrintsOneJsonObjectWithTheSameForces) {
     Eigen::Vector3d force(tool["force"][0], tool["force"][1], tool["force"][2]);
     EXPECT_LE((force - expected[t].reaction).norm(), 1e-12 * expected[t].reaction.norm());
     // The ids name the same nodes in the exported mesh, whose coordinates are in mm.
-    const Triangle& tri = model_->surface.triangles[expected[t].query.contact->triangle];
+    const Triangle& tri = body().surface.triangles[expected[t].query.contact->triangle];
     for (int i = 0; i < 3; ++i) {
       const std::int64_t id = tool["contact"]["triangle"][i];
-      EXPECT_EQ(id, model_->mesh.node_tags[tri[i]]);
+      EXPECT_EQ(id, body().mesh.node_tags[tri[i]]);
       const int index = node_index_from_tag(exported.mesh, id);
       ASSERT_GE(index, 0);
-      EXPECT_LE((exported.mesh.nodes.col(index) * 1e-3 - model_->mesh.nodes.col(tri[i])).norm(), 1e-15);
+      EXPECT_LE((exported.mesh.nodes.col(index) * 1e-3 - body().mesh.nodes.col(tri[i])).norm(), 1e-15);
       const double dz = tool["contact"]["displacement"][i][2];
       EXPECT_NEAR(dz, t == 0 ? -4.0 : -2.0, 1e-9);
     }

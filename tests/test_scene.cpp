@@ -104,9 +104,10 @@ TEST(SceneLoad, BaseSceneOfTheseTestsIsValid) {
   // Guards the error tests below: each of them differs from this scene in one place only.
   const Scene scene = parse_scene(kBaseScene, kSceneFile);
   EXPECT_EQ(scene.name, "block_scene");
-  EXPECT_DOUBLE_EQ(scene.object.mesh.box->size.x(), 0.010);
+  EXPECT_DOUBLE_EQ(single_elastic_object(scene).mesh.box->size.x(), 0.010);
   const Model model = build_model(scene);
-  EXPECT_EQ(model.mesh.node_count(), 27);
+  const ElasticBody& body = single_elastic_body(model);
+  EXPECT_EQ(body.mesh.node_count(), 27);
 }
 
 TEST(SceneLoad, CubeSceneFieldsInSIUnits) {
@@ -115,9 +116,9 @@ TEST(SceneLoad, CubeSceneFieldsInSIUnits) {
   EXPECT_EQ(scene.units, "mm");
   EXPECT_DOUBLE_EQ(scene.metres_per_unit, 0.001);
 
-  ASSERT_TRUE(scene.object.mesh.box.has_value());
-  EXPECT_TRUE(scene.object.mesh.file.empty());
-  const BoxMeshSpec& box = *scene.object.mesh.box;
+  ASSERT_TRUE(single_elastic_object(scene).mesh.box.has_value());
+  EXPECT_TRUE(single_elastic_object(scene).mesh.file.empty());
+  const BoxMeshSpec& box = *single_elastic_object(scene).mesh.box;
   for (int a = 0; a < 3; ++a) {
     EXPECT_TRUE(near(box.size[a], 0.13)) << "axis " << a << ": " << box.size[a];
     EXPECT_EQ(box.divisions[a], 11);
@@ -126,22 +127,22 @@ TEST(SceneLoad, CubeSceneFieldsInSIUnits) {
   EXPECT_TRUE(near(box.min_corner.y(), -0.065));
   EXPECT_TRUE(near(box.min_corner.z(), -0.13));
 
-  EXPECT_DOUBLE_EQ(scene.object.material.youngs_modulus, 1.0e6);
-  EXPECT_DOUBLE_EQ(scene.object.material.poisson_ratio, 0.4);
+  EXPECT_DOUBLE_EQ(single_elastic_object(scene).material.youngs_modulus, 1.0e6);
+  EXPECT_DOUBLE_EQ(single_elastic_object(scene).material.poisson_ratio, 0.4);
 
-  ASSERT_EQ(scene.object.fixed.size(), 1u);
-  const FixedRegion& fixed = scene.object.fixed[0];
+  ASSERT_EQ(single_elastic_object(scene).fixed.size(), 1u);
+  const FixedRegion& fixed = single_elastic_object(scene).fixed[0];
   EXPECT_EQ(fixed.axes, kAllAxes);
   EXPECT_EQ(fixed.nodes.kind, NodeSelector::Kind::plane);
   EXPECT_TRUE(near(fixed.nodes.plane_point.z(), -0.13));
   EXPECT_TRUE(fixed.nodes.plane_normal.isApprox(Eigen::Vector3d::UnitZ(), 1e-15));
   EXPECT_EQ(fixed.nodes.where, testing::source_path("scenes/cube.yaml") + ":14: objects[0].fixed[0]");
 
-  ASSERT_EQ(scene.object.touchable.size(), 1u);
-  EXPECT_EQ(scene.object.touchable[0].kind, NodeSelector::Kind::plane);
-  EXPECT_TRUE(near(scene.object.touchable[0].plane_point.z(), 0.0));
-  EXPECT_TRUE(scene.object.compliance.precompute_touchable);
-  EXPECT_TRUE(scene.object.compliance.disk_cache);
+  ASSERT_EQ(single_elastic_object(scene).touchable.size(), 1u);
+  EXPECT_EQ(single_elastic_object(scene).touchable[0].kind, NodeSelector::Kind::plane);
+  EXPECT_TRUE(near(single_elastic_object(scene).touchable[0].plane_point.z(), 0.0));
+  EXPECT_TRUE(single_elastic_object(scene).compliance.precompute_touchable);
+  EXPECT_TRUE(single_elastic_object(scene).compliance.disk_cache);
 
   ASSERT_EQ(scene.tools.size(), 1u);
   EXPECT_EQ(scene.tools[0].name, "A");
@@ -160,10 +161,11 @@ TEST(SceneModel, EveryShippedSceneAndMotionLoads) {
   for (const char* file : {"scenes/cube.yaml", "scenes/brain.yaml", "scenes/tradeoff/cube_two_users.yaml",
                            "scenes/tradeoff/brain_fine.yaml"}) {
     const Model model = build_model(load_scene(testing::source_path(file)));
-    EXPECT_GT(model.touchable_nodes.size(), 10u) << file;
+    const ElasticBody& body = single_elastic_body(model);
+    EXPECT_GT(body.touchable_nodes.size(), 10u) << file;
   }
   const Model fine = build_model(load_scene(testing::source_path("scenes/tradeoff/brain_fine.yaml")));
-  EXPECT_EQ(fine.mesh.node_count(), 9015);
+  EXPECT_EQ(single_elastic_body(fine).mesh.node_count(), 9015);
   for (const char* file : {"scenes/brain/surgeon_a.yaml", "scenes/brain/surgeon_b.yaml", "scenes/studies/press_front.yaml",
                            "scenes/tradeoff/cube_press_slide.yaml", "scenes/tradeoff/cube_press_hold.yaml",
                            "scenes/tradeoff/brain_press_slide.yaml", "scenes/tradeoff/brain_press_hold.yaml"}) {
@@ -176,14 +178,15 @@ TEST(SceneModel, EveryShippedSceneAndMotionLoads) {
 
 TEST(SceneModel, CubeModelFixedAndTouchableNodesAreTheTwoFaces) {
   const Model model = build_model(load_scene(testing::source_path("scenes/cube.yaml")));
-  EXPECT_EQ(model.mesh.node_count(), 1728);
-  EXPECT_EQ(model.mesh.tet_count(), 7986);
-  ASSERT_EQ(model.dofs.node_count(), 1728);
+  const ElasticBody& body = single_elastic_body(model);
+  EXPECT_EQ(body.mesh.node_count(), 1728);
+  EXPECT_EQ(body.mesh.tet_count(), 7986);
+  ASSERT_EQ(body.dofs.node_count(), 1728);
 
   // By hand from the coordinates: the rear face z = -0.13 m and the front face z = 0.
   std::vector<int> rear, front;
-  for (int n = 0; n < model.mesh.node_count(); ++n) {
-    const double z = model.mesh.nodes(2, n);
+  for (int n = 0; n < body.mesh.node_count(); ++n) {
+    const double z = body.mesh.nodes(2, n);
     if (std::abs(z + 0.13) < 1e-9) rear.push_back(n);
     if (std::abs(z) < 1e-9) front.push_back(n);
   }
@@ -191,21 +194,21 @@ TEST(SceneModel, CubeModelFixedAndTouchableNodesAreTheTwoFaces) {
   ASSERT_EQ(front.size(), 144u);
 
   std::vector<int> fixed;
-  for (int n = 0; n < model.dofs.node_count(); ++n) {
-    const AxisMask mask = model.dofs.fixed_axes[n];
+  for (int n = 0; n < body.dofs.node_count(); ++n) {
+    const AxisMask mask = body.dofs.fixed_axes[n];
     EXPECT_TRUE(mask == 0 || mask == kAllAxes) << "node " << n << " mask " << int(mask);
     if (mask != 0) fixed.push_back(n);
   }
   EXPECT_EQ(fixed, rear);
-  EXPECT_EQ(model.dofs.free_count(), 3 * (1728 - 144));
-  EXPECT_EQ(model.touchable_nodes, front);
+  EXPECT_EQ(body.dofs.free_count(), 3 * (1728 - 144));
+  EXPECT_EQ(body.touchable_nodes, front);
 
   // 11 x 11 cells, two triangles each, all on the front face, all facing +z.
-  EXPECT_EQ(model.touchable_triangles.size(), 2u * 11 * 11);
-  for (int t : model.touchable_triangles) {
-    const Triangle& tri = model.surface.triangles[t];
-    for (int v : tri) EXPECT_NEAR(model.mesh.nodes(2, v), 0.0, 1e-12) << "triangle " << t;
-    const Eigen::Vector3d normal = triangle_normal(model.mesh, tri);
+  EXPECT_EQ(body.touchable_triangles.size(), 2u * 11 * 11);
+  for (int t : body.touchable_triangles) {
+    const Triangle& tri = body.surface.triangles[t];
+    for (int v : tri) EXPECT_NEAR(body.mesh.nodes(2, v), 0.0, 1e-12) << "triangle " << t;
+    const Eigen::Vector3d normal = triangle_normal(body.mesh, tri);
     EXPECT_LT((normal - Eigen::Vector3d::UnitZ()).norm(), 1e-12) << "triangle " << t << " normal " << normal.transpose();
   }
 }
@@ -265,9 +268,14 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
     const auto object_begin = base.find("  - name: block");
     const auto object_end = base.find("tools:");
     const std::string object = base.substr(object_begin, object_end - object_begin);
-    const auto text = replaced(base, "tools:", object + "tools:");
-    // The list itself is the offender: yaml-cpp places it at its first item.
-    cases.push_back({"two objects", text, "  - name: block", {"objects", "exactly one object", "found a list of 2"}});
+    const auto text = replaced(base, "tools:", replaced(object, "name: block", "name: block  # again") + "tools:");
+    // The second object's name is the offender.
+    cases.push_back({"two objects of one name", text, "name: block  # again",
+                     {"objects[1].name", "an object name not used before", "found 'block'"}});
+  }
+  {
+    const auto text = replaced(base, "  - name: block\n", "  - name: block\n    model: rubber\n");
+    cases.push_back({"unknown body model", text, "model: rubber", {"objects[0].model", "linear_elastic", "found 'rubber'"}});
   }
   {
     const auto text = replaced(base, "tools:\n  - name: A\n    shape: point\n", "tools: []\n");
@@ -318,6 +326,32 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
   for (const BadScene& bad : cases) expect_scene_error(bad);
 }
 
+TEST(SceneModel, SeveralObjectsCompileIntoOneBodyEachInTheSceneOrder) {
+  // A second block beside the first, twice as fine; `model:` written out on one, defaulted on the other.
+  const auto object_begin = kBaseScene.find("  - name: block");
+  const std::string object = kBaseScene.substr(object_begin, kBaseScene.find("tools:") - object_begin);
+  std::string second = replaced(object, "name: block", "name: twin\n    model: linear_elastic");
+  second = replaced(second, "divisions: [2, 2, 2]", "divisions: [4, 4, 4]");
+  const Scene scene = parse_scene(replaced(kBaseScene, "tools:", second + "tools:"), kSceneFile);
+  ASSERT_EQ(scene.objects.size(), 2u);
+  EXPECT_EQ(scene.objects[1].name, "twin");
+  EXPECT_EQ(scene.objects[1].where, kSceneFile + ":" + std::to_string(line_of(replaced(kBaseScene, "tools:", second + "tools:"),
+                                                                              "name: twin")) + ": objects[1]");
+  const Model model = build_model(scene);
+  ASSERT_EQ(model.bodies.size(), 2u);
+  EXPECT_EQ(elastic_body(model, 0).mesh.node_count(), 27);
+  EXPECT_EQ(elastic_body(model, 1).mesh.node_count(), 125);
+  EXPECT_EQ(elastic_body(model, 1).name, "twin");
+  // The one-object tools say why they refuse.
+  try {
+    single_elastic_body(model);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("has 2 objects"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(elastic_body(model, 2), Error);
+}
+
 TEST(SceneErrors, MissingSceneFileNamesIt) {
   const std::string file = "/nonexistent-cohaptic-test/missing.yaml";
   try {
@@ -348,31 +382,32 @@ tools:
   - {name: A}
 )";
   const Model model = build_model(parse_scene(text, "per_axis.yaml"));
-  ASSERT_EQ(model.mesh.node_count(), 27);
+  const ElasticBody& body = single_elastic_body(model);
+  ASSERT_EQ(body.mesh.node_count(), 27);
   int fixed_dofs = 0;
   int x_and_z_only = 0;
-  for (int n = 0; n < model.mesh.node_count(); ++n) {
-    const Eigen::Vector3d x = model.mesh.nodes.col(n);
+  for (int n = 0; n < body.mesh.node_count(); ++n) {
+    const Eigen::Vector3d x = body.mesh.nodes.col(n);
     int expected = 0;
     if (std::abs(x.x()) < 1e-12) expected |= 0b001;
     if (std::abs(x.y()) < 1e-12) expected |= 0b010;
     if (std::abs(x.z()) < 1e-12) expected |= 0b100;
-    EXPECT_EQ(int(model.dofs.fixed_axes[n]), int(expected)) << "node at " << x.transpose();
+    EXPECT_EQ(int(body.dofs.fixed_axes[n]), int(expected)) << "node at " << x.transpose();
     for (int a = 0; a < 3; ++a) {
-      EXPECT_EQ(model.dofs.is_fixed(n, a), ((expected >> a) & 1) != 0);
+      EXPECT_EQ(body.dofs.is_fixed(n, a), ((expected >> a) & 1) != 0);
       fixed_dofs += (expected >> a) & 1;
       if (((expected >> a) & 1) == 0) {
-        ASSERT_GE(model.dofs.free_index[3 * n + a], 0);
-        EXPECT_EQ(model.dofs.free_dofs[model.dofs.free_index[3 * n + a]], 3 * n + a);
+        ASSERT_GE(body.dofs.free_index[3 * n + a], 0);
+        EXPECT_EQ(body.dofs.free_dofs[body.dofs.free_index[3 * n + a]], 3 * n + a);
       } else {
-        EXPECT_EQ(model.dofs.free_index[3 * n + a], -1);
+        EXPECT_EQ(body.dofs.free_index[3 * n + a], -1);
       }
     }
     if (expected == 0b101) ++x_and_z_only;
   }
   EXPECT_EQ(x_and_z_only, 2);  // the line x = z = 0 without the origin: y = 0.5 and 1
   EXPECT_EQ(fixed_dofs, 3 * 9);
-  EXPECT_EQ(model.dofs.free_count(), 3 * 27 - fixed_dofs);
+  EXPECT_EQ(body.dofs.free_count(), 3 * 27 - fixed_dofs);
 }
 
 std::string build_error(const std::string& text) {

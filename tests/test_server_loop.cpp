@@ -42,8 +42,9 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
 int movable_surface_nodes(const Model& model) {
+  const ElasticBody& body = single_elastic_body(model);
   int count = 0;
-  for (int node : model.surface.nodes) count += model.dofs.fixed_axes[static_cast<std::size_t>(node)] != kAllAxes;
+  for (int node : body.surface.nodes) count += body.dofs.fixed_axes[static_cast<std::size_t>(node)] != kAllAxes;
   return count;
 }
 
@@ -125,7 +126,7 @@ std::pair<std::optional<std::string>, std::vector<Outbox>> run_for(SimulationLoo
 TEST(SimulationLoop, AStepThatKeepsFailingEndsTheLoopAfterAHundredPacedSteps) {
   LoopRig rig(0);
   rig.options.step_nodes = movable_surface_nodes(*rig.cube.model);
-  SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr,
+  SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
                       wire::monotonic_now_ns());
   const auto start = std::chrono::steady_clock::now();
   const auto [stopped, outboxes] = run_for(loop, 20s);
@@ -148,7 +149,7 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
   // P0: every step sends the known tool's force, and only to its slot.
   {
     LoopRig rig(10, ServeProtocol::p0);
-    SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr,
+    SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
                         wire::monotonic_now_ns());
     const auto [stopped, outboxes] = run_for(loop, 400ms);
     EXPECT_FALSE(stopped.has_value()) << *stopped;
@@ -168,7 +169,7 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
   // P1: the first step builds slot 0's IR; keep-alives follow.
   {
     LoopRig rig(10, ServeProtocol::p1);
-    SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr,
+    SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
                         wire::monotonic_now_ns());
     const auto [stopped, outboxes] = run_for(loop, 400ms);
     EXPECT_FALSE(stopped.has_value());

@@ -177,15 +177,15 @@ SimulationOptions unlimited(int step_delay_nodes = 0, int patch_rings = 1) {
 // Mesh node tags of the IR's nodes in contact at its last evaluation.
 std::vector<std::int64_t> ir_contact_tags(const PreparedIR& prepared) {
   std::vector<std::int64_t> tags;
-  for (int i = 0; i < prepared.ir.row_node_count; ++i)
-    if (prepared.sphere.warm_start.active(i)) tags.push_back(prepared.ir.node_ids[static_cast<std::size_t>(i)]);
+  for (int i = 0; i < condensed_fem(prepared.ir).row_node_count; ++i)
+    if (std::get<PreparedFem>(prepared.body).sphere.warm_start.active(i)) tags.push_back(condensed_fem(prepared.ir).node_ids[static_cast<std::size_t>(i)]);
   std::sort(tags.begin(), tags.end());
   return tags;
 }
 
-std::vector<std::int64_t> tags_of(const Model& model, const std::vector<int>& nodes) {
+std::vector<std::int64_t> tags_of(const ElasticBody& body, const std::vector<int>& nodes) {
   std::vector<std::int64_t> tags;
-  for (int node : nodes) tags.push_back(model.mesh.node_tags[static_cast<std::size_t>(node)]);
+  for (int node : nodes) tags.push_back(body.mesh.node_tags[static_cast<std::size_t>(node)]);
   std::sort(tags.begin(), tags.end());
   return tags;
 }
@@ -201,15 +201,15 @@ struct Comparison {
   int checked = 0, contact_nodes = 0, released_nodes = 0;
 };
 
-void compare(const Model& model, const Simulation& simulation, const std::vector<Eigen::Vector3d>& tools, int user,
+void compare(const ElasticBody& body, const Simulation& simulation, const std::vector<Eigen::Vector3d>& tools, int user,
              Comparison& comparison) {
   const PreparedIR& prepared = *simulation.ir(user);
   std::vector<Eigen::Vector3d> remotes;
-  for (const IrRemoteContact& remote : prepared.ir.remotes) remotes.push_back(tools[static_cast<std::size_t>(remote.user)]);
+  for (int r = 0; r < remote_count(prepared.ir); ++r) remotes.push_back(tools[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
   const ForceSample sample = evaluate_force(prepared, tools[static_cast<std::size_t>(user)], remotes);
   std::vector<PressedTool> pressed;
   for (const Eigen::Vector3d& p : tools) pressed.push_back({p, kRadius});
-  const SphereContactSolution reference = sphere_reactions_reference(model, pressed, held_nodes(simulation));
+  const SphereContactSolution reference = sphere_reactions_reference(body, pressed, held_nodes(simulation));
   const Eigen::Vector3d expected = reference.reactions[static_cast<std::size_t>(user)];
   ASSERT_FALSE(sample.flags & (kOutsidePatch | kContactUnresolved | kNonFinite));
   if (expected.norm() == 0) {
@@ -220,7 +220,7 @@ void compare(const Model& model, const Simulation& simulation, const std::vector
   EXPECT_LE(error, 1e-9) << "user " << user << " at " << tools[static_cast<std::size_t>(user)].transpose() * 1e3 << " mm";
   comparison.worst = std::max(comparison.worst, error);
   // The node set: every node in contact in the reference is one in the IR's last solve.
-  EXPECT_EQ(ir_contact_tags(prepared), tags_of(model, reference.contact_nodes()));
+  EXPECT_EQ(ir_contact_tags(prepared), tags_of(body, reference.contact_nodes()));
   comparison.contact_nodes += static_cast<int>(reference.contact_nodes().size());
   comparison.released_nodes += static_cast<int>(reference.candidates.size() - reference.contact_nodes().size());
   ++comparison.checked;
@@ -228,8 +228,8 @@ void compare(const Model& model, const Simulation& simulation, const std::vector
 
 TEST(SphereContact, OneSphereSlidingEqualsTheFullSparseSolveInForceAndNodeSet) {
   testing::CubeRig& rig = shared_rig();
-  const Model& model = *rig.model;
-  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(1, model.scene.tools[0]), unlimited());
+  const ElasticBody& body = rig.body;
+  Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1, rig.model->scene.tools[0]), unlimited());
   Comparison comparison;
   // Press the centre 4 mm below touching, then slide 20 mm across several nodes.
   for (int k = 0; k <= 24; ++k) {
@@ -239,7 +239,7 @@ TEST(SphereContact, OneSphereSlidingEqualsTheFullSparseSolveInForceAndNodeSet) {
     simulation.set_tool(0, centre);
     simulation.step(k * 1e-3);
     ASSERT_TRUE(simulation.ir(0));
-    compare(model, simulation, {centre}, 0, comparison);
+    compare(body, simulation, {centre}, 0, comparison);
   }
   std::printf("  %d positions: worst relative force error %.2e; %d node contacts, %d held nodes released\n",
               comparison.checked, comparison.worst, comparison.contact_nodes, comparison.released_nodes);
@@ -249,29 +249,29 @@ TEST(SphereContact, OneSphereSlidingEqualsTheFullSparseSolveInForceAndNodeSet) {
 
 TEST(SphereContact, BetweenIrUpdatesTheClientFollowsTheSphereExactly) {
   testing::CubeRig& rig = shared_rig();
-  const Model& model = *rig.model;
-  Simulation simulation(model, *rig.columns, std::vector<ToolSpec>(1, model.scene.tools[0]), unlimited(0, 2));
+  const ElasticBody& body = rig.body;
+  Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1, rig.model->scene.tools[0]), unlimited(0, 2));
   simulation.set_tool(0, mm(0, 0, 27));
   simulation.step(0);
   Comparison comparison;
   // The IR stays the one built at 27 mm; the tool goes 2 mm deeper and 4 mm sideways.
-  for (int k = 0; k <= 10; ++k) compare(model, simulation, {mm(0.4 * k, 0, 27 - 0.2 * k)}, 0, comparison);
+  for (int k = 0; k <= 10; ++k) compare(body, simulation, {mm(0.4 * k, 0, 27 - 0.2 * k)}, 0, comparison);
   std::printf("  one IR, %d positions: worst relative force error %.2e\n", comparison.checked, comparison.worst);
   EXPECT_EQ(comparison.checked, 11);
 }
 
 TEST(SphereContact, TwoSpheresAndHeldNodesEqualTheFullSparseSolve) {
   testing::CubeRig& rig = shared_rig();
-  const Model& model = *rig.model;
+  const ElasticBody& body = rig.body;
   for (int step_delay_nodes : {0, 150}) {
-    Simulation simulation(model, *rig.columns, model.scene.tools, unlimited(step_delay_nodes));
+    Simulation simulation(body, rig.model->obstacles, *rig.columns, rig.model->scene.tools, unlimited(step_delay_nodes));
     Comparison comparison;
     for (int k = 0; k <= 12; ++k) {
       const std::vector<Eigen::Vector3d> tools = {mm(-22 + k, 4, 27 - 0.25 * std::min(k, 8)), mm(21, -6 + 0.5 * k, 26.5)};
       simulation.set_tool(0, tools[0]);
       simulation.set_tool(1, tools[1]);
       simulation.step(k * 1e-3);
-      for (int user = 0; user < 2; ++user) compare(model, simulation, tools, user, comparison);
+      for (int user = 0; user < 2; ++user) compare(body, simulation, tools, user, comparison);
     }
     std::printf("  two spheres, %d held nodes: %d comparisons, worst relative force error %.2e\n", step_delay_nodes,
                 comparison.checked, comparison.worst);
@@ -281,15 +281,15 @@ TEST(SphereContact, TwoSpheresAndHeldNodesEqualTheFullSparseSolve) {
 
 TEST(SphereContact, TheReferenceMeetsTheContactConditionsOnAnIndependentSolve) {
   testing::CubeRig& rig = shared_rig();
-  const Model& model = *rig.model;
+  const ElasticBody& body = rig.body;
   const std::vector<PressedTool> tools = {{mm(-6, 2, 25), kRadius}};  // 7 passed nodes, 4 touching
-  const SphereContactSolution solution = sphere_reactions_reference(model, tools);
+  const SphereContactSolution solution = sphere_reactions_reference(body, tools);
   ASSERT_GT(solution.contact_nodes().size(), 3u);
   // Apply the pushes as loads and solve the whole body once more, with no constraint.
-  Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * model.mesh.node_count());
+  Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * body.mesh.node_count());
   for (std::size_t i = 0; i < solution.candidates.size(); ++i)
     loads.segment<3>(3 * solution.candidates[i]) += solution.pushes[static_cast<Eigen::Index>(i)] * solution.constraints[i].normal;
-  const StaticSolution free = solve_static(model.stiffness, model.dofs, {}, loads);
+  const StaticSolution free = solve_static(body.stiffness, body.dofs, {}, loads);
   double scale = 0;
   for (const SphereConstraint& c : solution.constraints) scale = std::max(scale, -c.gap);
   int touching = 0, released = 0;
@@ -308,8 +308,8 @@ TEST(SphereContact, TheReferenceMeetsTheContactConditionsOnAnIndependentSolve) {
   }
   // The tool's force is what the body's supports take: the pushes sum to minus the reaction.
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (int node = 0; node < model.mesh.node_count(); ++node)
-    if (model.dofs.fixed_axes[static_cast<std::size_t>(node)] != 0) sum += free.reaction.segment<3>(3 * node);
+  for (int node = 0; node < body.mesh.node_count(); ++node)
+    if (body.dofs.fixed_axes[static_cast<std::size_t>(node)] != 0) sum += free.reaction.segment<3>(3 * node);
   EXPECT_LE((sum - solution.reactions[0]).norm(), 1e-9 * solution.reactions[0].norm());
   std::printf("  %d nodes touch the sphere, %d passed nodes released; |F| = %.4f N\n", touching, released,
               solution.reactions[0].norm());

@@ -25,7 +25,8 @@ Scene two_user_cube(int divisions) {
 
 TEST(ContactReference, EqualsTheOneShotFullSolveAndFactorsEachContactSetOnce) {
   const Model model = build_model(two_user_cube(7));
-  ContactReference reference(model);
+  const ElasticBody& body = single_elastic_body(model);
+  ContactReference reference(body);
   std::mt19937 rng(4);
   std::uniform_real_distribution<double> along(-12, 12), depth(0.2, 4);
   int queries = 0;
@@ -35,7 +36,7 @@ TEST(ContactReference, EqualsTheOneShotFullSolveAndFactorsEachContactSetOnce) {
                                             {mm(30 + along(rng), 20 + along(rng), trial % 3 == 0 ? 1.0 : -depth(rng)), 0}};
     const std::vector<Eigen::Vector3d> cached = reference.forces(tools);
     const std::vector<ToolReaction> direct =
-        contact_reactions_reference(model, find_tool_contacts(model, tools), {}, ContactModel::node_translation);
+        contact_reactions_reference(body, find_tool_contacts(body, tools), {}, ContactModel::node_translation);
     for (std::size_t u = 0; u < tools.size(); ++u)
       EXPECT_LE((cached[u] - direct[u].reaction).norm(), 1e-9 * std::max(1e-3, direct[u].reaction.norm()))
           << "trial " << trial << " tool " << u;
@@ -48,12 +49,13 @@ TEST(ContactReference, EqualsTheOneShotFullSolveAndFactorsEachContactSetOnce) {
 
 TEST(ContactReference, WithHeldNodesEqualsTheOneShotFullSolve) {
   const Model model = build_model(two_user_cube(7));
-  ContactReference reference(model);
+  const ElasticBody& body = single_elastic_body(model);
+  ContactReference reference(body);
   // The front face's nodes at its left and right edges and its lower two rows, held at small
   // displacements, as an obstacle would hold them.
   HeldNodes held;
-  for (int node : model.surface.nodes) {
-    const Eigen::Vector3d x = model.mesh.nodes.col(node);
+  for (int node : body.surface.nodes) {
+    const Eigen::Vector3d x = body.mesh.nodes.col(node);
     if (std::abs(x.z()) < 1e-9 && (std::abs(x.x()) > 0.05 || x.y() < -0.04)) {
       held.nodes.push_back(node);
       held.displacement.emplace_back(1e-4, -2e-4, -3e-4 * static_cast<double>(held.nodes.size() % 3));
@@ -67,7 +69,7 @@ TEST(ContactReference, WithHeldNodesEqualsTheOneShotFullSolve) {
                                             {mm(20 + along(rng), 20 + along(rng), -depth(rng)), 0}};
     const std::vector<Eigen::Vector3d> cached = reference.forces(tools, held);
     const std::vector<ToolReaction> direct =
-        contact_reactions_reference(model, find_tool_contacts(model, tools), held, ContactModel::node_translation);
+        contact_reactions_reference(body, find_tool_contacts(body, tools), held, ContactModel::node_translation);
     for (std::size_t u = 0; u < tools.size(); ++u)
       EXPECT_LE((cached[u] - direct[u].reaction).norm(), 1e-9 * direct[u].reaction.norm()) << "trial " << trial;
   }
@@ -75,10 +77,10 @@ TEST(ContactReference, WithHeldNodesEqualsTheOneShotFullSolve) {
   // set may be a simulation step older than the tools).
   HeldNodes under = held;
   const std::vector<PressedTool> one = {{mm(-20, 0, -1), 0}, {mm(20, 20, 1), 0}};
-  under.nodes.push_back(model.surface.triangles[find_tool_contacts(model, one)[0].contact->triangle][0]);
+  under.nodes.push_back(body.surface.triangles[find_tool_contacts(body, one)[0].contact->triangle][0]);
   under.displacement.emplace_back(0, 0, 1e-3);
   const Eigen::Vector3d tool_wins = reference.forces(one, under)[0];
-  const Eigen::Vector3d without = contact_reactions_reference(model, find_tool_contacts(model, one), held,
+  const Eigen::Vector3d without = contact_reactions_reference(body, find_tool_contacts(body, one), held,
                                                               ContactModel::node_translation)[0].reaction;
   EXPECT_LE((tool_wins - without).norm(), 1e-9 * without.norm());
 }
@@ -109,7 +111,7 @@ TEST(Tradeoff, GridVariesOneKnobAtATimeFromTheScenesOwnSettings) {
   EXPECT_EQ(per_knob["divisions"], 2) << "8 is the scene's own";
   EXPECT_EQ(per_knob["haptic_rate_hz"], 3);
   EXPECT_EQ(per_knob.count("boundary_truncation"), 0u) << "no obstacle, nothing held";
-  EXPECT_EQ(scene_with(scene, grid[1]).object.mesh.box->divisions, Eigen::Vector3i(6, 6, 6));
+  EXPECT_EQ(single_elastic_object(scene_with(scene, grid[1])).mesh.box->divisions, Eigen::Vector3i(6, 6, 6));
   // A 1 kHz comparison grid leaves out the haptic rates it cannot sample.
   per_knob.clear();
   for (const TradeoffSetting& s : tradeoff_grid(scene, {}, 1000)) ++per_knob[s.knob];

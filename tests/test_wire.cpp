@@ -165,7 +165,7 @@ TEST(WireHeader, StampsIncreasingSequencesAndMonotonicTime) {
   HeaderStamp stamp(kSession, sender_of_slot(2));
   const Header first = stamp.next();
   const Header second = stamp.next();
-  EXPECT_EQ(first.protocol_version(), 1u);
+  EXPECT_EQ(first.protocol_version(), kProtocolVersion);
   EXPECT_EQ(first.session(), kSession);
   EXPECT_EQ(first.sender(), 3u);
   EXPECT_EQ(first.sequence(), 1u);
@@ -365,8 +365,8 @@ TEST(WireDatagramInspector, RejectsEachHostileDatagramForItsReason) {
                  "oversized with a valid tag");
 
   Datagram version = tool_datagram(11);
-  version.mutable_header()->set_protocol_version(2);
-  expect_outcome(rig.inspector, encode_datagram(version, rig.key), Rejection::bad_version, "version 2");
+  version.mutable_header()->set_protocol_version(kProtocolVersion - 1);  // an older peer
+  expect_outcome(rig.inspector, encode_datagram(version, rig.key), Rejection::bad_version, "an older version");
   Datagram headless = tool_datagram(11);
   headless.clear_header();
   expect_outcome(rig.inspector, encode_datagram(headless, rig.key), Rejection::bad_version, "no header");
@@ -596,14 +596,14 @@ TEST(WireFrame, ReaderReassemblesOneByteFeedsAndSeveralFramesPerFeed) {
 TEST(WireFrame, ReaderCarriesAnIrAcrossTheStream) {
   const SessionKey key = key_of(5);
   Control c = control_with(1, "");
-  c.mutable_ir()->set_format_version(1);
-  for (int i = 0; i < 100000; ++i) c.mutable_ir()->add_m_tilde_f64(i * 0.5);
+  c.mutable_ir()->set_format_version(2);
+  for (int i = 0; i < 100000; ++i) c.mutable_ir()->mutable_fem()->add_m_tilde_f64(i * 0.5);
   FrameReader reader(key);
   reader.feed(encode_frame(c, key));
   const std::optional<Control> received = reader.next();
   ASSERT_TRUE(received);
-  ASSERT_EQ(received->ir().m_tilde_f64_size(), 100000);
-  EXPECT_EQ(received->ir().m_tilde_f64(99999), 99999 * 0.5);
+  ASSERT_EQ(received->ir().fem().m_tilde_f64_size(), 100000);
+  EXPECT_EQ(received->ir().fem().m_tilde_f64(99999), 99999 * 0.5);
 }
 
 TEST(WireFrame, ReaderRejectsOversizedLengthBeforeReceivingThePayload) {
@@ -652,10 +652,11 @@ TEST(WireFrame, ReaderRejectsCorruptedTagsWrongKeysAndBadPayloads) {
 TEST(WireFrame, ReaderChecksVersionBodyAndSequence) {
   const SessionKey key = key_of(5);
   Control v2 = control_with(1, "x");
-  v2.mutable_header()->set_protocol_version(2);
+  v2.mutable_header()->set_protocol_version(kProtocolVersion - 1);
   FrameReader version(key);
   version.feed(encode_frame(v2, key));
-  EXPECT_NE(frame_error(version).find("protocol version 2, expected 1"), std::string::npos);
+  EXPECT_NE(frame_error(version).find(fmt::format("protocol version {}, expected {}", kProtocolVersion - 1, kProtocolVersion)),
+            std::string::npos);
 
   Control bodiless = control_with(1, "x");
   bodiless.clear_body();
@@ -706,7 +707,7 @@ struct IrRig {
   explicit IrRig(IrPrecision precision) : rig(small_cube()) {
     SimulationOptions options;
     options.ir.precision = precision;
-    Simulation simulation(*rig.model, *rig.columns, std::vector<ToolSpec>(2), options);
+    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), options);
     simulation.set_tool(0, {0, 0, -0.002});
     simulation.set_tool(1, {0.03, 0, -0.002});
     simulation.step(0);
@@ -729,14 +730,18 @@ bool bit_equal(const Eigen::DenseBase<Derived>& a, const Eigen::DenseBase<Derive
 
 bool bit_equal(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::memcmp(a.data(), b.data(), 3 * sizeof(double)) == 0; }
 
-void expect_same_ir(const cohaptic::IntermediateRepresentation& a, const cohaptic::IntermediateRepresentation& b) {
-  EXPECT_EQ(a.epoch, b.epoch);
-  EXPECT_EQ(std::memcmp(&a.simulation_time, &b.simulation_time, sizeof(double)), 0);
-  EXPECT_EQ(a.user, b.user);
+void expect_same_ir(const cohaptic::IntermediateRepresentation& envelope_a,
+                    const cohaptic::IntermediateRepresentation& envelope_b) {
+  EXPECT_EQ(envelope_a.epoch, envelope_b.epoch);
+  EXPECT_EQ(std::memcmp(&envelope_a.simulation_time, &envelope_b.simulation_time, sizeof(double)), 0);
+  EXPECT_EQ(envelope_a.user, envelope_b.user);
+  EXPECT_EQ(envelope_a.object, envelope_b.object);
+  EXPECT_EQ(envelope_a.tool_radius, envelope_b.tool_radius);
+  EXPECT_EQ(envelope_a.force_limit, envelope_b.force_limit);
+  const CondensedFemIr& a = condensed_fem(envelope_a);
+  const CondensedFemIr& b = condensed_fem(envelope_b);
   EXPECT_EQ(a.contact_model, b.contact_model);
   EXPECT_EQ(a.precision, b.precision);
-  EXPECT_EQ(a.tool_radius, b.tool_radius);
-  EXPECT_EQ(a.force_limit, b.force_limit);
   EXPECT_EQ(a.node_ids, b.node_ids);
   EXPECT_EQ(a.fixed_axes, b.fixed_axes);
   EXPECT_TRUE(bit_equal(a.rest_positions, b.rest_positions));
@@ -786,18 +791,22 @@ cohaptic::IntermediateRepresentation through_the_wire(const cohaptic::Intermedia
 
 TEST(WireIr, RoundTripIsBitExactInDouble) {
   cohaptic::IntermediateRepresentation ir = sample_ir(IrPrecision::f64);
-  ASSERT_FALSE(ir.remotes.empty());
-  ASSERT_GT(ir.m_tilde.size(), 0);
+  CondensedFemIr& fem = condensed_fem(ir);
+  ASSERT_FALSE(fem.remotes.empty());
+  ASSERT_GT(fem.m_tilde.size(), 0);
   ir.epoch = 0xfedcba9876543210ull;
   ir.simulation_time = 1.0 / 3.0;
+  ir.object = 3;
   ir.force_limit = std::numeric_limits<double>::infinity();  // "no limit" travels too
-  ir.m_tilde(0, 0) = std::nextafter(ir.m_tilde(0, 0), 0.0);  // a value float would not keep
-  const IntermediateRepresentation w = to_wire(ir);
-  EXPECT_EQ(w.m_tilde_f64_size(), ir.m_tilde.size());
+  fem.m_tilde(0, 0) = std::nextafter(fem.m_tilde(0, 0), 0.0);  // a value float would not keep
+  const IntermediateRepresentation wire_ir = to_wire(ir);
+  EXPECT_EQ(wire_ir.format_version(), 2u);
+  const CondensedFem& w = wire_ir.fem();
+  EXPECT_EQ(w.m_tilde_f64_size(), fem.m_tilde.size());
   EXPECT_EQ(w.m_tilde_f32_size(), 0);
-  EXPECT_EQ(w.m_rows(), static_cast<std::uint32_t>(ir.m_tilde.rows()));
+  EXPECT_EQ(w.m_rows(), static_cast<std::uint32_t>(fem.m_tilde.rows()));
   // Column-major: entry (1, 0) follows (0, 0).
-  EXPECT_EQ(w.m_tilde_f64(1), ir.m_tilde(1, 0));
+  EXPECT_EQ(w.m_tilde_f64(1), fem.m_tilde(1, 0));
   expect_same_ir(through_the_wire(ir), ir);
 
   // The received IR evaluates to the same force as the original.
@@ -810,20 +819,23 @@ TEST(WireIr, RoundTripIsBitExactInDouble) {
 
 TEST(WireIr, RoundTripIsExactInFloat) {
   const cohaptic::IntermediateRepresentation& ir = sample_ir(IrPrecision::f32);
-  ASSERT_EQ(ir.precision, IrPrecision::f32);
-  const IntermediateRepresentation w = to_wire(ir);
+  const CondensedFemIr& fem = condensed_fem(ir);
+  ASSERT_EQ(fem.precision, IrPrecision::f32);
+  const IntermediateRepresentation wire_ir = to_wire(ir);
+  const CondensedFem& w = wire_ir.fem();
   EXPECT_EQ(w.m_tilde_f64_size(), 0);
-  ASSERT_EQ(w.m_tilde_f32_size(), ir.m_tilde.size());
-  for (Eigen::Index i = 0; i < ir.m_tilde.size(); ++i) ASSERT_EQ(static_cast<double>(w.m_tilde_f32(static_cast<int>(i))), ir.m_tilde.data()[i]);
+  ASSERT_EQ(w.m_tilde_f32_size(), fem.m_tilde.size());
+  for (Eigen::Index i = 0; i < fem.m_tilde.size(); ++i)
+    ASSERT_EQ(static_cast<double>(w.m_tilde_f32(static_cast<int>(i))), fem.m_tilde.data()[i]);
   expect_same_ir(through_the_wire(ir), ir);
   // Half the bytes of the double version for M~.
-  EXPECT_LT(w.ByteSizeLong(), to_wire(sample_ir(IrPrecision::f64)).ByteSizeLong());
+  EXPECT_LT(wire_ir.ByteSizeLong(), to_wire(sample_ir(IrPrecision::f64)).ByteSizeLong());
 }
 
 TEST(WireIr, FromWireRejectsEveryInconsistency) {
   const IntermediateRepresentation valid = to_wire(sample_ir(IrPrecision::f64));
   ASSERT_NO_THROW(from_wire(valid));
-  ASSERT_GT(valid.remotes_size(), 0);
+  ASSERT_GT(valid.fem().remotes_size(), 0);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   struct Case {
     const char* name;
@@ -831,37 +843,38 @@ TEST(WireIr, FromWireRejectsEveryInconsistency) {
     const char* message;
   };
   const std::vector<Case> cases = {
-      {"format version", [](auto& w) { w.set_format_version(2); }, "format version 2, expected 1"},
-      {"fixed_axes length", [](auto& w) { w.mutable_fixed_axes()->pop_back(); }, "fixed_axes bytes for"},
-      {"fixed_axes mask", [](auto& w) { (*w.mutable_fixed_axes())[0] = 8; }, "not a mask"},
-      {"row count", [](auto& w) { w.set_row_node_count(static_cast<std::uint32_t>(w.node_ids_size() + 1)); }, "exceeds the"},
-      {"patch count", [](auto& w) { w.set_patch_node_count(w.row_node_count() + 1); }, "exceeds row_node_count"},
-      {"rest positions", [](auto& w) { w.mutable_rest_positions()->RemoveLast(); }, "rest_positions has"},
-      {"NaN rest position", [nan](auto& w) { w.set_rest_positions(4, nan); }, "rest_positions[4] is not finite"},
-      {"empty patch", [](auto& w) { w.clear_patch(); }, "no triangle"},
-      {"two-node triangle", [](auto& w) { w.mutable_patch(0)->mutable_nodes()->RemoveLast(); }, "patch[0].nodes has 2 entries"},
-      {"node outside patch", [](auto& w) { w.mutable_patch(0)->set_nodes(1, w.patch_node_count()); }, "outside the patch"},
-      {"neighbour out of range", [](auto& w) { w.mutable_patch(0)->set_neighbours(2, w.patch_size()); }, "neighbours[2]"},
-      {"neighbour below -1", [](auto& w) { w.mutable_patch(0)->set_neighbours(0, -2); }, "neighbours[0] = -2"},
-      {"two edge normals", [](auto& w) { w.mutable_patch(0)->mutable_edge_normals()->RemoveLast(); }, "edge_normals has 2"},
-      {"NaN normal", [nan](auto& w) { w.mutable_patch(0)->mutable_normal()->set_z(nan); }, "patch[0].normal has a non-finite"},
-      {"negative surface index", [](auto& w) { w.mutable_patch(0)->set_surface_index(-1); }, "surface_index is negative"},
-      {"vertex normals", [](auto& w) { w.add_patch_vertex_normals(0); }, "patch_vertex_normals has"},
-      {"guard corners", [](auto& w) { w.add_guard()->add_corners(); }, "corners has 1 entries"},
-      {"remote node", [](auto& w) { w.mutable_remotes(0)->set_nodes(0, w.row_node_count()); }, "outside the contact nodes"},
-      {"remote vertex normals", [](auto& w) { w.mutable_remotes(0)->clear_vertex_normals(); }, "vertex_normals has 0"},
-      {"remote radius", [](auto& w) { w.mutable_remotes(0)->set_tool_radius(-1); }, "tool_radius -1"},
-      {"contact model", [](auto& w) { w.set_contact_model(static_cast<IntermediateRepresentation::ContactModel>(7)); }, "unknown contact model 7"},
+      {"format version", [](auto& w) { w.set_format_version(1); }, "format version 1, expected 2"},
+      {"no body", [](auto& w) { w.clear_fem(); }, "no body of a kind this build knows"},
+      {"fixed_axes length", [](auto& w) { w.mutable_fem()->mutable_fixed_axes()->pop_back(); }, "fixed_axes bytes for"},
+      {"fixed_axes mask", [](auto& w) { (*w.mutable_fem()->mutable_fixed_axes())[0] = 8; }, "not a mask"},
+      {"row count", [](auto& w) { w.mutable_fem()->set_row_node_count(static_cast<std::uint32_t>(w.fem().node_ids_size() + 1)); }, "exceeds the"},
+      {"patch count", [](auto& w) { w.mutable_fem()->set_patch_node_count(w.fem().row_node_count() + 1); }, "exceeds row_node_count"},
+      {"rest positions", [](auto& w) { w.mutable_fem()->mutable_rest_positions()->RemoveLast(); }, "rest_positions has"},
+      {"NaN rest position", [nan](auto& w) { w.mutable_fem()->set_rest_positions(4, nan); }, "rest_positions[4] is not finite"},
+      {"empty patch", [](auto& w) { w.mutable_fem()->clear_patch(); }, "no triangle"},
+      {"two-node triangle", [](auto& w) { w.mutable_fem()->mutable_patch(0)->mutable_nodes()->RemoveLast(); }, "patch[0].nodes has 2 entries"},
+      {"node outside patch", [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_nodes(1, w.fem().patch_node_count()); }, "outside the patch"},
+      {"neighbour out of range", [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_neighbours(2, w.fem().patch_size()); }, "neighbours[2]"},
+      {"neighbour below -1", [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_neighbours(0, -2); }, "neighbours[0] = -2"},
+      {"two edge normals", [](auto& w) { w.mutable_fem()->mutable_patch(0)->mutable_edge_normals()->RemoveLast(); }, "edge_normals has 2"},
+      {"NaN normal", [nan](auto& w) { w.mutable_fem()->mutable_patch(0)->mutable_normal()->set_z(nan); }, "patch[0].normal has a non-finite"},
+      {"negative surface index", [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_surface_index(-1); }, "surface_index is negative"},
+      {"vertex normals", [](auto& w) { w.mutable_fem()->add_patch_vertex_normals(0); }, "patch_vertex_normals has"},
+      {"guard corners", [](auto& w) { w.mutable_fem()->add_guard()->add_corners(); }, "corners has 1 entries"},
+      {"remote node", [](auto& w) { w.mutable_fem()->mutable_remotes(0)->set_nodes(0, w.fem().row_node_count()); }, "outside the contact nodes"},
+      {"remote vertex normals", [](auto& w) { w.mutable_fem()->mutable_remotes(0)->clear_vertex_normals(); }, "vertex_normals has 0"},
+      {"remote radius", [](auto& w) { w.mutable_fem()->mutable_remotes(0)->set_tool_radius(-1); }, "tool_radius -1"},
+      {"contact model", [](auto& w) { w.mutable_fem()->set_contact_model(static_cast<CondensedFem::ContactModel>(7)); }, "unknown contact model 7"},
       {"tool radius", [nan](auto& w) { w.set_tool_radius(nan); }, "tool_radius nan"},
       {"force limit", [](auto& w) { w.set_force_limit(-1); }, "force_limit -1"},
       {"simulation time", [](auto& w) { w.set_simulation_time(std::numeric_limits<double>::infinity()); }, "simulation_time"},
-      {"m_rows", [](auto& w) { w.set_m_rows(w.m_rows() - 1); }, "m_rows"},
-      {"m_cols", [](auto& w) { w.set_m_cols(w.m_cols() + 3); }, "m_cols"},
-      {"M~ length", [](auto& w) { w.mutable_m_tilde_f64()->RemoveLast(); }, "M~ has"},
-      {"NaN in M~", [nan](auto& w) { w.set_m_tilde_f64(5, nan); }, "m_tilde_f64[5] is not finite"},
-      {"u_B length", [](auto& w) { w.add_boundary_displacement_f64(0); }, "u_B has 1 values, expected 0"},
-      {"mixed precision", [](auto& w) { w.add_boundary_displacement_f32(0); }, "mix f64 and f32"},
-      {"M~ in both", [](auto& w) { w.add_m_tilde_f32(1); }, "mix f64 and f32"},
+      {"m_rows", [](auto& w) { w.mutable_fem()->set_m_rows(w.fem().m_rows() - 1); }, "m_rows"},
+      {"m_cols", [](auto& w) { w.mutable_fem()->set_m_cols(w.fem().m_cols() + 3); }, "m_cols"},
+      {"M~ length", [](auto& w) { w.mutable_fem()->mutable_m_tilde_f64()->RemoveLast(); }, "M~ has"},
+      {"NaN in M~", [nan](auto& w) { w.mutable_fem()->set_m_tilde_f64(5, nan); }, "m_tilde_f64[5] is not finite"},
+      {"u_B length", [](auto& w) { w.mutable_fem()->add_boundary_displacement_f64(0); }, "u_B has 1 values, expected 0"},
+      {"mixed precision", [](auto& w) { w.mutable_fem()->add_boundary_displacement_f32(0); }, "mix f64 and f32"},
+      {"M~ in both", [](auto& w) { w.mutable_fem()->add_m_tilde_f32(1); }, "mix f64 and f32"},
       {"user", [](auto& w) { w.set_user(0x80000000u); }, "user = 2147483648"},
   };
   for (const Case& c : cases) {
@@ -888,7 +901,8 @@ TEST(WireIr, FromWireSurvivesMutatedBytes) {
       const cohaptic::IntermediateRepresentation ir = from_wire(w);
       ++converted;
       // Whatever passed is self-consistent enough for the evaluator's own checks.
-      EXPECT_EQ(ir.m_tilde.size(), static_cast<Eigen::Index>(w.m_tilde_f64_size() + w.m_tilde_f32_size()));
+      EXPECT_EQ(condensed_fem(ir).m_tilde.size(),
+                static_cast<Eigen::Index>(w.fem().m_tilde_f64_size() + w.fem().m_tilde_f32_size()));
     } catch (const cohaptic::Error&) {
     }
   }
@@ -900,7 +914,8 @@ TEST(WireIr, FromWireSurvivesMutatedBytes) {
 
 TEST(WireSurfaceMesh, BoxSurfaceInCompactNumbering) {
   const Model model = build_model(parse_scene(testing::cube_scene_yaml(small_cube()), "cube.yaml"));
-  const SurfaceMesh message = surface_mesh_message(model);
+  const ElasticBody& body = single_elastic_body(model);
+  const SurfaceMesh message = surface_mesh_message(body);
   // A 3 x 3 x 3 grid of cells: 4^3 - 2^3 surface nodes, 6 faces x 9 squares x 2 triangles.
   ASSERT_EQ(message.vertices_size(), 3 * 56);
   ASSERT_EQ(message.node_ids_size(), 56);
@@ -911,9 +926,9 @@ TEST(WireSurfaceMesh, BoxSurfaceInCompactNumbering) {
     const Eigen::Vector3d v(message.vertices(3 * i), message.vertices(3 * i + 1), message.vertices(3 * i + 2));
     EXPECT_NEAR((v - centre).lpNorm<Eigen::Infinity>(), 0.065, 1e-12) << "vertex " << i << " is not on the cube's faces";
     ids.insert(message.node_ids(i));
-    const int node = node_index_from_tag(model.mesh, message.node_ids(i));
+    const int node = node_index_from_tag(body.mesh, message.node_ids(i));
     ASSERT_GE(node, 0);
-    EXPECT_EQ(model.mesh.nodes.col(node), v);  // the id names the node at that position
+    EXPECT_EQ(body.mesh.nodes.col(node), v);  // the id names the node at that position
   }
   EXPECT_EQ(ids.size(), 56u);
   std::set<std::pair<std::uint32_t, std::uint32_t>> edges;

@@ -9,13 +9,14 @@
 
 namespace cohaptic {
 
-std::vector<int> nearest_surface_nodes(const Model& model, std::span<const Eigen::Vector3d> points, int count,
+std::vector<int> nearest_surface_nodes(const TetMesh& mesh, const BoundarySurface& surface, const DofMap& dofs,
+                                       std::span<const Eigen::Vector3d> points, int count,
                                        const std::vector<bool>& excluded) {
   std::vector<std::pair<double, int>> candidates;
-  for (int node : model.surface.nodes) {
-    if (model.dofs.fixed_axes[node] == kAllAxes || (!excluded.empty() && excluded[node])) continue;
+  for (int node : surface.nodes) {
+    if (dofs.fixed_axes[node] == kAllAxes || (!excluded.empty() && excluded[node])) continue;
     double nearest = std::numeric_limits<double>::infinity();
-    for (const Eigen::Vector3d& p : points) nearest = std::min(nearest, (model.mesh.nodes.col(node) - p).squaredNorm());
+    for (const Eigen::Vector3d& p : points) nearest = std::min(nearest, (mesh.nodes.col(node) - p).squaredNorm());
     candidates.emplace_back(nearest, node);
   }
   if (count > static_cast<int>(candidates.size()))

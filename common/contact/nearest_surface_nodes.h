@@ -6,14 +6,17 @@
 #include <span>
 #include <vector>
 
-#include "common/model/model.h"
+#include "common/fem/dof_map.h"
+#include "common/mesh/boundary_surface.h"
+#include "common/mesh/tet_mesh.h"
 
 namespace cohaptic {
 
 /// The `count` surface nodes nearest any of `points` [m], nearest first, skipping fully
 /// fixed nodes and nodes marked in `excluded` (per volume node; may be empty). Throws
 /// Error if the surface has fewer such nodes.
-std::vector<int> nearest_surface_nodes(const Model& model, std::span<const Eigen::Vector3d> points, int count,
+std::vector<int> nearest_surface_nodes(const TetMesh& mesh, const BoundarySurface& surface, const DofMap& dofs,
+                                       std::span<const Eigen::Vector3d> points, int count,
                                        const std::vector<bool>& excluded);
 
 }  // namespace cohaptic

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "common/contact/aabb_tree.h"
-#include "common/model/model.h"
+#include "common/contact/obstacle.h"
 
 namespace cohaptic {
 

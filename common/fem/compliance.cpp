@@ -56,7 +56,7 @@ void ComplianceColumns::solve_chunk(std::span<const int> nodes) {
       const int free = dofs_.free_index[3 * nodes[k] + axis];
       if (free >= 0) rhs(free, 3 * k + axis) = 1.0;
     }
-  const Eigen::MatrixXd solution = factor_.solve(rhs);
+  const Eigen::MatrixXd solution = factor_.solve(rhs, workspace_);
   const auto rows = static_cast<Eigen::Index>(3 * row_nodes_.size());
   for (Eigen::Index k = 0; k < count; ++k) {
     ComplianceColumn column = ComplianceColumn::Zero(rows, 3);

@@ -30,7 +30,7 @@ class ComplianceColumns {
   const std::vector<int>& row_nodes() const { return row_nodes_; }
   int node_count() const { return static_cast<int>(row_position_.size()); }
   /// Position of `node` in row_nodes(), or -1.
-  int row_position(int node) const { return row_position_[node]; }
+  int row_position(int node) const { return row_position_[static_cast<std::size_t>(node)]; }
   bool has_column(int node) const { return columns_.count(node) != 0; }
   std::size_t column_count() const { return columns_.size(); }
 
@@ -52,6 +52,7 @@ class ComplianceColumns {
   void solve_chunk(std::span<const int> nodes);
 
   const SparseCholesky& factor_;
+  CholeskyWorkspace workspace_;  // the solves' scratch: the factor itself stays immutable
   const DofMap& dofs_;
   std::vector<int> row_nodes_;
   std::vector<int> row_position_;  // per volume node

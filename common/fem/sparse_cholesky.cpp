@@ -7,30 +7,14 @@
 
 namespace cohaptic {
 
-struct SparseCholesky::Impl {
-  mutable cholmod_common common{};
-  cholmod_factor* factor = nullptr;
-  // Reused solve workspace (cholmod_solve2), so repeated solves do not reallocate.
-  mutable cholmod_dense* solution = nullptr;
-  mutable cholmod_dense* work_y = nullptr;
-  mutable cholmod_dense* work_e = nullptr;
-
-  Impl() {
-    cholmod_start(&common);
-    common.supernodal = CHOLMOD_SUPERNODAL;
-    common.print = 0;           // errors are reported through exceptions, not stdout
-    common.error_handler = nullptr;
-  }
-  ~Impl() {
-    cholmod_free_dense(&solution, &common);
-    cholmod_free_dense(&work_y, &common);
-    cholmod_free_dense(&work_e, &common);
-    cholmod_free_factor(&factor, &common);
-    cholmod_finish(&common);
-  }
-};
-
 namespace {
+
+void start_common(cholmod_common& common) {
+  cholmod_start(&common);
+  common.supernodal = CHOLMOD_SUPERNODAL;
+  common.print = 0;  // errors are reported through exceptions, not stdout
+  common.error_handler = nullptr;
+}
 
 // A read-only CHOLMOD view of an Eigen compressed column matrix (no copy).
 cholmod_sparse view_of(const SparseMatrix& matrix) {
@@ -51,6 +35,39 @@ cholmod_sparse view_of(const SparseMatrix& matrix) {
 }
 
 }  // namespace
+
+// The factor with the common it was analysed and factored with (read-only afterwards).
+struct SparseCholesky::Impl {
+  cholmod_common common{};
+  cholmod_factor* factor = nullptr;
+
+  Impl() { start_common(common); }
+  ~Impl() {
+    cholmod_free_factor(&factor, &common);
+    cholmod_finish(&common);
+  }
+};
+
+// cholmod_solve2's reusable outputs and the common whose workspace the solve uses.
+struct CholeskyWorkspace::Impl {
+  cholmod_common common{};
+  cholmod_dense* solution = nullptr;
+  cholmod_dense* work_y = nullptr;
+  cholmod_dense* work_e = nullptr;
+
+  Impl() { start_common(common); }
+  ~Impl() {
+    cholmod_free_dense(&solution, &common);
+    cholmod_free_dense(&work_y, &common);
+    cholmod_free_dense(&work_e, &common);
+    cholmod_finish(&common);
+  }
+};
+
+CholeskyWorkspace::CholeskyWorkspace() : impl_(std::make_unique<Impl>()) {}
+CholeskyWorkspace::~CholeskyWorkspace() = default;
+CholeskyWorkspace::CholeskyWorkspace(CholeskyWorkspace&&) noexcept = default;
+CholeskyWorkspace& CholeskyWorkspace::operator=(CholeskyWorkspace&&) noexcept = default;
 
 SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row)
     : impl_(std::make_unique<Impl>()), size_(static_cast<int>(matrix.rows())) {
@@ -75,11 +92,18 @@ SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_
   }
   if (!ok || c.status < CHOLMOD_OK)
     throw NumericalError(fmt::format("CHOLMOD factorisation of a {0}x{0} matrix failed (status {1})", size_, c.status));
+  reciprocal_condition_ = cholmod_rcond(impl_->factor, &c);
+  factor_nonzeros_ = c.lnz;
 }
 
 SparseCholesky::~SparseCholesky() = default;
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
+  CholeskyWorkspace workspace;
+  return solve(rhs, workspace);
+}
+
+Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs, CholeskyWorkspace& workspace) const {
   if (rhs.rows() != size_)
     throw NumericalError(fmt::format("solve: right-hand side has {} rows, the factor {}", rhs.rows(), size_));
   Eigen::MatrixXd x(rhs.rows(), rhs.cols());
@@ -92,19 +116,14 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
   b.x = const_cast<double*>(rhs.data());
   b.xtype = CHOLMOD_REAL;
   b.dtype = CHOLMOD_DOUBLE;
-  cholmod_common& c = impl_->common;
-  if (!cholmod_solve2(CHOLMOD_A, impl_->factor, &b, nullptr, &impl_->solution, nullptr, &impl_->work_y,
-                      &impl_->work_e, &c))
-    throw NumericalError(fmt::format("CHOLMOD solve failed (status {})", c.status));
-  const auto* values = static_cast<const double*>(impl_->solution->x);
-  const auto leading = static_cast<Eigen::Index>(impl_->solution->d);
+  CholeskyWorkspace::Impl& w = *workspace.impl_;
+  if (!cholmod_solve2(CHOLMOD_A, impl_->factor, &b, nullptr, &w.solution, nullptr, &w.work_y, &w.work_e, &w.common))
+    throw NumericalError(fmt::format("CHOLMOD solve failed (status {})", w.common.status));
+  const auto* values = static_cast<const double*>(w.solution->x);
+  const auto leading = static_cast<Eigen::Index>(w.solution->d);
   for (Eigen::Index j = 0; j < x.cols(); ++j) x.col(j) = Eigen::Map<const Eigen::VectorXd>(values + j * leading, x.rows());
   return x;
 }
-
-double SparseCholesky::reciprocal_condition_estimate() const { return cholmod_rcond(impl_->factor, &impl_->common); }
-
-double SparseCholesky::factor_nonzeros() const { return impl_->common.lnz; }
 
 bool SparseCholesky::is_supernodal() const { return impl_->factor->is_super != 0; }
 

@@ -40,11 +40,11 @@ std::vector<bool> kept_boundary_nodes(const DofMap& dofs, std::span<const int> b
   return kept;
 }
 
-int nearest_touchable_triangle(const Model& model, const Eigen::Vector3d& position) {
-  return nearest_triangle(model.mesh, model.surface, model.normals, model.touchable_triangles, position).triangle;
+int nearest_touchable_triangle(const ElasticBody& body, const Eigen::Vector3d& position) {
+  return nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, position).triangle;
 }
 
-IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation& condensation,
+IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensation& condensation,
                                     std::span<const UserTool> users, std::size_t user_index,
                                     std::span<const Eigen::Vector3d> boundary_displacement,
                                     const IrBuildOptions& options, std::uint64_t epoch, double simulation_time) {
@@ -53,26 +53,26 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   if (boundary_displacement.size() != boundary.size())
     throw Error(fmt::format("build_ir: {} boundary displacements for {} boundary nodes", boundary_displacement.size(),
                             boundary.size()));
-  if (own.nearest_triangle < 0 || own.nearest_triangle >= model.surface.triangle_count())
+  if (own.nearest_triangle < 0 || own.nearest_triangle >= body.surface.triangle_count())
     throw Error(fmt::format("build_ir: user {} has no nearest triangle", own.user));
 
-  std::vector<bool> held(static_cast<std::size_t>(model.mesh.node_count()), false);
+  std::vector<bool> held(static_cast<std::size_t>(body.mesh.node_count()), false);
   for (int node : boundary) held[node] = true;
   const auto holds_node = [&](int triangle) {
-    const Triangle& tri = model.surface.triangles[triangle];
+    const Triangle& tri = body.surface.triangles[triangle];
     return held[tri[0]] || held[tri[1]] || held[tri[2]];
   };
   if (holds_node(own.nearest_triangle))
     throw Error(fmt::format("build_ir: user {}'s contact triangle has a node held as a boundary node", own.user));
 
-  std::vector<bool> allowed(model.surface.triangles.size(), false);
-  for (int t : model.touchable_triangles) allowed[t] = !holds_node(t);
+  std::vector<bool> allowed(body.surface.triangles.size(), false);
+  for (int t : body.touchable_triangles) allowed[t] = !holds_node(t);
   // The sphere model's patch covers every node the sphere holds (sphere_contact.h).
   const bool sphere = options.contact_model == ContactModel::sphere;
   const auto patch_of = [&](const UserTool& user) {
-    return sphere ? sphere_patch(model.mesh, model.surface, user.nearest_triangle, {user.position, user.radius},
+    return sphere ? sphere_patch(body.mesh, body.surface, user.nearest_triangle, {user.position, user.radius},
                                  options.patch_rings, allowed)
-                  : contact_patch(model.surface, user.nearest_triangle, options.patch_rings, allowed);
+                  : contact_patch(body.surface, user.nearest_triangle, options.patch_rings, allowed);
   };
   const std::vector<int> patch = patch_of(own);
 
@@ -80,10 +80,11 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   ir.epoch = epoch;
   ir.simulation_time = simulation_time;
   ir.user = own.user;
-  ir.contact_model = options.contact_model;
-  ir.precision = options.precision;
   ir.tool_radius = own.radius;
   ir.force_limit = options.force_limit;
+  CondensedFemIr& fem = std::get<CondensedFemIr>(ir.body);
+  fem.contact_model = options.contact_model;
+  fem.precision = options.precision;
 
   // Local numbering: patch nodes, remote contact nodes not in the patch, then B.
   std::vector<int> nodes;
@@ -95,50 +96,50 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   };
   std::unordered_map<int, int> patch_index;
   for (int t : patch) {
-    patch_index.emplace(t, static_cast<int>(ir.patch.size()));
+    patch_index.emplace(t, static_cast<int>(fem.patch.size()));
     IrTriangle tri;
     tri.surface_index = t;
-    for (int k = 0; k < 3; ++k) tri.nodes[k] = add_node(model.surface.triangles[t][k]);
-    tri.normal = model.normals.face[t];
-    ir.patch.push_back(tri);
+    for (int k = 0; k < 3; ++k) tri.nodes[k] = add_node(body.surface.triangles[t][k]);
+    tri.normal = body.normals.face[t];
+    fem.patch.push_back(tri);
   }
-  std::vector<bool> in_guard(model.surface.triangles.size(), false);
+  std::vector<bool> in_guard(body.surface.triangles.size(), false);
   for (std::size_t i = 0; i < patch.size(); ++i)
     for (int k = 0; k < 3; ++k) {
-      const auto it = patch_index.find(model.surface.triangle_neighbours[patch[i]][k]);
-      ir.patch[i].neighbours[k] = it == patch_index.end() ? -1 : it->second;
-      ir.patch[i].edge_normals[k] = edge_pseudo_normal(model.surface, model.normals, patch[i], k);
+      const auto it = patch_index.find(body.surface.triangle_neighbours[patch[i]][k]);
+      fem.patch[i].neighbours[k] = it == patch_index.end() ? -1 : it->second;
+      fem.patch[i].edge_normals[k] = edge_pseudo_normal(body.surface, body.normals, patch[i], k);
     }
-  ir.patch_node_count = static_cast<int>(nodes.size());
-  ir.patch_vertex_normals.resize(3, ir.patch_node_count);
-  for (int i = 0; i < ir.patch_node_count; ++i) ir.patch_vertex_normals.col(i) = model.normals.vertex.col(nodes[i]);
+  fem.patch_node_count = static_cast<int>(nodes.size());
+  fem.patch_vertex_normals.resize(3, fem.patch_node_count);
+  for (int i = 0; i < fem.patch_node_count; ++i) fem.patch_vertex_normals.col(i) = body.normals.vertex.col(nodes[i]);
   // The guard ring: every surface triangle sharing a vertex with the patch, not in it.
-  for (int i = 0; i < ir.patch_node_count; ++i)
-    for (int t : model.surface.node_triangles(nodes[i]))
+  for (int i = 0; i < fem.patch_node_count; ++i)
+    for (int t : body.surface.node_triangles(nodes[i]))
       if (!patch_index.count(t) && !in_guard[t]) {
         in_guard[t] = true;
         IrGuardTriangle guard;
-        for (int k = 0; k < 3; ++k) guard.corners[k] = model.mesh.nodes.col(model.surface.triangles[t][k]);
-        guard.normal = model.normals.face[t];
-        ir.guard.push_back(guard);
+        for (int k = 0; k < 3; ++k) guard.corners[k] = body.mesh.nodes.col(body.surface.triangles[t][k]);
+        guard.normal = body.normals.face[t];
+        fem.guard.push_back(guard);
       }
   for (std::size_t j = 0; j < users.size(); ++j) {
     if (j == user_index || users[j].nearest_triangle < 0 || holds_node(users[j].nearest_triangle)) continue;
     IrRemoteContact remote;
     remote.user = users[j].user;
-    for (int k = 0; k < 3; ++k) remote.nodes[k] = add_node(model.surface.triangles[users[j].nearest_triangle][k]);
+    for (int k = 0; k < 3; ++k) remote.nodes[k] = add_node(body.surface.triangles[users[j].nearest_triangle][k]);
     if (sphere)  // the remote sphere's candidates are contact nodes too
-      for (int node : triangle_nodes(model.surface, patch_of(users[j]))) add_node(node);
+      for (int node : triangle_nodes(body.surface, patch_of(users[j]))) add_node(node);
     const int t = users[j].nearest_triangle;
-    remote.normal = model.normals.face[t];
+    remote.normal = body.normals.face[t];
     for (int k = 0; k < 3; ++k) {
-      remote.edge_normals[k] = edge_pseudo_normal(model.surface, model.normals, t, k);
-      remote.vertex_normals[k] = model.normals.vertex.col(model.surface.triangles[t][k]);
+      remote.edge_normals[k] = edge_pseudo_normal(body.surface, body.normals, t, k);
+      remote.vertex_normals[k] = body.normals.vertex.col(body.surface.triangles[t][k]);
     }
     remote.tool_radius = users[j].radius;
-    ir.remotes.push_back(remote);
+    fem.remotes.push_back(remote);
   }
-  ir.row_node_count = static_cast<int>(nodes.size());
+  fem.row_node_count = static_cast<int>(nodes.size());
   const std::vector<int> contact_nodes = nodes;
   const CondensedOperator op = condensation.condense(contact_nodes);
 
@@ -146,12 +147,12 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   // truncation only those whose coupling to the contact rows is not negligible.
   std::vector<Eigen::Index> kept_columns;
   std::vector<double> kept_displacement;
-  const std::vector<bool> kept = kept_boundary_nodes(model.dofs, boundary, op.m_cb, options.boundary_truncation);
+  const std::vector<bool> kept = kept_boundary_nodes(body.dofs, boundary, op.m_cb, options.boundary_truncation);
   Eigen::Index column = 0;
   for (std::size_t b = 0; b < boundary.size(); ++b) {
     if (kept[b]) add_node(boundary[b]);
     for (int axis = 0; axis < 3; ++axis) {
-      if (model.dofs.is_fixed(boundary[b], axis)) continue;
+      if (body.dofs.is_fixed(boundary[b], axis)) continue;
       if (kept[b]) {
         kept_columns.push_back(column);
         kept_displacement.push_back(boundary_displacement[b][axis]);
@@ -161,20 +162,20 @@ IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation&
   }
 
   for (int node : nodes) {
-    ir.node_ids.push_back(model.mesh.node_tags[node]);
-    ir.fixed_axes.push_back(model.dofs.fixed_axes[node]);
+    fem.node_ids.push_back(body.mesh.node_tags[node]);
+    fem.fixed_axes.push_back(body.dofs.fixed_axes[node]);
   }
-  ir.rest_positions.resize(3, ir.row_node_count);
-  for (int i = 0; i < ir.row_node_count; ++i) ir.rest_positions.col(i) = model.mesh.nodes.col(nodes[i]);
+  fem.rest_positions.resize(3, fem.row_node_count);
+  for (int i = 0; i < fem.row_node_count; ++i) fem.rest_positions.col(i) = body.mesh.nodes.col(nodes[i]);
 
   const auto kept_count = static_cast<Eigen::Index>(kept_columns.size());
-  ir.m_tilde.resize(op.m_cc.rows(), op.m_cc.cols() + kept_count);
-  ir.m_tilde.leftCols(op.m_cc.cols()) = op.m_cc;
-  for (Eigen::Index k = 0; k < kept_count; ++k) ir.m_tilde.col(op.m_cc.cols() + k) = op.m_cb.col(kept_columns[k]);
-  ir.boundary_displacement = Eigen::Map<const Eigen::VectorXd>(kept_displacement.data(), kept_count);
+  fem.m_tilde.resize(op.m_cc.rows(), op.m_cc.cols() + kept_count);
+  fem.m_tilde.leftCols(op.m_cc.cols()) = op.m_cc;
+  for (Eigen::Index k = 0; k < kept_count; ++k) fem.m_tilde.col(op.m_cc.cols() + k) = op.m_cb.col(kept_columns[k]);
+  fem.boundary_displacement = Eigen::Map<const Eigen::VectorXd>(kept_displacement.data(), kept_count);
   if (options.precision == IrPrecision::f32) {
-    ir.m_tilde = ir.m_tilde.cast<float>().cast<double>();
-    ir.boundary_displacement = ir.boundary_displacement.cast<float>().cast<double>();
+    fem.m_tilde = fem.m_tilde.cast<float>().cast<double>();
+    fem.boundary_displacement = fem.boundary_displacement.cast<float>().cast<double>();
   }
   return ir;
 }

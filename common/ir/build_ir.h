@@ -15,7 +15,7 @@
 
 #include "common/condense/incremental_condensation.h"
 #include "common/ir/intermediate_representation.h"
-#include "common/model/model.h"
+#include "common/model/elastic_body.h"
 
 namespace cohaptic {
 
@@ -48,12 +48,12 @@ std::vector<bool> kept_boundary_nodes(const DofMap& dofs, std::span<const int> b
                                       double threshold);
 
 /// The touchable triangle nearest `position` (ties to the one it is deepest below).
-int nearest_touchable_triangle(const Model& model, const Eigen::Vector3d& position);
+int nearest_touchable_triangle(const ElasticBody& body, const Eigen::Vector3d& position);
 
 /// IR for users[user_index]. `boundary_displacement` gives u for each node of
 /// condensation.boundary_nodes(), in that order. Throws Error if the user's nearest
 /// triangle is unknown or holds a boundary node.
-IntermediateRepresentation build_ir(const Model& model, IncrementalCondensation& condensation,
+IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensation& condensation,
                                     std::span<const UserTool> users, std::size_t user_index,
                                     std::span<const Eigen::Vector3d> boundary_displacement,
                                     const IrBuildOptions& options, std::uint64_t epoch, double simulation_time);

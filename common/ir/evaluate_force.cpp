@@ -6,10 +6,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <limits>
 
 #include "common/condense/naive_condensation.h"
 #include "common/contact/closest_point_on_triangle.h"
+#include "common/contact/nearest_triangle_rule.h"
 #include "common/contact/surface_distance.h"
 #include "common/ir/evaluate_sphere_contact.h"
 #include "common/util/error.h"
@@ -33,28 +33,15 @@ struct PatchPoint {
   bool on_border = false;  // nearest the patch's rim or beyond it
 };
 
-PatchPoint nearest_on_patch(const PreparedIR& prepared, const Eigen::Vector3d& p) {
-  const IntermediateRepresentation& ir = prepared.ir;
+PatchPoint nearest_on_patch(const CondensedFemIr& ir, const PreparedFem& prepared, const Eigen::Vector3d& p) {
   PatchPoint best;
-  double best_distance2 = std::numeric_limits<double>::infinity();
-  double best_height = std::numeric_limits<double>::infinity();
+  NearestTriangleRule rule;  // on the patch's surface indices: the server's choice (find_contact.h)
   for (int t = 0; t < static_cast<int>(ir.patch.size()); ++t) {
     const IrTriangle& tri = ir.patch[t];
     const TriangleClosestPoint q = closest_point_on_triangle(p, ir.rest_positions.col(tri.nodes[0]),
                                                              ir.rest_positions.col(tri.nodes[1]),
                                                              ir.rest_positions.col(tri.nodes[2]));
-    const double d2 = (p - q.point).squaredNorm();
-    const double height = (p - q.point).dot(tri.normal);
-    // Ties (an edge or vertex shared by several triangles) go to the triangle the tool is
-    // deepest below, then to the lower surface index: the server's rule (find_contact.h).
-    const double tie = 1e-24 + 1e-12 * best_distance2;
-    const bool same_distance = std::abs(d2 - best_distance2) <= tie;
-    const bool deeper = height < best_height - 1e-15 * std::abs(best_height);
-    const bool same_height = !deeper && height <= best_height + 1e-15 * std::abs(best_height);
-    if (best.triangle < 0 || d2 < best_distance2 - tie ||
-        (same_distance && (deeper || (same_height && tri.surface_index < ir.patch[best.triangle].surface_index)))) {
-      best_distance2 = std::min(d2, best_distance2);
-      best_height = height;
+    if (rule.offer((p - q.point).squaredNorm(), (p - q.point).dot(tri.normal), tri.surface_index)) {
       best.triangle = t;
       best.closest = q;
     }
@@ -72,11 +59,11 @@ PatchPoint nearest_on_patch(const PreparedIR& prepared, const Eigen::Vector3d& p
   best.height = (p - best.closest.point).dot(normal);
 
   // Beyond the rim the guard ring decides the side, with its faces' normals.
-  double guard_distance2 = best_distance2;
+  double guard_distance2 = rule.distance2();
   for (const IrGuardTriangle& guard : ir.guard) {
     const TriangleClosestPoint q = closest_point_on_triangle(p, guard.corners[0], guard.corners[1], guard.corners[2]);
     const double d2 = (p - q.point).squaredNorm();
-    if (d2 < guard_distance2 * (1 - 1e-12) - 1e-24) {
+    if (strictly_nearer(d2, guard_distance2)) {
       guard_distance2 = d2;
       best.height = (p - q.point).dot(guard.normal);
       best.on_border = true;
@@ -85,10 +72,8 @@ PatchPoint nearest_on_patch(const PreparedIR& prepared, const Eigen::Vector3d& p
   return best;
 }
 
-}  // namespace
-
-PreparedIR prepare_ir(IntermediateRepresentation ir) {
-  PreparedIR prepared;
+PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, double& condition_estimate) {
+  PreparedFem prepared;
   const int rows = ir.row_node_count;
   if (ir.node_count() < rows || rows < ir.patch_node_count || ir.patch.empty() ||
       static_cast<int>(ir.fixed_axes.size()) != ir.node_count() || ir.rest_positions.cols() != rows)
@@ -118,7 +103,7 @@ PreparedIR prepare_ir(IntermediateRepresentation ir) {
   prepared.compliance = llt.solve(Eigen::MatrixXd::Identity(x, x));
   prepared.compliance = 0.5 * (prepared.compliance + prepared.compliance.transpose()).eval();
   prepared.free_displacement = -prepared.compliance * (ir.m_tilde.rightCols(b) * ir.boundary_displacement);
-  prepared.condition_estimate = cholesky_condition_estimate(llt.matrixL());
+  condition_estimate = cholesky_condition_estimate(llt.matrixL());
 
   prepared.dof_index.assign(static_cast<std::size_t>(rows), {-1, -1, -1});
   for (int i = 0; i < static_cast<int>(row_dofs.size()); ++i) prepared.dof_index[row_dofs[i] / 3][row_dofs[i] % 3] = i;
@@ -129,34 +114,35 @@ PreparedIR prepare_ir(IntermediateRepresentation ir) {
   for (const IrTriangle& tri : ir.patch)
     for (int k = 0; k < 3; ++k)
       if (tri.neighbours[k] < 0) prepared.on_patch_border[tri.nodes[k]] = prepared.on_patch_border[tri.nodes[(k + 1) % 3]] = true;
-  if (ir.contact_model == ContactModel::sphere) prepared.sphere = prepare_sphere_contact(ir);
-  prepared.ir = std::move(ir);
+  if (ir.contact_model == ContactModel::sphere) prepared.sphere = prepare_sphere_contact(ir, tool_radius);
   return prepared;
 }
 
-ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
-                           std::span<const Eigen::Vector3d> remote_tools) noexcept {
-  if (prepared.ir.contact_model == ContactModel::sphere) return evaluate_sphere_contact(prepared, own_tool, remote_tools);
+// The condensed FEM body's force: `envelope` holds the tool radius and the force limit.
+ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
+                                   const PreparedFem& prepared, const Eigen::Vector3d& own_tool,
+                                   std::span<const Eigen::Vector3d> remote_tools) noexcept {
+  if (ir.contact_model == ContactModel::sphere)
+    return evaluate_sphere_contact(envelope, ir, prepared, own_tool, remote_tools);
   ForceSample sample;
-  const IntermediateRepresentation& ir = prepared.ir;
   if (!own_tool.allFinite()) {
     sample.flags |= kNonFinite;
     return sample;
   }
 
   // 1. The own tool against its patch.
-  const PatchPoint own = nearest_on_patch(prepared, own_tool);
+  const PatchPoint own = nearest_on_patch(ir, prepared, own_tool);
   const IrTriangle& own_triangle = ir.patch[own.triangle];
   sample.triangle = own.triangle;
   if (own.on_border) sample.flags |= kOutsidePatch;
-  if (!(own.height < ir.tool_radius)) return sample;
+  if (!(own.height < envelope.tool_radius)) return sample;
   sample.flags |= kInContact;
 
   std::array<PressingTool, kMaxUsers> pressing;
   int pressing_count = 1;
   pressing[0].nodes = own_triangle.nodes;
   pressing[0].weights = own.closest.weights;
-  pressing[0].displacement = own_tool - ir.tool_radius * own_triangle.normal - own.closest.point;
+  pressing[0].displacement = own_tool - envelope.tool_radius * own_triangle.normal - own.closest.point;
   sample.depth = -pressing[0].displacement.dot(own_triangle.normal);
 
   // 2. Remote tools against their triangles; an unpressed remote's nodes stay unloaded.
@@ -218,8 +204,28 @@ ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& ow
                                            nodal_forces, std::span(tool_forces.data(), static_cast<std::size_t>(pressing_count)));
 
   // 4. Safety: never a non-finite or unbounded force.
-  finish_force(sample, tool_forces[0], solved, ir.force_limit);
+  finish_force(sample, tool_forces[0], solved, envelope.force_limit);
   return sample;
+}
+
+// Prepares the IR's body by its kind.
+struct BodyPreparer {
+  double tool_radius;
+  double& condition_estimate;
+  PreparedBody operator()(const CondensedFemIr& fem) const {
+    return prepare_condensed_fem(fem, tool_radius, condition_estimate);
+  }
+};
+
+}  // namespace
+
+PreparedIR prepare_ir(IntermediateRepresentation ir) {
+  PreparedIR prepared;
+  if (!(std::isfinite(ir.tool_radius) && ir.tool_radius >= 0) || !(ir.force_limit >= 0))
+    throw Error("intermediate representation: tool radius or force limit out of range");
+  prepared.body = std::visit(BodyPreparer{ir.tool_radius, prepared.condition_estimate}, ir.body);
+  prepared.ir = std::move(ir);
+  return prepared;
 }
 
 void finish_force(ForceSample& sample, const Eigen::Vector3d& contact_force, bool solved, double force_limit) noexcept {
@@ -231,6 +237,17 @@ void finish_force(ForceSample& sample, const Eigen::Vector3d& contact_force, boo
     sample.force *= force_limit / magnitude;
     sample.flags |= kClamped;
   }
+}
+
+ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
+                           std::span<const Eigen::Vector3d> remote_tools) noexcept {
+  // get_if, not visit: nothing on this path may throw. prepare_ir made the kinds match.
+  if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body))
+    if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body))
+      return evaluate_condensed_fem(prepared.ir, *fem, *prepared_fem, own_tool, remote_tools);
+  ForceSample unknown;
+  unknown.flags = kNonFinite;
+  return unknown;
 }
 
 }  // namespace cohaptic

@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <span>
+#include <variant>
 #include <vector>
 
 #include "common/ir/contact_solve.h"
@@ -33,14 +34,24 @@
 
 namespace cohaptic {
 
-struct PreparedIR {
-  IntermediateRepresentation ir;
+/// What prepare_ir derives from a CondensedFemIr.
+struct PreparedFem {
   Eigen::MatrixXd compliance;         ///< L~ over the free dofs of the contact nodes [m/N]
   Eigen::VectorXd free_displacement;  ///< u0 over the same dofs [m]
   std::vector<std::array<int, 3>> dof_index;  ///< per contact node and axis: row in L~, or -1 if fixed
   std::vector<bool> on_patch_border;  ///< per patch node
-  double condition_estimate = 1;      ///< of L~
   PreparedSphereContact sphere;       ///< the sphere contact model's (evaluate_sphere_contact.h)
+};
+
+/// One alternative per IrBody alternative, in the same order.
+using PreparedBody = std::variant<PreparedFem>;
+
+/// An IR and what its evaluation needs, computed once: `body` holds the alternative that
+/// matches ir.body's kind (PreparedFem for CondensedFemIr).
+struct PreparedIR {
+  IntermediateRepresentation ir;
+  PreparedBody body;
+  double condition_estimate = 1;      ///< of the body's operator (L~ for FEM)
 };
 
 /// Checks sizes, finiteness and positive definiteness; throws Error naming the problem.
@@ -67,8 +78,9 @@ struct ForceSample {
 /// not finite, and scaled down to `force_limit`; flags it.
 void finish_force(ForceSample& sample, const Eigen::Vector3d& contact_force, bool solved, double force_limit) noexcept;
 
-/// remote_tools[i] is the position of ir.remotes[i]'s tool [m] (NaN: unknown, ignored).
-/// The sphere contact model is evaluate_sphere_contact().
+/// Dispatches on the body kind (a condensed FEM body under the sphere contact model is
+/// evaluate_sphere_contact()). remote_tools[i] is the position of the tool of the body's
+/// i-th remote contact [m] (NaN: unknown, ignored).
 ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
                            std::span<const Eigen::Vector3d> remote_tools) noexcept;
 

@@ -14,10 +14,10 @@ using ContactVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 
 
 }  // namespace
 
-ForceSample evaluate_sphere_contact(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
+ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
+                                    const PreparedFem& prepared, const Eigen::Vector3d& own_tool,
                                     std::span<const Eigen::Vector3d> remote_tools) noexcept {
   ForceSample sample;
-  const IntermediateRepresentation& ir = prepared.ir;
   if (!own_tool.allFinite()) {
     sample.flags |= kNonFinite;
     return sample;
@@ -26,7 +26,7 @@ ForceSample evaluate_sphere_contact(const PreparedIR& prepared, const Eigen::Vec
   // The spheres: the own first, then the remote ones (a non-finite position holds nothing).
   std::array<SphereTool, kMaxUsers> tools;
   std::size_t tool_count = 1;
-  tools[0] = {own_tool, ir.tool_radius};
+  tools[0] = {own_tool, envelope.tool_radius};
   for (std::size_t r = 0; r < ir.remotes.size() && r < remote_tools.size(); ++r) {
     if (tool_count == tools.size()) {
       sample.flags |= kTooManyRemotes;
@@ -57,7 +57,7 @@ ForceSample evaluate_sphere_contact(const PreparedIR& prepared, const Eigen::Vec
   }
   const Eigen::Matrix3Xd& outside = prepared.sphere.outside_corners;
   for (Eigen::Index c = 0; c < outside.cols(); ++c)
-    if ((outside.col(c) - own_tool).norm() < ir.tool_radius) sample.flags |= kOutsidePatch;
+    if ((outside.col(c) - own_tool).norm() < envelope.tool_radius) sample.flags |= kOutsidePatch;
   if (!(sample.flags & kInContact)) return sample;
 
   // Their normal compliance and clearances, from L~ and u0 over the free dofs.
@@ -100,7 +100,7 @@ ForceSample evaluate_sphere_contact(const PreparedIR& prepared, const Eigen::Vec
   Eigen::Vector3d contact_force = Eigen::Vector3d::Zero();
   for (int i = 0; i < m; ++i)
     if (constraint[static_cast<std::size_t>(i)].tool == 0) contact_force += lambda[i] * constraint[static_cast<std::size_t>(i)].normal;
-  finish_force(sample, contact_force, true, ir.force_limit);
+  finish_force(sample, contact_force, true, envelope.force_limit);
   return sample;
 }
 

@@ -26,7 +26,10 @@ namespace cohaptic {
 /// Work budget of one tick's contact solve, in multiply-adds.
 constexpr double kSphereSolveWork = 5e5;
 
-ForceSample evaluate_sphere_contact(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
+/// `envelope` holds the own tool's radius and the force limit; `ir` is its body, `prepared`
+/// what prepare_ir derived from it.
+ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
+                                    const PreparedFem& prepared, const Eigen::Vector3d& own_tool,
                                     std::span<const Eigen::Vector3d> remote_tools) noexcept;
 
 }  // namespace cohaptic

@@ -1,10 +1,19 @@
 #include "common/ir/intermediate_representation.h"
 
+#include <fmt/format.h>
+
+#include "common/util/error.h"
+
 namespace cohaptic {
 
 std::size_t IntermediateRepresentation::size_bytes() const {
+  constexpr std::size_t kEnvelope = 4 + 8 + 8 + 4 + 4 + 8 + 8;  // version .. force_limit
+  return kEnvelope + std::visit([](const auto& content) { return content.size_bytes(); }, body);
+}
+
+std::size_t CondensedFemIr::size_bytes() const {
   const std::size_t scalar = precision == IrPrecision::f32 ? sizeof(float) : sizeof(double);
-  constexpr std::size_t kHeader = 4 + 8 + 8 + 4 + 1 + 1 + 8 + 8 + 4 + 4;  // version .. row_node_count
+  constexpr std::size_t kHeader = 1 + 1 + 4 + 4;  // contact model, precision, patch and row node counts
   const std::size_t nodes = node_ids.size() * (sizeof(std::int64_t) + sizeof(AxisMask)) +
                             static_cast<std::size_t>(rest_positions.size()) * sizeof(double);
   const std::size_t triangles = patch.size() * (7 * sizeof(std::int32_t) + 4 * 3 * sizeof(double)) +
@@ -15,7 +24,26 @@ std::size_t IntermediateRepresentation::size_bytes() const {
   return kHeader + nodes + triangles + remote + matrix;
 }
 
-std::vector<int> ir_dofs(const IntermediateRepresentation& ir, int first_node, int last_node) {
+const CondensedFemIr& condensed_fem(const IntermediateRepresentation& ir) {
+  if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body)) return *fem;
+  throw Error(fmt::format("the IR of user {} (epoch {}) is not a condensed FEM body", ir.user, ir.epoch));
+}
+
+CondensedFemIr& condensed_fem(IntermediateRepresentation& ir) {
+  return const_cast<CondensedFemIr&>(condensed_fem(static_cast<const IntermediateRepresentation&>(ir)));
+}
+
+int remote_count(const IntermediateRepresentation& ir) noexcept {
+  if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body)) return static_cast<int>(fem->remotes.size());
+  return 0;
+}
+
+int remote_user(const IntermediateRepresentation& ir, int i) noexcept {
+  if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body)) return fem->remotes[static_cast<std::size_t>(i)].user;
+  return -1;
+}
+
+std::vector<int> ir_dofs(const CondensedFemIr& ir, int first_node, int last_node) {
   std::vector<int> dofs;
   for (int node = first_node; node < last_node; ++node)
     for (int axis = 0; axis < 3; ++axis)

@@ -1,7 +1,9 @@
-// IntermediateRepresentation (IR): what the simulation exports to one user's haptic loop
-// (the paper's Sec. II-C): the local contact geometry and M~ = (M_CC M_CB).
+// IntermediateRepresentation (IR): what the simulation exports to one user's haptic loop.
+// An envelope (who, when, the tool, the force limit) around one body, a variant over the
+// body kinds: the client prepares and evaluates whichever kind the server sent.
 //
-// Nodes are numbered locally: first the user's own contact patch (the triangle nearest its
+// CondensedFemIr, the linear elastic body's (the paper's Sec. II-C): the local contact
+// geometry and M~ = (M_CC M_CB). Nodes are numbered locally: first the user's own contact patch (the triangle nearest its
 // tool and `patch_rings` rings of neighbours), then the other users' contact triangles
 // (nodes not already in the patch), then the colliding boundary nodes B. The first
 // `row_node_count` nodes (patch and remote contacts) are the contact nodes C: M~ has a row
@@ -17,6 +19,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <variant>
 #include <vector>
 
 #include "common/fem/dof_map.h"
@@ -55,16 +58,9 @@ struct IrRemoteContact {
   double tool_radius = 0;               ///< [m]
 };
 
-struct IntermediateRepresentation {
-  static constexpr std::uint32_t kFormatVersion = 1;
-
-  std::uint64_t epoch = 0;         ///< increases with every IR built for this user
-  double simulation_time = 0;      ///< [s] of the state it was built from
-  int user = 0;
+struct CondensedFemIr {
   ContactModel contact_model = ContactModel::node_translation;
   IrPrecision precision = IrPrecision::f64;
-  double tool_radius = 0;          ///< own tool [m], 0 for a point
-  double force_limit = 0;          ///< [N], the scene's haptic limit
 
   std::vector<std::int64_t> node_ids;  ///< mesh node tags, per local node
   std::vector<AxisMask> fixed_axes;    ///< per local node
@@ -81,12 +77,41 @@ struct IntermediateRepresentation {
   Eigen::VectorXd boundary_displacement;  ///< u_B, free dofs of B [m]
 
   int node_count() const { return static_cast<int>(node_ids.size()); }
-  /// Bytes of the content as sent: header, geometry, M~ and u_B at the stored precision.
+  /// Bytes of the content as sent: geometry, M~ and u_B at the stored precision.
   std::size_t size_bytes() const;
 };
 
+/// One alternative per body kind; the wire's `oneof body` mirrors it.
+using IrBody = std::variant<CondensedFemIr>;
+
+struct IntermediateRepresentation {
+  /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone).
+  static constexpr std::uint32_t kFormatVersion = 2;
+
+  std::uint64_t epoch = 0;         ///< increases with every IR built for this user
+  double simulation_time = 0;      ///< [s] of the state it was built from
+  int user = 0;
+  int object = 0;                  ///< the scene object (body) it describes
+  double tool_radius = 0;          ///< own tool [m], 0 for a point
+  double force_limit = 0;          ///< [N], the scene's haptic limit
+  IrBody body;
+
+  /// Bytes of the content as sent: the envelope and the body.
+  std::size_t size_bytes() const;
+};
+
+/// The IR's body as a condensed FEM body; throws Error naming the user when it is another
+/// kind. For tools and tests that work on FEM bodies, not for the haptic path.
+const CondensedFemIr& condensed_fem(const IntermediateRepresentation& ir);
+CondensedFemIr& condensed_fem(IntermediateRepresentation& ir);
+
+/// The remote tools the body's evaluation takes: how many, and the user slot of the i-th
+/// (0 <= i < remote_count). For the haptic path: no allocation, no exception.
+int remote_count(const IntermediateRepresentation& ir) noexcept;
+int remote_user(const IntermediateRepresentation& ir, int i) noexcept;
+
 /// Free dofs of local nodes [first, last) of `ir`, as (local node, axis) pairs flattened
 /// to 3 * node + axis.
-std::vector<int> ir_dofs(const IntermediateRepresentation& ir, int first_node, int last_node);
+std::vector<int> ir_dofs(const CondensedFemIr& ir, int first_node, int last_node);
 
 }  // namespace cohaptic

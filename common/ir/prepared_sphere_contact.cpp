@@ -27,11 +27,11 @@ void SphereWarmStart::store(std::span<const int> nodes, std::span<const std::uin
   for (std::size_t w = 0; w < words.size(); ++w) words_[w].store(words[w], std::memory_order_relaxed);
 }
 
-PreparedSphereContact prepare_sphere_contact(const IntermediateRepresentation& ir) {
+PreparedSphereContact prepare_sphere_contact(const CondensedFemIr& ir, double tool_radius) {
   if (ir.row_node_count > kMaxSphereCandidates)
     throw Error(fmt::format("intermediate representation: {} contact nodes for the sphere model, at most {}",
                             ir.row_node_count, kMaxSphereCandidates));
-  if (!(ir.tool_radius > 0)) throw Error("intermediate representation: the sphere model needs a sphere tool (radius > 0)");
+  if (!(tool_radius > 0)) throw Error("intermediate representation: the sphere model needs a sphere tool (radius > 0)");
   for (const IrRemoteContact& remote : ir.remotes)
     if (!(remote.tool_radius > 0))
       throw Error(fmt::format("intermediate representation: the sphere model needs a sphere tool, and user {}'s has radius {}",

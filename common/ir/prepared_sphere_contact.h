@@ -44,7 +44,8 @@ struct PreparedSphereContact {
   SphereWarmStart warm_start;
 };
 
-/// Checks the sphere IR's limits (Error naming them) and finds the outside corners.
-PreparedSphereContact prepare_sphere_contact(const IntermediateRepresentation& ir);
+/// Checks the sphere IR's limits (Error naming them) and finds the outside corners;
+/// `tool_radius` is the own tool's [m] (the IR's envelope holds it).
+PreparedSphereContact prepare_sphere_contact(const CondensedFemIr& ir, double tool_radius);
 
 }  // namespace cohaptic

@@ -28,8 +28,8 @@ struct BoundarySurface {
 
   /// Surface triangles incident to volume node `node`.
   std::span<const int> node_triangles(int node) const {
-    const int begin = node_triangle_offsets[node];
-    const int end = node_triangle_offsets[node + 1];
+    const int begin = node_triangle_offsets[static_cast<std::size_t>(node)];
+    const int end = node_triangle_offsets[static_cast<std::size_t>(node) + 1];
     return {node_triangle_list.data() + begin, static_cast<std::size_t>(end - begin)};
   }
 };

@@ -10,8 +10,8 @@
 
 namespace cohaptic {
 
-std::vector<int> compliance_row_nodes(const Model& model, bool whole_surface) {
-  return whole_surface || !model.obstacles.empty() ? model.surface.nodes : model.touchable_nodes;
+std::vector<int> compliance_row_nodes(const ElasticBody& body, bool whole_surface) {
+  return whole_surface ? body.surface.nodes : body.touchable_nodes;
 }
 
 std::filesystem::path default_cache_directory() {
@@ -22,19 +22,19 @@ std::filesystem::path default_cache_directory() {
 
 namespace {
 
-Digest cache_key(const Model& model, const ComplianceColumns& columns) {
-  return compliance_cache_key(model.mesh, model.scene.object.material, model.dofs, columns.row_nodes());
+Digest cache_key(const ElasticBody& body, const ComplianceColumns& columns) {
+  return compliance_cache_key(body.mesh, body.spec.material, body.dofs, columns.row_nodes());
 }
 
 }  // namespace
 
-ComplianceSetup prepare_compliance(const Model& model, ComplianceColumns& columns,
+ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& columns,
                                    const std::optional<std::filesystem::path>& cache_directory) {
   ComplianceSetup setup;
   Stopwatch watch;
-  const bool use_disk = cache_directory.has_value() && model.scene.object.compliance.disk_cache;
+  const bool use_disk = cache_directory.has_value() && body.spec.compliance.disk_cache;
   if (use_disk) {
-    const Digest key = cache_key(model, columns);
+    const Digest key = cache_key(body, columns);
     setup.cache_file = compliance_cache_file(*cache_directory, key);
     const ComplianceCacheLoad load = load_compliance_cache(setup.cache_file, key, columns);
     setup.from_disk = load.loaded;
@@ -43,11 +43,11 @@ ComplianceSetup prepare_compliance(const Model& model, ComplianceColumns& column
     if (!load.loaded && load.problem != "no cache file")
       spdlog::warn("compliance {}; rebuilding it", setup.note);
   }
-  const bool want_all = model.scene.object.compliance.precompute_touchable;
+  const bool want_all = body.spec.compliance.precompute_touchable;
   const std::size_t before = columns.column_count();
-  if (want_all) columns.compute_columns(model.touchable_nodes);
+  if (want_all) columns.compute_columns(body.touchable_nodes);
   if (use_disk && columns.column_count() > before) {
-    save_compliance(model, columns, *cache_directory);
+    save_compliance(body, columns, *cache_directory);
     setup.note += fmt::format("; computed {} columns and saved them", columns.column_count() - before);
   }
   setup.columns = columns.column_count();
@@ -57,8 +57,8 @@ ComplianceSetup prepare_compliance(const Model& model, ComplianceColumns& column
   return setup;
 }
 
-void save_compliance(const Model& model, const ComplianceColumns& columns, const std::filesystem::path& cache_directory) {
-  const Digest key = cache_key(model, columns);
+void save_compliance(const ElasticBody& body, const ComplianceColumns& columns, const std::filesystem::path& cache_directory) {
+  const Digest key = cache_key(body, columns);
   try {
     save_compliance_cache(compliance_cache_file(cache_directory, key), key, columns);
   } catch (const Error& e) {

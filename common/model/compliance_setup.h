@@ -8,14 +8,14 @@
 #include <string>
 
 #include "common/fem/compliance.h"
-#include "common/model/model.h"
+#include "common/model/elastic_body.h"
 
 namespace cohaptic {
 
 /// The nodes whose compliance rows are kept: the touchable surface nodes, or the whole
-/// surface when nodes outside the touchable region can be held (obstacles, step-delay
-/// boundary nodes).
-std::vector<int> compliance_row_nodes(const Model& model, bool whole_surface);
+/// surface (`whole_surface`) when nodes outside the touchable region can be held: the
+/// scene has obstacles, or step-delay boundary nodes are asked for.
+std::vector<int> compliance_row_nodes(const ElasticBody& body, bool whole_surface);
 
 struct ComplianceSetup {
   bool from_disk = false;
@@ -31,10 +31,10 @@ std::filesystem::path default_cache_directory();
 /// Fills `columns` for `model` per its scene's compliance settings (precompute: the
 /// touchable nodes' columns). `cache_directory`
 /// empty disables the disk cache. A cache that cannot be written is logged, not fatal.
-ComplianceSetup prepare_compliance(const Model& model, ComplianceColumns& columns,
+ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& columns,
                                    const std::optional<std::filesystem::path>& cache_directory);
 
 /// Saves the columns computed so far (e.g. on-demand columns at shutdown). Logs failures.
-void save_compliance(const Model& model, const ComplianceColumns& columns, const std::filesystem::path& cache_directory);
+void save_compliance(const ElasticBody& body, const ComplianceColumns& columns, const std::filesystem::path& cache_directory);
 
 }  // namespace cohaptic

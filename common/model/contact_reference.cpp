@@ -4,7 +4,7 @@
 
 namespace cohaptic {
 
-ContactReference::ContactReference(const Model& model) : model_(model) {}
+ContactReference::ContactReference(const ElasticBody& body) : body_(body) {}
 
 const ContactReference::ContactSet& ContactReference::contact_set(const std::vector<ContactQuery>& contacts) {
   std::vector<int> key;
@@ -16,9 +16,9 @@ const ContactReference::ContactSet& ContactReference::contact_set(const std::vec
   std::vector<std::pair<std::size_t, int>> owner;  // per prescribed dof: (pressing index, axis)
   for (std::size_t t = 0; t < contacts.size(); ++t) {
     if (!contacts[t].contact) continue;
-    for (int node : model_.surface.triangles[contacts[t].contact->triangle])
+    for (int node : body_.surface.triangles[contacts[t].contact->triangle])
       for (int axis = 0; axis < 3; ++axis)
-        if (!model_.dofs.is_fixed(node, axis)) {
+        if (!body_.dofs.is_fixed(node, axis)) {
           prescribed.push_back(3 * node + axis);
           owner.emplace_back(set.pressing.size(), axis);
         }
@@ -28,7 +28,7 @@ const ContactReference::ContactSet& ContactReference::contact_set(const std::vec
   set.nodal_per_displacement = Eigen::MatrixXd::Zero(9 * m, 3 * m);
   if (m > 0) {
     ++factorisations_;
-    const ConstrainedStaticSolver solver(model_.stiffness, model_.dofs, prescribed);
+    const ConstrainedStaticSolver solver(body_.stiffness, body_.dofs, prescribed);
     for (Eigen::Index unit = 0; unit < 3 * m; ++unit) {
       Eigen::VectorXd values(static_cast<Eigen::Index>(prescribed.size()));
       for (std::size_t i = 0; i < prescribed.size(); ++i)
@@ -36,10 +36,10 @@ const ContactReference::ContactSet& ContactReference::contact_set(const std::vec
             static_cast<Eigen::Index>(owner[i].first) == unit / 3 && owner[i].second == unit % 3 ? 1.0 : 0.0;
       const StaticSolution solution = solver.solve(values);
       for (Eigen::Index p = 0; p < m; ++p) {
-        const Triangle& tri = model_.surface.triangles[contacts[set.pressing[p]].contact->triangle];
+        const Triangle& tri = body_.surface.triangles[contacts[set.pressing[p]].contact->triangle];
         for (int i = 0; i < 3; ++i)
           for (int axis = 0; axis < 3; ++axis)
-            if (!model_.dofs.is_fixed(tri[i], axis))
+            if (!body_.dofs.is_fixed(tri[i], axis))
               set.nodal_per_displacement(9 * p + 3 * i + axis, unit) = solution.reaction[3 * tri[i] + axis];
       }
     }
@@ -56,24 +56,24 @@ std::vector<Eigen::Vector3d> ContactReference::forces_with_held(const std::vecto
   std::vector<std::pair<int, double>> values;  // (prescribed dof, value), in solver order
   for (const ContactQuery& query : contacts) {
     if (!query.contact) continue;
-    for (int node : model_.surface.triangles[query.contact->triangle])
+    for (int node : body_.surface.triangles[query.contact->triangle])
       for (int axis = 0; axis < 3; ++axis)
-        if (!model_.dofs.is_fixed(node, axis)) values.emplace_back(3 * node + axis, query.contact->displacement[axis]);
+        if (!body_.dofs.is_fixed(node, axis)) values.emplace_back(3 * node + axis, query.contact->displacement[axis]);
   }
-  std::vector<bool> under_tool(static_cast<std::size_t>(model_.mesh.node_count()), false);
+  std::vector<bool> under_tool(static_cast<std::size_t>(body_.mesh.node_count()), false);
   for (const ContactQuery& query : contacts)
     if (query.contact)
-      for (int node : model_.surface.triangles[query.contact->triangle]) under_tool[node] = true;
+      for (int node : body_.surface.triangles[query.contact->triangle]) under_tool[node] = true;
   for (std::size_t h = 0; h < held.nodes.size(); ++h) {
     if (under_tool[held.nodes[h]]) continue;  // the tool wins, as in the simulation
     for (int axis = 0; axis < 3; ++axis)
-      if (!model_.dofs.is_fixed(held.nodes[h], axis))
+      if (!body_.dofs.is_fixed(held.nodes[h], axis))
         values.emplace_back(3 * held.nodes[h] + axis, held.displacement[h][axis]);
   }
   if (!held_solver_ || key != held_key_) {
     std::vector<int> prescribed;
     for (const auto& [dof, value] : values) prescribed.push_back(dof);
-    held_solver_ = std::make_unique<ConstrainedStaticSolver>(model_.stiffness, model_.dofs, std::move(prescribed));
+    held_solver_ = std::make_unique<ConstrainedStaticSolver>(body_.stiffness, body_.dofs, std::move(prescribed));
     held_key_ = std::move(key);
     ++factorisations_;
   }
@@ -83,17 +83,17 @@ std::vector<Eigen::Vector3d> ContactReference::forces_with_held(const std::vecto
   std::vector<Eigen::Vector3d> out(contacts.size(), Eigen::Vector3d::Zero());
   for (std::size_t t = 0; t < contacts.size(); ++t) {
     if (!contacts[t].contact) continue;
-    const Triangle& tri = model_.surface.triangles[contacts[t].contact->triangle];
+    const Triangle& tri = body_.surface.triangles[contacts[t].contact->triangle];
     for (int i = 0; i < 3; ++i)
       for (int axis = 0; axis < 3; ++axis)
-        if (!model_.dofs.is_fixed(tri[i], axis))
+        if (!body_.dofs.is_fixed(tri[i], axis))
           out[t][axis] -= contacts[t].contact->weights[i] * solution.reaction[3 * tri[i] + axis];
   }
   return out;
 }
 
 std::vector<Eigen::Vector3d> ContactReference::forces(const std::vector<PressedTool>& tools, const HeldNodes& held) {
-  const std::vector<ContactQuery> contacts = find_tool_contacts(model_, tools);
+  const std::vector<ContactQuery> contacts = find_tool_contacts(body_, tools);
   if (!held.nodes.empty()) return forces_with_held(contacts, held);
   const ContactSet& set = contact_set(contacts);
   const auto m = static_cast<Eigen::Index>(set.pressing.size());

@@ -25,8 +25,8 @@ namespace cohaptic {
 
 class ContactReference {
  public:
-  /// `model` must outlive the reference.
-  explicit ContactReference(const Model& model);
+  /// `body` must outlive the reference.
+  explicit ContactReference(const ElasticBody& body);
 
   /// Force on each tool [N] (zero for a tool that presses nothing), with `held` nodes at
   /// their displacements (but those under a tool). Throws Error if two tools press
@@ -46,7 +46,7 @@ class ContactReference {
   const ContactSet& contact_set(const std::vector<ContactQuery>& contacts);
   std::vector<Eigen::Vector3d> forces_with_held(const std::vector<ContactQuery>& contacts, const HeldNodes& held);
 
-  const Model& model_;
+  const ElasticBody& body_;
   std::map<std::vector<int>, ContactSet> sets_;  // keyed by contact triangle per tool (-1: none)
   // The latest contact-and-held set: its key, prescribed dofs and factorisation.
   std::vector<int> held_key_;

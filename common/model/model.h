@@ -1,70 +1,43 @@
 // Model: everything compiled once from a Scene and never changed afterwards (after
-// MuJoCo's mjModel): the mesh in metres, its boundary surface, the dof map, the stiffness
-// K and the CHOLMOD factor of K_ff, the touchable region and the obstacles.
+// MuJoCo's mjModel): the scene itself, one compiled body per scene object (a variant over
+// the body kinds, in the scene's order) and the rigid obstacles.
 //
-// Functions that only need the model take it as const&. What the loops mutate (tool
-// positions, active sets, compliance columns computed on demand) lives elsewhere.
-// Units: SI. Node indices are 0-based volume-mesh indices; mesh.node_tags gives the ids
-// a user sees.
+// Functions that only need the model take it as const&. What the loops mutate lives in the
+// simulations (common/sim) and the clients' evaluation state. Units: SI.
 #pragma once
 
-#include <memory>
-#include <optional>
-#include <string>
+#include <variant>
 #include <vector>
 
-#include "common/contact/surface_distance.h"
-#include "common/fem/assemble_stiffness.h"
-#include "common/fem/dof_map.h"
-#include "common/fem/sparse_cholesky.h"
-#include "common/mesh/boundary_surface.h"
-#include "common/mesh/mesh_checks.h"
-#include "common/mesh/triangle_surface.h"
+#include "common/contact/obstacle.h"
+#include "common/model/elastic_body.h"
 #include "common/scene/scene.h"
 
 namespace cohaptic {
 
-struct Obstacle {
-  std::string name;
-  TriangleSurface surface;  ///< [m]; empty for a plane
-  std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> plane;  ///< point [m], unit normal
-};
-
-struct ModelBuildTimings {
-  double mesh_ms = 0;      ///< read or generate, check, extract the surface
-  double assemble_ms = 0;  ///< K
-  double factor_ms = 0;    ///< CHOLMOD analysis + factorisation of K_ff
-};
+/// A compiled scene object: one alternative per BodySpec alternative, in the same order.
+using BodyModel = std::variant<ElasticBody>;
 
 struct Model {
   Scene scene;
-  TetMesh mesh;
-  BoundarySurface surface;
-  SurfacePseudoNormals normals;
-  MeshCheckReport mesh_report;
-  DofMap dofs;
-  SparseMatrix stiffness;                         ///< K, 3N x 3N [N/m]
-  std::unique_ptr<SparseCholesky> free_factor;    ///< K_ff
-  std::vector<int> touchable_nodes;               ///< sorted volume node indices
-  std::vector<int> touchable_triangles;           ///< surface triangle indices
+  std::vector<BodyModel> bodies;  ///< bodies[i] compiled from scene.objects[i]
   std::vector<Obstacle> obstacles;
-  ModelBuildTimings timings;
-
-  /// "node <tag> axis <x|y|z>" for global dof `dof`, for messages.
-  std::string describe_dof(int dof) const;
 };
 
-/// Compiles `scene`. Throws SceneError (a selector that selects nothing, an unknown node
-/// id), MeshError or NumericalError (K_ff not positive definite) with a message naming
-/// the cause. Logs mesh warnings through spdlog.
+/// Compiles `scene`: every object, then the obstacles. Throws the errors of the body
+/// builders (SceneError, MeshError, NumericalError) and Error for an unreadable obstacle.
 Model build_model(const Scene& scene);
 
-/// Nodes chosen by `selector`; `surface_only` restricts to boundary nodes. Sorted.
-/// Throws SceneError naming selector.where if it selects nothing or names an unknown id.
-std::vector<int> select_nodes(const NodeSelector& selector, const TetMesh& mesh, const BoundarySurface& surface,
-                              bool surface_only);
+/// The scene object's name of body `index`.
+const std::string& body_name(const Model& model, int index);
 
-/// Tags of the nodes with at least one fixed axis, ascending.
-std::vector<std::int64_t> fixed_node_tags(const Model& model);
+/// Body `index` as an FEM body. Throws Error naming the object and its model when it is
+/// another kind, or when there is no such body: for tools that only work on FEM bodies.
+const ElasticBody& elastic_body(const Model& model, int index);
+
+/// The scene's only body, as an FEM body: for the tools that work on one FEM object (the
+/// probe, the trade-off, the display). Throws Error naming the scene when it has several
+/// objects or its object is of another kind.
+const ElasticBody& single_elastic_body(const Model& model);
 
 }  // namespace cohaptic

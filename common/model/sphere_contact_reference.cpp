@@ -17,10 +17,10 @@ std::vector<int> SphereContactSolution::contact_nodes() const {
   return nodes;
 }
 
-SphereContactReference::SphereContactReference(const Model& model)
-    : model_(model),
-      candidates_(triangle_nodes(model.surface, model.touchable_triangles)),
-      candidate_row_(static_cast<std::size_t>(model.mesh.node_count()), -1) {
+SphereContactReference::SphereContactReference(const ElasticBody& body)
+    : body_(body),
+      candidates_(triangle_nodes(body.surface, body.touchable_triangles)),
+      candidate_row_(static_cast<std::size_t>(body.mesh.node_count()), -1) {
   for (int node : candidates_) {
     candidate_row_[static_cast<std::size_t>(node)] = static_cast<int>(row_dofs_.size());
     for (int axis = 0; axis < 3; ++axis) row_dofs_.push_back(3 * node + axis);
@@ -34,8 +34,8 @@ void SphereContactReference::factor_for(const HeldNodes& held) {
   std::vector<int> prescribed;
   for (int node : held.nodes)
     for (int axis = 0; axis < 3; ++axis)
-      if (!model_.dofs.is_fixed(node, axis)) prescribed.push_back(3 * node + axis);
-  solver_ = std::make_unique<ConstrainedStaticSolver>(model_.stiffness, model_.dofs, std::move(prescribed));
+      if (!body_.dofs.is_fixed(node, axis)) prescribed.push_back(3 * node + axis);
+  solver_ = std::make_unique<ConstrainedStaticSolver>(body_.stiffness, body_.dofs, std::move(prescribed));
   held_key_ = held.nodes;
   columns_.clear();
   ++factorisations_;
@@ -65,12 +65,12 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   }
   factor_for(held);
 
-  std::vector<bool> is_held(static_cast<std::size_t>(model_.mesh.node_count()), false);
+  std::vector<bool> is_held(static_cast<std::size_t>(body_.mesh.node_count()), false);
   for (int node : held.nodes) is_held[static_cast<std::size_t>(node)] = true;
   std::vector<int> free_candidates;
   for (int node : candidates_)
     if (!is_held[static_cast<std::size_t>(node)]) free_candidates.push_back(node);
-  const HeldBySpheres holding = nodes_held_by_spheres(model_.mesh, model_.dofs, free_candidates, spheres);
+  const HeldBySpheres holding = nodes_held_by_spheres(body_.mesh, body_.dofs, free_candidates, spheres);
 
   SphereContactSolution solution;
   solution.candidates = holding.nodes;
@@ -83,9 +83,9 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   std::vector<double> values;
   for (std::size_t h = 0; h < held.nodes.size(); ++h)
     for (int axis = 0; axis < 3; ++axis)
-      if (!model_.dofs.is_fixed(held.nodes[h], axis)) values.push_back(held.displacement[h][axis]);
+      if (!body_.dofs.is_fixed(held.nodes[h], axis)) values.push_back(held.displacement[h][axis]);
   const Eigen::Map<const Eigen::VectorXd> held_values(values.data(), static_cast<Eigen::Index>(values.size()));
-  Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * model_.mesh.node_count());
+  Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * body_.mesh.node_count());
   if (!held.nodes.empty() || (displacement && m == 0)) u0 = solver_->solve(held_values).displacement;
   if (m == 0) {
     if (displacement) *displacement = u0;
@@ -117,7 +117,7 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
     solution.reactions[static_cast<std::size_t>(c.tool)] -= solution.pushes[i] * c.normal;
   }
   if (displacement) {
-    Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * model_.mesh.node_count());
+    Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * body_.mesh.node_count());
     for (Eigen::Index i = 0; i < m; ++i)
       loads.segment<3>(3 * holding.nodes[static_cast<std::size_t>(i)]) +=
           solution.pushes[i] * holding.constraints[static_cast<std::size_t>(i)].normal;
@@ -126,9 +126,9 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   return solution;
 }
 
-SphereContactSolution sphere_reactions_reference(const Model& model, const std::vector<PressedTool>& tools,
+SphereContactSolution sphere_reactions_reference(const ElasticBody& body, const std::vector<PressedTool>& tools,
                                                  const HeldNodes& held, Eigen::VectorXd* displacement) {
-  return SphereContactReference(model).solve(tools, held, displacement);
+  return SphereContactReference(body).solve(tools, held, displacement);
 }
 
 }  // namespace cohaptic

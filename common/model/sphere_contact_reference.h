@@ -38,8 +38,8 @@ struct SphereContactSolution {
 
 class SphereContactReference {
  public:
-  /// `model` must outlive the reference.
-  explicit SphereContactReference(const Model& model);
+  /// `body` must outlive the reference.
+  explicit SphereContactReference(const ElasticBody& body);
   ~SphereContactReference();
 
   /// Every tool is a sphere (radius > 0). Also returns the displacement field (3N) if asked.
@@ -54,7 +54,7 @@ class SphereContactReference {
   const Eigen::MatrixXd& columns_of(int node);
   void compute_columns(const std::vector<int>& nodes);
 
-  const Model& model_;
+  const ElasticBody& body_;
   std::vector<int> candidates_;      // nodes of the touchable triangles, ascending
   std::vector<int> candidate_row_;   // per volume node: its first row (3 per candidate), or -1
   std::vector<int> row_dofs_;        // global dof of each row
@@ -64,8 +64,8 @@ class SphereContactReference {
   std::size_t factorisations_ = 0;
 };
 
-/// One-shot: SphereContactReference(model).solve(tools, held).
-SphereContactSolution sphere_reactions_reference(const Model& model, const std::vector<PressedTool>& tools,
+/// One-shot: SphereContactReference(body).solve(tools, held).
+SphereContactSolution sphere_reactions_reference(const ElasticBody& body, const std::vector<PressedTool>& tools,
                                                  const HeldNodes& held = {}, Eigen::VectorXd* displacement = nullptr);
 
 }  // namespace cohaptic

@@ -9,16 +9,16 @@
 namespace cohaptic {
 namespace {
 
-const Triangle& contact_triangle(const Model& model, const ContactQuery& query) {
-  return model.surface.triangles[query.contact->triangle];
+const Triangle& contact_triangle(const ElasticBody& body, const ContactQuery& query) {
+  return body.surface.triangles[query.contact->triangle];
 }
 
 // Prescribed dofs and values for the held nodes, and (node translation) the contact nodes.
-void prescribe(const Model& model, const std::vector<int>& nodes, const std::vector<Eigen::Vector3d>& values,
+void prescribe(const ElasticBody& body, const std::vector<int>& nodes, const std::vector<Eigen::Vector3d>& values,
                std::vector<int>& dofs, std::vector<double>& prescribed) {
   for (std::size_t i = 0; i < nodes.size(); ++i)
     for (int axis = 0; axis < 3; ++axis)
-      if (!model.dofs.is_fixed(nodes[i], axis)) {
+      if (!body.dofs.is_fixed(nodes[i], axis)) {
         dofs.push_back(3 * nodes[i] + axis);
         prescribed.push_back(values[i][axis]);
       }
@@ -26,59 +26,59 @@ void prescribe(const Model& model, const std::vector<int>& nodes, const std::vec
 
 }  // namespace
 
-std::vector<ContactQuery> find_tool_contacts(const Model& model, const std::vector<PressedTool>& tools) {
+std::vector<ContactQuery> find_tool_contacts(const ElasticBody& body, const std::vector<PressedTool>& tools) {
   std::vector<ContactQuery> contacts;
-  std::vector<int> owner(static_cast<std::size_t>(model.mesh.node_count()), -1);
+  std::vector<int> owner(static_cast<std::size_t>(body.mesh.node_count()), -1);
   for (std::size_t t = 0; t < tools.size(); ++t) {
-    contacts.push_back(find_contact(model.mesh, model.surface, model.normals, model.touchable_triangles,
+    contacts.push_back(find_contact(body.mesh, body.surface, body.normals, body.touchable_triangles,
                                     tools[t].position, tools[t].radius));
     if (!contacts.back().contact) continue;
-    for (int node : contact_triangle(model, contacts.back())) {
+    for (int node : contact_triangle(body, contacts.back())) {
       if (owner[node] >= 0)
         throw Error(fmt::format("tools {} and {} press triangles that share node {}: move them apart", owner[node] + 1,
-                                t + 1, model.mesh.node_tags[node]));
+                                t + 1, body.mesh.node_tags[node]));
       owner[node] = static_cast<int>(t);
     }
   }
   return contacts;
 }
 
-std::vector<ToolReaction> contact_reactions_reference(const Model& model, const std::vector<ContactQuery>& contacts,
+std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body, const std::vector<ContactQuery>& contacts,
                                                       const HeldNodes& held, ContactModel contact_model,
                                                       Eigen::VectorXd* displacement) {
-  std::vector<bool> is_held(static_cast<std::size_t>(model.mesh.node_count()), false);
+  std::vector<bool> is_held(static_cast<std::size_t>(body.mesh.node_count()), false);
   for (int node : held.nodes) is_held[node] = true;
   std::vector<std::size_t> pressing;
   for (std::size_t t = 0; t < contacts.size(); ++t) {
     if (!contacts[t].contact) continue;
     pressing.push_back(t);
-    for (int node : contact_triangle(model, contacts[t]))
+    for (int node : contact_triangle(body, contacts[t]))
       if (is_held[node])
-        throw Error(fmt::format("node {} is both held and under tool {}", model.mesh.node_tags[node], t + 1));
+        throw Error(fmt::format("node {} is both held and under tool {}", body.mesh.node_tags[node], t + 1));
   }
 
   std::vector<int> dofs;
   std::vector<double> values;
-  prescribe(model, held.nodes, held.displacement, dofs, values);
+  prescribe(body, held.nodes, held.displacement, dofs, values);
   std::vector<ToolReaction> reactions(contacts.size());
   for (std::size_t t = 0; t < contacts.size(); ++t) reactions[t].query = contacts[t];
 
   if (contact_model == ContactModel::node_translation) {
     for (std::size_t t : pressing) {
-      const Triangle& tri = contact_triangle(model, contacts[t]);
+      const Triangle& tri = contact_triangle(body, contacts[t]);
       const Eigen::Vector3d d = contacts[t].contact->displacement;
-      prescribe(model, {tri.begin(), tri.end()}, {d, d, d}, dofs, values);
+      prescribe(body, {tri.begin(), tri.end()}, {d, d, d}, dofs, values);
     }
-    const StaticSolution solution = solve_static(model.stiffness, model.dofs, [&] {
+    const StaticSolution solution = solve_static(body.stiffness, body.dofs, [&] {
       std::vector<PrescribedDisplacement> list;
       for (std::size_t i = 0; i < dofs.size(); ++i) list.push_back({dofs[i], values[i]});
       return list;
     }());
     for (std::size_t t : pressing) {
-      const Triangle& tri = contact_triangle(model, contacts[t]);
+      const Triangle& tri = contact_triangle(body, contacts[t]);
       for (int i = 0; i < 3; ++i)
         for (int axis = 0; axis < 3; ++axis)
-          reactions[t].nodal_forces(axis, i) = model.dofs.is_fixed(tri[i], axis) ? 0.0 : solution.reaction[3 * tri[i] + axis];
+          reactions[t].nodal_forces(axis, i) = body.dofs.is_fixed(tri[i], axis) ? 0.0 : solution.reaction[3 * tri[i] + axis];
       reactions[t].reaction = -(reactions[t].nodal_forces * contacts[t].contact->weights);
     }
     if (displacement) *displacement = solution.displacement;
@@ -86,12 +86,12 @@ std::vector<ToolReaction> contact_reactions_reference(const Model& model, const 
   }
 
   // Point constraint: superpose the held-nodes case and a unit load per tool and axis.
-  const ConstrainedStaticSolver solver(model.stiffness, model.dofs, dofs);
+  const ConstrainedStaticSolver solver(body.stiffness, body.dofs, dofs);
   const Eigen::VectorXd held_values = Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
   const StaticSolution base = solver.solve(held_values);
   const auto m = static_cast<Eigen::Index>(3 * pressing.size());
   const auto contact_point_displacement = [&](const Eigen::VectorXd& u, std::size_t t) {
-    const Triangle& tri = contact_triangle(model, contacts[t]);
+    const Triangle& tri = contact_triangle(body, contacts[t]);
     const Eigen::Vector3d& w = contacts[t].contact->weights;
     return Eigen::Vector3d(w[0] * u.segment<3>(3 * tri[0]) + w[1] * u.segment<3>(3 * tri[1]) + w[2] * u.segment<3>(3 * tri[2]));
   };
@@ -100,8 +100,8 @@ std::vector<ToolReaction> contact_reactions_reference(const Model& model, const 
   Eigen::VectorXd rhs(m);
   for (Eigen::Index k = 0; k < m; ++k) {
     const std::size_t t = pressing[static_cast<std::size_t>(k / 3)];
-    Eigen::VectorXd load = Eigen::VectorXd::Zero(3 * model.mesh.node_count());
-    const Triangle& tri = contact_triangle(model, contacts[t]);
+    Eigen::VectorXd load = Eigen::VectorXd::Zero(3 * body.mesh.node_count());
+    const Triangle& tri = contact_triangle(body, contacts[t]);
     for (int i = 0; i < 3; ++i) load[3 * tri[i] + k % 3] = contacts[t].contact->weights[i];
     unit[static_cast<std::size_t>(k)] = solver.solve(Eigen::VectorXd::Zero(held_values.size()), load);
     for (std::size_t j = 0; j < pressing.size(); ++j)
@@ -114,11 +114,11 @@ std::vector<ToolReaction> contact_reactions_reference(const Model& model, const 
   for (std::size_t j = 0; j < pressing.size(); ++j) {
     const Eigen::Vector3d force = lambda.segment<3>(3 * static_cast<Eigen::Index>(j));
     const std::size_t t = pressing[j];
-    const Triangle& tri = contact_triangle(model, contacts[t]);
+    const Triangle& tri = contact_triangle(body, contacts[t]);
     for (int i = 0; i < 3; ++i)
       for (int axis = 0; axis < 3; ++axis)
         reactions[t].nodal_forces(axis, i) =
-            model.dofs.is_fixed(tri[i], axis) ? 0.0 : contacts[t].contact->weights[i] * force[axis];
+            body.dofs.is_fixed(tri[i], axis) ? 0.0 : contacts[t].contact->weights[i] * force[axis];
     reactions[t].reaction = -force;
   }
   if (displacement) {

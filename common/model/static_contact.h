@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "common/contact/find_contact.h"
-#include "common/model/model.h"
+#include "common/model/elastic_body.h"
 
 namespace cohaptic {
 
@@ -39,11 +39,11 @@ struct ToolReaction {
 
 /// Finds every tool's contact. Throws Error if two tools press triangles sharing a node
 /// (one node cannot follow two tools).
-std::vector<ContactQuery> find_tool_contacts(const Model& model, const std::vector<PressedTool>& tools);
+std::vector<ContactQuery> find_tool_contacts(const ElasticBody& body, const std::vector<PressedTool>& tools);
 
 /// Full sparse solve; also returns the displacement field (3N) if asked. Throws Error if a
 /// held node is also a contact node.
-std::vector<ToolReaction> contact_reactions_reference(const Model& model, const std::vector<ContactQuery>& contacts,
+std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body, const std::vector<ContactQuery>& contacts,
                                                       const HeldNodes& held, ContactModel contact_model,
                                                       Eigen::VectorXd* displacement = nullptr);
 

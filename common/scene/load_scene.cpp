@@ -109,10 +109,10 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
   return mesh;
 }
 
-ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
-  c.only_keys({"name", "mesh", "material", "fixed", "touchable", "compliance"});
-  ObjectSpec object;
-  object.name = c.at("name").text();
+// `model: linear_elastic` (also the default): the keys of an FEM solid.
+ElasticObjectSpec parse_elastic_object(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
+  c.only_keys({"name", "model", "mesh", "material", "fixed", "touchable", "compliance"});
+  ElasticObjectSpec object;
   object.mesh = parse_mesh(c.at("mesh"), scale, scene_dir);
 
   const Cursor material = c.at("material");
@@ -153,6 +153,16 @@ ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::pa
       object.compliance.precompute_touchable = precompute->choice({"touchable", "on_demand"}) == "touchable";
     if (auto disk_cache = compliance->find("disk_cache")) object.compliance.disk_cache = disk_cache->boolean();
   }
+  return object;
+}
+
+ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
+  if (!c.is_map()) c.fail("a map describing a deformable object");
+  ObjectSpec object;
+  object.where = c.location();
+  object.name = c.at("name").text();
+  const std::string model = c.find("model") ? c.at("model").choice({"linear_elastic"}) : "linear_elastic";
+  if (model == "linear_elastic") object.body = parse_elastic_object(c, scale, scene_dir);
   return object;
 }
 
@@ -230,10 +240,12 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
   const std::filesystem::path scene_dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
 
   const Cursor objects = top.at("objects");
-  const auto object_items = objects.items();
-  if (object_items.size() != 1)
-    objects.fail("exactly one object (scenes with several deformable objects are not supported yet)");
-  scene.object = parse_object(object_items[0], scale, scene_dir);
+  std::set<std::string> object_names;
+  for (const Cursor& item : objects.items()) {
+    scene.objects.push_back(parse_object(item, scale, scene_dir));
+    if (!object_names.insert(scene.objects.back().name).second) item.at("name").fail("an object name not used before");
+  }
+  if (scene.objects.empty()) objects.fail("at least one object");
 
   if (auto obstacles = top.find("obstacles"))
     for (const Cursor& item : obstacles->items()) scene.obstacles.push_back(parse_obstacle(item, scale, scene_dir));

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "common/fem/dof_map.h"
@@ -58,13 +59,26 @@ struct ComplianceSettings {
   bool disk_cache = true;            ///< persist computed columns, keyed by a content hash
 };
 
-struct ObjectSpec {
-  std::string name;
+/// `model: linear_elastic`: a solid of linear elastic tetrahedra, condensed for the haptic
+/// clients (the haptic-interface-protocol paper's body).
+struct ElasticObjectSpec {
   MeshSpec mesh;
   LinearElasticMaterial material;
   std::vector<FixedRegion> fixed;
   std::vector<NodeSelector> touchable;  ///< surface nodes a tool may press; triangles with all three
   ComplianceSettings compliance;
+};
+
+/// One alternative per body model a scene may ask for (`model:` in the file). Adding a
+/// model adds an alternative here, and the compiler then names every place that must
+/// learn it (the compiled body, its simulation, its IR body).
+using BodySpec = std::variant<ElasticObjectSpec>;
+
+/// A deformable object of the scene: its name (unique in the scene) and its model's spec.
+struct ObjectSpec {
+  std::string name;
+  BodySpec body;
+  std::string where;  ///< "file:line: objects[i]", for messages
 };
 
 /// A rigid surface: a triangle surface file (FreeSurfer .asc) or an infinite plane.
@@ -95,10 +109,16 @@ struct Scene {
   std::string name;
   std::string units = "m";      ///< the length unit of the file
   double metres_per_unit = 1;
-  ObjectSpec object;            ///< one deformable object per scene for now
+  std::vector<ObjectSpec> objects;  ///< at least one; the tools may press any of them
   std::vector<ObstacleSpec> obstacles;
   std::vector<ToolSpec> tools;
   HapticSettings haptic;
 };
+
+/// The scene's only object as an FEM object, for the tools that vary or read one FEM
+/// object's settings (the trade-off, the probe). Throws Error naming the scene file when it
+/// has several objects or its object is of another model.
+const ElasticObjectSpec& single_elastic_object(const Scene& scene);
+ElasticObjectSpec& single_elastic_object(Scene& scene);
 
 }  // namespace cohaptic

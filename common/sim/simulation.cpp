@@ -11,26 +11,26 @@
 
 namespace cohaptic {
 
-Simulation::Simulation(const Model& model, ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
+Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstacles, ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
                        SimulationOptions options)
-    : model_(model),
+    : body_(body),
       columns_(columns),
       options_(options),
-      condensation_(columns, model.dofs, [&] {
+      condensation_(columns, body.dofs, [&] {
         IncrementalCondensation::Options condensation;
         condensation.naive = options.naive_every_step;
         return condensation;
       }()) {
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
-  if (sphere_model()) sphere_candidates_ = triangle_nodes(model.surface, model.touchable_triangles);
-  if (!model.obstacles.empty()) {
-    Eigen::Matrix3Xd surface_points(3, static_cast<Eigen::Index>(model.surface.nodes.size()));
-    for (std::size_t i = 0; i < model.surface.nodes.size(); ++i)
-      surface_points.col(static_cast<Eigen::Index>(i)) = model.mesh.nodes.col(model.surface.nodes[i]);
-    for (const Obstacle& obstacle : model.obstacles) obstacles_.emplace_back(obstacle, surface_points);
-    rest_clearance_.assign(model.surface.nodes.size(), std::numeric_limits<double>::infinity());
-    for (std::size_t i = 0; i < model.surface.nodes.size(); ++i)
+  if (sphere_model()) sphere_candidates_ = triangle_nodes(body.surface, body.touchable_triangles);
+  if (!obstacles.empty()) {
+    Eigen::Matrix3Xd surface_points(3, static_cast<Eigen::Index>(body.surface.nodes.size()));
+    for (std::size_t i = 0; i < body.surface.nodes.size(); ++i)
+      surface_points.col(static_cast<Eigen::Index>(i)) = body.mesh.nodes.col(body.surface.nodes[i]);
+    for (const Obstacle& obstacle : obstacles) obstacles_.emplace_back(obstacle, surface_points);
+    rest_clearance_.assign(body.surface.nodes.size(), std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < body.surface.nodes.size(); ++i)
       for (const ObstacleDistance& obstacle : obstacles_)
         rest_clearance_[i] = std::min(rest_clearance_[i], obstacle.signed_distance(surface_points.col(static_cast<Eigen::Index>(i))));
   }
@@ -65,7 +65,7 @@ Eigen::VectorXd Simulation::boundary_dof_displacement() const {
   std::vector<double> values;
   for (int node : condensation_.boundary_nodes())
     for (int axis = 0; axis < 3; ++axis)
-      if (!model_.dofs.is_fixed(node, axis)) values.push_back(held_.at(node).displacement[axis]);
+      if (!body_.dofs.is_fixed(node, axis)) values.push_back(held_.at(node).displacement[axis]);
   return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
 }
 
@@ -73,14 +73,14 @@ std::vector<PressingContact> Simulation::pressing_contacts() const {
   std::vector<PressingContact> contacts;
   for (const UserState& user : users_)
     if (user.pressing && user.contact) {
-      const Triangle& tri = model_.surface.triangles[user.contact->triangle];
+      const Triangle& tri = body_.surface.triangles[user.contact->triangle];
       contacts.push_back({{tri[0], tri[1], tri[2]}, user.contact->weights, user.contact->displacement});
     }
   return contacts;
 }
 
 StateSolution Simulation::solve(std::span<const PressingContact> contacts) const {
-  return solve_state(columns_, condensation_, model_.dofs, contacts, boundary_dof_displacement(),
+  return solve_state(columns_, condensation_, body_.dofs, contacts, boundary_dof_displacement(),
                      options_.ir.contact_model);
 }
 
@@ -94,17 +94,17 @@ std::vector<SphereTool> Simulation::spheres() const {
 }
 
 StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) const {
-  return solve_sphere_state(columns_, condensation_, model_.mesh, model_.dofs, sphere_candidates_, spheres,
+  return solve_sphere_state(columns_, condensation_, body_.mesh, body_.dofs, sphere_candidates_, spheres,
                             boundary_dof_displacement());
 }
 
 void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
                              const std::vector<bool>& touchable) const {
   const SphereTool sphere{user.position, user.radius};
-  const std::vector<int> patch = sphere_patch(model_.mesh, model_.surface, user.nearest, sphere, options_.ir.patch_rings, touchable);
-  const std::vector<int> nodes = triangle_nodes(model_.surface, patch);
+  const std::vector<int> patch = sphere_patch(body_.mesh, body_.surface, user.nearest, sphere, options_.ir.patch_rings, touchable);
+  const std::vector<int> nodes = triangle_nodes(body_.surface, patch);
   for (int node : nodes) under_tool[node] = in_patch[node] = true;
-  user.sphere_holds = nodes_held_by_spheres(model_.mesh, model_.dofs, nodes, std::span(&sphere, 1)).nodes;
+  user.sphere_holds = nodes_held_by_spheres(body_.mesh, body_.dofs, nodes, std::span(&sphere, 1)).nodes;
   user.pressing = !user.sphere_holds.empty();
 }
 
@@ -120,22 +120,22 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
     const int node = condensation_.boundary_nodes()[b];
     Eigen::Vector3d force = Eigen::Vector3d::Zero();
     for (int axis = 0; axis < 3; ++axis)
-      if (!model_.dofs.is_fixed(node, axis)) force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
+      if (!body_.dofs.is_fixed(node, axis)) force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
     const HeldNode& held = held_.at(node);
     if (held.obstacle < 0) continue;
-    const Eigen::Vector3d at = model_.mesh.nodes.col(node) + held.displacement;
+    const Eigen::Vector3d at = body_.mesh.nodes.col(node) + held.displacement;
     if (force.dot(obstacles_[held.obstacle].closest_point(at).normal) < 0) pulling.push_back(node);
   }
   // Free nodes whose displaced position penetrates an obstacle are held on it. Only nodes
   // that can reach one are checked: rest clearance below the largest surface displacement.
-  const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, model_.surface.nodes);
+  const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, body_.surface.nodes);
   const double reach = u.colwise().norm().maxCoeff();
   std::vector<std::pair<int, HeldNode>> penetrating;
-  for (std::size_t i = 0; i < model_.surface.nodes.size(); ++i) {
-    const int node = model_.surface.nodes[i];
-    if (rest_clearance_[i] > reach || held_.count(node) || under_tool[node] || model_.dofs.fixed_axes[node] == kAllAxes)
+  for (std::size_t i = 0; i < body_.surface.nodes.size(); ++i) {
+    const int node = body_.surface.nodes[i];
+    if (rest_clearance_[i] > reach || held_.count(node) || under_tool[node] || body_.dofs.fixed_axes[node] == kAllAxes)
       continue;
-    const Eigen::Vector3d rest = model_.mesh.nodes.col(node);
+    const Eigen::Vector3d rest = body_.mesh.nodes.col(node);
     const Eigen::Vector3d moved = rest + u.col(static_cast<Eigen::Index>(i));
     for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
       const ObstaclePoint hit = obstacles_[o].closest_point(moved);
@@ -166,7 +166,7 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
   for (const auto& [node, held] : held_) step_delay_held |= held.obstacle < 0;
   if (options_.step_delay_nodes > 0 && !contact_points.empty() && !step_delay_held) {
     // Chosen outside every user's patch, so that the patches keep their triangles.
-    const std::vector<int> nodes = nearest_surface_nodes(model_, contact_points, options_.step_delay_nodes, in_patch);
+    const std::vector<int> nodes = nearest_surface_nodes(body_.mesh, body_.surface, body_.dofs, contact_points, options_.step_delay_nodes, in_patch);
     std::vector<int> fresh;
     for (int node : nodes)
       if (!held_.count(node)) fresh.push_back(node);
@@ -189,10 +189,10 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
 StepReport Simulation::step(double time) {
   StepReport report;
   std::vector<UserTool> tools;
-  std::vector<bool> under_tool(static_cast<std::size_t>(model_.mesh.node_count()), false);
+  std::vector<bool> under_tool(static_cast<std::size_t>(body_.mesh.node_count()), false);
   std::vector<bool> in_patch(under_tool.size(), false);
-  std::vector<bool> touchable(model_.surface.triangles.size(), false);
-  for (int t : model_.touchable_triangles) touchable[t] = true;
+  std::vector<bool> touchable(body_.surface.triangles.size(), false);
+  for (int t : body_.touchable_triangles) touchable[t] = true;
   for (std::size_t u = 0; u < users_.size(); ++u) {
     UserState& user = users_[u];
     if (!user.known) {
@@ -201,15 +201,15 @@ StepReport Simulation::step(double time) {
       user.ir.reset();
       continue;
     }
-    user.contact = find_contact(model_.mesh, model_.surface, model_.normals, model_.touchable_triangles, user.position,
+    user.contact = find_contact(body_.mesh, body_.surface, body_.normals, body_.touchable_triangles, user.position,
                                 user.radius)
                        .contact;
     user.pressing = user.contact.has_value();
-    user.nearest = nearest_triangle(model_.mesh, model_.surface, model_.normals, model_.touchable_triangles, user.position)
+    user.nearest = nearest_triangle(body_.mesh, body_.surface, body_.normals, body_.touchable_triangles, user.position)
                        .triangle;
-    for (int node : model_.surface.triangles[user.nearest]) under_tool[node] = true;
-    for (int t : contact_patch(model_.surface, user.nearest, options_.ir.patch_rings, touchable))
-      for (int node : model_.surface.triangles[t]) in_patch[node] = true;
+    for (int node : body_.surface.triangles[user.nearest]) under_tool[node] = true;
+    for (int t : contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable))
+      for (int node : body_.surface.triangles[t]) in_patch[node] = true;
     if (sphere_model()) mark_sphere(user, under_tool, in_patch, touchable);
     tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest});
   }
@@ -230,7 +230,7 @@ StepReport Simulation::step(double time) {
     const std::vector<Eigen::Vector3d> held = boundary_displacement();
     for (std::size_t i = 0; i < tools.size(); ++i) {
       UserState& user = users_[tools[i].user];
-      IntermediateRepresentation ir = build_ir(model_, condensation_, tools, i, held, options_.ir, user.epoch + 1, time);
+      IntermediateRepresentation ir = build_ir(body_, condensation_, tools, i, held, options_.ir, user.epoch + 1, time);
       if (!sets_changed) continue;
       ++user.epoch;
       report.ir_bytes += ir.size_bytes();
@@ -251,8 +251,8 @@ StepReport Simulation::step(double time) {
 
 std::vector<Eigen::Vector3d> Simulation::remote_positions(const IntermediateRepresentation& ir) const {
   std::vector<Eigen::Vector3d> positions;
-  for (const IrRemoteContact& remote : ir.remotes) {
-    const UserState& user = users_[remote.user];
+  for (int r = 0; r < remote_count(ir); ++r) {
+    const UserState& user = users_[remote_user(ir, r)];
     positions.push_back(user.known ? user.position : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   }
   return positions;

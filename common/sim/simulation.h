@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -34,7 +35,7 @@
 #include "common/contact/sphere_contact.h"
 #include "common/ir/build_ir.h"
 #include "common/ir/evaluate_force.h"
-#include "common/model/model.h"
+#include "common/model/elastic_body.h"
 #include "common/sim/state_solve.h"
 
 namespace cohaptic {
@@ -59,10 +60,11 @@ struct StepReport {
 
 class Simulation {
  public:
-  /// One user per tool (usually the scene's tools). `model` and `columns` (whose rows
-  /// must include every node that can be held) must outlive it.
-  Simulation(const Model& model, ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
-             SimulationOptions options);
+  /// One user per tool (usually the scene's tools). `body` and `columns` (whose rows
+  /// must include every node that can be held) must outlive it; the body's surface nodes
+  /// collide with `obstacles` (copied into distance queries here).
+  Simulation(const ElasticBody& body, std::span<const Obstacle> obstacles, ComplianceColumns& columns,
+             const std::vector<ToolSpec>& tools, SimulationOptions options);
 
   int user_count() const { return static_cast<int>(users_.size()); }
   void set_tool(int user, const Eigen::Vector3d& position);
@@ -72,12 +74,12 @@ class Simulation {
   StepReport step(double time);
 
   /// Latest IR of `user`; null until its tool position is known.
-  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[user].ir; }
+  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
   /// Reaction force on `user`'s tool now (zero if it has no IR).
   ForceSample force(int user) const;
   /// Positions of the remote tools of `ir`, in its remotes' order (NaN where unknown).
   std::vector<Eigen::Vector3d> remote_positions(const IntermediateRepresentation& ir) const;
-  bool pressing(int user) const { return users_[user].pressing; }
+  bool pressing(int user) const { return users_[static_cast<std::size_t>(user)].pressing; }
 
   /// The whole state solved at the current tool positions.
   StateSolution solve() const;
@@ -119,7 +121,7 @@ class Simulation {
   void release(int node);
   Eigen::VectorXd boundary_dof_displacement() const;
 
-  const Model& model_;
+  const ElasticBody& body_;
   ComplianceColumns& columns_;
   SimulationOptions options_;
   mutable IncrementalCondensation condensation_;  // its Z cache changes on const queries

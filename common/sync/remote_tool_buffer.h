@@ -49,7 +49,7 @@ class RemoteToolBuffer {
     Eigen::Vector3d position = Eigen::Vector3d::Zero();
     bool valid = false;
   };
-  const Sample& sample(int age) const noexcept { return samples_[(head_ - 1 - age + kCapacity) % kCapacity]; }
+  const Sample& sample(int age) const noexcept { return samples_[static_cast<std::size_t>((head_ - 1 - age + kCapacity) % kCapacity)]; }
 
   PlayoutPolicy policy_;
   std::int64_t fixed_delay_ns_;

@@ -30,6 +30,9 @@ Recording read_recording(const std::filesystem::path& file) {
     else if (topic == topic::kHaptic) add(reader, *message, recording.ticks, recording.unknown_messages);
     else if (topic == topic::kSteps) add(reader, *message, recording.steps, recording.unknown_messages);
     else if (topic == topic::kEvents) add(reader, *message, recording.events, recording.unknown_messages);
+    else if (topic == topic::kClientStatus) add(reader, *message, recording.client_statuses, recording.unknown_messages);
+    else if (topic == topic::kViewScene) add(reader, *message, recording.view_scenes, recording.unknown_messages);
+    else if (topic == topic::kViewFrames) add(reader, *message, recording.view_frames, recording.unknown_messages);
     else ++recording.unknown_messages;
   }
   if (configs.empty() && recording.ticks.empty() && recording.steps.empty())

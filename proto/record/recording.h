@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cohaptic/recording.pb.h"
+#include "cohaptic/view.pb.h"
 
 namespace cohaptic::record {
 
@@ -20,6 +21,9 @@ struct Recording {
   std::vector<HapticTick> ticks;
   std::vector<SimulationStep> steps;
   std::vector<SessionEvent> events;
+  std::vector<ReceivedClientStatus> client_statuses;  ///< server: the users' status reports
+  std::vector<view::Scene> view_scenes;               ///< server with --view: its live view's scene (one)
+  std::vector<view::Frame> view_frames;               ///< and every frame
   bool truncated = false;
   std::string truncation;         ///< where, if truncated
   std::size_t unknown_messages = 0;  ///< on channels this build does not know

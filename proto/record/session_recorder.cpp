@@ -19,6 +19,9 @@ SessionRecorder::SessionRecorder(const std::filesystem::path& file) : file_(file
   haptic_ = channel(HapticTick::descriptor(), topic::kHaptic);
   steps_ = channel(SimulationStep::descriptor(), topic::kSteps);
   events_ = channel(SessionEvent::descriptor(), topic::kEvents);
+  client_status_ = channel(ReceivedClientStatus::descriptor(), topic::kClientStatus);
+  view_scene_ = channel(view::Scene::descriptor(), topic::kViewScene);
+  view_frames_ = channel(view::Frame::descriptor(), topic::kViewFrames);
   writer_->flush();
 }
 
@@ -72,6 +75,14 @@ void SessionRecorder::event(std::int64_t time_ns, const std::string& kind, const
   }
   write(events_, time_ns, record);
 }
+
+void SessionRecorder::client_status(const ReceivedClientStatus& status) {
+  write(client_status_, status.receive_time_ns(), status);
+}
+
+void SessionRecorder::view_scene(std::int64_t time_ns, const view::Scene& scene) { write(view_scene_, time_ns, scene); }
+
+void SessionRecorder::view_frame(std::int64_t time_ns, const view::Frame& frame) { write(view_frames_, time_ns, frame); }
 
 void SessionRecorder::flush_if_due() {
   std::lock_guard lock(mutex_);

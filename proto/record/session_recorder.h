@@ -1,7 +1,9 @@
 // SessionRecorder: one process's recording of a session, in MCAP with the protobuf schemas
 // embedded (opens in Foxglove Studio / Lichtblick). One channel per recording.proto type:
 //   /config (SessionConfig, first), /datagrams_in (ReceivedDatagram), /ir (RecordedIr),
-//   /haptic (HapticTick, clients), /steps (SimulationStep, the server), /events.
+//   /haptic (HapticTick, clients), /steps (SimulationStep, the server), /events; the server
+//   also /client_status (ReceivedClientStatus) and, with --view, /view_scene and
+//   /view_frames (view.proto's Scene and Frame, as its browsers get them).
 // Log times are the recording process's monotonic nanoseconds. Records are flushed at least
 // every 100 ms, so a killed process leaves a file readable up to its last complete record.
 //
@@ -17,6 +19,7 @@
 #include <string>
 
 #include "cohaptic/recording.pb.h"
+#include "cohaptic/view.pb.h"
 
 namespace cohaptic::record {
 
@@ -30,6 +33,9 @@ inline constexpr const char* kIr = "/ir";
 inline constexpr const char* kHaptic = "/haptic";
 inline constexpr const char* kSteps = "/steps";
 inline constexpr const char* kEvents = "/events";
+inline constexpr const char* kClientStatus = "/client_status";
+inline constexpr const char* kViewScene = "/view_scene";
+inline constexpr const char* kViewFrames = "/view_frames";
 }  // namespace topic
 
 /// The user an event is about.
@@ -54,6 +60,9 @@ class SessionRecorder {
   /// An event; joins and leaves name their user and slot, so a user can be found by name.
   void event(std::int64_t time_ns, const std::string& kind, const std::string& text,
              const std::optional<EventUser>& user = std::nullopt);
+  void client_status(const ReceivedClientStatus& status);
+  void view_scene(std::int64_t time_ns, const view::Scene& scene);
+  void view_frame(std::int64_t time_ns, const view::Frame& frame);
   /// Hands buffered records to the file if the flush interval has passed.
   void flush_if_due();
   /// Writes the summary and footer; later records are dropped.
@@ -69,6 +78,7 @@ class SessionRecorder {
   mutable std::mutex mutex_;
   std::unique_ptr<McapWriter> writer_;
   std::uint16_t config_ = 0, datagrams_ = 0, ir_ = 0, haptic_ = 0, steps_ = 0, events_ = 0;
+  std::uint16_t client_status_ = 0, view_scene_ = 0, view_frames_ = 0;
   std::uint32_t sequence_ = 0;
   bool failed_ = false;
 };

@@ -14,7 +14,7 @@
 
 namespace cohaptic::wire {
 
-constexpr std::uint32_t kProtocolVersion = 1;
+constexpr std::uint32_t kProtocolVersion = 2;  ///< 2: IR format 2 (an envelope around a body)
 
 /// Sender ids in Header.sender: 0 the server, k + 1 the user in slot k.
 constexpr std::uint32_t kServerSender = 0;

@@ -49,7 +49,7 @@ std::array<Eigen::Vector3d, 3> read_triple(const Triples& vectors, const std::st
   std::array<Eigen::Vector3d, 3> out;
   for (int k = 0; k < 3; ++k) {
     check_vec3(vectors[k], fmt::format("{}[{}]", what, k));
-    out[k] = from_wire(vectors[k]);
+    out[static_cast<std::size_t>(k)] = from_wire(vectors[k]);
   }
   return out;
 }
@@ -66,7 +66,7 @@ std::array<int, 3> read_nodes(const google::protobuf::RepeatedField<std::uint32_
   std::array<int, 3> out{};
   for (int k = 0; k < 3; ++k) {
     if (nodes[k] >= limit) invalid("{}.nodes[{}] = {} is outside the {} ({} nodes)", what, k, nodes[k], range, limit);
-    out[k] = static_cast<int>(nodes[k]);
+    out[static_cast<std::size_t>(k)] = static_cast<int>(nodes[k]);
   }
   return out;
 }
@@ -90,7 +90,7 @@ int to_int(std::uint32_t value, const char* what) {
 std::size_t free_dofs(const std::string& fixed_axes, std::size_t first, std::size_t last) {
   std::size_t count = 0;
   for (std::size_t i = first; i < last; ++i)
-    for (int axis = 0; axis < 3; ++axis) count += ((static_cast<unsigned char>(fixed_axes[i]) >> axis) & 1u) ? 0 : 1;
+    for (int axis = 0; axis < 3; ++axis) count += ((static_cast<unsigned char>(fixed_axes[i]) >> axis) & 1u) ? 0u : 1u;
   return count;
 }
 
@@ -106,17 +106,12 @@ void read_values(const Field& values, Target& out, const char* what) {
 
 }  // namespace
 
-void to_wire(const CommonIr& ir, WireIr* out) {
-  out->Clear();
-  out->set_format_version(CommonIr::kFormatVersion);
-  out->set_epoch(ir.epoch);
-  out->set_simulation_time(ir.simulation_time);
-  out->set_user(static_cast<std::uint32_t>(ir.user));
-  out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? WireIr::POINT
-                         : ir.contact_model == ContactModel::sphere         ? WireIr::SPHERE
-                                                                            : WireIr::TRANSLATION);
-  out->set_tool_radius(ir.tool_radius);
-  out->set_force_limit(ir.force_limit);
+namespace {
+
+void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
+  out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? CondensedFem::POINT
+                         : ir.contact_model == ContactModel::sphere         ? CondensedFem::SPHERE
+                                                                            : CondensedFem::TRANSLATION);
   out->mutable_node_ids()->Reserve(static_cast<int>(ir.node_ids.size()));
   for (std::int64_t id : ir.node_ids) out->mutable_node_ids()->AddAlreadyReserved(id);
   out->set_fixed_axes(std::string(ir.fixed_axes.begin(), ir.fixed_axes.end()));
@@ -159,31 +154,42 @@ void to_wire(const CommonIr& ir, WireIr* out) {
   }
 }
 
+// Writes the IR's body into the wire's oneof, by kind.
+struct BodyToWire {
+  WireIr* out;
+  void operator()(const CondensedFemIr& fem) const { fem_to_wire(fem, out->mutable_fem()); }
+};
+
+}  // namespace
+
+void to_wire(const CommonIr& ir, WireIr* out) {
+  out->Clear();
+  out->set_format_version(CommonIr::kFormatVersion);
+  out->set_epoch(ir.epoch);
+  out->set_simulation_time(ir.simulation_time);
+  out->set_user(static_cast<std::uint32_t>(ir.user));
+  out->set_object(static_cast<std::uint32_t>(ir.object));
+  out->set_tool_radius(ir.tool_radius);
+  out->set_force_limit(ir.force_limit);
+  std::visit(BodyToWire{out}, ir.body);
+}
+
 WireIr to_wire(const CommonIr& ir) {
   WireIr out;
   to_wire(ir, &out);
   return out;
 }
 
-CommonIr from_wire(const WireIr& w) {
-  if (w.format_version() != CommonIr::kFormatVersion)
-    invalid("format version {}, expected {}", w.format_version(), CommonIr::kFormatVersion);
-  CommonIr ir;
-  ir.epoch = w.epoch();
-  if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());
-  ir.simulation_time = w.simulation_time();
-  ir.user = to_int(w.user(), "user");
+namespace {
+
+CondensedFemIr fem_from_wire(const CondensedFem& w) {
+  CondensedFemIr ir;
   switch (w.contact_model()) {
-    case WireIr::TRANSLATION: ir.contact_model = ContactModel::node_translation; break;
-    case WireIr::POINT: ir.contact_model = ContactModel::point_constraint; break;
-    case WireIr::SPHERE: ir.contact_model = ContactModel::sphere; break;
+    case CondensedFem::TRANSLATION: ir.contact_model = ContactModel::node_translation; break;
+    case CondensedFem::POINT: ir.contact_model = ContactModel::point_constraint; break;
+    case CondensedFem::SPHERE: ir.contact_model = ContactModel::sphere; break;
     default: invalid("unknown contact model {}", static_cast<int>(w.contact_model()));
   }
-  if (!(std::isfinite(w.tool_radius()) && w.tool_radius() >= 0)) invalid("tool_radius {} is not a finite length >= 0", w.tool_radius());
-  ir.tool_radius = w.tool_radius();
-  // +inf is a legitimate "no limit".
-  if (!(w.force_limit() >= 0)) invalid("force_limit {} is not >= 0", w.force_limit());
-  ir.force_limit = w.force_limit();
 
   // Nodes.
   const auto nodes = static_cast<std::uint32_t>(w.node_ids_size());
@@ -217,7 +223,7 @@ CommonIr from_wire(const WireIr& w) {
       const std::int32_t n = t.neighbours(k);
       if (n < -1 || n >= w.patch_size())
         invalid("{}.neighbours[{}] = {} is neither -1 nor one of the {} patch triangles", what, k, n, w.patch_size());
-      tri.neighbours[k] = n;
+      tri.neighbours[static_cast<std::size_t>(k)] = n;
     }
     tri.edge_normals = read_triple(t.edge_normals(), what + ".edge_normals");
     ir.patch.push_back(tri);
@@ -269,6 +275,30 @@ CommonIr from_wire(const WireIr& w) {
   } else {
     read_values(w.m_tilde_f64(), ir.m_tilde, "m_tilde_f64");
     read_values(w.boundary_displacement_f64(), ir.boundary_displacement, "boundary_displacement_f64");
+  }
+  return ir;
+}
+
+}  // namespace
+
+CommonIr from_wire(const WireIr& w) {
+  if (w.format_version() != CommonIr::kFormatVersion)
+    invalid("format version {}, expected {}{}", w.format_version(), CommonIr::kFormatVersion,
+            w.format_version() == 1 ? " (version 1 is read by cohaptic builds before the body framework)" : "");
+  CommonIr ir;
+  ir.epoch = w.epoch();
+  if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());
+  ir.simulation_time = w.simulation_time();
+  ir.user = to_int(w.user(), "user");
+  ir.object = to_int(w.object(), "object");
+  if (!(std::isfinite(w.tool_radius()) && w.tool_radius() >= 0)) invalid("tool_radius {} is not a finite length >= 0", w.tool_radius());
+  ir.tool_radius = w.tool_radius();
+  // +inf is a legitimate "no limit".
+  if (!(w.force_limit() >= 0)) invalid("force_limit {} is not >= 0", w.force_limit());
+  ir.force_limit = w.force_limit();
+  switch (w.body_case()) {
+    case WireIr::kFem: ir.body = fem_from_wire(w.fem()); break;
+    case WireIr::BODY_NOT_SET: invalid("no body of a kind this build knows");
   }
   return ir;
 }

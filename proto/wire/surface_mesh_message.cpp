@@ -6,22 +6,24 @@
 
 namespace cohaptic::wire {
 
-SurfaceMesh surface_mesh_message(const Model& model) {
-  const std::vector<int>& nodes = model.surface.nodes;
-  std::vector<int> compact(static_cast<std::size_t>(model.mesh.node_count()), -1);
+SurfaceMesh surface_mesh_message(const ElasticBody& body) {
+  const std::vector<int>& nodes = body.surface.nodes;
+  std::vector<int> compact(static_cast<std::size_t>(body.mesh.node_count()), -1);
   SurfaceMesh message;
   message.mutable_vertices()->Reserve(3 * static_cast<int>(nodes.size()));
   message.mutable_node_ids()->Reserve(static_cast<int>(nodes.size()));
   for (std::size_t i = 0; i < nodes.size(); ++i) {
-    compact[nodes[i]] = static_cast<int>(i);
-    for (int axis = 0; axis < 3; ++axis) message.add_vertices(model.mesh.nodes(axis, nodes[i]));
-    message.add_node_ids(model.mesh.node_tags[nodes[i]]);
+    const auto node = static_cast<std::size_t>(nodes[i]);
+    compact[node] = static_cast<int>(i);
+    for (int axis = 0; axis < 3; ++axis) message.add_vertices(body.mesh.nodes(axis, nodes[i]));
+    message.add_node_ids(body.mesh.node_tags[node]);
   }
-  message.mutable_triangles()->Reserve(3 * model.surface.triangle_count());
-  for (const Triangle& tri : model.surface.triangles)
-    for (int node : tri) {
+  message.mutable_triangles()->Reserve(3 * body.surface.triangle_count());
+  for (const Triangle& tri : body.surface.triangles)
+    for (int corner : tri) {
+      const auto node = static_cast<std::size_t>(corner);
       if (compact[node] < 0)
-        throw cohaptic::Error(fmt::format("surface mesh: triangle node {} is not a surface node", model.mesh.node_tags[node]));
+        throw cohaptic::Error(fmt::format("surface mesh: triangle node {} is not a surface node", body.mesh.node_tags[node]));
       message.add_triangles(static_cast<std::uint32_t>(compact[node]));
     }
   return message;

@@ -2,7 +2,7 @@
 // its own contact geometry.
 //
 // Vertices are the surface nodes in a compact numbering: vertex i is the i-th of
-// model.surface.nodes (ascending volume node index), at its rest position [m];
+// body.surface.nodes (ascending volume node index), at its rest position [m];
 // triangles are the surface triangles (outward, counter-clockwise seen from outside) in
 // that numbering; node_ids[i] is the mesh tag of vertex i (the ids users see).
 #pragma once
@@ -12,11 +12,11 @@
 
 #include "cohaptic/messages.pb.h"
 #include "common/mesh/triangle_surface.h"
-#include "common/model/model.h"
+#include "common/model/elastic_body.h"
 
 namespace cohaptic::wire {
 
-SurfaceMesh surface_mesh_message(const Model& model);
+SurfaceMesh surface_mesh_message(const ElasticBody& body);
 
 /// A received surface: its triangles and each vertex's mesh node id.
 struct ReceivedSurface {

@@ -24,8 +24,11 @@ haptic: {{force_limit: {6}}}
                      o.compliance);
 }
 
-CubeRig::CubeRig(const CubeSceneOptions& options)
-    : model(std::make_unique<Model>(build_model(parse_scene(cube_scene_yaml(options), "cube.yaml")))),
-      columns(std::make_unique<ComplianceColumns>(*model->free_factor, model->dofs, model->surface.nodes)) {}
+CubeRig::CubeRig(const CubeSceneOptions& options) : CubeRig(cube_scene_yaml(options)) {}
+
+CubeRig::CubeRig(const std::string& scene_yaml)
+    : model(std::make_unique<Model>(build_model(parse_scene(scene_yaml, "cube.yaml")))),
+      body(single_elastic_body(*model)),
+      columns(std::make_unique<ComplianceColumns>(*body.free_factor, body.dofs, body.surface.nodes)) {}
 
 }  // namespace cohaptic::testing

@@ -26,8 +26,11 @@ std::string cube_scene_yaml(const CubeSceneOptions& options = {});
 /// The cube's model and its compliance columns over the whole surface (any node may be held).
 struct CubeRig {
   std::unique_ptr<Model> model;
+  const ElasticBody& body;  ///< the cube, model's only body
   std::unique_ptr<ComplianceColumns> columns;
   explicit CubeRig(const CubeSceneOptions& options = {});
+  /// The same for scene text of the cube's shape (e.g. cube_scene_yaml with its mesh changed).
+  explicit CubeRig(const std::string& scene_yaml);
 };
 
 }  // namespace cohaptic::testing

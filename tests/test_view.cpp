@@ -1,0 +1,357 @@
+// The live view's parts without a browser (view/): the web server against real sockets
+// (what it serves, in what order, who it refuses, what a bad message closes, how a stalled
+// browser is kept from growing its queue), the recording's player against a recording made
+// up here, and a frame against the simulation it is built from. The page in a real
+// browser is tests/test_view_browser.cpp's.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+#include "common/sim/simulation.h"
+#include "common/util/error.h"
+#include "support/cube_scene.h"
+#include "support/wait.h"
+#include "support/websocket_client.h"
+#include "view/live_view.h"
+#include "view/replay_player.h"
+#include "view/view_server.h"
+#include "view/view_token.h"
+
+namespace cohaptic {
+namespace {
+
+using namespace std::chrono_literals;
+using testing::WebSocketClient;
+
+view::ViewServerOptions local_options(const std::string& token = "") {
+  view::ViewServerOptions options;
+  options.token = token;
+  options.assets = COHAPTIC_VIEW_WEB_DIR;
+  options.proto = COHAPTIC_PROTO_DIR;
+  return options;
+}
+
+std::string data_url(const view::ViewServer& server, const std::string& query = "") {
+  return "ws://127.0.0.1:" + std::to_string(server.port()) + "/ws" + query;
+}
+
+TEST(ViewServer, ServesThePageItsLibrariesAndItsSchemaAndNothingElse) {
+  view::ViewServer server(local_options());
+  server.start();
+  const auto get = [&](const std::string& path) { return testing::http_get("127.0.0.1", server.port(), path); };
+  const std::string page = get("/");
+  EXPECT_EQ(page.rfind("HTTP/1.1 200", 0), 0u) << page.substr(0, 200);
+  EXPECT_NE(page.find("<!DOCTYPE html>"), std::string::npos);
+  EXPECT_NE(page.find("text/html"), std::string::npos);
+  EXPECT_NE(get("/view.js?cache=1").find("cohapticView"), std::string::npos);
+  EXPECT_NE(get("/lib/three.module.js").find("REVISION"), std::string::npos);
+  EXPECT_NE(get("/lib/protobuf.min.js").find("protobuf"), std::string::npos);
+  EXPECT_NE(get("/proto/cohaptic/view.proto").find("package cohaptic.view;"), std::string::npos);
+  for (const char* path : {"/../CMakeLists.txt", "/lib/../../CMakeLists.txt", "/node_modules/three/package.json", "/missing"})
+    EXPECT_EQ(get(path).rfind("HTTP/1.1 404", 0), 0u) << path;
+  EXPECT_EQ(server.counters().http_requests, 9u);
+}
+
+TEST(ViewServer, AMissingLibraryIsAnErrorNamingItAndTheInstallStep) {
+  view::ViewServerOptions options = local_options();
+  options.assets = ::testing::TempDir() + "/no-such-web-dir";
+  try {
+    view::ViewServer server(options);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("index.html"), std::string::npos) << e.what();
+  }
+  // The page present, its libraries not: the message says how to install them.
+  const std::filesystem::path web = std::filesystem::path(::testing::TempDir()) / "web-without-libraries";
+  std::filesystem::create_directories(web);
+  for (const char* file : {"index.html", "view.js", "style.css"})
+    std::filesystem::copy_file(std::filesystem::path(COHAPTIC_VIEW_WEB_DIR) / file, web / file,
+                               std::filesystem::copy_options::overwrite_existing);
+  options.assets = web;
+  try {
+    view::ViewServer server(options);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("three.module.js"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("install-deps.sh"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ViewServer, ABrowserGetsTheSceneFirstThenTheNewestOfEachChannel) {
+  view::ViewServer server(local_options());
+  server.start();
+  // Before anyone watches: the scene, three frames and a status. Only the newest of each counts.
+  server.publish(view::Channel::frame, "frame 1");
+  server.publish(view::Channel::scene, "scene");
+  server.publish(view::Channel::frame, "frame 2");
+  server.publish(view::Channel::status, "status 1");
+  server.publish(view::Channel::frame, "frame 3");
+  WebSocketClient browser(data_url(server));
+  ASSERT_TRUE(browser.wait_open(10s));
+  ASSERT_TRUE(browser.wait_messages(3, 10s));
+  EXPECT_EQ(browser.messages(), (std::vector<std::string>{"scene", "frame 3", "status 1"}));
+  server.publish(view::Channel::frame, "frame 4");
+  ASSERT_TRUE(browser.wait_messages(4, 10s));
+  EXPECT_EQ(browser.messages().back(), "frame 4");
+  // A second browser gets the same start, never the frames it missed.
+  WebSocketClient late(data_url(server));
+  ASSERT_TRUE(late.wait_messages(3, 10s));
+  EXPECT_EQ(late.messages(), (std::vector<std::string>{"scene", "frame 4", "status 1"}));
+  EXPECT_EQ(server.counters().browsers, 2);
+  EXPECT_EQ(server.counters().connections, 2u);
+}
+
+TEST(ViewServer, OffLoopbackATokenIsRequiredAndAForeignPageIsRefused) {
+  EXPECT_TRUE(view::is_loopback("127.0.0.1"));
+  EXPECT_TRUE(view::is_loopback("127.1.2.3"));
+  EXPECT_TRUE(view::is_loopback("::1"));
+  EXPECT_FALSE(view::is_loopback("0.0.0.0"));
+  EXPECT_FALSE(view::is_loopback("10.77.0.1"));
+  EXPECT_EQ(view::access_token("127.0.0.1", std::nullopt), "");
+  const std::string drawn = view::access_token("0.0.0.0", std::nullopt);
+  EXPECT_EQ(drawn.size(), 32u);
+  EXPECT_NE(drawn, view::access_token("0.0.0.0", std::nullopt));
+
+  const std::string token = "abcdef0123456789abcd";
+  view::ViewServer server(local_options(token));
+  server.publish(view::Channel::scene, "scene");
+  server.start();
+  EXPECT_NE(server.url().find("?token=" + token), std::string::npos);
+  WebSocketClient without(data_url(server));
+  WebSocketClient wrong(data_url(server, "?token=abcdef0123456789abce"));
+  WebSocketClient foreign(data_url(server, "?token=" + token), "http://elsewhere.example");
+  WebSocketClient right(data_url(server, "?token=" + token), "http://127.0.0.1:" + std::to_string(server.port()));
+  EXPECT_FALSE(without.wait_open(10s));
+  EXPECT_FALSE(wrong.wait_open(10s));
+  EXPECT_FALSE(foreign.wait_open(10s));
+  EXPECT_EQ(without.refused_status(), 403);
+  EXPECT_EQ(wrong.refused_status(), 403);
+  EXPECT_EQ(foreign.refused_status(), 403);
+  ASSERT_TRUE(right.wait_open(10s));
+  ASSERT_TRUE(right.wait_messages(1, 10s));
+  EXPECT_EQ(right.messages().front(), "scene");
+  EXPECT_EQ(server.counters().refused, 3u);
+}
+
+TEST(ViewServer, AMalformedOrOversizedMessageClosesThatBrowserAndNothingElse) {
+  std::vector<view::Command> received;
+  std::mutex mutex;
+  view::ViewServer server(local_options(), [&](const view::Command& command) {
+    std::lock_guard lock(mutex);
+    received.push_back(command);
+  });
+  server.publish(view::Channel::scene, "scene");
+  server.start();
+  WebSocketClient oversized(data_url(server)), text(data_url(server)), garbage(data_url(server)), empty(data_url(server)),
+      good(data_url(server));
+  for (WebSocketClient* browser : {&oversized, &text, &garbage, &empty, &good}) ASSERT_TRUE(browser->wait_open(10s));
+  view::Command seek;
+  seek.set_seek(2.5);
+  oversized.send_binary(std::string(2000, '\x22'));  // over the 1024-byte limit
+  text.send_text(seek.SerializeAsString());
+  garbage.send_binary("\xff\xff\xff\xff");
+  empty.send_binary(view::Command().SerializeAsString());  // parses, but says nothing
+  good.send_binary(seek.SerializeAsString());
+  for (WebSocketClient* browser : {&oversized, &text, &garbage, &empty}) EXPECT_TRUE(browser->wait_closed(10s));
+  EXPECT_EQ(oversized.close_code(), 1009);  // message too big
+  EXPECT_EQ(text.close_code(), 1007);       // invalid payload
+  EXPECT_EQ(garbage.close_code(), 1007);
+  EXPECT_EQ(empty.close_code(), 1007);
+  server.publish(view::Channel::frame, "after");
+  ASSERT_TRUE(good.wait_messages(2, 10s));
+  EXPECT_EQ(good.messages().back(), "after");
+  EXPECT_EQ(good.close_code(), 0);
+  std::lock_guard lock(mutex);
+  ASSERT_EQ(received.size(), 1u);
+  EXPECT_EQ(received.front().seek(), 2.5);
+  EXPECT_EQ(server.counters().closed_for_bad_message, 3u);  // the oversized one websocketpp closes itself
+}
+
+TEST(ViewServer, AStalledBrowserGetsNothingNewWhileItsQueueIsFullAndTheOthersGetTheNewest) {
+  view::ViewServerOptions options = local_options();
+  options.max_buffered_bytes = 64 * 1024;
+  view::ViewServer server(options);
+  server.publish(view::Channel::scene, "scene");
+  server.start();
+  testing::StalledWebSocket stalled("127.0.0.1", server.port());
+  ASSERT_TRUE(stalled.upgraded());
+  WebSocketClient reader(data_url(server));
+  ASSERT_TRUE(reader.wait_open(10s));
+  reader.count_only();  // 40 MB
+  constexpr int kFrames = 400;
+  const std::string payload(100 * 1024, 'x');  // 40 MB in all
+  for (int k = 1; k <= kFrames; ++k) {
+    server.publish(view::Channel::frame, std::to_string(k) + payload);
+    std::this_thread::sleep_for(1ms);  // a frame rate, so that the reader gets many of them
+  }
+  server.publish(view::Channel::frame, "last");
+  // The reader ends with the newest frame; the stalled browser took what the kernel's socket
+  // buffers hold and then nothing: far fewer than were published, however many were.
+  ASSERT_TRUE(testing::wait_until([&] { return reader.last_message() == "last"; }, "the newest frame at the reader"));
+  const view::ViewCounters counters = server.counters();
+  const std::uint64_t to_stalled = counters.messages_sent - reader.message_count();
+  std::printf("  published %d frames of 100 kB: the reader got %zu, the stalled browser %llu; %llu dropped\n", kFrames + 1,
+              reader.message_count(), static_cast<unsigned long long>(to_stalled),
+              static_cast<unsigned long long>(counters.dropped));
+  EXPECT_LT(to_stalled, static_cast<std::uint64_t>(kFrames / 4));
+  EXPECT_GT(counters.dropped, static_cast<std::uint64_t>(kFrames / 2));
+}
+
+// ---- the recording's player ----
+
+// Frames every 0.1 s from t = 1: user 0's force rises by 0.1 N a frame to 1 N (the peak,
+// first reached at t = 2), holds, then drops to 0.2 N at t = 2.5 (the largest step);
+// user 1 is absent. Two status reports of user 0, at 1.25 s and 2.05 s.
+record::Recording made_up_recording() {
+  record::Recording recording;
+  recording.file = "made-up.mcap";
+  recording.config.set_start_time_ns(1'000'000'000);
+  view::Scene& scene = recording.view_scenes.emplace_back();
+  for (std::uint32_t slot : {0u, 1u}) scene.add_tools()->set_slot(slot);
+  for (int k = 0; k <= 20; ++k) {
+    view::Frame& frame = recording.view_frames.emplace_back();
+    frame.set_time(1.0 + 0.1 * k);
+    frame.set_sequence(static_cast<std::uint64_t>(k + 1));
+    const double force = k <= 10 ? 0.1 * k : (k < 15 ? 1.0 : 0.2);
+    view::UserFrame* user = frame.add_users();
+    user->set_slot(0);
+    user->set_present(true);
+    for (double component : {0.0, 0.0, force}) user->add_force(static_cast<float>(component));
+    frame.add_users()->set_slot(1);
+  }
+  for (double t : {1.25, 2.05}) {
+    record::ReceivedClientStatus& status = recording.client_statuses.emplace_back();
+    status.set_receive_time_ns(1'000'000'000 + static_cast<std::int64_t>(t * 1e9));
+    status.set_slot(0);
+    status.set_user("surgeon");
+    status.mutable_status()->set_ticks(static_cast<std::uint64_t>(t * 1000));
+  }
+  return recording;
+}
+
+TEST(ReplayPlayer, FindsThePeakAndTheLargestStepSeeksToTheFrameAtATimeAndPlaysAtItsSpeed) {
+  view::ReplayPlayer player(made_up_recording());
+  EXPECT_NEAR(player.peak_force_time(), 2.0, 1e-12);
+  EXPECT_NEAR(player.largest_step_time(), 2.5, 1e-12);
+  EXPECT_EQ(player.scene().source(), "made-up.mcap");
+  ASSERT_EQ(player.scene().force_series_size(), 2);
+  EXPECT_EQ(player.scene().force_series(0).magnitudes_size(), 21);
+  EXPECT_NEAR(player.scene().force_series(0).magnitudes(4), 0.4, 1e-6);
+
+  EXPECT_EQ(player.frame_index(), 0u);
+  EXPECT_EQ(player.status().users_size(), 0);  // nothing reported before 1.25 s
+  player.seek(1.55);
+  EXPECT_EQ(player.frame_index(), 5u);  // the frame at 1.5 s, the last not after 1.55 s
+  ASSERT_EQ(player.status().users_size(), 1);
+  EXPECT_EQ(player.status().users(0).figures().ticks(), 1250u);
+  player.seek(99);
+  EXPECT_EQ(player.frame_index(), 20u);
+  EXPECT_EQ(player.status().users(0).figures().ticks(), 2050u);
+  player.seek(-5);
+  EXPECT_EQ(player.frame_index(), 0u);
+
+  view::Command command;
+  command.set_jump(view::Command::LARGEST_STEP);
+  player.command(command);
+  EXPECT_NEAR(player.frame().time(), 2.5, 1e-12);
+  command.set_jump(view::Command::PEAK_FORCE);
+  player.command(command);
+  EXPECT_NEAR(player.frame().time(), 2.0, 1e-12);
+
+  command.set_speed(-1);  // ignored
+  player.command(command);
+  command.set_speed(2);
+  player.command(command);
+  player.advance(0.1);  // paused: nothing moves
+  EXPECT_NEAR(player.time(), 2.0, 1e-12);
+  command.mutable_play();
+  player.command(command);
+  player.advance(0.1);
+  EXPECT_NEAR(player.time(), 2.2, 1e-9);
+  EXPECT_EQ(player.timeline().speed(), 2);
+  EXPECT_TRUE(player.timeline().playing());
+  player.advance(10);  // past the end: it stops there
+  EXPECT_NEAR(player.time(), 3.0, 1e-12);
+  EXPECT_FALSE(player.playing());
+  player.command(command);  // play at the end starts again from the beginning
+  EXPECT_NEAR(player.time(), 1.0, 1e-12);
+  EXPECT_TRUE(player.playing());
+}
+
+TEST(ReplayPlayer, ARecordingWithoutViewFramesIsRefusedSayingHowToRecordOne) {
+  record::Recording recording;
+  recording.file = "plain.mcap";
+  try {
+    view::ReplayPlayer player(recording);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("plain.mcap"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("--view"), std::string::npos);
+  }
+}
+
+// ---- a frame, from the simulation ----
+
+TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes) {
+  testing::CubeSceneOptions soft;
+  soft.divisions = 6;
+  soft.youngs_modulus = 2.0e4;
+  soft.touchable = "{surface: true}";
+  testing::CubeRig cube(soft);
+  SimulationOptions options;
+  options.ir = ir_build_options(cube.model->scene.haptic);
+  options.step_delay_nodes = 12;
+  Simulation simulation(cube.body, cube.model->obstacles, *cube.columns, cube.model->scene.tools, options);
+  const Eigen::Vector3d pressing(0.003, 0.002, -0.002);  // 2 mm into the top face
+  simulation.set_tool(0, pressing);
+  simulation.step(0);
+  simulation.step(0.001);
+  ASSERT_TRUE(simulation.pressing(0));
+
+  const ShownSurface shown = shown_surface(cube.body, cube.columns->row_nodes());
+  const view::ShownIndex index(cube.body, shown);
+  const Eigen::Matrix3Xd displacement = simulation.displacement_of(shown.nodes);
+  const std::vector<view::ToolState> tools = {{true, pressing}, {false, Eigen::Vector3d::Zero()}};
+  const view::Frame frame = view::view_frame(simulation, index, 7, 0.001, displacement, tools, 999);
+  EXPECT_EQ(frame.sequence(), 7u);
+  ASSERT_EQ(frame.displacement_size(), displacement.size());
+  for (Eigen::Index i = 0; i < displacement.size(); ++i)
+    ASSERT_EQ(frame.displacement(static_cast<int>(i)), static_cast<float>(displacement.data()[i]));
+  ASSERT_EQ(frame.users_size(), 2);
+  const view::UserFrame& user = frame.users(0);
+  EXPECT_TRUE(user.present());
+  EXPECT_TRUE(user.pressing());
+  const Eigen::Vector3d force = simulation.force(0).force;
+  EXPECT_GT(force.norm(), 0.01);
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_EQ(user.force(axis), static_cast<float>(force[axis]));
+    EXPECT_EQ(user.position(axis), static_cast<float>(pressing[axis]));
+  }
+  // The contact triangle is the IR's first patch triangle, its nodes mapped to the shown
+  // surface's; every patch node is shown (the whole surface has rows).
+  const CondensedFemIr& ir = condensed_fem(simulation.ir(0)->ir);
+  ASSERT_EQ(user.contact_nodes_size(), 3);
+  for (int corner = 0; corner < 3; ++corner) {
+    const int shown_node = static_cast<int>(user.contact_nodes(corner));
+    const int volume_node = shown.nodes[static_cast<std::size_t>(shown_node)];
+    EXPECT_EQ(cube.body.mesh.node_tags[static_cast<std::size_t>(volume_node)],
+              ir.node_ids[static_cast<std::size_t>(ir.patch.front().nodes[static_cast<std::size_t>(corner)])]);
+  }
+  EXPECT_EQ(user.patch_nodes_size(), ir.patch_node_count);
+  EXPECT_FALSE(frame.users(1).present());
+  EXPECT_EQ(frame.users(1).force_size(), 0);
+  // The held step-delay nodes, all on the surface.
+  EXPECT_EQ(frame.boundary_nodes(), 12u);
+  ASSERT_EQ(frame.held_nodes_size(), 12);
+  for (std::uint32_t held : frame.held_nodes())
+    EXPECT_NE(std::find(simulation.condensation().boundary_nodes().begin(), simulation.condensation().boundary_nodes().end(),
+                        shown.nodes[held]),
+              simulation.condensation().boundary_nodes().end());
+}
+
+}  // namespace
+}  // namespace cohaptic

@@ -1,0 +1,273 @@
+// The live view in a real browser: real server, clients and lab processes on loopback, the
+// page opened in headless Chromium by tests/support/view_check.mjs (playwright-core), which
+// reports the page's own state and a screenshot's pixels; judged here against the
+// session's own numbers: the client reports and the server recording.
+// Skipped, with the reason printed, only when Chromium or playwright-core is missing
+// (deploy/install-deps.sh installs both).
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <cmath>
+#include <fmt/format.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+
+#include "proto/record/recording.h"
+#include "support/cube_scene.h"
+#include "support/process.h"
+
+namespace cohaptic {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using testing::ChildProcess;
+
+constexpr std::chrono::milliseconds kBrowserPatience{240'000};
+
+const fs::path kSource = COHAPTIC_SOURCE_DIR;
+
+// node, from the PATH; empty if there is none.
+std::string node_program() {
+  const char* path = std::getenv("PATH");
+  std::stringstream directories(path ? path : "");
+  for (std::string directory; std::getline(directories, directory, ':');)
+    if (fs::exists(fs::path(directory) / "node")) return (fs::path(directory) / "node").string();
+  return "";
+}
+
+// Why the browser test cannot run here, or empty.
+std::string missing_browser() {
+  const char* chosen = std::getenv("CHROMIUM");
+  const bool chromium = (chosen && fs::exists(chosen)) || fs::exists("/usr/bin/chromium") || fs::exists("/usr/bin/chromium-browser");
+  if (node_program().empty()) return "no node on the PATH: install Node.js (deploy/install-deps.sh does)";
+  if (!chromium) return "no Chromium: install the Debian package chromium (deploy/install-deps.sh does)";
+  if (!fs::exists(kSource / "deploy/node/node_modules/playwright-core"))
+    return "no playwright-core in deploy/node/node_modules: run deploy/install-deps.sh (npm ci --prefix deploy/node)";
+  return "";
+}
+
+// Runs view_check.mjs with `arguments`; its JSON result.
+json check_page(const fs::path& dir, const std::string& name, const std::vector<std::string>& arguments) {
+  std::vector<std::string> all = {(kSource / "tests/support/view_check.mjs").string()};
+  all.insert(all.end(), arguments.begin(), arguments.end());
+  ChildProcess node(node_program(), all, dir / (name + ".log"));
+  const std::optional<int> status = node.wait(kBrowserPatience);
+  const std::string output = node.log_text();
+  EXPECT_EQ(status, 0) << output;
+  const std::size_t start = output.rfind("\n{\"");
+  const json result = json::parse(output.substr(start == std::string::npos ? 0 : start + 1), nullptr, false);
+  EXPECT_FALSE(result.is_discarded()) << output;
+  return result.is_discarded() ? json::object() : result;
+}
+
+std::string url_in(const std::string& log, const std::string& before) {
+  std::smatch match;
+  const std::regex line(before + R"( (http://\S+/\S*))");
+  return std::regex_search(log, match, line) ? match[1].str() : "";
+}
+
+// A soft cube, two sphere tools, each user pressing its side of the top face: the scene,
+// and a script for each user that presses `depth_mm` and holds for `hold_s`.
+void write_session(const fs::path& dir, double depth_mm, double hold_s) {
+  testing::CubeSceneOptions soft;
+  soft.divisions = 8;
+  soft.youngs_modulus = 2.0e4;
+  soft.touchable = "{surface: true}";
+  soft.tools = "[{name: A, shape: sphere, radius: 4}, {name: B, shape: sphere, radius: 4}]";
+  std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(soft);
+  for (const auto& [name, x] : {std::pair{"a", -30}, std::pair{"b", 30}})
+    std::ofstream(dir / (std::string(name) + ".yaml")) << fmt::format(R"(
+units: mm
+start: [{0}, 5, 12]
+segments:
+  - {{move_to: [{0}, 5, 5], speed: 20}}
+  - {{press: {1}, speed: 5, direction: [0, 0, -1]}}
+  - {{hold: {2}}}
+  - {{release: {1}, speed: 5}}
+)",
+                                                                      x, depth_mm, hold_s);
+}
+
+struct ViewSession {
+  fs::path dir;
+  std::unique_ptr<ChildProcess> server;
+  std::string url;
+  int port = -1;
+
+  ViewSession(const std::string& name, double depth_mm, double hold_s) : dir(testing::scratch_directory(name)) {
+    write_session(dir, depth_mm, hold_s);
+    server = std::make_unique<ChildProcess>(
+        testing::server_program(),
+        std::vector<std::string>{"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--view", "127.0.0.1:0",
+                                 "--record", (dir / "server.mcap").string(), "--no-disk-cache"},
+        dir / "server.log");
+    EXPECT_TRUE(testing::wait_for_output(*server, "live view at"));
+    EXPECT_TRUE(testing::wait_for_output(*server, "listening on"));
+    port = testing::listening_port(server->log_text());
+    url = url_in(server->log_text(), "live view at");
+  }
+  std::unique_ptr<ChildProcess> client(const std::string& user, int slot) const {
+    return std::make_unique<ChildProcess>(
+        testing::client_program(),
+        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", "surgeon-" + user, "--slot",
+                                 std::to_string(slot), "--device", "hand:" + (dir / (user + ".yaml")).string(), "--report",
+                                 (dir / (user + ".json")).string()},
+        dir / (user + ".log"));
+  }
+  void stop() {
+    server->signal(SIGINT);
+    EXPECT_EQ(server->wait(testing::kPatience), 0) << server->log_text();
+  }
+};
+
+// The number in a panel cell ("999.9 Hz", "1046 µs (1047 µs)", "0.505 N (final)"): the
+// first, or the second; and how many decimals it was shown with.
+std::pair<double, int> shown_number(const std::string& text, int which = 0) {
+  static const std::regex number(R"(-?\d+(\.(\d+))?)");
+  auto it = std::sregex_iterator(text.begin(), text.end(), number);
+  for (int k = 0; k < which && it != std::sregex_iterator(); ++k) ++it;
+  if (it == std::sregex_iterator()) return {NAN, 0};
+  return {std::stod((*it)[0].str()), static_cast<int>((*it)[2].length())};
+}
+
+// `text`'s number equals `value` as the page rounds it.
+::testing::AssertionResult shows(const std::string& text, double value, int which = 0) {
+  const auto [shown, decimals] = shown_number(text, which);
+  const double half_unit = 0.5 * std::pow(10.0, -decimals) + 1e-9;
+  if (std::abs(shown - value) <= half_unit) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "the panel shows '" << text << "', the report " << value;
+}
+
+TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClientsFigures) {
+  if (const std::string why = missing_browser(); !why.empty()) GTEST_SKIP() << why;
+  ViewSession session("view-live", 4, 600);  // they hold until told to stop
+  ASSERT_FALSE(session.url.empty()) << session.server->log_text();
+  const auto a = session.client("a", 0);
+  const auto b = session.client("b", 1);
+
+  const json live = check_page(session.dir, "live", {"--url", session.url, "--screenshot", (session.dir / "live.png").string()});
+  ASSERT_FALSE(live.contains("error")) << live.dump();
+  EXPECT_TRUE(live["errors"].empty()) << live["errors"].dump();
+  const json& shown = live["shown"];
+  const json& pixels = live["pixels"];
+  std::printf("  page: %d frames received, %d drawn (%.1f/s in this headless software renderer); mesh pixels %d of %d\n",
+              shown["framesReceived"].get<int>(), shown["framesDrawn"].get<int>(), shown["drawFps"].get<double>(),
+              pixels["mesh"]["matching"].get<int>(), pixels["mesh"]["sampled"].get<int>());
+  // The mesh is drawn: inside its projected box most pixels are not the background, and a
+  // corner of the stage away from it is.
+  EXPECT_GT(pixels["mesh"]["matching"].get<double>(), 0.3 * pixels["mesh"]["sampled"].get<double>());
+  EXPECT_EQ(pixels["corner"]["matching"].get<int>(), 0);
+  EXPECT_GT(shown["meshTriangles"].get<int>(), 100);
+  ASSERT_EQ(shown["users"].size(), 2u);
+  for (int slot = 0; slot < 2; ++slot) {
+    const json& user = shown["users"][slot];
+    const json& seen = pixels["users"][slot];
+    SCOPED_TRACE("user " + std::to_string(slot));
+    // Its tool, in its colour, where the page puts it; pressing down into the top face, it
+    // feels a force upward, drawn as an arrow whose pixels are there along its length.
+    EXPECT_TRUE(user["present"].get<bool>());
+    EXPECT_TRUE(user["pressing"].get<bool>());
+    EXPECT_GT(seen["tool"]["matching"].get<int>(), 10) << seen.dump();
+    EXPECT_GT(user["force"][2].get<double>(), 0.01);
+    EXPECT_GT(user["force"][2].get<double>(), 5 * std::hypot(user["force"][0].get<double>(), user["force"][1].get<double>()));
+    EXPECT_TRUE(user["arrowVisible"].get<bool>());
+    ASSERT_TRUE(seen["arrow"].is_object()) << seen.dump();
+    EXPECT_GE(seen["arrow"]["matching"].get<double>(), 0.75 * seen["arrow"]["sampled"].get<double>()) << seen.dump();
+    // The strip chart moved on between two looks 1.5 s apart.
+    const json& before = live["before"]["users"][slot]["chart"];
+    const json& after = live["after"]["users"][slot]["chart"];
+    EXPECT_GT(after["last"].get<double>(), before["last"].get<double>() + 0.5);
+    EXPECT_GE(after["samples"].get<int>(), 2);
+  }
+
+  // The clients stop; their last reports reach the panel, which shows the reports' figures.
+  a->signal(SIGINT);
+  b->signal(SIGINT);
+  ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
+  ASSERT_EQ(b->wait(testing::kPatience), 0) << b->log_text();
+  const json final = check_page(session.dir, "final", {"--url", session.url, "--screenshot", (session.dir / "final.png").string(),
+                                                        "--final", "1"});
+  ASSERT_FALSE(final.contains("error")) << final.dump();
+  for (int slot = 0; slot < 2; ++slot) {
+    const json report = json::parse(std::ifstream(session.dir / (slot == 0 ? "a.json" : "b.json")));
+    const json& panel = final["shown"]["users"][slot]["panel"];
+    SCOPED_TRACE("user " + std::to_string(slot) + ": " + panel.dump());
+    EXPECT_TRUE(shows(panel["haptic_rate_hz"], report["haptic_rate_hz"]));
+    EXPECT_TRUE(shows(panel["period_p99_us"], report["period_us"]["p99"]));
+    EXPECT_TRUE(shows(panel["period_p99_us"], report["timer_floor"]["period_us"]["p99"], 1));
+    EXPECT_TRUE(shows(panel["missed_deadlines"], report["missed_deadlines"]));
+    EXPECT_TRUE(shows(panel["ir_age_p99_ms"], report["ir_age_ms"]["p99"]));
+    EXPECT_TRUE(shows(panel["one_way_delay_p99_ms"], report["one_way_delay_ms"]["p99"]));
+    EXPECT_TRUE(shows(panel["peak_force"], report["force_n"]["peak"]));
+    EXPECT_EQ(panel["protocol"], "P1");
+  }
+  session.stop();
+}
+
+TEST(ViewInBrowser, AReplayScrubsToAGivenTimeShowingThatTimesForceAndJumpsToThePeak) {
+  if (const std::string why = missing_browser(); !why.empty()) GTEST_SKIP() << why;
+  ViewSession session("view-replay", 3, 1);
+  {
+    const auto a = session.client("a", 0);
+    const auto b = session.client("b", 1);
+    ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
+    ASSERT_EQ(b->wait(testing::kPatience), 0) << b->log_text();
+  }
+  session.stop();
+
+  // From the recording: the frame of user 0's largest force, and the time halfway to the next.
+  const record::Recording recording = record::read_recording(session.dir / "server.mcap");
+  ASSERT_GT(recording.view_frames.size(), 10u);
+  const auto magnitude = [](const view::UserFrame& user) {
+    return user.force_size() == 3 ? std::hypot(user.force(0), user.force(1), user.force(2)) : 0.0;
+  };
+  std::size_t peak = 0, peak_any = 0;
+  double largest = -1;
+  for (std::size_t k = 0; k < recording.view_frames.size(); ++k) {
+    if (magnitude(recording.view_frames[k].users(0)) > magnitude(recording.view_frames[peak].users(0))) peak = k;
+    for (const view::UserFrame& user : recording.view_frames[k].users())
+      if (magnitude(user) > largest) {
+        largest = magnitude(user);
+        peak_any = k;
+      }
+  }
+  ASSERT_GT(peak + 1, 1u);
+  ASSERT_LT(peak + 1, recording.view_frames.size());
+  const view::Frame& expected = recording.view_frames[peak];
+  const double target = 0.5 * (expected.time() + recording.view_frames[peak + 1].time());
+
+  ChildProcess replay(COHAPTIC_LAB_EXE,
+                      {"replay", (session.dir / "server.mcap").string(), "--view", "127.0.0.1:0"}, session.dir / "replay.log");
+  ASSERT_TRUE(testing::wait_for_output(replay, "in the live view at"));
+  const std::string url = url_in(replay.log_text(), "in the live view at");
+  const json scrubbed = check_page(session.dir, "scrub", {"--url", url, "--screenshot", (session.dir / "scrub.png").string(),
+                                                           "--seek", fmt::format("{:.9f}", target)});
+  ASSERT_FALSE(scrubbed.contains("error")) << scrubbed.dump();
+  const json& shown = scrubbed["shown"];
+  EXPECT_NEAR(shown["timeline"]["time"].get<double>(), target, 1e-9);
+  EXPECT_DOUBLE_EQ(shown["frame"]["time"].get<double>(), expected.time());
+  for (int slot = 0; slot < 2; ++slot) {
+    const view::UserFrame& recorded = expected.users(slot);
+    const json& user = shown["users"][slot];
+    SCOPED_TRACE("user " + std::to_string(slot));
+    for (int axis = 0; axis < 3; ++axis) EXPECT_EQ(user["force"][axis].get<double>(), static_cast<double>(recorded.force(axis)));
+    // The chart ends at that time, at that force (floats, as the recording holds them).
+    EXPECT_NEAR(user["chart"]["last"].get<double>(), expected.time(), 1e-6);
+    EXPECT_NEAR(user["chart"]["latest"].get<double>(), magnitude(recorded), 1e-6 * magnitude(recorded) + 1e-9);
+  }
+  EXPECT_GT(shown["users"][0]["forceMagnitude"].get<double>(), 0.01);
+  EXPECT_GT(scrubbed["pixels"]["mesh"]["matching"].get<double>(), 0.3 * scrubbed["pixels"]["mesh"]["sampled"].get<double>());
+
+  const json jumped = check_page(session.dir, "jump", {"--url", url, "--screenshot", (session.dir / "jump.png").string(),
+                                                        "--jump", "peak"});
+  ASSERT_FALSE(jumped.contains("error")) << jumped.dump();
+  EXPECT_DOUBLE_EQ(jumped["shown"]["frame"]["time"].get<double>(), recording.view_frames[peak_any].time());
+  replay.signal(SIGTERM);
+  EXPECT_EQ(replay.wait(testing::kPatience), 0) << replay.log_text();
+}
+
+}  // namespace
+}  // namespace cohaptic

@@ -1,0 +1,45 @@
+#include "view/live_view.h"
+
+#include <spdlog/spdlog.h>
+
+#include "proto/wire/header.h"
+#include "view/view_token.h"
+
+namespace cohaptic::view {
+
+LiveView::LiveView(const Model& model, const ComplianceColumns& columns, wire::Protocol protocol,
+                   const record::InjectedDelays& injected, LiveViewOptions options, record::SessionRecorder* recorder)
+    : shown_(shown_surface(single_elastic_body(model), columns.row_nodes())),
+      index_(single_elastic_body(model), shown_),
+      recorder_(recorder),
+      period_ns_(static_cast<std::int64_t>(1e9 / options.rate_hz)),
+      server_({options.host, options.port, access_token(options.host, options.token_file), options.assets, options.proto}) {
+  const Scene scene = view_scene(model, single_elastic_body(model), shown_, protocol, injected, options.rate_hz, "live");
+  if (recorder_) recorder_->view_scene(wire::monotonic_now_ns(), scene);
+  server_.publish(Channel::scene, server_message(scene));
+}
+
+void LiveView::publish_frame(std::int64_t now_ns, double time, const Simulation& simulation,
+                             const Eigen::Matrix3Xd& displacement, const std::vector<ToolState>& tools,
+                             std::uint64_t steps) {
+  const double interval_s = static_cast<double>(now_ns - last_frame_ns_) * 1e-9;
+  const double rate = last_frame_ns_ > 0 && interval_s > 0 ? static_cast<double>(steps - last_steps_) / interval_s : 0.0;
+  last_frame_ns_ = now_ns;
+  last_steps_ = steps;
+  Frame frame = view_frame(simulation, index_, ++sequence_, time, displacement, tools, rate);
+  if (recorder_) recorder_->view_frame(now_ns, frame);
+  server_.publish(Channel::frame, server_message(std::move(frame)));
+}
+
+void LiveView::publish_status(int slot, const std::string& user, const wire::ClientStatus& status, double time) {
+  UserStatus& entry = statuses_[slot];
+  entry.set_slot(static_cast<std::uint32_t>(slot));
+  entry.set_user(user);
+  *entry.mutable_figures() = status;
+  entry.set_received_time(time);
+  Status message;
+  for (const auto& [_, each] : statuses_) *message.add_users() = each;
+  server_.publish(Channel::status, server_message(std::move(message)));
+}
+
+}  // namespace cohaptic::view

@@ -1,0 +1,64 @@
+#include "view/view_assets.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "common/util/error.h"
+
+namespace cohaptic::view {
+namespace {
+
+struct AssetFile {
+  const char* url;
+  const char* path;  // under its root
+  const char* content_type;
+  bool from_npm;     // installed by npm into view/web/node_modules
+};
+
+constexpr AssetFile kWebFiles[] = {
+    {"/", "index.html", "text/html; charset=utf-8", false},
+    {"/view.js", "view.js", "text/javascript; charset=utf-8", false},
+    {"/style.css", "style.css", "text/css; charset=utf-8", false},
+    {"/lib/three.module.js", "node_modules/three/build/three.module.js", "text/javascript; charset=utf-8", true},
+    {"/lib/OrbitControls.js", "node_modules/three/examples/jsm/controls/OrbitControls.js",
+     "text/javascript; charset=utf-8", true},
+    {"/lib/protobuf.min.js", "node_modules/protobufjs/dist/protobuf.min.js", "text/javascript; charset=utf-8", true},
+};
+
+constexpr AssetFile kProtoFiles[] = {
+    {"/proto/cohaptic/view.proto", "cohaptic/view.proto", "text/plain; charset=utf-8", false},
+    {"/proto/cohaptic/messages.proto", "cohaptic/messages.proto", "text/plain; charset=utf-8", false},
+    {"/proto/cohaptic/recording.proto", "cohaptic/recording.proto", "text/plain; charset=utf-8", false},
+};
+
+std::string read_file(const std::filesystem::path& file, bool from_npm, const std::filesystem::path& web) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    std::string how = from_npm ? " (the view's libraries are missing: run deploy/install-deps.sh, or npm ci --prefix " +
+                                     web.string() + ")"
+                               : "";
+    throw Error("view: cannot read " + file.string() + how);
+  }
+  std::ostringstream content;
+  content << in.rdbuf();
+  return content.str();
+}
+
+}  // namespace
+
+AssetTable load_assets(const std::filesystem::path& web, const std::filesystem::path& proto) {
+  AssetTable table;
+  for (const AssetFile& file : kWebFiles)
+    table[file.url] = {file.content_type, read_file(web / file.path, file.from_npm, web)};
+  for (const AssetFile& file : kProtoFiles)
+    table[file.url] = {file.content_type, read_file(proto / file.path, false, web)};
+  table["/index.html"] = table.at("/");
+  return table;
+}
+
+const Asset* find_asset(const AssetTable& assets, const std::string& resource) {
+  const auto found = assets.find(resource.substr(0, resource.find('?')));
+  return found == assets.end() ? nullptr : &found->second;
+}
+
+}  // namespace cohaptic::view

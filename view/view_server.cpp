@@ -1,0 +1,264 @@
+// Compiled as C++17 (websocketpp 0.8 does not compile as C++20 with GCC 12), with asio's
+// deprecated names allowed (websocketpp uses io_service). Its asio objects never leave
+// this file: the io_context, the endpoint and the connections are all in Impl.
+#include "view/view_server.h"
+
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+#include <map>
+#include <mutex>
+#include <thread>
+#include <websocketpp/config/asio_no_tls.hpp>
+#include <websocketpp/server.hpp>
+
+#include "cohaptic/view.pb.h"
+#include "common/util/error.h"
+#include "view/view_assets.h"
+
+namespace cohaptic::view {
+namespace {
+
+using WsServer = websocketpp::server<websocketpp::config::asio>;
+using websocketpp::connection_hdl;
+
+/// Time the closing handshakes get at stop().
+constexpr auto kCloseGrace = std::chrono::milliseconds(200);
+
+// The value of `name` in a resource's query string ("/ws?token=abc" -> "abc"); empty if absent.
+std::string query_value(const std::string& resource, const std::string& name) {
+  const std::size_t query = resource.find('?');
+  if (query == std::string::npos) return "";
+  std::size_t at = query + 1;
+  while (at < resource.size()) {
+    const std::size_t end = std::min(resource.find('&', at), resource.size());
+    const std::string pair = resource.substr(at, end - at);
+    if (pair.rfind(name + "=", 0) == 0) return pair.substr(name.size() + 1);
+    at = end + 1;
+  }
+  return "";
+}
+
+// Compares without stopping at the first difference, so the time taken tells nothing.
+bool same_secret(const std::string& a, const std::string& b) {
+  unsigned char difference = a.size() == b.size() ? 0 : 1;
+  for (std::size_t i = 0; i < a.size(); ++i) difference |= static_cast<unsigned char>(a[i] ^ b[i % std::max<std::size_t>(b.size(), 1)]);
+  return difference == 0;
+}
+
+}  // namespace
+
+struct ViewServer::Impl {
+  struct Browser {
+    std::array<std::uint64_t, kChannels> sent{};       // newest sequence sent, per channel
+    std::array<std::uint64_t, kChannels> accounted{};  // sent or counted as dropped up to here
+  };
+
+  ViewServerOptions options;
+  CommandHandler on_command;
+  AssetTable assets;
+  asio::io_context io;
+  WsServer server;
+  std::uint16_t port = 0;
+  std::thread thread;
+  bool stopped = false;
+
+  // The newest message of each channel; publish() and flush() swap pointers under the mutex.
+  std::mutex mutex;
+  std::array<std::shared_ptr<const std::string>, kChannels> newest;
+  std::array<std::uint64_t, kChannels> sequence{};
+  std::atomic<bool> flush_pending{false};
+
+  // The server's thread only.
+  std::map<connection_hdl, Browser, std::owner_less<connection_hdl>> browsers;
+
+  mutable std::mutex counters_mutex;
+  ViewCounters counters;
+
+  Impl(ViewServerOptions o, CommandHandler handler)
+      : options(std::move(o)), on_command(std::move(handler)), assets(load_assets(options.assets, options.proto)) {
+    server.clear_access_channels(websocketpp::log::alevel::all);
+    server.clear_error_channels(websocketpp::log::elevel::all);
+    server.init_asio(&io);
+    server.set_reuse_addr(true);
+    server.set_max_message_size(options.max_command_bytes);
+    server.set_http_handler([this](connection_hdl hdl) { http(hdl); });
+    server.set_validate_handler([this](connection_hdl hdl) { return validate(hdl); });
+    server.set_open_handler([this](connection_hdl hdl) { opened(hdl); });
+    server.set_close_handler([this](connection_hdl hdl) { closed(hdl); });
+    server.set_fail_handler([this](connection_hdl hdl) { closed(hdl); });
+    server.set_message_handler([this](connection_hdl hdl, WsServer::message_ptr message) { received(hdl, message); });
+    websocketpp::lib::error_code error;
+    asio::error_code address_error;
+    const auto address = asio::ip::make_address(options.host, address_error);
+    if (address_error) throw Error("view: '" + options.host + "' is not an IP address");
+    server.listen(asio::ip::tcp::endpoint(address, options.port), error);
+    if (error) throw Error("view: cannot listen on " + options.host + ":" + std::to_string(options.port) + ": " + error.message());
+    server.start_accept(error);
+    if (error) throw Error("view: cannot accept connections: " + error.message());
+    port = server.get_local_endpoint(error).port();
+  }
+
+  template <class Change>
+  void count(Change change) {
+    std::lock_guard lock(counters_mutex);
+    change(counters);
+  }
+
+  void http(connection_hdl hdl) {
+    const WsServer::connection_ptr connection = server.get_con_from_hdl(hdl);
+    count([](ViewCounters& c) { ++c.http_requests; });
+    const Asset* asset = connection->get_request().get_method() == "GET" ? find_asset(assets, connection->get_resource()) : nullptr;
+    if (!asset) {
+      connection->set_status(websocketpp::http::status_code::not_found);
+      connection->set_body("not found\n");
+      return;
+    }
+    connection->set_status(websocketpp::http::status_code::ok);
+    connection->replace_header("Content-Type", asset->content_type);
+    connection->replace_header("Cache-Control", "no-cache");
+    connection->set_body(asset->body);
+  }
+
+  // The handshake: the right path, the token when one is required, and no foreign page.
+  bool validate(connection_hdl hdl) {
+    const WsServer::connection_ptr connection = server.get_con_from_hdl(hdl);
+    const std::string resource = connection->get_resource();
+    const std::string origin = connection->get_request_header("Origin");
+    const std::string host = connection->get_request_header("Host");
+    std::string refusal;
+    if (resource.substr(0, resource.find('?')) != "/ws") refusal = "not the data path /ws";
+    else if (!options.token.empty() && !same_secret(query_value(resource, "token"), options.token)) refusal = "wrong or missing token";
+    else if (!origin.empty() && origin != "http://" + host) refusal = "a page from " + origin;
+    if (refusal.empty()) return true;
+    count([](ViewCounters& c) { ++c.refused; });
+    spdlog::warn("view: refused a browser from {}: {}", connection->get_remote_endpoint(), refusal);
+    connection->set_status(websocketpp::http::status_code::forbidden);
+    return false;
+  }
+
+  void opened(connection_hdl hdl) {
+    Browser& browser = browsers[hdl];
+    {
+      std::lock_guard lock(mutex);  // what was published before it came is not its loss
+      for (std::size_t channel = 0; channel < kChannels; ++channel)
+        browser.accounted[channel] = sequence[channel] > 0 ? sequence[channel] - 1 : 0;
+    }
+    count([this](ViewCounters& c) {
+      ++c.connections;
+      c.browsers = static_cast<int>(browsers.size());
+    });
+    spdlog::info("view: a browser connected from {} ({} now)", server.get_con_from_hdl(hdl)->get_remote_endpoint(),
+                 browsers.size());
+    flush();
+  }
+
+  void closed(connection_hdl hdl) {
+    if (browsers.erase(hdl) == 0) return;
+    count([this](ViewCounters& c) { c.browsers = static_cast<int>(browsers.size()); });
+  }
+
+  void received(connection_hdl hdl, const WsServer::message_ptr& message) {
+    Command command;
+    const bool valid = message->get_opcode() == websocketpp::frame::opcode::binary &&
+                       command.ParseFromString(message->get_payload()) && command.body_case() != Command::BODY_NOT_SET;
+    if (!valid) {
+      count([](ViewCounters& c) { ++c.closed_for_bad_message; });
+      websocketpp::lib::error_code error;
+      server.close(hdl, websocketpp::close::status::invalid_payload, "not a view Command", error);
+      return;
+    }
+    if (on_command) on_command(command);
+  }
+
+  // Each browser gets the newest message of each channel it has not had, scene first;
+  // one still busy with earlier messages gets nothing new.
+  void flush() {
+    flush_pending = false;
+    std::array<std::shared_ptr<const std::string>, kChannels> messages;
+    std::array<std::uint64_t, kChannels> sequences{};
+    {
+      std::lock_guard lock(mutex);
+      messages = newest;
+      sequences = sequence;
+    }
+    if (!messages[static_cast<std::size_t>(Channel::scene)]) return;
+    std::uint64_t sent = 0, bytes = 0, dropped = 0;
+    for (auto& [hdl, browser] : browsers) {
+      websocketpp::lib::error_code error;
+      const WsServer::connection_ptr connection = server.get_con_from_hdl(hdl, error);
+      if (error) continue;
+      for (std::size_t channel = 0; channel < kChannels; ++channel) {
+        if (!messages[channel] || browser.sent[channel] == sequences[channel]) continue;
+        // Everything older than the newest that it has not had, it never will.
+        if (sequences[channel] - 1 > browser.accounted[channel]) {
+          dropped += sequences[channel] - 1 - browser.accounted[channel];
+          browser.accounted[channel] = sequences[channel] - 1;
+        }
+        if (channel != static_cast<std::size_t>(Channel::scene) && connection->get_buffered_amount() > options.max_buffered_bytes)
+          continue;  // caught up later, with whatever is newest then
+        error = connection->send(*messages[channel], websocketpp::frame::opcode::binary);
+        if (error) break;
+        browser.sent[channel] = browser.accounted[channel] = sequences[channel];
+        ++sent;
+        bytes += messages[channel]->size();
+      }
+    }
+    count([&](ViewCounters& c) {
+      c.messages_sent += sent;
+      c.bytes_sent += bytes;
+      c.dropped += dropped;
+    });
+  }
+};
+
+ViewServer::ViewServer(ViewServerOptions options, CommandHandler on_command)
+    : impl_(std::make_unique<Impl>(std::move(options), std::move(on_command))) {}
+
+ViewServer::~ViewServer() { stop(); }
+
+void ViewServer::start() {
+  impl_->thread = std::thread([impl = impl_.get()] { impl->io.run(); });
+}
+
+void ViewServer::stop() {
+  Impl& s = *impl_;
+  if (s.stopped) return;
+  s.stopped = true;
+  asio::post(s.io, [&s] {
+    websocketpp::lib::error_code error;
+    s.server.stop_listening(error);
+    for (const auto& [hdl, browser] : s.browsers) s.server.close(hdl, websocketpp::close::status::going_away, "server stopped", error);
+    auto timer = std::make_shared<asio::steady_timer>(s.io, kCloseGrace);
+    timer->async_wait([&s, timer](const asio::error_code&) { s.io.stop(); });
+  });
+  if (s.thread.joinable()) s.thread.join();
+}
+
+std::uint16_t ViewServer::port() const { return impl_->port; }
+
+std::string ViewServer::url() const {
+  const Impl& s = *impl_;
+  const bool v6 = s.options.host.find(':') != std::string::npos;
+  std::string url = "http://" + (v6 ? "[" + s.options.host + "]" : s.options.host) + ":" + std::to_string(s.port) + "/";
+  if (!s.options.token.empty()) url += "?token=" + s.options.token;
+  return url;
+}
+
+void ViewServer::publish(Channel channel, std::string message) {
+  Impl& s = *impl_;
+  auto shared = std::make_shared<const std::string>(std::move(message));
+  {
+    std::lock_guard lock(s.mutex);
+    s.newest[static_cast<std::size_t>(channel)] = std::move(shared);
+    ++s.sequence[static_cast<std::size_t>(channel)];
+  }
+  if (!s.flush_pending.exchange(true)) asio::post(s.io, [&s] { s.flush(); });
+}
+
+ViewCounters ViewServer::counters() const {
+  std::lock_guard lock(impl_->counters_mutex);
+  return impl_->counters;
+}
+
+}  // namespace cohaptic::view

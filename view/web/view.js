@@ -1,0 +1,583 @@
+// cohaptic's live view: decodes the view server's messages (proto/cohaptic/view.proto, with
+// protobufjs) and draws them with three.js: the deformed surface coloured by |u|, each
+// user's tool, force arrow, patch and contact nodes, the held nodes, the obstacles; a strip
+// chart and a status table per user; for a recording, a timeline whose controls send
+// Commands back. Lengths arrive in m and are drawn in the scene's unit; forces in N.
+// window.cohapticView exposes the page's state (the browser test reads it).
+import * as THREE from 'three';
+import { OrbitControls } from '/lib/OrbitControls.js';
+
+const USER_COLOURS = ['#e4572e', '#17bebb', '#ffc914', '#76b041', '#b07bd8', '#f28fb1'];
+const CHART_SPAN_S = 10;
+// The displacement colour map (viridis at five stops), as the legend's gradient.
+const COLOUR_STOPS = [[0x44, 0x01, 0x54], [0x3b, 0x52, 0x8b], [0x21, 0x91, 0x8c], [0x5e, 0xc9, 0x62], [0xfd, 0xe7, 0x25]];
+
+const $ = (id) => document.getElementById(id);
+
+// ---- the schema ----
+
+async function loadSchema() {
+  const root = new protobuf.Root();
+  root.resolvePath = (origin, target) => (target.startsWith('/') ? target : '/proto/' + target);
+  await root.load('/proto/cohaptic/view.proto', { keepCase: true });
+  return {
+    ServerMessage: root.lookupType('cohaptic.view.ServerMessage'),
+    Command: root.lookupType('cohaptic.view.Command'),
+    Protocol: root.lookupEnum('cohaptic.wire.Protocol'),
+  };
+}
+
+// ---- numbers ----
+
+function niceCeiling(x) {
+  if (!(x > 0)) return 1;
+  const power = Math.pow(10, Math.floor(Math.log10(x)));
+  for (const step of [1, 2, 5, 10]) if (step * power >= x * (1 - 1e-9)) return step * power;
+  return 10 * power;
+}
+
+function colourOf(t, out, offset) {
+  const x = Math.min(Math.max(t, 0), 1) * (COLOUR_STOPS.length - 1);
+  const i = Math.min(Math.floor(x), COLOUR_STOPS.length - 2), f = x - i;
+  for (let c = 0; c < 3; ++c) out[offset + c] = (COLOUR_STOPS[i][c] * (1 - f) + COLOUR_STOPS[i + 1][c] * f) / 255;
+}
+
+// protobufjs gives 64-bit integers as {low, high} objects.
+const num = (x) => (typeof x === 'object' && x !== null ? x.high * 4294967296 + (x.low >>> 0) : Number(x));
+const norm3 = (v) => (v && v.length === 3 ? Math.hypot(v[0], v[1], v[2]) : 0);
+const fmt = (x, digits) => (Number.isFinite(x) ? x.toFixed(digits) : '–');
+
+// ---- the page ----
+
+class View {
+  constructor(schema) {
+    this.schema = schema;
+    this.state = {
+      connected: false, frozen: false, softwareRenderer: false, scene: null, replay: false, framesReceived: 0, framesDrawn: 0, frame: null,
+      status: {}, timeline: null, drawFps: 0, messageBytes: 0, displacementScaleMm: 0.1, closedReason: '',
+    };
+    this.history = new Map();  // slot -> [{t, f}] (live: from frames)
+    this.pendingFrame = null;
+    this.showObstacles = true;
+    this.setUpRenderer();
+    this.setUpControls();
+    this.connect();
+    requestAnimationFrame((t) => this.draw(t));
+  }
+
+  setUpRenderer() {
+    this.canvas = $('canvas');
+    // Multisampling is nearly free on a graphics card but costs a software renderer (a headless
+    // browser's SwiftShader) most of its time: only with a card.
+    const probe = document.createElement('canvas').getContext('webgl2');
+    const info = probe && probe.getExtension('WEBGL_debug_renderer_info');
+    this.state.softwareRenderer = !!(info && /swiftshader|llvmpipe/i.test(probe.getParameter(info.UNMASKED_RENDERER_WEBGL)));
+    this.renderer = new THREE.WebGLRenderer({ canvas: this.canvas, antialias: !this.state.softwareRenderer, preserveDrawingBuffer: true });
+    this.renderer.setPixelRatio(window.devicePixelRatio);
+    this.scene3d = new THREE.Scene();
+    this.scene3d.background = new THREE.Color(0x15171c);
+    this.camera = new THREE.PerspectiveCamera(40, 1, 0.1, 1e5);
+    this.camera.up.set(0, 0, 1);
+    this.orbit = new OrbitControls(this.camera, this.canvas);
+    // Drawn only when something changed (a frame, the camera, the window): an idle page costs nothing.
+    this.orbit.addEventListener('change', () => { this.needsRender = true; });
+    this.scene3d.add(new THREE.HemisphereLight(0xffffff, 0x404050, 1.6));
+    this.light = new THREE.DirectionalLight(0xffffff, 1.4);
+    this.scene3d.add(this.light);
+    this.scene3d.add(this.light.target);
+    window.addEventListener('resize', () => this.resize());
+    this.resize();
+  }
+
+  resize() {
+    const { clientWidth: w, clientHeight: h } = this.canvas.parentElement;
+    this.renderer.setSize(w, h, false);
+    this.camera.aspect = w / Math.max(h, 1);
+    this.camera.updateProjectionMatrix();
+    this.needsRender = true;
+  }
+
+  setUpControls() {
+    const send = (body) => this.send(body);
+    $('play').addEventListener('click', () => send(this.state.timeline?.playing ? { pause: {} } : { play: {} }));
+    $('speed').addEventListener('change', (e) => send({ speed: Number(e.target.value) }));
+    $('scrub').addEventListener('input', (e) => send({ seek: Number(e.target.value) }));
+    $('jump-peak').addEventListener('click', () => send({ jump: 1 }));
+    $('jump-step').addEventListener('click', () => send({ jump: 2 }));
+    window.addEventListener('keydown', (e) => {
+      if (e.target.tagName === 'INPUT' || e.target.tagName === 'SELECT') return;
+      const t = this.state.timeline;
+      const key = e.key.toLowerCase();
+      if (key === 'r') this.resetCamera();
+      else if (key === 'o') this.toggleObstacles();
+      else if (key === 'f') this.frozen = !this.frozen;
+      else if (key === 't') this.focusTools();
+      else if (!this.state.replay || !t) return;
+      else if (e.key === ' ') send(t.playing ? { pause: {} } : { play: {} });
+      else if (e.key === 'ArrowLeft' || e.key === 'ArrowRight')
+        send({ seek: t.time + (e.key === 'ArrowLeft' ? -1 : 1) * (e.shiftKey ? 0.1 : 1) });
+      else if (key === 'p') send({ jump: 1 });
+      else if (key === 'j') send({ jump: 2 });
+      else return;
+      e.preventDefault();
+    });
+  }
+
+  // ---- the connection ----
+
+  connect() {
+    const token = new URLSearchParams(location.search).get('token');
+    const url = `ws://${location.host}/ws${token ? `?token=${encodeURIComponent(token)}` : ''}`;
+    const ws = new WebSocket(url);
+    ws.binaryType = 'arraybuffer';
+    this.ws = ws;
+    ws.onopen = () => { this.state.connected = true; this.banner(''); };
+    ws.onmessage = (e) => this.receive(new Uint8Array(e.data));
+    ws.onclose = (e) => {
+      this.state.connected = false;
+      this.state.closedReason = e.reason || String(e.code);
+      this.banner(this.state.scene ? 'the session has ended (or the server went away): retrying…' : 'no view server: retrying…');
+      setTimeout(() => this.connect(), 1000);
+    };
+  }
+
+  send(body) {
+    if (!this.ws || this.ws.readyState !== WebSocket.OPEN) return false;
+    const message = this.schema.Command.create(body);
+    this.ws.send(this.schema.Command.encode(message).finish());
+    return true;
+  }
+
+  banner(text) {
+    $('connection').textContent = text;
+    $('connection').classList.toggle('hidden', !text);
+  }
+
+  receive(bytes) {
+    this.state.messageBytes += bytes.length;
+    const message = this.schema.ServerMessage.decode(bytes);
+    if (message.scene) this.setScene(message.scene);
+    else if (message.frame) {
+      ++this.state.framesReceived;
+      this.pendingFrame = message.frame;
+      if (!this.state.replay) this.remember(message.frame);
+    } else if (message.status) this.setStatus(message.status);
+    else if (message.timeline) this.setTimeline(message.timeline);
+  }
+
+  // ---- the scene ----
+
+  setScene(scene) {
+    const unit = 1 / scene.metres_per_unit;
+    this.unit = unit;
+    this.state.scene = {
+      name: scene.scene_name, units: scene.units, source: scene.source, nodes: scene.rest_positions.length / 3,
+      triangles: scene.triangles.length / 3, tools: scene.tools.map((t) => ({ slot: t.slot, name: t.name, radius: t.radius })),
+      obstacles: scene.obstacles.map((o) => o.name), protocol: this.schema.Protocol.valuesById[scene.protocol] || '?',
+      forceLimit: scene.force_limit, frameRateHz: scene.frame_rate_hz,
+    };
+    this.state.replay = scene.source !== 'live';
+    this.series = new Map(scene.force_series.map((s) => [s.slot, { times: s.times, magnitudes: s.magnitudes }]));
+    this.state.timeline = null;
+    document.body.classList.toggle('replay', this.state.replay);
+    if (this.root) this.scene3d.remove(this.root);
+    this.root = new THREE.Group();
+    this.scene3d.add(this.root);
+    this.history.clear();
+
+    const n = scene.rest_positions.length / 3;
+    this.rest = Float32Array.from(scene.rest_positions, (x) => x * unit);
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.BufferAttribute(this.rest.slice(), 3));
+    geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+    geometry.setIndex(scene.triangles);
+    for (let i = 0; i < n; ++i) colourOf(0, geometry.attributes.color.array, 3 * i);
+    geometry.computeVertexNormals();
+    geometry.computeBoundingBox();
+    this.surface = new THREE.Mesh(geometry, new THREE.MeshPhongMaterial({ vertexColors: true, side: THREE.DoubleSide, shininess: 25 }));
+    this.root.add(this.surface);
+    this.box = geometry.boundingBox.clone();
+    this.size = this.box.getSize(new THREE.Vector3()).length();
+    // Forces are drawn as arrows of a fixed scale: 1 N is a quarter of the object's diagonal.
+    this.arrowUnitsPerN = niceCeiling(this.size / 4);
+    $('arrow-scale').textContent = `arrow: ${this.arrowUnitsPerN} ${scene.units} = 1 N`;
+
+    this.obstacleGroup = new THREE.Group();
+    for (const obstacle of scene.obstacles) {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(Float32Array.from(obstacle.vertices, (x) => x * unit), 3));
+      g.setIndex(obstacle.triangles);
+      g.computeVertexNormals();
+      const material = new THREE.MeshPhongMaterial({ color: 0x9fb4c8, transparent: true, opacity: 0.13, depthWrite: false, side: THREE.DoubleSide });
+      this.obstacleGroup.add(new THREE.Mesh(g, material));
+    }
+    this.obstacleGroup.visible = this.showObstacles;
+    this.root.add(this.obstacleGroup);
+
+    const pointSize = Math.max(this.size / 160, 0.5);
+    const points = (colour, size) => {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+      g.setDrawRange(0, 0);
+      const p = new THREE.Points(g, new THREE.PointsMaterial({ color: colour, size, sizeAttenuation: true, depthTest: false }));
+      p.renderOrder = 2;
+      this.root.add(p);
+      return p;
+    };
+    this.heldPoints = points(0xff4fd8, pointSize);
+    this.users = scene.tools.map((tool, k) => {
+      const colour = new THREE.Color(USER_COLOURS[k % USER_COLOURS.length]);
+      const radius = tool.radius > 0 ? tool.radius * unit : this.size / 150;
+      const sphere = new THREE.Mesh(new THREE.SphereGeometry(radius, 24, 16), new THREE.MeshPhongMaterial({ color: colour }));
+      sphere.visible = false;
+      this.root.add(sphere);
+      const arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 1, colour, 1, 1);
+      arrow.visible = false;
+      arrow.traverse((o) => { if (o.material) { o.material.depthTest = false; } o.renderOrder = 3; });
+      this.root.add(arrow);
+      const patch = points(colour.clone().lerp(new THREE.Color(0xffffff), 0.55), pointSize);
+      const contact = points(0xffffff, pointSize * 1.8);
+      const label = document.createElement('div');
+      label.className = 'label';
+      label.style.background = USER_COLOURS[k % USER_COLOURS.length];
+      label.textContent = tool.name;
+      $('labels').appendChild(label);
+      return { slot: tool.slot, tool: tool.name, colour: USER_COLOURS[k % USER_COLOURS.length], sphere, arrow, patch, contact, label,
+               present: false, force: [0, 0, 0], position: null, pressing: false };
+    });
+    for (const old of [...$('labels').children]) if (!this.users.some((u) => u.label === old)) old.remove();
+    this.buildPanel();
+    this.resetCamera();
+    $('scene-name').textContent = `${scene.scene_name}${this.state.replay ? ' · recording' : ' · live'}`;
+    const injected = scene.injected || {};
+    $('session').textContent = `${this.state.scene.protocol} · ${n} surface nodes · force limit ${fmt(scene.force_limit, 2)} N` +
+      (this.state.replay ? ` · ${scene.source}` : '');
+    $('injected').textContent = `injected: shift ${fmt(injected.shift_delay_ms || 0, 1)} ms, jitter ${fmt(injected.jitter_ms || 0, 1)} ms, ` +
+      `loss ${fmt(100 * (injected.loss || 0), 1)} %, step nodes ${injected.step_nodes || 0}, ` +
+      `sim cap ${injected.sim_rate_hz ? fmt(injected.sim_rate_hz, 0) + ' Hz' : 'none'}`;
+  }
+
+  resetCamera() {
+    if (!this.box) return;
+    // From behind, to the left and above (the brain's surgeons work at its back), far enough
+    // for the object's bounding sphere to fit the narrower of the two fields of view.
+    const centre = this.box.getCenter(new THREE.Vector3());
+    const halfFov = THREE.MathUtils.degToRad(this.camera.fov / 2);
+    const narrowest = Math.min(halfFov, Math.atan(Math.tan(halfFov) * this.camera.aspect));
+    const distance = (this.size / 2 / Math.sin(narrowest)) * 1.05;
+    this.camera.position.copy(centre).add(new THREE.Vector3(-0.5, -1, 0.55).normalize().multiplyScalar(distance));
+    this.camera.near = this.size / 200;
+    this.camera.far = this.size * 20;
+    this.camera.updateProjectionMatrix();
+    this.orbit.target.copy(centre);
+    this.orbit.update();
+    this.needsRender = true;
+  }
+
+  // Closer, at the present tools' midpoint, looking from where the camera is.
+  focusTools() {
+    const present = (this.users || []).filter((u) => u.present && u.position);
+    if (!present.length) return;
+    const middle = present.reduce((sum, u) => sum.add(u.position), new THREE.Vector3()).multiplyScalar(1 / present.length);
+    const direction = this.camera.position.clone().sub(this.orbit.target).normalize();
+    this.orbit.target.copy(middle);
+    this.camera.position.copy(middle).add(direction.multiplyScalar(this.size * 0.45));
+    this.orbit.update();
+    this.needsRender = true;
+  }
+
+  toggleObstacles() {
+    this.showObstacles = !this.showObstacles;
+    if (this.obstacleGroup) this.obstacleGroup.visible = this.showObstacles;
+    this.needsRender = true;
+  }
+
+  buildPanel() {
+    const container = $('users');
+    container.innerHTML = '';
+    for (const user of this.users) {
+      const card = document.createElement('div');
+      card.className = 'user';
+      card.style.setProperty('--colour', user.colour);
+      card.innerHTML = `<h2><span class="name"></span><span class="force"></span></h2><canvas width="600" height="160"></canvas>
+        <table>
+          <tr><td>haptic rate</td><td data-field="haptic_rate_hz"></td></tr>
+          <tr><td>period p99 (timer floor p99)</td><td data-field="period_p99_us"></td></tr>
+          <tr><td>missed deadlines</td><td data-field="missed_deadlines"></td></tr>
+          <tr><td>IR age p99</td><td data-field="ir_age_p99_ms"></td></tr>
+          <tr><td>one-way delay p99</td><td data-field="one_way_delay_p99_ms"></td></tr>
+          <tr><td>peak force</td><td data-field="peak_force"></td></tr>
+          <tr><td>protocol</td><td data-field="protocol"></td></tr>
+        </table>`;
+      card.querySelector('.name').textContent = `tool ${user.tool}`;
+      container.appendChild(card);
+      user.card = card;
+      user.chart = card.querySelector('canvas');
+    }
+  }
+
+  // ---- data ----
+
+  remember(frame) {
+    for (const u of frame.users) {
+      if (!this.history.has(u.slot)) this.history.set(u.slot, []);
+      const list = this.history.get(u.slot);
+      list.push({ t: frame.time, f: u.present ? norm3(u.force) : NaN });
+      while (list.length && list[0].t < frame.time - CHART_SPAN_S - 1) list.shift();
+    }
+  }
+
+  setStatus(status) {
+    for (const s of status.users) {
+      const f = s.figures || {};
+      this.state.status[s.slot] = { user: s.user, receivedTime: s.received_time, ...f, missed_deadlines: num(f.missed_deadlines), ticks: num(f.ticks) };
+    }
+    for (const user of this.users || []) this.showStatus(user);
+  }
+
+  showStatus(user) {
+    const s = this.state.status[user.slot];
+    if (!user.card) return;
+    const cell = (field) => user.card.querySelector(`[data-field="${field}"]`);
+    if (s && s.user) user.card.querySelector('.name').textContent = `${s.user} · tool ${user.tool}`;
+    user.label.textContent = s && s.user ? `${s.user} (${user.tool})` : user.tool;
+    cell('protocol').textContent = this.state.scene ? this.state.scene.protocol : '';
+    if (!s) return;
+    cell('haptic_rate_hz').textContent = `${fmt(s.haptic_rate_hz, 1)} Hz`;
+    cell('period_p99_us').textContent = `${fmt(s.period_p99_us, 0)} µs (${fmt(s.timer_floor_p99_us, 0)} µs)`;
+    cell('missed_deadlines').textContent = `${num(s.missed_deadlines)}`;
+    cell('ir_age_p99_ms').textContent = `${fmt(s.ir_age_p99_ms, 1)} ms`;
+    cell('one_way_delay_p99_ms').textContent = `${fmt(s.one_way_delay_p99_ms, 2)} ms`;
+    cell('peak_force').textContent = `${fmt(s.peak_force, 3)} N${s.final ? ' (final)' : ''}`;
+  }
+
+  setTimeline(timeline) {
+    const first = !this.state.timeline;
+    this.state.timeline = {
+      start: timeline.start, end: timeline.end, time: timeline.time, playing: timeline.playing, speed: timeline.speed,
+      peakForceTime: timeline.peak_force_time, largestStepTime: timeline.largest_step_time,
+    };
+    if (first && this.series) this.drawScrubChart();
+    const scrub = $('scrub');
+    scrub.min = timeline.start;
+    scrub.max = timeline.end;
+    if (document.activeElement !== scrub || first) scrub.value = timeline.time;
+    $('play').textContent = timeline.playing ? '❚❚' : '▶';
+    $('speed').value = String(timeline.speed);
+    $('time').textContent = `${fmt(timeline.time, 2)} / ${fmt(timeline.end, 2)} s`;
+  }
+
+  // ---- drawing ----
+
+  applyFrame(frame) {
+    const unit = this.unit;
+    const positions = this.surface.geometry.attributes.position.array;
+    const colours = this.surface.geometry.attributes.color.array;
+    const u = frame.displacement;
+    const n = positions.length / 3;
+    let largest = 0;
+    for (let i = 0; i < n && 3 * i + 2 < u.length; ++i) largest = Math.max(largest, Math.hypot(u[3 * i], u[3 * i + 1], u[3 * i + 2]));
+    // The colour scale grows to the largest displacement seen, in round millimetres.
+    this.state.displacementScaleMm = Math.max(this.state.displacementScaleMm, niceCeiling(largest * 1e3));
+    const scale = this.state.displacementScaleMm / 1e3;
+    for (let i = 0; i < n; ++i) {
+      const ux = u[3 * i] || 0, uy = u[3 * i + 1] || 0, uz = u[3 * i + 2] || 0;
+      positions[3 * i] = this.rest[3 * i] + ux * unit;
+      positions[3 * i + 1] = this.rest[3 * i + 1] + uy * unit;
+      positions[3 * i + 2] = this.rest[3 * i + 2] + uz * unit;
+      colourOf(Math.hypot(ux, uy, uz) / scale, colours, 3 * i);
+    }
+    this.surface.geometry.attributes.position.needsUpdate = true;
+    this.surface.geometry.attributes.color.needsUpdate = true;
+    this.surface.geometry.computeVertexNormals();
+    $('legend-max').textContent = fmt(this.state.displacementScaleMm, this.state.displacementScaleMm < 1 ? 2 : 1);
+    $('legend-mid').textContent = fmt(this.state.displacementScaleMm / 2, this.state.displacementScaleMm < 1 ? 2 : 1);
+
+    const placeNodes = (points, nodes) => {
+      const array = points.geometry.attributes.position.array;
+      nodes.forEach((node, k) => { for (let c = 0; c < 3; ++c) array[3 * k + c] = positions[3 * node + c]; });
+      points.geometry.attributes.position.needsUpdate = true;
+      points.geometry.setDrawRange(0, nodes.length);
+    };
+    placeNodes(this.heldPoints, frame.held_nodes);
+    for (const user of this.users) {
+      const data = frame.users.find((f) => f.slot === user.slot);
+      user.present = !!(data && data.present);
+      user.sphere.visible = user.present;
+      user.label.style.display = user.present ? '' : 'none';
+      if (!user.present) {
+        user.arrow.visible = false;
+        placeNodes(user.patch, []);
+        placeNodes(user.contact, []);
+        user.force = [0, 0, 0];
+        user.card.querySelector('.force').textContent = 'absent';
+        continue;
+      }
+      const p = new THREE.Vector3(...data.position).multiplyScalar(unit);
+      user.position = p;
+      user.force = [...data.force];
+      user.pressing = data.pressing;
+      user.sphere.position.copy(p);
+      const magnitude = norm3(data.force);
+      const length = Math.min(magnitude * this.arrowUnitsPerN, this.size * 0.6);
+      user.arrow.visible = length > this.size / 500;
+      if (user.arrow.visible) {
+        user.arrow.position.copy(p);
+        user.arrow.setDirection(new THREE.Vector3(...data.force).normalize());
+        user.arrow.setLength(length, Math.min(length * 0.3, this.size / 25), Math.min(length * 0.15, this.size / 60));
+      }
+      user.arrowLength = user.arrow.visible ? length : 0;
+      placeNodes(user.patch, data.patch_nodes);
+      placeNodes(user.contact, data.contact_nodes);
+      user.card.querySelector('.force').textContent = `${fmt(magnitude, 3)} N`;
+    }
+    const boundary = frame.boundary_nodes;
+    $('frame-info').textContent = `t = ${fmt(frame.time, 2)} s · simulation ${fmt(frame.sim_rate_hz, 0)} steps/s · |B| = ${boundary}`;
+    this.state.frame = {
+      time: frame.time, sequence: num(frame.sequence), boundaryNodes: boundary, heldShown: frame.held_nodes.length,
+      simRateHz: frame.sim_rate_hz, maxDisplacementMm: largest * 1e3,
+    };
+  }
+
+  drawChart(user, now) {
+    const canvas = user.chart;
+    const ctx = canvas.getContext('2d');
+    const w = canvas.width, h = canvas.height;
+    ctx.clearRect(0, 0, w, h);
+    let samples = [];
+    if (this.state.replay && this.series?.has(user.slot)) {
+      const s = this.series.get(user.slot);
+      for (let i = 0; i < s.times.length; ++i)
+        if (s.times[i] >= now - CHART_SPAN_S && s.times[i] <= now) samples.push({ t: s.times[i], f: s.magnitudes[i] });
+    } else {
+      samples = (this.history.get(user.slot) || []).filter((s) => s.t >= now - CHART_SPAN_S);
+    }
+    const finite = samples.filter((s) => Number.isFinite(s.f));
+    const top = niceCeiling(Math.max(0.01, ...finite.map((s) => s.f)));
+    ctx.strokeStyle = '#3a404c';
+    ctx.fillStyle = '#8a90a0';
+    ctx.font = '20px system-ui';
+    ctx.lineWidth = 1;
+    for (const f of [0.5, 1]) {
+      const y = h - 4 - f * (h - 8);
+      ctx.beginPath(); ctx.moveTo(0, y); ctx.lineTo(w, y); ctx.stroke();
+    }
+    ctx.fillText(`${top} N`, 6, 22);
+    ctx.fillText(`|F| over the last ${CHART_SPAN_S} s`, w - 250, h - 8);
+    ctx.strokeStyle = user.colour;
+    ctx.lineWidth = 3;
+    ctx.beginPath();
+    let drawn = 0, moving = false;
+    for (const s of samples) {
+      if (!Number.isFinite(s.f)) { moving = false; continue; }
+      const x = w - ((now - s.t) / CHART_SPAN_S) * w, y = h - 4 - (s.f / top) * (h - 8);
+      if (moving) ctx.lineTo(x, y); else ctx.moveTo(x, y);
+      moving = true;
+      ++drawn;
+    }
+    ctx.stroke();
+    user.chartState = {
+      samples: drawn, first: finite.length ? finite[0].t : NaN, last: finite.length ? finite[finite.length - 1].t : NaN,
+      latest: finite.length ? finite[finite.length - 1].f : NaN, top,
+    };
+  }
+
+  drawScrubChart() {
+    const canvas = $('scrub-chart');
+    canvas.width = canvas.clientWidth * devicePixelRatio;
+    canvas.height = canvas.clientHeight * devicePixelRatio;
+    const ctx = canvas.getContext('2d');
+    const { start, end } = this.state.timeline;
+    const span = Math.max(end - start, 1e-9);
+    let top = 1e-6;
+    for (const s of this.series.values()) for (const m of s.magnitudes) top = Math.max(top, m);
+    for (const user of this.users) {
+      const s = this.series.get(user.slot);
+      if (!s) continue;
+      ctx.strokeStyle = user.colour;
+      ctx.lineWidth = devicePixelRatio;
+      ctx.beginPath();
+      s.times.forEach((t, i) => {
+        // Above the slider's track, which takes the lowest 16 px.
+        const x = ((t - start) / span) * canvas.width, y = 2 + (canvas.height - 18 * devicePixelRatio) * (1 - s.magnitudes[i] / top);
+        if (i) ctx.lineTo(x, y); else ctx.moveTo(x, y);
+      });
+      ctx.stroke();
+    }
+  }
+
+  placeLabels() {
+    const rect = this.canvas.getBoundingClientRect();
+    for (const user of this.users || []) {
+      if (!user.present || !user.position) continue;
+      const p = user.position.clone().project(this.camera);
+      user.label.style.left = `${((p.x + 1) / 2) * rect.width}px`;
+      user.label.style.top = `${((1 - p.y) / 2) * rect.height}px`;
+    }
+  }
+
+  draw(time) {
+    requestAnimationFrame((t) => this.draw(t));
+    if (!this.surface) return;
+    if (this.pendingFrame && !this.frozen) {
+      const frame = this.pendingFrame;
+      this.pendingFrame = null;
+      this.applyFrame(frame);
+      ++this.state.framesDrawn;
+      this.drawTimes = (this.drawTimes || []).filter((t) => t > time - 2000).concat([time]);
+      this.state.drawFps = this.drawTimes.length > 1 ? (this.drawTimes.length - 1) / ((time - this.drawTimes[0]) / 1000) : 0;
+      for (const user of this.users) this.drawChart(user, frame.time);
+      this.needsRender = true;
+    }
+    if (!this.needsRender) return;
+    this.needsRender = false;
+    this.light.position.copy(this.camera.position);
+    this.light.target.position.copy(this.orbit.target);
+    this.renderer.render(this.scene3d, this.camera);
+    this.placeLabels();
+  }
+
+  // ---- for tests: where things are on the screen (CSS pixels of the page) ----
+
+  screenBox(points) {
+    const rect = this.canvas.getBoundingClientRect();
+    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+    for (const q of points) {
+      const p = q.clone().project(this.camera);
+      const x = rect.left + ((p.x + 1) / 2) * rect.width, y = rect.top + ((1 - p.y) / 2) * rect.height;
+      x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+    }
+    return { x0, y0, x1, y1 };
+  }
+
+  snapshot() {
+    const box = this.surface ? new THREE.Box3().setFromBufferAttribute(this.surface.geometry.attributes.position) : null;
+    const corners = box ? [0, 1, 2, 3, 4, 5, 6, 7].map((k) => new THREE.Vector3(
+      k & 1 ? box.max.x : box.min.x, k & 2 ? box.max.y : box.min.y, k & 4 ? box.max.z : box.min.z)) : [];
+    const rect = this.canvas.getBoundingClientRect();
+    return {
+      ...this.state,
+      frozen: !!this.frozen,
+      canvas: { x: rect.left, y: rect.top, width: rect.width, height: rect.height },
+      meshScreenBox: box ? this.screenBox(corners) : null,
+      meshTriangles: this.surface ? this.surface.geometry.index.count / 3 : 0,
+      users: (this.users || []).map((u) => ({
+        slot: u.slot, tool: u.tool, colour: u.colour, present: u.present, pressing: u.pressing, force: u.force,
+        forceMagnitude: norm3(u.force), arrowVisible: u.arrow.visible, arrowLength: u.arrowLength || 0,
+        toolScreen: u.present && u.position ? this.screenBox([u.position]) : null,
+        arrowTipScreen: u.arrow.visible ? this.screenBox([u.position.clone().add(
+          new THREE.Vector3(...u.force).normalize().multiplyScalar(u.arrowLength))]) : null,
+        chart: u.chartState || null,
+        panel: u.card ? Object.fromEntries([...u.card.querySelectorAll('[data-field]')].map((c) => [c.dataset.field, c.textContent])) : {},
+      })),
+    };
+  }
+}
+
+const schema = await loadSchema();
+const view = new View(schema);
+window.cohapticView = {
+  snapshot: () => view.snapshot(),
+  command: (body) => view.send(body),
+  freeze: (on) => { view.frozen = on; },
+};
