@@ -93,7 +93,15 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       }
       record.remote_count = static_cast<std::uint8_t>(count);
       const ForceSample sample = evaluate_force(*slot.ir, own, std::span(remotes.data(), count));
-      force = sample.force;
+      // A sphere contact solve that could not finish inside the tick has no answer: hold the
+      // last one and count the tick.
+      if (sample.flags & kContactUnresolved) {
+        force = last_evaluated_;
+        ++metrics_.contact_unresolved;
+      } else {
+        force = sample.force;
+        last_evaluated_ = force;
+      }
       record.flags = sample.flags;
       record.ir_epoch = ir.epoch;
       if (count > 0 && (sample.flags & kInContact)) {

@@ -1,20 +1,35 @@
 #include "common/mesh/box_mesher.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fmt/format.h>
 
 #include "common/util/error.h"
 
 namespace cohaptic {
+namespace {
+
+// Where node i of n cells lies along an axis, as a fraction of its length: the cells
+// form a geometric series of ratio r.
+double graded_fraction(int i, int n, double r) {
+  if (i == n) return 1;
+  if (std::abs(r - 1) < 1e-12) return double(i) / n;
+  return (std::pow(r, i) - 1) / (std::pow(r, n) - 1);
+}
+
+}  // namespace
 
 TetMesh make_box_mesh(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& size,
-                      const Eigen::Vector3i& divisions) {
+                      const Eigen::Vector3i& divisions, const Eigen::Vector3d& grading) {
   if ((divisions.array() < 1).any())
     throw MeshError(fmt::format("box mesh: divisions must be >= 1 along every axis, got {} {} {}",
                                 divisions.x(), divisions.y(), divisions.z()));
   if (!(size.array() > 0).all() || !size.allFinite())
     throw MeshError(fmt::format("box mesh: size must be positive along every axis, got {} {} {}",
                                 size.x(), size.y(), size.z()));
+  if (!(grading.array() > 0).all() || !grading.allFinite())
+    throw MeshError(fmt::format("box mesh: grading must be a positive ratio along every axis, got {} {} {}",
+                                grading.x(), grading.y(), grading.z()));
   const int nx = divisions.x(), ny = divisions.y(), nz = divisions.z();
   const auto node_id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
 
@@ -25,7 +40,8 @@ TetMesh make_box_mesh(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& 
     for (int j = 0; j <= ny; ++j)
       for (int i = 0; i <= nx; ++i)
         mesh.nodes.col(node_id(i, j, k)) =
-            min_corner + size.cwiseProduct(Eigen::Vector3d(double(i) / nx, double(j) / ny, double(k) / nz));
+            min_corner + size.cwiseProduct(Eigen::Vector3d(graded_fraction(i, nx, grading.x()), graded_fraction(j, ny, grading.y()),
+                                                          graded_fraction(k, nz, grading.z())));
   mesh.node_tags.resize(static_cast<std::size_t>(node_count));
   for (int n = 0; n < node_count; ++n) mesh.node_tags[n] = n + 1;
 

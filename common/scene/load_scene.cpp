@@ -90,7 +90,7 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
     if (mesh.file.is_relative()) mesh.file = scene_dir / mesh.file;
     if (!std::filesystem::exists(mesh.file)) file->fail_message(fmt::format("mesh file {} does not exist", mesh.file.string()));
   } else {
-    box->only_keys({"min", "size", "divisions"});
+    box->only_keys({"min", "size", "divisions", "grading"});
     BoxMeshSpec spec;
     spec.min_corner = box->at("min").vec3() * scale;
     const Cursor size = box->at("size");
@@ -103,6 +103,11 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
       const std::int64_t d = parts[i].integer();
       if (d < 1 || d > 400) parts[i].fail("an integer from 1 to 400");
       spec.divisions[i] = static_cast<int>(d);
+    }
+    if (auto grading = box->find("grading")) {
+      if (!grading->is_sequence() || grading->items().size() != 3) grading->fail("a list of 3 ratios");
+      const auto ratios = grading->items();
+      for (int i = 0; i < 3; ++i) spec.grading[i] = ratios[i].number_in(0.2, 5, false, false, "a ratio from 0.2 to 5");
     }
     mesh.box = spec;
   }

@@ -29,6 +29,7 @@ struct BoxMeshSpec {
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();  ///< [m]
   Eigen::Vector3d size = Eigen::Vector3d::Zero();        ///< [m]
   Eigen::Vector3i divisions = Eigen::Vector3i::Ones();
+  Eigen::Vector3d grading = Eigen::Vector3d::Ones();     ///< per axis: each cell / the one before (box_mesher.h)
 };
 
 /// Exactly one of a mesh file (.msh 2.2/4.1, resolved against the scene's directory) or a generator.
