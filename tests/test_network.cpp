@@ -309,7 +309,11 @@ TEST(EndToEnd, HostileDatagramsAreRejectedByReasonAndDoNotMoveTheHapticPeriod) {
   const double floor_p99 = report["timer_floor"]["period_us"]["p99"].get<double>();
   std::printf("  under a flood of 20,000 hostile datagrams: haptic period p99 %.0f us, timer floor p99 %.0f us\n", p99,
               floor_p99);
-  EXPECT_LE(p99, std::max(1100.0, floor_p99 + 150));
+  // The floor is measured before the session, the flood's period during it: on an idle
+  // machine they agree within ~50 us; on a loaded one (a 2 ms floor) both swing by a
+  // tenth or more between the two measurements, so the margin grows with the floor. A flood
+  // handled on the haptic thread would cost milliseconds per burst, far beyond either.
+  EXPECT_LE(p99, std::max(1100.0, floor_p99 * 1.25 + 150));
   EXPECT_EQ(report["non_finite_ticks"], 0);
 }
 

@@ -69,17 +69,19 @@ std::string url_in(const std::string& log, const std::string& before) {
   return std::regex_search(log, match, line) ? match[1].str() : "";
 }
 
-// A soft cube, two sphere tools, each user pressing its side of the top face: the scene,
-// and a script for each user that presses `depth_mm` and holds for `hold_s`.
-void write_session(const fs::path& dir, double depth_mm, double hold_s) {
+// A soft cube, two sphere tools, each user pressing its side of the top face: a directory
+// holding the scene (cube.yaml) and a script for each user (a.yaml, b.yaml) that presses
+// `depth_mm` and holds for `hold_s`.
+fs::path cube_session(const std::string& name, double depth_mm, double hold_s) {
+  const fs::path dir = testing::scratch_directory(name);
   testing::CubeSceneOptions soft;
   soft.divisions = 8;
   soft.youngs_modulus = 2.0e4;
   soft.touchable = "{surface: true}";
   soft.tools = "[{name: A, shape: sphere, radius: 4}, {name: B, shape: sphere, radius: 4}]";
   std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(soft);
-  for (const auto& [name, x] : {std::pair{"a", -30}, std::pair{"b", 30}})
-    std::ofstream(dir / (std::string(name) + ".yaml")) << fmt::format(R"(
+  for (const auto& [user, x] : {std::pair{"a", -30}, std::pair{"b", 30}})
+    std::ofstream(dir / (std::string(user) + ".yaml")) << fmt::format(R"(
 units: mm
 start: [{0}, 5, 12]
 segments:
@@ -89,26 +91,42 @@ segments:
   - {{release: {1}, speed: 5}}
 )",
                                                                       x, depth_mm, hold_s);
+  return dir;
 }
 
+// The demo's session (scenes/brain.yaml): a directory holding each surgeon's script (a.yaml,
+// b.yaml) as the demo's, but holding its press until told to stop.
+fs::path brain_session(const std::string& name) {
+  const fs::path dir = testing::scratch_directory(name);
+  for (const auto& [user, surgeon] : {std::pair{"a", "surgeon_a"}, std::pair{"b", "surgeon_b"}}) {
+    std::stringstream demo;
+    demo << std::ifstream(kSource / "scenes/brain" / (std::string(surgeon) + ".yaml")).rdbuf();
+    const std::string held = std::regex_replace(demo.str(), std::regex(R"(\{hold: [0-9.]+\})"), "{hold: 600}");
+    EXPECT_NE(held, demo.str()) << surgeon << ".yaml has no hold";
+    std::ofstream(dir / (std::string(user) + ".yaml")) << held;
+  }
+  return dir;
+}
+
+// The server of a two-user session on `scene` with the live view, recording.
 struct ViewSession {
   fs::path dir;
   std::unique_ptr<ChildProcess> server;
   std::string url;
   int port = -1;
 
-  ViewSession(const std::string& name, double depth_mm, double hold_s) : dir(testing::scratch_directory(name)) {
-    write_session(dir, depth_mm, hold_s);
+  ViewSession(fs::path directory, const fs::path& scene) : dir(std::move(directory)) {
     server = std::make_unique<ChildProcess>(
         testing::server_program(),
-        std::vector<std::string>{"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--view", "127.0.0.1:0",
-                                 "--record", (dir / "server.mcap").string(), "--no-disk-cache"},
+        std::vector<std::string>{"--scene", scene.string(), "--listen", "127.0.0.1:0", "--view", "127.0.0.1:0", "--record",
+                                 (dir / "server.mcap").string(), "--no-disk-cache"},
         dir / "server.log");
     EXPECT_TRUE(testing::wait_for_output(*server, "live view at"));
     EXPECT_TRUE(testing::wait_for_output(*server, "listening on"));
     port = testing::listening_port(server->log_text());
     url = url_in(server->log_text(), "live view at");
   }
+  // User `user` ("a" or "b") in `slot`, its hand following dir/<user>.yaml.
   std::unique_ptr<ChildProcess> client(const std::string& user, int slot) const {
     return std::make_unique<ChildProcess>(
         testing::client_program(),
@@ -143,7 +161,8 @@ std::pair<double, int> shown_number(const std::string& text, int which = 0) {
 
 TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClientsFigures) {
   if (const std::string why = missing_browser(); !why.empty()) GTEST_SKIP() << why;
-  ViewSession session("view-live", 4, 600);  // they hold until told to stop
+  const fs::path dir = cube_session("view-live", 4, 600);  // they hold until told to stop
+  ViewSession session(dir, dir / "cube.yaml");
   ASSERT_FALSE(session.url.empty()) << session.server->log_text();
   const auto a = session.client("a", 0);
   const auto b = session.client("b", 1);
@@ -207,9 +226,48 @@ TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClients
   session.stop();
 }
 
+TEST(ViewInBrowser, TheDemosBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
+  if (const std::string why = missing_browser(); !why.empty()) GTEST_SKIP() << why;
+  const fs::path dir = brain_session("view-brain");
+  ViewSession session(dir, kSource / "scenes/brain.yaml");
+  ASSERT_FALSE(session.url.empty()) << session.server->log_text();
+  const auto a = session.client("a", 0);
+  const auto b = session.client("b", 1);
+
+  // As make demo's picture: once both surgeons press with 0.2 N, the camera close to the tools.
+  const json brain = check_page(dir, "brain", {"--url", session.url, "--screenshot", (dir / "brain.png").string(),
+                                               "--min-force", "0.2", "--focus-tools", "1"});
+  ASSERT_FALSE(brain.contains("error")) << brain.dump();
+  EXPECT_TRUE(brain["errors"].empty()) << brain["errors"].dump();
+  const json& shown = brain["shown"];
+  const json& pixels = brain["pixels"];
+  EXPECT_EQ(shown["scene"]["name"], "brain");
+  EXPECT_GT(shown["meshTriangles"].get<int>(), 1000);
+  EXPECT_EQ(shown["scene"]["obstacles"], json::array({"inner_skull"}));
+  EXPECT_GT(pixels["mesh"]["matching"].get<double>(), 0.3 * pixels["mesh"]["sampled"].get<double>());
+  ASSERT_EQ(shown["users"].size(), 2u);
+  for (int slot = 0; slot < 2; ++slot) {
+    const json& user = shown["users"][slot];
+    const json& seen = pixels["users"][slot];
+    SCOPED_TRACE("user " + std::to_string(slot) + ": " + seen.dump());
+    EXPECT_TRUE(user["pressing"].get<bool>());
+    EXPECT_GE(user["forceMagnitude"].get<double>(), 0.2);
+    EXPECT_GT(seen["tool"]["matching"].get<int>(), 10);
+    EXPECT_TRUE(user["arrowVisible"].get<bool>());
+    ASSERT_TRUE(seen["arrow"].is_object());
+    EXPECT_GE(seen["arrow"]["matching"].get<double>(), 0.75 * seen["arrow"]["sampled"].get<double>());
+  }
+  a->signal(SIGINT);
+  b->signal(SIGINT);
+  EXPECT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
+  EXPECT_EQ(b->wait(testing::kPatience), 0) << b->log_text();
+  session.stop();
+}
+
 TEST(ViewInBrowser, AReplayScrubsToAGivenTimeShowingThatTimesForceAndJumpsToThePeak) {
   if (const std::string why = missing_browser(); !why.empty()) GTEST_SKIP() << why;
-  ViewSession session("view-replay", 3, 1);
+  const fs::path dir = cube_session("view-replay", 3, 1);
+  ViewSession session(dir, dir / "cube.yaml");
   {
     const auto a = session.client("a", 0);
     const auto b = session.client("b", 1);

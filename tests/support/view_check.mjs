@@ -6,7 +6,7 @@
 //                       [--min-force N] [--stay SECONDS] [--focus-tools 1] [--width W --height H]
 //
 // Live: waits for frames with every tool present, takes the page's state, waits 1.5 s and
-// takes it again (the strip chart must have moved on), freezes the drawing, takes a third
+// takes it again at the next frame drawn (the strip chart must have moved on), freezes the drawing, takes a third
 // state and a screenshot of that same picture. With --seek (a recording): asks the page to
 // seek there and waits until the frame shown is the one at that time; with --jump peak, to
 // jump to the largest force. Live with --min-force (instead of the two looks): the
@@ -67,7 +67,11 @@ try {
   } else if (args.seek === undefined) {
     result.before = await waitFor('frames with every tool present', (s) => everyToolPresent(s) && s.users.every((u) => u.chart));
     await page.waitForTimeout(1500);
-    result.after = await waitFor('frames with every tool present, 1.5 s later', everyToolPresent);
+    // A software renderer on a loaded machine may draw nothing for a while: the second look
+    // is at the first frame drawn after those 1.5 s.
+    const drawnBefore = (await snapshot()).framesDrawn;
+    result.after = await waitFor('a frame drawn with every tool present, 1.5 s later',
+      (s) => everyToolPresent(s) && s.framesDrawn > drawnBefore);
   } else {
     const target = Number(args.seek);
     await waitFor('the recording\'s timeline', (s) => s.timeline && s.framesDrawn >= 1);
