@@ -2,7 +2,7 @@
 //   probe      static forces at tool positions          tradeoff   speed against accuracy
 //   replay     look at, re-run or export a recording    stability  the stability map of a wall
 //   study      a lab study, trial by trial              summarize  merge reports, judge a session
-//   keygen     a new session key file
+//   keygen     a new session key file                   hertz      a sphere in a block, against Hertz
 // Each tool adds its own subcommand (lab/lab_command.h). A tool that needs the server or the
 // client (study) starts them as processes; cohaptic-lab links neither.
 #include <CLI/CLI.hpp>
@@ -13,6 +13,7 @@
 
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
+#include "lab/hertz.h"
 #include "lab/keygen.h"
 #include "lab/probe.h"
 #include "lab/replay.h"
@@ -35,7 +36,7 @@ int main(int argc, char** argv) {
   const std::vector<cohaptic::LabCommand> commands = {
       cohaptic::add_probe_command(app),     cohaptic::add_replay_command(app),    cohaptic::add_study_command(app),
       cohaptic::add_tradeoff_command(app),  cohaptic::add_stability_command(app), cohaptic::add_summarize_command(app),
-      cohaptic::add_keygen_command(app)};
+      cohaptic::add_keygen_command(app),    cohaptic::add_hertz_command(app)};
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));
