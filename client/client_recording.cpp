@@ -32,6 +32,7 @@ record::HapticTick haptic_tick_record(const TickRecord& tick) {
   wire::to_wire(tick.force, record.mutable_force());
   wire::to_wire(tick.evaluated, record.mutable_evaluated());
   record.set_ir_epoch(tick.ir_epoch);
+  record.set_dt(tick.dt);
   record.set_flags(tick.flags);
   record.set_fade(tick.fade);
   record.set_own_valid(tick.own_valid);

@@ -35,6 +35,11 @@ std::uint64_t skip_missed(std::int64_t& deadline, std::int64_t woke, std::int64_
 
 }  // namespace
 
+IrSlot make_ir_slot(std::unique_ptr<const PreparedIR> ir, std::int64_t arrival_ns) {
+  auto state = std::make_unique<EvaluationState>(make_evaluation_state(*ir));
+  return IrSlot{std::move(ir), std::move(state), arrival_ns};
+}
+
 HapticClock HapticClock::monotonic() {
   return {[](void*) { return monotonic_now(); }, [](void*, std::int64_t deadline_ns) { sleep_until_monotonic(deadline_ns); }, nullptr};
 }
@@ -92,7 +97,9 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
         record.remotes[r] = remotes[r];
       }
       record.remote_count = static_cast<std::uint8_t>(count);
-      const ForceSample sample = evaluate_force(*slot.ir, own, std::span(remotes.data(), count));
+      // dt: the nominal period, so that a replay reproduces the force bit for bit.
+      const double dt = 1 / settings_.rate_hz;
+      const ForceSample sample = evaluate_force(*slot.ir, *slot.state, own, std::span(remotes.data(), count), dt);
       // A sphere contact solve that could not finish inside the tick has no answer: hold the
       // last one and count the tick.
       if (sample.flags & kContactUnresolved) {
@@ -104,8 +111,14 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       }
       record.flags = sample.flags;
       record.ir_epoch = ir.epoch;
-      if (count > 0 && (sample.flags & kInContact)) {
-        const ForceSample alone = evaluate_force(*slot.ir, own, {});
+      record.dt = dt;
+      // The coupling figure (the force without the remote tools) needs a second evaluation,
+      // which would advance a dynamic body's state a second time: static bodies only, on an
+      // empty state (a cold sphere solve) so that it leaves the warm start alone.
+      const bool static_body = std::holds_alternative<CondensedFemIr>(ir.body);
+      if (count > 0 && (sample.flags & kInContact) && static_body) {
+        EvaluationState cold;
+        const ForceSample alone = evaluate_force(*slot.ir, cold, own, {}, dt);
         metrics_.peak_coupling = std::max(metrics_.peak_coupling, (sample.force - alone.force).norm());
       }
     }

@@ -47,11 +47,16 @@ struct HapticLoopSettings {
   double passivity_mass_kg = 0.2;  ///< the lightest mass expected at the tool (caps its damping)
 };
 
-/// An IR handed to the haptic thread, with when it arrived.
+/// An IR handed to the haptic thread with its fresh evaluation state (made on the I/O
+/// thread; after the swap the haptic thread is its only user) and when it arrived.
 struct IrSlot {
   std::unique_ptr<const PreparedIR> ir;
+  std::unique_ptr<EvaluationState> state;
   std::int64_t arrival_ns = 0;
 };
+
+/// The slot for `ir` with the state its evaluation starts from (off the haptic thread).
+IrSlot make_ir_slot(std::unique_ptr<const PreparedIR> ir, std::int64_t arrival_ns);
 
 /// The server's latest confirmation that an IR is still valid (P1), with when it arrived.
 struct IrConfirmation {
@@ -92,6 +97,7 @@ struct TickRecord {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();       ///< as written to the device
   Eigen::Vector3d evaluated = Eigen::Vector3d::Zero();   ///< before fading and limiting
   std::uint64_t ir_epoch = 0;
+  double dt = 0;                                         ///< the period the evaluation advanced by [s] (P1)
   std::uint8_t flags = 0;
   float fade = 1;
 };

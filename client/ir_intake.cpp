@@ -10,7 +10,7 @@ namespace cohaptic {
 bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::size_t bytes, std::int64_t arrival_ns) {
   try {
     auto prepared = std::make_unique<const PreparedIR>(prepare_ir(wire::from_wire(message)));
-    to_haptic_.back() = IrSlot{std::move(prepared), arrival_ns};
+    to_haptic_.back() = make_ir_slot(std::move(prepared), arrival_ns);
     to_haptic_.publish();
   } catch (const Error& e) {
     ++rejected_;

@@ -1,6 +1,6 @@
 // IrIntake: the IRs the server sends, on the client's I/O thread. Each is converted from
 // the wire, checked and prepared (prepare_ir: the factorisations the haptic loop needs,
-// done here so the haptic thread never does them), then handed to the haptic thread
+// done here so the haptic thread never does them) with its fresh evaluation state, then handed to the haptic thread
 // through its TripleBuffer with the time it arrived. An IR that fails its checks is
 // counted and logged, and never reaches the haptic thread.
 #pragma once

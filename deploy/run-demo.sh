@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The two-surgeon demo on loopback: a cohaptic-server serving the brain scene (P1) and two
+# The two-surgeon demo on loopback: a cohaptic-server serving a scene (P1; the first
+# argument, default scenes/brain.yaml) and two
 # cohaptic-client processes whose hand models follow the surgeons' scripted motions (A
 # retracts the cerebellum downward, B the occipital lobe upward). About 20 s. Writes
 # every report under out/demo/, the three processes' recordings (server.mcap,
@@ -8,6 +9,11 @@
 # recordings bit for bit (cohaptic-lab replay --verify), and exits non-zero if the
 # session was unhealthy (see README.md, "Reports and the demo report") or a verification
 # failed.
+#
+# Another scene (e.g. deploy/run-demo.sh scenes/thin/noodle.yaml) takes the surgeons'
+# scripts from the directory named after it (scenes/thin/noodle/surgeon_a.yaml, _b.yaml),
+# and runs without the display and, unless DEMO_VIEW_PORT is set, the live view (both show
+# a scene of one linear elastic object).
 #
 # The server serves the live view (cohaptic-server --view) on 127.0.0.1:DEMO_VIEW_PORT and
 # the demo prints its address: open it in a browser to watch the session.
@@ -19,13 +25,20 @@
 # the README's picture is taken so).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+scene=${1:-scenes/brain.yaml}
+scripts=${scene%.yaml}
+[[ -f "$scene" && -f "$scripts/surgeon_a.yaml" && -f "$scripts/surgeon_b.yaml" ]] ||
+  { echo "demo: needs $scene and the scripts $scripts/surgeon_a.yaml and $scripts/surgeon_b.yaml" >&2; exit 2; }
+display=(--display "${DEMO_OUT:-out/demo}/display" --display-rate-hz 5)
+default_view_port=7480
+if [[ "$scene" != scenes/brain.yaml ]]; then display=(); default_view_port=off; fi
 build=${BUILD_DIR:-build}
 port=${DEMO_PORT:-7431}
 duration=${DEMO_DURATION:-20}
 protocol=${DEMO_PROTOCOL:-P1}
 device=${DEMO_DEVICE:-hand}
 out=${DEMO_OUT:-out/demo}
-view_port=${DEMO_VIEW_PORT:-7480}
+view_port=${DEMO_VIEW_PORT:-$default_view_port}
 screenshot=${DEMO_VIEW_SCREENSHOT:-}
 server_bin=$build/server/cohaptic-server
 client_bin=$build/client/cohaptic-client
@@ -40,8 +53,8 @@ trap cleanup EXIT
 view=()
 [[ "$view_port" == off ]] || view=(--view "127.0.0.1:$view_port")
 # The server outlives the clients by a few seconds so that both can say goodbye.
-"$server_bin" --scene scenes/brain.yaml --listen "127.0.0.1:$port" --protocol "$protocol" \
-  --duration $((duration + 6)) --report "$out/server.json" --record "$out/server.mcap" --display "$out/display" --display-rate-hz 5 \
+"$server_bin" --scene "$scene" --listen "127.0.0.1:$port" --protocol "$protocol" \
+  --duration $((duration + 6)) --report "$out/server.json" --record "$out/server.mcap" "${display[@]}" \
   "${view[@]}" >"$out/server.log" 2>&1 &
 pids+=($!)
 for _ in $(seq 1 300); do
@@ -63,10 +76,10 @@ if [[ ${#view[@]} -gt 0 ]]; then
   fi
 fi
 
-"$client_bin" --server "127.0.0.1:$port" --user surgeon-A --slot 0 --device "$device:scenes/brain/surgeon_a.yaml" \
+"$client_bin" --server "127.0.0.1:$port" --user surgeon-A --slot 0 --device "$device:$scripts/surgeon_a.yaml" \
   --duration "$duration" --report "$out/client_a.json" --record "$out/client_a.mcap" >"$out/client_a.log" 2>&1 &
 pids+=($!)
-"$client_bin" --server "127.0.0.1:$port" --user surgeon-B --slot 1 --device "$device:scenes/brain/surgeon_b.yaml" \
+"$client_bin" --server "127.0.0.1:$port" --user surgeon-B --slot 1 --device "$device:$scripts/surgeon_b.yaml" \
   --duration "$duration" --report "$out/client_b.json" --record "$out/client_b.mcap" >"$out/client_b.log" 2>&1 &
 pids+=($!)
 status=0

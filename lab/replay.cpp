@@ -9,11 +9,11 @@
 #include <map>
 #include <memory>
 
-#include "common/model/compliance_setup.h"
 #include "common/model/model.h"
+#include "common/model/scene_compliance.h"
 #include "common/net/host_port.h"
 #include "common/scene/load_scene.h"
-#include "common/sim/simulation.h"
+#include "common/sim/scene_simulation.h"
 #include "common/util/atomic_file.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
@@ -56,6 +56,10 @@ VerifyResult verify_client(const Recording& rec) {
     if (d.datagram().has_force())
       forces.emplace_back(d.receive_time_ns(), d.datagram().force().ir_epoch(), wire::from_wire(d.datagram().force().force()));
 
+  // Each IR's evaluation state, made when a tick first uses the IR and advanced by every
+  // tick that uses it, as the haptic loop did (a dynamic body's force depends on it).
+  std::map<const PreparedIR*, EvaluationState> states;
+  Eigen::Vector3d last_resolved = Eigen::Vector3d::Zero();  // held over unresolved sphere solves, as the loop does
   const auto fail = [&](std::size_t i, const record::HapticTick& tick, const std::string& what) {
     result.ok = false;
     result.first_difference =
@@ -78,7 +82,11 @@ VerifyResult verify_client(const Recording& rec) {
         }
         std::vector<Eigen::Vector3d> remotes;
         for (const wire::Vec3& r : tick.remotes()) remotes.push_back(wire::from_wire(r));
-        expected = evaluate_force(*ir, wire::from_wire(tick.own()), remotes).force;
+        auto state = states.find(ir.get());
+        if (state == states.end()) state = states.emplace(ir.get(), make_evaluation_state(*ir)).first;
+        const ForceSample sample = evaluate_force(*ir, state->second, wire::from_wire(tick.own()), remotes, tick.dt());
+        expected = (sample.flags & kContactUnresolved) ? last_resolved : sample.force;
+        last_resolved = expected;
       } else {
         // P0: the force held is one the server sent under that epoch and had arrived.
         expected = Eigen::Vector3d::Constant(std::nan(""));
@@ -107,16 +115,14 @@ VerifyResult verify_server(const Recording& rec) {
   const std::int64_t start = config.start_time_ns();
   const Scene scene = parse_scene(config.scene_yaml(), config.scene_file());
   const Model model = build_model(scene);
-  const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs,
-                            compliance_row_nodes(body, config.injected().step_nodes() > 0 || !model.obstacles.empty()));
-  prepare_compliance(body, columns, std::nullopt);
+  const SceneCompliance compliance =
+      prepare_scene_compliance(model, config.injected().step_nodes() > 0 || !model.obstacles.empty(), std::nullopt);
   SimulationOptions options;
   options.ir = ir_build_options(scene.haptic);
   options.ir.precision = config.ir_f32() ? IrPrecision::f32 : IrPrecision::f64;
   options.step_delay_nodes = static_cast<int>(config.injected().step_nodes());
   options.naive_every_step = config.injected().condensation() == "naive";
-  Simulation simulation(body, model.obstacles, columns, scene.tools, options);
+  SceneSimulation simulation(model, compliance.per_body, scene.tools, options);
 
   std::size_t next_ir = 0;
   std::string expected_bytes, replayed_bytes;
@@ -146,7 +152,7 @@ VerifyResult verify_server(const Recording& rec) {
     if (report.rebuilt) {
       for (int user = 0; user < simulation.user_count() && result.ok; ++user) {
         const auto prepared = simulation.ir(user);
-        if (!prepared) continue;
+        if (!prepared || !simulation.ir_changed(user)) continue;
         if (next_ir >= rec.irs.size()) {
           fail(fmt::format("the replay built an IR for user {} that was not recorded", user));
           break;
@@ -168,7 +174,9 @@ VerifyResult verify_server(const Recording& rec) {
       }
       ++result.checked;
     }
-    if (step.display_frame()) simulation.displacement_of(columns.row_nodes());  // same side effects as live
+    // Same side effects as live (display frames: a scene of one linear elastic object).
+    if (step.display_frame())
+      simulation.single_elastic().displacement_of(compliance.per_body.front()->row_nodes());
   }
   return result;
 }

@@ -236,7 +236,8 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
         remotes.clear();
         for (int r = 0; r < remote_count(published[u]->ir); ++r) remotes.push_back(positions[remote_user(published[u]->ir, r)]);
         const Stopwatch evaluation;
-        held[u] = evaluate_force(*published[u], positions[u], remotes).force;
+        EvaluationState stateless;  // the condensed FEM body keeps none and ignores dt
+        held[u] = evaluate_force(*published[u], stateless, positions[u], remotes, 0).force;
         evaluation_us.push_back(1000 * evaluation.elapsed_ms());
       }
     for (std::size_t u = 0; u < users; ++u) pressed[u] = {positions[u], varied.tools[u].radius};

@@ -11,7 +11,7 @@
 
 #include "cohaptic/recording.pb.h"
 #include "common/model/model.h"
-#include "common/sim/simulation.h"
+#include "common/sim/scene_simulation.h"
 #include "server/serve_options.h"
 #include "server/tool_inputs.h"
 
@@ -32,7 +32,7 @@ record::SessionConfig server_session_config(const ServeOptions& options, const M
 /// P0 forces it sent.
 record::SimulationStep simulation_step_record(std::int64_t time_ns, double simulation_time,
                                               const std::vector<ToolInput>& tools, const std::vector<bool>& used,
-                                              const Simulation& simulation, const StepReport& report,
+                                              const SceneSimulation& simulation, const StepReport& report,
                                               bool display_frame, const std::vector<record::ServerForce>& forces);
 
 }  // namespace cohaptic

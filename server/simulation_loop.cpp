@@ -24,8 +24,8 @@ SimulationOptions simulation_options(const Model& model, const ServeOptions& opt
 
 }  // namespace
 
-SimulationLoop::SimulationLoop(const Model& model, ComplianceColumns& columns, const ServeOptions& options,
-                               const ToolInputs& tools, LoopStatistics& statistics, DisplayWriter* display,
+SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns,
+                               const ServeOptions& options, const ToolInputs& tools, LoopStatistics& statistics, DisplayWriter* display,
                                view::LiveView* view, record::SessionRecorder* recorder, std::int64_t start_ns)
     : options_(options),
       tools_(tools),
@@ -34,8 +34,7 @@ SimulationLoop::SimulationLoop(const Model& model, ComplianceColumns& columns, c
       view_(view),
       recorder_(recorder),
       start_ns_(start_ns),
-      simulation_(single_elastic_body(model), model.obstacles, columns, model.scene.tools,
-                  simulation_options(model, options)) {}
+      simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {}
 
 Outbox SimulationLoop::step(std::int64_t now_ns) {
   take_tools(now_ns);
@@ -79,7 +78,7 @@ std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox) {
   std::uint64_t sent = 0;
   for (int user = 0; user < simulation_.user_count(); ++user) {
     const auto prepared = simulation_.ir(user);
-    if (!prepared) continue;
+    if (!prepared || !simulation_.ir_changed(user)) continue;
     wire::Control control;
     *control.mutable_ir() = wire::to_wire(prepared->ir);
     if (recorder_) recorder_->ir(now_ns, control.ir());
@@ -133,12 +132,13 @@ bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
   const bool view_due = view_ && view_->frame_due(now_ns);
   if (!display_due && !view_due) return false;
   // Both show the row nodes' surface (common/model/shown_surface.h): one solve serves both.
-  Eigen::Matrix3Xd displacement = simulation_.displacement_of(display_ ? display_->nodes() : view_->nodes());
+  const Simulation& shown = simulation_.single_elastic();
+  Eigen::Matrix3Xd displacement = shown.displacement_of(display_ ? display_->nodes() : view_->nodes());
   statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
   if (view_due) {
     view_tools_.resize(latest_.size());
     for (std::size_t slot = 0; slot < latest_.size(); ++slot) view_tools_[slot] = {used_[slot], latest_[slot].position};
-    view_->publish_frame(now_ns, seconds_since_start(now_ns), simulation_, displacement, view_tools_, steps_);
+    view_->publish_frame(now_ns, seconds_since_start(now_ns), shown, displacement, view_tools_, steps_);
   }
   if (display_due) {
     last_display_ns_ = now_ns;

@@ -1,8 +1,9 @@
 // SimulationLoop: the server's simulation thread. Each step
 //   1. copies the latest tool samples (ToolInputs) and gives the simulation those that
 //      are fresh (a tool silent for --client-timeout is released);
-//   2. steps the Simulation: contacts, active sets, M~ when a set changed;
-//   3. fills the step's Outbox: the new IRs (P1), the IR keep-alives (P1, every
+//   2. steps the SceneSimulation: each body's (FEM: contacts, active sets, M~ when a set
+//      changed; mass-spring: the whole network, and the IRs that are due);
+//   3. fills the step's Outbox: each user's new IR (P1), the IR keep-alives (P1, every
 //      kKeepAlivePeriod_ns), the forces (P0);
 //   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter,
 //      and every 1/--view-rate-hz for the live view (one solve when both are due);
@@ -12,8 +13,9 @@
 // side. It sleeps to the next deadline after every step, failed or not: a step that
 // throws releases every tool and is counted, and logged at a paced rate (StepFailures);
 // kMaxConsecutiveStepFailures in a row end the loop with the reason.
-// The loop owns the Simulation (the mutable state); the model is shared read-only, the
-// compliance columns are filled in on demand by this thread alone. Times: ns of
+// The loop owns the SceneSimulation (the mutable state); the model is shared read-only, the
+// FEM bodies' compliance columns are filled in on demand by this thread alone. The display
+// and the live view show a scene of one linear elastic object. Times: ns of
 // wire::monotonic_now_ns(); simulation time in s from the server's start.
 #pragma once
 
@@ -21,12 +23,13 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "common/fem/compliance.h"
 #include "common/model/model.h"
-#include "common/sim/simulation.h"
+#include "common/sim/scene_simulation.h"
 #include "proto/record/session_recorder.h"
 #include "server/display_writer.h"
 #include "view/live_view.h"
@@ -48,11 +51,13 @@ class SimulationLoop {
  public:
   /// `display`, `view` and `recorder` may be null (no --display, --view, --record).
   /// Everything given must outlive the loop.
-  SimulationLoop(const Model& model, ComplianceColumns& columns, const ServeOptions& options, const ToolInputs& tools,
+  /// columns[i]: body i's compliance columns (null unless it is linear elastic).
+  SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns, const ServeOptions& options,
+                 const ToolInputs& tools,
                  LoopStatistics& statistics, DisplayWriter* display, view::LiveView* view,
                  record::SessionRecorder* recorder, std::int64_t start_ns);
 
-  /// One step at `now_ns`: returns what to send. Throws whatever Simulation::step throws.
+  /// One step at `now_ns`: returns what to send. Throws whatever the simulation's step throws.
   Outbox step(std::int64_t now_ns);
 
   /// Steps until `running` turns false, handing each step's outbox to `send` (which must
@@ -77,7 +82,7 @@ class SimulationLoop {
   view::LiveView* view_;
   record::SessionRecorder* recorder_;
   std::int64_t start_ns_;
-  Simulation simulation_;
+  SceneSimulation simulation_;
   StepFailures failures_;
   std::vector<ToolInput> latest_;  // this step's copy of the tool inputs
   std::vector<bool> used_;         // per slot: fresh, given to the simulation

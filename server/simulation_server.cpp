@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "common/model/compliance_setup.h"
+#include "common/model/scene_compliance.h"
 #include "common/scene/load_scene.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
@@ -44,7 +45,7 @@ wire::Welcome welcome_template(const ServeOptions& options, const Model& model, 
   wire::Welcome welcome;
   welcome.set_scene_name(model.scene.name);
   welcome.set_scene_yaml(scene_yaml);
-  *welcome.mutable_surface() = wire::surface_mesh_message(single_elastic_body(model));
+  *welcome.mutable_surface() = wire::surface_mesh_message(model.bodies.front());  // the first object's
   welcome.set_protocol(wire_protocol(options));
   welcome.set_force_limit(model.scene.haptic.force_limit_n);
   welcome.set_haptic_rate_hz(model.scene.haptic.rate_hz);
@@ -64,7 +65,7 @@ struct SimulationServer::Impl {
   ServeOptions options;
   std::int64_t start_ns = wire::monotonic_now_ns();  // time zero of the simulation and the report
   std::unique_ptr<Model> model;
-  std::unique_ptr<ComplianceColumns> columns;
+  SceneCompliance compliance;
   std::string scene_yaml;
   wire::SessionKey key;
   std::uint64_t session_id = random_session_id();
@@ -92,11 +93,14 @@ struct SimulationServer::Impl {
       scene_yaml.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
     model = std::make_unique<Model>(build_model(scene));
-    const ElasticBody& body = single_elastic_body(*model);
-    columns = std::make_unique<ComplianceColumns>(
-        *body.free_factor, body.dofs, compliance_row_nodes(body, options.step_nodes > 0 || !model->obstacles.empty()));
-    prepare_compliance(body, *columns, options.cache_directory);
-    if (!options.display.empty()) display = std::make_unique<DisplayWriter>(*model, *columns, options.display);
+    compliance = prepare_scene_compliance(*model, options.step_nodes > 0 || !model->obstacles.empty(), options.cache_directory);
+    // The display and the live view show one linear elastic object (single_elastic_body
+    // says why it refuses another scene).
+    const auto shown_columns = [this]() -> ComplianceColumns& {
+      single_elastic_body(*model);
+      return *compliance.per_body.front();
+    };
+    if (!options.display.empty()) display = std::make_unique<DisplayWriter>(*model, shown_columns(), options.display);
     tools = std::make_unique<ToolInputs>(model->scene.tools.size());
     spdlog::info("scene '{}' ready in {:.0f} ms: {} user slots", scene.name, watch.elapsed_ms(), tools->size());
 
@@ -117,10 +121,10 @@ struct SimulationServer::Impl {
       settings.port = options.view_port;
       settings.token_file = options.view_token_file;
       settings.rate_hz = options.view_rate_hz;
-      view = std::make_unique<view::LiveView>(*model, *columns, wire_protocol(options), injected_delays(options),
+      view = std::make_unique<view::LiveView>(*model, shown_columns(), wire_protocol(options), injected_delays(options),
                                               settings, recorder.get());
     }
-    loop = std::make_unique<SimulationLoop>(*model, *columns, options, *tools, statistics, display.get(), view.get(),
+    loop = std::make_unique<SimulationLoop>(*model, compliance.per_body, options, *tools, statistics, display.get(), view.get(),
                                             recorder.get(), start_ns);
   }
 
@@ -234,8 +238,7 @@ void SimulationServer::run() {
   if (s.view) s.view->stop();
   if (s.recorder) s.recorder->close();
   // Compliance columns computed on demand during the session serve the next one.
-  const ElasticBody& body = single_elastic_body(*s.model);
-  if (s.options.cache_directory && body.spec.compliance.disk_cache) save_compliance(body, *s.columns, *s.options.cache_directory);
+  if (s.options.cache_directory) save_scene_compliance(*s.model, s.compliance, *s.options.cache_directory);
   if (!s.options.report.empty()) s.write_report();
   if (s.failure) throw Error(*s.failure + "; the session ended");
 }

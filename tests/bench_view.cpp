@@ -7,6 +7,7 @@
 // items_per_second is the simulation's step rate; the counters give, per browser, the
 // frames and bytes it received per second. The browsers and the view server's thread share
 // the machine's cores with the simulation, as they would on a server with local browsers.
+#include <array>
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -76,7 +77,7 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
   if (with_view)
     live = std::make_unique<view::LiveView>(*rig.model, *rig.columns, wire_protocol(options), injected_delays(options),
                                             view::LiveViewOptions{}, nullptr);
-  SimulationLoop loop(*rig.model, *rig.columns, options, tools, statistics, nullptr, live.get(), nullptr,
+  SimulationLoop loop(*rig.model, std::array{rig.columns.get()}, options, tools, statistics, nullptr, live.get(), nullptr,
                       wire::monotonic_now_ns());
   // Once along the whole motion first: every compliance column it needs is computed (or
   // loaded) before the clock runs.

@@ -10,6 +10,7 @@
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
+#include "support/evaluate_static.h"
 
 extern "C" void* __libc_malloc(std::size_t size);  // glibc's own, behind the interposed one
 
@@ -53,7 +54,7 @@ TEST(ForceEvaluator, AllocatesNothing) {
     counting = true;
     for (int i = 0; i < 5000; ++i) {
       const Eigen::Vector3d tool(-0.02 + 1e-6 * (i % 1000), 0.005, -0.004 + 1e-7 * (i % 300));
-      sum += evaluate_force(prepared, tool, remotes).force;
+      sum += testing::evaluate_static(prepared, tool, remotes).force;
     }
     counting = false;
     EXPECT_EQ(allocations.load(), 0) << "evaluate_force allocated";
@@ -78,12 +79,14 @@ TEST(ForceEvaluator, AllocatesNothingUnderTheSphereModel) {
   simulation.step(0);
   const PreparedIR& prepared = *simulation.ir(0);
   const std::vector<Eigen::Vector3d> remotes = simulation.remote_positions(prepared.ir);
+  EvaluationState state = make_evaluation_state(prepared);  // the warm start, sized here
+  ASSERT_TRUE(std::holds_alternative<SphereWarmStart>(state.body));
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   allocations = 0;
   counting = true;
   for (int i = 0; i < 5000; ++i) {
     const Eigen::Vector3d tool(-0.02 + 1e-6 * (i % 1000), 0.005, 0.026 - 1e-7 * (i % 300));
-    sum += evaluate_force(prepared, tool, remotes).force;
+    sum += evaluate_force(prepared, state, tool, remotes, 1e-3).force;
   }
   counting = false;
   EXPECT_EQ(allocations.load(), 0) << "evaluate_force allocated";

@@ -22,6 +22,7 @@
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
+#include "support/evaluate_static.h"
 
 namespace cohaptic {
 namespace {
@@ -187,7 +188,7 @@ TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
   const PreparedIR& prepared = *simulation.ir(0);
   // Pushed through the whole cube (130 mm deep) and beyond: still a bounded, finite force.
   for (double depth : {130.0, 200.0, 1e6}) {
-    const ForceSample sample = evaluate_force(prepared, mm(1, 2, -depth), {});
+    const ForceSample sample = testing::evaluate_static(prepared, mm(1, 2, -depth), {});
     EXPECT_TRUE(sample.force.allFinite());
     EXPECT_NEAR(sample.force.norm(), 3.3, 1e-9) << "depth " << depth;
     EXPECT_TRUE(sample.flags & kClamped);
@@ -199,8 +200,8 @@ TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
   const Eigen::Vector3d edge = (vertex + condensed_fem(prepared.ir).rest_positions.col(tri.nodes[1])) / 2;
   for (const Eigen::Vector3d& on : {vertex, edge}) {
     const Eigen::Vector3d tool = on - 2e-3 * tri.normal;
-    const ForceSample a = evaluate_force(prepared, tool, {});
-    const ForceSample b = evaluate_force(prepared, tool, {});
+    const ForceSample a = testing::evaluate_static(prepared, tool, {});
+    const ForceSample b = testing::evaluate_static(prepared, tool, {});
     ASSERT_TRUE(a.force.allFinite());
     EXPECT_EQ(a.force, b.force);
     EXPECT_EQ(a.triangle, b.triangle);

@@ -16,6 +16,7 @@
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
+#include "support/evaluate_static.h"
 
 namespace cohaptic {
 namespace {
@@ -58,12 +59,12 @@ struct Fixture {
   // A tool pressed 2 mm in, its IR and the force the evaluator gives there.
   const Eigen::Vector3d pressed{0.001, 0.002, -0.002};
   const std::shared_ptr<const PreparedIR> ir = ir_for(pressed);
-  const Eigen::Vector3d pressed_force = evaluate_force(*ir, pressed, {}).force;
+  const Eigen::Vector3d pressed_force = testing::evaluate_static(*ir, pressed, {}).force;
   /// Channels with tracing on, holding the pressed IR as arrived at `arrival_ns`.
   std::unique_ptr<HapticChannels> channels_with_ir(std::int64_t arrival_ns) const {
     auto channels = std::make_unique<HapticChannels>();
     channels->tracing = true;
-    channels->ir.back() = IrSlot{std::make_unique<const PreparedIR>(*ir), arrival_ns};
+    channels->ir.back() = make_ir_slot(std::make_unique<const PreparedIR>(*ir), arrival_ns);
     channels->ir.publish();
     return channels;
   }

@@ -23,6 +23,7 @@
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "lab/hertz.h"
+#include "support/evaluate_static.h"
 
 namespace cohaptic {
 namespace {
@@ -102,7 +103,7 @@ TEST(Hertz, OnTheGradedSymmetricBlockTheIrEqualsTheFullSolve) {
     simulation.set_tool(0, centre);
     simulation.step(k * 1e-3);
     ASSERT_TRUE(simulation.ir(0));
-    const ForceSample sample = evaluate_force(*simulation.ir(0), centre, {});
+    const ForceSample sample = testing::evaluate_static(*simulation.ir(0), centre, {});
     // The sphere also passes nodes of the symmetry planes, which are surface (not
     // touchable) there: the evaluator flags them as outside its patch, as it should, and
     // neither it nor the reference holds them.

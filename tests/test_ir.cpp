@@ -14,6 +14,7 @@
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
+#include "support/evaluate_static.h"
 
 namespace cohaptic {
 namespace {
@@ -104,7 +105,7 @@ void two_users_match_the_full_solve(ContactModel contact_model, int step_delay_n
       const PreparedIR& prepared = *simulation.ir(user);
       if (!ir_covers(model, prepared, pressed, user)) continue;
       const Eigen::Vector3d remote = pressed[1 - user];
-      const ForceSample sample = evaluate_force(prepared, pressed[user], std::span(&remote, 1));
+      const ForceSample sample = testing::evaluate_static(prepared, pressed[user], std::span(&remote, 1));
       ASSERT_TRUE(sample.flags & kInContact);
       worst = std::max(worst, relative_error(sample.force, expected[user]));
       EXPECT_LE(relative_error(sample.force, expected[user]), 1e-9) << "trial " << trial << " user " << user;
@@ -231,7 +232,7 @@ TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
   for (double x = 1; x <= 20; x += 0.5) {
     const std::vector<Eigen::Vector3d> tool = {mm(x, 2 + 0.3 * x, -3)};
     if (!ir_covers(model, prepared, tool, 0)) break;
-    const ForceSample sample = evaluate_force(prepared, tool[0], {});
+    const ForceSample sample = testing::evaluate_static(prepared, tool[0], {});
     EXPECT_LE(relative_error(sample.force, reference_forces(model, simulation, tool, ContactModel::node_translation)[0]), 1e-9)
         << "x = " << x;
     if (sample.triangle != previous) ++triangles_visited;
@@ -267,9 +268,9 @@ TEST(IntermediateRepresentation, Float32StorageStaysCloseToFloat64) {
 double largest_change_along_slide(const PreparedIR& prepared, double step, double& peak) {
   double largest = 0;
   peak = 0;
-  Eigen::Vector3d previous = evaluate_force(prepared, mm(0.5, 0.4, -3), {}).force;
+  Eigen::Vector3d previous = testing::evaluate_static(prepared, mm(0.5, 0.4, -3), {}).force;
   for (double x = 0.5 + step; x <= 12; x += step) {
-    const ForceSample sample = evaluate_force(prepared, mm(x, 0.4 + 0.4 * x, -3), {});
+    const ForceSample sample = testing::evaluate_static(prepared, mm(x, 0.4 + 0.4 * x, -3), {});
     if (sample.flags & kOutsidePatch) break;
     largest = std::max(largest, (sample.force - previous).norm());
     peak = std::max(peak, sample.force.norm());
@@ -307,14 +308,14 @@ TEST(IntermediateRepresentation, PastThePatchTheForceIsHeldAndTheNextIrCatchesUp
   simulation.set_tool(0, mm(1, 1, -3));
   simulation.step(0);
   const std::shared_ptr<const PreparedIR> old_ir = simulation.ir(0);
-  Eigen::Vector3d previous = evaluate_force(*old_ir, mm(1, 1, -3), {}).force;
+  Eigen::Vector3d previous = testing::evaluate_static(*old_ir, mm(1, 1, -3), {}).force;
   double largest_jump = 0;
   bool left = false;
   Eigen::Vector3d p;
   double beyond = 0;  // how far past the rim [mm]
   for (double x = 1; x < 30 && beyond < 1.0; x += 0.05) {
     p = mm(x, 1, -3);
-    const ForceSample sample = evaluate_force(*old_ir, p, {});
+    const ForceSample sample = testing::evaluate_static(*old_ir, p, {});
     if (sample.flags & kOutsidePatch) {
       left = true;
       beyond += 0.05;
@@ -374,12 +375,12 @@ TEST(IntermediateRepresentation, NonFiniteToolsGiveZeroOrAreIgnored) {
   simulation.step(0);
   const PreparedIR& prepared = *simulation.ir(0);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const ForceSample own_nan = evaluate_force(prepared, Eigen::Vector3d(nan, 0, 0), {});
+  const ForceSample own_nan = testing::evaluate_static(prepared, Eigen::Vector3d(nan, 0, 0), {});
   EXPECT_EQ(own_nan.force, Eigen::Vector3d::Zero());
   EXPECT_TRUE(own_nan.flags & kNonFinite);
   // An unknown remote leaves its nodes unloaded: the force of the own tool alone.
   const Eigen::Vector3d unknown(nan, nan, nan);
-  const ForceSample alone = evaluate_force(prepared, mm(-20, 5, -4), std::span(&unknown, 1));
+  const ForceSample alone = testing::evaluate_static(prepared, mm(-20, 5, -4), std::span(&unknown, 1));
   EXPECT_LE(relative_error(alone.force, reference_forces(model, simulation, {mm(-20, 5, -4)}, ContactModel::node_translation)[0]),
             1e-9);
 }

@@ -32,6 +32,7 @@
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/session_key.h"
 #include "support/process.h"
+#include "support/evaluate_static.h"
 
 namespace cohaptic {
 namespace {
@@ -173,7 +174,7 @@ TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
       const auto& ir = irs.at(t.epoch);
       // The same IR and positions give the same force, bit for bit.
       const Eigen::Vector3d remote = t.remote;
-      const ForceSample offline = evaluate_force(*ir, t.own, std::span(&remote, condensed_fem(ir->ir).remotes.empty() ? 0 : 1));
+      const ForceSample offline = testing::evaluate_static(*ir, t.own, std::span(&remote, condensed_fem(ir->ir).remotes.empty() ? 0 : 1));
       ASSERT_EQ(offline.force, t.evaluated) << user << " tick " << i;
       ++offline_checked;
       // And the full FEM solve with both tools at those positions, where both sit on the

@@ -1,6 +1,7 @@
 // Scene loading and validation (common/scene/load_scene.h) and compiling a scene into a
 // Model (common/model/model.h): the shipped cube scene, error messages that name the
-// file, line and key path, per-axis fixing and selectors that select nothing.
+// file, line and key path, per-axis fixing and selectors that select nothing, and the
+// mass-spring objects (`model: mass_spring`): the noodle scenes and their errors.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -13,6 +14,7 @@
 #include "common/haptics/trajectory.h"
 #include "common/mesh/box_mesher.h"
 #include "common/model/model.h"
+#include "common/mass_spring/tube_network.h"
 #include "common/scene/load_scene.h"
 #include "support/test_meshes.h"
 
@@ -465,6 +467,122 @@ TEST(SceneModel, UnknownOrInteriorNodeIdIsNamed) {
   EXPECT_NE(interior_message.find("objects[0].touchable[1]"), std::string::npos) << interior_message;
   EXPECT_NE(interior_message.find("node 14"), std::string::npos) << interior_message;
   EXPECT_NE(interior_message.find("not on the surface"), std::string::npos) << interior_message;
+}
+
+}  // namespace
+}  // namespace cohaptic
+
+namespace cohaptic {
+namespace {
+
+// A mass-spring object in block style, one value per line (the error tests below replace one).
+const std::string kNoodleScene = R"(name: noodle_test
+units: mm
+objects:
+  - name: noodle
+    model: mass_spring
+    tube:
+      centre_line: [[0, 0, 5], [40, 0, 5]]
+      radius: 5
+      sections: 11
+    material:
+      youngs_modulus: 700
+      density: 9049
+      spring_damping: 1.0e-6
+      node_damping: 0.007
+    plane:
+      point: [0, 0, 0]
+      normal: [0, 0, 1]
+      static_friction: 0.5
+      dynamic_friction: 0.2
+    tool_friction: 0.3
+    heated:
+      - box:
+          min: [-1, -10, -10]
+          max: [20, 10, 10]
+        temperature_rise: 40
+        expansion_coefficient: 1.0e-4
+        coupling: 100
+    ir:
+      sections: 3
+      rate_hz: 200
+tools:
+  - name: A
+    shape: sphere
+    radius: 2
+)";
+
+TEST(MassSpringScene, NoodleObjectParsesInSIUnitsAndCompiles) {
+  const Scene scene = parse_scene(kNoodleScene, kSceneFile);
+  const auto& spec = std::get<MassSpringObjectSpec>(scene.objects.at(0).body);
+  EXPECT_EQ(spec.tube.sections, 11);
+  EXPECT_TRUE(near(spec.tube.radius, 0.005));
+  EXPECT_TRUE(near(spec.tube.centre_line[1].x(), 0.040));
+  EXPECT_TRUE(near(spec.material.density, 9049));
+  ASSERT_TRUE(spec.plane.has_value());
+  EXPECT_DOUBLE_EQ(spec.plane->dynamic_friction, 0.2);
+  ASSERT_EQ(spec.heated.size(), 1u);
+  EXPECT_TRUE(near(spec.heated[0].box_max.x(), 0.020));
+  EXPECT_EQ(spec.ir.sections, 3);
+  EXPECT_DOUBLE_EQ(spec.ir.rate_hz, 200);
+
+  const Model model = build_model(scene);
+  const auto& body = std::get<MassSpringModel>(model.bodies.at(0));
+  EXPECT_EQ(body.network.node_count(), 11 * kSectionNodes);
+  EXPECT_GT(body.heated_springs, 50);
+  EXPECT_LT(body.network.parameters.time_step, body.critical_time_step);
+  EXPECT_EQ(body.section_of_node.back(), 10);
+  try {
+    elastic_body(model, 0);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is a mass_spring body"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MassSpringScene, ShippedNoodleScenesCompile) {
+  for (const char* file : {"scenes/thin/noodle.yaml", "scenes/thin/noodle_light.yaml", "scenes/thin/noodle_heated.yaml"}) {
+    const Model model = build_model(load_scene(testing::source_path(file)));
+    const auto& body = std::get<MassSpringModel>(model.bodies.at(0));
+    EXPECT_EQ(body.network.node_count(), 360) << file;
+    EXPECT_EQ(body.heated_springs > 0, std::string(file).find("heated") != std::string::npos) << file;
+  }
+}
+
+TEST(MassSpringScene, ErrorsNameFileLineKeyAndExpectation) {
+  const BadScene cases[] = {
+      {"unknown model", replaced(kNoodleScene, "model: mass_spring", "model: mass_springs"), "model: mass_springs",
+       {"objects[0].model", "linear_elastic", "mass_spring"}},
+      {"unknown key", replaced(kNoodleScene, "tool_friction: 0.3", "tool_frictions: 0.3"), "tool_frictions",
+       {"tool_frictions"}},
+      {"no tube", replaced(kNoodleScene, "    tube:\n", "    tubes:\n"), "tubes:", {"tubes"}},
+      {"both counts", replaced(kNoodleScene, "sections: 11", "sections: 11\n      section_spacing: 2"), "centre_line",
+       {"objects[0].tube", "exactly one of sections or section_spacing"}},
+      {"one point", replaced(kNoodleScene, "[[0, 0, 5], [40, 0, 5]]", "[[0, 0, 5]]"), "centre_line",
+       {"objects[0].tube.centre_line", "at least 2 points"}},
+      {"negative density", replaced(kNoodleScene, "density: 9049", "density: -1"), "density: -1",
+       {"objects[0].material.density", "positive density"}},
+      {"dynamic above static", replaced(kNoodleScene, "dynamic_friction: 0.2", "dynamic_friction: 0.7"),
+       "dynamic_friction: 0.7", {"objects[0].plane.dynamic_friction", "up to the static"}},
+      {"heating past zero stiffness", replaced(kNoodleScene, "temperature_rise: 40", "temperature_rise: 100"), "- box:",
+       {"objects[0].heated[0]", "no stiffness"}},
+      {"no sections sent", replaced(kNoodleScene, "sections: 3", "sections: 0"), "sections: 0",
+       {"objects[0].ir.sections", "from 1"}},
+  };
+  for (const BadScene& bad : cases) expect_scene_error(bad);
+}
+
+TEST(MassSpringScene, TimeStepAboveTheCriticalOneIsRefusedNamingTheObject) {
+  const Scene scene = parse_scene(replaced(kNoodleScene, "tool_friction: 0.3", "tool_friction: 0.3\n    time_step: 0.05"),
+                                  kSceneFile);
+  try {
+    build_model(scene);
+    FAIL() << "no error";
+  } catch (const SceneError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind(kSceneFile + ":4: objects[0]: time_step 0.05 s", 0), 0u) << message;
+    EXPECT_NE(message.find("critical step"), std::string::npos) << message;
+  }
 }
 
 }  // namespace

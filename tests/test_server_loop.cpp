@@ -17,6 +17,7 @@
 //   - the real server program: a client pressing makes the server end the session on its
 //     own, with a clear message, a goodbye to the client, a report, few log lines and
 //     exit status 1.
+#include <array>
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -126,7 +127,7 @@ std::pair<std::optional<std::string>, std::vector<Outbox>> run_for(SimulationLoo
 TEST(SimulationLoop, AStepThatKeepsFailingEndsTheLoopAfterAHundredPacedSteps) {
   LoopRig rig(0);
   rig.options.step_nodes = movable_surface_nodes(*rig.cube.model);
-  SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
+  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
                       wire::monotonic_now_ns());
   const auto start = std::chrono::steady_clock::now();
   const auto [stopped, outboxes] = run_for(loop, 20s);
@@ -149,7 +150,7 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
   // P0: every step sends the known tool's force, and only to its slot.
   {
     LoopRig rig(10, ServeProtocol::p0);
-    SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
+    SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
                         wire::monotonic_now_ns());
     const auto [stopped, outboxes] = run_for(loop, 400ms);
     EXPECT_FALSE(stopped.has_value()) << *stopped;
@@ -169,7 +170,7 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
   // P1: the first step builds slot 0's IR; keep-alives follow.
   {
     LoopRig rig(10, ServeProtocol::p1);
-    SimulationLoop loop(*rig.cube.model, *rig.cube.columns, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
+    SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
                         wire::monotonic_now_ns());
     const auto [stopped, outboxes] = run_for(loop, 400ms);
     EXPECT_FALSE(stopped.has_value());

@@ -174,11 +174,11 @@ SimulationOptions unlimited(int step_delay_nodes = 0, int patch_rings = 1) {
   return options;
 }
 
-// Mesh node tags of the IR's nodes in contact at its last evaluation.
-std::vector<std::int64_t> ir_contact_tags(const PreparedIR& prepared) {
+// Mesh node tags of the IR's nodes in contact at the evaluation that left `state`.
+std::vector<std::int64_t> ir_contact_tags(const PreparedIR& prepared, const EvaluationState& state) {
   std::vector<std::int64_t> tags;
   for (int i = 0; i < condensed_fem(prepared.ir).row_node_count; ++i)
-    if (std::get<PreparedFem>(prepared.body).sphere.warm_start.active(i)) tags.push_back(condensed_fem(prepared.ir).node_ids[static_cast<std::size_t>(i)]);
+    if (std::get<SphereWarmStart>(state.body).active(i)) tags.push_back(condensed_fem(prepared.ir).node_ids[static_cast<std::size_t>(i)]);
   std::sort(tags.begin(), tags.end());
   return tags;
 }
@@ -206,7 +206,8 @@ void compare(const ElasticBody& body, const Simulation& simulation, const std::v
   const PreparedIR& prepared = *simulation.ir(user);
   std::vector<Eigen::Vector3d> remotes;
   for (int r = 0; r < remote_count(prepared.ir); ++r) remotes.push_back(tools[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
-  const ForceSample sample = evaluate_force(prepared, tools[static_cast<std::size_t>(user)], remotes);
+  EvaluationState state = make_evaluation_state(prepared);
+  const ForceSample sample = evaluate_force(prepared, state, tools[static_cast<std::size_t>(user)], remotes, 1e-3);
   std::vector<PressedTool> pressed;
   for (const Eigen::Vector3d& p : tools) pressed.push_back({p, kRadius});
   const SphereContactSolution reference = sphere_reactions_reference(body, pressed, held_nodes(simulation));
@@ -220,7 +221,7 @@ void compare(const ElasticBody& body, const Simulation& simulation, const std::v
   EXPECT_LE(error, 1e-9) << "user " << user << " at " << tools[static_cast<std::size_t>(user)].transpose() * 1e3 << " mm";
   comparison.worst = std::max(comparison.worst, error);
   // The node set: every node in contact in the reference is one in the IR's last solve.
-  EXPECT_EQ(ir_contact_tags(prepared), tags_of(body, reference.contact_nodes()));
+  EXPECT_EQ(ir_contact_tags(prepared, state), tags_of(body, reference.contact_nodes()));
   comparison.contact_nodes += static_cast<int>(reference.contact_nodes().size());
   comparison.released_nodes += static_cast<int>(reference.candidates.size() - reference.contact_nodes().size());
   ++comparison.checked;

@@ -30,6 +30,7 @@
 #include "proto/wire/replay_window.h"
 #include "proto/wire/session_key.h"
 #include "support/cube_scene.h"
+#include "support/evaluate_static.h"
 
 namespace cohaptic::wire {
 namespace {
@@ -814,7 +815,7 @@ TEST(WireIr, RoundTripIsBitExactInDouble) {
   const PreparedIR received = prepare_ir(through_the_wire(ir));
   const std::vector<Eigen::Vector3d> remote = {Eigen::Vector3d(0.03, 0, -0.002)};
   const Eigen::Vector3d tool(0.001, 0.0005, -0.003);
-  EXPECT_TRUE(bit_equal(evaluate_force(received, tool, remote).force, evaluate_force(original, tool, remote).force));
+  EXPECT_TRUE(bit_equal(testing::evaluate_static(received, tool, remote).force, testing::evaluate_static(original, tool, remote).force));
 }
 
 TEST(WireIr, RoundTripIsExactInFloat) {

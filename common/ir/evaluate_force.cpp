@@ -122,8 +122,6 @@ PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, 
 ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
                                    const PreparedFem& prepared, const Eigen::Vector3d& own_tool,
                                    std::span<const Eigen::Vector3d> remote_tools) noexcept {
-  if (ir.contact_model == ContactModel::sphere)
-    return evaluate_sphere_contact(envelope, ir, prepared, own_tool, remote_tools);
   ForceSample sample;
   if (!own_tool.allFinite()) {
     sample.flags |= kNonFinite;
@@ -202,9 +200,26 @@ ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, c
   const bool solved = solve_contact_forces(ir.contact_model, l_zz, u0, std::span(z_dofs.data(), static_cast<std::size_t>(z)),
                                            std::span(displacement.data(), static_cast<std::size_t>(pressing_count)),
                                            nodal_forces, std::span(tool_forces.data(), static_cast<std::size_t>(pressing_count)));
+  const Eigen::Vector3d contact_force = tool_forces[0];
 
   // 4. Safety: never a non-finite or unbounded force.
-  finish_force(sample, tool_forces[0], solved, envelope.force_limit);
+  sample.force = -contact_force;
+  limit_force(sample, solved, envelope.force_limit);
+  return sample;
+}
+
+ForceSample evaluate_mass_spring(const IntermediateRepresentation& envelope, const MassSpringIr& ir,
+                                 const PreparedMassSpring& prepared, MassSpringPatchState& state,
+                                 const Eigen::Vector3d& own_tool, std::span<const Eigen::Vector3d> remote_tools,
+                                 double dt) noexcept {
+  const NetworkToolReaction reaction =
+      advance_mass_spring(ir, prepared, state, own_tool, envelope.tool_radius, remote_tools, dt);
+  ForceSample sample;
+  sample.force = reaction.force;
+  sample.depth = reaction.depth;
+  if (reaction.colliding) sample.flags |= kInContact;
+  if (remote_tools.size() + 1 > static_cast<std::size_t>(kMaxNetworkTools)) sample.flags |= kTooManyRemotes;
+  limit_force(sample, state.network.positions.allFinite(), envelope.force_limit);
   return sample;
 }
 
@@ -215,9 +230,20 @@ struct BodyPreparer {
   PreparedBody operator()(const CondensedFemIr& fem) const {
     return prepare_condensed_fem(fem, tool_radius, condition_estimate);
   }
+  PreparedBody operator()(const MassSpringIr& network) const { return prepare_mass_spring(network); }
 };
 
 }  // namespace
+
+void limit_force(ForceSample& sample, bool evaluated, double force_limit) noexcept {
+  if (!evaluated || !sample.force.allFinite()) {
+    sample.force.setZero();
+    sample.flags |= kNonFinite;
+  } else if (const double magnitude = sample.force.norm(); magnitude > force_limit) {
+    sample.force *= force_limit / magnitude;
+    sample.flags |= kClamped;
+  }
+}
 
 PreparedIR prepare_ir(IntermediateRepresentation ir) {
   PreparedIR prepared;
@@ -228,23 +254,29 @@ PreparedIR prepare_ir(IntermediateRepresentation ir) {
   return prepared;
 }
 
-void finish_force(ForceSample& sample, const Eigen::Vector3d& contact_force, bool solved, double force_limit) noexcept {
-  sample.force = -contact_force;
-  if (!solved || !sample.force.allFinite()) {
-    sample.force.setZero();
-    sample.flags |= kNonFinite;
-  } else if (const double magnitude = sample.force.norm(); magnitude > force_limit) {
-    sample.force *= force_limit / magnitude;
-    sample.flags |= kClamped;
-  }
+EvaluationState make_evaluation_state(const PreparedIR& prepared) {
+  EvaluationState state;
+  if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
+    state.body = make_mass_spring_state(*network, std::get<PreparedMassSpring>(prepared.body));
+  else if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body); fem && fem->contact_model == ContactModel::sphere)
+    state.body = SphereWarmStart{};
+  return state;
 }
 
-ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
-                           std::span<const Eigen::Vector3d> remote_tools) noexcept {
+ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, const Eigen::Vector3d& own_tool,
+                           std::span<const Eigen::Vector3d> remote_tools, double dt) noexcept {
   // get_if, not visit: nothing on this path may throw. prepare_ir made the kinds match.
   if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body))
-    if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body))
+    if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body)) {
+      if (fem->contact_model == ContactModel::sphere)
+        return evaluate_sphere_contact(prepared.ir, *fem, *prepared_fem, std::get_if<SphereWarmStart>(&state.body),
+                                       own_tool, remote_tools);
       return evaluate_condensed_fem(prepared.ir, *fem, *prepared_fem, own_tool, remote_tools);
+    }
+  if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
+    if (const auto* prepared_network = std::get_if<PreparedMassSpring>(&prepared.body))
+      if (auto* network_state = std::get_if<MassSpringPatchState>(&state.body))
+        return evaluate_mass_spring(prepared.ir, *network, *prepared_network, *network_state, own_tool, remote_tools, dt);
   ForceSample unknown;
   unknown.flags = kNonFinite;
   return unknown;

@@ -3,8 +3,14 @@
 //
 // The same function serves the client's haptic loop (P1) and the server (P0). It is
 // noexcept, takes no lock and allocates nothing: all working storage has a fixed maximum
-// size (kMaxUsers users, each contributing at most 3 contact nodes).
+// size (kMaxUsers users, each contributing at most 3 contact nodes), and what a dynamic
+// body changes from tick to tick lives in the caller's EvaluationState, made with the
+// prepared IR (make_evaluation_state) and advanced by dt, the loop's nominal period, at
+// every call. The condensed FEM body is static: it ignores dt, and its state is at most the
+// sphere contact model's warm start. The mass-spring body (mass_spring_evaluation.h)
+// integrates its sub-network over dt.
 //
+// The condensed FEM body:
 // prepare_ir() runs once per IR, off the haptic thread: it checks the IR and inverts the
 // contact block of M~ (in double) to the condensed compliance L~ = M_CC^-1 of the contact
 // nodes with B held, and u0 = -L~ M_CB u_B, their displacement when they carry no force.
@@ -20,6 +26,8 @@
 //   4. returns -F, set to zero if not finite and scaled down to the IR's force limit.
 // Exactly the full FEM solve's answer for the same tool positions, as long as every tool
 // stays on its IR triangles (the own tool within its patch).
+// Under the sphere contact model step 3 is the unilateral problem over every contact node
+// the spheres pass instead (evaluate_sphere_contact.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -30,6 +38,7 @@
 
 #include "common/ir/contact_solve.h"
 #include "common/ir/intermediate_representation.h"
+#include "common/ir/mass_spring_evaluation.h"
 #include "common/ir/prepared_sphere_contact.h"
 
 namespace cohaptic {
@@ -44,10 +53,11 @@ struct PreparedFem {
 };
 
 /// One alternative per IrBody alternative, in the same order.
-using PreparedBody = std::variant<PreparedFem>;
+using PreparedBody = std::variant<PreparedFem, PreparedMassSpring>;
 
 /// An IR and what its evaluation needs, computed once: `body` holds the alternative that
-/// matches ir.body's kind (PreparedFem for CondensedFemIr).
+/// matches ir.body's kind (PreparedFem for CondensedFemIr, PreparedMassSpring for
+/// MassSpringIr).
 struct PreparedIR {
   IntermediateRepresentation ir;
   PreparedBody body;
@@ -56,6 +66,17 @@ struct PreparedIR {
 
 /// Checks sizes, finiteness and positive definiteness; throws Error naming the problem.
 PreparedIR prepare_ir(IntermediateRepresentation ir);
+
+/// The mutable side of one evaluator of one prepared IR: nothing for a static body (FEM),
+/// the last tick's active set for an FEM body under the sphere contact model (only a warm
+/// start: an empty state solves cold, to the same answer), the sub-network's state for a
+/// mass-spring body. Made off the haptic thread, sized there.
+struct EvaluationState {
+  std::variant<std::monostate, MassSpringPatchState, SphereWarmStart> body;
+};
+
+/// The state an evaluator of `prepared` starts from (the server's state at the IR's time).
+EvaluationState make_evaluation_state(const PreparedIR& prepared);
 
 enum ForceFlag : std::uint8_t {
   kInContact = 1,         ///< the own tool presses the surface
@@ -74,14 +95,17 @@ struct ForceSample {
   std::uint8_t flags = 0;
 };
 
-/// Sets sample.force to -contact_force (the reaction on the tool), zero if not `solved` or
-/// not finite, and scaled down to `force_limit`; flags it.
-void finish_force(ForceSample& sample, const Eigen::Vector3d& contact_force, bool solved, double force_limit) noexcept;
+/// Never a non-finite or unbounded force: sets sample.force to zero (flagged kNonFinite) if
+/// not `evaluated` or not finite, scales it down to `force_limit` (flagged kClamped) if above.
+void limit_force(ForceSample& sample, bool evaluated, double force_limit) noexcept;
 
 /// Dispatches on the body kind (a condensed FEM body under the sphere contact model is
 /// evaluate_sphere_contact()). remote_tools[i] is the position of the tool of the body's
-/// i-th remote contact [m] (NaN: unknown, ignored).
-ForceSample evaluate_force(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
-                           std::span<const Eigen::Vector3d> remote_tools) noexcept;
+/// i-th remote contact [m] (NaN: unknown, ignored). `state` must come from
+/// make_evaluation_state(prepared) and be advanced by no other IR; dt [s] is the period
+/// since the previous call (the haptic loop's nominal period). A state of another kind
+/// than the body's gives a zero force flagged kNonFinite.
+ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, const Eigen::Vector3d& own_tool,
+                           std::span<const Eigen::Vector3d> remote_tools, double dt) noexcept;
 
 }  // namespace cohaptic

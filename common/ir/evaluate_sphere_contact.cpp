@@ -15,7 +15,8 @@ using ContactVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 
 }  // namespace
 
 ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
-                                    const PreparedFem& prepared, const Eigen::Vector3d& own_tool,
+                                    const PreparedFem& prepared, SphereWarmStart* warm_start,
+                                    const Eigen::Vector3d& own_tool,
                                     std::span<const Eigen::Vector3d> remote_tools) noexcept {
   ForceSample sample;
   if (!own_tool.allFinite()) {
@@ -84,7 +85,8 @@ ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, 
 
   // Which touch, warm started from the last tick.
   std::array<std::uint8_t, kMaxSphereContacts> active{};
-  for (int i = 0; i < m; ++i) active[static_cast<std::size_t>(i)] = prepared.sphere.warm_start.active(node[static_cast<std::size_t>(i)]);
+  if (warm_start)
+    for (int i = 0; i < m; ++i) active[static_cast<std::size_t>(i)] = warm_start->active(node[static_cast<std::size_t>(i)]);
   ContactVector lambda(m);
   ContactMatrix factor(m, m);
   std::array<int, kMaxSphereContacts> order{};
@@ -95,12 +97,13 @@ ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, 
     sample.flags |= kContactUnresolved;
     return sample;
   }
-  prepared.sphere.warm_start.store(std::span<const int>(node.data(), static_cast<std::size_t>(m)), active_span);
+  if (warm_start) warm_start->store(std::span<const int>(node.data(), static_cast<std::size_t>(m)), active_span);
 
   Eigen::Vector3d contact_force = Eigen::Vector3d::Zero();
   for (int i = 0; i < m; ++i)
     if (constraint[static_cast<std::size_t>(i)].tool == 0) contact_force += lambda[i] * constraint[static_cast<std::size_t>(i)].normal;
-  finish_force(sample, contact_force, true, envelope.force_limit);
+  sample.force = -contact_force;
+  limit_force(sample, true, envelope.force_limit);
   return sample;
 }
 

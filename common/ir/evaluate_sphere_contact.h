@@ -6,7 +6,7 @@
 // rest positions; their normal compliance A = N^T L~ N and clearances q = g + N^T u0 come
 // from the IR's condensed compliance L~ (B held) and free displacement u0; which of them
 // touch and with what push is the unilateral problem (unilateral_contact_solve.h), warm
-// started from the last evaluation of the same IR. The force on the own tool is
+// started from the evaluator's last tick on the same IR (cold without a warm start). The force on the own tool is
 // -sum lambda_i n_i over the nodes it holds: exactly the full FEM solve's, as long as
 // every node the spheres pass is a contact node of the IR.
 // Flags: kInContact when the own sphere holds a node; kOutsidePatch when it reaches a
@@ -27,9 +27,11 @@ namespace cohaptic {
 constexpr double kSphereSolveWork = 5e5;
 
 /// `envelope` holds the own tool's radius and the force limit; `ir` is its body, `prepared`
-/// what prepare_ir derived from it.
+/// what prepare_ir derived from it; `warm_start` (may be null: a cold solve) is read and
+/// replaced by this tick's active set.
 ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
-                                    const PreparedFem& prepared, const Eigen::Vector3d& own_tool,
+                                    const PreparedFem& prepared, SphereWarmStart* warm_start,
+                                    const Eigen::Vector3d& own_tool,
                                     std::span<const Eigen::Vector3d> remote_tools) noexcept;
 
 }  // namespace cohaptic

@@ -33,13 +33,24 @@ CondensedFemIr& condensed_fem(IntermediateRepresentation& ir) {
   return const_cast<CondensedFemIr&>(condensed_fem(static_cast<const IntermediateRepresentation&>(ir)));
 }
 
+std::size_t MassSpringIr::size_bytes() const {
+  constexpr std::size_t kParameters = (3 + 3 + 3 + 3 + 2) * sizeof(double) + 1;  // gravity .. time step, plane
+  const std::size_t nodes = node_ids.size() * (sizeof(std::int32_t) + 7 * sizeof(double) + 1);
+  const std::size_t springs_bytes = springs.size() * (2 * sizeof(std::int32_t) + 3 * sizeof(double));
+  const std::size_t tools = remote_users.size() * (sizeof(std::int32_t) + sizeof(double)) +
+                            presses.size() * (1 + 3 * sizeof(double));
+  return kParameters + nodes + springs_bytes + triangles.size() * 3 * sizeof(std::int32_t) + tools;
+}
+
 int remote_count(const IntermediateRepresentation& ir) noexcept {
   if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body)) return static_cast<int>(fem->remotes.size());
+  if (const auto* network = std::get_if<MassSpringIr>(&ir.body)) return static_cast<int>(network->remote_users.size());
   return 0;
 }
 
 int remote_user(const IntermediateRepresentation& ir, int i) noexcept {
   if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body)) return fem->remotes[static_cast<std::size_t>(i)].user;
+  if (const auto* network = std::get_if<MassSpringIr>(&ir.body)) return network->remote_users[static_cast<std::size_t>(i)];
   return -1;
 }
 

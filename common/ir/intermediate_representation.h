@@ -1,6 +1,7 @@
 // IntermediateRepresentation (IR): what the simulation exports to one user's haptic loop.
 // An envelope (who, when, the tool, the force limit) around one body, a variant over the
-// body kinds: the client prepares and evaluates whichever kind the server sent.
+// body kinds: the client prepares and evaluates whichever kind the server sent. The
+// mass-spring body's IR is in mass_spring_ir.h.
 //
 // CondensedFemIr, the linear elastic body's (the paper's Sec. II-C): the local contact
 // geometry and M~ = (M_CC M_CB). Nodes are numbered locally: first the user's own contact patch (the triangle nearest its
@@ -23,6 +24,7 @@
 #include <vector>
 
 #include "common/fem/dof_map.h"
+#include "common/ir/mass_spring_ir.h"
 #include "common/mesh/tet_mesh.h"
 #include "common/scene/scene.h"
 
@@ -82,7 +84,7 @@ struct CondensedFemIr {
 };
 
 /// One alternative per body kind; the wire's `oneof body` mirrors it.
-using IrBody = std::variant<CondensedFemIr>;
+using IrBody = std::variant<CondensedFemIr, MassSpringIr>;
 
 struct IntermediateRepresentation {
   /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone).

@@ -8,23 +8,16 @@
 
 namespace cohaptic {
 
-SphereWarmStart& SphereWarmStart::operator=(const SphereWarmStart& other) noexcept {
-  for (std::size_t w = 0; w < words_.size(); ++w)
-    words_[w].store(other.words_[w].load(std::memory_order_relaxed), std::memory_order_relaxed);
-  return *this;
-}
-
 bool SphereWarmStart::active(int node) const noexcept {
   if (node < 0 || node >= kMaxSphereCandidates) return false;
-  return (words_[static_cast<std::size_t>(node / 64)].load(std::memory_order_relaxed) >> (node % 64)) & 1u;
+  return (words_[static_cast<std::size_t>(node / 64)] >> (node % 64)) & 1u;
 }
 
-void SphereWarmStart::store(std::span<const int> nodes, std::span<const std::uint8_t> active) const noexcept {
-  std::array<std::uint64_t, kMaxSphereCandidates / 64> words{};
+void SphereWarmStart::store(std::span<const int> nodes, std::span<const std::uint8_t> active) noexcept {
+  words_.fill(0);
   for (std::size_t i = 0; i < nodes.size() && i < active.size(); ++i)
     if (active[i] && nodes[i] >= 0 && nodes[i] < kMaxSphereCandidates)
-      words[static_cast<std::size_t>(nodes[i] / 64)] |= std::uint64_t{1} << (nodes[i] % 64);
-  for (std::size_t w = 0; w < words.size(); ++w) words_[w].store(words[w], std::memory_order_relaxed);
+      words_[static_cast<std::size_t>(nodes[i] / 64)] |= std::uint64_t{1} << (nodes[i] % 64);
 }
 
 PreparedSphereContact prepare_sphere_contact(const CondensedFemIr& ir, double tool_radius) {

@@ -1,7 +1,8 @@
 // What the client derives once per intermediate representation for the sphere contact
 // model (common/contact/sphere_contact.h), beside the condensed compliance every model
 // uses: the guard ring's corners that are not candidate nodes (a sphere reaching one has
-// left what the IR describes), and the warm start of the per-tick contact solve.
+// left what the IR describes); and the warm start of the per-tick contact solve, which each
+// evaluator keeps in its own state.
 //
 // In a sphere IR every contact (row) node is a candidate for every tool, own and remote:
 // the patch holds the own sphere's candidates, the nodes after it the remote spheres'.
@@ -10,7 +11,6 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <atomic>
 #include <cstdint>
 #include <span>
 
@@ -22,26 +22,20 @@ constexpr int kMaxSphereCandidates = 128;  ///< contact nodes of a sphere IR
 constexpr int kMaxSphereContacts = 64;     ///< nodes the spheres hold at once, in one tick
 
 /// The active set of the last sphere contact solve, one bit per contact node: the next
-/// tick's warm start. Only the path to the answer depends on it, never the answer
-/// (unilateral_contact_solve.h). Atomic words, so that evaluating one prepared IR from
-/// several threads at once is still defined (they then share the warm start).
+/// tick's warm start, held in the evaluator's EvaluationState. Only the path to the answer
+/// depends on it, never the answer (unilateral_contact_solve.h).
 class SphereWarmStart {
  public:
-  SphereWarmStart() = default;
-  SphereWarmStart(const SphereWarmStart& other) noexcept { *this = other; }
-  SphereWarmStart& operator=(const SphereWarmStart& other) noexcept;
-
   bool active(int node) const noexcept;
   /// Replaces the set: `nodes[i]` is active when `active[i]` is non-zero; all others are not.
-  void store(std::span<const int> nodes, std::span<const std::uint8_t> active) const noexcept;
+  void store(std::span<const int> nodes, std::span<const std::uint8_t> active) noexcept;
 
  private:
-  mutable std::array<std::atomic<std::uint64_t>, kMaxSphereCandidates / 64> words_{};
+  std::array<std::uint64_t, kMaxSphereCandidates / 64> words_{};
 };
 
 struct PreparedSphereContact {
   Eigen::Matrix3Xd outside_corners;  ///< guard triangle corners that are not contact nodes [m]
-  SphereWarmStart warm_start;
 };
 
 /// Checks the sphere IR's limits (Error naming them) and finds the outside corners;

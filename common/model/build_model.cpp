@@ -28,11 +28,13 @@ struct BodyBuilder {
   BodyModel operator()(const ElasticObjectSpec& spec) const {
     return build_elastic_body(object, spec, metres_per_unit);
   }
+  BodyModel operator()(const MassSpringObjectSpec& spec) const { return build_mass_spring_body(object.name, spec, object.where); }
 };
 
 // The model name a user wrote for the body kind, for messages.
 struct KindName {
   const char* operator()(const ElasticBody&) const { return "linear_elastic"; }
+  const char* operator()(const MassSpringModel&) const { return "mass_spring"; }
 };
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "common/scene/load_scene.h"
 
+#include "common/scene/parse_mass_spring.h"
 #include "common/util/yaml_cursor.h"
 
 
@@ -166,8 +167,9 @@ ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::pa
   ObjectSpec object;
   object.where = c.location();
   object.name = c.at("name").text();
-  const std::string model = c.find("model") ? c.at("model").choice({"linear_elastic"}) : "linear_elastic";
+  const std::string model = c.find("model") ? c.at("model").choice({"linear_elastic", "mass_spring"}) : "linear_elastic";
   if (model == "linear_elastic") object.body = parse_elastic_object(c, scale, scene_dir);
+  else object.body = parse_mass_spring_object(c, scale);
   return object;
 }
 

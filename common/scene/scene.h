@@ -16,6 +16,7 @@
 
 #include "common/fem/dof_map.h"
 #include "common/fem/linear_elastic_material.h"
+#include "common/mass_spring/mass_spring_spec.h"
 
 namespace cohaptic {
 
@@ -73,7 +74,7 @@ struct ElasticObjectSpec {
 /// One alternative per body model a scene may ask for (`model:` in the file). Adding a
 /// model adds an alternative here, and the compiler then names every place that must
 /// learn it (the compiled body, its simulation, its IR body).
-using BodySpec = std::variant<ElasticObjectSpec>;
+using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec>;
 
 /// A deformable object of the scene: its name (unique in the scene) and its model's spec.
 struct ObjectSpec {

@@ -43,6 +43,8 @@ void Simulation::set_tool(int user, const Eigen::Vector3d& position) {
 
 void Simulation::clear_tool(int user) { users_[user].known = false; }
 
+void Simulation::continue_epochs(int user, std::uint64_t epoch) { users_[user].epoch = std::max(users_[user].epoch, epoch); }
+
 void Simulation::hold(int node, const HeldNode& held) {
   condensation_.add_boundary_node(node);
   held_[node] = held;
@@ -261,7 +263,8 @@ std::vector<Eigen::Vector3d> Simulation::remote_positions(const IntermediateRepr
 ForceSample Simulation::force(int user) const {
   const UserState& state = users_[user];
   if (!state.ir) return {};
-  return evaluate_force(*state.ir, state.position, remote_positions(state.ir->ir));
+  EvaluationState stateless;  // the condensed FEM body ignores dt; without a warm start a sphere solve runs cold
+  return evaluate_force(*state.ir, stateless, state.position, remote_positions(state.ir->ir), 0);
 }
 
 }  // namespace cohaptic

@@ -37,6 +37,7 @@
 #include "common/ir/evaluate_force.h"
 #include "common/model/elastic_body.h"
 #include "common/sim/state_solve.h"
+#include "common/sim/step_report.h"
 
 namespace cohaptic {
 
@@ -49,14 +50,6 @@ struct SimulationOptions {
   bool naive_every_step = false;
 };
 
-struct StepReport {
-  bool rebuilt = false;       ///< new IRs were built this step (a set changed)
-  bool recomputed = false;    ///< M~ was computed this step (rebuilt, or naive_every_step)
-  double rebuild_ms = 0;      ///< time to update B and compute every M~
-  std::size_t ir_bytes = 0;   ///< total size of the IRs rebuilt
-  int boundary_nodes = 0;     ///< |B| after the step
-  int obstacle_nodes = 0;     ///< of which held by obstacles
-};
 
 class Simulation {
  public:
@@ -70,6 +63,8 @@ class Simulation {
   void set_tool(int user, const Eigen::Vector3d& position);
   /// The user's tool is no longer known (disconnected): it presses nothing.
   void clear_tool(int user);
+  /// The user's next IR gets an epoch above `epoch` (a user coming from another body).
+  void continue_epochs(int user, std::uint64_t epoch);
 
   StepReport step(double time);
 

@@ -154,10 +154,47 @@ void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
   }
 }
 
+void mass_spring_to_wire(const MassSpringIr& ir, MassSpringPatch* out) {
+  out->mutable_node_ids()->Add(ir.node_ids.begin(), ir.node_ids.end());
+  add_xyz(ir.positions, out->mutable_positions());
+  add_xyz(ir.velocities, out->mutable_velocities());
+  add_values<double>(ir.mass.data(), ir.mass.size(), out->mutable_masses());
+  out->set_held(std::string(ir.held.begin(), ir.held.end()));
+  for (const Spring& spring : ir.springs) {
+    out->add_spring_nodes(static_cast<std::uint32_t>(spring.a));
+    out->add_spring_nodes(static_cast<std::uint32_t>(spring.b));
+    out->add_spring_rest_lengths(spring.rest_length);
+    out->add_spring_stiffness(spring.stiffness);
+    out->add_spring_damping(spring.damping);
+  }
+  for (const auto& triangle : ir.triangles)
+    for (int node : triangle) out->add_triangles(static_cast<std::uint32_t>(node));
+  const MassSpringParameters& p = ir.parameters;
+  to_wire(p.gravity, out->mutable_gravity());
+  out->set_node_damping(p.node_damping);
+  out->set_tool_friction(p.tool_friction);
+  out->set_time_step(p.time_step);
+  if (p.plane) {
+    MassSpringPlane* plane = out->mutable_plane();
+    to_wire(p.plane->point, plane->mutable_point());
+    to_wire(p.plane->normal, plane->mutable_normal());
+    plane->set_static_friction(p.plane->static_friction);
+    plane->set_dynamic_friction(p.plane->dynamic_friction);
+  }
+  for (int user : ir.remote_users) out->add_remote_users(static_cast<std::uint32_t>(user));
+  out->mutable_remote_radii()->Add(ir.remote_radii.begin(), ir.remote_radii.end());
+  for (const ToolPress& press : ir.presses) {
+    ToolPressState* state = out->add_presses();
+    state->set_pressing(press.pressing);
+    to_wire(press.previous, state->mutable_previous());
+  }
+}
+
 // Writes the IR's body into the wire's oneof, by kind.
 struct BodyToWire {
   WireIr* out;
   void operator()(const CondensedFemIr& fem) const { fem_to_wire(fem, out->mutable_fem()); }
+  void operator()(const MassSpringIr& network) const { mass_spring_to_wire(network, out->mutable_mass_spring()); }
 };
 
 }  // namespace
@@ -279,6 +316,71 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   return ir;
 }
 
+// Sizes and indices here; signs and physical ranges are prepare_ir's (check_network).
+MassSpringIr mass_spring_from_wire(const MassSpringPatch& w) {
+  MassSpringIr ir;
+  const auto nodes = static_cast<std::uint32_t>(w.node_ids_size());
+  ir.node_ids.assign(w.node_ids().begin(), w.node_ids().end());
+  ir.positions = read_xyz(w.positions(), nodes, "positions");
+  ir.velocities = read_xyz(w.velocities(), nodes, "velocities");
+  if (static_cast<std::uint32_t>(w.masses_size()) != nodes) invalid("{} masses for {} nodes", w.masses_size(), nodes);
+  ir.mass.resize(static_cast<Eigen::Index>(nodes));
+  read_values(w.masses(), ir.mass, "masses");
+  if (w.held().size() != nodes) invalid("{} held bytes for {} nodes", w.held().size(), nodes);
+  for (char held : w.held()) {
+    if (held != 0 && held != 1) invalid("a held byte is {}, not 0 or 1", static_cast<int>(held));
+    ir.held.push_back(static_cast<std::uint8_t>(held));
+  }
+  const int springs = w.spring_rest_lengths_size();
+  if (w.spring_nodes_size() != 2 * springs || w.spring_stiffness_size() != springs || w.spring_damping_size() != springs)
+    invalid("{} spring node indices, {} rest lengths, {} stiffnesses and {} dampings", w.spring_nodes_size(), springs,
+            w.spring_stiffness_size(), w.spring_damping_size());
+  for (int i = 0; i < springs; ++i) {
+    Spring spring;
+    for (int end = 0; end < 2; ++end) {
+      const std::uint32_t node = w.spring_nodes(2 * i + end);
+      if (node >= nodes) invalid("spring {} names node {} of {}", i, node, nodes);
+      (end == 0 ? spring.a : spring.b) = static_cast<int>(node);
+    }
+    spring.rest_length = w.spring_rest_lengths(i);
+    spring.stiffness = w.spring_stiffness(i);
+    spring.damping = w.spring_damping(i);
+    ir.springs.push_back(spring);
+  }
+  if (w.triangles_size() % 3 != 0) invalid("{} triangle indices, not a multiple of 3", w.triangles_size());
+  for (int i = 0; i < w.triangles_size(); i += 3) {
+    std::array<int, 3> triangle{};
+    for (int k = 0; k < 3; ++k) {
+      if (w.triangles(i + k) >= nodes) invalid("triangle {} names node {} of {}", i / 3, w.triangles(i + k), nodes);
+      triangle[static_cast<std::size_t>(k)] = static_cast<int>(w.triangles(i + k));
+    }
+    ir.triangles.push_back(triangle);
+  }
+  MassSpringParameters& p = ir.parameters;
+  p.gravity = read_vec3(w.gravity(), "gravity");
+  p.node_damping = w.node_damping();
+  p.tool_friction = w.tool_friction();
+  p.time_step = w.time_step();
+  if (w.has_plane()) {
+    SupportPlane plane;
+    plane.point = read_vec3(w.plane().point(), "plane.point");
+    plane.normal = read_vec3(w.plane().normal(), "plane.normal");
+    plane.static_friction = w.plane().static_friction();
+    plane.dynamic_friction = w.plane().dynamic_friction();
+    p.plane = plane;
+  }
+  if (w.remote_radii_size() != w.remote_users_size() || w.presses_size() != w.remote_users_size() + 1)
+    invalid("{} remote users, {} radii and {} presses (expected one more)", w.remote_users_size(), w.remote_radii_size(),
+            w.presses_size());
+  for (int i = 0; i < w.remote_users_size(); ++i) {
+    ir.remote_users.push_back(to_int(w.remote_users(i), "remote user"));
+    ir.remote_radii.push_back(w.remote_radii(i));
+  }
+  for (int i = 0; i < w.presses_size(); ++i)
+    ir.presses.push_back({w.presses(i).pressing(), read_vec3(w.presses(i).previous(), fmt::format("presses[{}]", i))});
+  return ir;
+}
+
 }  // namespace
 
 CommonIr from_wire(const WireIr& w) {
@@ -298,6 +400,7 @@ CommonIr from_wire(const WireIr& w) {
   ir.force_limit = w.force_limit();
   switch (w.body_case()) {
     case WireIr::kFem: ir.body = fem_from_wire(w.fem()); break;
+    case WireIr::kMassSpring: ir.body = mass_spring_from_wire(w.mass_spring()); break;
     case WireIr::BODY_NOT_SET: invalid("no body of a kind this build knows");
   }
   return ir;

@@ -1,6 +1,8 @@
 // cohaptic::IntermediateRepresentation (common/ir) <-> wire::IntermediateRepresentation
 // (messages.proto), field by field.
 //
+// The mass-spring body (MassSpringPatch) goes in double, field by field; its round trip is
+// bit-exact.
 // Matrices: M~ column-major in m_tilde_f64 or m_tilde_f32 and u_B in
 // boundary_displacement_f64 or _f32, by ir.precision; the wire form has no precision
 // field: it is f32 if either f32 field is non-empty, f64 otherwise (so an IR whose M~ and

@@ -29,6 +29,25 @@ SurfaceMesh surface_mesh_message(const ElasticBody& body) {
   return message;
 }
 
+SurfaceMesh surface_mesh_message(const MassSpringModel& body) {
+  const MassSpringNetwork& network = body.network;
+  std::vector<int> compact(static_cast<std::size_t>(network.node_count()), -1);
+  SurfaceMesh message;
+  for (std::size_t i = 0; i < network.surface_nodes.size(); ++i) {
+    const int node = network.surface_nodes[i];
+    compact[static_cast<std::size_t>(node)] = static_cast<int>(i);
+    for (int axis = 0; axis < 3; ++axis) message.add_vertices(network.rest_positions(axis, node));
+    message.add_node_ids(node);
+  }
+  for (const auto& triangle : network.triangles)
+    for (int corner : triangle) message.add_triangles(static_cast<std::uint32_t>(compact[static_cast<std::size_t>(corner)]));
+  return message;
+}
+
+SurfaceMesh surface_mesh_message(const BodyModel& body) {
+  return std::visit([](const auto& kind) { return surface_mesh_message(kind); }, body);
+}
+
 ReceivedSurface from_wire(const SurfaceMesh& mesh) {
   const auto fail = [](const std::string& what) { throw cohaptic::Error("surface mesh: " + what); };
   if (mesh.vertices_size() % 3 != 0) fail(fmt::format("{} vertex coordinates, not a multiple of 3", mesh.vertices_size()));

@@ -13,10 +13,16 @@
 #include "cohaptic/messages.pb.h"
 #include "common/mesh/triangle_surface.h"
 #include "common/model/elastic_body.h"
+#include "common/model/model.h"
 
 namespace cohaptic::wire {
 
 SurfaceMesh surface_mesh_message(const ElasticBody& body);
+/// A mass-spring body's surface at rest: vertex i is network.surface_nodes[i], its node id
+/// the network's node index.
+SurfaceMesh surface_mesh_message(const MassSpringModel& body);
+/// Whichever kind `body` is.
+SurfaceMesh surface_mesh_message(const BodyModel& body);
 
 /// A received surface: its triangles and each vertex's mesh node id.
 struct ReceivedSurface {

@@ -1,0 +1,120 @@
+#include "common/sim/scene_simulation.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <limits>
+
+#include "common/util/error.h"
+
+namespace cohaptic {
+namespace {
+
+// Makes body i's simulation from its compiled body.
+struct SimulationMaker {
+  const Model& model;
+  ComplianceColumns* columns;
+  const std::vector<ToolSpec>& tools;
+  const SimulationOptions& options;
+  int object;
+  std::unique_ptr<BodySimulation> operator()(const ElasticBody& body) const {
+    if (!columns) throw Error(fmt::format("scene simulation: no compliance columns for the linear elastic object '{}'", body.name));
+    return std::make_unique<BodySimulation>(std::in_place_type<Simulation>, body, model.obstacles, *columns, tools, options);
+  }
+  std::unique_ptr<BodySimulation> operator()(const MassSpringModel& body) const {
+    return std::make_unique<BodySimulation>(std::in_place_type<MassSpringSimulation>, body, object, tools,
+                                            model.scene.haptic.force_limit_n);
+  }
+};
+
+}  // namespace
+
+SceneSimulation::SceneSimulation(const Model& model, std::span<ComplianceColumns* const> columns,
+                                 const std::vector<ToolSpec>& tools, const SimulationOptions& options)
+    : model_(model), users_(tools.size()) {
+  if (columns.size() != model.bodies.size())
+    throw Error(fmt::format("scene simulation: {} compliance column sets for {} bodies", columns.size(), model.bodies.size()));
+  for (std::size_t i = 0; i < model.bodies.size(); ++i)
+    bodies_.push_back(std::visit(SimulationMaker{model, columns[i], tools, options, static_cast<int>(i)}, model.bodies[i]));
+}
+
+void SceneSimulation::set_tool(int user, const Eigen::Vector3d& position) {
+  UserState& state = users_[static_cast<std::size_t>(user)];
+  state.known = position.allFinite();
+  state.position = position;
+}
+
+void SceneSimulation::clear_tool(int user) { users_[static_cast<std::size_t>(user)].known = false; }
+
+bool SceneSimulation::pressing(int user) const {
+  return std::visit([user](const auto& simulation) { return simulation.pressing(user); }, body(body_of(user)));
+}
+
+double SceneSimulation::distance_to_body(int body_index, const Eigen::Vector3d& point) const {
+  if (const auto* network = std::get_if<MassSpringSimulation>(&body(body_index))) return network->distance_to_surface(point);
+  const ElasticBody& elastic = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(body_index)]);
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int node : elastic.touchable_nodes) nearest = std::min(nearest, (elastic.mesh.nodes.col(node) - point).norm());
+  return nearest;
+}
+
+void SceneSimulation::assign_bodies() {
+  if (bodies_.size() < 2) return;
+  for (int u = 0; u < user_count(); ++u) {
+    UserState& user = users_[static_cast<std::size_t>(u)];
+    if (!user.known || pressing(u)) continue;
+    int nearest = user.body;
+    double best = distance_to_body(user.body, user.position);
+    for (int b = 0; b < body_count(); ++b)
+      if (const double distance = distance_to_body(b, user.position); distance < best) {
+        best = distance;
+        nearest = b;
+      }
+    if (nearest == user.body) continue;
+    user.body = nearest;
+    const std::uint64_t epoch = user.ir ? user.ir->ir.epoch : 0;
+    std::visit([&](auto& simulation) { simulation.continue_epochs(u, epoch); }, *bodies_[static_cast<std::size_t>(nearest)]);
+  }
+}
+
+StepReport SceneSimulation::step(double time) {
+  period_ = started_ ? time - time_ : 0;
+  started_ = true;
+  time_ = time;
+  assign_bodies();
+  StepReport report;
+  for (int b = 0; b < body_count(); ++b) {
+    BodySimulation& simulation = *bodies_[static_cast<std::size_t>(b)];
+    std::visit(
+        [&](auto& body_simulation) {
+          for (int u = 0; u < user_count(); ++u) {
+            const UserState& user = users_[static_cast<std::size_t>(u)];
+            if (user.known && user.body == b) body_simulation.set_tool(u, user.position);
+            else body_simulation.clear_tool(u);
+          }
+          report += body_simulation.step(time);
+        },
+        simulation);
+  }
+  for (int u = 0; u < user_count(); ++u) {
+    UserState& user = users_[static_cast<std::size_t>(u)];
+    auto latest = std::visit([u](const auto& simulation) { return simulation.ir(u); }, body(user.body));
+    // A body the user left long ago may still hold an older IR for it: never hand one back.
+    user.changed = latest && latest != user.ir && (!user.ir || latest->ir.epoch > user.ir->ir.epoch);
+    if (user.changed) user.ir = std::move(latest);
+  }
+  return report;
+}
+
+ForceSample SceneSimulation::force(int user) {
+  BodySimulation& simulation = *bodies_[static_cast<std::size_t>(body_of(user))];
+  if (auto* network = std::get_if<MassSpringSimulation>(&simulation)) return network->force(user, period_);
+  return std::get<Simulation>(simulation).force(user);
+}
+
+const Simulation& SceneSimulation::single_elastic() const {
+  single_elastic_body(model_);  // throws naming the scene when it is not one linear elastic object
+  return std::get<Simulation>(*bodies_.front());
+}
+
+}  // namespace cohaptic

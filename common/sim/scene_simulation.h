@@ -1,0 +1,80 @@
+// SceneSimulation: the server's simulation of a whole scene, one body simulation per scene
+// object (BodySimulation: the condensed FEM body's Simulation, or a MassSpringSimulation),
+// with no threads or sockets. It is what the server loop and the replay step.
+//
+// Each user is on one body at a time: the body whose touchable surface is nearest its tool
+// (the FEM body's at rest, a dynamic body's in its current state). A user changes body only
+// while it presses nothing, so a tool between two bodies does not flip-flop; its tool is
+// given to its body and cleared on the others, so users on different bodies do not couple.
+// The IR handed for a user (ir(user)) is its body's latest, with epochs that keep rising
+// across a change of body. force() is the P0 force: the same evaluation the client runs.
+// Units: SI; times in s of the simulation's clock.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <span>
+#include <variant>
+#include <vector>
+
+#include "common/model/model.h"
+#include "common/sim/mass_spring_simulation.h"
+#include "common/sim/simulation.h"
+
+namespace cohaptic {
+
+/// One alternative per BodyModel alternative, in the same order.
+using BodySimulation = std::variant<Simulation, MassSpringSimulation>;
+
+class SceneSimulation {
+ public:
+  /// One user per tool. columns[i] holds body i's compliance columns when it is linear
+  /// elastic (rows as Simulation requires), null otherwise; `model` and the columns must
+  /// outlive it. `options` applies to the FEM bodies.
+  SceneSimulation(const Model& model, std::span<ComplianceColumns* const> columns, const std::vector<ToolSpec>& tools,
+                  const SimulationOptions& options);
+
+  int user_count() const { return static_cast<int>(users_.size()); }
+  int body_count() const { return static_cast<int>(bodies_.size()); }
+  void set_tool(int user, const Eigen::Vector3d& position);
+  /// The user's tool is no longer known (disconnected): it presses nothing.
+  void clear_tool(int user);
+
+  StepReport step(double time);
+
+  /// The user's latest IR; null until its body built one.
+  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
+  /// True if ir(user) changed in the latest step.
+  bool ir_changed(int user) const { return users_[static_cast<std::size_t>(user)].changed; }
+  /// P0: the reaction force on `user`'s tool now, from its IR (zero without one). A dynamic
+  /// body's server-held evaluation advances by the latest step's period.
+  ForceSample force(int user);
+  bool pressing(int user) const;
+  /// The body `user` is on.
+  int body_of(int user) const { return users_[static_cast<std::size_t>(user)].body; }
+
+  const BodySimulation& body(int i) const { return *bodies_[static_cast<std::size_t>(i)]; }
+  /// The FEM simulation of a scene whose only object is linear elastic (the display and the
+  /// live view show that body); throws Error (single_elastic_body's) otherwise.
+  const Simulation& single_elastic() const;
+
+ private:
+  struct UserState {
+    bool known = false;
+    Eigen::Vector3d position = Eigen::Vector3d::Zero();
+    int body = 0;
+    std::shared_ptr<const PreparedIR> ir;
+    bool changed = false;
+  };
+  void assign_bodies();
+  double distance_to_body(int body, const Eigen::Vector3d& point) const;
+
+  const Model& model_;
+  std::vector<std::unique_ptr<BodySimulation>> bodies_;
+  std::vector<UserState> users_;
+  bool started_ = false;
+  double time_ = 0;    // of the latest step [s]
+  double period_ = 0;  // of the latest step [s]
+};
+
+}  // namespace cohaptic

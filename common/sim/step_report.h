@@ -1,0 +1,29 @@
+// StepReport: what one step of a body's simulation did, and summed over the scene's bodies
+// (SceneSimulation). Times in ms.
+#pragma once
+
+#include <cstddef>
+
+namespace cohaptic {
+
+struct StepReport {
+  bool rebuilt = false;       ///< new IRs were built this step (a set changed, or a dynamic body's IR was due)
+  bool recomputed = false;    ///< M~ was computed this step (rebuilt, or naive_every_step)
+  double rebuild_ms = 0;      ///< time to update B and compute every M~ (or cut every sub-network)
+  std::size_t ir_bytes = 0;   ///< total size of the IRs rebuilt
+  int boundary_nodes = 0;     ///< |B| after the step
+  int obstacle_nodes = 0;     ///< of which held by obstacles
+
+  /// Adds another body's report to this one.
+  StepReport& operator+=(const StepReport& other) {
+    rebuilt = rebuilt || other.rebuilt;
+    recomputed = recomputed || other.recomputed;
+    rebuild_ms += other.rebuild_ms;
+    ir_bytes += other.ir_bytes;
+    boundary_nodes += other.boundary_nodes;
+    obstacle_nodes += other.obstacle_nodes;
+    return *this;
+  }
+};
+
+}  // namespace cohaptic
