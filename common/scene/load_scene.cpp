@@ -91,7 +91,7 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
     if (mesh.file.is_relative()) mesh.file = scene_dir / mesh.file;
     if (!std::filesystem::exists(mesh.file)) file->fail_message(fmt::format("mesh file {} does not exist", mesh.file.string()));
   } else {
-    box->only_keys({"min", "size", "divisions", "grading"});
+    box->only_keys({"min", "size", "divisions", "grading", "uniform_cells"});
     BoxMeshSpec spec;
     spec.min_corner = box->at("min").vec3() * scale;
     const Cursor size = box->at("size");
@@ -109,6 +109,16 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
       if (!grading->is_sequence() || grading->items().size() != 3) grading->fail("a list of 3 ratios");
       const auto ratios = grading->items();
       for (int i = 0; i < 3; ++i) spec.grading[i] = ratios[i].number_in(0.2, 5, false, false, "a ratio from 0.2 to 5");
+    }
+    if (auto uniform = box->find("uniform_cells")) {
+      if (!uniform->is_sequence() || uniform->items().size() != 3) uniform->fail("a list of 3 integers");
+      const auto cells = uniform->items();
+      for (int i = 0; i < 3; ++i) {
+        const std::int64_t count = cells[i].integer();
+        if (count < 0 || count > spec.divisions[i])
+          cells[i].fail(fmt::format("an integer from 0 to the divisions ({})", spec.divisions[i]));
+        spec.uniform_cells[i] = static_cast<int>(count);
+      }
     }
     mesh.box = spec;
   }

@@ -31,6 +31,7 @@ struct BoxMeshSpec {
   Eigen::Vector3d size = Eigen::Vector3d::Zero();        ///< [m]
   Eigen::Vector3i divisions = Eigen::Vector3i::Ones();
   Eigen::Vector3d grading = Eigen::Vector3d::Ones();     ///< per axis: each cell / the one before (box_mesher.h)
+  Eigen::Vector3i uniform_cells = Eigen::Vector3i::Zero();  ///< per axis: equal cells on the fine side first
 };
 
 /// Exactly one of a mesh file (.msh 2.2/4.1, resolved against the scene's directory) or a generator.
