@@ -21,25 +21,39 @@ namespace {
 constexpr double kQuarters = 4;         // the meshed quarter carries a quarter of the force
 constexpr double kSidePerRadius = 20;   // the quarter block's side, in sphere radii
 
-double cell_ratio(const HertzBlock& block) { return std::pow(block.growth, 1.0 / block.divisions); }
+int core_cells(const HertzBlock& block) { return block.divisions / 2; }
+
+double core_cell(const HertzBlock& block) { return block.core / core_cells(block); }  // over R
 
 double change(double coarse, double fine) { return std::abs(fine - coarse) / std::abs(fine); }
 
 }  // namespace
 
+double hertz_cell_growth(const HertzBlock& block) {
+  if (block.divisions < 2 || !(block.core > 0 && block.core < kSidePerRadius / 2))
+    throw Error(fmt::format("hertz: {} divisions, core {} R: need at least 2 divisions and a core from 0 to {} R",
+                            block.divisions, block.core, kSidePerRadius / 2));
+  // The grown cells (the first r times a core cell) fill the rest of the side: bisection on
+  // r, their length rising with it.
+  const int grown = block.divisions - core_cells(block);
+  const double rest = (kSidePerRadius - block.core) / core_cell(block);
+  const auto length = [grown](double r) { return r * (std::pow(r, grown) - 1) / (r - 1); };
+  double low = 1 + 1e-12, high = 2;
+  while (length(high) < rest) high *= 2;
+  for (int i = 0; i < 200 && high - low > 1e-15 * high; ++i) (length(0.5 * (low + high)) < rest ? low : high) = 0.5 * (low + high);
+  return 0.5 * (low + high);
+}
+
 std::string hertz_block_yaml(const HertzBlock& block) {
-  if (!(block.radius > 0) || block.divisions < 1 || !(block.growth > 1))
-    throw Error(fmt::format("hertz: radius {} m, divisions {}, growth {}: need a positive radius, at least one division "
-                            "and a growth above 1",
-                            block.radius, block.divisions, block.growth));
-  const double r_mm = block.radius * 1e3, side = kSidePerRadius * r_mm, ratio = cell_ratio(block);
+  if (!(block.radius > 0)) throw Error(fmt::format("hertz: radius {} m: need a positive radius", block.radius));
+  const double r_mm = block.radius * 1e3, side = kSidePerRadius * r_mm, ratio = hertz_cell_growth(block);
   return fmt::format(
       R"(name: hertz
 units: mm
 objects:
   - name: block
     mesh:
-      box: {{min: [0, 0, {neg_side}], size: [{side}, {side}, {side}], divisions: [{n}, {n}, {n}], grading: [{r}, {r}, {inv_r}]}}
+      box: {{min: [0, 0, {neg_side}], size: [{side}, {side}, {side}], divisions: [{n}, {n}, {n}], grading: [{r}, {r}, {inv_r}], uniform_cells: [{c}, {c}, {c}]}}
     material: {{model: linear_elastic, youngs_modulus: {e}, poisson_ratio: {nu}, element: {element}}}
     fixed:
       - plane: {{point: [0, 0, {neg_side}], normal: [0, 0, 1]}}
@@ -54,7 +68,7 @@ tools:
   - {{name: A, shape: sphere, radius: {radius}}}
 haptic: {{contact_model: sphere}}
 )",
-      fmt::arg("neg_side", -side), fmt::arg("side", side), fmt::arg("n", block.divisions),
+      fmt::arg("neg_side", -side), fmt::arg("side", side), fmt::arg("n", block.divisions), fmt::arg("c", core_cells(block)),
       fmt::arg("r", fmt::format("{:.17g}", ratio)), fmt::arg("inv_r", fmt::format("{:.17g}", 1 / ratio)),
       fmt::arg("e", fmt::format("{:.17g}", block.material.youngs_modulus)),
       fmt::arg("nu", fmt::format("{:.17g}", block.material.poisson_ratio)),
@@ -75,8 +89,7 @@ HertzMesh measure_hertz(const HertzBlock& block, const std::vector<double>& dept
   mesh.divisions = block.divisions;
   mesh.nodes = body.mesh.node_count();
   mesh.tets = body.mesh.tet_count();
-  const double ratio = cell_ratio(block);
-  mesh.smallest_cell = kSidePerRadius * (ratio - 1) / (block.growth - 1);
+  mesh.smallest_cell = core_cell(block);
   SphereContactReference sphere_model(body);
   for (double depth_ratio : depth_ratios) {
     const std::vector<PressedTool> tool = {{Eigen::Vector3d(0, 0, block.radius * (1 - depth_ratio)), block.radius}};
@@ -93,9 +106,9 @@ HertzMesh measure_hertz(const HertzBlock& block, const std::vector<double>& dept
 std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh>& meshes) {
   const HertzBlock& block = options.block;
   std::string out = fmt::format(
-      "Sphere of R = {:g} mm into a block 40 R wide and 20 R deep (a graded quarter, growth {:g}), E = {:g} Pa, "
+      "Sphere of R = {:g} mm into a block 40 R wide and 20 R deep (a graded quarter, core {:g} R), E = {:g} Pa, "
       "nu = {:g}, {}.\nF / F_Hertz, sphere model (full solve of the unilateral problem) | node translation:\n\n",
-      block.radius * 1e3, block.growth, block.material.youngs_modulus, block.material.poisson_ratio,
+      block.radius * 1e3, block.core, block.material.youngs_modulus, block.material.poisson_ratio,
       formulation_name(block.material.formulation));
   out += "| divisions | nodes | smallest cell / R |";
   for (const char* model : {"sphere", "translation"})
@@ -183,9 +196,10 @@ LabCommand add_hertz_command(CLI::App& lab) {
       ->capture_default_str()
       ->check(CLI::Range(2, 60));
   command->add_option("--depths", options->depth_ratios, "Depths d/R")->capture_default_str()->check(CLI::Range(1e-4, 0.5));
-  command->add_option("--growth", options->block.growth, "Ratio of the last cell to the first along a side (about)")
+  command->add_option("--core", options->block.core,
+                      "Side of the uniformly meshed core under the sphere, in sphere radii (half the cells)")
       ->capture_default_str()
-      ->check(CLI::Range(1.01, 1e5));
+      ->check(CLI::Range(0.05, 5.0));
   command->add_option("--out", options->out, "Also write hertz.md and hertz.svg here");
   return {command, [options] { return run_hertz(*options); }};
 }

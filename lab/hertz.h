@@ -5,10 +5,12 @@
 // block 40 R wide and 20 R deep, fixed at its bottom; one quarter of it is meshed (20 R
 // on every side) with the sphere pressing at the corner where its two symmetry planes
 // meet: each plane holds the axis normal to it, and the force on the whole block is four
-// times the quarter's. The box mesh is graded geometrically towards that corner
-// (box_mesher.h): with n cells per side each cell is G^(1/n) times the one before, for a
-// fixed growth G, so every mesh of the study refines the same map of the block, and the
-// cells under the sphere are small where the far field is coarse.
+// times the quarter's. The box mesh is fine under the sphere and coarse in the far field
+// (box_mesher.h): with n cells per side, half of them are equal and fill a core of side
+// `core` R at the corner (it holds every node a sphere at d/R <= 0.1 passes), and the
+// other half grow geometrically from there to the block's far sides. The growth ratio r
+// solves the fill; as n grows, r^(n/2) tends to a constant, so every mesh of the study
+// refines the same map of the block.
 //
 // At each depth the sphere model's force is the full sparse solve of its unilateral
 // problem (sphere_contact_reference.h); beside it the paper's node translation model's
@@ -30,9 +32,12 @@ namespace cohaptic {
 struct HertzBlock {
   double radius = 0.01;  ///< R [m]
   LinearElasticMaterial material{1.0e5, 0.3, ElementFormulation::linear_tet};
-  int divisions = 16;    ///< cells along each side of the quarter block
-  double growth = 1000;  ///< G: the side's cells grow by G^(1/divisions) each (> 1)
+  int divisions = 16;    ///< cells along each side of the quarter block (>= 2)
+  double core = 0.5;     ///< side of the uniformly meshed core under the sphere, in R (0 < core < 10)
 };
+
+/// The growth ratio of the cells outside the core along a side of `block`'s quarter.
+double hertz_cell_growth(const HertzBlock& block);
 
 /// The block as scene text (units mm; its sphere tool `A` of radius R, contact model sphere).
 std::string hertz_block_yaml(const HertzBlock& block);
@@ -44,7 +49,7 @@ double hertz_force(const LinearElasticMaterial& material, double radius, double 
 /// One mesh of the study: forces on the whole block (four quarters) at each depth.
 struct HertzMesh {
   int divisions = 0, nodes = 0, tets = 0;
-  double smallest_cell = 0;                ///< under the sphere, over R
+  double smallest_cell = 0;                ///< under the sphere (the core's cells), over R
   std::vector<double> sphere_force;        ///< [N] per depth, the sphere model
   std::vector<int> contact_nodes;          ///< per depth: nodes the sphere pushes (in the quarter)
   std::vector<double> translation_force;   ///< [N] per depth, node translation
