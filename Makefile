@@ -3,15 +3,47 @@
 #   make demo   the same set-up, then the main job
 #   make tradeoff  the same set-up, then the speed/accuracy grid on the cube
 #   make bench  the same set-up, then the benchmarks (BENCH_ARGS passes arguments through)
+#   make fuzz       build the fuzz targets with clang (libFuzzer, ASan, UBSan) in build-asan
+#                   and run each for FUZZ_SECONDS (default 15; 0 builds only), FUZZ_JOBS at once
+#   make test-asan  the suite (ASAN_TESTS: all by default) built with clang, ASan + UBSan, in
+#                   the same build-asan as the fuzz targets
+#   make test-tsan  the threaded end-to-end tests (TSAN_TESTS) built with ThreadSanitizer in build-tsan
 BUILD_DIR ?= build
 BUILD_TYPE ?= Release
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 BENCH_ARGS ?=
+# As typed, '$' included (make would expand it): the bench recipe reads it from the environment.
+export COHAPTIC_BENCH_ARGS = $(value BENCH_ARGS)
 # Extra CMake settings for the first configure, e.g. CMAKE_ARGS=-DCOHAPTIC_WARNINGS_AS_ERRORS=ON (CI).
 CMAKE_ARGS ?=
 LAB := $(BUILD_DIR)/lab/cohaptic-lab
 
-.PHONY: all deps configure build test demo probe-demo tradeoff bench clean
+ASAN_BUILD_DIR ?= build-asan
+TSAN_BUILD_DIR ?= build-tsan
+FUZZ_SECONDS ?= 15
+FUZZ_JOBS ?= 2
+# CTest arguments choosing the ASan + UBSan tests: empty runs the whole suite; CI runs the
+# unit label (every unit test and every fuzz corpus), the end-to-end tests being TSan's.
+ASAN_TESTS ?=
+# ThreadSanitizer runs the end-to-end sessions, whose server and client processes (built
+# with TSan too) run every thread the system has: the haptic loop and its hand-overs, the
+# transport's I/O threads, the server's simulation loop. These ones check behaviour, not
+# timing (TSan slows a program 5 to 15 times): two users' forces against the offline
+# evaluation, IRs over a lossy link, a server restart and reconnection, a recording
+# verified bit for bit, and the security tests (participant keys, no plaintext, stale and
+# old peers, the participant limit).
+TSAN_TESTS ?= EndToEnd\.ClientForcesEqualOfflineEvaluationAndTheFullSolve|EndToEnd\.OnALossyLinkEveryIrArrivesOverTcp|EndToEnd\.AServerRestartFadesTheForceOutAndTheClientReconnects|Replay\.ATwoUserSessionVerifiesBitForBit|Security\.
+# Sanitizer and fuzz builds: clang, -O1 with line tables only (file:line in every report,
+# half the compile time of -O2 -g), and assertions on (Eigen's index checks too); no
+# benchmarks. The ASan build is also the fuzzing build (COHAPTIC_FUZZ: coverage
+# instrumentation in every library, libFuzzer's main in the fuzz targets only), so the
+# libraries are compiled once for both.
+SANITIZER_CMAKE = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
+  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DCOHAPTIC_BUILD_BENCHMARKS=OFF
+SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
+
+.PHONY: all deps configure build test demo probe-demo tradeoff bench fuzz test-asan test-tsan clean
 
 all: build
 
@@ -49,8 +81,29 @@ tradeoff: build
 	$(LAB) tradeoff --scene scenes/tradeoff/cube_two_users.yaml --motion scenes/tradeoff/cube_press_slide.yaml \
 	  --motion scenes/tradeoff/cube_press_hold.yaml --out out/tradeoff/cube
 
-bench: build
-	$(BUILD_DIR)/tests/cohaptic_bench $(BENCH_ARGS)
+# BENCH_ARGS reaches the program through the environment, split at spaces and otherwise as
+# typed (no globbing, no pipes): BENCH_ARGS="--benchmark_filter=naive|incremental" works.
+# The set-up's output goes to stderr, so that stdout is only the table, JSON or CSV asked for.
+bench:
+	@$(MAKE) --no-print-directory build >&2
+	@set -f; exec $(BUILD_DIR)/tests/cohaptic_bench $$COHAPTIC_BENCH_ARGS
+
+$(ASAN_BUILD_DIR)/CMakeCache.txt: | deps
+	cmake -S . -B $(ASAN_BUILD_DIR) $(SANITIZER_CMAKE) -DCOHAPTIC_FUZZ=ON
+
+fuzz: $(ASAN_BUILD_DIR)/CMakeCache.txt
+	cmake --build $(ASAN_BUILD_DIR) -j $(JOBS) --target fuzz_targets
+	@if [ "$(FUZZ_SECONDS)" != 0 ]; then \
+	  FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_JOBS=$(FUZZ_JOBS) tests/fuzz/run_fuzzers.sh $(ASAN_BUILD_DIR); fi
+
+test-asan: $(ASAN_BUILD_DIR)/CMakeCache.txt
+	cmake --build $(ASAN_BUILD_DIR) -j $(JOBS)
+	$(SANITIZER_ENV) ctest --test-dir $(ASAN_BUILD_DIR) --output-on-failure -j $(JOBS) $(ASAN_TESTS)
+
+test-tsan: deps
+	cmake -S . -B $(TSAN_BUILD_DIR) $(SANITIZER_CMAKE) -DCOHAPTIC_SANITIZE=thread
+	cmake --build $(TSAN_BUILD_DIR) -j $(JOBS) --target cohaptic_e2e_tests
+	$(SANITIZER_ENV) ctest --test-dir $(TSAN_BUILD_DIR) --output-on-failure -j $(JOBS) -R '$(TSAN_TESTS)'
 
 clean:
-	rm -rf $(BUILD_DIR)
+	rm -rf $(BUILD_DIR) $(ASAN_BUILD_DIR) $(TSAN_BUILD_DIR)

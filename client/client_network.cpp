@@ -14,11 +14,13 @@
 #include "client/clock_sync.h"
 #include "client/ir_intake.h"
 #include "client/server_connection.h"
+#include "client/welcome.h"
 #include "net/datagram_endpoint.h"
 #include "proto/record/session_recorder.h"
 #include "proto/wire/header.h"
 #include "proto/wire/sealer.h"
 #include "proto/wire/session_key.h"
+#include "proto/wire/traffic_keys.h"
 #include "proto/wire/vec3_convert.h"
 
 namespace cohaptic {
@@ -45,24 +47,23 @@ const char* event_name(HapticEventKind kind) {
   return "?";
 }
 
-// Datagrams are accepted from the server only; its session is learnt from the Welcome.
-std::unique_ptr<wire::DatagramInspector> server_only_inspector(const wire::SessionKey& key) {
-  auto inspector = std::make_unique<wire::DatagramInspector>(key);
-  inspector->allow_sender(wire::kServerSender);
-  return inspector;
+// The keys of the key file, or the public development session key.
+std::variant<wire::SessionKey, wire::ParticipantKey> client_keys(const ClientOptions& options) {
+  if (!options.key_file) {
+    spdlog::warn("no --key-file: using the public development key");
+    return wire::development_key();
+  }
+  return wire::load_key_file(*options.key_file);
 }
 
-WelcomeInfo welcome_info(const wire::Welcome& welcome) {
-  WelcomeInfo info;
-  info.slot = static_cast<int>(welcome.slot());
-  info.scene_name = welcome.scene_name();
-  info.scene_yaml = welcome.scene_yaml();
-  info.protocol = welcome.protocol() == wire::P0 ? HapticProtocol::p0 : HapticProtocol::p1;
-  info.force_limit = welcome.force_limit();
-  info.haptic_rate_hz = welcome.haptic_rate_hz();
-  info.ir_max_age_s = welcome.ir_max_age_s();
-  info.user_count = welcome.users_size();
-  return info;
+// The slot to ask for: --slot, or a participant key's own (and no other).
+int requested_slot(const ClientOptions& options, const wire::ClientKeys& keys) {
+  const std::optional<std::uint32_t> fixed = keys.fixed_slot();
+  if (!fixed) return options.requested_slot;
+  if (options.requested_slot >= 0 && static_cast<std::uint32_t>(options.requested_slot) != *fixed)
+    throw Error(fmt::format("--slot {}, but the key file is participant {}'s: it can only join slot {}",
+                            options.requested_slot, *fixed, *fixed));
+  return static_cast<int>(*fixed);
 }
 
 }  // namespace
@@ -71,7 +72,8 @@ struct ClientNetwork::Impl {
   ClientOptions options;
   HapticChannels& channels;
   std::atomic<bool>& stop_requested;
-  wire::SessionKey key;
+  wire::ClientKeys keys;
+  int slot_asked;
 
   asio::io_context io;
   net::DatagramEndpoint udp;
@@ -105,15 +107,18 @@ struct ClientNetwork::Impl {
       : options(std::move(o)),
         channels(c),
         stop_requested(stop),
-        key(options.key_file ? wire::load_session_key(*options.key_file) : wire::development_key()),
-        udp(io, udp::endpoint(asio::ip::make_address("0.0.0.0"), 0), server_only_inspector(key)),
-        udp_sealer(key, 0, 0),
-        connection(io, options.host, options.port, key,
+        keys(client_keys(options)),
+        slot_asked(requested_slot(options, keys)),
+        // Datagrams are accepted from the server only, once the Welcome has named its key and salt.
+        udp(io, udp::endpoint(asio::ip::make_address("0.0.0.0"), 0),
+            std::make_unique<wire::DatagramInspector>(std::nullopt, !options.encrypt)),
+        udp_sealer(0, 0, options.encrypt),
+        connection(io, options.host, options.port, keys, options.encrypt,
                    {[this] { return join_request(); }, [this](const wire::Control& control) { handle_control(control); },
                     [this](const std::string& why) { lost(why); }}),
         clock(io, [this](wire::Datagram& ping) { send_datagram(ping); }),
         irs(channels.ir) {
-    if (!options.key_file) spdlog::warn("no --key-file: using the public development key");
+    if (!options.encrypt) spdlog::warn("--no-encryption: frames and datagrams travel in clear (authenticated, readable by anyone on the path)");
     spdlog::info("receiving datagrams on UDP port {}", udp.port());
   }
 
@@ -123,7 +128,9 @@ struct ClientNetwork::Impl {
     wire::Control control;
     control.mutable_join()->set_user_name(options.user_name);
     control.mutable_join()->set_udp_port(udp.port());
-    control.mutable_join()->set_requested_slot(options.requested_slot >= 0 ? static_cast<std::uint32_t>(options.requested_slot + 1) : 0);
+    control.mutable_join()->set_requested_slot(slot_asked >= 0 ? static_cast<std::uint32_t>(slot_asked + 1) : 0);
+    control.mutable_join()->set_datagram_salt(udp_sealer.salt());
+    control.mutable_join()->set_datagram_sequence(udp_sealer.stamp().last_sequence());
     return control;
   }
 
@@ -153,16 +160,28 @@ struct ClientNetwork::Impl {
   }
 
   void joined(const wire::Welcome& message, std::uint64_t session) {
-    const WelcomeInfo info = welcome_info(message);
-    server_udp = udp::endpoint(connection.server_address(), static_cast<std::uint16_t>(message.server_udp_port()));
-    udp.inspector().set_expected_session(session);
-    // A fresh replay window for a new session: our sequence numbers keep increasing across
-    // sessions, the server's start again.
-    udp.inspector().allow_sender(wire::kServerSender);
-    for (wire::HeaderStamp* stamp : {&udp_sealer.stamp(), &connection.stamp()}) {
-      stamp->set_session(session);
-      stamp->set_sender(wire::sender_of_slot(message.slot()));
+    WelcomeInfo info;
+    try {
+      info = welcome_info(message);
+    } catch (const Error& error) {
+      // Nothing of a welcome we cannot use reaches the haptic loop: start() fails with why.
+      spdlog::error("{}", error.what());
+      connection.drop(error.what());
+      std::lock_guard lock(welcome_mutex);
+      refusal = error.what();
+      welcome_ready.notify_all();
+      return;
     }
+    udp.distrust(server_udp);
+    server_udp = udp::endpoint(connection.server_address(), static_cast<std::uint16_t>(message.server_udp_port()));
+    udp.trust(server_udp);
+    udp.inspector().set_expected_session(session);
+    // The server's datagrams to us: our slot's key, its sealer's salt, a fresh replay window.
+    // Our sequence numbers keep increasing across sessions, the server's sealer is new.
+    udp.inspector().allow_sender(wire::kServerSender, connection.key(), message.datagram_salt());
+    udp_sealer.set_key(connection.key());
+    udp_sealer.stamp().set_session(session);
+    udp_sealer.stamp().set_sender(wire::sender_of_slot(message.slot()));
     if (ever_connected) ++reconnects;
     ever_connected = connected = true;
     spdlog::info("joined '{}' as slot {} ({} protocol, force limit {:g} N)", info.scene_name, info.slot,
@@ -354,6 +373,7 @@ nlohmann::json ClientNetwork::report() const {
   out["remote_samples_received"] = s.remote_samples;
   s.clock.add_to_report(out);
   out["reconnects"] = s.reconnects;
+  out["encrypted"] = s.options.encrypt;
   out["non_finite_events"] = s.non_finite_events;
   return out;
 }

@@ -26,6 +26,7 @@
 #include <string>
 
 #include "client/haptic_loop.h"
+#include "client/welcome.h"
 
 namespace cohaptic {
 
@@ -33,24 +34,15 @@ struct ClientOptions {
   std::string host = "127.0.0.1";
   std::uint16_t port = 7400;
   std::string user_name;
-  std::optional<std::filesystem::path> key_file;  ///< empty: the public development key
-  int requested_slot = -1;                        ///< -1: any free slot
-};
-
-/// What the server told us when we joined.
-struct WelcomeInfo {
-  int slot = 0;
-  std::string scene_name;
-  std::string scene_yaml;
-  HapticProtocol protocol = HapticProtocol::p1;
-  double force_limit = 0;
-  double haptic_rate_hz = 1000;
-  double ir_max_age_s = 0.5;
-  int user_count = 0;
+  std::optional<std::filesystem::path> key_file;  ///< session or participant key; empty: the public development key
+  bool encrypt = true;                            ///< false: send in clear (authenticated), and accept the server's so
+  int requested_slot = -1;                        ///< -1: any free slot (a participant key: its own)
 };
 
 class ClientNetwork {
  public:
+  /// Throws Error if the key file cannot be used (see wire/session_key.h), or names
+  /// another slot than --slot.
   ClientNetwork(ClientOptions options, HapticChannels& channels);
   ~ClientNetwork();
   ClientNetwork(const ClientNetwork&) = delete;

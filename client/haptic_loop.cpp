@@ -113,9 +113,11 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       record.ir_epoch = ir.epoch;
       record.dt = dt;
       // The coupling figure (the force without the remote tools) needs a second evaluation,
-      // which would advance a dynamic body's state a second time: static bodies only, on an
-      // empty state (a cold sphere solve) so that it leaves the warm start alone.
-      const bool static_body = std::holds_alternative<CondensedFemIr>(ir.body);
+      // which would advance a dynamic body's state a second time: static bodies only. A sphere's
+      // warm start is no body state: it is left alone by evaluating on an empty state (a cold
+      // solve, the same answer).
+      const bool static_body = !std::holds_alternative<MassSpringPatchState>(slot.state->body);
+      metrics_.coupling_measured = metrics_.coupling_measured || static_body;
       if (count > 0 && (sample.flags & kInContact) && static_body) {
         EvaluationState cold;
         const ForceSample alone = evaluate_force(*slot.ir, cold, own, {}, dt);

@@ -1,7 +1,6 @@
 // cohaptic-client: a haptic client. Joins a cohaptic-server session, runs the haptic loop
 // against a device at its rate, and writes a report at the end. See README.md.
 #include <CLI/CLI.hpp>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <fstream>
@@ -13,6 +12,7 @@
 #include "common/net/host_port.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
+#include "common/util/log_to_stderr.h"
 
 namespace {
 
@@ -25,9 +25,7 @@ nlohmann::json quantiles_us(const cohaptic::Histogram& h) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  auto logger = spdlog::stderr_color_mt("cohaptic");
-  spdlog::set_default_logger(logger);
-  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+  cohaptic::log_to_stderr();
 
   CLI::App app{"cohaptic-client: a haptic client of a cohaptic-server session"};
   std::string server = "127.0.0.1:7400", device_spec, log_level = "info", playout = "fixed";
@@ -42,8 +40,14 @@ int main(int argc, char** argv) {
   std::string device_forms;
   for (const std::string& form : cohaptic::device_spec_forms()) device_forms += (device_forms.empty() ? "" : "; ") + form;
   app.add_option("--device", device_spec, "The device: " + device_forms)->required();
-  app.add_option("--key-file", options.key_file, "Session key (64 hex characters), the server's")->check(CLI::ExistingFile);
-  app.add_option("--slot", slot, "Ask for this user slot (tool) instead of the first free one");
+  app.add_option("--key-file", options.key_file,
+                 "Key file (mode 0600): your participant key (cohaptic-lab keygen --participant), or the session key")
+      ->check(CLI::ExistingFile);
+  app.add_option("--slot", slot, "Ask for this user slot (tool) instead of the first free one (a participant key: its own)");
+  bool no_encryption = false;
+  app.add_flag("--no-encryption", no_encryption,
+               "Send frames and datagrams in clear (still authenticated), and accept the server's in clear; the server "
+               "must be run with --no-encryption too");
   app.add_option("--rate-hz", rate_hz, "Haptic loop rate (default: the scene's, usually 1000)");
   app.add_option("--duration", settings.duration_s, "Stop after S seconds (0: when the device's script ends, or SIGINT)")
       ->capture_default_str();
@@ -80,6 +84,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     options.requested_slot = slot;
+    options.encrypt = !no_encryption;
     auto channels = std::make_unique<cohaptic::HapticChannels>();
     cohaptic::ClientNetwork network(options, *channels);
     const cohaptic::WelcomeInfo welcome = network.start(join_timeout_s);
@@ -124,7 +129,7 @@ int main(int argc, char** argv) {
     report["ir_age_ms"] = {{"p50", static_cast<double>(m.ir_age_ns.quantile(0.5)) * 1e-6},
                            {"p99", static_cast<double>(m.ir_age_ns.quantile(0.99)) * 1e-6}};
     report["force_n"] = {{"peak", m.peak_force}, {"clamped_ticks", m.clamped}};
-    report["coupling_n"] = {{"peak", m.peak_coupling}};
+    report["coupling_n"] = {{"peak", m.peak_coupling}, {"measured", m.coupling_measured}};
     report["force_step_on_ir_switch_n"] = m.largest_step_on_ir_switch;
     if (settings.passivity_control)
       report["passivity_controller"] = {{"active_ticks", loop.passivity().active_ticks()},

@@ -6,14 +6,15 @@ namespace cohaptic {
 
 using asio::ip::tcp;
 
-ServerConnection::ServerConnection(asio::io_context& io, std::string host, std::uint16_t port,
-                                   const wire::SessionKey& key, Handlers handlers)
+ServerConnection::ServerConnection(asio::io_context& io, std::string host, std::uint16_t port, wire::ClientKeys keys,
+                                   bool encrypt, Handlers handlers)
     : io_(io),
       host_(std::move(host)),
       port_(port),
-      key_(key),
+      keys_(std::move(keys)),
+      encrypt_(encrypt),
       handlers_(std::move(handlers)),
-      sealer_(key, 0, 0),
+      sealer_(0, 0, encrypt),
       reconnect_timer_(io) {}
 
 void ServerConnection::start() { connect(); }
@@ -39,8 +40,13 @@ void ServerConnection::connect() {
       return;
     }
     socket->set_option(tcp::no_delay(true));
+    // Every connection starts over: the join key, until the Welcome names the slot.
+    key_ = keys_.join_key();
+    sealer_.set_key(key_);
+    sealer_.stamp().set_sender(keys_.join_sender());
+    join_sent_ = false;
     net::FramedConnection::Handlers handlers;
-    handlers.on_control = [this](const wire::Control& control) { handlers_.on_control(control); };
+    handlers.on_control = [this](const wire::Control& control) { handle(control); };
     handlers.on_close = [this](net::CloseCause cause, const std::string& why) {
       switch (cause) {
         case net::CloseCause::peer_closed: drop("closed"); return;
@@ -49,13 +55,56 @@ void ServerConnection::connect() {
           drop("protocol error");
           return;
         case net::CloseCause::io_error:
-        case net::CloseCause::write_queue_full: drop(why); return;
+        case net::CloseCause::write_queue_full:
+        case net::CloseCause::write_stalled: drop(why); return;
       }
     };
-    connection_ = net::FramedConnection::start(std::move(*socket), wire::FrameReader(key_), std::move(handlers));
-    wire::Control join = handlers_.make_join();
-    send(join);
+    wire::FrameReader reader(
+        [this](std::uint32_t sender) { return sender == wire::kServerSender ? &key_ : nullptr; },
+        {.expect_greeting = true, .allow_cleartext = !encrypt_});
+    connection_ = net::FramedConnection::start(std::move(*socket), std::move(reader), std::move(handlers));
   });
+}
+
+void ServerConnection::handle(const wire::Control& control) {
+  if (control.has_hello()) {
+    greeted(control.hello());
+  } else if (control.has_welcome()) {
+    if (welcomed(control)) handlers_.on_control(control);
+  } else {
+    handlers_.on_control(control);
+  }
+}
+
+void ServerConnection::greeted(const wire::Hello& hello) {
+  if (join_sent_) return;
+  join_sent_ = true;
+  client_challenge_ = wire::random_challenge();
+  wire::Control join = handlers_.make_join();
+  join.mutable_join()->set_challenge(hello.challenge());
+  join.mutable_join()->set_client_challenge(client_challenge_.data(), client_challenge_.size());
+  send(join);
+}
+
+// Checks the Welcome answers our join, then moves to the slot's key.
+bool ServerConnection::welcomed(const wire::Control& control) {
+  const wire::Welcome& welcome = control.welcome();
+  if (!wire::is_challenge(welcome.client_challenge(), client_challenge_)) {
+    spdlog::error("control channel: a welcome that does not answer this connection's join (replayed?)");
+    drop("protocol error");
+    return false;
+  }
+  const std::optional<wire::TrafficKey> key = keys_.slot_key(welcome.slot());
+  if (!key) {
+    spdlog::error("the server gave slot {}, and the key file is another slot's", welcome.slot());
+    drop("wrong slot");
+    return false;
+  }
+  key_ = *key;
+  sealer_.set_key(key_);
+  sealer_.stamp().set_session(control.header().session());
+  sealer_.stamp().set_sender(wire::sender_of_slot(welcome.slot()));
+  return true;
 }
 
 void ServerConnection::schedule_reconnect() {

@@ -17,6 +17,8 @@ packages=(
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   # tests and benchmarks; the browser the live view's test opens the page in
   libgtest-dev libgmock-dev libbenchmark-dev chromium
+  # fuzzing (libFuzzer) and sanitizer reports: make fuzz, make test-asan, make test-tsan
+  clang libclang-rt-14-dev llvm
 )
 
 # Node.js and npm, for the live view's page libraries (three.js, protobufjs), the official

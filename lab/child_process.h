@@ -25,6 +25,8 @@ class ChildProcess {
   std::optional<int> wait(std::chrono::milliseconds timeout);
   void signal(int signal);
   bool running();
+  /// The process id (for /proc), while it runs.
+  pid_t pid() const { return pid_; }
   std::string log_text() const;
   /// Waits until the log contains `text`; false on timeout or if the process ended first.
   bool wait_for_log(const std::string& text, std::chrono::milliseconds timeout);

@@ -2,17 +2,18 @@
 //   probe      static forces at tool positions          tradeoff   speed against accuracy
 //   replay     look at, re-run or export a recording    stability  the stability map of a wall
 //   study      a lab study, trial by trial              summarize  merge reports, judge a session
-//   keygen     a new session key file                   hertz      a sphere in a block, against Hertz
+//   keygen     a new session key file, or a participant key file
+//   hertz      a sphere in a block, against Hertz
 // Each tool adds its own subcommand (lab/lab_command.h). A tool that needs the server or the
 // client (study) starts them as processes; cohaptic-lab links neither.
 #include <CLI/CLI.hpp>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <vector>
 
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
+#include "common/util/log_to_stderr.h"
 #include "lab/hertz.h"
 #include "lab/keygen.h"
 #include "lab/probe.h"
@@ -23,8 +24,7 @@
 #include "lab/tradeoff.h"
 
 int main(int argc, char** argv) {
-  spdlog::set_default_logger(spdlog::stderr_color_mt("cohaptic"));
-  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+  cohaptic::log_to_stderr();
 
   CLI::App app{"cohaptic-lab: the offline tools of cohaptic (probing, replay, studies, measurements)."};
   app.require_subcommand(1);

@@ -21,6 +21,7 @@
 #include "common/util/csv.h"
 #include "common/util/error.h"
 #include "common/util/stopwatch.h"
+#include "common/util/regular_file.h"
 #include "common/util/yaml_cursor.h"
 #include "lab/child_process.h"
 #include "proto/record/recording.h"
@@ -117,9 +118,11 @@ std::string StudyCondition::name() const {
   return out;
 }
 
-Study load_study(const std::filesystem::path& file) {
+Study load_study(const std::filesystem::path& file) { return parse_study(read_text_file(file.string()), file); }
+
+Study parse_study(const std::string& yaml_text, const std::filesystem::path& file) {
   const std::string name = file.string();
-  const YamlCursor top(load_yaml(read_text_file(name), name), "", &name, 1);
+  const YamlCursor top(load_yaml(yaml_text, name), "", &name, 1);
   top.only_keys({"name", "scene", "trial_duration", "condensation", "participants", "factors", "repetitions", "order", "session"});
   const std::filesystem::path base = file.has_parent_path() ? file.parent_path() : ".";
   Study study;
@@ -127,7 +130,7 @@ Study load_study(const std::filesystem::path& file) {
   study.name = top.find("name") ? top.at("name").text() : file.stem().string();
   const YamlCursor scene = top.at("scene");
   study.scene = base / scene.text();
-  if (!std::filesystem::exists(study.scene)) scene.fail_message(fmt::format("scene file {} does not exist", study.scene.string()));
+  if (const auto why = why_not_a_regular_file(study.scene)) scene.fail_message(fmt::format("scene file {} {}", study.scene.string(), *why));
   if (auto duration = top.find("trial_duration")) study.trial_duration_s = duration->number_in(0.5, 3600, false, false, "seconds, 0.5 to 3600");
   if (auto condensation = top.find("condensation")) study.condensation = condensation->choice({"naive", "incremental"});
 
@@ -138,8 +141,8 @@ Study load_study(const std::filesystem::path& file) {
     p.device = item.find("device") ? item.at("device").choice({"hand", "script"}) : "hand";
     const YamlCursor trajectory = item.at("trajectory");
     p.trajectory = base / trajectory.text();
-    if (!std::filesystem::exists(p.trajectory))
-      trajectory.fail_message(fmt::format("trajectory file {} does not exist", p.trajectory.string()));
+    if (const auto why = why_not_a_regular_file(p.trajectory))
+      trajectory.fail_message(fmt::format("trajectory file {} {}", p.trajectory.string(), *why));
     p.slot = static_cast<int>(study.participants.size());
     study.participants.push_back(p);
   }

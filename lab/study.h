@@ -63,6 +63,9 @@ struct Study {
 /// generated in the file's order.
 Study load_study(const std::filesystem::path& file);
 
+/// Parses study text; `file` names it in messages and resolves the relative paths in it.
+Study parse_study(const std::string& yaml_text, const std::filesystem::path& file);
+
 struct StudyRunOptions {
   std::filesystem::path out;
   std::string server_program;  ///< empty: cohaptic-server beside this program's build

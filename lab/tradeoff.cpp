@@ -22,6 +22,7 @@
 #include "common/util/error.h"
 #include "common/util/percentile.h"
 #include "common/util/stopwatch.h"
+#include "lab/tradeoff_mass_spring.h"
 
 namespace cohaptic {
 namespace {
@@ -380,16 +381,18 @@ void write_pareto_plot(const std::filesystem::path& file, const std::vector<Trad
 
 int run_tradeoff(const TradeoffOptions& options) {
   const Scene scene = load_scene(options.scene);
-  if (!options.reference_scene.empty() && single_elastic_object(scene).mesh.box)
-    throw Error(fmt::format("{}: a box scene's reference is its own box at --reference-divisions; --reference-scene is "
-                            "for mesh files",
-                            options.scene.string()));
   std::vector<Trajectory> motions;
   for (const auto& file : options.motions) motions.push_back(load_trajectory(file));
   if (motions.size() != scene.tools.size())
     throw Error(fmt::format("{}: the scene has {} tools; give one --motion per tool (got {})", options.scene.string(),
                             scene.tools.size(), motions.size()));
   std::filesystem::create_directories(options.out);
+  if (scene.objects.size() == 1 && std::holds_alternative<MassSpringObjectSpec>(scene.objects.front().body))
+    return run_mass_spring_tradeoff(scene, motions, options);
+  if (!options.reference_scene.empty() && single_elastic_object(scene).mesh.box)
+    throw Error(fmt::format("{}: a box scene's reference is its own box at --reference-divisions; --reference-scene is "
+                            "for mesh files",
+                            options.scene.string()));
 
   // Check the rates before the (long) reference: the simulation's and the scene's haptic
   // rate must divide the comparison grid.
@@ -458,7 +461,8 @@ LabCommand add_tradeoff_command(CLI::App& lab) {
   auto options = std::make_shared<TradeoffOptions>();
   CLI::App* command = lab.add_subcommand(
       "tradeoff", "Measure what each speed/accuracy setting costs and buys on a scene, against the full solve on its "
-                  "finest mesh: tradeoff.csv, tradeoff.md and Pareto plots in --out");
+                  "finest mesh (a mass-spring scene: against the server's whole network at the haptic rate): "
+                  "tradeoff.csv, tradeoff.md and Pareto plots in --out");
   command->add_option("--scene", options->scene, "Scene file (YAML)")->required()->check(CLI::ExistingFile);
   command->add_option("--motion", options->motions, "Trajectory file for each scene tool, in order (repeat)")
       ->required()

@@ -1,5 +1,6 @@
 #include "net/datagram_endpoint.h"
 
+#include <algorithm>
 #include <span>
 
 #include "proto/wire/header.h"
@@ -9,10 +10,13 @@ namespace cohaptic::net {
 using asio::ip::udp;
 
 DatagramEndpoint::DatagramEndpoint(asio::io_context& io, const udp::endpoint& local,
-                                   std::unique_ptr<wire::DatagramInspector> inspector)
-    : socket_(io), inspector_(std::move(inspector)) {
+                                   std::unique_ptr<wire::DatagramInspector> inspector, RateLimit limit)
+    : socket_(io), inspector_(std::move(inspector)), limiter_(limit) {
   socket_.open(local.protocol());
   socket_.bind(local);
+  std::error_code ignored;  // a smaller queue is still a queue
+  socket_.set_option(asio::socket_base::receive_buffer_size(kReceiveBufferBytes), ignored);
+  socket_.non_blocking(true);  // the drain after each wake-up must not wait
   port_ = socket_.local_endpoint().port();
 }
 
@@ -26,14 +30,38 @@ void DatagramEndpoint::receive_next() {
     if (error == asio::error::operation_aborted) return;  // closed
     // Other errors (an ICMP "port unreachable" for an earlier send, say) concern no one
     // datagram: keep receiving.
-    if (!error) {
-      const std::int64_t arrival = wire::monotonic_now_ns();
-      if (std::optional<wire::Datagram> datagram = inspector_->inspect(std::span(buffer_.data(), n)))
-        on_datagram_(std::move(*datagram), from_, arrival);
+    if (!error) take(n);
+    for (int read = 1; read < kReadsPerWakeUp && socket_.is_open(); ++read) {
+      n = socket_.receive_from(asio::buffer(buffer_), from_, 0, error);
+      if (error == asio::error::would_block) break;
+      if (!error) take(n);
     }
-    receive_next();
+    if (socket_.is_open()) receive_next();
   });
 }
+
+void DatagramEndpoint::take(std::size_t bytes) {
+  const std::int64_t arrival = wire::monotonic_now_ns();
+  const bool admitted = trusted(from_);
+  if (!admitted && limiter_.limited(from_.address(), arrival)) {
+    inspector_->count_unread(wire::Rejection::rate_limited);
+    return;
+  }
+  if (std::optional<wire::Datagram> datagram = inspector_->inspect(std::span(buffer_.data(), bytes)))
+    on_datagram_(std::move(*datagram), from_, arrival);
+  else if (!admitted)
+    limiter_.charge(from_.address(), arrival);
+}
+
+bool DatagramEndpoint::trusted(const udp::endpoint& peer) const {
+  return std::find(trusted_.begin(), trusted_.end(), peer) != trusted_.end();
+}
+
+void DatagramEndpoint::trust(const udp::endpoint& peer) {
+  if (!trusted(peer)) trusted_.push_back(peer);
+}
+
+void DatagramEndpoint::distrust(const udp::endpoint& peer) { std::erase(trusted_, peer); }
 
 void DatagramEndpoint::send(std::vector<std::uint8_t> datagram, const udp::endpoint& to) {
   auto bytes = std::make_shared<std::vector<std::uint8_t>>(std::move(datagram));

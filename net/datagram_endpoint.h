@@ -4,7 +4,15 @@
 // through the endpoint's wire::DatagramInspector, which checks it and counts each
 // rejection by reason; an accepted datagram goes to the handler with its sender's address
 // and its arrival time. send() sends sealed bytes (wire::DatagramSealer) and counts them.
-// It holds no keys and decides nothing about messages: the inspector (with its key and
+//
+// Floods: a source address whose datagrams keep failing is rate limited
+// (source_rate_limiter.h): its datagrams are then dropped unread and counted as
+// rate_limited, so a flood costs a table look-up per datagram. The endpoints of the peers
+// this side has admitted (trust(): a joined user's, the server's) are never limited, so a
+// flood from their host never silences them. After each wake-up the socket is drained of
+// what is already queued before waiting again, and its receive buffer is asked to be
+// kReceiveBufferBytes, so that a burst does not overflow the kernel's queue.
+// It holds no keys and decides nothing about messages: the inspector (with its keys and
 // allowed senders) is given, the datagrams come sealed. Counters: read them on the I/O
 // thread, or after it stopped; the inspector's rejection counters from any thread.
 #pragma once
@@ -18,7 +26,7 @@
 #include <vector>
 
 #include "cohaptic/messages.pb.h"
-#include "proto/wire/authenticated.h"
+#include "net/source_rate_limiter.h"
 #include "proto/wire/datagram_codec.h"
 
 namespace cohaptic::net {
@@ -26,6 +34,10 @@ namespace cohaptic::net {
 /// The receive buffer: every valid datagram (at most wire::kMaxDatagramBytes) fits with room to spare.
 inline constexpr std::size_t kDatagramBufferBytes = 2048;
 static_assert(kDatagramBufferBytes > wire::kMaxDatagramBytes);
+/// The socket's kernel receive queue asked for (the kernel caps it at net.core.rmem_max).
+inline constexpr int kReceiveBufferBytes = 4 << 20;
+/// Datagrams read per wake-up at most, before the loop goes back to the reactor.
+inline constexpr int kReadsPerWakeUp = 64;
 
 class DatagramEndpoint {
  public:
@@ -34,7 +46,7 @@ class DatagramEndpoint {
 
   /// Opens and binds the socket (port 0: any free port). Throws std::system_error if it cannot.
   DatagramEndpoint(asio::io_context& io, const asio::ip::udp::endpoint& local,
-                   std::unique_ptr<wire::DatagramInspector> inspector);
+                   std::unique_ptr<wire::DatagramInspector> inspector, RateLimit limit = {});
 
   /// Starts the receive loop; it runs until close().
   void start(Handler on_datagram);
@@ -43,6 +55,10 @@ class DatagramEndpoint {
   void send(std::vector<std::uint8_t> datagram, const asio::ip::udp::endpoint& to);
   void close();
 
+  /// Datagrams from `peer` (address and port) are never rate limited; distrust() undoes it.
+  void trust(const asio::ip::udp::endpoint& peer);
+  void distrust(const asio::ip::udp::endpoint& peer);
+
   std::uint16_t port() const { return port_; }
   wire::DatagramInspector& inspector() { return *inspector_; }
   const wire::DatagramInspector& inspector() const { return *inspector_; }
@@ -50,9 +66,13 @@ class DatagramEndpoint {
 
  private:
   void receive_next();
+  void take(std::size_t bytes);
+  bool trusted(const asio::ip::udp::endpoint& peer) const;
 
   asio::ip::udp::socket socket_;
   std::unique_ptr<wire::DatagramInspector> inspector_;
+  SourceRateLimiter limiter_;
+  std::vector<asio::ip::udp::endpoint> trusted_;
   Handler on_datagram_;
   std::array<std::uint8_t, kDatagramBufferBytes> buffer_{};
   asio::ip::udp::endpoint from_;

@@ -17,17 +17,21 @@
 namespace cohaptic::net {
 
 /// Calls `deliver(delivered_ns)` after `link`'s delay for a message sent at `now_ns`:
-/// inline if the delay is zero (delivered_ns = now_ns), else from a timer on `io`'s thread.
+/// inline on a link without injection, else from a timer on `io`'s thread that expires at
+/// the absolute time now_ns + delay. Timers that are due fire in the order of their expiry,
+/// so an ordered link's messages (strictly increasing times, link_delay.h) keep their
+/// order, even a message of zero delay behind one whose timer has not run yet.
 /// Returns false, without calling it, if the link loses the message.
 template <class Deliver>
 bool deliver_over(LinkDelay& link, asio::io_context& io, std::int64_t now_ns, Deliver deliver) {
   const std::optional<std::int64_t> delay = link.delay_ns(now_ns);
   if (!delay) return false;
-  if (*delay <= 0) {
+  if (!link.settings().active()) {
     deliver(now_ns);
     return true;
   }
-  auto timer = std::make_shared<asio::steady_timer>(io, std::chrono::nanoseconds(*delay));
+  auto timer = std::make_shared<asio::steady_timer>(
+      io, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(now_ns + *delay)));
   timer->async_wait([timer, deliver = std::move(deliver)](std::error_code error) mutable {
     if (!error) deliver(wire::monotonic_now_ns());
   });

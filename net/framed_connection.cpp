@@ -8,10 +8,13 @@ namespace cohaptic::net {
 
 using asio::ip::tcp;
 
-FramedConnection::FramedConnection(Passkey, tcp::socket socket, wire::FrameReader reader, Handlers handlers)
+FramedConnection::FramedConnection(Passkey, tcp::socket socket, wire::FrameReader reader, Handlers handlers,
+                                   std::chrono::milliseconds write_timeout)
     : socket_(std::move(socket)),
       reader_(std::move(reader)),
-      handlers_(std::make_shared<const Handlers>(std::move(handlers))) {
+      handlers_(std::make_shared<const Handlers>(std::move(handlers))),
+      write_timer_(socket_.get_executor()),
+      write_timeout_(write_timeout) {
   std::error_code error;
   const tcp::endpoint remote = socket_.remote_endpoint(error);
   peer_ = error ? "?" : fmt::format("{}:{}", remote.address().to_string(), remote.port());
@@ -19,8 +22,9 @@ FramedConnection::FramedConnection(Passkey, tcp::socket socket, wire::FrameReade
 }
 
 std::shared_ptr<FramedConnection> FramedConnection::start(tcp::socket socket, wire::FrameReader reader,
-                                                          Handlers handlers) {
-  auto connection = std::make_shared<FramedConnection>(Passkey{}, std::move(socket), std::move(reader), std::move(handlers));
+                                                          Handlers handlers, std::chrono::milliseconds write_timeout) {
+  auto connection = std::make_shared<FramedConnection>(Passkey{}, std::move(socket), std::move(reader), std::move(handlers),
+                                                       write_timeout);
   connection->read_next();
   return connection;
 }
@@ -41,6 +45,7 @@ void FramedConnection::read_next() {
         if (self->closed_) return;  // the owner closed it while handling the frame
       }
     } catch (const wire::FrameError& e) {
+      self->rejection_ = e.reason();
       self->fail(CloseCause::rejected_frame, e.what());
       return;
     }
@@ -61,8 +66,20 @@ FramedConnection::Sent FramedConnection::send(std::vector<std::uint8_t> frame, F
 }
 
 void FramedConnection::write_next() {
+  if (queue_.writing()) return;  // one at a time; its completion comes back here
   const std::vector<std::uint8_t>* frame = queue_.begin_write();
-  if (!frame) return;
+  if (!frame) {
+    write_timer_.cancel();  // nothing in flight: nothing can stall
+    return;
+  }
+  const std::uint64_t write = ++writes_started_;
+  write_timer_.expires_after(write_timeout_);  // cancels the wait of the write before
+  write_timer_.async_wait([self = shared_from_this(), write](std::error_code error) {
+    if (error || self->closed_ || self->writes_started_ != write || !self->queue_.writing()) return;
+    self->fail(CloseCause::write_stalled,
+               fmt::format("the peer stopped reading: a frame has waited {:.1f} s to be written, {} more behind it",
+                           std::chrono::duration<double>(self->write_timeout_).count(), self->queue_.waiting()));
+  });
   asio::async_write(socket_, asio::buffer(*frame), [self = shared_from_this()](std::error_code error, std::size_t) {
     self->queue_.end_write();
     if (self->closed_) return;
@@ -79,6 +96,7 @@ void FramedConnection::close() {
   closed_ = true;
   std::error_code ignored;
   socket_.close(ignored);
+  write_timer_.cancel();
   handlers_.reset();
 }
 

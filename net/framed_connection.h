@@ -7,11 +7,14 @@
 //   - Writing: send() takes a sealed frame (wire::FrameSealer) into a BoundedWriteQueue,
 //     written one at a time. When the queue is full the oldest superseded newest-wins frame
 //     is dropped (see bounded_write_queue.h); if nothing can be dropped, the peer has
-//     stopped reading and the connection closes (CloseCause::write_queue_full).
+//     stopped reading and the connection closes (CloseCause::write_queue_full). A frame
+//     that the kernel has not taken within the write timeout (its buffers are full: the
+//     peer stopped reading, even if only newest-wins frames wait) closes it too
+//     (CloseCause::write_stalled).
 //   - on_close is called once, on the I/O thread but never from inside send() or close(),
-//     when the peer closes, an I/O error happens, a frame is rejected or the queue
-//     overflows. close() by the owner calls nothing. After either, the handlers are
-//     released, so they may capture the owner's per-connection state.
+//     when the peer closes, an I/O error happens, a frame is rejected, the queue overflows
+//     or a write stalls. close() by the owner calls nothing. After either, the handlers
+//     are released, so they may capture the owner's per-connection state.
 // It holds no keys and decides nothing about messages: the reader (with its key) is
 // given, the frames come sealed, and what a message means is its owner's business.
 // Held by shared_ptr: pending reads and writes keep it alive until they complete.
@@ -19,10 +22,12 @@
 
 #include <array>
 #include <asio.hpp>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,8 +39,10 @@ namespace cohaptic::net {
 
 /// Bytes read from the socket at a time: frames larger than this arrive in several reads.
 inline constexpr std::size_t kReadBufferBytes = 64 * 1024;
+/// A frame not taken by the kernel within this time means the peer has stopped reading.
+inline constexpr std::chrono::milliseconds kWriteTimeout{5000};
 
-enum class CloseCause : std::uint8_t { peer_closed, io_error, rejected_frame, write_queue_full };
+enum class CloseCause : std::uint8_t { peer_closed, io_error, rejected_frame, write_queue_full, write_stalled };
 
 class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
  public:
@@ -47,7 +54,8 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
 
   /// Takes over a connected socket and starts reading. Call on the I/O thread (or before it runs).
   static std::shared_ptr<FramedConnection> start(asio::ip::tcp::socket socket, wire::FrameReader reader,
-                                                 Handlers handlers);
+                                                 Handlers handlers,
+                                                 std::chrono::milliseconds write_timeout = kWriteTimeout);
 
   /// Queues a sealed frame; `closed` if the connection is (or, its queue overflowing, becomes) closed.
   Sent send(std::vector<std::uint8_t> frame, FrameKind kind);
@@ -58,8 +66,8 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
   /// The peer as "address:port" (kept from the start: still known after closing).
   const std::string& peer() const { return peer_; }
   asio::ip::address peer_address() const { return peer_address_; }
-  /// The reader, for a codec change within the stream (e.g. a key derived after the join).
-  wire::FrameReader& reader() { return reader_; }
+  /// Why the reader rejected a frame, once it has (CloseCause::rejected_frame).
+  std::optional<wire::Rejection> rejection() const { return rejection_; }
   /// Frames waiting behind the one being written (at most kMaxWaitingFrames).
   std::size_t frames_waiting() const { return queue_.waiting(); }
   /// Newest-wins frames dropped by the write queue.
@@ -69,7 +77,8 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
     friend class FramedConnection;
     Passkey() = default;
   };
-  FramedConnection(Passkey, asio::ip::tcp::socket socket, wire::FrameReader reader, Handlers handlers);
+  FramedConnection(Passkey, asio::ip::tcp::socket socket, wire::FrameReader reader, Handlers handlers,
+                   std::chrono::milliseconds write_timeout);
 
  private:
   void read_next();
@@ -81,6 +90,10 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
   wire::FrameReader reader_;
   std::shared_ptr<const Handlers> handlers_;  // a handler running keeps them alive if it closes the connection
   BoundedWriteQueue queue_;
+  asio::steady_timer write_timer_;  ///< runs while a write is in flight
+  std::chrono::milliseconds write_timeout_;
+  std::uint64_t writes_started_ = 0;
+  std::optional<wire::Rejection> rejection_;
   std::array<std::uint8_t, kReadBufferBytes> buffer_{};
   std::string peer_;
   asio::ip::address peer_address_;

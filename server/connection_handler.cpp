@@ -3,13 +3,14 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "common/net/link_delay.h"
 #include "net/delayed_delivery.h"
-#include "net/framed_connection.h"
 #include "proto/wire/header.h"
+#include "proto/wire/traffic_keys.h"
 #include "proto/wire/vec3_convert.h"
 
 namespace cohaptic {
@@ -20,35 +21,43 @@ using asio::ip::udp;
 // One control connection; a user once it has joined.
 struct ConnectionHandler::Participant {
   std::shared_ptr<net::FramedConnection> connection;
-  wire::FrameSealer sealer;  // this connection's frames
+  wire::Challenge challenge = wire::random_challenge();  // in the greeting; the Join must carry it
+  wire::FrameSealer sealer;                             // this connection's frames; keyed at the join
+  std::optional<wire::DatagramSealer> datagram_sealer;  // the datagrams to this user, from the join on
   int slot = -1;
   std::string user_name;
   udp::endpoint udp_endpoint;
   LinkDelay to_client_udp, to_client_tcp, from_client_udp;
+  asio::steady_timer join_timer;
   bool gone = false;
-  Participant(const wire::SessionKey& key, std::uint64_t session, const LinkDelaySettings& shift)
-      : sealer(key, session, wire::kServerSender),
+  Participant(asio::io_context& io, std::uint64_t session, const LinkDelaySettings& shift, bool encrypt)
+      : sealer(session, wire::kServerSender, encrypt),
         to_client_udp(shift, false),
         to_client_tcp(shift, true),
-        from_client_udp(shift, false) {}
+        from_client_udp(shift, false),
+        join_timer(io) {}
 };
 
 namespace {
 
-std::unique_ptr<wire::DatagramInspector> server_inspector(const wire::SessionKey& key, std::uint64_t session) {
-  return std::make_unique<wire::DatagramInspector>(key, session);
+std::vector<wire::TrafficKey> every_slot_key(const wire::SessionKey& key, std::size_t slots) {
+  std::vector<wire::TrafficKey> keys;
+  for (std::size_t slot = 0; slot < slots; ++slot) keys.push_back(wire::participant_key(key, static_cast<std::uint32_t>(slot)));
+  return keys;
 }
 
 }  // namespace
 
 ConnectionHandler::ConnectionHandler(asio::io_context& io, const ServeOptions& options, wire::Welcome welcome,
-                                     const wire::SessionKey& key, std::uint64_t session, ToolInputs& tools,
-                                     record::SessionRecorder* recorder)
+                                     const wire::SessionKey& key, std::uint64_t session, int max_participants,
+                                     ToolInputs& tools, record::SessionRecorder* recorder)
     : io_(io),
       options_(options),
       welcome_(std::move(welcome)),
-      key_(key),
+      slot_keys_(every_slot_key(key, static_cast<std::size_t>(welcome_.users_size()))),
+      joining_key_(wire::joining_key(key)),
       session_(session),
+      max_participants_(max_participants > 0 ? max_participants : welcome_.users_size()),
       tools_(tools),
       recorder_(recorder),
       acceptor_([&] {
@@ -61,8 +70,8 @@ ConnectionHandler::ConnectionHandler(asio::io_context& io, const ServeOptions& o
         return acceptor;
       }()),
       tcp_port_(acceptor_.local_endpoint().port()),
-      udp_(io, udp::endpoint(acceptor_.local_endpoint().address(), tcp_port_), server_inspector(key, session)),
-      udp_sealer_(key, session, wire::kServerSender),
+      udp_(io, udp::endpoint(acceptor_.local_endpoint().address(), tcp_port_),
+           std::make_unique<wire::DatagramInspector>(session, !options.encrypt)),
       slots_(static_cast<std::size_t>(welcome_.users_size())) {
   welcome_.set_server_udp_port(udp_.port());
 }
@@ -88,6 +97,18 @@ ConnectionCounters ConnectionHandler::counters() const {
   return counters;
 }
 
+void ConnectionHandler::warn_throttled(const std::string& message) {
+  const std::int64_t now = wire::monotonic_now_ns();
+  if (now - last_warning_ns_ < 1'000'000'000) {
+    ++warnings_held_;
+    return;
+  }
+  if (warnings_held_ > 0) spdlog::warn("{} (and {} more such since the last one logged)", message, warnings_held_);
+  else spdlog::warn("{}", message);
+  last_warning_ns_ = now;
+  warnings_held_ = 0;
+}
+
 // ---- control connections ----
 
 void ConnectionHandler::accept() {
@@ -96,36 +117,90 @@ void ConnectionHandler::accept() {
       if (error != asio::error::operation_aborted) spdlog::warn("accept failed: {}", error.message());
       return;
     }
+    ++counters_.connections;
+    const auto unjoined = std::count_if(participants_.begin(), participants_.end(),
+                                        [](const ParticipantPtr& p) { return p->slot < 0; });
+    if (static_cast<std::size_t>(unjoined) >= kMaxUnjoinedConnections) {
+      ++counters_.turned_away;
+      std::error_code ignored;
+      warn_throttled(fmt::format("connection from {} closed at once: {} connections have not joined yet",
+                                 socket.remote_endpoint(ignored).address().to_string(), unjoined));
+      socket.close(ignored);
+      accept();
+      return;
+    }
     socket.set_option(tcp::no_delay(true));
-    auto participant = std::make_shared<Participant>(key_, session_, options_.shift);
+    socket.set_option(asio::socket_base::send_buffer_size(kControlSendBufferBytes));
+    auto participant = std::make_shared<Participant>(io_, session_, options_.shift, options_.encrypt);
     const std::weak_ptr<Participant> weak = participant;
     net::FramedConnection::Handlers handlers;
     handlers.on_control = [this, weak](const wire::Control& control) {
       if (const ParticipantPtr p = weak.lock()) handle_control(p, control);
     };
     handlers.on_close = [this, weak](net::CloseCause cause, const std::string& why) {
-      const ParticipantPtr p = weak.lock();
-      if (!p) return;
-      switch (cause) {
-        case net::CloseCause::peer_closed: leave(p, "disconnected"); return;
-        case net::CloseCause::rejected_frame:
-          ++counters_.frames_rejected;
-          spdlog::warn("control connection from {}: {}", p->connection->peer(), why);
-          leave(p, "protocol error");
-          return;
-        case net::CloseCause::write_queue_full: spdlog::warn("control connection to {}: {}", p->connection->peer(), why); break;
-        case net::CloseCause::io_error: break;
-      }
-      leave(p, why);
+      if (const ParticipantPtr p = weak.lock()) closed(p, cause, why);
     };
-    participant->connection = net::FramedConnection::start(std::move(socket), wire::FrameReader(key_), std::move(handlers));
+    wire::FrameReader reader(
+        [this, weak](std::uint32_t sender) -> const wire::TrafficKey* {
+          const ParticipantPtr p = weak.lock();
+          return p ? key_for(*p, sender) : nullptr;
+        },
+        {.expect_greeting = false, .allow_cleartext = !options_.encrypt, .max_body_bytes = kMaxClientFrameBytes});
+    participant->connection = net::FramedConnection::start(std::move(socket), std::move(reader), std::move(handlers));
     participants_.push_back(participant);
+    send_bytes(participant, wire::encode_greeting(participant->challenge), net::FrameKind::must_arrive, false);
+    participant->join_timer.expires_after(kJoinTimeout);
+    participant->join_timer.async_wait([this, weak](std::error_code timer_error) {
+      const ParticipantPtr p = weak.lock();
+      if (timer_error || !p || p->gone || p->slot >= 0) return;
+      ++counters_.join_timeouts;
+      warn_throttled(fmt::format("connection from {} closed: no join within {} s", p->connection->peer(), kJoinTimeout.count()));
+      leave(p, "no join in time");
+    });
     accept();
   });
 }
 
+void ConnectionHandler::closed(const ParticipantPtr& participant, net::CloseCause cause, const std::string& why) {
+  const std::string& peer = participant->connection->peer();
+  switch (cause) {
+    case net::CloseCause::peer_closed: leave(participant, "disconnected"); return;
+    case net::CloseCause::rejected_frame:
+      reject_frame(participant, participant->connection->rejection().value_or(wire::Rejection::truncated), why);
+      return;
+    case net::CloseCause::write_queue_full:
+      ++counters_.queue_overflows;
+      spdlog::warn("control connection to {}: {}", peer, why);
+      break;
+    case net::CloseCause::write_stalled:
+      ++counters_.write_stalls;
+      spdlog::warn("control connection to {}: {}", peer, why);
+      break;
+    case net::CloseCause::io_error: break;
+  }
+  leave(participant, why);
+}
+
+void ConnectionHandler::reject_frame(const ParticipantPtr& participant, wire::Rejection reason, const std::string& why) {
+  ++counters_.frames_rejected;
+  ++counters_.frames_rejected_by_reason[static_cast<std::size_t>(reason)];
+  warn_throttled(fmt::format("control connection from {} closed ({}): {}", participant->connection->peer(),
+                             wire::to_string(reason), why));
+  leave(participant, "protocol error");
+}
+
+const wire::TrafficKey* ConnectionHandler::key_for(const Participant& participant, std::uint32_t sender) const {
+  if (participant.slot >= 0)  // joined: its own slot's key only
+    return sender == wire::sender_of_slot(static_cast<std::uint32_t>(participant.slot))
+               ? &slot_keys_[static_cast<std::size_t>(participant.slot)]
+               : nullptr;
+  if (sender == wire::kJoiningSender) return &joining_key_;
+  if (sender != wire::kServerSender && sender - 1 < slot_keys_.size()) return &slot_keys_[sender - 1];
+  return nullptr;
+}
+
 void ConnectionHandler::handle_control(const ParticipantPtr& participant, const wire::Control& control) {
-  if (control.has_join()) join(participant, control.join());
+  if (control.has_join()) join(participant, control);
   else if (control.has_bye()) leave(participant, "left: " + control.bye().reason());
   else if (control.has_status() && participant->slot >= 0) client_status(*participant, control.status());
 }
@@ -150,39 +225,75 @@ void ConnectionHandler::client_status(const Participant& participant, const wire
   if (on_status_) on_status_(participant.slot, participant.user_name, status);
 }
 
-void ConnectionHandler::join(const ParticipantPtr& participant, const wire::Join& request) {
-  if (participant->slot >= 0) return;
-  int slot = -1;
-  if (request.requested_slot() > 0) {
-    const auto wanted = static_cast<int>(request.requested_slot() - 1);
-    if (wanted < slots() && !slots_[static_cast<std::size_t>(wanted)]) slot = wanted;
-  } else {
-    for (int s = 0; s < slots() && slot < 0; ++s)
-      if (!slots_[static_cast<std::size_t>(s)]) slot = s;
+// The slot `request` may take (-1 after a refusal, sent). `sender`: whose key sealed it.
+int ConnectionHandler::take_slot(const ParticipantPtr& participant, const wire::Join& request, std::uint32_t sender) {
+  const auto refuse = [&](const std::string& code, const std::string& text) {
+    ++counters_.joins_refused;
+    send_error(participant, code, text);
+    spdlog::warn("{} ('{}') refused: {}", participant->connection->peer(), request.user_name(), text);
+    return -1;
+  };
+  int wanted = request.requested_slot() > 0 ? static_cast<int>(request.requested_slot() - 1) : -1;
+  if (sender != wire::kJoiningSender) {  // a participant key: its slot, and no other
+    const int own = static_cast<int>(sender - 1);
+    if (wanted >= 0 && wanted != own)
+      return refuse("wrong_slot", fmt::format("the key given is slot {}'s, and slot {} was asked for", own, wanted));
+    wanted = own;
   }
-  const std::string& peer = participant->connection->peer();
-  if (slot < 0) {
-    send_error(participant, "session_full", fmt::format("no free user slot (the scene has {} tools)", slots()));
-    spdlog::warn("{} ('{}') refused: no free slot", peer, request.user_name());
+  if (users() >= max_participants_)
+    return refuse("session_full", fmt::format("the session is full: the scene allows {} participant{} at once "
+                                              "(network.max_participants)",
+                                              max_participants_, max_participants_ == 1 ? "" : "s"));
+  if (wanted >= slots())
+    return refuse("session_full", fmt::format("slot {} does not exist: the scene has {} tools", wanted, slots()));
+  if (wanted >= 0) {
+    if (slots_[static_cast<std::size_t>(wanted)])
+      return refuse("session_full", fmt::format("slot {} is taken", wanted));
+    return wanted;
+  }
+  for (int s = 0; s < slots(); ++s)
+    if (!slots_[static_cast<std::size_t>(s)]) return s;
+  return refuse("session_full", fmt::format("no free user slot (the scene has {} tools)", slots()));
+}
+
+void ConnectionHandler::join(const ParticipantPtr& participant, const wire::Control& control) {
+  if (participant->slot >= 0) return;
+  const wire::Join& request = control.join();
+  const std::uint32_t sender = control.header().sender();  // the envelope's: its key opened the frame
+  if (!wire::is_challenge(request.challenge(), participant->challenge)) {
+    reject_frame(participant, wire::Rejection::replayed, "a join without this connection's challenge (replayed?)");
     return;
   }
+  // The reply goes under the key the join came with; what follows under the slot's.
+  participant->sealer.set_key(sender == wire::kJoiningSender ? joining_key_ : slot_keys_[sender - 1]);
+  const int slot = take_slot(participant, request, sender);
+  if (slot < 0) return;
+  const wire::TrafficKey& key = slot_keys_[static_cast<std::size_t>(slot)];
   participant->slot = slot;
   participant->user_name = request.user_name();
   participant->udp_endpoint =
       udp::endpoint(participant->connection->peer_address(), static_cast<std::uint16_t>(request.udp_port()));
+  participant->datagram_sealer.emplace(key, session_, wire::kServerSender, options_.encrypt);
   slots_[static_cast<std::size_t>(slot)] = participant;
-  udp_.inspector().allow_sender(wire::sender_of_slot(static_cast<std::uint32_t>(slot)));
+  udp_.inspector().allow_sender(wire::sender_of_slot(static_cast<std::uint32_t>(slot)), key, request.datagram_salt(),
+                                request.datagram_sequence());
+  udp_.trust(participant->udp_endpoint);
   tools_.join(slot);
+  ++counters_.joins;
 
-  wire::Control control;
-  wire::Welcome* welcome = control.mutable_welcome();
+  wire::Control reply;
+  wire::Welcome* welcome = reply.mutable_welcome();
   *welcome = welcome_;
   welcome->set_slot(static_cast<std::uint32_t>(slot));
+  welcome->set_client_challenge(request.client_challenge());
+  welcome->set_datagram_salt(participant->datagram_sealer->salt());
   for (int s = 0; s < slots(); ++s)
     if (const ParticipantPtr& user = slots_[static_cast<std::size_t>(s)]) welcome->mutable_users(s)->set_user_name(user->user_name);
-  send_control(participant, control);
+  send_control(participant, reply);
+  participant->sealer.set_key(key);
   const std::string& tool = welcome_.users(slot).tool_name();
-  spdlog::info("user '{}' joined from {} as slot {} (tool {})", participant->user_name, peer, slot, tool);
+  spdlog::info("user '{}' joined from {} as slot {} (tool {})", participant->user_name, participant->connection->peer(),
+               slot, tool);
   broadcast_event("user_joined", fmt::format("{} took tool {}", participant->user_name, tool),
                   record::EventUser{participant->user_name, static_cast<std::uint32_t>(slot)});
 }
@@ -191,10 +302,12 @@ void ConnectionHandler::leave(const ParticipantPtr& participant, const std::stri
   if (participant->gone) return;
   participant->gone = true;
   participant->connection->close();
+  participant->join_timer.cancel();
   std::erase(participants_, participant);
   const int slot = participant->slot;
   if (slot < 0 || slots_[static_cast<std::size_t>(slot)] != participant) return;
   slots_[static_cast<std::size_t>(slot)].reset();
+  udp_.distrust(participant->udp_endpoint);
   auto timer = std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(kLeftSenderGrace_ms));
   timer->async_wait([this, timer, slot](std::error_code) {
     if (!slots_[static_cast<std::size_t>(slot)]) udp_.inspector().forget_sender(wire::sender_of_slot(static_cast<std::uint32_t>(slot)));
@@ -223,17 +336,23 @@ void ConnectionHandler::send_error(const ParticipantPtr& participant, const std:
   send_control(participant, control);
 }
 
-void ConnectionHandler::send_control(const ParticipantPtr& participant, wire::Control& control, bool newest_wins) {
+void ConnectionHandler::send_bytes(const ParticipantPtr& participant, std::vector<std::uint8_t> bytes, net::FrameKind kind,
+                                   bool frame) {
   if (participant->gone) return;
-  const net::FrameKind kind = newest_wins ? net::FrameKind::newest_wins : net::FrameKind::must_arrive;
   // The TCP link keeps order and loses nothing: every frame is delivered, perhaps later.
   net::deliver_over(participant->to_client_tcp, io_, wire::monotonic_now_ns(),
-                    [this, participant, kind, frame = participant->sealer.seal(control)](std::int64_t) mutable {
+                    [this, participant, kind, frame, bytes = std::move(bytes)](std::int64_t) mutable {
                       if (participant->gone) return;
-                      ++counters_.frames_sent;
-                      if (participant->connection->send(std::move(frame), kind) == net::FramedConnection::Sent::queued_after_drop)
+                      counters_.frames_sent += frame;
+                      if (participant->connection->send(std::move(bytes), kind) == net::FramedConnection::Sent::queued_after_drop)
                         ++counters_.frames_dropped;
                     });
+}
+
+void ConnectionHandler::send_control(const ParticipantPtr& participant, wire::Control& control, bool newest_wins) {
+  if (participant->gone) return;
+  send_bytes(participant, participant->sealer.seal(control),
+             newest_wins ? net::FrameKind::newest_wins : net::FrameKind::must_arrive, true);
 }
 
 void ConnectionHandler::say_goodbye(const std::string& reason) {
@@ -264,7 +383,7 @@ void ConnectionHandler::send(Outbox outbox) {
 void ConnectionHandler::send_datagram(Participant& participant, wire::Datagram& datagram) {
   const udp::endpoint to = participant.udp_endpoint;
   const bool delivered = net::deliver_over(participant.to_client_udp, io_, wire::monotonic_now_ns(),
-                                           [this, to, bytes = udp_sealer_.seal(datagram)](std::int64_t) mutable {
+                                           [this, to, bytes = participant.datagram_sealer->seal(datagram)](std::int64_t) mutable {
                                              udp_.send(std::move(bytes), to);
                                            });
   if (!delivered) ++counters_.dropped_to_clients;

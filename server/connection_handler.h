@@ -1,13 +1,21 @@
 // ConnectionHandler: the server's side of the network, run by the I/O thread. It owns
 //   - the TCP acceptor and one participant per control connection (net::FramedConnection):
-//     join (a free user slot, the Welcome), leave (the slot and its tool released),
-//     events to every user;
+//     the greeting with its challenge, join (a free user slot, the Welcome), leave (the
+//     slot and its tool released), events to every user;
 //   - the UDP endpoint (net::DatagramEndpoint): tool samples in (the newest of each slot
 //     to ToolInputs, and relayed to the other users), clock pings answered with pongs;
 //   - the sending of each step's Outbox (IRs over TCP, keep-alives and forces over UDP);
 //   - the injected shift delay: per participant, one LinkDelay per link and direction (to
 //     the client over UDP and over TCP, from the client over UDP), applied where a message
 //     leaves or enters the process;
+//   - the keys: every slot's traffic key and the joining key, derived from the session key
+//     (wire/traffic_keys.h). A connection's frames are opened with the key of the sender
+//     they name: before its join, any slot's or the joining key; after it, its slot's only.
+//     What the server sends a user is sealed with that user's key;
+//   - the limits: at most the scene's network.max_participants users at once; at most
+//     kMaxUnjoinedConnections connections that have not joined, each closed if it has not
+//     joined within kJoinTimeout; a user that stops reading is dropped by its connection
+//     (newest-wins IRs, then net::kWriteTimeout);
 //   - its counters, for the status line and the report.
 // It decides slots and what to relay; sealing is the codec's (wire::FrameSealer,
 // wire::DatagramSealer), the sockets are net/'s. With --record it records the datagrams
@@ -16,7 +24,9 @@
 // except the counters' readers noted below.
 #pragma once
 
+#include <array>
 #include <asio.hpp>
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -26,6 +36,7 @@
 
 #include "cohaptic/messages.pb.h"
 #include "net/datagram_endpoint.h"
+#include "net/framed_connection.h"
 #include "proto/record/session_recorder.h"
 #include "proto/wire/rejection.h"
 #include "proto/wire/sealer.h"
@@ -40,21 +51,42 @@ namespace cohaptic {
 /// the goodbye may still be in flight, and are accepted and ignored rather than counted
 /// as hostile.
 inline constexpr std::int64_t kLeftSenderGrace_ms = 500;
+/// A connection that has not joined within this time is closed.
+inline constexpr std::chrono::seconds kJoinTimeout{10};
+/// Connections that have not joined, at most; more are closed as they come.
+inline constexpr std::size_t kMaxUnjoinedConnections = 16;
+/// The kernel's send buffer of a control connection, fixed rather than grown without a
+/// say: with kMaxWaitingFrames, what a user that stops reading can hold up is bounded, and
+/// its writes stall (net::kWriteTimeout) within seconds. A few IRs' worth at any link speed.
+inline constexpr int kControlSendBufferBytes = 1 << 20;
+/// The largest frame body a client may send: its frames (Join, Event, Bye, ClientStatus) are
+/// small, and a frame declared larger is refused (oversized) before its body is buffered,
+/// so that a connection that has not even joined cannot make the server hold megabytes.
+inline constexpr std::size_t kMaxClientFrameBytes = std::size_t{64} << 10;
 
 struct ConnectionCounters {
   std::uint64_t datagrams_sent = 0, datagrams_relayed = 0;
   std::uint64_t frames_sent = 0, frames_rejected = 0, frames_dropped = 0;
+  std::array<std::uint64_t, wire::kRejectionCount> frames_rejected_by_reason{};
   std::uint64_t dropped_to_clients = 0, dropped_from_clients = 0;  ///< by the injected loss
+  std::uint64_t connections = 0;       ///< accepted
+  std::uint64_t joins = 0;             ///< welcomed
+  std::uint64_t joins_refused = 0;     ///< session full, slot taken, or a key for another slot
+  std::uint64_t turned_away = 0;       ///< closed at once: too many connections not joined
+  std::uint64_t join_timeouts = 0;     ///< closed: not joined within kJoinTimeout
+  std::uint64_t write_stalls = 0;      ///< closed: the user stopped reading (write timeout)
+  std::uint64_t queue_overflows = 0;   ///< closed: frames that must arrive piled up unread
 };
 
 class ConnectionHandler {
  public:
   /// Binds TCP and UDP on `options.host`:`options.port` (the UDP port is the TCP one).
   /// `welcome` carries everything a joining user is told but its slot and the users' names
-  /// (one entry per slot, with tool names). `recorder` may be null. Throws
-  /// std::system_error if a socket cannot be bound.
+  /// (one entry per slot, with tool names). `max_participants`: users joined at once, at
+  /// most (0: one per slot). `recorder` may be null. Throws std::system_error if a socket
+  /// cannot be bound.
   ConnectionHandler(asio::io_context& io, const ServeOptions& options, wire::Welcome welcome,
-                    const wire::SessionKey& key, std::uint64_t session, ToolInputs& tools,
+                    const wire::SessionKey& key, std::uint64_t session, int max_participants, ToolInputs& tools,
                     record::SessionRecorder* recorder);
   ~ConnectionHandler();
   ConnectionHandler(const ConnectionHandler&) = delete;
@@ -87,31 +119,41 @@ class ConnectionHandler {
   using ParticipantPtr = std::shared_ptr<Participant>;
 
   void accept();
+  void closed(const ParticipantPtr& participant, net::CloseCause cause, const std::string& why);
+  const wire::TrafficKey* key_for(const Participant& participant, std::uint32_t sender) const;
   void handle_control(const ParticipantPtr& participant, const wire::Control& control);
-  void join(const ParticipantPtr& participant, const wire::Join& request);
+  void join(const ParticipantPtr& participant, const wire::Control& control);
+  int take_slot(const ParticipantPtr& participant, const wire::Join& request, std::uint32_t sender);
   void client_status(const Participant& participant, const wire::ClientStatus& status);
   void leave(const ParticipantPtr& participant, const std::string& why);
+  void reject_frame(const ParticipantPtr& participant, wire::Rejection reason, const std::string& why);
   void broadcast_event(const std::string& kind, const std::string& text, const record::EventUser& user);
+  void send_bytes(const ParticipantPtr& participant, std::vector<std::uint8_t> bytes, net::FrameKind kind, bool frame);
   void send_control(const ParticipantPtr& participant, wire::Control& control, bool newest_wins = false);
   void send_error(const ParticipantPtr& participant, const std::string& code, const std::string& text);
   void send_datagram(Participant& participant, wire::Datagram& datagram);
   void receive_datagram(wire::Datagram&& datagram, std::int64_t arrival_ns);
   void handle_datagram(const wire::Datagram& datagram, int slot, std::int64_t arrival_ns);
+  /// Logs a warning about hostile or broken input at most once a second (the counters keep the rest).
+  void warn_throttled(const std::string& message);
 
   asio::io_context& io_;
   const ServeOptions& options_;
   wire::Welcome welcome_;
-  wire::SessionKey key_;
+  std::vector<wire::TrafficKey> slot_keys_;  ///< by slot
+  wire::TrafficKey joining_key_;
   std::uint64_t session_;
+  int max_participants_;
   ToolInputs& tools_;
   record::SessionRecorder* recorder_;
   asio::ip::tcp::acceptor acceptor_;
   std::uint16_t tcp_port_ = 0;
   net::DatagramEndpoint udp_;
-  wire::DatagramSealer udp_sealer_;
   std::vector<ParticipantPtr> participants_;  // every connection
   std::vector<ParticipantPtr> slots_;         // joined users, by slot
   ConnectionCounters counters_;
+  std::int64_t last_warning_ns_ = 0;
+  std::uint64_t warnings_held_ = 0;
   StatusHandler on_status_;
 };
 

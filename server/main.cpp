@@ -2,7 +2,6 @@
 //   cohaptic-server --scene FILE --listen HOST:PORT [...]   serve a scene to haptic clients
 // The offline tools (probe, replay, study, ...) are cohaptic-lab's. See README.md for every option.
 #include <CLI/CLI.hpp>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <string>
@@ -12,12 +11,11 @@
 #include "common/net/host_port.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
+#include "common/util/log_to_stderr.h"
 #include "server/simulation_server.h"
 
 int main(int argc, char** argv) {
-  auto logger = spdlog::stderr_color_mt("cohaptic");
-  spdlog::set_default_logger(logger);
-  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+  cohaptic::log_to_stderr();
 
   CLI::App app{"cohaptic-server: FEM simulation server for networked haptic collaboration. Serves a scene to "
                "haptic clients (--scene, --listen). The offline tools are cohaptic-lab's."};
@@ -37,8 +35,13 @@ int main(int argc, char** argv) {
                                          "sends the IR, the client computes the force at its haptic rate")
       ->check(CLI::IsMember({"P0", "P1"}))
       ->capture_default_str();
-  app.add_option("--key-file", serve.key_file, "Session key (64 hex characters); without it the public development key")
+  app.add_option("--key-file", serve.key_file,
+                 "Session key file (cohaptic-lab keygen; mode 0600); without it the public development key")
       ->check(CLI::ExistingFile);
+  bool no_encryption = false;
+  app.add_flag("--no-encryption", no_encryption,
+               "Send frames and datagrams in clear (still authenticated), and accept clients that do; for debugging "
+               "with a packet capture");
   app.add_option("--shift-delay-ms", serve.shift.delay_ms, "Injected one-way delay on every link, each direction [ms]")
       ->capture_default_str();
   app.add_option("--jitter-ms", serve.shift.jitter_ms, "Injected jitter: extra delay drawn from U(0, J) ms")->capture_default_str();
@@ -110,6 +113,7 @@ int main(int argc, char** argv) {
       fmt::print(stderr, "cohaptic-server: --listen: {}\n", problem);
       return 2;
     }
+    serve.encrypt = !no_encryption;
     if (!view_address.empty()) {
       if (const std::string problem = cohaptic::parse_host_port(view_address, serve.view_host, serve.view_port, true);
           !problem.empty()) {

@@ -18,7 +18,8 @@ struct ServeOptions {
   std::string host = "127.0.0.1";
   std::uint16_t port = 7400;            ///< TCP and UDP; 0: any free port (tests)
   ServeProtocol protocol = ServeProtocol::p1;
-  std::optional<std::filesystem::path> key_file;  ///< empty: the public development key
+  std::optional<std::filesystem::path> key_file;  ///< the session key; empty: the public development key
+  bool encrypt = true;                  ///< false: frames and datagrams in clear (still authenticated), and accepted so
   LinkDelaySettings shift;              ///< injected on every link, each direction
   int step_nodes = 0;                   ///< step-delay boundary nodes (the paper's T150/T300)
   double sim_rate_hz = 0;               ///< cap of the simulation loop; 0: up to 1 kHz

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <map>
+#include <string>
+
 namespace cohaptic {
 
 nlohmann::json server_report(const ServerFigures& figures) {
@@ -29,9 +32,22 @@ nlohmann::json server_report(const ServerFigures& figures) {
                          {"rejected_by_reason", figures.datagrams.snapshot()},
                          {"sent", connections.datagrams_sent},
                          {"relayed", connections.datagrams_relayed}};
+  std::map<std::string, std::uint64_t> frame_rejections;
+  for (wire::Rejection reason : wire::kAllRejections)
+    frame_rejections.emplace(std::string(wire::to_string(reason)),
+                             connections.frames_rejected_by_reason[static_cast<std::size_t>(reason)]);
   server["control_frames"] = {{"sent", connections.frames_sent},
                               {"rejected", connections.frames_rejected},
+                              {"rejected_by_reason", frame_rejections},
                               {"dropped", connections.frames_dropped}};
+  server["connections"] = {{"accepted", connections.connections},
+                           {"joins", connections.joins},
+                           {"joins_refused", connections.joins_refused},
+                           {"turned_away", connections.turned_away},
+                           {"join_timeouts", connections.join_timeouts},
+                           {"write_stalls", connections.write_stalls},
+                           {"queue_overflows", connections.queue_overflows}};
+  server["encrypted"] = options.encrypt;
   server["injected"] = {{"shift_delay_ms", options.shift.delay_ms},
                         {"jitter_ms", options.shift.jitter_ms},
                         {"loss", options.shift.loss},

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <thread>
 
+#include "common/sim/loaded_columns.h"
 #include "proto/wire/header.h"
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/vec3_convert.h"
@@ -33,8 +34,17 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       display_(display),
       view_(view),
       recorder_(recorder),
+      shown_columns_(display || view ? columns.front() : nullptr),
       start_ns_(start_ns),
-      simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {}
+      simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {
+  for (std::size_t i = 0; i < model.bodies.size(); ++i)
+    if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i]); body && columns[i])
+      prefetch_.push_back({columns[i], static_cast<int>(i), std::make_unique<CompliancePrefetch>(*body, columns[i]->row_nodes())});
+}
+
+void SimulationLoop::deliver_prefetched() {
+  for (BodyPrefetch& prefetch : prefetch_) prefetch.worker->deliver(*prefetch.columns);
+}
 
 Outbox SimulationLoop::step(std::int64_t now_ns) {
   take_tools(now_ns);
@@ -60,15 +70,22 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
 }
 
 void SimulationLoop::take_tools(std::int64_t now_ns) {
+  deliver_prefetched();
   tools_.copy_to(latest_);
   used_.assign(latest_.size(), false);
   const auto timeout = static_cast<std::int64_t>(options_.client_timeout_s * 1e9);
   for (std::size_t slot = 0; slot < latest_.size(); ++slot) {
     const ToolInput& tool = latest_[slot];
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
-    if (used_[slot]) simulation_.set_tool(static_cast<int>(slot), tool.position);
-    else simulation_.clear_tool(static_cast<int>(slot));
+    if (used_[slot]) {
+      simulation_.set_tool(static_cast<int>(slot), tool.position);
+      for (BodyPrefetch& prefetch : prefetch_) prefetch.worker->request_near(tool.position, *prefetch.columns);
+    } else {
+      simulation_.clear_tool(static_cast<int>(slot));
+    }
   }
+  for (BodyPrefetch& prefetch : prefetch_)  // as of the previous step
+    prefetch.worker->request(std::get<Simulation>(simulation_.body(prefetch.body)).nodes_near_obstacles());
 }
 
 // The new IRs: sent to their users (P1), and recorded (either protocol).
@@ -131,16 +148,19 @@ bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
       display_ && now_ns - last_display_ns_ >= static_cast<std::int64_t>(1e9 / options_.display_rate_hz);
   const bool view_due = view_ && view_->frame_due(now_ns);
   if (!display_due && !view_due) return false;
-  // Both show the row nodes' surface (common/model/shown_surface.h): one solve serves both.
+  // Both show the row nodes' surface (common/model/shown_surface.h): one state solve serves both.
   const Simulation& shown = simulation_.single_elastic();
-  Eigen::Matrix3Xd displacement = shown.displacement_of(display_ ? display_->nodes() : view_->nodes());
-  statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
+  const StateSolution state = shown.solve();
   if (view_due) {
     view_tools_.resize(latest_.size());
     for (std::size_t slot = 0; slot < latest_.size(); ++slot) view_tools_[slot] = {used_[slot], latest_[slot].position};
-    view_->publish_frame(now_ns, seconds_since_start(now_ns), shown, displacement, view_tools_, steps_);
+    // The displacement and the encoding are the view's thread's work.
+    view_->publish_frame(now_ns, seconds_since_start(now_ns),
+                         view::frame_state(shown, loaded_columns(*shown_columns_, state), view_tools_), steps_);
   }
   if (display_due) {
+    Eigen::Matrix3Xd displacement = displacement_of_nodes(*shown_columns_, state, display_->nodes());
+    statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
     last_display_ns_ = now_ns;
     display_->offer(seconds_since_start(now_ns), std::move(displacement));  // dropped if the writer is behind
   }
@@ -172,6 +192,7 @@ std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,
     if (next < step_end) next = step_end;  // behind: no catch-up burst
     std::this_thread::sleep_for(std::chrono::nanoseconds(next - step_end));
   }
+  deliver_prefetched();  // so that the disk cache keeps them too
   return std::nullopt;
 }
 

@@ -1,12 +1,16 @@
 // SimulationLoop: the server's simulation thread. Each step
 //   1. copies the latest tool samples (ToolInputs) and gives the simulation those that
-//      are fresh (a tool silent for --client-timeout is released);
+//      are fresh (a tool silent for --client-timeout is released); takes in each FEM
+//      body's compliance columns solved ahead, and asks for those near the tools and the
+//      obstacles (CompliancePrefetch, one per FEM body);
 //   2. steps the SceneSimulation: each body's (FEM: contacts, active sets, M~ when a set
 //      changed; mass-spring: the whole network, and the IRs that are due);
 //   3. fills the step's Outbox: each user's new IR (P1), the IR keep-alives (P1, every
 //      kKeepAlivePeriod_ns), the forces (P0);
-//   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter,
-//      and every 1/--view-rate-hz for the live view (one solve when both are due);
+//   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter;
+//      every 1/--view-rate-hz, while a browser watches or the session is recorded, hands the
+//      live view the state it draws (its loads, not its displacement: the view's thread
+//      computes that); one state solve when both are due;
 //   5. records the step and the IRs it built (--record), and its figures (LoopStatistics).
 // run() paces the steps at the loop's rate with absolute deadlines (when behind, the next
 // step starts at once, with no catch-up burst) and hands each non-empty outbox to the I/O
@@ -14,14 +18,16 @@
 // throws releases every tool and is counted, and logged at a paced rate (StepFailures);
 // kMaxConsecutiveStepFailures in a row end the loop with the reason.
 // The loop owns the SceneSimulation (the mutable state); the model is shared read-only, the
-// FEM bodies' compliance columns are filled in on demand by this thread alone. The display
-// and the live view show a scene of one linear elastic object. Times: ns of
+// FEM bodies' compliance columns are filled in by this thread alone (each prefetch worker
+// solves into its own, handed over at the start of a step). The display and the live view
+// show a scene of one linear elastic object. Times: ns of
 // wire::monotonic_now_ns(); simulation time in s from the server's start.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -31,6 +37,7 @@
 #include "common/model/model.h"
 #include "common/sim/scene_simulation.h"
 #include "proto/record/session_recorder.h"
+#include "server/compliance_prefetch.h"
 #include "server/display_writer.h"
 #include "view/live_view.h"
 #include "server/loop_statistics.h"
@@ -75,17 +82,27 @@ class SimulationLoop {
   bool solve_display_frame(std::int64_t now_ns);
   double seconds_since_start(std::int64_t ns) const { return static_cast<double>(ns - start_ns_) * 1e-9; }
 
+  // One compliance prefetch per FEM body, with the columns it fills.
+  struct BodyPrefetch {
+    ComplianceColumns* columns;
+    int body;
+    std::unique_ptr<CompliancePrefetch> worker;
+  };
+  void deliver_prefetched();
+
   const ServeOptions& options_;
   const ToolInputs& tools_;
   LoopStatistics& statistics_;
   DisplayWriter* display_;
   view::LiveView* view_;
   record::SessionRecorder* recorder_;
+  ComplianceColumns* shown_columns_;  // the displayed body's, with a display or a view
   std::int64_t start_ns_;
   SceneSimulation simulation_;
   StepFailures failures_;
   std::vector<ToolInput> latest_;  // this step's copy of the tool inputs
   std::vector<bool> used_;         // per slot: fresh, given to the simulation
+  std::vector<BodyPrefetch> prefetch_;
   std::int64_t last_keep_alive_ns_ = 0, last_display_ns_ = 0;
   std::uint64_t steps_ = 0;                      // successful steps so far
   std::vector<view::ToolState> view_tools_;      // this step's tools, for the view

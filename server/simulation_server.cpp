@@ -130,10 +130,12 @@ struct SimulationServer::Impl {
 
   void bind() {
     connections = std::make_unique<ConnectionHandler>(io, options, welcome_template(options, *model, scene_yaml), key,
-                                                      session_id, *tools, recorder.get());
+                                                      session_id, model->scene.network.max_participants, *tools,
+                                                      recorder.get());
     spdlog::info("listening on {}:{} (TCP control, UDP samples), protocol {}, session {:016x}", options.host,
                  connections->tcp_port(), options.protocol == ServeProtocol::p1 ? "P1" : "P0", session_id);
     if (options.shift.active()) spdlog::info("injected shift delay on every link, each direction: {}", options.shift.describe());
+    if (!options.encrypt) spdlog::warn("--no-encryption: frames and datagrams travel in clear (authenticated, readable by anyone on the path)");
     if (view) {
       connections->on_client_status([this](int slot, const std::string& user, const wire::ClientStatus& status) {
         view->publish_status(slot, user, status, static_cast<double>(wire::monotonic_now_ns() - start_ns) * 1e-9);

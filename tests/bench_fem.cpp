@@ -2,6 +2,9 @@
 // compliance columns per node, and the whole touchable block (batched multi-RHS solve
 // against the naive one-solve-per-node). The argument is the cube's divisions per edge:
 // 11 is the paper's cube (1,728 nodes), 22 a finer one (12,167 nodes).
+//   BM_ComplianceGroupSolve/<nodes>  one solve for the columns of that many neighbouring
+//                                    surface nodes of the brain (8,991 free dofs): the
+//                                    cost of a compliance solve group of that size
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -99,11 +102,27 @@ void BM_ComplianceSurfaceBlock_per_node(benchmark::State& state) {
   state.counters["touchable_nodes"] = static_cast<double>(body.touchable_nodes.size());
 }
 
+// A solve group's cost against its size: what ComplianceColumns::kGroupSize trades.
+void BM_ComplianceGroupSolve(benchmark::State& state) {
+  static const Model model = build_model(load_scene(std::string(COHAPTIC_SOURCE_DIR) + "/scenes/brain.yaml"));
+  const ElasticBody& brain = single_elastic_body(model);
+  const std::vector<int> rows = compliance_row_nodes(brain, true);
+  const std::vector<int> group(rows.begin(), rows.begin() + state.range(0));
+  for (auto _ : state) {
+    ComplianceColumns columns(*brain.free_factor, brain.dofs, group);
+    columns.compute_columns(group);  // one solve: the group is the whole row set
+    benchmark::DoNotOptimize(columns.column_count());
+  }
+  state.counters["cpu_s_per_node"] = benchmark::Counter(static_cast<double>(state.range(0)),
+                                                     benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 BENCHMARK(BM_Assemble)->Arg(11)->Arg(22)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Factor)->Arg(11)->Arg(22)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ComplianceColumn)->Arg(11)->Arg(22)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ComplianceSurfaceBlock_batched)->Arg(11)->Arg(22)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ComplianceSurfaceBlock_per_node)->Arg(11)->Arg(22)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ComplianceGroupSolve)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace cohaptic

@@ -4,20 +4,46 @@
 //   - no view (BM_SimulationSteps/no_view), the reference;
 //   - the live view at 30 frames/s and 0, 1 or 50 browsers (WebSocket clients in this
 //     process, reading everything) connected: BM_SimulationSteps/view_browsers/N.
-// items_per_second is the simulation's step rate; the counters give, per browser, the
-// frames and bytes it received per second. The browsers and the view server's thread share
-// the machine's cores with the simulation, as they would on a server with local browsers.
+// A browser runs on another machine in real use. Here the browsers share this one, and the
+// kernel charges a loopback receive to whichever thread happens to run, so the benchmark
+// pins the simulation (this thread) to CPU 0 and the view's thread and the browsers to
+// CPU 1 (on a machine with both): it then measures what the view costs the simulation
+// thread itself, as on a server whose browsers are elsewhere.
+// Time: real time per step; CPU: the simulation thread's own CPU time per step
+// (CLOCK_THREAD_CPUTIME_ID); items_per_second: the step rate. Counters: others_cpu_us_per_step,
+// the CPU of every other thread of the process (the view's, the browsers') per step; per
+// browser, the frames and kB it received per second; the frames the view built and dropped.
+//
+// What one frame costs each thread, at one state of the same motions (both surgeons
+// pressing, 3 s in), CPU time per frame:
+//   - BM_ViewFrame_simulation_thread: the simulation thread's part, the state solve, its
+//     loads (LoadedColumn) and the FrameState handed over;
+//   - BM_ViewFrame_view_thread: the view's thread's part, the shown surface's displacement
+//     from those loads, the Frame and its encoding;
+//   - BM_ViewFrame_displacement_from_loads: of which the displacement;
+//   - BM_ViewFrame_displacement_gathered: the displacement as the display solves it
+//     (Simulation::displacement_of: the state solve and a gathered block of L), which the
+//     simulation thread solved for every view frame, and encoded, before the view's thread
+//     took the frame over.
 #include <array>
 #include <benchmark/benchmark.h>
 
+#include <pthread.h>
+#include <sched.h>
+#include <sys/resource.h>
+
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <spdlog/spdlog.h>
 #include <thread>
 
 #include "common/haptics/trajectory.h"
 #include "common/model/compliance_setup.h"
+#include "common/model/shown_surface.h"
 #include "common/scene/load_scene.h"
+#include "common/sim/loaded_columns.h"
+#include "common/sim/simulation.h"
 #include "common/util/blas_threads.h"
 #include "proto/wire/header.h"
 #include "server/server_recording.h"
@@ -66,8 +92,42 @@ void set_tools(ToolInputs& tools, const BrainRig& rig, double t) {
   }
 }
 
+// Pins the calling thread (and the threads it starts from now on) to `cpu`, if this process
+// may run on CPUs 0 and 1; restores the thread's CPUs when it goes.
+class PinnedThread {
+ public:
+  static bool possible() {
+    cpu_set_t allowed;
+    return sched_getaffinity(0, sizeof allowed, &allowed) == 0 && CPU_ISSET(0, &allowed) && CPU_ISSET(1, &allowed);
+  }
+  explicit PinnedThread(int cpu) {
+    pthread_getaffinity_np(pthread_self(), sizeof before_, &before_);
+    cpu_set_t only;
+    CPU_ZERO(&only);
+    CPU_SET(cpu, &only);
+    pthread_setaffinity_np(pthread_self(), sizeof only, &only);
+  }
+  ~PinnedThread() { pthread_setaffinity_np(pthread_self(), sizeof before_, &before_); }
+  PinnedThread(const PinnedThread&) = delete;
+  PinnedThread& operator=(const PinnedThread&) = delete;
+
+ private:
+  cpu_set_t before_;
+};
+
+// User and system CPU time so far [s] of the process (RUSAGE_SELF) or this thread
+// (RUSAGE_THREAD), from the same accounting.
+double cpu_seconds(int who) {
+  rusage usage{};
+  getrusage(who, &usage);
+  const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
 void run_steps(benchmark::State& state, bool with_view, int browsers) {
   BrainRig& rig = BrainRig::get();
+  const bool pin = PinnedThread::possible();
+  if (!pin) state.SetLabel("not pinned: CPUs 0 and 1 are not both available");
   ServeOptions options;
   options.client_timeout_s = 3600;
   ToolInputs tools(rig.motions.size());
@@ -87,6 +147,8 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
   }
   std::vector<std::unique_ptr<testing::WebSocketClient>> clients;
   if (live) {
+    std::optional<PinnedThread> on_cpu1;  // the view's thread and the browsers' start there
+    if (pin) on_cpu1.emplace(1);
     live->start();
     const std::string url = "ws://127.0.0.1:" + std::to_string(live->port()) + "/ws";
     for (int k = 0; k < browsers; ++k) {
@@ -95,11 +157,16 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
       clients.back()->count_only();
     }
   }
+  std::optional<PinnedThread> on_cpu0;  // the simulation
+  if (pin) on_cpu0.emplace(0);
+  std::this_thread::yield();  // on CPU 0 from here
   std::vector<std::uint64_t> frames_before, bytes_before;
   for (const auto& client : clients) {
     frames_before.push_back(client->message_count());
     bytes_before.push_back(client->bytes_received());
   }
+  const std::uint64_t built_before = live ? live->frames_built() : 0;
+  const double process_cpu_before = cpu_seconds(RUSAGE_SELF), thread_cpu_before = cpu_seconds(RUSAGE_THREAD);
   const auto start = std::chrono::steady_clock::now();
   double t = kWindowStart_s;
   for (auto _ : state) {
@@ -108,7 +175,11 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
     t += kWindowStride_s;  // the motion at a fixed stride, whatever the steps cost
   }
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double others_cpu = (cpu_seconds(RUSAGE_SELF) - process_cpu_before) -
+                            (cpu_seconds(RUSAGE_THREAD) - thread_cpu_before);
   state.SetItemsProcessed(state.iterations());
+  state.counters["others_cpu_us_per_step"] = 1e6 * others_cpu / static_cast<double>(state.iterations());
+  if (live) state.counters["frames_built_per_s"] = static_cast<double>(live->frames_built() - built_before) / elapsed;
   if (!clients.empty()) {
     double frames = 0, bytes = 0;
     for (std::size_t k = 0; k < clients.size(); ++k) {
@@ -122,6 +193,78 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
   clients.clear();
   if (live) live->stop();
 }
+
+// The brain with both surgeons pressing, 3 s into their motions, and what a frame of it needs.
+struct PressedBrain {
+  BrainRig& rig = BrainRig::get();
+  Simulation simulation;
+  ShownSurface shown;
+  view::ShownIndex index;
+  std::vector<int> positions;
+  std::vector<view::ToolState> tools;
+  static SimulationOptions options(const Model& model) {
+    SimulationOptions options;
+    options.ir = ir_build_options(model.scene.haptic);
+    return options;
+  }
+  PressedBrain()
+      : simulation(single_elastic_body(*rig.model), rig.model->obstacles, *rig.columns, rig.model->scene.tools,
+                   options(*rig.model)),
+        shown(shown_surface(single_elastic_body(*rig.model), rig.columns->row_nodes())),
+        index(single_elastic_body(*rig.model), shown) {
+    for (double t = 0; t < 3.0; t += 0.005) {
+      for (std::size_t slot = 0; slot < rig.motions.size(); ++slot)
+        simulation.set_tool(static_cast<int>(slot), rig.motions[slot].position(t));
+      simulation.step(t);
+    }
+    for (int node : shown.nodes) positions.push_back(rig.columns->row_position(node));
+    for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) tools.push_back({true, rig.motions[slot].position(3.0)});
+  }
+  static PressedBrain& get() {
+    static PressedBrain brain;
+    return brain;
+  }
+  view::FrameState frame_state() { return view::frame_state(simulation, loaded_columns(*rig.columns, simulation.solve()), tools); }
+  void describe(benchmark::State& state) {
+    state.counters["pressing"] = simulation.pressing(0) + simulation.pressing(1);
+    state.counters["boundary_nodes"] = static_cast<double>(simulation.condensation().boundary_nodes().size());
+    state.counters["shown_nodes"] = static_cast<double>(shown.nodes.size());
+  }
+};
+
+void BM_ViewFrame_simulation_thread(benchmark::State& state) {
+  PressedBrain& brain = PressedBrain::get();
+  for (auto _ : state) benchmark::DoNotOptimize(brain.frame_state());
+  brain.describe(state);
+}
+
+void BM_ViewFrame_view_thread(benchmark::State& state) {
+  PressedBrain& brain = PressedBrain::get();
+  const view::FrameState frame = brain.frame_state();
+  std::size_t bytes = 0;
+  for (auto _ : state) {
+    const std::string message = view::server_message(view::view_frame(frame, brain.index, brain.positions, 1, 3.0, 400));
+    bytes = message.size();
+    benchmark::DoNotOptimize(message.data());
+  }
+  state.counters["frame_kB"] = static_cast<double>(bytes) / 1e3;
+}
+
+void BM_ViewFrame_displacement_from_loads(benchmark::State& state) {
+  PressedBrain& brain = PressedBrain::get();
+  const view::FrameState frame = brain.frame_state();
+  for (auto _ : state) benchmark::DoNotOptimize(displacement_of_rows(frame.loads, brain.positions));
+}
+
+void BM_ViewFrame_displacement_gathered(benchmark::State& state) {
+  PressedBrain& brain = PressedBrain::get();
+  for (auto _ : state) benchmark::DoNotOptimize(brain.simulation.displacement_of(brain.shown.nodes));
+}
+
+BENCHMARK(BM_ViewFrame_simulation_thread)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ViewFrame_view_thread)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ViewFrame_displacement_from_loads)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ViewFrame_displacement_gathered)->Unit(benchmark::kMicrosecond);
 
 void BM_SimulationSteps_no_view(benchmark::State& state) { run_steps(state, false, 0); }
 void BM_SimulationSteps_view_browsers(benchmark::State& state) { run_steps(state, true, static_cast<int>(state.range(0))); }

@@ -7,13 +7,15 @@
 //   - |B| = 0, 1, 300, 1000 and the whole movable surface: equal to the full solve;
 //   - a tool deeper than the object is thick, exactly on an edge or a vertex: finite,
 //     never above the limit, deterministic;
-//   - a rigid obstacle: held nodes push, free nodes stay out, forces equal the full solve.
+//   - a rigid obstacle: held nodes push, free nodes stay out, forces equal the full solve;
+//     the free nodes about to reach it, and only those, are named for prefetching.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <set>
 
 #include "common/mesh/box_mesher.h"
 #include "common/mesh/mesh_checks.h"
@@ -255,6 +257,46 @@ TEST(Extremes, ARigidWallCatchesTheBulge) {
                 contact_model == ContactModel::node_translation ? "translation" : "point", report.obstacle_nodes,
                 ir_force.norm(), free.force(0).force.norm());
   }
+}
+
+TEST(Extremes, TheNodesAboutToReachAWallAreNamedForPrefetching) {
+  // A wall 0.5 mm beside the x = +65 mm side: its nodes are within the 1 mm that
+  // nodes_near_obstacles() reports, the rest of the surface is not. The rig's columns
+  // start empty, so these nodes lack their columns until the simulation needs them.
+  testing::CubeSceneOptions scene;
+  scene.divisions = 6;
+  scene.obstacles = "{name: wall, plane: {point: [65.5, 0, 0], normal: [-1, 0, 0]}}";
+  Rig rig(scene);
+  const ElasticBody& body = rig.body;
+  SimulationOptions o = options(kUnlimited);
+  ASSERT_EQ(o.near_obstacle_distance, 1e-3);
+  Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), o);
+  simulation.set_tool(0, mm(30, 0, -4));  // the side bulges towards the wall by a few tenths of a millimetre
+  const StepReport report = simulation.step(0);
+  EXPECT_GT(report.obstacle_nodes, 0) << "the bulge should reach the wall";
+  std::vector<int> named;
+  for (const NodeDistance& near : simulation.nodes_near_obstacles()) named.push_back(near.node);
+  const Eigen::Matrix3Xd u = simulation.displacement_of(named);
+  for (std::size_t k = 0; k < named.size(); ++k) {
+    const int node = named[k];
+    EXPECT_EQ(body.mesh.nodes(0, node), 65e-3) << "node " << node << " is not on the side by the wall";
+    // A plane's estimate is exact: the gap left by the bulge.
+    EXPECT_NEAR(simulation.nodes_near_obstacles()[k].distance, 65.5e-3 - (65e-3 + u(0, static_cast<Eigen::Index>(k))),
+                1e-12)
+        << "node " << node;
+  }
+  // Every free node of that side without columns is named, once.
+  const std::set<int> named_set(named.begin(), named.end());
+  EXPECT_EQ(named_set.size(), named.size());
+  int side = 0;
+  for (int node : body.surface.nodes) {
+    if (body.mesh.nodes(0, node) != 65e-3 || body.dofs.fixed_axes[node] == kAllAxes) continue;
+    ++side;
+    if (!rig.columns->has_column(node)) {
+      EXPECT_TRUE(named_set.count(node)) << "node " << node << " not named";
+    }
+  }
+  EXPECT_GT(named_set.size(), static_cast<std::size_t>(side) / 2);
 }
 
 }  // namespace

@@ -403,6 +403,10 @@ TEST(IntermediateRepresentation, PrepareRejectsMalformedIrs) {
   bad = good;
   condensed_fem(bad).patch[0].nodes[1] = condensed_fem(bad).node_count() + 5;
   EXPECT_THROW(prepare_ir(bad), Error);
+  bad = good;  // a lying server: M_CC not symmetric (its symmetric part is still definite)
+  Eigen::MatrixXd& m_tilde = condensed_fem(bad).m_tilde;
+  m_tilde(0, 1) += 1e-3 * m_tilde.leftCols(m_tilde.rows()).cwiseAbs().maxCoeff();
+  EXPECT_THROW(prepare_ir(bad), Error);
   EXPECT_NO_THROW(prepare_ir(good));
 }
 

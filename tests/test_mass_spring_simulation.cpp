@@ -3,9 +3,7 @@
 // server's whole network (bit for bit when the IR carries the whole network, within a
 // bound for a sub-network), the client's force through the wire against the server's P0
 // evaluation in lockstep (bit for bit), the IR rate, and SceneSimulation's assignment of
-// users to the nearest of two bodies with epochs that keep rising. (The tool's contact
-// flag flickers while it holds a node: the node is driven onto the tool's surface, so the
-// next period may start just short of contact.)
+// users to the nearest of two bodies with epochs that keep rising.
 #include <gtest/gtest.h>
 
 #include <cmath>

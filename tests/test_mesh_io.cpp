@@ -387,6 +387,18 @@ TEST(WriteVtu, FieldWithWrongNodeCountThrowsNamingIt) {
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
+// Found by fuzzing: storage was sized by the header, so 47 bytes claiming 1.8e9 vertices
+// asked for 42 GB. Now the missing lines are the error.
+TEST(ReadFreeSurfer, AHeaderClaimingBillionsOfVerticesFailsOnItsMissingLines) {
+  std::istringstream in("#!ascii\n1772764997 4\n0 0 0 0\n");
+  try {
+    parse_freesurfer_ascii(in, "claims.asc");
+    FAIL() << "no ParseError";
+  } catch (const ParseError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("claims.asc:3: the file ends after 1 of the 1772764997 vertices"));
+  }
+}
+
 TEST(ReadFreeSurfer, TetrahedronSurface) {
   const TriangleSurface surface = read_freesurfer_ascii(data_file("tet_surface.asc"));
   Eigen::Matrix3Xd expected(3, 4);

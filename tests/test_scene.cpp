@@ -325,7 +325,48 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
                      {"objects[0].mesh.file", "/nonexistent-cohaptic-test/scenes/no_such_mesh.msh", "does not exist"}});
   }
 
+  {
+    const auto text = replaced(base, "haptic:\n", "network:\n  max_participants: 2\nhaptic:\n");
+    cases.push_back({"more participants than tools", text, "max_participants: 2",
+                     {"network.max_participants", "an integer from 1 to the number of tools (1)", "found '2'"}});
+  }
+  {
+    const auto text = replaced(base, "haptic:\n", "network:\n  max_users: 1\nhaptic:\n");
+    cases.push_back({"unknown network key", text, "max_users: 1", {"network.max_users", "unknown key", "max_participants"}});
+  }
+
+  {
+    // Found by fuzzing: a list as a map key escaped as a YAML library exception.
+    const auto text = replaced(base, "      youngs_modulus: 1000\n", "      ? [youngs, modulus]\n      : 1000\n");
+    cases.push_back({"list as a key", text, "? [youngs, modulus]",
+                     {"objects[0].material", "a map whose keys are names", "found a list of 2"}});
+  }
+
+  {
+    // Found by fuzzing: a name the system refuses (too long) threw std::filesystem's error.
+    const std::string long_name(5000, 'm');
+    const auto text = replaced(base,
+                               "      box:\n        min: [0, 0, 0]\n        size: [10, 10, 10]\n"
+                               "        divisions: [2, 2, 2]\n",
+                               "      file: " + long_name + ".msh\n");
+    cases.push_back({"file name too long", text, "file: mmm", {"objects[0].mesh.file", "cannot be examined: File name too long"}});
+  }
+  {
+    const auto text = replaced(base,
+                               "      box:\n        min: [0, 0, 0]\n        size: [10, 10, 10]\n"
+                               "        divisions: [2, 2, 2]\n",
+                               "      file: /tmp\n");
+    cases.push_back({"directory as mesh", text, "file: /tmp", {"objects[0].mesh.file", "mesh file /tmp is a directory"}});
+  }
+
   for (const BadScene& bad : cases) expect_scene_error(bad);
+}
+
+TEST(SceneLoad, MaxParticipantsDefaultsToOnePerToolAndMayBeFewer) {
+  const std::string two_tools = replaced(kBaseScene, "    shape: point\n", "    shape: point\n  - name: B\n");
+  EXPECT_EQ(parse_scene(two_tools, kSceneFile).network.max_participants, 2);
+  const std::string one_at_a_time = replaced(two_tools, "haptic:\n", "network: {max_participants: 1}\nhaptic:\n");
+  EXPECT_EQ(parse_scene(one_at_a_time, kSceneFile).network.max_participants, 1);
 }
 
 TEST(SceneModel, SeveralObjectsCompileIntoOneBodyEachInTheSceneOrder) {
@@ -570,6 +611,22 @@ TEST(MassSpringScene, ErrorsNameFileLineKeyAndExpectation) {
        {"objects[0].ir.sections", "from 1"}},
   };
   for (const BadScene& bad : cases) expect_scene_error(bad);
+}
+
+// Found reviewing the scene fuzz target's reach: a direction of huge components (finite
+// numbers) has a squared length that overflows, so normalize() made it the zero vector: a
+// plane without a normal, a tube ring without its orientation. Now scaled without overflow.
+TEST(Scene, DirectionsOfHugeComponentsBecomeUnitVectors) {
+  const Eigen::Vector3d diagonal = Eigen::Vector3d(1, 1, 0).normalized();
+  const Scene solid = parse_scene(replaced(kBaseScene, "normal: [0, 0, 1]", "normal: [1.0e200, 1.0e200, 0]"), kSceneFile);
+  EXPECT_TRUE(std::get<ElasticObjectSpec>(solid.objects.at(0).body).fixed.at(0).nodes.plane_normal.isApprox(diagonal));
+  const Scene tube = parse_scene(replaced(replaced(kNoodleScene, "normal: [0, 0, 1]", "normal: [1.0e200, 1.0e200, 0]"),
+                                          "radius: 5\n", "radius: 5\n      up: [0, 1.0e300, 1.0e300]\n"),
+                                 kSceneFile);
+  const auto& spec = std::get<MassSpringObjectSpec>(tube.objects.at(0).body);
+  EXPECT_TRUE(spec.tube.up.isApprox(Eigen::Vector3d(0, 1, 1).normalized()));
+  ASSERT_TRUE(spec.plane.has_value());
+  EXPECT_TRUE(spec.plane->normal.isApprox(diagonal));
 }
 
 TEST(MassSpringScene, TimeStepAboveTheCriticalOneIsRefusedNamingTheObject) {

@@ -7,8 +7,15 @@
 //   - against a peer that stops reading, it stays bounded: it drops superseded newest-wins
 //     frames, and when it has read again every must-arrive frame and the newest
 //     newest-wins frame arrived; with nothing it may drop, it closes the connection;
+//   - a frame the kernel does not take within the write timeout closes the connection,
+//     even when only newest-wins frames wait;
 //   - the UDP endpoint hands over the datagrams that pass the inspector and counts every
-//     other by its reason.
+//     other by its reason;
+//   - the per-source rate limit against a token-bucket model on a driven clock, and on a
+//     real socket: a flooding source is heard only at the refill rate, while an admitted
+//     peer on the same address loses nothing;
+//   - delivery over an ordered link with jitter (the server's injected delay on TCP) keeps
+//     the order of a burst: timers due at one instant, or run late, never swap two frames.
 #include <gtest/gtest.h>
 
 #include <asio.hpp>
@@ -20,10 +27,13 @@
 
 #include "net/bounded_write_queue.h"
 #include "net/datagram_endpoint.h"
+#include "net/delayed_delivery.h"
 #include "net/framed_connection.h"
+#include "net/source_rate_limiter.h"
 #include "proto/wire/frame_codec.h"
 #include "proto/wire/sealer.h"
 #include "proto/wire/session_key.h"
+#include "proto/wire/traffic_keys.h"
 
 namespace cohaptic::net {
 namespace {
@@ -144,6 +154,12 @@ struct TcpPair {
   }
 };
 
+// Both ends of these tests seal with one participant's key and open any sender's frames with it.
+wire::TrafficKey test_key() { return wire::participant_key(wire::development_key(), 0); }
+wire::FrameReader reader_with(const wire::TrafficKey& key) {
+  return wire::FrameReader([key](std::uint32_t) { return &key; });
+}
+
 wire::Control event(const std::string& kind, const std::string& text) {
   wire::Control control;
   control.mutable_event()->set_kind(kind);
@@ -152,7 +168,7 @@ wire::Control event(const std::string& kind, const std::string& text) {
 }
 
 TEST(FramedConnection, CarriesSealedFramesInOrderBothWaysAndClosesOnABadTag) {
-  const wire::SessionKey key = wire::development_key();
+  const wire::TrafficKey key = test_key();
   TcpPair pair;
   std::vector<std::string> at_server, at_client;
   std::map<std::string, CloseCause> closed;
@@ -162,8 +178,8 @@ TEST(FramedConnection, CarriesSealedFramesInOrderBothWaysAndClosesOnABadTag) {
     h.on_close = [&closed, side](CloseCause cause, const std::string&) { closed[side] = cause; };
     return h;
   };
-  auto server = FramedConnection::start(std::move(pair.server), wire::FrameReader(key), handlers(at_server, "server"));
-  auto client = FramedConnection::start(std::move(pair.client), wire::FrameReader(key), handlers(at_client, "client"));
+  auto server = FramedConnection::start(std::move(pair.server), reader_with(key), handlers(at_server, "server"));
+  auto client = FramedConnection::start(std::move(pair.client), reader_with(key), handlers(at_client, "client"));
   wire::FrameSealer server_sealer(key, kSession, 0), client_sealer(key, kSession, 1);
   for (int i = 0; i < 100; ++i) {
     wire::Control to_client = event("count", std::to_string(i)), to_server = event("count", std::to_string(-i));
@@ -190,14 +206,14 @@ TEST(FramedConnection, CarriesSealedFramesInOrderBothWaysAndClosesOnABadTag) {
 }
 
 TEST(FramedConnection, AgainstAPeerThatStopsReadingItStaysBoundedAndTheFramesThatMustArriveDo) {
-  const wire::SessionKey key = wire::development_key();
+  const wire::TrafficKey key = test_key();
   TcpPair pair(64 * 1024);  // a small receive window: the peer's kernel takes few frames
   bool sender_closed = false;
   FramedConnection::Handlers handlers;
   handlers.on_control = [](const wire::Control&) {};
   handlers.on_close = [&](CloseCause, const std::string&) { sender_closed = true; };
   pair.server.set_option(asio::socket_base::send_buffer_size(64 * 1024));
-  auto sender = FramedConnection::start(std::move(pair.server), wire::FrameReader(key), std::move(handlers));
+  auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers));
   wire::FrameSealer sealer(key, kSession, 0);
   // 200 frames of 100 kB, every 20th a must-arrive event, the rest newest-wins "IRs".
   const std::string payload(100'000, 'p');
@@ -223,7 +239,7 @@ TEST(FramedConnection, AgainstAPeerThatStopsReadingItStaysBoundedAndTheFramesTha
     received.emplace_back(control.event().kind(), std::stoi(control.event().text()));
   };
   receiving.on_close = [](CloseCause, const std::string&) {};
-  auto reader = FramedConnection::start(std::move(pair.client), wire::FrameReader(key), std::move(receiving));
+  auto reader = FramedConnection::start(std::move(pair.client), reader_with(key), std::move(receiving));
   ASSERT_TRUE(pair.run_until([&] { return !received.empty() && received.back().second == kFrames - 1; }));
   int irs = 0;
   std::vector<int> events;
@@ -241,14 +257,14 @@ TEST(FramedConnection, AgainstAPeerThatStopsReadingItStaysBoundedAndTheFramesTha
 }
 
 TEST(FramedConnection, ClosesWhenFramesThatMustArrivePileUpUnread) {
-  const wire::SessionKey key = wire::development_key();
+  const wire::TrafficKey key = test_key();
   TcpPair pair(64 * 1024);
   pair.server.set_option(asio::socket_base::send_buffer_size(64 * 1024));
   std::optional<CloseCause> cause;
   FramedConnection::Handlers handlers;
   handlers.on_control = [](const wire::Control&) {};
   handlers.on_close = [&](CloseCause c, const std::string&) { cause = c; };
-  auto sender = FramedConnection::start(std::move(pair.server), wire::FrameReader(key), std::move(handlers));
+  auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers));
   wire::FrameSealer sealer(key, kSession, 0);
   const std::string payload(100'000, 'e');
   int sent = 0;
@@ -264,13 +280,46 @@ TEST(FramedConnection, ClosesWhenFramesThatMustArrivePileUpUnread) {
   EXPECT_EQ(sender->send(Bytes(10), FrameKind::must_arrive), FramedConnection::Sent::closed);
 }
 
+
+TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWinsFramesWaiting) {
+  const wire::TrafficKey key = test_key();
+  TcpPair pair(64 * 1024);
+  pair.server.set_option(asio::socket_base::send_buffer_size(64 * 1024));
+  std::optional<CloseCause> cause;
+  std::string why;
+  FramedConnection::Handlers handlers;
+  handlers.on_control = [](const wire::Control&) {};
+  handlers.on_close = [&](CloseCause c, const std::string& w) {
+    cause = c;
+    why = w;
+  };
+  constexpr auto kTimeout = 300ms;
+  auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers), kTimeout);
+  wire::FrameSealer sealer(key, kSession, 0);
+  const std::string payload(100'000, 'i');
+  const auto started = std::chrono::steady_clock::now();
+  // Newest-wins frames only, which the queue may always drop: without the timeout it would never close.
+  while (!cause && std::chrono::steady_clock::now() - started < 10s) {
+    wire::Control control = event("ir", payload);
+    sender->send(sealer.seal(control), FrameKind::newest_wins);
+    pair.io.restart();
+    pair.io.run_for(20ms);
+  }
+  ASSERT_TRUE(cause) << "still open after 10 s";
+  EXPECT_EQ(*cause, CloseCause::write_stalled);
+  EXPECT_NE(why.find("the peer stopped reading"), std::string::npos) << why;
+  EXPECT_GE(std::chrono::steady_clock::now() - started, kTimeout) << "closed before any write could have stalled that long";
+  EXPECT_LE(sender->frames_waiting(), kMaxWaitingFrames);
+}
+
 // ---- the UDP endpoint ----
 
 TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) {
-  const wire::SessionKey key = wire::development_key();
+  const wire::TrafficKey key = test_key();
   asio::io_context io;
-  auto inspector = std::make_unique<wire::DatagramInspector>(key, kSession);
-  inspector->allow_sender(1);
+  wire::DatagramSealer user(key, kSession, 1), stranger(key, kSession, 2);
+  auto inspector = std::make_unique<wire::DatagramInspector>(kSession);
+  inspector->allow_sender(1, key, user.salt());
   DatagramEndpoint endpoint(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0), std::move(inspector));
   std::vector<std::pair<double, udp::endpoint>> received;
   endpoint.start([&](wire::Datagram&& datagram, const udp::endpoint& from, std::int64_t) {
@@ -278,7 +327,6 @@ TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) 
   });
   udp::socket peer(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
   const udp::endpoint to(asio::ip::make_address("127.0.0.1"), endpoint.port());
-  wire::DatagramSealer user(key, kSession, 1), stranger(key, kSession, 2);
   const auto tool_sample = [](double x) {
     wire::Datagram datagram;
     datagram.mutable_tool()->mutable_position()->set_x(x);
@@ -295,7 +343,7 @@ TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) 
   }
   wire::Datagram forged_datagram = tool_sample(9);
   Bytes forged = user.seal(forged_datagram);
-  forged[3] ^= 0x10;
+  forged[forged.size() - 3] ^= 0x10;
   peer.send_to(asio::buffer(forged), to);                               // bad_tag
   peer.send_to(asio::buffer(Bytes(wire::kMaxDatagramBytes + 100)), to);  // oversized, seen whole
   peer.send_to(asio::buffer(Bytes(3000)), to);                           // oversized, larger than the buffer
@@ -327,6 +375,111 @@ TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) 
   echo.resize(n);
   EXPECT_EQ(echo, first);
   EXPECT_EQ(endpoint.sent(), 1u);
+}
+
+// ---- rate limits ----
+
+TEST(SourceRateLimiter, FollowsATokenBucketPerAddressOnADrivenClock) {
+  SourceRateLimiter limiter({.burst = 4, .refill_per_s = 2, .max_sources = 2});
+  const auto a = asio::ip::make_address("10.0.0.1"), b = asio::ip::make_address("10.0.0.2"),
+             c = asio::ip::make_address("10.0.0.3");
+  constexpr std::int64_t s = 1'000'000'000;
+  // An independent model: tokens start at the burst, each failure takes one, refill 2/s.
+  double tokens = 4;
+  std::int64_t now = 0;
+  std::mt19937 rng(5);
+  int heard = 0, dropped = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const std::int64_t step = static_cast<std::int64_t>(rng() % (s / 20));
+    tokens = std::min(4.0, tokens + 2.0 * static_cast<double>(step) / static_cast<double>(s));
+    now += step;
+    const bool limited = limiter.limited(a, now);
+    ASSERT_EQ(limited, tokens < 1) << "at " << now << " ns, model tokens " << tokens;
+    if (limited) {
+      ++dropped;
+      continue;
+    }
+    ++heard;
+    limiter.charge(a, now);
+    tokens = std::max(0.0, tokens - 1);
+  }
+  // Over ~50 s, a source that always fails is heard about burst + 2/s times.
+  const double seconds = static_cast<double>(now) / static_cast<double>(s);
+  EXPECT_NEAR(heard, 4 + 2 * seconds, 2.0);
+  EXPECT_GT(dropped, heard);
+  // Other addresses are independent; a third evicts the one heard from longest ago.
+  EXPECT_FALSE(limiter.limited(b, now));
+  limiter.charge(b, now);
+  EXPECT_EQ(limiter.sources(), 2u);
+  limiter.charge(c, now + 1);
+  EXPECT_EQ(limiter.sources(), 2u);
+  EXPECT_FALSE(limiter.limited(a, now + 1)) << "a was evicted: a new source starts with a full bucket";
+}
+
+TEST(DatagramEndpoint, AFloodingSourceIsRateLimitedAndAnAdmittedPeerOnItsAddressLosesNothing) {
+  const wire::TrafficKey key = test_key();
+  asio::io_context io;
+  wire::DatagramSealer user(key, kSession, 1);
+  auto inspector = std::make_unique<wire::DatagramInspector>(kSession);
+  inspector->allow_sender(1, key, user.salt());
+  const RateLimit limit{.burst = 64, .refill_per_s = 16, .max_sources = 256};
+  DatagramEndpoint endpoint(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0), std::move(inspector), limit);
+  int received = 0;
+  endpoint.start([&](wire::Datagram&&, const udp::endpoint&, std::int64_t) { ++received; });
+  const udp::endpoint to(asio::ip::make_address("127.0.0.1"), endpoint.port());
+  udp::socket peer(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  udp::socket attacker(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  endpoint.trust(peer.local_endpoint());
+  std::mt19937 rng(9);
+  constexpr int kGarbage = 20000, kSamples = 200;
+  const auto started = std::chrono::steady_clock::now();
+  for (int i = 0; i < kGarbage; ++i) {
+    Bytes junk(40 + rng() % 200);
+    for (auto& byte : junk) byte = static_cast<std::uint8_t>(rng());
+    attacker.send_to(asio::buffer(junk), to);
+    if (i % (kGarbage / kSamples) == 0) {
+      wire::Datagram sample;
+      sample.mutable_tool()->mutable_position()->set_x(i);
+      peer.send_to(asio::buffer(user.seal(sample)), to);
+    }
+    if (i % 50 == 49) {  // let the endpoint read: the kernel's queue is finite
+      io.restart();
+      io.poll();
+    }
+  }
+  const wire::RejectionCounters& counters = endpoint.inspector().counters();
+  const auto end = std::chrono::steady_clock::now() + 10s;
+  while (counters.accepted() + counters.rejected() < kGarbage + kSamples && std::chrono::steady_clock::now() < end) {
+    io.restart();
+    io.run_for(5ms);
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  EXPECT_EQ(received, kSamples) << "an admitted peer's datagram was lost or refused";
+  EXPECT_EQ(counters.accepted() + counters.rejected(), static_cast<std::uint64_t>(kGarbage + kSamples))
+      << "the kernel dropped some: the test sends faster than it reads";
+  const std::uint64_t inspected_garbage = counters.rejected() - counters.count(wire::Rejection::rate_limited);
+  std::printf("  %d garbage datagrams in %.2f s: %lu inspected, %lu dropped unread (rate_limited); %d samples of an "
+              "admitted peer on the same address all accepted\n",
+              kGarbage, seconds, static_cast<unsigned long>(inspected_garbage),
+              static_cast<unsigned long>(counters.count(wire::Rejection::rate_limited)), received);
+  EXPECT_LE(static_cast<double>(inspected_garbage), limit.burst + limit.refill_per_s * seconds + 1);
+  EXPECT_GE(counters.count(wire::Rejection::rate_limited), static_cast<std::uint64_t>(kGarbage) - inspected_garbage);
+}
+
+// What the soak found: frames sent in a burst over the server's jittered TCP link were
+// delivered by timers that could expire out of order (each deadline was counted from its
+// own reading of the clock, and equal deadlines fire in any order), so a client received
+// an event sealed with its slot's key before the Welcome that gave it the slot.
+TEST(DelayedDelivery, AnOrderedLinkWithJitterDeliversABurstInOrder) {
+  asio::io_context io;
+  LinkDelay link({.delay_ms = 0, .jitter_ms = 10, .seed = 16}, true);
+  std::vector<int> delivered;
+  constexpr int kMessages = 5000;  // sent as fast as the loop goes: a burst, many within one jitter
+  for (int i = 0; i < kMessages; ++i)
+    ASSERT_TRUE(deliver_over(link, io, wire::monotonic_now_ns(), [&delivered, i](std::int64_t) { delivered.push_back(i); }));
+  io.run();
+  ASSERT_EQ(delivered.size(), static_cast<std::size_t>(kMessages));
+  for (int i = 0; i < kMessages; ++i) ASSERT_EQ(delivered[static_cast<std::size_t>(i)], i) << "delivered out of order";
 }
 
 }  // namespace

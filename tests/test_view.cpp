@@ -6,14 +6,20 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <mutex>
 #include <thread>
 
+#include "common/sim/loaded_columns.h"
 #include "common/sim/simulation.h"
 #include "common/util/error.h"
+#include "proto/record/recording.h"
+#include "proto/wire/header.h"
+#include "server/simulation_loop.h"
 #include "support/cube_scene.h"
+#include "support/process.h"
 #include "support/wait.h"
 #include "support/websocket_client.h"
 #include "view/live_view.h"
@@ -296,31 +302,90 @@ TEST(ReplayPlayer, ARecordingWithoutViewFramesIsRefusedSayingHowToRecordOne) {
 
 // ---- a frame, from the simulation ----
 
+// A soft cube pressed 2 mm into its top face by tool 0, with 12 step-delay nodes held: loads
+// on the contact triangle and on the held nodes.
+struct PressedCube {
+  testing::CubeRig cube;
+  Simulation simulation;
+  const Eigen::Vector3d pressing{0.003, 0.002, -0.002};
+  static testing::CubeSceneOptions soft() {
+    testing::CubeSceneOptions soft;
+    soft.divisions = 6;
+    soft.youngs_modulus = 2.0e4;
+    soft.touchable = "{surface: true}";
+    return soft;
+  }
+  static SimulationOptions options(const Model& model) {
+    SimulationOptions options;
+    options.ir = ir_build_options(model.scene.haptic);
+    options.step_delay_nodes = 12;
+    return options;
+  }
+  PressedCube()
+      : cube(soft()),
+        simulation(cube.body, cube.model->obstacles, *cube.columns, cube.model->scene.tools, options(*cube.model)) {
+    simulation.set_tool(0, pressing);
+    simulation.step(0);
+    simulation.step(0.001);
+  }
+};
+
+// ---- the state's loads, for the view's thread ----
+
+TEST(LoadedColumns, GiveTheDisplacementOfTheGatheredComplianceAndRefuseAPositionOutsideTheRows) {
+  PressedCube pressed;
+  ASSERT_TRUE(pressed.simulation.pressing(0));
+  ComplianceColumns& columns = *pressed.cube.columns;
+  const StateSolution state = pressed.simulation.solve();
+  ASSERT_FALSE(state.contact_dofs.empty());
+  ASSERT_FALSE(state.boundary_dofs.empty());
+  const std::vector<LoadedColumn> loads = loaded_columns(columns, state);
+  EXPECT_EQ(loads.size(), state.contact_dofs.size() + state.boundary_dofs.size());
+  // Every row node, in a shuffled order: against L[rows, dofs] f gathered as a block.
+  std::vector<int> nodes = columns.row_nodes();
+  std::reverse(nodes.begin(), nodes.end());
+  std::vector<int> positions;
+  for (int node : nodes) positions.push_back(columns.row_position(node));
+  const Eigen::Matrix3Xd expected = displacement_of_nodes(columns, state, nodes);
+  const Eigen::Matrix3Xd u = displacement_of_rows(loads, positions);
+  ASSERT_EQ(u.cols(), expected.cols());
+  EXPECT_GT(expected.colwise().norm().maxCoeff(), 1e-3);  // the 2 mm press moves the surface
+  EXPECT_LT((u - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+
+  const std::vector<int> outside = {columns.node_count()};
+  try {
+    displacement_of_rows(loads, outside);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(std::to_string(columns.node_count())), std::string::npos) << e.what();
+  }
+}
+
+// ---- a frame, from the simulation ----
+
 TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes) {
-  testing::CubeSceneOptions soft;
-  soft.divisions = 6;
-  soft.youngs_modulus = 2.0e4;
-  soft.touchable = "{surface: true}";
-  testing::CubeRig cube(soft);
-  SimulationOptions options;
-  options.ir = ir_build_options(cube.model->scene.haptic);
-  options.step_delay_nodes = 12;
-  Simulation simulation(cube.body, cube.model->obstacles, *cube.columns, cube.model->scene.tools, options);
-  const Eigen::Vector3d pressing(0.003, 0.002, -0.002);  // 2 mm into the top face
-  simulation.set_tool(0, pressing);
-  simulation.step(0);
-  simulation.step(0.001);
+  PressedCube pressed;
+  testing::CubeRig& cube = pressed.cube;
+  Simulation& simulation = pressed.simulation;
+  const Eigen::Vector3d pressing = pressed.pressing;
   ASSERT_TRUE(simulation.pressing(0));
 
   const ShownSurface shown = shown_surface(cube.body, cube.columns->row_nodes());
   const view::ShownIndex index(cube.body, shown);
-  const Eigen::Matrix3Xd displacement = simulation.displacement_of(shown.nodes);
+  std::vector<int> positions;
+  for (int node : shown.nodes) positions.push_back(cube.columns->row_position(node));
   const std::vector<view::ToolState> tools = {{true, pressing}, {false, Eigen::Vector3d::Zero()}};
-  const view::Frame frame = view::view_frame(simulation, index, 7, 0.001, displacement, tools, 999);
+  const view::FrameState state = view::frame_state(simulation, loaded_columns(*cube.columns, simulation.solve()), tools);
+  const view::Frame frame = view::view_frame(state, index, positions, 7, 0.001, 999);
   EXPECT_EQ(frame.sequence(), 7u);
+  EXPECT_EQ(frame.time(), 0.001);
+  EXPECT_EQ(frame.sim_rate_hz(), 999.0);
+  // The shown nodes' displacement, as the simulation solves it for the display (in float).
+  const Eigen::Matrix3Xd displacement = simulation.displacement_of(shown.nodes);
+  const double largest = displacement.cwiseAbs().maxCoeff();
   ASSERT_EQ(frame.displacement_size(), displacement.size());
   for (Eigen::Index i = 0; i < displacement.size(); ++i)
-    ASSERT_EQ(frame.displacement(static_cast<int>(i)), static_cast<float>(displacement.data()[i]));
+    ASSERT_NEAR(frame.displacement(static_cast<int>(i)), displacement.data()[i], 1e-6 * largest) << i;
   ASSERT_EQ(frame.users_size(), 2);
   const view::UserFrame& user = frame.users(0);
   EXPECT_TRUE(user.present());
@@ -351,6 +416,100 @@ TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes)
     EXPECT_NE(std::find(simulation.condensation().boundary_nodes().begin(), simulation.condensation().boundary_nodes().end(),
                         shown.nodes[held]),
               simulation.condensation().boundary_nodes().end());
+}
+
+// ---- the live view on the server's loop ----
+
+// The server's loop on the pressed cube with a live view, stepped by hand at 1 ms a step:
+// the same state as `pressed`'s simulation.
+struct ViewedLoop {
+  static ServeOptions like_pressed() {
+    ServeOptions options;
+    options.step_nodes = 12;
+    return options;
+  }
+  PressedCube pressed;
+  ServeOptions options = like_pressed();
+  ToolInputs tools{pressed.cube.model->scene.tools.size()};
+  LoopStatistics statistics;
+  view::LiveView live;
+  SimulationLoop loop;
+  std::int64_t now_ns = wire::monotonic_now_ns();
+  explicit ViewedLoop(record::SessionRecorder* recorder)
+      : live(*pressed.cube.model, *pressed.cube.columns, wire::P0, {}, {}, recorder),
+        loop(*pressed.cube.model, std::array{pressed.cube.columns.get()}, options, tools, statistics, nullptr, &live,
+             recorder, now_ns) {
+    tools.join(0);
+    live.start();
+  }
+  void run(double seconds) {
+    for (int k = 0; k < static_cast<int>(seconds * 1000); ++k) {
+      now_ns += 1'000'000;
+      tools.update(0, true, pressed.pressing, now_ns, now_ns);
+      loop.step(now_ns);
+    }
+  }
+};
+
+TEST(LiveView, BuildsNoFrameWhileNobodyWatchesAndTheSimulationsStateForABrowser) {
+  ViewedLoop session(nullptr);
+  session.run(0.5);  // 15 frame periods
+  EXPECT_EQ(session.live.frames_built(), 0u);
+
+  auto browser = std::make_unique<WebSocketClient>("ws://127.0.0.1:" + std::to_string(session.live.port()) + "/ws");
+  ASSERT_TRUE(browser->wait_open(testing::kPatience));
+  ASSERT_TRUE(testing::wait_until([&] { return session.live.counters().browsers == 1; }, "the browser counted"));
+  session.run(0.2);
+  ASSERT_TRUE(testing::wait_until([&] { return browser->message_count() >= 2; }, "the scene and a frame"));
+  EXPECT_GE(session.live.frames_built(), 1u);
+  EXPECT_LE(session.live.frames_built(), 7u);  // at most one per 1/30 s of the 0.2 s stepped
+  view::ServerMessage message;
+  ASSERT_TRUE(message.ParseFromString(browser->last_message()));
+  ASSERT_TRUE(message.has_frame());
+  const view::Frame& frame = message.frame();
+  // The state the loop stepped: tool 0 pressing where it was put, the surface pressed as a
+  // simulation of its own solves it.
+  ASSERT_EQ(frame.users_size(), 2);
+  EXPECT_TRUE(frame.users(0).present());
+  EXPECT_TRUE(frame.users(0).pressing());
+  EXPECT_FALSE(frame.users(1).present());
+  EXPECT_EQ(frame.users(0).position(2), static_cast<float>(session.pressed.pressing.z()));
+  const ShownSurface shown = shown_surface(session.pressed.cube.body, session.pressed.cube.columns->row_nodes());
+  const Eigen::Matrix3Xd expected = session.pressed.simulation.displacement_of(shown.nodes);
+  ASSERT_EQ(frame.displacement_size(), expected.size());
+  double largest = 0;
+  for (float each : frame.displacement()) largest = std::max(largest, std::abs(static_cast<double>(each)));
+  EXPECT_NEAR(largest, expected.cwiseAbs().maxCoeff(), 1e-5 * largest);
+
+  // Gone again: no more frames.
+  browser.reset();
+  ASSERT_TRUE(testing::wait_until([&] { return session.live.counters().browsers == 0; }, "the browser gone"));
+  const std::uint64_t built = session.live.frames_built();
+  session.run(0.5);
+  EXPECT_EQ(session.live.frames_built(), built);
+  session.live.stop();
+}
+
+TEST(LiveView, ARecordedSessionGetsItsFramesWithoutABrowser) {
+  const std::filesystem::path file = testing::scratch_directory("live_view_recorded") / "server.mcap";
+  {
+    record::SessionRecorder recorder(file);
+    ViewedLoop session(&recorder);
+    // A frame period at a time (33 steps of 1 ms, one frame due in each), each frame built
+    // before the next is due: stepped faster than real time, a state the view's thread has
+    // not taken yet would be replaced by the newer.
+    for (std::uint64_t frame = 1; frame <= 15; ++frame) {
+      session.run(0.033);
+      ASSERT_TRUE(testing::wait_until([&] { return session.live.frames_built() == frame; }, "the period's frame"));
+    }
+    session.live.stop();
+    recorder.close();
+  }
+  const record::Recording recording = record::read_recording(file);
+  ASSERT_EQ(recording.view_frames.size(), 15u);
+  for (std::size_t k = 1; k < recording.view_frames.size(); ++k)
+    EXPECT_EQ(recording.view_frames[k].sequence(), recording.view_frames[k - 1].sequence() + 1);
+  EXPECT_TRUE(recording.view_frames.back().users(0).pressing());
 }
 
 }  // namespace

@@ -1,6 +1,9 @@
-// The wire layer (proto/wire/): session keys, authentication tags, the datagram codec and
-// its replay window and rejection counters (every reason with a hand-made hostile packet,
-// and random garbage), the TCP frame reader, and the IR and surface conversions.
+// The wire layer (proto/wire/): key files (both kinds, and the modes refused), traffic-key
+// derivation against BLAKE2b computed directly, the AEAD seal against libsodium's own
+// XChaCha20-Poly1305 over the documented nonce, the datagram codec with its replay window
+// and rejection counters (every reason with a hand-made hostile packet, another slot's
+// key, and random garbage), the TCP frame reader with the greeting, and the IR and surface
+// conversions.
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 #include <sodium.h>
@@ -22,13 +25,16 @@
 #include "common/ir/evaluate_force.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
-#include "proto/wire/authenticated.h"
+#include "proto/wire/aead.h"
 #include "proto/wire/datagram_codec.h"
+#include "proto/wire/envelope.h"
 #include "proto/wire/frame_codec.h"
 #include "proto/wire/header.h"
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/replay_window.h"
+#include "proto/wire/sealer.h"
 #include "proto/wire/session_key.h"
+#include "proto/wire/traffic_keys.h"
 #include "support/cube_scene.h"
 #include "support/evaluate_static.h"
 
@@ -37,14 +43,15 @@ namespace {
 
 using Bytes = std::vector<std::uint8_t>;
 constexpr std::uint64_t kSession = 0x5e5510'0001;
+constexpr std::uint64_t kSalt = 0x5a17'0000'0000'00abull;
 
-SessionKey key_of(std::uint8_t seed) {
-  SessionKey key;
+TrafficKey key_of(std::uint8_t seed) {
+  TrafficKey key;
   for (std::size_t i = 0; i < key.bytes.size(); ++i) key.bytes[i] = static_cast<std::uint8_t>(seed + 7 * i);
   return key;
 }
 
-// ---- session keys ----
+// ---- key files ----
 
 class TempDir {
  public:
@@ -60,9 +67,13 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-void write_text(const std::filesystem::path& file, const std::string& text) {
-  std::ofstream out(file, std::ios::binary);
-  out << text;
+// Writes a key file with `mode` (0600 unless said otherwise: key files must be private).
+void write_text(const std::filesystem::path& file, const std::string& text, ::mode_t mode = 0600) {
+  {
+    std::ofstream out(file, std::ios::binary);
+    out << text;
+  }
+  ::chmod(file.c_str(), mode);
 }
 
 std::string error_of(const std::function<void()>& f) {
@@ -74,7 +85,7 @@ std::string error_of(const std::function<void()>& f) {
   return "(no error)";
 }
 
-TEST(WireSessionKey, LoadsHexWithWhitespaceInEitherCase) {
+TEST(WireKeyFile, LoadsHexWithWhitespaceInEitherCase) {
   TempDir dir;
   write_text(dir / "key.txt", "  00112233445566778899AABBCCDDEEFF\n\t00112233445566778899aabbccddeeff  \r\n");
   const SessionKey key = load_session_key(dir / "key.txt");
@@ -85,7 +96,7 @@ TEST(WireSessionKey, LoadsHexWithWhitespaceInEitherCase) {
   EXPECT_EQ(to_hex(key), "00112233445566778899aabbccddeeff00112233445566778899aabbccddeeff");
 }
 
-TEST(WireSessionKey, RejectsMalformedFilesNamingFileAndProblem) {
+TEST(WireKeyFile, RejectsMalformedFilesNamingFileAndProblem) {
   TempDir dir;
   write_text(dir / "short.txt", "0123456789ab\n");
   const std::string short_error = error_of([&] { load_session_key(dir / "short.txt"); });
@@ -103,11 +114,37 @@ TEST(WireSessionKey, RejectsMalformedFilesNamingFileAndProblem) {
   write_text(dir / "zero.txt", std::string(64, '0'));
   EXPECT_NE(error_of([&] { load_session_key(dir / "zero.txt"); }).find("all zeros"), std::string::npos);
 
+  write_text(dir / "slot.txt", "participant two\n" + std::string(64, 'a'));
+  const std::string slot_error = error_of([&] { load_key_file(dir / "slot.txt"); });
+  EXPECT_NE(slot_error.find("slot.txt: line 1: expected `participant K`"), std::string::npos) << slot_error;
+  write_text(dir / "slot_hex.txt", "participant 2\n" + std::string(63, 'a') + "x");
+  const std::string slot_hex_error = error_of([&] { load_key_file(dir / "slot_hex.txt"); });
+  EXPECT_NE(slot_hex_error.find("'x' at line 2 column 64"), std::string::npos) << slot_hex_error;
+
   const std::string missing = error_of([&] { load_session_key(dir / "missing.txt"); });
   EXPECT_NE(missing.find("missing.txt"), std::string::npos) << missing;
+  const std::string directory = error_of([&] { load_session_key(dir / ""); });
+  EXPECT_NE(directory.find("regular file"), std::string::npos) << directory;
 }
 
-TEST(WireSessionKey, WritesFreshPrivateRandomKeys) {
+TEST(WireKeyFile, RefusesAKeyFileItsGroupOrOthersMayUse) {
+  TempDir dir;
+  const std::string hex(64, 'c');
+  for (const ::mode_t mode : {0644, 0640, 0604, 0660, 0602, 0610, 0601}) {
+    const std::string name = fmt::format("key-{:o}", mode);
+    write_text(dir / name, hex, mode);
+    const std::string error = error_of([&] { load_key_file(dir / name); });
+    EXPECT_NE(error.find(fmt::format("mode {:04o}", mode)), std::string::npos) << error;
+    EXPECT_NE(error.find("chmod 600"), std::string::npos) << error;
+  }
+  for (const ::mode_t mode : {0600, 0400}) {
+    write_text(dir / "private", hex, mode);
+    EXPECT_EQ(to_hex(load_session_key(dir / "private")), hex) << fmt::format("mode {:o}", mode);
+    std::filesystem::remove(dir / "private");
+  }
+}
+
+TEST(WireKeyFile, WritesFreshPrivateRandomKeys) {
   TempDir dir;
   write_session_key(dir / "a.key");
   write_session_key(dir / "b.key");
@@ -123,41 +160,147 @@ TEST(WireSessionKey, WritesFreshPrivateRandomKeys) {
   EXPECT_EQ(load_session_key(dir / "a.key").bytes, a.bytes);
 }
 
-TEST(WireSessionKey, DevelopmentKeyIsTheDocumentedText) {
+TEST(WireKeyFile, ParticipantKeyFilesHoldTheSlotAndItsDerivedKey) {
+  TempDir dir;
+  write_session_key(dir / "session.key");
+  const SessionKey session = load_session_key(dir / "session.key");
+  write_participant_key(dir / "alice.key", session, 3);
+  struct stat st {};
+  ASSERT_EQ(::stat((dir / "alice.key").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+  std::ifstream in(dir / "alice.key");
+  std::string first_line;
+  std::getline(in, first_line);
+  EXPECT_EQ(first_line, "participant 3");
+  const auto loaded = load_key_file(dir / "alice.key");
+  ASSERT_TRUE(std::holds_alternative<ParticipantKey>(loaded));
+  EXPECT_EQ(std::get<ParticipantKey>(loaded).slot, 3u);
+  EXPECT_EQ(std::get<ParticipantKey>(loaded).key.bytes, participant_key(session, 3).bytes);
+  // The server needs the session key: a participant's file is refused, naming its slot.
+  const std::string error = error_of([&] { load_session_key(dir / "alice.key"); });
+  EXPECT_NE(error.find("participant 3's key file"), std::string::npos) << error;
+  EXPECT_TRUE(std::holds_alternative<SessionKey>(load_key_file(dir / "session.key")));
+}
+
+TEST(WireKeyFile, DevelopmentKeyIsTheDocumentedText) {
   const std::string text = "cohaptic-development-key-public!";
   const SessionKey key = development_key();
   EXPECT_EQ(std::string(key.bytes.begin(), key.bytes.end()), text);
   EXPECT_EQ(to_hex(key), "636f6861707469632d646576656c6f706d656e742d6b65792d7075626c696321");
 }
 
-// ---- authentication ----
+// ---- traffic keys ----
 
-TEST(WireAuthenticated, TagIsHmacSha512TruncatedTo256Bits) {
-  const SessionKey key = key_of(3);
-  const Bytes payload = {1, 2, 3, 4, 5, 250, 0, 17};
-  const Bytes packet = seal(payload, key);
-  ASSERT_EQ(packet.size(), payload.size() + kTagBytes);
-  EXPECT_TRUE(std::equal(payload.begin(), payload.end(), packet.begin()));
-  // Independently: the first 32 bytes of HMAC-SHA-512 with the same 32-byte key.
-  std::array<std::uint8_t, crypto_auth_hmacsha512_BYTES> full{};
-  crypto_auth_hmacsha512_state state;
-  crypto_auth_hmacsha512_init(&state, key.bytes.data(), key.bytes.size());
-  crypto_auth_hmacsha512_update(&state, payload.data(), payload.size());
-  crypto_auth_hmacsha512_final(&state, full.data());
-  EXPECT_TRUE(std::equal(full.begin(), full.begin() + kTagBytes, packet.begin() + static_cast<long>(payload.size())));
+// crypto_kdf as documented, computed directly: BLAKE2b-256 keyed with the master key, the
+// sender id as the little-endian salt, "cohaptic" as the personalisation.
+std::array<std::uint8_t, 32> blake2b_kdf(const SessionKey& master, std::uint64_t id) {
+  std::array<std::uint8_t, crypto_generichash_blake2b_SALTBYTES> salt{};
+  for (int i = 0; i < 8; ++i) salt[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(id >> (8 * i));
+  std::array<std::uint8_t, crypto_generichash_blake2b_PERSONALBYTES> personal{};
+  std::memcpy(personal.data(), "cohaptic", 8);
+  std::array<std::uint8_t, 32> out{};
+  crypto_generichash_blake2b_salt_personal(out.data(), out.size(), nullptr, 0, master.bytes.data(), master.bytes.size(),
+                                           salt.data(), personal.data());
+  return out;
+}
 
-  const auto opened = open(packet, key);
+TEST(WireTrafficKeys, EachSenderHasItsOwnKeyDerivedAsDocumented) {
+  const SessionKey session = development_key();
+  std::set<std::array<std::uint8_t, 32>> keys;
+  for (std::uint32_t slot = 0; slot < 8; ++slot) {
+    const TrafficKey key = participant_key(session, slot);
+    EXPECT_EQ(key.bytes, blake2b_kdf(session, slot + 1)) << "slot " << slot;
+    keys.insert(key.bytes);
+  }
+  EXPECT_EQ(joining_key(session).bytes, blake2b_kdf(session, kJoiningSender));
+  keys.insert(joining_key(session).bytes);
+  keys.insert(session.bytes);
+  EXPECT_EQ(keys.size(), 10u);  // all different, and none is the session key itself
+  SessionKey other = session;
+  other.bytes[31] ^= 1;
+  EXPECT_NE(participant_key(other, 0).bytes, participant_key(session, 0).bytes);
+}
+
+TEST(WireTrafficKeys, AParticipantKeyOpensItsOwnSlotOnlyAndTheSessionKeyAny) {
+  const SessionKey session = development_key();
+  const ClientKeys holder(session);
+  EXPECT_FALSE(holder.fixed_slot());
+  EXPECT_EQ(holder.join_sender(), kJoiningSender);
+  EXPECT_EQ(holder.join_key().bytes, joining_key(session).bytes);
+  EXPECT_EQ(holder.slot_key(5)->bytes, participant_key(session, 5).bytes);
+
+  const ClientKeys participant(ParticipantKey{2, participant_key(session, 2)});
+  EXPECT_EQ(participant.fixed_slot(), 2u);
+  EXPECT_EQ(participant.join_sender(), sender_of_slot(2));
+  EXPECT_EQ(participant.join_key().bytes, participant_key(session, 2).bytes);
+  EXPECT_EQ(participant.slot_key(2)->bytes, participant_key(session, 2).bytes);
+  EXPECT_FALSE(participant.slot_key(1));
+}
+
+// ---- sealing ----
+
+TEST(WireAead, SealIsXChaCha20Poly1305OverTheDocumentedNonce) {
+  const TrafficKey key = key_of(3);
+  const Envelope envelope{kProtocolVersion, kEncryptedFlag, 7, 0x0102030405060708ull, 0x1112131415161718ull};
+  const Bytes body = {1, 2, 3, 4, 5, 250, 0, 17};
+  Bytes message(kEnvelopeBytes + body.size() + kTagBytes);
+  write_envelope(envelope, message.data());
+  std::copy(body.begin(), body.end(), message.begin() + kEnvelopeBytes);
+  seal_in_place(message, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key, true);
+  EXPECT_FALSE(std::equal(body.begin(), body.end(), message.begin() + kEnvelopeBytes));  // encrypted
+
+  // The documented layout of the envelope and the nonce, byte by byte.
+  EXPECT_EQ(Bytes(message.begin(), message.begin() + kEnvelopeBytes),
+            (Bytes{3, 1, 7, 0, 0, 0, 8, 7, 6, 5, 4, 3, 2, 1, 0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11}));
+  const Bytes nonce = {8, 7, 6, 5, 4, 3, 2, 1, 7, 0, 0, 0, 1, 0, 0, 0, 0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11};
+  // Independently: libsodium's combined decryption with that nonce and the envelope as associated data.
+  Bytes plain(body.size());
+  unsigned long long plain_size = 0;
+  ASSERT_EQ(crypto_aead_xchacha20poly1305_ietf_decrypt(plain.data(), &plain_size, nullptr, message.data() + kEnvelopeBytes,
+                                                       body.size() + kTagBytes, message.data(), kEnvelopeBytes,
+                                                       nonce.data(), key.bytes.data()),
+            0);
+  EXPECT_EQ(plain, body);
+
+  Bytes scratch(body.size());
+  const auto opened = open_sealed(message, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key, true, scratch);
   ASSERT_TRUE(opened);
-  EXPECT_TRUE(std::equal(opened->begin(), opened->end(), payload.begin(), payload.end()));
-  EXPECT_FALSE(open(packet, key_of(4)));
-  EXPECT_FALSE(open(std::span(packet).first(kTagBytes - 1), key));
-  Bytes flipped = packet;
-  flipped[2] ^= 0x01;
-  EXPECT_FALSE(open(flipped, key));
-  // An empty payload has a tag too.
-  const Bytes empty_packet = seal({}, key);
-  ASSERT_TRUE(open(empty_packet, key));
-  EXPECT_TRUE(open(empty_packet, key)->empty());
+  EXPECT_TRUE(std::equal(opened->begin(), opened->end(), body.begin(), body.end()));
+  // Another key, channel, or any byte flipped: refused.
+  EXPECT_FALSE(open_sealed(message, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key_of(4), true, scratch));
+  EXPECT_FALSE(open_sealed(message, kEnvelopeBytes, make_nonce(Channel::frame, envelope), key, true, scratch));
+  for (std::size_t i = 0; i < message.size(); ++i) {
+    Bytes flipped = message;
+    flipped[i] ^= 0x04;
+    EXPECT_FALSE(open_sealed(flipped, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key, true, scratch)) << i;
+  }
+}
+
+TEST(WireAead, InClearTheBodyIsReadableAndStillAuthenticated) {
+  const TrafficKey key = key_of(3);
+  const Envelope envelope{kProtocolVersion, 0, 1, kSalt, 9};
+  const Bytes body = {9, 8, 7, 6};
+  Bytes message(kEnvelopeBytes + body.size() + kTagBytes);
+  write_envelope(envelope, message.data());
+  std::copy(body.begin(), body.end(), message.begin() + kEnvelopeBytes);
+  seal_in_place(message, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key, false);
+  EXPECT_TRUE(std::equal(body.begin(), body.end(), message.begin() + kEnvelopeBytes));
+  const Nonce nonce = make_nonce(Channel::datagram, envelope);
+  // The tag is the AEAD's over an empty message with everything before it as associated data.
+  EXPECT_EQ(crypto_aead_xchacha20poly1305_ietf_decrypt_detached(nullptr, nullptr, message.data(), 0,
+                                                                message.data() + message.size() - kTagBytes, message.data(),
+                                                                message.size() - kTagBytes, nonce.data(), key.bytes.data()),
+            0);
+  ASSERT_TRUE(open_sealed(message, kEnvelopeBytes, nonce, key, false, {}));
+  Bytes changed = message;
+  changed[kEnvelopeBytes] ^= 1;
+  EXPECT_FALSE(open_sealed(changed, kEnvelopeBytes, nonce, key, false, {}));
+}
+
+TEST(WireAead, EverySealerDrawsItsOwnSalt) {
+  std::set<std::uint64_t> salts;
+  for (int i = 0; i < 1000; ++i) salts.insert(DatagramSealer(key_of(1), kSession, 1).salt());
+  EXPECT_EQ(salts.size(), 1000u);
 }
 
 // ---- header ----
@@ -203,6 +346,10 @@ TEST(WireReplayWindow, AcceptsNewAndInWindowUnseenRejectsDuplicatesAndOld) {
   EXPECT_FALSE(window.accept(102));
   window.reset();
   EXPECT_TRUE(window.accept(5));
+  window.start_after(40);  // a sender that said its last was 40
+  for (std::uint64_t old : {0, 1, 39, 40}) EXPECT_FALSE(window.fresh(old)) << old;
+  EXPECT_TRUE(window.accept(42));
+  EXPECT_TRUE(window.accept(41));
 }
 
 TEST(WireReplayWindow, MatchesASetOfSeenSequencesUnderRandomReordering) {
@@ -237,7 +384,7 @@ Datagram tool_datagram(std::uint64_t sequence, std::uint32_t sender = 1, std::ui
   h->set_sender_time_ns(123456789);
   ToolSample* tool = d.mutable_tool();
   tool->set_user(sender - 1);
-  tool->set_sample_time_ns(-42);
+  tool->set_sample_time_ns(42);
   tool->mutable_position()->set_x(0.01);
   tool->mutable_position()->set_y(-0.02);
   tool->mutable_position()->set_z(-0.003);
@@ -246,12 +393,28 @@ Datagram tool_datagram(std::uint64_t sequence, std::uint32_t sender = 1, std::ui
   return d;
 }
 
+// Arbitrary body bytes sealed behind `envelope`, as a datagram or (with a length) a frame.
+Bytes sealed(const Bytes& body, const Envelope& envelope, const TrafficKey& key, Channel channel = Channel::datagram) {
+  const std::size_t clear = channel == Channel::frame ? kFrameClearBytes : kEnvelopeBytes;
+  Bytes out(clear + body.size() + kTagBytes);
+  if (channel == Channel::frame) write_le(body.size(), kFrameLengthBytes, out.data());
+  write_envelope(envelope, out.data() + clear - kEnvelopeBytes);
+  std::copy(body.begin(), body.end(), out.begin() + static_cast<long>(clear));
+  seal_in_place(out, clear, make_nonce(channel, envelope), key, envelope.encrypted());
+  return out;
+}
+
+// Two users: slot 0 (sender 1) and slot 1 (sender 2), each with its own key and sealer.
 struct InspectorRig {
-  SessionKey key = key_of(1);
-  DatagramInspector inspector{key, kSession};
+  SessionKey session = development_key();
+  TrafficKey key = participant_key(session, 0), key2 = participant_key(session, 1);
+  DatagramInspector inspector{kSession};
   InspectorRig() {
-    inspector.allow_sender(1);
-    inspector.allow_sender(2);
+    inspector.allow_sender(1, key, kSalt);
+    inspector.allow_sender(2, key2, kSalt + 1);
+  }
+  Bytes encode(const Datagram& d) const {
+    return encode_datagram(d, {d.header().sender() == 2 ? key2 : key, d.header().sender() == 2 ? kSalt + 1 : kSalt});
   }
 };
 
@@ -269,18 +432,24 @@ void expect_outcome(DatagramInspector& inspector, const Bytes& bytes, std::optio
     EXPECT_EQ(count - before.at(name), name == expected_name ? 1u : 0u) << what << ": counter " << name;
 }
 
-TEST(WireDatagram, RoundTripsEveryBody) {
-  const SessionKey key = key_of(1);
+TEST(WireDatagram, RoundTripsEveryBodyBehindTheDocumentedEnvelope) {
+  const TrafficKey key = key_of(1);
   Datagram tool = tool_datagram(7);
-  const Bytes bytes = encode_datagram(tool, key);
-  EXPECT_LE(bytes.size(), kMaxDatagramBytes);
+  const Bytes bytes = encode_datagram(tool, {key, kSalt});
+  EXPECT_EQ(bytes.size(), kEnvelopeBytes + tool.ByteSizeLong() + kTagBytes);
+  const Envelope envelope = *read_envelope(bytes);
+  EXPECT_EQ(envelope.version, kProtocolVersion);
+  EXPECT_TRUE(envelope.encrypted());
+  EXPECT_EQ(envelope.sender, 1u);
+  EXPECT_EQ(envelope.salt, kSalt);
+  EXPECT_EQ(envelope.sequence, 7u);
   auto decoded = decode_datagram(bytes, key, kSession);
   ASSERT_TRUE(std::holds_alternative<Datagram>(decoded));
   const Datagram& d = std::get<Datagram>(decoded);
   EXPECT_EQ(d.header().sequence(), 7u);
   EXPECT_EQ(d.header().sender_time_ns(), 123456789);
   EXPECT_EQ(d.tool().position().y(), -0.02);
-  EXPECT_EQ(d.tool().sample_time_ns(), -42);
+  EXPECT_EQ(d.tool().sample_time_ns(), 42);
   EXPECT_EQ(d.tool().buttons(), 5u);
   EXPECT_TRUE(d.tool().valid());
 
@@ -290,7 +459,7 @@ TEST(WireDatagram, RoundTripsEveryBody) {
   to_wire(Eigen::Vector3d(0.5, -1.25, 3.0), force.mutable_force()->mutable_force());
   force.mutable_force()->set_ir_epoch(12);
   force.mutable_force()->set_flags(3);
-  decoded = decode_datagram(encode_datagram(force, key), key);
+  decoded = decode_datagram(encode_datagram(force, {key, kSalt}), key);
   ASSERT_TRUE(std::holds_alternative<Datagram>(decoded));
   EXPECT_EQ(from_wire(std::get<Datagram>(decoded).force().force()), Eigen::Vector3d(0.5, -1.25, 3.0));
   EXPECT_EQ(std::get<Datagram>(decoded).force().ir_epoch(), 12u);
@@ -298,16 +467,24 @@ TEST(WireDatagram, RoundTripsEveryBody) {
   Datagram pong;
   *pong.mutable_header() = tool.header();
   pong.mutable_pong()->set_client_send_ns(1);
-  pong.mutable_pong()->set_server_receive_ns(std::numeric_limits<std::int64_t>::max());
-  pong.mutable_pong()->set_server_send_ns(-3);
-  decoded = decode_datagram(encode_datagram(pong, key), key);
+  pong.mutable_pong()->set_server_receive_ns(kMaxClockNs - 1);
+  pong.mutable_pong()->set_server_send_ns(0);
+  decoded = decode_datagram(encode_datagram(pong, {key, kSalt}), key);
   ASSERT_TRUE(std::holds_alternative<Datagram>(decoded));
-  EXPECT_EQ(std::get<Datagram>(decoded).pong().server_receive_ns(), std::numeric_limits<std::int64_t>::max());
+  EXPECT_EQ(std::get<Datagram>(decoded).pong().server_receive_ns(), kMaxClockNs - 1);
 
   // The in-place encoder produces the same bytes.
   Bytes reused;
-  encode_datagram(tool, key, reused);
+  encode_datagram(tool, {key, kSalt}, reused);
   EXPECT_EQ(reused, bytes);
+
+  // In clear: the serialized message lies readable behind the envelope, and decodes only
+  // where clear datagrams are allowed.
+  const Bytes clear = encode_datagram(tool, {key, kSalt, false});
+  const std::string serialized = tool.SerializeAsString();
+  EXPECT_EQ(std::memcmp(serialized.data(), clear.data() + kEnvelopeBytes, serialized.size()), 0);
+  EXPECT_EQ(std::get<Rejection>(decode_datagram(clear, key)), Rejection::cleartext);
+  EXPECT_TRUE(std::holds_alternative<Datagram>(decode_datagram(clear, key, kSession, true)));
 }
 
 TEST(WireDatagram, EncoderRefusesOversizedDatagrams) {
@@ -317,14 +494,14 @@ TEST(WireDatagram, EncoderRefusesOversizedDatagrams) {
   big.mutable_pong();
   // Unknown fields are kept and counted: grow the message past the limit with one.
   big.mutable_pong()->GetReflection()->MutableUnknownFields(big.mutable_pong())->AddLengthDelimited(99, std::string(1400, 'x'));
-  EXPECT_THROW(encode_datagram(big, key_of(1)), cohaptic::Error);
+  EXPECT_THROW(encode_datagram(big, {key_of(1), kSalt}), cohaptic::Error);
 }
 
 TEST(WireDatagramInspector, AcceptsValidDatagramsAndCountsThem) {
   InspectorRig rig;
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1), rig.key), std::nullopt, "first");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(2), rig.key), std::nullopt, "second");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1, 2), rig.key), std::nullopt, "other sender");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(1)), std::nullopt, "first");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(2)), std::nullopt, "second");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(1, 2)), std::nullopt, "other sender");
   EXPECT_EQ(rig.inspector.counters().accepted(), 3u);
   EXPECT_EQ(rig.inspector.counters().rejected(), 0u);
   const auto snapshot = rig.inspector.counters().snapshot();
@@ -334,105 +511,162 @@ TEST(WireDatagramInspector, AcceptsValidDatagramsAndCountsThem) {
 
 TEST(WireDatagramInspector, RejectsEachHostileDatagramForItsReason) {
   InspectorRig rig;
-  const Bytes valid = encode_datagram(tool_datagram(10), rig.key);
+  const Datagram ten = tool_datagram(10);
+  const Bytes valid = rig.encode(ten);
+  const std::string serialized = ten.SerializeAsString();
+  const Bytes body(serialized.begin(), serialized.end());
+  const Envelope envelope{kProtocolVersion, kEncryptedFlag, 1, kSalt, 10};
 
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(10), key_of(2)), Rejection::bad_tag, "wrong key");
-  for (std::size_t i : {std::size_t{0}, valid.size() / 2, valid.size() - kTagBytes - 1, valid.size() - 1}) {
+  // Identity: another key, and slot 1's own key claiming slot 0.
+  expect_outcome(rig.inspector, encode_datagram(ten, {key_of(2), kSalt}), Rejection::bad_tag, "wrong key");
+  expect_outcome(rig.inspector, encode_datagram(ten, {rig.key2, kSalt}), Rejection::bad_tag, "slot 1's key, slot 0's name");
+  for (std::size_t i : {std::size_t{0} + 2, std::size_t{6}, std::size_t{14}, valid.size() / 2, valid.size() - 1}) {
     Bytes flipped = valid;
     flipped[i] ^= 0x20;
-    expect_outcome(rig.inspector, flipped, Rejection::bad_tag, fmt::format("flipped byte {}", i));
+    const Rejection expected = i == 2 ? Rejection::unknown_sender : Rejection::bad_tag;  // byte 2: the sender's name
+    expect_outcome(rig.inspector, flipped, expected, fmt::format("flipped byte {}", i));
   }
-  for (std::size_t length : {std::size_t{0}, std::size_t{1}, kTagBytes - 1})
+  // Size.
+  for (std::size_t length : {std::size_t{0}, std::size_t{1}, kDatagramOverheadBytes - 1})
     expect_outcome(rig.inspector, Bytes(valid.begin(), valid.begin() + static_cast<long>(length)), Rejection::truncated,
                    fmt::format("truncated to {}", length));
-  // Longer cuts lose the tag's alignment: the tail no longer authenticates the head.
-  for (std::size_t length : {kTagBytes, kTagBytes + 5, valid.size() - 1})
+  for (std::size_t length : {kDatagramOverheadBytes, valid.size() - 1})  // the tag no longer where it was
     expect_outcome(rig.inspector, Bytes(valid.begin(), valid.begin() + static_cast<long>(length)), Rejection::bad_tag,
                    fmt::format("cut to {}", length));
-  // Authentic bytes that are not a Datagram (field 1 with the invalid wire type 7).
-  expect_outcome(rig.inspector, seal(Bytes{0x0f, 0x01, 0x02}, rig.key), Rejection::truncated, "unparsable payload");
-  // An authentic payload cut short inside a field.
-  {
-    Datagram d = tool_datagram(10);
-    std::string serialized = d.SerializeAsString();
-    serialized.resize(serialized.size() - 3);
-    expect_outcome(rig.inspector, seal(Bytes(serialized.begin(), serialized.end()), rig.key), Rejection::truncated,
-                   "payload cut inside a field");
-  }
   Bytes oversized = valid;
   oversized.resize(kMaxDatagramBytes + 1, 0);
   expect_outcome(rig.inspector, oversized, Rejection::oversized, "oversized");
-  expect_outcome(rig.inspector, seal(Bytes(kMaxDatagramBytes - kTagBytes + 1, 0), rig.key), Rejection::oversized,
-                 "oversized with a valid tag");
-
+  expect_outcome(rig.inspector, sealed(Bytes(kMaxDatagramBytes - kDatagramOverheadBytes + 1, 0), envelope, rig.key),
+                 Rejection::oversized, "oversized with a valid tag");
+  // Versions and flags: a protocol 1 or 2 datagram starts with its protobuf (0x0a), not an envelope.
+  Bytes v1 = body;
+  v1.resize(v1.size() + 32, 0xab);
+  expect_outcome(rig.inspector, v1, Rejection::bad_version, "protocol 1 or 2");
+  Envelope newer = envelope;
+  newer.version = kProtocolVersion + 1;
+  expect_outcome(rig.inspector, sealed(body, newer, rig.key), Rejection::bad_version, "a newer envelope version");
+  Envelope flagged = envelope;
+  flagged.flags |= 0x80;
+  expect_outcome(rig.inspector, sealed(body, flagged, rig.key), Rejection::bad_version, "unknown flag");
   Datagram version = tool_datagram(11);
-  version.mutable_header()->set_protocol_version(kProtocolVersion - 1);  // an older peer
-  expect_outcome(rig.inspector, encode_datagram(version, rig.key), Rejection::bad_version, "an older version");
-  Datagram headless = tool_datagram(11);
-  headless.clear_header();
-  expect_outcome(rig.inspector, encode_datagram(headless, rig.key), Rejection::bad_version, "no header");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11, 1, kSession + 1), rig.key), Rejection::wrong_session,
-                 "wrong session");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11, 7), rig.key), Rejection::unknown_sender,
+  version.mutable_header()->set_protocol_version(kProtocolVersion - 1);  // an older peer, in a new envelope
+  expect_outcome(rig.inspector, rig.encode(version), Rejection::bad_version, "an older sealed header version");
+  // In clear, where encryption is required.
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11), {rig.key, kSalt, false}), Rejection::cleartext, "clear");
+  // Authentic bytes that are not a Datagram (field 1 with the invalid wire type 7), or cut inside a field.
+  expect_outcome(rig.inspector, sealed(Bytes{0x0f, 0x01, 0x02}, envelope, rig.key), Rejection::truncated, "unparsable");
+  expect_outcome(rig.inspector, sealed(Bytes(body.begin(), body.end() - 3), envelope, rig.key), Rejection::truncated,
+                 "body cut inside a field");
+  // The sealed header must name the envelope's sender and sequence.
+  Envelope other_sequence = envelope;
+  other_sequence.sequence = 11;
+  expect_outcome(rig.inspector, sealed(body, other_sequence, rig.key), Rejection::bad_tag, "sequence disagrees");
+  const std::string from_two = tool_datagram(10, 2).SerializeAsString();
+  expect_outcome(rig.inspector, sealed(Bytes(from_two.begin(), from_two.end()), envelope, rig.key), Rejection::bad_tag,
+                 "sender disagrees");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(11, 1, kSession + 1)), Rejection::wrong_session, "wrong session");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11, 7), {rig.key, kSalt}), Rejection::unknown_sender,
                  "unknown sender");
+  // Authentic, but sealed by another sealer than the one the sender announced (a restarted peer's old traffic).
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11), {rig.key, kSalt + 9}), Rejection::replayed, "other salt");
 
   Datagram nan = tool_datagram(12);
   nan.mutable_tool()->mutable_position()->set_y(std::numeric_limits<double>::quiet_NaN());
-  expect_outcome(rig.inspector, encode_datagram(nan, rig.key), Rejection::non_finite, "NaN tool position");
+  expect_outcome(rig.inspector, rig.encode(nan), Rejection::non_finite, "NaN tool position");
   Datagram invalid_nan = nan;
   invalid_nan.mutable_tool()->set_valid(false);
-  expect_outcome(rig.inspector, encode_datagram(invalid_nan, rig.key), Rejection::non_finite, "NaN in an invalid sample");
+  expect_outcome(rig.inspector, rig.encode(invalid_nan), Rejection::non_finite, "NaN in an invalid sample");
   Datagram inf;
   *inf.mutable_header() = tool_datagram(13).header();
   to_wire(Eigen::Vector3d(0, std::numeric_limits<double>::infinity(), 0), inf.mutable_force()->mutable_force());
-  expect_outcome(rig.inspector, encode_datagram(inf, rig.key), Rejection::non_finite, "infinite force");
+  expect_outcome(rig.inspector, rig.encode(inf), Rejection::non_finite, "infinite force");
 
   Datagram empty = tool_datagram(14);
   empty.clear_body();
-  expect_outcome(rig.inspector, encode_datagram(empty, rig.key), Rejection::empty, "no body");
+  expect_outcome(rig.inspector, rig.encode(empty), Rejection::empty, "no body");
+
+  // Clock readings outside [0, 2^61) ns: found by review while fuzzing, a pong's INT64_MIN
+  // overflowed the client's clock offset arithmetic (undefined behaviour).
+  constexpr std::int64_t kMin = std::numeric_limits<std::int64_t>::min(), kMax = std::numeric_limits<std::int64_t>::max();
+  Datagram early = tool_datagram(15);
+  early.mutable_header()->set_sender_time_ns(-1);
+  expect_outcome(rig.inspector, rig.encode(early), Rejection::bad_time, "negative sender time");
+  Datagram sample = tool_datagram(15);
+  sample.mutable_tool()->set_sample_time_ns(kMaxClockNs);
+  expect_outcome(rig.inspector, rig.encode(sample), Rejection::bad_time, "sample time at 2^61");
+  Datagram ping;
+  *ping.mutable_header() = tool_datagram(15).header();
+  ping.mutable_ping()->set_client_send_ns(kMin);
+  expect_outcome(rig.inspector, rig.encode(ping), Rejection::bad_time, "ping at INT64_MIN");
+  for (int field = 0; field < 3; ++field) {
+    Datagram pong;
+    *pong.mutable_header() = tool_datagram(15).header();
+    pong.mutable_pong()->set_client_send_ns(field == 0 ? kMin : 1);
+    pong.mutable_pong()->set_server_receive_ns(field == 1 ? kMax : 2);
+    pong.mutable_pong()->set_server_send_ns(field == 2 ? -3 : 3);
+    expect_outcome(rig.inspector, rig.encode(pong), Rejection::bad_time, "pong field " + std::to_string(field));
+  }
+  Datagram answer;
+  *answer.mutable_header() = tool_datagram(15).header();
+  answer.mutable_force()->set_tool_time_ns(kMax);
+  expect_outcome(rig.inspector, rig.encode(answer), Rejection::bad_time, "force answering INT64_MAX");
 
   // None of the rejected packets moved the window: the valid one is still fresh, once.
   expect_outcome(rig.inspector, valid, std::nullopt, "valid");
   expect_outcome(rig.inspector, valid, Rejection::replayed, "the same bytes again");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(100), rig.key), std::nullopt, "jump to 100");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(36), rig.key), Rejection::replayed, "older than the window");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(37), rig.key), std::nullopt, "oldest in the window");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(100)), std::nullopt, "jump to 100");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(36)), Rejection::replayed, "older than the window");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(37)), std::nullopt, "oldest in the window");
 }
 
 TEST(WireDatagramInspector, AcceptsReorderedFreshSequencesAndKeepsWindowsPerSender) {
   InspectorRig rig;
   for (std::uint64_t s : {20, 23, 21, 22, 5})
-    expect_outcome(rig.inspector, encode_datagram(tool_datagram(s), rig.key), std::nullopt, fmt::format("sequence {}", s));
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(21), rig.key), Rejection::replayed, "21 again");
+    expect_outcome(rig.inspector, rig.encode(tool_datagram(s)), std::nullopt, fmt::format("sequence {}", s));
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(21)), Rejection::replayed, "21 again");
   // Sender 2 has its own window.
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(21, 2), rig.key), std::nullopt, "21 from sender 2");
-  // A slot taken over by a new user starts afresh.
-  rig.inspector.allow_sender(1);
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1), rig.key), std::nullopt, "new user in slot 0");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(21, 2)), std::nullopt, "21 from sender 2");
+  // A slot taken over by a new user (a new sealer, that said its last sequence was 3) starts afresh.
+  rig.inspector.allow_sender(1, rig.key, kSalt + 5, 3);
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(3), {rig.key, kSalt + 5}), Rejection::replayed, "3: its last");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(4), {rig.key, kSalt + 5}), std::nullopt, "4: new user");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(30)), Rejection::replayed, "the old user's sealer");
   rig.inspector.forget_sender(2);
   EXPECT_FALSE(rig.inspector.allows(2));
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(22, 2), rig.key), Rejection::unknown_sender, "forgotten");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(22, 2)), Rejection::unknown_sender, "forgotten");
 }
 
 TEST(WireDatagramInspector, RejectedPacketsNeverAdvanceTheWindow) {
   InspectorRig rig;
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(5), rig.key), std::nullopt, "5");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(5)), std::nullopt, "5");
   Datagram far_nan = tool_datagram(1000);
   far_nan.mutable_tool()->mutable_position()->set_x(std::numeric_limits<double>::infinity());
-  expect_outcome(rig.inspector, encode_datagram(far_nan, rig.key), Rejection::non_finite, "authentic but infinite");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1000), key_of(9)), Rejection::bad_tag, "forged");
+  expect_outcome(rig.inspector, rig.encode(far_nan), Rejection::non_finite, "authentic but infinite");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1000), {key_of(9), kSalt}), Rejection::bad_tag, "forged");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1000), {rig.key, kSalt + 1}), Rejection::replayed, "other salt");
   EXPECT_EQ(*rig.inspector.window(1)->highest(), 5u);
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(6), rig.key), std::nullopt, "6 still fresh");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(6)), std::nullopt, "6 still fresh");
 }
 
 TEST(WireDatagramInspector, ExpectedSessionCanBeLearnedOrIgnored) {
-  const SessionKey key = key_of(1);
-  DatagramInspector inspector(key);  // no session expected yet
-  inspector.allow_sender(kServerSender);
-  expect_outcome(inspector, encode_datagram(tool_datagram(1, kServerSender, 77), key), std::nullopt, "any session");
+  const TrafficKey key = key_of(1);
+  DatagramInspector inspector;  // no session expected yet
+  inspector.allow_sender(kServerSender, key, kSalt);
+  expect_outcome(inspector, encode_datagram(tool_datagram(1, kServerSender, 77), {key, kSalt}), std::nullopt, "any session");
   inspector.set_expected_session(78);
-  expect_outcome(inspector, encode_datagram(tool_datagram(2, kServerSender, 77), key), Rejection::wrong_session, "77");
-  expect_outcome(inspector, encode_datagram(tool_datagram(3, kServerSender, 78), key), std::nullopt, "78");
+  expect_outcome(inspector, encode_datagram(tool_datagram(2, kServerSender, 77), {key, kSalt}), Rejection::wrong_session, "77");
+  expect_outcome(inspector, encode_datagram(tool_datagram(3, kServerSender, 78), {key, kSalt}), std::nullopt, "78");
+}
+
+TEST(WireDatagramInspector, AcceptsDatagramsInClearOnlyWhereAllowed) {
+  const TrafficKey key = key_of(1);
+  DatagramInspector lenient(kSession, true);
+  lenient.allow_sender(1, key, kSalt);
+  expect_outcome(lenient, encode_datagram(tool_datagram(1), {key, kSalt, false}), std::nullopt, "clear, allowed");
+  expect_outcome(lenient, encode_datagram(tool_datagram(2), {key, kSalt, true}), std::nullopt, "encrypted, always");
+  Bytes tampered = encode_datagram(tool_datagram(3), {key, kSalt, false});
+  tampered[kEnvelopeBytes + 5] ^= 1;  // readable, but not changeable
+  expect_outcome(lenient, tampered, Rejection::bad_tag, "clear, tampered");
 }
 
 TEST(WireDatagramInspector, RandomBytesAndMutationsNeverThrowNorPassAsAuthentic) {
@@ -443,14 +677,18 @@ TEST(WireDatagramInspector, RandomBytesAndMutationsNeverThrowNorPassAsAuthentic)
   for (int i = 0; i < 20000; ++i) {
     Bytes garbage(length(rng));
     for (auto& b : garbage) b = static_cast<std::uint8_t>(byte(rng));
+    if (i % 2 && garbage.size() >= kEnvelopeBytes) {  // half with a well-formed envelope naming an allowed sender
+      write_envelope({kProtocolVersion, kEncryptedFlag, 1 + static_cast<std::uint32_t>(i % 4 == 1), rng(), rng()}, garbage.data());
+    }
     std::optional<Datagram> result;
     ASSERT_NO_THROW(result = rig.inspector.inspect(garbage));
     ASSERT_FALSE(result);
   }
   EXPECT_EQ(rig.inspector.counters().accepted(), 0u);
   EXPECT_EQ(rig.inspector.counters().rejected(), 20000u);
+  EXPECT_GT(rig.inspector.counters().count(Rejection::bad_tag), 4000u);  // the envelopes led as far as the tag
 
-  const Bytes valid = encode_datagram(tool_datagram(50), rig.key);
+  const Bytes valid = rig.encode(tool_datagram(50));
   ASSERT_TRUE(rig.inspector.inspect(valid));
   int identical = 0;
   for (int i = 0; i < 20000; ++i) {
@@ -477,7 +715,8 @@ TEST(WireDatagramInspector, RandomBytesAndMutationsNeverThrowNorPassAsAuthentic)
       EXPECT_EQ(rig.inspector.last_rejection(), Rejection::replayed);
     } else {
       const Rejection r = *rig.inspector.last_rejection();
-      ASSERT_TRUE(r == Rejection::bad_tag || r == Rejection::truncated || r == Rejection::oversized)
+      ASSERT_TRUE(r == Rejection::bad_tag || r == Rejection::truncated || r == Rejection::oversized ||
+                  r == Rejection::bad_version || r == Rejection::cleartext || r == Rejection::unknown_sender)
           << "mutation " << i << ": " << to_string(r);
     }
   }
@@ -486,76 +725,98 @@ TEST(WireDatagramInspector, RandomBytesAndMutationsNeverThrowNorPassAsAuthentic)
   EXPECT_EQ(rig.inspector.counters().count(Rejection::replayed), static_cast<std::uint64_t>(identical));
 }
 
-TEST(WireDatagramInspector, AuthenticGarbagePayloadsNeverThrow) {
+TEST(WireDatagramInspector, AuthenticGarbageBodiesNeverThrow) {
   // A peer holding the key but sending nonsense: parse and every later check must hold.
   InspectorRig rig;
   std::mt19937 rng(7);
   const std::string valid = tool_datagram(1).SerializeAsString();
   for (int i = 0; i < 20000; ++i) {
-    Bytes payload(valid.begin(), valid.end());
+    Bytes body(valid.begin(), valid.end());
     if (i % 2) {
-      payload.resize(rng() % 64);
-      for (auto& b : payload) b = static_cast<std::uint8_t>(rng());
+      body.resize(rng() % 64);
+      for (auto& b : body) b = static_cast<std::uint8_t>(rng());
     } else {
-      for (int k = 0; k < 3; ++k) payload[rng() % payload.size()] = static_cast<std::uint8_t>(rng());
+      for (int k = 0; k < 3; ++k) body[rng() % body.size()] = static_cast<std::uint8_t>(rng());
     }
-    ASSERT_NO_THROW(rig.inspector.inspect(seal(payload, rig.key)));
+    const Envelope envelope{kProtocolVersion, kEncryptedFlag, 1, kSalt, 1 + static_cast<std::uint64_t>(i)};
+    ASSERT_NO_THROW(rig.inspector.inspect(sealed(body, envelope, rig.key)));
   }
   const RejectionCounters& c = rig.inspector.counters();
   EXPECT_EQ(c.accepted() + c.rejected(), 20000u);
-  EXPECT_EQ(c.count(Rejection::bad_tag), 0u);
 }
 
 TEST(WireDatagramInspector, RejectionNamesAreTheEnumerators) {
   std::set<std::string> names;
   for (Rejection r : kAllRejections) names.insert(std::string(to_string(r)));
   EXPECT_EQ(names, (std::set<std::string>{"oversized", "truncated", "bad_tag", "bad_version", "wrong_session",
-                                          "unknown_sender", "replayed", "non_finite", "empty"}));
+                                          "unknown_sender", "replayed", "non_finite", "empty", "cleartext",
+                                          "rate_limited", "bad_time"}));
 }
 
 // ---- TCP frames ----
 
-Control control_with(std::uint64_t sequence, const std::string& text) {
+Control control_with(std::uint64_t sequence, const std::string& text, std::uint32_t sender = kServerSender) {
   Control c;
   Header* h = c.mutable_header();
   h->set_protocol_version(kProtocolVersion);
   h->set_session(kSession);
+  h->set_sender(sender);
   h->set_sequence(sequence);
   c.mutable_event()->set_kind("test");
   c.mutable_event()->set_text(text);
   return c;
 }
 
-std::string frame_error(FrameReader& reader) {
+// A reader that opens the server's frames with `key`.
+FrameReader reader_for(const TrafficKey& key, FrameReaderOptions options = {}) {
+  return FrameReader([key](std::uint32_t sender) { return sender == kServerSender ? &key : nullptr; }, options);
+}
+
+Bytes frame_of(const Control& c, const TrafficKey& key, std::uint64_t salt = kSalt, bool encrypt = true) {
+  return encode_frame(c, {key, salt, encrypt});
+}
+
+// The error the reader throws once fed, and its reason.
+std::pair<std::string, std::optional<Rejection>> frame_error(FrameReader& reader) {
   try {
     while (reader.next()) {
     }
   } catch (const FrameError& e) {
-    return e.what();
+    return {e.what(), e.reason()};
   }
-  return "(no error)";
+  return {"(no error)", std::nullopt};
 }
 
-TEST(WireFrame, LayoutIsLengthPayloadTag) {
-  const SessionKey key = key_of(5);
+TEST(WireFrame, LayoutIsLengthEnvelopeSealedBodyTag) {
+  const TrafficKey key = key_of(5);
   const Control c = control_with(1, "hello");
-  const Bytes frame = encode_frame(c, key);
-  const std::string payload = c.SerializeAsString();
-  ASSERT_EQ(frame.size(), 4 + payload.size() + kTagBytes);
-  EXPECT_EQ(frame[0] | frame[1] << 8 | frame[2] << 16 | frame[3] << 24, static_cast<int>(payload.size()));
-  EXPECT_EQ(Bytes(frame.begin() + 4, frame.end() - kTagBytes), Bytes(payload.begin(), payload.end()));
-  const auto tag = authentication_tag(std::span(frame).first(4 + payload.size()), key);
-  EXPECT_TRUE(std::equal(tag.begin(), tag.end(), frame.end() - kTagBytes));
+  const Bytes frame = frame_of(c, key);
+  const std::string body = c.SerializeAsString();
+  ASSERT_EQ(frame.size(), 4 + kEnvelopeBytes + body.size() + kTagBytes);
+  EXPECT_EQ(frame[0] | frame[1] << 8 | frame[2] << 16 | frame[3] << 24, static_cast<int>(body.size()));
+  const Envelope envelope = *read_envelope(std::span(frame).subspan(4));
+  EXPECT_EQ(envelope.sequence, 1u);
+  EXPECT_EQ(envelope.sender, kServerSender);
+  EXPECT_EQ(envelope.salt, kSalt);
+  // Encrypted: the body is not readable; libsodium opens it with the length and envelope as associated data.
+  EXPECT_NE(Bytes(frame.begin() + kFrameClearBytes, frame.end() - kTagBytes), Bytes(body.begin(), body.end()));
+  Bytes plain(body.size());
+  const Nonce nonce = make_nonce(Channel::frame, envelope);
+  ASSERT_EQ(crypto_aead_xchacha20poly1305_ietf_decrypt(plain.data(), nullptr, nullptr, frame.data() + kFrameClearBytes,
+                                                       body.size() + kTagBytes, frame.data(), kFrameClearBytes,
+                                                       nonce.data(), key.bytes.data()),
+            0);
+  EXPECT_EQ(plain, Bytes(body.begin(), body.end()));
 }
 
 TEST(WireFrame, ReaderReassemblesOneByteFeedsAndSeveralFramesPerFeed) {
-  const SessionKey key = key_of(5);
+  const TrafficKey key = key_of(5);
   Bytes stream;
   for (int i = 1; i <= 3; ++i) {
-    const Bytes frame = encode_frame(control_with(static_cast<std::uint64_t>(i), std::string(100 * static_cast<std::size_t>(i), static_cast<char>('a' + i))), key);
+    const Bytes frame = frame_of(control_with(static_cast<std::uint64_t>(i), std::string(100 * static_cast<std::size_t>(i), static_cast<char>('a' + i))), key);
     stream.insert(stream.end(), frame.begin(), frame.end());
   }
-  FrameReader slow(key);
+  FrameReader slow = reader_for(key);
   std::vector<Control> received;
   for (std::uint8_t b : stream) {
     slow.feed(std::span(&b, 1));
@@ -568,7 +829,7 @@ TEST(WireFrame, ReaderReassemblesOneByteFeedsAndSeveralFramesPerFeed) {
   }
   EXPECT_EQ(slow.buffered(), 0u);
 
-  FrameReader fast(key);
+  FrameReader fast = reader_for(key);
   fast.feed(stream);
   for (int i = 1; i <= 3; ++i) {
     std::optional<Control> c = fast.next();
@@ -578,7 +839,7 @@ TEST(WireFrame, ReaderReassemblesOneByteFeedsAndSeveralFramesPerFeed) {
   EXPECT_FALSE(fast.next());
 
   // Arbitrary chunking, with a partial frame left over.
-  FrameReader chunked(key);
+  FrameReader chunked = reader_for(key);
   std::mt19937 rng(3);
   std::size_t at = 0, got = 0;
   while (at < stream.size() - 10) {
@@ -594,92 +855,161 @@ TEST(WireFrame, ReaderReassemblesOneByteFeedsAndSeveralFramesPerFeed) {
   EXPECT_FALSE(chunked.next());
 }
 
+TEST(WireFrame, TheClientsReaderTakesTheGreetingFirst) {
+  const TrafficKey key = key_of(5);
+  const Challenge challenge = random_challenge();
+  const Bytes greeting = encode_greeting(challenge);
+  ASSERT_EQ(greeting.size(), kGreetingBytes);
+  EXPECT_EQ(std::string(greeting.begin(), greeting.begin() + 8), "cohaptic");
+  EXPECT_EQ(greeting[8], kProtocolVersion);
+  Bytes stream = greeting;
+  const Bytes frame = frame_of(control_with(1, "after"), key);
+  stream.insert(stream.end(), frame.begin(), frame.end());
+  FrameReader reader = reader_for(key, {.expect_greeting = true});
+  for (std::uint8_t b : stream) {  // byte by byte
+    reader.feed(std::span(&b, 1));
+    if (std::optional<Control> c = reader.next()) {
+      if (c->has_hello()) {
+        EXPECT_TRUE(is_challenge(c->hello().challenge(), challenge));
+      } else {
+        EXPECT_EQ(c->event().text(), "after");
+      }
+    }
+  }
+  EXPECT_FALSE(is_challenge(std::string(16, 'x'), challenge));
+
+  // A peer of another version, or none at all.
+  Bytes other_version = greeting;
+  other_version[8] = 4;
+  FrameReader newer = reader_for(key, {.expect_greeting = true});
+  newer.feed(other_version);
+  const auto [newer_error, newer_reason] = frame_error(newer);
+  EXPECT_EQ(newer_reason, Rejection::bad_version);
+  EXPECT_NE(newer_error.find("speaks protocol version 4, this program 3"), std::string::npos) << newer_error;
+  FrameReader silent = reader_for(key, {.expect_greeting = true});
+  silent.feed(frame);  // a server that sends a frame first is no cohaptic 3 server
+  EXPECT_EQ(frame_error(silent).second, Rejection::bad_version);
+  // The server's reader takes no greeting: one is garbage to it.
+  FrameReader server = reader_for(key);
+  server.feed(greeting);
+  EXPECT_EQ(frame_error(server).second, Rejection::oversized);  // "coha" read as a length
+}
+
 TEST(WireFrame, ReaderCarriesAnIrAcrossTheStream) {
-  const SessionKey key = key_of(5);
+  const TrafficKey key = key_of(5);
   Control c = control_with(1, "");
   c.mutable_ir()->set_format_version(2);
   for (int i = 0; i < 100000; ++i) c.mutable_ir()->mutable_fem()->add_m_tilde_f64(i * 0.5);
-  FrameReader reader(key);
-  reader.feed(encode_frame(c, key));
+  FrameReader reader = reader_for(key);
+  reader.feed(frame_of(c, key));
   const std::optional<Control> received = reader.next();
   ASSERT_TRUE(received);
   ASSERT_EQ(received->ir().fem().m_tilde_f64_size(), 100000);
   EXPECT_EQ(received->ir().fem().m_tilde_f64(99999), 99999 * 0.5);
 }
 
-TEST(WireFrame, ReaderRejectsOversizedLengthBeforeReceivingThePayload) {
-  FrameReader reader(key_of(5), 1000);
+TEST(WireFrame, ReaderRejectsOversizedLengthBeforeReceivingTheBody) {
+  FrameReader reader = reader_for(key_of(5), {.max_body_bytes = 1000});
   const Bytes length = {0xe9, 0x03, 0x00, 0x00};  // 1001
   reader.feed(length);
-  const std::string error = frame_error(reader);
-  EXPECT_NE(error.find("declared payload length 1001 exceeds the limit of 1000"), std::string::npos) << error;
+  const auto [error, reason] = frame_error(reader);
+  EXPECT_EQ(reason, Rejection::oversized);
+  EXPECT_NE(error.find("declared body length 1001 exceeds the limit of 1000"), std::string::npos) << error;
   // Sticky: the stream cannot be resynchronised.
-  reader.feed(encode_frame(control_with(1, "x"), key_of(5)));
+  reader.feed(frame_of(control_with(1, "x"), key_of(5)));
   EXPECT_THROW(reader.next(), FrameError);
 
-  FrameReader default_limit(key_of(5));
+  FrameReader default_limit = reader_for(key_of(5));
   default_limit.feed(Bytes{0xff, 0xff, 0xff, 0xff});
-  EXPECT_NE(frame_error(default_limit).find("exceeds the limit of 67108864"), std::string::npos);
+  EXPECT_NE(frame_error(default_limit).first.find("exceeds the limit of 67108864"), std::string::npos);
 }
 
-TEST(WireFrame, ReaderRejectsCorruptedTagsWrongKeysAndBadPayloads) {
-  const SessionKey key = key_of(5);
-  Bytes frame = encode_frame(control_with(1, "hello"), key);
-  frame[frame.size() - 1] ^= 0x80;
-  FrameReader corrupted(key);
-  corrupted.feed(frame);
-  EXPECT_NE(frame_error(corrupted).find("bad authentication tag"), std::string::npos);
+TEST(WireFrame, ReaderRejectsEachHostileFrameForItsReason) {
+  const TrafficKey key = key_of(5);
+  const auto reason_of = [&](const Bytes& bytes, FrameReaderOptions options = {}) {
+    FrameReader reader = reader_for(key, options);
+    reader.feed(bytes);
+    return frame_error(reader);
+  };
+  Bytes corrupted = frame_of(control_with(1, "hello"), key);
+  corrupted[corrupted.size() - 1] ^= 0x80;
+  const auto [corrupted_error, corrupted_reason] = reason_of(corrupted);
+  EXPECT_EQ(corrupted_reason, Rejection::bad_tag);
+  EXPECT_NE(corrupted_error.find("bad authentication tag"), std::string::npos) << corrupted_error;
 
-  Bytes length_changed = encode_frame(control_with(1, "hello"), key);
-  length_changed.push_back(0);  // one more byte, and the length claims it: the tag no longer matches
-  length_changed[0] = static_cast<std::uint8_t>(length_changed[0] + 1);
-  FrameReader lengthened(key);
-  lengthened.feed(length_changed);
-  EXPECT_NE(frame_error(lengthened).find("bad authentication tag"), std::string::npos);
+  Bytes lengthened = frame_of(control_with(1, "hello"), key);
+  lengthened.push_back(0);  // one more byte, and the length claims it: the tag no longer matches
+  lengthened[0] = static_cast<std::uint8_t>(lengthened[0] + 1);
+  EXPECT_EQ(reason_of(lengthened).second, Rejection::bad_tag);
+  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello"), key_of(6))).second, Rejection::bad_tag);  // wrong key
+  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello", 4), key)).second, Rejection::unknown_sender);
+  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello"), key, kSalt, false)).second, Rejection::cleartext);
+  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello"), key, kSalt, false), {.allow_cleartext = true}).second, std::nullopt);
 
-  FrameReader wrong_key(key);
-  wrong_key.feed(encode_frame(control_with(1, "hello"), key_of(6)));
-  EXPECT_NE(frame_error(wrong_key).find("bad authentication tag"), std::string::npos);
+  // A protocol 1 or 2 frame: [length][protobuf starting 0x0a][HMAC].
+  const std::string v1_body = control_with(1, "old").SerializeAsString();
+  Bytes v1(4, 0);
+  write_le(v1_body.size(), 4, v1.data());
+  v1.insert(v1.end(), v1_body.begin(), v1_body.end());
+  v1.resize(v1.size() + 32, 0x55);
+  const auto [v1_error, v1_reason] = reason_of(v1);
+  EXPECT_EQ(v1_reason, Rejection::bad_version);
+  EXPECT_NE(v1_error.find("envelope version byte 10"), std::string::npos) << v1_error;
 
-  // An authentic frame whose payload is not a Control.
-  Bytes garbage = {3, 0, 0, 0, 0x0f, 0x01, 0x02};
-  const auto tag = authentication_tag(garbage, key);
-  garbage.insert(garbage.end(), tag.begin(), tag.end());
-  FrameReader unparsable(key);
-  unparsable.feed(garbage);
-  EXPECT_NE(frame_error(unparsable).find("not a Control message"), std::string::npos);
-}
-
-TEST(WireFrame, ReaderChecksVersionBodyAndSequence) {
-  const SessionKey key = key_of(5);
-  Control v2 = control_with(1, "x");
-  v2.mutable_header()->set_protocol_version(kProtocolVersion - 1);
-  FrameReader version(key);
-  version.feed(encode_frame(v2, key));
-  EXPECT_NE(frame_error(version).find(fmt::format("protocol version {}, expected {}", kProtocolVersion - 1, kProtocolVersion)),
-            std::string::npos);
-
+  const Envelope envelope{kProtocolVersion, kEncryptedFlag, kServerSender, kSalt, 1};
+  const auto [parse_error, parse_reason] = reason_of(sealed(Bytes{0x0f, 0x01, 0x02}, envelope, key, Channel::frame));
+  EXPECT_EQ(parse_reason, Rejection::truncated);
+  EXPECT_NE(parse_error.find("not a Control message"), std::string::npos) << parse_error;
+  const std::string body = control_with(2, "x").SerializeAsString();
+  EXPECT_EQ(reason_of(sealed(Bytes(body.begin(), body.end()), envelope, key, Channel::frame)).second, Rejection::bad_tag)
+      << "sealed sequence 2, envelope 1";
+  Control v1_header = control_with(1, "x");
+  v1_header.mutable_header()->set_protocol_version(kProtocolVersion - 1);
+  EXPECT_EQ(reason_of(frame_of(v1_header, key)).second, Rejection::bad_version);
   Control bodiless = control_with(1, "x");
   bodiless.clear_body();
-  FrameReader empty(key);
-  empty.feed(encode_frame(bodiless, key));
-  EXPECT_NE(frame_error(empty).find("without a body"), std::string::npos);
+  const auto [empty_error, empty_reason] = reason_of(frame_of(bodiless, key));
+  EXPECT_EQ(empty_reason, Rejection::empty);
+  EXPECT_NE(empty_error.find("without a body"), std::string::npos);
+}
 
-  FrameReader replay(key);
-  replay.feed(encode_frame(control_with(4, "x"), key));
-  replay.feed(encode_frame(control_with(9, "x"), key));
-  replay.feed(encode_frame(control_with(9, "x"), key));
+TEST(WireFrame, AStreamIsOneSealersStrictlyIncreasingSequence) {
+  const TrafficKey key = key_of(5);
+  FrameReader replay = reader_for(key);
+  replay.feed(frame_of(control_with(4, "x"), key));
+  replay.feed(frame_of(control_with(9, "x"), key));
+  replay.feed(frame_of(control_with(9, "x"), key));
   EXPECT_TRUE(replay.next());
   EXPECT_TRUE(replay.next());
-  EXPECT_NE(frame_error(replay).find("sequence 9 is not above the previous frame's 9"), std::string::npos);
+  const auto [error, reason] = frame_error(replay);
+  EXPECT_EQ(reason, Rejection::replayed);
+  EXPECT_NE(error.find("sequence 9 is not above the previous frame's 9"), std::string::npos) << error;
+
+  // A frame of another connection's sealer, however new its sequence, is refused.
+  FrameReader spliced = reader_for(key);
+  spliced.feed(frame_of(control_with(1, "x"), key));
+  spliced.feed(frame_of(control_with(100, "x"), key, kSalt + 1));
+  EXPECT_TRUE(spliced.next());
+  EXPECT_EQ(frame_error(spliced).second, Rejection::replayed);
+
+  // The key may change within the stream (after a join), the sealer not.
+  TrafficKey current = key_of(1);
+  FrameReader rekeyed([&current](std::uint32_t) { return &current; });
+  rekeyed.feed(frame_of(control_with(1, "x", kJoiningSender), key_of(1)));
+  ASSERT_TRUE(rekeyed.next());
+  EXPECT_EQ(rekeyed.last_sender(), kJoiningSender);
+  current = key_of(2);
+  rekeyed.feed(frame_of(control_with(2, "y", 3), key_of(2)));
+  ASSERT_TRUE(rekeyed.next());
+  EXPECT_EQ(rekeyed.last_sender(), 3u);
 }
 
 TEST(WireFrame, ReaderSurvivesRandomStreams) {
-  const SessionKey key = key_of(5);
+  const TrafficKey key = key_of(5);
   std::mt19937 rng(17);
-  const Bytes valid = encode_frame(control_with(1, "hello"), key);
+  const Bytes valid = frame_of(control_with(1, "hello"), key);
   for (int i = 0; i < 2000; ++i) {
-    FrameReader reader(key, 4096);
+    FrameReader reader = reader_for(key, {.expect_greeting = i % 3 == 0, .max_body_bytes = 4096});
     Bytes stream = valid;
     if (i % 2) {
       stream.resize(rng() % 200);
@@ -779,12 +1109,12 @@ void expect_same_ir(const cohaptic::IntermediateRepresentation& envelope_a,
 
 // Through bytes, as it travels: to_wire, a Control frame, FrameReader, from_wire.
 cohaptic::IntermediateRepresentation through_the_wire(const cohaptic::IntermediateRepresentation& ir) {
-  const SessionKey key = key_of(8);
+  const TrafficKey key = key_of(8);
   Control control;
   HeaderStamp(kSession, kServerSender).stamp(*control.mutable_header());
   to_wire(ir, control.mutable_ir());
-  FrameReader reader(key);
-  reader.feed(encode_frame(control, key));
+  FrameReader reader = reader_for(key);
+  reader.feed(frame_of(control, key));
   std::optional<Control> received = reader.next();
   EXPECT_TRUE(received);
   return from_wire(received->ir());

@@ -2,18 +2,23 @@
 // live view"). It owns the ViewServer (view_server.h, its own thread) and turns what the
 // server has into view.proto messages:
 //   - the Scene, once (built at construction; recorded as /view_scene with --record);
-//   - a Frame every 1/rate s, from the simulation thread: publish_frame() builds it from the
-//     step's state and the displacement the loop solved, and hands it over newest-wins, so
-//     the simulation never waits on a browser (recorded as /view_frames);
+//   - a Frame every 1/rate s while a browser watches or the session is recorded (nothing is
+//     computed for a view nobody watches): the simulation thread hands over the step's
+//     FrameState (view_messages.h: tools, forces, held nodes, the state's loads), newest
+//     wins, and the view's own thread computes the surface's displacement, encodes, records
+//     (/view_frames) and sends the frame, so the simulation neither waits on a browser nor
+//     spends its time on the drawing;
 //   - the Status, from the I/O thread, whenever a user reports (publish_status()).
 // Units: m, N, s, as view.proto.
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -57,28 +62,47 @@ class LiveView {
   std::uint16_t port() const { return server_.port(); }
   ViewCounters counters() const { return server_.counters(); }
 
-  /// The nodes whose displacement publish_frame() expects, in order.
-  const std::vector<int>& nodes() const { return shown_.nodes; }
-  /// True when a frame is due at `now_ns` (simulation thread).
-  bool frame_due(std::int64_t now_ns) const { return now_ns - last_frame_ns_ >= period_ns_; }
-  /// Builds, records and publishes the frame of the state after a step (simulation thread):
-  /// `steps` is the loop's count so far, for the rate shown.
-  void publish_frame(std::int64_t now_ns, double time, const Simulation& simulation, const Eigen::Matrix3Xd& displacement,
-                     const std::vector<ToolState>& tools, std::uint64_t steps);
+  /// True when a frame is due at `now_ns` and someone will have it: a browser is connected,
+  /// or the session is recorded (simulation thread). Frames are due every 1/rate s on
+  /// average, whatever the steps' length (none to catch up after a gap).
+  bool frame_due(std::int64_t now_ns) const {
+    return now_ns >= next_frame_ns_ && (recorder_ || server_.watched());
+  }
+  /// Hands over the state after a step at `now_ns` (simulation thread; `steps`: the loop's
+  /// count so far, for the rate shown). The frame is built, recorded and sent on the view's
+  /// thread; a state still waiting there is replaced by this one (that frame is neither
+  /// sent nor recorded).
+  void publish_frame(std::int64_t now_ns, double time, FrameState state, std::uint64_t steps);
+  /// Frames built so far (any thread).
+  std::uint64_t frames_built() const { return sequence_.load(); }
   /// A user's status report (I/O thread).
   void publish_status(int slot, const std::string& user, const wire::ClientStatus& status, double time);
 
  private:
+  struct PendingFrame {
+    std::int64_t time_ns = 0;
+    double time = 0, sim_rate_hz = 0;
+    FrameState state;
+  };
+  void build_frame();  // the view's thread
+
   ShownSurface shown_;
   ShownIndex index_;
+  std::vector<int> row_positions_;  // of the shown nodes, in the compliance columns
   record::SessionRecorder* recorder_;
   std::int64_t period_ns_;
-  ViewServer server_;
   // Simulation thread.
-  std::int64_t last_frame_ns_ = 0;
-  std::uint64_t sequence_ = 0, last_steps_ = 0;
+  std::int64_t last_frame_ns_ = 0, next_frame_ns_ = 0;
+  std::uint64_t last_steps_ = 0;
+  // Handed from the simulation thread to the view's.
+  std::mutex pending_mutex_;
+  std::optional<PendingFrame> pending_;
+  // The view's thread (read anywhere).
+  std::atomic<std::uint64_t> sequence_{0};
   // I/O thread.
   std::map<int, UserStatus> statuses_;
+  // Last: its thread, which uses the members above, ends before they go.
+  ViewServer server_;
 };
 
 /// A ServerMessage holding `body` (one of view.proto's message types), serialized.

@@ -54,6 +54,8 @@ ReplayPlayer::ReplayPlayer(const record::Recording& recording)
   }
   std::stable_sort(statuses_.begin(), statuses_.end(), [](const auto& a, const auto& b) { return a.time < b.time; });
 
+  // A recording without forces (or with none finite) jumps to its start, never outside it.
+  peak_force_time_ = largest_step_time_ = frames_.front().time();
   double peak = -1, largest_step = -1;
   for (std::size_t k = 0; k < frames_.size(); ++k)
     for (int u = 0; u < frames_[k].users_size(); ++u) {

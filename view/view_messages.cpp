@@ -66,38 +66,52 @@ int ShownIndex::of_tag(std::int64_t tag) const {
   return found == node_of_tag_.end() ? -1 : of_node(found->second);
 }
 
-Frame view_frame(const Simulation& simulation, const ShownIndex& index, std::uint64_t sequence, double time,
-                 const Eigen::Matrix3Xd& displacement, const std::vector<ToolState>& tools, double sim_rate_hz) {
+FrameState frame_state(const Simulation& simulation, std::vector<LoadedColumn> loads, const std::vector<ToolState>& tools) {
+  FrameState state;
+  for (int user = 0; user < simulation.user_count(); ++user) {
+    UserFrameState& out = state.users.emplace_back();
+    out.tool = tools[static_cast<std::size_t>(user)];
+    if (!out.tool.present) continue;
+    out.force = simulation.force(user).force;
+    out.pressing = simulation.pressing(user);
+    out.ir = simulation.ir(user);
+  }
+  state.held_nodes = simulation.condensation().boundary_nodes();
+  state.loads = std::move(loads);
+  return state;
+}
+
+Frame view_frame(const FrameState& state, const ShownIndex& index, std::span<const int> row_positions,
+                 std::uint64_t sequence, double time, double sim_rate_hz) {
   Frame frame;
   frame.set_sequence(sequence);
   frame.set_time(time);
   frame.set_sim_rate_hz(sim_rate_hz);
+  const Eigen::Matrix3Xd displacement = displacement_of_rows(state.loads, row_positions);
   auto& u = *frame.mutable_displacement();
   u.Reserve(static_cast<int>(displacement.size()));
   for (Eigen::Index i = 0; i < displacement.size(); ++i) u.AddAlreadyReserved(static_cast<float>(displacement.data()[i]));
   const auto add_tagged = [&](google::protobuf::RepeatedField<std::uint32_t>& out, std::int64_t tag) {
     if (const int shown = index.of_tag(tag); shown >= 0) out.Add(static_cast<std::uint32_t>(shown));
   };
-  for (int user = 0; user < simulation.user_count(); ++user) {
-    const ToolState& tool = tools[static_cast<std::size_t>(user)];
+  for (std::size_t user = 0; user < state.users.size(); ++user) {
+    const UserFrameState& each = state.users[user];
     UserFrame* out = frame.add_users();
     out->set_slot(static_cast<std::uint32_t>(user));
-    out->set_present(tool.present);
-    if (!tool.present) continue;
-    add_point(*out->mutable_position(), tool.position);
-    add_point(*out->mutable_force(), simulation.force(user).force);
-    out->set_pressing(simulation.pressing(user));
-    const auto ir = simulation.ir(user);
-    const CondensedFemIr* fem = ir ? std::get_if<CondensedFemIr>(&ir->ir.body) : nullptr;
+    out->set_present(each.tool.present);
+    if (!each.tool.present) continue;
+    add_point(*out->mutable_position(), each.tool.position);
+    add_point(*out->mutable_force(), each.force);
+    out->set_pressing(each.pressing);
+    const CondensedFemIr* fem = each.ir ? std::get_if<CondensedFemIr>(&each.ir->ir.body) : nullptr;
     if (!fem) continue;
     for (int node = 0; node < fem->patch_node_count; ++node)
       add_tagged(*out->mutable_patch_nodes(), fem->node_ids[static_cast<std::size_t>(node)]);
-    if (simulation.pressing(user) && !fem->patch.empty())
+    if (each.pressing && !fem->patch.empty())
       for (int node : fem->patch.front().nodes) add_tagged(*out->mutable_contact_nodes(), fem->node_ids[static_cast<std::size_t>(node)]);
   }
-  const std::vector<int>& held = simulation.condensation().boundary_nodes();
-  frame.set_boundary_nodes(static_cast<std::uint32_t>(held.size()));
-  for (int node : held)
+  frame.set_boundary_nodes(static_cast<std::uint32_t>(state.held_nodes.size()));
+  for (int node : state.held_nodes)
     if (const int shown = index.of_node(node); shown >= 0) frame.add_held_nodes(static_cast<std::uint32_t>(shown));
   return frame;
 }

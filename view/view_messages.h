@@ -1,10 +1,16 @@
 // The live view's messages (proto/cohaptic/view.proto) built from the server's model and
 // simulation: the Scene once, a Frame per view frame, the Status from the users' reports.
+// A frame is built in two halves: frame_state() takes what it shows from the simulation
+// after a step (small: the tools, forces, IRs, held nodes and the state's loads, no
+// displacement), on the simulation thread; view_frame() computes the surface's
+// displacement from those loads and encodes it, on the view's own thread.
 // Lengths stay in m and forces in N on the wire; float precision is plenty for drawing.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -12,6 +18,7 @@
 #include "cohaptic/view.pb.h"
 #include "common/model/model.h"
 #include "common/model/shown_surface.h"
+#include "common/sim/loaded_columns.h"
 #include "common/sim/simulation.h"
 
 namespace cohaptic::view {
@@ -42,10 +49,30 @@ class ShownIndex {
   std::unordered_map<std::int64_t, int> node_of_tag_;
 };
 
-/// A frame at simulation time `time` [s]: `displacement` of the shown nodes [m], each
-/// user's tool, its force evaluated from its IR (Simulation::force), its IR patch and, while
-/// it presses, its contact triangle; the held nodes and |B|.
-Frame view_frame(const Simulation& simulation, const ShownIndex& index, std::uint64_t sequence, double time,
-                 const Eigen::Matrix3Xd& displacement, const std::vector<ToolState>& tools, double sim_rate_hz);
+/// One user as a frame shows it.
+struct UserFrameState {
+  ToolState tool;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< evaluated from its IR (Simulation::force) [N]
+  bool pressing = false;
+  std::shared_ptr<const PreparedIR> ir;             ///< its latest (immutable, shared with the simulation)
+};
+
+/// What a frame shows of the simulation after a step.
+struct FrameState {
+  std::vector<UserFrameState> users;
+  std::vector<int> held_nodes;      ///< B, the condensation's boundary nodes (volume indices)
+  std::vector<LoadedColumn> loads;  ///< the solved state's forces, for the displacement
+};
+
+/// Takes a frame's state (simulation thread): each user's tool as `tools` says, its force,
+/// contact and IR; the held nodes; `loads`, the loaded_columns() of simulation.solve().
+FrameState frame_state(const Simulation& simulation, std::vector<LoadedColumn> loads, const std::vector<ToolState>& tools);
+
+/// A frame at simulation time `time` [s] (any thread): the displacement of the shown nodes
+/// (`row_positions`: their ComplianceColumns::row_position) under the state's loads, each
+/// user's tool, its force, its IR patch and, while it presses, its contact triangle; the held
+/// nodes and |B|.
+Frame view_frame(const FrameState& state, const ShownIndex& index, std::span<const int> row_positions,
+                 std::uint64_t sequence, double time, double sim_rate_hz);
 
 }  // namespace cohaptic::view

@@ -8,12 +8,14 @@
 #include <atomic>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
 #include "cohaptic/view.pb.h"
 #include "common/util/error.h"
+#include "view/browser_input.h"
 #include "view/view_assets.h"
 
 namespace cohaptic::view {
@@ -24,27 +26,6 @@ using websocketpp::connection_hdl;
 
 /// Time the closing handshakes get at stop().
 constexpr auto kCloseGrace = std::chrono::milliseconds(200);
-
-// The value of `name` in a resource's query string ("/ws?token=abc" -> "abc"); empty if absent.
-std::string query_value(const std::string& resource, const std::string& name) {
-  const std::size_t query = resource.find('?');
-  if (query == std::string::npos) return "";
-  std::size_t at = query + 1;
-  while (at < resource.size()) {
-    const std::size_t end = std::min(resource.find('&', at), resource.size());
-    const std::string pair = resource.substr(at, end - at);
-    if (pair.rfind(name + "=", 0) == 0) return pair.substr(name.size() + 1);
-    at = end + 1;
-  }
-  return "";
-}
-
-// Compares without stopping at the first difference, so the time taken tells nothing.
-bool same_secret(const std::string& a, const std::string& b) {
-  unsigned char difference = a.size() == b.size() ? 0 : 1;
-  for (std::size_t i = 0; i < a.size(); ++i) difference |= static_cast<unsigned char>(a[i] ^ b[i % std::max<std::size_t>(b.size(), 1)]);
-  return difference == 0;
-}
 
 }  // namespace
 
@@ -68,6 +49,7 @@ struct ViewServer::Impl {
   std::array<std::shared_ptr<const std::string>, kChannels> newest;
   std::array<std::uint64_t, kChannels> sequence{};
   std::atomic<bool> flush_pending{false};
+  std::atomic<int> connected{0};  // browsers, for watched()
 
   // The server's thread only.
   std::map<connection_hdl, Browser, std::owner_less<connection_hdl>> browsers;
@@ -126,10 +108,7 @@ struct ViewServer::Impl {
     const std::string resource = connection->get_resource();
     const std::string origin = connection->get_request_header("Origin");
     const std::string host = connection->get_request_header("Host");
-    std::string refusal;
-    if (resource.substr(0, resource.find('?')) != "/ws") refusal = "not the data path /ws";
-    else if (!options.token.empty() && !same_secret(query_value(resource, "token"), options.token)) refusal = "wrong or missing token";
-    else if (!origin.empty() && origin != "http://" + host) refusal = "a page from " + origin;
+    const std::string refusal = handshake_refusal(resource, origin, host, options.token);
     if (refusal.empty()) return true;
     count([](ViewCounters& c) { ++c.refused; });
     spdlog::warn("view: refused a browser from {}: {}", connection->get_remote_endpoint(), refusal);
@@ -144,6 +123,7 @@ struct ViewServer::Impl {
       for (std::size_t channel = 0; channel < kChannels; ++channel)
         browser.accounted[channel] = sequence[channel] > 0 ? sequence[channel] - 1 : 0;
     }
+    connected = static_cast<int>(browsers.size());
     count([this](ViewCounters& c) {
       ++c.connections;
       c.browsers = static_cast<int>(browsers.size());
@@ -155,20 +135,20 @@ struct ViewServer::Impl {
 
   void closed(connection_hdl hdl) {
     if (browsers.erase(hdl) == 0) return;
+    connected = static_cast<int>(browsers.size());
     count([this](ViewCounters& c) { c.browsers = static_cast<int>(browsers.size()); });
   }
 
   void received(connection_hdl hdl, const WsServer::message_ptr& message) {
-    Command command;
-    const bool valid = message->get_opcode() == websocketpp::frame::opcode::binary &&
-                       command.ParseFromString(message->get_payload()) && command.body_case() != Command::BODY_NOT_SET;
-    if (!valid) {
+    const std::optional<Command> command =
+        message->get_opcode() == websocketpp::frame::opcode::binary ? parse_command(message->get_payload()) : std::nullopt;
+    if (!command) {
       count([](ViewCounters& c) { ++c.closed_for_bad_message; });
       websocketpp::lib::error_code error;
       server.close(hdl, websocketpp::close::status::invalid_payload, "not a view Command", error);
       return;
     }
-    if (on_command) on_command(command);
+    if (on_command) on_command(*command);
   }
 
   // Each browser gets the newest message of each channel it has not had, scene first;
@@ -255,6 +235,10 @@ void ViewServer::publish(Channel channel, std::string message) {
   }
   if (!s.flush_pending.exchange(true)) asio::post(s.io, [&s] { s.flush(); });
 }
+
+bool ViewServer::watched() const { return impl_->connected.load() > 0; }
+
+void ViewServer::post(std::function<void()> task) { asio::post(impl_->io, std::move(task)); }
 
 ViewCounters ViewServer::counters() const {
   std::lock_guard lock(impl_->counters_mutex);

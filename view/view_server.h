@@ -77,6 +77,11 @@ class ViewServer {
   void publish(Channel channel, std::string message);
   /// Any thread.
   ViewCounters counters() const;
+  /// Whether a browser is connected now (any thread; one atomic load).
+  bool watched() const;
+  /// Runs `task` on the server's thread, after what is queued there (any thread). Tasks
+  /// still queued when the server stops are dropped.
+  void post(std::function<void()> task);
 
  private:
   struct Impl;

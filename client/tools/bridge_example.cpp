@@ -22,6 +22,7 @@
 
 #include "client/device/bridge_peer.h"
 #include "common/util/error.h"
+#include "common/util/log_to_stderr.h"
 
 namespace {
 
@@ -51,6 +52,7 @@ struct Motion {
 }  // namespace
 
 int main(int argc, char** argv) {
+  cohaptic::log_to_stderr();  // anything the client library logs; stdout carries the forces
   CLI::App app{"Plays the vendor-SDK side of the cohaptic external-device bridge: sends poses, prints forces."};
   std::string client;
   std::string axis = "z";

@@ -142,4 +142,27 @@ AabbHit AabbTree::closest_triangle(const Eigen::Vector3d& p, double max_distance
   return hit;
 }
 
+void AabbTree::triangles_near(const Eigen::Vector3d& p, double max_distance, std::vector<int>& out) const {
+  if (nodes_.empty() || !(max_distance >= 0)) return;
+  const double reach2 = max_distance * max_distance;
+  std::array<int, kMaxDepth + 1> stack;  // one pending sibling per level, and the root
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (box_distance2(p, node.lo, node.hi) > reach2) continue;
+    if (node.count > 0) {
+      for (int slot = node.first_or_right; slot < node.first_or_right + node.count; ++slot) {
+        const Corners& c = corners_[slot];
+        const Eigen::Vector3d lo = c.a.cwiseMin(c.b).cwiseMin(c.c), hi = c.a.cwiseMax(c.b).cwiseMax(c.c);
+        if (box_distance2(p, lo, hi) <= reach2) out.push_back(triangle_index_[slot]);
+      }
+    } else {
+      // Depth-first: at most one pending sibling per level.
+      stack[top++] = node.first_or_right;
+      stack[top++] = static_cast<int>(&node - nodes_.data()) + 1;
+    }
+  }
+}
+
 }  // namespace cohaptic

@@ -46,6 +46,11 @@ class AabbTree {
   AabbHit closest_triangle(const Eigen::Vector3d& p,
                            double max_distance = std::numeric_limits<double>::infinity()) const;
 
+  /// Appends to `out` the input index of every triangle whose bounding box is within
+  /// `max_distance` of `p` (inclusive): a superset of the triangles within that distance, in
+  /// no particular order. Allocates only when `out` grows.
+  void triangles_near(const Eigen::Vector3d& p, double max_distance, std::vector<int>& out) const;
+
   int triangle_count() const { return static_cast<int>(triangle_index_.size()); }
   int node_count() const { return static_cast<int>(nodes_.size()); }
   /// Levels of nodes (1 for a single leaf, 0 for an empty tree).

@@ -23,9 +23,9 @@ SurfacePoint nearest_triangle(const TetMesh& mesh, const BoundarySurface& surfac
 
 ContactQuery find_contact(const TetMesh& mesh, const BoundarySurface& surface, const SurfacePseudoNormals& normals,
                           std::span<const int> touchable_triangles, const Eigen::Vector3d& tool_position,
-                          double tool_radius) {
+                          double tool_radius, std::span<const int> surface_candidates) {
   ContactQuery query;
-  query.signed_distance = closest_surface_point(mesh, surface, normals, tool_position).signed_distance;
+  query.signed_distance = closest_surface_point(mesh, surface, normals, tool_position, surface_candidates).signed_distance;
   if (!(query.signed_distance < tool_radius) || touchable_triangles.empty()) return query;
 
   const SurfacePoint nearest = nearest_triangle(mesh, surface, normals, touchable_triangles, tool_position);

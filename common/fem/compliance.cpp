@@ -35,7 +35,7 @@ void ComplianceColumns::compute_columns(const std::vector<int>& nodes) {
     if (has_column(node)) continue;
     const int position = row_position(node);
     std::vector<int>& list = position >= 0 ? groups : singles;
-    const int key = position >= 0 ? position / kGroupSize : node;
+    const int key = position >= 0 ? group_of(position) : node;
     if (std::find(list.begin(), list.end(), key) == list.end()) list.push_back(key);
   }
   std::sort(groups.begin(), groups.end());

@@ -21,7 +21,8 @@
 
 namespace cohaptic {
 
-constexpr std::uint32_t kComplianceCacheFormatVersion = 2;  // 2: columns solved in fixed groups
+// 2: columns solved in fixed groups; 3: groups of 4 (a column's bits depend on its group's size)
+constexpr std::uint32_t kComplianceCacheFormatVersion = 3;
 
 Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
                             const std::vector<int>& row_nodes);

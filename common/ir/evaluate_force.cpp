@@ -17,6 +17,10 @@
 namespace cohaptic {
 namespace {
 
+// Asymmetry of M_CC tolerated, relative to its largest entry: round-off of another
+// producer's arithmetic, far below any physical meaning.
+constexpr double kMaxRelativeAsymmetry = 1e-9;
+
 // One pressing tool during a tick.
 struct PressingTool {
   std::array<int, 3> nodes{};  // local node indices
@@ -97,7 +101,15 @@ PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, 
     for (int node : remote.nodes)
       if (node < 0 || node >= rows) throw Error("intermediate representation: a remote contact refers to a non-contact node");
 
-  const Eigen::MatrixXd m_cc = 0.5 * (ir.m_tilde.leftCols(x) + ir.m_tilde.leftCols(x).transpose());
+  // M_CC is symmetric as every server builds it (to round-off at most): an asymmetric one
+  // is refused, not silently replaced by its symmetric part.
+  const auto sent_m_cc = ir.m_tilde.leftCols(x);
+  const double asymmetry = x > 0 ? (sent_m_cc - sent_m_cc.transpose()).cwiseAbs().maxCoeff() : 0.0;
+  const double scale = x > 0 ? sent_m_cc.cwiseAbs().maxCoeff() : 0.0;
+  if (asymmetry > kMaxRelativeAsymmetry * scale)
+    throw Error(fmt::format("intermediate representation: M_CC is not symmetric (|M - M^T| up to {:g}, |M| up to {:g})",
+                            asymmetry, scale));
+  const Eigen::MatrixXd m_cc = 0.5 * (sent_m_cc + sent_m_cc.transpose());
   const Eigen::LLT<Eigen::MatrixXd> llt(m_cc);
   if (llt.info() != Eigen::Success) throw Error("intermediate representation: M_CC is not positive definite");
   prepared.compliance = llt.solve(Eigen::MatrixXd::Identity(x, x));

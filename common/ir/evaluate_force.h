@@ -64,7 +64,8 @@ struct PreparedIR {
   double condition_estimate = 1;      ///< of the body's operator (L~ for FEM)
 };
 
-/// Checks sizes, finiteness and positive definiteness; throws Error naming the problem.
+/// Checks sizes, finiteness, symmetry (to 1e-9 of the largest entry) and positive
+/// definiteness of M_CC; throws Error naming the problem.
 PreparedIR prepare_ir(IntermediateRepresentation ir);
 
 /// The mutable side of one evaluator of one prepared IR: nothing for a static body (FEM),

@@ -2,14 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Core>
+#include <algorithm>
 #include <climits>
 #include <cstdint>
+#include <vector>
 
 #include "common/util/line_reader.h"
 
 namespace cohaptic {
 
 namespace {
+
+/// Vertices or triangles reserved up front at most, whatever the header claims.
+constexpr std::int64_t kMaxReserved = 1 << 20;
 
 /// Moves to the next vertex or triangle line, which must exist and not be blank.
 void require_line(LineReader& reader, const char* what, const char* plural, std::int64_t index,
@@ -48,28 +54,34 @@ TriangleSurface parse_freesurfer_ascii(std::istream& in, const std::string& sour
     reader.fail(fmt::format("bad header: a surface needs at least 3 vertices and 1 triangle, found {} and {}",
                             vertex_count, triangle_count));
 
-  TriangleSurface surface;
-  surface.vertices.resize(3, vertex_count);
+  // Storage grows with the lines actually read: the header's counts are only a claim, and
+  // a short file claiming billions must fail on its missing lines, not on memory.
+  const auto reservation = [](std::int64_t count) { return static_cast<std::size_t>(std::min<std::int64_t>(count, kMaxReserved)); };
+  std::vector<double> coordinates;
+  coordinates.reserve(3 * reservation(vertex_count));
   for (std::int64_t v = 0; v < vertex_count; ++v) {
     require_line(reader, "vertex", "vertices", v, vertex_count);
     expect_values(reader, "a vertex line", "x y z flag");
     const auto& t = reader.tokens();
-    surface.vertices(0, v) = reader.real(t[0], "x coordinate");
-    surface.vertices(1, v) = reader.real(t[1], "y coordinate");
-    surface.vertices(2, v) = reader.real(t[2], "z coordinate");
+    coordinates.push_back(reader.real(t[0], "x coordinate"));
+    coordinates.push_back(reader.real(t[1], "y coordinate"));
+    coordinates.push_back(reader.real(t[2], "z coordinate"));
   }
-  surface.triangles.resize(static_cast<std::size_t>(triangle_count));
+  TriangleSurface surface;
+  surface.vertices = Eigen::Map<const Eigen::Matrix3Xd>(coordinates.data(), 3, static_cast<Eigen::Index>(vertex_count));
+  surface.triangles.reserve(reservation(triangle_count));
   for (std::int64_t f = 0; f < triangle_count; ++f) {
     require_line(reader, "triangle", "triangles", f, triangle_count);
     expect_values(reader, "a triangle line", "i j k flag");
     const auto& t = reader.tokens();
+    Triangle& triangle = surface.triangles.emplace_back();
     for (int k = 0; k < 3; ++k) {
       const std::int64_t index = reader.integer(t[k], "vertex index");
       if (index < 0 || index >= vertex_count)
         reader.fail(fmt::format("triangle {} refers to vertex index {}, out of range: the file has {} vertices "
                                 "(0-based indices 0 to {})",
                                 f, index, vertex_count, vertex_count - 1));
-      surface.triangles[f][k] = static_cast<int>(index);
+      triangle[k] = static_cast<int>(index);
     }
   }
   while (reader.next())

@@ -5,13 +5,15 @@
 #include <cstdlib>
 
 #include "common/fem/compliance_disk_cache.h"
+#include "common/mesh/compact_groups.h"
 #include "common/util/error.h"
 #include "common/util/stopwatch.h"
 
 namespace cohaptic {
 
 std::vector<int> compliance_row_nodes(const ElasticBody& body, bool whole_surface) {
-  return whole_surface ? body.surface.nodes : body.touchable_nodes;
+  return order_in_compact_groups(body.mesh.nodes, whole_surface ? body.surface.nodes : body.touchable_nodes,
+                                 ComplianceColumns::kGroupSize);
 }
 
 std::filesystem::path default_cache_directory() {

@@ -14,7 +14,8 @@ namespace cohaptic {
 
 /// The nodes whose compliance rows are kept: the touchable surface nodes, or the whole
 /// surface (`whole_surface`) when nodes outside the touchable region can be held: the
-/// scene has obstacles, or step-delay boundary nodes are asked for.
+/// scene has obstacles, or step-delay boundary nodes are asked for. Ordered in spatially
+/// compact solve groups (compact_groups.h).
 std::vector<int> compliance_row_nodes(const ElasticBody& body, bool whole_surface);
 
 struct ComplianceSetup {

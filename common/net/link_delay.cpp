@@ -43,9 +43,10 @@ std::optional<std::int64_t> LinkDelay::delay_ns(std::int64_t now_ns) {
     ++counters_.reordered;
   }
   auto delay = static_cast<std::int64_t>(delay_ms * 1e6);
-  if (ordered_) {
-    delay = std::max(delay, last_delivery_ns_ - now_ns);
+  if (ordered_) {  // strictly after the previous delivery: timers due at one instant may fire in any order
+    if (delivered_before_) delay = std::max(delay, last_delivery_ns_ - now_ns + 1);
     last_delivery_ns_ = now_ns + delay;
+    delivered_before_ = true;
   }
   counters_.delay_sum_ms += static_cast<double>(delay) * 1e-6;
   counters_.delay_max_ms = std::max(counters_.delay_max_ms, static_cast<double>(delay) * 1e-6);

@@ -4,7 +4,8 @@
 //
 // Delay = constant + U(0, jitter); with probability `reorder` a message is held back by a
 // further 2 x jitter + 1 ms, so it arrives after later ones; with probability `loss` it is
-// dropped. An ordered link (TCP) never loses or reorders: its deliveries keep their order.
+// dropped. An ordered link (TCP) never loses or reorders: each delivery time is strictly
+// after the previous one's (net/delayed_delivery.h delivers at those absolute times).
 // Units: ms in the settings, ns in the results.
 #pragma once
 
@@ -38,7 +39,8 @@ class LinkDelay {
  public:
   LinkDelay(const LinkDelaySettings& settings, bool ordered);
 
-  /// Delay for a message sent at `now_ns`, or nothing if it is lost.
+  /// Delay for a message sent at `now_ns`, or nothing if it is lost. On an ordered link,
+  /// now_ns + delay is strictly above every earlier message's.
   std::optional<std::int64_t> delay_ns(std::int64_t now_ns);
 
   const LinkDelaySettings& settings() const { return settings_; }
@@ -49,6 +51,7 @@ class LinkDelay {
   bool ordered_;
   std::mt19937_64 rng_;
   std::int64_t last_delivery_ns_ = 0;
+  bool delivered_before_ = false;
   LinkDelayCounters counters_;
 };
 

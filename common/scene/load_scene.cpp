@@ -1,6 +1,7 @@
 #include "common/scene/load_scene.h"
 
 #include "common/scene/parse_mass_spring.h"
+#include "common/util/regular_file.h"
 #include "common/util/yaml_cursor.h"
 
 
@@ -50,10 +51,7 @@ NodeSelector parse_selector(const Cursor& c, double scale) {
     plane->only_keys({"point", "normal", "tolerance"});
     s.kind = NodeSelector::Kind::plane;
     s.plane_point = plane->at("point").vec3() * scale;
-    const Cursor normal = plane->at("normal");
-    s.plane_normal = normal.vec3();
-    if (s.plane_normal.norm() < 1e-12) normal.fail("a non-zero normal vector");
-    s.plane_normal.normalize();
+    s.plane_normal = plane->at("normal").direction("a non-zero normal vector");
     if (auto tolerance = plane->find("tolerance"))
       s.tolerance = tolerance->number_in(0, INFINITY, true, false, "a positive length") * scale;
     ++kinds;
@@ -89,7 +87,7 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
   if (file) {
     mesh.file = file->text();
     if (mesh.file.is_relative()) mesh.file = scene_dir / mesh.file;
-    if (!std::filesystem::exists(mesh.file)) file->fail_message(fmt::format("mesh file {} does not exist", mesh.file.string()));
+    if (const auto why = why_not_a_regular_file(mesh.file)) file->fail_message(fmt::format("mesh file {} {}", mesh.file.string(), *why));
   } else {
     box->only_keys({"min", "size", "divisions", "grading", "uniform_cells"});
     BoxMeshSpec spec;
@@ -193,8 +191,8 @@ ObstacleSpec parse_obstacle(const Cursor& c, double scale, const std::filesystem
   if (surface) {
     obstacle.surface_file = surface->text();
     if (obstacle.surface_file.is_relative()) obstacle.surface_file = scene_dir / obstacle.surface_file;
-    if (!std::filesystem::exists(obstacle.surface_file))
-      surface->fail_message(fmt::format("surface file {} does not exist", obstacle.surface_file.string()));
+    if (const auto why = why_not_a_regular_file(obstacle.surface_file))
+      surface->fail_message(fmt::format("surface file {} {}", obstacle.surface_file.string(), *why));
   } else {
     plane->only_keys({"point", "normal"});
     const Cursor normal = plane->at("normal");
@@ -238,13 +236,26 @@ HapticSettings parse_haptic(const Cursor& c) {
   return haptic;
 }
 
+NetworkSettings parse_network(const Cursor& c, std::size_t tools) {
+  c.only_keys({"max_participants"});
+  NetworkSettings network;
+  network.max_participants = static_cast<int>(tools);
+  if (auto max = c.find("max_participants")) {
+    const std::int64_t value = max->integer();
+    if (value < 1 || value > static_cast<std::int64_t>(tools))
+      max->fail(fmt::format("an integer from 1 to the number of tools ({})", tools));
+    network.max_participants = static_cast<int>(value);
+  }
+  return network;
+}
+
 }  // namespace
 
 Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file) {
   const std::string file_name = file.string();
   const Cursor top(load_yaml(yaml_text, file_name, raise_scene_error), "", &file_name, 1, raise_scene_error);
   if (!top.is_map()) top.fail("a map of scene settings");
-  top.only_keys({"name", "units", "objects", "obstacles", "tools", "haptic"});
+  top.only_keys({"name", "units", "objects", "obstacles", "tools", "haptic", "network"});
 
   Scene scene;
   scene.file = file;
@@ -286,6 +297,8 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
     contact_model->fail_message(fmt::format("the sphere contact model needs sphere tools, and tool '{}' is a point "
                                             "(give it shape: sphere and a radius, or use translation or point)",
                                             point->name));
+  scene.network.max_participants = static_cast<int>(scene.tools.size());
+  if (auto network = top.find("network")) scene.network = parse_network(*network, scene.tools.size());
   return scene;
 }
 

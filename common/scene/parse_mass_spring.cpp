@@ -34,9 +34,7 @@ TubeGeometry parse_tube(const YamlCursor& c, double scale) {
     tube.sections = static_cast<int>(count);
   }
   if (auto up = c.find("up")) {
-    tube.up = up->vec3();
-    if (tube.up.norm() < 1e-12) up->fail("a non-zero vector");
-    tube.up.normalize();
+    tube.up = up->direction("a non-zero vector");
   }
   return tube;
 }
@@ -45,10 +43,7 @@ SupportPlane parse_plane(const YamlCursor& c, double scale) {
   c.only_keys({"point", "normal", "static_friction", "dynamic_friction"});
   SupportPlane plane;
   plane.point = c.at("point").vec3() * scale;
-  const YamlCursor normal = c.at("normal");
-  plane.normal = normal.vec3();
-  if (plane.normal.norm() < 1e-12) normal.fail("a non-zero normal vector");
-  plane.normal.normalize();
+  plane.normal = c.at("normal").direction("a non-zero normal vector");
   plane.static_friction = c.at("static_friction").number_in(0, INFINITY, false, true, "a friction coefficient >= 0");
   const YamlCursor dynamic = c.at("dynamic_friction");
   plane.dynamic_friction = dynamic.number_in(0, plane.static_friction, false, false,

@@ -107,6 +107,13 @@ struct HapticSettings {
   double boundary_truncation = 0;
 };
 
+/// How the session is served.
+struct NetworkSettings {
+  /// Users that may be joined at once; beyond it a join is refused ("session_full"). At
+  /// most the number of tools (one slot per tool), which is also the default.
+  int max_participants = 0;
+};
+
 struct Scene {
   std::filesystem::path file;   ///< where it was loaded from (empty if built in code)
   std::string name;
@@ -116,6 +123,7 @@ struct Scene {
   std::vector<ObstacleSpec> obstacles;
   std::vector<ToolSpec> tools;
   HapticSettings haptic;
+  NetworkSettings network;  ///< max_participants resolved on load (never 0 after load_scene)
 };
 
 /// The scene's only object as an FEM object, for the tools that vary or read one FEM

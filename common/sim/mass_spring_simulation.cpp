@@ -60,7 +60,9 @@ StepReport MassSpringSimulation::step(double time) {
     user.pressing = reactions_[u].colliding;
     if (!user.known) continue;
     const bool near = user.pressing || distance_to_surface(user.position) - user.radius <= settings.near_distance;
-    const bool due = !user.ir || time - user.last_ir_time >= 1 / settings.rate_hz;
+    // A nanosecond's slack: steps at a rate's exact multiples of 1/rate_hz are due although
+    // their difference rounds a bit short.
+    const bool due = !user.ir || time - user.last_ir_time >= 1 / settings.rate_hz - 1e-9;
     if (near && due) publish_ir(static_cast<int>(u), time, report);
   }
   if (report.rebuilt) report.rebuild_ms = rebuild.elapsed_ms();

@@ -51,6 +51,9 @@ class MassSpringSimulation {
   /// P0: advances the user's server-held evaluation of its IR by `dt` [s] at the current
   /// tool positions and returns its force (zero without an IR).
   ForceSample force(int user, double dt);
+  /// The whole network's reaction on the user's tool in the latest step: what the user
+  /// would feel if the server's own step drove its force (the trade-off's reference).
+  const NetworkToolReaction& reaction(int user) const { return reactions_[static_cast<std::size_t>(user)]; }
   /// Distance from `point` to the nearest surface node in the current state [m].
   double distance_to_surface(const Eigen::Vector3d& point) const;
 

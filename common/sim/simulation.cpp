@@ -20,7 +20,10 @@ Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstac
         IncrementalCondensation::Options condensation;
         condensation.naive = options.naive_every_step;
         return condensation;
-      }()) {
+      }()),
+      candidates_(body.mesh, body.surface, body.touchable_triangles),
+      touchable_triangle_(body.surface.triangles.size(), false) {
+  for (int t : body.touchable_triangles) touchable_triangle_[t] = true;
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
   if (sphere_model()) sphere_candidates_ = triangle_nodes(body.surface, body.touchable_triangles);
@@ -29,10 +32,7 @@ Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstac
     for (std::size_t i = 0; i < body.surface.nodes.size(); ++i)
       surface_points.col(static_cast<Eigen::Index>(i)) = body.mesh.nodes.col(body.surface.nodes[i]);
     for (const Obstacle& obstacle : obstacles) obstacles_.emplace_back(obstacle, surface_points);
-    rest_clearance_.assign(body.surface.nodes.size(), std::numeric_limits<double>::infinity());
-    for (std::size_t i = 0; i < body.surface.nodes.size(); ++i)
-      for (const ObstacleDistance& obstacle : obstacles_)
-        rest_clearance_[i] = std::min(rest_clearance_[i], obstacle.signed_distance(surface_points.col(static_cast<Eigen::Index>(i))));
+    clearance_ = ObstacleClearance(obstacles_, surface_points);
   }
 }
 
@@ -129,22 +129,28 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
     if (force.dot(obstacles_[held.obstacle].closest_point(at).normal) < 0) pulling.push_back(node);
   }
   // Free nodes whose displaced position penetrates an obstacle are held on it. Only nodes
-  // that can reach one are checked: rest clearance below the largest surface displacement.
+  // that may have reached one since their last query are queried (ObstacleClearance).
   const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, body_.surface.nodes);
-  const double reach = u.colwise().norm().maxCoeff();
+  near_obstacles_.clear();  // as of this pass's state
   std::vector<std::pair<int, HeldNode>> penetrating;
   for (std::size_t i = 0; i < body_.surface.nodes.size(); ++i) {
     const int node = body_.surface.nodes[i];
-    if (rest_clearance_[i] > reach || held_.count(node) || under_tool[node] || body_.dofs.fixed_axes[node] == kAllAxes)
-      continue;
+    if (held_.count(node) || under_tool[node] || body_.dofs.fixed_axes[node] == kAllAxes) continue;
     const Eigen::Vector3d rest = body_.mesh.nodes.col(node);
     const Eigen::Vector3d moved = rest + u.col(static_cast<Eigen::Index>(i));
+    if (const double estimate = clearance_.estimate(i, moved);
+        estimate < options_.near_obstacle_distance && !columns_.has_column(node))
+      near_obstacles_.push_back({node, estimate});
+    if (clearance_.certainly_clear(i, moved)) continue;
+    ObstaclePoint nearest{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), std::numeric_limits<double>::infinity(), -1};
     for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
       const ObstaclePoint hit = obstacles_[o].closest_point(moved);
+      if (hit.signed_distance < nearest.signed_distance) nearest = hit;
       if (hit.signed_distance >= 0) continue;
       penetrating.push_back({node, {hit.point - rest, o}});
       break;
     }
+    clearance_.record(i, moved, nearest.signed_distance, nearest.normal);
   }
   for (int node : pulling) release(node);
   std::vector<int> joining;
@@ -190,11 +196,14 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
 
 StepReport Simulation::step(double time) {
   StepReport report;
-  std::vector<UserTool> tools;
-  std::vector<bool> under_tool(static_cast<std::size_t>(body_.mesh.node_count()), false);
-  std::vector<bool> in_patch(under_tool.size(), false);
-  std::vector<bool> touchable(body_.surface.triangles.size(), false);
-  for (int t : body_.touchable_triangles) touchable[t] = true;
+  // The step's scratch lives in the simulation, so that a step allocates no more than its
+  // mathematics does.
+  std::vector<UserTool>& tools = step_tools_;
+  std::vector<bool>& under_tool = under_tool_;
+  std::vector<bool>& in_patch = in_patch_;
+  tools.clear();
+  under_tool.assign(static_cast<std::size_t>(body_.mesh.node_count()), false);
+  in_patch.assign(under_tool.size(), false);
   for (std::size_t u = 0; u < users_.size(); ++u) {
     UserState& user = users_[u];
     if (!user.known) {
@@ -203,23 +212,34 @@ StepReport Simulation::step(double time) {
       user.ir.reset();
       continue;
     }
-    user.contact = find_contact(body_.mesh, body_.surface, body_.normals, body_.touchable_triangles, user.position,
-                                user.radius)
+    candidates_.find(user.position, surface_candidates_, touchable_candidates_);
+    user.contact = find_contact(body_.mesh, body_.surface, body_.normals, touchable_candidates_, user.position,
+                                user.radius, surface_candidates_)
                        .contact;
     user.pressing = user.contact.has_value();
-    user.nearest = nearest_triangle(body_.mesh, body_.surface, body_.normals, body_.touchable_triangles, user.position)
-                       .triangle;
+    // A contact's triangle is the nearest touchable one, found by the same rule.
+    user.nearest = user.pressing ? user.contact->triangle
+                                 : nearest_triangle(body_.mesh, body_.surface, body_.normals, touchable_candidates_,
+                                                    user.position)
+                                       .triangle;
     for (int node : body_.surface.triangles[user.nearest]) under_tool[node] = true;
-    for (int t : contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable))
-      for (int node : body_.surface.triangles[t]) in_patch[node] = true;
-    if (sphere_model()) mark_sphere(user, under_tool, in_patch, touchable);
+    if (options_.step_delay_nodes > 0)  // only step-delay nodes are chosen outside the patches
+      for (int t : contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable_triangle_))
+        for (int node : body_.surface.triangles[t]) in_patch[node] = true;
+    if (sphere_model()) mark_sphere(user, under_tool, in_patch, touchable_triangle_);
     tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest});
   }
-  std::vector<int> nearest;
-  std::vector<std::vector<int>> sphere_holds;
-  for (const UserState& user : users_) {
+  std::vector<int>& nearest = step_nearest_;
+  std::vector<std::vector<int>>& sphere_holds = step_sphere_holds_;
+  nearest.clear();
+  sphere_holds.resize(users_.size());
+  for (std::size_t u = 0; u < users_.size(); ++u) {
+    const UserState& user = users_[u];
     nearest.push_back(user.known ? user.nearest : -1);
-    sphere_holds.push_back(user.known ? user.sphere_holds : std::vector<int>{});
+    if (user.known)
+      sphere_holds[u] = user.sphere_holds;
+    else
+      sphere_holds[u].clear();
   }
 
   Stopwatch watch;

@@ -31,6 +31,8 @@
 
 #include "common/condense/incremental_condensation.h"
 #include "common/contact/find_contact.h"
+#include "common/contact/nearest_triangle_candidates.h"
+#include "common/contact/obstacle_clearance.h"
 #include "common/contact/obstacle_distance.h"
 #include "common/contact/sphere_contact.h"
 #include "common/ir/build_ir.h"
@@ -45,11 +47,19 @@ struct SimulationOptions {
   IrBuildOptions ir;
   int step_delay_nodes = 0;     ///< N surface nodes held while any tool presses (0: none)
   int obstacle_iterations = 4;  ///< active-set passes per step
+  /// Free surface nodes about this close to an obstacle are listed by
+  /// nodes_near_obstacles() [m].
+  double near_obstacle_distance = 0.001;
   /// Compute every M~ from scratch (naive condensation) at every step, as the paper's
   /// conventional simulation loop did: the step delay of large boundary sets then shows.
   bool naive_every_step = false;
 };
 
+/// A node and an estimate of its distance to something [m].
+struct NodeDistance {
+  int node = -1;
+  double distance = 0;
+};
 
 class Simulation {
  public:
@@ -80,6 +90,13 @@ class Simulation {
   StateSolution solve() const;
   /// Displacement of `nodes` (row nodes) in the current state [m].
   Eigen::Matrix3Xd displacement_of(std::span<const int> nodes) const;
+
+  /// Free surface nodes without compliance columns yet that were about (to first order,
+  /// ObstacleClearance::estimate) options.near_obstacle_distance or less from an obstacle
+  /// in the last step's last obstacle pass, with that estimate: should one reach the
+  /// obstacle, the step that holds it solves its columns first. A caller may have them
+  /// solved ahead (the server's CompliancePrefetch).
+  const std::vector<NodeDistance>& nodes_near_obstacles() const { return near_obstacles_; }
 
   const IncrementalCondensation& condensation() const { return condensation_; }
   /// u of each node of condensation().boundary_nodes(), in that order [m].
@@ -121,7 +138,11 @@ class Simulation {
   SimulationOptions options_;
   mutable IncrementalCondensation condensation_;  // its Z cache changes on const queries
   std::vector<ObstacleDistance> obstacles_;
-  std::vector<double> rest_clearance_;            // per surface node: distance to the nearest obstacle at rest
+  NearestTriangleCandidates candidates_;          // the few triangles each tool's nearest-triangle scans visit
+  std::vector<int> surface_candidates_, touchable_candidates_;  // their scratch, reused step to step
+  std::vector<bool> touchable_triangle_;          // per surface triangle
+  ObstacleClearance clearance_;                   // per surface node: where it was last found clear of the obstacles
+  std::vector<NodeDistance> near_obstacles_;      // see nodes_near_obstacles()
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
@@ -129,6 +150,12 @@ class Simulation {
   std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
   std::vector<SphereTool> previous_spheres_;        // the sphere model's: the spheres of the previous step
   std::vector<int> sphere_candidates_;              // the touchable triangles' nodes
+  // step()'s scratch: the known tools, their nearest triangles and sphere-held nodes, the
+  // nodes under them and in their patches.
+  std::vector<UserTool> step_tools_;
+  std::vector<int> step_nearest_;
+  std::vector<std::vector<int>> step_sphere_holds_;
+  std::vector<bool> under_tool_, in_patch_;
   bool boundary_dirty_ = false;
 };
 

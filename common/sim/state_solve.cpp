@@ -5,6 +5,7 @@
 
 #include "common/condense/dof_blocks.h"
 #include "common/ir/contact_solve.h"
+#include "common/sim/loaded_columns.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -57,14 +58,13 @@ void solve_boundary_forces(ComplianceColumns& columns, const IncrementalCondensa
 }
 
 Eigen::Matrix3Xd displacement_of_nodes(ComplianceColumns& columns, const StateSolution& state, std::span<const int> nodes) {
-  std::vector<int> rows;
-  for (int node : nodes)
-    for (int axis = 0; axis < 3; ++axis) rows.push_back(3 * node + axis);
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows.size()));
-  // Fixed rows of L are zero: gathering them is harmless and keeps the layout simple.
-  if (!state.contact_dofs.empty()) u += gather_compliance(columns, rows, state.contact_dofs) * state.contact_forces;
-  if (!state.boundary_dofs.empty()) u += gather_compliance(columns, rows, state.boundary_dofs) * state.boundary_forces;
-  return Eigen::Map<const Eigen::Matrix3Xd>(u.data(), 3, static_cast<Eigen::Index>(nodes.size()));
+  std::vector<int> positions(nodes.size());
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    positions[k] = columns.row_position(nodes[k]);
+    if (positions[k] < 0)
+      throw Error(fmt::format("compliance rows are not kept for node {} (not touchable or on the surface)", nodes[k]));
+  }
+  return displacement_of_rows(loaded_columns(columns, state), positions);
 }
 
 }  // namespace cohaptic

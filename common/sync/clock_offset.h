@@ -7,6 +7,8 @@
 //   round trip = (t3 - t0) - (t2 - t1).
 // Of the last `window` samples, the one with the smallest round trip wins: its error is
 // at most half its round trip, and queueing only ever adds to a round trip. Units: ns.
+// Times must lie in [0, 2^61) ns (the wire rejects others as bad_time): then no offset,
+// round trip or conversion overflows.
 #pragma once
 
 #include <cstddef>

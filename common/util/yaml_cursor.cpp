@@ -57,7 +57,7 @@ void YamlCursor::only_keys(std::initializer_list<const char*> allowed) const {
   if (!node_.IsMap()) fail("a map");
   const std::set<std::string> known(allowed.begin(), allowed.end());
   for (const auto& entry : node_) {
-    const auto key = entry.first.as<std::string>();
+    const std::string key = key_text(entry.first);
     if (!known.count(key)) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
@@ -69,7 +69,7 @@ void YamlCursor::only_keys(std::initializer_list<const char*> allowed) const {
 std::vector<std::string> YamlCursor::keys() const {
   if (!node_.IsMap()) fail("a map");
   std::vector<std::string> out;
-  for (const auto& entry : node_) out.push_back(entry.first.as<std::string>());
+  for (const auto& entry : node_) out.push_back(key_text(entry.first));
   return out;
 }
 
@@ -142,6 +142,20 @@ Eigen::Vector3d YamlCursor::vec3() const {
   if (!node_.IsSequence() || node_.size() != 3) fail("a list of 3 numbers");
   const auto parts = items();
   return {parts[0].number(), parts[1].number(), parts[2].number()};
+}
+
+Eigen::Vector3d YamlCursor::direction(const std::string& expected) const {
+  // stableNorm, not norm: (1e200, 1e200, 0) has a finite length, but its squared norm
+  // overflows, and normalize() would then return the zero vector.
+  const Eigen::Vector3d v = vec3();
+  const double length = v.stableNorm();
+  if (!(length >= 1e-12)) fail(expected);
+  return v / length;
+}
+
+std::string YamlCursor::key_text(const YAML::Node& key) const {
+  if (!key.IsScalar()) YamlCursor(key, path_, file_, line_, raise_).fail("a map whose keys are names");
+  return key.Scalar();
 }
 
 std::string YamlCursor::join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }

@@ -67,9 +67,14 @@ class YamlCursor {
   std::string choice(std::initializer_list<const char*> options) const;
   /// A list of exactly 3 finite numbers.
   Eigen::Vector3d vec3() const;
+  /// A vec3() of length 1e-12 or more, returned scaled to unit length; `expected` describes
+  /// it in the message. Huge components are fine (the length is computed without overflow).
+  Eigen::Vector3d direction(const std::string& expected) const;
 
  private:
   std::string join(const std::string& key) const;
+  /// The map key `key` as text; a key that is a list or a map fails, naming where.
+  std::string key_text(const YAML::Node& key) const;
   std::string describe() const;
 
   YAML::Node node_;

@@ -14,10 +14,15 @@
 
 namespace cohaptic::wire {
 
-constexpr std::uint32_t kProtocolVersion = 2;  ///< 2: IR format 2 (an envelope around a body)
+/// 3: every frame and datagram sealed with its sender's traffic key (XChaCha20-Poly1305
+/// behind a clear envelope); 2: IR format 2 (an envelope around a body), and like 1 the
+/// shared session key's HMAC tag on clear messages.
+constexpr std::uint32_t kProtocolVersion = 3;
 
-/// Sender ids in Header.sender: 0 the server, k + 1 the user in slot k.
+/// Sender ids in Header.sender: 0 the server, k + 1 the user in slot k, kJoiningSender a
+/// client that holds the session key and has no slot yet (its Join; traffic_keys.h).
 constexpr std::uint32_t kServerSender = 0;
+constexpr std::uint32_t kJoiningSender = 0xffff'ffff;
 constexpr std::uint32_t sender_of_slot(std::uint32_t slot) { return slot + 1; }
 
 /// Nanoseconds of std::chrono::steady_clock now (the clock of sender_time_ns).

@@ -13,6 +13,9 @@ std::string_view to_string(Rejection reason) {
     case Rejection::replayed: return "replayed";
     case Rejection::non_finite: return "non_finite";
     case Rejection::empty: return "empty";
+    case Rejection::cleartext: return "cleartext";
+    case Rejection::rate_limited: return "rate_limited";
+    case Rejection::bad_time: return "bad_time";
   }
   return "unknown";
 }

@@ -1,8 +1,9 @@
-// Why a received datagram was dropped, and how many were, per reason.
+// Why a received datagram or control frame was dropped, and how many were, per reason.
 //
-// Reasons in the order the checks run (datagram_codec.h): size, tag, parse, version,
-// session, sender, body present, finite values, replay. The counters are atomics so a
-// monitoring thread may read them while the receiving thread counts.
+// The checks and their order are datagram_codec.h's and frame_codec.h's; rate_limited is
+// counted by the UDP endpoint (net/), which drops a misbehaving source's datagrams unread.
+// The counters are atomics so a monitoring thread may read them while the receiving
+// thread counts.
 #pragma once
 
 #include <array>
@@ -16,22 +17,29 @@
 namespace cohaptic::wire {
 
 enum class Rejection : std::uint8_t {
-  oversized,       ///< longer than kMaxDatagramBytes
-  truncated,       ///< shorter than a tag, or the authenticated payload does not parse
-  bad_tag,         ///< authentication failed (wrong key, corrupted or forged)
-  bad_version,     ///< header.protocol_version != kProtocolVersion (or no header)
+  oversized,       ///< longer than kMaxDatagramBytes (a frame: its declared length above the limit)
+  truncated,       ///< shorter than an envelope and a tag, or the opened body does not parse
+  bad_tag,         ///< authentication failed (wrong key, another slot's key, corrupted or forged),
+                   ///< or the sealed header names another sender or sequence than the envelope
+  bad_version,     ///< the envelope's or the header's protocol version is not kProtocolVersion
+                   ///< (an older peer), or the envelope has flags this version does not know
   wrong_session,   ///< header.session differs from the expected session
-  unknown_sender,  ///< header.sender is not an allowed sender
-  replayed,        ///< sequence already seen, or older than the replay window
+  unknown_sender,  ///< the envelope's sender is not one this receiver holds a key for
+  replayed,        ///< sequence already seen or older than the replay window, or sealed by
+                   ///< another sealer (salt) than the sender's current one, or a stale join
   non_finite,      ///< a NaN or infinite value in the body
   empty,           ///< no body
+  cleartext,       ///< not encrypted, and this receiver requires encryption
+  rate_limited,    ///< from a source whose datagrams keep failing: dropped unread (net/)
+  bad_time,        ///< a clock reading (header or body) outside [0, kMaxClockNs)
 };
 
-constexpr std::size_t kRejectionCount = 9;
+constexpr std::size_t kRejectionCount = 12;
 
 constexpr std::array<Rejection, kRejectionCount> kAllRejections = {
-    Rejection::oversized,      Rejection::truncated, Rejection::bad_tag,    Rejection::bad_version, Rejection::wrong_session,
-    Rejection::unknown_sender, Rejection::replayed,  Rejection::non_finite, Rejection::empty};
+    Rejection::oversized,     Rejection::truncated,      Rejection::bad_tag,  Rejection::bad_version,
+    Rejection::wrong_session, Rejection::unknown_sender, Rejection::replayed, Rejection::non_finite,
+    Rejection::empty,         Rejection::cleartext,      Rejection::rate_limited, Rejection::bad_time};
 
 /// "oversized", "truncated", "bad_tag", ...: the enumerator's name.
 std::string_view to_string(Rejection reason);

@@ -23,6 +23,13 @@ class ReplayWindow {
   bool accept(std::uint64_t sequence);
   /// Forgets everything (a new sender in the slot).
   void reset() { *this = ReplayWindow{}; }
+  /// Forgets everything, then treats every sequence up to `sequence` as seen: a sender that
+  /// said its last sequence was `sequence` is heard from the next one on.
+  void start_after(std::uint64_t sequence) {
+    started_ = true;
+    highest_ = sequence;
+    seen_ = ~std::uint64_t{0};
+  }
   /// The highest sequence accepted so far.
   std::optional<std::uint64_t> highest() const {
     return started_ ? std::optional<std::uint64_t>(highest_) : std::nullopt;

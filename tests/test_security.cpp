@@ -1,0 +1,319 @@
+// Security and robustness, end to end: a real cohaptic-server process on loopback against
+// real clients and hand-made participants (support/raw_participant.h) that misbehave.
+//   - keys: a participant key joins its own slot only; a datagram sealed with one slot's
+//     key in another slot's name is rejected as bad_tag and counted; a client refuses a
+//     key file others may read, and a --slot its key does not open;
+//   - confidentiality: the bytes on the control connection do not contain the scene they
+//     carry, unless the session runs --no-encryption; an encrypting client refuses a server
+//     in clear; a join replayed on another connection is refused (replayed), and so are a
+//     protocol 2 peer's frame and datagram (bad_version), and a frame declared larger than
+//     a client ever sends (oversized, before its body is read), each counted;
+//   - limits: the scene's network.max_participants refuses a join beyond it, clearly; a
+//     participant that stops reading its control connection has its IRs dropped (newest
+//     wins) and is disconnected, while the other user's haptic loop keeps its period;
+//   - a flood of 10^6 hostile datagrams of every kind leaves the simulation rate within 5 %
+//     of the rate just before it, measured from the server's recording, and every datagram
+//     the real clients sent is accepted.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <array>
+#include <asio.hpp>
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <thread>
+
+#include "common/util/error.h"
+#include "proto/record/recording.h"
+#include "proto/wire/datagram_codec.h"
+#include "proto/wire/envelope.h"
+#include "proto/wire/frame_codec.h"
+#include "proto/wire/header.h"
+#include "proto/wire/sealer.h"
+#include "proto/wire/session_key.h"
+#include "proto/wire/traffic_keys.h"
+#include "support/cube_session.h"
+#include "support/hostile_traffic.h"
+#include "support/process.h"
+#include "support/raw_participant.h"
+
+namespace cohaptic {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+using testing::ChildProcess;
+using testing::CubeSession;
+using testing::HostileDatagrams;
+using testing::RawParticipant;
+using testing::write_press;
+using Bytes = std::vector<std::uint8_t>;
+
+std::uint64_t count(const nlohmann::json& report, const std::vector<std::string>& path) {
+  const nlohmann::json* node = &report;
+  for (const std::string& key : path) node = &node->at(key);
+  return node->get<std::uint64_t>();
+}
+
+bool contains(const Bytes& haystack, const std::string& needle) {
+  return std::search(haystack.begin(), haystack.end(), needle.begin(), needle.end()) != haystack.end();
+}
+
+// Whether the server closed `socket` (reads what it sent before, without waiting).
+bool closed_by_server(asio::ip::tcp::socket& socket) {
+  socket.non_blocking(true);
+  std::array<std::uint8_t, 4096> sink{};
+  std::error_code error;
+  while (!error) socket.read_some(asio::buffer(sink), error);
+  return error != asio::error::would_block;
+}
+
+TEST(Security, EachParticipantKeyOpensItsOwnSlotOnly) {
+  const fs::path keys = testing::scratch_directory("keys");
+  wire::write_session_key(keys / "session.key");
+  const wire::SessionKey session_key = wire::load_session_key(keys / "session.key");
+  wire::write_participant_key(keys / "p0.key", session_key, 0);
+  wire::write_participant_key(keys / "p1.key", session_key, 1);
+  CubeSession session("security-keys", {"--duration", "60", "--key-file", (keys / "session.key").string()});
+
+  // A client with participant 0's key file joins slot 0 without asking for it.
+  const auto alice = session.client("alice", -1, write_press(session.dir, "a", 3, 2, 3, 3.0),
+                                    {"--key-file", (keys / "p0.key").string()});
+  ASSERT_TRUE(testing::wait_for_output(*alice, "haptic loop at")) << alice->log_text();
+  // Participant 1 holds its own key only: slot 0 is refused to it, slot 1 is its own.
+  RawParticipant wrong_slot({.server_port = static_cast<std::uint16_t>(session.port), .slot = 0},
+                            wire::ClientKeys(std::get<wire::ParticipantKey>(wire::load_key_file(keys / "p1.key"))));
+  std::string refusal;
+  try {
+    wrong_slot.join();
+  } catch (const Error& e) {
+    refusal = e.what();
+  }
+  EXPECT_NE(refusal.find("the key given is slot 1's, and slot 0 was asked for (wrong_slot)"), std::string::npos) << refusal;
+  RawParticipant bob({.server_port = static_cast<std::uint16_t>(session.port), .slot = 1},
+                     wire::ClientKeys(std::get<wire::ParticipantKey>(wire::load_key_file(keys / "p1.key"))));
+  EXPECT_EQ(bob.join().slot(), 1u);
+  // Bob forges alice's tool: his own key, alice's name, even the right session.
+  const wire::TrafficKey bobs_key = wire::participant_key(session_key, 1);
+  wire::DatagramSealer forger(bobs_key, testing::session_id(*session.server), wire::sender_of_slot(0));
+  asio::io_context io;
+  asio::ip::udp::socket socket(io, asio::ip::udp::endpoint(asio::ip::udp::v4(), 0));
+  constexpr int kForged = 50;
+  for (int i = 0; i < kForged; ++i) {
+    wire::Datagram sample;
+    sample.mutable_tool()->set_user(0);
+    sample.mutable_tool()->mutable_position()->set_z(-0.05);  // deep in the cube: it would be felt
+    sample.mutable_tool()->set_valid(true);
+    socket.send_to(asio::buffer(forger.seal(sample)),
+                   asio::ip::udp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<std::uint16_t>(session.port)));
+  }
+  ASSERT_EQ(alice->wait(testing::kPatience), 0) << alice->log_text();
+  bob.stop();
+  session.stop_server();
+
+  const nlohmann::json server = session.report("server")["server"];
+  EXPECT_EQ(count(server, {"datagrams", "rejected_by_reason", "bad_tag"}), static_cast<std::uint64_t>(kForged))
+      << server["datagrams"].dump();
+  EXPECT_EQ(count(server, {"connections", "joins_refused"}), 1u);
+  EXPECT_EQ(count(server, {"connections", "joins"}), 2u);
+  const nlohmann::json a = session.report("alice");
+  EXPECT_EQ(a["slot"], 0);
+  EXPECT_GT(a["force_n"]["peak"].get<double>(), 0.1);
+  EXPECT_LT(a["force_n"]["peak"].get<double>(), 3.3) << "a forged sample 50 mm deep moved alice's tool";
+  EXPECT_EQ(a["datagrams"]["rejected"], 0);
+
+  // A client refuses a --slot its key file does not open, and a key file others may read.
+  const auto mismatch = session.client("carol", 0, write_press(session.dir, "c", 0, 0, 1, 0),
+                                       {"--key-file", (keys / "p1.key").string()});
+  EXPECT_EQ(mismatch->wait(testing::kPatience), 1);
+  EXPECT_NE(mismatch->log_text().find("--slot 0, but the key file is participant 1's"), std::string::npos)
+      << mismatch->log_text();
+  ::chmod((keys / "p1.key").c_str(), 0644);
+  const auto readable = session.client("dave", -1, write_press(session.dir, "d", 0, 0, 1, 0),
+                                       {"--key-file", (keys / "p1.key").string()});
+  EXPECT_EQ(readable->wait(testing::kPatience), 1);
+  EXPECT_NE(readable->log_text().find("mode 0644"), std::string::npos) << readable->log_text();
+  EXPECT_NE(readable->log_text().find("chmod 600"), std::string::npos) << readable->log_text();
+  EXPECT_EQ(readable->log_text().find(wire::to_hex(wire::participant_key(session_key, 1))), std::string::npos)
+      << "the key was logged";
+}
+
+TEST(Security, TheWireCarriesNoPlaintextAndStaleOrOldPeersAreRefused) {
+  CubeSession session("security-wire", {"--duration", "60"});
+  const std::uint16_t port = static_cast<std::uint16_t>(session.port);
+  const wire::ClientKeys dev(wire::development_key());
+  RawParticipant first({.server_port = port, .slot = 0}, dev);
+  const wire::Welcome welcome = first.join();
+  ASSERT_NE(welcome.scene_yaml().find("soft-cube"), std::string::npos);
+  // What travelled: the greeting, then the Welcome, sealed. The scene is in it, unreadable.
+  EXPECT_GT(first.received_bytes().size(), welcome.scene_yaml().size());
+  EXPECT_FALSE(contains(first.received_bytes(), "soft-cube"));
+  EXPECT_FALSE(contains(first.received_bytes(), "youngs_modulus"));
+
+  // The first participant's join, replayed on a new connection, is refused.
+  asio::io_context io;
+  asio::ip::tcp::socket replay(io);
+  replay.connect(asio::ip::tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  asio::write(replay, asio::buffer(first.join_bytes()));
+  // A protocol 2 peer's frame (as protocol 1's): [length][protobuf, which starts 0x0a][32-byte HMAC].
+  wire::Control old_join;
+  old_join.mutable_header()->set_protocol_version(2);
+  old_join.mutable_join()->set_user_name("old");
+  const std::string old_body = old_join.SerializeAsString();
+  Bytes old_frame(4);
+  wire::write_le(old_body.size(), 4, old_frame.data());
+  old_frame.insert(old_frame.end(), old_body.begin(), old_body.end());
+  old_frame.resize(old_frame.size() + 32, 0x5a);
+  asio::ip::tcp::socket old_peer(io);
+  old_peer.connect(asio::ip::tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  asio::write(old_peer, asio::buffer(old_frame));
+  // And its datagram.
+  asio::ip::udp::socket udp(io, asio::ip::udp::endpoint(asio::ip::udp::v4(), 0));
+  Bytes old_datagram(old_body.begin(), old_body.end());
+  old_datagram.resize(old_datagram.size() + 32, 0x5a);
+  udp.send_to(asio::buffer(old_datagram), asio::ip::udp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  // A frame declared larger than any a client sends (a megabyte): refused before its body comes.
+  asio::ip::tcp::socket bulky(io);
+  bulky.connect(asio::ip::tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  Bytes bulky_start(wire::kFrameClearBytes, 0);
+  wire::write_le(1u << 20, wire::kFrameLengthBytes, bulky_start.data());
+  asio::write(bulky, asio::buffer(bulky_start));
+  ASSERT_TRUE(testing::wait_until(
+      [&] { return closed_by_server(replay) && closed_by_server(old_peer) && closed_by_server(bulky); },
+      "the server to close the replaying, the protocol 2 peer's and the bulky connections"))
+      << session.server->log_text();
+  first.stop();
+  session.stop_server();
+  const nlohmann::json server = session.report("server")["server"];
+  EXPECT_EQ(count(server, {"control_frames", "rejected_by_reason", "replayed"}), 1u) << server["control_frames"].dump();
+  EXPECT_EQ(count(server, {"control_frames", "rejected_by_reason", "bad_version"}), 1u) << server["control_frames"].dump();
+  EXPECT_EQ(count(server, {"control_frames", "rejected_by_reason", "oversized"}), 1u) << server["control_frames"].dump();
+  EXPECT_EQ(count(server, {"datagrams", "rejected_by_reason", "bad_version"}), 1u) << server["datagrams"].dump();
+  EXPECT_EQ(count(server, {"connections", "joins"}), 1u);
+
+  // --no-encryption: the same Welcome readable on the wire; an encrypting client refuses it.
+  CubeSession clear("security-clear", {"--duration", "60", "--no-encryption"});
+  RawParticipant reader({.server_port = static_cast<std::uint16_t>(clear.port), .slot = 0, .encrypt = false}, dev);
+  reader.join();
+  EXPECT_TRUE(contains(reader.received_bytes(), "soft-cube"));
+  EXPECT_TRUE(contains(reader.received_bytes(), "youngs_modulus"));
+  const auto strict = clear.client("erin", 1, write_press(clear.dir, "e", 0, 0, 1, 0), {"--join-timeout", "3"});
+  EXPECT_EQ(strict->wait(testing::kPatience), 1);
+  EXPECT_NE(strict->log_text().find("a frame in clear, and this side requires encryption"), std::string::npos)
+      << strict->log_text();
+  reader.stop();
+  clear.stop_server();
+  EXPECT_FALSE(clear.report("server")["server"]["encrypted"].get<bool>());
+}
+
+TEST(Security, ASessionRefusesParticipantsBeyondItsScenesMaximum) {
+  CubeSession session("security-full", {"--duration", "60"}, "network: {max_participants: 1}\n");
+  const auto a = session.client("alice", -1, write_press(session.dir, "a", 3, 2, 2, 2.0));
+  ASSERT_TRUE(testing::wait_for_output(*a, "haptic loop at")) << a->log_text();
+  const auto b = session.client("bob", -1, write_press(session.dir, "b", -3, 2, 2, 0.1));
+  EXPECT_EQ(b->wait(testing::kPatience), 1);
+  EXPECT_NE(b->log_text().find("the server refused to join: the session is full: the scene allows 1 participant at "
+                               "once (network.max_participants)"),
+            std::string::npos)
+      << b->log_text();
+  ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
+  session.stop_server();
+  EXPECT_EQ(count(session.report("server")["server"], {"connections", "joins_refused"}), 1u);
+}
+
+// Slides `depth` m deep across the top face, back and forth along x: a new IR at every triangle.
+Eigen::Vector3d slide(double t, double depth) {
+  const double x = 0.04 * std::sin(2 * M_PI * t / 3.0);
+  return {x, 0.011, -depth};
+}
+
+TEST(Robustness, AUserThatStopsReadingLosesItsOldIrsAndThenItsConnectionNotTheOthersTheirPeriod) {
+  CubeSession session("robust-stalled", {"--duration", "120"});
+  // Alice presses and holds, a well-behaved user, for as long as the test needs.
+  const auto alice = session.client("alice", 0, write_press(session.dir, "a", 3, 2, 3, 100.0));
+  ASSERT_TRUE(testing::wait_for_output(*alice, "haptic loop at")) << alice->log_text();
+  // Bob joins with a small receive window, then slides along the face without ever reading.
+  RawParticipant bob({.server_port = static_cast<std::uint16_t>(session.port), .slot = 1, .tcp_receive_buffer = 4096},
+                     wire::ClientKeys(wire::development_key()));
+  bob.join();
+  bob.press_along([](double t) { return slide(t, 0.002); });
+  ASSERT_TRUE(testing::wait_for_output(*session.server, "the peer stopped reading", 60s));
+  bob.stop();
+  alice->signal(SIGINT);
+  ASSERT_EQ(alice->wait(testing::kPatience), 0) << alice->log_text();
+  session.stop_server();
+  const nlohmann::json server = session.report("server")["server"];
+  const nlohmann::json a = session.report("alice");
+  std::printf("  a user that stopped reading: %lu of its IRs dropped unsent (newest wins), then disconnected; alice's "
+              "period p99 %.0f us (timer floor %.0f us)\n",
+              static_cast<unsigned long>(count(server, {"control_frames", "dropped"})), a["period_us"]["p99"].get<double>(),
+              a["timer_floor"]["period_us"]["p99"].get<double>());
+  EXPECT_GT(count(server, {"control_frames", "dropped"}), 0u);
+  EXPECT_EQ(count(server, {"connections", "write_stalls"}), 1u);
+  EXPECT_EQ(count(server, {"connections", "queue_overflows"}), 0u) << "only IRs waited: nothing that must arrive";
+  EXPECT_LE(a["period_us"]["p99"].get<double>(), testing::period_p99_allowance_us(a));
+  EXPECT_EQ(a["non_finite_ticks"], 0);
+  EXPECT_GE(a["coupling_n"]["peak"].get<double>(), 0.0);
+}
+
+// Steps per second of the server's recording within [from, to) (ns of the monotonic clock).
+double step_rate(const record::Recording& recording, std::int64_t from, std::int64_t to) {
+  const auto steps = std::count_if(recording.steps.begin(), recording.steps.end(), [&](const record::SimulationStep& s) {
+    return s.time_ns() >= from && s.time_ns() < to;
+  });
+  return static_cast<double>(steps) / (static_cast<double>(to - from) * 1e-9);
+}
+
+TEST(Robustness, AMillionHostileDatagramsLeaveTheSimulationRateAndEveryLegitimateSample) {
+  CubeSession session("robust-flood", {"--duration", "300", "--record", "server.mcap"});
+  const std::string server_mcap = (session.dir / "server.mcap").string();
+  // Two users press and hold for as long as the test needs; the test ends them.
+  const auto alice = session.client("alice", 0, write_press(session.dir, "a", -20, 2, 3, 300.0));
+  const auto bob = session.client("bob", 1, write_press(session.dir, "b", 20, -2, 3, 300.0));
+  for (auto* client : {alice.get(), bob.get()}) ASSERT_TRUE(testing::wait_for_output(*client, "haptic loop at"));
+  std::this_thread::sleep_for(3s);  // stimulus: both presses reach their hold
+  const std::int64_t calm_from = wire::monotonic_now_ns();
+  std::this_thread::sleep_for(5s);  // the undisturbed window
+  const std::int64_t flood_from = wire::monotonic_now_ns();
+
+  asio::io_context io;
+  asio::ip::udp::socket socket(io, asio::ip::udp::endpoint(asio::ip::udp::v4(), 0));
+  const asio::ip::udp::endpoint server(asio::ip::make_address("127.0.0.1"), static_cast<std::uint16_t>(session.port));
+  std::mt19937 rng(1);
+  HostileDatagrams hostile(testing::session_id(*session.server), rng);
+  constexpr int kFlood = 1'000'000, kBurst = 100;
+  for (int i = 0; i < kFlood; ++i) {
+    socket.send_to(asio::buffer(hostile.next()), server);
+    if (i % kBurst == kBurst - 1) std::this_thread::sleep_for(1ms);  // stimulus: bursts, not a wall
+  }
+  const std::int64_t flood_to = wire::monotonic_now_ns();
+  std::this_thread::sleep_for(1s);  // the last of the flood is read
+  for (const auto& client : {alice.get(), bob.get()}) client->signal(SIGINT);
+  for (const auto& client : {alice.get(), bob.get()}) ASSERT_EQ(client->wait(testing::kPatience), 0) << client->log_text();
+  session.stop_server();
+
+  const nlohmann::json server_report = session.report("server")["server"];
+  const nlohmann::json& datagrams = server_report["datagrams"];
+  const std::uint64_t sent_by_users =
+      session.report("alice")["datagrams"]["sent"].get<std::uint64_t>() + session.report("bob")["datagrams"]["sent"].get<std::uint64_t>();
+  const record::Recording recording = record::read_recording(server_mcap);
+  const double calm = step_rate(recording, calm_from, flood_from), flooded = step_rate(recording, flood_from, flood_to);
+  std::printf("  %d hostile datagrams in %.1f s: simulation %.1f Hz before, %.1f Hz during (%+.2f %%); rejected %lu "
+              "(%lu decoded, %lu dropped undecoded as rate_limited); users' datagrams %lu sent, %lu accepted\n",
+              kFlood, static_cast<double>(flood_to - flood_from) * 1e-9, calm, flooded, 100 * (flooded / calm - 1),
+              static_cast<unsigned long>(datagrams["rejected"].get<std::uint64_t>()),
+              static_cast<unsigned long>(datagrams["rejected"].get<std::uint64_t>() - count(datagrams, {"rejected_by_reason", "rate_limited"})),
+              static_cast<unsigned long>(count(datagrams, {"rejected_by_reason", "rate_limited"})),
+              static_cast<unsigned long>(sent_by_users), static_cast<unsigned long>(datagrams["accepted"].get<std::uint64_t>()));
+  EXPECT_NEAR(flooded / calm, 1.0, 0.05);
+  EXPECT_EQ(datagrams["accepted"].get<std::uint64_t>(), sent_by_users) << "a legitimate datagram was lost or refused";
+  EXPECT_GE(datagrams["rejected"].get<std::uint64_t>(), kFlood * 99 / 100) << "the kernel dropped much of the flood";
+  EXPECT_EQ(server_report["failed_steps"]["count"], 0);
+}
+
+}  // namespace
+}  // namespace cohaptic
