@@ -1,13 +1,19 @@
 // The sphere contact model against Hertz's solution for a rigid sphere pressed into a
-// large block (lab/hertz.h), on the two graded meshes a test can afford (12 and 16 cells a
-// side): at every depth up to d/R = 0.1 the force approaches Hertz's as the mesh is refined,
-// and is within the case's tolerance of it on the finer mesh, while node translation on
-// the same meshes changes by the element-size ratio (it has no limit). The tolerances are
-// what these meshes reach (measured: at most 7.3 % above Hertz with nodal-pressure
-// tetrahedra, 17 % with plain ones at nu = 0.3); the 5 % of issue 14 needs finer meshes
-// (README, "The sphere against Hertz"). On that graded block with its symmetry planes
-// (nodes held along one axis), the intermediate representation's force equals the full
-// sparse solve's.
+// large block (lab/hertz.h), on the two core meshes a test can afford (12 and 16 cells a
+// side), at d/R = 0.02, 0.05 and 0.1. At every depth and in every case: the force is above
+// Hertz's and approaches it as the mesh is refined (stiff elements converge from above),
+// the two meshes differ by less than 5 % (issue 14), and node translation on the same
+// meshes changes more than three times as much (it has no limit). Where the coarser mesh
+// resolves the contact (8 or more nodes in contact: d/R = 0.05 and 0.1), the finer mesh is
+// nearer Hertz and the force extrapolated to zero cell size from the two meshes (first
+// order: the error falls with the core cell, as the finer meshes of README "The sphere
+// against Hertz" show) is within 5 % of Hertz.
+// Issue 14's own check, the finer mesh itself within 5 % of Hertz, holds on these meshes
+// for nodal-pressure tetrahedra at nu = 0.45 and is asserted there; at nu = 0.3 these
+// meshes are about 10 % (plain) and 8 % (nodal pressure) stiff, and only the 40-cell mesh of
+// `cohaptic-lab hertz --divisions 32 40` (3 minutes of CPU) comes within 5 % (README).
+// On that graded block with its symmetry planes (nodes held along one axis), the
+// intermediate representation's force equals the full sparse solve's.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -30,16 +36,17 @@ namespace {
 
 const std::vector<double> kDepthRatios = {0.02, 0.05, 0.1};
 constexpr int kCoarse = 12, kFine = 16;  // cells per side of the two meshes
+constexpr int kResolvedContactNodes = 8;  // in the quarter: the contact circle spans a few cells
 
 struct HertzCase {
   const char* name;
   LinearElasticMaterial material;
-  double tolerance;  // of F / F_Hertz - 1 on the finer mesh
+  bool fine_mesh_within_5_percent;  // issue 14's check on the finer mesh itself
 };
 
 class HertzConvergence : public ::testing::TestWithParam<HertzCase> {};
 
-TEST_P(HertzConvergence, SphereModelApproachesHertzWhereNodeTranslationDoesNotConverge) {
+TEST_P(HertzConvergence, SphereModelConvergesToHertzWhereNodeTranslationDoesNotConverge) {
   const HertzCase& c = GetParam();
   HertzBlock block;
   block.material = c.material;
@@ -49,18 +56,27 @@ TEST_P(HertzConvergence, SphereModelApproachesHertzWhereNodeTranslationDoesNotCo
   const HertzMesh fine = measure_hertz(block, kDepthRatios);
   for (std::size_t j = 0; j < kDepthRatios.size(); ++j) {
     const double hertz = hertz_force(block.material, block.radius, kDepthRatios[j] * block.radius);
-    const double coarse_error = std::abs(coarse.sphere_force[j] / hertz - 1);
-    const double fine_error = std::abs(fine.sphere_force[j] / hertz - 1);
+    const double coarse_ratio = coarse.sphere_force[j] / hertz, fine_ratio = fine.sphere_force[j] / hertz;
+    // F(h) = F_0 + C h with h proportional to 1 / divisions.
+    const double extrapolated_ratio = (kFine * fine_ratio - kCoarse * coarse_ratio) / (kFine - kCoarse);
     const double sphere_change = std::abs(fine.sphere_force[j] - coarse.sphere_force[j]) / fine.sphere_force[j];
     const double translation_change =
         std::abs(fine.translation_force[j] - coarse.translation_force[j]) / fine.translation_force[j];
-    std::printf("  d/R %.2f: F/F_Hertz %.4f (%d divisions, %d nodes in contact), %.4f (%d, %d); change %.1f %%, node "
-                "translation %.1f %%\n",
-                kDepthRatios[j], coarse.sphere_force[j] / hertz, kCoarse, coarse.contact_nodes[j],
-                fine.sphere_force[j] / hertz, kFine, fine.contact_nodes[j], 100 * sphere_change, 100 * translation_change);
-    EXPECT_LT(fine_error, c.tolerance) << "d/R " << kDepthRatios[j];
-    // Where the two meshes already agree (within 0.5 %), the order of their errors says nothing.
-    EXPECT_LT(fine_error, coarse_error + 0.005) << "refining moved away from Hertz at d/R " << kDepthRatios[j];
+    std::printf("  d/R %.2f: F/F_Hertz %.4f (%d divisions, %d nodes in contact), %.4f (%d, %d), extrapolated %.4f; "
+                "change %.1f %%, node translation %.1f %%\n",
+                kDepthRatios[j], coarse_ratio, kCoarse, coarse.contact_nodes[j], fine_ratio, kFine,
+                fine.contact_nodes[j], extrapolated_ratio, 100 * sphere_change, 100 * translation_change);
+    EXPECT_GT(fine_ratio, 1) << "d/R " << kDepthRatios[j];
+    EXPECT_LT(sphere_change, 0.05) << "d/R " << kDepthRatios[j];
+    // The order of convergence shows only where the coarser mesh resolves the contact
+    // circle: at d/R = 0.02 the 12-cell mesh holds 4 nodes, and the meshes agree within 0.1 %.
+    if (coarse.contact_nodes[j] >= kResolvedContactNodes) {
+      EXPECT_LT(fine_ratio, coarse_ratio) << "refining moved away from Hertz at d/R " << kDepthRatios[j];
+      EXPECT_NEAR(extrapolated_ratio, 1, 0.05) << "d/R " << kDepthRatios[j];
+    }
+    if (c.fine_mesh_within_5_percent) {
+      EXPECT_LT(fine_ratio, 1.05) << "d/R " << kDepthRatios[j];
+    }
     EXPECT_GT(translation_change, 3 * sphere_change) << "node translation converged as well at d/R " << kDepthRatios[j];
     EXPECT_GT(fine.contact_nodes[j], 5) << "the sphere pushes too few nodes for the test to mean anything";
   }
@@ -70,9 +86,9 @@ std::string case_name(const ::testing::TestParamInfo<HertzCase>& tested) { retur
 
 INSTANTIATE_TEST_SUITE_P(
     Hertz, HertzConvergence,
-    ::testing::Values(HertzCase{"LinearTetNu030", {1.0e5, 0.3, ElementFormulation::linear_tet}, 0.2},
-                      HertzCase{"NodalPressureNu030", {1.0e5, 0.3, ElementFormulation::nodal_pressure_tet}, 0.12},
-                      HertzCase{"NodalPressureNu045", {1.0e5, 0.45, ElementFormulation::nodal_pressure_tet}, 0.08}),
+    ::testing::Values(HertzCase{"LinearTetNu030", {1.0e5, 0.3, ElementFormulation::linear_tet}, false},
+                      HertzCase{"NodalPressureNu030", {1.0e5, 0.3, ElementFormulation::nodal_pressure_tet}, false},
+                      HertzCase{"NodalPressureNu045", {1.0e5, 0.45, ElementFormulation::nodal_pressure_tet}, true}),
     case_name);
 
 TEST(Hertz, TheFormulaScalesAsHertzSays) {
