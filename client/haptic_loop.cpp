@@ -100,16 +100,27 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       // dt: the nominal period, so that a replay reproduces the force bit for bit.
       const double dt = 1 / settings_.rate_hz;
       const ForceSample sample = evaluate_force(*slot.ir, *slot.state, own, std::span(remotes.data(), count), dt);
-      force = sample.force;
+      // A sphere contact solve that could not finish inside the tick has no answer: hold the
+      // last one and count the tick.
+      if (sample.flags & kContactUnresolved) {
+        force = last_evaluated_;
+        ++metrics_.contact_unresolved;
+      } else {
+        force = sample.force;
+        last_evaluated_ = force;
+      }
       record.flags = sample.flags;
       record.ir_epoch = ir.epoch;
       record.dt = dt;
       // The coupling figure (the force without the remote tools) needs a second evaluation,
-      // which would advance a dynamic body's state a second time: static bodies only.
-      const bool stateless = std::holds_alternative<std::monostate>(slot.state->body);
-      metrics_.coupling_measured = metrics_.coupling_measured || stateless;
-      if (count > 0 && (sample.flags & kInContact) && stateless) {
-        const ForceSample alone = evaluate_force(*slot.ir, *slot.state, own, {}, dt);
+      // which would advance a dynamic body's state a second time: static bodies only. A sphere's
+      // warm start is no body state: it is left alone by evaluating on an empty state (a cold
+      // solve, the same answer).
+      const bool static_body = !std::holds_alternative<MassSpringPatchState>(slot.state->body);
+      metrics_.coupling_measured = metrics_.coupling_measured || static_body;
+      if (count > 0 && (sample.flags & kInContact) && static_body) {
+        EvaluationState cold;
+        const ForceSample alone = evaluate_force(*slot.ir, cold, own, {}, dt);
         metrics_.peak_coupling = std::max(metrics_.peak_coupling, (sample.force - alone.force).norm());
       }
     }

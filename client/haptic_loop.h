@@ -136,6 +136,7 @@ struct HapticMetrics {
   Histogram period_ns{1000, 50000};   ///< 1 us bins up to 50 ms
   Histogram ir_age_ns{100000, 20000}; ///< 0.1 ms bins up to 2 s
   std::uint64_t ticks = 0, missed_deadlines = 0, non_finite = 0, clamped = 0, ir_switches = 0;
+  std::uint64_t contact_unresolved = 0;  ///< ticks that held the last force (sphere solve unfinished)
   double peak_force = 0;      ///< [N]
   double peak_coupling = 0;   ///< [N], |F - F without the remote tools|
   /// Whether peak_coupling was measured: only on bodies whose evaluation keeps no state
@@ -179,6 +180,7 @@ class HapticLoop {
   HapticMetrics metrics_;
   std::array<RemoteToolBuffer, kMaxUsers> remote_buffers_;
   Eigen::Vector3d last_force_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d last_evaluated_ = Eigen::Vector3d::Zero();  // the IR's last resolved force
   PassivityController passivity_;
   HapticClock clock_;
 };

@@ -135,6 +135,7 @@ int main(int argc, char** argv) {
       report["passivity_controller"] = {{"active_ticks", loop.passivity().active_ticks()},
                                         {"dissipated_j", loop.passivity().dissipated_energy()}};
     report["non_finite_ticks"] = m.non_finite;
+    report["contact_unresolved_ticks"] = m.contact_unresolved;
     report["elapsed_s"] = m.elapsed_s;
     report.update(network.report());
     spdlog::info("done: {} ticks at {:.1f} Hz, period p99 {:.0f} us (timer floor p99 {:.0f} us), peak force {:.3f} N, "

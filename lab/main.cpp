@@ -3,6 +3,7 @@
 //   replay     look at, re-run or export a recording    stability  the stability map of a wall
 //   study      a lab study, trial by trial              summarize  merge reports, judge a session
 //   keygen     a new session key file, or a participant key file
+//   hertz      a sphere in a block, against Hertz
 //   objects-push  the several-objects pushing test: back free, fixed, on an elastic box
 // Each tool adds its own subcommand (lab/lab_command.h). A tool that needs the server or the
 // client (study) starts them as processes; cohaptic-lab links neither.
@@ -14,6 +15,7 @@
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
 #include "common/util/log_to_stderr.h"
+#include "lab/hertz.h"
 #include "lab/keygen.h"
 #include "lab/objects_push.h"
 #include "lab/probe.h"
@@ -36,7 +38,7 @@ int main(int argc, char** argv) {
   const std::vector<cohaptic::LabCommand> commands = {
       cohaptic::add_probe_command(app),     cohaptic::add_replay_command(app),    cohaptic::add_study_command(app),
       cohaptic::add_tradeoff_command(app),  cohaptic::add_stability_command(app), cohaptic::add_summarize_command(app),
-      cohaptic::add_keygen_command(app),   cohaptic::add_objects_push_command(app)};
+      cohaptic::add_keygen_command(app),    cohaptic::add_hertz_command(app),    cohaptic::add_objects_push_command(app)};
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));

@@ -59,6 +59,7 @@ VerifyResult verify_client(const Recording& rec) {
   // Each IR's evaluation state, made when a tick first uses the IR and advanced by every
   // tick that uses it, as the haptic loop did (a dynamic body's force depends on it).
   std::map<const PreparedIR*, EvaluationState> states;
+  Eigen::Vector3d last_resolved = Eigen::Vector3d::Zero();  // held over unresolved sphere solves, as the loop does
   const auto fail = [&](std::size_t i, const record::HapticTick& tick, const std::string& what) {
     result.ok = false;
     result.first_difference =
@@ -83,7 +84,9 @@ VerifyResult verify_client(const Recording& rec) {
         for (const wire::Vec3& r : tick.remotes()) remotes.push_back(wire::from_wire(r));
         auto state = states.find(ir.get());
         if (state == states.end()) state = states.emplace(ir.get(), make_evaluation_state(*ir)).first;
-        expected = evaluate_force(*ir, state->second, wire::from_wire(tick.own()), remotes, tick.dt()).force;
+        const ForceSample sample = evaluate_force(*ir, state->second, wire::from_wire(tick.own()), remotes, tick.dt());
+        expected = (sample.flags & kContactUnresolved) ? last_resolved : sample.force;
+        last_resolved = expected;
       } else {
         // P0: the force held is one the server sent under that epoch and had arrived.
         expected = Eigen::Vector3d::Constant(std::nan(""));

@@ -14,6 +14,7 @@
 #include "common/model/compliance_setup.h"
 #include "common/model/model.h"
 #include "common/model/contact_reference.h"
+#include "common/model/sphere_contact_reference.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "common/study/svg_plot.h"
@@ -29,7 +30,11 @@ namespace {
 constexpr double kSimulationRateHz = 1000;
 
 const char* contact_model_name(ContactModel model) {
-  return model == ContactModel::node_translation ? "translation" : "point";
+  return model == ContactModel::node_translation ? "translation" : model == ContactModel::point_constraint ? "point" : "sphere";
+}
+
+bool all_spheres(const Scene& scene) {
+  return std::all_of(scene.tools.begin(), scene.tools.end(), [](const ToolSpec& tool) { return tool.radius > 0; });
 }
 
 HeldNodes held_nodes(const Simulation& simulation) {
@@ -42,6 +47,29 @@ int samples_per(double sample_rate_hz, double rate_hz, const std::string& what) 
     throw Error(fmt::format("tradeoff: the {} ({:g} Hz) must divide {:g} Hz", what, rate_hz, sample_rate_hz));
   return static_cast<int>(std::lround(ratio));
 }
+
+// The full sparse solve of a contact model on one mesh: the sphere model's unilateral
+// problem (SphereContactReference), or node translation (ContactReference) for the paper's
+// two models, which share it as their reference.
+class FullSolve {
+ public:
+  FullSolve(const ElasticBody& body, ContactModel model) {
+    if (model == ContactModel::sphere)
+      sphere_ = std::make_unique<SphereContactReference>(body);
+    else
+      translation_ = std::make_unique<ContactReference>(body);
+  }
+
+  std::vector<Eigen::Vector3d> forces(const std::vector<PressedTool>& tools, const HeldNodes& held = {}) {
+    return sphere_ ? sphere_->solve(tools, held).reactions : translation_->forces(tools, held);
+  }
+
+  std::size_t factorisations() const { return sphere_ ? sphere_->factorisations() : translation_->factorisations(); }
+
+ private:
+  std::unique_ptr<ContactReference> translation_;
+  std::unique_ptr<SphereContactReference> sphere_;
+};
 
 double model_memory_mb(const ElasticBody& body, const ComplianceColumns& columns) {
   const double stiffness = static_cast<double>(body.stiffness.nonZeros()) * (sizeof(double) + sizeof(int));
@@ -77,10 +105,9 @@ std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector
                                                ? ElementFormulation::nodal_pressure_tet
                                                : ElementFormulation::linear_tet;
   vary("element", formulation_name(other_element), [&](TradeoffSetting& s) { s.formulation = other_element; });
-  const ContactModel other_contact = base.contact_model == ContactModel::node_translation
-                                         ? ContactModel::point_constraint
-                                         : ContactModel::node_translation;
-  vary("contact_model", contact_model_name(other_contact), [&](TradeoffSetting& s) { s.contact_model = other_contact; });
+  for (ContactModel other : {ContactModel::sphere, ContactModel::node_translation, ContactModel::point_constraint})
+    if (other != base.contact_model && (other != ContactModel::sphere || all_spheres(scene)))
+      vary("contact_model", contact_model_name(other), [other](TradeoffSetting& s) { s.contact_model = other; });
   for (int rings : {0, 2})
     if (rings != base.patch_rings)
       vary("patch_rings", std::to_string(rings), [rings](TradeoffSetting& s) { s.patch_rings = rings; });
@@ -123,7 +150,7 @@ ReferenceTrace reference_trace(const Scene& reference, const std::vector<Traject
   const Stopwatch watch;
   const Model model = build_model(reference);
   const ElasticBody& body = single_elastic_body(model);
-  ContactReference solver(body);
+  FullSolve solver(body, reference.haptic.contact_model);
   // With obstacles, which nodes rest on them at each moment comes from the simulation's
   // active set on this mesh; the forces then from the full solve with those nodes held.
   std::unique_ptr<ComplianceColumns> columns;
@@ -193,7 +220,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
   options.ir.precision = setting.precision;
   options.ir.force_limit = std::numeric_limits<double>::infinity();  // compare the physics, not the limiter
   Simulation simulation(body, model.obstacles, columns, varied.tools, options);
-  ContactReference own_mesh(body);
+  FullSolve own_mesh(body, setting.contact_model);
   std::vector<PressedTool> pressed(varied.tools.size());
 
   const int per_step = samples_per(reference.sample_rate_hz, kSimulationRateHz, "simulation rate");

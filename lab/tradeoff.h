@@ -6,8 +6,11 @@
 // builds IRs (server), each user's haptic loop evaluates its latest IR at the setting's
 // haptic rate and holds the force in between (client). The forces are compared, on a
 // 10 kHz time grid, with the reference: the finest mesh of the same geometry solved in
-// full (ContactReference, node translation) at the same tool positions; and, to separate
-// the discretisation from the rest, with the full solve on the setting's own mesh.
+// full at the same tool positions, under the baseline's contact model (the sphere model's
+// unilateral problem, SphereContactReference; for the paper's two models node translation,
+// ContactReference); and, to separate the discretisation from the rest, with the full
+// solve of the setting's own contact model (node translation for both of the paper's) on
+// the setting's own mesh.
 //
 // One knob at a time is varied from the scene's own settings (the baseline): mesh
 // divisions (box scenes), element formulation, contact model, patch rings, IR precision,
@@ -77,7 +80,7 @@ struct TradeoffRow {
   int nodes = 0, tets = 0;
   double error_rms = 0;           ///< RMS over samples and tools of |F - F_ref|, over the reference's peak
   double error_max = 0;           ///< max of the same, over the peak
-  /// The same against the full solve (node translation) on the setting's own mesh, over the
+  /// The same against the full solve (the sphere model's, or node translation) on the setting's own mesh, over the
   /// same (the reference's) peak, so that both columns share a scale: what the
   /// IR pipeline itself costs in accuracy (patch, update policy, precision, haptic rate,
   /// truncation, contact model), without the discretisation.

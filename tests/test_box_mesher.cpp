@@ -4,6 +4,7 @@
 
 #include "common/mesh/boundary_surface.h"
 #include "common/mesh/box_mesher.h"
+#include "common/util/error.h"
 
 namespace cohaptic {
 namespace {
@@ -20,6 +21,53 @@ TEST(BoxMesher, CountsAndVolumeOfThePaperCube) {
     volume += v;
   }
   EXPECT_NEAR(volume, 0.13 * 0.13 * 0.13, 1e-15);
+}
+
+TEST(BoxMesher, GradedCellsFormAGeometricSeriesAndFillTheBox) {
+  // x: each cell 2 times the one before; y uniform; z: each half the one before.
+  const TetMesh mesh = make_box_mesh(Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(7, 1, 1), Eigen::Vector3i(3, 2, 2),
+                                     Eigen::Vector3d(2, 1, 0.5));
+  // x nodes at 0, 1, 3, 7 (cells 1, 2, 4); z nodes at -1, -1/3, 0 (cells 2/3, 1/3).
+  const double x[] = {0, 1, 3, 7}, z[] = {-1, -1.0 / 3, 0};
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 4; ++i) {
+      const Eigen::Vector3d node = mesh.nodes.col(i + 4 * (1 + 3 * k));  // j = 1: y = 0.5
+      EXPECT_NEAR(node.x(), x[i], 1e-14);
+      EXPECT_NEAR(node.y(), 0.5, 1e-14);
+      EXPECT_NEAR(node.z(), z[k], 1e-14);
+    }
+  double volume = 0;
+  for (int t = 0; t < mesh.tet_count(); ++t) {
+    ASSERT_GT(signed_volume(mesh, t), 0) << "tet " << t;
+    volume += signed_volume(mesh, t);
+  }
+  EXPECT_NEAR(volume, 7, 1e-13);
+  EXPECT_THROW(make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones(), Eigen::Vector3i::Ones(),
+                             Eigen::Vector3d(1, 0, 1)),
+               MeshError);
+}
+
+TEST(BoxMesher, UniformCellsComeFirstOnTheFineSide) {
+  // x: 2 equal cells, then each 3 times the one before: cells 1, 1, 3, 9 (length 14).
+  // z: fine side at the max end: cells 4, 2, 1, 1 from the min (length 8).
+  const TetMesh mesh = make_box_mesh(Eigen::Vector3d(0, 0, -8), Eigen::Vector3d(14, 1, 8), Eigen::Vector3i(4, 1, 4),
+                                     Eigen::Vector3d(3, 1, 0.5), Eigen::Vector3i(2, 0, 2));
+  const double x[] = {0, 1, 2, 5, 14}, z[] = {-8, -4, -2, -1, 0};
+  for (int k = 0; k < 5; ++k)
+    for (int i = 0; i < 5; ++i) {
+      const Eigen::Vector3d node = mesh.nodes.col(i + 5 * 2 * k);  // j = 0
+      EXPECT_NEAR(node.x(), x[i], 1e-13);
+      EXPECT_NEAR(node.z(), z[k], 1e-13);
+    }
+  // With one uniform cell (or none) it is the plain geometric series.
+  const TetMesh plain = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones(), Eigen::Vector3i::Constant(3),
+                                      Eigen::Vector3d::Constant(1.7));
+  const TetMesh one = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones(), Eigen::Vector3i::Constant(3),
+                                    Eigen::Vector3d::Constant(1.7), Eigen::Vector3i::Ones());
+  EXPECT_LT((plain.nodes - one.nodes).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_THROW(make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones(), Eigen::Vector3i::Constant(2),
+                             Eigen::Vector3d::Ones(), Eigen::Vector3i(3, 0, 0)),
+               MeshError);
 }
 
 TEST(BoundarySurface, BoxSurfaceIsClosedOutwardAndComplete) {

@@ -1,9 +1,9 @@
 // The haptic path allocates nothing: malloc is interposed for this test program and
 // counts the calls made while a flag is set, around thousands of evaluations of the FEM
-// body's force (every contact model, remote tools, held boundary nodes), of a mass-spring
-// body's sub-network integrated tick by tick with two tools pressing it, and of the
-// laparoscopy model's per-tick functions (home-spring tick, alone and as the IR's body
-// through evaluate_force, forceps step, display frames by both methods).
+// body's force (every contact model, the sphere model's too, remote tools, held boundary
+// nodes), of a mass-spring body's sub-network integrated tick by tick with two tools
+// pressing it, and of the laparoscopy model's per-tick functions (home-spring tick, alone
+// and as the IR's body through evaluate_force, forceps step, display frames by both methods).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -152,6 +152,37 @@ TEST(LaparoscopyHapticPath, AllocatesNothing) {
   EXPECT_EQ(allocations.load(), 0) << "the laparoscopy haptic path allocated";
   EXPECT_TRUE(sum.allFinite());
   EXPECT_GT(touching, 500);  // the tool does go through the sheet
+}
+
+TEST(ForceEvaluator, AllocatesNothingUnderTheSphereModel) {
+  testing::CubeSceneOptions cube;
+  cube.tools = "[{name: A, shape: sphere, radius: 30}, {name: B, shape: sphere, radius: 30}]";
+  const Model model = build_model(parse_scene(testing::cube_scene_yaml(cube), "cube.yaml"));
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  SimulationOptions options;
+  options.ir.contact_model = ContactModel::sphere;
+  options.ir.patch_rings = 2;
+  options.step_delay_nodes = 150;
+  Simulation simulation(body, model.obstacles, columns, model.scene.tools, options);
+  simulation.set_tool(0, Eigen::Vector3d(-0.02, 0.005, 0.026));
+  simulation.set_tool(1, Eigen::Vector3d(0.025, -0.005, 0.027));
+  simulation.step(0);
+  const PreparedIR& prepared = *simulation.ir(0);
+  const std::vector<Eigen::Vector3d> remotes = simulation.remote_positions(prepared.ir);
+  EvaluationState state = make_evaluation_state(prepared);  // the warm start, sized here
+  ASSERT_TRUE(std::holds_alternative<SphereWarmStart>(state.body));
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  allocations = 0;
+  counting = true;
+  for (int i = 0; i < 5000; ++i) {
+    const Eigen::Vector3d tool(-0.02 + 1e-6 * (i % 1000), 0.005, 0.026 - 1e-7 * (i % 300));
+    sum += evaluate_force(prepared, state, tool, remotes, 1e-3).force;
+  }
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0) << "evaluate_force allocated";
+  EXPECT_TRUE(sum.allFinite());
+  EXPECT_GT(sum.norm(), 0);
 }
 
 }  // namespace

@@ -5,9 +5,18 @@
 namespace cohaptic {
 
 std::vector<int> contact_patch(const BoundarySurface& surface, int triangle, int rings, const std::vector<bool>& allowed) {
-  std::vector<int> patch{triangle};
+  return contact_patch(surface, std::span<const int>(&triangle, 1), rings, allowed);
+}
+
+std::vector<int> contact_patch(const BoundarySurface& surface, std::span<const int> seeds, int rings,
+                               const std::vector<bool>& allowed) {
+  std::vector<int> patch;
   std::vector<bool> in_patch(surface.triangles.size(), false);
-  in_patch[triangle] = true;
+  for (int t : seeds)
+    if (!in_patch[t]) {
+      in_patch[t] = true;
+      patch.push_back(t);
+    }
   std::size_t ring_begin = 0;
   for (int ring = 0; ring < rings; ++ring) {
     const std::size_t ring_end = patch.size();

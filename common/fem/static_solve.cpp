@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -55,6 +57,30 @@ StaticSolution ConstrainedStaticSolver::solve(const Eigen::VectorXd& prescribed_
   solution.reaction = stiffness_ * solution.displacement;
   if (applied_forces.size() == n) solution.reaction -= applied_forces;
   return solution;
+}
+
+Eigen::MatrixXd ConstrainedStaticSolver::compliance_block(std::span<const int> rows, std::span<const int> columns) const {
+  constexpr Eigen::Index kBlock = 64;
+  const auto n = static_cast<int>(stiffness_.rows());
+  std::vector<int> position(static_cast<std::size_t>(n), -1);  // among the unknowns
+  for (std::size_t i = 0; i < unknown_.size(); ++i) position[static_cast<std::size_t>(unknown_[i])] = static_cast<int>(i);
+  const auto at = [&](int dof) {
+    if (dof < 0 || dof >= n) throw Error(fmt::format("static solve: compliance of dof {}, out of range", dof));
+    return position[static_cast<std::size_t>(dof)];
+  };
+  const auto row_count = static_cast<Eigen::Index>(rows.size());
+  const auto column_count = static_cast<Eigen::Index>(columns.size());
+  Eigen::MatrixXd block = Eigen::MatrixXd::Zero(row_count, column_count);
+  for (Eigen::Index begin = 0; begin < column_count && factor_; begin += kBlock) {
+    const Eigen::Index width = std::min(kBlock, column_count - begin);
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(unknown_.size()), width);
+    for (Eigen::Index c = 0; c < width; ++c)
+      if (const int p = at(columns[static_cast<std::size_t>(begin + c)]); p >= 0) rhs(p, c) = 1;
+    const Eigen::MatrixXd x = factor_->solve(rhs);
+    for (Eigen::Index r = 0; r < row_count; ++r)
+      if (const int p = at(rows[static_cast<std::size_t>(r)]); p >= 0) block.row(r).segment(begin, width) = x.row(p);
+  }
+  return block;
 }
 
 StaticSolution solve_static(const SparseMatrix& stiffness, const DofMap& dofs,

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "common/fem/assemble_stiffness.h"
@@ -38,6 +39,12 @@ class ConstrainedStaticSolver {
   /// `prescribed_values` aligned with the constructor's dofs [m]; `applied_forces` 3N [N]
   /// or empty. Loads on constrained dofs are carried by the constraint.
   StaticSolution solve(const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& applied_forces = {}) const;
+
+  /// The compliance between global dofs with every prescribed dof held at zero [m/N]:
+  /// entry (i, j) is the displacement of rows[i] under a unit force at columns[j]. Rows
+  /// and columns that are fixed or prescribed give zeros. Solved in blocks of 64
+  /// right-hand sides.
+  Eigen::MatrixXd compliance_block(std::span<const int> rows, std::span<const int> columns) const;
 
  private:
   const SparseMatrix& stiffness_;

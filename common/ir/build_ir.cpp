@@ -7,6 +7,7 @@
 
 #include "common/contact/contact_patch.h"
 #include "common/contact/find_contact.h"
+#include "common/contact/sphere_contact.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -66,7 +67,14 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
 
   std::vector<bool> allowed(body.surface.triangles.size(), false);
   for (int t : body.touchable_triangles) allowed[t] = !holds_node(t);
-  const std::vector<int> patch = contact_patch(body.surface, own.nearest_triangle, options.patch_rings, allowed);
+  // The sphere model's patch covers every node the sphere holds (sphere_contact.h).
+  const bool sphere = options.contact_model == ContactModel::sphere;
+  const auto patch_of = [&](const UserTool& user) {
+    return sphere ? sphere_patch(body.mesh, body.surface, user.nearest_triangle, {user.position, user.radius},
+                                 options.patch_rings, allowed)
+                  : contact_patch(body.surface, user.nearest_triangle, options.patch_rings, allowed);
+  };
+  const std::vector<int> patch = patch_of(own);
 
   IntermediateRepresentation ir;
   ir.epoch = epoch;
@@ -120,6 +128,8 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
     IrRemoteContact remote;
     remote.user = users[j].user;
     for (int k = 0; k < 3; ++k) remote.nodes[k] = add_node(body.surface.triangles[users[j].nearest_triangle][k]);
+    if (sphere)  // the remote sphere's candidates are contact nodes too
+      for (int node : triangle_nodes(body.surface, patch_of(users[j]))) add_node(node);
     const int t = users[j].nearest_triangle;
     remote.normal = body.normals.face[t];
     for (int k = 0; k < 3; ++k) {

@@ -3,7 +3,9 @@
 // The patch is centred on the touchable triangle nearest the user's tool (in contact or
 // not, so the client can detect contact itself); the other users' nearest triangles are
 // included as remote contacts; M~ comes from the incremental condensation for
-// C = patch nodes + remote contact nodes and the current boundary set B.
+// C = patch nodes + remote contact nodes and the current boundary set B. Under the sphere
+// contact model the patch also holds every touchable triangle with a node inside the
+// sphere (sphere_patch), and every remote sphere's patch nodes are contact nodes too.
 #pragma once
 
 #include <Eigen/Core>

@@ -11,6 +11,7 @@
 #include "common/contact/closest_point_on_triangle.h"
 #include "common/contact/nearest_triangle_rule.h"
 #include "common/contact/surface_distance.h"
+#include "common/ir/evaluate_sphere_contact.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -75,19 +76,7 @@ PatchPoint nearest_on_patch(const CondensedFemIr& ir, const PreparedFem& prepare
   return best;
 }
 
-// Never a non-finite or unbounded force: zero (flagged) if the evaluation failed or is not
-// finite, scaled down to the limit (flagged) if above it.
-void limit_force(ForceSample& sample, bool evaluated, double force_limit) noexcept {
-  if (!evaluated || !sample.force.allFinite()) {
-    sample.force.setZero();
-    sample.flags |= kNonFinite;
-  } else if (const double magnitude = sample.force.norm(); magnitude > force_limit) {
-    sample.force *= force_limit / magnitude;
-    sample.flags |= kClamped;
-  }
-}
-
-PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double& condition_estimate) {
+PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, double& condition_estimate) {
   PreparedFem prepared;
   const int rows = ir.row_node_count;
   if (ir.node_count() < rows || rows < ir.patch_node_count || ir.patch.empty() ||
@@ -137,6 +126,7 @@ PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double& condition_es
   for (const IrTriangle& tri : ir.patch)
     for (int k = 0; k < 3; ++k)
       if (tri.neighbours[k] < 0) prepared.on_patch_border[tri.nodes[k]] = prepared.on_patch_border[tri.nodes[(k + 1) % 3]] = true;
+  if (ir.contact_model == ContactModel::sphere) prepared.sphere = prepare_sphere_contact(ir, tool_radius);
   return prepared;
 }
 
@@ -260,19 +250,32 @@ ForceSample evaluate_home_spring_body(const IntermediateRepresentation& envelope
 
 // Prepares the IR's body by its kind.
 struct BodyPreparer {
+  double tool_radius;
   double& condition_estimate;
-  PreparedBody operator()(const CondensedFemIr& fem) const { return prepare_condensed_fem(fem, condition_estimate); }
+  PreparedBody operator()(const CondensedFemIr& fem) const {
+    return prepare_condensed_fem(fem, tool_radius, condition_estimate);
+  }
   PreparedBody operator()(const MassSpringIr& network) const { return prepare_mass_spring(network); }
   PreparedBody operator()(const HomeSpringPatch& patch) const { return prepare_home_spring_patch(patch); }
 };
 
 }  // namespace
 
+void limit_force(ForceSample& sample, bool evaluated, double force_limit) noexcept {
+  if (!evaluated || !sample.force.allFinite()) {
+    sample.force.setZero();
+    sample.flags |= kNonFinite;
+  } else if (const double magnitude = sample.force.norm(); magnitude > force_limit) {
+    sample.force *= force_limit / magnitude;
+    sample.flags |= kClamped;
+  }
+}
+
 PreparedIR prepare_ir(IntermediateRepresentation ir) {
   PreparedIR prepared;
   if (!(std::isfinite(ir.tool_radius) && ir.tool_radius >= 0) || !(ir.force_limit >= 0))
     throw Error("intermediate representation: tool radius or force limit out of range");
-  prepared.body = std::visit(BodyPreparer{prepared.condition_estimate}, ir.body);
+  prepared.body = std::visit(BodyPreparer{ir.tool_radius, prepared.condition_estimate}, ir.body);
   prepared.ir = std::move(ir);
   return prepared;
 }
@@ -281,6 +284,8 @@ EvaluationState make_evaluation_state(const PreparedIR& prepared) {
   EvaluationState state;
   if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
     state.body = make_mass_spring_state(*network, std::get<PreparedMassSpring>(prepared.body));
+  else if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body); fem && fem->contact_model == ContactModel::sphere)
+    state.body = SphereWarmStart{};
   return state;
 }
 
@@ -288,8 +293,12 @@ ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, c
                            std::span<const Eigen::Vector3d> remote_tools, double dt) noexcept {
   // get_if, not visit: nothing on this path may throw. prepare_ir made the kinds match.
   if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body))
-    if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body))
+    if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body)) {
+      if (fem->contact_model == ContactModel::sphere)
+        return evaluate_sphere_contact(prepared.ir, *fem, *prepared_fem, std::get_if<SphereWarmStart>(&state.body),
+                                       own_tool, remote_tools);
       return evaluate_condensed_fem(prepared.ir, *fem, *prepared_fem, own_tool, remote_tools);
+    }
   if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
     if (const auto* prepared_network = std::get_if<PreparedMassSpring>(&prepared.body))
       if (auto* network_state = std::get_if<MassSpringPatchState>(&state.body))

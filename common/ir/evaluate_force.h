@@ -6,11 +6,12 @@
 // size (kMaxUsers users, each contributing at most 3 contact nodes), and what a dynamic
 // body changes from tick to tick lives in the caller's EvaluationState, made with the
 // prepared IR (make_evaluation_state) and advanced by dt, the loop's nominal period, at
-// every call. The condensed FEM body is static: it ignores both. The mass-spring body
-// (mass_spring_evaluation.h) integrates its sub-network over dt. The home-spring body is
-// static too (its grasp travels in the IR): home_spring_contact.h's tick, from the shaft
-// through the patch's trocar pivot; the sample's depth is then |u|, the contact vertex's
-// displacement, and its triangle -1.
+// every call. The condensed FEM body is static: it ignores dt, and its state is at most the
+// sphere contact model's warm start. The mass-spring body (mass_spring_evaluation.h)
+// integrates its sub-network over dt. The home-spring body is static too (its grasp
+// travels in the IR): home_spring_contact.h's tick, from the shaft through the patch's
+// trocar pivot; the sample's depth is then |u|, the contact vertex's displacement, and
+// its triangle -1.
 //
 // The condensed FEM body:
 // prepare_ir() runs once per IR, off the haptic thread: it checks the IR and inverts the
@@ -28,6 +29,8 @@
 //   4. returns -F, set to zero if not finite and scaled down to the IR's force limit.
 // Exactly the full FEM solve's answer for the same tool positions, as long as every tool
 // stays on its IR triangles (the own tool within its patch).
+// Under the sphere contact model step 3 is the unilateral problem over every contact node
+// the spheres pass instead (evaluate_sphere_contact.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -39,6 +42,7 @@
 #include "common/ir/contact_solve.h"
 #include "common/ir/intermediate_representation.h"
 #include "common/ir/mass_spring_evaluation.h"
+#include "common/ir/prepared_sphere_contact.h"
 #include "common/laparoscopy/home_spring_contact.h"
 
 namespace cohaptic {
@@ -49,6 +53,7 @@ struct PreparedFem {
   Eigen::VectorXd free_displacement;  ///< u0 over the same dofs [m]
   std::vector<std::array<int, 3>> dof_index;  ///< per contact node and axis: row in L~, or -1 if fixed
   std::vector<bool> on_patch_border;  ///< per patch node
+  PreparedSphereContact sphere;       ///< the sphere contact model's (evaluate_sphere_contact.h)
 };
 
 /// One alternative per IrBody alternative, in the same order.
@@ -68,9 +73,11 @@ struct PreparedIR {
 PreparedIR prepare_ir(IntermediateRepresentation ir);
 
 /// The mutable side of one evaluator of one prepared IR: nothing for a static body (FEM),
-/// the sub-network's state for a mass-spring body. Made off the haptic thread, sized there.
+/// the last tick's active set for an FEM body under the sphere contact model (only a warm
+/// start: an empty state solves cold, to the same answer), the sub-network's state for a
+/// mass-spring body. Made off the haptic thread, sized there.
 struct EvaluationState {
-  std::variant<std::monostate, MassSpringPatchState> body;
+  std::variant<std::monostate, MassSpringPatchState, SphereWarmStart> body;
 };
 
 /// The state an evaluator of `prepared` starts from (the server's state at the IR's time).
@@ -83,6 +90,7 @@ enum ForceFlag : std::uint8_t {
   kOutsidePatch = 8,      ///< the tool is past the patch border: held on it until the next IR
   kRemoteOverlap = 16,    ///< a remote triangle shares a node with the own one: that remote ignored
   kTooManyRemotes = 32,   ///< remotes beyond kMaxUsers - 1 ignored
+  kContactUnresolved = 64,  ///< sphere model: the contact solve did not finish in its budget (zero force)
 };
 
 struct ForceSample {
@@ -92,7 +100,12 @@ struct ForceSample {
   std::uint8_t flags = 0;
 };
 
-/// Dispatches on the body kind. remote_tools[i] is the position of the tool of the body's
+/// Never a non-finite or unbounded force: sets sample.force to zero (flagged kNonFinite) if
+/// not `evaluated` or not finite, scales it down to `force_limit` (flagged kClamped) if above.
+void limit_force(ForceSample& sample, bool evaluated, double force_limit) noexcept;
+
+/// Dispatches on the body kind (a condensed FEM body under the sphere contact model is
+/// evaluate_sphere_contact()). remote_tools[i] is the position of the tool of the body's
 /// i-th remote contact [m] (NaN: unknown, ignored). `state` must come from
 /// make_evaluation_state(prepared) and be advanced by no other IR; dt [s] is the period
 /// since the previous call (the haptic loop's nominal period). A state of another kind

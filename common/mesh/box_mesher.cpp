@@ -1,20 +1,45 @@
 #include "common/mesh/box_mesher.h"
 
 #include <algorithm>
+#include <cmath>
 #include <fmt/format.h>
 
 #include "common/util/error.h"
 
 namespace cohaptic {
+namespace {
+
+// Where node i of n cells lies along an axis, as a fraction of its length: `uniform`
+// equal cells on the fine side, then a geometric series of ratio r (r < 1: mirrored, the
+// fine side at the max end).
+double graded_fraction(int i, int n, double r, int uniform) {
+  if (r < 1) return 1 - graded_fraction(n - i, n, 1 / r, uniform);
+  // The length of the first `cells` cells, in units of the first cell.
+  const auto length = [&](int cells) {
+    const int equal = std::min(cells, std::max(uniform, 1));
+    const int grown = cells - equal;
+    return equal + (std::abs(r - 1) < 1e-12 ? grown : r * (std::pow(r, grown) - 1) / (r - 1));
+  };
+  return i == n ? 1 : length(i) / length(n);
+}
+
+}  // namespace
 
 TetMesh make_box_mesh(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& size,
-                      const Eigen::Vector3i& divisions) {
+                      const Eigen::Vector3i& divisions, const Eigen::Vector3d& grading,
+                      const Eigen::Vector3i& uniform_cells) {
   if ((divisions.array() < 1).any())
     throw MeshError(fmt::format("box mesh: divisions must be >= 1 along every axis, got {} {} {}",
                                 divisions.x(), divisions.y(), divisions.z()));
   if (!(size.array() > 0).all() || !size.allFinite())
     throw MeshError(fmt::format("box mesh: size must be positive along every axis, got {} {} {}",
                                 size.x(), size.y(), size.z()));
+  if (!(grading.array() > 0).all() || !grading.allFinite())
+    throw MeshError(fmt::format("box mesh: grading must be a positive ratio along every axis, got {} {} {}",
+                                grading.x(), grading.y(), grading.z()));
+  if ((uniform_cells.array() < 0).any() || (uniform_cells.array() > divisions.array()).any())
+    throw MeshError(fmt::format("box mesh: uniform cells must be from 0 to the divisions along every axis, got {} {} {}",
+                                uniform_cells.x(), uniform_cells.y(), uniform_cells.z()));
   const int nx = divisions.x(), ny = divisions.y(), nz = divisions.z();
   const auto node_id = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
 
@@ -25,7 +50,9 @@ TetMesh make_box_mesh(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& 
     for (int j = 0; j <= ny; ++j)
       for (int i = 0; i <= nx; ++i)
         mesh.nodes.col(node_id(i, j, k)) =
-            min_corner + size.cwiseProduct(Eigen::Vector3d(double(i) / nx, double(j) / ny, double(k) / nz));
+            min_corner + size.cwiseProduct(Eigen::Vector3d(graded_fraction(i, nx, grading.x(), uniform_cells.x()),
+                                                          graded_fraction(j, ny, grading.y(), uniform_cells.y()),
+                                                          graded_fraction(k, nz, grading.z(), uniform_cells.z())));
   mesh.node_tags.resize(static_cast<std::size_t>(node_count));
   for (int n = 0; n < node_count; ++n) mesh.node_tags[n] = n + 1;
 

@@ -14,7 +14,8 @@ namespace cohaptic {
 namespace {
 
 TetMesh load_mesh(const MeshSpec& spec, double metres_per_unit) {
-  if (spec.box) return make_box_mesh(spec.box->min_corner, spec.box->size, spec.box->divisions);
+  if (spec.box) return make_box_mesh(spec.box->min_corner, spec.box->size, spec.box->divisions, spec.box->grading,
+                                       spec.box->uniform_cells);
   GmshMesh gmsh = read_gmsh(spec.file);
   if (gmsh.unused_nodes_dropped > 0)
     spdlog::info("{}: dropped {} nodes that no tetrahedron uses", spec.file.string(), gmsh.unused_nodes_dropped);

@@ -5,6 +5,7 @@
 #include "common/util/yaml_cursor.h"
 
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -88,7 +89,7 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
     if (mesh.file.is_relative()) mesh.file = scene_dir / mesh.file;
     if (const auto why = why_not_a_regular_file(mesh.file)) file->fail_message(fmt::format("mesh file {} {}", mesh.file.string(), *why));
   } else {
-    box->only_keys({"min", "size", "divisions"});
+    box->only_keys({"min", "size", "divisions", "grading", "uniform_cells"});
     BoxMeshSpec spec;
     spec.min_corner = box->at("min").vec3() * scale;
     const Cursor size = box->at("size");
@@ -101,6 +102,21 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
       const std::int64_t d = parts[i].integer();
       if (d < 1 || d > 400) parts[i].fail("an integer from 1 to 400");
       spec.divisions[i] = static_cast<int>(d);
+    }
+    if (auto grading = box->find("grading")) {
+      if (!grading->is_sequence() || grading->items().size() != 3) grading->fail("a list of 3 ratios");
+      const auto ratios = grading->items();
+      for (int i = 0; i < 3; ++i) spec.grading[i] = ratios[i].number_in(0.2, 5, false, false, "a ratio from 0.2 to 5");
+    }
+    if (auto uniform = box->find("uniform_cells")) {
+      if (!uniform->is_sequence() || uniform->items().size() != 3) uniform->fail("a list of 3 integers");
+      const auto cells = uniform->items();
+      for (int i = 0; i < 3; ++i) {
+        const std::int64_t count = cells[i].integer();
+        if (count < 0 || count > spec.divisions[i])
+          cells[i].fail(fmt::format("an integer from 0 to the divisions ({})", spec.divisions[i]));
+        spec.uniform_cells[i] = static_cast<int>(count);
+      }
     }
     mesh.box = spec;
   }
@@ -211,9 +227,12 @@ HapticSettings parse_haptic(const Cursor& c) {
   }
   if (auto truncation = c.find("boundary_truncation"))
     haptic.boundary_truncation = truncation->number_in(0, 1, false, true, "a fraction in [0, 1)");
-  if (auto model = c.find("contact_model"))
-    haptic.contact_model = model->choice({"translation", "point"}) == "translation" ? ContactModel::node_translation
-                                                                                     : ContactModel::point_constraint;
+  if (auto model = c.find("contact_model")) {
+    const std::string name = model->choice({"translation", "point", "sphere"});
+    haptic.contact_model = name == "translation" ? ContactModel::node_translation
+                           : name == "point"     ? ContactModel::point_constraint
+                                                 : ContactModel::sphere;
+  }
   return haptic;
 }
 
@@ -267,7 +286,17 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
   }
   if (scene.tools.empty()) tools.fail("at least one tool");
 
-  if (auto haptic = top.find("haptic")) scene.haptic = parse_haptic(*haptic);
+  const std::optional<Cursor> haptic = top.find("haptic");
+  if (haptic) scene.haptic = parse_haptic(*haptic);
+  // The sphere model is the default when every tool is a sphere, and needs sphere tools.
+  const std::optional<Cursor> contact_model = haptic ? haptic->find("contact_model") : std::nullopt;
+  const auto point = std::find_if(scene.tools.begin(), scene.tools.end(),
+                                  [](const ToolSpec& tool) { return tool.shape != ToolShape::sphere; });
+  if (!contact_model && point == scene.tools.end()) scene.haptic.contact_model = ContactModel::sphere;
+  if (contact_model && scene.haptic.contact_model == ContactModel::sphere && point != scene.tools.end())
+    contact_model->fail_message(fmt::format("the sphere contact model needs sphere tools, and tool '{}' is a point "
+                                            "(give it shape: sphere and a radius, or use translation or point)",
+                                            point->name));
   scene.network.max_participants = static_cast<int>(scene.tools.size());
   if (auto network = top.find("network")) scene.network = parse_network(*network, scene.tools.size());
   return scene;

@@ -21,12 +21,17 @@
 namespace cohaptic {
 
 enum class ToolShape { point, sphere };
-enum class ContactModel { node_translation, point_constraint };
+/// How a tool holds the surface: the paper's two (node translation of the contact triangle, the
+/// contact point alone) and the sphere model (every node a sphere tool has passed, held on
+/// its surface; common/contact/sphere_contact.h), the default for sphere tools.
+enum class ContactModel { node_translation, point_constraint, sphere };
 
 struct BoxMeshSpec {
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();  ///< [m]
   Eigen::Vector3d size = Eigen::Vector3d::Zero();        ///< [m]
   Eigen::Vector3i divisions = Eigen::Vector3i::Ones();
+  Eigen::Vector3d grading = Eigen::Vector3d::Ones();     ///< per axis: each cell / the one before (box_mesher.h)
+  Eigen::Vector3i uniform_cells = Eigen::Vector3i::Zero();  ///< per axis: equal cells on the fine side first
 };
 
 /// Exactly one of a mesh file (.msh 2.2/4.1, resolved against the scene's directory) or a generator.

@@ -6,6 +6,7 @@
 #include "common/contact/contact_patch.h"
 #include "common/contact/find_contact.h"
 #include "common/contact/nearest_surface_nodes.h"
+#include "common/sim/sphere_state_solve.h"
 #include "common/util/stopwatch.h"
 
 namespace cohaptic {
@@ -25,6 +26,7 @@ Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstac
   for (int t : body.touchable_triangles) touchable_triangle_[t] = true;
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
+  if (sphere_model()) sphere_candidates_ = triangle_nodes(body.surface, body.touchable_triangles);
   if (!obstacles.empty()) {
     Eigen::Matrix3Xd surface_points(3, static_cast<Eigen::Index>(body.surface.nodes.size()));
     for (std::size_t i = 0; i < body.surface.nodes.size(); ++i)
@@ -72,7 +74,7 @@ Eigen::VectorXd Simulation::boundary_dof_displacement() const {
 std::vector<PressingContact> Simulation::pressing_contacts() const {
   std::vector<PressingContact> contacts;
   for (const UserState& user : users_)
-    if (user.pressing) {
+    if (user.pressing && user.contact) {
       const Triangle& tri = body_.surface.triangles[user.contact->triangle];
       contacts.push_back({{tri[0], tri[1], tri[2]}, user.contact->weights, user.contact->displacement});
     }
@@ -84,7 +86,29 @@ StateSolution Simulation::solve(std::span<const PressingContact> contacts) const
                      options_.ir.contact_model);
 }
 
-StateSolution Simulation::solve() const { return solve(pressing_contacts()); }
+StateSolution Simulation::solve() const { return sphere_model() ? solve_spheres(spheres()) : solve(pressing_contacts()); }
+
+std::vector<SphereTool> Simulation::spheres() const {
+  std::vector<SphereTool> out;
+  for (const UserState& user : users_)
+    if (user.known) out.push_back({user.position, user.radius});
+  return out;
+}
+
+StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) const {
+  return solve_sphere_state(columns_, condensation_, body_.mesh, body_.dofs, sphere_candidates_, spheres,
+                            boundary_dof_displacement());
+}
+
+void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
+                             const std::vector<bool>& touchable) const {
+  const SphereTool sphere{user.position, user.radius};
+  const std::vector<int> patch = sphere_patch(body_.mesh, body_.surface, user.nearest, sphere, options_.ir.patch_rings, touchable);
+  const std::vector<int> nodes = triangle_nodes(body_.surface, patch);
+  for (int node : nodes) under_tool[node] = in_patch[node] = true;
+  user.sphere_holds = nodes_held_by_spheres(body_.mesh, body_.dofs, nodes, std::span(&sphere, 1)).nodes;
+  user.pressing = !user.sphere_holds.empty();
+}
 
 Eigen::Matrix3Xd Simulation::displacement_of(std::span<const int> nodes) const {
   return displacement_of_nodes(columns_, solve(), nodes);
@@ -155,7 +179,8 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
     for (int node : nodes)
       if (!held_.count(node)) fresh.push_back(node);
     // Held where they were before the touch: the previous step's state.
-    const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, solve(previous_contacts_), fresh);
+    const Eigen::Matrix3Xd u =
+        displacement_of_nodes(columns_, sphere_model() ? solve_spheres(previous_spheres_) : solve(previous_contacts_), fresh);
     for (std::size_t i = 0; i < fresh.size(); ++i) hold(fresh[i], {u.col(static_cast<Eigen::Index>(i)), -1});
   } else if (contact_points.empty() && step_delay_held) {
     std::vector<int> step_nodes;
@@ -201,18 +226,28 @@ StepReport Simulation::step(double time) {
     if (options_.step_delay_nodes > 0)  // only step-delay nodes are chosen outside the patches
       for (int t : contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable_triangle_))
         for (int node : body_.surface.triangles[t]) in_patch[node] = true;
+    if (sphere_model()) mark_sphere(user, under_tool, in_patch, touchable_triangle_);
     tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest});
   }
   std::vector<int>& nearest = step_nearest_;
+  std::vector<std::vector<int>>& sphere_holds = step_sphere_holds_;
   nearest.clear();
-  for (const UserState& user : users_) nearest.push_back(user.known ? user.nearest : -1);
+  sphere_holds.resize(users_.size());
+  for (std::size_t u = 0; u < users_.size(); ++u) {
+    const UserState& user = users_[u];
+    nearest.push_back(user.known ? user.nearest : -1);
+    if (user.known)
+      sphere_holds[u] = user.sphere_holds;
+    else
+      sphere_holds[u].clear();
+  }
 
   Stopwatch watch;
   const bool boundary_changed = update_boundary(under_tool, in_patch);
   // Under naive_every_step M~ is computed again every step, as the paper's conventional loop
   // did (that cost is the step delay), but with unchanged sets it is the same IR: a new one
   // (a new epoch) is published only when a set changed.
-  const bool sets_changed = boundary_changed || nearest != built_nearest_;
+  const bool sets_changed = boundary_changed || nearest != built_nearest_ || sphere_holds != built_sphere_holds_;
   if (sets_changed || options_.naive_every_step) {
     const std::vector<Eigen::Vector3d> held = boundary_displacement();
     for (std::size_t i = 0; i < tools.size(); ++i) {
@@ -224,11 +259,13 @@ StepReport Simulation::step(double time) {
       user.ir = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
     }
     built_nearest_ = nearest;
+    built_sphere_holds_ = sphere_holds;
     report.rebuilt = sets_changed;
     report.recomputed = true;
   }
   report.rebuild_ms = watch.elapsed_ms();
   previous_contacts_ = pressing_contacts();
+  previous_spheres_ = spheres();
   report.boundary_nodes = static_cast<int>(condensation_.boundary_nodes().size());
   for (const auto& [node, held] : held_) report.obstacle_nodes += held.obstacle >= 0;
   return report;
@@ -246,7 +283,7 @@ std::vector<Eigen::Vector3d> Simulation::remote_positions(const IntermediateRepr
 ForceSample Simulation::force(int user) const {
   const UserState& state = users_[user];
   if (!state.ir) return {};
-  EvaluationState stateless;  // the condensed FEM body keeps no evaluation state and ignores dt
+  EvaluationState stateless;  // the condensed FEM body ignores dt; without a warm start a sphere solve runs cold
   return evaluate_force(*state.ir, stateless, state.position, remote_positions(state.ir->ir), 0);
 }
 

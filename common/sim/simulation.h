@@ -11,8 +11,10 @@
 //        joins B, held at its closest point on the obstacle; a held node whose holding
 //        force would pull it into the obstacle is released. The active set is iterated up
 //        to `obstacle_iterations` times per step (and keeps converging over steps);
-//      - a node of a tool's nearest triangle is never held: the tool wins;
-//   3. rebuilds every user's IR when a set changed (nearest triangles or B): M~ depends
+//      - a node of a tool's nearest triangle is never held: the tool wins (under the
+//        sphere contact model, no node of the sphere's patch);
+//   3. rebuilds every user's IR when a set changed (nearest triangles, the nodes each
+//      sphere holds under the sphere contact model, or B): M~ depends
 //      only on the sets, so it is not rebuilt otherwise (`naive_every_step` computes it
 //      every step all the same, for its cost, and publishes it only when a set changed).
 // force() evaluates a user's force from its IR and the current tool positions: the P0
@@ -32,6 +34,7 @@
 #include "common/contact/nearest_triangle_candidates.h"
 #include "common/contact/obstacle_clearance.h"
 #include "common/contact/obstacle_distance.h"
+#include "common/contact/sphere_contact.h"
 #include "common/ir/build_ir.h"
 #include "common/ir/evaluate_force.h"
 #include "common/model/elastic_body.h"
@@ -107,6 +110,7 @@ class Simulation {
     int nearest = -1;
     std::optional<ToolContact> contact;
     bool pressing = false;
+    std::vector<int> sphere_holds;  ///< sphere contact model: the nodes its sphere holds
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
   };
@@ -116,6 +120,13 @@ class Simulation {
   };
   std::vector<PressingContact> pressing_contacts() const;
   StateSolution solve(std::span<const PressingContact> contacts) const;
+  bool sphere_model() const { return options_.ir.contact_model == ContactModel::sphere; }
+  /// The sphere contact model's part of a user's step: its patch's nodes are under the tool
+  /// and in the patch, and it presses when its sphere holds a node.
+  void mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
+                   const std::vector<bool>& touchable) const;
+  std::vector<SphereTool> spheres() const;  ///< every known user's tool
+  StateSolution solve_spheres(std::span<const SphereTool> spheres) const;
   bool update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch);
   bool update_obstacle_contacts(const std::vector<bool>& under_tool);
   void hold(int node, const HeldNode& held);
@@ -135,10 +146,15 @@ class Simulation {
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
+  std::vector<std::vector<int>> built_sphere_holds_;  // nodes each sphere held when they were built
   std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
-  // step()'s scratch: the known tools, their nearest triangles, the nodes under them and in their patches.
+  std::vector<SphereTool> previous_spheres_;        // the sphere model's: the spheres of the previous step
+  std::vector<int> sphere_candidates_;              // the touchable triangles' nodes
+  // step()'s scratch: the known tools, their nearest triangles and sphere-held nodes, the
+  // nodes under them and in their patches.
   std::vector<UserTool> step_tools_;
   std::vector<int> step_nearest_;
+  std::vector<std::vector<int>> step_sphere_holds_;
   std::vector<bool> under_tool_, in_patch_;
   bool boundary_dirty_ = false;
 };

@@ -16,7 +16,6 @@ StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& c
   if (static_cast<int>(contacts.size()) > kMaxUsers)
     throw Error(fmt::format("solve_state: {} pressing tools, at most {}", contacts.size(), kMaxUsers));
   StateSolution state;
-  state.boundary_dofs = free_dofs_of_nodes(dofs, condensation.boundary_nodes());
   state.tool_forces.assign(contacts.size(), Eigen::Vector3d::Zero());
 
   std::vector<int> nodes;
@@ -45,12 +44,17 @@ StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& c
       throw NumericalError("the state's contact system is not positive definite");
     state.contact_forces = nodal;
   }
-  // The holding forces on B: L_BB f_B = u_B - L_BZ f_Z.
+  solve_boundary_forces(columns, condensation, dofs, boundary_displacement, state);
+  return state;
+}
+
+void solve_boundary_forces(ComplianceColumns& columns, const IncrementalCondensation& condensation, const DofMap& dofs,
+                           const Eigen::VectorXd& boundary_displacement, StateSolution& state) {
+  state.boundary_dofs = free_dofs_of_nodes(dofs, condensation.boundary_nodes());
   Eigen::VectorXd rhs = boundary_displacement;
   if (!state.contact_dofs.empty())
     rhs -= gather_compliance(columns, state.boundary_dofs, state.contact_dofs) * state.contact_forces;
   state.boundary_forces = condensation.solve_boundary(rhs);
-  return state;
 }
 
 Eigen::Matrix3Xd displacement_of_nodes(ComplianceColumns& columns, const StateSolution& state, std::span<const int> nodes) {

@@ -38,6 +38,11 @@ StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& c
                           std::span<const PressingContact> contacts, const Eigen::VectorXd& boundary_displacement,
                           ContactModel contact_model);
 
+/// Completes `state` from its contact forces: the holding forces on B, from
+/// L_BB f_B = u_B - L_BZ f_Z (sets state.boundary_dofs and state.boundary_forces).
+void solve_boundary_forces(ComplianceColumns& columns, const IncrementalCondensation& condensation, const DofMap& dofs,
+                           const Eigen::VectorXd& boundary_displacement, StateSolution& state);
+
 /// Displacement [m] of `nodes` (row nodes of `columns`) in the solved state, one column each.
 Eigen::Matrix3Xd displacement_of_nodes(ComplianceColumns& columns, const StateSolution& state, std::span<const int> nodes);
 

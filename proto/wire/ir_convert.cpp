@@ -111,7 +111,8 @@ namespace {
 
 void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
   out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? CondensedFem::POINT
-                                                                              : CondensedFem::TRANSLATION);
+                         : ir.contact_model == ContactModel::sphere         ? CondensedFem::SPHERE
+                                                                            : CondensedFem::TRANSLATION);
   out->mutable_node_ids()->Reserve(static_cast<int>(ir.node_ids.size()));
   for (std::int64_t id : ir.node_ids) out->mutable_node_ids()->AddAlreadyReserved(id);
   out->set_fixed_axes(std::string(ir.fixed_axes.begin(), ir.fixed_axes.end()));
@@ -242,6 +243,7 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   switch (w.contact_model()) {
     case CondensedFem::TRANSLATION: ir.contact_model = ContactModel::node_translation; break;
     case CondensedFem::POINT: ir.contact_model = ContactModel::point_constraint; break;
+    case CondensedFem::SPHERE: ir.contact_model = ContactModel::sphere; break;
     default: invalid("unknown contact model {}", static_cast<int>(w.contact_model()));
   }
 

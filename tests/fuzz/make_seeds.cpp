@@ -1,8 +1,9 @@
 // fuzz_make_seeds: writes the seed corpora of the wire and recording targets
 // (corpus/{datagram,control_frames,ir,mcap,bridge,view}/) from real session recordings:
-//   fuzz_make_seeds SERVER.mcap CLIENT.mcap MASS_SPRING_CLIENT.mcap OUT_DIR
-// make_seeds.sh records a short two-user session on the cube, and a client's on the noodle
-// (a mass-spring body, whose IRs carry a MassSpringPatch), and runs this on them. The
+//   fuzz_make_seeds SERVER.mcap CLIENT.mcap MASS_SPRING_CLIENT.mcap SPHERE_CLIENT.mcap OUT_DIR
+// make_seeds.sh records a short two-user session on the cube, a client's on the noodle
+// (a mass-spring body, whose IRs carry a MassSpringPatch), and a client's pressing a sphere
+// tool into the cube (the sphere contact model's IRs), and runs this on them. The
 // file-format targets (scene, study, gmsh, freesurfer) take their seeds straight from the
 // repository's files; make_seeds.sh copies those.
 //
@@ -185,9 +186,11 @@ void control_seeds(const record::Recording& client, const std::vector<wire::Inte
 }
 
 void ir_seeds(const std::vector<wire::IntermediateRepresentation>& irs,
-              const wire::IntermediateRepresentation& mass_spring_ir, const fs::path& out) {
+              const wire::IntermediateRepresentation& mass_spring_ir, const wire::IntermediateRepresentation& sphere_ir,
+              const fs::path& out) {
   write_seed(out, "smallest", bytes_of(irs.front()));
   write_seed(out, "mass_spring", bytes_of(mass_spring_ir));
+  write_seed(out, "sphere", bytes_of(sphere_ir));
   const auto with_remote = std::find_if(irs.begin(), irs.end(), [](const auto& ir) { return ir.fem().remotes_size() > 0; });
   if (with_remote != irs.end()) write_seed(out, "with_remote", bytes_of(*with_remote));
   // The smallest as a server with --ir-precision f32 sends it: M~ and u_B rounded to float.
@@ -320,24 +323,32 @@ void bridge_seeds(const record::Recording& client, const fs::path& out) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 5) {
-    std::fprintf(stderr, "usage: %s SERVER.mcap CLIENT.mcap MASS_SPRING_CLIENT.mcap OUT_DIR\n", argv[0]);
+  if (argc != 6) {
+    std::fprintf(stderr, "usage: %s SERVER.mcap CLIENT.mcap MASS_SPRING_CLIENT.mcap SPHERE_CLIENT.mcap OUT_DIR\n",
+                 argv[0]);
     return 2;
   }
   const record::Recording server = record::read_recording(argv[1]);
   const record::Recording client = record::read_recording(argv[2]);
   const record::Recording mass_spring_client = record::read_recording(argv[3]);
-  const fs::path out = argv[4];
+  const record::Recording sphere_client = record::read_recording(argv[4]);
+  const fs::path out = argv[5];
   const std::vector<wire::IntermediateRepresentation> irs = irs_by_size({&server, &client});
   const std::vector<wire::IntermediateRepresentation> patches = irs_by_size({&mass_spring_client});
   const auto patch = std::find_if(patches.begin(), patches.end(), [](const auto& ir) { return ir.has_mass_spring(); });
-  if (irs.empty() || client.datagrams.empty() || client.ticks.empty() || patch == patches.end()) {
-    std::fprintf(stderr, "%s: the recordings hold no IRs of both kinds, datagrams or haptic ticks\n", argv[0]);
+  // The smallest sphere IR that holds a node: one whose contact solve has work to do.
+  const std::vector<wire::IntermediateRepresentation> sphere_irs = irs_by_size({&sphere_client});
+  const auto sphere = std::find_if(sphere_irs.begin(), sphere_irs.end(), [](const auto& ir) {
+    return ir.has_fem() && ir.fem().contact_model() == wire::CondensedFem::SPHERE && ir.fem().node_ids_size() > 0;
+  });
+  if (irs.empty() || client.datagrams.empty() || client.ticks.empty() || patch == patches.end() ||
+      sphere == sphere_irs.end()) {
+    std::fprintf(stderr, "%s: the recordings hold no IRs of all three kinds, datagrams or haptic ticks\n", argv[0]);
     return 1;
   }
   datagram_seeds({&server, &client}, out / "datagram");
   control_seeds(client, irs, *patch, COHAPTIC_SOURCE_DIR, out / "control_frames");
-  ir_seeds(irs, *patch, out / "ir");
+  ir_seeds(irs, *patch, *sphere, out / "ir");
   mcap_seeds(server, client, out / "mcap");
   bridge_seeds(client, out / "bridge");
   view_seeds(server, out / "view");

@@ -5,7 +5,8 @@
 #   - datagram, control_frames, ir, mcap, bridge, view: taken by fuzz_make_seeds from the
 #     recordings of a 4 s, two-user session on the cube (scenes/tradeoff/cube_two_users.yaml,
 #     P1, both users pressing) and of a 4 s session of one user pressing the noodle
-#     (scenes/thin/noodle.yaml, a mass-spring body), run here with the real server and
+#     (scenes/thin/noodle.yaml, a mass-spring body) and of one sphere pressing the cube under
+#     the sphere contact model (scenes/tradeoff/cube_two_spheres.yaml), run here with the real server and
 #     clients on loopback (protocol 3, the development key);
 #   - ir also from text_seeds/ir/*.txtpb (protoc --encode): bodies no recorded session has
 #     yet (the home-spring body).
@@ -52,11 +53,20 @@ sleep 2
   --device script:scenes/thin/noodle/surgeon_a.yaml --record "$work/client_noodle.mcap" --log-level warn
 wait "$server"
 
+"$build/server/cohaptic-server" --scene scenes/tradeoff/cube_two_spheres.yaml --listen "127.0.0.1:$port" --duration 10 \
+  --no-disk-cache --log-level warn &
+server=$!
+sleep 4
+"$build/client/cohaptic-client" --server "127.0.0.1:$port" --user dave --slot 1 --best-effort --duration 3 \
+  --device script:scenes/tradeoff/cube_sphere_press_hold.yaml --record "$work/client_sphere.mcap" --log-level warn
+wait "$server"
+
 for target in datagram control_frames ir mcap bridge view; do
   mkdir -p "$corpus/$target"
   find "$corpus/$target" -type f ! -name 'crash-*' ! -name 'regression-*' -delete
 done
-"$build/tests/fuzz/fuzz_make_seeds" "$work/server.mcap" "$work/client_b.mcap" "$work/client_noodle.mcap" "$corpus"
+"$build/tests/fuzz/fuzz_make_seeds" "$work/server.mcap" "$work/client_b.mcap" "$work/client_noodle.mcap" "$work/client_sphere.mcap" \
+  "$corpus"
 # Bodies no recorded session has yet, written by hand in protobuf text format.
 for seed in tests/fuzz/text_seeds/ir/*.txtpb; do
   protoc -Iproto --encode=cohaptic.wire.IntermediateRepresentation proto/cohaptic/messages.proto \

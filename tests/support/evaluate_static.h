@@ -1,5 +1,6 @@
 // The force of a static IR body (the condensed FEM body) for the tests: evaluate_force with
-// the empty evaluation state such a body has; dt is unused by it.
+// the empty evaluation state such a body has (under the sphere contact model: a cold solve);
+// dt is unused by it.
 #pragma once
 
 #include <span>

@@ -1,0 +1,79 @@
+// `cohaptic-lab hertz`: the sphere contact model against Hertz's solution, mesh by mesh.
+//
+// A rigid frictionless sphere of radius R pressed to depth d into an elastic half-space
+// takes F = (4/3) E / (1 - nu^2) sqrt(R) d^(3/2) (Hertz; d << R). The half-space here is a
+// block 40 R wide and 20 R deep, fixed at its bottom; one quarter of it is meshed (20 R
+// on every side) with the sphere pressing at the corner where its two symmetry planes
+// meet: each plane holds the axis normal to it, and the force on the whole block is four
+// times the quarter's. The box mesh is fine under the sphere and coarse in the far field
+// (box_mesher.h): with n cells per side, half of them are equal and fill a core of side
+// `core` R at the corner (it holds every node a sphere at d/R <= 0.1 passes), and the
+// other half grow geometrically from there to the block's far sides. The growth ratio r
+// solves the fill; as n grows, r^(n/2) tends to a constant, so every mesh of the study
+// refines the same map of the block.
+//
+// At each depth the sphere model's force is the full sparse solve of its unilateral
+// problem (sphere_contact_reference.h); beside it the paper's node translation model's
+// force at the same tool position (the sphere's contact triangle moved with the tool,
+// static_contact.h), whose stiffness grows without bound as the mesh is refined (a
+// load on one triangle has no finite stiffness in 3-D elasticity). Units: SI.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "common/fem/linear_elastic_material.h"
+#include "lab/lab_command.h"
+
+namespace cohaptic {
+
+/// The quarter block and its mesh.
+struct HertzBlock {
+  double radius = 0.01;  ///< R [m]
+  LinearElasticMaterial material{1.0e5, 0.3, ElementFormulation::linear_tet};
+  int divisions = 16;    ///< cells along each side of the quarter block (>= 2)
+  double core = 0.5;     ///< side of the uniformly meshed core under the sphere, in R (0 < core < 10)
+};
+
+/// The growth ratio of the cells outside the core along a side of `block`'s quarter.
+double hertz_cell_growth(const HertzBlock& block);
+
+/// The block as scene text (units mm; its sphere tool `A` of radius R, contact model sphere).
+std::string hertz_block_yaml(const HertzBlock& block);
+
+/// Hertz's force [N] for a rigid sphere of radius `radius` [m] at depth `depth` [m] in a
+/// half-space of `material`.
+double hertz_force(const LinearElasticMaterial& material, double radius, double depth);
+
+/// One mesh of the study: forces on the whole block (four quarters) at each depth.
+struct HertzMesh {
+  int divisions = 0, nodes = 0, tets = 0;
+  double smallest_cell = 0;                ///< under the sphere (the core's cells), over R
+  std::vector<double> sphere_force;        ///< [N] per depth, the sphere model
+  std::vector<int> contact_nodes;          ///< per depth: nodes the sphere pushes (in the quarter)
+  std::vector<double> translation_force;   ///< [N] per depth, node translation
+};
+
+/// Solves `block` at each depth d = ratio R of `depth_ratios`. Throws Error if a ratio is
+/// not in (0, 0.5].
+HertzMesh measure_hertz(const HertzBlock& block, const std::vector<double>& depth_ratios);
+
+struct HertzOptions {
+  HertzBlock block;
+  std::vector<int> divisions = {8, 12, 16, 24};
+  std::vector<double> depth_ratios = {0.02, 0.05, 0.1};
+  std::filesystem::path out;  ///< empty: the table on stdout only; else also hertz.md, hertz.svg
+};
+
+/// The study's table (markdown): F / F_Hertz per mesh and depth for both models, and the
+/// change between the two finest meshes.
+std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh>& meshes);
+
+/// Measures every mesh, prints the table, writes the files. Returns the exit code.
+int run_hertz(const HertzOptions& options);
+
+/// `cohaptic-lab hertz [--poisson-ratio NU] [--element E] [--divisions N...] [--depths D...] [--out DIR]`.
+LabCommand add_hertz_command(CLI::App& lab);
+
+}  // namespace cohaptic

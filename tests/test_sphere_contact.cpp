@@ -1,0 +1,337 @@
+// The sphere contact model: its unilateral solve against an enumeration of every active
+// set, its geometry against hand-worked cases, and the intermediate representation's force
+// and contact set against the full sparse FEM solve of the same unilateral problem (one and
+// two users, held boundary nodes, sliding), which is itself checked against the
+// complementarity conditions on an independently solved displacement field.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <random>
+
+#include "common/contact/sphere_contact.h"
+#include "common/contact/unilateral_contact_solve.h"
+#include "common/fem/static_solve.h"
+#include "common/ir/evaluate_sphere_contact.h"
+#include "common/model/sphere_contact_reference.h"
+#include "common/scene/load_scene.h"
+#include "common/sim/simulation.h"
+#include "support/cube_scene.h"
+
+namespace cohaptic {
+namespace {
+
+Eigen::Vector3d mm(double x, double y, double z) { return Eigen::Vector3d(x, y, z) * 1e-3; }
+
+double relative_error(const Eigen::Vector3d& value, const Eigen::Vector3d& expected) {
+  return (value - expected).norm() / std::max(expected.norm(), 1e-300);
+}
+
+// ---------------------------------------------------------------------------------------
+// The unilateral solve.
+
+struct Lcp {
+  Eigen::MatrixXd a;
+  Eigen::VectorXd q;
+};
+
+Lcp random_lcp(std::mt19937& random, int m) {
+  std::normal_distribution<double> normal(0, 1);
+  Eigen::MatrixXd g(m, m);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) g(i, j) = normal(random);
+  Lcp lcp;
+  lcp.a = g * g.transpose() + 0.05 * m * Eigen::MatrixXd::Identity(m, m);
+  lcp.q = Eigen::VectorXd(m);
+  for (int i = 0; i < m; ++i) lcp.q[i] = normal(random);
+  return lcp;
+}
+
+// Every set S in turn: lambda_S = -A_SS^-1 q_S; the one that satisfies all conditions.
+std::vector<Eigen::VectorXd> enumerate_solutions(const Lcp& lcp) {
+  const auto m = static_cast<int>(lcp.q.size());
+  std::vector<Eigen::VectorXd> solutions;
+  for (int mask = 0; mask < (1 << m); ++mask) {
+    std::vector<int> set;
+    for (int i = 0; i < m; ++i)
+      if (mask & (1 << i)) set.push_back(i);
+    const auto k = static_cast<Eigen::Index>(set.size());
+    Eigen::MatrixXd a_ss(k, k);
+    Eigen::VectorXd q_s(k);
+    for (Eigen::Index i = 0; i < k; ++i) {
+      q_s[i] = lcp.q[set[i]];
+      for (Eigen::Index j = 0; j < k; ++j) a_ss(i, j) = lcp.a(set[i], set[j]);
+    }
+    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m);
+    if (k > 0) {
+      const Eigen::VectorXd x = a_ss.ldlt().solve(-q_s);
+      for (Eigen::Index i = 0; i < k; ++i) lambda[set[i]] = x[i];
+    }
+    const Eigen::VectorXd w = lcp.a * lambda + lcp.q;
+    bool ok = true;
+    for (int i = 0; i < m; ++i) ok &= (mask & (1 << i)) ? lambda[i] >= 0 : w[i] >= 0;
+    if (ok) solutions.push_back(lambda);
+  }
+  return solutions;
+}
+
+TEST(UnilateralContactSolve, EqualsTheOneActiveSetOfAnEnumerationFromAnyWarmStart) {
+  std::mt19937 random(7);
+  int checked = 0, most_trials = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int m = 1 + trial % 10;
+    const Lcp lcp = random_lcp(random, m);
+    const std::vector<Eigen::VectorXd> expected = enumerate_solutions(lcp);
+    ASSERT_EQ(expected.size(), 1u) << "a positive definite LCP has one solution";
+    Eigen::VectorXd first;
+    for (int start = 0; start < 4; ++start) {
+      std::vector<std::uint8_t> active(static_cast<std::size_t>(m));
+      for (auto& a : active) a = static_cast<std::uint8_t>(start == 0 ? 0 : start == 1 ? 1 : random() % 2);
+      Eigen::VectorXd lambda(m);
+      Eigen::MatrixXd factor(m, m);
+      std::vector<int> order(static_cast<std::size_t>(m));
+      const UnilateralSolveResult result =
+          solve_unilateral_contact(lcp.a, lcp.q, active, lambda, factor, order, std::numeric_limits<double>::infinity());
+      ASSERT_TRUE(result.solved);
+      most_trials = std::max(most_trials, result.trials);
+      EXPECT_LE((lambda - expected[0]).norm(), 1e-10 * (1 + expected[0].norm())) << "m " << m << " start " << start;
+      for (int i = 0; i < m; ++i) EXPECT_EQ(active[static_cast<std::size_t>(i)] != 0, lambda[i] > 0 || (expected[0][i] > 0));
+      // The answer depends on the final set only: bit-identical from every warm start.
+      if (start == 0)
+        first = lambda;
+      else
+        EXPECT_TRUE(lambda == first) << "m " << m << " start " << start;
+      ++checked;
+    }
+  }
+  std::printf("  %d solves of LCPs with 1 to 10 unknowns, every one the enumeration's; at most %d sets factored\n", checked,
+              most_trials);
+}
+
+TEST(UnilateralContactSolve, ReportsFailureBeyondItsBudgetAndForAnIndefiniteMatrix) {
+  std::mt19937 random(3);
+  const Lcp lcp = random_lcp(random, 30);
+  std::vector<std::uint8_t> active(30, 0);
+  Eigen::VectorXd lambda(30);
+  Eigen::MatrixXd factor(30, 30);
+  std::vector<int> order(30);
+  EXPECT_FALSE(solve_unilateral_contact(lcp.a, lcp.q, active, lambda, factor, order, 10).solved);
+  Lcp indefinite = lcp;
+  indefinite.a(3, 3) = -1;
+  std::fill(active.begin(), active.end(), 1);
+  EXPECT_FALSE(solve_unilateral_contact(indefinite.a, indefinite.q, active, lambda, factor, order, 1e9).solved);
+}
+
+// ---------------------------------------------------------------------------------------
+// The geometry.
+
+TEST(SphereContact, HoldsThePassedNodesAlongTheSpheresNormalByTheDeepestSphere) {
+  const std::vector<SphereTool> one = {{Eigen::Vector3d(0, 0, 1), 2}};
+  const auto held = sphere_constraint(Eigen::Vector3d(0, 0, 0), 0, one);
+  ASSERT_TRUE(held.has_value());
+  EXPECT_DOUBLE_EQ(held->gap, -1);
+  EXPECT_TRUE(held->normal.isApprox(Eigen::Vector3d(0, 0, -1)));
+  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(0, 0, -1.5), 0, one).has_value()) << "outside the sphere";
+  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(0, 0, -1), 0, one).has_value()) << "exactly on it";
+  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(0, 0, 1), 0, one).has_value()) << "at the centre: no normal";
+  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(0, 0, 0), 0b100, one).has_value()) << "normal along its fixed axis";
+  EXPECT_TRUE(sphere_constraint(Eigen::Vector3d(1, 0, 0), 0b100, one).has_value()) << "a free part of the normal";
+  const std::vector<SphereTool> two = {{Eigen::Vector3d(0, 0, 1), 2},
+                                       {Eigen::Vector3d(0.5, 0, 0.5), 2},
+                                       {Eigen::Vector3d::Constant(std::nan("")), 5}};
+  const auto deepest = sphere_constraint(Eigen::Vector3d(0, 0, 0), 0, two);
+  ASSERT_TRUE(deepest.has_value());
+  EXPECT_EQ(deepest->tool, 1);
+  EXPECT_NEAR(deepest->gap, std::sqrt(0.5) - 2, 1e-15);
+}
+
+// ---------------------------------------------------------------------------------------
+// The intermediate representation against the full sparse solve.
+
+constexpr double kRadius = 30e-3;  // on the 11.8 mm cube mesh a 4 mm press holds several nodes
+
+testing::CubeSceneOptions sphere_cube() {
+  testing::CubeSceneOptions options;
+  options.tools = "[{name: A, shape: sphere, radius: 30}, {name: B, shape: sphere, radius: 30}]";
+  return options;
+}
+
+testing::CubeRig& shared_rig() {
+  static testing::CubeRig rig(sphere_cube());
+  return rig;
+}
+
+SimulationOptions unlimited(int step_delay_nodes = 0, int patch_rings = 1) {
+  SimulationOptions options;
+  options.ir.contact_model = ContactModel::sphere;
+  options.ir.patch_rings = patch_rings;
+  options.ir.force_limit = std::numeric_limits<double>::infinity();
+  options.step_delay_nodes = step_delay_nodes;
+  return options;
+}
+
+// Mesh node tags of the IR's nodes in contact at the evaluation that left `state`.
+std::vector<std::int64_t> ir_contact_tags(const PreparedIR& prepared, const EvaluationState& state) {
+  std::vector<std::int64_t> tags;
+  for (int i = 0; i < condensed_fem(prepared.ir).row_node_count; ++i)
+    if (std::get<SphereWarmStart>(state.body).active(i)) tags.push_back(condensed_fem(prepared.ir).node_ids[static_cast<std::size_t>(i)]);
+  std::sort(tags.begin(), tags.end());
+  return tags;
+}
+
+std::vector<std::int64_t> tags_of(const ElasticBody& body, const std::vector<int>& nodes) {
+  std::vector<std::int64_t> tags;
+  for (int node : nodes) tags.push_back(body.mesh.node_tags[static_cast<std::size_t>(node)]);
+  std::sort(tags.begin(), tags.end());
+  return tags;
+}
+
+HeldNodes held_nodes(const Simulation& simulation) {
+  return {simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
+}
+
+// The user's IR evaluated at the tools' positions against the reference, force and contact
+// set; returns the relative force error (and counts the nodes).
+struct Comparison {
+  double worst = 0;
+  int checked = 0, contact_nodes = 0, released_nodes = 0;
+};
+
+void compare(const ElasticBody& body, const Simulation& simulation, const std::vector<Eigen::Vector3d>& tools, int user,
+             Comparison& comparison) {
+  const PreparedIR& prepared = *simulation.ir(user);
+  std::vector<Eigen::Vector3d> remotes;
+  for (int r = 0; r < remote_count(prepared.ir); ++r) remotes.push_back(tools[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
+  EvaluationState state = make_evaluation_state(prepared);
+  const ForceSample sample = evaluate_force(prepared, state, tools[static_cast<std::size_t>(user)], remotes, 1e-3);
+  std::vector<PressedTool> pressed;
+  for (const Eigen::Vector3d& p : tools) pressed.push_back({p, kRadius});
+  const SphereContactSolution reference = sphere_reactions_reference(body, pressed, held_nodes(simulation));
+  const Eigen::Vector3d expected = reference.reactions[static_cast<std::size_t>(user)];
+  ASSERT_FALSE(sample.flags & (kOutsidePatch | kContactUnresolved | kNonFinite));
+  if (expected.norm() == 0) {
+    EXPECT_EQ(sample.force.norm(), 0);
+    return;
+  }
+  const double error = relative_error(sample.force, expected);
+  EXPECT_LE(error, 1e-9) << "user " << user << " at " << tools[static_cast<std::size_t>(user)].transpose() * 1e3 << " mm";
+  comparison.worst = std::max(comparison.worst, error);
+  // The node set: every node in contact in the reference is one in the IR's last solve.
+  EXPECT_EQ(ir_contact_tags(prepared, state), tags_of(body, reference.contact_nodes()));
+  comparison.contact_nodes += static_cast<int>(reference.contact_nodes().size());
+  comparison.released_nodes += static_cast<int>(reference.candidates.size() - reference.contact_nodes().size());
+  ++comparison.checked;
+}
+
+TEST(SphereContact, OneSphereSlidingEqualsTheFullSparseSolveInForceAndNodeSet) {
+  testing::CubeRig& rig = shared_rig();
+  const ElasticBody& body = rig.body;
+  Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1, rig.model->scene.tools[0]), unlimited());
+  Comparison comparison;
+  // Press the centre 4 mm below touching, then slide 20 mm across several nodes.
+  for (int k = 0; k <= 24; ++k) {
+    const double depth = std::min(k, 8) * 0.5;  // mm
+    const double slide = std::max(0, k - 8) * 1.25;
+    const Eigen::Vector3d centre = mm(-7 + slide, 3, 30 - depth);
+    simulation.set_tool(0, centre);
+    simulation.step(k * 1e-3);
+    ASSERT_TRUE(simulation.ir(0));
+    compare(body, simulation, {centre}, 0, comparison);
+  }
+  std::printf("  %d positions: worst relative force error %.2e; %d node contacts, %d held nodes released\n",
+              comparison.checked, comparison.worst, comparison.contact_nodes, comparison.released_nodes);
+  EXPECT_GT(comparison.checked, 10);
+  EXPECT_GT(comparison.released_nodes, 0) << "the unilateral release never happened";
+}
+
+TEST(SphereContact, BetweenIrUpdatesTheClientFollowsTheSphereExactly) {
+  testing::CubeRig& rig = shared_rig();
+  const ElasticBody& body = rig.body;
+  Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1, rig.model->scene.tools[0]), unlimited(0, 2));
+  simulation.set_tool(0, mm(0, 0, 27));
+  simulation.step(0);
+  Comparison comparison;
+  // The IR stays the one built at 27 mm; the tool goes 2 mm deeper and 4 mm sideways.
+  for (int k = 0; k <= 10; ++k) compare(body, simulation, {mm(0.4 * k, 0, 27 - 0.2 * k)}, 0, comparison);
+  std::printf("  one IR, %d positions: worst relative force error %.2e\n", comparison.checked, comparison.worst);
+  EXPECT_EQ(comparison.checked, 11);
+}
+
+TEST(SphereContact, TwoSpheresAndHeldNodesEqualTheFullSparseSolve) {
+  testing::CubeRig& rig = shared_rig();
+  const ElasticBody& body = rig.body;
+  for (int step_delay_nodes : {0, 150}) {
+    Simulation simulation(body, rig.model->obstacles, *rig.columns, rig.model->scene.tools, unlimited(step_delay_nodes));
+    Comparison comparison;
+    for (int k = 0; k <= 12; ++k) {
+      const std::vector<Eigen::Vector3d> tools = {mm(-22 + k, 4, 27 - 0.25 * std::min(k, 8)), mm(21, -6 + 0.5 * k, 26.5)};
+      simulation.set_tool(0, tools[0]);
+      simulation.set_tool(1, tools[1]);
+      simulation.step(k * 1e-3);
+      for (int user = 0; user < 2; ++user) compare(body, simulation, tools, user, comparison);
+    }
+    std::printf("  two spheres, %d held nodes: %d comparisons, worst relative force error %.2e\n", step_delay_nodes,
+                comparison.checked, comparison.worst);
+    EXPECT_EQ(comparison.checked, 26);
+  }
+}
+
+TEST(SphereContact, TheReferenceMeetsTheContactConditionsOnAnIndependentSolve) {
+  testing::CubeRig& rig = shared_rig();
+  const ElasticBody& body = rig.body;
+  const std::vector<PressedTool> tools = {{mm(-6, 2, 25), kRadius}};  // 7 passed nodes, 4 touching
+  const SphereContactSolution solution = sphere_reactions_reference(body, tools);
+  ASSERT_GT(solution.contact_nodes().size(), 3u);
+  // Apply the pushes as loads and solve the whole body once more, with no constraint.
+  Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * body.mesh.node_count());
+  for (std::size_t i = 0; i < solution.candidates.size(); ++i)
+    loads.segment<3>(3 * solution.candidates[i]) += solution.pushes[static_cast<Eigen::Index>(i)] * solution.constraints[i].normal;
+  const StaticSolution free = solve_static(body.stiffness, body.dofs, {}, loads);
+  double scale = 0;
+  for (const SphereConstraint& c : solution.constraints) scale = std::max(scale, -c.gap);
+  int touching = 0, released = 0;
+  for (std::size_t i = 0; i < solution.candidates.size(); ++i) {
+    const SphereConstraint& c = solution.constraints[i];
+    const double clearance = c.normal.dot(free.displacement.segment<3>(3 * solution.candidates[i])) + c.gap;
+    const double push = solution.pushes[static_cast<Eigen::Index>(i)];
+    EXPECT_GE(push, 0);
+    if (push > 0) {
+      EXPECT_NEAR(clearance, 0, 1e-9 * scale) << "a pushed node is on the sphere";
+      ++touching;
+    } else {
+      EXPECT_GE(clearance, -1e-9 * scale) << "a released node is outside the sphere";
+      ++released;
+    }
+  }
+  // The tool's force is what the body's supports take: the pushes sum to minus the reaction.
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int node = 0; node < body.mesh.node_count(); ++node)
+    if (body.dofs.fixed_axes[static_cast<std::size_t>(node)] != 0) sum += free.reaction.segment<3>(3 * node);
+  EXPECT_LE((sum - solution.reactions[0]).norm(), 1e-9 * solution.reactions[0].norm());
+  std::printf("  %d nodes touch the sphere, %d passed nodes released; |F| = %.4f N\n", touching, released,
+              solution.reactions[0].norm());
+  EXPECT_GT(released, 0);
+}
+
+TEST(SphereContact, IsTheSceneDefaultForSphereToolsAndNeedsThem) {
+  const Scene spheres = parse_scene(testing::cube_scene_yaml(sphere_cube()), "cube.yaml");
+  EXPECT_EQ(spheres.haptic.contact_model, ContactModel::sphere);
+  const Scene points = parse_scene(testing::cube_scene_yaml(), "cube.yaml");
+  EXPECT_EQ(points.haptic.contact_model, ContactModel::node_translation);
+  std::string text = testing::cube_scene_yaml();
+  text.replace(text.find("haptic: {"), 9, "haptic: {contact_model: sphere, ");
+  try {
+    parse_scene(text, "cube.yaml");
+    FAIL() << "a point tool with the sphere model was accepted";
+  } catch (const SceneError& error) {
+    EXPECT_NE(std::string(error.what()).find("tool 'A' is a point"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("haptic.contact_model"), std::string::npos) << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace cohaptic
