@@ -65,8 +65,9 @@ void DatagramEndpoint::distrust(const udp::endpoint& peer) { std::erase(trusted_
 
 void DatagramEndpoint::send(std::vector<std::uint8_t> datagram, const udp::endpoint& to) {
   auto bytes = std::make_shared<std::vector<std::uint8_t>>(std::move(datagram));
-  socket_.async_send_to(asio::buffer(*bytes), to, [bytes](std::error_code, std::size_t) {});
-  ++sent_;
+  socket_.async_send_to(asio::buffer(*bytes), to, [bytes, sent = sent_](std::error_code error, std::size_t) {
+    if (!error) sent->fetch_add(1, std::memory_order_relaxed);
+  });
 }
 
 void DatagramEndpoint::close() {

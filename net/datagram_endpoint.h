@@ -18,6 +18,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <asio.hpp>
 #include <cstddef>
 #include <cstdint>
@@ -62,7 +63,8 @@ class DatagramEndpoint {
   std::uint16_t port() const { return port_; }
   wire::DatagramInspector& inspector() { return *inspector_; }
   const wire::DatagramInspector& inspector() const { return *inspector_; }
-  std::uint64_t sent() const { return sent_; }
+  /// Datagrams the kernel took (a send aborted by close() or failed is not counted).
+  std::uint64_t sent() const { return sent_->load(std::memory_order_relaxed); }
 
  private:
   void receive_next();
@@ -77,7 +79,8 @@ class DatagramEndpoint {
   std::array<std::uint8_t, kDatagramBufferBytes> buffer_{};
   asio::ip::udp::endpoint from_;
   std::uint16_t port_ = 0;
-  std::uint64_t sent_ = 0;
+  // Shared with pending sends' handlers, which may run after this endpoint is gone.
+  std::shared_ptr<std::atomic<std::uint64_t>> sent_ = std::make_shared<std::atomic<std::uint64_t>>(0);
 };
 
 }  // namespace cohaptic::net
