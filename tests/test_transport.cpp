@@ -374,6 +374,8 @@ TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) 
   const std::size_t n = peer.receive(asio::buffer(echo));
   echo.resize(n);
   EXPECT_EQ(echo, first);
+  io.restart();
+  io.poll();  // the send's completion, which counts it
   EXPECT_EQ(endpoint.sent(), 1u);
 }
 

@@ -18,10 +18,10 @@ objects:
     compliance: {7}
 obstacles: [{4}]
 tools: {5}
-haptic: {{force_limit: {6}}}
+haptic: {{force_limit: {6}{8}}}
 )",
                      o.divisions, o.youngs_modulus, o.poisson_ratio, o.touchable, o.obstacles, o.tools, o.force_limit,
-                     o.compliance);
+                     o.compliance, o.contact_model.empty() ? std::string() : ", contact_model: " + o.contact_model);
 }
 
 CubeRig::CubeRig(const CubeSceneOptions& options) : CubeRig(cube_scene_yaml(options)) {}

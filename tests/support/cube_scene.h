@@ -18,6 +18,7 @@ struct CubeSceneOptions {
   std::string tools = "[{name: A}, {name: B}]";
   std::string compliance = "{precompute: on_demand, disk_cache: false}";
   double force_limit = 3.3;
+  std::string contact_model;  ///< haptic.contact_model; empty: the scene's default for its tools
 };
 
 /// A 130 mm cube (z from -130 to 0 mm), rear face fixed, in millimetres.
