@@ -28,6 +28,9 @@ FUZZ_JOBS ?= 2
 # CTest arguments choosing the ASan + UBSan tests: empty runs the whole suite; CI runs the
 # unit label (every unit test and every fuzz corpus), the end-to-end tests being TSan's.
 ASAN_TESTS ?=
+# What test-asan builds: everything by default; CI names the unit tests' program (the fuzz
+# targets are already built by `make fuzz`), not the end-to-end tests it leaves to TSan.
+ASAN_TARGETS ?= all
 # ThreadSanitizer runs the end-to-end sessions, whose server and client processes (built
 # with TSan too) run every thread the system has: the haptic loop and its hand-overs, the
 # transport's I/O threads, the server's simulation loop. These ones check behaviour, not
@@ -107,7 +110,7 @@ fuzz: $(ASAN_BUILD_DIR)/CMakeCache.txt
 	  FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_JOBS=$(FUZZ_JOBS) tests/fuzz/run_fuzzers.sh $(ASAN_BUILD_DIR); fi
 
 test-asan: $(ASAN_BUILD_DIR)/CMakeCache.txt
-	cmake --build $(ASAN_BUILD_DIR) -j $(JOBS)
+	cmake --build $(ASAN_BUILD_DIR) -j $(JOBS) --target $(ASAN_TARGETS)
 	$(SANITIZER_ENV) ctest --test-dir $(ASAN_BUILD_DIR) --output-on-failure -j $(JOBS) $(ASAN_TESTS)
 
 test-tsan: deps
