@@ -338,6 +338,31 @@ TEST(MassSpringFriction, StaysBelowTheStaticThresholdAndAcceleratesByTheDynamicL
   }
 }
 
+// Coulomb's law on one node pressed onto the plane by F_n = m g: sliding, it feels mu_d F_n
+// against its motion until mu_d F_n can stop it within the step; at rest, a pull below
+// mu_s F_n is cancelled and one above it is met by mu_s F_n.
+TEST(MassSpringFriction, ASlidingNodeFeelsTheDynamicLawUntilItCanStopAndANodeAtRestTheStaticOne) {
+  const SupportPlane plane{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.2};
+  const double m = 2e-4, h = 1e-3, load = m * kG;
+  const Eigen::Vector3d x = Eigen::Vector3d::Zero(), weight(0, 0, -load);
+  bool sliding = false;
+  // Sliding at a speed that mu_s F_n could stop within the step but mu_d F_n cannot.
+  const double speed = 0.35 * load * h / m;
+  const Eigen::Vector3d slow = plane_reaction(plane, x, Eigen::Vector3d(speed, 0, 0), weight, m, h, sliding);
+  EXPECT_TRUE(sliding);
+  EXPECT_NEAR(slow.x(), -0.2 * load, 1e-15);
+  EXPECT_NEAR(slow.z(), load, 1e-15);
+  // Slow enough for mu_d F_n to stop: stopped exactly.
+  const Eigen::Vector3d stopped = plane_reaction(plane, x, Eigen::Vector3d(0.1 * load * h / m, 0, 0), weight, m, h, sliding);
+  EXPECT_FALSE(sliding);
+  EXPECT_NEAR(stopped.x(), -0.1 * load, 1e-15);
+  // At rest, pulled by 0.35 F_n: held; by 0.6 F_n: mu_s F_n against the pull.
+  const Eigen::Vector3d held = plane_reaction(plane, x, Eigen::Vector3d::Zero(), weight + Eigen::Vector3d(0.35 * load, 0, 0), m, h, sliding);
+  EXPECT_NEAR(held.x(), -0.35 * load, 1e-15);
+  const Eigen::Vector3d broke = plane_reaction(plane, x, Eigen::Vector3d::Zero(), weight + Eigen::Vector3d(0.6 * load, 0, 0), m, h, sliding);
+  EXPECT_NEAR(broke.x(), -0.5 * load, 1e-15);
+}
+
 TEST(MassSpringFriction, SlidingTubeStopsAfterVSquaredOverTwoMuG) {
   const MassSpringNetwork network = rigid_tube_on_plane(8, Eigen::Vector3d(0, 0, -kG));
   MassSpringState state = make_state(network);
