@@ -520,8 +520,8 @@ TEST(MassSpringStatics, BentTubeKeepsItsVolumeWithinTwoPercent) {
 // tool_coupling.h). The tube is 10 times stiffer than the paper's and its springs damped at
 // alpha = 1e-4 s: the paper's E = 737 Pa tube, flattened to half its height by its own
 // weight, is crushed by the tool (its volume falls to about a quarter), and at alpha = 1e-6 s
-// (damping ratio alpha omega / 2 below 0.003) the sliding tube vibrates and its friction
-// cancels on average (README, "Open").
+// (damping ratio alpha omega / 2 below 0.003) the tool's blows make the tube vibrate
+// (README, "Open").
 TEST(MassSpringStatics, TubeBentByAToolKeepsItsVolumeWithinTwoPercent) {
   const int sections = 20;
   MassSpringNetwork network = tube_network(straight_tube(sections), {10 * kYoungsModulus, 9049, 1e-4});

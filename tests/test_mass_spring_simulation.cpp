@@ -359,9 +359,9 @@ Eigen::Vector3d mean_of(std::span<const Eigen::Vector3d> forces) {
 // the tube's own friction, 0.11 N, compress it by more than its length: E A = 0.058 N) and
 // damped at alpha = 1e-4 s, the scene's 2 mm sphere against the left end cap, 20 mm/s, mean
 // over the last second of 1.5 s. (At the scene's alpha = 1e-6 s, a damping ratio
-// alpha omega / 2 below 0.003 for every mode, the sliding tube vibrates, its bottom nodes
-// stick and slip and their friction cancels on average, and the tool feels a third of this:
-// README, "Open".)
+// alpha omega / 2 below 0.003 for every mode, the tool's blows make the tube vibrate, its
+// bottom nodes' friction cancels on average, and the tool feels a third of this: README,
+// "Open".)
 TEST(MassSpringSimulation, ToolPushingTheTubeAlongThePlaneFeelsItsSlidingFriction) {
   MassSpringModel stiff = noodle();
   for (Spring& s : stiff.network.springs) {
