@@ -9,12 +9,13 @@
 #include <chrono>
 #include <cstring>
 #include <fstream>
-#include <map>
 #include <memory>
-#include <random>
+#include <ctime>
 #include <unordered_set>
-#include <utility>
+#include <unordered_map>
 
+#include "common/model/model.h"
+#include "common/scene/load_scene.h"
 #include "common/util/error.h"
 #include "proto/record/recording.h"
 #include "proto/wire/ir_convert.h"
@@ -35,39 +36,45 @@ std::size_t changed_entries(const google::protobuf::RepeatedField<double>& befor
   return changed;
 }
 
-// CPU time [µs] of what a client would do per IR under the compliance-rows option: factor a
-// `dofs` x `dofs` SPD block and solve for `row_dofs` columns of its inverse. The matrix is
-// diagonally dominant (hence SPD) and synthetic: the cost depends on the sizes only.
-double condensation_us(int dofs, int row_dofs) {
-  std::mt19937 random(7);
-  std::uniform_real_distribution<double> uniform(-1, 1);
-  Eigen::MatrixXd block(dofs, dofs);
-  for (int j = 0; j < dofs; ++j)
-    for (int i = 0; i <= j; ++i) block(i, j) = block(j, i) = uniform(random);
-  block.diagonal().array() += 2.0 * dofs;
-  const Eigen::MatrixXd unit = Eigen::MatrixXd::Identity(dofs, row_dofs);
-  double best = 1e300;
-  for (int repeat = 0; repeat < 3; ++repeat) {
-    const auto start = std::chrono::steady_clock::now();
-    const Eigen::LLT<Eigen::MatrixXd> factor(block);
-    const Eigen::MatrixXd rows = factor.solve(unit);
-    const auto stop = std::chrono::steady_clock::now();
-    if (!rows.allFinite()) throw Error("ir-bytes: the timing matrix did not factor");
-    best = std::min(best, std::chrono::duration<double, std::micro>(stop - start).count());
-  }
-  return best;
+// What a client sent compliance rows would do per IR: L_AA over the IR's free dofs (local
+// nodes in order, axes x, y, z, fixed axes left out, as M~'s columns), factored, and M~ =
+// the C rows of its inverse (the first `row_dofs` rows; L_AA^-1 is symmetric, so its C
+// columns transposed). `cpu_us`: the factor and the solve, per the thread's CPU clock.
+Eigen::MatrixXd condense_compliance(const CondensedFemIr& fem, const std::vector<int>& nodes, ComplianceColumns& columns,
+                                    double& cpu_us) {
+  const Eigen::MatrixXd whole = columns.gather(nodes);
+  std::vector<Eigen::Index> free;
+  Eigen::Index row_dofs = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    for (int axis = 0; axis < 3; ++axis)
+      if (((fem.fixed_axes[i] >> axis) & 1) == 0) {
+        free.push_back(static_cast<Eigen::Index>(3 * i) + axis);
+        if (static_cast<int>(i) < fem.row_node_count) ++row_dofs;
+      }
+  const Eigen::MatrixXd block = whole(free, free);
+  const Eigen::MatrixXd unit = Eigen::MatrixXd::Identity(block.rows(), row_dofs);
+  timespec start{}, stop{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &start);
+  const Eigen::LLT<Eigen::MatrixXd> factor(block);
+  Eigen::MatrixXd rows = factor.solve(unit).transpose();
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &stop);
+  cpu_us = static_cast<double>(stop.tv_sec - start.tv_sec) * 1e6 + static_cast<double>(stop.tv_nsec - start.tv_nsec) * 1e-3;
+  if (factor.info() != Eigen::Success) throw Error("ir-bytes: an IR's compliance block L_AA is not positive definite");
+  return rows;
 }
 
 }  // namespace
 
-IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const std::filesystem::path& frames) {
+IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body, ComplianceColumns& columns,
+                            const std::filesystem::path& frames) {
   const record::Recording rec = record::read_recording(recording);
+  std::unordered_map<std::int64_t, int> node_of_tag;
+  for (std::size_t i = 0; i < body.mesh.node_tags.size(); ++i) node_of_tag.emplace(body.mesh.node_tags[i], static_cast<int>(i));
   IrBytesRow row;
   row.recording = recording.string();
   if (!frames.empty()) std::filesystem::create_directories(frames);
   const wire::IntermediateRepresentation* previous = nullptr;
   std::int64_t first_ns = 0, last_ns = 0;
-  std::map<std::pair<int, int>, double> us_by_size;
   std::vector<double> client_us;
   for (const record::RecordedIr& recorded : rec.irs) {
     const wire::IntermediateRepresentation& ir = recorded.ir();
@@ -84,7 +91,8 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const std::f
     }
     row.sent_bytes += static_cast<double>(bytes.size());
 
-    IntermediateRepresentation rounded = wire::from_wire(ir);
+    const IntermediateRepresentation received = wire::from_wire(ir);
+    IntermediateRepresentation rounded = received;
     condensed_fem(rounded).precision = IrPrecision::f32;
     row.f32_bytes += static_cast<double>(wire::to_wire(rounded).ByteSizeLong());
 
@@ -114,10 +122,25 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const std::f
     row.delta_bytes += rest + delta_m;
     row.rows_bytes += rest + value_bytes * compliance_row_values(nodes, added);
 
-    const std::pair<int, int> size{3 * fem.node_ids_size(), static_cast<int>(3 * fem.row_node_count())};
-    auto timed = us_by_size.find(size);
-    if (timed == us_by_size.end()) timed = us_by_size.emplace(size, condensation_us(size.first, size.second)).first;
-    client_us.push_back(timed->second);
+    const CondensedFemIr& sent = condensed_fem(received);
+    std::vector<int> mesh_nodes;
+    for (const std::int64_t tag : sent.node_ids) {
+      const auto found = node_of_tag.find(tag);
+      if (found == node_of_tag.end() || columns.row_position(found->second) < 0)
+        throw Error(fmt::format("ir-bytes: {}: IR epoch {} has node {}, which is no surface node of the scene's body",
+                                recording.string(), ir.epoch(), tag));
+      mesh_nodes.push_back(found->second);
+    }
+    double cpu_us = 0;
+    const Eigen::MatrixXd condensed = condense_compliance(sent, mesh_nodes, columns, cpu_us);
+    client_us.push_back(cpu_us);
+    if (condensed.rows() != sent.m_tilde.rows() || condensed.cols() != sent.m_tilde.cols())
+      throw Error(fmt::format("ir-bytes: {}: IR epoch {}: its M~ is {} x {}, its free dofs give {} x {} (boundary truncation "
+                              "is not measured)",
+                              recording.string(), ir.epoch(), sent.m_tilde.rows(), sent.m_tilde.cols(), condensed.rows(),
+                              condensed.cols()));
+    row.rows_m_tilde_difference = std::max(row.rows_m_tilde_difference, (condensed - sent.m_tilde).cwiseAbs().maxCoeff() /
+                                                                             sent.m_tilde.cwiseAbs().maxCoeff());
 
     previous = &ir;
     ++row.irs;
@@ -134,28 +157,37 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const std::f
 
 LabCommand add_ir_bytes_command(CLI::App& lab) {
   struct Options {
+    std::filesystem::path scene;
     std::vector<std::filesystem::path> recordings;
     std::filesystem::path frames;
   };
   auto options = std::make_shared<Options>();
   CLI::App* command = lab.add_subcommand(
       "ir-bytes", "IR bytes per second a client received, and what f32, M~ deltas or compliance rows would have sent");
+  command->add_option("--scene", options->scene, "The recorded session's scene (one linear elastic object)")
+      ->required()
+      ->check(CLI::ExistingFile);
   command->add_option("recordings", options->recordings, "Client recordings (cohaptic-client --record)")
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--frames", options->frames, "Also write every IR as sent into this directory, one file each");
   return {command, [options] {
-            fmt::print("| recording | IRs | span s | nodes per IR | new nodes per IR | sent kB/s | without M~ kB/s | f32 kB/s | M~ delta kB/s | "
-                       "compliance rows kB/s | rows: client µs p50 / max |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+            const Model model = build_model(load_scene(options->scene));
+            const ElasticBody& body = single_elastic_body(model);
+            ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+            fmt::print("| recording | IRs | span s | nodes per IR | new nodes per IR | sent kB/s | without M~ kB/s | f32 kB/s | "
+                       "M~ delta kB/s | compliance rows kB/s | rows: client CPU µs p50 / max | rows: M~ difference |\n"
+                       "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
             for (std::size_t i = 0; i < options->recordings.size(); ++i) {
               const std::filesystem::path frames =
                   options->frames.empty() ? options->frames : options->frames / fmt::format("{}", i);
-              const IrBytesRow r = measure_ir_bytes(options->recordings[i], frames);
+              const IrBytesRow r = measure_ir_bytes(options->recordings[i], body, columns, frames);
               const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;
-              fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.0f} / {:.0f} |\n",
-                         r.recording, r.irs, r.span_s, r.nodes_mean, r.new_nodes_mean, r.sent_bytes * per_s, r.without_m_bytes * per_s,
-                         r.f32_bytes * per_s, r.delta_bytes * per_s, r.rows_bytes * per_s, r.rows_client_us_p50,
-                         r.rows_client_us_max);
+              fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.0f} / {:.0f} | "
+                         "{:.1e} |\n",
+                         r.recording, r.irs, r.span_s, r.nodes_mean, r.new_nodes_mean, r.sent_bytes * per_s,
+                         r.without_m_bytes * per_s, r.f32_bytes * per_s, r.delta_bytes * per_s, r.rows_bytes * per_s,
+                         r.rows_client_us_p50, r.rows_client_us_max, r.rows_m_tilde_difference);
             }
             return 0;
           }};

@@ -8,10 +8,11 @@
 //     (value + index, 12 bytes each) when the local nodes are the same, else the whole M~;
 //   - compliance rows: instead of M~, the rows of the compliance block L_AA (A: every local
 //     node, 3 dofs each, symmetric) of nodes the previous IR did not have; the client would
-//     keep L_AA and condense it itself (M~ = the C rows of L_AA^-1). Its CPU per IR is timed
-//     here as a dense Cholesky of the IR's 3|A| x 3|A| block and the solve for its C rows,
-//     on a synthetic symmetric positive definite matrix of that size (the cost depends on
-//     the size only).
+//     keep L_AA and condense it itself. That client work is done here, per IR, on the
+//     scene's own compliance: L_AA over the IR's free dofs, a dense Cholesky, and M~ = its
+//     inverse's C rows; timed (µs of CPU per IR, an upper bound for an incremental client)
+//     and compared with the M~ the server sent (largest entry difference relative to the
+//     largest entry: 0 up to rounding if this way of sending gives the same forces).
 // `--frames DIR` also writes every IR as sent, one file each (frame_NNNNNN.bin), to measure a
 // general-purpose compressor on them (e.g. zstd). Units: bytes, kB = 1000 bytes, s, µs.
 #pragma once
@@ -20,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "common/fem/compliance.h"
+#include "common/model/elastic_body.h"
 #include "lab/lab_command.h"
 
 namespace cohaptic {
@@ -33,13 +36,17 @@ struct IrBytesRow {
   double sent_bytes = 0, f32_bytes = 0, delta_bytes = 0, rows_bytes = 0;  ///< totals
   double without_m_bytes = 0;  ///< everything but M~: what no way of sending M~ can save
   double rows_client_us_p50 = 0, rows_client_us_max = 0;  ///< condensing L_AA per IR
+  double rows_m_tilde_difference = 0;  ///< largest over the IRs, relative to each IR's largest |M~| entry
 };
 
-/// Measures one recording (throws Error naming it if it holds no condensed FEM IR).
-/// `frames`: if not empty, a directory to write the IRs as sent into.
-IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const std::filesystem::path& frames);
+/// Measures one recording (throws Error naming it if it holds no condensed FEM IR, or one
+/// whose nodes `body` does not have). `body` and `columns`: the recorded session's body and
+/// its compliance (rows for every surface node). `frames`: if not empty, a directory to write
+/// the IRs as sent into.
+IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body, ComplianceColumns& columns,
+                            const std::filesystem::path& frames);
 
-/// `cohaptic-lab ir-bytes RECORDING... [--frames DIR]`: a Markdown table on stdout.
+/// `cohaptic-lab ir-bytes --scene SCENE RECORDING... [--frames DIR]`: a Markdown table on stdout.
 LabCommand add_ir_bytes_command(CLI::App& lab);
 
 }  // namespace cohaptic
