@@ -1,19 +1,18 @@
 #include "lab/ir_bytes.h"
 
 #include <CLI/CLI.hpp>
-#include <Eigen/Cholesky>
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstring>
+#include <ctime>
 #include <fstream>
 #include <memory>
-#include <ctime>
-#include <unordered_set>
+#include <span>
 #include <unordered_map>
+#include <unordered_set>
 
+#include "common/condense/naive_condensation.h"
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
@@ -34,33 +33,6 @@ std::size_t changed_entries(const google::protobuf::RepeatedField<double>& befor
   for (int i = 0; i < now.size(); ++i)
     if (std::memcmp(&before[i], &now[i], sizeof(double)) != 0) ++changed;
   return changed;
-}
-
-// What a client sent compliance rows would do per IR: L_AA over the IR's free dofs (local
-// nodes in order, axes x, y, z, fixed axes left out, as M~'s columns), factored, and M~ =
-// the C rows of its inverse (the first `row_dofs` rows; L_AA^-1 is symmetric, so its C
-// columns transposed). `cpu_us`: the factor and the solve, per the thread's CPU clock.
-Eigen::MatrixXd condense_compliance(const CondensedFemIr& fem, const std::vector<int>& nodes, ComplianceColumns& columns,
-                                    double& cpu_us) {
-  const Eigen::MatrixXd whole = columns.gather(nodes);
-  std::vector<Eigen::Index> free;
-  Eigen::Index row_dofs = 0;
-  for (std::size_t i = 0; i < nodes.size(); ++i)
-    for (int axis = 0; axis < 3; ++axis)
-      if (((fem.fixed_axes[i] >> axis) & 1) == 0) {
-        free.push_back(static_cast<Eigen::Index>(3 * i) + axis);
-        if (static_cast<int>(i) < fem.row_node_count) ++row_dofs;
-      }
-  const Eigen::MatrixXd block = whole(free, free);
-  const Eigen::MatrixXd unit = Eigen::MatrixXd::Identity(block.rows(), row_dofs);
-  timespec start{}, stop{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &start);
-  const Eigen::LLT<Eigen::MatrixXd> factor(block);
-  Eigen::MatrixXd rows = factor.solve(unit).transpose();
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &stop);
-  cpu_us = static_cast<double>(stop.tv_sec - start.tv_sec) * 1e6 + static_cast<double>(stop.tv_nsec - start.tv_nsec) * 1e-3;
-  if (factor.info() != Eigen::Success) throw Error("ir-bytes: an IR's compliance block L_AA is not positive definite");
-  return rows;
 }
 
 }  // namespace
@@ -131,9 +103,20 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
                                 recording.string(), ir.epoch(), tag));
       mesh_nodes.push_back(found->second);
     }
-    double cpu_us = 0;
-    const Eigen::MatrixXd condensed = condense_compliance(sent, mesh_nodes, columns, cpu_us);
-    client_us.push_back(cpu_us);
+    // The client's work under compliance rows: the naive condensation of L_AA (the server's
+    // reference path), on the thread's CPU clock; the columns are solved before (a client
+    // receives them).
+    columns.compute_columns(mesh_nodes);
+    const auto contact = static_cast<std::size_t>(sent.row_node_count);
+    timespec start{}, stop{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &start);
+    const CondensedOperator op = naive_condensation(columns, body.dofs, std::span(mesh_nodes).first(contact),
+                                                    std::span(mesh_nodes).subspan(contact));
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &stop);
+    client_us.push_back(static_cast<double>(stop.tv_sec - start.tv_sec) * 1e6 +
+                        static_cast<double>(stop.tv_nsec - start.tv_nsec) * 1e-3);
+    Eigen::MatrixXd condensed(op.m_cc.rows(), op.m_cc.cols() + op.m_cb.cols());
+    condensed << op.m_cc, op.m_cb;
     if (condensed.rows() != sent.m_tilde.rows() || condensed.cols() != sent.m_tilde.cols())
       throw Error(fmt::format("ir-bytes: {}: IR epoch {}: its M~ is {} x {}, its free dofs give {} x {} (boundary truncation "
                               "is not measured)",

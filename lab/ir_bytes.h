@@ -9,10 +9,11 @@
 //   - compliance rows: instead of M~, the rows of the compliance block L_AA (A: every local
 //     node, 3 dofs each, symmetric) of nodes the previous IR did not have; the client would
 //     keep L_AA and condense it itself. That client work is done here, per IR, on the
-//     scene's own compliance: L_AA over the IR's free dofs, a dense Cholesky, and M~ = its
-//     inverse's C rows; timed (µs of CPU per IR, an upper bound for an incremental client)
-//     and compared with the M~ the server sent (largest entry difference relative to the
-//     largest entry: 0 up to rounding if this way of sending gives the same forces).
+//     scene's own compliance by the naive condensation (L_AA over the IR's free dofs, a
+//     dense Cholesky, M~ = its inverse's C rows): timed (µs of the thread's CPU per IR, an
+//     upper bound for an incremental client) and compared with the M~ the server sent
+//     (largest entry difference relative to the largest entry: 0 up to rounding if this way
+//     of sending gives the same forces).
 // `--frames DIR` also writes every IR as sent, one file each (frame_NNNNNN.bin), to measure a
 // general-purpose compressor on them (e.g. zstd). Units: bytes, kB = 1000 bytes, s, µs.
 #pragma once
