@@ -71,7 +71,12 @@ void expect_tree_matches_scan(const Eigen::Matrix3Xd& vertices, const std::vecto
   std::uniform_real_distribution<double> reach(0.3, 2.0);
   int crossed = 0;
   for (int trial = 0; trial < 10000; ++trial) {
-    const Vector3d from(coordinate(rng), coordinate(rng), coordinate(rng));
+    // One declaration per draw: a constructor's arguments are evaluated in an unspecified
+    // order (GCC and clang differ), and the trials must be the same with either compiler.
+    const double x = coordinate(rng);
+    const double y = coordinate(rng);
+    const double z = coordinate(rng);
+    const Vector3d from(x, y, z);
     // Odd trials: short and long segments in random directions; even trials: aimed at a
     // surface vertex, stopping short of it or running past, so that many do cross.
     const Vector3d to =
@@ -84,7 +89,9 @@ void expect_tree_matches_scan(const Eigen::Matrix3Xd& vertices, const std::vecto
     ++crossed;
     EXPECT_EQ(hit.crossing.t, scan.t);
   }
-  EXPECT_GT(crossed, 3000);
+  // An aimed trial crosses when its reach passes the vertex (reach >= 1: about 59 % of the
+  // 5000 aimed trials, so near 3000 with a few odd ones); 2500 says many were compared.
+  EXPECT_GT(crossed, 2500);
 }
 
 TEST(SegmentCrossing, TreeMatchesScanOnASphere) {
