@@ -8,7 +8,6 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
-#include <limits>
 #include <vector>
 
 #include "common/condense/dense_kernels.h"

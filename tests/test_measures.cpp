@@ -8,7 +8,6 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
-#include <limits>
 #include <numbers>
 #include <sstream>
 

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
-#include <limits>
 #include <spdlog/spdlog.h>
 
 #include "common/mesh/boundary_surface.h"

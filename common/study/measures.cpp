@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "common/study/zero_phase_lowpass.h"
 #include "common/util/error.h"
