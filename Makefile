@@ -19,6 +19,10 @@ SCENE ?=
 export COHAPTIC_BENCH_ARGS = $(value BENCH_ARGS)
 # Extra CMake settings for the first configure, e.g. CMAKE_ARGS=-DCOHAPTIC_WARNINGS_AS_ERRORS=ON (CI).
 CMAKE_ARGS ?=
+# Unity builds (CMake compiles each target's sources eight to a unit): a build from scratch
+# takes about 40 % less CPU, an edit recompiles its file's unit. UNITY=OFF for one file a unit.
+UNITY ?= ON
+UNITY_CMAKE = -DCMAKE_UNITY_BUILD=$(UNITY)
 LAB := $(BUILD_DIR)/lab/cohaptic-lab
 
 ASAN_BUILD_DIR ?= build-asan
@@ -51,7 +55,7 @@ TSAN_TESTS ?= EndToEnd\.ClientForcesEqualOfflineEvaluationAndTheFullSolve|EndToE
 # instrumentation in every library, libFuzzer's main in the fuzz targets only), so the
 # libraries are compiled once for both.
 SANITIZER_CMAKE = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
-  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DCOHAPTIC_BUILD_BENCHMARKS=OFF
+  -DCMAKE_CXX_FLAGS_DEBUG="-O1 -gline-tables-only" -DCOHAPTIC_BUILD_BENCHMARKS=OFF $(UNITY_CMAKE)
 SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
   TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
 
@@ -63,7 +67,7 @@ deps:
 	@./deploy/install-deps.sh
 
 $(BUILD_DIR)/CMakeCache.txt: | deps
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) $(CMAKE_ARGS)
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) $(UNITY_CMAKE) $(CMAKE_ARGS)
 
 configure: deps $(BUILD_DIR)/CMakeCache.txt
 

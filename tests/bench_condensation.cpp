@@ -191,7 +191,7 @@ void BM_PrepareIr(benchmark::State& state) {
 
 const std::vector<std::int64_t> kBoundarySizes = {0, 150, 300, 1000};
 
-void register_all() {
+void register_condensation_benchmarks() {
   // For the whole program, whatever runs first: the server's setting (server/main.cpp).
   use_single_blas_thread();
   const auto add = [](const char* name, void (*fn)(benchmark::State&), benchmark::TimeUnit unit) {
@@ -207,7 +207,7 @@ void register_all() {
   add("BM_PrepareIr", BM_PrepareIr, benchmark::kMicrosecond);
 }
 
-const int registered = (register_all(), 0);
+const int condensation_benchmarks_registered = (register_condensation_benchmarks(), 0);
 
 }  // namespace
 }  // namespace cohaptic

@@ -34,15 +34,15 @@
 namespace cohaptic {
 namespace {
 
-struct Fixture {
+struct InteractionFixture {
   std::unique_ptr<testing::PairedBoxesRig> rig;
   std::vector<int> face;  // B's near-face nodes nearest its centre, nearest first
 };
 
-Fixture& fixture() {
-  static Fixture f = [] {
+InteractionFixture& interaction_fixture() {
+  static InteractionFixture f = [] {
     use_single_blas_thread();
-    Fixture made;
+    InteractionFixture made;
     testing::PairedBoxesOptions options;
     options.behind_divisions = {9, 14, 12};
     options.front_divisions = {4, 7, 4};
@@ -65,7 +65,7 @@ struct Displaced {
   std::vector<int> nodes;
   Eigen::VectorXd displacement;
   explicit Displaced(std::size_t n)
-      : nodes(fixture().face.begin(), fixture().face.begin() + static_cast<std::ptrdiff_t>(n)) {
+      : nodes(interaction_fixture().face.begin(), interaction_fixture().face.begin() + static_cast<std::ptrdiff_t>(n)) {
     std::sort(nodes.begin(), nodes.end());
     displacement = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(n));
     for (std::size_t j = 0; j < n; ++j) displacement[3 * static_cast<Eigen::Index>(j)] = 0.001;
@@ -73,7 +73,7 @@ struct Displaced {
 };
 
 void BM_BehindReaction(benchmark::State& state) {
-  Fixture& f = fixture();
+  InteractionFixture& f = interaction_fixture();
   const Displaced displaced(static_cast<std::size_t>(state.range(0)));
   Eigen::VectorXd forces(displaced.displacement.size());
   CondensedResponseWorkspace workspace;
@@ -86,7 +86,7 @@ void BM_BehindReaction(benchmark::State& state) {
 BENCHMARK(BM_BehindReaction)->DenseRange(1, 4)->Unit(benchmark::kMicrosecond);
 
 void BM_BehindDeformation(benchmark::State& state) {
-  Fixture& f = fixture();
+  InteractionFixture& f = interaction_fixture();
   const Displaced displaced(static_cast<std::size_t>(state.range(0)));
   Eigen::VectorXd forces(displaced.displacement.size());
   CondensedResponseWorkspace workspace;
@@ -102,7 +102,7 @@ void BM_BehindDeformation(benchmark::State& state) {
 BENCHMARK(BM_BehindDeformation)->DenseRange(1, 4)->Unit(benchmark::kMicrosecond);
 
 void BM_BehindFullSolve(benchmark::State& state) {
-  Fixture& f = fixture();
+  InteractionFixture& f = interaction_fixture();
   const Displaced displaced(static_cast<std::size_t>(state.range(0)));
   std::vector<int> dofs;
   for (int node : displaced.nodes)
@@ -123,7 +123,7 @@ struct PairsScenario {
   SurfaceAdjacency active_surface;
   NodePairList list;
   explicit PairsScenario(int pairs) : active(3, pairs), active_surface(make_surface_adjacency({}, pairs)) {
-    const Fixture& f = fixture();
+    const InteractionFixture& f = interaction_fixture();
     list.paired.assign(static_cast<std::size_t>(pairs), 1);
     for (int k = 0; k < pairs; ++k) {
       const int node = f.face[static_cast<std::size_t>(k)];
@@ -133,7 +133,7 @@ struct PairsScenario {
     }
   }
   InteractingBodies bodies() {
-    Fixture& f = fixture();
+    InteractionFixture& f = interaction_fixture();
     return {active,
             active_surface,
             f.rig->behind.mesh.nodes,
@@ -213,7 +213,7 @@ BENCHMARK(BM_Conveyance)->Arg(1)->Arg(16)->Unit(benchmark::kMicrosecond);
 // Addition of pairs around one colliding node of A's face (the paper's front box): its
 // neighbours join, then the list is cut back for the next iteration.
 void BM_AddPairs(benchmark::State& state) {
-  Fixture& f = fixture();
+  InteractionFixture& f = interaction_fixture();
   const testing::PairedBoxesRig& rig = *f.rig;
   const int centre = rig.front_face[rig.front_face.size() / 2];
   NodePairList list =

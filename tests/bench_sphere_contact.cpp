@@ -85,7 +85,7 @@ void run_ticks(benchmark::State& state, bool cold_start) {
 void BM_Tick(benchmark::State& state) { run_ticks(state, false); }
 void BM_TickColdStart(benchmark::State& state) { run_ticks(state, true); }
 
-void BM_PrepareIr(benchmark::State& state) {
+void BM_PrepareSphereIr(benchmark::State& state) {
   const PreparedIR& prepared = prepared_ir(model_of(state), static_cast<int>(state.range(1)));
   for (auto _ : state) {
     const PreparedIR again = prepare_ir(prepared.ir);
@@ -93,7 +93,7 @@ void BM_PrepareIr(benchmark::State& state) {
   }
 }
 
-void register_all() {
+void register_sphere_contact_benchmarks() {
   use_single_blas_thread();
   for (const auto& [name, model] : {std::pair{"translation", 0}, std::pair{"sphere", 1}}) {
     const std::string suffix = std::string("/") + name;
@@ -103,14 +103,14 @@ void register_all() {
           ->Args({model, 0})
           ->Args({model, 300})
           ->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("BM_PrepareIr" + suffix).c_str(), BM_PrepareIr)
+    benchmark::RegisterBenchmark(("BM_PrepareIr" + suffix).c_str(), BM_PrepareSphereIr)
         ->Args({model, 0})
         ->Args({model, 300})
         ->Unit(benchmark::kMicrosecond);
   }
 }
 
-const int registered = (register_all(), 0);
+const int sphere_contact_benchmarks_registered = (register_sphere_contact_benchmarks(), 0);
 
 }  // namespace
 }  // namespace cohaptic

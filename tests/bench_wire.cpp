@@ -116,7 +116,7 @@ void BM_IrFrame(benchmark::State& state, Mode mode) {
   state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(size));
 }
 
-void register_all() {
+void register_wire_benchmarks() {
   for (Mode mode : {none, clear, encrypted})
     benchmark::RegisterBenchmark((std::string("BM_Datagram/") + kModeNames[mode]).c_str(),
                                  [mode](benchmark::State& s) { BM_Datagram(s, mode); })
@@ -130,7 +130,7 @@ void register_all() {
         ->Arg(300);
 }
 
-const int registered = (register_all(), 0);
+const int wire_benchmarks_registered = (register_wire_benchmarks(), 0);
 
 }  // namespace
 }  // namespace cohaptic

@@ -10,9 +10,12 @@
 #include "common/model/compliance_setup.h"
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
+#include "support/scratch_directory.h"
 
 namespace cohaptic {
 namespace {
+
+using testing::ScratchDirectory;
 
 namespace fs = std::filesystem;
 
@@ -30,13 +33,6 @@ tools: [{{name: A}}]
 )",
                      divisions, youngs_modulus, precompute);
 }
-
-struct ScratchDirectory {
-  fs::path path = fs::temp_directory_path() / ("cohaptic-test-" + std::to_string(::getpid()) + "-" +
-                                               ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  ScratchDirectory() { fs::create_directories(path); }
-  ~ScratchDirectory() { fs::remove_all(path); }
-};
 
 TEST(Compliance, ColumnsEqualTheDenseInverseAndAreSymmetric) {
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));

@@ -25,9 +25,12 @@
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
 #include "support/evaluate_static.h"
+#include "support/measures.h"
 
 namespace cohaptic {
 namespace {
+
+using testing::mm;
 
 using Rig = testing::CubeRig;
 
@@ -36,8 +39,6 @@ testing::CubeSceneOptions cube(int divisions) {
   options.divisions = divisions;
   return options;
 }
-
-Eigen::Vector3d mm(double x, double y, double z) { return Eigen::Vector3d(x, y, z) * 1e-3; }
 
 SimulationOptions options(double force_limit, int step_delay_nodes = 0,
                           ContactModel contact_model = ContactModel::node_translation) {

@@ -43,14 +43,14 @@ Fan random_fan(std::mt19937& rng) {
   return fan;
 }
 
-struct BruteForce {
+struct BruteForceCollisions {
   bool collides = false;
   int triangle = -1;
   TriangleClosestPoint target;
 };
 
-BruteForce brute_force(const Fan& fan, const Eigen::Vector3d& active) {
-  BruteForce answer;
+BruteForceCollisions brute_force(const Fan& fan, const Eigen::Vector3d& active) {
+  BruteForceCollisions answer;
   bool behind_every_plane = true;
   double nearest = INFINITY;
   for (int t = 0; t < static_cast<int>(fan.surface.triangles.size()); ++t) {
@@ -79,7 +79,7 @@ TEST(InteractionCollision, AgreesWithBruteForceClosestPointsOnRandomFans) {
   for (int trial = 0; trial < 10000; ++trial) {
     const Fan fan = random_fan(rng);
     const Eigen::Vector3d active = fan.positions.col(0) + Eigen::Vector3d(offset(rng), offset(rng), offset(rng));
-    const BruteForce expected = brute_force(fan, active);
+    const BruteForceCollisions expected = brute_force(fan, active);
     const bool instant = instant_collision_test(active, 0, fan.positions, fan.surface);
     const auto target = node_polygon_collision(active, 0, fan.positions, fan.surface);
     ASSERT_EQ(target.has_value(), expected.collides) << "trial " << trial;

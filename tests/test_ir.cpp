@@ -15,28 +15,21 @@
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
 #include "support/evaluate_static.h"
+#include "support/measures.h"
+#include "support/unlimited_options.h"
 
 namespace cohaptic {
 namespace {
+
+using testing::mm;
+using testing::relative_error;
+using testing::unlimited_options;
 
 using Rig = testing::CubeRig;
 
 Rig& shared_cube() {
   static Rig rig;
   return rig;
-}
-
-Eigen::Vector3d mm(double x, double y, double z) { return Eigen::Vector3d(x, y, z) * 1e-3; }
-
-SimulationOptions unlimited(ContactModel model, int step_delay_nodes = 0, int patch_rings = 1,
-                            IrPrecision precision = IrPrecision::f64) {
-  SimulationOptions options;
-  options.ir.contact_model = model;
-  options.ir.patch_rings = patch_rings;
-  options.ir.precision = precision;
-  options.ir.force_limit = std::numeric_limits<double>::infinity();
-  options.step_delay_nodes = step_delay_nodes;
-  return options;
 }
 
 // The full sparse solve with all `tools` pressing and the simulation's held nodes.
@@ -50,10 +43,6 @@ std::vector<Eigen::Vector3d> reference_forces(const Model& model, const Simulati
   for (const ToolReaction& r : contact_reactions_reference(body, find_tool_contacts(body, pressed), held, contact_model))
     forces.push_back(r.reaction);
   return forces;
-}
-
-double relative_error(const Eigen::Vector3d& value, const Eigen::Vector3d& expected) {
-  return (value - expected).norm() / std::max(expected.norm(), 1e-300);
 }
 
 // Whether the IR of `user` holds the triangles the tools now press (own within the patch,
@@ -76,7 +65,7 @@ bool ir_covers(const Model& model, const PreparedIR& prepared, const std::vector
 void two_users_match_the_full_solve(ContactModel contact_model, int step_delay_nodes) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(contact_model, step_delay_nodes));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(contact_model, step_delay_nodes));
   const std::vector<Eigen::Vector3d> start = {mm(-20, 5, -4), mm(25, -5, -3)};
   simulation.set_tool(0, start[0]);
   simulation.set_tool(1, start[1]);
@@ -204,8 +193,8 @@ TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
 TEST(IntermediateRepresentation, EachUserFeelsTheOther) {
   Rig& rig = shared_cube();
   const auto force_alone_and_together = [&](int user) {
-    Simulation alone(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
-    Simulation together(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
+    Simulation alone(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
+    Simulation together(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
     alone.set_tool(user, user == 0 ? mm(-12, 0, -5) : mm(12, 0, -5));
     together.set_tool(0, mm(-12, 0, -5));
     together.set_tool(1, mm(12, 0, -5));
@@ -224,7 +213,7 @@ TEST(IntermediateRepresentation, EachUserFeelsTheOther) {
 TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::node_translation, 0, 2));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited_options(ContactModel::node_translation, 0, 2));
   simulation.set_tool(0, mm(1, 2, -3));
   simulation.step(0);
   const PreparedIR& prepared = *simulation.ir(0);
@@ -244,9 +233,9 @@ TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
 TEST(IntermediateRepresentation, Float32StorageStaysCloseToFloat64) {
   Rig& rig = shared_cube();
   for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
-    Simulation f64(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(contact_model, 300));
+    Simulation f64(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(contact_model, 300));
     Simulation f32(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
-                   unlimited(contact_model, 300, 1, IrPrecision::f32));
+                   unlimited_options(contact_model, 300, 1, IrPrecision::f32));
     for (Simulation* s : {&f64, &f32}) {
       s->set_tool(0, mm(-20, 5, -4));
       s->set_tool(1, mm(25, -5, -3));
@@ -284,7 +273,7 @@ TEST(IntermediateRepresentation, NodeTranslationJumpsAtEdgesThePointModelDoesNot
   Rig& rig = shared_cube();
   std::printf("  tool sliding 3 mm deep across several triangles (patch rings 2), largest change between samples:\n");
   for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
-    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited(contact_model, 0, 2));
+    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited_options(contact_model, 0, 2));
     simulation.set_tool(0, mm(0.5, 0.4, -3));
     simulation.step(0);
     double peak = 0;
@@ -304,7 +293,7 @@ TEST(IntermediateRepresentation, NodeTranslationJumpsAtEdgesThePointModelDoesNot
 TEST(IntermediateRepresentation, PastThePatchTheForceIsHeldAndTheNextIrCatchesUp) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::point_constraint, 0, 0));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited_options(ContactModel::point_constraint, 0, 0));
   simulation.set_tool(0, mm(1, 1, -3));
   simulation.step(0);
   const std::shared_ptr<const PreparedIR> old_ir = simulation.ir(0);
@@ -349,7 +338,7 @@ TEST(IntermediateRepresentation, SphereToolsEqualTheFullSolve) {
       tool.shape = ToolShape::sphere;
       tool.radius = radius;
     }
-    Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, tools, unlimited(contact_model));
+    Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, tools, unlimited_options(contact_model));
     // Centres outside the surface (1 mm above it) and inside (2 mm below): both press.
     const std::vector<Eigen::Vector3d> centres = {mm(-20, 5, 1), mm(25, -5, -2)};
     simulation.set_tool(0, centres[0]);
@@ -369,7 +358,7 @@ TEST(IntermediateRepresentation, SphereToolsEqualTheFullSolve) {
 TEST(IntermediateRepresentation, NonFiniteToolsGiveZeroOrAreIgnored) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited(ContactModel::node_translation));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
   simulation.set_tool(0, mm(-20, 5, -4));
   simulation.set_tool(1, mm(25, -5, -3));
   simulation.step(0);
@@ -387,7 +376,7 @@ TEST(IntermediateRepresentation, NonFiniteToolsGiveZeroOrAreIgnored) {
 
 TEST(IntermediateRepresentation, PrepareRejectsMalformedIrs) {
   Rig& rig = shared_cube();
-  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited(ContactModel::node_translation));
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited_options(ContactModel::node_translation));
   simulation.set_tool(0, mm(0, 0, -2));
   simulation.step(0);
   const IntermediateRepresentation good = simulation.ir(0)->ir;

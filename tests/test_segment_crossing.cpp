@@ -45,14 +45,14 @@ TEST(SegmentCrossing, AgreesWithThePlaneCrossing) {
   EXPECT_GT(crossings, 500);
 }
 
-struct Scan {
+struct CrossingScan {
   int triangle = -1;
   double t = 2;
 };
 
-Scan scan_all(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& triangles, const Vector3d& from,
+CrossingScan scan_all(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& triangles, const Vector3d& from,
               const Vector3d& to) {
-  Scan best;
+  CrossingScan best;
   for (int i = 0; i < static_cast<int>(triangles.size()); ++i) {
     const Triangle& tri = triangles[static_cast<std::size_t>(i)];
     const auto crossing =
@@ -82,7 +82,7 @@ void expect_tree_matches_scan(const Eigen::Matrix3Xd& vertices, const std::vecto
     const Vector3d to =
         trial % 2 ? Vector3d(from + std::pow(10.0, -2 + 2.0 * (trial % 7) / 6) * extent * testing::random_direction(rng))
                   : Vector3d(from + reach(rng) * (Vector3d(vertices.col(vertex(rng))) - from));
-    const Scan scan = scan_all(vertices, triangles, from, to);
+    const CrossingScan scan = scan_all(vertices, triangles, from, to);
     const AabbCrossing hit = tree.first_crossing(from, to);
     ASSERT_EQ(hit.triangle, scan.triangle) << "trial " << trial;
     if (scan.triangle < 0) continue;

@@ -13,6 +13,7 @@
 #include "common/separation/laser_groove.h"
 #include "common/separation/pull_loop.h"
 #include "common/separation/two_layer_setup.h"
+#include "support/default_two_layers.h"
 #include "support/sanitizer_owns_malloc.h"
 
 namespace {
@@ -34,10 +35,7 @@ extern "C" void free(void* pointer) {
 namespace cohaptic {
 namespace {
 
-const TwoLayerSetup& layers() {
-  static const TwoLayerSetup setup = make_two_layer_setup(TwoLayerBoxes{}, FieldSettings{}, SeparationSettings{});
-  return setup;
-}
+using testing::default_two_layers;
 
 // An opened strip along the free rim: every triangle with its centroid at x < 10 mm.
 SeparationState opened_strip(const SeparationPatch& patch) {
@@ -71,7 +69,7 @@ ContactPoint point_at(const SeparationPatch& patch, const Eigen::Vector3d& p) {
 // c slides with |F_t| = mu (F . n), stops where the opened strip ends (x = 10 mm), and the
 // force then builds up until the flap tears there.
 TEST(SeparationContact, SlidingStopsAtACrackEdge) {
-  const SeparationPatch& patch = layers().patch;
+  const SeparationPatch& patch = default_two_layers().patch;
   SeparationState state = opened_strip(patch);
   const Eigen::Vector3d start(0.005, 0.0203, 0);
   SeparationContact contact = begin_contact(patch, ContactMode::push, point_at(patch, start), start);
@@ -110,7 +108,7 @@ TEST(SeparationContact, SlidingStopsAtACrackEdge) {
 }
 
 TEST(SeparationContact, PushingToolLetsGoWhenItWouldPull) {
-  const SeparationPatch& patch = layers().patch;
+  const SeparationPatch& patch = default_two_layers().patch;
   SeparationState state = opened_strip(patch);
   const Eigen::Vector3d start(0.005, 0.0203, 0);
   SeparationContact contact = begin_contact(patch, ContactMode::push, point_at(patch, start), start);
@@ -132,7 +130,7 @@ TEST(SeparationContact, PushingToolLetsGoWhenItWouldPull) {
 // Thousands of ticks of pulling, tearing, sliding and lasering: no allocation, no free,
 // never a NaN, never more than the force limit.
 TEST(SeparationContact, EvaluationAllocatesNothingAndStaysBounded) {
-  const SeparationPatch& patch = layers().patch;
+  const SeparationPatch& patch = default_two_layers().patch;
   SeparationState state = make_separation_state(patch);
   const int node = nearest_patch_node(patch, Eigen::Vector3d(0, 0.02, 0));
   const Eigen::Vector3d start = patch.positions.col(node);
@@ -189,7 +187,7 @@ TEST(SeparationContact, EvaluationAllocatesNothingAndStaysBounded) {
 // patch (here one rebuilt from its parts, as a receiver would) and the same tool samples,
 // every force and every separated share agree to the bit.
 TEST(SeparationContact, TwoCopiesAgreeBitForBit) {
-  const TwoLayerSetup& setup = layers();
+  const TwoLayerSetup& setup = default_two_layers();
   const SeparationPatch server = setup.patch;
   const SeparationPatch client = make_separation_patch(setup.interface, setup.fields, SeparationSettings{});
   SeparationState server_state = make_separation_state(server), client_state = make_separation_state(client);

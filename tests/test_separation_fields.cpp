@@ -18,9 +18,12 @@
 #include "common/separation/tied_system.h"
 #include "common/separation/two_layer_setup.h"
 #include "common/util/error.h"
+#include "support/scratch_directory.h"
 
 namespace cohaptic {
 namespace {
+
+using testing::ScratchDirectory;
 
 namespace fs = std::filesystem;
 
@@ -33,13 +36,6 @@ TwoLayerBoxes small_boxes() {
   boxes.pulled_material.youngs_modulus = 40e3;  // a softer flap on a stiffer bed
   return boxes;
 }
-
-struct ScratchDirectory {
-  fs::path path = fs::temp_directory_path() / ("cohaptic-test-" + std::to_string(::getpid()) + "-" +
-                                               ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  ScratchDirectory() { fs::create_directories(path); }
-  ~ScratchDirectory() { fs::remove_all(path); }
-};
 
 double relative(const Eigen::Vector3d& value, const Eigen::Vector3d& reference) {
   return (value - reference).norm() / reference.norm();

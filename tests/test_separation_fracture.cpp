@@ -13,22 +13,19 @@
 #include "common/separation/fracture_step.h"
 #include "common/separation/pull_loop_figure.h"
 #include "common/separation/two_layer_setup.h"
+#include "support/default_two_layers.h"
 
 namespace cohaptic {
 namespace {
 
-// The default scene: two 40 x 40 mm layers (4 mm flap on a 10 mm bed), 2 mm cells, J_c =
-// 75 J/m^2, l_n = l_t = 5 mm. Built once per test program.
-const TwoLayerSetup& layers() {
-  static const TwoLayerSetup setup = make_two_layer_setup(TwoLayerBoxes{}, FieldSettings{}, SeparationSettings{});
-  return setup;
-}
+using testing::default_two_layers;
 
-int rim_node() { return nearest_patch_node(layers().patch, Eigen::Vector3d(0, 0.02, 0)); }
-int centre_node() { return nearest_patch_node(layers().patch, Eigen::Vector3d(0.02, 0.02, 0)); }
+// On the default layers the interface has J_c = 75 J/m^2 and l_n = l_t = 5 mm.
+int rim_node() { return nearest_patch_node(default_two_layers().patch, Eigen::Vector3d(0, 0.02, 0)); }
+int centre_node() { return nearest_patch_node(default_two_layers().patch, Eigen::Vector3d(0.02, 0.02, 0)); }
 
 TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
-  const SeparationPatch& patch = layers().patch;
+  const SeparationPatch& patch = default_two_layers().patch;
   const int node = rim_node();
   // The precondition for a flat BC: l_n is long enough for these fields at this node.
   ASSERT_LT(holding_normal_length(patch, node), patch.normal_length);
@@ -108,7 +105,7 @@ TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
 // along the pull stays at J_c l(direction). The loop is passive: the hand's work exceeds
 // what the fields still store at the end.
 TEST(SeparationFracture, EnergyBalanceAtOtherSpeedsAndAngles) {
-  const SeparationPatch& patch = layers().patch;
+  const SeparationPatch& patch = default_two_layers().patch;
   for (double speed : {0.002, 0.01, 0.05, 0.2})
     for (double tilt_deg : {0.0, 20.0, 40.0, 60.0})
       for (const Eigen::Vector3d& towards : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)}) {
@@ -167,7 +164,7 @@ double tangential(const SeparationPatch& patch, const SeparationSample& s, int n
 // the force along the push holds there and l_t of area separates per metre the tool moves
 // (Eqs. 4–11).
 TEST(SeparationFracture, TangentialThresholdIsJcLt) {
-  const SeparationPatch& patch = layers().patch;
+  const SeparationPatch& patch = default_two_layers().patch;
   const int node = rim_node();
   const double f_t = patch.toughness * patch.tangential_length;
   const Push p = push(patch, make_separation_state(patch), node, Eigen::Vector3d::UnitX(), 1e-5, 800,
@@ -199,7 +196,7 @@ TEST(SeparationFracture, TangentialThresholdIsJcLt) {
 // VI.C): away from the rim a push of ten times the thresholds separates nothing; after a
 // laser groove through the contact's region the same push does.
 TEST(SeparationFracture, NoCrackNoFractureUntilALaserGroove) {
-  const SeparationPatch& patch = layers().patch;
+  const SeparationPatch& patch = default_two_layers().patch;
   const int node = centre_node();
   const double f_t = patch.toughness * patch.tangential_length;
   const auto ten_times = [&](const SeparationSample& s) { return tangential(patch, s, node) >= 10 * f_t; };

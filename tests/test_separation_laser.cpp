@@ -8,14 +8,12 @@
 #include "common/separation/laser_groove.h"
 #include "common/separation/two_layer_setup.h"
 #include "common/util/error.h"
+#include "support/default_two_layers.h"
 
 namespace cohaptic {
 namespace {
 
-const TwoLayerSetup& layers() {
-  static const TwoLayerSetup setup = make_two_layer_setup(TwoLayerBoxes{}, FieldSettings{}, SeparationSettings{});
-  return setup;
-}
+using testing::default_two_layers;
 
 // Sweeps the fibre from `from` towards `to` at `speed` with 1 ms ticks, for as many whole
 // ticks as fit; returns the area vaporised and sets `length` to the distance swept.
@@ -39,7 +37,7 @@ TEST(SeparationLaser, VaporisationSpeedFromTheEnergyBalance) {
   const double v_s = 0.5 * 80.0 / (q * 0.55e-3 * 0.55e-3);
   EXPECT_NEAR(vaporisation_speed(LaserSettings{}, TissueThermal{}), v_s, 1e-12 * v_s);
   EXPECT_NEAR(v_s, 0.0524, 0.0001);
-  EXPECT_DOUBLE_EQ(layers().patch.vaporisation_speed, v_s);
+  EXPECT_DOUBLE_EQ(default_two_layers().patch.vaporisation_speed, v_s);
   // Twice the power, twice the speed; twice the spot, a quarter.
   LaserSettings laser;
   laser.power *= 2;
@@ -54,7 +52,7 @@ TEST(SeparationLaser, VaporisationSpeedFromTheEnergyBalance) {
 // Below v_s the groove follows the fibre: the area is l_f L, across every triangle it
 // passes; above v_s nothing is removed; a held, switched-off or distant fibre removes nothing.
 TEST(SeparationLaser, HalfSpeedVaporisesTheStripOneAndAHalfNothing) {
-  const SeparationPatch& patch = layers().patch;
+  const SeparationPatch& patch = default_two_layers().patch;
   const double v_s = patch.vaporisation_speed, l_f = patch.spot_diameter;
   // A slanted 17 mm path well inside the interface, crossing edges at all angles.
   const Eigen::Vector3d from(0.0113, 0.0087, 0), to(0.0261, 0.0171, 0);
@@ -89,7 +87,7 @@ TEST(SeparationLaser, HalfSpeedVaporisesTheStripOneAndAHalfNothing) {
 }
 
 TEST(SeparationLaser, StripAreaIsTheExactIntersection) {
-  const SeparationPatch& patch = layers().patch;
+  const SeparationPatch& patch = default_two_layers().patch;
   const int t = 0;
   const Triangle& tri = patch.triangles[t];
   const Eigen::Vector3d a = patch.positions.col(tri[0]), b = patch.positions.col(tri[1]), c = patch.positions.col(tri[2]);

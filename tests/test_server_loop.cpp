@@ -42,7 +42,7 @@ namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
-int movable_surface_nodes(const Model& model) {
+int movable_surface_node_count(const Model& model) {
   const ElasticBody& body = single_elastic_body(model);
   int count = 0;
   for (int node : body.surface.nodes) count += body.dofs.fixed_axes[static_cast<std::size_t>(node)] != kAllAxes;
@@ -126,7 +126,7 @@ std::pair<std::optional<std::string>, std::vector<Outbox>> run_for(SimulationLoo
 
 TEST(SimulationLoop, AStepThatKeepsFailingEndsTheLoopAfterAHundredPacedSteps) {
   LoopRig rig(0);
-  rig.options.step_nodes = movable_surface_nodes(*rig.cube.model);
+  rig.options.step_nodes = movable_surface_node_count(*rig.cube.model);
   SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
                       wire::monotonic_now_ns());
   const auto start = std::chrono::steady_clock::now();
@@ -198,7 +198,7 @@ TEST(ServerProgram, EndsTheSessionWithAnErrorWhenEveryStepFails) {
   testing::CubeSceneOptions scene = LoopRig::soft_cube();
   scene.divisions = 8;
   std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(scene);
-  const int step_nodes = movable_surface_nodes(*testing::CubeRig(scene).model);
+  const int step_nodes = movable_surface_node_count(*testing::CubeRig(scene).model);
   std::ofstream(dir / "press.yaml") << R"(
 units: mm
 start: [3, 2, 6]

@@ -21,15 +21,15 @@
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
+#include "support/measures.h"
+#include "support/unlimited_options.h"
 
 namespace cohaptic {
 namespace {
 
-Eigen::Vector3d mm(double x, double y, double z) { return Eigen::Vector3d(x, y, z) * 1e-3; }
-
-double relative_error(const Eigen::Vector3d& value, const Eigen::Vector3d& expected) {
-  return (value - expected).norm() / std::max(expected.norm(), 1e-300);
-}
+using testing::mm;
+using testing::relative_error;
+using testing::unlimited_options;
 
 // ---------------------------------------------------------------------------------------
 // The unilateral solve.
@@ -152,7 +152,7 @@ TEST(SphereContact, HoldsThePassedNodesAlongTheSpheresNormalByTheDeepestSphere) 
 // ---------------------------------------------------------------------------------------
 // The intermediate representation against the full sparse solve.
 
-constexpr double kRadius = 30e-3;  // on the 11.8 mm cube mesh a 4 mm press holds several nodes
+constexpr double kSphereRadius = 30e-3;  // on the 11.8 mm cube mesh a 4 mm press holds several nodes
 
 testing::CubeSceneOptions sphere_cube() {
   testing::CubeSceneOptions options;
@@ -163,15 +163,6 @@ testing::CubeSceneOptions sphere_cube() {
 testing::CubeRig& shared_rig() {
   static testing::CubeRig rig(sphere_cube());
   return rig;
-}
-
-SimulationOptions unlimited(int step_delay_nodes = 0, int patch_rings = 1) {
-  SimulationOptions options;
-  options.ir.contact_model = ContactModel::sphere;
-  options.ir.patch_rings = patch_rings;
-  options.ir.force_limit = std::numeric_limits<double>::infinity();
-  options.step_delay_nodes = step_delay_nodes;
-  return options;
 }
 
 // Mesh node tags of the IR's nodes in contact at the evaluation that left `state`.
@@ -196,20 +187,20 @@ HeldNodes held_nodes(const Simulation& simulation) {
 
 // The user's IR evaluated at the tools' positions against the reference, force and contact
 // set; returns the relative force error (and counts the nodes).
-struct Comparison {
+struct SphereComparison {
   double worst = 0;
   int checked = 0, contact_nodes = 0, released_nodes = 0;
 };
 
 void compare(const ElasticBody& body, const Simulation& simulation, const std::vector<Eigen::Vector3d>& tools, int user,
-             Comparison& comparison) {
+             SphereComparison& comparison) {
   const PreparedIR& prepared = *simulation.ir(user);
   std::vector<Eigen::Vector3d> remotes;
   for (int r = 0; r < remote_count(prepared.ir); ++r) remotes.push_back(tools[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
   EvaluationState state = make_evaluation_state(prepared);
   const ForceSample sample = evaluate_force(prepared, state, tools[static_cast<std::size_t>(user)], remotes, 1e-3);
   std::vector<PressedTool> pressed;
-  for (const Eigen::Vector3d& p : tools) pressed.push_back({p, kRadius});
+  for (const Eigen::Vector3d& p : tools) pressed.push_back({p, kSphereRadius});
   const SphereContactSolution reference = sphere_reactions_reference(body, pressed, held_nodes(simulation));
   const Eigen::Vector3d expected = reference.reactions[static_cast<std::size_t>(user)];
   ASSERT_FALSE(sample.flags & (kOutsidePatch | kContactUnresolved | kNonFinite));
@@ -230,8 +221,8 @@ void compare(const ElasticBody& body, const Simulation& simulation, const std::v
 TEST(SphereContact, OneSphereSlidingEqualsTheFullSparseSolveInForceAndNodeSet) {
   testing::CubeRig& rig = shared_rig();
   const ElasticBody& body = rig.body;
-  Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1, rig.model->scene.tools[0]), unlimited());
-  Comparison comparison;
+  Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1, rig.model->scene.tools[0]), unlimited_options(ContactModel::sphere));
+  SphereComparison comparison;
   // Press the centre 4 mm below touching, then slide 20 mm across several nodes.
   for (int k = 0; k <= 24; ++k) {
     const double depth = std::min(k, 8) * 0.5;  // mm
@@ -251,10 +242,10 @@ TEST(SphereContact, OneSphereSlidingEqualsTheFullSparseSolveInForceAndNodeSet) {
 TEST(SphereContact, BetweenIrUpdatesTheClientFollowsTheSphereExactly) {
   testing::CubeRig& rig = shared_rig();
   const ElasticBody& body = rig.body;
-  Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1, rig.model->scene.tools[0]), unlimited(0, 2));
+  Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1, rig.model->scene.tools[0]), unlimited_options(ContactModel::sphere, 0, 2));
   simulation.set_tool(0, mm(0, 0, 27));
   simulation.step(0);
-  Comparison comparison;
+  SphereComparison comparison;
   // The IR stays the one built at 27 mm; the tool goes 2 mm deeper and 4 mm sideways.
   for (int k = 0; k <= 10; ++k) compare(body, simulation, {mm(0.4 * k, 0, 27 - 0.2 * k)}, 0, comparison);
   std::printf("  one IR, %d positions: worst relative force error %.2e\n", comparison.checked, comparison.worst);
@@ -265,8 +256,8 @@ TEST(SphereContact, TwoSpheresAndHeldNodesEqualTheFullSparseSolve) {
   testing::CubeRig& rig = shared_rig();
   const ElasticBody& body = rig.body;
   for (int step_delay_nodes : {0, 150}) {
-    Simulation simulation(body, rig.model->obstacles, *rig.columns, rig.model->scene.tools, unlimited(step_delay_nodes));
-    Comparison comparison;
+    Simulation simulation(body, rig.model->obstacles, *rig.columns, rig.model->scene.tools, unlimited_options(ContactModel::sphere, step_delay_nodes));
+    SphereComparison comparison;
     for (int k = 0; k <= 12; ++k) {
       const std::vector<Eigen::Vector3d> tools = {mm(-22 + k, 4, 27 - 0.25 * std::min(k, 8)), mm(21, -6 + 0.5 * k, 26.5)};
       simulation.set_tool(0, tools[0]);
@@ -283,7 +274,7 @@ TEST(SphereContact, TwoSpheresAndHeldNodesEqualTheFullSparseSolve) {
 TEST(SphereContact, TheReferenceMeetsTheContactConditionsOnAnIndependentSolve) {
   testing::CubeRig& rig = shared_rig();
   const ElasticBody& body = rig.body;
-  const std::vector<PressedTool> tools = {{mm(-6, 2, 25), kRadius}};  // 7 passed nodes, 4 touching
+  const std::vector<PressedTool> tools = {{mm(-6, 2, 25), kSphereRadius}};  // 7 passed nodes, 4 touching
   const SphereContactSolution solution = sphere_reactions_reference(body, tools);
   ASSERT_GT(solution.contact_nodes().size(), 3u);
   // Apply the pushes as loads and solve the whole body once more, with no constraint.

@@ -11,11 +11,12 @@
 #include "common/util/error.h"
 #include "lab/tradeoff.h"
 #include "support/cube_scene.h"
+#include "support/measures.h"
 
 namespace cohaptic {
 namespace {
 
-Eigen::Vector3d mm(double x, double y, double z) { return Eigen::Vector3d(x, y, z) * 1e-3; }
+using testing::mm;
 
 Scene two_user_cube(int divisions) {
   testing::CubeSceneOptions options;

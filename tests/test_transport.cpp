@@ -43,7 +43,7 @@ using asio::ip::udp;
 using namespace std::chrono_literals;
 using Bytes = std::vector<std::uint8_t>;
 
-constexpr std::uint64_t kSession = 0x7e57'0001;
+constexpr std::uint64_t kTransportSession = 0x7e57'0001;
 
 // ---- the write queue's policy ----
 
@@ -180,7 +180,7 @@ TEST(FramedConnection, CarriesSealedFramesInOrderBothWaysAndClosesOnABadTag) {
   };
   auto server = FramedConnection::start(std::move(pair.server), reader_with(key), handlers(at_server, "server"));
   auto client = FramedConnection::start(std::move(pair.client), reader_with(key), handlers(at_client, "client"));
-  wire::FrameSealer server_sealer(key, kSession, 0), client_sealer(key, kSession, 1);
+  wire::FrameSealer server_sealer(key, kTransportSession, 0), client_sealer(key, kTransportSession, 1);
   for (int i = 0; i < 100; ++i) {
     wire::Control to_client = event("count", std::to_string(i)), to_server = event("count", std::to_string(-i));
     server->send(server_sealer.seal(to_client), FrameKind::must_arrive);
@@ -214,7 +214,7 @@ TEST(FramedConnection, AgainstAPeerThatStopsReadingItStaysBoundedAndTheFramesTha
   handlers.on_close = [&](CloseCause, const std::string&) { sender_closed = true; };
   pair.server.set_option(asio::socket_base::send_buffer_size(64 * 1024));
   auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers));
-  wire::FrameSealer sealer(key, kSession, 0);
+  wire::FrameSealer sealer(key, kTransportSession, 0);
   // 200 frames of 100 kB, every 20th a must-arrive event, the rest newest-wins "IRs".
   const std::string payload(100'000, 'p');
   constexpr int kFrames = 200;
@@ -265,7 +265,7 @@ TEST(FramedConnection, ClosesWhenFramesThatMustArrivePileUpUnread) {
   handlers.on_control = [](const wire::Control&) {};
   handlers.on_close = [&](CloseCause c, const std::string&) { cause = c; };
   auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers));
-  wire::FrameSealer sealer(key, kSession, 0);
+  wire::FrameSealer sealer(key, kTransportSession, 0);
   const std::string payload(100'000, 'e');
   int sent = 0;
   for (; sent < 1000 && !sender->closed(); ++sent) {
@@ -295,7 +295,7 @@ TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWin
   };
   constexpr auto kTimeout = 300ms;
   auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers), kTimeout);
-  wire::FrameSealer sealer(key, kSession, 0);
+  wire::FrameSealer sealer(key, kTransportSession, 0);
   const std::string payload(100'000, 'i');
   const auto started = std::chrono::steady_clock::now();
   // Newest-wins frames only, which the queue may always drop: without the timeout it would never close.
@@ -317,8 +317,8 @@ TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWin
 TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) {
   const wire::TrafficKey key = test_key();
   asio::io_context io;
-  wire::DatagramSealer user(key, kSession, 1), stranger(key, kSession, 2);
-  auto inspector = std::make_unique<wire::DatagramInspector>(kSession);
+  wire::DatagramSealer user(key, kTransportSession, 1), stranger(key, kTransportSession, 2);
+  auto inspector = std::make_unique<wire::DatagramInspector>(kTransportSession);
   inspector->allow_sender(1, key, user.salt());
   DatagramEndpoint endpoint(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0), std::move(inspector));
   std::vector<std::pair<double, udp::endpoint>> received;
@@ -421,8 +421,8 @@ TEST(SourceRateLimiter, FollowsATokenBucketPerAddressOnADrivenClock) {
 TEST(DatagramEndpoint, AFloodingSourceIsRateLimitedAndAnAdmittedPeerOnItsAddressLosesNothing) {
   const wire::TrafficKey key = test_key();
   asio::io_context io;
-  wire::DatagramSealer user(key, kSession, 1);
-  auto inspector = std::make_unique<wire::DatagramInspector>(kSession);
+  wire::DatagramSealer user(key, kTransportSession, 1);
+  auto inspector = std::make_unique<wire::DatagramInspector>(kTransportSession);
   inspector->allow_sender(1, key, user.salt());
   const RateLimit limit{.burst = 64, .refill_per_s = 16, .max_sources = 256};
   DatagramEndpoint endpoint(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0), std::move(inspector), limit);
