@@ -43,12 +43,16 @@ HapticClock HapticClock::monotonic() {
   return {[](void*) { return monotonic_now(); }, [](void*, std::int64_t deadline_ns) { sleep_until_monotonic(deadline_ns); }, nullptr};
 }
 
+bool lock_process_memory() {
+  static const bool locked = mlockall(MCL_CURRENT | MCL_FUTURE) == 0;  // once, thread-safe
+  return locked;
+}
+
 bool enter_realtime(int priority) {
   sched_param param{};
   param.sched_priority = priority;
   const bool fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
-  const bool locked = mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
-  return fifo && locked;
+  return fifo && lock_process_memory();
 }
 
 HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings, HapticClock clock)

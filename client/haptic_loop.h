@@ -190,8 +190,16 @@ class HapticLoop {
 /// periods were missed (0 if on time). Shared by the haptic loop and its timer floors.
 std::uint64_t skip_missed_deadlines(std::int64_t& deadline, std::int64_t woke, std::int64_t period);
 
-/// Tries SCHED_FIFO (priority `priority`) and mlockall for the calling thread; returns
-/// whether both took effect. Never throws.
+/// Locks the process's memory (mlockall, MCL_CURRENT | MCL_FUTURE) once: later calls return
+/// the first call's result without locking again (every mapping made since is locked by
+/// MCL_FUTURE). Locking populates the whole address space, 10 to 300 ms of kernel work; a
+/// real-time thread doing it would hold its CPU that long, stalling the timer floor there,
+/// so cohaptic-client calls this on its main thread before any real-time thread starts.
+/// Never throws.
+bool lock_process_memory();
+
+/// Tries SCHED_FIFO (priority `priority`) for the calling thread and lock_process_memory();
+/// returns whether both took effect. Never throws.
 bool enter_realtime(int priority);
 
 }  // namespace cohaptic

@@ -95,6 +95,8 @@ int main(int argc, char** argv) {
     cohaptic::HapticLoop loop(*device, *channels, settings);
     cohaptic::TimerFloors floors;  // one bare timer on each CPU the haptic thread may run on
     network.report_status(loop.metrics(), floors);
+    // Before any real-time thread: one that locked the memory would stall a floor meanwhile.
+    if (settings.realtime) cohaptic::lock_process_memory();
     floors.start(settings.rate_hz, settings.realtime);
     std::thread haptic_thread([&] { loop.run(network.stop_requested()); });
     haptic_thread.join();
