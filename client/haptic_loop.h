@@ -192,9 +192,10 @@ std::uint64_t skip_missed_deadlines(std::int64_t& deadline, std::int64_t woke, s
 
 /// Locks the process's memory (mlockall, MCL_CURRENT | MCL_FUTURE) once: later calls return
 /// the first call's result without locking again (every mapping made since is locked by
-/// MCL_FUTURE). Locking populates the whole address space, 10 to 300 ms of kernel work; a
-/// real-time thread doing it would hold its CPU that long, stalling the timer floor there,
-/// so cohaptic-client calls this on its main thread before any real-time thread starts.
+/// MCL_FUTURE). Locking populates the whole address space, up to hundreds of ms of kernel
+/// work (116 ms for a 200 MB process on a 2-core VM); a real-time thread doing it would hold
+/// its CPU that long, stalling the timer floor there, so cohaptic-client calls this on its
+/// main thread before any real-time thread starts.
 /// Never throws.
 bool lock_process_memory();
 
