@@ -85,7 +85,7 @@ struct ClientNetwork::Impl {
   asio::steady_timer drain_timer{io};
   asio::steady_timer status_timer{io};
   const HapticMetrics* haptic_metrics = nullptr;  // from report_status() on
-  const Histogram* floor_period = nullptr;
+  const TimerFloors* floors = nullptr;
   asio::signal_set signals{io, SIGINT, SIGTERM};
   std::thread thread;
 
@@ -265,7 +265,7 @@ struct ClientNetwork::Impl {
     channels.progress.update();
     wire::Control control;
     *control.mutable_status() =
-        client_status(channels.progress.front(), *haptic_metrics, *floor_period, clock.one_way_delay());
+        client_status(channels.progress.front(), *haptic_metrics, floors->period_p99_us(), clock.one_way_delay());
     connection.send(control);
   }
 
@@ -329,11 +329,11 @@ void ClientNetwork::record_session(const std::filesystem::path& file, const std:
   spdlog::info("recording to {}", file.string());
 }
 
-void ClientNetwork::report_status(const HapticMetrics& metrics, const Histogram& floor_period_ns) {
+void ClientNetwork::report_status(const HapticMetrics& metrics, const TimerFloors& floors) {
   Impl& s = *impl_;
-  asio::post(s.io, [&s, &metrics, &floor_period_ns] {
+  asio::post(s.io, [&s, &metrics, &floors] {
     s.haptic_metrics = &metrics;
-    s.floor_period = &floor_period_ns;
+    s.floors = &floors;
     s.schedule_status();
   });
 }

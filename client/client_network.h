@@ -26,6 +26,7 @@
 #include <string>
 
 #include "client/haptic_loop.h"
+#include "client/timer_floors.h"
 #include "client/welcome.h"
 
 namespace cohaptic {
@@ -56,9 +57,9 @@ class ClientNetwork {
   /// Throws Error if the file cannot be created.
   void record_session(const std::filesystem::path& file, const std::string& device, double force_limit);
   /// Reports the haptic loop's figures to the server from now on (status reports):
-  /// `metrics` are the loop's, `floor_period_ns` the timer floor's; both must outlive
-  /// stop(). The progress comes through the channels' `progress` buffer.
-  void report_status(const HapticMetrics& metrics, const Histogram& floor_period_ns);
+  /// `metrics` are the loop's, `floors` its timer floors; both must outlive stop(). The
+  /// progress comes through the channels' `progress` buffer.
+  void report_status(const HapticMetrics& metrics, const TimerFloors& floors);
   /// Stops the I/O thread (after a last drain of the haptic thread's rings, the UDP
   /// socket closed and a final status sent: call it after the haptic loop has ended, and
   /// that status carries the report's figures).

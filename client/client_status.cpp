@@ -3,7 +3,7 @@
 namespace cohaptic {
 
 wire::ClientStatus client_status(const HapticProgress& progress, const HapticMetrics& metrics,
-                                 const Histogram& floor_period_ns, const Histogram& one_way_delay_ns) {
+                                 double timer_floor_p99_us, const Histogram& one_way_delay_ns) {
   const auto quantile = [](const Histogram& h, double scale) { return static_cast<double>(h.quantile(0.99)) * scale; };
   wire::ClientStatus status;
   status.set_haptic_rate_hz(progress.elapsed_s > 0 ? static_cast<double>(progress.ticks) / progress.elapsed_s : 0.0);
@@ -11,7 +11,7 @@ wire::ClientStatus client_status(const HapticProgress& progress, const HapticMet
   status.set_missed_deadlines(progress.missed_deadlines);
   status.set_ir_age_p99_ms(quantile(metrics.ir_age_ns, 1e-6));
   status.set_one_way_delay_p99_ms(quantile(one_way_delay_ns, 1e-6));
-  status.set_timer_floor_p99_us(quantile(floor_period_ns, 1e-3));
+  status.set_timer_floor_p99_us(timer_floor_p99_us);
   status.set_peak_force(progress.peak_force);
   status.set_ticks(progress.ticks);
   status.set_elapsed_s(progress.elapsed_s);

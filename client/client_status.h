@@ -13,9 +13,9 @@ namespace cohaptic {
 /// How often a status is sent (and once more, final, before the client's goodbye).
 inline constexpr std::int64_t kStatusPeriod_ms = 200;
 
-/// The figures from the haptic loop's progress and histograms, the timer floor's period
-/// histogram and the one-way delays the clock measured.
+/// The figures from the haptic loop's progress and histograms, the timer floors' period
+/// p99 (the worst CPU's, TimerFloors::period_p99_us) and the one-way delays the clock measured.
 wire::ClientStatus client_status(const HapticProgress& progress, const HapticMetrics& metrics,
-                                 const Histogram& floor_period_ns, const Histogram& one_way_delay_ns);
+                                 double timer_floor_p99_us, const Histogram& one_way_delay_ns);
 
 }  // namespace cohaptic

@@ -25,15 +25,14 @@ void sleep_until_monotonic(std::int64_t deadline_ns) {
   }
 }
 
-// Advances `deadline` past `woke`, returning how many whole periods were missed.
-std::uint64_t skip_missed(std::int64_t& deadline, std::int64_t woke, std::int64_t period) {
+}  // namespace
+
+std::uint64_t skip_missed_deadlines(std::int64_t& deadline, std::int64_t woke, std::int64_t period) {
   if (woke < deadline + period) return 0;
   const auto missed = static_cast<std::uint64_t>((woke - deadline) / period);
   deadline += static_cast<std::int64_t>(missed) * period;
   return missed;
 }
-
-}  // namespace
 
 IrSlot make_ir_slot(std::unique_ptr<const PreparedIR> ir, std::int64_t arrival_ns) {
   auto state = std::make_unique<EvaluationState>(make_evaluation_state(*ir));
@@ -44,27 +43,16 @@ HapticClock HapticClock::monotonic() {
   return {[](void*) { return monotonic_now(); }, [](void*, std::int64_t deadline_ns) { sleep_until_monotonic(deadline_ns); }, nullptr};
 }
 
+bool lock_process_memory() {
+  static const bool locked = mlockall(MCL_CURRENT | MCL_FUTURE) == 0;  // once, thread-safe
+  return locked;
+}
+
 bool enter_realtime(int priority) {
   sched_param param{};
   param.sched_priority = priority;
   const bool fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
-  const bool locked = mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
-  return fifo && locked;
-}
-
-void TimerFloor::run(double rate_hz, const std::atomic<bool>& stop, bool realtime) {
-  if (realtime) enter_realtime(79);
-  const auto period = static_cast<std::int64_t>(1e9 / rate_hz);
-  std::int64_t deadline = monotonic_now() + period;
-  std::int64_t last = 0;
-  while (!stop.load(std::memory_order_relaxed)) {
-    sleep_until_monotonic(deadline);
-    const std::int64_t woke = monotonic_now();
-    if (last) period_ns.record(woke - last);
-    last = woke;
-    missed_deadlines += skip_missed(deadline, woke, period);
-    deadline += period;
-  }
+  return fifo && lock_process_memory();
 }
 
 HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings, HapticClock clock)
@@ -164,7 +152,7 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     const std::int64_t woke = now();
     if (last_woke) metrics_.period_ns.record(woke - last_woke);
     last_woke = woke;
-    metrics_.missed_deadlines += skip_missed(deadline, woke, period);
+    metrics_.missed_deadlines += skip_missed_deadlines(deadline, woke, period);
     deadline += period;
     const double time_s = static_cast<double>(woke - start) * 1e-9;
     if ((settings_.duration_s > 0 && time_s >= settings_.duration_s) || device_.finished(time_s)) break;

@@ -185,16 +185,22 @@ class HapticLoop {
   HapticClock clock_;
 };
 
-/// A loop that does nothing but sleep to absolute deadlines at `rate_hz`: the timer floor
-/// the haptic loop is judged against, measured at the same time on the same machine.
-struct TimerFloor {
-  Histogram period_ns{1000, 50000};
-  std::uint64_t missed_deadlines = 0;
-  void run(double rate_hz, const std::atomic<bool>& stop, bool realtime);
-};
+/// A loop that woke at `woke` for `deadline` (ns) and finds the next deadline passed too:
+/// moves `deadline` past the missed ones, keeping the phase, and returns how many whole
+/// periods were missed (0 if on time). Shared by the haptic loop and its timer floors.
+std::uint64_t skip_missed_deadlines(std::int64_t& deadline, std::int64_t woke, std::int64_t period);
 
-/// Tries SCHED_FIFO (priority `priority`) and mlockall for the calling thread; returns
-/// whether both took effect. Never throws.
+/// Locks the process's memory (mlockall, MCL_CURRENT | MCL_FUTURE) once: later calls return
+/// the first call's result without locking again (every mapping made since is locked by
+/// MCL_FUTURE). Locking populates the whole address space, up to hundreds of ms of kernel
+/// work (116 ms for a 200 MB process on a 2-core VM); a real-time thread doing it would hold
+/// its CPU that long, stalling the timer floor there, so cohaptic-client calls this on its
+/// main thread before any real-time thread starts.
+/// Never throws.
+bool lock_process_memory();
+
+/// Tries SCHED_FIFO (priority `priority`) for the calling thread and lock_process_memory();
+/// returns whether both took effect. Never throws.
 bool enter_realtime(int priority);
 
 }  // namespace cohaptic

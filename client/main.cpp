@@ -9,20 +9,11 @@
 #include "client/client_network.h"
 #include "client/device/make_device.h"
 #include "client/haptic_loop.h"
+#include "client/timer_floors.h"
 #include "common/net/host_port.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
 #include "common/util/log_to_stderr.h"
-
-namespace {
-
-nlohmann::json quantiles_us(const cohaptic::Histogram& h) {
-  return {{"p50", static_cast<double>(h.quantile(0.5)) * 1e-3},
-          {"p99", static_cast<double>(h.quantile(0.99)) * 1e-3},
-          {"max", static_cast<double>(h.max()) * 1e-3}};
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   cohaptic::log_to_stderr();
@@ -102,14 +93,14 @@ int main(int argc, char** argv) {
 
     if (!record_path.empty()) network.record_session(record_path, device->describe(), settings.force_limit);
     cohaptic::HapticLoop loop(*device, *channels, settings);
-    std::atomic<bool> floor_stop{false};
-    cohaptic::TimerFloor floor;
-    network.report_status(loop.metrics(), floor.period_ns);
-    std::thread floor_thread([&] { floor.run(settings.rate_hz, floor_stop, settings.realtime); });
+    cohaptic::TimerFloors floors;  // one bare timer on each CPU the haptic thread may run on
+    network.report_status(loop.metrics(), floors);
+    // Before any real-time thread: one that locked the memory would stall a floor meanwhile.
+    if (settings.realtime) cohaptic::lock_process_memory();
+    floors.start(settings.rate_hz, settings.realtime);
     std::thread haptic_thread([&] { loop.run(network.stop_requested()); });
     haptic_thread.join();
-    floor_stop = true;
-    floor_thread.join();
+    floors.stop();
     device->stop();
     network.stop();
 
@@ -122,9 +113,9 @@ int main(int argc, char** argv) {
     report["rate_setting_hz"] = settings.rate_hz;
     report["haptic_rate_hz"] = m.elapsed_s > 0 ? static_cast<double>(m.ticks) / m.elapsed_s : 0.0;
     report["ticks"] = m.ticks;
-    report["period_us"] = quantiles_us(m.period_ns);
+    report["period_us"] = cohaptic::quantiles_us(m.period_ns);
     report["missed_deadlines"] = m.missed_deadlines;
-    report["timer_floor"] = {{"period_us", quantiles_us(floor.period_ns)}, {"missed_deadlines", floor.missed_deadlines}};
+    report["timer_floor"] = floors.report();
     report["realtime"] = m.realtime;
     report["ir_age_ms"] = {{"p50", static_cast<double>(m.ir_age_ns.quantile(0.5)) * 1e-6},
                            {"p99", static_cast<double>(m.ir_age_ns.quantile(0.99)) * 1e-6}};

@@ -80,12 +80,20 @@ SessionVerdict summarize_session(const nlohmann::json& server, const std::vector
     // misses beyond the floor's are the loop's own.
     const double missed = number(c, {"missed_deadlines"});
     const double floor_missed = number(c, {"timer_floor", "missed_deadlines"});
+    // The timer floor is the worst of one per CPU; each also says how long the host held its
+    // CPU back (steal time, in a virtual machine), which names a stall the host made.
+    std::string steal;
+    if (c.contains("timer_floor") && c["timer_floor"].contains("cpus"))
+      for (const nlohmann::json& cpu : c["timer_floor"]["cpus"])
+        if (cpu.contains("host_steal_ms"))
+          steal += fmt::format("{}CPU {} {:.0f} ms", steal.empty() ? "; host steal time: " : ", ", cpu.value("cpu", -1),
+                               number(cpu, {"host_steal_ms"}));
     if (missed > 0.001 * ticks && missed - floor_missed > 0.001 * ticks)
-      problem(fmt::format("{}: {:.0f} missed deadlines ({:.2f} %), the bare timer floor {:.0f}", user, missed,
-                          100 * missed / ticks, floor_missed));
+      problem(fmt::format("{}: {:.0f} missed deadlines ({:.2f} %), the bare timer floor {:.0f}{}", user, missed,
+                          100 * missed / ticks, floor_missed, steal));
     else if (missed > 0)
-      verdict.notes.push_back(fmt::format("{}: {:.0f} missed deadlines (timer floor missed {:.0f})", user, missed,
-                                          number(c, {"timer_floor", "missed_deadlines"})));
+      verdict.notes.push_back(
+          fmt::format("{}: {:.0f} missed deadlines (timer floor missed {:.0f}{})", user, missed, floor_missed, steal));
     // A dynamic body's client does not measure the coupling (reports before that flag
     // always did).
     const bool coupling_measured = !c.contains("coupling_n") || c["coupling_n"].value("measured", true);

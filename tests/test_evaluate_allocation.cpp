@@ -3,15 +3,18 @@
 // body's force (every contact model, the sphere model's too, remote tools, held boundary
 // nodes), of a mass-spring body's sub-network integrated tick by tick with two tools
 // pressing it, and of the laparoscopy model's per-tick functions (home-spring tick, alone
-// and as the IR's body through evaluate_force, forceps step, display frames by both methods).
+// and as the IR's body through evaluate_force, forceps step, display frames by both methods),
+// and of the client's whole haptic loop while new mass-spring IRs of different sizes arrive.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdlib>
+#include <iostream>
 #include <limits>
 
+#include "client/haptic_loop.h"
 #include "common/laparoscopy/extract_home_spring_patch.h"
 #include "common/laparoscopy/forceps_jaws.h"
 #include "common/laparoscopy/home_spring_contact.h"
@@ -120,6 +123,101 @@ TEST(ForceEvaluator, MassSpringSubNetworkAllocatesNothing) {
   EXPECT_EQ(allocations.load(), 0) << "evaluate_force allocated on a mass-spring body";
   EXPECT_TRUE(finite);
   EXPECT_GT(largest, 0) << "the tool pressed";
+}
+
+// A device at scripted positions, read without allocating.
+class PathDevice final : public HapticDevice {
+ public:
+  explicit PathDevice(std::vector<Eigen::Vector3d> path) : path_(std::move(path)) {}
+  std::string describe() const override { return "path"; }
+  DeviceState read(double) override {
+    DeviceState state;
+    state.position = path_[std::min(next_++, path_.size() - 1)];
+    return state;
+  }
+  void write_force(const Eigen::Vector3d&, double) override {}
+  double force_limit() const override { return 3.3; }
+
+ private:
+  std::vector<Eigen::Vector3d> path_;
+  std::size_t next_ = 0;
+};
+
+// The client's haptic loop ticking on a driven clock (every tick on the 1 ms grid) while the
+// noodle's IRs arrive as the I/O thread hands them over: a tool pressing the tube slides from
+// its end towards its middle, so each IR's sub-network grows (sections cut off by the end
+// come into it) and then keeps its size. Every tick (device, rings, the IR switch, the
+// evaluation on the new IR's fresh state, the trace, the progress) allocates nothing: a new
+// or bigger sub-network costs the haptic thread no allocation. The IRs are made and handed
+// over between ticks, outside the count, as the I/O thread does them.
+TEST(HapticLoop, TicksAllocateNothingWhileMassSpringIrsOfGrowingSubNetworksArrive) {
+  const Model model = build_model(load_scene(testing::source_path("scenes/thin/noodle.yaml")));
+  const MassSpringModel& body = std::get<MassSpringModel>(model.bodies.front());
+  MassSpringSimulation simulation(body, 0, model.scene.tools, model.scene.haptic.force_limit_n, 0.001);
+  std::vector<Eigen::Vector3d> path;
+  std::vector<IrSlot> slots;  // one every 10 ticks
+  std::vector<int> node_counts;
+  for (int i = 0; i < 600; ++i) {  // 0.6 s: from 2 mm to 26 mm along the tube, 1.5 mm into its top
+    const Eigen::Vector3d tool(0.002 + 0.04 * i * 1e-3, 0, 0.0092 - 0.0015 * std::min(1.0, i / 100.0));
+    path.push_back(tool);
+    simulation.set_tool(0, tool);
+    simulation.step(1e-3 * i);
+    if (i % 10 == 0 && simulation.ir(0)) {
+      slots.push_back(make_ir_slot(std::make_unique<const PreparedIR>(*simulation.ir(0)), 0));
+      node_counts.push_back(std::get<MassSpringIr>(simulation.ir(0)->ir.body).node_count());
+    }
+  }
+  ASSERT_GE(slots.size(), 50u);
+  ASSERT_LT(*std::min_element(node_counts.begin(), node_counts.end()),
+            *std::max_element(node_counts.begin(), node_counts.end()))
+      << "the sub-network grows as the tool leaves the tube's end";
+
+  struct Driven {
+    std::int64_t now = 1'000'000'000;
+    std::int64_t ticks = 0;
+    HapticChannels* channels = nullptr;
+    std::vector<IrSlot>* slots = nullptr;
+    std::size_t next = 0;
+  } driven;
+  auto channels = std::make_unique<HapticChannels>();
+  channels->tracing = true;
+  driven.channels = channels.get();
+  driven.slots = &slots;
+  const HapticClock clock{
+      [](void* c) { return static_cast<Driven*>(c)->now; },
+      [](void* c, std::int64_t deadline) {
+        auto& d = *static_cast<Driven*>(c);
+        counting = false;  // the I/O thread's part: hand over the next IR, drain the rings
+        if (d.ticks++ % 10 == 0 && d.next < d.slots->size()) {
+          (*d.slots)[d.next].arrival_ns = deadline;  // fresh: no fading
+          d.channels->ir.back() = std::move((*d.slots)[d.next++]);
+          d.channels->ir.publish();
+        }
+        while (d.channels->trace.pop()) {
+        }
+        while (d.channels->own_samples.pop()) {
+        }
+        while (d.channels->events.pop()) {
+        }
+        d.now = deadline;
+        counting = true;
+      },
+      &driven};
+  PathDevice device(path);
+  HapticLoopSettings settings;
+  settings.duration_s = 0.59;
+  settings.realtime = false;
+  HapticLoop loop(device, *channels, settings, clock);
+  REQUIRE_COUNTED_MALLOC();
+  allocations = 0;
+  loop.run(std::atomic<bool>{false});
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0) << "a haptic tick allocated";
+  EXPECT_GE(loop.metrics().ir_switches, slots.size() - 1);
+  EXPECT_EQ(loop.metrics().non_finite, 0u);
+  EXPECT_GT(loop.metrics().peak_force, 0) << "the tool pressed";
+  std::cout << "sub-network nodes from " << node_counts.front() << " to " << node_counts.back() << ", " << slots.size()
+            << " IRs, " << loop.metrics().ir_switches << " switches, peak force " << loop.metrics().peak_force << " N\n";
 }
 
 TEST(LaparoscopyHapticPath, AllocatesNothing) {

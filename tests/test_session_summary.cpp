@@ -60,6 +60,24 @@ TEST(SessionSummary, MissedDeadlinesAreTheLoopsOnlyBeyondWhatTheBareTimerMissed)
   EXPECT_TRUE(mentions(verdict.problems, "a: 60 missed deadlines"));
 }
 
+// A client's floors, one per CPU, as cohaptic-client reports them (client/timer_floors.h): the
+// host held CPU 1 back for 100 ms, and that CPU's floor missed what the loop did.
+TEST(SessionSummary, MissedDeadlinesNameTheHostsStealTimePerCpu) {
+  nlohmann::json stalled = healthy_client("a");
+  stalled["missed_deadlines"] = 99;
+  stalled["timer_floor"]["missed_deadlines"] = 100;
+  stalled["timer_floor"]["cpus"] = {{{"cpu", 0}, {"missed_deadlines", 0}, {"host_steal_ms", 0.0}},
+                                    {{"cpu", 1}, {"missed_deadlines", 100}, {"host_steal_ms", 100.0}}};
+  SessionVerdict verdict = summarize_session(healthy_server(), {stalled, healthy_client("b")});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
+  EXPECT_TRUE(mentions(verdict.notes, "a: 99 missed deadlines (timer floor missed 100; host steal time: CPU 0 0 ms, CPU 1 100 ms)"))
+      << verdict.report["notes"].dump();
+  stalled["timer_floor"]["missed_deadlines"] = 0;  // no floor saw it: the loop's own
+  verdict = summarize_session(healthy_server(), {stalled, healthy_client("b")});
+  EXPECT_TRUE(mentions(verdict.problems, "the bare timer floor 0; host steal time: CPU 0 0 ms, CPU 1 100 ms"))
+      << verdict.report["problems"].dump();
+}
+
 TEST(SessionSummary, SlowPeriodIsAProblemUnlessTheTimerFloorIsAsSlow) {
   nlohmann::json slow = healthy_client("a");
   slow["period_us"]["p99"] = 1300.0;
