@@ -23,4 +23,16 @@ void evaluate_linear_backing(const LinearBacking& backing, const Eigen::Ref<cons
   force.noalias() -= backing.stiffness * displacement;
 }
 
+NodeBacking node_backing(const LinearBacking& backing, std::span<const PolygonCollision> collisions,
+                         const Eigen::Ref<const Eigen::Matrix3Xd>& active_rest_positions) {
+  const Eigen::Index size = backing.contact_displacement.size();
+  NodeBacking nodes{backing.nodes, backing.stiffness, backing.contact_displacement, Eigen::VectorXd::Zero(size),
+                    Eigen::VectorXd(size)};
+  for (std::size_t k = 0; k < backing.nodes.size(); ++k) {
+    nodes.targets.segment<3>(3 * static_cast<Eigen::Index>(k)) += active_rest_positions.col(backing.nodes[k]);
+    nodes.normals.segment<3>(3 * static_cast<Eigen::Index>(k)) = collisions[k].normal;
+  }
+  return nodes;
+}
+
 }  // namespace cohaptic

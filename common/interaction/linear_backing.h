@@ -19,6 +19,7 @@
 
 #include "common/fem/compliance.h"
 #include "common/interaction/forcible_displacement.h"
+#include "common/mass_spring/node_backing.h"
 
 namespace cohaptic {
 
@@ -39,5 +40,10 @@ LinearBacking build_linear_backing(std::span<const PolygonCollision> collisions,
 /// 3|nodes|.
 void evaluate_linear_backing(const LinearBacking& backing, const Eigen::Ref<const Eigen::VectorXd>& displacement,
                              Eigen::Ref<Eigen::VectorXd> force) noexcept;
+
+/// The same backing in the front body's positions (node_backing.h): x* = X + u*, no offset,
+/// each node's normal from `collisions` (those it was built from, in the same order).
+NodeBacking node_backing(const LinearBacking& backing, std::span<const PolygonCollision> collisions,
+                         const Eigen::Ref<const Eigen::Matrix3Xd>& active_rest_positions);
 
 }  // namespace cohaptic
