@@ -5,6 +5,7 @@
 //   keygen     a new session key file, or a participant key file
 //   hertz      a sphere in a block, against Hertz
 //   objects-push  the several-objects pushing test: back free, fixed, on an elastic box
+//   ir-bytes   a client's IR bytes, and what f32, M~ deltas or compliance rows would send
 // Each tool adds its own subcommand (lab/lab_command.h). A tool that needs the server or the
 // client (study) starts them as processes; cohaptic-lab links neither.
 #include <CLI/CLI.hpp>
@@ -16,6 +17,7 @@
 #include "common/util/error.h"
 #include "common/util/log_to_stderr.h"
 #include "lab/hertz.h"
+#include "lab/ir_bytes.h"
 #include "lab/keygen.h"
 #include "lab/objects_push.h"
 #include "lab/probe.h"
@@ -38,7 +40,8 @@ int main(int argc, char** argv) {
   const std::vector<cohaptic::LabCommand> commands = {
       cohaptic::add_probe_command(app),     cohaptic::add_replay_command(app),    cohaptic::add_study_command(app),
       cohaptic::add_tradeoff_command(app),  cohaptic::add_stability_command(app), cohaptic::add_summarize_command(app),
-      cohaptic::add_keygen_command(app),    cohaptic::add_hertz_command(app),    cohaptic::add_objects_push_command(app)};
+      cohaptic::add_keygen_command(app),    cohaptic::add_hertz_command(app),    cohaptic::add_objects_push_command(app),
+      cohaptic::add_ir_bytes_command(app)};
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));

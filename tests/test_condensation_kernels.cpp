@@ -8,16 +8,14 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
-#include <limits>
 #include <vector>
 
 #include "common/condense/dense_kernels.h"
 #include "common/util/error.h"
+#include "common/util/not_a_number.h"
 
 namespace cohaptic {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // A well-conditioned lower Cholesky factor of size n, at offset (2, 3) of a buffer whose
 // every other entry, the strictly upper triangle included, is NaN.

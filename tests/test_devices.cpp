@@ -27,6 +27,7 @@
 #include "common/haptics/scripted_device.h"
 #include "common/haptics/trajectory.h"
 #include "common/util/error.h"
+#include "support/sanitizer_owns_malloc.h"
 #include "support/wait.h"
 
 // Counting operator new, for the "no allocation in the haptic thread" checks. Weak, so that
@@ -37,6 +38,7 @@ std::atomic<bool> g_count_new{false};
 std::atomic<long> g_new_calls{0};
 }  // namespace
 
+#ifndef COHAPTIC_SANITIZER_OWNS_MALLOC
 __attribute__((weak)) void* operator new(std::size_t size) {
   if (g_count_new.load(std::memory_order_relaxed)) g_new_calls.fetch_add(1, std::memory_order_relaxed);
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
@@ -47,6 +49,7 @@ __attribute__((weak)) void* operator new[](std::size_t size) {
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
+#endif
 
 namespace cohaptic {
 namespace {

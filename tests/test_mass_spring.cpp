@@ -338,6 +338,31 @@ TEST(MassSpringFriction, StaysBelowTheStaticThresholdAndAcceleratesByTheDynamicL
   }
 }
 
+// Coulomb's law on one node pressed onto the plane by F_n = m g: sliding, it feels mu_d F_n
+// against its motion until mu_d F_n can stop it within the step; at rest, a pull below
+// mu_s F_n is cancelled and one above it is met by mu_s F_n.
+TEST(MassSpringFriction, ASlidingNodeFeelsTheDynamicLawUntilItCanStopAndANodeAtRestTheStaticOne) {
+  const SupportPlane plane{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.2};
+  const double m = 2e-4, h = 1e-3, load = m * kG;
+  const Eigen::Vector3d x = Eigen::Vector3d::Zero(), weight(0, 0, -load);
+  bool sliding = false;
+  // Sliding at a speed that mu_s F_n could stop within the step but mu_d F_n cannot.
+  const double speed = 0.35 * load * h / m;
+  const Eigen::Vector3d slow = plane_reaction(plane, x, Eigen::Vector3d(speed, 0, 0), weight, m, h, sliding);
+  EXPECT_TRUE(sliding);
+  EXPECT_NEAR(slow.x(), -0.2 * load, 1e-15);
+  EXPECT_NEAR(slow.z(), load, 1e-15);
+  // Slow enough for mu_d F_n to stop: stopped exactly.
+  const Eigen::Vector3d stopped = plane_reaction(plane, x, Eigen::Vector3d(0.1 * load * h / m, 0, 0), weight, m, h, sliding);
+  EXPECT_FALSE(sliding);
+  EXPECT_NEAR(stopped.x(), -0.1 * load, 1e-15);
+  // At rest, pulled by 0.35 F_n: held; by 0.6 F_n: mu_s F_n against the pull.
+  const Eigen::Vector3d held = plane_reaction(plane, x, Eigen::Vector3d::Zero(), weight + Eigen::Vector3d(0.35 * load, 0, 0), m, h, sliding);
+  EXPECT_NEAR(held.x(), -0.35 * load, 1e-15);
+  const Eigen::Vector3d broke = plane_reaction(plane, x, Eigen::Vector3d::Zero(), weight + Eigen::Vector3d(0.6 * load, 0, 0), m, h, sliding);
+  EXPECT_NEAR(broke.x(), -0.5 * load, 1e-15);
+}
+
 TEST(MassSpringFriction, SlidingTubeStopsAfterVSquaredOverTwoMuG) {
   const MassSpringNetwork network = rigid_tube_on_plane(8, Eigen::Vector3d(0, 0, -kG));
   MassSpringState state = make_state(network);
@@ -487,6 +512,56 @@ TEST(MassSpringStatics, BentTubeKeepsItsVolumeWithinTwoPercent) {
   const double ratio = enclosed_volume(network, state.positions) / rest_volume;
   EXPECT_NEAR(ratio, 1, 0.02);
   std::printf("bent tube: middle %.2f mm off, volume ratio %.4f\n", 1000 * (middle - left), ratio);
+}
+
+// The volume of a tube bent by a tool. A 2 mm sphere pushes the middle of a resting tube
+// (20 sections) sideways along the plane, 12 mm at 10 mm/s, and holds; the plane's friction
+// holds the rest back, so the tube bends around the tool (the driven node follows the tool,
+// tool_coupling.h). The tube is 10 times stiffer than the paper's and its springs damped at
+// alpha = 1e-4 s: the paper's E = 737 Pa tube, flattened to half its height by its own
+// weight, is crushed by the tool (its volume falls to about a quarter), and at alpha = 1e-6 s
+// (damping ratio alpha omega / 2 below 0.003) the tool's blows make the tube vibrate
+// (README, "Open").
+TEST(MassSpringStatics, TubeBentByAToolKeepsItsVolumeWithinTwoPercent) {
+  const int sections = 20;
+  MassSpringNetwork network = tube_network(straight_tube(sections), {10 * kYoungsModulus, 9049, 1e-4});
+  network.parameters.gravity = Eigen::Vector3d(0, 0, -kG);
+  network.parameters.node_damping = 0.007;
+  network.parameters.plane = SupportPlane{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.2};
+  network.parameters.tool_friction = 0.3;
+  network.parameters.time_step = 0.5 * critical_time_step(network);
+  MassSpringState state = make_state(network);
+  run(network, state, 0.3);
+  const double rest_volume = enclosed_volume(network, state.positions);
+  const int middle = centre(sections / 2);
+  const double radius = 0.002, speed = 0.01, period = 1e-3;
+  const double side = state.positions.row(1).minCoeff();
+  const Eigen::Vector3d start(state.positions(0, middle), side - radius - 0.0005, 0.002);
+  const Eigen::VectorXd start_y = state.positions.row(1).transpose();
+  std::array<ToolPress, 1> press;
+  std::array<NetworkToolReaction, 1> reaction;
+  double largest = 0, lowest = 1;
+  int in_contact = 0;
+  for (int i = 1; i <= 1700; ++i) {
+    const std::array<ToolOnNetwork, 1> tool{
+        ToolOnNetwork{start + Eigen::Vector3d(0, speed * std::min(i, 1200) * period, 0), radius}};
+    advance_with_tools(network, state, tool, press, reaction, period);
+    ASSERT_TRUE(reaction[0].force.allFinite()) << "period " << i;
+    largest = std::max(largest, reaction[0].force.norm());
+    lowest = std::min(lowest, state.positions.row(2).minCoeff());
+    in_contact += reaction[0].colliding;
+  }
+  const auto moved = [&](int node) { return state.positions(1, node) - start_y[node]; };
+  const double middle_moved = moved(middle), ends_moved = 0.5 * (moved(centre(0)) + moved(centre(sections - 1)));
+  const double ratio = enclosed_volume(network, state.positions) / rest_volume;
+  std::printf("bent by a tool: middle moved %.2f mm, ends %.2f mm, largest force %.3f N, volume ratio %.4f, "
+              "%d periods in contact\n",
+              1e3 * middle_moved, 1e3 * ends_moved, largest, ratio, in_contact);
+  EXPECT_GT(middle_moved, 0.009) << "the tool pushed the tube, it did not sink through it";
+  EXPECT_LT(ends_moved, middle_moved - 0.001) << "the tube bent";
+  EXPECT_GE(lowest, 0.0);
+  EXPECT_LT(largest, 1.0);
+  EXPECT_NEAR(ratio, 1, 0.02);
 }
 
 }  // namespace

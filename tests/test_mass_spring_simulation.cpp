@@ -11,9 +11,12 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <span>
+#include <vector>
 
 #include "common/ir/build_mass_spring_ir.h"
 #include "common/mass_spring/integrate_network.h"
+#include "common/mass_spring/internal_forces.h"
 #include "common/mass_spring/plane_friction.h"
 #include "common/mass_spring/stable_time_step.h"
 #include "common/mass_spring/tube_network.h"
@@ -324,6 +327,118 @@ TEST(MassSpringSimulation, NoodleSceneDroppedAndSlidFollowsTheRigidClosedForms) 
   EXPECT_LT(rigid.landed_speed, 1e-3);
   EXPECT_NEAR(rigid.slide, rigid.expected_slide, 0.03 * rigid.expected_slide);
   EXPECT_LT(rigid.speed_after, 1e-3);
+}
+
+// A scripted tool driven through the server's simulation of `body` (the scene's tools, one
+// user): from `start` at `velocity` [m/s] for `seconds`, 1 ms periods. The whole network's
+// reaction on the tool each period.
+std::vector<Eigen::Vector3d> move_tool(MassSpringSimulation& simulation, double& time, const Eigen::Vector3d& start,
+                                       const Eigen::Vector3d& velocity, double seconds) {
+  std::vector<Eigen::Vector3d> forces;
+  const int periods = static_cast<int>(std::round(seconds / 1e-3));
+  for (int i = 1; i <= periods; ++i) {
+    simulation.set_tool(0, start + velocity * (i * 1e-3));
+    time += 1e-3;
+    simulation.step(time);
+    forces.push_back(simulation.reaction(0).force);
+  }
+  return forces;
+}
+
+Eigen::Vector3d mean_of(std::span<const Eigen::Vector3d> forces) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& f : forces) sum += f;
+  return sum / static_cast<double>(forces.size());
+}
+
+// A tool pushing a resting tube along its plane at constant speed v, against the steady
+// sliding of a rigid body: every node moves at v, so the plane's dynamic friction is
+// mu_d (M g - L) (L the tool's lift on the body, the weight of the nodes it holds and the
+// vertical part of its push) and the nodal damping adds beta N v; the tool must supply
+// their sum. The scene's noodle with its springs 100 times stiffer (E = 737 Pa would let
+// the tube's own friction, 0.11 N, compress it by more than its length: E A = 0.058 N) and
+// damped at alpha = 1e-4 s, the scene's 2 mm sphere against the left end cap, 20 mm/s, mean
+// over the last second of 1.5 s. (At the scene's alpha = 1e-6 s, a damping ratio
+// alpha omega / 2 below 0.003 for every mode, the tool's blows make the tube vibrate, its
+// bottom nodes' friction cancels on average, and the tool feels a third of this: README,
+// "Open".)
+TEST(MassSpringSimulation, ToolPushingTheTubeAlongThePlaneFeelsItsSlidingFriction) {
+  MassSpringModel stiff = noodle();
+  for (Spring& s : stiff.network.springs) {
+    s.stiffness *= 100;
+    s.damping = 1e-4 * s.stiffness;
+  }
+  stiff.network.parameters.time_step = 0.8 * critical_time_step(stiff.network);
+  MassSpringSimulation simulation(stiff, 0, noodle_model().scene.tools, 3.3, 1e-3);
+  double time = 0;
+  simulation.step(time);
+  const double radius = noodle_model().scene.tools[0].radius, speed = 0.02;
+  const MassSpringNetwork& network = stiff.network;
+  const double mass = network.mass.sum(), g = -network.parameters.gravity.z();
+  const double mu = network.parameters.plane->dynamic_friction, beta = network.parameters.node_damping;
+  const double axis = network.rest_positions(2, 0);  // section 0's centre node, on the end cap
+  const Eigen::Vector3d start(-radius - 0.001, 0, axis), velocity(speed, 0, 0);
+  const auto centre_x = [&] { return (simulation.state().positions * network.mass).x() / mass; };
+  const std::vector<Eigen::Vector3d> starting = move_tool(simulation, time, start, velocity, 0.5);
+  const double from = centre_x();
+  const std::vector<Eigen::Vector3d> forces = move_tool(simulation, time, start + 0.5 * velocity, velocity, 1.0);
+  const double centre_speed = centre_x() - from;  // over 1 s
+  for (const Eigen::Vector3d& f : starting) ASSERT_TRUE(f.allFinite());
+  const Eigen::Vector3d mean = mean_of(forces);
+  const double lift = -mean.z();
+  const double expected = mu * (mass * g - lift) + beta * network.node_count() * speed;
+  std::printf("push along: mean force on the tool %.4f %.4f %.4f N; mu_d (M g - L) + beta N v = %.4f N "
+              "(mu_d M g = %.4f, beta N v = %.4f, L = %.4f N); tube at %.2f mm/s\n",
+              mean.x(), mean.y(), mean.z(), expected, mu * mass * g, beta * network.node_count() * speed, lift,
+              1e3 * centre_speed);
+  EXPECT_NEAR(-mean.x(), expected, 0.05 * expected);
+  EXPECT_NEAR(centre_speed, speed, 0.01 * speed) << "the tube slides with the tool";
+  EXPECT_LT(std::abs(mean.y()), 0.05 * expected);
+  for (const Eigen::Vector3d& f : forces) ASSERT_TRUE(f.allFinite());
+}
+
+// The scene's noodle, springs 100 times stiffer but damped as the scene has them (alpha =
+// 1e-6 s), dragged along its plane at 20 mm/s by its first section, held and moved at that
+// speed. The pull on the held section (minus the springs' forces on it) over the second after
+// a 0.5 s start, against a rigid body's steady sliding: mu_d (m g - L) + beta N v over the
+// free nodes (L the pull's lift). A sliding node that kinetic friction cannot stop within a
+// step keeps sliding (plane_friction.h); stopping it with static friction made this barely
+// damped tube stick and slip, and the pull was 0.05 N.
+TEST(MassSpringSimulation, TubeDraggedByItsEndFeelsItsSlidingFriction) {
+  MassSpringNetwork network = noodle().network;
+  for (Spring& s : network.springs) {
+    s.stiffness *= 100;
+    s.damping *= 100;
+  }
+  network.parameters.time_step = 0.8 * critical_time_step(network);
+  const double h = network.parameters.time_step, speed = 0.02;
+  const MassSpringParameters& p = network.parameters;
+  MassSpringState state = make_state(network);
+  for (int i = 0; i < static_cast<int>(0.3 / h); ++i) step_network(network, state, {}, {}, h);
+  for (int n = 0; n < kSectionNodes; ++n) {
+    network.held[static_cast<std::size_t>(n)] = 1;
+    state.velocities.col(n) = Eigen::Vector3d(speed, 0, 0);
+  }
+  double free_mass = 0;
+  for (int n = kSectionNodes; n < network.node_count(); ++n) free_mass += network.mass[n];
+  const int start = static_cast<int>(0.5 / h), steps = static_cast<int>(1.5 / h);
+  Eigen::Matrix3Xd forces(3, network.node_count());
+  Eigen::Vector3d pull = Eigen::Vector3d::Zero();
+  for (int i = 0; i < steps; ++i) {
+    step_network(network, state, {}, {}, h);
+    if (i < start) continue;
+    internal_forces(network, state.positions, state.velocities, forces);
+    for (int n = 0; n < kSectionNodes; ++n)  // the springs' pull on the held node, reversed
+      pull -= forces.col(n) - network.mass[n] * p.gravity + p.node_damping * state.velocities.col(n);
+  }
+  pull /= steps - start;
+  const double free_nodes = network.node_count() - kSectionNodes;
+  const double expected =
+      p.plane->dynamic_friction * (free_mass * -p.gravity.z() - pull.z()) + p.node_damping * free_nodes * speed;
+  std::printf("dragged by its end: pull %.4f %.4f %.4f N, mu_d (m g - L) + beta N v = %.4f N\n", pull.x(), pull.y(),
+              pull.z(), expected);
+  EXPECT_NEAR(pull.x(), expected, 0.05 * expected);
+  EXPECT_LT(std::abs(pull.y()), 0.05 * expected);
 }
 
 // Two noodles 5 cm apart; a user goes to the one its tool is nearest.

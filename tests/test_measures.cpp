@@ -8,7 +8,6 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
-#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -17,13 +16,13 @@
 #include "common/study/summary.h"
 #include "common/study/zero_phase_lowpass.h"
 #include "common/util/error.h"
+#include "common/util/not_a_number.h"
 #include "support/process.h"
 
 namespace cohaptic {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Samples k = 0..n-1 at t = k dt of a force magnitude along `axis` and a position.
 ForceTrace sample(std::size_t n, double dt, const std::function<Eigen::Vector3d(std::size_t, double)>& force,

@@ -161,7 +161,7 @@ TEST(SceneLoad, CubeSceneFieldsInSIUnits) {
 // motions written for it fit (the trade-off's motions press inside the touchable surface).
 TEST(SceneModel, EveryShippedSceneAndMotionLoads) {
   for (const char* file : {"scenes/cube.yaml", "scenes/brain.yaml", "scenes/tradeoff/cube_two_users.yaml",
-                           "scenes/tradeoff/brain_fine.yaml"}) {
+                           "scenes/tradeoff/brain_fine.yaml", "scenes/tradeoff/brain_spheres.yaml"}) {
     const Model model = build_model(load_scene(testing::source_path(file)));
     const ElasticBody& body = single_elastic_body(model);
     EXPECT_GT(body.touchable_nodes.size(), 10u) << file;
@@ -170,7 +170,8 @@ TEST(SceneModel, EveryShippedSceneAndMotionLoads) {
   EXPECT_EQ(single_elastic_body(fine).mesh.node_count(), 9015);
   for (const char* file : {"scenes/brain/surgeon_a.yaml", "scenes/brain/surgeon_b.yaml", "scenes/studies/press_front.yaml",
                            "scenes/tradeoff/cube_press_slide.yaml", "scenes/tradeoff/cube_press_hold.yaml",
-                           "scenes/tradeoff/brain_press_slide.yaml", "scenes/tradeoff/brain_press_hold.yaml"}) {
+                           "scenes/tradeoff/brain_press_slide.yaml", "scenes/tradeoff/brain_press_hold.yaml",
+                           "scenes/tradeoff/brain_sphere_press_slide.yaml", "scenes/tradeoff/brain_sphere_press_hold.yaml"}) {
     const Trajectory motion = load_trajectory(testing::source_path(file));
     EXPECT_GT(motion.duration(), 1.0) << file;
   }

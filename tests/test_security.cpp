@@ -313,6 +313,9 @@ TEST(Robustness, AMillionHostileDatagramsLeaveTheSimulationRateAndEveryLegitimat
   }
   const std::int64_t flood_to = wire::monotonic_now_ns();
   std::this_thread::sleep_for(1s);  // the last of the flood is read
+  const std::int64_t calm_again_from = wire::monotonic_now_ns();
+  std::this_thread::sleep_for(5s);  // the undisturbed window after
+  const std::int64_t calm_again_to = wire::monotonic_now_ns();
   for (const auto& client : {alice.get(), bob.get()}) client->signal(SIGINT);
   for (const auto& client : {alice.get(), bob.get()}) ASSERT_EQ(client->wait(testing::kPatience), 0) << client->log_text();
   session.stop_server();
@@ -323,15 +326,23 @@ TEST(Robustness, AMillionHostileDatagramsLeaveTheSimulationRateAndEveryLegitimat
   const std::uint64_t sent_by_users =
       session.report("alice")["datagrams"]["sent"].get<std::uint64_t>() + session.report("bob")["datagrams"]["sent"].get<std::uint64_t>();
   const record::Recording recording = record::read_recording(server_mcap);
-  const double calm = step_rate(recording, calm_from, flood_from), flooded = step_rate(recording, flood_from, flood_to);
-  std::printf("  %d hostile datagrams in %.1f s: simulation %.1f Hz before, %.1f Hz during (%+.2f %%); rejected %lu "
+  // The calm rate is that of the windows before and after the flood together: a machine
+  // whose other load changes during the test moves both, not the comparison alone.
+  const double calm_before = step_rate(recording, calm_from, flood_from);
+  const double calm_after = step_rate(recording, calm_again_from, calm_again_to);
+  const double calm = (calm_before + calm_after) / 2, flooded = step_rate(recording, flood_from, flood_to);
+  std::printf("  %d hostile datagrams in %.1f s: simulation %.1f Hz calm (%.1f before, %.1f after), %.1f Hz during "
+              "(%+.2f %%); rejected %lu "
               "(%lu decoded, %lu dropped undecoded as rate_limited); users' datagrams %lu sent, %lu accepted\n",
-              kFlood, static_cast<double>(flood_to - flood_from) * 1e-9, calm, flooded, 100 * (flooded / calm - 1),
+              kFlood, static_cast<double>(flood_to - flood_from) * 1e-9, calm, calm_before, calm_after, flooded,
+              100 * (flooded / calm - 1),
               static_cast<unsigned long>(datagrams["rejected"].get<std::uint64_t>()),
               static_cast<unsigned long>(datagrams["rejected"].get<std::uint64_t>() - count(datagrams, {"rejected_by_reason", "rate_limited"})),
               static_cast<unsigned long>(count(datagrams, {"rejected_by_reason", "rate_limited"})),
               static_cast<unsigned long>(sent_by_users), static_cast<unsigned long>(datagrams["accepted"].get<std::uint64_t>()));
-  EXPECT_NEAR(flooded / calm, 1.0, 0.05);
+  // The flood must not slow the simulation. It cannot speed it up either, so a faster flooded
+  // window is the machine's other load easing, not a finding.
+  EXPECT_GE(flooded / calm, 0.95);
   // Every legitimate datagram the server was handed is accepted. One the kernel dropped
   // from a full queue (the machine gave the server no CPU for the queue's length: other
   // builds or tests) never reached it; those are counted, not excused silently.

@@ -14,12 +14,11 @@
 
 #include "common/study/svg_plot.h"
 #include "common/util/error.h"
+#include "common/util/not_a_number.h"
 #include "support/process.h"
 
 namespace cohaptic {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Checks that tags balance, with exactly one root <svg>, and that character data has no raw '<'
 // and every '&' starts an entity; returns "" or what is wrong.

@@ -1055,8 +1055,10 @@ const cohaptic::IntermediateRepresentation& sample_ir(IrPrecision precision) {
 
 template <typename Derived>
 bool bit_equal(const Eigen::DenseBase<Derived>& a, const Eigen::DenseBase<Derived>& b) {
+  // An empty matrix's data() may be null, which memcmp must not be given even for 0 bytes.
   return a.rows() == b.rows() && a.cols() == b.cols() &&
-         std::memcmp(a.derived().data(), b.derived().data(), static_cast<std::size_t>(a.size()) * sizeof(double)) == 0;
+         (a.size() == 0 ||
+          std::memcmp(a.derived().data(), b.derived().data(), static_cast<std::size_t>(a.size()) * sizeof(double)) == 0);
 }
 
 bool bit_equal(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::memcmp(a.data(), b.data(), 3 * sizeof(double)) == 0; }

@@ -4,16 +4,14 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
-#include <limits>
 #include <spdlog/spdlog.h>
 
 #include "common/mesh/boundary_surface.h"
 #include "common/util/error.h"
+#include "common/util/not_a_number.h"
 
 namespace cohaptic {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// Six times the volume enclosed by a closed surface: > 0 when its triangles face outwards.
 double six_volume(const TriangleSurface& surface) {

@@ -13,8 +13,10 @@ Eigen::Vector3d plane_reaction(const SupportPlane& plane, const Eigen::Vector3d&
   const Eigen::Vector3d v_t = v - v.dot(n) * n;
   const Eigen::Vector3d f_t = force - pressing * n;
   const Eigen::Vector3d stop = -(f_t + mass / h * v_t);
-  if (stop.norm() <= plane.static_friction * normal_load) return normal_force + stop;
   const double speed = v_t.norm();
+  // A sliding node feels mu_d until it stops; mu_s holds only a node at rest.
+  const double holding = (speed > 0 ? plane.dynamic_friction : plane.static_friction) * normal_load;
+  if (stop.norm() <= holding) return normal_force + stop;
   if (speed > 0) {
     sliding = true;
     return normal_force - plane.dynamic_friction * normal_load * v_t / speed;

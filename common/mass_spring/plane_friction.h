@@ -6,10 +6,14 @@
 // tangential parts of the force and the velocity:
 //   normal force  -(F . N_p) N_p  (cancels the pressing part);
 //   sticking: the tangential force that stops the node within this step of length h,
-//     f_stop = -(F_t + m v_t / h), if |f_stop| <= mu_s F_n (at rest, v_t = 0, this is -F_t:
-//     static friction cancels the pull); the node's tangential velocity is then exactly 0;
+//     f_stop = -(F_t + m v_t / h), if |f_stop| <= mu_d F_n for a sliding node (kinetic
+//     friction can stop it) or <= mu_s F_n for a node at rest (v_t = 0: f_stop = -F_t, static
+//     friction cancels the pull); the node's tangential velocity is then exactly 0;
 //   sliding (v_t != 0, not stopped): dynamic friction -mu_d F_n v_t/|v_t|;
 //   at rest and pulled harder than mu_s F_n: -mu_s F_n F_t/|F_t|.
+// Stopping a sliding node with up to mu_s F_n would be friction above Coulomb's while it
+// slides; on a barely damped network dragged at constant speed (the paper's alpha) it made the
+// bottom nodes stick and slip, and their friction cancelled on average.
 // Without the stopping test a node, once moving, could only come to rest by reversing
 // within a step (settle_on_plane), and a load fluctuating above the static threshold for
 // one step would leave it sliding under the weaker dynamic law for good. Units: SI.

@@ -4,16 +4,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "common/study/zero_phase_lowpass.h"
 #include "common/util/error.h"
 #include "common/util/percentile.h"
+#include "common/util/not_a_number.h"
 
 namespace cohaptic {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::vector<Stroke> contact_strokes(const ForceTrace& trace, const MeasureSettings& settings) {
   validate(settings);

@@ -3,18 +3,13 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <limits>
 #include <map>
 
 #include "common/util/atomic_file.h"
 #include "common/util/csv.h"
+#include "common/util/not_a_number.h"
 
 namespace cohaptic {
-namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-}  // namespace
 
 Statistics describe(std::span<const double> values) {
   Statistics s;

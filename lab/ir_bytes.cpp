@@ -1,0 +1,179 @@
+#include "lab/ir_bytes.h"
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <memory>
+#include <span>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "common/condense/naive_condensation.h"
+#include "common/model/model.h"
+#include "common/scene/load_scene.h"
+#include "common/util/error.h"
+#include "proto/record/recording.h"
+#include "proto/wire/ir_convert.h"
+
+namespace cohaptic {
+namespace {
+
+// Entries of L_AA (symmetric, 3 dofs per node) that involve at least one of `added` new
+// nodes among `nodes`: the new nodes' rows against every node, each pair once.
+double compliance_row_values(double nodes, double added) { return 9 * (added * nodes - added * (added - 1) / 2); }
+
+// Entries of `now` that differ from `before` bit for bit (same shape).
+std::size_t changed_entries(const google::protobuf::RepeatedField<double>& before,
+                            const google::protobuf::RepeatedField<double>& now) {
+  std::size_t changed = 0;
+  for (int i = 0; i < now.size(); ++i)
+    if (std::memcmp(&before[i], &now[i], sizeof(double)) != 0) ++changed;
+  return changed;
+}
+
+}  // namespace
+
+IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body, ComplianceColumns& columns,
+                            const std::filesystem::path& frames) {
+  const record::Recording rec = record::read_recording(recording);
+  std::unordered_map<std::int64_t, int> node_of_tag;
+  for (std::size_t i = 0; i < body.mesh.node_tags.size(); ++i) node_of_tag.emplace(body.mesh.node_tags[i], static_cast<int>(i));
+  IrBytesRow row;
+  row.recording = recording.string();
+  if (!frames.empty()) std::filesystem::create_directories(frames);
+  const wire::IntermediateRepresentation* previous = nullptr;
+  std::int64_t first_ns = 0, last_ns = 0;
+  std::vector<double> client_us;
+  for (const record::RecordedIr& recorded : rec.irs) {
+    const wire::IntermediateRepresentation& ir = recorded.ir();
+    if (!ir.has_fem()) continue;
+    const wire::CondensedFem& fem = ir.fem();
+    if (row.irs == 0) first_ns = recorded.time_ns();
+    last_ns = recorded.time_ns();
+
+    const std::string bytes = ir.SerializeAsString();
+    if (!frames.empty()) {
+      std::ofstream out(frames / fmt::format("frame_{:06d}.bin", row.irs), std::ios::binary);
+      out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      if (!out) throw Error(fmt::format("ir-bytes: cannot write into {}", frames.string()));
+    }
+    row.sent_bytes += static_cast<double>(bytes.size());
+
+    const IntermediateRepresentation received = wire::from_wire(ir);
+    IntermediateRepresentation rounded = received;
+    condensed_fem(rounded).precision = IrPrecision::f32;
+    row.f32_bytes += static_cast<double>(wire::to_wire(rounded).ByteSizeLong());
+
+    wire::IntermediateRepresentation without_m = ir;
+    without_m.mutable_fem()->clear_m_tilde_f64();
+    without_m.mutable_fem()->clear_m_tilde_f32();
+    const auto rest = static_cast<double>(without_m.ByteSizeLong());
+    const double value_bytes = fem.m_tilde_f32_size() > 0 ? 4 : 8;
+    const double m_bytes = static_cast<double>(bytes.size()) - rest;
+    row.without_m_bytes += rest;
+
+    const auto nodes = static_cast<double>(fem.node_ids_size());
+    std::unordered_set<std::int64_t> had;
+    if (previous) had.insert(previous->fem().node_ids().begin(), previous->fem().node_ids().end());
+    double added = 0;
+    for (const std::int64_t id : fem.node_ids()) added += had.contains(id) ? 0 : 1;
+    row.nodes_mean += nodes;
+    row.new_nodes_mean += added;
+
+    const bool same_nodes = previous && std::equal(fem.node_ids().begin(), fem.node_ids().end(),
+                                                   previous->fem().node_ids().begin(), previous->fem().node_ids().end()) &&
+                            previous->fem().m_rows() == fem.m_rows() && previous->fem().m_cols() == fem.m_cols() &&
+                            fem.m_tilde_f64_size() > 0 && previous->fem().m_tilde_f64_size() == fem.m_tilde_f64_size();
+    const double delta_m =
+        same_nodes ? std::min(m_bytes, 12.0 * static_cast<double>(changed_entries(previous->fem().m_tilde_f64(), fem.m_tilde_f64())))
+                   : m_bytes;
+    row.delta_bytes += rest + delta_m;
+    row.rows_bytes += rest + value_bytes * compliance_row_values(nodes, added);
+
+    const CondensedFemIr& sent = condensed_fem(received);
+    std::vector<int> mesh_nodes;
+    for (const std::int64_t tag : sent.node_ids) {
+      const auto found = node_of_tag.find(tag);
+      if (found == node_of_tag.end() || columns.row_position(found->second) < 0)
+        throw Error(fmt::format("ir-bytes: {}: IR epoch {} has node {}, which is no surface node of the scene's body",
+                                recording.string(), ir.epoch(), tag));
+      mesh_nodes.push_back(found->second);
+    }
+    // The client's work under compliance rows: the naive condensation of L_AA (the server's
+    // reference path), on the thread's CPU clock; the columns are solved before (a client
+    // receives them).
+    columns.compute_columns(mesh_nodes);
+    const auto contact = static_cast<std::size_t>(sent.row_node_count);
+    timespec start{}, stop{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &start);
+    const CondensedOperator op = naive_condensation(columns, body.dofs, std::span(mesh_nodes).first(contact),
+                                                    std::span(mesh_nodes).subspan(contact));
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &stop);
+    client_us.push_back(static_cast<double>(stop.tv_sec - start.tv_sec) * 1e6 +
+                        static_cast<double>(stop.tv_nsec - start.tv_nsec) * 1e-3);
+    Eigen::MatrixXd condensed(op.m_cc.rows(), op.m_cc.cols() + op.m_cb.cols());
+    condensed << op.m_cc, op.m_cb;
+    if (condensed.rows() != sent.m_tilde.rows() || condensed.cols() != sent.m_tilde.cols())
+      throw Error(fmt::format("ir-bytes: {}: IR epoch {}: its M~ is {} x {}, its free dofs give {} x {} (boundary truncation "
+                              "is not measured)",
+                              recording.string(), ir.epoch(), sent.m_tilde.rows(), sent.m_tilde.cols(), condensed.rows(),
+                              condensed.cols()));
+    row.rows_m_tilde_difference = std::max(row.rows_m_tilde_difference, (condensed - sent.m_tilde).cwiseAbs().maxCoeff() /
+                                                                             sent.m_tilde.cwiseAbs().maxCoeff());
+
+    previous = &ir;
+    ++row.irs;
+  }
+  if (row.irs == 0) throw Error(fmt::format("ir-bytes: {} holds no condensed FEM IR", recording.string()));
+  row.span_s = static_cast<double>(last_ns - first_ns) * 1e-9;
+  row.nodes_mean /= static_cast<double>(row.irs);
+  row.new_nodes_mean /= static_cast<double>(row.irs);
+  std::sort(client_us.begin(), client_us.end());
+  row.rows_client_us_p50 = client_us[client_us.size() / 2];
+  row.rows_client_us_max = client_us.back();
+  return row;
+}
+
+LabCommand add_ir_bytes_command(CLI::App& lab) {
+  struct Options {
+    std::filesystem::path scene;
+    std::vector<std::filesystem::path> recordings;
+    std::filesystem::path frames;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* command = lab.add_subcommand(
+      "ir-bytes", "IR bytes per second a client received, and what f32, M~ deltas or compliance rows would have sent");
+  command->add_option("--scene", options->scene, "The recorded session's scene (one linear elastic object)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("recordings", options->recordings, "Client recordings (cohaptic-client --record)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--frames", options->frames, "Also write every IR as sent into this directory, one file each");
+  return {command, [options] {
+            const Model model = build_model(load_scene(options->scene));
+            const ElasticBody& body = single_elastic_body(model);
+            ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+            fmt::print("| recording | IRs | span s | nodes per IR | new nodes per IR | sent kB/s | without M~ kB/s | f32 kB/s | "
+                       "M~ delta kB/s | compliance rows kB/s | rows: client CPU µs p50 / max | rows: M~ difference |\n"
+                       "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+            for (std::size_t i = 0; i < options->recordings.size(); ++i) {
+              const std::filesystem::path frames =
+                  options->frames.empty() ? options->frames : options->frames / fmt::format("{}", i);
+              const IrBytesRow r = measure_ir_bytes(options->recordings[i], body, columns, frames);
+              const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;
+              fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.0f} / {:.0f} | "
+                         "{:.1e} |\n",
+                         r.recording, r.irs, r.span_s, r.nodes_mean, r.new_nodes_mean, r.sent_bytes * per_s,
+                         r.without_m_bytes * per_s, r.f32_bytes * per_s, r.delta_bytes * per_s, r.rows_bytes * per_s,
+                         r.rows_client_us_p50, r.rows_client_us_max, r.rows_m_tilde_difference);
+            }
+            return 0;
+          }};
+}
+
+}  // namespace cohaptic
