@@ -126,9 +126,7 @@ TEST(ForceEvaluator, MassSpringSubNetworkAllocatesNothing) {
 
 // The paired boxes (scenes/objects/paired_boxes.yaml): A's IR carries B's backing, which
 // the client's evaluation integrates every substep.
-// Disabled with InteractionScene's runtime tests: the front object falls through the box
-// before its IR is taken. Not a passing check.
-TEST(ForceEvaluator, DISABLED_BackedMassSpringSubNetworkAllocatesNothing) {
+TEST(ForceEvaluator, BackedMassSpringSubNetworkAllocatesNothing) {
   const Model model = build_model(load_scene(testing::source_path("scenes/objects/paired_boxes.yaml")));
   const SceneCompliance compliance = prepare_scene_compliance(model, true, std::nullopt);
   SceneSimulation simulation(model, compliance.per_body, model.scene.tools, SimulationOptions{});

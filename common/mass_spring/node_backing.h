@@ -1,14 +1,16 @@
-// NodeBacking: a body behind a mass-spring network pressing back on some of its nodes,
-// linear in their positions while the contacts hold:
-//   f = -K (x - x*) + f0   over the backed nodes (3 rows and columns per node),
-// with K symmetric positive semidefinite, x* the positions at which the backed nodes just
-// touch the undisplaced behind body, f0 a constant force (the part of the backing that
-// nodes outside a sub-network exert through K, zero on the whole network). A contact cannot
-// pull: a node whose force points into the behind body (against its outward normal n) gets
-// none, so a node that bounces off between two rebuilds is not held to the surface. The server's
-// network and the sub-network an IR carries to a client integrate it every substep through
-// the same function (integrate_network.h), so the client feels the behind body through
-// the front one. Plain data; its evaluation is allocation-free and noexcept. Units: m, N, N/m.
+// NodeBacking: a body behind a mass-spring network pressing back on some of its nodes, as
+// one contact spring-damper per node along the behind body's outward normal n:
+//   g = (x - x*) . n   (x* the point of the behind body's rest surface under the node),
+//   f = max(0, -k g - c (v . n)) n   while g < 0, and nothing while g >= 0.
+// Each node's force is the gradient of its own convex potential k min(0, g)^2 / 2 plus a
+// dashpot that only acts in contact, so the backing can only take energy out of the
+// network, and each node engages and releases on its own gap at every substep: it cannot
+// fall into the behind body unresisted for the rest of a step, nor be pushed out by a force
+// stored from an earlier position. A contact cannot pull: the dashpot never holds a node
+// that leaves. The server's network and the sub-network an IR carries to a client integrate
+// it every substep through the same function (integrate_network.h), so the client feels the
+// behind body through the front one. Plain data; its evaluation is allocation-free and
+// noexcept. Units: m, N, N/m, N s/m.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,27 +21,27 @@
 namespace cohaptic {
 
 struct NodeBacking {
-  std::vector<int> nodes;   ///< the network's backed nodes
-  Eigen::MatrixXd stiffness;  ///< K, 3|nodes| square [N/m]
+  std::vector<int> nodes;     ///< the network's backed nodes
+  Eigen::VectorXd stiffness;  ///< k per node, along its normal [N/m] >= 0
+  Eigen::VectorXd damping;    ///< c per node, along its normal [N s/m] >= 0
   Eigen::VectorXd targets;    ///< x*, 3 per node [m]
-  Eigen::VectorXd offset;     ///< f0, 3 per node [N]
   Eigen::VectorXd normals;    ///< n, the behind body's outward unit normal, 3 per node
 
   bool empty() const { return nodes.empty(); }
 };
 
-/// forces.col(n) += f_n for each backed node n at `positions` (one column per network node)
-/// whose f_n . n_n >= 0.
+/// forces.col(n) += f_n for each backed node n at `positions` and `velocities` (one column
+/// per network node).
 void add_node_backing_forces(const NodeBacking& backing, const Eigen::Ref<const Eigen::Matrix3Xd>& positions,
+                             const Eigen::Ref<const Eigen::Matrix3Xd>& velocities,
                              Eigen::Ref<Eigen::Matrix3Xd> forces) noexcept;
 
 /// The backing of a sub-network: the backed nodes among `body_nodes` (the body's node of
-/// each local node) in local indices; the others, at `body_positions` (the whole body's
-/// current positions), fold into the offset.
-NodeBacking sub_network_backing(const NodeBacking& whole, std::span<const std::int32_t> body_nodes,
-                                const Eigen::Ref<const Eigen::Matrix3Xd>& body_positions);
+/// each local node), in local indices.
+NodeBacking sub_network_backing(const NodeBacking& whole, std::span<const std::int32_t> body_nodes);
 
-/// Throws Error naming `what` when sizes, node indices (below node_count) or values are bad.
+/// Throws Error naming `what` when sizes, node indices (below node_count) or values are bad
+/// (negative or non-finite stiffness or damping, normals not of unit length).
 void check_node_backing(const NodeBacking& backing, int node_count, const char* what);
 
 }  // namespace cohaptic

@@ -24,13 +24,17 @@ NodeBacking step_body_interaction(BodyInteraction& interaction, const Eigen::Mat
   const InteractingBodies bodies{front_positions,     interaction.front_surface, behind_body.mesh.nodes,
                                  interaction.behind_surface, behind_body.dofs, columns};
   interaction.latest = interaction_step(interaction.pairs, bodies, InteractionWorkflow::improved, interaction.workspace);
-  const InteractionStep& step = interaction.latest;
-  if (step.collisions.empty()) return {};
+  // The backing holds every node that collided or may collide before the next step, each
+  // engaging on its own gap at every substep (node_backing.h).
+  const std::vector<PolygonCollision> within = find_polygons_within(interaction.pairs, bodies, kBackingReach);
+  if (within.empty()) return {};
+  const std::vector<AxisMask>& fixed_axes = behind_body.dofs.fixed_axes;
+  const ForcibleDisplacement displacement = forcible_displacement(within, fixed_axes);
+  const MassSpringNetwork& network = front_body.network;
   const LinearBacking backing =
-      build_linear_backing(step.collisions, step.displacement,
-                           condensed_stiffness(columns, behind_body.dofs, step.displacement.nodes),
-                           front_body.network.rest_positions);
-  return node_backing(backing, step.collisions, front_body.network.rest_positions);
+      build_linear_backing(within, displacement, condensed_stiffness(columns, behind_body.dofs, displacement.nodes),
+                           network.rest_positions);
+  return node_backing(backing, within, network.mass, kBackingDampingRatio);
 }
 
 }  // namespace cohaptic

@@ -3,9 +3,11 @@
 // several-objects paper, Sec. 2). Each step the front network's surface nodes, at their
 // current positions, are tested against the behind body's surface at rest (linear body)
 // through the pairs of nearest nodes (improved workflow, interaction_step.h); the behind
-// body's displaced nodes are condensed through its compliance columns and its reaction is
-// handed to the front body as its backing (linear_backing.h, node_backing.h), which the front
-// body's integrator evaluates every substep until the next step rebuilds it.
+// body's displaced nodes are condensed through its compliance columns (B's deformation,
+// `latest`). The front body feels B through a backing (node_backing.h) over every front node
+// that is behind B's surface or within kBackingReach of it: B's condensed stiffness mapped
+// onto those nodes (linear_backing.h), lumped to one normal contact spring-damper per node,
+// which the front body's integrator evaluates every substep until the next step rebuilds it.
 // Units: m, N. A step allocates (server side, not the haptic path).
 #pragma once
 
@@ -20,6 +22,13 @@
 #include "common/model/mass_spring_body.h"
 
 namespace cohaptic {
+
+/// How far in front of B's surface a front node joins the backing [m]: a node must be in it
+/// before it reaches B, and between two steps (1 ms) a node moves far less than this (1 m/s
+/// would take 1 mm).
+inline constexpr double kBackingReach = 2e-3;
+/// The backing's dashpots: critically damped contact of each node's mass on its spring.
+inline constexpr double kBackingDampingRatio = 1.0;
 
 struct BodyInteraction {
   int front = -1;   ///< body index of the mass-spring front body

@@ -192,10 +192,9 @@ void mass_spring_to_wire(const MassSpringIr& ir, MassSpringPatch* out) {
   if (!ir.backing.empty()) {
     NodeBacking* backing = out->mutable_backing();
     for (int node : ir.backing.nodes) backing->add_nodes(static_cast<std::uint32_t>(node));
-    const Eigen::MatrixXd row_major = ir.backing.stiffness.transpose();  // column-major storage of K^T: K row by row
-    add_values<double>(row_major.data(), row_major.size(), backing->mutable_stiffness());
+    add_values<double>(ir.backing.stiffness.data(), ir.backing.stiffness.size(), backing->mutable_stiffness());
+    add_values<double>(ir.backing.damping.data(), ir.backing.damping.size(), backing->mutable_damping());
     add_values<double>(ir.backing.targets.data(), ir.backing.targets.size(), backing->mutable_targets());
-    add_values<double>(ir.backing.offset.data(), ir.backing.offset.size(), backing->mutable_offsets());
     add_values<double>(ir.backing.normals.data(), ir.backing.normals.size(), backing->mutable_normals());
   }
 }
@@ -409,24 +408,23 @@ MassSpringIr mass_spring_from_wire(const MassSpringPatch& w) {
   if (w.has_backing()) {
     const NodeBacking& b = w.backing();
     const auto backed = static_cast<std::uint64_t>(b.nodes_size());
-    const auto size = static_cast<Eigen::Index>(3 * backed);
-    if (static_cast<std::uint64_t>(b.stiffness_size()) != 9 * backed * backed || static_cast<std::uint64_t>(b.targets_size()) != 3 * backed ||
-        static_cast<std::uint64_t>(b.offsets_size()) != 3 * backed || static_cast<std::uint64_t>(b.normals_size()) != 3 * backed)
-      invalid("a backing of {} nodes with {} stiffness values, {} targets, {} offsets and {} normals (expected {}, {}, {}, {})",
-              backed, b.stiffness_size(), b.targets_size(), b.offsets_size(), b.normals_size(), 9 * backed * backed,
-              3 * backed, 3 * backed, 3 * backed);
+    const auto count = static_cast<Eigen::Index>(backed);
+    if (static_cast<std::uint64_t>(b.stiffness_size()) != backed || static_cast<std::uint64_t>(b.damping_size()) != backed ||
+        static_cast<std::uint64_t>(b.targets_size()) != 3 * backed || static_cast<std::uint64_t>(b.normals_size()) != 3 * backed)
+      invalid("a backing of {} nodes with {} stiffnesses, {} dampings, {} targets and {} normals (expected {}, {}, {}, {})",
+              backed, b.stiffness_size(), b.damping_size(), b.targets_size(), b.normals_size(), backed, backed,
+              3 * backed, 3 * backed);
     for (std::uint32_t node : b.nodes()) {
       if (node >= nodes) invalid("the backing names node {} of {}", node, nodes);
       ir.backing.nodes.push_back(static_cast<int>(node));
     }
-    Eigen::MatrixXd transposed(size, size);
-    read_values(b.stiffness(), transposed, "backing.stiffness");
-    ir.backing.stiffness = transposed.transpose();
-    ir.backing.targets.resize(size);
+    ir.backing.stiffness.resize(count);
+    read_values(b.stiffness(), ir.backing.stiffness, "backing.stiffness");
+    ir.backing.damping.resize(count);
+    read_values(b.damping(), ir.backing.damping, "backing.damping");
+    ir.backing.targets.resize(3 * count);
     read_values(b.targets(), ir.backing.targets, "backing.targets");
-    ir.backing.offset.resize(size);
-    read_values(b.offsets(), ir.backing.offset, "backing.offsets");
-    ir.backing.normals.resize(size);
+    ir.backing.normals.resize(3 * count);
     read_values(b.normals(), ir.backing.normals, "backing.normals");
   }
   return ir;
