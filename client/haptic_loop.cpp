@@ -105,7 +105,9 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       // warm start is no body state: it is left alone by evaluating on an empty state (a cold
       // solve, the same answer).
       const bool static_body = !std::holds_alternative<MassSpringPatchState>(slot.state->body);
-      metrics_.coupling_measured = metrics_.coupling_measured || static_body;
+      // Measured only in contact: a user that passed by a static body without touching it
+      // (e.g. on its way to a mass-spring object lying on it) measured nothing.
+      metrics_.coupling_measured = metrics_.coupling_measured || (static_body && (sample.flags & kInContact));
       if (count > 0 && (sample.flags & kInContact) && static_body) {
         EvaluationState cold;
         const ForceSample alone = evaluate_force(*slot.ir, cold, own, {}, dt);

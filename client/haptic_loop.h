@@ -139,8 +139,8 @@ struct HapticMetrics {
   std::uint64_t contact_unresolved = 0;  ///< ticks that held the last force (sphere solve unfinished)
   double peak_force = 0;      ///< [N]
   double peak_coupling = 0;   ///< [N], |F - F without the remote tools|
-  /// Whether peak_coupling was measured: only on bodies whose evaluation keeps no state
-  /// (a second evaluation would advance a dynamic body twice).
+  /// Whether peak_coupling was measured: only while in contact with a body whose evaluation
+  /// keeps no state (a second evaluation would advance a dynamic body twice).
   bool coupling_measured = false;
   double largest_step_on_ir_switch = 0;  ///< [N]
   double elapsed_s = 0;

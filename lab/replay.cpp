@@ -115,8 +115,9 @@ VerifyResult verify_server(const Recording& rec) {
   const std::int64_t start = config.start_time_ns();
   const Scene scene = parse_scene(config.scene_yaml(), config.scene_file());
   const Model model = build_model(scene);
-  const SceneCompliance compliance =
-      prepare_scene_compliance(model, config.injected().step_nodes() > 0 || !model.obstacles.empty(), std::nullopt);
+  const bool whole_surface =
+      config.injected().step_nodes() > 0 || !model.obstacles.empty() || !model.scene.interactions.empty();
+  const SceneCompliance compliance = prepare_scene_compliance(model, whole_surface, std::nullopt);
   SimulationOptions options;
   options.ir = ir_build_options(scene.haptic);
   options.ir.precision = config.ir_f32() ? IrPrecision::f32 : IrPrecision::f64;

@@ -93,7 +93,9 @@ struct SimulationServer::Impl {
       scene_yaml.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
     model = std::make_unique<Model>(build_model(scene));
-    compliance = prepare_scene_compliance(*model, options.step_nodes > 0 || !model->obstacles.empty(), options.cache_directory);
+    const bool whole_surface =
+        options.step_nodes > 0 || !model->obstacles.empty() || !model->scene.interactions.empty();
+    compliance = prepare_scene_compliance(*model, whole_surface, options.cache_directory);
     // The display and the live view show one linear elastic object (single_elastic_body
     // says why it refuses another scene).
     const auto shown_columns = [this]() -> ComplianceColumns& {

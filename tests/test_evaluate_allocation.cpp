@@ -19,7 +19,9 @@
 #include "common/laparoscopy/forceps_jaws.h"
 #include "common/laparoscopy/home_spring_contact.h"
 #include "common/laparoscopy/tissue_display.h"
+#include "common/model/scene_compliance.h"
 #include "common/scene/load_scene.h"
+#include "common/sim/scene_simulation.h"
 #include "common/sim/mass_spring_simulation.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
@@ -218,6 +220,36 @@ TEST(HapticLoop, TicksAllocateNothingWhileMassSpringIrsOfGrowingSubNetworksArriv
   EXPECT_GT(loop.metrics().peak_force, 0) << "the tool pressed";
   std::cout << "sub-network nodes from " << node_counts.front() << " to " << node_counts.back() << ", " << slots.size()
             << " IRs, " << loop.metrics().ir_switches << " switches, peak force " << loop.metrics().peak_force << " N\n";
+}
+
+// The paired boxes (scenes/objects/paired_boxes.yaml): A's IR carries B's backing, which
+// the client's evaluation integrates every substep.
+TEST(ForceEvaluator, BackedMassSpringSubNetworkAllocatesNothing) {
+  const Model model = build_model(load_scene(testing::source_path("scenes/objects/paired_boxes.yaml")));
+  const SceneCompliance compliance = prepare_scene_compliance(model, true, std::nullopt);
+  SceneSimulation simulation(model, compliance.per_body, model.scene.tools, SimulationOptions{});
+  const Eigen::Vector3d tool(0, 0, 0.0535);  // its 2 mm radius about 2 mm into A's top (53.3 mm less its sag)
+  for (int i = 0; i < 500; ++i) {
+    simulation.set_tool(0, tool);
+    simulation.step(0.001 * i);
+  }
+  ASSERT_NE(simulation.ir(0), nullptr);
+  const PreparedIR& prepared = *simulation.ir(0);
+  ASSERT_FALSE(std::get<MassSpringIr>(prepared.ir.body).backing.empty());
+  EvaluationState state = make_evaluation_state(prepared);
+  REQUIRE_COUNTED_MALLOC();
+  double largest = 0;
+  bool finite = true;
+  counting = true;
+  for (int i = 0; i < 2000; ++i) {
+    const ForceSample sample = evaluate_force(prepared, state, tool - Eigen::Vector3d(0, 0, 2e-6 * (i % 1000)), {}, 0.001);
+    finite = finite && sample.force.allFinite();
+    largest = std::max(largest, sample.force.norm());
+  }
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0) << "evaluate_force allocated on a backed mass-spring body";
+  EXPECT_TRUE(finite);
+  EXPECT_GT(largest, 0) << "the tool pressed";
 }
 
 TEST(LaparoscopyHapticPath, AllocatesNothing) {

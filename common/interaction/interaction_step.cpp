@@ -1,19 +1,46 @@
 #include "common/interaction/interaction_step.h"
 
+#include <optional>
+
+#include "common/interaction/node_polygon_collision.h"
+
 namespace cohaptic {
 
-std::vector<PolygonCollision> find_polygon_collisions(const NodePairList& list, const InteractingBodies& bodies) {
+namespace {
+
+// The collisions of the listed pairs whose active node `target_of` finds a polygon for.
+template <typename TargetOf>
+std::vector<PolygonCollision> collect_polygon_collisions(const NodePairList& list, const InteractingBodies& bodies,
+                                                         TargetOf target_of) {
   std::vector<PolygonCollision> collisions;
   for (std::size_t index = 0; index < list.pairs.size(); ++index) {
     const NodePair& pair = list.pairs[index];
     const Eigen::Vector3d active = bodies.active_positions.col(pair.active);
-    const auto target = node_polygon_collision(active, pair.passive, bodies.passive_positions, bodies.passive_surface);
+    const std::optional<PolygonTarget> target = target_of(active, pair.passive);
     if (!target) continue;
     collisions.push_back({static_cast<int>(index), pair.active,
                           bodies.passive_surface.triangles[static_cast<std::size_t>(target->triangle)], target->weights,
                           target->point, active - target->point, target->normal});
   }
   return collisions;
+}
+
+}  // namespace
+
+std::vector<PolygonCollision> find_polygon_collisions(const NodePairList& list, const InteractingBodies& bodies) {
+  return collect_polygon_collisions(list, bodies, [&](const Eigen::Vector3d& active, int passive) {
+    return node_polygon_collision(active, passive, bodies.passive_positions, bodies.passive_surface);
+  });
+}
+
+std::vector<PolygonCollision> find_polygons_within(const NodePairList& list, const InteractingBodies& bodies,
+                                                   double reach) {
+  return collect_polygon_collisions(list, bodies, [&](const Eigen::Vector3d& active, int passive) {
+    std::optional<PolygonTarget> target =
+        detailed_collision_test(active, passive, bodies.passive_positions, bodies.passive_surface);
+    if (target && (active - target->point).dot(target->normal) > reach) target.reset();
+    return target;
+  });
 }
 
 Eigen::VectorXd convey_reaction(const ForcibleDisplacement& displacement, const Eigen::VectorXd& passive_forces) {

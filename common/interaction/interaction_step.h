@@ -60,6 +60,12 @@ struct InteractionStep {
 /// The collisions of the listed pairs (update of pairs is the caller's; see interaction_step).
 std::vector<PolygonCollision> find_polygon_collisions(const NodePairList& list, const InteractingBodies& bodies);
 
+/// The pairs whose active node is behind a polygon around its passive node or at most
+/// `reach` [m] in front of it (the detailed test's target, without the instant test): the
+/// nodes a backing must hold before the next step, collided or about to.
+std::vector<PolygonCollision> find_polygons_within(const NodePairList& list, const InteractingBodies& bodies,
+                                                   double reach);
+
 /// Reaction on the active nodes: -map^T passive_forces, 3 per collision [N].
 Eigen::VectorXd convey_reaction(const ForcibleDisplacement& displacement, const Eigen::VectorXd& passive_forces);
 

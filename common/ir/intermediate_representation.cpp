@@ -39,7 +39,9 @@ std::size_t MassSpringIr::size_bytes() const {
   const std::size_t springs_bytes = springs.size() * (2 * sizeof(std::int32_t) + 3 * sizeof(double));
   const std::size_t tools = remote_users.size() * (sizeof(std::int32_t) + sizeof(double)) +
                             presses.size() * (1 + 3 * sizeof(double));
-  return kParameters + nodes + springs_bytes + triangles.size() * 3 * sizeof(std::int32_t) + tools;
+  const std::size_t backed = backing.nodes.size();
+  const std::size_t backing_bytes = backed * (sizeof(std::int32_t) + 9 * sizeof(double)) + 9 * backed * backed * sizeof(double);
+  return kParameters + nodes + springs_bytes + triangles.size() * 3 * sizeof(std::int32_t) + tools + backing_bytes;
 }
 
 int remote_count(const IntermediateRepresentation& ir) noexcept {

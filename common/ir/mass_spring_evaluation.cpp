@@ -43,6 +43,7 @@ PreparedMassSpring prepare_mass_spring(const MassSpringIr& ir) {
         throw Error(fmt::format("intermediate representation: a triangle names node {} of {}", node, nodes));
   index_surface(network);
   check_network(network, "intermediate representation");
+  check_node_backing(ir.backing, static_cast<int>(nodes), "intermediate representation");
   return prepared;
 }
 
@@ -67,7 +68,8 @@ NetworkToolReaction advance_mass_spring(const MassSpringIr& ir, const PreparedMa
     tools[count] = {i < remote_tools.size() ? remote_tools[i] : absent, ir.remote_radii[i]};
   }
   advance_with_tools(prepared.network, state.network, std::span(tools.data(), count),
-                     std::span(state.presses.data(), count), std::span(reactions.data(), count), dt);
+                     std::span(state.presses.data(), count), std::span(reactions.data(), count), dt,
+                     ir.backing.empty() ? nullptr : &ir.backing);
   return reactions[0];
 }
 

@@ -10,6 +10,9 @@
 // and triangles are those with every end inside, in local indices. The presses carry each
 // tool's contact memory (own first, then the remote tools in remote_users' order), so that
 // the client continues exactly where the server's whole-network step left off.
+// A body behind this one (a scene interaction) comes as the backing on the sub-network's
+// nodes that press it (node_backing.h; the backed nodes outside it folded into its offset),
+// so the client feels the behind body through this one.
 // Units: m, m/s, kg, N/m, N s/m, s.
 #pragma once
 
@@ -19,6 +22,7 @@
 #include <vector>
 
 #include "common/mass_spring/mass_spring_network.h"
+#include "common/mass_spring/node_backing.h"
 #include "common/mass_spring/tool_coupling.h"
 
 namespace cohaptic {
@@ -35,6 +39,7 @@ struct MassSpringIr {
   std::vector<int> remote_users;       ///< the other users whose tools act on the sub-network
   std::vector<double> remote_radii;    ///< their tool radii [m]
   std::vector<ToolPress> presses;      ///< 1 + remote_users.size(): own, then remotes
+  NodeBacking backing;                 ///< local nodes; empty: nothing behind the body
 
   int node_count() const { return static_cast<int>(node_ids.size()); }
   /// Bytes of the content as sent.

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <span>
 
+#include "common/mass_spring/node_backing.h"
 #include "common/mass_spring/mass_spring_network.h"
 #include "common/mass_spring/mass_spring_state.h"
 
@@ -26,7 +27,9 @@ struct NodeDrive {
 
 /// Advances `state` by h [s]. applied[i] receives the haptic force on drives[i].node [N]
 /// (`applied` at least as long as `drives`). A node driven twice takes the first drive.
+/// `backing` (may be null): a body behind this one pressing back on some nodes
+/// (node_backing.h), over the network's node indices.
 void step_network(const MassSpringNetwork& network, MassSpringState& state, std::span<const NodeDrive> drives,
-                  std::span<Eigen::Vector3d> applied, double h) noexcept;
+                  std::span<Eigen::Vector3d> applied, double h, const NodeBacking* backing = nullptr) noexcept;
 
 }  // namespace cohaptic

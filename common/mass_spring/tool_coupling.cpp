@@ -14,7 +14,8 @@ int substeps_for(const MassSpringNetwork& network, double period) noexcept {
 }
 
 void advance_with_tools(const MassSpringNetwork& network, MassSpringState& state, std::span<const ToolOnNetwork> tools,
-                        std::span<ToolPress> presses, std::span<NetworkToolReaction> reactions, double period) noexcept {
+                        std::span<ToolPress> presses, std::span<NetworkToolReaction> reactions, double period,
+                        const NodeBacking* backing) noexcept {
   const std::size_t count = std::min(tools.size(), static_cast<std::size_t>(kMaxNetworkTools));
   std::array<NodeDrive, kMaxNetworkTools> drives;
   std::array<Eigen::Vector3d, kMaxNetworkTools> start, displacement, applied;
@@ -68,7 +69,7 @@ void advance_with_tools(const MassSpringNetwork& network, MassSpringState& state
         if (below < 0) drives[j].target -= below * plane.normal;
       }
     }
-    step_network(network, state, active, std::span(applied.data(), driven), h);
+    step_network(network, state, active, std::span(applied.data(), driven), h, backing);
     for (std::size_t j = 0; j < driven; ++j) total[j] += applied[j];
   }
   for (std::size_t j = 0; j < driven; ++j) {

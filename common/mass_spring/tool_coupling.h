@@ -46,8 +46,10 @@ struct NetworkToolReaction {
 
 /// Advances `state` by `period` [s] (> 0) with `tools` pressing; presses[i] and reactions[i]
 /// belong to tools[i] (both at least as long as tools; at most kMaxNetworkTools used).
+/// `backing` (may be null) presses back on the network every substep (step_network).
 void advance_with_tools(const MassSpringNetwork& network, MassSpringState& state, std::span<const ToolOnNetwork> tools,
-                        std::span<ToolPress> presses, std::span<NetworkToolReaction> reactions, double period) noexcept;
+                        std::span<ToolPress> presses, std::span<NetworkToolReaction> reactions, double period,
+                        const NodeBacking* backing = nullptr) noexcept;
 
 /// The number of integrator steps for `period`.
 int substeps_for(const MassSpringNetwork& network, double period) noexcept;

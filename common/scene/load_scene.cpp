@@ -1,5 +1,6 @@
 #include "common/scene/load_scene.h"
 
+#include "common/scene/parse_interactions.h"
 #include "common/scene/parse_mass_spring.h"
 #include "common/util/regular_file.h"
 #include "common/util/yaml_cursor.h"
@@ -255,7 +256,7 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
   const std::string file_name = file.string();
   const Cursor top(load_yaml(yaml_text, file_name, raise_scene_error), "", &file_name, 1, raise_scene_error);
   if (!top.is_map()) top.fail("a map of scene settings");
-  top.only_keys({"name", "units", "objects", "obstacles", "tools", "haptic", "network"});
+  top.only_keys({"name", "units", "objects", "interactions", "obstacles", "tools", "haptic", "network"});
 
   Scene scene;
   scene.file = file;
@@ -274,6 +275,7 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
     if (!object_names.insert(scene.objects.back().name).second) item.at("name").fail("an object name not used before");
   }
   if (scene.objects.empty()) objects.fail("at least one object");
+  if (auto interactions = top.find("interactions")) scene.interactions = parse_interactions(*interactions, scene.objects);
 
   if (auto obstacles = top.find("obstacles"))
     for (const Cursor& item : obstacles->items()) scene.obstacles.push_back(parse_obstacle(item, scale, scene_dir));

@@ -114,12 +114,22 @@ struct NetworkSettings {
   int max_participants = 0;
 };
 
+/// Two objects that press on each other (the several-objects paper): the front object's
+/// nodes collide with the behind object's surface, which is displaced to hold them and
+/// pushes back. Today: a mass-spring front on a linear elastic behind object.
+struct InteractionSpec {
+  std::string front;   ///< object name (model: mass_spring)
+  std::string behind;  ///< object name (model: linear_elastic)
+  std::string where;   ///< file:line of the entry, for errors
+};
+
 struct Scene {
   std::filesystem::path file;   ///< where it was loaded from (empty if built in code)
   std::string name;
   std::string units = "m";      ///< the length unit of the file
   double metres_per_unit = 1;
   std::vector<ObjectSpec> objects;  ///< at least one; the tools may press any of them
+  std::vector<InteractionSpec> interactions;
   std::vector<ObstacleSpec> obstacles;
   std::vector<ToolSpec> tools;
   HapticSettings haptic;

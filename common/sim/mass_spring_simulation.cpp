@@ -59,7 +59,8 @@ StepReport MassSpringSimulation::step(double time) {
   // difference of their times rounds a bit short.
   pending_ += period;
   while (pending_ >= period_ - 1e-9) {
-    advance_with_tools(body_.network, state_, tools_, presses_, reactions_, period_);
+    advance_with_tools(body_.network, state_, tools_, presses_, reactions_, period_,
+                       backing_.empty() ? nullptr : &backing_);
     pending_ -= period_;
   }
 
@@ -99,6 +100,7 @@ void MassSpringSimulation::publish_ir(int user, double time, StepReport& report)
     body.remote_radii.push_back(remote.radius);
     body.presses.push_back(presses_[static_cast<std::size_t>(other)]);
   }
+  if (!backing_.empty()) body.backing = sub_network_backing(backing_, body.node_ids);
   report.ir_bytes += body.size_bytes();
   ir.body = std::move(body);
   auto prepared = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));

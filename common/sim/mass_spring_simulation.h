@@ -24,6 +24,7 @@
 
 #include "common/ir/evaluate_force.h"
 #include "common/mass_spring/mass_spring_state.h"
+#include "common/mass_spring/node_backing.h"
 #include "common/mass_spring/tool_coupling.h"
 #include "common/model/mass_spring_body.h"
 #include "common/scene/scene.h"
@@ -59,6 +60,10 @@ class MassSpringSimulation {
   /// The whole network's reaction on the user's tool in the latest step: what the user
   /// would feel if the server's own step drove its force (the trade-off's reference).
   const NetworkToolReaction& reaction(int user) const { return reactions_[static_cast<std::size_t>(user)]; }
+  /// The body behind this one pressing back on its colliding nodes from the next step on
+  /// (SceneSimulation's interactions; an empty backing: nothing behind it).
+  void set_backing(NodeBacking backing) { backing_ = std::move(backing); }
+  const NodeBacking& backing() const { return backing_; }
   /// Distance from `point` to the nearest surface node in the current state [m].
   double distance_to_surface(const Eigen::Vector3d& point) const;
 
@@ -89,6 +94,7 @@ class MassSpringSimulation {
   std::vector<ToolOnNetwork> tools_;            // per user, for each step
   std::vector<ToolPress> presses_;              // per user: the whole network's contact memory
   std::vector<NetworkToolReaction> reactions_;  // per user, of the latest step
+  NodeBacking backing_;                         // the body behind this one, if any
   bool started_ = false;
   double time_ = 0;                             // of the latest step [s]
 };

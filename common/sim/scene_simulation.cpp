@@ -27,15 +27,40 @@ struct SimulationMaker {
   }
 };
 
+// The index of the body named `name` (the loader checked that it exists).
+int body_index(const Model& model, const std::string& name) {
+  for (int i = 0; i < static_cast<int>(model.bodies.size()); ++i)
+    if (body_name(model, i) == name) return i;
+  throw Error(fmt::format("scene simulation: no object named '{}'", name));
+}
+
 }  // namespace
 
 SceneSimulation::SceneSimulation(const Model& model, std::span<ComplianceColumns* const> columns,
                                  const std::vector<ToolSpec>& tools, const SimulationOptions& options)
-    : model_(model), users_(tools.size()) {
+    : model_(model), users_(tools.size()), columns_(columns.begin(), columns.end()) {
   if (columns.size() != model.bodies.size())
     throw Error(fmt::format("scene simulation: {} compliance column sets for {} bodies", columns.size(), model.bodies.size()));
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
     bodies_.push_back(std::visit(SimulationMaker{model, columns[i], tools, options, static_cast<int>(i)}, model.bodies[i]));
+  for (const InteractionSpec& spec : model.scene.interactions) {
+    const int front = body_index(model, spec.front);
+    const int behind = body_index(model, spec.behind);
+    const auto* front_body = std::get_if<MassSpringModel>(&model.bodies[static_cast<std::size_t>(front)]);
+    const auto* behind_body = std::get_if<ElasticBody>(&model.bodies[static_cast<std::size_t>(behind)]);
+    if (!front_body || !behind_body)
+      throw Error(fmt::format("{}: the interaction needs a mass-spring front and a linear elastic behind object", spec.where));
+    interactions_.push_back(make_body_interaction(front, *front_body, behind, *behind_body));
+  }
+}
+
+void SceneSimulation::run_interactions() {
+  for (BodyInteraction& interaction : interactions_) {
+    auto& front = std::get<MassSpringSimulation>(*bodies_[static_cast<std::size_t>(interaction.front)]);
+    const auto& behind = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(interaction.behind)]);
+    front.set_backing(step_body_interaction(interaction, front.state().positions, front.body(), behind,
+                                            *columns_[static_cast<std::size_t>(interaction.behind)]));
+  }
 }
 
 void SceneSimulation::set_tool(int user, const Eigen::Vector3d& position) {
@@ -82,6 +107,7 @@ StepReport SceneSimulation::step(double time) {
   started_ = true;
   time_ = time;
   assign_bodies();
+  run_interactions();
   StepReport report;
   for (int b = 0; b < body_count(); ++b) {
     BodySimulation& simulation = *bodies_[static_cast<std::size_t>(b)];

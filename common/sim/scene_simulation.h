@@ -8,6 +8,9 @@
 // given to its body and cleared on the others, so users on different bodies do not couple.
 // The IR handed for a user (ir(user)) is its body's latest, with epochs that keep rising
 // across a change of body. force() is the P0 force: the same evaluation the client runs.
+// The scene's interactions (a mass-spring body pressing on a linear elastic one behind it,
+// body_interaction.h) run at the start of each step, before the bodies advance: the
+// front body then integrates the behind body's reaction as a linear backing.
 // Units: SI; times in s of the simulation's clock.
 #pragma once
 
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "common/model/model.h"
+#include "common/sim/body_interaction.h"
 #include "common/sim/mass_spring_simulation.h"
 #include "common/sim/simulation.h"
 
@@ -57,6 +61,8 @@ class SceneSimulation {
   /// The FEM simulation of a scene whose only object is linear elastic (the display and the
   /// live view show that body); throws Error (single_elastic_body's) otherwise.
   const Simulation& single_elastic() const;
+  /// The scene's interactions in scene order, as of the latest step.
+  const std::vector<BodyInteraction>& interactions() const { return interactions_; }
 
  private:
   struct UserState {
@@ -67,11 +73,14 @@ class SceneSimulation {
     bool changed = false;
   };
   void assign_bodies();
+  void run_interactions();
   double distance_to_body(int body, const Eigen::Vector3d& point) const;
 
   const Model& model_;
   std::vector<std::unique_ptr<BodySimulation>> bodies_;
   std::vector<UserState> users_;
+  std::vector<ComplianceColumns*> columns_;  // per body, null unless linear elastic
+  std::vector<BodyInteraction> interactions_;
   bool started_ = false;
   double time_ = 0;    // of the latest step [s]
   double period_ = 0;  // of the latest step [s]

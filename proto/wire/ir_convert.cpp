@@ -189,6 +189,14 @@ void mass_spring_to_wire(const MassSpringIr& ir, MassSpringPatch* out) {
     state->set_pressing(press.pressing);
     to_wire(press.previous, state->mutable_previous());
   }
+  if (!ir.backing.empty()) {
+    NodeBacking* backing = out->mutable_backing();
+    for (int node : ir.backing.nodes) backing->add_nodes(static_cast<std::uint32_t>(node));
+    add_values<double>(ir.backing.stiffness.data(), ir.backing.stiffness.size(), backing->mutable_stiffness());
+    add_values<double>(ir.backing.damping.data(), ir.backing.damping.size(), backing->mutable_damping());
+    add_values<double>(ir.backing.targets.data(), ir.backing.targets.size(), backing->mutable_targets());
+    add_values<double>(ir.backing.normals.data(), ir.backing.normals.size(), backing->mutable_normals());
+  }
 }
 
 void home_spring_to_wire(const cohaptic::HomeSpringPatch& patch, HomeSpringPatch* out) {
@@ -397,6 +405,28 @@ MassSpringIr mass_spring_from_wire(const MassSpringPatch& w) {
   }
   for (int i = 0; i < w.presses_size(); ++i)
     ir.presses.push_back({w.presses(i).pressing(), read_vec3(w.presses(i).previous(), fmt::format("presses[{}]", i))});
+  if (w.has_backing()) {
+    const NodeBacking& b = w.backing();
+    const auto backed = static_cast<std::uint64_t>(b.nodes_size());
+    const auto count = static_cast<Eigen::Index>(backed);
+    if (static_cast<std::uint64_t>(b.stiffness_size()) != backed || static_cast<std::uint64_t>(b.damping_size()) != backed ||
+        static_cast<std::uint64_t>(b.targets_size()) != 3 * backed || static_cast<std::uint64_t>(b.normals_size()) != 3 * backed)
+      invalid("a backing of {} nodes with {} stiffnesses, {} dampings, {} targets and {} normals (expected {}, {}, {}, {})",
+              backed, b.stiffness_size(), b.damping_size(), b.targets_size(), b.normals_size(), backed, backed,
+              3 * backed, 3 * backed);
+    for (std::uint32_t node : b.nodes()) {
+      if (node >= nodes) invalid("the backing names node {} of {}", node, nodes);
+      ir.backing.nodes.push_back(static_cast<int>(node));
+    }
+    ir.backing.stiffness.resize(count);
+    read_values(b.stiffness(), ir.backing.stiffness, "backing.stiffness");
+    ir.backing.damping.resize(count);
+    read_values(b.damping(), ir.backing.damping, "backing.damping");
+    ir.backing.targets.resize(3 * count);
+    read_values(b.targets(), ir.backing.targets, "backing.targets");
+    ir.backing.normals.resize(3 * count);
+    read_values(b.normals(), ir.backing.normals, "backing.normals");
+  }
   return ir;
 }
 

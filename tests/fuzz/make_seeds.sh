@@ -28,7 +28,8 @@ copy_seeds() {  # target, files...
   find "$corpus/$target" -type f ! -name 'crash-*' ! -name 'regression-*' -delete
   for file in "$@"; do cp "$file" "$corpus/$target/$(basename "$file")"; done
 }
-copy_seeds scene scenes/cube.yaml scenes/brain.yaml scenes/tradeoff/cube_two_users.yaml scenes/thin/noodle.yaml scenes/thin/noodle_heated.yaml
+copy_seeds scene scenes/cube.yaml scenes/brain.yaml scenes/tradeoff/cube_two_users.yaml scenes/thin/noodle.yaml scenes/thin/noodle_heated.yaml \
+  scenes/objects/paired_boxes.yaml
 copy_seeds study scenes/studies/*.yaml
 copy_seeds gmsh tests/data/mesh_io/*.msh
 copy_seeds freesurfer tests/data/mesh_io/*.asc

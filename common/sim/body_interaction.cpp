@@ -1,0 +1,40 @@
+#include "common/sim/body_interaction.h"
+
+#include "common/interaction/condensed_response.h"
+
+namespace cohaptic {
+
+BodyInteraction make_body_interaction(int front, const MassSpringModel& front_body, int behind,
+                                      const ElasticBody& behind_body) {
+  BodyInteraction interaction;
+  interaction.front = front;
+  interaction.behind = behind;
+  const MassSpringNetwork& network = front_body.network;
+  interaction.front_surface = make_surface_adjacency(
+      std::vector<Triangle>(network.triangles.begin(), network.triangles.end()), network.node_count());
+  interaction.behind_surface = make_surface_adjacency(behind_body.surface.triangles, behind_body.mesh.node_count());
+  interaction.pairs = make_node_pairs(network.surface_nodes, network.rest_positions, behind_body.surface.nodes,
+                                      behind_body.mesh.nodes);
+  return interaction;
+}
+
+NodeBacking step_body_interaction(BodyInteraction& interaction, const Eigen::Matrix3Xd& front_positions,
+                                    const MassSpringModel& front_body, const ElasticBody& behind_body,
+                                    ComplianceColumns& columns) {
+  const InteractingBodies bodies{front_positions,     interaction.front_surface, behind_body.mesh.nodes,
+                                 interaction.behind_surface, behind_body.dofs, columns};
+  interaction.latest = interaction_step(interaction.pairs, bodies, InteractionWorkflow::improved, interaction.workspace);
+  // The backing holds every node that collided or may collide before the next step, each
+  // engaging on its own gap at every substep (node_backing.h).
+  const std::vector<PolygonCollision> within = find_polygons_within(interaction.pairs, bodies, kBackingReach);
+  if (within.empty()) return {};
+  const std::vector<AxisMask>& fixed_axes = behind_body.dofs.fixed_axes;
+  const ForcibleDisplacement displacement = forcible_displacement(within, fixed_axes);
+  const MassSpringNetwork& network = front_body.network;
+  const LinearBacking backing =
+      build_linear_backing(within, displacement, condensed_stiffness(columns, behind_body.dofs, displacement.nodes),
+                           network.rest_positions);
+  return node_backing(backing, within, network.mass, kBackingDampingRatio);
+}
+
+}  // namespace cohaptic
