@@ -3,7 +3,13 @@
 // the same window of them in every run), stepped as fast as it goes, with
 //   - no view (BM_SimulationSteps/no_view), the reference;
 //   - the live view at 30 frames/s and 0, 1 or 50 browsers (WebSocket clients in this
-//     process, reading everything) connected: BM_SimulationSteps/view_browsers/N.
+//     process, reading everything) connected: BM_SimulationSteps/view_browsers/N;
+//   - no view, but a thread on the browsers' CPU burning CPU for P per mille of every
+//     millisecond: BM_SimulationSteps_no_view_with_load/P, the control. The simulation does
+//     nothing for the browsers, yet its steps slowed with 50 of them; this separates what
+//     any work on the other CPU costs it (shared caches, memory bandwidth, a sibling
+//     hyperthread of this VM) from what the view's own work does: compare the cases whose
+//     others_cpu_us_per_step match (P = 50: about what the view and its 50 browsers take).
 // A browser runs on another machine in real use. Here the browsers share this one, and the
 // kernel charges a loopback receive to whichever thread happens to run, so the benchmark
 // pins the simulation (this thread) to CPU 0 and the view's thread and the browsers to
@@ -32,6 +38,7 @@
 #include <sched.h>
 #include <sys/resource.h>
 
+#include <atomic>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -124,7 +131,47 @@ double cpu_seconds(int who) {
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
-void run_steps(benchmark::State& state, bool with_view, int browsers) {
+// A thread on `cpu` that, in every 1 ms slice, busy-loops for `per_mille` of it over a few
+// MB of memory (more than a core's cache, as the browsers' buffers are), then sleeps to the
+// next slice: other work on that CPU, at a set duty cycle, that the simulation does not use.
+class CpuBurner {
+ public:
+  CpuBurner(int cpu, int per_mille)
+      : thread_([this, cpu, per_mille] {
+          const PinnedThread pinned(cpu);
+          constexpr std::chrono::microseconds kSlice{1000};
+          const auto busy = kSlice * per_mille / 1000;
+          std::vector<std::uint64_t> memory(std::size_t{4} << 20 >> 3);
+          std::size_t next = 0;
+          for (auto slice = std::chrono::steady_clock::now(); !stop_.load(std::memory_order_relaxed); slice += kSlice) {
+            const auto woke = std::chrono::steady_clock::now();  // late by the timer's slack
+            while (std::chrono::steady_clock::now() < woke + busy)
+              for (int k = 0; k < 256; ++k, next = (next + 8) % memory.size()) ++memory[next];  // one cache line each
+            std::this_thread::sleep_until(slice + kSlice);
+          }
+          benchmark::DoNotOptimize(memory.data());
+        }) {}
+  ~CpuBurner() {
+    stop_ = true;
+    thread_.join();
+  }
+  CpuBurner(const CpuBurner&) = delete;
+  CpuBurner& operator=(const CpuBurner&) = delete;
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+// What runs beside the simulation loop: the live view with `browsers` connected, or not,
+// and a CpuBurner at `load_per_mille` (0: none) on the view's CPU.
+struct Beside {
+  bool view = false;
+  int browsers = 0;
+  int load_per_mille = 0;
+};
+
+void run_steps(benchmark::State& state, Beside beside) {
   BrainRig& rig = BrainRig::get();
   const bool pin = PinnedThread::possible();
   if (!pin) state.SetLabel("not pinned: CPUs 0 and 1 are not both available");
@@ -134,7 +181,7 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
   for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) tools.join(static_cast<int>(slot));
   LoopStatistics statistics;
   std::unique_ptr<view::LiveView> live;
-  if (with_view)
+  if (beside.view)
     live = std::make_unique<view::LiveView>(*rig.model, *rig.columns, wire_protocol(options), injected_delays(options),
                                             view::LiveViewOptions{}, nullptr);
   SimulationLoop loop(*rig.model, std::array{rig.columns.get()}, options, tools, statistics, nullptr, live.get(), nullptr,
@@ -151,12 +198,14 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
     if (pin) on_cpu1.emplace(1);
     live->start();
     const std::string url = "ws://127.0.0.1:" + std::to_string(live->port()) + "/ws";
-    for (int k = 0; k < browsers; ++k) {
+    for (int k = 0; k < beside.browsers; ++k) {
       clients.push_back(std::make_unique<testing::WebSocketClient>(url));
       if (!clients.back()->wait_open(std::chrono::seconds(10))) state.SkipWithError("a browser could not connect");
       clients.back()->count_only();
     }
   }
+  std::optional<CpuBurner> load;
+  if (beside.load_per_mille > 0) load.emplace(pin ? 1 : 0, beside.load_per_mille);
   std::optional<PinnedThread> on_cpu0;  // the simulation
   if (pin) on_cpu0.emplace(0);
   std::this_thread::yield();  // on CPU 0 from here
@@ -192,6 +241,7 @@ void run_steps(benchmark::State& state, bool with_view, int browsers) {
   }
   clients.clear();
   if (live) live->stop();
+  load.reset();
 }
 
 // The brain with both surgeons pressing, 3 s into their motions, and what a frame of it needs.
@@ -266,14 +316,26 @@ BENCHMARK(BM_ViewFrame_view_thread)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ViewFrame_displacement_from_loads)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ViewFrame_displacement_gathered)->Unit(benchmark::kMicrosecond);
 
-void BM_SimulationSteps_no_view(benchmark::State& state) { run_steps(state, false, 0); }
-void BM_SimulationSteps_view_browsers(benchmark::State& state) { run_steps(state, true, static_cast<int>(state.range(0))); }
+void BM_SimulationSteps_no_view(benchmark::State& state) { run_steps(state, {}); }
+void BM_SimulationSteps_view_browsers(benchmark::State& state) {
+  run_steps(state, {.view = true, .browsers = static_cast<int>(state.range(0))});
+}
+void BM_SimulationSteps_no_view_with_load(benchmark::State& state) {
+  run_steps(state, {.load_per_mille = static_cast<int>(state.range(0))});
+}
 
 BENCHMARK(BM_SimulationSteps_no_view)->Iterations(kWindowSteps)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_SimulationSteps_view_browsers)
     ->Arg(0)
     ->Arg(1)
     ->Arg(50)
+    ->Iterations(kWindowSteps)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK(BM_SimulationSteps_no_view_with_load)
+    ->Arg(50)
+    ->Arg(90)
+    ->Arg(300)
     ->Iterations(kWindowSteps)
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
