@@ -111,7 +111,7 @@ TEST(InteractionScene, BehindBoxCarriesTheFrontObjectsWeightAndATool) {
   EXPECT_EQ(no_push, 0);
   EXPECT_LT(boxes.lowest(), 0);  // A sank into B's rest surface as B gave way ...
   EXPECT_GT(boxes.lowest(), -1e-3);  // ... by less than a millimetre
-  EXPECT_FALSE(boxes.simulation.interactions()[0].latest.collisions.empty());
+  EXPECT_FALSE(boxes.front().backing().empty());
 
   // A tool pressing A's top 3 mm down: B then carries the weight and the tool's push.
   const double top = state.positions.row(2).maxCoeff();

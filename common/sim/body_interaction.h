@@ -2,9 +2,8 @@
 // mass-spring front body pressing on a condensed linear elastic body behind it (the
 // several-objects paper, Sec. 2). Each step the front network's surface nodes, at their
 // current positions, are tested against the behind body's surface at rest (linear body)
-// through the pairs of nearest nodes (improved workflow, interaction_step.h); the behind
-// body's displaced nodes are condensed through its compliance columns (B's deformation,
-// `latest`). The front body feels B through a backing (node_backing.h) over every front node
+// through the pairs of nearest nodes, kept as interaction_step.h keeps them. The front
+// body feels B through a backing (node_backing.h) over every front node
 // that is behind B's surface or within kBackingReach of it: B's condensed stiffness mapped
 // onto those nodes (linear_backing.h), lumped to one normal contact spring-damper per node,
 // which the front body's integrator evaluates every substep until the next step rebuilds it.
@@ -36,8 +35,6 @@ struct BodyInteraction {
   SurfaceAdjacency front_surface;
   SurfaceAdjacency behind_surface;
   NodePairList pairs;
-  CondensedResponseWorkspace workspace;
-  InteractionStep latest;  ///< of the latest step: collisions, displaced nodes, B's deformation
 };
 
 /// Pairs every surface node of the front network at rest with the nearest surface node
