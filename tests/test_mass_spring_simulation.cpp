@@ -140,7 +140,7 @@ Eigen::Vector3d pressing_tool(const MassSpringModel& body, double t, double dept
 struct Lockstep {
   // The server advances by the test's tick, 1/1024 s: exact in binary, so its step times'
   // differences are exactly one tick.
-  explicit Lockstep(const MassSpringModel& body) : simulation(body, 0, {ToolSpec{"A", ToolShape::sphere, 0.002}}, 3.3, 1.0 / 1024) {}
+  explicit Lockstep(const MassSpringModel& body) : simulation(body, 0, {ToolSpec{"A", ToolShape::sphere, 0.002, {}}}, 3.3, 1.0 / 1024) {}
   MassSpringSimulation simulation;
   std::unique_ptr<PreparedIR> client;
   EvaluationState client_state;

@@ -29,12 +29,16 @@ struct BodyBuilder {
     return build_elastic_body(object, spec, metres_per_unit);
   }
   BodyModel operator()(const MassSpringObjectSpec& spec) const { return build_mass_spring_body(object.name, spec, object.where); }
+  BodyModel operator()(const HomeSpringObjectSpec& spec) const {
+    return build_home_spring_body(object.name, spec, object.where, metres_per_unit);
+  }
 };
 
 // The model name a user wrote for the body kind, for messages.
 struct KindName {
   const char* operator()(const ElasticBody&) const { return "linear_elastic"; }
   const char* operator()(const MassSpringModel&) const { return "mass_spring"; }
+  const char* operator()(const HomeSpringBody&) const { return "home_spring"; }
 };
 
 }  // namespace

@@ -11,13 +11,14 @@
 
 #include "common/contact/obstacle.h"
 #include "common/model/elastic_body.h"
+#include "common/model/home_spring_body.h"
 #include "common/model/mass_spring_body.h"
 #include "common/scene/scene.h"
 
 namespace cohaptic {
 
 /// A compiled scene object: one alternative per BodySpec alternative, in the same order.
-using BodyModel = std::variant<ElasticBody, MassSpringModel>;
+using BodyModel = std::variant<ElasticBody, MassSpringModel, HomeSpringBody>;
 
 struct Model {
   Scene scene;

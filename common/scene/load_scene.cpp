@@ -1,5 +1,6 @@
 #include "common/scene/load_scene.h"
 
+#include "common/scene/parse_home_spring.h"
 #include "common/scene/parse_interactions.h"
 #include "common/scene/parse_mass_spring.h"
 #include "common/util/regular_file.h"
@@ -176,9 +177,11 @@ ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::pa
   ObjectSpec object;
   object.where = c.location();
   object.name = c.at("name").text();
-  const std::string model = c.find("model") ? c.at("model").choice({"linear_elastic", "mass_spring"}) : "linear_elastic";
+  const std::string model =
+      c.find("model") ? c.at("model").choice({"linear_elastic", "mass_spring", "home_spring"}) : "linear_elastic";
   if (model == "linear_elastic") object.body = parse_elastic_object(c, scale, scene_dir);
-  else object.body = parse_mass_spring_object(c, scale);
+  else if (model == "mass_spring") object.body = parse_mass_spring_object(c, scale);
+  else object.body = parse_home_spring_object(c, scale, scene_dir);
   return object;
 }
 
@@ -205,14 +208,23 @@ ObstacleSpec parse_obstacle(const Cursor& c, double scale, const std::filesystem
 }
 
 ToolSpec parse_tool(const Cursor& c, double scale) {
-  c.only_keys({"name", "shape", "radius"});
+  c.only_keys({"name", "shape", "radius", "trocar", "jaws"});
   ToolSpec tool;
   tool.name = c.at("name").text();
-  if (auto shape = c.find("shape")) tool.shape = shape->choice({"point", "sphere"}) == "point" ? ToolShape::point : ToolShape::sphere;
+  if (auto shape = c.find("shape")) {
+    const std::string name = shape->choice({"point", "sphere", "probe", "forceps"});
+    tool.shape = name == "point" ? ToolShape::point : name == "sphere" ? ToolShape::sphere : name == "probe" ? ToolShape::probe : ToolShape::forceps;
+  }
+  if (tool.shape == ToolShape::probe || tool.shape == ToolShape::forceps)
+    tool.instrument = parse_instrument(c, scale, tool.shape == ToolShape::forceps);
+  else if (auto trocar = c.find("trocar"))
+    trocar->fail_message("only an instrument has a trocar (use shape: probe or shape: forceps)");
+  else if (auto jaws = c.find("jaws"))
+    jaws->fail_message("only forceps have jaws (use shape: forceps)");
   if (tool.shape == ToolShape::sphere)
     tool.radius = c.at("radius").number_in(0, INFINITY, true, true, "a positive radius") * scale;
   else if (auto radius = c.find("radius"))
-    radius->fail_message("a point tool has no radius (use shape: sphere)");
+    radius->fail_message(fmt::format("a {} tool has no radius (use shape: sphere)", tool.instrument ? "instrument" : "point"));
   return tool;
 }
 

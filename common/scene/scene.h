@@ -16,11 +16,14 @@
 
 #include "common/fem/dof_map.h"
 #include "common/fem/linear_elastic_material.h"
+#include "common/laparoscopy/home_spring_spec.h"
 #include "common/mass_spring/mass_spring_spec.h"
 
 namespace cohaptic {
 
-enum class ToolShape { point, sphere };
+/// probe and forceps are laparoscopic instruments (home_spring_spec.h): a shaft through a
+/// trocar; on any other body kind their tip is a point.
+enum class ToolShape { point, sphere, probe, forceps };
 /// How a tool holds the surface: the paper's two (node translation of the contact triangle, the
 /// contact point alone) and the sphere model (every node a sphere tool has passed, held on
 /// its surface; common/contact/sphere_contact.h), the default for sphere tools.
@@ -75,7 +78,7 @@ struct ElasticObjectSpec {
 /// One alternative per body model a scene may ask for (`model:` in the file). Adding a
 /// model adds an alternative here, and the compiler then names every place that must
 /// learn it (the compiled body, its simulation, its IR body).
-using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec>;
+using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec, HomeSpringObjectSpec>;
 
 /// A deformable object of the scene: its name (unique in the scene) and its model's spec.
 struct ObjectSpec {
@@ -95,6 +98,7 @@ struct ToolSpec {
   std::string name;
   ToolShape shape = ToolShape::point;
   double radius = 0;  ///< [m], > 0 for a sphere
+  std::optional<InstrumentSpec> instrument;  ///< set exactly for probe and forceps
 };
 
 struct HapticSettings {

@@ -44,6 +44,18 @@ SurfaceMesh surface_mesh_message(const MassSpringModel& body) {
   return message;
 }
 
+SurfaceMesh surface_mesh_message(const HomeSpringBody& body) {
+  SurfaceMesh message;
+  const TriangleSurface& surface = body.surface;
+  for (int v = 0; v < surface.vertex_count(); ++v) {
+    for (int axis = 0; axis < 3; ++axis) message.add_vertices(surface.vertices(axis, v));
+    message.add_node_ids(v);
+  }
+  for (const Triangle& triangle : surface.triangles)
+    for (int corner : triangle) message.add_triangles(static_cast<std::uint32_t>(corner));
+  return message;
+}
+
 SurfaceMesh surface_mesh_message(const BodyModel& body) {
   return std::visit([](const auto& kind) { return surface_mesh_message(kind); }, body);
 }

@@ -21,6 +21,8 @@ SurfaceMesh surface_mesh_message(const ElasticBody& body);
 /// A mass-spring body's surface at rest: vertex i is network.surface_nodes[i], its node id
 /// the network's node index.
 SurfaceMesh surface_mesh_message(const MassSpringModel& body);
+/// A home-spring tissue's surface at rest: vertex i is surface vertex i, its node id i.
+SurfaceMesh surface_mesh_message(const HomeSpringBody& body);
 /// Whichever kind `body` is.
 SurfaceMesh surface_mesh_message(const BodyModel& body);
 

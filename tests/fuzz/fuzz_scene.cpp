@@ -53,13 +53,36 @@ void require_valid(const MassSpringObjectSpec& object) {
   require(std::isfinite(object.material.density) && object.material.density > 0, "the density is positive and finite");
 }
 
+void require_valid(const HomeSpringObjectSpec& object) {
+  require(!object.surface_file.empty() != object.grid.has_value(), "a tissue has a surface file or a grid");
+  if (object.grid) {
+    require(object.grid->min.allFinite() && object.grid->size.allFinite() && (object.grid->size.array() > 0).all(),
+            "a grid has a corner and a size");
+    require((object.grid->divisions.array() >= 1).all(), "a grid has cells");
+  }
+  require(std::isfinite(object.home_stiffness) && object.home_stiffness > 0, "k1 is positive and finite");
+  require(std::isfinite(object.neighbour_stiffness) && object.neighbour_stiffness >= 0, "k2 is finite and not negative");
+  require(std::isfinite(object.patch_radius) && object.patch_radius > 0, "the patch radius is positive");
+  require(std::isfinite(object.display_radius) && object.display_radius > 0, "the display radius is positive");
+}
+
 void require_valid(const Scene& scene) {
   require(std::isfinite(scene.metres_per_unit) && scene.metres_per_unit > 0, "the unit scale is positive");
   require(!scene.objects.empty(), "a scene has objects");
   for (const ObjectSpec& object : scene.objects) std::visit([](const auto& body) { require_valid(body); }, object.body);
   require(!scene.tools.empty(), "a scene has tools");
-  for (const ToolSpec& tool : scene.tools)
-    require(tool.shape == ToolShape::point || (std::isfinite(tool.radius) && tool.radius > 0), "a sphere has a radius");
+  for (const ToolSpec& tool : scene.tools) {
+    require(tool.shape != ToolShape::sphere || (std::isfinite(tool.radius) && tool.radius > 0), "a sphere has a radius");
+    const bool instrument = tool.shape == ToolShape::probe || tool.shape == ToolShape::forceps;
+    require(instrument == tool.instrument.has_value(), "exactly the instruments have a trocar");
+    if (tool.instrument) {
+      require(tool.instrument->trocar.allFinite(), "a trocar is finite");
+      require_unit(tool.instrument->opening);
+      require(tool.instrument->open_angle > 0 && tool.instrument->open_angle < M_PI / 2, "the jaws open below 90 degrees");
+      require(tool.instrument->closing_step > 0 && tool.instrument->closing_step <= tool.instrument->open_angle,
+              "the jaws close in positive steps");
+    }
+  }
   for (const ObstacleSpec& obstacle : scene.obstacles)
     if (obstacle.plane) require_unit(obstacle.plane->second);
   require(scene.haptic.rate_hz >= 1 && scene.haptic.rate_hz <= 100000, "the haptic rate is in range");

@@ -1,0 +1,140 @@
+#include "common/sim/home_spring_simulation.h"
+
+#include "common/laparoscopy/extract_home_spring_patch.h"
+#include "common/util/stopwatch.h"
+
+namespace cohaptic {
+namespace {
+
+// The corner of surface triangle `triangle` nearest `point` (the lowest corner on a tie),
+// as the client picks the vertex of the triangle its shaft crosses.
+int nearest_tissue_corner(const HomeSpringBody& body, int triangle, const Eigen::Vector3d& point) {
+  int nearest = -1;
+  double best = 0;
+  for (const int v : body.surface.triangles[static_cast<std::size_t>(triangle)]) {
+    const double d2 = (body.surface.vertices.col(v) - point).squaredNorm();
+    if (nearest < 0 || d2 < best) {
+      nearest = v;
+      best = d2;
+    }
+  }
+  return nearest;
+}
+
+ForcepsGeometry jaw_geometry(const InstrumentSpec& instrument) {
+  return {instrument.jaw_length, instrument.open_angle, instrument.closing_step};
+}
+
+}  // namespace
+
+HomeSpringSimulation::HomeSpringSimulation(const HomeSpringBody& body, int object, const std::vector<ToolSpec>& tools,
+                                           double force_limit)
+    : body_(body), object_(object), force_limit_(force_limit), users_(tools.size()), displayed_(body.surface.vertices) {
+  for (std::size_t u = 0; u < tools.size(); ++u) {
+    UserState& user = users_[u];
+    user.instrument = tools[u].instrument;
+    user.forceps = tools[u].shape == ToolShape::forceps;
+    if (user.forceps) user.jaws = open_forceps(jaw_geometry(*user.instrument));
+  }
+}
+
+void HomeSpringSimulation::set_tool(int user, const Eigen::Vector3d& position, std::uint32_t buttons) {
+  UserState& state = users_[static_cast<std::size_t>(user)];
+  state.known = position.allFinite();
+  state.position = position;
+  state.buttons = buttons;
+}
+
+void HomeSpringSimulation::clear_tool(int user) { users_[static_cast<std::size_t>(user)].known = false; }
+
+void HomeSpringSimulation::continue_epochs(int user, std::uint64_t epoch) {
+  UserState& state = users_[static_cast<std::size_t>(user)];
+  state.epoch = std::max(state.epoch, epoch);
+}
+
+double HomeSpringSimulation::distance_to_surface(const Eigen::Vector3d& point) const {
+  return std::sqrt(body_.tree.closest_triangle(point).distance2);
+}
+
+StepReport HomeSpringSimulation::step(double time) {
+  StepReport report;
+  const Stopwatch watch;
+  displayed_ = body_.display.rest;
+  for (int u = 0; u < user_count(); ++u) step_user(u, time, report);
+  if (report.rebuilt) report.rebuild_ms = watch.elapsed_ms();
+  return report;
+}
+
+void HomeSpringSimulation::step_user(int u, double time, StepReport& report) {
+  UserState& user = users_[static_cast<std::size_t>(u)];
+  user.pressing = false;
+  if (!user.instrument) return;
+  if (!user.known) {
+    if (user.forceps) user.jaws = open_forceps(jaw_geometry(*user.instrument));
+    return;
+  }
+  const auto shaft = shaft_frame(user.instrument->trocar, user.position, user.instrument->opening);
+  if (!shaft) return;
+  if (user.forceps) step_forceps(jaw_geometry(*user.instrument), *shaft, (user.buttons & 1u) != 0, body_.tree, user.jaws);
+
+  int centre = -1;
+  if (user.jaws.grasping) {
+    const AabbHit hit = body_.tree.closest_triangle(user.jaws.grasp_point);
+    centre = nearest_tissue_corner(body_, hit.triangle, user.jaws.grasp_point);
+  } else {
+    // The shaft's line on through the tip, far enough to leave the tissue's bounds.
+    const Eigen::Vector3d extent = body_.surface.vertices.rowwise().maxCoeff() - body_.surface.vertices.rowwise().minCoeff();
+    const double reach = (user.position - shaft->pivot).norm() + extent.norm() + body_.longest_edge;
+    const AabbCrossing hit = body_.tree.first_crossing(shaft->pivot, shaft->pivot + reach * shaft->axis);
+    if (hit.triangle >= 0)
+      centre = nearest_tissue_corner(body_, hit.triangle, shaft->pivot + hit.crossing.t * reach * shaft->axis);
+    else if (user.grasped)
+      centre = user.centre;  // released with the line off the tissue: the same patch, without the grasp
+  }
+  if (centre >= 0 && (!user.ir || centre != user.centre || user.jaws.grasping != user.grasped))
+    publish_ir(u, centre, time, report);
+  if (!user.ir) return;
+
+  const HomeSpringContact contact = evaluate_home_spring(std::get<PreparedHomeSpringPatch>(user.ir->body), user.position);
+  user.pressing = contact.touching;
+  if (contact.touching) add_dent(user, contact);
+}
+
+void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport& report) {
+  UserState& user = users_[static_cast<std::size_t>(u)];
+  const HomeSpringObjectSpec& spec = body_.spec;
+  HomeSpringPatch patch = extract_home_spring_patch({body_.surface.vertices, body_.surface.triangles, body_.rings},
+                                                    body_.surface.vertices.col(centre), spec.patch_radius,
+                                                    {spec.home_stiffness, spec.neighbour_stiffness}, user.instrument->trocar);
+  if (user.jaws.grasping) patch.grasp = {nearest_touchable_vertex(patch, user.jaws.grasp_point), user.jaws.tool_at_grasp};
+  IntermediateRepresentation ir;
+  ir.epoch = ++user.epoch;
+  ir.simulation_time = time;
+  ir.user = u;
+  ir.object = object_;
+  ir.force_limit = force_limit_;
+  ir.body = std::move(patch);
+  user.ir = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
+  user.evaluation = make_evaluation_state(*user.ir);
+  user.centre = centre;
+  user.grasped = user.jaws.grasping;
+  report.rebuilt = true;
+  report.ir_bytes += user.ir->ir.size_bytes();
+}
+
+void HomeSpringSimulation::add_dent(const UserState& user, const HomeSpringContact& contact) {
+  const bool grasping = user.jaws.grasping;
+  const Eigen::Vector3d from = grasping ? user.jaws.grasp_point : contact.contact_point;
+  const Eigen::Vector3d to = grasping ? Eigen::Vector3d(from + (user.position - user.jaws.tool_at_grasp)) : user.position;
+  dented_.resize(3, body_.display.rest.cols());
+  display_tissue(body_.display, from, to, dented_);
+  displayed_ += dented_ - body_.display.rest;
+}
+
+ForceSample HomeSpringSimulation::force(int u) {
+  UserState& user = users_[static_cast<std::size_t>(u)];
+  if (!user.ir || !user.known) return {};
+  return evaluate_force(*user.ir, user.evaluation, user.position, {}, 0);
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,92 @@
+// HomeSpringSimulation: the server's simulation of one laparoscopy tissue (the laparoscopy
+// paper's model: home springs for the force, a local deformation for the eye, decoupled),
+// with no threads or sockets.
+//
+// Per user, an instrument: the shaft from the tool's trocar pivot to its tip (the device's
+// position); forceps close their jaws on the tissue while button 0 is held (one increment
+// per step, forceps_jaws.h), grasp when both stop on it, and release on button up. Tools
+// that are not instruments (no trocar) touch nothing on this body.
+//
+// IRs: the user's HomeSpringPatch around its contact vertex: the corner nearest the point
+// where the shaft's line (from the pivot through the tip, and on) first crosses the rest
+// surface, so the patch is there before the tip reaches it; while grasped, around the
+// vertex nearest the grasp point, with the grasp. A new IR is built when that vertex or
+// the grasp changes (not otherwise: the patch is static, the client evaluates it exactly);
+// a shaft whose line misses the surface keeps its last IR.
+//
+// force() is the P0 force: the client's evaluate_force on the user's IR. The display
+// deformation (displayed()) dents the rest surface per pressing user: P the contact point
+// and A the tip for a probe; P the grasp point, fixed, and A it moved by the pull for
+// grasping forceps; the users' dents add. Units: SI; times in s of the simulation's clock.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "common/ir/evaluate_force.h"
+#include "common/laparoscopy/forceps_jaws.h"
+#include "common/model/home_spring_body.h"
+#include "common/scene/scene.h"
+#include "common/sim/step_report.h"
+
+namespace cohaptic {
+
+class HomeSpringSimulation {
+ public:
+  /// One user per tool; `body` must outlive it. `object` is the body's index in the scene
+  /// (the IRs' object); `force_limit` [N] goes into every IR.
+  HomeSpringSimulation(const HomeSpringBody& body, int object, const std::vector<ToolSpec>& tools, double force_limit);
+
+  // The members SceneSimulation visits, as Simulation has them.
+  int user_count() const { return static_cast<int>(users_.size()); }
+  /// `buttons`: bit i is the device's button i held (button 0 closes forceps).
+  void set_tool(int user, const Eigen::Vector3d& position, std::uint32_t buttons = 0);
+  void clear_tool(int user);  ///< the tool touches nothing, forceps release, until set again
+  void continue_epochs(int user, std::uint64_t epoch);  ///< the user's next epoch is above `epoch`
+  StepReport step(double time);
+  /// Null until the user's shaft first aimed at the tissue.
+  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
+  /// The shaft crosses the rest surface, or the forceps grasp.
+  bool pressing(int user) const { return users_[static_cast<std::size_t>(user)].pressing; }
+  /// P0: the user's IR evaluated at its tool's position now (zero without an IR).
+  ForceSample force(int user);
+  /// The forceps' jaws of `user` as of the latest step (open, for a probe).
+  const ForcepsJaws& jaws(int user) const { return users_[static_cast<std::size_t>(user)].jaws; }
+  /// The rest surface dented by the pressing users, as of the latest step [m].
+  const Eigen::Matrix3Xd& displayed() const { return displayed_; }
+  /// Distance from `point` to the rest surface [m].
+  double distance_to_surface(const Eigen::Vector3d& point) const;
+
+  const HomeSpringBody& body() const { return body_; }
+
+ private:
+  struct UserState {
+    std::optional<InstrumentSpec> instrument;
+    bool forceps = false;
+    bool known = false;
+    Eigen::Vector3d position = Eigen::Vector3d::Zero();
+    std::uint32_t buttons = 0;
+    ForcepsJaws jaws;
+    bool pressing = false;
+    int centre = -1;           // surface vertex the IR's patch is built around
+    bool grasped = false;      // the IR's grasp
+    std::uint64_t epoch = 0;
+    std::shared_ptr<const PreparedIR> ir;
+    EvaluationState evaluation;  // P0
+  };
+  void step_user(int user, double time, StepReport& report);
+  void publish_ir(int user, int centre, double time, StepReport& report);
+  void add_dent(const UserState& user, const HomeSpringContact& contact);
+
+  const HomeSpringBody& body_;
+  int object_;
+  double force_limit_;
+  std::vector<UserState> users_;
+  Eigen::Matrix3Xd displayed_;
+  Eigen::Matrix3Xd dented_;  // one user's dent, scratch
+};
+
+}  // namespace cohaptic
