@@ -22,6 +22,7 @@
 #include "common/util/error.h"
 #include "common/util/percentile.h"
 #include "common/util/stopwatch.h"
+#include "lab/tradeoff_home_spring.h"
 #include "lab/tradeoff_mass_spring.h"
 
 namespace cohaptic {
@@ -377,6 +378,71 @@ void write_pareto_plot(const std::filesystem::path& file, const std::vector<Trad
   write_svg(file, plot);
 }
 
+// The table, the CSV and the Pareto plots of `rows` under `heading`, in options.out.
+void write_tradeoff_results(const TradeoffOptions& options, const std::string& heading, const std::vector<TradeoffRow>& rows) {
+  std::vector<double> error, cpu, bytes;
+  for (const TradeoffRow& r : rows) {
+    error.push_back(r.error_rms);
+    cpu.push_back(r.cpu_ms_per_s);
+    bytes.push_back(r.ir_bytes_per_s);
+  }
+  const std::vector<bool> cpu_front = pareto_front(error, cpu);
+  const std::vector<bool> bytes_front = pareto_front(error, bytes);
+  write_csv(options.out / "tradeoff.csv", rows, cpu_front, bytes_front);
+  write_markdown(options.out / "tradeoff.md", heading, rows, cpu_front, bytes_front);
+  write_pareto_plot(options.out / "pareto_cpu.svg", rows, "CPU per second of session, ms",
+                    [](const TradeoffRow& r) { return r.cpu_ms_per_s; }, cpu_front);
+  write_pareto_plot(options.out / "pareto_bytes.svg", rows, "IR traffic, bytes per second",
+                    [](const TradeoffRow& r) { return r.ir_bytes_per_s; }, bytes_front);
+  spdlog::info("front (error against CPU): {}", front_names(rows, cpu_front));
+  spdlog::info("front (error against IR bytes): {}", front_names(rows, bytes_front));
+  spdlog::info("wrote {}/tradeoff.csv, tradeoff.md, pareto_cpu.svg, pareto_bytes.svg", options.out.string());
+}
+
+std::string motion_names(const TradeoffOptions& options) {
+  std::string names;
+  for (const auto& file : options.motions) names += (names.empty() ? "" : ", ") + file.filename().string();
+  return names;
+}
+
+// A home_spring scene beside its FEM twin (--reference-scene): one row per model on the
+// same pokes, both against the twin's full solve.
+int run_model_comparison(const Scene& scene, const std::vector<Trajectory>& motions, const TradeoffOptions& options) {
+  if (options.reference_scene.empty())
+    throw Error(fmt::format("{}: a home_spring scene is compared with the same tissue as a linear elastic body: give "
+                            "its scene as --reference-scene",
+                            options.scene.string()));
+  const Scene fem = load_scene(options.reference_scene);
+  single_elastic_object(fem);  // throws naming the scene when it is not one linear elastic object
+  if (fem.tools.size() != scene.tools.size())
+    throw Error(fmt::format("{}: the FEM scene has {} tools, the scene {}", options.reference_scene.string(), fem.tools.size(),
+                            scene.tools.size()));
+  const int per_step = samples_per(options.sample_rate_hz, kSimulationRateHz, "simulation rate");
+  const int per_tick = samples_per(options.sample_rate_hz, scene.haptic.rate_hz, "scene's haptic rate");
+  samples_per(options.sample_rate_hz, fem.haptic.rate_hz, "FEM scene's haptic rate");
+  TradeoffSetting fem_setting = tradeoff_grid(fem, {}).front();
+  fem_setting.knob = "model";
+  fem_setting.value = "linear_elastic";
+  spdlog::info("reference: {} solved in full at {:g} Hz over the motions ...", options.reference_scene.string(),
+               options.sample_rate_hz);
+  const ReferenceTrace reference = reference_trace(scene_with(fem, fem_setting), motions, options.sample_rate_hz);
+  std::vector<TradeoffRow> rows = {run_setting(fem, fem_setting, motions, reference),
+                                   run_home_spring_setting(scene, motions, reference, per_step, per_tick)};
+  for (const TradeoffRow& r : rows)
+    spdlog::info("{}: error RMS {:.2f} % (max {:.2f} %; own model {:.3g} %), eval {:.2f} us, {:.1f} kB/s, CPU {:.2f} ms/s",
+                 r.setting.name(), 100 * r.error_rms, 100 * r.error_max, 100 * r.own_mesh_error_rms, r.evaluation_us,
+                 r.ir_bytes_per_s / 1000, r.cpu_ms_per_s);
+  write_tradeoff_results(
+      options,
+      fmt::format("# The laparoscopy tissue's two models: {} against {}\n\nReference: {} ({} nodes, {} tetrahedra), "
+                  "full sparse solve at {:g} Hz; peak force {:.3f} N. Workload: {}. The home-spring row's own-mesh "
+                  "columns are against its own model solved at every sample.\n",
+                  scene.name, fem.name, options.reference_scene.filename().string(), reference.nodes, reference.tets,
+                  options.sample_rate_hz, reference.peak_force, motion_names(options)),
+      rows);
+  return 0;
+}
+
 }  // namespace
 
 int run_tradeoff(const TradeoffOptions& options) {
@@ -389,6 +455,8 @@ int run_tradeoff(const TradeoffOptions& options) {
   std::filesystem::create_directories(options.out);
   if (scene.objects.size() == 1 && std::holds_alternative<MassSpringObjectSpec>(scene.objects.front().body))
     return run_mass_spring_tradeoff(scene, motions, options);
+  if (scene.objects.size() == 1 && std::holds_alternative<HomeSpringObjectSpec>(scene.objects.front().body))
+    return run_model_comparison(scene, motions, options);
   if (!options.reference_scene.empty() && single_elastic_object(scene).mesh.box)
     throw Error(fmt::format("{}: a box scene's reference is its own box at --reference-divisions; --reference-scene is "
                             "for mesh files",
@@ -429,31 +497,11 @@ int run_tradeoff(const TradeoffOptions& options) {
                  r.ir_bytes_per_s / 1000, r.cpu_ms_per_s, watch.elapsed_ms() / 1000);
   }
 
-  std::vector<double> error, cpu, bytes;
-  for (const TradeoffRow& r : rows) {
-    error.push_back(r.error_rms);
-    cpu.push_back(r.cpu_ms_per_s);
-    bytes.push_back(r.ir_bytes_per_s);
-  }
-  const std::vector<bool> cpu_front = pareto_front(error, cpu);
-  const std::vector<bool> bytes_front = pareto_front(error, bytes);
   const std::string heading = fmt::format(
       "# Speed against accuracy: {}\n\nReference: {} nodes, {} tetrahedra, full sparse solve at {:g} Hz; peak force "
       "{:.3f} N. Workload: {}.\n",
-      scene.name, reference.nodes, reference.tets, options.sample_rate_hz, reference.peak_force, [&] {
-        std::string names;
-        for (const auto& file : options.motions) names += (names.empty() ? "" : ", ") + file.filename().string();
-        return names;
-      }());
-  write_csv(options.out / "tradeoff.csv", rows, cpu_front, bytes_front);
-  write_markdown(options.out / "tradeoff.md", heading, rows, cpu_front, bytes_front);
-  write_pareto_plot(options.out / "pareto_cpu.svg", rows, "CPU per second of session, ms",
-                    [](const TradeoffRow& r) { return r.cpu_ms_per_s; }, cpu_front);
-  write_pareto_plot(options.out / "pareto_bytes.svg", rows, "IR traffic, bytes per second",
-                    [](const TradeoffRow& r) { return r.ir_bytes_per_s; }, bytes_front);
-  spdlog::info("front (error against CPU): {}", front_names(rows, cpu_front));
-  spdlog::info("front (error against IR bytes): {}", front_names(rows, bytes_front));
-  spdlog::info("wrote {}/tradeoff.csv, tradeoff.md, pareto_cpu.svg, pareto_bytes.svg", options.out.string());
+      scene.name, reference.nodes, reference.tets, options.sample_rate_hz, reference.peak_force, motion_names(options));
+  write_tradeoff_results(options, heading, rows);
   return 0;
 }
 

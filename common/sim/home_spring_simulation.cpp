@@ -29,7 +29,10 @@ ForcepsGeometry jaw_geometry(const InstrumentSpec& instrument) {
 
 HomeSpringSimulation::HomeSpringSimulation(const HomeSpringBody& body, int object, const std::vector<ToolSpec>& tools,
                                            double force_limit)
-    : body_(body), object_(object), force_limit_(force_limit), users_(tools.size()), displayed_(body.surface.vertices) {
+    : body_(body), object_(object), force_limit_(force_limit),
+      beyond_tip_((body.surface.vertices.rowwise().maxCoeff() - body.surface.vertices.rowwise().minCoeff()).norm() +
+                  body.longest_edge),
+      users_(tools.size()) {
   for (std::size_t u = 0; u < tools.size(); ++u) {
     UserState& user = users_[u];
     user.instrument = tools[u].instrument;
@@ -59,7 +62,6 @@ double HomeSpringSimulation::distance_to_surface(const Eigen::Vector3d& point) c
 StepReport HomeSpringSimulation::step(double time) {
   StepReport report;
   const Stopwatch watch;
-  displayed_ = body_.display.rest;
   for (int u = 0; u < user_count(); ++u) step_user(u, time, report);
   if (report.rebuilt) report.rebuild_ms = watch.elapsed_ms();
   return report;
@@ -83,8 +85,7 @@ void HomeSpringSimulation::step_user(int u, double time, StepReport& report) {
     centre = nearest_tissue_corner(body_, hit.triangle, user.jaws.grasp_point);
   } else {
     // The shaft's line on through the tip, far enough to leave the tissue's bounds.
-    const Eigen::Vector3d extent = body_.surface.vertices.rowwise().maxCoeff() - body_.surface.vertices.rowwise().minCoeff();
-    const double reach = (user.position - shaft->pivot).norm() + extent.norm() + body_.longest_edge;
+    const double reach = (user.position - shaft->pivot).norm() + beyond_tip_;
     const AabbCrossing hit = body_.tree.first_crossing(shaft->pivot, shaft->pivot + reach * shaft->axis);
     if (hit.triangle >= 0)
       centre = nearest_tissue_corner(body_, hit.triangle, shaft->pivot + hit.crossing.t * reach * shaft->axis);
@@ -97,7 +98,9 @@ void HomeSpringSimulation::step_user(int u, double time, StepReport& report) {
 
   const HomeSpringContact contact = evaluate_home_spring(std::get<PreparedHomeSpringPatch>(user.ir->body), user.position);
   user.pressing = contact.touching;
-  if (contact.touching) add_dent(user, contact);
+  const bool grasping = user.jaws.grasping;
+  user.dent_from = grasping ? user.jaws.grasp_point : contact.contact_point;
+  user.dent_to = grasping ? Eigen::Vector3d(user.dent_from + (user.position - user.jaws.tool_at_grasp)) : user.position;
 }
 
 void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport& report) {
@@ -122,13 +125,15 @@ void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport
   report.ir_bytes += user.ir->ir.size_bytes();
 }
 
-void HomeSpringSimulation::add_dent(const UserState& user, const HomeSpringContact& contact) {
-  const bool grasping = user.jaws.grasping;
-  const Eigen::Vector3d from = grasping ? user.jaws.grasp_point : contact.contact_point;
-  const Eigen::Vector3d to = grasping ? Eigen::Vector3d(from + (user.position - user.jaws.tool_at_grasp)) : user.position;
-  dented_.resize(3, body_.display.rest.cols());
-  display_tissue(body_.display, from, to, dented_);
-  displayed_ += dented_ - body_.display.rest;
+Eigen::Matrix3Xd HomeSpringSimulation::displayed() const {
+  Eigen::Matrix3Xd shown = body_.display.rest;
+  Eigen::Matrix3Xd dented(3, shown.cols());
+  for (const UserState& user : users_) {
+    if (!user.pressing) continue;
+    display_tissue(body_.display, user.dent_from, user.dent_to, dented);
+    shown += dented - body_.display.rest;
+  }
+  return shown;
 }
 
 ForceSample HomeSpringSimulation::force(int u) {

@@ -15,9 +15,9 @@
 // a shaft whose line misses the surface keeps its last IR.
 //
 // force() is the P0 force: the client's evaluate_force on the user's IR. The display
-// deformation (displayed()) dents the rest surface per pressing user: P the contact point
-// and A the tip for a probe; P the grasp point, fixed, and A it moved by the pull for
-// grasping forceps; the users' dents add. Units: SI; times in s of the simulation's clock.
+// deformation (displayed(), computed when asked, not every step) dents the rest surface per
+// pressing user: P the contact point and A the tip for a probe; P the grasp point, fixed,
+// and A it moved by the pull for grasping forceps; the users' dents add. Units: SI; times in s of the simulation's clock.
 #pragma once
 
 #include <Eigen/Core>
@@ -56,7 +56,7 @@ class HomeSpringSimulation {
   /// The forceps' jaws of `user` as of the latest step (open, for a probe).
   const ForcepsJaws& jaws(int user) const { return users_[static_cast<std::size_t>(user)].jaws; }
   /// The rest surface dented by the pressing users, as of the latest step [m].
-  const Eigen::Matrix3Xd& displayed() const { return displayed_; }
+  Eigen::Matrix3Xd displayed() const;
   /// Distance from `point` to the rest surface [m].
   double distance_to_surface(const Eigen::Vector3d& point) const;
 
@@ -71,6 +71,7 @@ class HomeSpringSimulation {
     std::uint32_t buttons = 0;
     ForcepsJaws jaws;
     bool pressing = false;
+    Eigen::Vector3d dent_from = Eigen::Vector3d::Zero(), dent_to = Eigen::Vector3d::Zero();  // P -> A while pressing
     int centre = -1;           // surface vertex the IR's patch is built around
     bool grasped = false;      // the IR's grasp
     std::uint64_t epoch = 0;
@@ -79,14 +80,12 @@ class HomeSpringSimulation {
   };
   void step_user(int user, double time, StepReport& report);
   void publish_ir(int user, int centre, double time, StepReport& report);
-  void add_dent(const UserState& user, const HomeSpringContact& contact);
 
   const HomeSpringBody& body_;
   int object_;
   double force_limit_;
+  double beyond_tip_;  // how far past the tip the shaft's line is followed: across the tissue's bounds [m]
   std::vector<UserState> users_;
-  Eigen::Matrix3Xd displayed_;
-  Eigen::Matrix3Xd dented_;  // one user's dent, scratch
 };
 
 }  // namespace cohaptic
