@@ -143,6 +143,25 @@ TEST(LaparoscopyScene, TheShippedScenesLoad) {
   EXPECT_EQ(matched, sheet.cols());
 }
 
+TEST(LaparoscopyScene, ATissueFromAFreeSurferFileIsScaledToMetres) {
+  const std::filesystem::path data = std::filesystem::path(COHAPTIC_SOURCE_DIR) / "tests/data/mesh_io";
+  const Scene scene = parse_scene(
+      replaced(replaced(kTissueScene, "surface: {grid: {min: [-40, -40, 0], size: [80, 80], divisions: [20, 20]}}",
+                        "surface: {file: tet_surface.asc}"),
+               "patch_radius: 12", "patch_radius: 20"),
+      data / "tissue.yaml");
+  EXPECT_EQ(std::get<HomeSpringObjectSpec>(scene.objects[0].body).surface_file, data / "tet_surface.asc");
+  const Model model = build_model(scene);
+  const auto& body = std::get<HomeSpringBody>(model.bodies[0]);
+  ASSERT_EQ(body.surface.vertex_count(), 4);
+  EXPECT_EQ(body.surface.vertices.col(1), Vector3d(0.0105, 0, 0));
+  EXPECT_EQ(body.rings.ring(0).size(), 3u);
+  const std::string missing =
+      load_error(replaced(kTissueScene, "{grid: {min: [-40, -40, 0], size: [80, 80], divisions: [20, 20]}}", "{file: none.asc}"));
+  EXPECT_NE(missing.find("tissue.yaml:6: objects[0].surface.file: surface file"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("none.asc"), std::string::npos) << missing;
+}
+
 TEST(LaparoscopyScene, MistakesAreNamedByFileLineAndKey) {
   EXPECT_NE(load_error(replaced(kTissueScene, "{name: probe, shape: probe, trocar: [-60, 0, 120]}", "{name: probe, shape: probe}"))
                 .find("tissue.yaml:11: tools[0]: missing required key 'trocar'"),
