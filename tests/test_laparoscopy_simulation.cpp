@@ -329,5 +329,33 @@ TEST(SceneSimulation, EachInstrumentGetsItsOwnPatchOnTheTissue) {
   }
 }
 
+TEST(SceneSimulation, ButtonZeroReachesTheForcepsAndClosesThem) {
+  const Model model = build_model(tissue_scene());
+  SceneSimulation simulation(model, std::vector<ComplianceColumns*>{nullptr}, model.scene.tools, SimulationOptions{});
+  const Vector3d above(0.0012, -0.0007, 0.0085);
+  const auto& tissue = std::get<HomeSpringSimulation>(simulation.body(0));
+  double time = 0;
+  for (int step = 0; step < 30; ++step) {
+    simulation.set_tool(1, above);  // no button: the jaws stay open
+    simulation.step(time += 0.001);
+  }
+  EXPECT_FALSE(tissue.jaws(1).grasping);
+  EXPECT_EQ(tissue.jaws(1).angle[0], model.scene.tools[1].instrument->open_angle);
+  for (int step = 0; step < 30; ++step) {
+    simulation.set_tool(1, above, 1u);
+    simulation.step(time += 0.001);
+  }
+  EXPECT_TRUE(tissue.jaws(1).grasping);
+  EXPECT_TRUE(std::get<HomeSpringPatch>(simulation.ir(1)->ir.body).grasp.active());
+  EXPECT_TRUE(simulation.pressing(1));
+  simulation.set_tool(1, above + Vector3d(0, 0, 0.003), 1u);
+  simulation.step(time += 0.001);
+  EXPECT_LT(simulation.force(1).force.z(), 0) << "pulled up, held down";
+  simulation.set_tool(1, above, 0);
+  simulation.step(time += 0.001);
+  EXPECT_FALSE(tissue.jaws(1).grasping);
+  EXPECT_FALSE(simulation.pressing(1));
+}
+
 }  // namespace
 }  // namespace cohaptic
