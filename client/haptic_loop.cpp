@@ -106,8 +106,10 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       // solve, the same answer).
       const bool static_body = !std::holds_alternative<MassSpringPatchState>(slot.state->body);
       // Measured only in contact: a user that passed by a static body without touching it
-      // (e.g. on its way to a mass-spring object lying on it) measured nothing.
-      metrics_.coupling_measured = metrics_.coupling_measured || (static_body && (sample.flags & kInContact));
+      // (e.g. on its way to a mass-spring object lying on it) measured nothing. A home-spring
+      // body's users never couple (each feels its own vertex's springs): nothing to measure.
+      const bool couples = static_body && !std::holds_alternative<HomeSpringPatch>(slot.ir->ir.body);
+      metrics_.coupling_measured = metrics_.coupling_measured || (couples && (sample.flags & kInContact));
       if (count > 0 && (sample.flags & kInContact) && static_body) {
         EvaluationState cold;
         const ForceSample alone = evaluate_force(*slot.ir, cold, own, {}, dt);

@@ -7,6 +7,7 @@
 //     tool position it used, bit for bit;
 //   - the forceps user was sent a grasp, and while grasping and pulling its force points
 //     back against the pull; after the release it was sent an IR without the grasp;
+//   - the users do not couple, and their clients say they measured no coupling;
 //   - the forceps client runs its haptic loop at 2 kHz (--rate-hz 2000), the paper's top
 //     rate; the rate it kept is printed.
 #include <gtest/gtest.h>
@@ -110,6 +111,9 @@ TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
                 ticks.size(), contact_ticks, grasp_ticks, pulled_back, peak, irs.size());
     EXPECT_GT(contact_ticks, 200) << user;
     EXPECT_GT(peak, 0.2) << user << " feels the tissue";
+    // Each feels its own vertex's springs: the users do not couple, and the client says it
+    // measured no coupling (the demo's health check then asks for none).
+    EXPECT_FALSE(read_json(dir / (user + ".json"))["coupling_n"]["measured"].get<bool>()) << user;
     if (user == "grasper") {
       EXPECT_GT(grasp_ticks, 500) << "the forceps grasped";
       EXPECT_GT(pulled_back, 200) << "the pull is pulled back";

@@ -122,6 +122,7 @@ void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport
   user.centre = centre;
   user.grasped = user.jaws.grasping;
   report.rebuilt = true;
+  report.recomputed = true;  // the patch was extracted: this body's counterpart of computing M~
   report.ir_bytes += user.ir->ir.size_bytes();
 }
 
