@@ -509,7 +509,8 @@ LabCommand add_tradeoff_command(CLI::App& lab) {
   auto options = std::make_shared<TradeoffOptions>();
   CLI::App* command = lab.add_subcommand(
       "tradeoff", "Measure what each speed/accuracy setting costs and buys on a scene, against the full solve on its "
-                  "finest mesh (a mass-spring scene: against the server's whole network at the haptic rate): "
+                  "finest mesh (a mass-spring scene: against the server's whole network at the haptic rate; a home_spring "
+                  "scene: a row beside its FEM twin's, given as --reference-scene, both against the twin's full solve): "
                   "tradeoff.csv, tradeoff.md and Pareto plots in --out");
   command->add_option("--scene", options->scene, "Scene file (YAML)")->required()->check(CLI::ExistingFile);
   command->add_option("--motion", options->motions, "Trajectory file for each scene tool, in order (repeat)")
@@ -521,7 +522,8 @@ LabCommand add_tradeoff_command(CLI::App& lab) {
       ->capture_default_str()
       ->check(CLI::Range(2, 60));
   command->add_option("--reference-scene", options->reference_scene,
-                      "Mesh-file scenes: the same scene on a finer mesh, the reference (default: the scene itself)")
+                      "Mesh-file scenes: the same scene on a finer mesh, the reference (default: the scene itself); a "
+                      "home_spring scene: the same tissue as a linear elastic body (required)")
       ->check(CLI::ExistingFile);
   command->add_option("--sample-rate-hz", options->sample_rate_hz,
                       "The comparison grid; haptic rates that do not divide it are left out")
