@@ -313,6 +313,28 @@ TEST(HomeSpringSimulation, ForcepsGraspPullBackAndLetGoOnButtonUp) {
   EXPECT_EQ(simulation.displayed(), body.surface.vertices);
 }
 
+TEST(HomeSpringSimulation, TheSceneChoosesTheDisplayDeformationLocalOrGlobal) {
+  // The probe 5 mm into the sheet near its centre: Eq. 1 dents within R = 20 mm and leaves
+  // the rim at rest; FFD (Eq. 7 on the lattice) moves the whole sheet, less far away.
+  const Vector3d tool(0.001, 0.0005, -0.005);
+  for (const std::string method : {"polynomial", "ffd"}) {
+    const Model model = build_model(tissue_scene(replaced(kTissueScene, "deformation: polynomial", "deformation: " + method)));
+    const auto& body = std::get<HomeSpringBody>(model.bodies[0]);
+    HomeSpringSimulation simulation(body, 0, model.scene.tools, 100);
+    simulation.set_tool(0, tool);
+    simulation.step(0);
+    ASSERT_TRUE(simulation.pressing(0));
+    const BruteCrossing crossing = brute_force_crossing(body, model.scene.tools[0].instrument->trocar, tool);
+    const double pull = (tool - crossing.point).norm();
+    const Eigen::VectorXd moved = (simulation.displayed() - body.surface.vertices).colwise().norm();
+    const double corner = moved(0);  // vertex 0: the sheet's corner at (-40, -40) mm, 57 mm away
+    EXPECT_LE(moved.maxCoeff(), pull * (1 + 1e-12)) << method;
+    EXPECT_GT(moved(crossing.vertex), 0.5 * pull) << method;
+    if (method == "polynomial") EXPECT_EQ(corner, 0);
+    else EXPECT_GT(corner, 1e-6) << "FFD moves the whole tissue";
+  }
+}
+
 TEST(SceneSimulation, EachInstrumentGetsItsOwnPatchOnTheTissue) {
   const Model model = build_model(tissue_scene());
   SceneSimulation simulation(model, std::vector<ComplianceColumns*>{nullptr}, model.scene.tools, SimulationOptions{});
