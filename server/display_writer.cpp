@@ -11,10 +11,26 @@
 namespace cohaptic {
 
 DisplayWriter::DisplayWriter(const Model& model, const ComplianceColumns& columns, std::filesystem::path directory)
-    : model_(model), body_(single_elastic_body(model)), directory_(std::move(directory)) {
-  ShownSurface shown = shown_surface(body_, columns.row_nodes());
+    : model_(model), directory_(std::move(directory)) {
+  const ElasticBody& body = single_elastic_body(model);
+  ShownSurface shown = shown_surface(body, columns.row_nodes());
   nodes_ = std::move(shown.nodes);
   triangles_ = std::move(shown.triangles);
+  rest_.resize(3, static_cast<Eigen::Index>(nodes_.size()));
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    rest_.col(static_cast<Eigen::Index>(i)) = body.mesh.nodes.col(nodes_[i]) / model.scene.metres_per_unit;
+    tags_.push_back(body.mesh.node_tags[static_cast<std::size_t>(nodes_[i])]);
+  }
+  std::filesystem::create_directories(directory_);
+}
+
+DisplayWriter::DisplayWriter(const Model& model, const HomeSpringBody& tissue, std::filesystem::path directory)
+    : model_(model), directory_(std::move(directory)), triangles_(tissue.surface.triangles),
+      rest_(tissue.surface.vertices / model.scene.metres_per_unit) {
+  for (int v = 0; v < tissue.surface.vertex_count(); ++v) {
+    nodes_.push_back(v);
+    tags_.push_back(v);
+  }
   std::filesystem::create_directories(directory_);
 }
 
@@ -41,12 +57,6 @@ void DisplayWriter::stop() {
 
 void DisplayWriter::write_frames() {
   const double unit = model_.scene.metres_per_unit;
-  Eigen::Matrix3Xd rest(3, static_cast<Eigen::Index>(nodes_.size()));
-  std::vector<std::int64_t> tags;
-  for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    rest.col(static_cast<Eigen::Index>(i)) = body_.mesh.nodes.col(nodes_[i]) / unit;
-    tags.push_back(body_.mesh.node_tags[static_cast<std::size_t>(nodes_[i])]);
-  }
   for (;;) {
     Frame frame;
     {
@@ -58,7 +68,7 @@ void DisplayWriter::write_frames() {
     }
     const std::string name = fmt::format("surface-{:06d}.vtu", written_.size());
     try {
-      write_surface_vtu(directory_ / name, rest, triangles_, tags,
+      write_surface_vtu(directory_ / name, rest_, triangles_, tags_,
                         {{"displacement", Eigen::MatrixXd(frame.displacement / unit)}});
       written_.emplace_back(frame.time, name);
     } catch (const Error& e) {

@@ -1,8 +1,10 @@
 // DisplayWriter: the deformation for display (--display DIR). The simulation thread
 // offers frames (the displacement of the shown surface nodes at a time); the writer's own
 // thread writes each as DIR/surface-NNNNNN.vtu, and DIR/surface.pvd (the ParaView
-// collection of them all) when it stops. Shown: the surface triangles whose nodes all
-// have compliance rows (common/model/shown_surface.h). Its queue holds at most kMaxQueuedDisplayFrames: a frame offered
+// collection of them all) when it stops. Shown, for a linear elastic object: the surface
+// triangles whose nodes all have compliance rows (common/model/shown_surface.h); for a
+// home-spring tissue: its whole surface, vertex i its node i, dented by its display
+// deformation (HomeSpringSimulation::displayed). Its queue holds at most kMaxQueuedDisplayFrames: a frame offered
 // while the writer is that far behind is dropped, so the simulation is never held up.
 // Units: offered in m and s; written in the scene's units.
 #pragma once
@@ -29,8 +31,11 @@ inline constexpr std::size_t kMaxQueuedDisplayFrames = 16;
 
 class DisplayWriter {
  public:
-  /// Chooses the shown nodes and triangles and creates `directory`. `model` must outlive it.
+  /// Chooses the shown nodes and triangles of the scene's only object, linear elastic, and
+  /// creates `directory`. `model` must outlive it.
   DisplayWriter(const Model& model, const ComplianceColumns& columns, std::filesystem::path directory);
+  /// The same for a scene whose only object is a home-spring tissue: its whole surface.
+  DisplayWriter(const Model& model, const HomeSpringBody& tissue, std::filesystem::path directory);
   ~DisplayWriter();  ///< stop()
   DisplayWriter(const DisplayWriter&) = delete;
   DisplayWriter& operator=(const DisplayWriter&) = delete;
@@ -55,10 +60,11 @@ class DisplayWriter {
   void write_index() const;
 
   const Model& model_;
-  const ElasticBody& body_;  // the body drawn (the scene's only one)
   std::filesystem::path directory_;
-  std::vector<int> nodes_;            // row nodes shown
+  std::vector<int> nodes_;            // nodes shown: FEM row nodes, or every tissue vertex
   std::vector<Triangle> triangles_;   // in nodes_ numbering
+  Eigen::Matrix3Xd rest_;             // of nodes_, in the scene's units
+  std::vector<std::int64_t> tags_;    // of nodes_: the mesh's node ids, or the vertex indices
   std::mutex mutex_;
   std::condition_variable ready_;
   std::deque<Frame> queue_;

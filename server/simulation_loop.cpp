@@ -148,6 +148,11 @@ bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
       display_ && now_ns - last_display_ns_ >= static_cast<std::int64_t>(1e9 / options_.display_rate_hz);
   const bool view_due = view_ && view_->frame_due(now_ns);
   if (!display_due && !view_due) return false;
+  if (const auto* tissue = std::get_if<HomeSpringSimulation>(&simulation_.body(0))) {
+    // A home-spring tissue (display only, no view): its display deformation, decoupled from the force.
+    offer_display_frame(now_ns, tissue->displayed() - tissue->body().surface.vertices);
+    return true;
+  }
   // Both show the row nodes' surface (common/model/shown_surface.h): one state solve serves both.
   const Simulation& shown = simulation_.single_elastic();
   const StateSolution state = shown.solve();
@@ -158,13 +163,14 @@ bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
     view_->publish_frame(now_ns, seconds_since_start(now_ns),
                          view::frame_state(shown, loaded_columns(*shown_columns_, state), view_tools_), steps_);
   }
-  if (display_due) {
-    Eigen::Matrix3Xd displacement = displacement_of_nodes(*shown_columns_, state, display_->nodes());
-    statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
-    last_display_ns_ = now_ns;
-    display_->offer(seconds_since_start(now_ns), std::move(displacement));  // dropped if the writer is behind
-  }
+  if (display_due) offer_display_frame(now_ns, displacement_of_nodes(*shown_columns_, state, display_->nodes()));
   return true;
+}
+
+void SimulationLoop::offer_display_frame(std::int64_t now_ns, Eigen::Matrix3Xd displacement) {
+  statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
+  last_display_ns_ = now_ns;
+  display_->offer(seconds_since_start(now_ns), std::move(displacement));  // dropped if the writer is behind
 }
 
 std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,

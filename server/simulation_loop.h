@@ -20,7 +20,8 @@
 // The loop owns the SceneSimulation (the mutable state); the model is shared read-only, the
 // FEM bodies' compliance columns are filled in by this thread alone (each prefetch worker
 // solves into its own, handed over at the start of a step). The display and the live view
-// show a scene of one linear elastic object. Times: ns of
+// show a scene of one linear elastic object; the display also a scene of one home-spring
+// tissue (its display deformation, no solve). Times: ns of
 // wire::monotonic_now_ns(); simulation time in s from the server's start.
 #pragma once
 
@@ -80,6 +81,7 @@ class SimulationLoop {
   void add_keep_alives(Outbox& outbox);
   std::vector<record::ServerForce> add_forces(Outbox& outbox);
   bool solve_display_frame(std::int64_t now_ns);
+  void offer_display_frame(std::int64_t now_ns, Eigen::Matrix3Xd displacement);
   double seconds_since_start(std::int64_t ns) const { return static_cast<double>(ns - start_ns_) * 1e-9; }
 
   // One compliance prefetch per FEM body, with the columns it fills.

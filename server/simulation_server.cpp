@@ -97,12 +97,15 @@ struct SimulationServer::Impl {
         options.step_nodes > 0 || !model->obstacles.empty() || !model->scene.interactions.empty();
     compliance = prepare_scene_compliance(*model, whole_surface, options.cache_directory);
     // The display and the live view show one linear elastic object (single_elastic_body
-    // says why it refuses another scene).
+    // says why it refuses another scene); the display also a scene of one home-spring tissue.
     const auto shown_columns = [this]() -> ComplianceColumns& {
       single_elastic_body(*model);
       return *compliance.per_body.front();
     };
-    if (!options.display.empty()) display = std::make_unique<DisplayWriter>(*model, shown_columns(), options.display);
+    const auto* tissue = model->bodies.size() == 1 ? std::get_if<HomeSpringBody>(&model->bodies.front()) : nullptr;
+    if (!options.display.empty())
+      display = tissue ? std::make_unique<DisplayWriter>(*model, *tissue, options.display)
+                       : std::make_unique<DisplayWriter>(*model, shown_columns(), options.display);
     tools = std::make_unique<ToolInputs>(model->scene.tools.size());
     spdlog::info("scene '{}' ready in {:.0f} ms: {} user slots", scene.name, watch.elapsed_ms(), tools->size());
 

@@ -7,6 +7,7 @@
 //     tool position it used, bit for bit;
 //   - the forceps user was sent a grasp, and while grasping and pulling its force points
 //     back against the pull; after the release it was sent an IR without the grasp;
+//   - the server's display frames dent the tissue by at most the pull, and by nearly all of it;
 //   - the users do not couple, and their clients say they measured no coupling;
 //   - the forceps client runs its haptic loop at 2 kHz (--rate-hz 2000), the paper's top
 //     rate; the rate it kept is printed.
@@ -15,6 +16,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <fstream>
@@ -56,7 +59,7 @@ TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
   const fs::path dir = testing::scratch_directory("e2e-laparoscopy");
   ChildProcess server(testing::server_program(),
                       {"--scene", (kScenes / "tissue.yaml").string(), "--listen", "127.0.0.1:0", "--report",
-                       (dir / "server.json").string()},
+                       (dir / "server.json").string(), "--display", (dir / "display").string(), "--display-rate-hz", "20"},
                       dir / "server.log");
   ASSERT_TRUE(testing::wait_for_output(server, "listening on"));
   const int port = testing::listening_port(server.log_text());
@@ -74,6 +77,18 @@ TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
   ASSERT_EQ(forceps->wait(testing::kPatience), 0) << forceps->log_text();
   server.signal(SIGINT);
   ASSERT_EQ(server.wait(testing::kPatience), 0) << server.log_text();
+
+  // The display: the tissue dented by Eq. 1 (R = 20 mm). Its largest displacement is the
+  // grasped vertex's while pulled 8.31 mm ((2, 1, 8) mm), (1 - r^2/R^2) of the pull for its
+  // distance r to the grasp point (under 2.9 mm, a half cell's diagonal, so at least 97.9 %).
+  const double pull_mm = std::sqrt(2.0 * 2 + 1 + 8 * 8);
+  const double displayed_mm = read_json(dir / "server.json")["server"]["max_surface_displacement_mm"].get<double>();
+  EXPECT_LE(displayed_mm, pull_mm + 1e-9);
+  EXPECT_GE(displayed_mm, 0.979 * pull_mm - 0.1) << "the 20 Hz frames catch the 1 s hold";
+  std::printf("  display: largest surface displacement %.3f mm (the pull: %.3f mm)\n", displayed_mm, pull_mm);
+  std::ifstream index(dir / "display" / "surface.pvd");
+  const std::string pvd((std::istreambuf_iterator<char>(index)), std::istreambuf_iterator<char>());
+  EXPECT_GT(std::count(pvd.begin(), pvd.end(), '\n'), 50) << "display frames listed in surface.pvd";
 
   for (const std::string user : {"prober", "grasper"}) {
     const record::Recording recording = record::read_recording(dir / (user + ".mcap"));
