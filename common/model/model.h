@@ -12,12 +12,13 @@
 #include "common/contact/obstacle.h"
 #include "common/model/elastic_body.h"
 #include "common/model/mass_spring_body.h"
+#include "common/model/separation_body.h"
 #include "common/scene/scene.h"
 
 namespace cohaptic {
 
 /// A compiled scene object: one alternative per BodySpec alternative, in the same order.
-using BodyModel = std::variant<ElasticBody, MassSpringModel>;
+using BodyModel = std::variant<ElasticBody, MassSpringModel, SeparationModel>;
 
 struct Model {
   Scene scene;

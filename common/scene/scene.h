@@ -17,6 +17,7 @@
 #include "common/fem/dof_map.h"
 #include "common/fem/linear_elastic_material.h"
 #include "common/mass_spring/mass_spring_spec.h"
+#include "common/separation/separation_object_spec.h"
 
 namespace cohaptic {
 
@@ -75,7 +76,7 @@ struct ElasticObjectSpec {
 /// One alternative per body model a scene may ask for (`model:` in the file). Adding a
 /// model adds an alternative here, and the compiler then names every place that must
 /// learn it (the compiled body, its simulation, its IR body).
-using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec>;
+using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec, SeparationObjectSpec>;
 
 /// A deformable object of the scene: its name (unique in the scene) and its model's spec.
 struct ObjectSpec {
