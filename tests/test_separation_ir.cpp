@@ -112,6 +112,9 @@ TEST(SeparationIr, WireRoundTripIsBitExact) {
   EXPECT_EQ(got.epoch, sent.epoch);
   EXPECT_EQ(got.force_limit, sent.force_limit);
   EXPECT_GT(sent.size_bytes(), p.fields.size() * sizeof(double));
+  const std::size_t wire_bytes = wire::to_wire(sent).ByteSizeLong();
+  EXPECT_NEAR(static_cast<double>(wire_bytes), static_cast<double>(sent.size_bytes()), 0.1 * static_cast<double>(wire_bytes));
+  std::printf("  the default layers' IR: %zu bytes on the wire, %zu counted by size_bytes\n", wire_bytes, sent.size_bytes());
 }
 
 // One user's instrument on the default layers, driven tick by tick on the server; the
