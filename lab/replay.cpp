@@ -134,7 +134,7 @@ VerifyResult verify_server(const Recording& rec) {
       result.first_difference = fmt::format("simulation step {} (t = {:.6f} s): {}", i, seconds(step.time_ns(), start), what);
     };
     for (const record::ToolInput& tool : step.tools()) {
-      if (tool.known()) simulation.set_tool(static_cast<int>(tool.slot()), wire::from_wire(tool.position()));
+      if (tool.known()) simulation.set_tool(static_cast<int>(tool.slot()), wire::from_wire(tool.position()), tool.buttons());
       else simulation.clear_tool(static_cast<int>(tool.slot()));
     }
     const StepReport report = simulation.step(step.simulation_time());

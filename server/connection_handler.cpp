@@ -405,7 +405,8 @@ void ConnectionHandler::handle_datagram(const wire::Datagram& datagram, int slot
   if (datagram.has_tool()) {
     const wire::ToolSample& sample = datagram.tool();
     if (static_cast<int>(sample.user()) != slot) return;  // a user speaks for its own tool only
-    if (!tools_.update(slot, sample.valid(), wire::from_wire(sample.position()), sample.sample_time_ns(), arrival_ns))
+    if (!tools_.update(slot, sample.valid(), wire::from_wire(sample.position()), sample.buttons(), sample.sample_time_ns(),
+                       arrival_ns))
       return;  // older than the sample held
     // Relay to the other users, who play it out against their own clocks.
     for (int other = 0; other < slots(); ++other) {

@@ -54,6 +54,7 @@ record::SimulationStep simulation_step_record(std::int64_t time_ns, double simul
     tool->set_known(used[slot]);
     wire::to_wire(tools[slot].position, tool->mutable_position());
     tool->set_sample_time_ns(tools[slot].sample_time_ns);
+    tool->set_buttons(tools[slot].buttons);
   }
   step.set_rebuilt(report.rebuilt);
   for (int user = 0; user < simulation.user_count(); ++user)

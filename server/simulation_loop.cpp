@@ -78,7 +78,7 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
     const ToolInput& tool = latest_[slot];
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
     if (used_[slot]) {
-      simulation_.set_tool(static_cast<int>(slot), tool.position);
+      simulation_.set_tool(static_cast<int>(slot), tool.position, tool.buttons);
       for (BodyPrefetch& prefetch : prefetch_) prefetch.worker->request_near(tool.position, *prefetch.columns);
     } else {
       simulation_.clear_tool(static_cast<int>(slot));

@@ -13,13 +13,14 @@ void ToolInputs::release(int slot) {
   tools_[static_cast<std::size_t>(slot)] = ToolInput{};
 }
 
-bool ToolInputs::update(int slot, bool valid, const Eigen::Vector3d& position, std::int64_t sample_time_ns,
+bool ToolInputs::update(int slot, bool valid, const Eigen::Vector3d& position, std::uint32_t buttons, std::int64_t sample_time_ns,
                         std::int64_t received_ns) {
   std::lock_guard lock(mutex_);
   ToolInput& tool = tools_[static_cast<std::size_t>(slot)];
   if (sample_time_ns <= tool.sample_time_ns) return false;
   tool.valid = valid;
   tool.position = position;
+  tool.buttons = buttons;
   tool.sample_time_ns = sample_time_ns;
   tool.received_ns = received_ns;
   return true;

@@ -16,6 +16,7 @@ struct ToolInput {
   bool joined = false;  ///< a user holds the slot
   bool valid = false;   ///< the device reported a position
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  std::uint32_t buttons = 0;        ///< the device's buttons (bit i = button i)
   std::int64_t sample_time_ns = 0;  ///< the server's clock, as stamped by the client
   std::int64_t received_ns = 0;     ///< when the server took it in
 };
@@ -30,7 +31,7 @@ class ToolInputs {
   void release(int slot);
   /// Takes a sample of `slot`'s tool; false (and nothing changes) if it is not newer than
   /// the one held, as a reordered datagram would be.
-  bool update(int slot, bool valid, const Eigen::Vector3d& position, std::int64_t sample_time_ns,
+  bool update(int slot, bool valid, const Eigen::Vector3d& position, std::uint32_t buttons, std::int64_t sample_time_ns,
               std::int64_t received_ns);
   /// Copies every slot into `out` (resized to the number of slots).
   void copy_to(std::vector<ToolInput>& out) const;

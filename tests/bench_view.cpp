@@ -94,8 +94,8 @@ constexpr benchmark::IterationCount kWindowSteps = 2450;
 void set_tools(ToolInputs& tools, const BrainRig& rig, double t) {
   for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) {
     const Trajectory& motion = rig.motions[slot];
-    tools.update(static_cast<int>(slot), true, motion.position(std::fmod(t, motion.duration())), wire::monotonic_now_ns(),
-                 wire::monotonic_now_ns());
+    tools.update(static_cast<int>(slot), true, motion.position(std::fmod(t, motion.duration())), 0,
+                 wire::monotonic_now_ns(), wire::monotonic_now_ns());
   }
 }
 

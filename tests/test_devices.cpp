@@ -172,12 +172,38 @@ TEST(Trajectory, MoveToWhereTheToolIsTakesNoTime) {
   EXPECT_NEAR(tr.duration(), 2.0, 1e-15);
 }
 
+TEST(Trajectory, ButtonsAreHeldForTheirSegmentAndFromTheEndOn) {
+  // Approach 10 mm at 10 mm/s (0-1 s, no buttons), hold 2 s with button 0 (1-3 s), a
+  // zero-length move with button 1 (takes no time: never seen), pull 20 mm at 10 mm/s with
+  // buttons 0 and 2 (3-5 s), hold 1 s with none (5-6 s); then again with repeat, and the
+  // last segment's buttons (none) from the end on.
+  const Trajectory tr = parse_trajectory(
+      "units: mm\nstart: [0, 0, 10]\nsegments:\n  - {move_to: [0, 0, 0], speed: 10}\n  - {hold: 2, buttons: 1}\n"
+      "  - {move_to: [0, 0, 0], speed: 10, buttons: 2}\n  - {move_by: [0, 0, 20], speed: 10, buttons: 5}\n  - {hold: 1}\n",
+      "grasp.yaml");
+  ASSERT_NEAR(tr.duration(), 6.0, 1e-12);
+  const std::vector<std::pair<double, std::uint32_t>> expected{{-1, 0},  {0, 0},   {0.99, 0}, {1.0, 1}, {2.99, 1},
+                                                               {3.0, 5}, {4.5, 5}, {5.0, 0},  {5.5, 0}, {9, 0}};
+  for (const auto& [t, buttons] : expected) EXPECT_EQ(tr.buttons(t), buttons) << "t = " << t;
+  EXPECT_NEAR(tr.position(4.0).z(), 0.010, 1e-15);  // buttons do not move the tool
+
+  const Trajectory holding = parse_trajectory("start: [0, 0, 0]\nsegments:\n  - {hold: 1, buttons: 1}\n", "hold.yaml");
+  EXPECT_EQ(holding.buttons(0.5), 1u);
+  EXPECT_EQ(holding.buttons(7.0), 1u) << "a script that ends holding a button keeps holding it";
+  EXPECT_EQ(parse_trajectory("start: [0, 0, 0]\nsegments:\n  - {hold: 1}\n", "none.yaml").buttons(0.5), 0u);
+
+  ScriptedDevice device(tr, 3.3);
+  EXPECT_EQ(device.read(1.5).buttons, 1u);
+  EXPECT_EQ(device.read(4.0).buttons, 5u);
+}
+
 TEST(Trajectory, KnotsAreValidated) {
   EXPECT_NO_THROW(Trajectory({0.0}, {Eigen::Vector3d::Zero()}, "point"));
   EXPECT_THROW(Trajectory({}, {}, "empty"), Error);
   EXPECT_THROW(Trajectory({0.5}, {Eigen::Vector3d::Zero()}, "late start"), Error);
   EXPECT_THROW(Trajectory({0.0, 1.0, 1.0}, std::vector<Eigen::Vector3d>(3, Eigen::Vector3d::Zero()), "repeated time"), Error);
   EXPECT_THROW(Trajectory({0.0, 1.0}, {Eigen::Vector3d::Zero()}, "mismatch"), Error);
+  EXPECT_THROW(Trajectory({0.0, 1.0}, std::vector<Eigen::Vector3d>(2, Eigen::Vector3d::Zero()), "buttons", {1u}), Error);
 }
 
 TEST(Trajectory, DemoFilesMatchHandComputation) {
@@ -275,6 +301,7 @@ TEST(Trajectory, ErrorsNameFileLineAndKey) {
       {"segment with no kind", 9, "  - wait: 1.0", "segments[2]", "one of move_to, move_by, press, release or hold"},
       {"two kinds", 8, "    hold: 1", "segments[1].hold", "exactly one of"},
       {"missing speed", 5, "    spede: 20", "segments[0].spede", "unknown key"},
+      {"negative buttons", 11, "    buttons: -1", "segments[3].buttons", "a button mask"},
   };
   for (const auto& c : cases) {
     const std::string text = replace_line(kBlock, c.line, c.with);

@@ -99,7 +99,7 @@ struct LoopRig {
     options.client_timeout_s = 3600;  // the one sample below stays fresh
     tools.join(0);
     // Slot 0 presses 2 mm into the top face; slot 1 stays away.
-    tools.update(0, true, Eigen::Vector3d(0.003, 0.002, -0.002), 1, wire::monotonic_now_ns());
+    tools.update(0, true, Eigen::Vector3d(0.003, 0.002, -0.002), 0, 1, wire::monotonic_now_ns());
   }
   static testing::CubeSceneOptions soft_cube() {
     testing::CubeSceneOptions options;

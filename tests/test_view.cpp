@@ -445,7 +445,7 @@ struct ViewedLoop {
   void run(double seconds) {
     for (int k = 0; k < static_cast<int>(seconds * 1000); ++k) {
       now_ns += 1'000'000;
-      tools.update(0, true, pressed.pressing, now_ns, now_ns);
+      tools.update(0, true, pressed.pressing, 0, now_ns, now_ns);
       loop.step(now_ns);
     }
   }

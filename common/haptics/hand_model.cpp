@@ -78,7 +78,7 @@ DeviceState HandModelDevice::read(double time_s) {
   advance_to(time_s);
   DeviceState out;
   out.position = state_.position;
-  out.buttons = 0;
+  out.buttons = reference_.buttons(time_s);  // the hand presses what its script says
   out.valid = true;
   return out;
 }

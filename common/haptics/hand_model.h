@@ -64,7 +64,7 @@ class HandModelDevice : public HapticDevice {
                   double max_substep_s = kDefaultMaxSubstep);
 
   std::string describe() const override;
-  /// Advances the arm to time_s and returns its position (always valid, no buttons).
+  /// Advances the arm to time_s and returns its position (always valid) and the script's buttons.
   DeviceState read(double time_s) override;
   /// The force on the arm from now until the next read [N]; a non-finite force counts as zero.
   void write_force(const Eigen::Vector3d& force, double time_s) override;

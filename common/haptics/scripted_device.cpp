@@ -21,7 +21,7 @@ std::string ScriptedDevice::describe() const {
 DeviceState ScriptedDevice::read(double time_s) {
   DeviceState state;
   state.position = trajectory_.position(time_s);
-  state.buttons = 0;
+  state.buttons = trajectory_.buttons(time_s);
   state.valid = true;
   return state;
 }

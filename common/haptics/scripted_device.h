@@ -1,7 +1,7 @@
 // ScriptedDevice: a device that plays a Trajectory and ignores the force it is given, so
 // that a run is repeatable whatever the tissue does (open-loop probing, benchmarks, demos).
 //
-// read(t) is the trajectory's position at t (valid, no buttons pressed); write_force()
+// read(t) is the trajectory's position and buttons at t (valid); write_force()
 // only keeps the last force and its time, for tests. finished(t) once t > duration().
 // Units: m, N, s. Haptic-thread methods neither allocate nor lock.
 #pragma once

@@ -10,11 +10,15 @@
 
 namespace cohaptic {
 
-Trajectory::Trajectory(std::vector<double> times, std::vector<Eigen::Vector3d> points, std::string source)
-    : times_(std::move(times)), points_(std::move(points)), source_(std::move(source)) {
+Trajectory::Trajectory(std::vector<double> times, std::vector<Eigen::Vector3d> points, std::string source,
+                       std::vector<std::uint32_t> buttons)
+    : times_(std::move(times)), points_(std::move(points)), source_(std::move(source)), buttons_(std::move(buttons)) {
   if (times_.empty() || times_.size() != points_.size())
     throw Error(fmt::format("trajectory {}: expected as many knot times as points (at least one), found {} and {}", source_,
                             times_.size(), points_.size()));
+  if (!buttons_.empty() && buttons_.size() != times_.size())
+    throw Error(fmt::format("trajectory {}: expected no buttons or one entry per knot ({}), found {}", source_, times_.size(),
+                            buttons_.size()));
   if (times_[0] != 0.0) throw Error(fmt::format("trajectory {}: the first knot must be at t = 0, found {}", source_, times_[0]));
   for (std::size_t i = 0; i < times_.size(); ++i) {
     if (!std::isfinite(times_[i]) || !points_[i].allFinite())
@@ -44,6 +48,12 @@ Eigen::Vector3d Trajectory::velocity(double t) const {
   return (points_[i + 1] - points_[i]) / (times_[i + 1] - times_[i]);
 }
 
+std::uint32_t Trajectory::buttons(double t) const {
+  if (buttons_.empty() || !(t >= 0.0)) return 0;
+  if (t >= times_.back()) return buttons_.back();
+  return buttons_[segment_at(t)];
+}
+
 namespace {
 
 using Cursor = YamlCursor;
@@ -57,6 +67,7 @@ struct Segment {
   bool has_direction = false;                        // press: direction given explicitly
   double amount = 0;                                 // depth (press), distance (release), seconds (hold)
   double speed = 0;                                  // m/s
+  std::uint32_t buttons = 0;                         // held during the segment
   Cursor where;                                      // for errors found while playing (release before press)
 };
 
@@ -84,15 +95,20 @@ Segment parse_segment(const Cursor& c, double scale) {
   }
   if (!kind_cursor) c.fail("a map with one of move_to, move_by, press, release or hold");
 
-  Segment s{Segment::Kind::hold, Eigen::Vector3d::Zero(), false, 0, 0, c};
+  Segment s{Segment::Kind::hold, Eigen::Vector3d::Zero(), false, 0, 0, 0, c};
+  if (auto buttons = c.find("buttons")) {
+    const std::int64_t mask = buttons->integer();
+    if (mask < 0 || mask > std::int64_t{0xffffffff}) buttons->fail("a button mask from 0 to 4294967295 (bit i = button i)");
+    s.buttons = static_cast<std::uint32_t>(mask);
+  }
   auto speed = [&] { return c.at("speed").positive("a positive speed (in units per second)") * scale; };
   if (kind == "move_to" || kind == "move_by") {
-    c.only_keys({kind.c_str(), "speed"});
+    c.only_keys({kind.c_str(), "speed", "buttons"});
     s.kind = kind == "move_to" ? Segment::Kind::move_to : Segment::Kind::move_by;
     s.vector = kind_cursor->vec3() * scale;
     s.speed = speed();
   } else if (kind == "press") {
-    c.only_keys({"press", "speed", "direction"});
+    c.only_keys({"press", "speed", "direction", "buttons"});
     s.kind = Segment::Kind::press;
     s.amount = kind_cursor->positive("a positive depth") * scale;
     s.speed = speed();
@@ -103,12 +119,12 @@ Segment parse_segment(const Cursor& c, double scale) {
       s.has_direction = true;
     }
   } else if (kind == "release") {
-    c.only_keys({"release", "speed"});
+    c.only_keys({"release", "speed", "buttons"});
     s.kind = Segment::Kind::release;
     s.amount = kind_cursor->positive("a positive distance") * scale;
     s.speed = speed();
   } else {
-    c.only_keys({"hold"});
+    c.only_keys({"hold", "buttons"});
     s.kind = Segment::Kind::hold;
     s.amount = kind_cursor->positive("a positive duration in s");
   }
@@ -139,9 +155,19 @@ Trajectory parse_trajectory(const std::string& yaml, const std::string& name) {
 
   std::vector<double> times{0.0};
   std::vector<Eigen::Vector3d> points{start};
+  std::vector<std::uint32_t> buttons{0};  // buttons[i]: held from knot i on
+  bool any_buttons = false;
   Eigen::Vector3d here = start;
   double now = 0.0;
   std::optional<Eigen::Vector3d> press_direction;
+  // The segment being played: its buttons are held from the knot it starts at.
+  std::uint32_t held = 0;
+  auto add_knot = [&] {
+    buttons.back() = held;
+    times.push_back(now);
+    points.push_back(here);
+    buttons.push_back(held);  // from the end on, until a next segment starts here
+  };
   auto go = [&](const Eigen::Vector3d& target, double speed) {
     const double length = (target - here).norm();
     if (length == 0.0) return;  // already there: takes no time, adds no knot
@@ -152,11 +178,12 @@ Trajectory parse_trajectory(const std::string& yaml, const std::string& name) {
       return;
     }
     now = then;
-    times.push_back(now);
-    points.push_back(here);
+    add_knot();
   };
   for (std::int64_t r = 0; r < repeat; ++r) {
     for (const Segment& s : segments) {
+      held = s.buttons;
+      any_buttons = any_buttons || held != 0;
       switch (s.kind) {
         case Segment::Kind::move_to:
           go(s.vector, s.speed);
@@ -174,13 +201,13 @@ Trajectory parse_trajectory(const std::string& yaml, const std::string& name) {
           break;
         case Segment::Kind::hold:
           now += s.amount;
-          times.push_back(now);
-          points.push_back(here);
+          add_knot();
           break;
       }
     }
   }
-  return Trajectory(std::move(times), std::move(points), name);
+  if (!any_buttons) buttons.clear();
+  return Trajectory(std::move(times), std::move(points), name, std::move(buttons));
 }
 
 Trajectory load_trajectory(const std::filesystem::path& file) {

@@ -67,10 +67,11 @@ void SceneSimulation::run_interactions() {
   }
 }
 
-void SceneSimulation::set_tool(int user, const Eigen::Vector3d& position) {
+void SceneSimulation::set_tool(int user, const Eigen::Vector3d& position, std::uint32_t buttons) {
   UserState& state = users_[static_cast<std::size_t>(user)];
   state.known = position.allFinite();
   state.position = position;
+  state.buttons = buttons;
 }
 
 void SceneSimulation::clear_tool(int user) { users_[static_cast<std::size_t>(user)].known = false; }
@@ -120,8 +121,11 @@ StepReport SceneSimulation::step(double time) {
         [&](auto& body_simulation) {
           for (int u = 0; u < user_count(); ++u) {
             const UserState& user = users_[static_cast<std::size_t>(u)];
-            if (user.known && user.body == b) body_simulation.set_tool(u, user.position);
-            else body_simulation.clear_tool(u);
+            if (!user.known || user.body != b) body_simulation.clear_tool(u);
+            else if constexpr (requires { body_simulation.set_tool(u, user.position, user.buttons); })
+              body_simulation.set_tool(u, user.position, user.buttons);  // a body whose tools have buttons
+            else
+              body_simulation.set_tool(u, user.position);
           }
           report += body_simulation.step(time);
         },

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <variant>
@@ -42,7 +43,10 @@ class SceneSimulation {
 
   int user_count() const { return static_cast<int>(users_.size()); }
   int body_count() const { return static_cast<int>(bodies_.size()); }
-  void set_tool(int user, const Eigen::Vector3d& position);
+  /// The user's tool tip [m] and device buttons (bit i = button i), given to the body it is on
+  /// at the next step: a body whose tools use buttons (an instrument's jaws, a laser) has
+  /// set_tool(user, position, buttons); the others take the position alone.
+  void set_tool(int user, const Eigen::Vector3d& position, std::uint32_t buttons = 0);
   /// The user's tool is no longer known (disconnected): it presses nothing.
   void clear_tool(int user);
 
@@ -70,6 +74,7 @@ class SceneSimulation {
   struct UserState {
     bool known = false;
     Eigen::Vector3d position = Eigen::Vector3d::Zero();
+    std::uint32_t buttons = 0;
     int body = 0;
     std::shared_ptr<const PreparedIR> ir;
     bool changed = false;
