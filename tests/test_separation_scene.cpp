@@ -1,6 +1,6 @@
 // The separating-tissue body in scenes (issue 12, item 5): `model: separation` loads with
 // its cited settings, compiles into a Model (the fields fitted to our FEM) and is stepped
-// by the server's body simulation: two users on one interface, the server deciding fracture and
+// by the server's scene simulation: two users on one interface, the server deciding fracture and
 // vaporisation, each user's IR rebuilt when the separated state changes, its epochs rising.
 // Checked against: the scene file's settings and the paper's laws (Eq. 20's v_s, the
 // groove's area l_f L, F_n = J_c l_n held while the flap tears), and the IRs' own states.
@@ -11,7 +11,7 @@
 
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
-#include "common/sim/separation_simulation.h"
+#include "common/sim/scene_simulation.h"
 #include "support/run_program.h"
 #include "support/scratch_directory.h"
 
@@ -71,7 +71,9 @@ TEST(SeparationScene, AnInstrumentOfAnUnknownToolIsRefusedWithItsLine) {
 TEST(SeparationScene, TwoUsersTearAndCutOneInterfaceAndTheirIrsFollow) {
   const Model& model = two_layers_model();
   const auto& body = std::get<SeparationModel>(model.bodies[0]);
-  SeparationSimulation layers(body, 0, model.scene.tools, model.scene.haptic.force_limit_n);
+  std::vector<ComplianceColumns*> columns(model.bodies.size(), nullptr);
+  SceneSimulation scene(model, columns, model.scene.tools, SimulationOptions{});
+  const auto& layers = std::get<SeparationSimulation>(scene.body(0));
   const SeparationPatch& patch = *body.patch;
   const double dt = 1e-3;
   const Vector3d rim(0, 0.02, 0.0002), from(0.0205, 0.012, 0.0002), to(0.0205, 0.028, 0.0002), grip(0.02, 0.02, 0.0002);
@@ -83,7 +85,7 @@ TEST(SeparationScene, TwoUsersTearAndCutOneInterfaceAndTheirIrsFollow) {
   for (int i = 0; i <= cut + 1400; ++i) {
     // Forceps: jaws close at 100 ms, pull up 4 mm at 5 mm/s from 200 ms, then hold.
     const double up = std::clamp((i - 200) * 5e-6, 0.0, 0.004);
-    layers.set_tool(0, rim + Vector3d(0, 0, up), i >= 100 ? 1u : 0u);
+    scene.set_tool(0, rim + Vector3d(0, 0, up), i >= 100 ? 1u : 0u);
     // Fibre: the groove at 20 mm/s (laser, button 0), then to the grip, jaws (button 1), push +x.
     Vector3d tip;
     std::uint32_t buttons = 0;
@@ -96,16 +98,16 @@ TEST(SeparationScene, TwoUsersTearAndCutOneInterfaceAndTheirIrsFollow) {
       tip = grip + Vector3d(std::clamp((i - cut - 200) * 5e-6, 0.0, 0.005), 0, 0);
       buttons = i >= cut + 150 ? 2u : 0u;
     }
-    layers.set_tool(1, tip, buttons);
-    layers.step(i * dt);
+    scene.set_tool(1, tip, buttons);
+    scene.step(i * dt);
     if (i == cut) {
       area_after_cut = layers.state().separated_area;
       vaporised_after_cut = layers.vaporised_area();
     }
-    peak_pull = std::max(peak_pull, -layers.force(0).force.z());
+    peak_pull = std::max(peak_pull, -scene.force(0).force.z());
     for (int u = 0; u < 2; ++u) {
-      if (!layers.ir(u) || layers.ir(u)->ir.epoch == last_epoch[u]) continue;
-      const auto& ir = layers.ir(u)->ir;
+      if (!scene.ir_changed(u)) continue;
+      const auto& ir = scene.ir(u)->ir;
       EXPECT_GT(ir.epoch, last_epoch[u]);
       last_epoch[u] = ir.epoch;
       ++irs[u];

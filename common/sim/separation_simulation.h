@@ -33,7 +33,7 @@ class SeparationSimulation {
 
   // The members SceneSimulation visits, as Simulation has them.
   int user_count() const { return static_cast<int>(users_.size()); }
-  void set_tool(int user, const Eigen::Vector3d& position, std::uint32_t buttons = 0);
+  void set_tool(int user, const Eigen::Vector3d& position, std::uint32_t buttons);
   void clear_tool(int user);  ///< the tool lets go and fires nothing until set again
   void continue_epochs(int user, std::uint64_t epoch);  ///< the user's next epoch is above `epoch`
   StepReport step(double time);

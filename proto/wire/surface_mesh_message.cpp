@@ -44,6 +44,18 @@ SurfaceMesh surface_mesh_message(const MassSpringModel& body) {
   return message;
 }
 
+SurfaceMesh surface_mesh_message(const SeparationModel& body) {
+  const cohaptic::SeparationPatch& patch = *body.patch;
+  SurfaceMesh message;
+  for (int node = 0; node < patch.node_count(); ++node) {
+    for (int axis = 0; axis < 3; ++axis) message.add_vertices(patch.positions(axis, node));
+    message.add_node_ids(node);
+  }
+  for (const Triangle& triangle : patch.triangles)
+    for (int corner : triangle) message.add_triangles(static_cast<std::uint32_t>(corner));
+  return message;
+}
+
 SurfaceMesh surface_mesh_message(const BodyModel& body) {
   return std::visit([](const auto& kind) { return surface_mesh_message(kind); }, body);
 }

@@ -21,6 +21,9 @@ SurfaceMesh surface_mesh_message(const ElasticBody& body);
 /// A mass-spring body's surface at rest: vertex i is network.surface_nodes[i], its node id
 /// the network's node index.
 SurfaceMesh surface_mesh_message(const MassSpringModel& body);
+/// A separating-tissue body's interface at rest (what its tools grasp): vertex i is
+/// interface node i, its node id i.
+SurfaceMesh surface_mesh_message(const SeparationModel& body);
 /// Whichever kind `body` is.
 SurfaceMesh surface_mesh_message(const BodyModel& body);
 
