@@ -12,6 +12,7 @@
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/scene_simulation.h"
+#include "proto/wire/surface_mesh_message.h"
 #include "support/run_program.h"
 #include "support/scratch_directory.h"
 
@@ -44,6 +45,10 @@ TEST(SeparationScene, TheTwoLayerSceneLoadsWithItsCitedSettings) {
   EXPECT_NEAR(patch.vaporisation_speed, 0.5 * 80 / (q * 0.55e-3 * 0.55e-3), 1e-12);
   EXPECT_NEAR(patch.vaporisation_speed, 0.052, 0.001);
   EXPECT_LE(patch.force_limit, model.scene.haptic.force_limit_n);
+  // A client's Welcome shows the interface (vertex i = interface node i).
+  const wire::SurfaceMesh surface = wire::surface_mesh_message(model.bodies[0]);
+  EXPECT_EQ(surface.vertices_size(), 3 * patch.node_count());
+  EXPECT_EQ(surface.triangles_size(), 3 * patch.triangle_count());
   ASSERT_EQ(body.spec.instruments.size(), 1u);
   EXPECT_EQ(body.spec.instruments[0].tool, "fibre");
   EXPECT_TRUE(body.spec.instruments[0].settings.laser);

@@ -2,15 +2,27 @@
 
 #include <cmath>
 
+#include "common/util/error.h"
+
 namespace cohaptic {
 namespace {
 
-double positive_length(const YamlCursor& c, double scale) { return c.positive("a positive length") * scale; }
+double positive_length(const YamlCursor& c, double scale) {
+  const double length = c.positive("a positive length") * scale;
+  if (!std::isfinite(length)) c.fail("a finite length");
+  return length;
+}
 
 int count_in(const YamlCursor& c, int low, int high) {
   const std::int64_t value = c.integer();
   if (value < low || value > high) c.fail("an integer from " + std::to_string(low) + " to " + std::to_string(high));
   return static_cast<int>(value);
+}
+
+double reach_length(const YamlCursor& c, double scale) {
+  const double length = c.number_in(0, INFINITY, false, true, "a length >= 0") * scale;
+  if (!std::isfinite(length)) c.fail("a finite length");
+  return length;
 }
 
 LinearElasticMaterial parse_layer_material(const YamlCursor& c) {
@@ -88,7 +100,7 @@ SeparationObjectSpec parse_separation_object(const YamlCursor& c, double scale) 
   if (auto tissue = c.find("tissue")) parse_tissue(*tissue, object.settings.tissue);
   if (auto limit = c.find("force_limit")) object.settings.force_limit = limit->positive("a positive force in N");
   if (auto reach = c.find("grasp_reach"))
-    object.grasp_reach = reach->number_in(0, INFINITY, false, true, "a length >= 0") * scale;
+    object.grasp_reach = reach_length(*reach, scale);
   if (auto instruments = c.find("instruments")) {
     for (const YamlCursor& item : instruments->items()) {
       item.only_keys({"tool", "laser", "grasp_reach"});
@@ -98,12 +110,18 @@ SeparationObjectSpec parse_separation_object(const YamlCursor& c, double scale) 
       instrument.settings.grasp_reach = object.grasp_reach;
       if (auto laser = item.find("laser")) instrument.settings.laser = laser->boolean();
       if (auto reach = item.find("grasp_reach"))
-        instrument.settings.grasp_reach = reach->number_in(0, INFINITY, false, true, "a length >= 0") * scale;
+        instrument.settings.grasp_reach = reach_length(*reach, scale);
       object.instruments.push_back(instrument);
     }
   }
   if (auto rate = c.find("ir_rate_hz")) object.ir_rate_hz = rate->positive("a positive rate in Hz");
   if (auto cache = c.find("disk_cache")) object.disk_cache = cache->boolean();
+  try {
+    validate(object.settings);
+    validate(object.fields);
+  } catch (const Error& e) {
+    c.fail_message(e.what());
+  }
   return object;
 }
 

@@ -29,7 +29,7 @@ copy_seeds() {  # target, files...
   for file in "$@"; do cp "$file" "$corpus/$target/$(basename "$file")"; done
 }
 copy_seeds scene scenes/cube.yaml scenes/brain.yaml scenes/tradeoff/cube_two_users.yaml scenes/thin/noodle.yaml scenes/thin/noodle_heated.yaml \
-  scenes/objects/paired_boxes.yaml
+  scenes/objects/paired_boxes.yaml scenes/separation/two_layers.yaml
 copy_seeds study scenes/studies/*.yaml
 copy_seeds gmsh tests/data/mesh_io/*.msh
 copy_seeds freesurfer tests/data/mesh_io/*.asc
