@@ -94,6 +94,7 @@ void SeparationSimulation::publish_ir(int user, double time, StepReport& report)
   state.epoch += 1;
   state.last_ir_time = time;
   report.rebuilt = true;
+  report.recomputed = true;  // the IR was built this step: its time counts as a build
 }
 
 }  // namespace cohaptic
