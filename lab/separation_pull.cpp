@@ -23,7 +23,7 @@ const SeparationModel& first_separation_body(const Model& model) {
   throw Error(fmt::format("scene '{}' has no object of model: separation", model.scene.name));
 }
 
-void write_pull_csv(const std::filesystem::path& file, const PullLoop& loop) {
+void write_separation_pull_csv(const std::filesystem::path& file, const PullLoop& loop) {
   std::ofstream out(file);
   if (!out) throw Error(fmt::format("cannot write {}", file.string()));
   out << "time_s,travel_mm,force_N,normal_force_N,separated_area_mm2,local_separated,phase\n";
@@ -74,7 +74,7 @@ int run_separation_pull(const SeparationPullOptions& options) {
     std::filesystem::create_directories(options.out);
     write_svg(options.out / "fig10_force.svg", pull_loop_force_plot(loop));
     write_svg(options.out / "fig10_area.svg", pull_loop_area_plot(loop, patch.interface_area));
-    write_pull_csv(options.out / "pull_loop.csv", loop);
+    write_separation_pull_csv(options.out / "pull_loop.csv", loop);
     spdlog::info("wrote fig10_force.svg, fig10_area.svg and pull_loop.csv to {}", options.out.string());
   }
   return 0;

@@ -119,12 +119,12 @@ TEST(SeparationIr, WireRoundTripIsBitExact) {
 
 // One user's instrument on the default layers, driven tick by tick on the server; the
 // user's first IR goes over the wire and the client evaluates it on every later tick.
-struct Drive {
+struct SeparationDrive {
   Vector3d tip;
   std::uint32_t buttons;
 };
 
-SeparationModel default_model(bool laser) {
+SeparationModel default_separation_model(bool laser) {
   SeparationModel model;
   model.name = "layers";
   model.patch = shared_default_patch();
@@ -142,17 +142,17 @@ struct ClientServerRun {
 
 template <typename Script>
 ClientServerRun run_client_and_server(bool laser, int ticks, const Script& script) {
-  const SeparationModel model = default_model(laser);
+  const SeparationModel model = default_separation_model(laser);
   SeparationSimulation server(model, 0, {ToolSpec{"tool", ToolShape::point, 0}}, 3.3);
   const double dt = 1e-3;
-  Drive first = script(0);
+  SeparationDrive first = script(0);
   server.set_tool(0, first.tip, first.buttons);
   server.step(0);
   const PreparedIR client_ir = prepare_ir(over_the_wire(server.ir(0)->ir));
   EvaluationState client = make_evaluation_state(client_ir);
   ClientServerRun run;
   for (int i = 1; i <= ticks; ++i) {
-    const Drive drive = script(i);
+    const SeparationDrive drive = script(i);
     server.set_tool(0, drive.tip, drive.buttons);
     server.step(i * dt);
     const ForceSample expected = server.force(0);
@@ -176,7 +176,7 @@ TEST(SeparationIr, ClientForceEqualsTheServersThroughAPullThatTears) {
   const Vector3d rim = default_two_layers().patch.positions.col(nearest_patch_node(default_two_layers().patch, Vector3d(0, 0.02, 0)));
   const ClientServerRun run = run_client_and_server(false, 800, [&](int i) {
     const double up = i <= 400 ? 1e-5 * i : 1e-5 * (800 - i);
-    return Drive{rim + Vector3d(0, 0, up), i >= 5 ? 1u : 0u};
+    return SeparationDrive{rim + Vector3d(0, 0, up), i >= 5 ? 1u : 0u};
   });
   EXPECT_GT(run.fractured, 0) << "the pull did not tear; peak " << run.largest_force << " N, area " << run.server_area;
   EXPECT_GT(run.in_contact, 700);
@@ -195,10 +195,10 @@ TEST(SeparationIr, ClientForceEqualsTheServersThroughALaserGrooveAndAPushThatOpe
   const int cut = static_cast<int>(std::ceil((to - from).norm() / (speed * dt)));
   const Vector3d grip(0.02, 0.02, 0);
   const ClientServerRun run = run_client_and_server(true, cut + 400, [&](int i) {
-    if (i <= cut) return Drive{from + (to - from) * (double(i) / cut), 1u};
+    if (i <= cut) return SeparationDrive{from + (to - from) * (double(i) / cut), 1u};
     const int k = i - cut;
-    if (k <= 50) return Drive{to + (grip - to) * (k / 50.0), 0u};  // laser off, jaws open
-    return Drive{grip + Vector3d(2e-5 * (k - 50), 0, 0), 2u};       // jaws closed, pushing along x
+    if (k <= 50) return SeparationDrive{to + (grip - to) * (k / 50.0), 0u};  // laser off, jaws open
+    return SeparationDrive{grip + Vector3d(2e-5 * (k - 50), 0, 0), 2u};       // jaws closed, pushing along x
   });
   EXPECT_GT(run.vaporised, 0.9 * patch.spot_diameter * (to - from).norm()) << "no groove";
   EXPECT_GT(run.fractured, 0) << "the push did not open the groove";
@@ -206,7 +206,7 @@ TEST(SeparationIr, ClientForceEqualsTheServersThroughALaserGrooveAndAPushThatOpe
   EXPECT_EQ(run.client_area, run.server_area);
 }
 
-PreparedIR prepared_seed(const std::string& name) {
+PreparedIR prepared_separation_seed(const std::string& name) {
   std::ifstream in(std::string(COHAPTIC_SOURCE_DIR) + "/tests/fuzz/corpus/ir/" + name, std::ios::binary);
   wire::IntermediateRepresentation message;
   EXPECT_TRUE(message.ParseFromIstream(&in)) << name;
@@ -218,10 +218,10 @@ PreparedIR prepared_seed(const std::string& name) {
 // Eq. 2 blended by hand over its areas (fields k_z = 300, 150, 60 N/m; triangle 0 half
 // separated: A(R-bar) = 1/4, 1/2, 1/4 at its nodes, A(S-bar) = 1/4; c at weights 1/2, 1/4, 1/4).
 TEST(SeparationIr, FuzzSeedsReachTheEvaluation) {
-  const PreparedIR free = prepared_seed("separation");
+  const PreparedIR free = prepared_separation_seed("separation");
   EvaluationState free_state = make_evaluation_state(free);
   EXPECT_EQ(evaluate_force(free, free_state, Vector3d(0.002, 0.001, 0.0001), {}, 1e-3, 0).force, Vector3d::Zero());
-  const PreparedIR grasped = prepared_seed("separation_grasped");
+  const PreparedIR grasped = prepared_separation_seed("separation_grasped");
   EvaluationState state = make_evaluation_state(grasped);
   const auto field = [](double local, double global) { return (1 - global) * ((1 - local) * 300 + local * 150) + global * 60; };
   const double k = 0.5 * field(0.25, 0.25) + 0.25 * field(0.5, 0.25) + 0.25 * field(0.25, 0.25);
@@ -233,7 +233,7 @@ TEST(SeparationIr, FuzzSeedsReachTheEvaluation) {
   EXPECT_EQ(evaluate_force(grasped, state, Vector3d(0.002, 0.001, 0.0003), {}, 1e-3, 0).force, Vector3d::Zero());
 }
 
-void expect_refused(const wire::IntermediateRepresentation& message, const std::string& fragment) {
+void expect_separation_refused(const wire::IntermediateRepresentation& message, const std::string& fragment) {
   try {
     wire::from_wire(message);
     ADD_FAILURE() << "accepted; expected an error containing \"" << fragment << "\"";
@@ -246,34 +246,34 @@ TEST(SeparationIr, LyingMessagesAreRefusedByName) {
   const wire::IntermediateRepresentation good = wire::to_wire(busy_ir());
   wire::IntermediateRepresentation w = good;
   w.mutable_separation()->set_triangles(4, 100000);
-  expect_refused(w, "triangle 1 names node 100000");
+  expect_separation_refused(w, "triangle 1 names node 100000");
   w = good;
   w.mutable_separation()->set_neighbours(0, 5000);
-  expect_refused(w, "names neighbour 5000");
+  expect_separation_refused(w, "names neighbour 5000");
   w = good;
   w.mutable_separation()->set_region_offsets(1, 30);
-  expect_refused(w, "a region of 30 triangles");
+  expect_separation_refused(w, "a region of 30 triangles");
   w = good;
   w.mutable_separation()->mutable_fields()->RemoveLast();
-  expect_refused(w, "field values, expected");
+  expect_separation_refused(w, "field values, expected");
   w = good;
   w.mutable_separation()->set_fields(7, std::nan(""));
-  expect_refused(w, "field value 7 is not finite");
+  expect_separation_refused(w, "field value 7 is not finite");
   w = good;
   w.mutable_separation()->set_separated(3, 1.5);
-  expect_refused(w, "separated share 1.5");
+  expect_separation_refused(w, "separated share 1.5");
   w = good;
   w.mutable_separation()->mutable_contact()->set_mode(7);
-  expect_refused(w, "contact mode 7");
+  expect_separation_refused(w, "contact mode 7");
   w = good;
   w.mutable_separation()->mutable_contact()->set_triangle(1u << 31);
-  expect_refused(w, "contact triangle = 2147483648 is out of range");
+  expect_separation_refused(w, "contact triangle = 2147483648 is out of range");
   w = good;
   w.mutable_separation()->set_toughness(-75);
-  expect_refused(w, "toughness (J_c) must be a positive finite number");
+  expect_separation_refused(w, "toughness (J_c) must be a positive finite number");
   w = good;
   w.mutable_separation()->set_open_rim(std::string(w.separation().open_rim().size(), '\x09'));
-  expect_refused(w, "crack flags 9");
+  expect_separation_refused(w, "crack flags 9");
 }
 
 }  // namespace

@@ -27,9 +27,9 @@ namespace {
 namespace fs = std::filesystem;
 using testing::ChildProcess;
 
-const fs::path kScenes = fs::path(COHAPTIC_SOURCE_DIR) / "scenes" / "separation";
+const fs::path kSeparationScenes = fs::path(COHAPTIC_SOURCE_DIR) / "scenes" / "separation";
 
-struct UserCheck {
+struct SeparationUserCheck {
   int ticks = 0, evaluated = 0, in_contact = 0;
   double peak_force = 0;
   std::vector<std::shared_ptr<const PreparedIR>> irs;  // in epoch order
@@ -37,12 +37,12 @@ struct UserCheck {
 
 // Re-evaluates every tick of a client's recording on the IR it held, each IR's state
 // starting where the client started it (fresh from the IR), and compares bit for bit.
-UserCheck check_recording(const fs::path& file) {
+SeparationUserCheck check_separation_recording(const fs::path& file) {
   const record::Recording recording = record::read_recording(file);
   std::map<std::uint64_t, std::shared_ptr<const PreparedIR>> irs;
   for (const record::RecordedIr& recorded : recording.irs)
     irs[recorded.ir().epoch()] = std::make_shared<const PreparedIR>(prepare_ir(wire::from_wire(recorded.ir())));
-  UserCheck check;
+  SeparationUserCheck check;
   for (const auto& [epoch, ir] : irs) check.irs.push_back(ir);
   std::map<std::uint64_t, EvaluationState> states;
   for (const record::HapticTick& tick : recording.ticks) {
@@ -81,7 +81,7 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
   const fs::path dir = testing::scratch_directory("separation-session");
   auto server = std::make_unique<ChildProcess>(
       testing::server_program(),
-      std::vector<std::string>{"--scene", (kScenes / "two_layers.yaml").string(), "--listen", "127.0.0.1:0", "--duration",
+      std::vector<std::string>{"--scene", (kSeparationScenes / "two_layers.yaml").string(), "--listen", "127.0.0.1:0", "--duration",
                                "60", "--report", (dir / "server.json").string(), "--cache-dir", (dir / "cache").string()},
       dir / "server.log");
   ASSERT_TRUE(testing::wait_for_output(*server, "listening on")) << server->log_text();
@@ -90,7 +90,7 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
     return std::make_unique<ChildProcess>(
         testing::client_program(),
         std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot", std::to_string(slot),
-                                 "--device", "script:" + (kScenes / "two_layers" / script).string(), "--record",
+                                 "--device", "script:" + (kSeparationScenes / "two_layers" / script).string(), "--record",
                                  (dir / (user + ".mcap")).string(), "--report", (dir / (user + ".json")).string()},
         dir / (user + ".log"));
   };
@@ -101,13 +101,13 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
   server->signal(SIGINT);
   ASSERT_EQ(server->wait(testing::kPatience), 0) << server->log_text();
 
-  const UserCheck alice = check_recording(dir / "alice.mcap");
-  const UserCheck bob = check_recording(dir / "bob.mcap");
+  const SeparationUserCheck alice = check_separation_recording(dir / "alice.mcap");
+  const SeparationUserCheck bob = check_separation_recording(dir / "bob.mcap");
   std::printf("  alice: %d ticks, %d re-evaluated, %d in contact, peak %.3f N, %zu IRs\n", alice.ticks, alice.evaluated,
               alice.in_contact, alice.peak_force, alice.irs.size());
   std::printf("  bob: %d ticks, %d re-evaluated, %d in contact, peak %.3f N, %zu IRs\n", bob.ticks, bob.evaluated,
               bob.in_contact, bob.peak_force, bob.irs.size());
-  for (const UserCheck* user : {&alice, &bob}) {
+  for (const SeparationUserCheck* user : {&alice, &bob}) {
     EXPECT_GT(user->evaluated, 3000);
     EXPECT_GT(user->in_contact, 500);
     ASSERT_GE(user->irs.size(), 3u);
@@ -118,11 +118,11 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
 
   // The server's state, as each user's IRs carried it: never shrinking, and at the end the
   // rim torn, the groove cut and more separated than the groove alone.
-  for (const UserCheck* user : {&alice, &bob})
+  for (const SeparationUserCheck* user : {&alice, &bob})
     for (std::size_t i = 1; i < user->irs.size(); ++i)
       EXPECT_GE(std::get<SeparationIr>(user->irs[i]->ir.body).state.separated_area,
                 std::get<SeparationIr>(user->irs[i - 1]->ir.body).state.separated_area);
-  const UserCheck& later = alice.irs.back()->ir.simulation_time > bob.irs.back()->ir.simulation_time ? alice : bob;
+  const SeparationUserCheck& later = alice.irs.back()->ir.simulation_time > bob.irs.back()->ir.simulation_time ? alice : bob;
   const auto& last = std::get<SeparationIr>(later.irs.back()->ir.body);
   const double rim = separated_where(last, [](const Eigen::Vector3d& c) { return c.x() < 0.006; });
   const double groove = separated_where(last, [](const Eigen::Vector3d& c) { return std::abs(c.x() - 0.0205) < 0.002; });

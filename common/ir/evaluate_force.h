@@ -66,7 +66,8 @@ using PreparedBody = std::variant<PreparedFem, PreparedMassSpring, PreparedHomeS
 
 /// An IR and what its evaluation needs, computed once: `body` holds the alternative that
 /// matches ir.body's kind (PreparedFem for CondensedFemIr, PreparedMassSpring for
-/// MassSpringIr, PreparedHomeSpringPatch for HomeSpringPatch).
+/// MassSpringIr, PreparedHomeSpringPatch for HomeSpringPatch, PreparedSeparation for
+/// SeparationIr).
 struct PreparedIR {
   IntermediateRepresentation ir;
   PreparedBody body;

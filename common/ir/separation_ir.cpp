@@ -12,20 +12,20 @@ namespace {
 // Degrees the fields may have (separation_fields.h's FieldSettings validates the same).
 constexpr int kMaxSeparationDegree = 9;
 // A unit normal's length may be off by round-off of another producer's arithmetic.
-constexpr double kUnitTolerance = 1e-9;
+constexpr double kSeparationUnitTolerance = 1e-9;
 
 template <typename... Args>
 [[noreturn]] void refuse_separation(fmt::format_string<Args...> format, Args&&... args) {
   throw Error("separation patch: " + fmt::format(format, std::forward<Args>(args)...));
 }
 
-void require_positive(double value, const char* what) {
+void require_positive_setting(double value, const char* what) {
   if (!(std::isfinite(value) && value > 0)) refuse_separation("{} must be a positive finite number, got {}", what, value);
 }
 
-bool finite_vector(const Eigen::Vector3d& v) { return v.allFinite(); }
+bool separation_vector_finite(const Eigen::Vector3d& v) { return v.allFinite(); }
 
-void check_geometry(const SeparationPatch& p) {
+void check_separation_geometry(const SeparationPatch& p) {
   const int nodes = p.node_count(), triangles = p.triangle_count();
   if (nodes < 3 || triangles < 1) refuse_separation("{} nodes and {} triangles", nodes, triangles);
   if (!p.positions.allFinite()) refuse_separation("a node position is not finite");
@@ -45,15 +45,15 @@ void check_geometry(const SeparationPatch& p) {
         refuse_separation("triangle {} names neighbour {} ({} triangles)", t, neighbour, triangles);
     }
     if (p.open_rim[t] > 7) refuse_separation("triangle {} has crack flags {} (three edge bits at most)", t, p.open_rim[t]);
-    if (!finite_vector(p.normals[t]) || std::abs(p.normals[t].norm() - 1) > kUnitTolerance)
+    if (!separation_vector_finite(p.normals[t]) || std::abs(p.normals[t].norm() - 1) > kSeparationUnitTolerance)
       refuse_separation("triangle {} has a normal that is not a unit vector", t);
-    if (!finite_vector(p.centroids[t])) refuse_separation("triangle {} has a non-finite centroid", t);
-    require_positive(p.areas[t], "a triangle's area");
+    if (!separation_vector_finite(p.centroids[t])) refuse_separation("triangle {} has a non-finite centroid", t);
+    require_positive_setting(p.areas[t], "a triangle's area");
   }
-  require_positive(p.interface_area, "interface_area");
+  require_positive_setting(p.interface_area, "interface_area");
 }
 
-void check_regions(const SeparationPatch& p) {
+void check_separation_regions(const SeparationPatch& p) {
   const NodeRegions& r = p.regions;
   const int nodes = p.node_count(), triangles = p.triangle_count();
   if (static_cast<int>(r.offsets.size()) != nodes + 1 || r.offsets.front() != 0 ||
@@ -69,10 +69,10 @@ void check_regions(const SeparationPatch& p) {
     if (t < 0 || t >= triangles) refuse_separation("a region names triangle {} ({} triangles)", t, triangles);
   if (static_cast<int>(p.region_areas.size()) != nodes)
     refuse_separation("{} region areas for {} nodes", p.region_areas.size(), nodes);
-  for (double area : p.region_areas) require_positive(area, "a region's area");
+  for (double area : p.region_areas) require_positive_setting(area, "a region's area");
 }
 
-void check_fields_and_settings(const SeparationPatch& p) {
+void check_separation_fields_and_settings(const SeparationPatch& p) {
   if (p.degree < 1 || p.degree > kMaxSeparationDegree)
     refuse_separation("degree {} (1 to {})", p.degree, kMaxSeparationDegree);
   if (p.tool_node_count < 1 || p.tool_node_count > p.node_count())
@@ -82,25 +82,25 @@ void check_fields_and_settings(const SeparationPatch& p) {
   if (p.fields.size() != expected) refuse_separation("{} field values, expected {}", p.fields.size(), expected);
   for (std::size_t i = 0; i < p.fields.size(); ++i)
     if (!std::isfinite(p.fields[i])) refuse_separation("field value {} is not finite", i);
-  require_positive(p.toughness, "toughness (J_c)");
-  require_positive(p.normal_length, "normal_length (l_n)");
-  require_positive(p.tangential_length, "tangential_length (l_t)");
-  require_positive(p.normal_threshold, "normal_threshold (F_n)");
-  require_positive(p.tangential_threshold, "tangential_threshold (F_t)");
+  require_positive_setting(p.toughness, "toughness (J_c)");
+  require_positive_setting(p.normal_length, "normal_length (l_n)");
+  require_positive_setting(p.tangential_length, "tangential_length (l_t)");
+  require_positive_setting(p.normal_threshold, "normal_threshold (F_n)");
+  require_positive_setting(p.tangential_threshold, "tangential_threshold (F_t)");
   if (!(std::isfinite(p.friction) && p.friction >= 0)) refuse_separation("friction {} is not >= 0", p.friction);
-  require_positive(p.laser_absorbed_power, "laser_absorbed_power (alpha P)");
-  require_positive(p.spot_diameter, "spot_diameter (l_f)");
-  require_positive(p.laser_reach, "laser_reach");
-  require_positive(p.vaporisation_energy, "vaporisation_energy (q)");
-  require_positive(p.vaporisation_speed, "vaporisation_speed (v_s)");
-  require_positive(p.force_limit, "force_limit");
+  require_positive_setting(p.laser_absorbed_power, "laser_absorbed_power (alpha P)");
+  require_positive_setting(p.spot_diameter, "spot_diameter (l_f)");
+  require_positive_setting(p.laser_reach, "laser_reach");
+  require_positive_setting(p.vaporisation_energy, "vaporisation_energy (q)");
+  require_positive_setting(p.vaporisation_speed, "vaporisation_speed (v_s)");
+  require_positive_setting(p.force_limit, "force_limit");
 }
 
-bool valid_weights(const Eigen::Vector3d& w) {
+bool separation_weights_valid(const Eigen::Vector3d& w) {
   return w.allFinite() && (w.array() >= 0).all() && std::abs(w.sum() - 1) < 1e-9;
 }
 
-void check_tool(const SeparationPatch& p, const SeparationIr& ir) {
+void check_separation_tool(const SeparationPatch& p, const SeparationIr& ir) {
   if (!(std::isfinite(ir.tool.grasp_reach) && ir.tool.grasp_reach >= 0))
     refuse_separation("grasp_reach {} is not a finite length >= 0", ir.tool.grasp_reach);
   const SeparationContact& c = ir.tool_state.contact;
@@ -111,12 +111,12 @@ void check_tool(const SeparationPatch& p, const SeparationIr& ir) {
       refuse_separation("the contact is on triangle {} ({} triangles)", c.point.triangle, p.triangle_count());
     for (int j : c.point.tool_nodes)
       if (j < 0 || j >= p.tool_node_count) refuse_separation("the contact names tool node {} ({})", j, p.tool_node_count);
-    if (!valid_weights(c.point.weights) || !valid_weights(c.point.tool_weights))
+    if (!separation_weights_valid(c.point.weights) || !separation_weights_valid(c.point.tool_weights))
       refuse_separation("the contact's area coordinates are not non-negative weights summing to 1");
-    if (!finite_vector(c.position) || !finite_vector(c.tool_offset) || !finite_vector(c.last_tool))
+    if (!separation_vector_finite(c.position) || !separation_vector_finite(c.tool_offset) || !separation_vector_finite(c.last_tool))
       refuse_separation("the contact has a non-finite position");
   }
-  if (!finite_vector(ir.tool_state.fibre.last_tip)) refuse_separation("the fibre's last tip is not finite");
+  if (!separation_vector_finite(ir.tool_state.fibre.last_tip)) refuse_separation("the fibre's last tip is not finite");
 }
 
 }  // namespace
@@ -135,9 +135,9 @@ std::size_t SeparationIr::size_bytes() const {
 void validate_separation_ir(const SeparationIr& ir) {
   if (!ir.patch) refuse_separation("missing");
   const SeparationPatch& p = *ir.patch;
-  check_geometry(p);
-  check_regions(p);
-  check_fields_and_settings(p);
+  check_separation_geometry(p);
+  check_separation_regions(p);
+  check_separation_fields_and_settings(p);
   if (static_cast<int>(ir.state.separated.size()) != p.triangle_count())
     refuse_separation("{} separated shares for {} triangles", ir.state.separated.size(), p.triangle_count());
   for (std::size_t t = 0; t < ir.state.separated.size(); ++t)
@@ -145,7 +145,7 @@ void validate_separation_ir(const SeparationIr& ir) {
       refuse_separation("triangle {}'s separated share {} is not in [0, 1]", t, ir.state.separated[t]);
   if (!(std::isfinite(ir.state.separated_area) && ir.state.separated_area >= 0))
     refuse_separation("separated_area {} is not a finite area >= 0", ir.state.separated_area);
-  check_tool(p, ir);
+  check_separation_tool(p, ir);
 }
 
 }  // namespace cohaptic

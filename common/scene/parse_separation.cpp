@@ -7,25 +7,25 @@
 namespace cohaptic {
 namespace {
 
-double positive_length(const YamlCursor& c, double scale) {
+double separation_length(const YamlCursor& c, double scale) {
   const double length = c.positive("a positive length") * scale;
   if (!std::isfinite(length)) c.fail("a finite length");
   return length;
 }
 
-int count_in(const YamlCursor& c, int low, int high) {
+int separation_count(const YamlCursor& c, int low, int high) {
   const std::int64_t value = c.integer();
   if (value < low || value > high) c.fail("an integer from " + std::to_string(low) + " to " + std::to_string(high));
   return static_cast<int>(value);
 }
 
-double reach_length(const YamlCursor& c, double scale) {
+double separation_reach(const YamlCursor& c, double scale) {
   const double length = c.number_in(0, INFINITY, false, true, "a length >= 0") * scale;
   if (!std::isfinite(length)) c.fail("a finite length");
   return length;
 }
 
-LinearElasticMaterial parse_layer_material(const YamlCursor& c) {
+LinearElasticMaterial parse_separation_layer_material(const YamlCursor& c) {
   c.only_keys({"youngs_modulus", "poisson_ratio"});
   LinearElasticMaterial material;
   material.youngs_modulus = c.at("youngs_modulus").number_in(0, INFINITY, true, true, "a positive modulus in Pa");
@@ -33,53 +33,53 @@ LinearElasticMaterial parse_layer_material(const YamlCursor& c) {
   return material;
 }
 
-TwoLayerBoxes parse_layers(const YamlCursor& c, double scale) {
+TwoLayerBoxes parse_separation_layers(const YamlCursor& c, double scale) {
   c.only_keys({"size", "flap_thickness", "base_thickness", "divisions", "flap_layers", "base_layers", "flap_material",
                "base_material"});
   TwoLayerBoxes layers;
   const std::vector<YamlCursor> size = c.at("size").items();
   if (size.size() != 2) c.at("size").fail("a list of two lengths [a, b]");
-  layers.size = Eigen::Vector2d(positive_length(size[0], scale), positive_length(size[1], scale));
-  layers.pulled_thickness = positive_length(c.at("flap_thickness"), scale);
-  layers.base_thickness = positive_length(c.at("base_thickness"), scale);
+  layers.size = Eigen::Vector2d(separation_length(size[0], scale), separation_length(size[1], scale));
+  layers.pulled_thickness = separation_length(c.at("flap_thickness"), scale);
+  layers.base_thickness = separation_length(c.at("base_thickness"), scale);
   const std::vector<YamlCursor> divisions = c.at("divisions").items();
   if (divisions.size() != 2) c.at("divisions").fail("a list of two cell counts [nx, ny]");
-  layers.divisions = Eigen::Vector2i(count_in(divisions[0], 1, 200), count_in(divisions[1], 1, 200));
-  if (auto flap = c.find("flap_layers")) layers.pulled_layers = count_in(*flap, 1, 50);
-  if (auto base = c.find("base_layers")) layers.base_layers = count_in(*base, 1, 50);
-  if (auto material = c.find("flap_material")) layers.pulled_material = parse_layer_material(*material);
-  if (auto material = c.find("base_material")) layers.base_material = parse_layer_material(*material);
+  layers.divisions = Eigen::Vector2i(separation_count(divisions[0], 1, 200), separation_count(divisions[1], 1, 200));
+  if (auto flap = c.find("flap_layers")) layers.pulled_layers = separation_count(*flap, 1, 50);
+  if (auto base = c.find("base_layers")) layers.base_layers = separation_count(*base, 1, 50);
+  if (auto material = c.find("flap_material")) layers.pulled_material = parse_separation_layer_material(*material);
+  if (auto material = c.find("base_material")) layers.base_material = parse_separation_layer_material(*material);
   return layers;
 }
 
-FieldSettings parse_fields(const YamlCursor& c, double scale) {
+FieldSettings parse_separation_fields(const YamlCursor& c, double scale) {
   c.only_keys({"degree", "samples_per_axis", "max_deflection"});
   FieldSettings fields;
-  if (auto degree = c.find("degree")) fields.degree = count_in(*degree, 1, 9);
-  if (auto samples = c.find("samples_per_axis")) fields.samples_per_axis = count_in(*samples, 1, 50);
+  if (auto degree = c.find("degree")) fields.degree = separation_count(*degree, 1, 9);
+  if (auto samples = c.find("samples_per_axis")) fields.samples_per_axis = separation_count(*samples, 1, 50);
   if (fields.samples_per_axis - fields.samples_per_axis % 2 < fields.degree)
     c.fail_message("samples_per_axis must give at least `degree` non-zero samples (an odd count has a zero)");
-  if (auto range = c.find("max_deflection")) fields.max_deflection = positive_length(*range, scale);
+  if (auto range = c.find("max_deflection")) fields.max_deflection = separation_length(*range, scale);
   return fields;
 }
 
-void parse_fracture(const YamlCursor& c, double scale, FractureSettings& fracture) {
+void parse_separation_fracture(const YamlCursor& c, double scale, FractureSettings& fracture) {
   c.only_keys({"toughness", "normal_length", "tangential_length", "friction"});
   if (auto v = c.find("toughness")) fracture.toughness = v->positive("a positive toughness J_c in J/m^2");
-  if (auto v = c.find("normal_length")) fracture.normal_length = positive_length(*v, scale);
-  if (auto v = c.find("tangential_length")) fracture.tangential_length = positive_length(*v, scale);
+  if (auto v = c.find("normal_length")) fracture.normal_length = separation_length(*v, scale);
+  if (auto v = c.find("tangential_length")) fracture.tangential_length = separation_length(*v, scale);
   if (auto v = c.find("friction")) fracture.friction = v->number_in(0, INFINITY, false, true, "a friction coefficient >= 0");
 }
 
-void parse_laser(const YamlCursor& c, double scale, LaserSettings& laser) {
+void parse_separation_laser(const YamlCursor& c, double scale, LaserSettings& laser) {
   c.only_keys({"power", "absorbed_fraction", "spot_diameter", "reach"});
   if (auto v = c.find("power")) laser.power = v->positive("a positive power in W");
   if (auto v = c.find("absorbed_fraction")) laser.absorbed_fraction = v->number_in(0, 1, true, false, "a fraction in (0, 1]");
-  if (auto v = c.find("spot_diameter")) laser.spot_diameter = positive_length(*v, scale);
-  if (auto v = c.find("reach")) laser.reach = positive_length(*v, scale);
+  if (auto v = c.find("spot_diameter")) laser.spot_diameter = separation_length(*v, scale);
+  if (auto v = c.find("reach")) laser.reach = separation_length(*v, scale);
 }
 
-void parse_tissue(const YamlCursor& c, TissueThermal& tissue) {
+void parse_separation_tissue(const YamlCursor& c, TissueThermal& tissue) {
   c.only_keys({"density", "specific_heat", "temperature_rise", "latent_heat"});
   if (auto v = c.find("density")) tissue.density = v->positive("a positive density in kg/m^3");
   if (auto v = c.find("specific_heat")) tissue.specific_heat = v->positive("a positive specific heat in J/(kg K)");
@@ -93,14 +93,14 @@ SeparationObjectSpec parse_separation_object(const YamlCursor& c, double scale) 
   c.only_keys({"name", "model", "layers", "fields", "fracture", "laser", "tissue", "force_limit", "instruments",
                "grasp_reach", "ir_rate_hz", "disk_cache"});
   SeparationObjectSpec object;
-  object.layers = parse_layers(c.at("layers"), scale);
-  if (auto fields = c.find("fields")) object.fields = parse_fields(*fields, scale);
-  if (auto fracture = c.find("fracture")) parse_fracture(*fracture, scale, object.settings.fracture);
-  if (auto laser = c.find("laser")) parse_laser(*laser, scale, object.settings.laser);
-  if (auto tissue = c.find("tissue")) parse_tissue(*tissue, object.settings.tissue);
+  object.layers = parse_separation_layers(c.at("layers"), scale);
+  if (auto fields = c.find("fields")) object.fields = parse_separation_fields(*fields, scale);
+  if (auto fracture = c.find("fracture")) parse_separation_fracture(*fracture, scale, object.settings.fracture);
+  if (auto laser = c.find("laser")) parse_separation_laser(*laser, scale, object.settings.laser);
+  if (auto tissue = c.find("tissue")) parse_separation_tissue(*tissue, object.settings.tissue);
   if (auto limit = c.find("force_limit")) object.settings.force_limit = limit->positive("a positive force in N");
   if (auto reach = c.find("grasp_reach"))
-    object.grasp_reach = reach_length(*reach, scale);
+    object.grasp_reach = separation_reach(*reach, scale);
   if (auto instruments = c.find("instruments")) {
     for (const YamlCursor& item : instruments->items()) {
       item.only_keys({"tool", "laser", "grasp_reach"});
@@ -110,7 +110,7 @@ SeparationObjectSpec parse_separation_object(const YamlCursor& c, double scale) 
       instrument.settings.grasp_reach = object.grasp_reach;
       if (auto laser = item.find("laser")) instrument.settings.laser = laser->boolean();
       if (auto reach = item.find("grasp_reach"))
-        instrument.settings.grasp_reach = reach_length(*reach, scale);
+        instrument.settings.grasp_reach = separation_reach(*reach, scale);
       object.instruments.push_back(instrument);
     }
   }
