@@ -36,6 +36,7 @@ record::HapticTick haptic_tick_record(const TickRecord& tick) {
   record.set_flags(tick.flags);
   record.set_fade(tick.fade);
   record.set_own_valid(tick.own_valid);
+  record.set_buttons(tick.buttons);
   return record;
 }
 

@@ -87,7 +87,7 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       record.remote_count = static_cast<std::uint8_t>(count);
       // dt: the nominal period, so that a replay reproduces the force bit for bit.
       const double dt = 1 / settings_.rate_hz;
-      const ForceSample sample = evaluate_force(*slot.ir, *slot.state, own, std::span(remotes.data(), count), dt);
+      const ForceSample sample = evaluate_force(*slot.ir, *slot.state, own, std::span(remotes.data(), count), dt, record.buttons);
       // A sphere contact solve that could not finish inside the tick has no answer: hold the
       // last one and count the tick.
       if (sample.flags & kContactUnresolved) {
@@ -104,7 +104,8 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       // which would advance a dynamic body's state a second time: static bodies only. A sphere's
       // warm start is no body state: it is left alone by evaluating on an empty state (a cold
       // solve, the same answer).
-      const bool static_body = !std::holds_alternative<MassSpringPatchState>(slot.state->body);
+      const bool static_body = std::holds_alternative<std::monostate>(slot.state->body) ||
+                               std::holds_alternative<SphereWarmStart>(slot.state->body);
       // Measured only in contact: a user that passed by a static body without touching it
       // (e.g. on its way to a mass-spring object lying on it) measured nothing. A home-spring
       // body's users never couple (each feels its own vertex's springs): nothing to measure.
@@ -173,6 +174,7 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     TickRecord record;
     record.time_ns = woke;
     record.own = state.position;
+    record.buttons = state.buttons;
     record.own_valid = state.valid;
     Eigen::Vector3d force = state.valid ? compute_force(woke, state.position, record) : Eigen::Vector3d::Zero();
     if (settings_.protocol == HapticProtocol::p1 && record.ir_epoch != epoch_in_use) {

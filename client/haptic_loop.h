@@ -91,6 +91,7 @@ struct OwnSample {
 struct TickRecord {
   std::int64_t time_ns = 0;
   Eigen::Vector3d own = Eigen::Vector3d::Zero();
+  std::uint32_t buttons = 0;                             ///< the own tool's, as evaluated
   bool own_valid = false;
   std::uint8_t remote_count = 0;                         ///< remote positions used
   std::array<Eigen::Vector3d, kMaxUsers - 1> remotes{};  ///< in the IR's remotes order (NaN: unknown)

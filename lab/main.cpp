@@ -6,6 +6,7 @@
 //   hertz      a sphere in a block, against Hertz
 //   objects-push  the several-objects pushing test: back free, fixed, on an elastic box
 //   ir-bytes   a client's IR bytes, and what f32, M~ deltas or compliance rows would send
+//   separation-pull  the separation-forces paper's Fig. 10 on a scene's separating interface
 // Each tool adds its own subcommand (lab/lab_command.h). A tool that needs the server or the
 // client (study) starts them as processes; cohaptic-lab links neither.
 #include <CLI/CLI.hpp>
@@ -22,6 +23,7 @@
 #include "lab/objects_push.h"
 #include "lab/probe.h"
 #include "lab/replay.h"
+#include "lab/separation_pull.h"
 #include "lab/session_summary.h"
 #include "lab/stability.h"
 #include "lab/study.h"
@@ -41,7 +43,7 @@ int main(int argc, char** argv) {
       cohaptic::add_probe_command(app),     cohaptic::add_replay_command(app),    cohaptic::add_study_command(app),
       cohaptic::add_tradeoff_command(app),  cohaptic::add_stability_command(app), cohaptic::add_summarize_command(app),
       cohaptic::add_keygen_command(app),    cohaptic::add_hertz_command(app),    cohaptic::add_objects_push_command(app),
-      cohaptic::add_ir_bytes_command(app)};
+      cohaptic::add_ir_bytes_command(app),  cohaptic::add_separation_pull_command(app)};
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));

@@ -84,7 +84,7 @@ VerifyResult verify_client(const Recording& rec) {
         for (const wire::Vec3& r : tick.remotes()) remotes.push_back(wire::from_wire(r));
         auto state = states.find(ir.get());
         if (state == states.end()) state = states.emplace(ir.get(), make_evaluation_state(*ir)).first;
-        const ForceSample sample = evaluate_force(*ir, state->second, wire::from_wire(tick.own()), remotes, tick.dt());
+        const ForceSample sample = evaluate_force(*ir, state->second, wire::from_wire(tick.own()), remotes, tick.dt(), tick.buttons());
         expected = (sample.flags & kContactUnresolved) ? last_resolved : sample.force;
         last_resolved = expected;
       } else {

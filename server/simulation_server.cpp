@@ -87,7 +87,8 @@ struct SimulationServer::Impl {
 
   void load() {
     Stopwatch watch;
-    const Scene scene = load_scene(options.scene);
+    Scene scene = load_scene(options.scene);
+    use_separation_field_cache(scene, options.cache_directory);
     {
       std::ifstream in(options.scene);
       scene_yaml.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());

@@ -4,7 +4,8 @@
 // nodes), of a mass-spring body's sub-network integrated tick by tick with two tools
 // pressing it, and of the laparoscopy model's per-tick functions (home-spring tick, alone
 // and as the IR's body through evaluate_force, forceps step, display frames by both methods),
-// and of the client's whole haptic loop while new mass-spring IRs of different sizes arrive.
+// and of the client's whole haptic loop while new mass-spring IRs of different sizes arrive,
+// and of a separation body's instrument as the IR's body (a laser groove, a grasp that tears).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -25,6 +26,7 @@
 #include "common/sim/mass_spring_simulation.h"
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
+#include "support/default_two_layers.h"
 #include "support/evaluate_static.h"
 #include "support/sanitizer_owns_malloc.h"
 #include "support/test_meshes.h"
@@ -289,6 +291,32 @@ TEST(LaparoscopyHapticPath, AllocatesNothing) {
   EXPECT_EQ(allocations.load(), 0) << "the laparoscopy haptic path allocated";
   EXPECT_TRUE(sum.allFinite());
   EXPECT_GT(touching, 500);  // the tool does go through the sheet
+}
+
+TEST(ForceEvaluator, SeparationBodyAllocatesNothing) {
+  REQUIRE_COUNTED_MALLOC();
+  const SeparationPatch& patch = testing::default_two_layers().patch;
+  IntermediateRepresentation ir;
+  ir.force_limit = 3.3;
+  SeparationIr body;
+  body.patch = std::make_shared<const SeparationPatch>(patch);
+  body.state = make_separation_state(patch);
+  body.tool.laser = true;
+  ir.body = std::move(body);
+  const PreparedIR client = prepare_ir(std::move(ir));
+  EvaluationState state = make_evaluation_state(client);
+  const Eigen::Vector3d from(0.0205, 0.012, 0.0002), to(0.0205, 0.028, 0.0002), rim(0, 0.02, 0.0002);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  counting = true;
+  for (int i = 0; i <= 800; ++i)  // the groove at 20 mm/s, firing
+    sum += evaluate_force(client, state, from + (to - from) * (i / 800.0), {}, 1e-3, kLaserFireButton).force;
+  for (int i = 0; i <= 1000; ++i)  // jaws closed on the rim, pulled up 5 mm: it tears
+    sum += evaluate_force(client, state, rim + Eigen::Vector3d(0, 0, 5e-6 * i), {}, 1e-3, 2).force;
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0) << "the separation body's haptic path allocated";
+  EXPECT_TRUE(sum.allFinite());
+  EXPECT_GT(std::get<SeparationEvaluation>(state.body).state.separated_area, patch.spot_diameter * 0.016)
+      << "the groove and the tear happened";
 }
 
 TEST(ForceEvaluator, AllocatesNothingUnderTheSphereModel) {

@@ -12,6 +12,7 @@
 #include "common/contact/nearest_triangle_rule.h"
 #include "common/contact/surface_distance.h"
 #include "common/ir/evaluate_sphere_contact.h"
+#include "common/ir/separation_evaluation.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -257,6 +258,10 @@ struct BodyPreparer {
   }
   PreparedBody operator()(const MassSpringIr& network) const { return prepare_mass_spring(network); }
   PreparedBody operator()(const HomeSpringPatch& patch) const { return prepare_home_spring_patch(patch); }
+  PreparedBody operator()(const SeparationIr& separation) const {
+    validate_separation_ir(separation);
+    return PreparedSeparation{};
+  }
 };
 
 }  // namespace
@@ -286,11 +291,13 @@ EvaluationState make_evaluation_state(const PreparedIR& prepared) {
     state.body = make_mass_spring_state(*network, std::get<PreparedMassSpring>(prepared.body));
   else if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body); fem && fem->contact_model == ContactModel::sphere)
     state.body = SphereWarmStart{};
+  else if (const auto* separation = std::get_if<SeparationIr>(&prepared.ir.body))
+    state.body = SeparationEvaluation{separation->state, separation->tool_state};
   return state;
 }
 
 ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, const Eigen::Vector3d& own_tool,
-                           std::span<const Eigen::Vector3d> remote_tools, double dt) noexcept {
+                           std::span<const Eigen::Vector3d> remote_tools, double dt, std::uint32_t buttons) noexcept {
   // get_if, not visit: nothing on this path may throw. prepare_ir made the kinds match.
   if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body))
     if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body)) {
@@ -306,6 +313,10 @@ ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, c
   if (std::holds_alternative<HomeSpringPatch>(prepared.ir.body))
     if (const auto* prepared_patch = std::get_if<PreparedHomeSpringPatch>(&prepared.body))
       return evaluate_home_spring_body(prepared.ir, *prepared_patch, own_tool);
+  if (const auto* separation = std::get_if<SeparationIr>(&prepared.ir.body))
+    if (auto* separation_state = std::get_if<SeparationEvaluation>(&state.body))
+      return step_separation_force(*separation->patch, separation_state->state, separation_state->tool, separation->tool,
+                                   own_tool, buttons, dt, prepared.ir.force_limit);
   ForceSample unknown;
   unknown.flags = kNonFinite;
   return unknown;

@@ -11,7 +11,9 @@
 // integrates its sub-network over dt. The home-spring body is static too (its grasp
 // travels in the IR): home_spring_contact.h's tick, from the shaft through the patch's
 // trocar pivot; the sample's depth is then |u|, the contact vertex's displacement, and
-// its triangle -1.
+// its triangle -1. The separation body (separation_ir.h) steps the user's instrument on
+// the state that make_evaluation_state copied from the IR: grasp, fracture and the laser
+// (its buttons), exactly as the server's step does; depth is then the deflection's length.
 //
 // The condensed FEM body:
 // prepare_ir() runs once per IR, off the haptic thread: it checks the IR and inverts the
@@ -56,12 +58,16 @@ struct PreparedFem {
   PreparedSphereContact sphere;       ///< the sphere contact model's (evaluate_sphere_contact.h)
 };
 
+/// The separation body needs nothing derived: prepare_ir validates it.
+struct PreparedSeparation {};
+
 /// One alternative per IrBody alternative, in the same order.
-using PreparedBody = std::variant<PreparedFem, PreparedMassSpring, PreparedHomeSpringPatch>;
+using PreparedBody = std::variant<PreparedFem, PreparedMassSpring, PreparedHomeSpringPatch, PreparedSeparation>;
 
 /// An IR and what its evaluation needs, computed once: `body` holds the alternative that
 /// matches ir.body's kind (PreparedFem for CondensedFemIr, PreparedMassSpring for
-/// MassSpringIr, PreparedHomeSpringPatch for HomeSpringPatch).
+/// MassSpringIr, PreparedHomeSpringPatch for HomeSpringPatch, PreparedSeparation for
+/// SeparationIr).
 struct PreparedIR {
   IntermediateRepresentation ir;
   PreparedBody body;
@@ -75,9 +81,15 @@ PreparedIR prepare_ir(IntermediateRepresentation ir);
 /// The mutable side of one evaluator of one prepared IR: nothing for a static body (FEM),
 /// the last tick's active set for an FEM body under the sphere contact model (only a warm
 /// start: an empty state solves cold, to the same answer), the sub-network's state for a
-/// mass-spring body. Made off the haptic thread, sized there.
+/// mass-spring body, the separated state and the instrument for a separation body. Made off
+/// the haptic thread, sized there.
+struct SeparationEvaluation {
+  SeparationState state;
+  SeparationToolState tool;
+};
+
 struct EvaluationState {
-  std::variant<std::monostate, MassSpringPatchState, SphereWarmStart> body;
+  std::variant<std::monostate, MassSpringPatchState, SphereWarmStart, SeparationEvaluation> body;
 };
 
 /// The state an evaluator of `prepared` starts from (the server's state at the IR's time).
@@ -109,8 +121,9 @@ void limit_force(ForceSample& sample, bool evaluated, double force_limit) noexce
 /// i-th remote contact [m] (NaN: unknown, ignored). `state` must come from
 /// make_evaluation_state(prepared) and be advanced by no other IR; dt [s] is the period
 /// since the previous call (the haptic loop's nominal period). A state of another kind
-/// than the body's gives a zero force flagged kNonFinite.
+/// than the body's gives a zero force flagged kNonFinite. `buttons` are the own tool's
+/// (bit i = button i held); only the separation body reads them.
 ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, const Eigen::Vector3d& own_tool,
-                           std::span<const Eigen::Vector3d> remote_tools, double dt) noexcept;
+                           std::span<const Eigen::Vector3d> remote_tools, double dt, std::uint32_t buttons = 0) noexcept;
 
 }  // namespace cohaptic

@@ -2,7 +2,8 @@
 // An envelope (who, when, the tool, the force limit) around one body, a variant over the
 // body kinds: the client prepares and evaluates whichever kind the server sent. The
 // mass-spring body's IR is in mass_spring_ir.h, the home-spring (laparoscopy) body's is
-// the HomeSpringPatch itself (common/laparoscopy/home_spring_patch.h).
+// the HomeSpringPatch itself (common/laparoscopy/home_spring_patch.h), the separating
+// tissue's is in separation_ir.h.
 //
 // CondensedFemIr, the linear elastic body's (the paper's Sec. II-C): the local contact
 // geometry and M~ = (M_CC M_CB). Nodes are numbered locally: first the user's own contact patch (the triangle nearest its
@@ -26,6 +27,7 @@
 
 #include "common/fem/dof_map.h"
 #include "common/ir/mass_spring_ir.h"
+#include "common/ir/separation_ir.h"
 #include "common/laparoscopy/home_spring_patch.h"
 #include "common/mesh/tet_mesh.h"
 #include "common/scene/scene.h"
@@ -86,7 +88,7 @@ struct CondensedFemIr {
 };
 
 /// One alternative per body kind; the wire's `oneof body` mirrors it.
-using IrBody = std::variant<CondensedFemIr, MassSpringIr, HomeSpringPatch>;
+using IrBody = std::variant<CondensedFemIr, MassSpringIr, HomeSpringPatch, SeparationIr>;
 
 struct IntermediateRepresentation {
   /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone).

@@ -25,12 +25,16 @@ Obstacle load_obstacle(const ObstacleSpec& spec, double metres_per_unit) {
 struct BodyBuilder {
   const ObjectSpec& object;
   double metres_per_unit;
+  double force_limit;  // the scene's haptic limit [N]
   BodyModel operator()(const ElasticObjectSpec& spec) const {
     return build_elastic_body(object, spec, metres_per_unit);
   }
   BodyModel operator()(const MassSpringObjectSpec& spec) const { return build_mass_spring_body(object.name, spec, object.where); }
   BodyModel operator()(const HomeSpringObjectSpec& spec) const {
     return build_home_spring_body(object.name, spec, object.where, metres_per_unit);
+  }
+  BodyModel operator()(const SeparationObjectSpec& spec) const {
+    return build_separation_body(object.name, spec, force_limit, object.where);
   }
 };
 
@@ -39,6 +43,7 @@ struct KindName {
   const char* operator()(const ElasticBody&) const { return "linear_elastic"; }
   const char* operator()(const MassSpringModel&) const { return "mass_spring"; }
   const char* operator()(const HomeSpringBody&) const { return "home_spring"; }
+  const char* operator()(const SeparationModel&) const { return "separation"; }
 };
 
 }  // namespace
@@ -47,7 +52,7 @@ Model build_model(const Scene& scene) {
   Model model;
   model.scene = scene;
   for (const ObjectSpec& object : scene.objects)
-    model.bodies.push_back(std::visit(BodyBuilder{object, scene.metres_per_unit}, object.body));
+    model.bodies.push_back(std::visit(BodyBuilder{object, scene.metres_per_unit, scene.haptic.force_limit_n}, object.body));
   for (const ObstacleSpec& spec : scene.obstacles) model.obstacles.push_back(load_obstacle(spec, scene.metres_per_unit));
   return model;
 }

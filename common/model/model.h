@@ -13,12 +13,13 @@
 #include "common/model/elastic_body.h"
 #include "common/model/home_spring_body.h"
 #include "common/model/mass_spring_body.h"
+#include "common/model/separation_body.h"
 #include "common/scene/scene.h"
 
 namespace cohaptic {
 
 /// A compiled scene object: one alternative per BodySpec alternative, in the same order.
-using BodyModel = std::variant<ElasticBody, MassSpringModel, HomeSpringBody>;
+using BodyModel = std::variant<ElasticBody, MassSpringModel, HomeSpringBody, SeparationModel>;
 
 struct Model {
   Scene scene;

@@ -3,6 +3,7 @@
 #include "common/scene/parse_home_spring.h"
 #include "common/scene/parse_interactions.h"
 #include "common/scene/parse_mass_spring.h"
+#include "common/scene/parse_separation.h"
 #include "common/util/regular_file.h"
 #include "common/util/yaml_cursor.h"
 
@@ -178,10 +179,11 @@ ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::pa
   object.where = c.location();
   object.name = c.at("name").text();
   const std::string model =
-      c.find("model") ? c.at("model").choice({"linear_elastic", "mass_spring", "home_spring"}) : "linear_elastic";
+      c.find("model") ? c.at("model").choice({"linear_elastic", "mass_spring", "home_spring", "separation"}) : "linear_elastic";
   if (model == "linear_elastic") object.body = parse_elastic_object(c, scale, scene_dir);
   else if (model == "mass_spring") object.body = parse_mass_spring_object(c, scale);
-  else object.body = parse_home_spring_object(c, scale, scene_dir);
+  else if (model == "home_spring") object.body = parse_home_spring_object(c, scale, scene_dir);
+  else object.body = parse_separation_object(c, scale);
   return object;
 }
 
@@ -299,6 +301,11 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
     if (!tool_names.insert(scene.tools.back().name).second) item.at("name").fail("a tool name not used before");
   }
   if (scene.tools.empty()) tools.fail("at least one tool");
+  for (const ObjectSpec& object : scene.objects)
+    if (const auto* separation = std::get_if<SeparationObjectSpec>(&object.body))
+      for (const SeparationInstrumentSpec& instrument : separation->instruments)
+        if (!tool_names.count(instrument.tool))
+          throw SceneError(fmt::format("{}.tool: expected the name of a scene tool, found '{}'", instrument.where, instrument.tool));
 
   const std::optional<Cursor> haptic = top.find("haptic");
   if (haptic) scene.haptic = parse_haptic(*haptic);

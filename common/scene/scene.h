@@ -18,6 +18,7 @@
 #include "common/fem/linear_elastic_material.h"
 #include "common/laparoscopy/home_spring_spec.h"
 #include "common/mass_spring/mass_spring_spec.h"
+#include "common/separation/separation_object_spec.h"
 
 namespace cohaptic {
 
@@ -78,7 +79,7 @@ struct ElasticObjectSpec {
 /// One alternative per body model a scene may ask for (`model:` in the file). Adding a
 /// model adds an alternative here, and the compiler then names every place that must
 /// learn it (the compiled body, its simulation, its IR body).
-using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec, HomeSpringObjectSpec>;
+using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec, HomeSpringObjectSpec, SeparationObjectSpec>;
 
 /// A deformable object of the scene: its name (unique in the scene) and its model's spec.
 struct ObjectSpec {

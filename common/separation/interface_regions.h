@@ -19,7 +19,8 @@ struct NodeRegions {
   std::vector<int> triangles;  ///< triangle indices, ascending within each node
 
   std::span<const int> of(int node) const {
-    return {triangles.data() + offsets[node], static_cast<std::size_t>(offsets[node + 1] - offsets[node])};
+    const auto n = static_cast<std::size_t>(node);
+    return {triangles.data() + offsets[n], static_cast<std::size_t>(offsets[n + 1] - offsets[n])};
   }
   int node_count() const { return static_cast<int>(offsets.size()) - 1; }
 };

@@ -62,7 +62,8 @@ struct SeparationPatch {
   int triangle_count() const { return static_cast<int>(triangles.size()); }
   /// The field block (frame, then coefficients) of (node, tool node, state).
   const double* field(int node, int tool_node, FieldState state) const {
-    return fields.data() + ((static_cast<std::size_t>(node) * tool_node_count + tool_node) * kFieldStates +
+    return fields.data() + ((static_cast<std::size_t>(node) * static_cast<std::size_t>(tool_node_count) +
+                             static_cast<std::size_t>(tool_node)) * kFieldStates +
                             static_cast<std::size_t>(state)) *
                                static_cast<std::size_t>(SeparationFields::block_size(degree));
   }

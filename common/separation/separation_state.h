@@ -40,21 +40,21 @@ inline double global_separated_share(const SeparationPatch& patch, const Separat
   return state.separated_area / patch.interface_area;
 }
 
-inline bool is_open(const SeparationState& state, int t) noexcept { return state.separated[t] > 0; }
+inline bool is_open(const SeparationState& state, int t) noexcept { return state.separated[static_cast<std::size_t>(t)] > 0; }
 
 /// Whether a crack may grow into triangle t (see above) when share(m) is the separated
 /// share of triangle m.
 template <typename Share>
 bool crack_may_grow(const SeparationPatch& patch, int t, const Share& share) noexcept {
   if (share(t) >= 1) return false;
-  if (share(t) > 0 || patch.open_rim[t] != 0) return true;
-  for (int neighbour : patch.neighbours[t])
+  if (share(t) > 0 || patch.open_rim[static_cast<std::size_t>(t)] != 0) return true;
+  for (int neighbour : patch.neighbours[static_cast<std::size_t>(t)])
     if (neighbour >= 0 && share(neighbour) >= 1) return true;
   return false;
 }
 
 inline bool can_grow(const SeparationPatch& patch, const SeparationState& state, int t) noexcept {
-  return crack_may_grow(patch, t, [&](int m) { return state.separated[m]; });
+  return crack_may_grow(patch, t, [&](int m) { return state.separated[static_cast<std::size_t>(m)]; });
 }
 
 }  // namespace cohaptic

@@ -29,6 +29,10 @@ struct SimulationMaker {
     return std::make_unique<BodySimulation>(std::in_place_type<HomeSpringSimulation>, body, object, tools,
                                             model.scene.haptic.force_limit_n);
   }
+  std::unique_ptr<BodySimulation> operator()(const SeparationModel& body) const {
+    return std::make_unique<BodySimulation>(std::in_place_type<SeparationSimulation>, body, object, tools,
+                                            model.scene.haptic.force_limit_n);
+  }
 };
 
 // The index of the body named `name` (the loader checked that it exists).
@@ -83,6 +87,7 @@ bool SceneSimulation::pressing(int user) const {
 double SceneSimulation::distance_to_body(int body_index, const Eigen::Vector3d& point) const {
   if (const auto* network = std::get_if<MassSpringSimulation>(&body(body_index))) return network->distance_to_surface(point);
   if (const auto* tissue = std::get_if<HomeSpringSimulation>(&body(body_index))) return tissue->distance_to_surface(point);
+  if (const auto* layers = std::get_if<SeparationSimulation>(&body(body_index))) return layers->distance_to_interface(point);
   const ElasticBody& elastic = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(body_index)]);
   double nearest = std::numeric_limits<double>::infinity();
   for (int node : elastic.touchable_nodes) nearest = std::min(nearest, (elastic.mesh.nodes.col(node) - point).norm());
@@ -145,6 +150,7 @@ ForceSample SceneSimulation::force(int user) {
   BodySimulation& simulation = *bodies_[static_cast<std::size_t>(body_of(user))];
   if (auto* network = std::get_if<MassSpringSimulation>(&simulation)) return network->force(user, period_);
   if (auto* tissue = std::get_if<HomeSpringSimulation>(&simulation)) return tissue->force(user);
+  if (auto* layers = std::get_if<SeparationSimulation>(&simulation)) return layers->force(user);
   return std::get<Simulation>(simulation).force(user);
 }
 

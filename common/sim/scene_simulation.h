@@ -1,6 +1,6 @@
 // SceneSimulation: the server's simulation of a whole scene, one body simulation per scene
-// object (BodySimulation: the condensed FEM body's Simulation, a MassSpringSimulation or a
-// HomeSpringSimulation),
+// object (BodySimulation: the condensed FEM body's Simulation, a MassSpringSimulation, a
+// HomeSpringSimulation or a SeparationSimulation),
 // with no threads or sockets. It is what the server loop and the replay step.
 //
 // Each user is on one body at a time: the body whose touchable surface is nearest its tool
@@ -26,12 +26,13 @@
 #include "common/sim/body_interaction.h"
 #include "common/sim/home_spring_simulation.h"
 #include "common/sim/mass_spring_simulation.h"
+#include "common/sim/separation_simulation.h"
 #include "common/sim/simulation.h"
 
 namespace cohaptic {
 
 /// One alternative per BodyModel alternative, in the same order.
-using BodySimulation = std::variant<Simulation, MassSpringSimulation, HomeSpringSimulation>;
+using BodySimulation = std::variant<Simulation, MassSpringSimulation, HomeSpringSimulation, SeparationSimulation>;
 
 class SceneSimulation {
  public:

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/util/error.h"
+#include "proto/wire/separation_convert.h"
 
 namespace cohaptic::wire {
 namespace {
@@ -222,6 +223,9 @@ struct BodyToWire {
   void operator()(const CondensedFemIr& fem) const { fem_to_wire(fem, out->mutable_fem()); }
   void operator()(const MassSpringIr& network) const { mass_spring_to_wire(network, out->mutable_mass_spring()); }
   void operator()(const cohaptic::HomeSpringPatch& patch) const { home_spring_to_wire(patch, out->mutable_home_spring()); }
+  void operator()(const cohaptic::SeparationIr& separation) const {
+    separation_to_wire(separation, out->mutable_separation());
+  }
 };
 
 }  // namespace
@@ -487,6 +491,13 @@ CommonIr from_wire(const WireIr& w) {
     case WireIr::kFem: ir.body = fem_from_wire(w.fem()); break;
     case WireIr::kMassSpring: ir.body = mass_spring_from_wire(w.mass_spring()); break;
     case WireIr::kHomeSpring: ir.body = home_spring_from_wire(w.home_spring()); break;
+    case WireIr::kSeparation:
+      try {
+        ir.body = separation_from_wire(w.separation());
+      } catch (const cohaptic::Error& e) {
+        invalid("{}", e.what());
+      }
+      break;
     case WireIr::BODY_NOT_SET: invalid("no body of a kind this build knows");
   }
   return ir;

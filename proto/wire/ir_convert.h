@@ -1,7 +1,8 @@
 // cohaptic::IntermediateRepresentation (common/ir) <-> wire::IntermediateRepresentation
 // (messages.proto), field by field.
 //
-// The mass-spring body (MassSpringPatch) and the home-spring body (HomeSpringPatch) go in
+// The mass-spring body (MassSpringPatch), the home-spring body (HomeSpringPatch) and the
+// separation body (SeparationPatch, separation_convert.h) go in
 // double, field by field; their round trips are bit-exact.
 // Matrices: M~ column-major in m_tilde_f64 or m_tilde_f32 and u_B in
 // boundary_displacement_f64 or _f32, by ir.precision; the wire form has no precision

@@ -44,16 +44,28 @@ SurfaceMesh surface_mesh_message(const MassSpringModel& body) {
   return message;
 }
 
-SurfaceMesh surface_mesh_message(const HomeSpringBody& body) {
+namespace {
+
+// A surface whose vertex i is point i of `vertices`, its node id i.
+SurfaceMesh indexed_surface_message(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& triangles) {
   SurfaceMesh message;
-  const TriangleSurface& surface = body.surface;
-  for (int v = 0; v < surface.vertex_count(); ++v) {
-    for (int axis = 0; axis < 3; ++axis) message.add_vertices(surface.vertices(axis, v));
+  for (int v = 0; v < static_cast<int>(vertices.cols()); ++v) {
+    for (int axis = 0; axis < 3; ++axis) message.add_vertices(vertices(axis, v));
     message.add_node_ids(v);
   }
-  for (const Triangle& triangle : surface.triangles)
+  for (const Triangle& triangle : triangles)
     for (int corner : triangle) message.add_triangles(static_cast<std::uint32_t>(corner));
   return message;
+}
+
+}  // namespace
+
+SurfaceMesh surface_mesh_message(const HomeSpringBody& body) {
+  return indexed_surface_message(body.surface.vertices, body.surface.triangles);
+}
+
+SurfaceMesh surface_mesh_message(const SeparationModel& body) {
+  return indexed_surface_message(body.patch->positions, body.patch->triangles);
 }
 
 SurfaceMesh surface_mesh_message(const BodyModel& body) {

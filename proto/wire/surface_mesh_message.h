@@ -23,6 +23,9 @@ SurfaceMesh surface_mesh_message(const ElasticBody& body);
 SurfaceMesh surface_mesh_message(const MassSpringModel& body);
 /// A home-spring tissue's surface at rest: vertex i is surface vertex i, its node id i.
 SurfaceMesh surface_mesh_message(const HomeSpringBody& body);
+/// A separating-tissue body's interface at rest (what its tools grasp): vertex i is
+/// interface node i, its node id i.
+SurfaceMesh surface_mesh_message(const SeparationModel& body);
 /// Whichever kind `body` is.
 SurfaceMesh surface_mesh_message(const BodyModel& body);
 

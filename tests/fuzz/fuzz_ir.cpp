@@ -15,7 +15,10 @@
 //       mass-spring: a tool moving through the sub-network's nodes, one haptic tick
 //       (1 ms) per position, the sub-network integrated all the while.
 //       home-spring: a tool on the shaft through each touchable vertex from the trocar
-//       pivot, short of it, on it and past it (and pulled aside while grasping).
+//       pivot, short of it, on it and past it (and pulled aside while grasping);
+//       separation: a tool at each triangle's centroid with its jaws closed (buttons 0
+//       and 1: either kind of instrument), pulled away from the interface and along it,
+//       then firing the laser across the patch, one haptic tick per position.
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
@@ -37,8 +40,8 @@ using fuzz::require;
 constexpr double kHapticPeriod = 1e-3;  // [s]
 
 void require_safe(const PreparedIR& prepared, EvaluationState& state, const Eigen::Vector3d& own,
-                  std::span<const Eigen::Vector3d> remotes) {
-  const ForceSample sample = evaluate_force(prepared, state, own, remotes, kHapticPeriod);
+                  std::span<const Eigen::Vector3d> remotes, std::uint32_t buttons = 0) {
+  const ForceSample sample = evaluate_force(prepared, state, own, remotes, kHapticPeriod, buttons);
   require(sample.force.allFinite(), "the haptic force is finite");
   require(sample.force.norm() <= prepared.ir.force_limit * (1 + 1e-12), "the haptic force respects the IR's limit");
   require(!(sample.flags & kNonFinite) || sample.force.isZero(0), "a non-finite evaluation gives zero force");
@@ -99,6 +102,25 @@ void probe(const PreparedIR& prepared, const HomeSpringPatch& patch) {
     for (double along : {0.5, 1.0, 1.2, 3.0}) require_safe(prepared, state, patch.trocar_pivot + along * shaft, {});
     require_safe(prepared, state, patch.rest_positions.col(v) + Eigen::Vector3d(shaft.norm(), 0, 0), {});
   }
+}
+
+void probe(const PreparedIR& prepared, const SeparationIr& ir) {
+  EvaluationState state = make_evaluation_state(prepared);
+  const SeparationPatch& patch = *ir.patch;
+  const double extent = std::max((patch.positions.rowwise().maxCoeff() - patch.positions.rowwise().minCoeff()).norm(), 1e-6);
+  constexpr int kMaxProbedTriangles = 16, kTicksPerMove = 8;
+  for (int t = 0; t < std::min(patch.triangle_count(), kMaxProbedTriangles); ++t) {
+    const Eigen::Vector3d& centre = patch.centroids[static_cast<std::size_t>(t)];
+    const Eigen::Vector3d& normal = patch.normals[static_cast<std::size_t>(t)];
+    require_safe(prepared, state, centre, {}, 0);  // jaws open
+    for (int tick = 1; tick <= kTicksPerMove; ++tick)
+      require_safe(prepared, state, centre + 0.1 * extent * tick / kTicksPerMove * normal, {}, 3);
+    for (int tick = 1; tick <= kTicksPerMove; ++tick)
+      require_safe(prepared, state, centre + 0.1 * extent * (normal + Eigen::Vector3d(tick, 0, 0) / kTicksPerMove), {}, 3);
+  }
+  const Eigen::Vector3d from = patch.positions.col(0), to = patch.positions.col(patch.node_count() - 1);
+  for (int tick = 0; tick <= 4 * kTicksPerMove; ++tick)
+    require_safe(prepared, state, from + (to - from) * tick / (4.0 * kTicksPerMove), {}, 1);
 }
 
 }  // namespace

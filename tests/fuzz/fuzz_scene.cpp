@@ -8,7 +8,9 @@
 //   - a scene accepted holds what the format promises: a unit scale; objects, each body
 //     checked by its kind (linear_elastic: a finite positive modulus, a Poisson ratio in
 //     (-1, 0.5), box meshes of positive size; mass_spring: a finite tube of positive radius,
-//     two sections or more, a unit `up`, finite positive modulus and density); tools; plane normals of unit length; a
+//     two sections or more, a unit `up`, finite positive modulus and density; separation:
+//     finite positive layers with cells, fracture/laser/tissue/field settings that validate);
+//     tools; plane normals of unit length; a
 //     haptic rate in [1, 100000] Hz and a force limit in (0, 1000] N.
 #include <cmath>
 #include <cstdint>
@@ -64,6 +66,25 @@ void require_valid(const HomeSpringObjectSpec& object) {
   require(std::isfinite(object.neighbour_stiffness) && object.neighbour_stiffness >= 0, "k2 is finite and not negative");
   require(std::isfinite(object.patch_radius) && object.patch_radius > 0, "the patch radius is positive");
   require(std::isfinite(object.display_radius) && object.display_radius > 0, "the display radius is positive");
+}
+
+void require_valid(const SeparationObjectSpec& object) {
+  const TwoLayerBoxes& layers = object.layers;
+  require(layers.size.allFinite() && (layers.size.array() > 0).all(), "the layers have a finite positive size");
+  require(std::isfinite(layers.pulled_thickness) && layers.pulled_thickness > 0 && std::isfinite(layers.base_thickness) &&
+              layers.base_thickness > 0,
+          "the layers have finite positive thicknesses");
+  require((layers.divisions.array() >= 1).all() && layers.pulled_layers >= 1 && layers.base_layers >= 1, "the layers have cells");
+  bool settings_valid = true;
+  try {
+    validate(object.settings);
+    validate(object.fields);
+  } catch (const Error&) {
+    settings_valid = false;
+  }
+  require(settings_valid, "an accepted separation object's fracture, laser, tissue and field settings are valid");
+  for (const SeparationInstrumentSpec& instrument : object.instruments)
+    require(std::isfinite(instrument.settings.grasp_reach) && instrument.settings.grasp_reach >= 0, "a grasp reach is a length");
 }
 
 void require_valid(const Scene& scene) {

@@ -9,7 +9,7 @@
 #     the sphere contact model (scenes/tradeoff/cube_two_spheres.yaml), run here with the real server and
 #     clients on loopback (protocol 3, the development key);
 #   - ir also from text_seeds/ir/*.txtpb (protoc --encode): bodies no recorded session has
-#     yet (the home-spring body).
+#     yet (the home-spring and separation bodies).
 # Seeds that fuzzing found (crash-*, regression-*) are kept. Run from a configured build:
 #   BUILD_DIR=build tests/fuzz/make_seeds.sh
 set -euo pipefail
@@ -29,7 +29,7 @@ copy_seeds() {  # target, files...
   for file in "$@"; do cp "$file" "$corpus/$target/$(basename "$file")"; done
 }
 copy_seeds scene scenes/cube.yaml scenes/brain.yaml scenes/tradeoff/cube_two_users.yaml scenes/thin/noodle.yaml scenes/thin/noodle_heated.yaml \
-  scenes/objects/paired_boxes.yaml scenes/laparoscopy/tissue.yaml
+  scenes/objects/paired_boxes.yaml scenes/laparoscopy/tissue.yaml scenes/separation/two_layers.yaml
 copy_seeds study scenes/studies/*.yaml
 copy_seeds gmsh tests/data/mesh_io/*.msh
 copy_seeds freesurfer tests/data/mesh_io/*.asc
