@@ -10,6 +10,11 @@
 //     any work on the other CPU costs it (shared caches, memory bandwidth, a sibling
 //     hyperthread of this VM) from what the view's own work does: compare the cases whose
 //     others_cpu_us_per_step match (P = 50: about what the view and its 50 browsers take).
+// And as the server runs it, the rate a user gets: SimulationLoop::run paced at its 1 kHz on
+// its own thread for 10 s of wall time, the motions fed every millisecond as the I/O thread
+// would, with no view (BM_SimulationRate_paced_no_view) or the view and 0, 1 or 50 browsers
+// (BM_SimulationRate_paced_view_browsers/N). Counters: steps_per_s, rate_vs_1kHz_pct (the
+// rate against the 1 kHz the loop aims at), and the browsers' frames and kB per second.
 // A browser runs on another machine in real use. Here the browsers share this one, and the
 // kernel charges a loopback receive to whichever thread happens to run, so the benchmark
 // pins the simulation (this thread) to CPU 0 and the view's thread and the browsers to
@@ -171,56 +176,107 @@ struct Beside {
   int load_per_mille = 0;
 };
 
-void run_steps(benchmark::State& state, Beside beside) {
-  BrainRig& rig = BrainRig::get();
-  const bool pin = PinnedThread::possible();
-  if (!pin) state.SetLabel("not pinned: CPUs 0 and 1 are not both available");
-  ServeOptions options;
-  options.client_timeout_s = 3600;
-  ToolInputs tools(rig.motions.size());
-  for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) tools.join(static_cast<int>(slot));
-  LoopStatistics statistics;
-  std::unique_ptr<view::LiveView> live;
-  if (beside.view)
-    live = std::make_unique<view::LiveView>(*rig.model, *rig.columns, wire_protocol(options), injected_delays(options),
-                                            view::LiveViewOptions{}, nullptr);
-  SimulationLoop loop(*rig.model, std::array{rig.columns.get()}, options, tools, statistics, nullptr, live.get(), nullptr,
-                      wire::monotonic_now_ns());
-  // Once along the whole motion first: every compliance column it needs is computed (or
-  // loaded) before the clock runs.
-  for (double t = 0; t < rig.motions[0].duration(); t += 0.005) {
-    set_tools(tools, rig, t);
-    loop.step(wire::monotonic_now_ns());
-  }
-  std::vector<std::unique_ptr<testing::WebSocketClient>> clients;
-  if (live) {
-    std::optional<PinnedThread> on_cpu1;  // the view's thread and the browsers' start there
-    if (pin) on_cpu1.emplace(1);
-    live->start();
-    const std::string url = "ws://127.0.0.1:" + std::to_string(live->port()) + "/ws";
-    for (int k = 0; k < beside.browsers; ++k) {
-      clients.push_back(std::make_unique<testing::WebSocketClient>(url));
-      if (!clients.back()->wait_open(std::chrono::seconds(10))) state.SkipWithError("a browser could not connect");
-      clients.back()->count_only();
+// The server's simulation loop on the brain with what runs beside it: the live view and its
+// browsers on CPU 1 (when the machine has it), a burner there, and the simulation's thread
+// to be pinned to CPU 0 by whoever steps it.
+class LoopBeside {
+ public:
+  LoopBeside(benchmark::State& state, Beside beside) : rig_(BrainRig::get()), tools_(rig_.motions.size()) {
+    if (!pin_) state.SetLabel("not pinned: CPUs 0 and 1 are not both available");
+    options_.client_timeout_s = 3600;
+    for (std::size_t slot = 0; slot < rig_.motions.size(); ++slot) tools_.join(static_cast<int>(slot));
+    if (beside.view)
+      live_ = std::make_unique<view::LiveView>(*rig_.model, *rig_.columns, wire_protocol(options_), injected_delays(options_),
+                                               view::LiveViewOptions{}, nullptr);
+    loop_ = std::make_unique<SimulationLoop>(*rig_.model, std::array{rig_.columns.get()}, options_, tools_, statistics_,
+                                             nullptr, live_.get(), nullptr, wire::monotonic_now_ns());
+    // Once along the whole motion first: every compliance column it needs is computed (or
+    // loaded) before the clock runs.
+    for (double t = 0; t < rig_.motions[0].duration(); t += 0.005) {
+      set_tools(tools_, rig_, t);
+      loop_->step(wire::monotonic_now_ns());
     }
+    if (live_) {
+      std::optional<PinnedThread> on_cpu1;  // the view's thread and the browsers' start there
+      if (pin_) on_cpu1.emplace(1);
+      live_->start();
+      const std::string url = "ws://127.0.0.1:" + std::to_string(live_->port()) + "/ws";
+      for (int k = 0; k < beside.browsers; ++k) {
+        clients_.push_back(std::make_unique<testing::WebSocketClient>(url));
+        if (!clients_.back()->wait_open(std::chrono::seconds(10))) state.SkipWithError("a browser could not connect");
+        clients_.back()->count_only();
+      }
+    }
+    if (beside.load_per_mille > 0) load_.emplace(pin_ ? 1 : 0, beside.load_per_mille);
   }
-  std::optional<CpuBurner> load;
-  if (beside.load_per_mille > 0) load.emplace(pin ? 1 : 0, beside.load_per_mille);
-  std::optional<PinnedThread> on_cpu0;  // the simulation
-  if (pin) on_cpu0.emplace(0);
-  std::this_thread::yield();  // on CPU 0 from here
-  std::vector<std::uint64_t> frames_before, bytes_before;
-  for (const auto& client : clients) {
-    frames_before.push_back(client->message_count());
-    bytes_before.push_back(client->bytes_received());
+  ~LoopBeside() {
+    clients_.clear();
+    if (live_) live_->stop();
   }
-  const std::uint64_t built_before = live ? live->frames_built() : 0;
+  LoopBeside(const LoopBeside&) = delete;
+  LoopBeside& operator=(const LoopBeside&) = delete;
+
+  /// Pins the calling thread, the simulation's, to CPU 0 while `pinned` lives, when the
+  /// machine has CPUs 0 and 1.
+  void pin_simulation(std::optional<PinnedThread>& pinned) const {
+    if (pin_) pinned.emplace(0);
+    std::this_thread::yield();  // on CPU 0 from here
+  }
+  /// Starts the window whose browser figures report_browsers() gives.
+  void start_window() {
+    frames_before_.clear();
+    bytes_before_.clear();
+    for (const auto& client : clients_) {
+      frames_before_.push_back(client->message_count());
+      bytes_before_.push_back(client->bytes_received());
+    }
+    built_before_ = live_ ? live_->frames_built() : 0;
+  }
+  /// The view's frames and each browser's frames and kB per second over the window.
+  void report_browsers(benchmark::State& state, double elapsed_s) const {
+    if (live_) state.counters["frames_built_per_s"] = static_cast<double>(live_->frames_built() - built_before_) / elapsed_s;
+    if (clients_.empty()) return;
+    double frames = 0, bytes = 0;
+    for (std::size_t k = 0; k < clients_.size(); ++k) {
+      frames += static_cast<double>(clients_[k]->message_count() - frames_before_[k]);
+      bytes += static_cast<double>(clients_[k]->bytes_received() - bytes_before_[k]);
+    }
+    state.counters["frames_per_s_per_browser"] = frames / static_cast<double>(clients_.size()) / elapsed_s;
+    state.counters["kB_per_s_per_browser"] = bytes / static_cast<double>(clients_.size()) / elapsed_s / 1e3;
+    state.counters["dropped"] = static_cast<double>(live_->counters().dropped);
+  }
+
+  BrainRig& rig() { return rig_; }
+  ToolInputs& tools() { return tools_; }
+  SimulationLoop& loop() { return *loop_; }
+  const LoopStatistics& statistics() const { return statistics_; }
+
+ private:
+  BrainRig& rig_;
+  const bool pin_ = PinnedThread::possible();
+  ServeOptions options_;
+  ToolInputs tools_;
+  LoopStatistics statistics_;
+  std::unique_ptr<view::LiveView> live_;
+  std::unique_ptr<SimulationLoop> loop_;
+  std::vector<std::unique_ptr<testing::WebSocketClient>> clients_;
+  std::optional<CpuBurner> load_;
+  std::vector<std::uint64_t> frames_before_, bytes_before_;
+  std::uint64_t built_before_ = 0;
+};
+
+// Steps as fast as they go, the motion at a fixed stride: the time a step takes.
+void run_steps(benchmark::State& state, Beside beside) {
+  LoopBeside session(state, beside);
+  std::optional<PinnedThread> on_cpu0;
+  session.pin_simulation(on_cpu0);
+  session.start_window();
   const double process_cpu_before = cpu_seconds(RUSAGE_SELF), thread_cpu_before = cpu_seconds(RUSAGE_THREAD);
   const auto start = std::chrono::steady_clock::now();
   double t = kWindowStart_s;
   for (auto _ : state) {
-    set_tools(tools, rig, t);
-    benchmark::DoNotOptimize(loop.step(wire::monotonic_now_ns()));
+    set_tools(session.tools(), session.rig(), t);
+    benchmark::DoNotOptimize(session.loop().step(wire::monotonic_now_ns()));
     t += kWindowStride_s;  // the motion at a fixed stride, whatever the steps cost
   }
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -228,20 +284,45 @@ void run_steps(benchmark::State& state, Beside beside) {
                             (cpu_seconds(RUSAGE_THREAD) - thread_cpu_before);
   state.SetItemsProcessed(state.iterations());
   state.counters["others_cpu_us_per_step"] = 1e6 * others_cpu / static_cast<double>(state.iterations());
-  if (live) state.counters["frames_built_per_s"] = static_cast<double>(live->frames_built() - built_before) / elapsed;
-  if (!clients.empty()) {
-    double frames = 0, bytes = 0;
-    for (std::size_t k = 0; k < clients.size(); ++k) {
-      frames += static_cast<double>(clients[k]->message_count() - frames_before[k]);
-      bytes += static_cast<double>(clients[k]->bytes_received() - bytes_before[k]);
+  session.report_browsers(state, elapsed);
+}
+
+// As the server runs it: SimulationLoop::run paced at its 1 kHz on its own thread (pinned to
+// CPU 0), for kPacedWindow of wall time, while this thread feeds the surgeons' motions as
+// the I/O thread would, every millisecond. What the view may cost here is the rate itself:
+// steps that overrun their period push the next ones later (no catch-up burst).
+constexpr std::chrono::seconds kPacedWindow{10};
+
+void run_paced(benchmark::State& state, Beside beside) {
+  LoopBeside session(state, beside);
+  for (auto _ : state) {
+    set_tools(session.tools(), session.rig(), kWindowStart_s);
+    const LoopSummary before = session.statistics().summary();
+    session.start_window();
+    std::atomic<bool> running{true};
+    std::thread simulation([&] {
+      std::optional<PinnedThread> on_cpu0;
+      session.pin_simulation(on_cpu0);
+      session.loop().run(running, [](Outbox&&) {});
+    });
+    const auto start = std::chrono::steady_clock::now();
+    for (auto now = start; now - start < kPacedWindow; now = std::chrono::steady_clock::now()) {
+      const double t = kWindowStart_s + std::fmod(std::chrono::duration<double>(now - start).count(),
+                                                  static_cast<double>(kWindowSteps) * kWindowStride_s);
+      set_tools(session.tools(), session.rig(), t);
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
-    state.counters["frames_per_s_per_browser"] = frames / static_cast<double>(clients.size()) / elapsed;
-    state.counters["kB_per_s_per_browser"] = bytes / static_cast<double>(clients.size()) / elapsed / 1e3;
-    state.counters["dropped"] = static_cast<double>(live->counters().dropped);
+    running = false;
+    simulation.join();
+    const LoopSummary after = session.statistics().summary();
+    const double elapsed = after.elapsed_s - before.elapsed_s;
+    const double rate = static_cast<double>(after.steps - before.steps) / elapsed;
+    state.SetIterationTime(elapsed);
+    state.counters["steps_per_s"] = rate;
+    state.counters["rate_vs_1kHz_pct"] = 100.0 * (rate / kDefaultSimulationRate_hz - 1.0);
+    state.counters["step_p99_ms"] = after.step_p99_ms;  // of every step, the warm-up's included
+    session.report_browsers(state, elapsed);
   }
-  clients.clear();
-  if (live) live->stop();
-  load.reset();
 }
 
 // The brain with both surgeons pressing, 3 s into their motions, and what a frame of it needs.
@@ -324,6 +405,11 @@ void BM_SimulationSteps_no_view_with_load(benchmark::State& state) {
   run_steps(state, {.load_per_mille = static_cast<int>(state.range(0))});
 }
 
+void BM_SimulationRate_paced_no_view(benchmark::State& state) { run_paced(state, {}); }
+void BM_SimulationRate_paced_view_browsers(benchmark::State& state) {
+  run_paced(state, {.view = true, .browsers = static_cast<int>(state.range(0))});
+}
+
 BENCHMARK(BM_SimulationSteps_no_view)->Iterations(kWindowSteps)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_SimulationSteps_view_browsers)
     ->Arg(0)
@@ -339,6 +425,15 @@ BENCHMARK(BM_SimulationSteps_no_view_with_load)
     ->Iterations(kWindowSteps)
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
+
+BENCHMARK(BM_SimulationRate_paced_no_view)->Iterations(1)->UseManualTime()->Unit(benchmark::kSecond);
+BENCHMARK(BM_SimulationRate_paced_view_browsers)
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(50)
+    ->Iterations(1)
+    ->UseManualTime()
+    ->Unit(benchmark::kSecond);
 
 }  // namespace
 }  // namespace cohaptic
