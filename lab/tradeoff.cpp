@@ -1,4 +1,5 @@
 #include "lab/tradeoff.h"
+#include "lab/tradeoff_tally.h"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -20,7 +21,6 @@
 #include "common/study/svg_plot.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
-#include "common/util/percentile.h"
 #include "common/util/stopwatch.h"
 #include "lab/tradeoff_home_spring.h"
 #include "lab/tradeoff_mass_spring.h"
@@ -231,8 +231,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
   std::vector<double> last_published(users, -INFINITY);
   std::vector<Eigen::Vector3d> held(users, Eigen::Vector3d::Zero());
   std::vector<Eigen::Vector3d> remotes;
-  std::vector<double> mtilde_ms, plain_step_ms, evaluation_us;
-  double rebuild_step_ms = 0, bytes = 0, sum_squared = 0, worst = 0, own_sum_squared = 0, own_worst = 0;
+  TradeoffTally tally;
   const std::size_t samples = reference.positions.size();
   for (std::size_t j = 0; j < samples; ++j) {
     const double t = static_cast<double>(j) / reference.sample_rate_hz;
@@ -241,21 +240,14 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
       for (std::size_t u = 0; u < users; ++u) simulation.set_tool(static_cast<int>(u), positions[u]);
       const Stopwatch step;
       const StepReport report = simulation.step(t);
-      const double ms = step.elapsed_ms();
-      if (report.rebuilt) {
-        mtilde_ms.push_back(report.rebuild_ms);
-        rebuild_step_ms += ms;
-      } else {
-        plain_step_ms.push_back(ms);
-      }
+      tally.step(report, step.elapsed_ms());
       for (std::size_t u = 0; u < users; ++u) {
         const std::shared_ptr<const PreparedIR> ir = simulation.ir(static_cast<int>(u));
         const bool due = setting.ir_rate_hz <= 0 || t - last_published[u] >= 1 / setting.ir_rate_hz - 1e-9;
         if (ir && ir != published[u] && due) {
           published[u] = ir;
           last_published[u] = t;
-          bytes += static_cast<double>(ir->ir.size_bytes());
-          ++row.irs_sent;
+          tally.published(ir->ir);
         }
       }
     }
@@ -267,36 +259,14 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
         const Stopwatch evaluation;
         EvaluationState stateless;  // the condensed FEM body keeps none and ignores dt
         held[u] = evaluate_force(*published[u], stateless, positions[u], remotes, 0).force;
-        evaluation_us.push_back(1000 * evaluation.elapsed_ms());
+        tally.evaluation(1000 * evaluation.elapsed_ms());
       }
     for (std::size_t u = 0; u < users; ++u) pressed[u] = {positions[u], varied.tools[u].radius};
     const std::vector<Eigen::Vector3d> own_forces = own_mesh.forces(pressed, held_nodes(simulation));
-    for (std::size_t u = 0; u < users; ++u) {
-      const double error = (held[u] - reference.forces[j][u]).norm();
-      sum_squared += error * error;
-      worst = std::max(worst, error);
-      const double own_error = (held[u] - own_forces[u]).norm();
-      own_sum_squared += own_error * own_error;
-      own_worst = std::max(own_worst, own_error);
-    }
+    for (std::size_t u = 0; u < users; ++u) tally.sample(held[u], reference.forces[j][u], own_forces[u]);
   }
-  const double duration = static_cast<double>(samples) / reference.sample_rate_hz;
-  const double peak = std::max(reference.peak_force, 1e-300);
-  row.error_rms = std::sqrt(sum_squared / static_cast<double>(samples * users)) / peak;
-  row.error_max = worst / peak;
-  row.own_mesh_error_rms = std::sqrt(own_sum_squared / static_cast<double>(samples * users)) / peak;
-  row.own_mesh_error_max = own_worst / peak;
-  row.mtilde_ms_p50 = mtilde_ms.empty() ? 0 : percentile(mtilde_ms, 0.5);
-  row.mtilde_ms_p99 = mtilde_ms.empty() ? 0 : percentile(mtilde_ms, 0.99);
-  // Medians of the many cheap steps and evaluations, so that a scheduler hiccup on a busy
-  // machine does not decide the front; the steps that rebuilt IRs count in full.
-  row.evaluation_us = evaluation_us.empty() ? 0 : percentile(evaluation_us, 0.5);
-  row.ir_bytes_per_s = bytes / duration;
+  tally.finish(row, reference, users);
   row.memory_mb = model_memory_mb(body, columns);
-  const double plain_steps_ms =
-      plain_step_ms.empty() ? 0 : percentile(plain_step_ms, 0.5) * static_cast<double>(plain_step_ms.size());
-  const double evaluations_ms = row.evaluation_us * static_cast<double>(evaluation_us.size()) / 1000;
-  row.cpu_ms_per_s = (rebuild_step_ms + plain_steps_ms + evaluations_ms) / duration;
   return row;
 }
 

@@ -10,8 +10,8 @@
 #include "common/model/model.h"
 #include "common/sim/home_spring_simulation.h"
 #include "common/util/error.h"
-#include "common/util/percentile.h"
 #include "common/util/stopwatch.h"
+#include "lab/tradeoff_tally.h"
 
 namespace cohaptic {
 namespace {
@@ -49,8 +49,7 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
   HomeSpringSimulation every_sample(body, 0, scene.tools, kUnlimited);
   std::vector<std::shared_ptr<const PreparedIR>> published(users);
   std::vector<Eigen::Vector3d> held(users, Eigen::Vector3d::Zero());
-  std::vector<double> rebuild_ms, plain_step_ms, evaluation_us;
-  double rebuild_step_ms = 0, bytes = 0, sum_squared = 0, worst = 0, own_sum_squared = 0, own_worst = 0;
+  TradeoffTally tally;
   const std::size_t samples = reference.positions.size();
   for (std::size_t j = 0; j < samples; ++j) {
     const double t = static_cast<double>(j) / reference.sample_rate_hz;
@@ -59,18 +58,11 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
       for (std::size_t u = 0; u < users; ++u) server.set_tool(static_cast<int>(u), positions[u]);
       const Stopwatch step;
       const StepReport report = server.step(t);
-      const double ms = step.elapsed_ms();
-      if (report.rebuilt) {
-        rebuild_ms.push_back(report.rebuild_ms);
-        rebuild_step_ms += ms;
-      } else {
-        plain_step_ms.push_back(ms);
-      }
+      tally.step(report, step.elapsed_ms());
       for (std::size_t u = 0; u < users; ++u)
         if (const auto ir = server.ir(static_cast<int>(u)); ir && ir != published[u]) {
           published[u] = ir;
-          bytes += static_cast<double>(ir->ir.size_bytes());
-          ++row.irs_sent;
+          tally.published(ir->ir);
         }
     }
     if (j % static_cast<std::size_t>(per_tick) == 0)
@@ -79,33 +71,14 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
         const Stopwatch evaluation;
         EvaluationState stateless;  // the home-spring body keeps none and ignores dt
         held[u] = evaluate_force(*published[u], stateless, positions[u], {}, 0).force;
-        evaluation_us.push_back(1000 * evaluation.elapsed_ms());
+        tally.evaluation(1000 * evaluation.elapsed_ms());
       }
     for (std::size_t u = 0; u < users; ++u) every_sample.set_tool(static_cast<int>(u), positions[u]);
     every_sample.step(t);
-    for (std::size_t u = 0; u < users; ++u) {
-      const double error = (held[u] - reference.forces[j][u]).norm();
-      sum_squared += error * error;
-      worst = std::max(worst, error);
-      const double own_error = (held[u] - every_sample.force(static_cast<int>(u)).force).norm();
-      own_sum_squared += own_error * own_error;
-      own_worst = std::max(own_worst, own_error);
-    }
+    for (std::size_t u = 0; u < users; ++u)
+      tally.sample(held[u], reference.forces[j][u], every_sample.force(static_cast<int>(u)).force);
   }
-  const double duration = static_cast<double>(samples) / reference.sample_rate_hz;
-  const double peak = std::max(reference.peak_force, 1e-300);
-  row.error_rms = std::sqrt(sum_squared / static_cast<double>(samples * users)) / peak;
-  row.error_max = worst / peak;
-  row.own_mesh_error_rms = std::sqrt(own_sum_squared / static_cast<double>(samples * users)) / peak;
-  row.own_mesh_error_max = own_worst / peak;
-  row.mtilde_ms_p50 = rebuild_ms.empty() ? 0 : percentile(rebuild_ms, 0.5);
-  row.mtilde_ms_p99 = rebuild_ms.empty() ? 0 : percentile(rebuild_ms, 0.99);
-  row.evaluation_us = evaluation_us.empty() ? 0 : percentile(evaluation_us, 0.5);
-  row.ir_bytes_per_s = bytes / duration;
-  const double plain_steps_ms =
-      plain_step_ms.empty() ? 0 : percentile(plain_step_ms, 0.5) * static_cast<double>(plain_step_ms.size());
-  const double evaluations_ms = row.evaluation_us * static_cast<double>(evaluation_us.size()) / 1000;
-  row.cpu_ms_per_s = (rebuild_step_ms + plain_steps_ms + evaluations_ms) / duration;
+  tally.finish(row, reference, users);
   return row;
 }
 
