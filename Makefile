@@ -37,7 +37,7 @@ ASAN_TESTS ?=
 # suite, and the lighter tests of the same suites run under ASan): CI's ASan stage, whose
 # time they would double.
 ASAN_SKIP_SLOW ?= 0
-ASAN_SLOW_TESTS = SegmentCrossing\.TreeMatchesScan|Tradeoff\.ErrorIsMeasuredAgainstTheReference|NearestTriangleCandidates\.GiveTheFullScansAnswersOnTheBrain|Extremes\.FromNoHeldNodesToTheWholeSurface|MassSpringSimulation\.(NoodleSceneDroppedAndSlid|SubNetworkForceFollows|ClientForceThroughTheWire)|HertzConvergence|MassSpringScene\.ShippedNoodleScenesCompile|MassSpringFriction\.StaysBelow|SphereContact\.TwoSpheresAndHeldNodes|SeparationContact\.(SlidingStops|PushingTool|TwoCopies)|SeparationLaser\.|SeparationFracture\.|SceneModel\.EveryShipped|ContactModels\.ForcesFall|ObstacleClearance\.PointsItSkips|ObstacleDistance\.Colin27
+ASAN_SLOW_TESTS = SegmentCrossing\.TreeMatchesScan|Tradeoff\.ErrorIsMeasuredAgainstTheReference|NearestTriangleCandidates\.GiveTheFullScansAnswersOnTheBrain|Extremes\.FromNoHeldNodesToTheWholeSurface|MassSpringSimulation\.(NoodleSceneDroppedAndSlid|SubNetworkForceFollows|ClientForceThroughTheWire)|HertzConvergence|MassSpringScene\.ShippedNoodleScenesCompile|MassSpringFriction\.StaysBelow|SphereContact\.TwoSpheresAndHeldNodes|SeparationContact\.(SlidingStops|PushingTool|TwoCopies)|SeparationLaser\.|SeparationFracture\.|SceneModel\.EveryShipped|ContactModels\.ForcesFall|ObstacleClearance\.PointsItSkips|ObstacleDistance\.Colin27|LaparoscopyTradeoff\.|SeparationIr\.ClientForceEqualsTheServersThroughALaserGroove|SeparationScene\.TwoUsersTear
 # What test-asan builds: everything by default; CI names the unit tests' program (the fuzz
 # targets are already built by `make fuzz`), not the end-to-end tests it leaves to TSan.
 ASAN_TARGETS ?= all
