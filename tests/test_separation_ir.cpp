@@ -143,7 +143,7 @@ struct ClientServerRun {
 template <typename Script>
 ClientServerRun run_client_and_server(bool laser, int ticks, const Script& script) {
   const SeparationModel model = default_separation_model(laser);
-  SeparationSimulation server(model, 0, {ToolSpec{"tool", ToolShape::point, 0}}, 3.3);
+  SeparationSimulation server(model, 0, {ToolSpec{"tool", ToolShape::point, 0, {}}}, 3.3);
   const double dt = 1e-3;
   SeparationDrive first = script(0);
   server.set_tool(0, first.tip, first.buttons);
