@@ -138,7 +138,18 @@ TEST(ViewBodies, ThePairedBoxesShowTheNetworkAndTheElasticBoxEachFromItsOwnState
     const bool in_box = tri[0] >= box.offset;
     for (int corner : tri) EXPECT_EQ(corner >= box.offset, in_box);
   }
-  expect_scene_is_shown(view::view_scene(boxes.model, boxes.shown, wire::P1, {}, 30, "live"), boxes.shown);
+  const view::Scene scene = view::view_scene(boxes.model, boxes.shown, wire::P1, {}, 30, "live");
+  expect_scene_is_shown(scene, boxes.shown);
+  // The page is told which shown nodes are which object's.
+  ASSERT_EQ(scene.objects_size(), 2);
+  EXPECT_EQ(scene.objects(0).name(), "A");
+  EXPECT_EQ(scene.objects(0).model(), "mass_spring");
+  EXPECT_EQ(scene.objects(0).first_node(), 0u);
+  EXPECT_EQ(scene.objects(0).node_count(), static_cast<std::uint32_t>(box.offset));
+  EXPECT_EQ(scene.objects(1).name(), "B");
+  EXPECT_EQ(scene.objects(1).model(), "linear_elastic");
+  EXPECT_EQ(scene.objects(1).first_node(), static_cast<std::uint32_t>(box.offset));
+  EXPECT_EQ(scene.objects(1).node_count(), static_cast<std::uint32_t>(box.size()));
   // A's top face is at z = 26.76 + 26.56 mm: tool A's 2 mm sphere goes 2 mm into it. B's
   // displacement is its own state's (B holds A through A's backing, and is not dented by
   // A in its own state): tool B goes 1 mm into B's top face beside A.

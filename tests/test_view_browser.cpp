@@ -374,6 +374,8 @@ segments:
   EXPECT_TRUE(live["errors"].empty()) << live["errors"].dump();
   const json& shown = live["shown"];
   EXPECT_EQ(shown["scene"]["name"], "noodle");
+  EXPECT_EQ(shown["scene"]["objects"], json::array({{{"name", "noodle"}, {"model", "mass_spring"}, {"firstNode", 0},
+                                                      {"nodes", shown["scene"]["nodes"]}}}));
   EXPECT_GT(shown["meshTriangles"].get<int>(), 100);
   // A thin tube seen obliquely covers less of its projected box than a cube does.
   EXPECT_GT(live["pixels"]["mesh"]["matching"].get<double>(), 0.15 * live["pixels"]["mesh"]["sampled"].get<double>());

@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 
+#include "common/model/body_model_name.h"
+
 namespace cohaptic::view {
 namespace {
 
@@ -31,6 +33,13 @@ Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol pro
   for (Eigen::Index node = 0; node < shown.rest.cols(); ++node) add_point(*scene.mutable_rest_positions(), shown.rest.col(node));
   for (const Triangle& tri : shown.triangles)
     for (int corner : tri) scene.add_triangles(static_cast<std::uint32_t>(corner));
+  for (std::size_t body = 0; body < shown.parts.size(); ++body) {
+    ShownObject* object = scene.add_objects();
+    object->set_name(body_name(model, static_cast<int>(body)));
+    object->set_model(body_model_name(model.bodies[body]));
+    object->set_first_node(static_cast<std::uint32_t>(shown.parts[body].offset));
+    object->set_node_count(static_cast<std::uint32_t>(shown.parts[body].size()));
+  }
   for (std::size_t slot = 0; slot < model.scene.tools.size(); ++slot) {
     Tool* tool = scene.add_tools();
     tool->set_slot(static_cast<std::uint32_t>(slot));

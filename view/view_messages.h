@@ -30,7 +30,7 @@ struct ToolState {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< [m]
 };
 
-/// The scene: `shown` (model's, at rest), the tools, the obstacles (a plane as a square of
+/// The scene: `shown` (model's, at rest, with each object's name, model and shown nodes), the tools, the obstacles (a plane as a square of
 /// twice the shown surface's size around its projection), and the session's settings.
 Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
                  double frame_rate_hz, const std::string& source);
