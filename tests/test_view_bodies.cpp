@@ -28,7 +28,7 @@ namespace cohaptic {
 namespace {
 
 // A shipped scene as the server runs it, its first tools pressing.
-struct ViewedScene {
+struct ViewedShippedScene {
   Model model;
   SceneCompliance compliance;
   SceneSimulation simulation;
@@ -36,7 +36,7 @@ struct ViewedScene {
   std::vector<Eigen::Vector3d> tools;  // of the users pressing, from user 0 on
   double time = 0;
 
-  explicit ViewedScene(const Scene& scene)
+  explicit ViewedShippedScene(const Scene& scene)
       : model(build_model(scene)),
         compliance(prepare_scene_compliance(model, true, std::nullopt)),
         simulation(model, compliance.per_body, model.scene.tools, SimulationOptions{}),
@@ -69,10 +69,10 @@ struct ViewedScene {
   }
 };
 
-Scene shipped_scene(const std::string& relative) { return load_scene(testing::source_path(relative)); }
+Scene load_shipped_view_scene(const std::string& relative) { return load_scene(testing::source_path(relative)); }
 
 // A frame's displacement of `part`'s nodes, one column per node [m].
-Eigen::Matrix3Xd shown_displacement(const view::Frame& frame, const view::ShownPart& part) {
+Eigen::Matrix3Xd frame_part_displacement(const view::Frame& frame, const view::ShownPart& part) {
   Eigen::Matrix3Xd u(3, part.size());
   for (int k = 0; k < part.size(); ++k)
     for (int axis = 0; axis < 3; ++axis) u(axis, k) = frame.displacement(3 * (part.offset + k) + axis);
@@ -80,7 +80,7 @@ Eigen::Matrix3Xd shown_displacement(const view::Frame& frame, const view::ShownP
 }
 
 // The Scene's rest positions and triangles are the shown scene's, every index in range.
-void expect_scene_is_shown(const view::Scene& scene, const view::ShownScene& shown) {
+void expect_view_scene_is_shown(const view::Scene& scene, const view::ShownScene& shown) {
   ASSERT_EQ(scene.rest_positions_size(), 3 * shown.node_count());
   for (int i = 0; i < scene.rest_positions_size(); ++i)
     EXPECT_EQ(scene.rest_positions(i), static_cast<float>(shown.rest.data()[i])) << i;
@@ -89,9 +89,9 @@ void expect_scene_is_shown(const view::Scene& scene, const view::ShownScene& sho
 }
 
 // A mass-spring body's shown nodes are its surface nodes, displaced to their state's positions.
-void expect_network_shown(const view::Frame& frame, const view::ShownPart& part, const MassSpringSimulation& body) {
+void expect_view_network_shown(const view::Frame& frame, const view::ShownPart& part, const MassSpringSimulation& body) {
   EXPECT_EQ(part.nodes, body.body().network.surface_nodes);
-  const Eigen::Matrix3Xd u = shown_displacement(frame, part);
+  const Eigen::Matrix3Xd u = frame_part_displacement(frame, part);
   Eigen::Matrix3Xd expected(3, part.size());
   for (int k = 0; k < part.size(); ++k) {
     const int node = part.nodes[static_cast<std::size_t>(k)];
@@ -103,19 +103,19 @@ void expect_network_shown(const view::Frame& frame, const view::ShownPart& part,
 }
 
 TEST(ViewBodies, TheNoodlesFrameShowsItsNodesPositionsMinusRestAndTheIrsPatch) {
-  ViewedScene noodle(shipped_scene("scenes/thin/noodle.yaml"));
+  ViewedShippedScene noodle(load_shipped_view_scene("scenes/thin/noodle.yaml"));
   const auto& body = std::get<MassSpringSimulation>(noodle.simulation.body(0));
   const MassSpringNetwork& network = body.body().network;
   ASSERT_EQ(noodle.shown.parts.size(), 1u);
   EXPECT_EQ(noodle.shown.triangles.size(), network.triangles.size());  // every node of a triangle is a surface node
-  expect_scene_is_shown(view::view_scene(noodle.model, noodle.shown, wire::P1, {}, 30, "live"), noodle.shown);
+  expect_view_scene_is_shown(view::view_scene(noodle.model, noodle.shown, wire::P1, {}, 30, "live"), noodle.shown);
   // The 2 mm sphere midway along, down to 7 mm: the soft noodle sags under its weight from
   // its top face at 9.2 mm to about 6.7 mm in the first 0.1 s, and is pressed 1-2 mm.
   noodle.press({Eigen::Vector3d(0.043, 0, 0.007)}, 0.2);
   ASSERT_NE(noodle.simulation.ir(0), nullptr);
   const view::Frame frame = noodle.frame();
   ASSERT_EQ(frame.displacement_size(), 3 * noodle.shown.node_count());
-  expect_network_shown(frame, noodle.shown.parts[0], body);
+  expect_view_network_shown(frame, noodle.shown.parts[0], body);
   // The IR's sub-network, as far as it is on the surface: shown, and around the tool.
   const view::UserFrame& user = frame.users(0);
   EXPECT_EQ(user.pressing(), noodle.simulation.pressing(0));
@@ -126,7 +126,7 @@ TEST(ViewBodies, TheNoodlesFrameShowsItsNodesPositionsMinusRestAndTheIrsPatch) {
 }
 
 TEST(ViewBodies, ThePairedBoxesShowTheNetworkAndTheElasticBoxEachFromItsOwnState) {
-  ViewedScene boxes(shipped_scene("scenes/objects/paired_boxes.yaml"));
+  ViewedShippedScene boxes(load_shipped_view_scene("scenes/objects/paired_boxes.yaml"));
   ASSERT_EQ(boxes.shown.parts.size(), 2u);
   const auto& front = std::get<MassSpringSimulation>(boxes.simulation.body(0));
   const auto& behind = std::get<Simulation>(boxes.simulation.body(1));
@@ -139,7 +139,7 @@ TEST(ViewBodies, ThePairedBoxesShowTheNetworkAndTheElasticBoxEachFromItsOwnState
     for (int corner : tri) EXPECT_EQ(corner >= box.offset, in_box);
   }
   const view::Scene scene = view::view_scene(boxes.model, boxes.shown, wire::P1, {}, 30, "live");
-  expect_scene_is_shown(scene, boxes.shown);
+  expect_view_scene_is_shown(scene, boxes.shown);
   // The page is told which shown nodes are which object's.
   ASSERT_EQ(scene.objects_size(), 2);
   EXPECT_EQ(scene.objects(0).name(), "A");
@@ -158,15 +158,15 @@ TEST(ViewBodies, ThePairedBoxesShowTheNetworkAndTheElasticBoxEachFromItsOwnState
   ASSERT_TRUE(boxes.simulation.pressing(1));
   EXPECT_EQ(boxes.simulation.body_of(1), 1);
   const view::Frame frame = boxes.frame();
-  expect_network_shown(frame, boxes.shown.parts[0], front);
+  expect_view_network_shown(frame, boxes.shown.parts[0], front);
   const Eigen::Matrix3Xd expected = behind.displacement_of(box.nodes);
   const double largest = expected.cwiseAbs().maxCoeff();
   EXPECT_GT(largest, 1e-4) << "tool B dents B";
-  EXPECT_LT((shown_displacement(frame, box) - expected).cwiseAbs().maxCoeff(), 1e-6 * largest);
+  EXPECT_LT((frame_part_displacement(frame, box) - expected).cwiseAbs().maxCoeff(), 1e-6 * largest);
 }
 
 TEST(ViewBodies, TheTissuesFrameIsItsDisplayedDent) {
-  ViewedScene tissue(shipped_scene("scenes/laparoscopy/tissue.yaml"));
+  ViewedShippedScene tissue(load_shipped_view_scene("scenes/laparoscopy/tissue.yaml"));
   const auto& body = std::get<HomeSpringSimulation>(tissue.simulation.body(0));
   ASSERT_EQ(tissue.shown.node_count(), body.body().surface.vertex_count());
   EXPECT_EQ(tissue.shown.triangles, body.body().surface.triangles);
@@ -177,19 +177,19 @@ TEST(ViewBodies, TheTissuesFrameIsItsDisplayedDent) {
   const Eigen::Matrix3Xd expected = body.displayed() - body.body().surface.vertices;
   const double largest = expected.cwiseAbs().maxCoeff();
   EXPECT_GT(largest, 1e-3);
-  EXPECT_LT((shown_displacement(frame, tissue.shown.parts[0]) - expected).cwiseAbs().maxCoeff(), 1e-6 * largest);
+  EXPECT_LT((frame_part_displacement(frame, tissue.shown.parts[0]) - expected).cwiseAbs().maxCoeff(), 1e-6 * largest);
   EXPECT_GT(frame.users(0).patch_nodes_size(), 0);
 }
 
 TEST(ViewBodies, TheSeparatingTissuesSceneHasBothLayersSurfacesDrawnAtRest) {
-  Scene scene = shipped_scene("scenes/separation/two_layers.yaml");
+  Scene scene = load_shipped_view_scene("scenes/separation/two_layers.yaml");
   std::get<SeparationObjectSpec>(scene.objects[0].body).disk_cache = false;  // no cache written by a test
-  ViewedScene layers(scene);
+  ViewedShippedScene layers(scene);
   const auto& body = std::get<SeparationModel>(layers.model.bodies[0]);
   const BoundarySurface pulled = extract_boundary_surface(body.bodies.pulled.mesh);
   const BoundarySurface base = extract_boundary_surface(body.bodies.base.mesh);
   const view::Scene message = view::view_scene(layers.model, layers.shown, wire::P1, {}, 30, "live");
-  expect_scene_is_shown(message, layers.shown);
+  expect_view_scene_is_shown(message, layers.shown);
   ASSERT_EQ(layers.shown.node_count(), static_cast<int>(pulled.nodes.size() + base.nodes.size()));
   EXPECT_EQ(layers.shown.triangles.size(), pulled.triangles.size() + base.triangles.size());
   // The pulled layer's surface first, then the base's, each node where its mesh has it.

@@ -332,7 +332,7 @@ TEST(ViewInBrowser, AReplayScrubsToAGivenTimeShowingThatTimesForceAndJumpsToTheP
 }
 
 // The largest displacement in a frame [m], as the page computes it from the floats.
-double largest_displacement(const view::Frame& frame) {
+double largest_frame_displacement(const view::Frame& frame) {
   const auto u = [&](int i) { return static_cast<double>(frame.displacement(i)); };
   double largest = 0;
   for (int i = 0; i + 2 < frame.displacement_size(); i += 3) largest = std::max(largest, std::hypot(u(i), u(i + 1), u(i + 2)));
@@ -389,8 +389,8 @@ segments:
     return frame.sequence() == shown["frame"]["sequence"].get<std::uint64_t>();
   });
   ASSERT_NE(drawn, recording.view_frames.end());
-  EXPECT_NEAR(shown["frame"]["maxDisplacementMm"].get<double>(), largest_displacement(*drawn) * 1e3, 1e-6);
-  EXPECT_GT(largest_displacement(*drawn), 2e-3) << "the noodle settled and was pressed";
+  EXPECT_NEAR(shown["frame"]["maxDisplacementMm"].get<double>(), largest_frame_displacement(*drawn) * 1e3, 1e-6);
+  EXPECT_GT(largest_frame_displacement(*drawn), 2e-3) << "the noodle settled and was pressed";
   for (int slot = 0; slot < 2; ++slot)
     EXPECT_TRUE(std::any_of(recording.view_frames.begin(), recording.view_frames.end(), [&](const view::Frame& frame) {
       return frame.users(slot).pressing() && frame.users(slot).patch_nodes_size() > 0;
@@ -406,7 +406,7 @@ segments:
                                                   (dir / "scrub.png").string(), "--seek", fmt::format("{:.9f}", target)});
   ASSERT_FALSE(scrubbed.contains("error")) << scrubbed.dump();
   EXPECT_DOUBLE_EQ(scrubbed["shown"]["frame"]["time"].get<double>(), expected.time());
-  EXPECT_NEAR(scrubbed["shown"]["frame"]["maxDisplacementMm"].get<double>(), largest_displacement(expected) * 1e3, 1e-6);
+  EXPECT_NEAR(scrubbed["shown"]["frame"]["maxDisplacementMm"].get<double>(), largest_frame_displacement(expected) * 1e3, 1e-6);
   EXPECT_GT(scrubbed["pixels"]["mesh"]["matching"].get<double>(), 0.15 * scrubbed["pixels"]["mesh"]["sampled"].get<double>());
   replay.signal(SIGTERM);
   EXPECT_EQ(replay.wait(testing::kPatience), 0) << replay.log_text();

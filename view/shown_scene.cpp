@@ -10,9 +10,8 @@ namespace {
 
 // Appends the part showing `shown_nodes` of a body whose nodes are at `positions`, with the
 // body's `triangles` whose three corners are shown.
-template <class Triangles>
 ShownPart& append_shown_part(ShownScene& scene, const Eigen::Matrix3Xd& positions, std::span<const int> shown_nodes,
-                             const Triangles& triangles) {
+                             std::span<const Triangle> triangles) {
   ShownPart& part = scene.parts.emplace_back();
   part.offset = scene.node_count();
   part.nodes.assign(shown_nodes.begin(), shown_nodes.end());
@@ -23,7 +22,7 @@ ShownPart& append_shown_part(ShownScene& scene, const Eigen::Matrix3Xd& position
     part.index_of[static_cast<std::size_t>(node)] = part.offset + k;
     scene.rest.col(part.offset + k) = positions.col(node);
   }
-  for (const auto& tri : triangles) {
+  for (const Triangle& tri : triangles) {
     const Triangle shown = {part.index_of[static_cast<std::size_t>(tri[0])], part.index_of[static_cast<std::size_t>(tri[1])],
                             part.index_of[static_cast<std::size_t>(tri[2])]};
     if (shown[0] >= 0 && shown[1] >= 0 && shown[2] >= 0) scene.triangles.push_back(shown);
