@@ -77,6 +77,9 @@ FrameState frame_state(const SceneSimulation& simulation, std::span<ComplianceCo
     out.force = forces[static_cast<std::size_t>(user)];
     out.pressing = simulation.pressing(user);
     out.ir = simulation.ir(user);
+    out.body = simulation.body_of(user);
+    if (const auto* network = std::get_if<MassSpringSimulation>(&simulation.body(out.body)); network && out.pressing)
+      out.contact_node = network->reaction(user).node;
   }
   for (int body = 0; body < simulation.body_count(); ++body) {
     const auto i = static_cast<std::size_t>(body);
@@ -102,6 +105,7 @@ void add_ir_nodes(UserFrame& out, const UserFrameState& user, const ShownScene& 
       for (int node : fem->patch.front().nodes) add(*out.mutable_contact_nodes(), shown.of_tag(body, tag_of(node)));
   } else if (const auto* network = std::get_if<MassSpringIr>(&user.ir->ir.body)) {
     for (std::int32_t node : network->node_ids) add(*out.mutable_patch_nodes(), shown.of_node(body, node));
+    if (user.contact_node >= 0 && user.body == body) add(*out.mutable_contact_nodes(), shown.of_node(body, user.contact_node));
   } else if (const auto* tissue = std::get_if<HomeSpringPatch>(&user.ir->ir.body)) {
     for (int vertex : tissue->surface_vertex) add(*out.mutable_patch_nodes(), shown.of_node(body, vertex));
   }

@@ -41,6 +41,8 @@ struct UserFrameState {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< the force the server has for it [N]
   bool pressing = false;
   std::shared_ptr<const PreparedIR> ir;             ///< its latest (immutable, shared with the simulation)
+  int body = -1;                                    ///< the body it is on
+  int contact_node = -1;  ///< on a mass-spring body, while it presses: the node its tool drives
 };
 
 /// What a frame shows of the simulation after a step.
@@ -58,8 +60,8 @@ FrameState frame_state(const SceneSimulation& simulation, std::span<ComplianceCo
 
 /// A frame at simulation time `time` [s] (any thread): the displacement of the shown nodes,
 /// each user's tool, its force, its IR patch (linear elastic, mass-spring and tissue IRs) and,
-/// while it presses a linear elastic body, its contact triangle; the held nodes and |B| of
-/// the linear elastic bodies.
+/// while it presses, its contact (a linear elastic body's contact triangle, the mass-spring
+/// node its tool drives); the held nodes and |B| of the linear elastic bodies.
 Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t sequence, double time, double sim_rate_hz);
 
 }  // namespace cohaptic::view
