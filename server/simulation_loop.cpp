@@ -5,6 +5,7 @@
 #include <chrono>
 #include <thread>
 
+#include "common/sim/elastic_states.h"
 #include "common/sim/loaded_columns.h"
 #include "proto/wire/header.h"
 #include "proto/wire/ir_convert.h"
@@ -34,9 +35,10 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       display_(display),
       view_(view),
       recorder_(recorder),
-      shown_columns_(display || view ? columns.front() : nullptr),
+      columns_(columns.begin(), columns.end()),
       start_ns_(start_ns),
-      simulation_(model, columns, model.scene.tools, simulation_options(model, options)) {
+      simulation_(model, columns, model.scene.tools, simulation_options(model, options)),
+      view_forces_(static_cast<std::size_t>(simulation_.user_count()), Eigen::Vector3d::Zero()) {
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
     if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i]); body && columns[i])
       prefetch_.push_back({columns[i], static_cast<int>(i), std::make_unique<CompliancePrefetch>(*body, columns[i]->row_nodes())});
@@ -122,10 +124,12 @@ void SimulationLoop::add_keep_alives(Outbox& outbox) {
 // P0: each user's force, from its IR at the current tool positions; recorded with the step.
 std::vector<record::ServerForce> SimulationLoop::add_forces(Outbox& outbox) {
   std::vector<record::ServerForce> forces;
+  std::fill(view_forces_.begin(), view_forces_.end(), Eigen::Vector3d::Zero());
   for (int user = 0; user < simulation_.user_count(); ++user) {
     const auto prepared = simulation_.ir(user);
     if (!prepared) continue;
     const ForceSample force = simulation_.force(user);
+    view_forces_[static_cast<std::size_t>(user)] = force.force;
     wire::Datagram datagram;
     auto* sample = datagram.mutable_force();
     sample->set_user(static_cast<std::uint32_t>(user));
@@ -148,23 +152,33 @@ bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
       display_ && now_ns - last_display_ns_ >= static_cast<std::int64_t>(1e9 / options_.display_rate_hz);
   const bool view_due = view_ && view_->frame_due(now_ns);
   if (!display_due && !view_due) return false;
-  if (const auto* tissue = std::get_if<HomeSpringSimulation>(&simulation_.body(0))) {
-    // A home-spring tissue (display only, no view): its display deformation, decoupled from the force.
-    offer_display_frame(now_ns, tissue->displayed() - tissue->body().surface.vertices);
-    return true;
-  }
-  // Both show the row nodes' surface (common/model/shown_surface.h): one state solve serves both.
-  const Simulation& shown = simulation_.single_elastic();
-  const StateSolution state = shown.solve();
+  // One state solve per linear elastic body serves both (the replay solves them too).
+  const std::vector<std::optional<StateSolution>> states = solve_elastic_states(simulation_);
   if (view_due) {
     view_tools_.resize(latest_.size());
     for (std::size_t slot = 0; slot < latest_.size(); ++slot) view_tools_[slot] = {used_[slot], latest_[slot].position};
     // The displacement and the encoding are the view's thread's work.
     view_->publish_frame(now_ns, seconds_since_start(now_ns),
-                         view::frame_state(shown, loaded_columns(*shown_columns_, state), view_tools_), steps_);
+                         view::frame_state(simulation_, columns_, states, view_tools_, view_forces()), steps_);
   }
-  if (display_due) offer_display_frame(now_ns, displacement_of_nodes(*shown_columns_, state, display_->nodes()));
+  if (!display_due) return true;
+  if (const auto* tissue = std::get_if<HomeSpringSimulation>(&simulation_.body(0))) {
+    // A home-spring tissue: its display deformation, decoupled from the force.
+    offer_display_frame(now_ns, tissue->displayed() - tissue->body().surface.vertices);
+    return true;
+  }
+  // Otherwise the display shows the row nodes' surface of a scene of one linear elastic
+  // object (the server refuses it on another scene).
+  offer_display_frame(now_ns, displacement_of_nodes(*columns_.front(), states.front().value(), display_->nodes()));
   return true;
+}
+
+const std::vector<Eigen::Vector3d>& SimulationLoop::view_forces() {
+  if (options_.protocol == ServeProtocol::p1)
+    for (int user = 0; user < simulation_.user_count(); ++user)
+      view_forces_[static_cast<std::size_t>(user)] =
+          used_[static_cast<std::size_t>(user)] ? simulation_.force(user).force : Eigen::Vector3d::Zero();
+  return view_forces_;
 }
 
 void SimulationLoop::offer_display_frame(std::int64_t now_ns, Eigen::Matrix3Xd displacement) {

@@ -9,8 +9,9 @@
 //      kKeepAlivePeriod_ns), the forces (P0);
 //   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter;
 //      every 1/--view-rate-hz, while a browser watches or the session is recorded, hands the
-//      live view the state it draws (its loads, not its displacement: the view's thread
-//      computes that); one state solve when both are due;
+//      live view the state it draws of every body (view/body_frame_state.h: an FEM body's
+//      loads, not its displacement: the view's thread computes that); one state solve per
+//      FEM body when both are due;
 //   5. records the step and the IRs it built (--record), and its figures (LoopStatistics).
 // run() paces the steps at the loop's rate with absolute deadlines (when behind, the next
 // step starts at once, with no catch-up burst) and hands each non-empty outbox to the I/O
@@ -19,9 +20,9 @@
 // kMaxConsecutiveStepFailures in a row end the loop with the reason.
 // The loop owns the SceneSimulation (the mutable state); the model is shared read-only, the
 // FEM bodies' compliance columns are filled in by this thread alone (each prefetch worker
-// solves into its own, handed over at the start of a step). The display and the live view
-// show a scene of one linear elastic object; the display also a scene of one home-spring
-// tissue (its display deformation, no solve). Times: ns of
+// solves into its own, handed over at the start of a step). The live view shows every body;
+// the display a scene of one linear elastic object or of one home-spring tissue (its display
+// deformation, no solve). Times: ns of
 // wire::monotonic_now_ns(); simulation time in s from the server's start.
 #pragma once
 
@@ -82,6 +83,9 @@ class SimulationLoop {
   std::vector<record::ServerForce> add_forces(Outbox& outbox);
   bool solve_display_frame(std::int64_t now_ns);
   void offer_display_frame(std::int64_t now_ns, Eigen::Matrix3Xd displacement);
+  // The forces a view frame shows: P0's, as sent this step; under P1, evaluated for the view
+  // alone (the server-held evaluations serve nothing else then).
+  const std::vector<Eigen::Vector3d>& view_forces();
   double seconds_since_start(std::int64_t ns) const { return static_cast<double>(ns - start_ns_) * 1e-9; }
 
   // One compliance prefetch per FEM body, with the columns it fills.
@@ -98,7 +102,7 @@ class SimulationLoop {
   DisplayWriter* display_;
   view::LiveView* view_;
   record::SessionRecorder* recorder_;
-  ComplianceColumns* shown_columns_;  // the displayed body's, with a display or a view
+  std::vector<ComplianceColumns*> columns_;  // per body, null unless linear elastic
   std::int64_t start_ns_;
   SceneSimulation simulation_;
   StepFailures failures_;
@@ -108,6 +112,7 @@ class SimulationLoop {
   std::int64_t last_keep_alive_ns_ = 0, last_display_ns_ = 0;
   std::uint64_t steps_ = 0;                      // successful steps so far
   std::vector<view::ToolState> view_tools_;      // this step's tools, for the view
+  std::vector<Eigen::Vector3d> view_forces_;     // per user, for the view [N]
 };
 
 }  // namespace cohaptic

@@ -97,16 +97,13 @@ struct SimulationServer::Impl {
     const bool whole_surface =
         options.step_nodes > 0 || !model->obstacles.empty() || !model->scene.interactions.empty();
     compliance = prepare_scene_compliance(*model, whole_surface, options.cache_directory);
-    // The display and the live view show one linear elastic object (single_elastic_body
-    // says why it refuses another scene); the display also a scene of one home-spring tissue.
-    const auto shown_columns = [this]() -> ComplianceColumns& {
-      single_elastic_body(*model);
-      return *compliance.per_body.front();
-    };
+    // The display shows one linear elastic object (single_elastic_body says why it refuses
+    // another scene) or one home-spring tissue; the live view shows every body.
     const auto* tissue = model->bodies.size() == 1 ? std::get_if<HomeSpringBody>(&model->bodies.front()) : nullptr;
+    if (!options.display.empty() && !tissue) single_elastic_body(*model);  // refuses another scene, naming it
     if (!options.display.empty())
       display = tissue ? std::make_unique<DisplayWriter>(*model, *tissue, options.display)
-                       : std::make_unique<DisplayWriter>(*model, shown_columns(), options.display);
+                       : std::make_unique<DisplayWriter>(*model, *compliance.per_body.front(), options.display);
     tools = std::make_unique<ToolInputs>(model->scene.tools.size());
     spdlog::info("scene '{}' ready in {:.0f} ms: {} user slots", scene.name, watch.elapsed_ms(), tools->size());
 
@@ -127,7 +124,7 @@ struct SimulationServer::Impl {
       settings.port = options.view_port;
       settings.token_file = options.view_token_file;
       settings.rate_hz = options.view_rate_hz;
-      view = std::make_unique<view::LiveView>(*model, shown_columns(), wire_protocol(options), injected_delays(options),
+      view = std::make_unique<view::LiveView>(*model, compliance.per_body, wire_protocol(options), injected_delays(options),
                                               settings, recorder.get());
     }
     loop = std::make_unique<SimulationLoop>(*model, compliance.per_body, options, *tools, statistics, display.get(), view.get(),

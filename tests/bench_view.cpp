@@ -28,7 +28,7 @@
 // What one frame costs each thread, at one state of the same motions (both surgeons
 // pressing, 3 s in), CPU time per frame:
 //   - BM_ViewFrame_simulation_thread: the simulation thread's part, the state solve, its
-//     loads (LoadedColumn) and the FrameState handed over;
+//     loads (LoadedColumn) and the FrameState handed over (its one body's);
 //   - BM_ViewFrame_view_thread: the view's thread's part, the shown surface's displacement
 //     from those loads, the Frame and its encoding;
 //   - BM_ViewFrame_displacement_from_loads: of which the displacement;
@@ -52,10 +52,10 @@
 
 #include "common/haptics/trajectory.h"
 #include "common/model/compliance_setup.h"
-#include "common/model/shown_surface.h"
 #include "common/scene/load_scene.h"
+#include "common/sim/elastic_states.h"
 #include "common/sim/loaded_columns.h"
-#include "common/sim/simulation.h"
+#include "common/sim/scene_simulation.h"
 #include "common/util/blas_threads.h"
 #include "proto/wire/header.h"
 #include "server/server_recording.h"
@@ -186,8 +186,8 @@ class LoopBeside {
     options_.client_timeout_s = 3600;
     for (std::size_t slot = 0; slot < rig_.motions.size(); ++slot) tools_.join(static_cast<int>(slot));
     if (beside.view)
-      live_ = std::make_unique<view::LiveView>(*rig_.model, *rig_.columns, wire_protocol(options_), injected_delays(options_),
-                                               view::LiveViewOptions{}, nullptr);
+      live_ = std::make_unique<view::LiveView>(*rig_.model, std::array{rig_.columns.get()}, wire_protocol(options_),
+                                               injected_delays(options_), view::LiveViewOptions{}, nullptr);
     loop_ = std::make_unique<SimulationLoop>(*rig_.model, std::array{rig_.columns.get()}, options_, tools_, statistics_,
                                              nullptr, live_.get(), nullptr, wire::monotonic_now_ns());
     // Once along the whole motion first: every compliance column it needs is computed (or
@@ -328,38 +328,39 @@ void run_paced(benchmark::State& state, Beside beside) {
 // The brain with both surgeons pressing, 3 s into their motions, and what a frame of it needs.
 struct PressedBrain {
   BrainRig& rig = BrainRig::get();
-  Simulation simulation;
-  ShownSurface shown;
-  view::ShownIndex index;
-  std::vector<int> positions;
+  std::array<ComplianceColumns*, 1> columns{rig.columns.get()};
+  SceneSimulation scene;
+  const Simulation& simulation;
+  view::ShownScene shown;
   std::vector<view::ToolState> tools;
+  std::vector<Eigen::Vector3d> forces;
   static SimulationOptions options(const Model& model) {
     SimulationOptions options;
     options.ir = ir_build_options(model.scene.haptic);
     return options;
   }
   PressedBrain()
-      : simulation(single_elastic_body(*rig.model), rig.model->obstacles, *rig.columns, rig.model->scene.tools,
-                   options(*rig.model)),
-        shown(shown_surface(single_elastic_body(*rig.model), rig.columns->row_nodes())),
-        index(single_elastic_body(*rig.model), shown) {
+      : scene(*rig.model, columns, rig.model->scene.tools, options(*rig.model)),
+        simulation(scene.single_elastic()),
+        shown(view::shown_scene(*rig.model, columns)) {
     for (double t = 0; t < 3.0; t += 0.005) {
-      for (std::size_t slot = 0; slot < rig.motions.size(); ++slot)
-        simulation.set_tool(static_cast<int>(slot), rig.motions[slot].position(t));
-      simulation.step(t);
+      for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) scene.set_tool(static_cast<int>(slot), rig.motions[slot].position(t));
+      scene.step(t);
     }
-    for (int node : shown.nodes) positions.push_back(rig.columns->row_position(node));
-    for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) tools.push_back({true, rig.motions[slot].position(3.0)});
+    for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) {
+      tools.push_back({true, rig.motions[slot].position(3.0)});
+      forces.push_back(simulation.force(static_cast<int>(slot)).force);
+    }
   }
   static PressedBrain& get() {
     static PressedBrain brain;
     return brain;
   }
-  view::FrameState frame_state() { return view::frame_state(simulation, loaded_columns(*rig.columns, simulation.solve()), tools); }
+  view::FrameState frame_state() { return view::frame_state(scene, columns, solve_elastic_states(scene), tools, forces); }
   void describe(benchmark::State& state) {
     state.counters["pressing"] = simulation.pressing(0) + simulation.pressing(1);
     state.counters["boundary_nodes"] = static_cast<double>(simulation.condensation().boundary_nodes().size());
-    state.counters["shown_nodes"] = static_cast<double>(shown.nodes.size());
+    state.counters["shown_nodes"] = static_cast<double>(shown.node_count());
   }
 };
 
@@ -374,7 +375,7 @@ void BM_ViewFrame_view_thread(benchmark::State& state) {
   const view::FrameState frame = brain.frame_state();
   std::size_t bytes = 0;
   for (auto _ : state) {
-    const std::string message = view::server_message(view::view_frame(frame, brain.index, brain.positions, 1, 3.0, 400));
+    const std::string message = view::server_message(view::view_frame(frame, brain.shown, 1, 3.0, 400));
     bytes = message.size();
     benchmark::DoNotOptimize(message.data());
   }
@@ -384,12 +385,13 @@ void BM_ViewFrame_view_thread(benchmark::State& state) {
 void BM_ViewFrame_displacement_from_loads(benchmark::State& state) {
   PressedBrain& brain = PressedBrain::get();
   const view::FrameState frame = brain.frame_state();
-  for (auto _ : state) benchmark::DoNotOptimize(displacement_of_rows(frame.loads, brain.positions));
+  for (auto _ : state) benchmark::DoNotOptimize(
+      displacement_of_rows(std::get<view::ElasticFrameState>(frame.bodies.front()).loads, brain.shown.parts.front().row_positions));
 }
 
 void BM_ViewFrame_displacement_gathered(benchmark::State& state) {
   PressedBrain& brain = PressedBrain::get();
-  for (auto _ : state) benchmark::DoNotOptimize(brain.simulation.displacement_of(brain.shown.nodes));
+  for (auto _ : state) benchmark::DoNotOptimize(brain.simulation.displacement_of(brain.shown.parts.front().nodes));
 }
 
 BENCHMARK(BM_ViewFrame_simulation_thread)->Unit(benchmark::kMicrosecond);

@@ -12,7 +12,10 @@
 #include <mutex>
 #include <thread>
 
+#include "common/model/shown_surface.h"
+#include "common/sim/elastic_states.h"
 #include "common/sim/loaded_columns.h"
+#include "common/sim/scene_simulation.h"
 #include "common/sim/simulation.h"
 #include "common/util/error.h"
 #include "proto/record/recording.h"
@@ -364,19 +367,27 @@ TEST(LoadedColumns, GiveTheDisplacementOfTheGatheredComplianceAndRefuseAPosition
 // ---- a frame, from the simulation ----
 
 TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes) {
+  // The pressed cube's press, stepped by a scene simulation as the server steps it.
   PressedCube pressed;
   testing::CubeRig& cube = pressed.cube;
-  Simulation& simulation = pressed.simulation;
+  const std::array columns{cube.columns.get()};
+  SceneSimulation scene(*cube.model, columns, cube.model->scene.tools, PressedCube::options(*cube.model));
   const Eigen::Vector3d pressing = pressed.pressing;
+  scene.set_tool(0, pressing);
+  scene.step(0);
+  scene.step(0.001);
+  const Simulation& simulation = scene.single_elastic();
   ASSERT_TRUE(simulation.pressing(0));
 
+  const view::ShownScene shown_scene = view::shown_scene(*cube.model, columns);
+  ASSERT_EQ(shown_scene.parts.size(), 1u);
   const ShownSurface shown = shown_surface(cube.body, cube.columns->row_nodes());
-  const view::ShownIndex index(cube.body, shown);
-  std::vector<int> positions;
-  for (int node : shown.nodes) positions.push_back(cube.columns->row_position(node));
+  EXPECT_EQ(shown_scene.parts[0].nodes, shown.nodes);
+  EXPECT_EQ(shown_scene.triangles, shown.triangles);
   const std::vector<view::ToolState> tools = {{true, pressing}, {false, Eigen::Vector3d::Zero()}};
-  const view::FrameState state = view::frame_state(simulation, loaded_columns(*cube.columns, simulation.solve()), tools);
-  const view::Frame frame = view::view_frame(state, index, positions, 7, 0.001, 999);
+  const std::vector<Eigen::Vector3d> forces = {simulation.force(0).force, Eigen::Vector3d::Zero()};
+  const view::FrameState state = view::frame_state(scene, columns, solve_elastic_states(scene), tools, forces);
+  const view::Frame frame = view::view_frame(state, shown_scene, 7, 0.001, 999);
   EXPECT_EQ(frame.sequence(), 7u);
   EXPECT_EQ(frame.time(), 0.001);
   EXPECT_EQ(frame.sim_rate_hz(), 999.0);
@@ -436,7 +447,7 @@ struct ViewedLoop {
   SimulationLoop loop;
   std::int64_t now_ns = wire::monotonic_now_ns();
   explicit ViewedLoop(record::SessionRecorder* recorder)
-      : live(*pressed.cube.model, *pressed.cube.columns, wire::P0, {}, {}, recorder),
+      : live(*pressed.cube.model, std::array{pressed.cube.columns.get()}, wire::P0, {}, {}, recorder),
         loop(*pressed.cube.model, std::array{pressed.cube.columns.get()}, options, tools, statistics, nullptr, &live,
              recorder, now_ns) {
     tools.join(0);

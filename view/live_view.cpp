@@ -7,15 +7,13 @@
 
 namespace cohaptic::view {
 
-LiveView::LiveView(const Model& model, const ComplianceColumns& columns, wire::Protocol protocol,
+LiveView::LiveView(const Model& model, std::span<ComplianceColumns* const> columns, wire::Protocol protocol,
                    const record::InjectedDelays& injected, LiveViewOptions options, record::SessionRecorder* recorder)
-    : shown_(shown_surface(single_elastic_body(model), columns.row_nodes())),
-      index_(single_elastic_body(model), shown_),
+    : shown_(shown_scene(model, columns)),
       recorder_(recorder),
       period_ns_(static_cast<std::int64_t>(1e9 / options.rate_hz)),
       server_({options.host, options.port, access_token(options.host, options.token_file), options.assets, options.proto}) {
-  for (int node : shown_.nodes) row_positions_.push_back(columns.row_position(node));
-  const Scene scene = view_scene(model, single_elastic_body(model), shown_, protocol, injected, options.rate_hz, "live");
+  const Scene scene = view_scene(model, shown_, protocol, injected, options.rate_hz, "live");
   if (recorder_) recorder_->view_scene(wire::monotonic_now_ns(), scene);
   server_.publish(Channel::scene, server_message(scene));
 }
@@ -43,7 +41,7 @@ void LiveView::build_frame() {
     taken.swap(pending_);
   }
   if (!taken) return;
-  Frame frame = view_frame(taken->state, index_, row_positions_, sequence_ + 1, taken->time, taken->sim_rate_hz);
+  Frame frame = view_frame(taken->state, shown_, sequence_ + 1, taken->time, taken->sim_rate_hz);
   ++sequence_;
   if (recorder_) recorder_->view_frame(taken->time_ns, frame);
   server_.publish(Channel::frame, server_message(std::move(frame)));

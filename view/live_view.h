@@ -4,7 +4,7 @@
 //   - the Scene, once (built at construction; recorded as /view_scene with --record);
 //   - a Frame every 1/rate s while a browser watches or the session is recorded (nothing is
 //     computed for a view nobody watches): the simulation thread hands over the step's
-//     FrameState (view_messages.h: tools, forces, held nodes, the state's loads), newest
+//     FrameState (view_messages.h: tools, forces, each body's BodyFrameState), newest
 //     wins, and the view's own thread computes the surface's displacement, encodes, records
 //     (/view_frames) and sends the frame, so the simulation neither waits on a browser nor
 //     spends its time on the drawing;
@@ -20,6 +20,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -28,9 +29,8 @@
 #include "cohaptic/messages.pb.h"
 #include "common/fem/compliance.h"
 #include "common/model/model.h"
-#include "common/model/shown_surface.h"
-#include "common/sim/simulation.h"
 #include "proto/record/session_recorder.h"
+#include "view/shown_scene.h"
 #include "view/view_messages.h"
 #include "view/view_server.h"
 
@@ -50,11 +50,12 @@ struct LiveViewOptions {
 
 class LiveView {
  public:
-  /// Binds the view's port and records the scene (`recorder` may be null). `model` and
-  /// `columns` must outlive it. Throws Error (a missing asset, an address in use, a bad
-  /// token file).
-  LiveView(const Model& model, const ComplianceColumns& columns, wire::Protocol protocol, const record::InjectedDelays& injected,
-           LiveViewOptions options, record::SessionRecorder* recorder);
+  /// Binds the view's port and records the scene of every body of `model` (`recorder` may
+  /// be null). columns[i]: body i's compliance columns, null unless it is linear elastic.
+  /// `model` and the columns must outlive it. Throws Error (a missing asset, an address in
+  /// use, a bad token file).
+  LiveView(const Model& model, std::span<ComplianceColumns* const> columns, wire::Protocol protocol,
+           const record::InjectedDelays& injected, LiveViewOptions options, record::SessionRecorder* recorder);
 
   void start() { server_.start(); }
   void stop() { server_.stop(); }
@@ -86,9 +87,7 @@ class LiveView {
   };
   void build_frame();  // the view's thread
 
-  ShownSurface shown_;
-  ShownIndex index_;
-  std::vector<int> row_positions_;  // of the shown nodes, in the compliance columns
+  ShownScene shown_;
   record::SessionRecorder* recorder_;
   std::int64_t period_ns_;
   // Simulation thread.

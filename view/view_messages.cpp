@@ -2,6 +2,8 @@
 
 #include <Eigen/Geometry>
 
+#include "common/model/body_model_name.h"
+
 namespace cohaptic::view {
 namespace {
 
@@ -22,15 +24,22 @@ void add_plane(Obstacle& out, const Eigen::Vector3d& point, const Eigen::Vector3
 
 }  // namespace
 
-Scene view_scene(const Model& model, const ElasticBody& body, const ShownSurface& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
+Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
                  double frame_rate_hz, const std::string& source) {
   Scene scene;
   scene.set_scene_name(model.scene.name);
   scene.set_units(model.scene.units);
   scene.set_metres_per_unit(model.scene.metres_per_unit);
-  for (int node : shown.nodes) add_point(*scene.mutable_rest_positions(), body.mesh.nodes.col(node));
+  for (Eigen::Index node = 0; node < shown.rest.cols(); ++node) add_point(*scene.mutable_rest_positions(), shown.rest.col(node));
   for (const Triangle& tri : shown.triangles)
     for (int corner : tri) scene.add_triangles(static_cast<std::uint32_t>(corner));
+  for (std::size_t body = 0; body < shown.parts.size(); ++body) {
+    ShownObject* object = scene.add_objects();
+    object->set_name(body_name(model, static_cast<int>(body)));
+    object->set_model(body_model_name(model.bodies[body]));
+    object->set_first_node(static_cast<std::uint32_t>(shown.parts[body].offset));
+    object->set_node_count(static_cast<std::uint32_t>(shown.parts[body].size()));
+  }
   for (std::size_t slot = 0; slot < model.scene.tools.size(); ++slot) {
     Tool* tool = scene.add_tools();
     tool->set_slot(static_cast<std::uint32_t>(slot));
@@ -41,7 +50,7 @@ Scene view_scene(const Model& model, const ElasticBody& body, const ShownSurface
     Obstacle* out = scene.add_obstacles();
     out->set_name(obstacle.name);
     if (obstacle.plane) {
-      add_plane(*out, obstacle.plane->first, obstacle.plane->second, body.mesh.nodes);
+      add_plane(*out, obstacle.plane->first, obstacle.plane->second, shown.rest);
       continue;
     }
     for (Eigen::Index v = 0; v < obstacle.surface.vertices.cols(); ++v)
@@ -57,43 +66,66 @@ Scene view_scene(const Model& model, const ElasticBody& body, const ShownSurface
   return scene;
 }
 
-ShownIndex::ShownIndex(const ElasticBody& body, const ShownSurface& shown) : shown_(shown) {
-  for (int node : shown.nodes) node_of_tag_[body.mesh.node_tags[static_cast<std::size_t>(node)]] = node;
-}
-
-int ShownIndex::of_tag(std::int64_t tag) const {
-  const auto found = node_of_tag_.find(tag);
-  return found == node_of_tag_.end() ? -1 : of_node(found->second);
-}
-
-FrameState frame_state(const Simulation& simulation, std::vector<LoadedColumn> loads, const std::vector<ToolState>& tools) {
+FrameState frame_state(const SceneSimulation& simulation, std::span<ComplianceColumns* const> columns,
+                       const std::vector<std::optional<StateSolution>>& states, const std::vector<ToolState>& tools,
+                       std::span<const Eigen::Vector3d> forces) {
   FrameState state;
   for (int user = 0; user < simulation.user_count(); ++user) {
     UserFrameState& out = state.users.emplace_back();
     out.tool = tools[static_cast<std::size_t>(user)];
     if (!out.tool.present) continue;
-    out.force = simulation.force(user).force;
+    out.force = forces[static_cast<std::size_t>(user)];
     out.pressing = simulation.pressing(user);
     out.ir = simulation.ir(user);
+    out.body = simulation.body_of(user);
+    if (const auto* network = std::get_if<MassSpringSimulation>(&simulation.body(out.body)); network && out.pressing)
+      out.contact_node = network->reaction(user).node;
   }
-  state.held_nodes = simulation.condensation().boundary_nodes();
-  state.loads = std::move(loads);
+  for (int body = 0; body < simulation.body_count(); ++body) {
+    const auto i = static_cast<std::size_t>(body);
+    state.bodies.push_back(body_frame_state(simulation.body(body), i < columns.size() ? columns[i] : nullptr, states[i]));
+  }
   return state;
 }
 
-Frame view_frame(const FrameState& state, const ShownIndex& index, std::span<const int> row_positions,
-                 std::uint64_t sequence, double time, double sim_rate_hz) {
+namespace {
+
+// The user's IR patch and, while it presses, contact nodes, as shown indices (those shown).
+void add_ir_nodes(UserFrame& out, const UserFrameState& user, const ShownScene& shown) {
+  if (!user.ir) return;
+  const int body = user.ir->ir.object;
+  if (body < 0 || static_cast<std::size_t>(body) >= shown.parts.size()) return;
+  const auto add = [](google::protobuf::RepeatedField<std::uint32_t>& to, int index) {
+    if (index >= 0) to.Add(static_cast<std::uint32_t>(index));
+  };
+  if (const auto* fem = std::get_if<CondensedFemIr>(&user.ir->ir.body)) {
+    const auto tag_of = [&](int node) { return fem->node_ids[static_cast<std::size_t>(node)]; };
+    for (int node = 0; node < fem->patch_node_count; ++node) add(*out.mutable_patch_nodes(), shown.of_tag(body, tag_of(node)));
+    if (user.pressing && !fem->patch.empty())
+      for (int node : fem->patch.front().nodes) add(*out.mutable_contact_nodes(), shown.of_tag(body, tag_of(node)));
+  } else if (const auto* network = std::get_if<MassSpringIr>(&user.ir->ir.body)) {
+    for (std::int32_t node : network->node_ids) add(*out.mutable_patch_nodes(), shown.of_node(body, node));
+    if (user.contact_node >= 0 && user.body == body) add(*out.mutable_contact_nodes(), shown.of_node(body, user.contact_node));
+  } else if (const auto* tissue = std::get_if<HomeSpringPatch>(&user.ir->ir.body)) {
+    for (int vertex : tissue->surface_vertex) add(*out.mutable_patch_nodes(), shown.of_node(body, vertex));
+  }
+}
+
+}  // namespace
+
+Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t sequence, double time, double sim_rate_hz) {
   Frame frame;
   frame.set_sequence(sequence);
   frame.set_time(time);
   frame.set_sim_rate_hz(sim_rate_hz);
-  const Eigen::Matrix3Xd displacement = displacement_of_rows(state.loads, row_positions);
+  Eigen::Matrix3Xd displacement(3, shown.node_count());
+  for (std::size_t body = 0; body < state.bodies.size(); ++body) {
+    const ShownPart& part = shown.parts[body];
+    displacement.middleCols(part.offset, part.size()) = part_displacement(state.bodies[body], part, shown);
+  }
   auto& u = *frame.mutable_displacement();
   u.Reserve(static_cast<int>(displacement.size()));
   for (Eigen::Index i = 0; i < displacement.size(); ++i) u.AddAlreadyReserved(static_cast<float>(displacement.data()[i]));
-  const auto add_tagged = [&](google::protobuf::RepeatedField<std::uint32_t>& out, std::int64_t tag) {
-    if (const int shown = index.of_tag(tag); shown >= 0) out.Add(static_cast<std::uint32_t>(shown));
-  };
   for (std::size_t user = 0; user < state.users.size(); ++user) {
     const UserFrameState& each = state.users[user];
     UserFrame* out = frame.add_users();
@@ -103,16 +135,17 @@ Frame view_frame(const FrameState& state, const ShownIndex& index, std::span<con
     add_point(*out->mutable_position(), each.tool.position);
     add_point(*out->mutable_force(), each.force);
     out->set_pressing(each.pressing);
-    const CondensedFemIr* fem = each.ir ? std::get_if<CondensedFemIr>(&each.ir->ir.body) : nullptr;
-    if (!fem) continue;
-    for (int node = 0; node < fem->patch_node_count; ++node)
-      add_tagged(*out->mutable_patch_nodes(), fem->node_ids[static_cast<std::size_t>(node)]);
-    if (each.pressing && !fem->patch.empty())
-      for (int node : fem->patch.front().nodes) add_tagged(*out->mutable_contact_nodes(), fem->node_ids[static_cast<std::size_t>(node)]);
+    add_ir_nodes(*out, each, shown);
   }
-  frame.set_boundary_nodes(static_cast<std::uint32_t>(state.held_nodes.size()));
-  for (int node : state.held_nodes)
-    if (const int shown = index.of_node(node); shown >= 0) frame.add_held_nodes(static_cast<std::uint32_t>(shown));
+  std::uint32_t boundary_nodes = 0;
+  for (std::size_t body = 0; body < state.bodies.size(); ++body) {
+    const auto* fem = std::get_if<ElasticFrameState>(&state.bodies[body]);
+    if (!fem) continue;
+    boundary_nodes += static_cast<std::uint32_t>(fem->held_nodes.size());
+    for (int node : fem->held_nodes)
+      if (const int index = shown.of_node(static_cast<int>(body), node); index >= 0) frame.add_held_nodes(static_cast<std::uint32_t>(index));
+  }
+  frame.set_boundary_nodes(boundary_nodes);
   return frame;
 }
 

@@ -1,25 +1,26 @@
 // The live view's messages (proto/cohaptic/view.proto) built from the server's model and
 // simulation: the Scene once, a Frame per view frame, the Status from the users' reports.
-// A frame is built in two halves: frame_state() takes what it shows from the simulation
-// after a step (small: the tools, forces, IRs, held nodes and the state's loads, no
-// displacement), on the simulation thread; view_frame() computes the surface's
-// displacement from those loads and encodes it, on the view's own thread.
+// Every body of the scene is shown (shown_scene.h). A frame is built in two halves:
+// frame_state() takes what it shows from the simulation after a step (small: the tools,
+// forces, IRs and each body's BodyFrameState, no displacement), on the simulation thread;
+// view_frame() computes the surface's displacement from those and encodes it, on the
+// view's own thread.
 // Lengths stay in m and forces in N on the wire; float precision is plenty for drawing.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "cohaptic/view.pb.h"
 #include "common/model/model.h"
-#include "common/model/shown_surface.h"
-#include "common/sim/loaded_columns.h"
-#include "common/sim/simulation.h"
+#include "common/sim/scene_simulation.h"
+#include "view/body_frame_state.h"
+#include "view/shown_scene.h"
 
 namespace cohaptic::view {
 
@@ -29,50 +30,38 @@ struct ToolState {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< [m]
 };
 
-/// The scene: the shown surface of `body` (one of `model`'s) at rest, the tools, the obstacles (a plane as a square of
-/// twice the object's size around the object's projection), and the session's settings.
-Scene view_scene(const Model& model, const ElasticBody& body, const ShownSurface& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
+/// The scene: `shown` (model's, at rest, with each object's name, model and shown nodes), the tools, the obstacles (a plane as a square of
+/// twice the shown surface's size around its projection), and the session's settings.
+Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
                  double frame_rate_hz, const std::string& source);
-
-/// Maps the simulation's nodes to the shown surface's: by volume index, or by mesh tag
-/// (as IRs name their nodes).
-class ShownIndex {
- public:
-  ShownIndex(const ElasticBody& body, const ShownSurface& shown);
-  /// The shown index of volume node `node`, or -1.
-  int of_node(int node) const { return shown_.index_of[static_cast<std::size_t>(node)]; }
-  /// The shown index of the node with mesh tag `tag`, or -1.
-  int of_tag(std::int64_t tag) const;
-
- private:
-  const ShownSurface& shown_;
-  std::unordered_map<std::int64_t, int> node_of_tag_;
-};
 
 /// One user as a frame shows it.
 struct UserFrameState {
   ToolState tool;
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< evaluated from its IR (Simulation::force) [N]
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< the force the server has for it [N]
   bool pressing = false;
   std::shared_ptr<const PreparedIR> ir;             ///< its latest (immutable, shared with the simulation)
+  int body = -1;                                    ///< the body it is on
+  int contact_node = -1;  ///< on a mass-spring body, while it presses: the node its tool drives
 };
 
 /// What a frame shows of the simulation after a step.
 struct FrameState {
   std::vector<UserFrameState> users;
-  std::vector<int> held_nodes;      ///< B, the condensation's boundary nodes (volume indices)
-  std::vector<LoadedColumn> loads;  ///< the solved state's forces, for the displacement
+  std::vector<BodyFrameState> bodies;  ///< per model body
 };
 
-/// Takes a frame's state (simulation thread): each user's tool as `tools` says, its force,
-/// contact and IR; the held nodes; `loads`, the loaded_columns() of simulation.solve().
-FrameState frame_state(const Simulation& simulation, std::vector<LoadedColumn> loads, const std::vector<ToolState>& tools);
+/// Takes a frame's state (simulation thread): each user's tool as `tools` says, its force
+/// (`forces`, per user: what P0 sends, Simulation::force), contact and IR; each body's state
+/// (`columns` and `states`: per body, its compliance columns and solve_elastic_states()'s).
+FrameState frame_state(const SceneSimulation& simulation, std::span<ComplianceColumns* const> columns,
+                       const std::vector<std::optional<StateSolution>>& states, const std::vector<ToolState>& tools,
+                       std::span<const Eigen::Vector3d> forces);
 
-/// A frame at simulation time `time` [s] (any thread): the displacement of the shown nodes
-/// (`row_positions`: their ComplianceColumns::row_position) under the state's loads, each
-/// user's tool, its force, its IR patch and, while it presses, its contact triangle; the held
-/// nodes and |B|.
-Frame view_frame(const FrameState& state, const ShownIndex& index, std::span<const int> row_positions,
-                 std::uint64_t sequence, double time, double sim_rate_hz);
+/// A frame at simulation time `time` [s] (any thread): the displacement of the shown nodes,
+/// each user's tool, its force, its IR patch (linear elastic, mass-spring and tissue IRs) and,
+/// while it presses, its contact (a linear elastic body's contact triangle, the mass-spring
+/// node its tool drives); the held nodes and |B| of the linear elastic bodies.
+Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t sequence, double time, double sim_rate_hz);
 
 }  // namespace cohaptic::view

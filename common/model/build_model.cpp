@@ -2,6 +2,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/mesh/read_freesurfer.h"
+#include "common/model/body_model_name.h"
 #include "common/model/model.h"
 #include "common/util/error.h"
 
@@ -59,12 +60,14 @@ Model build_model(const Scene& scene) {
 
 const std::string& body_name(const Model& model, int index) { return model.scene.objects.at(index).name; }
 
+const char* body_model_name(const BodyModel& body) { return std::visit(KindName{}, body); }
+
 const ElasticBody& elastic_body(const Model& model, int index) {
   if (index < 0 || index >= static_cast<int>(model.bodies.size()))
     throw Error(fmt::format("scene '{}' has {} objects: there is no object {}", model.scene.name, model.bodies.size(), index));
   if (const auto* body = std::get_if<ElasticBody>(&model.bodies[index])) return *body;
   throw Error(fmt::format("object '{}' is a {} body, and this needs a linear_elastic one", body_name(model, index),
-                          std::visit(KindName{}, model.bodies[index])));
+                          body_model_name(model.bodies[index])));
 }
 
 const ElasticBody& single_elastic_body(const Model& model) {

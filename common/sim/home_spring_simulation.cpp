@@ -4,6 +4,17 @@
 #include "common/util/stopwatch.h"
 
 namespace cohaptic {
+
+Eigen::Matrix3Xd dented_surface(const TissueDisplay& display, std::span<const TissueDent> dents) {
+  Eigen::Matrix3Xd shown = display.rest;
+  Eigen::Matrix3Xd dented(3, shown.cols());
+  for (const TissueDent& dent : dents) {
+    display_tissue(display, dent.from, dent.to, dented);
+    shown += dented - display.rest;
+  }
+  return shown;
+}
+
 namespace {
 
 // The corner of surface triangle `triangle` nearest `point` (the lowest corner on a tie),
@@ -126,15 +137,11 @@ void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport
   report.ir_bytes += user.ir->ir.size_bytes();
 }
 
-Eigen::Matrix3Xd HomeSpringSimulation::displayed() const {
-  Eigen::Matrix3Xd shown = body_.display.rest;
-  Eigen::Matrix3Xd dented(3, shown.cols());
-  for (const UserState& user : users_) {
-    if (!user.pressing) continue;
-    display_tissue(body_.display, user.dent_from, user.dent_to, dented);
-    shown += dented - body_.display.rest;
-  }
-  return shown;
+std::vector<TissueDent> HomeSpringSimulation::dents() const {
+  std::vector<TissueDent> dents;
+  for (const UserState& user : users_)
+    if (user.pressing) dents.push_back({user.dent_from, user.dent_to});
+  return dents;
 }
 
 ForceSample HomeSpringSimulation::force(int u) {

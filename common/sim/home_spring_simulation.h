@@ -24,15 +24,25 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "common/ir/evaluate_force.h"
 #include "common/laparoscopy/forceps_jaws.h"
+#include "common/laparoscopy/tissue_display.h"
 #include "common/model/home_spring_body.h"
 #include "common/scene/scene.h"
 #include "common/sim/step_report.h"
 
 namespace cohaptic {
+
+/// One pressing user's dent of the displayed tissue: P -> A (see above) [m].
+struct TissueDent {
+  Eigen::Vector3d from = Eigen::Vector3d::Zero(), to = Eigen::Vector3d::Zero();
+};
+
+/// The rest surface of `display` dented by every one of `dents`, the dents added [m].
+Eigen::Matrix3Xd dented_surface(const TissueDisplay& display, std::span<const TissueDent> dents);
 
 class HomeSpringSimulation {
  public:
@@ -56,7 +66,10 @@ class HomeSpringSimulation {
   /// The forceps' jaws of `user` as of the latest step (open, for a probe).
   const ForcepsJaws& jaws(int user) const { return users_[static_cast<std::size_t>(user)].jaws; }
   /// The rest surface dented by the pressing users, as of the latest step [m].
-  Eigen::Matrix3Xd displayed() const;
+  Eigen::Matrix3Xd displayed() const { return dented_surface(body_.display, dents()); }
+  /// The pressing users' dents as of the latest step: what displayed() draws, small to hand
+  /// to another thread (the live view dents the surface on its own).
+  std::vector<TissueDent> dents() const;
   /// Distance from `point` to the rest surface [m].
   double distance_to_surface(const Eigen::Vector3d& point) const;
 

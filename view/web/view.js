@@ -175,6 +175,7 @@ class View {
       triangles: scene.triangles.length / 3, tools: scene.tools.map((t) => ({ slot: t.slot, name: t.name, radius: t.radius })),
       obstacles: scene.obstacles.map((o) => o.name), protocol: this.schema.Protocol.valuesById[scene.protocol] || '?',
       forceLimit: scene.force_limit, frameRateHz: scene.frame_rate_hz,
+      objects: scene.objects.map((o) => ({ name: o.name, model: o.model, firstNode: o.first_node, nodes: o.node_count })),
     };
     this.state.replay = scene.source !== 'live';
     this.series = new Map(scene.force_series.map((s) => [s.slot, { times: s.times, magnitudes: s.magnitudes }]));
@@ -250,7 +251,9 @@ class View {
     this.resetCamera();
     $('scene-name').textContent = `${scene.scene_name}${this.state.replay ? ' · recording' : ' · live'}`;
     const injected = scene.injected || {};
-    $('session').textContent = `${this.state.scene.protocol} · ${n} surface nodes · force limit ${fmt(scene.force_limit, 2)} N` +
+    // The objects shown (a recording made before they were listed has none).
+    const objects = scene.objects.map((o) => `${o.name} (${o.model.replace('_', ' ')}, ${o.node_count} nodes)`).join(', ');
+    $('session').textContent = `${this.state.scene.protocol} · ${objects || `${n} surface nodes`} · force limit ${fmt(scene.force_limit, 2)} N` +
       (this.state.replay ? ` · ${scene.source}` : '');
     $('injected').textContent = `injected: shift ${fmt(injected.shift_delay_ms || 0, 1)} ms, jitter ${fmt(injected.jitter_ms || 0, 1)} ms, ` +
       `loss ${fmt(100 * (injected.loss || 0), 1)} %, step nodes ${injected.step_nodes || 0}, ` +
