@@ -443,9 +443,9 @@ struct ViewedLoop {
   ServeOptions options = like_pressed();
   ToolInputs tools{pressed.cube.model->scene.tools.size()};
   LoopStatistics statistics;
+  std::int64_t now_ns = wire::monotonic_now_ns();  // before `loop`, which starts its clock at it
   view::LiveView live;
   SimulationLoop loop;
-  std::int64_t now_ns = wire::monotonic_now_ns();
   explicit ViewedLoop(record::SessionRecorder* recorder)
       : live(*pressed.cube.model, std::array{pressed.cube.columns.get()}, wire::P0, {}, {}, recorder),
         loop(*pressed.cube.model, std::array{pressed.cube.columns.get()}, options, tools, statistics, nullptr, &live,
