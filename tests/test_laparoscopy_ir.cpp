@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <random>
 #include <string>
 
@@ -16,6 +15,7 @@
 #include "common/laparoscopy/home_spring_contact.h"
 #include "common/util/error.h"
 #include "proto/wire/ir_convert.h"
+#include "support/ir_seed.h"
 #include "support/tissue_sheet.h"
 
 namespace cohaptic {
@@ -121,18 +121,11 @@ TEST(LaparoscopyIr, NonFiniteToolGivesZeroForce) {
 // The fuzz corpus's home-spring seeds (tests/fuzz/text_seeds/ir) decode and prepare, so
 // fuzzing starts from IRs that reach the evaluation; the grasped one pulled straight up by
 // delta gives the flat hexagon's closed form k1 delta + 6 k2 delta (1 - h / sqrt(h^2 + delta^2)).
-PreparedIR prepared_seed(const char* name) {
-  std::ifstream in(std::string(COHAPTIC_SOURCE_DIR) + "/tests/fuzz/corpus/ir/" + name, std::ios::binary);
-  wire::IntermediateRepresentation message;
-  EXPECT_TRUE(message.ParseFromIstream(&in)) << name;
-  return prepare_ir(wire::from_wire(message));
-}
-
 TEST(LaparoscopyIr, FuzzSeedsReachTheEvaluation) {
-  const PreparedIR free = prepared_seed("home_spring");
+  const PreparedIR free = testing::prepared_ir_seed("home_spring");
   EvaluationState free_state = make_evaluation_state(free);
   EXPECT_TRUE(evaluate_force(free, free_state, Vector3d(0.0005, 0.0003, -0.001), {}, 1e-3).flags & kInContact);
-  const PreparedIR grasped = prepared_seed("home_spring_grasped");
+  const PreparedIR grasped = testing::prepared_ir_seed("home_spring_grasped");
   const HomeSpringPatch& patch = std::get<HomeSpringPatch>(grasped.ir.body);
   EvaluationState state = make_evaluation_state(grasped);
   const double h = 0.004, delta = 0.005, k1 = 300, k2 = 120;

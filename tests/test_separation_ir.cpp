@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <string>
 
 #include "common/ir/evaluate_force.h"
@@ -15,6 +14,7 @@
 #include "common/sim/separation_simulation.h"
 #include "common/util/error.h"
 #include "proto/wire/ir_convert.h"
+#include "support/ir_seed.h"
 #include "support/default_two_layers.h"
 
 namespace cohaptic {
@@ -206,22 +206,15 @@ TEST(SeparationIr, ClientForceEqualsTheServersThroughALaserGrooveAndAPushThatOpe
   EXPECT_EQ(run.client_area, run.server_area);
 }
 
-PreparedIR prepared_separation_seed(const std::string& name) {
-  std::ifstream in(std::string(COHAPTIC_SOURCE_DIR) + "/tests/fuzz/corpus/ir/" + name, std::ios::binary);
-  wire::IntermediateRepresentation message;
-  EXPECT_TRUE(message.ParseFromIstream(&in)) << name;
-  return prepare_ir(wire::from_wire(message));
-}
-
 // The fuzz corpus's hand-written seeds (tests/fuzz/text_seeds/ir/separation*.txtpb) are
 // accepted and reach the evaluation: the grasped one, pulled 0.1 mm along the normal, gives
 // Eq. 2 blended by hand over its areas (fields k_z = 300, 150, 60 N/m; triangle 0 half
 // separated: A(R-bar) = 1/4, 1/2, 1/4 at its nodes, A(S-bar) = 1/4; c at weights 1/2, 1/4, 1/4).
 TEST(SeparationIr, FuzzSeedsReachTheEvaluation) {
-  const PreparedIR free = prepared_separation_seed("separation");
+  const PreparedIR free = testing::prepared_ir_seed("separation");
   EvaluationState free_state = make_evaluation_state(free);
   EXPECT_EQ(evaluate_force(free, free_state, Vector3d(0.002, 0.001, 0.0001), {}, 1e-3, 0).force, Vector3d::Zero());
-  const PreparedIR grasped = prepared_separation_seed("separation_grasped");
+  const PreparedIR grasped = testing::prepared_ir_seed("separation_grasped");
   EvaluationState state = make_evaluation_state(grasped);
   const auto field = [](double local, double global) { return (1 - global) * ((1 - local) * 300 + local * 150) + global * 60; };
   const double k = 0.5 * field(0.25, 0.25) + 0.25 * field(0.5, 0.25) + 0.25 * field(0.25, 0.25);
