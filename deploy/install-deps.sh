@@ -17,8 +17,9 @@ packages=(
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   # the mass-spring benchmark tables (make bench-thin) read the benchmarks' JSON
   jq
-  # tests and benchmarks; the browser the live view's test opens the page in
-  libgtest-dev libgmock-dev libbenchmark-dev chromium
+  # tests and benchmarks; the browser the live view's test opens the page in; the mesher
+  # of the Hertz study's graded block (scenes/hertz/quarter_block.geo, meshed by the build)
+  libgtest-dev libgmock-dev libbenchmark-dev chromium gmsh
   # fuzzing (libFuzzer) and sanitizer reports: make fuzz, make test-asan, make test-tsan
   clang libclang-rt-14-dev llvm
 )

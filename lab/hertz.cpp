@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "common/mesh/read_gmsh.h"
+#include "common/mesh/tet_mesh.h"
 #include "common/model/model.h"
 #include "common/model/sphere_contact_reference.h"
 #include "common/model/static_contact.h"
@@ -27,6 +29,40 @@ double core_cell(const HertzBlock& block) { return block.core / core_cells(block
 
 double change(double coarse, double fine) { return std::abs(fine - coarse) / std::abs(fine); }
 
+// The quarter block's side [m]: 20 R for the box mesh; for a mesh file (millimetres), its
+// side, checked to be the quarter block [0, s]^2 x [-s, 0] with s >= 20 R that the
+// symmetry planes and the fixed bottom assume.
+double quarter_block_side(const HertzBlock& block) {
+  if (block.mesh.empty()) return kSidePerRadius * block.radius;
+  const TetMesh mesh = read_gmsh(block.mesh).mesh;
+  const Eigen::Vector3d min = mesh.nodes.rowwise().minCoeff() * 1e-3, max = mesh.nodes.rowwise().maxCoeff() * 1e-3;
+  const double side = max.x();
+  const Eigen::Vector3d low(0, 0, -side), high(side, side, 0);
+  if ((min - low).norm() > 1e-6 * side || (max - high).norm() > 1e-6 * side || side < kSidePerRadius * block.radius)
+    throw Error(fmt::format("hertz: mesh {} spans ({:g}, {:g}, {:g}) to ({:g}, {:g}, {:g}) mm; a quarter block is "
+                            "(0, 0, -s) to (s, s, 0) with s at least {:g} mm (20 R)",
+                            block.mesh.string(), 1e3 * min.x(), 1e3 * min.y(), 1e3 * min.z(), 1e3 * max.x(),
+                            1e3 * max.y(), 1e3 * max.z(), 1e3 * kSidePerRadius * block.radius));
+  return side;
+}
+
+// The mean edge of the tetrahedra with a node within 0.3 R of the contact point, over R.
+double mean_edge_near_contact(const TetMesh& mesh, double radius) {
+  constexpr int kEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  double sum = 0;
+  long count = 0;
+  for (int t = 0; t < mesh.tet_count(); ++t) {
+    const Tet& tet = mesh.tets[static_cast<std::size_t>(t)];
+    bool near = false;
+    for (int k = 0; k < 4; ++k) near = near || mesh.nodes.col(tet[k]).norm() < 0.3 * radius;
+    if (!near) continue;
+    for (const auto& edge : kEdges) sum += (mesh.nodes.col(tet[edge[0]]) - mesh.nodes.col(tet[edge[1]])).norm();
+    count += 6;
+  }
+  if (count == 0) throw Error("hertz: the mesh has no tetrahedron within 0.3 R of the contact point (0, 0, 0)");
+  return sum / static_cast<double>(count) / radius;
+}
+
 }  // namespace
 
 double hertz_cell_growth(const HertzBlock& block) {
@@ -46,14 +82,25 @@ double hertz_cell_growth(const HertzBlock& block) {
 
 std::string hertz_block_yaml(const HertzBlock& block) {
   if (!(block.radius > 0)) throw Error(fmt::format("hertz: radius {} m: need a positive radius", block.radius));
-  const double r_mm = block.radius * 1e3, side = kSidePerRadius * r_mm, ratio = hertz_cell_growth(block);
+  const double r_mm = block.radius * 1e3, side = quarter_block_side(block) * 1e3;
+  std::string mesh;
+  if (block.mesh.empty()) {
+    const double ratio = hertz_cell_growth(block);
+    mesh = fmt::format(
+        "box: {{min: [0, 0, {}], size: [{}, {}, {}], divisions: [{n}, {n}, {n}], grading: [{r}, {r}, {inv_r}], "
+        "uniform_cells: [{c}, {c}, {c}]}}",
+        -side, side, side, side, fmt::arg("n", block.divisions), fmt::arg("c", core_cells(block)),
+        fmt::arg("r", fmt::format("{:.17g}", ratio)), fmt::arg("inv_r", fmt::format("{:.17g}", 1 / ratio)));
+  } else {
+    mesh = fmt::format("file: \"{}\"", std::filesystem::absolute(block.mesh).generic_string());
+  }
   return fmt::format(
       R"(name: hertz
 units: mm
 objects:
   - name: block
     mesh:
-      box: {{min: [0, 0, {neg_side}], size: [{side}, {side}, {side}], divisions: [{n}, {n}, {n}], grading: [{r}, {r}, {inv_r}], uniform_cells: [{c}, {c}, {c}]}}
+      {mesh}
     material: {{model: linear_elastic, youngs_modulus: {e}, poisson_ratio: {nu}, element: {element}}}
     fixed:
       - plane: {{point: [0, 0, {neg_side}], normal: [0, 0, 1]}}
@@ -68,9 +115,7 @@ tools:
   - {{name: A, shape: sphere, radius: {radius}}}
 haptic: {{contact_model: sphere}}
 )",
-      fmt::arg("neg_side", -side), fmt::arg("side", side), fmt::arg("n", block.divisions), fmt::arg("c", core_cells(block)),
-      fmt::arg("r", fmt::format("{:.17g}", ratio)), fmt::arg("inv_r", fmt::format("{:.17g}", 1 / ratio)),
-      fmt::arg("e", fmt::format("{:.17g}", block.material.youngs_modulus)),
+      fmt::arg("mesh", mesh), fmt::arg("neg_side", -side), fmt::arg("e", fmt::format("{:.17g}", block.material.youngs_modulus)),
       fmt::arg("nu", fmt::format("{:.17g}", block.material.poisson_ratio)),
       fmt::arg("element", formulation_name(block.material.formulation)), fmt::arg("radius", fmt::format("{:.17g}", r_mm)));
 }
@@ -86,10 +131,11 @@ HertzMesh measure_hertz(const HertzBlock& block, const std::vector<double>& dept
   const Model model = build_model(parse_scene(hertz_block_yaml(block), "hertz.yaml"));
   const ElasticBody& body = single_elastic_body(model);
   HertzMesh mesh;
-  mesh.divisions = block.divisions;
+  mesh.name = block.mesh.empty() ? fmt::format("{} cells", block.divisions) : block.mesh.filename().string();
+  mesh.side = quarter_block_side(block) / block.radius;
   mesh.nodes = body.mesh.node_count();
   mesh.tets = body.mesh.tet_count();
-  mesh.smallest_cell = core_cell(block);
+  mesh.contact_cell = block.mesh.empty() ? core_cell(block) : mean_edge_near_contact(body.mesh, block.radius);
   SphereContactReference sphere_model(body);
   for (double depth_ratio : depth_ratios) {
     const std::vector<PressedTool> tool = {{Eigen::Vector3d(0, 0, block.radius * (1 - depth_ratio)), block.radius}};
@@ -106,18 +152,19 @@ HertzMesh measure_hertz(const HertzBlock& block, const std::vector<double>& dept
 std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh>& meshes) {
   const HertzBlock& block = options.block;
   std::string out = fmt::format(
-      "Sphere of R = {:g} mm into a block 40 R wide and 20 R deep (a graded quarter, core {:g} R), E = {:g} Pa, "
-      "nu = {:g}, {}.\nF / F_Hertz, sphere model (full solve of the unilateral problem) | node translation:\n\n",
+      "Sphere of R = {:g} mm into a block twice the quarter's side wide and one side deep, fixed at its bottom "
+      "(a graded quarter; box meshes: core {:g} R), E = {:g} Pa, nu = {:g}, {}.\nF / F_Hertz, sphere model (full "
+      "solve of the unilateral problem) | node translation:\n\n",
       block.radius * 1e3, block.core, block.material.youngs_modulus, block.material.poisson_ratio,
       formulation_name(block.material.formulation));
-  out += "| divisions | nodes | smallest cell / R |";
+  out += "| mesh | quarter side / R | nodes | contact cell / R |";
   for (const char* model : {"sphere", "translation"})
     for (double d : options.depth_ratios) out += fmt::format(" {} d/R = {:g} |", model, d);
-  out += "\n|---|---|---|";
+  out += "\n|---|---|---|---|";
   for (std::size_t i = 0; i < 2 * options.depth_ratios.size(); ++i) out += "---|";
   out += "\n";
   for (const HertzMesh& mesh : meshes) {
-    out += fmt::format("| {} | {} | {:.4f} |", mesh.divisions, mesh.nodes, mesh.smallest_cell);
+    out += fmt::format("| {} | {:g} | {} | {:.4f} |", mesh.name, mesh.side, mesh.nodes, mesh.contact_cell);
     for (const std::vector<double>* forces : {&mesh.sphere_force, &mesh.translation_force})
       for (std::size_t j = 0; j < options.depth_ratios.size(); ++j)
         out += fmt::format(" {:.4f} |", (*forces)[j] / hertz_force(block.material, block.radius,
@@ -127,7 +174,7 @@ std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh
   if (meshes.size() >= 2) {
     const HertzMesh& coarse = meshes[meshes.size() - 2];
     const HertzMesh& fine = meshes.back();
-    out += fmt::format("| change {} → {} | | |", coarse.divisions, fine.divisions);
+    out += fmt::format("| change {} → {} | | | |", coarse.name, fine.name);
     for (const auto member : {&HertzMesh::sphere_force, &HertzMesh::translation_force})
       for (std::size_t j = 0; j < options.depth_ratios.size(); ++j)
         out += fmt::format(" {:.1f} % |", 100 * change((coarse.*member)[j], (fine.*member)[j]));
@@ -141,13 +188,21 @@ std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh
 }
 
 int run_hertz(const HertzOptions& options) {
-  std::vector<HertzMesh> meshes;
+  std::vector<HertzBlock> blocks;
   for (int divisions : options.divisions) {
+    blocks.push_back(options.block);
+    blocks.back().divisions = divisions;
+  }
+  if (!options.meshes.empty()) blocks.clear();
+  for (const std::filesystem::path& file : options.meshes) {
+    blocks.push_back(options.block);
+    blocks.back().mesh = file;
+  }
+  std::vector<HertzMesh> meshes;
+  for (const HertzBlock& block : blocks) {
     const Stopwatch watch;
-    HertzBlock block = options.block;
-    block.divisions = divisions;
     meshes.push_back(measure_hertz(block, options.depth_ratios));
-    spdlog::info("{} divisions: {} nodes, {} tetrahedra, {:.1f} s", divisions, meshes.back().nodes, meshes.back().tets,
+    spdlog::info("{}: {} nodes, {} tetrahedra, {:.1f} s", meshes.back().name, meshes.back().nodes, meshes.back().tets,
                  watch.elapsed_ms() / 1000);
   }
   const std::string table = hertz_table(options, meshes);
@@ -160,19 +215,19 @@ int run_hertz(const HertzOptions& options) {
   LinePlot plot;
   plot.title = fmt::format("Sphere into a block against Hertz (nu = {:g}, {})", options.block.material.poisson_ratio,
                            formulation_name(options.block.material.formulation));
-  plot.x_label = "cells per side of the quarter block";
+  plot.x_label = "R / contact cell";
   plot.y_label = "F / F_Hertz, sphere model";
   // Node translation stays in the table: at a few percent of Hertz it would flatten the plot.
   for (std::size_t j = 0; j < options.depth_ratios.size(); ++j) {
     Series series{fmt::format("d/R = {:g}", options.depth_ratios[j]), {}, {}, {}, true};
     for (const HertzMesh& mesh : meshes) {
-      series.x.push_back(mesh.divisions);
+      series.x.push_back(1 / mesh.contact_cell);
       series.y.push_back(mesh.sphere_force[j] / hertz_force(options.block.material, options.block.radius,
                                                             options.depth_ratios[j] * options.block.radius));
     }
     plot.series.push_back(std::move(series));
   }
-  const double first = options.divisions.front(), last = options.divisions.back();
+  const double first = 1 / meshes.front().contact_cell, last = 1 / meshes.back().contact_cell;
   for (const auto& [label, level] : {std::pair{"Hertz", 1.0}, std::pair{"Hertz + 5 %", 1.05}})
     plot.series.push_back(Series{label, {first, last}, {level, level}, "#888888", false});
   write_svg(options.out / "hertz.svg", plot);
@@ -195,6 +250,9 @@ LabCommand add_hertz_command(CLI::App& lab) {
   command->add_option("--divisions", options->divisions, "Cells per side of the quarter block, one mesh each")
       ->capture_default_str()
       ->check(CLI::Range(2, 60));
+  command->add_option("--mesh", options->meshes,
+                      "Quarter-block mesh files (millimetres, R = 10 mm: scenes/hertz/quarter_block.geo meshed by gmsh; the build writes two into build/scenes/hertz/) instead of boxes, one each")
+      ->check(CLI::ExistingFile);
   command->add_option("--depths", options->depth_ratios, "Depths d/R")->capture_default_str()->check(CLI::Range(1e-4, 0.5));
   command->add_option("--core", options->block.core,
                       "Side of the uniformly meshed core under the sphere, in sphere radii (half the cells)")

@@ -10,7 +10,10 @@
 // `core` R at the corner (it holds every node a sphere at d/R <= 0.1 passes), and the
 // other half grow geometrically from there to the block's far sides. The growth ratio r
 // solves the fill; as n grows, r^(n/2) tends to a constant, so every mesh of the study
-// refines the same map of the block.
+// refines the same map of the block. A tensor-product grading spends most of its nodes on
+// fine columns far from the contact; the alternative is a quarter block meshed by gmsh
+// with a size field around the contact point (scenes/hertz/, deploy/remesh-hertz.sh),
+// read from its file.
 //
 // At each depth the sphere model's force is the full sparse solve of its unilateral
 // problem (sphere_contact_reference.h); beside it the paper's node translation model's
@@ -34,12 +37,16 @@ struct HertzBlock {
   LinearElasticMaterial material{1.0e5, 0.3, ElementFormulation::linear_tet};
   int divisions = 16;    ///< cells along each side of the quarter block (>= 2)
   double core = 0.5;     ///< side of the uniformly meshed core under the sphere, in R (0 < core < 10)
+  /// If set, the quarter block's mesh instead of the box: a .msh of [0, s]^2 x [-s, 0] with
+  /// s >= 20 R, in millimetres, the contact point at the origin (scenes/hertz/quarter_block.geo).
+  std::filesystem::path mesh;
 };
 
 /// The growth ratio of the cells outside the core along a side of `block`'s quarter.
 double hertz_cell_growth(const HertzBlock& block);
 
 /// The block as scene text (units mm; its sphere tool `A` of radius R, contact model sphere).
+/// Throws Error if `block.mesh` does not span the quarter block of `block.radius`.
 std::string hertz_block_yaml(const HertzBlock& block);
 
 /// Hertz's force [N] for a rigid sphere of radius `radius` [m] at depth `depth` [m] in a
@@ -48,8 +55,12 @@ double hertz_force(const LinearElasticMaterial& material, double radius, double 
 
 /// One mesh of the study: forces on the whole block (four quarters) at each depth.
 struct HertzMesh {
-  int divisions = 0, nodes = 0, tets = 0;
-  double smallest_cell = 0;                ///< under the sphere (the core's cells), over R
+  std::string name;                        ///< "16 cells" or the mesh file's name
+  double side = 0;                         ///< the quarter block's side, over R (20 for box meshes)
+  int nodes = 0, tets = 0;
+  /// Under the sphere, over R: the core's cell side for a box mesh; the mean edge of the
+  /// tetrahedra within 0.3 R of the contact point for a mesh file.
+  double contact_cell = 0;
   std::vector<double> sphere_force;        ///< [N] per depth, the sphere model
   std::vector<int> contact_nodes;          ///< per depth: nodes the sphere pushes (in the quarter)
   std::vector<double> translation_force;   ///< [N] per depth, node translation
@@ -62,6 +73,7 @@ HertzMesh measure_hertz(const HertzBlock& block, const std::vector<double>& dept
 struct HertzOptions {
   HertzBlock block;
   std::vector<int> divisions = {8, 12, 16, 24};
+  std::vector<std::filesystem::path> meshes;  ///< if any, these mesh files instead of `divisions`
   std::vector<double> depth_ratios = {0.02, 0.05, 0.1};
   std::filesystem::path out;  ///< empty: the table on stdout only; else also hertz.md, hertz.svg
 };
@@ -73,7 +85,7 @@ std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh
 /// Measures every mesh, prints the table, writes the files. Returns the exit code.
 int run_hertz(const HertzOptions& options);
 
-/// `cohaptic-lab hertz [--poisson-ratio NU] [--element E] [--divisions N...] [--depths D...] [--out DIR]`.
+/// `cohaptic-lab hertz [--poisson-ratio NU] [--element E] [--divisions N... | --mesh FILE...] [--depths D...] [--out DIR]`.
 LabCommand add_hertz_command(CLI::App& lab);
 
 }  // namespace cohaptic
