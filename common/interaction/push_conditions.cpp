@@ -100,7 +100,11 @@ std::vector<PushSample> push_front(const PushedFront& front, BackCondition condi
             condensed_stiffness(behind->columns, behind->body.dofs, sample.forcible.nodes), front.rest_positions);
         stiffness = backed_stiffness(spring_stiffness, backing);
       }
-      const StaticSolution solution = solve_static(stiffness, dofs, {{tool_dof, depth}});
+      // The tool holds its node: pushed along the axis, held across it.
+      std::vector<PrescribedDisplacement> pushed;
+      for (int axis = 0; axis < 3; ++axis)
+        pushed.push_back({3 * front.tool_node + axis, axis == front.push_axis ? depth : 0.0});
+      const StaticSolution solution = solve_static(stiffness, dofs, pushed);
       sample.displacement = solution.displacement;
       sample.force = solution.reaction[tool_dof];
       if (condition != BackCondition::on_behind) break;

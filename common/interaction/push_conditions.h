@@ -10,7 +10,9 @@
 // surface and collide with its polygons at rest (A touches B); B's condensed stiffness
 // mapped onto them (the linear backing, f = -K (u - u*)) is added to A's; a back node that
 // B would pull is released and the push solved again, until none pulls (as
-// interaction_step.h does). The tool is frictionless: only its axis is prescribed.
+// interaction_step.h does). The tool holds the node it pushes (the paper prescribes the
+// pushed node's displacement): the node moves along the push axis and not across it, as a
+// tool that grips the surface drives it in time (tool_coupling.h with enough friction).
 // Units: m, N.
 #pragma once
 

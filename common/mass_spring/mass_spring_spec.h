@@ -1,8 +1,8 @@
-// MassSpringObjectSpec: a scene object of `model: mass_spring` (the thin-objects paper's
-// body), as parsed by common/scene/parse_mass_spring.cpp: the tube's geometry and
-// material, the supporting plane with its friction, the tool's friction, heated regions,
-// the integrator's step, and what a client is sent (sections each side of the contact, IR
-// rate). Units: SI (lengths already scaled by the scene's units).
+// MassSpringObjectSpec: a scene object of `model: mass_spring`, as parsed by
+// common/scene/parse_mass_spring.cpp: either the thin-objects paper's tube (its geometry and
+// material) or the several-objects paper's box lattice (spring_lattice.h); and for both
+// the nodes held still, the supporting plane with its friction, the tool's friction, heated regions, the
+// integrator's step, and what a client is sent (sections each side of the contact, IR rate). Units: SI (lengths already scaled by the scene's units).
 #pragma once
 
 #include <Eigen/Core>
@@ -10,8 +10,10 @@
 #include <vector>
 
 #include "common/mass_spring/mass_spring_network.h"
+#include "common/mass_spring/spring_lattice.h"
 #include "common/mass_spring/thermal_stiffness.h"
 #include "common/mass_spring/tube_network.h"
+#include "common/mesh/node_selector.h"
 
 namespace cohaptic {
 
@@ -23,8 +25,10 @@ struct MassSpringIrSettings {
 };
 
 struct MassSpringObjectSpec {
-  TubeGeometry tube;
-  TubeMaterial material;
+  TubeGeometry tube;        ///< the tube's, unless `lattice` is set
+  TubeMaterial material;    ///< the tube's, unless `lattice` is set
+  std::optional<SpringLatticeSpec> lattice;  ///< set: the body is this lattice, not a tube
+  std::vector<NodeSelector> fixed;  ///< nodes held still (a lattice's support, a vessel's anchored ends)
   double node_damping = 0.007;  ///< beta [N s/m]
   Eigen::Vector3d gravity = Eigen::Vector3d(0, 0, -9.81);
   std::optional<SupportPlane> plane;

@@ -1,6 +1,7 @@
 // MassSpringModel: a mass–spring body compiled from its scene object (`model: mass_spring`),
-// never changed afterwards: the tube's network with its heated springs and parameters, the
-// cross-section of every node (for the IR's sub-network), and the critical time step. One
+// never changed afterwards: the tube's or the lattice's network (its fixed nodes held) with
+// its heated springs and parameters, the cross-section of every node (for the IR's
+// sub-network; a lattice's layers across its longest axis), and the critical time step. One
 // of the body kinds a Model holds (common/model/model.h). Units: SI.
 #pragma once
 

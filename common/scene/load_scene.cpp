@@ -3,6 +3,7 @@
 #include "common/scene/parse_home_spring.h"
 #include "common/scene/parse_interactions.h"
 #include "common/scene/parse_mass_spring.h"
+#include "common/scene/parse_node_selector.h"
 #include "common/scene/parse_separation.h"
 #include "common/util/regular_file.h"
 #include "common/util/yaml_cursor.h"
@@ -29,44 +30,6 @@ using Cursor = YamlCursor;
 double metres_per(const Cursor& units) {
   const std::string u = units.choice({"m", "cm", "mm"});
   return u == "m" ? 1.0 : u == "cm" ? 0.01 : 0.001;
-}
-
-// The caller checks the keys allowed beside the selector (e.g. `axes` for a fixed region).
-NodeSelector parse_selector(const Cursor& c, double scale) {
-  if (!c.is_map()) c.fail("a map with one of surface, box, plane or nodes");
-  NodeSelector s;
-  s.where = c.location();
-  int kinds = 0;
-  if (auto surface = c.find("surface")) {
-    if (!surface->boolean()) surface->fail("true (select the whole surface)");
-    s.kind = NodeSelector::Kind::surface;
-    ++kinds;
-  }
-  if (auto box = c.find("box")) {
-    box->only_keys({"min", "max"});
-    s.kind = NodeSelector::Kind::box;
-    s.box_min = box->at("min").vec3() * scale;
-    s.box_max = box->at("max").vec3() * scale;
-    if ((s.box_max.array() < s.box_min.array()).any()) box->at("max").fail("a corner not below min on any axis");
-    ++kinds;
-  }
-  if (auto plane = c.find("plane")) {
-    plane->only_keys({"point", "normal", "tolerance"});
-    s.kind = NodeSelector::Kind::plane;
-    s.plane_point = plane->at("point").vec3() * scale;
-    s.plane_normal = plane->at("normal").direction("a non-zero normal vector");
-    if (auto tolerance = plane->find("tolerance"))
-      s.tolerance = tolerance->number_in(0, INFINITY, true, false, "a positive length") * scale;
-    ++kinds;
-  }
-  if (auto nodes = c.find("nodes")) {
-    s.kind = NodeSelector::Kind::node_tags;
-    for (const Cursor& item : nodes->items()) s.node_tags.push_back(item.integer());
-    if (s.node_tags.empty()) nodes->fail("a non-empty list of node ids");
-    ++kinds;
-  }
-  if (kinds != 1) c.fail("exactly one of surface, box, plane or nodes");
-  return s;
 }
 
 AxisMask parse_axes(const Cursor& c) {
@@ -147,7 +110,7 @@ ElasticObjectSpec parse_elastic_object(const Cursor& c, double scale, const std:
   for (const Cursor& item : fixed.items()) {
     item.only_keys({"surface", "box", "plane", "nodes", "axes"});
     FixedRegion region;
-    region.nodes = parse_selector(item, scale);
+    region.nodes = parse_node_selector(item, scale);
     if (auto axes = item.find("axes")) region.axes = parse_axes(*axes);
     object.fixed.push_back(region);
   }
@@ -156,7 +119,7 @@ ElasticObjectSpec parse_elastic_object(const Cursor& c, double scale, const std:
   if (auto touchable = c.find("touchable")) {
     for (const Cursor& item : touchable->items()) {
       item.only_keys({"surface", "box", "plane", "nodes"});
-      object.touchable.push_back(parse_selector(item, scale));
+      object.touchable.push_back(parse_node_selector(item, scale));
     }
   } else {
     NodeSelector whole;

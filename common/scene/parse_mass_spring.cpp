@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "common/scene/parse_node_selector.h"
+
 namespace cohaptic {
 namespace {
 
@@ -51,6 +53,31 @@ SupportPlane parse_plane(const YamlCursor& c, double scale) {
   return plane;
 }
 
+// The several-objects paper's object A: `lattice: {box: {min, size, divisions}, spring_stiffness,
+// spring_damping, node_mass}`.
+SpringLatticeSpec parse_lattice(const YamlCursor& c, double scale) {
+  c.only_keys({"box", "spring_stiffness", "spring_damping", "node_mass"});
+  SpringLatticeSpec lattice;
+  const YamlCursor box = c.at("box");
+  box.only_keys({"min", "size", "divisions"});
+  lattice.min_corner = box.at("min").vec3() * scale;
+  const YamlCursor size = box.at("size");
+  lattice.size = size.vec3() * scale;
+  if (!(lattice.size.array() > 0).all()) size.fail("three positive lengths");
+  const YamlCursor divisions = box.at("divisions");
+  if (!divisions.is_sequence() || divisions.items().size() != 3) divisions.fail("a list of 3 integers");
+  const auto parts = divisions.items();
+  for (int i = 0; i < 3; ++i) {
+    const std::int64_t d = parts[static_cast<std::size_t>(i)].integer();
+    if (d < 1 || d > 100) parts[static_cast<std::size_t>(i)].fail("an integer from 1 to 100");
+    lattice.divisions[i] = static_cast<int>(d);
+  }
+  lattice.spring_stiffness = c.at("spring_stiffness").positive("a positive stiffness in N/m");
+  lattice.spring_damping = c.at("spring_damping").number_in(0, INFINITY, false, true, "a damping in N s/m, >= 0");
+  lattice.node_mass = c.at("node_mass").positive("a positive mass in kg");
+  return lattice;
+}
+
 HeatedRegion parse_heated(const YamlCursor& c, double scale) {
   c.only_keys({"box", "temperature_rise", "expansion_coefficient", "coupling"});
   HeatedRegion region;
@@ -73,19 +100,36 @@ HeatedRegion parse_heated(const YamlCursor& c, double scale) {
 }  // namespace
 
 MassSpringObjectSpec parse_mass_spring_object(const YamlCursor& c, double scale) {
-  c.only_keys({"name", "model", "tube", "material", "plane", "tool_friction", "gravity", "time_step", "heated", "ir"});
+  c.only_keys({"name", "model", "tube", "lattice", "material", "fixed", "node_damping", "plane", "tool_friction",
+               "gravity", "time_step", "heated", "ir"});
   MassSpringObjectSpec object;
-  object.tube = parse_tube(c.at("tube"), scale);
+  const auto tube = c.find("tube");
+  const auto lattice = c.find("lattice");
+  if (static_cast<bool>(tube) == static_cast<bool>(lattice)) c.fail("exactly one of tube or lattice");
+  if (lattice) {
+    // A lattice's springs are given directly: no material to derive them from.
+    if (auto material = c.find("material")) material->fail_message("a lattice takes no material (its springs and masses are in lattice:)");
+    object.lattice = parse_lattice(*lattice, scale);
+    object.node_damping = 0;
+    if (auto beta = c.find("node_damping")) object.node_damping = beta->number_in(0, INFINITY, false, true, "beta in N s/m, >= 0");
+  } else {
+    if (auto beta = c.find("node_damping")) beta->fail_message("a tube's node_damping goes in its material");
+    object.tube = parse_tube(*tube, scale);
+    const YamlCursor material = c.at("material");
+    material.only_keys({"youngs_modulus", "density", "spring_damping", "node_damping"});
+    object.material.youngs_modulus = material.at("youngs_modulus").positive("a positive modulus in Pa");
+    object.material.density = material.at("density").positive("a positive density in kg/m^3");
+    if (auto alpha = material.find("spring_damping"))
+      object.material.spring_damping = alpha->number_in(0, INFINITY, false, true, "alpha of Eq. (2) in s, >= 0");
+    if (auto beta = material.find("node_damping"))
+      object.node_damping = beta->number_in(0, INFINITY, false, true, "beta in N s/m, >= 0");
+  }
 
-  const YamlCursor material = c.at("material");
-  material.only_keys({"youngs_modulus", "density", "spring_damping", "node_damping"});
-  object.material.youngs_modulus = material.at("youngs_modulus").positive("a positive modulus in Pa");
-  object.material.density = material.at("density").positive("a positive density in kg/m^3");
-  if (auto alpha = material.find("spring_damping"))
-    object.material.spring_damping = alpha->number_in(0, INFINITY, false, true, "alpha of Eq. (2) in s, >= 0");
-  if (auto beta = material.find("node_damping"))
-    object.node_damping = beta->number_in(0, INFINITY, false, true, "beta in N s/m, >= 0");
-
+  if (auto fixed = c.find("fixed"))
+    for (const YamlCursor& item : fixed->items()) {
+      item.only_keys({"surface", "box", "plane", "nodes"});  // a held node is held on every axis
+      object.fixed.push_back(parse_node_selector(item, scale));
+    }
   if (auto plane = c.find("plane")) object.plane = parse_plane(*plane, scale);
   if (auto mu = c.find("tool_friction")) object.tool_friction = mu->number_in(0, INFINITY, false, true, "a friction coefficient >= 0");
   if (auto gravity = c.find("gravity")) object.gravity = gravity->vec3();  // m/s^2 whatever the length unit

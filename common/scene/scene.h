@@ -18,6 +18,7 @@
 #include "common/fem/linear_elastic_material.h"
 #include "common/laparoscopy/home_spring_spec.h"
 #include "common/mass_spring/mass_spring_spec.h"
+#include "common/mesh/node_selector.h"
 #include "common/separation/separation_object_spec.h"
 
 namespace cohaptic {
@@ -42,18 +43,6 @@ struct BoxMeshSpec {
 struct MeshSpec {
   std::filesystem::path file;
   std::optional<BoxMeshSpec> box;
-};
-
-/// Selects nodes of an object: on its whole surface, inside a box, on a plane, or by tag.
-struct NodeSelector {
-  enum class Kind { surface, box, plane, node_tags };
-  Kind kind = Kind::surface;
-  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();  ///< [m]
-  Eigen::Vector3d plane_point = Eigen::Vector3d::Zero();  ///< [m]
-  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();  ///< unit
-  std::optional<double> tolerance;   ///< [m]; default: 1e-6 of the mesh's bounding-box diagonal
-  std::vector<std::int64_t> node_tags;
-  std::string where;                 ///< "file:line: key.path" it came from, for messages
 };
 
 struct FixedRegion {

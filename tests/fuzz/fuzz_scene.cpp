@@ -46,6 +46,14 @@ void require_valid(const ElasticObjectSpec& object) {
 }
 
 void require_valid(const MassSpringObjectSpec& object) {
+  for (const NodeSelector& selector : object.fixed)
+    if (selector.kind == NodeSelector::Kind::plane) require_unit(selector.plane_normal);
+  if (object.lattice) {
+    require((object.lattice->size.array() > 0).all() && object.lattice->size.allFinite(), "a lattice has a size");
+    require((object.lattice->divisions.array() >= 1).all(), "a lattice has divisions");
+    require(object.lattice->spring_stiffness > 0 && object.lattice->node_mass > 0, "a lattice has springs and masses");
+    return;
+  }
   require(object.tube.centre_line.size() >= 2, "a tube has a centre line");
   for (const Eigen::Vector3d& point : object.tube.centre_line) require(point.allFinite(), "the centre line is finite");
   require(std::isfinite(object.tube.radius) && object.tube.radius > 0, "a tube has a radius");
