@@ -100,7 +100,7 @@ void MassSpringSimulation::publish_ir(int user, double time, StepReport& report)
     body.remote_radii.push_back(remote.radius);
     body.presses.push_back(presses_[static_cast<std::size_t>(other)]);
   }
-  if (!backing_.empty()) body.backing = sub_network_backing(backing_, body.node_ids);
+  if (!backing_.empty()) body.backing = sub_network_backing(backing_, state_.backing.pushes, body.node_ids);
   report.ir_bytes += body.size_bytes();
   ir.body = std::move(body);
   auto prepared = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));

@@ -62,7 +62,10 @@ class MassSpringSimulation {
   const NetworkToolReaction& reaction(int user) const { return reactions_[static_cast<std::size_t>(user)]; }
   /// The body behind this one pressing back on its colliding nodes from the next step on
   /// (SceneSimulation's interactions; an empty backing: nothing behind it).
-  void set_backing(NodeBacking backing) { backing_ = std::move(backing); }
+  void set_backing(NodeBacking backing) {
+    backing_ = std::move(backing);
+    prepare_backing_solve(state_.backing, backing_);
+  }
   const NodeBacking& backing() const { return backing_; }
   /// Distance from `point` to the nearest surface node in the current state [m].
   double distance_to_surface(const Eigen::Vector3d& point) const;
