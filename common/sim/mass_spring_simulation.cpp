@@ -6,6 +6,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "common/ir/build_mass_spring_ir.h"
 #include "common/mass_spring/surface_collision.h"
@@ -62,6 +63,13 @@ StepReport MassSpringSimulation::step(double time) {
     advance_with_tools(body_.network, state_, tools_, presses_, reactions_, period_,
                        backing_.empty() ? nullptr : &backing_);
     pending_ -= period_;
+  }
+  if (state_.backing.failures > reported_backing_failures_) {
+    // Never silently wrong: a failed solve held the last pushes (node_backing.h).
+    spdlog::warn("mass-spring object '{}': the contact solve of the body behind it failed in {} of {} substeps so far "
+                 "(each held its previous pushes)",
+                 body_.name, state_.backing.failures, state_.backing.evaluations);
+    reported_backing_failures_ = state_.backing.failures;
   }
 
   StepReport report;

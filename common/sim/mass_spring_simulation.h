@@ -19,6 +19,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -98,6 +99,7 @@ class MassSpringSimulation {
   std::vector<ToolPress> presses_;              // per user: the whole network's contact memory
   std::vector<NetworkToolReaction> reactions_;  // per user, of the latest step
   NodeBacking backing_;                         // the body behind this one, if any
+  std::uint64_t reported_backing_failures_ = 0;  // of state_.backing.failures, logged so far
   bool started_ = false;
   double time_ = 0;                             // of the latest step [s]
 };
