@@ -17,8 +17,8 @@
 // the improved one once per step for all pairs. Both see the same displaced set, so their
 // results are equal; the naive one costs a deformation per pair.
 // Positions: the active body's current ones and the passive body's rest ones (linear).
-// Units: m, N. The step allocates (small per-step lists); the haptic path uses the linear
-// backing (linear_backing.h) instead.
+// Units: m, N. The step allocates (small per-step lists); the haptic path uses a backing
+// (linear_backing.h, node_backing.h) instead.
 #pragma once
 
 #include <Eigen/Core>

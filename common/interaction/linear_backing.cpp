@@ -1,8 +1,5 @@
 #include "common/interaction/linear_backing.h"
 
-#include <algorithm>
-#include <cmath>
-
 namespace cohaptic {
 
 LinearBacking build_linear_backing(std::span<const PolygonCollision> collisions,
@@ -24,26 +21,6 @@ void evaluate_linear_backing(const LinearBacking& backing, const Eigen::Ref<cons
                              Eigen::Ref<Eigen::VectorXd> force) noexcept {
   force.noalias() = backing.stiffness * backing.contact_displacement;
   force.noalias() -= backing.stiffness * displacement;
-}
-
-NodeBacking node_backing(const LinearBacking& backing, std::span<const PolygonCollision> collisions,
-                         const Eigen::Ref<const Eigen::VectorXd>& masses, double damping_ratio) {
-  const auto count = static_cast<Eigen::Index>(backing.nodes.size());
-  NodeBacking nodes{backing.nodes, Eigen::VectorXd(count), Eigen::VectorXd(count), Eigen::VectorXd(3 * count),
-                    Eigen::VectorXd(3 * count)};
-  for (Eigen::Index i = 0; i < count; ++i) {
-    const PolygonCollision& collision = collisions[static_cast<std::size_t>(i)];
-    nodes.targets.segment<3>(3 * i) = collision.target;
-    nodes.normals.segment<3>(3 * i) = collision.normal;
-    double row = 0;
-    for (Eigen::Index j = 0; j < count; ++j)
-      row += collision.normal.dot(backing.stiffness.block<3, 3>(3 * i, 3 * j) *
-                                  collisions[static_cast<std::size_t>(j)].normal);
-    const double own = collision.normal.dot(backing.stiffness.block<3, 3>(3 * i, 3 * i) * collision.normal);
-    nodes.stiffness[i] = std::max(row > 0 ? row : own, 0.0);
-    nodes.damping[i] = 2 * damping_ratio * std::sqrt(nodes.stiffness[i] * masses[collision.active]);
-  }
-  return nodes;
 }
 
 }  // namespace cohaptic

@@ -19,7 +19,6 @@
 
 #include "common/fem/compliance.h"
 #include "common/interaction/forcible_displacement.h"
-#include "common/mass_spring/node_backing.h"
 
 namespace cohaptic {
 
@@ -40,18 +39,5 @@ LinearBacking build_linear_backing(std::span<const PolygonCollision> collisions,
 /// 3|nodes|.
 void evaluate_linear_backing(const LinearBacking& backing, const Eigen::Ref<const Eigen::VectorXd>& displacement,
                              Eigen::Ref<Eigen::VectorXd> force) noexcept;
-
-/// The same backing as one contact spring-damper per node (node_backing.h), lumped: node i
-/// of the backing gets k_i = sum_j n_i^T K_ij n_j, K's normal stiffness summed over its row,
-/// which is B's exact reaction when every backed node sinks along its normal by the same
-/// depth (the mode a resting weight or a broad push excites: sum_i k_i is B's stiffness under
-/// the whole contact), and a dashpot c_i = 2 damping_ratio sqrt(k_i m_i) (m_i the node's
-/// mass, from `masses` per front-body node). x* = T and n from `collisions` (those K was built
-/// from, in the same order). A row whose sum is not positive (a node that B's coupling would
-/// lift) keeps its own normal stiffness n_i^T K_ii n_i. Why not K itself: a dense K clipped
-/// node by node ("a contact cannot pull") is the gradient of no energy, and its coupling
-/// terms from released nodes pumped energy into the front body (see node_backing.h).
-NodeBacking node_backing(const LinearBacking& backing, std::span<const PolygonCollision> collisions,
-                         const Eigen::Ref<const Eigen::VectorXd>& masses, double damping_ratio);
 
 }  // namespace cohaptic

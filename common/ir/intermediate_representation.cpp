@@ -40,7 +40,7 @@ std::size_t MassSpringIr::size_bytes() const {
   const std::size_t tools = remote_users.size() * (sizeof(std::int32_t) + sizeof(double)) +
                             presses.size() * (1 + 3 * sizeof(double));
   const std::size_t backed = backing.nodes.size();
-  const std::size_t backing_bytes = backed * (sizeof(std::int32_t) + 9 * sizeof(double)) + 9 * backed * backed * sizeof(double);
+  const std::size_t backing_bytes = backed * (sizeof(std::int32_t) + 8 * sizeof(double)) + backed * backed * sizeof(double);
   return kParameters + nodes + springs_bytes + triangles.size() * 3 * sizeof(std::int32_t) + tools + backing_bytes;
 }
 

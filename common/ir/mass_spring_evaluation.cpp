@@ -51,6 +51,7 @@ MassSpringPatchState make_mass_spring_state(const MassSpringIr& ir, const Prepar
   MassSpringPatchState state;
   state.network = make_state(prepared.network);
   state.network.velocities = ir.velocities;
+  prepare_backing_solve(state.network.backing, ir.backing);
   for (std::size_t i = 0; i < ir.presses.size(); ++i) state.presses[i] = ir.presses[i];
   return state;
 }

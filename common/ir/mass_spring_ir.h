@@ -11,8 +11,9 @@
 // tool's contact memory (own first, then the remote tools in remote_users' order), so that
 // the client continues exactly where the server's whole-network step left off.
 // A body behind this one (a scene interaction) comes as the backing on the sub-network's
-// nodes that press it (node_backing.h; the backed nodes outside it folded into its offset),
-// so the client feels the behind body through this one.
+// nodes that press it (node_backing.h: B's normal compliance over them; the server's pushes
+// on backed nodes outside the sub-network are held, as the rim is, and enter as the
+// offsets), so the client feels the behind body through this one.
 // Units: m, m/s, kg, N/m, N s/m, s.
 #pragma once
 

@@ -19,7 +19,7 @@ void step_network(const MassSpringNetwork& network, MassSpringState& state, std:
                   std::span<Eigen::Vector3d> applied, double h, const NodeBacking* backing) noexcept {
   const MassSpringParameters& p = network.parameters;
   internal_forces(network, state.positions, state.velocities, state.forces);
-  if (backing) add_node_backing_forces(*backing, state.positions, state.velocities, state.forces);
+  if (backing) add_node_backing_forces(*backing, state.backing, state.positions, state.velocities, state.forces);
   for (std::size_t i = 0; i < drives.size(); ++i) applied[i].setZero();
   for (int n = 0; n < network.node_count(); ++n) {
     auto x = state.positions.col(n);

@@ -1,7 +1,6 @@
 #include "common/sim/body_interaction.h"
 
-#include "common/interaction/condensed_response.h"
-#include "common/interaction/forcible_displacement.h"
+#include "common/interaction/compliance_backing.h"
 
 namespace cohaptic {
 
@@ -33,17 +32,12 @@ NodeBacking step_body_interaction(BodyInteraction& interaction, const Eigen::Mat
   for (const PolygonCollision& collision : find_polygon_collisions(pairs, bodies)) colliding.push_back(collision.pair);
   add_neighbour_pairs(pairs, colliding, front_positions, interaction.front_surface, behind_body.mesh.nodes,
                       interaction.behind_surface);
-  // The backing holds every node that collided or may collide before the next step, each
-  // engaging on its own gap at every substep (node_backing.h).
+  // The backing holds every node that collided or may collide before the next step; its
+  // contact set is solved at every substep (node_backing.h).
   const std::vector<PolygonCollision> within = find_polygons_within(pairs, bodies, kBackingReach);
   if (within.empty()) return {};
-  const std::vector<AxisMask>& fixed_axes = behind_body.dofs.fixed_axes;
-  const ForcibleDisplacement displacement = forcible_displacement(within, fixed_axes);
   const MassSpringNetwork& network = front_body.network;
-  const LinearBacking backing =
-      build_linear_backing(within, displacement, condensed_stiffness(columns, behind_body.dofs, displacement.nodes),
-                           network.rest_positions);
-  return node_backing(backing, within, network.mass, kBackingDampingRatio);
+  return compliance_backing(within, columns, network.mass, network.parameters.time_step, kBackingDampingRatio);
 }
 
 }  // namespace cohaptic

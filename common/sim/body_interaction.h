@@ -4,9 +4,10 @@
 // current positions, are tested against the behind body's surface at rest (linear body)
 // through the pairs of nearest nodes, kept as interaction_step.h keeps them. The front
 // body feels B through a backing (node_backing.h) over every front node
-// that is behind B's surface or within kBackingReach of it: B's condensed stiffness mapped
-// onto those nodes (linear_backing.h), lumped to one normal contact spring-damper per node,
-// which the front body's integrator evaluates every substep until the next step rebuilds it.
+// that is behind B's surface or within kBackingReach of it: B's normal compliance at those
+// nodes' target points (compliance_backing.h), a unilateral contact coupled across the
+// nodes, which the front body's integrator solves every substep until the next step
+// rebuilds it.
 // Units: m, N. A step allocates (server side, not the haptic path).
 #pragma once
 
@@ -14,9 +15,9 @@
 
 #include "common/fem/compliance.h"
 #include "common/interaction/interaction_step.h"
-#include "common/interaction/linear_backing.h"
 #include "common/interaction/node_pairs.h"
 #include "common/interaction/surface_adjacency.h"
+#include "common/mass_spring/node_backing.h"
 #include "common/model/elastic_body.h"
 #include "common/model/mass_spring_body.h"
 
@@ -26,7 +27,7 @@ namespace cohaptic {
 /// before it reaches B, and between two steps (1 ms) a node moves far less than this (1 m/s
 /// would take 1 mm).
 inline constexpr double kBackingReach = 2e-3;
-/// The backing's dashpots: critically damped contact of each node's mass on its spring.
+/// The backing's dashpots: critically damped contact of each node's mass on its own contact.
 inline constexpr double kBackingDampingRatio = 1.0;
 
 struct BodyInteraction {

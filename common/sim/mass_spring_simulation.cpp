@@ -6,6 +6,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "common/ir/build_mass_spring_ir.h"
 #include "common/mass_spring/surface_collision.h"
@@ -63,6 +64,13 @@ StepReport MassSpringSimulation::step(double time) {
                        backing_.empty() ? nullptr : &backing_);
     pending_ -= period_;
   }
+  if (state_.backing.failures > reported_backing_failures_) {
+    // Never silently wrong: a failed solve held the last pushes (node_backing.h).
+    spdlog::warn("mass-spring object '{}': the contact solve of the body behind it failed in {} of {} substeps so far "
+                 "(each held its previous pushes)",
+                 body_.name, state_.backing.failures, state_.backing.evaluations);
+    reported_backing_failures_ = state_.backing.failures;
+  }
 
   StepReport report;
   const Stopwatch rebuild;
@@ -100,7 +108,7 @@ void MassSpringSimulation::publish_ir(int user, double time, StepReport& report)
     body.remote_radii.push_back(remote.radius);
     body.presses.push_back(presses_[static_cast<std::size_t>(other)]);
   }
-  if (!backing_.empty()) body.backing = sub_network_backing(backing_, body.node_ids);
+  if (!backing_.empty()) body.backing = sub_network_backing(backing_, state_.backing.pushes, body.node_ids);
   report.ir_bytes += body.size_bytes();
   ir.body = std::move(body);
   auto prepared = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -62,7 +63,10 @@ class MassSpringSimulation {
   const NetworkToolReaction& reaction(int user) const { return reactions_[static_cast<std::size_t>(user)]; }
   /// The body behind this one pressing back on its colliding nodes from the next step on
   /// (SceneSimulation's interactions; an empty backing: nothing behind it).
-  void set_backing(NodeBacking backing) { backing_ = std::move(backing); }
+  void set_backing(NodeBacking backing) {
+    backing_ = std::move(backing);
+    prepare_backing_solve(state_.backing, backing_);
+  }
   const NodeBacking& backing() const { return backing_; }
   /// Distance from `point` to the nearest surface node in the current state [m].
   double distance_to_surface(const Eigen::Vector3d& point) const;
@@ -95,6 +99,7 @@ class MassSpringSimulation {
   std::vector<ToolPress> presses_;              // per user: the whole network's contact memory
   std::vector<NetworkToolReaction> reactions_;  // per user, of the latest step
   NodeBacking backing_;                         // the body behind this one, if any
+  std::uint64_t reported_backing_failures_ = 0;  // of state_.backing.failures, logged so far
   bool started_ = false;
   double time_ = 0;                             // of the latest step [s]
 };

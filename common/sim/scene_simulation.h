@@ -11,7 +11,7 @@
 // across a change of body. force() is the P0 force: the same evaluation the client runs.
 // The scene's interactions (a mass-spring body pressing on a linear elastic one behind it,
 // body_interaction.h) run at the start of each step, before the bodies advance: the
-// front body then integrates the behind body's reaction as a linear backing.
+// front body then integrates the behind body's reaction as a backing (node_backing.h).
 // Units: SI; times in s of the simulation's clock.
 #pragma once
 

@@ -193,7 +193,9 @@ void mass_spring_to_wire(const MassSpringIr& ir, MassSpringPatch* out) {
   if (!ir.backing.empty()) {
     NodeBacking* backing = out->mutable_backing();
     for (int node : ir.backing.nodes) backing->add_nodes(static_cast<std::uint32_t>(node));
-    add_values<double>(ir.backing.stiffness.data(), ir.backing.stiffness.size(), backing->mutable_stiffness());
+    const Eigen::MatrixXd& compliance = ir.backing.compliance;  // symmetric: column-major is row-major
+    add_values<double>(compliance.data(), compliance.size(), backing->mutable_compliance());
+    add_values<double>(ir.backing.offsets.data(), ir.backing.offsets.size(), backing->mutable_offsets());
     add_values<double>(ir.backing.damping.data(), ir.backing.damping.size(), backing->mutable_damping());
     add_values<double>(ir.backing.targets.data(), ir.backing.targets.size(), backing->mutable_targets());
     add_values<double>(ir.backing.normals.data(), ir.backing.normals.size(), backing->mutable_normals());
@@ -413,17 +415,21 @@ MassSpringIr mass_spring_from_wire(const MassSpringPatch& w) {
     const NodeBacking& b = w.backing();
     const auto backed = static_cast<std::uint64_t>(b.nodes_size());
     const auto count = static_cast<Eigen::Index>(backed);
-    if (static_cast<std::uint64_t>(b.stiffness_size()) != backed || static_cast<std::uint64_t>(b.damping_size()) != backed ||
+    if (static_cast<std::uint64_t>(b.compliance_size()) != backed * backed ||
+        static_cast<std::uint64_t>(b.offsets_size()) != backed || static_cast<std::uint64_t>(b.damping_size()) != backed ||
         static_cast<std::uint64_t>(b.targets_size()) != 3 * backed || static_cast<std::uint64_t>(b.normals_size()) != 3 * backed)
-      invalid("a backing of {} nodes with {} stiffnesses, {} dampings, {} targets and {} normals (expected {}, {}, {}, {})",
-              backed, b.stiffness_size(), b.damping_size(), b.targets_size(), b.normals_size(), backed, backed,
-              3 * backed, 3 * backed);
+      invalid("a backing of {} nodes with {} compliances, {} offsets, {} dampings, {} targets and {} normals (expected {}, "
+              "{}, {}, {}, {})",
+              backed, b.compliance_size(), b.offsets_size(), b.damping_size(), b.targets_size(), b.normals_size(),
+              backed * backed, backed, backed, 3 * backed, 3 * backed);
     for (std::uint32_t node : b.nodes()) {
       if (node >= nodes) invalid("the backing names node {} of {}", node, nodes);
       ir.backing.nodes.push_back(static_cast<int>(node));
     }
-    ir.backing.stiffness.resize(count);
-    read_values(b.stiffness(), ir.backing.stiffness, "backing.stiffness");
+    ir.backing.compliance.resize(count, count);
+    read_values(b.compliance(), ir.backing.compliance, "backing.compliance");
+    ir.backing.offsets.resize(count);
+    read_values(b.offsets(), ir.backing.offsets, "backing.offsets");
     ir.backing.damping.resize(count);
     read_values(b.damping(), ir.backing.damping, "backing.damping");
     ir.backing.targets.resize(3 * count);
