@@ -4,8 +4,8 @@ namespace cohaptic {
 
 void ToolInputs::join(int slot) {
   std::lock_guard lock(mutex_);
-  tools_[static_cast<std::size_t>(slot)] = ToolInput{};
-  tools_[static_cast<std::size_t>(slot)].joined = true;
+  ToolInput& tool = tools_[static_cast<std::size_t>(slot)];
+  tool = ToolInput{.joined = true, .joins = tool.joins + 1};
 }
 
 void ToolInputs::release(int slot) {

@@ -26,6 +26,7 @@
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
+#include "common/ir/client_condensation.h"
 #include "common/ir/evaluate_force.h"
 #include "proto/record/recording.h"
 #include "proto/wire/datagram_codec.h"
@@ -72,11 +73,16 @@ std::vector<Tick> read_ticks(const fs::path& file) {
   return ticks;
 }
 
-// The IRs of a client's recording, by epoch.
+// The IRs of a client's recording, by epoch; those sent as compliance rows completed in
+// arrival order, as the client did.
 std::map<std::uint64_t, std::unique_ptr<PreparedIR>> read_irs(const fs::path& file) {
   std::map<std::uint64_t, std::unique_ptr<PreparedIR>> irs;
-  for (const record::RecordedIr& recorded : record::read_recording(file).irs)
-    irs[recorded.ir().epoch()] = std::make_unique<PreparedIR>(prepare_ir(wire::from_wire(recorded.ir())));
+  ClientCondensation condensation;
+  for (const record::RecordedIr& recorded : record::read_recording(file).irs) {
+    IntermediateRepresentation ir = wire::from_wire(recorded.ir());
+    condensation.complete(condensed_fem(ir));
+    irs[recorded.ir().epoch()] = std::make_unique<PreparedIR>(prepare_ir(std::move(ir)));
+  }
   return irs;
 }
 

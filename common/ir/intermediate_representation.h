@@ -96,8 +96,10 @@ struct CondensedFemIr {
 using IrBody = std::variant<CondensedFemIr, MassSpringIr, HomeSpringPatch, SeparationIr>;
 
 struct IntermediateRepresentation {
-  /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone).
-  static constexpr std::uint32_t kFormatVersion = 2;
+  /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone);
+  /// 3: a condensed FEM body may come as compliance rows instead of M~ (still reads 2).
+  static constexpr std::uint32_t kFormatVersion = 3;
+  static constexpr std::uint32_t kOldestReadableVersion = 2;
 
   std::uint64_t epoch = 0;         ///< increases with every IR built for this user
   double simulation_time = 0;      ///< [s] of the state it was built from

@@ -497,9 +497,12 @@ cohaptic::HomeSpringPatch home_spring_from_wire(const HomeSpringPatch& w) {
 }  // namespace
 
 CommonIr from_wire(const WireIr& w) {
-  if (w.format_version() != CommonIr::kFormatVersion)
-    invalid("format version {}, expected {}{}", w.format_version(), CommonIr::kFormatVersion,
+  if (w.format_version() < CommonIr::kOldestReadableVersion || w.format_version() > CommonIr::kFormatVersion)
+    invalid("format version {}, expected {} to {}{}", w.format_version(), CommonIr::kOldestReadableVersion,
+            CommonIr::kFormatVersion,
             w.format_version() == 1 ? " (version 1 is read by cohaptic builds before the body framework)" : "");
+  if (w.format_version() < 3 && w.has_fem() && w.fem().rows_generation() > 0)
+    invalid("format version {} cannot carry compliance rows (version 3 can)", w.format_version());
   CommonIr ir;
   ir.epoch = w.epoch();
   if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());
