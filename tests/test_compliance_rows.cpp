@@ -19,6 +19,7 @@
 #include "common/ir/evaluate_force.h"
 #include "proto/wire/ir_convert.h"
 #include "support/cube_scene.h"
+#include "support/ir_seed.h"
 #include "support/measures.h"
 
 namespace cohaptic {
@@ -238,6 +239,16 @@ TEST(ComplianceRows, TheWireRefusesRowsThatDoNotMatchTheirCount) {
   wire::IntermediateRepresentation no_generation = w;
   no_generation.mutable_fem()->set_rows_generation(0);
   EXPECT_THROW(wire::from_wire(no_generation), Error);
+}
+
+// The fuzzer's seed of an IR sent as compliance rows (the first of a recorded connection)
+// completes and reaches the evaluation, so the fuzzer's mutations of it do too.
+TEST(ComplianceRows, TheFuzzSeedCompletesAndPrepares) {
+  const PreparedIR prepared = testing::prepared_ir_seed("rows_first");
+  const CondensedFemIr& fem = condensed_fem(prepared.ir);
+  EXPECT_FALSE(fem.compliance_rows);
+  EXPECT_GT(fem.m_tilde.rows(), 0);
+  EXPECT_EQ(fem.m_tilde.cols(), static_cast<Eigen::Index>(ir_dofs(fem, 0, fem.node_count()).size()));
 }
 
 }  // namespace
