@@ -63,7 +63,8 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
   take_tools(now_ns);
   const StepReport report = simulation_.step(seconds_since_start(now_ns));
   Outbox outbox;
-  const std::uint64_t irs = report.rebuilt ? add_irs(now_ns, outbox) : 0;
+  std::uint64_t ir_bytes = 0;
+  const std::uint64_t irs = report.rebuilt ? add_irs(now_ns, outbox, ir_bytes) : 0;
   if (options_.protocol == ServeProtocol::p1 && now_ns - last_keep_alive_ns_ >= kKeepAlivePeriod_ns) {
     last_keep_alive_ns_ = now_ns;
     add_keep_alives(outbox);
@@ -78,7 +79,7 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
   }
   ++steps_;
   const std::int64_t end_ns = wire::monotonic_now_ns();
-  statistics_.record_step({end_ns - now_ns, report, irs, forces.size()}, seconds_since_start(end_ns));
+  statistics_.record_step({end_ns - now_ns, report, irs, ir_bytes, forces.size()}, seconds_since_start(end_ns));
   return outbox;
 }
 
@@ -106,7 +107,7 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
 }
 
 // The new IRs: sent to their users (P1), and recorded (either protocol).
-std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox) {
+std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox, std::uint64_t& bytes) {
   const bool send = options_.protocol == ServeProtocol::p1;
   if (!send && !recorder_) return 0;
   std::uint64_t sent = 0;
@@ -120,6 +121,7 @@ std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox) {
     const bool rows = to_compliance_rows(ir, user);
     wire::Control control;
     *control.mutable_ir() = wire::to_wire(ir);
+    bytes += control.ir().ByteSizeLong();
     outbox.irs.push_back({user, std::move(control), rows});
     ++sent;
   }

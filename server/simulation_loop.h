@@ -80,7 +80,8 @@ class SimulationLoop {
 
  private:
   void take_tools(std::int64_t now_ns);
-  std::uint64_t add_irs(std::int64_t now_ns, Outbox& outbox);
+  /// Returns the IRs put in the outbox and adds their bytes (as they travel) to `bytes`.
+  std::uint64_t add_irs(std::int64_t now_ns, Outbox& outbox, std::uint64_t& bytes);
   /// `ir` as compliance rows for `user`, if it is a condensed FEM body sent that way.
   bool to_compliance_rows(IntermediateRepresentation& ir, int user);
   void add_keep_alives(Outbox& outbox);

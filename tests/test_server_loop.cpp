@@ -183,15 +183,17 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
     ASSERT_EQ(outboxes.front().irs.size(), 1u);
     EXPECT_EQ(outboxes.front().irs[0].slot, 0);
     EXPECT_TRUE(outboxes.front().irs[0].message.has_ir());
-    std::size_t keep_alives = 0, irs = 0;
+    std::size_t keep_alives = 0, irs = 0, ir_bytes = 0;
     for (const Outbox& outbox : outboxes) {
       irs += outbox.irs.size();
+      for (const auto& ir : outbox.irs) ir_bytes += ir.message.ir().ByteSizeLong();
       for (const auto& datagram : outbox.datagrams) {
         EXPECT_EQ(datagram.slot, 0);
         keep_alives += datagram.message.has_keep_alive();
       }
     }
     EXPECT_EQ(irs, rig.statistics.summary().irs_sent);
+    EXPECT_EQ(ir_bytes, rig.statistics.summary().ir_bytes_sent) << "the bytes as they travel";
     EXPECT_GE(keep_alives, 2u);
   }
 }
