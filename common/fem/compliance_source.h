@@ -1,7 +1,7 @@
 // ComplianceSource: where a condensation reads blocks of the compliance L = K_ff^-1 from.
 // The server reads them from its sparse factor (ComplianceColumns, compliance.h); a haptic
 // client reads them from the rows the server sent it (HeldCompliance,
-// common/ir/compliance_rows.h), so that both condense with the same code (common/condense).
+// common/ir/client_condensation.h), so that both condense with the same code (common/condense).
 // Dofs are global (3 * node + axis) and free; L in m/N, symmetric.
 #pragma once
 

@@ -1,8 +1,9 @@
 // ComplianceRowsSender: the server's record of what one client holds under compliance
 // rows (compliance_rows.h), and the rows to send it with each IR. One per user and
 // connection; the IRs it converts must reach that client in order and none dropped (the
-// server sends them as must-arrive frames on the user's TCP connection), else the client
-// refuses the next one and the server starts afresh (restart()).
+// server sends them as must-arrive frames on the user's TCP connection; a client that
+// still missed one refuses every later one). restart() when a new user takes the slot, or
+// the user's IR moves to another body: the next IR is generation 1, every row.
 #pragma once
 
 #include <cstdint>
@@ -23,7 +24,7 @@ class ComplianceRowsSender {
   /// Throws Error for an IR without the whole boundary set (B truncation: the client
   /// could not form M_CC) or whose sizes do not match.
   void convert(CondensedFemIr& ir, std::span<const int> mesh_nodes, ComplianceSource& columns, const DofMap& dofs);
-  /// The client holds nothing (a new connection, or it refused an IR): the next IR starts
+  /// The client holds nothing (a new user of the slot, another body): the next IR starts
   /// generation 1 with every row.
   void restart();
   std::uint64_t generation() const { return generation_; }
