@@ -2,14 +2,23 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+
 #include "common/util/error.h"
+#include "common/util/stopwatch.h"
 #include "proto/wire/ir_convert.h"
 
 namespace cohaptic {
 
 bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::size_t bytes, std::int64_t arrival_ns) {
   try {
-    auto prepared = std::make_unique<const PreparedIR>(prepare_ir(wire::from_wire(message)));
+    IntermediateRepresentation ir = wire::from_wire(message);
+    if (auto* fem = std::get_if<CondensedFemIr>(&ir.body); fem && fem->compliance_rows) {
+      const double start_us = thread_cpu_us();
+      condensation_.complete(*fem);
+      condense_us_.record(std::llround(thread_cpu_us() - start_us));
+    }
+    auto prepared = std::make_unique<const PreparedIR>(prepare_ir(std::move(ir)));
     to_haptic_.back() = make_ir_slot(std::move(prepared), arrival_ns);
     to_haptic_.publish();
   } catch (const Error& e) {
@@ -27,6 +36,9 @@ bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::siz
 nlohmann::json IrIntake::report() const {
   const double span_s = static_cast<double>(last_ns_ - first_ns_) * 1e-9;
   return {{"received", received_},
+          {"condensed", condense_us_.count()},
+          {"condense_cpu_us_p50", condense_us_.quantile(0.5)},
+          {"condense_cpu_us_max", condense_us_.max()},
           {"rejected", rejected_},
           {"bytes", bytes_},
           {"bytes_per_s", span_s > 0 ? static_cast<double>(bytes_) / span_s : 0.0}};

@@ -1,5 +1,6 @@
 // IrIntake: the IRs the server sends, on the client's I/O thread. Each is converted from
-// the wire, checked and prepared (prepare_ir: the factorisations the haptic loop needs,
+// the wire, completed if it came as compliance rows (its M~ condensed here from the rows
+// held, ClientCondensation), checked and prepared (prepare_ir: the factorisations the haptic loop needs,
 // done here so the haptic thread never does them) with its fresh evaluation state, then handed to the haptic thread
 // through its TripleBuffer with the time it arrived. An IR that fails its checks is
 // counted and logged, and never reaches the haptic thread.
@@ -11,6 +12,8 @@
 
 #include "cohaptic/messages.pb.h"
 #include "client/haptic_loop.h"
+#include "common/ir/client_condensation.h"
+#include "common/util/histogram.h"
 #include "common/util/triple_buffer.h"
 
 namespace cohaptic {
@@ -22,11 +25,15 @@ class IrIntake {
   /// Prepares and hands over `message` (`bytes` on the wire). False if it was rejected.
   bool receive(const wire::IntermediateRepresentation& message, std::size_t bytes, std::int64_t arrival_ns);
 
-  /// The report's "ir": received, rejected, bytes, bytes_per_s (from the first IR to the last).
+  /// The report's "ir": received, rejected, bytes, bytes_per_s (from the first IR to the
+  /// last), and of those sent as compliance rows: condensed, condense_cpu_us_p50 and _max
+  /// (the I/O thread's CPU for M~ per IR).
   nlohmann::json report() const;
 
  private:
   TripleBuffer<IrSlot>& to_haptic_;
+  ClientCondensation condensation_;
+  Histogram condense_us_{5, 20000};  // CPU of completing each IR sent as compliance rows [µs], to 100 ms
   std::uint64_t received_ = 0, rejected_ = 0, bytes_ = 0;
   std::int64_t first_ns_ = 0, last_ns_ = 0;
 };

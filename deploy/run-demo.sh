@@ -20,7 +20,8 @@
 #
 # Environment: BUILD_DIR (default build), DEMO_PORT (default 7431), DEMO_DURATION (s, default
 # 20), DEMO_PROTOCOL (P1), DEMO_DEVICE (hand or script), DEMO_OUT (out/demo), DEMO_VIEW_PORT
-# (default 7480; "off": no live view), DEMO_VIEW_SCREENSHOT (a PNG file: a headless Chromium
+# (default 7480; "off": no live view), DEMO_IR_FORM (rows or m_tilde, the server's --ir-form;
+# default rows), DEMO_VIEW_SCREENSHOT (a PNG file: a headless Chromium
 # watches the whole session and takes this screenshot once both surgeons press with 0.2 N;
 # the README's picture is taken so).
 set -euo pipefail
@@ -40,6 +41,7 @@ device=${DEMO_DEVICE:-hand}
 out=${DEMO_OUT:-out/demo}
 view_port=${DEMO_VIEW_PORT:-$default_view_port}
 screenshot=${DEMO_VIEW_SCREENSHOT:-}
+ir_form=${DEMO_IR_FORM:-rows}
 server_bin=$build/server/cohaptic-server
 client_bin=$build/client/cohaptic-client
 lab_bin=$build/lab/cohaptic-lab
@@ -53,7 +55,7 @@ trap cleanup EXIT
 view=()
 [[ "$view_port" == off ]] || view=(--view "127.0.0.1:$view_port")
 # The server outlives the clients by a few seconds so that both can say goodbye.
-"$server_bin" --scene "$scene" --listen "127.0.0.1:$port" --protocol "$protocol" \
+"$server_bin" --scene "$scene" --listen "127.0.0.1:$port" --protocol "$protocol" --ir-form "$ir_form" \
   --duration $((duration + 6)) --report "$out/server.json" --record "$out/server.mcap" "${display[@]}" \
   "${view[@]}" >"$out/server.log" 2>&1 &
 pids+=($!)

@@ -8,14 +8,17 @@
 #include <ctime>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <span>
 #include <unordered_map>
 #include <unordered_set>
 
 #include "common/condense/naive_condensation.h"
+#include "common/ir/client_condensation.h"
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
+#include "common/util/stopwatch.h"
 #include "proto/record/recording.h"
 #include "proto/wire/ir_convert.h"
 
@@ -45,17 +48,27 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
   IrBytesRow row;
   row.recording = recording.string();
   if (!frames.empty()) std::filesystem::create_directories(frames);
-  const wire::IntermediateRepresentation* previous = nullptr;
+  std::optional<wire::IntermediateRepresentation> previous;
   std::int64_t first_ns = 0, last_ns = 0;
-  std::vector<double> client_us;
+  std::vector<double> client_us, completed_us;
+  ClientCondensation client;
   for (const record::RecordedIr& recorded : rec.irs) {
-    const wire::IntermediateRepresentation& ir = recorded.ir();
-    if (!ir.has_fem()) continue;
+    if (!recorded.ir().has_fem()) continue;
+    // An IR that came as compliance rows is completed as the client did: the options are
+    // measured against its whole-M~ form, "sent" is what came.
+    wire::IntermediateRepresentation ir = recorded.ir();
+    const std::string bytes = ir.SerializeAsString();
+    if (ir.fem().rows_generation() > 0) {
+      IntermediateRepresentation completed = wire::from_wire(ir);
+      const double start_us = thread_cpu_us();
+      client.complete(condensed_fem(completed));
+      completed_us.push_back(thread_cpu_us() - start_us);
+      ir = wire::to_wire(completed);
+    }
     const wire::CondensedFem& fem = ir.fem();
     if (row.irs == 0) first_ns = recorded.time_ns();
     last_ns = recorded.time_ns();
 
-    const std::string bytes = ir.SerializeAsString();
     if (!frames.empty()) {
       std::ofstream out(frames / fmt::format("frame_{:06d}.bin", row.irs), std::ios::binary);
       out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
@@ -73,7 +86,7 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
     without_m.mutable_fem()->clear_m_tilde_f32();
     const auto rest = static_cast<double>(without_m.ByteSizeLong());
     const double value_bytes = fem.m_tilde_f32_size() > 0 ? 4 : 8;
-    const double m_bytes = static_cast<double>(bytes.size()) - rest;
+    const double m_bytes = static_cast<double>(ir.ByteSizeLong()) - rest;
     row.without_m_bytes += rest;
 
     const auto nodes = static_cast<double>(fem.node_ids_size());
@@ -108,13 +121,10 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
     // receives them).
     columns.compute_columns(mesh_nodes);
     const auto contact = static_cast<std::size_t>(sent.row_node_count);
-    timespec start{}, stop{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &start);
+    const double start_us = thread_cpu_us();
     const CondensedOperator op = naive_condensation(columns, body.dofs, std::span(mesh_nodes).first(contact),
                                                     std::span(mesh_nodes).subspan(contact));
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &stop);
-    client_us.push_back(static_cast<double>(stop.tv_sec - start.tv_sec) * 1e6 +
-                        static_cast<double>(stop.tv_nsec - start.tv_nsec) * 1e-3);
+    client_us.push_back(thread_cpu_us() - start_us);
     Eigen::MatrixXd condensed(op.m_cc.rows(), op.m_cc.cols() + op.m_cb.cols());
     condensed << op.m_cc, op.m_cb;
     if (condensed.rows() != sent.m_tilde.rows() || condensed.cols() != sent.m_tilde.cols())
@@ -125,7 +135,7 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
     row.rows_m_tilde_difference = std::max(row.rows_m_tilde_difference, (condensed - sent.m_tilde).cwiseAbs().maxCoeff() /
                                                                              sent.m_tilde.cwiseAbs().maxCoeff());
 
-    previous = &ir;
+    previous = std::move(ir);
     ++row.irs;
   }
   if (row.irs == 0) throw Error(fmt::format("ir-bytes: {} holds no condensed FEM IR", recording.string()));
@@ -135,6 +145,12 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
   std::sort(client_us.begin(), client_us.end());
   row.rows_client_us_p50 = client_us[client_us.size() / 2];
   row.rows_client_us_max = client_us.back();
+  if (!completed_us.empty()) {
+    row.sent_rows_first_us = completed_us.front();
+    std::sort(completed_us.begin(), completed_us.end());
+    row.sent_rows_us_p50 = completed_us[completed_us.size() / 2];
+    row.sent_rows_us_max = completed_us.back();
+  }
   return row;
 }
 
@@ -159,18 +175,22 @@ LabCommand add_ir_bytes_command(CLI::App& lab) {
             const ElasticBody& body = single_elastic_body(model);
             ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
             fmt::print("| recording | IRs | span s | nodes per IR | new nodes per IR | sent kB/s | without M~ kB/s | f32 kB/s | "
-                       "M~ delta kB/s | compliance rows kB/s | rows: client CPU µs p50 / max | rows: M~ difference |\n"
-                       "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                       "M~ delta kB/s | compliance rows kB/s | rows: client CPU µs p50 / max | rows: M~ difference | "
+                       "as sent: client CPU µs p50 / max / first |\n"
+                       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
             for (std::size_t i = 0; i < options->recordings.size(); ++i) {
               const std::filesystem::path frames =
                   options->frames.empty() ? options->frames : options->frames / fmt::format("{}", i);
               const IrBytesRow r = measure_ir_bytes(options->recordings[i], body, columns, frames);
               const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;
               fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.0f} / {:.0f} | "
-                         "{:.1e} |\n",
+                         "{:.1e} | {} |\n",
                          r.recording, r.irs, r.span_s, r.nodes_mean, r.new_nodes_mean, r.sent_bytes * per_s,
                          r.without_m_bytes * per_s, r.f32_bytes * per_s, r.delta_bytes * per_s, r.rows_bytes * per_s,
-                         r.rows_client_us_p50, r.rows_client_us_max, r.rows_m_tilde_difference);
+                         r.rows_client_us_p50, r.rows_client_us_max, r.rows_m_tilde_difference,
+                         r.sent_rows_us_max > 0 ? fmt::format("{:.0f} / {:.0f} / {:.0f}", r.sent_rows_us_p50,
+                                                              r.sent_rows_us_max, r.sent_rows_first_us)
+                                                : std::string("M~ sent whole"));
             }
             return 0;
           }};

@@ -2,7 +2,9 @@
 // and what three ways of sending less would have cost, on the IRs a client recorded
 // (cohaptic-client --record). Per recording, over its IRs in arrival order:
 //   - sent: the wire IRs as received (bytes and kB/s over the span from first to last IR),
-//     and of that everything but M~ (geometry, node ids, u_B);
+//     and of the whole-M~ form everything but M~ (geometry, node ids, u_B). An IR that came
+//     as compliance rows (the server's default since issue 14) is first completed as the
+//     client did (ClientCondensation); every option below is measured on that whole form;
 //   - f32: the same IRs with M~ and u_B rounded to float;
 //   - M~ delta: each IR with only the entries of M~ that differ from the previous IR's
 //     (value + index, 12 bytes each) when the local nodes are the same, else the whole M~;
@@ -13,7 +15,9 @@
 //     dense Cholesky, M~ = its inverse's C rows): timed (µs of the thread's CPU per IR, an
 //     upper bound for an incremental client) and compared with the M~ the server sent
 //     (largest entry difference relative to the largest entry: 0 up to rounding if this way
-//     of sending gives the same forces).
+//     of sending gives the same forces);
+//   - as sent: for IRs that came as compliance rows, the CPU of completing them as the
+//     client does (ClientCondensation, incremental): p50, max and the first IR's.
 // `--frames DIR` also writes every IR as sent, one file each (frame_NNNNNN.bin), to measure a
 // general-purpose compressor on them (e.g. zstd). Units: bytes, kB = 1000 bytes, s, µs.
 #pragma once
@@ -38,6 +42,9 @@ struct IrBytesRow {
   double without_m_bytes = 0;  ///< everything but M~: what no way of sending M~ can save
   double rows_client_us_p50 = 0, rows_client_us_max = 0;  ///< condensing L_AA per IR
   double rows_m_tilde_difference = 0;  ///< largest over the IRs, relative to each IR's largest |M~| entry
+  /// IRs that came as compliance rows: the client's own completion (ClientCondensation,
+  /// incremental), µs of CPU per IR; 0 when M~ came whole.
+  double sent_rows_us_p50 = 0, sent_rows_us_max = 0, sent_rows_first_us = 0;
 };
 
 /// Measures one recording (throws Error naming it if it holds no condensed FEM IR, or one

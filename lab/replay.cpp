@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 
+#include "common/ir/client_condensation.h"
 #include "common/model/model.h"
 #include "common/model/scene_compliance.h"
 #include "common/net/host_port.h"
@@ -48,10 +49,16 @@ VerifyResult verify_client(const Recording& rec) {
   const std::int64_t start = rec.config.start_time_ns();
   const bool p1 = rec.config.protocol() != wire::P0;
   // IRs by epoch, in arrival order (epochs restart when the server does).
+  // IRs sent as compliance rows are completed in arrival order, as the client did (it
+  // records only those it took, so the held rows follow the same sequence).
   std::multimap<std::uint64_t, std::pair<std::int64_t, std::shared_ptr<const PreparedIR>>> irs;
-  for (const record::RecordedIr& recorded : rec.irs)
-    irs.emplace(recorded.ir().epoch(), std::make_pair(recorded.time_ns(), std::make_shared<const PreparedIR>(
-                                                                              prepare_ir(wire::from_wire(recorded.ir())))));
+  ClientCondensation condensation;
+  for (const record::RecordedIr& recorded : rec.irs) {
+    IntermediateRepresentation ir = wire::from_wire(recorded.ir());
+    if (auto* fem = std::get_if<CondensedFemIr>(&ir.body)) condensation.complete(*fem);
+    irs.emplace(recorded.ir().epoch(),
+                std::make_pair(recorded.time_ns(), std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)))));
+  }
   std::vector<std::tuple<std::int64_t, std::uint64_t, Eigen::Vector3d>> forces;  // P0: arrival, epoch, force
   for (const record::ReceivedDatagram& d : rec.datagrams)
     if (d.datagram().has_force())
@@ -287,10 +294,13 @@ VerifyResult verify_recording(const std::filesystem::path& file) {
   if (!rec.has_config) throw Error(fmt::format("{}: the recording has no configuration: it cannot be verified", file.string()));
   // Re-running needs this build's IR format; a recording of another is refused, never misread.
   for (const record::RecordedIr& recorded : rec.irs)
-    if (recorded.ir().format_version() != IntermediateRepresentation::kFormatVersion)
-      throw Error(fmt::format("{}: its IRs are in format version {}, and this build re-runs format version {}: verify it "
-                              "with the cohaptic build that recorded it (format 1: builds before scenes had several bodies)",
-                              file.string(), recorded.ir().format_version(), IntermediateRepresentation::kFormatVersion));
+    if (recorded.ir().format_version() < IntermediateRepresentation::kOldestReadableVersion ||
+        recorded.ir().format_version() > IntermediateRepresentation::kFormatVersion)
+      throw Error(fmt::format("{}: its IRs are in format version {}, and this build re-runs format version {} (and {}): "
+                              "verify it with the cohaptic build that recorded it (format 1: builds before scenes had "
+                              "several bodies; 2: before compliance rows)",
+                              file.string(), recorded.ir().format_version(), IntermediateRepresentation::kFormatVersion,
+                              IntermediateRepresentation::kOldestReadableVersion));
   return rec.config.role() == "server" ? verify_server(rec) : verify_client(rec);
 }
 

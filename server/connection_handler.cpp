@@ -373,7 +373,8 @@ void ConnectionHandler::close_all(const std::string& why) {
 
 void ConnectionHandler::send(Outbox outbox) {
   for (ToSlot<wire::Control>& ir : outbox.irs)
-    if (const ParticipantPtr& participant = slots_[static_cast<std::size_t>(ir.slot)]) send_control(participant, ir.message, true);
+    if (const ParticipantPtr& participant = slots_[static_cast<std::size_t>(ir.slot)])
+      send_control(participant, ir.message, !ir.must_arrive);
   for (ToSlot<wire::Datagram>& datagram : outbox.datagrams)
     if (const ParticipantPtr& participant = slots_[static_cast<std::size_t>(datagram.slot)]) send_datagram(*participant, datagram.message);
 }

@@ -14,6 +14,7 @@ void LoopStatistics::record_step(const StepFigures& step, double elapsed_s) {
   }
   ++totals_.steps;
   totals_.irs_sent += step.irs_sent;
+  totals_.ir_bytes_sent += step.ir_bytes_sent;
   totals_.forces_sent += step.forces_sent;
   totals_.max_boundary_nodes = std::max(totals_.max_boundary_nodes, step.report.boundary_nodes);
   totals_.max_obstacle_nodes = std::max(totals_.max_obstacle_nodes, step.report.obstacle_nodes);

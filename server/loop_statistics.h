@@ -19,12 +19,13 @@ struct StepFigures {
   std::int64_t duration_ns = 0;
   StepReport report;
   std::uint64_t irs_sent = 0;     ///< IRs put in the outbox
+  std::uint64_t ir_bytes_sent = 0;  ///< their bytes as they travel (compliance rows or M~ whole)
   std::uint64_t forces_sent = 0;  ///< P0 forces put in the outbox
 };
 
 /// The figures so far.
 struct LoopSummary {
-  std::uint64_t steps = 0, rebuilds = 0, ir_bytes = 0, irs_sent = 0, forces_sent = 0;
+  std::uint64_t steps = 0, rebuilds = 0, ir_bytes = 0, irs_sent = 0, ir_bytes_sent = 0, forces_sent = 0;
   double step_p50_ms = 0, step_p99_ms = 0, step_max_ms = 0;
   double ir_build_p50_ms = 0, ir_build_p99_ms = 0;
   std::uint64_t ir_builds = 0;  ///< steps that computed M~

@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
 
   // Serving.
   cohaptic::ServeOptions serve;
-  std::string listen = "127.0.0.1:7400", protocol = "P1", condensation = "incremental", serve_precision = "f64";
+  std::string listen = "127.0.0.1:7400", protocol = "P1", condensation = "incremental", serve_precision = "f64", ir_form = "rows";
   std::string serve_cache_dir = cohaptic::default_cache_directory().string();
   bool serve_no_disk_cache = false;
   app.add_option("--scene", serve.scene, "Scene file (YAML) to serve")->check(CLI::ExistingFile);
@@ -59,6 +59,11 @@ int main(int argc, char** argv) {
                  "incremental (M~ updated when a set changes) or naive (M~ computed from scratch every step, as the "
                  "paper's conventional loop; a new IR is still sent only when a set changes)")
       ->check(CLI::IsMember({"incremental", "naive"}))
+      ->capture_default_str();
+  app.add_option("--ir-form", ir_form,
+                 "How condensed FEM IRs travel: rows (the compliance rows of the nodes a client does not hold yet; it "
+                 "condenses them itself) or m_tilde (M~ whole)")
+      ->check(CLI::IsMember({"rows", "m_tilde"}))
       ->capture_default_str();
   app.add_option("--ir-precision", serve_precision, "Storage of M~ and u_B in the IRs sent: f64 or f32")
       ->check(CLI::IsMember({"f64", "f32"}))
@@ -124,6 +129,7 @@ int main(int argc, char** argv) {
     }
     serve.protocol = protocol == "P0" ? cohaptic::ServeProtocol::p0 : cohaptic::ServeProtocol::p1;
     serve.naive_condensation = condensation == "naive";
+    serve.compliance_rows = ir_form == "rows";
     serve.precision = serve_precision == "f32" ? cohaptic::IrPrecision::f32 : cohaptic::IrPrecision::f64;
     if (!serve_no_disk_cache) serve.cache_directory = serve_cache_dir;
     serve.options_text = app.config_to_str(true, false);

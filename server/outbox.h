@@ -14,10 +14,13 @@ template <class Message>
 struct ToSlot {
   int slot = 0;
   Message message;
+  /// An IR sent as compliance rows: the next one builds on it, so it is never dropped
+  /// for a newer one (newest-wins applies to whole IRs only).
+  bool must_arrive = false;
 };
 
 struct Outbox {
-  std::vector<ToSlot<wire::Control>> irs;         ///< P1: new IRs, over TCP (newest wins)
+  std::vector<ToSlot<wire::Control>> irs;         ///< P1: new IRs, over TCP (newest wins unless must_arrive)
   std::vector<ToSlot<wire::Datagram>> datagrams;  ///< P1: IR keep-alives; P0: forces (UDP)
 
   bool empty() const { return irs.empty() && datagrams.empty(); }

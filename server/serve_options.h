@@ -25,6 +25,9 @@ struct ServeOptions {
   double sim_rate_hz = 0;               ///< cap of the simulation loop; 0: up to 1 kHz
   bool naive_condensation = false;      ///< rebuild M~ from scratch every step (the paper's loop)
   IrPrecision precision = IrPrecision::f64;
+  /// Condensed FEM IRs as compliance rows (common/ir/compliance_rows.h; the client condenses),
+  /// unless the scene truncates B; false: M~ whole, as before.
+  bool compliance_rows = true;
   double duration_s = 0;                ///< 0: until SIGINT/SIGTERM
   std::filesystem::path report;         ///< JSON report at exit; empty: none
   double client_timeout_s = 0.5;        ///< no tool sample for this long: the tool is released

@@ -19,7 +19,8 @@ nlohmann::json server_report(const ServerFigures& figures) {
   server["step_ms"] = {{"p50", loop.step_p50_ms}, {"p99", loop.step_p99_ms}, {"max", loop.step_max_ms}};
   server["ir_build_ms"] = {{"p50", loop.ir_build_p50_ms}, {"p99", loop.ir_build_p99_ms}, {"count", loop.ir_builds}};
   server["irs_sent"] = loop.irs_sent;
-  server["ir_bytes_sent"] = loop.ir_bytes;
+  server["ir_bytes_sent"] = loop.ir_bytes_sent;
+  server["ir_bytes_built"] = loop.ir_bytes;
   server["boundary_nodes"] = {{"max", loop.max_boundary_nodes}, {"obstacle_max", loop.max_obstacle_nodes}};
   server["forces_sent"] = loop.forces_sent;
   server["max_surface_displacement_mm"] = loop.max_surface_displacement_m * 1e3;

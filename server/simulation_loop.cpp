@@ -38,7 +38,18 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       columns_(columns.begin(), columns.end()),
       start_ns_(start_ns),
       simulation_(model, columns, model.scene.tools, simulation_options(model, options)),
-      view_forces_(static_cast<std::size_t>(simulation_.user_count()), Eigen::Vector3d::Zero()) {
+      view_forces_(static_cast<std::size_t>(simulation_.user_count()), Eigen::Vector3d::Zero()),
+      model_(model),
+      // B truncation leaves held nodes out of the IR: a client could not condense without them.
+      compliance_rows_(options.compliance_rows && ir_build_options(model.scene.haptic).boundary_truncation == 0),
+      rows_senders_(static_cast<std::size_t>(simulation_.user_count())),
+      rows_objects_(static_cast<std::size_t>(simulation_.user_count()), -1),
+      joins_seen_(static_cast<std::size_t>(simulation_.user_count()), 0),
+      node_of_tag_(model.bodies.size()) {
+  for (std::size_t i = 0; i < model.bodies.size(); ++i)
+    if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i]))
+      for (std::size_t node = 0; node < body->mesh.node_tags.size(); ++node)
+        node_of_tag_[i].emplace(body->mesh.node_tags[node], static_cast<int>(node));
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
     if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i]); body && columns[i])
       prefetch_.push_back({columns[i], static_cast<int>(i), std::make_unique<CompliancePrefetch>(*body, columns[i]->row_nodes())});
@@ -52,7 +63,8 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
   take_tools(now_ns);
   const StepReport report = simulation_.step(seconds_since_start(now_ns));
   Outbox outbox;
-  const std::uint64_t irs = report.rebuilt ? add_irs(now_ns, outbox) : 0;
+  std::uint64_t ir_bytes = 0;
+  const std::uint64_t irs = report.rebuilt ? add_irs(now_ns, outbox, ir_bytes) : 0;
   if (options_.protocol == ServeProtocol::p1 && now_ns - last_keep_alive_ns_ >= kKeepAlivePeriod_ns) {
     last_keep_alive_ns_ = now_ns;
     add_keep_alives(outbox);
@@ -67,7 +79,7 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
   }
   ++steps_;
   const std::int64_t end_ns = wire::monotonic_now_ns();
-  statistics_.record_step({end_ns - now_ns, report, irs, forces.size()}, seconds_since_start(end_ns));
+  statistics_.record_step({end_ns - now_ns, report, irs, ir_bytes, forces.size()}, seconds_since_start(end_ns));
   return outbox;
 }
 
@@ -78,6 +90,10 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
   const auto timeout = static_cast<std::int64_t>(options_.client_timeout_s * 1e9);
   for (std::size_t slot = 0; slot < latest_.size(); ++slot) {
     const ToolInput& tool = latest_[slot];
+    if (slot < joins_seen_.size() && tool.joins != joins_seen_[slot]) {  // a new user holds no rows
+      joins_seen_[slot] = tool.joins;
+      rows_senders_[slot].restart();
+    }
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
     if (used_[slot]) {
       simulation_.set_tool(static_cast<int>(slot), tool.position, tool.buttons);
@@ -91,21 +107,43 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
 }
 
 // The new IRs: sent to their users (P1), and recorded (either protocol).
-std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox) {
+std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox, std::uint64_t& bytes) {
   const bool send = options_.protocol == ServeProtocol::p1;
   if (!send && !recorder_) return 0;
   std::uint64_t sent = 0;
   for (int user = 0; user < simulation_.user_count(); ++user) {
     const auto prepared = simulation_.ir(user);
     if (!prepared || !simulation_.ir_changed(user)) continue;
-    wire::Control control;
-    *control.mutable_ir() = wire::to_wire(prepared->ir);
-    if (recorder_) recorder_->ir(now_ns, control.ir());
+    // The recording keeps the IR whole (M~ as built), whatever form it travels in.
+    if (recorder_) recorder_->ir(now_ns, wire::to_wire(prepared->ir));
     if (!send) continue;
-    outbox.irs.push_back({user, std::move(control)});
+    IntermediateRepresentation ir = prepared->ir;
+    const bool rows = to_compliance_rows(ir, user);
+    wire::Control control;
+    *control.mutable_ir() = wire::to_wire(ir);
+    bytes += control.ir().ByteSizeLong();
+    outbox.irs.push_back({user, std::move(control), rows});
     ++sent;
   }
   return sent;
+}
+
+bool SimulationLoop::to_compliance_rows(IntermediateRepresentation& ir, int user) {
+  auto* fem = std::get_if<CondensedFemIr>(&ir.body);
+  const auto object = static_cast<std::size_t>(ir.object);
+  if (!compliance_rows_ || !fem || object >= columns_.size() || !columns_[object]) return false;
+  const auto& body = std::get<ElasticBody>(model_.bodies[object]);
+  ComplianceRowsSender& sender = rows_senders_[static_cast<std::size_t>(user)];
+  // Node tags are per body: the user's IR moving to another body starts the client afresh.
+  if (rows_objects_[static_cast<std::size_t>(user)] != ir.object) {
+    rows_objects_[static_cast<std::size_t>(user)] = ir.object;
+    sender.restart();
+  }
+  std::vector<int> mesh_nodes;
+  mesh_nodes.reserve(fem->node_ids.size());
+  for (const std::int64_t tag : fem->node_ids) mesh_nodes.push_back(node_of_tag_[object].at(tag));
+  sender.convert(*fem, mesh_nodes, *columns_[object], body.dofs);
+  return true;
 }
 
 void SimulationLoop::add_keep_alives(Outbox& outbox) {

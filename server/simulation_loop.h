@@ -33,9 +33,11 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "common/fem/compliance.h"
+#include "common/ir/compliance_rows_sender.h"
 #include "common/model/model.h"
 #include "common/sim/scene_simulation.h"
 #include "proto/record/session_recorder.h"
@@ -78,7 +80,10 @@ class SimulationLoop {
 
  private:
   void take_tools(std::int64_t now_ns);
-  std::uint64_t add_irs(std::int64_t now_ns, Outbox& outbox);
+  /// Returns the IRs put in the outbox and adds their bytes (as they travel) to `bytes`.
+  std::uint64_t add_irs(std::int64_t now_ns, Outbox& outbox, std::uint64_t& bytes);
+  /// `ir` as compliance rows for `user`, if it is a condensed FEM body sent that way.
+  bool to_compliance_rows(IntermediateRepresentation& ir, int user);
   void add_keep_alives(Outbox& outbox);
   std::vector<record::ServerForce> add_forces(Outbox& outbox);
   bool solve_display_frame(std::int64_t now_ns);
@@ -113,6 +118,14 @@ class SimulationLoop {
   std::uint64_t steps_ = 0;                      // successful steps so far
   std::vector<view::ToolState> view_tools_;      // this step's tools, for the view
   std::vector<Eigen::Vector3d> view_forces_;     // per user, for the view [N]
+  // Compliance rows: what each user's client holds (restarted when a new user takes the
+  // slot), and per body the mesh node of each node tag.
+  const Model& model_;
+  bool compliance_rows_;
+  std::vector<ComplianceRowsSender> rows_senders_;
+  std::vector<int> rows_objects_;  // per user: the body its held rows are of
+  std::vector<std::uint64_t> joins_seen_;
+  std::vector<std::unordered_map<std::int64_t, int>> node_of_tag_;
 };
 
 }  // namespace cohaptic

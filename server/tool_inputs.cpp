@@ -4,13 +4,14 @@ namespace cohaptic {
 
 void ToolInputs::join(int slot) {
   std::lock_guard lock(mutex_);
-  tools_[static_cast<std::size_t>(slot)] = ToolInput{};
-  tools_[static_cast<std::size_t>(slot)].joined = true;
+  ToolInput& tool = tools_[static_cast<std::size_t>(slot)];
+  tool = ToolInput{.joined = true, .joins = tool.joins + 1};
 }
 
 void ToolInputs::release(int slot) {
   std::lock_guard lock(mutex_);
-  tools_[static_cast<std::size_t>(slot)] = ToolInput{};
+  ToolInput& tool = tools_[static_cast<std::size_t>(slot)];
+  tool = ToolInput{.joins = tool.joins};  // still counted: a leave and a join between two steps is a new user
 }
 
 bool ToolInputs::update(int slot, bool valid, const Eigen::Vector3d& position, std::uint32_t buttons, std::int64_t sample_time_ns,

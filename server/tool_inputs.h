@@ -14,6 +14,7 @@ namespace cohaptic {
 
 struct ToolInput {
   bool joined = false;  ///< a user holds the slot
+  std::uint64_t joins = 0;  ///< users that have taken the slot so far (a new one holds nothing of the last's)
   bool valid = false;   ///< the device reported a position
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   std::uint32_t buttons = 0;        ///< the device's buttons (bit i = button i)

@@ -10,7 +10,8 @@
 //     a client ever sends (oversized, before its body is read), each counted;
 //   - limits: the scene's network.max_participants refuses a join beyond it, clearly; a
 //     participant that stops reading its control connection has its IRs dropped (newest
-//     wins) and is disconnected, while the other user's haptic loop keeps its period;
+//     wins, whole M~) or none (compliance rows, which must arrive) and is disconnected,
+//     while the other user's haptic loop keeps its period;
 //   - a flood of 10^6 hostile datagrams of every kind leaves the simulation rate within 5 %
 //     of the rate just before it, measured from the server's recording, and every datagram
 //     the real clients sent is accepted.
@@ -234,8 +235,10 @@ Eigen::Vector3d slide(double t, double depth) {
   return {x, y, -depth};
 }
 
-TEST(Robustness, AUserThatStopsReadingLosesItsOldIrsAndThenItsConnectionNotTheOthersTheirPeriod) {
-  CubeSession session("robust-stalled", {"--duration", "120"});
+// Bob stops reading while IRs keep coming for him; alice goes on. Gives the server's and
+// alice's reports.
+void stall_a_reader(const std::string& name, const std::string& ir_form, nlohmann::json& server, nlohmann::json& a) {
+  CubeSession session(name, {"--duration", "120", "--ir-form", ir_form});
   // Alice presses and holds, a well-behaved user, for as long as the test needs.
   const auto alice = session.client("alice", 0, write_press(session.dir, "a", 3, 2, 3, 100.0));
   ASSERT_TRUE(testing::wait_for_output(*alice, "haptic loop at")) << alice->log_text();
@@ -244,13 +247,20 @@ TEST(Robustness, AUserThatStopsReadingLosesItsOldIrsAndThenItsConnectionNotTheOt
                      wire::ClientKeys(wire::development_key()));
   bob.join();
   bob.press_along([](double t) { return slide(t, 0.002); });
-  ASSERT_TRUE(testing::wait_for_output(*session.server, "the peer stopped reading", 60s));
+  EXPECT_TRUE(testing::wait_for_output(*session.server, "the peer stopped reading", 60s));
   bob.stop();
   alice->signal(SIGINT);
-  ASSERT_EQ(alice->wait(testing::kPatience), 0) << alice->log_text();
+  EXPECT_EQ(alice->wait(testing::kPatience), 0) << alice->log_text();
   session.stop_server();
-  const nlohmann::json server = session.report("server")["server"];
-  const nlohmann::json a = session.report("alice");
+  server = session.report("server")["server"];
+  a = session.report("alice");
+}
+
+// Whole IRs (M~): the newest wins, so the old ones are dropped before the user is.
+TEST(Robustness, AUserThatStopsReadingLosesItsOldIrsAndThenItsConnectionNotTheOthersTheirPeriod) {
+  nlohmann::json server, a;
+  stall_a_reader("robust-stalled", "m_tilde", server, a);
+  if (HasFatalFailure()) return;
   std::printf("  a user that stopped reading: %lu of its IRs dropped unsent (newest wins), then disconnected; alice's "
               "period p99 %.0f us (timer floor %.0f us)\n",
               static_cast<unsigned long>(count(server, {"control_frames", "dropped"})), a["period_us"]["p99"].get<double>(),
@@ -261,6 +271,18 @@ TEST(Robustness, AUserThatStopsReadingLosesItsOldIrsAndThenItsConnectionNotTheOt
   EXPECT_LE(a["period_us"]["p99"].get<double>(), testing::period_p99_allowance_us(a));
   EXPECT_EQ(a["non_finite_ticks"], 0);
   EXPECT_GE(a["coupling_n"]["peak"].get<double>(), 0.0);
+}
+
+// IRs as compliance rows build on each other: none is dropped, the user is disconnected
+// (32 waiting, or one stalled 5 s), and the others keep their period.
+TEST(Robustness, AUserThatStopsReadingComplianceRowsLosesNoIrButItsConnectionNotTheOthersTheirPeriod) {
+  nlohmann::json server, a;
+  stall_a_reader("robust-stalled-rows", "rows", server, a);
+  if (HasFatalFailure()) return;
+  EXPECT_EQ(count(server, {"control_frames", "dropped"}), 0u);
+  EXPECT_EQ(count(server, {"connections", "write_stalls"}) + count(server, {"connections", "queue_overflows"}), 1u);
+  EXPECT_LE(a["period_us"]["p99"].get<double>(), testing::period_p99_allowance_us(a));
+  EXPECT_EQ(a["non_finite_ticks"], 0);
 }
 
 // The kernel's count of UDP datagrams dropped because a socket's receive queue was full

@@ -14,6 +14,8 @@
 //     the cause; it slept to each deadline meanwhile (100 steps take >= 99 periods); it
 //     released the tools; with fewer step nodes the same loop steps on and fills each
 //     step's outbox (P0: one force per step for the known tool; P1: its IRs, keep-alives);
+//   - P1's IRs go as compliance rows (must arrive), generation 1 again for each new user of
+//     a slot, even one that joins between two steps after another left;
 //   - the real server program: a client pressing makes the server end the session on its
 //     own, with a clear message, a goodbye to the client, a report, few log lines and
 //     exit status 1.
@@ -30,6 +32,9 @@
 #include <thread>
 
 #include "common/fem/dof_map.h"
+#include "common/ir/client_condensation.h"
+#include "common/ir/evaluate_force.h"
+#include "proto/wire/ir_convert.h"
 #include "proto/wire/header.h"
 #include "server/simulation_loop.h"
 #include "server/step_failures.h"
@@ -178,17 +183,56 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
     ASSERT_EQ(outboxes.front().irs.size(), 1u);
     EXPECT_EQ(outboxes.front().irs[0].slot, 0);
     EXPECT_TRUE(outboxes.front().irs[0].message.has_ir());
-    std::size_t keep_alives = 0, irs = 0;
+    std::size_t keep_alives = 0, irs = 0, ir_bytes = 0;
     for (const Outbox& outbox : outboxes) {
       irs += outbox.irs.size();
+      for (const auto& ir : outbox.irs) ir_bytes += ir.message.ir().ByteSizeLong();
       for (const auto& datagram : outbox.datagrams) {
         EXPECT_EQ(datagram.slot, 0);
         keep_alives += datagram.message.has_keep_alive();
       }
     }
     EXPECT_EQ(irs, rig.statistics.summary().irs_sent);
+    EXPECT_EQ(ir_bytes, rig.statistics.summary().ir_bytes_sent) << "the bytes as they travel";
     EXPECT_GE(keep_alives, 2u);
   }
+}
+
+// P1 sends a condensed FEM IR as compliance rows, generation 1 first, as a must-arrive
+// frame; a new user of the slot starts at generation 1 again, even when the old one left
+// and the new one joined between two steps. A client completes each.
+TEST(SimulationLoop, SendsComplianceRowsAndStartsEachNewUserOfASlotAfresh) {
+  LoopRig rig(0, ServeProtocol::p1);
+  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
+                      nullptr, nullptr, wire::monotonic_now_ns());
+  const auto first_ir = [&](const Eigen::Vector3d& tool, std::int64_t sample_time) {
+    rig.tools.update(0, true, tool, 0, sample_time, wire::monotonic_now_ns());
+    for (int step = 0; step < 20; ++step) {
+      Outbox outbox = loop.step(wire::monotonic_now_ns());
+      if (!outbox.irs.empty()) return outbox.irs.front();
+    }
+    ADD_FAILURE() << "no IR in 20 steps";
+    return ToSlot<wire::Control>{};
+  };
+  const ToSlot<wire::Control> first = first_ir(Eigen::Vector3d(0.003, 0.002, -0.002), 2);
+  EXPECT_TRUE(first.must_arrive);
+  EXPECT_EQ(first.message.ir().fem().rows_generation(), 1u);
+  const ToSlot<wire::Control> second = first_ir(Eigen::Vector3d(-0.03, 0.02, -0.002), 3);
+  EXPECT_EQ(second.message.ir().fem().rows_generation(), 2u);
+  ClientCondensation client;
+  for (const ToSlot<wire::Control>* sent : {&first, &second}) {
+    IntermediateRepresentation ir = wire::from_wire(sent->message.ir());
+    client.complete(condensed_fem(ir));
+    EXPECT_NO_THROW(prepare_ir(ir));
+  }
+  rig.tools.release(0);
+  rig.tools.join(0);
+  const ToSlot<wire::Control> again = first_ir(Eigen::Vector3d(0.02, -0.02, -0.002), 1);
+  EXPECT_EQ(again.message.ir().fem().rows_generation(), 1u) << "the new user holds nothing";
+  ClientCondensation newcomer;
+  IntermediateRepresentation ir = wire::from_wire(again.message.ir());
+  newcomer.complete(condensed_fem(ir));
+  EXPECT_NO_THROW(prepare_ir(ir));
 }
 
 // ---- the real server program ----

@@ -17,9 +17,8 @@ namespace cohaptic {
 /// Free dofs of `nodes`, node by node, axes in x, y, z order.
 std::vector<int> free_dofs_of_nodes(const DofMap& dofs, std::span<const int> nodes);
 
-/// L[row_dofs, col_dofs]. Every row dof's node must be a row node of `columns`; the
-/// column nodes' blocks are computed on demand.
-Eigen::MatrixXd gather_compliance(ComplianceColumns& columns, std::span<const int> row_dofs,
+/// L[row_dofs, col_dofs], from the server's columns or the rows a client holds.
+Eigen::MatrixXd gather_compliance(ComplianceSource& columns, std::span<const int> row_dofs,
                                   std::span<const int> col_dofs);
 
 /// Nodes of `dofs` (one entry per distinct node, in order of first appearance).

@@ -46,7 +46,7 @@ double symmetric_frobenius_norm(const Eigen::Ref<const Eigen::MatrixXd>& lower) 
 
 }  // namespace
 
-IncrementalCondensation::IncrementalCondensation(ComplianceColumns& columns, const DofMap& dofs, Options options)
+IncrementalCondensation::IncrementalCondensation(ComplianceSource& columns, const DofMap& dofs, Options options)
     : columns_(columns), dofs_(dofs), options_(options) {}
 
 bool IncrementalCondensation::in_boundary(int node) const {
@@ -317,15 +317,23 @@ void IncrementalCondensation::forget_least_recently_used() {
     const auto oldest = std::min_element(cached_.begin(), cached_.end(),
                                          [](const CachedNode& a, const CachedNode& b) { return a.last_used < b.last_used; });
     if (oldest->last_used == clock_) break;
-    const auto slot = static_cast<Eigen::Index>(oldest - cached_.begin());
-    const auto last = static_cast<Eigen::Index>(cached_.size()) - 1;
-    if (slot != last) {
-      z_.block(0, 3 * slot, n_, 3) = z_.block(0, 3 * last, n_, 3);
-      l_bz_.block(0, 3 * slot, n_, 3) = l_bz_.block(0, 3 * last, n_, 3);
-      *oldest = cached_.back();
-    }
-    cached_.pop_back();
+    drop_slot(static_cast<std::size_t>(oldest - cached_.begin()));
   }
+}
+
+void IncrementalCondensation::drop_slot(std::size_t slot) {
+  const std::size_t last = cached_.size() - 1;
+  if (slot != last) {
+    z_.block(0, 3 * static_cast<Eigen::Index>(slot), n_, 3) = z_.block(0, 3 * static_cast<Eigen::Index>(last), n_, 3);
+    l_bz_.block(0, 3 * static_cast<Eigen::Index>(slot), n_, 3) = l_bz_.block(0, 3 * static_cast<Eigen::Index>(last), n_, 3);
+    cached_[slot] = cached_.back();
+  }
+  cached_.pop_back();
+}
+
+void IncrementalCondensation::forget_node(int node) {
+  if (in_boundary(node)) remove_boundary_node(node);
+  if (const int slot = slot_of(node); slot >= 0) drop_slot(static_cast<std::size_t>(slot));
 }
 
 Eigen::MatrixXd IncrementalCondensation::solve_boundary(const Eigen::MatrixXd& rhs) const {

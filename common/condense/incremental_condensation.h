@@ -48,8 +48,8 @@ class IncrementalCondensation {
   };
 
   /// `columns` and `dofs` must outlive this object; B and C nodes must be row nodes of `columns`.
-  IncrementalCondensation(ComplianceColumns& columns, const DofMap& dofs, Options options);
-  IncrementalCondensation(ComplianceColumns& columns, const DofMap& dofs)
+  IncrementalCondensation(ComplianceSource& columns, const DofMap& dofs, Options options);
+  IncrementalCondensation(ComplianceSource& columns, const DofMap& dofs)
       : IncrementalCondensation(columns, dofs, Options{}) {}
 
   const std::vector<int>& boundary_nodes() const { return b_nodes_; }
@@ -61,6 +61,10 @@ class IncrementalCondensation {
   void add_boundary_node(int node);
   /// A node leaves B. Throws Error if it is not in B.
   void remove_boundary_node(int node);
+  /// Forgets `node` (a client drops it when the server stops sending its rows): it leaves B
+  /// if it is in it, and its cached Z column is dropped, so that nothing reads its
+  /// compliance again. Nothing happens for a node it does not know.
+  void forget_node(int node);
   /// Adds and removes nodes so that B equals `nodes` (order of new joins as given). More
   /// than kBulkJoin new nodes are appended at once and factored from scratch.
   void set_boundary_nodes(std::span<const int> nodes);
@@ -95,13 +99,14 @@ class IncrementalCondensation {
                                 const Eigen::MatrixXd& rho_lower);
   void update_cached_z_for_leave(int first, int k);
   void forget_least_recently_used();
+  void drop_slot(std::size_t slot);
   void factor_from_scratch(const char* failure);
   void after_update();
   double check_residuals();
   void compute_z(std::span<const int> nodes);
   Eigen::MatrixXd column_rows_at_boundary(int node);  // L[B dofs, free dofs of node]
 
-  ComplianceColumns& columns_;
+  ComplianceSource& columns_;
   const DofMap& dofs_;
   Options options_;
   std::vector<int> b_nodes_;

@@ -16,7 +16,7 @@ double cholesky_condition_estimate(const Eigen::MatrixXd& factor) {
   return ratio * ratio;
 }
 
-CondensedOperator naive_condensation(ComplianceColumns& columns, const DofMap& dofs, std::span<const int> contact_nodes,
+CondensedOperator naive_condensation(ComplianceSource& columns, const DofMap& dofs, std::span<const int> contact_nodes,
                                      std::span<const int> boundary_nodes) {
   CondensedOperator op;
   op.contact_dofs = free_dofs_of_nodes(dofs, contact_nodes);

@@ -101,4 +101,23 @@ void ComplianceColumns::insert_column(int node, ComplianceColumn column) {
   columns_[node] = std::move(column);
 }
 
+Eigen::MatrixXd ComplianceColumns::dof_block(std::span<const int> row_dofs, std::span<const int> col_dofs) {
+  std::vector<int> row_index(row_dofs.size());
+  for (std::size_t i = 0; i < row_dofs.size(); ++i) {
+    const int position = row_position(row_dofs[i] / 3);
+    if (position < 0)
+      throw Error(fmt::format("compliance rows are not kept for node {} (not touchable or on the surface)", row_dofs[i] / 3));
+    row_index[i] = 3 * position + row_dofs[i] % 3;
+  }
+  // Missing columns are solved on first use, in their fixed groups (see compute_columns).
+  Eigen::MatrixXd block(static_cast<Eigen::Index>(row_dofs.size()), static_cast<Eigen::Index>(col_dofs.size()));
+  for (std::size_t j = 0; j < col_dofs.size(); ++j) {
+    const ComplianceColumn& node_column = column(col_dofs[j] / 3);
+    const int axis = col_dofs[j] % 3;
+    for (std::size_t i = 0; i < row_dofs.size(); ++i)
+      block(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = node_column(row_index[i], axis);
+  }
+  return block;
+}
+
 }  // namespace cohaptic

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/fem/compliance_source.h"
 #include "common/fem/dof_map.h"
 #include "common/fem/sparse_cholesky.h"
 
@@ -20,7 +21,7 @@ namespace cohaptic {
 /// Rows: 3 per row node, in row_nodes order; columns: the node's x, y, z.
 using ComplianceColumn = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 
-class ComplianceColumns {
+class ComplianceColumns : public ComplianceSource {
  public:
   /// Row nodes solved together (see compute_columns): 12 right-hand sides per solve. On the
   /// brain (9k free dofs) a solve costs 6.0 ms of CPU for one node, but 10 ms for 4: 2.5 ms
@@ -43,7 +44,10 @@ class ComplianceColumns {
   const ComplianceColumn& column(int node);
   /// Computes every missing column of `nodes`, in fixed groups of row nodes (so that a
   /// column's bits never depend on what was asked for with it).
-  void compute_columns(const std::vector<int>& nodes);
+  void compute_columns(const std::vector<int>& nodes) override;
+  /// L[row_dofs, col_dofs]. Every row dof's node must be a row node; the column nodes'
+  /// blocks are computed on demand.
+  Eigen::MatrixXd dof_block(std::span<const int> row_dofs, std::span<const int> col_dofs) override;
   /// The 3x3 block L_ij; i must be a row node.
   Eigen::Matrix3d block(int row_node, int column_node);
   /// L_AA (3|A| x 3|A|, symmetrised) for nodes A, all of them row nodes.

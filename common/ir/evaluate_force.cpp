@@ -83,6 +83,8 @@ PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, 
   if (ir.node_count() < rows || rows < ir.patch_node_count || ir.patch.empty() ||
       static_cast<int>(ir.fixed_axes.size()) != ir.node_count() || ir.rest_positions.cols() != rows)
     throw Error("intermediate representation: inconsistent node counts");
+  if (ir.compliance_rows)
+    throw Error("intermediate representation: it carries compliance rows, not M~ (a ClientCondensation completes it first)");
   const std::vector<int> row_dofs = ir_dofs(ir, 0, rows);
   const std::vector<int> boundary_dofs = ir_dofs(ir, rows, ir.node_count());
   const auto x = static_cast<Eigen::Index>(row_dofs.size());

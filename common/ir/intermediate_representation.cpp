@@ -20,7 +20,8 @@ std::size_t CondensedFemIr::size_bytes() const {
                                static_cast<std::size_t>(patch_vertex_normals.size()) * sizeof(double) +
                                guard.size() * 4 * 3 * sizeof(double);
   const std::size_t remote = remotes.size() * (sizeof(std::int32_t) * 4 + (1 + 7 * 3) * sizeof(double));
-  const std::size_t matrix = static_cast<std::size_t>(m_tilde.size() + boundary_displacement.size()) * scalar;
+  const std::size_t matrix = static_cast<std::size_t>(m_tilde.size() + boundary_displacement.size()) * scalar +
+                             (compliance_rows ? 8 + static_cast<std::size_t>(compliance_rows->rows.size()) * sizeof(double) : 0);
   return kHeader + nodes + triangles + remote + matrix;
 }
 

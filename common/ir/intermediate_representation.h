@@ -22,10 +22,12 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <variant>
 #include <vector>
 
 #include "common/fem/dof_map.h"
+#include "common/ir/compliance_rows.h"
 #include "common/ir/mass_spring_ir.h"
 #include "common/ir/separation_ir.h"
 #include "common/laparoscopy/home_spring_patch.h"
@@ -81,6 +83,9 @@ struct CondensedFemIr {
 
   Eigen::MatrixXd m_tilde;                ///< rows: free dofs of C; columns: free dofs of all nodes [N/m]
   Eigen::VectorXd boundary_displacement;  ///< u_B, free dofs of B [m]
+  /// Sent instead of M~ (then empty) to a client that condenses itself (compliance_rows.h);
+  /// the client's ClientCondensation fills M~ from them and clears them.
+  std::optional<ComplianceRows> compliance_rows;
 
   int node_count() const { return static_cast<int>(node_ids.size()); }
   /// Bytes of the content as sent: geometry, M~ and u_B at the stored precision.
@@ -91,8 +96,10 @@ struct CondensedFemIr {
 using IrBody = std::variant<CondensedFemIr, MassSpringIr, HomeSpringPatch, SeparationIr>;
 
 struct IntermediateRepresentation {
-  /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone).
-  static constexpr std::uint32_t kFormatVersion = 2;
+  /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone);
+  /// 3: a condensed FEM body may come as compliance rows instead of M~ (still reads 2).
+  static constexpr std::uint32_t kFormatVersion = 3;
+  static constexpr std::uint32_t kOldestReadableVersion = 2;
 
   std::uint64_t epoch = 0;         ///< increases with every IR built for this user
   double simulation_time = 0;      ///< [s] of the state it was built from

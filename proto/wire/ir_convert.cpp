@@ -143,8 +143,17 @@ void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
     add_triple(remote.vertex_normals, r->mutable_vertex_normals());
     r->set_tool_radius(remote.tool_radius);
   }
-  out->set_m_rows(static_cast<std::uint32_t>(ir.m_tilde.rows()));
-  out->set_m_cols(static_cast<std::uint32_t>(ir.m_tilde.cols()));
+  if (ir.compliance_rows) {
+    const Eigen::MatrixXd& rows = ir.compliance_rows->rows;
+    out->set_m_rows(static_cast<std::uint32_t>(ir_dofs(ir, 0, ir.row_node_count).size()));
+    out->set_m_cols(static_cast<std::uint32_t>(rows.cols()));
+    out->set_rows_generation(ir.compliance_rows->generation);
+    out->set_compliance_row_count(static_cast<std::uint32_t>(rows.rows()));
+    add_values<double>(rows.data(), rows.size(), out->mutable_compliance_rows());
+  } else {
+    out->set_m_rows(static_cast<std::uint32_t>(ir.m_tilde.rows()));
+    out->set_m_cols(static_cast<std::uint32_t>(ir.m_tilde.cols()));
+  }
   if (ir.precision == IrPrecision::f32) {
     add_values<float>(ir.m_tilde.data(), ir.m_tilde.size(), out->mutable_m_tilde_f32());
     add_values<float>(ir.boundary_displacement.data(), ir.boundary_displacement.size(),
@@ -331,13 +340,22 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   if (w.m_rows() != row_dofs) invalid("m_rows {} differs from the {} free dofs of the contact nodes", w.m_rows(), row_dofs);
   if (w.m_cols() != row_dofs + boundary_dofs)
     invalid("m_cols {} differs from the {} free dofs of all nodes", w.m_cols(), row_dofs + boundary_dofs);
-  const std::uint64_t entries = std::uint64_t{w.m_rows()} * w.m_cols();
+  const bool rows_form = w.rows_generation() > 0;
+  const std::uint64_t entries = rows_form ? 0 : std::uint64_t{w.m_rows()} * w.m_cols();
   const auto m_length = static_cast<std::uint64_t>(f32 ? w.m_tilde_f32_size() : w.m_tilde_f64_size());
-  if (m_length != entries) invalid("M~ has {} values, expected m_rows x m_cols = {} x {}", m_length, w.m_rows(), w.m_cols());
+  if (m_length != entries)
+    invalid("M~ has {} values, expected {} (m_rows x m_cols = {} x {}, none with compliance rows)", m_length, entries,
+            w.m_rows(), w.m_cols());
+  const std::uint64_t row_values = std::uint64_t{w.compliance_row_count()} * w.m_cols();
+  if (!rows_form && (w.compliance_row_count() > 0 || w.compliance_rows_size() > 0))
+    invalid("compliance rows without a rows_generation");
+  if (static_cast<std::uint64_t>(w.compliance_rows_size()) != row_values)
+    invalid("compliance_rows has {} values, expected compliance_row_count x m_cols = {} x {}", w.compliance_rows_size(),
+            w.compliance_row_count(), w.m_cols());
   const auto u_length =
       static_cast<std::uint64_t>(f32 ? w.boundary_displacement_f32_size() : w.boundary_displacement_f64_size());
   if (u_length != boundary_dofs) invalid("u_B has {} values, expected {} (free boundary dofs)", u_length, boundary_dofs);
-  ir.m_tilde.resize(static_cast<Eigen::Index>(w.m_rows()), static_cast<Eigen::Index>(w.m_cols()));
+  ir.m_tilde.resize(rows_form ? 0 : static_cast<Eigen::Index>(w.m_rows()), rows_form ? 0 : static_cast<Eigen::Index>(w.m_cols()));
   ir.boundary_displacement.resize(static_cast<Eigen::Index>(boundary_dofs));
   if (f32) {
     read_values(w.m_tilde_f32(), ir.m_tilde, "m_tilde_f32");
@@ -345,6 +363,12 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   } else {
     read_values(w.m_tilde_f64(), ir.m_tilde, "m_tilde_f64");
     read_values(w.boundary_displacement_f64(), ir.boundary_displacement, "boundary_displacement_f64");
+  }
+  if (rows_form) {
+    ComplianceRows rows{w.rows_generation(), Eigen::MatrixXd(static_cast<Eigen::Index>(w.compliance_row_count()),
+                                                             static_cast<Eigen::Index>(w.m_cols()))};
+    read_values(w.compliance_rows(), rows.rows, "compliance_rows");
+    ir.compliance_rows = std::move(rows);
   }
   return ir;
 }
@@ -479,9 +503,12 @@ cohaptic::HomeSpringPatch home_spring_from_wire(const HomeSpringPatch& w) {
 }  // namespace
 
 CommonIr from_wire(const WireIr& w) {
-  if (w.format_version() != CommonIr::kFormatVersion)
-    invalid("format version {}, expected {}{}", w.format_version(), CommonIr::kFormatVersion,
+  if (w.format_version() < CommonIr::kOldestReadableVersion || w.format_version() > CommonIr::kFormatVersion)
+    invalid("format version {}, expected {} to {}{}", w.format_version(), CommonIr::kOldestReadableVersion,
+            CommonIr::kFormatVersion,
             w.format_version() == 1 ? " (version 1 is read by cohaptic builds before the body framework)" : "");
+  if (w.format_version() < 3 && w.has_fem() && w.fem().rows_generation() > 0)
+    invalid("format version {} cannot carry compliance rows (version 3 can)", w.format_version());
   CommonIr ir;
   ir.epoch = w.epoch();
   if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());

@@ -4,8 +4,10 @@
 // lie: sizes, indices, NaN and infinities, asymmetric or indefinite M~, huge values.
 //
 // Input: a serialized wire::IntermediateRepresentation. Properties:
-//   - from_wire() and prepare_ir() either accept or throw cohaptic::Error; an M_CC
-//     accepted is symmetric to 1e-9 of its largest entry;
+//   - from_wire(), a fresh client's completion of an IR sent as compliance rows
+//     (ClientCondensation: rows of generation 1, any other refused) and prepare_ir() either
+//     accept or throw cohaptic::Error; an M_CC accepted is symmetric to 1e-9 of its
+//     largest entry;
 //   - for an IR they accept, evaluate_force() returns a finite force no larger than the IR's
 //     force limit, zero whenever it flags a non-finite value (what the haptic thread writes
 //     to the motor), at probe positions by body kind:
@@ -27,6 +29,7 @@
 #include <variant>
 #include <vector>
 
+#include "common/ir/client_condensation.h"
 #include "common/ir/evaluate_force.h"
 #include "common/util/error.h"
 #include "proto/wire/ir_convert.h"
@@ -130,7 +133,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (!message.ParseFromArray(data, static_cast<int>(size))) return 0;
   PreparedIR prepared;
   try {
-    prepared = prepare_ir(wire::from_wire(message));
+    IntermediateRepresentation ir = wire::from_wire(message);
+    if (auto* fem = std::get_if<CondensedFemIr>(&ir.body)) {
+      ClientCondensation client;
+      client.complete(*fem);
+    }
+    prepared = prepare_ir(std::move(ir));
   } catch (const Error&) {
     return 0;  // refused with a message: what a lying IR should get
   }

@@ -22,6 +22,7 @@
 
 #include "client/device/bridge_protocol.h"
 #include "cohaptic/view.pb.h"
+#include "common/ir/client_condensation.h"
 #include "common/mesh/boundary_surface.h"
 #include "common/mesh/read_gmsh.h"
 #include "common/util/error.h"
@@ -30,6 +31,7 @@
 #include "proto/record/session_recorder.h"
 #include "proto/wire/frame_codec.h"
 #include "proto/wire/header.h"
+#include "proto/wire/ir_convert.h"
 #include "tests/fuzz/fuzz_support.h"
 
 namespace {
@@ -66,11 +68,18 @@ std::map<int, wire::Datagram> one_of_each_kind(const std::vector<const record::R
   return kinds;
 }
 
-// The recorded IRs by size, smallest first.
+// The recorded IRs by size, smallest first, those sent as compliance rows completed as the
+// client did (each stands alone then; rows_seed keeps one as it came).
 std::vector<wire::IntermediateRepresentation> irs_by_size(const std::vector<const record::Recording*>& recordings) {
   std::vector<wire::IntermediateRepresentation> irs;
-  for (const record::Recording* recording : recordings)
-    for (const record::RecordedIr& recorded : recording->irs) irs.push_back(recorded.ir());
+  for (const record::Recording* recording : recordings) {
+    ClientCondensation client;
+    for (const record::RecordedIr& recorded : recording->irs) {
+      IntermediateRepresentation ir = wire::from_wire(recorded.ir());
+      if (auto* fem = std::get_if<CondensedFemIr>(&ir.body)) client.complete(*fem);
+      irs.push_back(wire::to_wire(ir));
+    }
+  }
   std::stable_sort(irs.begin(), irs.end(), [](const auto& a, const auto& b) { return a.ByteSizeLong() < b.ByteSizeLong(); });
   return irs;
 }
@@ -201,6 +210,15 @@ void ir_seeds(const std::vector<wire::IntermediateRepresentation>& irs,
   for (double v : irs.front().fem().m_tilde_f64()) fem.add_m_tilde_f32(static_cast<float>(v));
   for (double v : irs.front().fem().boundary_displacement_f64()) fem.add_boundary_displacement_f32(static_cast<float>(v));
   write_seed(out, "smallest_f32", bytes_of(f32));
+}
+
+// The first IR a client took as compliance rows (generation 1: it stands alone), if any.
+void rows_seed(const record::Recording& client, const fs::path& out) {
+  for (const record::RecordedIr& recorded : client.irs)
+    if (recorded.ir().has_fem() && recorded.ir().fem().rows_generation() == 1) {
+      write_seed(out, "rows_first", bytes_of(recorded.ir()));
+      return;
+    }
 }
 
 // A complete recording of a few messages of each kind, and the same cut short as a killed
@@ -349,6 +367,7 @@ int main(int argc, char** argv) {
   datagram_seeds({&server, &client}, out / "datagram");
   control_seeds(client, irs, *patch, COHAPTIC_SOURCE_DIR, out / "control_frames");
   ir_seeds(irs, *patch, *sphere, out / "ir");
+  rows_seed(client, out / "ir");
   mcap_seeds(server, client, out / "mcap");
   bridge_seeds(client, out / "bridge");
   view_seeds(server, out / "view");

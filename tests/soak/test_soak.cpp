@@ -15,7 +15,8 @@
 // loop output a NaN; every recording (the server's, every client session's) reads and
 // verifies clean (replay --verify); alice's and bob's haptic period p99 within their bare
 // timer floor's allowance; every datagram alice, bob and carol sent accepted, every hostile
-// datagram and connection rejected and counted; dave dropped every time, his old IRs first.
+// datagram and connection rejected and counted; dave dropped every time (his IRs come as
+// compliance rows, which must arrive: none is dropped before he is).
 #include <gtest/gtest.h>
 #include <signal.h>
 
