@@ -13,6 +13,7 @@
 //   client completing it from compliance rows of the supported compliance, through the
 //   wire, gets its M~ and forces (1e-9); rows of A's own L would lose B;
 // - a tool pushing A towards B meets F_free < F_on-B < F_fixed (A's back face fixed).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
@@ -426,6 +427,11 @@ TEST(FemPairCoupling, AToolPushingAOnBFeelsMoreThanFreeAndLessThanFixed) {
     const double on_behind = push.tool_force().x();
     EXPECT_LT(free, on_behind) << depth;
     EXPECT_LT(on_behind, fixed) << depth;
+    // The forces [N] for the closing note (--gtest_output=xml:...).
+    const auto mm = static_cast<int>(std::lround(depth * 1e3));
+    RecordProperty(fmt::format("force_{}mm_free_on_b_fixed", mm), fmt::format("{:.6f} {:.6f} {:.6f}", free, on_behind, fixed));
+    RecordProperty(fmt::format("pushing_nodes_{}mm", mm),
+                   fmt::format("{} of {}", (push.contact.pushes.array() > 0).count(), push.collisions.size()));
   }
 }
 
