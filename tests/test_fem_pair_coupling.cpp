@@ -1,4 +1,4 @@
-// FEM against FEM (fem_pair_coupling.h) on the paired boxes (tests/support/paired_boxes.h:
+// FEM against FEM (fem_pair_coupling.h) on the paired boxes (tests/support/fem_pair_rig.h:
 // front A and behind B both linear elastic), against independent answers:
 // - the pushes and the tool's force equal one sparse solve of A and B together, the
 //   contact constraints as Lagrange multipliers (Eigen's SparseLU on the saddle-point
@@ -16,21 +16,17 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <Eigen/LU>
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
 #include <memory>
-#include <optional>
 #include <unordered_map>
 #include <vector>
 
-#include "common/fem/assemble_stiffness.h"
-#include "common/fem/sparse_cholesky.h"
-#include "common/fem/static_solve.h"
-#include "common/interaction/node_polygon_collision.h"
 #include "common/condense/incremental_condensation.h"
 #include "common/condense/naive_condensation.h"
+#include "common/fem/assemble_stiffness.h"
+#include "common/fem/sparse_cholesky.h"
 #include "common/ir/build_ir.h"
 #include "common/ir/client_condensation.h"
 #include "common/ir/compliance_rows_sender.h"
@@ -38,74 +34,10 @@
 #include "common/sim/fem_pair_coupling.h"
 #include "common/sim/supported_compliance.h"
 #include "proto/wire/ir_convert.h"
-#include "support/paired_boxes.h"
+#include "support/fem_pair_rig.h"
 
 namespace cohaptic {
 namespace {
-
-constexpr double kReach = 2e-3;  // candidates: A's back-face nodes this close to B or behind it [m]
-
-// A pushed by a tool holding the node of its front face nearest the face's centre, moved
-// `depth` along +x (towards B), in B's absence.
-struct FreePush {
-  std::vector<int> tool_dofs;
-  Eigen::VectorXd tool_values;
-  Eigen::VectorXd displacement;  // A's, 3N [m]
-  Eigen::Vector3d tool_force;    // on A by the tool [N]
-};
-
-std::vector<int> node_dofs(int node) { return {3 * node, 3 * node + 1, 3 * node + 2}; }
-
-int front_tool_node(const ElasticBody& front) {
-  const double front_x = front.mesh.nodes.row(0).minCoeff();
-  const Eigen::Vector3d centre = (front.mesh.nodes.rowwise().minCoeff() + front.mesh.nodes.rowwise().maxCoeff()) / 2;
-  int best = -1;
-  for (int node : front.surface.nodes) {
-    const Eigen::Vector3d x = front.mesh.nodes.col(node);
-    if (x.x() > front_x + 1e-9) continue;
-    if (best < 0 || (x - centre).tail<2>().norm() < (front.mesh.nodes.col(best) - centre).tail<2>().norm() - 1e-12) best = node;
-  }
-  return best;
-}
-
-FreePush push_without_behind(const ElasticBody& front, double depth, const std::vector<int>& also_held = {}) {
-  FreePush push;
-  push.tool_dofs = node_dofs(front_tool_node(front));
-  std::vector<int> prescribed = push.tool_dofs;
-  prescribed.insert(prescribed.end(), also_held.begin(), also_held.end());
-  Eigen::VectorXd values = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(prescribed.size()));
-  values[0] = depth;
-  push.tool_values = values.head(3);
-  const StaticSolution solution = ConstrainedStaticSolver(front.stiffness, front.dofs, prescribed).solve(values);
-  push.displacement = solution.displacement;
-  for (int a = 0; a < 3; ++a) push.tool_force[a] = solution.reaction[push.tool_dofs[static_cast<std::size_t>(a)]];
-  return push;
-}
-
-// A's back-face nodes at `displacement` against B's rest surface, within kReach.
-std::vector<PolygonCollision> back_face_candidates(const testing::PairedBoxesRig& rig,
-                                                   const Eigen::VectorXd& displacement) {
-  std::vector<PolygonCollision> collisions;
-  for (int node : rig.front_face) {
-    const Eigen::Vector3d point = rig.front.mesh.nodes.col(node) + displacement.segment<3>(3 * node);
-    int nearest = -1;
-    for (int b : rig.behind.surface.nodes)
-      if (nearest < 0 || (rig.behind.mesh.nodes.col(b) - point).norm() < (rig.behind.mesh.nodes.col(nearest) - point).norm())
-        nearest = b;
-    const std::optional<PolygonTarget> target =
-        detailed_collision_test(point, nearest, rig.behind.mesh.nodes, rig.behind_surface);
-    if (!target || (point - target->point).dot(target->normal) > kReach) continue;
-    PolygonCollision collision;
-    collision.active = node;
-    collision.polygon = rig.behind_surface.triangles[static_cast<std::size_t>(target->triangle)];
-    collision.weights = target->weights;
-    collision.target = target->point;
-    collision.gap = point - target->point;
-    collision.normal = target->normal;
-    collisions.push_back(collision);
-  }
-  return collisions;
-}
 
 // The sparse solve of A and B together: unknowns A's free dofs but the tool's, B's free
 // dofs, and one multiplier (push) per collision of the set; each pushing collision's gap is
@@ -117,7 +49,7 @@ struct JointSolution {
   Eigen::Vector3d tool_force;     // on A by the tool [N]
 };
 
-JointSolution joint_sparse_solve(const testing::PairedBoxesRig& rig, const FreePush& push,
+JointSolution joint_sparse_solve(const testing::PairedBoxesRig& rig, const testing::FreePush& push,
                                  const std::vector<PolygonCollision>& collisions, const std::vector<bool>& in_set) {
   const ElasticBody& a = rig.front;
   const ElasticBody& b = rig.behind;
@@ -198,7 +130,7 @@ JointSolution joint_sparse_solve(const testing::PairedBoxesRig& rig, const FreeP
 
 // The joint solve's own active set: start from the penetrating candidates, drop pulling
 // ones, add penetrating ones, until none is left to move.
-JointSolution joint_contact_solve(const testing::PairedBoxesRig& rig, const FreePush& push,
+JointSolution joint_contact_solve(const testing::PairedBoxesRig& rig, const testing::FreePush& push,
                                   const std::vector<PolygonCollision>& collisions) {
   std::vector<bool> in_set(collisions.size());
   for (std::size_t j = 0; j < collisions.size(); ++j) in_set[j] = collisions[j].gap.dot(collisions[j].normal) < 0;
@@ -218,26 +150,8 @@ JointSolution joint_contact_solve(const testing::PairedBoxesRig& rig, const Free
   return {};
 }
 
-struct CoupledPush {
-  testing::PairedBoxesRig rig;
-  FreePush free;
-  std::vector<PolygonCollision> collisions;
-  std::unique_ptr<ComplianceColumns> front_columns;
-  FemPairContact contact;
-  CoupledPush(double gap_mm, double depth)
-      : rig([gap_mm] {
-          PairedBoxesOptions options;
-          options.gap_mm = gap_mm;
-          return options;
-        }()),
-        free(push_without_behind(rig.front, depth)),
-        collisions(back_face_candidates(rig, free.displacement)),
-        front_columns(std::make_unique<ComplianceColumns>(*rig.front.free_factor, rig.front.dofs, rig.front.surface.nodes)),
-        contact(solve_fem_pair_contact(collisions, *front_columns, free.tool_dofs, *rig.behind_columns)) {}
-  Eigen::Vector3d tool_force() const { return free.tool_force + contact.held_force_change; }
-};
 
-void expect_joint_solve(const CoupledPush& push) {
+void expect_joint_solve(const testing::CoupledPush& push) {
   ASSERT_TRUE(push.contact.solved);
   const JointSolution joint = joint_contact_solve(push.rig, push.free, push.collisions);
   const double push_scale = joint.pushes.cwiseAbs().maxCoeff();
@@ -262,45 +176,23 @@ void expect_joint_solve(const CoupledPush& push) {
 }
 
 TEST(FemPairCoupling, AToolPushingAIntoBGetsTheJointSparseSolvesPushesAndForce) {
-  const CoupledPush push(0.0, 5e-3);
+  const testing::CoupledPush push(0.0, 5e-3);
   expect_joint_solve(push);
   EXPECT_GE((push.contact.pushes.array() > 0).count(), 2);
 }
 
 TEST(FemPairCoupling, ThroughAGapOnlyTheNodesThatReachBPushAsInTheJointSolve) {
-  const CoupledPush push(0.5, 15e-3);
+  const testing::CoupledPush push(0.5, 15e-3);
   expect_joint_solve(push);
   const auto pushing = (push.contact.pushes.array() > 0).count();
   EXPECT_GE(pushing, 1);
   EXPECT_LT(pushing, static_cast<Eigen::Index>(push.collisions.size()));  // some candidates stay clear or are released
 }
 
-// K_ff of `a` plus the springs N support^-1 N^T on `nodes` (normals' columns).
-SparseMatrix stiffness_with_support(const ElasticBody& a, const std::vector<int>& nodes, const Eigen::Matrix3Xd& normals,
-                                    const Eigen::MatrixXd& support) {
-  std::vector<Eigen::Triplet<double>> entries;
-  const SparseMatrix k_ff = restrict_to_dofs(a.stiffness, a.dofs.free_dofs);
-  for (int outer = 0; outer < k_ff.outerSize(); ++outer)
-    for (SparseMatrix::InnerIterator it(k_ff, outer); it; ++it) entries.emplace_back(it.row(), it.col(), it.value());
-  const Eigen::MatrixXd springs = support.inverse();
-  const auto count = static_cast<Eigen::Index>(nodes.size());
-  for (Eigen::Index i = 0; i < count; ++i)
-    for (Eigen::Index j = 0; j < count; ++j)
-      for (int p = 0; p < 3; ++p)
-        for (int q = 0; q < 3; ++q) {
-          const int row = a.dofs.free_index[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(i)] + p)];
-          const int col = a.dofs.free_index[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(j)] + q)];
-          if (row >= 0 && col >= 0) entries.emplace_back(row, col, normals(p, i) * springs(i, j) * normals(q, j));
-        }
-  SparseMatrix with_springs(k_ff.rows(), k_ff.cols());
-  with_springs.setFromTriplets(entries.begin(), entries.end());
-  return with_springs;
-}
-
 // A pushed 5 mm into B (touching at rest), B folded into A's compliance on the pushing set;
 // and, independently, A's compliance from CHOLMOD's factor of K_A with the support springs.
 struct FoldedFront {
-  CoupledPush push{0.0, 5e-3};
+  testing::CoupledPush push{0.0, 5e-3};
   std::vector<int> support_nodes;
   Eigen::Matrix3Xd normals;
   Eigen::MatrixXd support;
@@ -327,7 +219,7 @@ struct FoldedFront {
     }
     const ElasticBody& a = push.rig.front;
     supported = std::make_unique<SupportedCompliance>(*push.front_columns, a.dofs, support_nodes, normals, support);
-    with_springs = stiffness_with_support(a, support_nodes, normals, support);
+    with_springs = testing::stiffness_with_support(a, support_nodes, normals, support);
     factor = std::make_unique<SparseCholesky>(with_springs);
     reference = std::make_unique<ComplianceColumns>(*factor, a.dofs, a.surface.nodes);
   }
@@ -416,13 +308,13 @@ TEST(FemPairCoupling, TheClientFeelsBThroughAExactlyWhenTheRowsAreOfTheSupported
 
 TEST(FemPairCoupling, AToolPushingAOnBFeelsMoreThanFreeAndLessThanFixed) {
   for (double depth : {2e-3, 8e-3, 15e-3}) {
-    const CoupledPush push(0.0, depth);
+    const testing::CoupledPush push(0.0, depth);
     ASSERT_TRUE(push.contact.solved);
     std::vector<int> back_dofs;
     for (int node : push.rig.front_face)
-      for (int dof : node_dofs(node))
+      for (int dof : testing::node_dofs(node))
         if (push.rig.front.dofs.free_index[static_cast<std::size_t>(dof)] >= 0) back_dofs.push_back(dof);
-    const double fixed = push_without_behind(push.rig.front, depth, back_dofs).tool_force.x();
+    const double fixed = testing::push_without_behind(push.rig.front, depth, back_dofs).tool_force.x();
     const double free = push.free.tool_force.x();
     const double on_behind = push.tool_force().x();
     EXPECT_LT(free, on_behind) << depth;
