@@ -11,7 +11,6 @@
 //                                     assembled, factored by CHOLMOD, the columns solved
 #include <benchmark/benchmark.h>
 
-#include <cmath>
 #include <vector>
 
 #include "common/condense/naive_condensation.h"
@@ -22,37 +21,15 @@
 namespace cohaptic {
 namespace {
 
-// The pushing set of a 5 mm push, its normals and B's compliance there, and M~'s nodes.
+// A 5 mm push, its pushing set and M~'s nodes, with every column M~ and the support read
+// cached, as the server's columns would hold them.
 struct FemPairBench {
   testing::CoupledPush push{0.0, 5e-3};
-  std::vector<int> support_nodes;
-  Eigen::Matrix3Xd normals;
-  Eigen::MatrixXd support;
-  std::vector<int> contact;
+  testing::PushingSupport support = testing::pushing_support(push);
+  std::vector<int> contact = testing::tool_neighbourhood(push);
   FemPairBench() {
-    std::vector<Eigen::Index> set;
-    for (Eigen::Index j = 0; j < push.contact.pushes.size(); ++j)
-      if (push.contact.pushes[j] > 0) set.push_back(j);
-    const auto s = static_cast<Eigen::Index>(set.size());
-    normals.resize(3, s);
-    support.resize(s, s);
-    for (Eigen::Index a = 0; a < s; ++a) {
-      const PolygonCollision& collision = push.collisions[static_cast<std::size_t>(set[static_cast<std::size_t>(a)])];
-      support_nodes.push_back(collision.active);
-      normals.col(a) = collision.normal;
-      for (Eigen::Index b = 0; b < s; ++b)
-        support(a, b) = push.contact.behind_compliance(set[static_cast<std::size_t>(a)], set[static_cast<std::size_t>(b)]);
-    }
-    const ElasticBody& a = push.rig.front;
-    const int tool = push.free.tool_dofs[0] / 3;
-    contact.push_back(tool);
-    for (int node : a.surface.nodes)
-      if (node != tool && std::abs(a.mesh.nodes(0, node) - a.mesh.nodes(0, tool)) < 1e-9 &&
-          (a.mesh.nodes.col(node) - a.mesh.nodes.col(tool)).norm() < 0.03)
-        contact.push_back(node);
-    // Cache every column M~ and the support read, as the server's columns would hold them.
     std::vector<int> nodes = contact;
-    nodes.insert(nodes.end(), support_nodes.begin(), support_nodes.end());
+    nodes.insert(nodes.end(), support.nodes.begin(), support.nodes.end());
     push.front_columns->compute_columns(nodes);
   }
 };
@@ -73,11 +50,12 @@ void BM_FemPairSupportChange_folded(benchmark::State& state) {
   FemPairBench bench;
   const ElasticBody& a = bench.push.rig.front;
   for (auto _ : state) {
-    SupportedCompliance supported(*bench.push.front_columns, a.dofs, bench.support_nodes, bench.normals, bench.support);
+    SupportedCompliance supported(*bench.push.front_columns, a.dofs, bench.support.nodes, bench.support.normals,
+                                  bench.support.compliance);
     const CondensedOperator m = naive_condensation(supported, a.dofs, bench.contact, {});
     benchmark::DoNotOptimize(m.m_cc.data());
   }
-  state.counters["support_nodes"] = static_cast<double>(bench.support_nodes.size());
+  state.counters["support_nodes"] = static_cast<double>(bench.support.nodes.size());
   state.counters["contact_nodes"] = static_cast<double>(bench.contact.size());
 }
 
@@ -85,12 +63,12 @@ void BM_FemPairSupportChange_refactor(benchmark::State& state) {
   FemPairBench bench;
   const ElasticBody& a = bench.push.rig.front;
   for (auto _ : state) {
-    const SparseCholesky factor(testing::stiffness_with_support(a, bench.support_nodes, bench.normals, bench.support));
+    const SparseCholesky factor(testing::stiffness_with_support(a, bench.support.nodes, bench.support.normals, bench.support.compliance));
     ComplianceColumns columns(factor, a.dofs, a.surface.nodes);
     const CondensedOperator m = naive_condensation(columns, a.dofs, bench.contact, {});
     benchmark::DoNotOptimize(m.m_cc.data());
   }
-  state.counters["support_nodes"] = static_cast<double>(bench.support_nodes.size());
+  state.counters["support_nodes"] = static_cast<double>(bench.support.nodes.size());
   state.counters["contact_nodes"] = static_cast<double>(bench.contact.size());
 }
 

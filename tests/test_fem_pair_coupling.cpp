@@ -193,34 +193,18 @@ TEST(FemPairCoupling, ThroughAGapOnlyTheNodesThatReachBPushAsInTheJointSolve) {
 // and, independently, A's compliance from CHOLMOD's factor of K_A with the support springs.
 struct FoldedFront {
   testing::CoupledPush push{0.0, 5e-3};
-  std::vector<int> support_nodes;
-  Eigen::Matrix3Xd normals;
-  Eigen::MatrixXd support;
+  testing::PushingSupport support = testing::pushing_support(push);
   std::unique_ptr<SupportedCompliance> supported;
-  SparseMatrix with_springs;
   std::unique_ptr<SparseCholesky> factor;
   std::unique_ptr<ComplianceColumns> reference;
   FoldedFront() {
     EXPECT_TRUE(push.contact.solved);
-    std::vector<Eigen::Index> set;
-    for (Eigen::Index j = 0; j < push.contact.pushes.size(); ++j)
-      if (push.contact.pushes[j] > 0) {
-        set.push_back(j);
-        support_nodes.push_back(push.collisions[static_cast<std::size_t>(j)].active);
-      }
-    EXPECT_GE(set.size(), 2u);
-    const auto s = static_cast<Eigen::Index>(set.size());
-    normals.resize(3, s);
-    support.resize(s, s);
-    for (Eigen::Index a = 0; a < s; ++a) {
-      normals.col(a) = push.collisions[static_cast<std::size_t>(set[static_cast<std::size_t>(a)])].normal;
-      for (Eigen::Index b = 0; b < s; ++b)
-        support(a, b) = push.contact.behind_compliance(set[static_cast<std::size_t>(a)], set[static_cast<std::size_t>(b)]);
-    }
+    EXPECT_GE(support.nodes.size(), 2u);
     const ElasticBody& a = push.rig.front;
-    supported = std::make_unique<SupportedCompliance>(*push.front_columns, a.dofs, support_nodes, normals, support);
-    with_springs = testing::stiffness_with_support(a, support_nodes, normals, support);
-    factor = std::make_unique<SparseCholesky>(with_springs);
+    supported = std::make_unique<SupportedCompliance>(*push.front_columns, a.dofs, support.nodes, support.normals,
+                                                      support.compliance);
+    factor = std::make_unique<SparseCholesky>(
+        testing::stiffness_with_support(a, support.nodes, support.normals, support.compliance));
     reference = std::make_unique<ComplianceColumns>(*factor, a.dofs, a.surface.nodes);
   }
   int tool_node() const { return push.free.tool_dofs[0] / 3; }
@@ -231,12 +215,7 @@ TEST(FemPairCoupling, AsMTildeWithBFoldedInEqualsCholmodOnKAWithTheSupportSpring
   const ElasticBody& a = folded_front.push.rig.front;
   // M~ of the tool's node and its neighbours on the front face, with a top node of the back
   // face held, condensed over each.
-  const int tool_node = folded_front.tool_node();
-  std::vector<int> contact{tool_node};
-  for (int node : a.surface.nodes)
-    if (node != tool_node && std::abs(a.mesh.nodes(0, node) - a.mesh.nodes(0, tool_node)) < 1e-9 &&
-        (a.mesh.nodes.col(node) - a.mesh.nodes.col(tool_node)).norm() < 0.03)
-      contact.push_back(node);
+  const std::vector<int> contact = testing::tool_neighbourhood(folded_front.push);
   ASSERT_GE(contact.size(), 3u);
   const std::vector<int>& back = folded_front.push.rig.front_face;
   int top = back.front();

@@ -1,6 +1,7 @@
 #include "support/fem_pair_rig.h"
 
 #include <Eigen/LU>
+#include <cmath>
 #include <optional>
 
 #include "common/fem/static_solve.h"
@@ -75,6 +76,36 @@ CoupledPush::CoupledPush(double gap_mm, double depth)
       collisions(back_face_candidates(rig, free.displacement)),
       front_columns(std::make_unique<ComplianceColumns>(*rig.front.free_factor, rig.front.dofs, rig.front.surface.nodes)),
       contact(solve_fem_pair_contact(collisions, *front_columns, free.tool_dofs, *rig.behind_columns)) {}
+
+PushingSupport pushing_support(const CoupledPush& push) {
+  std::vector<Eigen::Index> set;
+  for (Eigen::Index j = 0; j < push.contact.pushes.size(); ++j)
+    if (push.contact.pushes[j] > 0) set.push_back(j);
+  const auto count = static_cast<Eigen::Index>(set.size());
+  PushingSupport support;
+  support.normals.resize(3, count);
+  support.compliance.resize(count, count);
+  for (Eigen::Index a = 0; a < count; ++a) {
+    const PolygonCollision& collision = push.collisions[static_cast<std::size_t>(set[static_cast<std::size_t>(a)])];
+    support.nodes.push_back(collision.active);
+    support.normals.col(a) = collision.normal;
+    for (Eigen::Index b = 0; b < count; ++b)
+      support.compliance(a, b) =
+          push.contact.behind_compliance(set[static_cast<std::size_t>(a)], set[static_cast<std::size_t>(b)]);
+  }
+  return support;
+}
+
+std::vector<int> tool_neighbourhood(const CoupledPush& push) {
+  const ElasticBody& a = push.rig.front;
+  const int tool = push.free.tool_dofs[0] / 3;
+  std::vector<int> nodes{tool};
+  for (int node : a.surface.nodes)
+    if (node != tool && std::abs(a.mesh.nodes(0, node) - a.mesh.nodes(0, tool)) < 1e-9 &&
+        (a.mesh.nodes.col(node) - a.mesh.nodes.col(tool)).norm() < 0.03)
+      nodes.push_back(node);
+  return nodes;
+}
 
 SparseMatrix stiffness_with_support(const ElasticBody& a, const std::vector<int>& nodes, const Eigen::Matrix3Xd& normals,
                                     const Eigen::MatrixXd& support) {

@@ -47,6 +47,18 @@ struct CoupledPush {
   Eigen::Vector3d tool_force() const { return free.tool_force + contact.held_force_change; }
 };
 
+/// The pushing set S of a coupled push: A's nodes, B's normals there (columns) and B's
+/// normal compliance A_B,SS between them.
+struct PushingSupport {
+  std::vector<int> nodes;
+  Eigen::Matrix3Xd normals;
+  Eigen::MatrixXd compliance;
+};
+PushingSupport pushing_support(const CoupledPush& push);
+
+/// The tool's node and its neighbours on A's front face (within 30 mm): the nodes of M~.
+std::vector<int> tool_neighbourhood(const CoupledPush& push);
+
 /// K_ff of `a` plus the springs N support^-1 N^T on `nodes` (one normal each, `normals`'
 /// columns): A resting on the support, the naive way.
 SparseMatrix stiffness_with_support(const ElasticBody& a, const std::vector<int>& nodes, const Eigen::Matrix3Xd& normals,
