@@ -6,9 +6,7 @@
 
 namespace cohaptic {
 
-NodeBacking compliance_backing(std::span<const PolygonCollision> collisions, ComplianceColumns& columns,
-                               const Eigen::Ref<const Eigen::VectorXd>& masses, double time_step,
-                               double damping_ratio) {
+Eigen::MatrixXd target_normal_compliance(std::span<const PolygonCollision> collisions, ComplianceColumns& columns) {
   const auto count = static_cast<Eigen::Index>(collisions.size());
   std::vector<int> polygon_nodes;
   for (const PolygonCollision& collision : collisions)
@@ -16,13 +14,7 @@ NodeBacking compliance_backing(std::span<const PolygonCollision> collisions, Com
   std::sort(polygon_nodes.begin(), polygon_nodes.end());
   polygon_nodes.erase(std::unique(polygon_nodes.begin(), polygon_nodes.end()), polygon_nodes.end());
   columns.compute_columns(polygon_nodes);
-
-  NodeBacking backing;
-  backing.compliance.resize(count, count);
-  backing.offsets = Eigen::VectorXd::Zero(count);
-  backing.damping.resize(count);
-  backing.targets.resize(3 * count);
-  backing.normals.resize(3 * count);
+  Eigen::MatrixXd compliance(count, count);
   for (Eigen::Index j = 0; j < count; ++j) {
     const PolygonCollision& cj = collisions[static_cast<std::size_t>(j)];
     for (Eigen::Index i = 0; i <= j; ++i) {
@@ -31,10 +23,23 @@ NodeBacking compliance_backing(std::span<const PolygonCollision> collisions, Com
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b)
           value += ci.weights[a] * cj.weights[b] * ci.normal.dot(columns.block(ci.polygon[a], cj.polygon[b]) * cj.normal);
-      backing.compliance(i, j) = value;
-      backing.compliance(j, i) = value;  // exactly symmetric, as the wire and the check want
+      compliance(i, j) = value;
+      compliance(j, i) = value;  // exactly symmetric, as the wire and the check want
     }
   }
+  return compliance;
+}
+
+NodeBacking compliance_backing(std::span<const PolygonCollision> collisions, ComplianceColumns& columns,
+                               const Eigen::Ref<const Eigen::VectorXd>& masses, double time_step,
+                               double damping_ratio) {
+  const auto count = static_cast<Eigen::Index>(collisions.size());
+  NodeBacking backing;
+  backing.compliance = target_normal_compliance(collisions, columns);
+  backing.offsets = Eigen::VectorXd::Zero(count);
+  backing.damping.resize(count);
+  backing.targets.resize(3 * count);
+  backing.normals.resize(3 * count);
   for (Eigen::Index i = 0; i < count; ++i) {
     const PolygonCollision& collision = collisions[static_cast<std::size_t>(i)];
     const double mass = masses[collision.active];

@@ -1,0 +1,85 @@
+#include "common/sim/fem_pair_coupling.h"
+
+#include <Eigen/Cholesky>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "common/contact/unilateral_contact_solve.h"
+#include "common/interaction/compliance_backing.h"
+
+namespace cohaptic {
+namespace {
+
+// The 3 dofs of each collision's active node, collision-major.
+std::vector<int> pair_active_dofs(std::span<const PolygonCollision> collisions) {
+  std::vector<int> dofs;
+  for (const PolygonCollision& collision : collisions)
+    for (int axis = 0; axis < 3; ++axis) dofs.push_back(3 * collision.active + axis);
+  return dofs;
+}
+
+// N: 3|collisions| x |collisions|, column j holding n_j in rows 3j..3j+2.
+Eigen::MatrixXd pair_normal_matrix(std::span<const PolygonCollision> collisions) {
+  const auto count = static_cast<Eigen::Index>(collisions.size());
+  Eigen::MatrixXd normals = Eigen::MatrixXd::Zero(3 * count, count);
+  for (Eigen::Index j = 0; j < count; ++j) normals.block<3, 1>(3 * j, j) = collisions[static_cast<std::size_t>(j)].normal;
+  return normals;
+}
+
+}  // namespace
+
+FemPairContact solve_fem_pair_contact(std::span<const PolygonCollision> collisions, ComplianceColumns& front_columns,
+                                      std::span<const int> front_held_dofs, ComplianceColumns& behind_columns) {
+  const auto count = static_cast<Eigen::Index>(collisions.size());
+  FemPairContact contact;
+  contact.behind_compliance = target_normal_compliance(collisions, behind_columns);
+  const std::vector<int> active_dofs = pair_active_dofs(collisions);
+  const Eigen::MatrixXd normals = pair_normal_matrix(collisions);
+  contact.front_compliance = normals.transpose() * front_columns.dof_block(active_dofs, active_dofs) * normals;
+  // The held dofs stay where they are: the Schur complement of L_HH.
+  Eigen::MatrixXd held_response;  // L_HH^-1 L_HP N
+  if (!front_held_dofs.empty()) {
+    const Eigen::LLT<Eigen::MatrixXd> held(front_columns.dof_block(front_held_dofs, front_held_dofs));
+    const Eigen::MatrixXd coupling = front_columns.dof_block(front_held_dofs, active_dofs) * normals;  // L_HP N
+    held_response = held.solve(coupling);
+    contact.front_compliance -= coupling.transpose() * held_response;
+  }
+  contact.front_compliance = (contact.front_compliance + contact.front_compliance.transpose()) / 2;
+
+  contact.free_gaps.resize(count);
+  for (Eigen::Index i = 0; i < count; ++i) {
+    const PolygonCollision& collision = collisions[static_cast<std::size_t>(i)];
+    contact.free_gaps[i] = collision.gap.dot(collision.normal);
+  }
+  const Eigen::MatrixXd sum = contact.front_compliance + contact.behind_compliance;
+  std::vector<std::uint8_t> active(static_cast<std::size_t>(count));
+  for (Eigen::Index i = 0; i < count; ++i) active[static_cast<std::size_t>(i)] = contact.free_gaps[i] < 0;
+  contact.pushes = Eigen::VectorXd::Zero(count);
+  Eigen::MatrixXd factor(count, count);
+  std::vector<int> order(static_cast<std::size_t>(count));
+  contact.solved = solve_unilateral_contact(sum, contact.free_gaps, active, contact.pushes, factor, order,
+                                            std::numeric_limits<double>::infinity())
+                       .solved;
+  contact.gaps = sum * contact.pushes + contact.free_gaps;
+  contact.held_force_change = front_held_dofs.empty()
+                                  ? Eigen::VectorXd()
+                                  : Eigen::VectorXd(-held_response * contact.pushes);
+  return contact;
+}
+
+Eigen::VectorXd behind_pair_displacement(std::span<const PolygonCollision> collisions,
+                                         const Eigen::Ref<const Eigen::VectorXd>& pushes,
+                                         ComplianceColumns& behind_columns) {
+  Eigen::VectorXd displacement = Eigen::VectorXd::Zero(3 * behind_columns.node_count());
+  for (std::size_t j = 0; j < collisions.size(); ++j) {
+    const PolygonCollision& collision = collisions[j];
+    const double push = pushes[static_cast<Eigen::Index>(j)];
+    if (push == 0) continue;
+    for (int b = 0; b < 3; ++b)
+      displacement -= behind_columns.column(collision.polygon[b]) * (collision.weights[b] * push * collision.normal);
+  }
+  return displacement;
+}
+
+}  // namespace cohaptic

@@ -1,0 +1,49 @@
+// SupportedCompliance: the compliance of a linear elastic body A resting on an elastic
+// support at some of its nodes, read through the ComplianceSource interface, so that a
+// condensation (M~ of A's IR, common/condense) formed over it feels the support.
+//
+// The support acts along one normal per supporting node s (unit n_s): a push lambda along
+// n_s moves the support back by A_S lambda (A_S the support's normal compliance,
+// symmetric positive semidefinite), i.e. a stiffness N A_S^-1 N^T on A's nodes S. With L
+// A's own compliance, Woodbury gives, on blocks A already holds,
+//   L'_XY = L_XY - L_XS N (A_S + N^T L_SS N)^-1 N^T L_SY,
+// equal to inverting K_A with the support springs added (defined also where A_S is
+// singular, e.g. a support that cannot give way). The support is bilateral: this is the
+// compliance while the supporting set stays the same; a caller that finds nodes released
+// or added builds another (fem_pair_coupling.h: the behind body B as the support of the
+// front body's pushing nodes). Units: m/N; dofs global (3 * node + axis) and free.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <span>
+#include <vector>
+
+#include "common/fem/compliance_source.h"
+#include "common/fem/dof_map.h"
+
+namespace cohaptic {
+
+class SupportedCompliance final : public ComplianceSource {
+ public:
+  /// `base` (A's L over its free dofs under `dofs`; outlives this) must hold rows for every
+  /// node asked for and for `nodes` (S, one normal each, the columns of `normals`);
+  /// `support_compliance` A_S is |S| square. Throws Error if A_S + N^T L_SS N is not
+  /// positive definite.
+  SupportedCompliance(ComplianceSource& base, const DofMap& dofs, std::vector<int> nodes, const Eigen::Matrix3Xd& normals,
+                      const Eigen::MatrixXd& support_compliance);
+
+  void compute_columns(const std::vector<int>& nodes) override;
+  Eigen::MatrixXd dof_block(std::span<const int> row_dofs, std::span<const int> col_dofs) override;
+
+  const std::vector<int>& support_nodes() const { return nodes_; }
+
+ private:
+  ComplianceSource& base_;
+  std::vector<int> nodes_;
+  std::vector<int> dofs_;            // the support nodes' free dofs
+  Eigen::MatrixXd normals_;          // N over those dofs, |dofs_| x |S|
+  Eigen::LLT<Eigen::MatrixXd> coupled_;  // of A_S + N^T L_SS N
+};
+
+}  // namespace cohaptic
