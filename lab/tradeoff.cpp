@@ -75,7 +75,7 @@ class FullSolve {
 double model_memory_mb(const ElasticBody& body, const ComplianceColumns& columns) {
   const double stiffness = static_cast<double>(body.stiffness.nonZeros()) * (sizeof(double) + sizeof(int));
   const double factor = body.free_factor->factor_nonzeros() * (sizeof(double) + sizeof(int));
-  const double compliance = static_cast<double>(columns.column_count()) * columns.node_count() * 9 * sizeof(double);
+  const double compliance = static_cast<double>(columns.column_count() * columns.row_nodes().size()) * 9 * sizeof(double);
   return (stiffness + factor + compliance) / 1e6;
 }
 

@@ -355,12 +355,12 @@ TEST(LoadedColumns, GiveTheDisplacementOfTheGatheredComplianceAndRefuseAPosition
   EXPECT_GT(expected.colwise().norm().maxCoeff(), 1e-3);  // the 2 mm press moves the surface
   EXPECT_LT((u - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
 
-  const std::vector<int> outside = {columns.node_count()};
+  const std::vector<int> outside = {columns.volume_node_count()};
   try {
     displacement_of_rows(loads, outside);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(std::to_string(columns.node_count())), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(std::to_string(columns.volume_node_count())), std::string::npos) << e.what();
   }
 }
 

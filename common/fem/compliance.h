@@ -34,7 +34,8 @@ class ComplianceColumns : public ComplianceSource {
   ComplianceColumns(const SparseCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes);
 
   const std::vector<int>& row_nodes() const { return row_nodes_; }
-  int node_count() const { return static_cast<int>(row_position_.size()); }
+  /// Nodes of the whole volume mesh (the range of column nodes), not the row count.
+  int volume_node_count() const { return static_cast<int>(row_position_.size()); }
   /// Position of `node` in row_nodes(), or -1.
   int row_position(int node) const { return row_position_[static_cast<std::size_t>(node)]; }
   bool has_column(int node) const { return columns_.count(node) != 0; }

@@ -124,7 +124,7 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
       result.problem = fmt::format("truncated at column {}", c);
       return result;
     }
-    if (node < 0 || node >= columns.node_count()) {
+    if (node < 0 || node >= columns.volume_node_count()) {
       result.problem = fmt::format("column {} names node {}, outside the mesh", c, node);
       return result;
     }

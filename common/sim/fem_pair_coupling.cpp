@@ -71,7 +71,7 @@ FemPairContact solve_fem_pair_contact(std::span<const PolygonCollision> collisio
 Eigen::VectorXd behind_pair_displacement(std::span<const PolygonCollision> collisions,
                                          const Eigen::Ref<const Eigen::VectorXd>& pushes,
                                          ComplianceColumns& behind_columns) {
-  Eigen::VectorXd displacement = Eigen::VectorXd::Zero(3 * behind_columns.node_count());
+  Eigen::VectorXd displacement = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(behind_columns.row_nodes().size()));
   for (std::size_t j = 0; j < collisions.size(); ++j) {
     const PolygonCollision& collision = collisions[j];
     const double push = pushes[static_cast<Eigen::Index>(j)];
