@@ -15,6 +15,7 @@
 
 #include "common/condense/naive_condensation.h"
 #include "common/ir/client_condensation.h"
+#include "common/mesh/tet_mesh.h"
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
@@ -43,8 +44,7 @@ std::size_t changed_entries(const google::protobuf::RepeatedField<double>& befor
 IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body, ComplianceColumns& columns,
                             const std::filesystem::path& frames) {
   const record::Recording rec = record::read_recording(recording);
-  std::unordered_map<std::int64_t, int> node_of_tag;
-  for (std::size_t i = 0; i < body.mesh.node_tags.size(); ++i) node_of_tag.emplace(body.mesh.node_tags[i], static_cast<int>(i));
+  const std::unordered_map<std::int64_t, int> node_of_tag = node_indices_by_tag(body.mesh);
   IrBytesRow row;
   row.recording = recording.string();
   if (!frames.empty()) std::filesystem::create_directories(frames);

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <thread>
 
+#include "common/mesh/tet_mesh.h"
 #include "common/sim/elastic_states.h"
 #include "common/sim/loaded_columns.h"
 #include "proto/wire/header.h"
@@ -47,9 +48,7 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       joins_seen_(static_cast<std::size_t>(simulation_.user_count()), 0),
       node_of_tag_(model.bodies.size()) {
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
-    if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i]))
-      for (std::size_t node = 0; node < body->mesh.node_tags.size(); ++node)
-        node_of_tag_[i].emplace(body->mesh.node_tags[node], static_cast<int>(node));
+    if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i])) node_of_tag_[i] = node_indices_by_tag(body->mesh);
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
     if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i]); body && columns[i])
       prefetch_.push_back({columns[i], static_cast<int>(i), std::make_unique<CompliancePrefetch>(*body, columns[i]->row_nodes())});

@@ -96,9 +96,8 @@ void HeldCompliance::clear() {
 
 ClientCondensation::ClientCondensation() : condensation_(std::make_unique<IncrementalCondensation>(held_, dofs_)) {}
 
-int ClientCondensation::index_for(std::int64_t tag, AxisMask fixed) {
+int ClientCondensation::index_for(std::int64_t tag, AxisMask fixed, std::vector<AxisMask>& fixed_axes) {
   int index;
-  std::vector<AxisMask> fixed_axes = dofs_.fixed_axes;
   if (!free_indices_.empty()) {
     index = free_indices_.back();
     free_indices_.pop_back();
@@ -107,7 +106,6 @@ int ClientCondensation::index_for(std::int64_t tag, AxisMask fixed) {
     index = static_cast<int>(fixed_axes.size());
     fixed_axes.push_back(fixed);
   }
-  dofs_ = make_dof_map(std::move(fixed_axes));  // in place: the condensation holds a reference
   index_of_tag_.emplace(tag, index);
   return index;
 }
@@ -173,8 +171,10 @@ void ClientCondensation::complete(CondensedFemIr& ir) {
   }
   held_.keep_only(keep);
   std::vector<int> added;
+  std::vector<AxisMask> fixed_axes = dofs_.fixed_axes;
   for (std::size_t i = kept; i < after.size(); ++i)
-    added.push_back(index_for(after[i], ir.fixed_axes[static_cast<std::size_t>(local_of_tag.at(after[i]))]));
+    added.push_back(index_for(after[i], ir.fixed_axes[static_cast<std::size_t>(local_of_tag.at(after[i]))], fixed_axes));
+  dofs_ = make_dof_map(std::move(fixed_axes));  // in place: the condensation holds a reference
   held_.append(added, sent.rows, dofs_);
   held_tags_ = after;
   generation_ = sent.generation;

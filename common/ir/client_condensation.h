@@ -64,7 +64,9 @@ class ClientCondensation {
   std::size_t held_node_count() const { return held_tags_.size(); }
 
  private:
-  int index_for(std::int64_t tag, AxisMask fixed);
+  /// A node index for `tag` (a forgotten one reused, else the next), its fixed axes set in
+  /// `fixed_axes` (the dof map's, rebuilt from it once all new nodes have theirs).
+  int index_for(std::int64_t tag, AxisMask fixed, std::vector<AxisMask>& fixed_axes);
   void forget_all();
 
   DofMap dofs_;  // by node index; the condensation reads it

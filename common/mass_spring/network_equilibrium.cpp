@@ -3,30 +3,22 @@
 #include <Eigen/LU>
 #include <fmt/format.h>
 
+#include "common/mass_spring/network_stiffness.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
 namespace {
 
-// The springs' forces on every dof and their tangent stiffness (-d force / d position).
-void spring_forces_and_tangent(const MassSpringNetwork& network, const Eigen::Matrix3Xd& x, Eigen::VectorXd& force,
-                               Eigen::MatrixXd& tangent) {
+// The springs' forces on every dof (no dampers: the network at rest).
+void spring_forces(const MassSpringNetwork& network, const Eigen::Matrix3Xd& x, Eigen::VectorXd& force) {
   force.setZero();
-  tangent.setZero();
   for (const Spring& s : network.springs) {
     const Eigen::Vector3d l = x.col(s.b) - x.col(s.a);
     const double length = l.norm();
     if (!(length > 0)) continue;
-    const Eigen::Vector3d n = l / length;
-    const Eigen::Vector3d on_a = s.stiffness * (length - s.rest_length) * n;
+    const Eigen::Vector3d on_a = s.stiffness * (length - s.rest_length) * (l / length);
     force.segment<3>(3 * s.a) += on_a;
     force.segment<3>(3 * s.b) -= on_a;
-    const Eigen::Matrix3d nn = n * n.transpose();
-    const Eigen::Matrix3d k = s.stiffness * (nn + (1 - s.rest_length / length) * (Eigen::Matrix3d::Identity() - nn));
-    tangent.block<3, 3>(3 * s.a, 3 * s.a) += k;
-    tangent.block<3, 3>(3 * s.b, 3 * s.b) += k;
-    tangent.block<3, 3>(3 * s.a, 3 * s.b) -= k;
-    tangent.block<3, 3>(3 * s.b, 3 * s.a) -= k;
   }
 }
 
@@ -53,9 +45,9 @@ NetworkEquilibrium network_equilibrium(const MassSpringNetwork& network, std::sp
   const auto count = static_cast<Eigen::Index>(free.size());
 
   Eigen::VectorXd force(dofs);
-  Eigen::MatrixXd tangent(dofs, dofs);
   for (;; ++result.iterations) {
-    spring_forces_and_tangent(network, result.positions, force, tangent);
+    spring_forces(network, result.positions, force);
+    const Eigen::MatrixXd tangent = network_stiffness(result.positions, network.springs).toDense();
     Eigen::VectorXd residual(count);
     Eigen::MatrixXd k(count, count);
     for (Eigen::Index i = 0; i < count; ++i) {

@@ -1,9 +1,9 @@
 // The static equilibrium of a mass-spring network's springs, geometrically nonlinear: the
 // positions where every spring force f = k (|l| - l0) l/|l| balances at each node that is
 // neither held nor prescribed, found by Newton's method on the springs' tangent stiffness
-//   K_ab = k [n n^T + (1 - l0/|l|) (I - n n^T)]   (n = l/|l|).
+// (network_stiffness.h at the current positions).
 // No gravity, dampers or masses: the slow limit of the network's dynamics, and the
-// reference a push in time tends to as it slows (the linearised one, network_stiffness.h,
+// reference a push in time tends to as it slows (the linearised one, the tangent at rest,
 // holds only while the springs barely turn). Dense: for small networks (a few hundred
 // nodes). Units: m, N.
 #pragma once

@@ -8,8 +8,13 @@ SparseMatrix network_stiffness(const Eigen::Ref<const Eigen::Matrix3Xd>& positio
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(36 * springs.size());
   for (const Spring& spring : springs) {
-    const Eigen::Vector3d n = (positions.col(spring.b) - positions.col(spring.a)).normalized();
-    const Eigen::Matrix3d block = spring.stiffness * n * n.transpose();
+    const Eigen::Vector3d l = positions.col(spring.b) - positions.col(spring.a);
+    const double length = l.norm();
+    if (!(length > 0)) continue;  // a collapsed spring has no direction (and no force)
+    const Eigen::Vector3d n = l / length;
+    const Eigen::Matrix3d nn = n * n.transpose();
+    const Eigen::Matrix3d block =
+        spring.stiffness * (nn + (1 - spring.rest_length / length) * (Eigen::Matrix3d::Identity() - nn));
     const int nodes[2] = {spring.a, spring.b};
     for (int i = 0; i < 2; ++i)
       for (int j = 0; j < 2; ++j)

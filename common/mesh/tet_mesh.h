@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 namespace cohaptic {
@@ -32,5 +33,8 @@ double signed_volume(const TetMesh& mesh, int t);
 
 /// Index of the node whose tag is `tag`, or -1. Linear scan: for user input, not inner loops.
 int node_index_from_tag(const TetMesh& mesh, std::int64_t tag);
+
+/// The index of every node by its tag, for many look-ups.
+std::unordered_map<std::int64_t, int> node_indices_by_tag(const TetMesh& mesh);
 
 }  // namespace cohaptic

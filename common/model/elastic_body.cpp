@@ -38,8 +38,7 @@ std::vector<int> select_nodes(const NodeSelector& selector, const TetMesh& mesh,
 
   std::vector<int> selected;
   if (selector.kind == NodeSelector::Kind::node_tags) {
-    std::unordered_map<std::int64_t, int> index_of_tag;
-    for (int n = 0; n < mesh.node_count(); ++n) index_of_tag.emplace(mesh.node_tags[n], n);
+    const std::unordered_map<std::int64_t, int> index_of_tag = node_indices_by_tag(mesh);
     for (std::int64_t tag : selector.node_tags) {
       const auto it = index_of_tag.find(tag);
       if (it == index_of_tag.end())
