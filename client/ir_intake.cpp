@@ -33,12 +33,31 @@ bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::siz
   return true;
 }
 
+std::optional<wire::IntermediateRepresentation> IrIntake::receive_compressed(const wire::CompressedIr& block,
+                                                                             std::size_t bytes, std::int64_t arrival_ns) {
+  std::optional<wire::IntermediateRepresentation> message;
+  try {
+    const double start_us = thread_cpu_us();
+    message = stream_.open(block);
+    inflate_us_.record(std::llround(thread_cpu_us() - start_us));
+  } catch (const Error& e) {
+    ++rejected_;
+    spdlog::warn("IR rejected: {}", e.what());
+    return std::nullopt;
+  }
+  if (!receive(*message, bytes, arrival_ns)) return std::nullopt;
+  return message;
+}
+
 nlohmann::json IrIntake::report() const {
   const double span_s = static_cast<double>(last_ns_ - first_ns_) * 1e-9;
   return {{"received", received_},
           {"condensed", condense_us_.count()},
           {"condense_cpu_us_p50", condense_us_.quantile(0.5)},
           {"condense_cpu_us_max", condense_us_.max()},
+          {"inflated", inflate_us_.count()},
+          {"inflate_cpu_us_p50", inflate_us_.quantile(0.5)},
+          {"inflate_cpu_us_max", inflate_us_.max()},
           {"rejected", rejected_},
           {"bytes", bytes_},
           {"bytes_per_s", span_s > 0 ? static_cast<double>(bytes_) / span_s : 0.0}};

@@ -1,4 +1,5 @@
-// IrIntake: the IRs the server sends, on the client's I/O thread. Each is converted from
+// IrIntake: the IRs the server sends, on the client's I/O thread. Each is taken out of its
+// connection's zstd stream if it came compressed (proto/wire/ir_stream.h), converted from
 // the wire, completed if it came as compliance rows (its M~ condensed here from the rows
 // held, ClientCondensation), checked and prepared (prepare_ir: the factorisations the haptic loop needs,
 // done here so the haptic thread never does them) with its fresh evaluation state, then handed to the haptic thread
@@ -9,12 +10,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cohaptic/messages.pb.h"
 #include "client/haptic_loop.h"
 #include "common/ir/client_condensation.h"
 #include "common/util/histogram.h"
 #include "common/util/triple_buffer.h"
+#include "proto/wire/ir_stream.h"
 
 namespace cohaptic {
 
@@ -24,15 +27,22 @@ class IrIntake {
 
   /// Prepares and hands over `message` (`bytes` on the wire). False if it was rejected.
   bool receive(const wire::IntermediateRepresentation& message, std::size_t bytes, std::int64_t arrival_ns);
+  /// Decompresses `block` in this connection's IR stream, then as receive(); the IR, or
+  /// nullopt if it was rejected. A new connection's stream starts at its first block.
+  std::optional<wire::IntermediateRepresentation> receive_compressed(const wire::CompressedIr& block, std::size_t bytes,
+                                                                     std::int64_t arrival_ns);
 
   /// The report's "ir": received, rejected, bytes, bytes_per_s (from the first IR to the
   /// last), and of those sent as compliance rows: condensed, condense_cpu_us_p50 and _max
-  /// (the I/O thread's CPU for M~ per IR).
+  /// (the I/O thread's CPU for M~ per IR); of those that came compressed: inflated,
+  /// inflate_cpu_us_p50 and _max (the I/O thread's CPU to decompress each).
   nlohmann::json report() const;
 
  private:
   TripleBuffer<IrSlot>& to_haptic_;
   ClientCondensation condensation_;
+  wire::IrStreamReader stream_;
+  Histogram inflate_us_{5, 20000};  // CPU of decompressing each IR that came compressed [µs]
   Histogram condense_us_{5, 20000};  // CPU of completing each IR sent as compliance rows [µs], to 100 ms
   std::uint64_t received_ = 0, rejected_ = 0, bytes_ = 0;
   std::int64_t first_ns_ = 0, last_ns_ = 0;

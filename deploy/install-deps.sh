@@ -11,8 +11,8 @@ packages=(
   build-essential cmake pkg-config git ca-certificates
   # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it
   libeigen3-dev libsuitesparse-dev libopenblas-dev
-  # networking and the wire format; the live view's web server
-  libasio-dev libprotobuf-dev protobuf-compiler libsodium-dev libwebsocketpp-dev
+  # networking and the wire format (zstd: the IR streams); the live view's web server
+  libasio-dev libprotobuf-dev protobuf-compiler libsodium-dev libzstd-dev libwebsocketpp-dev
   # configuration, command line, logging, JSON output
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   # the mass-spring benchmark tables (make bench-thin) read the benchmarks' JSON

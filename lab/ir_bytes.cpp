@@ -22,6 +22,7 @@
 #include "common/util/stopwatch.h"
 #include "proto/record/recording.h"
 #include "proto/wire/ir_convert.h"
+#include "proto/wire/ir_stream.h"
 
 namespace cohaptic {
 namespace {
@@ -52,8 +53,21 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
   std::int64_t first_ns = 0, last_ns = 0;
   std::vector<double> client_us, completed_us;
   ClientCondensation client;
+  wire::IrStreamWriter stream_out;
+  wire::IrStreamReader stream_in;
+  std::vector<double> inflate_us;
   for (const record::RecordedIr& recorded : rec.irs) {
     if (!recorded.ir().has_fem()) continue;
+    {
+      const wire::CompressedIr block = stream_out.compress(recorded.ir(), recorded.ir().fem().rows_generation() == 1);
+      row.stream_bytes += static_cast<double>(block.ByteSizeLong());
+      const double start_us = thread_cpu_us();
+      const wire::IntermediateRepresentation opened = stream_in.open(block);
+      inflate_us.push_back(thread_cpu_us() - start_us);
+      if (opened.ByteSizeLong() != recorded.ir().ByteSizeLong())
+        throw Error(fmt::format("ir-bytes: {}: IR epoch {} came out of the IR stream changed", recording.string(),
+                                recorded.ir().epoch()));
+    }
     // An IR that came as compliance rows is completed as the client did: the options are
     // measured against its whole-M~ form, "sent" is what came.
     wire::IntermediateRepresentation ir = recorded.ir();
@@ -145,6 +159,9 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
   std::sort(client_us.begin(), client_us.end());
   row.rows_client_us_p50 = client_us[client_us.size() / 2];
   row.rows_client_us_max = client_us.back();
+  std::sort(inflate_us.begin(), inflate_us.end());
+  row.stream_inflate_us_p50 = inflate_us[inflate_us.size() / 2];
+  row.stream_inflate_us_max = inflate_us.back();
   if (!completed_us.empty()) {
     row.sent_rows_first_us = completed_us.front();
     std::sort(completed_us.begin(), completed_us.end());
@@ -176,21 +193,22 @@ LabCommand add_ir_bytes_command(CLI::App& lab) {
             ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
             fmt::print("| recording | IRs | span s | nodes per IR | new nodes per IR | sent kB/s | without M~ kB/s | f32 kB/s | "
                        "M~ delta kB/s | compliance rows kB/s | rows: client CPU µs p50 / max | rows: M~ difference | "
-                       "as sent: client CPU µs p50 / max / first |\n"
-                       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                       "as sent: client CPU µs p50 / max / first | zstd stream kB/s | zstd stream: client CPU µs p50 / max |\n"
+                       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
             for (std::size_t i = 0; i < options->recordings.size(); ++i) {
               const std::filesystem::path frames =
                   options->frames.empty() ? options->frames : options->frames / fmt::format("{}", i);
               const IrBytesRow r = measure_ir_bytes(options->recordings[i], body, columns, frames);
               const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;
               fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.0f} / {:.0f} | "
-                         "{:.1e} | {} |\n",
+                         "{:.1e} | {} | {:.1f} | {:.0f} / {:.0f} |\n",
                          r.recording, r.irs, r.span_s, r.nodes_mean, r.new_nodes_mean, r.sent_bytes * per_s,
                          r.without_m_bytes * per_s, r.f32_bytes * per_s, r.delta_bytes * per_s, r.rows_bytes * per_s,
                          r.rows_client_us_p50, r.rows_client_us_max, r.rows_m_tilde_difference,
                          r.sent_rows_us_max > 0 ? fmt::format("{:.0f} / {:.0f} / {:.0f}", r.sent_rows_us_p50,
                                                               r.sent_rows_us_max, r.sent_rows_first_us)
-                                                : std::string("M~ sent whole"));
+                                                : std::string("M~ sent whole"),
+                         r.stream_bytes * per_s, r.stream_inflate_us_p50, r.stream_inflate_us_max);
             }
             return 0;
           }};

@@ -1,7 +1,8 @@
 // `cohaptic-lab ir-bytes RECORDING...`: what a client's condensed FEM IRs cost on the wire,
 // and what three ways of sending less would have cost, on the IRs a client recorded
 // (cohaptic-client --record). Per recording, over its IRs in arrival order:
-//   - sent: the wire IRs as received (bytes and kB/s over the span from first to last IR),
+//   - sent: the wire IRs as received, out of the connection's stream if they came compressed
+//     (bytes and kB/s over the span from first to last IR),
 //     and of the whole-M~ form everything but M~ (geometry, node ids, u_B). An IR that came
 //     as compliance rows (the server's default since issue 14) is first completed as the
 //     client did (ClientCondensation); every option below is measured on that whole form;
@@ -17,7 +18,10 @@
 //     (largest entry difference relative to the largest entry: 0 up to rounding if this way
 //     of sending gives the same forces);
 //   - as sent: for IRs that came as compliance rows, the CPU of completing them as the
-//     client does (ClientCondensation, incremental): p50, max and the first IR's.
+//     client does (ClientCondensation, incremental): p50, max and the first IR's;
+//   - zstd stream: the IRs as recorded (rows IRs as they came out of the connection's
+//     stream) put through a new IR stream (proto/wire/ir_stream.h) as the server does, its
+//     bytes, and the client's CPU to take each out of it (p50 / max).
 // `--frames DIR` also writes every IR as sent, one file each (frame_NNNNNN.bin), to measure a
 // general-purpose compressor on them (e.g. zstd). Units: bytes, kB = 1000 bytes, s, µs.
 #pragma once
@@ -45,6 +49,8 @@ struct IrBytesRow {
   /// IRs that came as compliance rows: the client's own completion (ClientCondensation,
   /// incremental), µs of CPU per IR; 0 when M~ came whole.
   double sent_rows_us_p50 = 0, sent_rows_us_max = 0, sent_rows_first_us = 0;
+  double stream_bytes = 0;  ///< the IRs as recorded, through one IR stream (ir_stream.h)
+  double stream_inflate_us_p50 = 0, stream_inflate_us_max = 0;  ///< the client's CPU per IR to decompress
 };
 
 /// Measures one recording (throws Error naming it if it holds no condensed FEM IR, or one

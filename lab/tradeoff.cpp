@@ -1,5 +1,6 @@
 #include "lab/tradeoff.h"
 #include "lab/tradeoff_tally.h"
+#include "lab/tradeoff_wire_bytes.h"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -232,6 +233,8 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
   std::vector<Eigen::Vector3d> held(users, Eigen::Vector3d::Zero());
   std::vector<Eigen::Vector3d> remotes;
   TradeoffTally tally;
+  // As the server: compliance rows unless B truncation leaves held nodes out of the IR.
+  TradeoffWireBytes wire_bytes(body, columns, users, options.ir.boundary_truncation == 0);
   const std::size_t samples = reference.positions.size();
   for (std::size_t j = 0; j < samples; ++j) {
     const double t = static_cast<double>(j) / reference.sample_rate_hz;
@@ -247,7 +250,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
         if (ir && ir != published[u] && due) {
           published[u] = ir;
           last_published[u] = t;
-          tally.published(ir->ir);
+          tally.published(wire_bytes.published(ir->ir, u));
         }
       }
     }

@@ -17,7 +17,8 @@
 // B truncation (scenes with obstacles, the only ones with held nodes here), IR update
 // policy (every set change, or at most R per second), haptic rate. With obstacles the
 // references hold the nodes that the simulation's active set puts on them. Costs per setting: precompute time, M~ build time (p50/p99 of
-// the steps that rebuilt IRs), evaluation time per tick, IR bytes per second sent, memory
+// the steps that rebuilt IRs), evaluation time per tick, IR bytes per second as the wire
+// carries them (compliance rows, lab/tradeoff_wire_bytes.h), memory
 // (K, its factor, compliance columns) and CPU per second of session (simulation steps +
 // evaluations). Units as the column names say.
 #pragma once

@@ -62,7 +62,7 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
       for (std::size_t u = 0; u < users; ++u)
         if (const auto ir = server.ir(static_cast<int>(u)); ir && ir != published[u]) {
           published[u] = ir;
-          tally.published(ir->ir);
+          tally.published(ir->ir.size_bytes());
         }
     }
     if (j % static_cast<std::size_t>(per_tick) == 0)

@@ -16,8 +16,8 @@ void TradeoffTally::step(const StepReport& report, double ms) {
   }
 }
 
-void TradeoffTally::published(const IntermediateRepresentation& ir) {
-  bytes_ += static_cast<double>(ir.size_bytes());
+void TradeoffTally::published(std::size_t bytes) {
+  bytes_ += static_cast<double>(bytes);
   ++irs_;
 }
 

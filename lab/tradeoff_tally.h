@@ -9,7 +9,6 @@
 #include <cstddef>
 #include <vector>
 
-#include "common/ir/intermediate_representation.h"
 #include "common/sim/step_report.h"
 #include "lab/tradeoff.h"
 
@@ -20,8 +19,8 @@ class TradeoffTally {
   /// A simulation step that took `ms` of wall time: a step that rebuilt IRs counts in full,
   /// the others at their median (robust to a scheduler hiccup).
   void step(const StepReport& report, double ms);
-  /// An IR handed to its user.
-  void published(const IntermediateRepresentation& ir);
+  /// An IR handed to its user, `bytes` long on the wire.
+  void published(std::size_t bytes);
   /// One haptic evaluation's time [µs].
   void evaluation(double us) { evaluation_us_.push_back(us); }
   /// One user's force at one sample: `held` (what the client outputs) against the

@@ -44,6 +44,7 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       // B truncation leaves held nodes out of the IR: a client could not condense without them.
       compliance_rows_(options.compliance_rows && ir_build_options(model.scene.haptic).boundary_truncation == 0),
       rows_senders_(static_cast<std::size_t>(simulation_.user_count())),
+      ir_streams_(static_cast<std::size_t>(simulation_.user_count())),
       rows_objects_(static_cast<std::size_t>(simulation_.user_count()), -1),
       joins_seen_(static_cast<std::size_t>(simulation_.user_count()), 0),
       node_of_tag_(model.bodies.size()) {
@@ -119,8 +120,13 @@ std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox, std::
     IntermediateRepresentation ir = prepared->ir;
     const bool rows = to_compliance_rows(ir, user);
     wire::Control control;
-    *control.mutable_ir() = wire::to_wire(ir);
-    bytes += control.ir().ByteSizeLong();
+    if (rows) {  // in the user's stream, which starts afresh with the rows
+      const bool fresh = std::get<CondensedFemIr>(ir.body).compliance_rows->generation == 1;
+      *control.mutable_compressed_ir() = ir_streams_[static_cast<std::size_t>(user)].compress(wire::to_wire(ir), fresh);
+    } else {
+      *control.mutable_ir() = wire::to_wire(ir);
+    }
+    bytes += rows ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
     outbox.irs.push_back({user, std::move(control), rows});
     ++sent;
   }

@@ -41,6 +41,7 @@
 #include "common/model/model.h"
 #include "common/sim/scene_simulation.h"
 #include "proto/record/session_recorder.h"
+#include "proto/wire/ir_stream.h"
 #include "server/compliance_prefetch.h"
 #include "server/display_writer.h"
 #include "view/live_view.h"
@@ -119,10 +120,12 @@ class SimulationLoop {
   std::vector<view::ToolState> view_tools_;      // this step's tools, for the view
   std::vector<Eigen::Vector3d> view_forces_;     // per user, for the view [N]
   // Compliance rows: what each user's client holds (restarted when a new user takes the
-  // slot), and per body the mesh node of each node tag.
+  // slot), the zstd stream they travel in (proto/wire/ir_stream.h: afresh with the rows),
+  // and per body the mesh node of each node tag.
   const Model& model_;
   bool compliance_rows_;
   std::vector<ComplianceRowsSender> rows_senders_;
+  std::vector<wire::IrStreamWriter> ir_streams_;
   std::vector<int> rows_objects_;  // per user: the body its held rows are of
   std::vector<std::uint64_t> joins_seen_;
   std::vector<std::unordered_map<std::int64_t, int>> node_of_tag_;

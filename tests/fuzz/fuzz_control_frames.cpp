@@ -20,7 +20,9 @@
 //   - a message yielded after it has our protocol version, a body, and a sequence number
 //     above the previous one;
 //   - the client's checks of a Welcome and its surface mesh, and the conversion of an IR
-//     (proto/wire/ir_convert.h) either accept or throw cohaptic::Error: nothing else escapes.
+//     (proto/wire/ir_convert.h), plain or taken out of the stream's compressed IR blocks
+//     (proto/wire/ir_stream.h, one reader for the stream), either accept or throw
+//     cohaptic::Error: nothing else escapes.
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -31,6 +33,7 @@
 #include "proto/wire/frame_codec.h"
 #include "proto/wire/header.h"
 #include "proto/wire/ir_convert.h"
+#include "proto/wire/ir_stream.h"
 #include "proto/wire/surface_mesh_message.h"
 #include "tests/fuzz/fuzz_support.h"
 
@@ -89,13 +92,15 @@ bool same(const Outcome& a, const Outcome& b) {
 }
 
 // What the client does with a frame's content before anything else sees it.
-void check_content(const wire::Control& control) {
+void check_content(const wire::Control& control, wire::IrStreamReader& ir_stream) {
   try {
     if (control.has_welcome()) {
       welcome_info(control.welcome());
       wire::from_wire(control.welcome().surface());
     } else if (control.has_ir()) {
       wire::from_wire(control.ir());
+    } else if (control.has_compressed_ir()) {
+      wire::from_wire(ir_stream.open(control.compressed_ir()));
     }
   } catch (const Error&) {
     // Refused with a message: what a hostile or broken peer should get.
@@ -129,6 +134,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   require(same(whole, read_in_chunks(stream, chunks)), "reads of any size read the same frames as the whole stream");
 
   std::optional<std::uint64_t> previous;
+  wire::IrStreamReader ir_stream;
   for (std::size_t i = 0; i < whole.messages.size(); ++i) {
     const wire::Control& control = whole.messages[i];
     if (i == 0) {
@@ -140,7 +146,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     require(control.body_case() != wire::Control::BODY_NOT_SET, "a frame read has a body");
     require(!previous || control.header().sequence() > *previous, "sequence numbers increase");
     previous = control.header().sequence();
-    check_content(control);
+    check_content(control, ir_stream);
   }
   return 0;
 }

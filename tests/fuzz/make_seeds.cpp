@@ -32,6 +32,7 @@
 #include "proto/wire/frame_codec.h"
 #include "proto/wire/header.h"
 #include "proto/wire/ir_convert.h"
+#include "proto/wire/ir_stream.h"
 #include "tests/fuzz/fuzz_support.h"
 
 namespace {
@@ -169,6 +170,17 @@ void control_seeds(const record::Recording& client, const std::vector<wire::Inte
   wire::Control patch = control(session, server, 2);
   *patch.mutable_ir() = mass_spring_ir;
   write_seed(out, "ir_mass_spring", pieces({bytes_of(patch)}));
+
+  // Compressed IR blocks (proto/wire/ir_stream.h): a stream's first two, then one out of turn.
+  wire::IrStreamWriter ir_stream;
+  std::vector<std::vector<std::uint8_t>> compressed;
+  for (std::uint64_t k = 0; k < 3; ++k) {
+    wire::Control block = control(session, server, 2 + k);
+    *block.mutable_compressed_ir() = ir_stream.compress(irs[std::min<std::size_t>(k, irs.size() - 1)], k == 0);
+    if (k == 2) block.mutable_compressed_ir()->set_index(7);
+    compressed.push_back(bytes_of(block));
+  }
+  write_seed(out, "ir_compressed_stream", pieces(compressed));
 
   std::vector<std::vector<std::uint8_t>> stream{bytes_of(welcome), bytes_of(ir)};
   std::uint64_t sequence = 3;

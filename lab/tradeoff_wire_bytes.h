@@ -1,0 +1,41 @@
+// TradeoffWireBytes: the bytes a trade-off run's IRs take on the wire, as the server sends
+// them (server/simulation_loop.cpp): a condensed FEM IR in the compliance rows form
+// (common/ir/compliance_rows.h: the rows of L for the nodes the user's client does not hold
+// yet instead of M~, one ComplianceRowsSender per user) compressed in the user's IR stream
+// (proto/wire/ir_stream.h), unless B truncation leaves held nodes out (the server then sends
+// M~ whole, uncompressed); counted as the protobuf message's size (what the server's
+// ir_bytes_sent counts). Bytes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "common/fem/compliance_source.h"
+#include "common/ir/compliance_rows_sender.h"
+#include "common/ir/intermediate_representation.h"
+#include "common/model/elastic_body.h"
+#include "proto/wire/ir_stream.h"
+
+namespace cohaptic {
+
+class TradeoffWireBytes {
+ public:
+  /// `rows`: send compliance rows (false: M~ whole, as with B truncation). `body` and
+  /// `columns` outlive this.
+  TradeoffWireBytes(const ElasticBody& body, ComplianceSource& columns, std::size_t users, bool rows);
+  /// The wire bytes of `ir`, published to `user` (0 .. users - 1) after the IRs counted
+  /// before for that user.
+  std::size_t published(const IntermediateRepresentation& ir, std::size_t user);
+
+ private:
+  const ElasticBody& body_;
+  ComplianceSource& columns_;
+  std::vector<ComplianceRowsSender> senders_;
+  std::vector<wire::IrStreamWriter> streams_;
+  std::unordered_map<std::int64_t, int> node_of_tag_;
+  bool rows_;
+};
+
+}  // namespace cohaptic
