@@ -35,6 +35,7 @@
 #include "common/ir/client_condensation.h"
 #include "common/ir/evaluate_force.h"
 #include "proto/wire/ir_convert.h"
+#include "proto/wire/ir_stream.h"
 #include "proto/wire/header.h"
 #include "server/simulation_loop.h"
 #include "server/step_failures.h"
@@ -182,11 +183,16 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
     ASSERT_FALSE(outboxes.empty());
     ASSERT_EQ(outboxes.front().irs.size(), 1u);
     EXPECT_EQ(outboxes.front().irs[0].slot, 0);
-    EXPECT_TRUE(outboxes.front().irs[0].message.has_ir());
+    // The cube's IRs are compliance rows: they travel in the user's zstd stream.
+    EXPECT_TRUE(outboxes.front().irs[0].message.has_compressed_ir());
+    wire::IrStreamReader stream;
     std::size_t keep_alives = 0, irs = 0, ir_bytes = 0;
     for (const Outbox& outbox : outboxes) {
       irs += outbox.irs.size();
-      for (const auto& ir : outbox.irs) ir_bytes += ir.message.ir().ByteSizeLong();
+      for (const auto& ir : outbox.irs) {
+        ir_bytes += ir.message.compressed_ir().ByteSizeLong();
+        EXPECT_EQ(stream.open(ir.message.compressed_ir()).fem().rows_generation(), ir.message.compressed_ir().index());
+      }
       for (const auto& datagram : outbox.datagrams) {
         EXPECT_EQ(datagram.slot, 0);
         keep_alives += datagram.message.has_keep_alive();
@@ -199,8 +205,9 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
 }
 
 // P1 sends a condensed FEM IR as compliance rows, generation 1 first, as a must-arrive
-// frame; a new user of the slot starts at generation 1 again, even when the old one left
-// and the new one joined between two steps. A client completes each.
+// frame in the user's zstd stream; a new user of the slot starts at generation 1 again, and
+// a stream of its own, even when the old one left and the new one joined between two steps.
+// A client opens and completes each.
 TEST(SimulationLoop, SendsComplianceRowsAndStartsEachNewUserOfASlotAfresh) {
   LoopRig rig(0, ServeProtocol::p1);
   SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
@@ -214,23 +221,32 @@ TEST(SimulationLoop, SendsComplianceRowsAndStartsEachNewUserOfASlotAfresh) {
     ADD_FAILURE() << "no IR in 20 steps";
     return ToSlot<wire::Control>{};
   };
+  wire::IrStreamReader stream;
+  const auto open = [&stream](const ToSlot<wire::Control>& sent) {
+    EXPECT_TRUE(sent.message.has_compressed_ir());
+    return stream.open(sent.message.compressed_ir());
+  };
   const ToSlot<wire::Control> first = first_ir(Eigen::Vector3d(0.003, 0.002, -0.002), 2);
   EXPECT_TRUE(first.must_arrive);
-  EXPECT_EQ(first.message.ir().fem().rows_generation(), 1u);
+  const wire::IntermediateRepresentation first_sent = open(first);
+  EXPECT_EQ(first_sent.fem().rows_generation(), 1u);
   const ToSlot<wire::Control> second = first_ir(Eigen::Vector3d(-0.03, 0.02, -0.002), 3);
-  EXPECT_EQ(second.message.ir().fem().rows_generation(), 2u);
+  const wire::IntermediateRepresentation second_sent = open(second);
+  EXPECT_EQ(second_sent.fem().rows_generation(), 2u);
   ClientCondensation client;
-  for (const ToSlot<wire::Control>* sent : {&first, &second}) {
-    IntermediateRepresentation ir = wire::from_wire(sent->message.ir());
+  for (const wire::IntermediateRepresentation* sent : {&first_sent, &second_sent}) {
+    IntermediateRepresentation ir = wire::from_wire(*sent);
     client.complete(condensed_fem(ir));
     EXPECT_NO_THROW(prepare_ir(ir));
   }
   rig.tools.release(0);
   rig.tools.join(0);
   const ToSlot<wire::Control> again = first_ir(Eigen::Vector3d(0.02, -0.02, -0.002), 1);
-  EXPECT_EQ(again.message.ir().fem().rows_generation(), 1u) << "the new user holds nothing";
+  EXPECT_EQ(again.message.compressed_ir().index(), 1u) << "the new user's stream starts afresh";
+  const wire::IntermediateRepresentation again_sent = open(again);
+  EXPECT_EQ(again_sent.fem().rows_generation(), 1u) << "the new user holds nothing";
   ClientCondensation newcomer;
-  IntermediateRepresentation ir = wire::from_wire(again.message.ir());
+  IntermediateRepresentation ir = wire::from_wire(again_sent);
   newcomer.complete(condensed_fem(ir));
   EXPECT_NO_THROW(prepare_ir(ir));
 }

@@ -6,8 +6,8 @@
 // the distance beyond: the cells keep the same size relative to their distance from the
 // contact, the grading a point-like load's field asks for (its strains fall off with the
 // distance). A box mesh's tensor-product grading spends most of its nodes on fine columns
-// far from the contact; this one does not (20,811 nodes hold the contact as finely as the
-// 40-cell box's 68,921).
+// far from the contact; this one does not (the coarse block's 20,767 nodes hold the contact
+// as finely as the 40-cell box's 68,921).
 //
 // The build meshes it twice (CMakeLists.txt: build/scenes/hertz/quarter_block_{coarse,fine}.msh):
 //   gmsh quarter_block.geo -3 -nt 1 -setnumber fine 0.03 -setnumber growth 0.07 -o quarter_block_coarse.msh
