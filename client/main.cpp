@@ -12,6 +12,7 @@
 #include "client/timer_floors.h"
 #include "common/net/host_port.h"
 #include "common/util/atomic_file.h"
+#include "common/util/blas_threads.h"
 #include "common/util/error.h"
 #include "common/util/log_to_stderr.h"
 
@@ -68,6 +69,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));
+  // The I/O thread condenses compliance rows through BLAS: on one thread it neither competes
+  // with the haptic loop for the cores nor rounds differently from `replay --verify`.
+  cohaptic::use_single_blas_thread();
 
   try {
     if (const std::string problem = cohaptic::parse_host_port(server, options.host, options.port, false); !problem.empty()) {
