@@ -10,7 +10,10 @@
 //     stopped reading and the connection closes (CloseCause::write_queue_full). A frame
 //     that the kernel has not taken within the write timeout (its buffers are full: the
 //     peer stopped reading, even if only newest-wins frames wait) closes it too
-//     (CloseCause::write_stalled).
+//     (CloseCause::write_stalled). So does a peer whose TCP has acknowledged nothing for
+//     twice the write timeout while bytes the kernel took wait for it (the kernel's count
+//     of unacknowledged bytes, polled): small frames fit in the kernel's buffers for
+//     minutes, and a peer that stopped reading them would otherwise hold its slot as long.
 //   - on_close is called once, on the I/O thread but never from inside send() or close(),
 //     when the peer closes, an I/O error happens, a frame is rejected, the queue overflows
 //     or a write stalls. close() by the owner calls nothing. After either, the handlers
@@ -83,6 +86,9 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
  private:
   void read_next();
   void write_next();
+  /// Starts polling the kernel's unacknowledged bytes, if not already (after a write).
+  void watch_delivery();
+  void check_delivery();
   /// Closes and tells the owner (once), later on the I/O thread.
   void fail(CloseCause cause, std::string why);
 
@@ -93,6 +99,11 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
   asio::steady_timer write_timer_;  ///< runs while a write is in flight
   std::chrono::milliseconds write_timeout_;
   std::uint64_t writes_started_ = 0;
+  asio::steady_timer delivery_timer_;  ///< runs while written bytes wait for the peer's acknowledgement
+  std::uint64_t bytes_written_ = 0;       ///< taken by the kernel, since the start
+  std::uint64_t bytes_acknowledged_ = 0;  ///< by the peer's TCP, as last polled
+  std::chrono::steady_clock::time_point acknowledged_at_;  ///< when that count last grew
+  bool watching_delivery_ = false;
   std::optional<wire::Rejection> rejection_;
   std::array<std::uint8_t, kReadBufferBytes> buffer_{};
   std::string peer_;

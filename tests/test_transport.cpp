@@ -18,9 +18,13 @@
 //     the order of a burst: timers due at one instant, or run late, never swap two frames.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <asio.hpp>
 #include <chrono>
+#include <functional>
 #include <map>
+#include <memory>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
@@ -310,6 +314,58 @@ TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWin
   EXPECT_NE(why.find("the peer stopped reading"), std::string::npos) << why;
   EXPECT_GE(std::chrono::steady_clock::now() - started, kTimeout) << "closed before any write could have stalled that long";
   EXPECT_LE(sender->frames_waiting(), kMaxWaitingFrames);
+}
+
+// Small must-arrive frames, which the kernel's buffers take for minutes: the connection
+// stays open while the peer reads, however slowly, and closes as stalled once its TCP has
+// acknowledged nothing for twice the write timeout, though no write ever waited.
+TEST(FramedConnection, ClosesWhenThePeerStopsTakingFramesThatTheKernelStillTakes) {
+  const wire::TrafficKey key = test_key();
+  TcpPair pair(4096);  // the peer's kernel takes a few frames, then acknowledges nothing unread
+  std::optional<CloseCause> cause;
+  std::string why;
+  FramedConnection::Handlers handlers;
+  handlers.on_control = [](const wire::Control&) {};
+  handlers.on_close = [&](CloseCause c, const std::string& w) {
+    cause = c;
+    why = w;
+  };
+  constexpr auto kTimeout = 200ms;
+  auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers), kTimeout);
+  wire::FrameSealer sealer(key, kTransportSession, 0);
+  // The peer reads in pieces of 512 bytes, one every 10 ms: its TCP acknowledges as it goes.
+  bool reading = true;
+  std::array<std::uint8_t, 512> sink{};
+  std::function<void()> read_a_little = [&] {
+    if (!reading) return;
+    pair.client.async_read_some(asio::buffer(sink), [&](std::error_code error, std::size_t) {
+      if (error) return;
+      auto pause = std::make_shared<asio::steady_timer>(pair.io, 10ms);
+      pause->async_wait([&, pause](std::error_code) { read_a_little(); });
+    });
+  };
+  read_a_little();
+  const auto send_for = [&](std::chrono::milliseconds span) {
+    const auto end = std::chrono::steady_clock::now() + span;
+    while (!cause && std::chrono::steady_clock::now() < end) {
+      wire::Control control = event("ir", std::string(500, 'r'));
+      sender->send(sealer.seal(control), FrameKind::must_arrive);
+      pair.io.restart();
+      pair.io.run_for(20ms);
+    }
+  };
+  send_for(8 * kTimeout);
+  EXPECT_FALSE(cause) << "closed while the peer read: " << why;
+  EXPECT_LE(sender->frames_waiting(), 2u) << "the kernel took the frames";
+
+  reading = false;  // the read in flight completes; no other follows
+  const auto stopped = std::chrono::steady_clock::now();
+  send_for(20 * kTimeout);
+  ASSERT_TRUE(cause) << "still open after " << 20 * kTimeout.count() << " ms";
+  EXPECT_EQ(*cause, CloseCause::write_stalled);
+  EXPECT_NE(why.find("the peer stopped reading"), std::string::npos) << why;
+  EXPECT_GE(std::chrono::steady_clock::now() - stopped, 2 * kTimeout);
+  EXPECT_LT(sender->frames_waiting(), kMaxWaitingFrames) << "closed for the kernel's count, not the queue";
 }
 
 // ---- the UDP endpoint ----
