@@ -285,27 +285,40 @@ TEST(FramedConnection, ClosesWhenFramesThatMustArrivePileUpUnread) {
 }
 
 
+// A connection started on `pair.server` with `write_timeout`, keeping why it closed.
+struct WatchedSender {
+  std::optional<CloseCause> cause;
+  std::string why;
+  std::shared_ptr<FramedConnection> connection;
+  WatchedSender(TcpPair& pair, const wire::TrafficKey& key, std::chrono::milliseconds write_timeout) {
+    FramedConnection::Handlers handlers;
+    handlers.on_control = [](const wire::Control&) {};
+    handlers.on_close = [this](CloseCause c, const std::string& w) {
+      cause = c;
+      why = w;
+    };
+    connection = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers), write_timeout);
+  }
+  WatchedSender(const WatchedSender&) = delete;  // the handler holds `this`
+  WatchedSender& operator=(const WatchedSender&) = delete;
+};
+
 TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWinsFramesWaiting) {
   const wire::TrafficKey key = test_key();
   TcpPair pair(64 * 1024);
   pair.server.set_option(asio::socket_base::send_buffer_size(64 * 1024));
-  std::optional<CloseCause> cause;
-  std::string why;
-  FramedConnection::Handlers handlers;
-  handlers.on_control = [](const wire::Control&) {};
-  handlers.on_close = [&](CloseCause c, const std::string& w) {
-    cause = c;
-    why = w;
-  };
   constexpr auto kTimeout = 300ms;
-  auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers), kTimeout);
+  WatchedSender watched(pair, key, kTimeout);
+  const std::optional<CloseCause>& cause = watched.cause;
+  const std::string& why = watched.why;
+  FramedConnection& sender = *watched.connection;
   wire::FrameSealer sealer(key, kTransportSession, 0);
   const std::string payload(100'000, 'i');
   const auto started = std::chrono::steady_clock::now();
   // Newest-wins frames only, which the queue may always drop: without the timeout it would never close.
   while (!cause && std::chrono::steady_clock::now() - started < 10s) {
     wire::Control control = event("ir", payload);
-    sender->send(sealer.seal(control), FrameKind::newest_wins);
+    sender.send(sealer.seal(control), FrameKind::newest_wins);
     pair.io.restart();
     pair.io.run_for(20ms);
   }
@@ -313,7 +326,7 @@ TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWin
   EXPECT_EQ(*cause, CloseCause::write_stalled);
   EXPECT_NE(why.find("the peer stopped reading"), std::string::npos) << why;
   EXPECT_GE(std::chrono::steady_clock::now() - started, kTimeout) << "closed before any write could have stalled that long";
-  EXPECT_LE(sender->frames_waiting(), kMaxWaitingFrames);
+  EXPECT_LE(sender.frames_waiting(), kMaxWaitingFrames);
 }
 
 // Small must-arrive frames, which the kernel's buffers take for minutes: the connection
@@ -322,16 +335,11 @@ TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWin
 TEST(FramedConnection, ClosesWhenThePeerStopsTakingFramesThatTheKernelStillTakes) {
   const wire::TrafficKey key = test_key();
   TcpPair pair(4096);  // the peer's kernel takes a few frames, then acknowledges nothing unread
-  std::optional<CloseCause> cause;
-  std::string why;
-  FramedConnection::Handlers handlers;
-  handlers.on_control = [](const wire::Control&) {};
-  handlers.on_close = [&](CloseCause c, const std::string& w) {
-    cause = c;
-    why = w;
-  };
   constexpr auto kTimeout = 200ms;
-  auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers), kTimeout);
+  WatchedSender watched(pair, key, kTimeout);
+  const std::optional<CloseCause>& cause = watched.cause;
+  const std::string& why = watched.why;
+  FramedConnection& sender = *watched.connection;
   wire::FrameSealer sealer(key, kTransportSession, 0);
   // The peer reads in pieces of 512 bytes, one every 10 ms: its TCP acknowledges as it goes.
   bool reading = true;
@@ -349,14 +357,14 @@ TEST(FramedConnection, ClosesWhenThePeerStopsTakingFramesThatTheKernelStillTakes
     const auto end = std::chrono::steady_clock::now() + span;
     while (!cause && std::chrono::steady_clock::now() < end) {
       wire::Control control = event("ir", std::string(500, 'r'));
-      sender->send(sealer.seal(control), FrameKind::must_arrive);
+      sender.send(sealer.seal(control), FrameKind::must_arrive);
       pair.io.restart();
       pair.io.run_for(20ms);
     }
   };
   send_for(8 * kTimeout);
   EXPECT_FALSE(cause) << "closed while the peer read: " << why;
-  EXPECT_LE(sender->frames_waiting(), 2u) << "the kernel took the frames";
+  EXPECT_LE(sender.frames_waiting(), 2u) << "the kernel took the frames";
 
   reading = false;  // the read in flight completes; no other follows
   const auto stopped = std::chrono::steady_clock::now();
@@ -365,7 +373,7 @@ TEST(FramedConnection, ClosesWhenThePeerStopsTakingFramesThatTheKernelStillTakes
   EXPECT_EQ(*cause, CloseCause::write_stalled);
   EXPECT_NE(why.find("the peer stopped reading"), std::string::npos) << why;
   EXPECT_GE(std::chrono::steady_clock::now() - stopped, 2 * kTimeout);
-  EXPECT_LT(sender->frames_waiting(), kMaxWaitingFrames) << "closed for the kernel's count, not the queue";
+  EXPECT_LT(sender.frames_waiting(), kMaxWaitingFrames) << "closed for the kernel's count, not the queue";
 }
 
 // ---- the UDP endpoint ----
