@@ -96,6 +96,18 @@ std::size_t free_dofs(const std::string& fixed_axes, std::size_t first, std::siz
   return count;
 }
 
+/// One byte per node, each a mask of x, y, z (`what`: the field, for the message).
+std::vector<AxisMask> read_fixed_axes(const std::string& bytes, const char* what) {
+  std::vector<AxisMask> masks;
+  masks.reserve(bytes.size());
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    const auto mask = static_cast<AxisMask>(bytes[i]);
+    if (mask & ~kAllAxes) invalid("{} of node {} is 0x{:02x}, not a mask of x, y, z", what, i, static_cast<unsigned>(mask));
+    masks.push_back(mask);
+  }
+  return masks;
+}
+
 /// `values` (f64 or f32 on the wire) into doubles, each finite.
 template <typename Field, typename Target>
 void read_values(const Field& values, Target& out, const char* what) {
@@ -279,12 +291,7 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   if (w.patch_node_count() > w.row_node_count())
     invalid("patch_node_count {} exceeds row_node_count {}", w.patch_node_count(), w.row_node_count());
   ir.node_ids.assign(w.node_ids().begin(), w.node_ids().end());
-  ir.fixed_axes.reserve(nodes);
-  for (std::uint32_t i = 0; i < nodes; ++i) {
-    const auto mask = static_cast<AxisMask>(w.fixed_axes()[i]);
-    if (mask & ~kAllAxes) invalid("fixed_axes of node {} is 0x{:02x}, not a mask of x, y, z", i, static_cast<unsigned>(mask));
-    ir.fixed_axes.push_back(mask);
-  }
+  ir.fixed_axes = read_fixed_axes(w.fixed_axes(), "fixed_axes");
   ir.row_node_count = static_cast<int>(w.row_node_count());
   ir.patch_node_count = static_cast<int>(w.patch_node_count());
   ir.rest_positions = read_xyz(w.rest_positions(), w.row_node_count(), "rest_positions");
@@ -355,12 +362,7 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   if (w.truncated_fixed_axes().size() != truncated)
     invalid("{} truncated_fixed_axes bytes for {} truncated held nodes", w.truncated_fixed_axes().size(), truncated);
   ir.truncated_node_ids.assign(w.truncated_node_ids().begin(), w.truncated_node_ids().end());
-  for (std::uint32_t i = 0; i < truncated; ++i) {
-    const auto mask = static_cast<AxisMask>(w.truncated_fixed_axes()[i]);
-    if (mask & ~kAllAxes)
-      invalid("truncated_fixed_axes of node {} is 0x{:02x}, not a mask of x, y, z", i, static_cast<unsigned>(mask));
-    ir.truncated_fixed_axes.push_back(mask);
-  }
+  ir.truncated_fixed_axes = read_fixed_axes(w.truncated_fixed_axes(), "truncated_fixed_axes");
   const std::uint64_t row_cols = w.m_cols() + free_dofs(w.truncated_fixed_axes(), 0, truncated);
   const std::uint64_t row_values = std::uint64_t{w.compliance_row_count()} * row_cols;
   if (!rows_form && (w.compliance_row_count() > 0 || w.compliance_rows_size() > 0))
