@@ -50,6 +50,7 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
   row.recording = recording.string();
   if (!frames.empty()) std::filesystem::create_directories(frames);
   std::optional<wire::IntermediateRepresentation> previous;
+  std::unordered_set<std::int64_t> previous_truncated;  // the held nodes it left out (B truncation)
   std::int64_t first_ns = 0, last_ns = 0;
   std::vector<double> client_us, completed_us;
   ClientCondensation client;
@@ -72,6 +73,8 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
     // measured against its whole-M~ form, "sent" is what came.
     wire::IntermediateRepresentation ir = recorded.ir();
     const std::string bytes = ir.SerializeAsString();
+    // B truncation: held nodes the IR leaves out, which the client condenses over too.
+    const std::vector<std::int64_t> truncated(ir.fem().truncated_node_ids().begin(), ir.fem().truncated_node_ids().end());
     if (ir.fem().rows_generation() > 0) {
       IntermediateRepresentation completed = wire::from_wire(ir);
       const double start_us = thread_cpu_us();
@@ -119,11 +122,18 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
         same_nodes ? std::min(m_bytes, 12.0 * static_cast<double>(changed_entries(previous->fem().m_tilde_f64(), fem.m_tilde_f64())))
                    : m_bytes;
     row.delta_bytes += rest + delta_m;
-    row.rows_bytes += rest + value_bytes * compliance_row_values(nodes, added);
+    // Rows go to every node the client holds: with B truncation the left-out ones too.
+    double held_added = 0;
+    const auto count_new = [&](std::int64_t id) { held_added += had.contains(id) || previous_truncated.contains(id) ? 0 : 1; };
+    std::for_each(fem.node_ids().begin(), fem.node_ids().end(), count_new);
+    std::for_each(truncated.begin(), truncated.end(), count_new);
+    row.rows_bytes += rest + value_bytes * compliance_row_values(nodes + static_cast<double>(truncated.size()), held_added);
 
     const CondensedFemIr& sent = condensed_fem(received);
+    std::vector<std::int64_t> held = sent.node_ids;
+    held.insert(held.end(), truncated.begin(), truncated.end());
     std::vector<int> mesh_nodes;
-    for (const std::int64_t tag : sent.node_ids) {
+    for (const std::int64_t tag : held) {
       const auto found = node_of_tag.find(tag);
       if (found == node_of_tag.end() || columns.row_position(found->second) < 0)
         throw Error(fmt::format("ir-bytes: {}: IR epoch {} has node {}, which is no surface node of the scene's body",
@@ -139,17 +149,19 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
     const CondensedOperator op = naive_condensation(columns, body.dofs, std::span(mesh_nodes).first(contact),
                                                     std::span(mesh_nodes).subspan(contact));
     client_us.push_back(thread_cpu_us() - start_us);
-    Eigen::MatrixXd condensed(op.m_cc.rows(), op.m_cc.cols() + op.m_cb.cols());
-    condensed << op.m_cc, op.m_cb;
-    if (condensed.rows() != sent.m_tilde.rows() || condensed.cols() != sent.m_tilde.cols())
-      throw Error(fmt::format("ir-bytes: {}: IR epoch {}: its M~ is {} x {}, its free dofs give {} x {} (boundary truncation "
-                              "is not measured)",
-                              recording.string(), ir.epoch(), sent.m_tilde.rows(), sent.m_tilde.cols(), condensed.rows(),
-                              condensed.cols()));
+    // The truncated nodes' columns (the last ones) are dropped, as the client drops them.
+    const Eigen::Index kept_columns = sent.m_tilde.cols() - op.m_cc.cols();
+    if (sent.m_tilde.rows() != op.m_cc.rows() || kept_columns < 0 || kept_columns > op.m_cb.cols())
+      throw Error(fmt::format("ir-bytes: {}: IR epoch {}: its M~ is {} x {}, its free dofs give {} x {} and {} held",
+                              recording.string(), ir.epoch(), sent.m_tilde.rows(), sent.m_tilde.cols(), op.m_cc.rows(),
+                              op.m_cc.cols(), op.m_cb.cols()));
+    Eigen::MatrixXd condensed(op.m_cc.rows(), op.m_cc.cols() + kept_columns);
+    condensed << op.m_cc, op.m_cb.leftCols(kept_columns);
     row.rows_m_tilde_difference = std::max(row.rows_m_tilde_difference, (condensed - sent.m_tilde).cwiseAbs().maxCoeff() /
                                                                              sent.m_tilde.cwiseAbs().maxCoeff());
 
     previous = std::move(ir);
+    previous_truncated = std::unordered_set<std::int64_t>(truncated.begin(), truncated.end());
     ++row.irs;
   }
   if (row.irs == 0) throw Error(fmt::format("ir-bytes: {} holds no condensed FEM IR", recording.string()));

@@ -126,6 +126,19 @@ std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector
   return grid;
 }
 
+std::vector<TradeoffSetting> only_knobs(const std::vector<TradeoffSetting>& grid,
+                                        const std::vector<std::string>& knobs) {
+  if (knobs.empty()) return grid;
+  for (const std::string& knob : knobs)
+    if (std::none_of(grid.begin(), grid.end(), [&](const TradeoffSetting& s) { return s.knob == knob; }))
+      throw Error(fmt::format("--knob {}: this scene's grid has no setting of that knob", knob));
+  std::vector<TradeoffSetting> only;
+  for (const TradeoffSetting& setting : grid)
+    if (setting.knob == "baseline" || std::find(knobs.begin(), knobs.end(), setting.knob) != knobs.end())
+      only.push_back(setting);
+  return only;
+}
+
 Scene scene_with(const Scene& scene, const TradeoffSetting& setting) {
   Scene out = scene;
   ElasticObjectSpec& object = single_elastic_object(out);
@@ -233,8 +246,8 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
   std::vector<Eigen::Vector3d> held(users, Eigen::Vector3d::Zero());
   std::vector<Eigen::Vector3d> remotes;
   TradeoffTally tally;
-  // As the server: compliance rows unless B truncation leaves held nodes out of the IR.
-  TradeoffWireBytes wire_bytes(body, columns, users, options.ir.boundary_truncation == 0);
+  // As the server: compliance rows, B truncation or not.
+  TradeoffWireBytes wire_bytes(body, columns, users);
   const std::size_t samples = reference.positions.size();
   for (std::size_t j = 0; j < samples; ++j) {
     const double t = static_cast<double>(j) / reference.sample_rate_hz;
@@ -439,6 +452,8 @@ int run_tradeoff(const TradeoffOptions& options) {
   // rate must divide the comparison grid.
   samples_per(options.sample_rate_hz, kSimulationRateHz, "simulation rate");
   samples_per(options.sample_rate_hz, scene.haptic.rate_hz, "scene's haptic rate");
+  const std::vector<TradeoffSetting> grid = only_knobs(tradeoff_grid(scene, options.divisions, options.sample_rate_hz),
+                                                      options.knobs);
   TradeoffSetting reference_setting = tradeoff_grid(scene, {}).front();
   if (single_elastic_object(scene).mesh.box) reference_setting.divisions = options.reference_divisions;
   const Scene reference_scene =
@@ -457,7 +472,6 @@ int run_tradeoff(const TradeoffOptions& options) {
                reference.nodes, reference.tets, reference.positions.size(), reference.factorisations,
                reference.peak_force, reference.seconds);
 
-  const std::vector<TradeoffSetting> grid = tradeoff_grid(scene, options.divisions, options.sample_rate_hz);
   std::vector<TradeoffRow> rows;
   for (std::size_t i = 0; i < grid.size(); ++i) {
     const Stopwatch watch;
@@ -502,6 +516,9 @@ LabCommand add_tradeoff_command(CLI::App& lab) {
                       "The comparison grid; haptic rates that do not divide it are left out")
       ->capture_default_str()
       ->check(CLI::Range(1000.0, 100000.0));
+  command->add_option("--knob", options->knobs,
+                      "Measure only the baseline and this knob's settings (repeat; e.g. boundary_truncation; default: "
+                      "every knob)");
   return {command, [options] { return run_tradeoff(*options); }};
 }
 

@@ -57,6 +57,11 @@ struct TradeoffSetting {
 std::vector<TradeoffSetting> tradeoff_grid(const Scene& scene, const std::vector<int>& divisions,
                                            double sample_rate_hz = 10000);
 
+/// The baseline and the settings of `knobs` in `grid` (all of it if `knobs` is empty);
+/// throws Error naming a knob the grid has no setting of.
+std::vector<TradeoffSetting> only_knobs(const std::vector<TradeoffSetting>& grid,
+                                        const std::vector<std::string>& knobs);
+
 /// The scene with a setting applied (mesh divisions, element, contact model, patch rings,
 /// B truncation, haptic rate; the disk cache off, so precompute is measured).
 Scene scene_with(const Scene& scene, const TradeoffSetting& setting);
@@ -114,6 +119,8 @@ struct TradeoffOptions {
   /// Mesh-file scenes: the same geometry on a finer mesh (empty: the scene itself).
   std::filesystem::path reference_scene;
   double sample_rate_hz = 10000;  ///< the comparison grid; every haptic rate measured divides it
+  /// Measure only the baseline and the settings of these knobs (TradeoffSetting::knob); empty: all.
+  std::vector<std::string> knobs;
 };
 
 /// Writes DIR/tradeoff.csv, DIR/tradeoff.md and DIR/pareto_cpu.svg, DIR/pareto_bytes.svg;

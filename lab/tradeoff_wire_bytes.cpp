@@ -4,20 +4,19 @@
 
 namespace cohaptic {
 
-TradeoffWireBytes::TradeoffWireBytes(const ElasticBody& body, ComplianceSource& columns, std::size_t users, bool rows)
-    : body_(body), columns_(columns), senders_(users), streams_(users), rows_(rows) {
+TradeoffWireBytes::TradeoffWireBytes(const ElasticBody& body, ComplianceSource& columns, std::size_t users)
+    : body_(body), columns_(columns), senders_(users), streams_(users) {
   for (std::size_t node = 0; node < body.mesh.node_tags.size(); ++node)
     node_of_tag_.emplace(body.mesh.node_tags[node], static_cast<int>(node));
 }
 
 std::size_t TradeoffWireBytes::published(const IntermediateRepresentation& ir, std::size_t user) {
   const auto* fem = std::get_if<CondensedFemIr>(&ir.body);
-  if (!rows_ || !fem) return wire::to_wire(ir).ByteSizeLong();
+  if (!fem) return wire::to_wire(ir).ByteSizeLong();
   IntermediateRepresentation sent = ir;
   auto& sent_fem = std::get<CondensedFemIr>(sent.body);
   std::vector<int> mesh_nodes;
-  mesh_nodes.reserve(fem->node_ids.size());
-  for (const std::int64_t tag : fem->node_ids) mesh_nodes.push_back(node_of_tag_.at(tag));
+  for (const std::int64_t tag : fem->held_node_ids()) mesh_nodes.push_back(node_of_tag_.at(tag));
   senders_.at(user).convert(sent_fem, mesh_nodes, columns_, body_.dofs);
   return streams_.at(user).compress(wire::to_wire(sent), sent_fem.compliance_rows->generation == 1).ByteSizeLong();
 }

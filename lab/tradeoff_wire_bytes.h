@@ -2,9 +2,9 @@
 // them (server/simulation_loop.cpp): a condensed FEM IR in the compliance rows form
 // (common/ir/compliance_rows.h: the rows of L for the nodes the user's client does not hold
 // yet instead of M~, one ComplianceRowsSender per user) compressed in the user's IR stream
-// (proto/wire/ir_stream.h), unless B truncation leaves held nodes out (the server then sends
-// M~ whole, uncompressed); counted as the protobuf message's size (what the server's
-// ir_bytes_sent counts). Bytes.
+// (proto/wire/ir_stream.h), B truncation or not (a truncated IR lists the held nodes it
+// leaves out); counted as the protobuf message's size (what the server's ir_bytes_sent
+// counts). Bytes.
 #pragma once
 
 #include <cstddef>
@@ -22,9 +22,8 @@ namespace cohaptic {
 
 class TradeoffWireBytes {
  public:
-  /// `rows`: send compliance rows (false: M~ whole, as with B truncation). `body` and
-  /// `columns` outlive this.
-  TradeoffWireBytes(const ElasticBody& body, ComplianceSource& columns, std::size_t users, bool rows);
+  /// `body` and `columns` outlive this.
+  TradeoffWireBytes(const ElasticBody& body, ComplianceSource& columns, std::size_t users);
   /// The wire bytes of `ir`, published to `user` (0 .. users - 1) after the IRs counted
   /// before for that user.
   std::size_t published(const IntermediateRepresentation& ir, std::size_t user);
@@ -35,7 +34,6 @@ class TradeoffWireBytes {
   std::vector<ComplianceRowsSender> senders_;
   std::vector<wire::IrStreamWriter> streams_;
   std::unordered_map<std::int64_t, int> node_of_tag_;
-  bool rows_;
 };
 
 }  // namespace cohaptic

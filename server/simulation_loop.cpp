@@ -41,8 +41,9 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       simulation_(model, columns, model.scene.tools, simulation_options(model, options)),
       view_forces_(static_cast<std::size_t>(simulation_.user_count()), Eigen::Vector3d::Zero()),
       model_(model),
-      // B truncation leaves held nodes out of the IR: a client could not condense without them.
-      compliance_rows_(options.compliance_rows && ir_build_options(model.scene.haptic).boundary_truncation == 0),
+      // Rows whenever asked, B truncation or not: a truncated IR lists the held nodes it leaves
+      // out, and the client condenses over them too (common/ir/compliance_rows.h).
+      compliance_rows_(options.compliance_rows),
       rows_senders_(static_cast<std::size_t>(simulation_.user_count())),
       ir_streams_(static_cast<std::size_t>(simulation_.user_count())),
       rows_objects_(static_cast<std::size_t>(simulation_.user_count()), -1),
@@ -145,8 +146,7 @@ bool SimulationLoop::to_compliance_rows(IntermediateRepresentation& ir, int user
     sender.restart();
   }
   std::vector<int> mesh_nodes;
-  mesh_nodes.reserve(fem->node_ids.size());
-  for (const std::int64_t tag : fem->node_ids) mesh_nodes.push_back(node_of_tag_[object].at(tag));
+  for (const std::int64_t tag : fem->held_node_ids()) mesh_nodes.push_back(node_of_tag_[object].at(tag));
   sender.convert(*fem, mesh_nodes, *columns_[object], body.dofs);
   return true;
 }

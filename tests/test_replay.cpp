@@ -25,12 +25,15 @@ namespace {
 namespace fs = std::filesystem;
 using testing::ChildProcess;
 
-void write_files(const fs::path& dir) {
+// `truncation`: the scene's haptic boundary_truncation.
+void write_files(const fs::path& dir, double truncation) {
   testing::CubeSceneOptions soft;  // forces well under the 3.3 N limit
   soft.divisions = 8;
   soft.youngs_modulus = 2.0e4;
   soft.touchable = "{surface: true}";
-  std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(soft);
+  std::string scene = testing::cube_scene_yaml(soft);
+  if (truncation > 0) scene.replace(scene.find("haptic: {"), 9, fmt::format("haptic: {{boundary_truncation: {}, ", truncation));
+  std::ofstream(dir / "cube.yaml") << scene;
   for (const auto& [name, x] : {std::pair{"a", -20}, std::pair{"b", 20}})
     std::ofstream(dir / (std::string(name) + ".yaml")) << fmt::format(R"(
 units: mm
@@ -46,9 +49,10 @@ segments:
 
 struct RecordedSession {
   fs::path dir;
-  explicit RecordedSession(const std::string& name, const std::vector<std::string>& server_extra = {})
+  explicit RecordedSession(const std::string& name, const std::vector<std::string>& server_extra = {},
+                           double truncation = 0)
       : dir(testing::scratch_directory(name)) {
-    write_files(dir);
+    write_files(dir, truncation);
     std::vector<std::string> args = {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--duration", "30",
                                      "--record", (dir / "server.mcap").string(), "--step-nodes", "40", "--no-disk-cache"};
     args.insert(args.end(), server_extra.begin(), server_extra.end());
@@ -98,6 +102,24 @@ TEST(Replay, ATwoUserSessionVerifiesBitForBit) {
   for (const auto& tick : a_recording.ticks) saw_remote |= tick.remotes_size() > 0 && std::isfinite(tick.remotes(0).x());
   EXPECT_TRUE(saw_remote);
   EXPECT_FALSE(a_recording.truncated);
+}
+
+// With B truncation the client receives compliance rows that list the held nodes left out;
+// its recording keeps them as they came, and the replay completes them again, bit for bit.
+TEST(Replay, ASessionWithBTruncationVerifiesBitForBit) {
+  RecordedSession session("replay-truncation", {"--protocol", "P1"}, 0.2);
+  session.run_one_user("a");
+  const record::Recording a_recording = record::read_recording(session.dir / "a.mcap");
+  std::size_t truncating = 0;
+  for (const record::RecordedIr& ir : a_recording.irs) truncating += ir.ir().fem().truncated_node_ids_size() > 0;
+  EXPECT_GT(truncating, 0u) << "no IR left a held node out";
+  for (const char* file : {"server.mcap", "a.mcap"}) {
+    const VerifyResult result = verify_recording(session.dir / file);
+    EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
+    EXPECT_GT(result.checked, 3u) << file;
+    std::printf("  %s: %zu values re-run, identical (%zu IRs with truncated held nodes)\n", file, result.checked,
+                truncating);
+  }
 }
 
 TEST(Replay, AChangedForceIsFoundAndNamed) {

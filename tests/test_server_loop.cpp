@@ -251,6 +251,36 @@ TEST(SimulationLoop, SendsComplianceRowsAndStartsEachNewUserOfASlotAfresh) {
   EXPECT_NO_THROW(prepare_ir(ir));
 }
 
+// With B truncation too the server sends compliance rows: the IR lists the held nodes it
+// leaves out, and a client completes it over all of them.
+TEST(SimulationLoop, SendsComplianceRowsUnderBTruncation) {
+  LoopRig rig(60);
+  rig.cube.model->scene.haptic.boundary_truncation = 0.2;
+  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
+                      nullptr, nullptr, wire::monotonic_now_ns());
+  std::vector<ToSlot<wire::Control>> sent;
+  for (int step = 0; step < 40 && sent.size() < 2; ++step) {
+    if (step == 20) rig.tools.update(0, true, Eigen::Vector3d(-0.03, 0.02, -0.002), 0, 2, wire::monotonic_now_ns());
+    Outbox outbox = loop.step(wire::monotonic_now_ns());
+    for (ToSlot<wire::Control>& ir : outbox.irs) sent.push_back(std::move(ir));
+  }
+  ASSERT_FALSE(sent.empty());
+  wire::IrStreamReader stream;
+  ClientCondensation client;
+  for (const ToSlot<wire::Control>& ir : sent) {
+    EXPECT_TRUE(ir.must_arrive);
+    ASSERT_TRUE(ir.message.has_compressed_ir()) << "rows travel in the user's stream";
+    const wire::IntermediateRepresentation message = stream.open(ir.message.compressed_ir());
+    const wire::CondensedFem& fem = message.fem();
+    EXPECT_GT(fem.rows_generation(), 0u);
+    EXPECT_GT(fem.truncated_node_ids_size(), 0) << "the step-delay nodes far from the tool are left out";
+    IntermediateRepresentation completed = wire::from_wire(message);
+    client.complete(condensed_fem(completed));
+    EXPECT_EQ(condensed_fem(completed).m_tilde.cols(), static_cast<Eigen::Index>(fem.m_cols()));
+    EXPECT_NO_THROW(prepare_ir(completed));
+  }
+}
+
 // ---- the real server program ----
 
 TEST(ServerProgram, EndsTheSessionWithAnErrorWhenEveryStepFails) {

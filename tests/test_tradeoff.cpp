@@ -121,9 +121,17 @@ TEST(Tradeoff, GridVariesOneKnobAtATimeFromTheScenesOwnSettings) {
   testing::CubeSceneOptions walled;
   walled.obstacles = "{name: wall, plane: {point: [0, 0, 5], normal: [0, 0, -1]}}";
   per_knob.clear();
-  for (const TradeoffSetting& s : tradeoff_grid(parse_scene(testing::cube_scene_yaml(walled), "cube.yaml"), {}))
-    ++per_knob[s.knob];
+  const std::vector<TradeoffSetting> walled_grid =
+      tradeoff_grid(parse_scene(testing::cube_scene_yaml(walled), "cube.yaml"), {});
+  for (const TradeoffSetting& s : walled_grid) ++per_knob[s.knob];
   EXPECT_EQ(per_knob["boundary_truncation"], 3);
+  // --knob: the baseline and that knob's settings only; a knob the grid lacks is refused.
+  const std::vector<TradeoffSetting> truncation = only_knobs(walled_grid, {"boundary_truncation"});
+  ASSERT_EQ(truncation.size(), 4u);
+  EXPECT_EQ(truncation[0].knob, "baseline");
+  for (std::size_t i = 1; i < truncation.size(); ++i) EXPECT_EQ(truncation[i].knob, "boundary_truncation");
+  EXPECT_EQ(only_knobs(walled_grid, {}).size(), walled_grid.size());
+  EXPECT_THROW(only_knobs(grid, {"boundary_truncation"}), Error) << "no obstacle: no truncation setting";
 }
 
 TEST(Tradeoff, ErrorIsMeasuredAgainstTheReferenceNotAgainstItself) {

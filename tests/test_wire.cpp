@@ -1133,7 +1133,7 @@ TEST(WireIr, RoundTripIsBitExactInDouble) {
   ir.force_limit = std::numeric_limits<double>::infinity();  // "no limit" travels too
   fem.m_tilde(0, 0) = std::nextafter(fem.m_tilde(0, 0), 0.0);  // a value float would not keep
   const IntermediateRepresentation wire_ir = to_wire(ir);
-  EXPECT_EQ(wire_ir.format_version(), 3u);
+  EXPECT_EQ(wire_ir.format_version(), 4u);
   const CondensedFem& w = wire_ir.fem();
   EXPECT_EQ(w.m_tilde_f64_size(), fem.m_tilde.size());
   EXPECT_EQ(w.m_tilde_f32_size(), 0);

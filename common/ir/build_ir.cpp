@@ -144,7 +144,8 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
   const CondensedOperator op = condensation.condense(contact_nodes);
 
   // The held nodes the IR carries, with their columns of M_CB: all of them, or with B
-  // truncation only those whose coupling to the contact rows is not negligible.
+  // truncation only those whose coupling to the contact rows is not negligible (the others
+  // are listed apart, for a client that condenses itself).
   std::vector<Eigen::Index> kept_columns;
   std::vector<double> kept_displacement;
   const std::vector<bool> kept = kept_boundary_nodes(body.dofs, boundary, op.m_cb, options.boundary_truncation);
@@ -158,6 +159,10 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
         kept_displacement.push_back(boundary_displacement[b][axis]);
       }
       ++column;
+    }
+    if (!kept[b]) {
+      fem.truncated_node_ids.push_back(body.mesh.node_tags[boundary[b]]);
+      fem.truncated_fixed_axes.push_back(body.dofs.fixed_axes[boundary[b]]);
     }
   }
 

@@ -32,8 +32,9 @@ struct IrBuildOptions {
   IrPrecision precision = IrPrecision::f64;
   ContactModel contact_model = ContactModel::node_translation;
   double force_limit = 3.3;  ///< [N]
-  /// B truncation: a held node is left out of the IR (its columns of M_CB and its u_B) when
-  /// the norm of its columns is below this fraction of the largest node's. 0 keeps all;
+  /// B truncation: a held node is left out of the IR (its columns of M_CB and its u_B; it is
+  /// listed in truncated_node_ids) when the norm of its columns is below this fraction of
+  /// the largest node's. 0 keeps all;
   /// M_CC is unchanged either way (the node stays held, only its displacement's effect on
   /// the contact forces is dropped).
   double boundary_truncation = 0;

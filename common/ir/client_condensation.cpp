@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <bit>
+#include <span>
 #include <unordered_set>
 
 #include "common/condense/dof_blocks.h"
@@ -131,17 +132,25 @@ void ClientCondensation::complete(CondensedFemIr& ir) {
     throw Error(fmt::format("compliance rows of generation {} extend generation {}, but this client holds generation {}: "
                             "refused, an IR was lost or came out of order",
                             sent.generation, sent.generation - 1, generation_));
+  // With B truncation the IR holds more nodes than it lists (compliance_rows.h).
+  if (ir.truncated_fixed_axes.size() != ir.truncated_node_ids.size())
+    throw Error(fmt::format("{} fixed axes for {} truncated held nodes", ir.truncated_fixed_axes.size(),
+                            ir.truncated_node_ids.size()));
+  const std::vector<std::int64_t> ir_held = ir.held_node_ids();
+  std::vector<AxisMask> ir_fixed = ir.fixed_axes;
+  ir_fixed.insert(ir_fixed.end(), ir.truncated_fixed_axes.begin(), ir.truncated_fixed_axes.end());
   std::unordered_map<std::int64_t, int> local_of_tag;
-  for (int i = 0; i < ir.node_count(); ++i)
-    if (!local_of_tag.emplace(ir.node_ids[static_cast<std::size_t>(i)], i).second)
-      throw Error(fmt::format("node {} is listed twice in the IR", ir.node_ids[static_cast<std::size_t>(i)]));
+  for (std::size_t i = 0; i < ir_held.size(); ++i)
+    if (!local_of_tag.emplace(ir_held[i], static_cast<int>(i)).second)
+      throw Error(fmt::format("node {} is listed twice in the IR{}", ir_held[i],
+                              i >= ir.node_ids.size() ? " (among the nodes B truncation leaves out)" : ""));
   const std::vector<std::int64_t> no_nodes;
   const std::vector<std::int64_t>& before = fresh ? no_nodes : held_tags_;
-  const std::vector<std::int64_t> after = held_after(before, ir.node_ids);
+  const std::vector<std::int64_t> after = held_after(before, ir_held);
   Eigen::Index kept_dofs = 0, added_dofs = 0;
   std::size_t kept = 0;
   for (const std::int64_t tag : after) {
-    const AxisMask fixed = ir.fixed_axes[static_cast<std::size_t>(local_of_tag.at(tag))];
+    const AxisMask fixed = ir_fixed[static_cast<std::size_t>(local_of_tag.at(tag))];
     const auto held = fresh ? index_of_tag_.end() : index_of_tag_.find(tag);
     if (held != index_of_tag_.end()) {
       if (dofs_.fixed_axes[static_cast<std::size_t>(held->second)] != fixed)
@@ -173,16 +182,17 @@ void ClientCondensation::complete(CondensedFemIr& ir) {
   std::vector<int> added;
   std::vector<AxisMask> fixed_axes = dofs_.fixed_axes;
   for (std::size_t i = kept; i < after.size(); ++i)
-    added.push_back(index_for(after[i], ir.fixed_axes[static_cast<std::size_t>(local_of_tag.at(after[i]))], fixed_axes));
+    added.push_back(index_for(after[i], ir_fixed[static_cast<std::size_t>(local_of_tag.at(after[i]))], fixed_axes));
   dofs_ = make_dof_map(std::move(fixed_axes));  // in place: the condensation holds a reference
   held_.append(added, sent.rows, dofs_);
   held_tags_ = after;
   generation_ = sent.generation;
 
-  // M~ for the IR's contact nodes with its boundary nodes held, in the IR's columns.
+  // M~ for the IR's contact nodes with all its held nodes as B (the truncated ones last),
+  // in the IR's columns: the truncated nodes' columns of M_CB are dropped.
   std::vector<int> contact, boundary;
-  for (int i = 0; i < ir.node_count(); ++i)
-    (i < ir.row_node_count ? contact : boundary).push_back(index_of_tag_.at(ir.node_ids[static_cast<std::size_t>(i)]));
+  for (std::size_t i = 0; i < ir_held.size(); ++i)
+    (i < static_cast<std::size_t>(ir.row_node_count) ? contact : boundary).push_back(index_of_tag_.at(ir_held[i]));
   CondensedOperator op;
   try {
     condensation_->set_boundary_nodes(boundary);
@@ -192,15 +202,20 @@ void ClientCondensation::complete(CondensedFemIr& ir) {
     condensation_ = std::make_unique<IncrementalCondensation>(held_, dofs_);
     throw;
   }
-  const std::vector<int> boundary_dofs = free_dofs_of_nodes(dofs_, boundary);
+  const auto listed_boundary =
+      std::span<const int>(boundary).first(ir.node_ids.size() - static_cast<std::size_t>(ir.row_node_count));
+  const std::vector<int> boundary_dofs = free_dofs_of_nodes(dofs_, listed_boundary);
   std::unordered_map<int, Eigen::Index> column_of_dof;
   const Eigen::Index c = op.m_cc.rows();
   for (std::size_t k = 0; k < boundary_dofs.size(); ++k) column_of_dof.emplace(boundary_dofs[k], c + static_cast<Eigen::Index>(k));
   ir.m_tilde.resize(c, c + static_cast<Eigen::Index>(boundary_dofs.size()));
   ir.m_tilde.leftCols(c) = op.m_cc;
   for (std::size_t k = 0; k < op.boundary_dofs.size(); ++k)
-    ir.m_tilde.col(column_of_dof.at(op.boundary_dofs[k])) = op.m_cb.col(static_cast<Eigen::Index>(k));
+    if (const auto column = column_of_dof.find(op.boundary_dofs[k]); column != column_of_dof.end())
+      ir.m_tilde.col(column->second) = op.m_cb.col(static_cast<Eigen::Index>(k));
   ir.compliance_rows.reset();
+  ir.truncated_node_ids.clear();
+  ir.truncated_fixed_axes.clear();
 }
 
 }  // namespace cohaptic

@@ -4,13 +4,15 @@
 //
 // It keeps the compliance L_HH of the held nodes H (HeldCompliance, dense, free dofs only)
 // and an IncrementalCondensation over it, the server's class: per IR, the nodes that left
-// H are forgotten, the added rows appended, B set to the IR's boundary nodes and M~ formed
-// for its contact nodes, then reordered to the IR's columns. Nodes get small indices of
+// H are forgotten, the added rows appended, B set to the IR's boundary nodes (with B
+// truncation also the held nodes the IR leaves out, whose columns of M_CB are then dropped:
+// the server's choice, never re-decided here) and M~ formed for its contact nodes, then
+// reordered to the IR's columns. Nodes get small indices of
 // their own here (reused once forgotten), so the DofMap stays as small as H.
 //
 // An IR it cannot complete (a generation that does not follow the one held, a row count
 // that does not match the added nodes' free dofs, non-finite rows, a held node whose
-// fixed axes changed, a node listed twice) throws Error saying which, and changes nothing:
+// fixed axes changed, a node listed twice, also as kept and truncated) throws Error saying which, and changes nothing:
 // the next IR that follows the held generation still completes exactly. Units: m/N, N/m.
 // Not thread-safe: one I/O thread owns it.
 #pragma once

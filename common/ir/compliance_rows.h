@@ -3,7 +3,10 @@
 // IR it took) and condenses it itself, with the server's own code (common/condense), so
 // the server sends only the rows of L for the nodes H gains.
 //
-// The rule both sides follow, for an IR whose nodes are A (its node_ids):
+// The rule both sides follow, for an IR whose nodes are A (its node_ids, then with B
+// truncation its truncated_node_ids: held nodes whose columns M~ leaves out, which the
+// client holds and condenses over all the same, dropping their columns afterwards; the
+// server decides which are left out and says so, the client never re-decides):
 //   - H after the IR = the nodes of H still in A, in H's order, then A's other nodes (the
 //     "added" ones) in A's order (held_after below); nodes of H not in A are forgotten;
 //   - `rows` = L[free dofs of the added nodes, free dofs of H after], dofs node by node,

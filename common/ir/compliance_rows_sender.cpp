@@ -12,16 +12,17 @@ namespace cohaptic {
 
 void ComplianceRowsSender::convert(CondensedFemIr& ir, std::span<const int> mesh_nodes, ComplianceSource& columns,
                                    const DofMap& dofs) {
-  if (mesh_nodes.size() != ir.node_ids.size())
-    throw Error(fmt::format("compliance rows: {} mesh nodes for an IR of {} nodes", mesh_nodes.size(), ir.node_ids.size()));
-  const std::vector<int> all_dofs = free_dofs_of_nodes(dofs, mesh_nodes);
-  if (ir.m_tilde.cols() != static_cast<Eigen::Index>(all_dofs.size()))
-    throw Error(fmt::format("compliance rows: M~ has {} columns, the IR's nodes {} free dofs (B truncation leaves nodes out "
-                            "of the IR, and a client cannot condense without them)",
-                            ir.m_tilde.cols(), all_dofs.size()));
+  const std::vector<std::int64_t> ir_held = ir.held_node_ids();
+  if (mesh_nodes.size() != ir_held.size())
+    throw Error(
+        fmt::format("compliance rows: {} mesh nodes for an IR holding {} nodes", mesh_nodes.size(), ir_held.size()));
+  const std::vector<int> ir_dofs = free_dofs_of_nodes(dofs, mesh_nodes.first(ir.node_ids.size()));
+  if (ir.m_tilde.cols() != static_cast<Eigen::Index>(ir_dofs.size()))
+    throw Error(fmt::format("compliance rows: M~ has {} columns, the IR's nodes {} free dofs", ir.m_tilde.cols(),
+                            ir_dofs.size()));
   std::unordered_map<std::int64_t, int> mesh_of_tag;
-  for (std::size_t i = 0; i < mesh_nodes.size(); ++i) mesh_of_tag.emplace(ir.node_ids[i], mesh_nodes[i]);
-  const std::vector<std::int64_t> after = held_after(held_, ir.node_ids);
+  for (std::size_t i = 0; i < mesh_nodes.size(); ++i) mesh_of_tag.emplace(ir_held[i], mesh_nodes[i]);
+  const std::vector<std::int64_t> after = held_after(held_, ir_held);
   // held_after puts the nodes still held first.
   const auto kept = static_cast<std::size_t>(
       std::count_if(held_.begin(), held_.end(), [&](std::int64_t tag) { return mesh_of_tag.contains(tag); }));

@@ -20,9 +20,9 @@ class ComplianceRowsSender {
  public:
   /// Replaces `ir`'s M~ by the rows of L for the nodes the client does not hold yet, read
   /// from `columns` (the body's compliance, mesh node indices and `dofs`); `mesh_nodes`:
-  /// the mesh node of each of the IR's nodes. The client holds the IR's nodes afterwards.
-  /// Throws Error for an IR without the whole boundary set (B truncation: the client
-  /// could not form M_CC) or whose sizes do not match.
+  /// the mesh node of each of ir.held_node_ids() (with B truncation these include the held
+  /// nodes the IR leaves out). The client holds all of them afterwards. Throws Error if the
+  /// sizes do not match.
   void convert(CondensedFemIr& ir, std::span<const int> mesh_nodes, ComplianceSource& columns, const DofMap& dofs);
   /// The client holds nothing (a new user of the slot, another body): the next IR starts
   /// generation 1 with every row.

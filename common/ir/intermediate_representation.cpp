@@ -22,7 +22,15 @@ std::size_t CondensedFemIr::size_bytes() const {
   const std::size_t remote = remotes.size() * (sizeof(std::int32_t) * 4 + (1 + 7 * 3) * sizeof(double));
   const std::size_t matrix = static_cast<std::size_t>(m_tilde.size() + boundary_displacement.size()) * scalar +
                              (compliance_rows ? 8 + static_cast<std::size_t>(compliance_rows->rows.size()) * sizeof(double) : 0);
-  return kHeader + nodes + triangles + remote + matrix;
+  const std::size_t truncated =  // sent with compliance rows only
+      compliance_rows ? truncated_node_ids.size() * (sizeof(std::int64_t) + sizeof(AxisMask)) : 0;
+  return kHeader + nodes + triangles + remote + matrix + truncated;
+}
+
+std::vector<std::int64_t> CondensedFemIr::held_node_ids() const {
+  std::vector<std::int64_t> held = node_ids;
+  held.insert(held.end(), truncated_node_ids.begin(), truncated_node_ids.end());
+  return held;
 }
 
 const CondensedFemIr& condensed_fem(const IntermediateRepresentation& ir) {

@@ -86,8 +86,16 @@ struct CondensedFemIr {
   /// Sent instead of M~ (then empty) to a client that condenses itself (compliance_rows.h);
   /// the client's ClientCondensation fills M~ from them and clears them.
   std::optional<ComplianceRows> compliance_rows;
+  /// B truncation: the held nodes the IR leaves out (their columns of M~ and u_B), tags and
+  /// fixed axes. M~ needs none of them, but a client that condenses itself must hold their
+  /// compliance too (M_CC condenses over all of B), so they travel with compliance rows
+  /// only; the nodes past row_node_count are the held nodes kept, as the server chose them.
+  std::vector<std::int64_t> truncated_node_ids;
+  std::vector<AxisMask> truncated_fixed_axes;
 
   int node_count() const { return static_cast<int>(node_ids.size()); }
+  /// The nodes a client condensing itself holds after this IR: node_ids, then truncated_node_ids.
+  std::vector<std::int64_t> held_node_ids() const;
   /// Bytes of the content as sent: geometry, M~ and u_B at the stored precision.
   std::size_t size_bytes() const;
 };
@@ -97,8 +105,9 @@ using IrBody = std::variant<CondensedFemIr, MassSpringIr, HomeSpringPatch, Separ
 
 struct IntermediateRepresentation {
   /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone);
-  /// 3: a condensed FEM body may come as compliance rows instead of M~ (still reads 2).
-  static constexpr std::uint32_t kFormatVersion = 3;
+  /// 3: a condensed FEM body may come as compliance rows instead of M~;
+  /// 4: compliance rows may name held nodes that B truncation leaves out (still reads 2, 3).
+  static constexpr std::uint32_t kFormatVersion = 4;
   static constexpr std::uint32_t kOldestReadableVersion = 2;
 
   std::uint64_t epoch = 0;         ///< increases with every IR built for this user

@@ -96,6 +96,18 @@ std::size_t free_dofs(const std::string& fixed_axes, std::size_t first, std::siz
   return count;
 }
 
+/// One byte per node, each a mask of x, y, z (`what`: the field, for the message).
+std::vector<AxisMask> read_fixed_axes(const std::string& bytes, const char* what) {
+  std::vector<AxisMask> masks;
+  masks.reserve(bytes.size());
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    const auto mask = static_cast<AxisMask>(bytes[i]);
+    if (mask & ~kAllAxes) invalid("{} of node {} is 0x{:02x}, not a mask of x, y, z", what, i, static_cast<unsigned>(mask));
+    masks.push_back(mask);
+  }
+  return masks;
+}
+
 /// `values` (f64 or f32 on the wire) into doubles, each finite.
 template <typename Field, typename Target>
 void read_values(const Field& values, Target& out, const char* what) {
@@ -146,7 +158,9 @@ void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
   if (ir.compliance_rows) {
     const Eigen::MatrixXd& rows = ir.compliance_rows->rows;
     out->set_m_rows(static_cast<std::uint32_t>(ir_dofs(ir, 0, ir.row_node_count).size()));
-    out->set_m_cols(static_cast<std::uint32_t>(rows.cols()));
+    out->set_m_cols(static_cast<std::uint32_t>(ir_dofs(ir, 0, ir.node_count()).size()));
+    out->mutable_truncated_node_ids()->Add(ir.truncated_node_ids.begin(), ir.truncated_node_ids.end());
+    out->set_truncated_fixed_axes(std::string(ir.truncated_fixed_axes.begin(), ir.truncated_fixed_axes.end()));
     out->set_rows_generation(ir.compliance_rows->generation);
     out->set_compliance_row_count(static_cast<std::uint32_t>(rows.rows()));
     add_values<double>(rows.data(), rows.size(), out->mutable_compliance_rows());
@@ -277,12 +291,7 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   if (w.patch_node_count() > w.row_node_count())
     invalid("patch_node_count {} exceeds row_node_count {}", w.patch_node_count(), w.row_node_count());
   ir.node_ids.assign(w.node_ids().begin(), w.node_ids().end());
-  ir.fixed_axes.reserve(nodes);
-  for (std::uint32_t i = 0; i < nodes; ++i) {
-    const auto mask = static_cast<AxisMask>(w.fixed_axes()[i]);
-    if (mask & ~kAllAxes) invalid("fixed_axes of node {} is 0x{:02x}, not a mask of x, y, z", i, static_cast<unsigned>(mask));
-    ir.fixed_axes.push_back(mask);
-  }
+  ir.fixed_axes = read_fixed_axes(w.fixed_axes(), "fixed_axes");
   ir.row_node_count = static_cast<int>(w.row_node_count());
   ir.patch_node_count = static_cast<int>(w.patch_node_count());
   ir.rest_positions = read_xyz(w.rest_positions(), w.row_node_count(), "rest_positions");
@@ -346,12 +355,22 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   if (m_length != entries)
     invalid("M~ has {} values, expected {} (m_rows x m_cols = {} x {}, none with compliance rows)", m_length, entries,
             w.m_rows(), w.m_cols());
-  const std::uint64_t row_values = std::uint64_t{w.compliance_row_count()} * w.m_cols();
+  // B truncation's held nodes left out of M~: the rows' columns cover them too.
+  const auto truncated = static_cast<std::uint32_t>(w.truncated_node_ids_size());
+  if (!rows_form && (truncated > 0 || !w.truncated_fixed_axes().empty()))
+    invalid("truncated held nodes without a rows_generation (only compliance rows carry them)");
+  if (w.truncated_fixed_axes().size() != truncated)
+    invalid("{} truncated_fixed_axes bytes for {} truncated held nodes", w.truncated_fixed_axes().size(), truncated);
+  ir.truncated_node_ids.assign(w.truncated_node_ids().begin(), w.truncated_node_ids().end());
+  ir.truncated_fixed_axes = read_fixed_axes(w.truncated_fixed_axes(), "truncated_fixed_axes");
+  const std::uint64_t row_cols = w.m_cols() + free_dofs(w.truncated_fixed_axes(), 0, truncated);
+  const std::uint64_t row_values = std::uint64_t{w.compliance_row_count()} * row_cols;
   if (!rows_form && (w.compliance_row_count() > 0 || w.compliance_rows_size() > 0))
     invalid("compliance rows without a rows_generation");
   if (static_cast<std::uint64_t>(w.compliance_rows_size()) != row_values)
-    invalid("compliance_rows has {} values, expected compliance_row_count x m_cols = {} x {}", w.compliance_rows_size(),
-            w.compliance_row_count(), w.m_cols());
+    invalid("compliance_rows has {} values, expected compliance_row_count x (m_cols + free dofs of the truncated "
+            "held nodes) = {} x {}",
+            w.compliance_rows_size(), w.compliance_row_count(), row_cols);
   const auto u_length =
       static_cast<std::uint64_t>(f32 ? w.boundary_displacement_f32_size() : w.boundary_displacement_f64_size());
   if (u_length != boundary_dofs) invalid("u_B has {} values, expected {} (free boundary dofs)", u_length, boundary_dofs);
@@ -366,7 +385,7 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   }
   if (rows_form) {
     ComplianceRows rows{w.rows_generation(), Eigen::MatrixXd(static_cast<Eigen::Index>(w.compliance_row_count()),
-                                                             static_cast<Eigen::Index>(w.m_cols()))};
+                                                             static_cast<Eigen::Index>(row_cols))};
     read_values(w.compliance_rows(), rows.rows, "compliance_rows");
     ir.compliance_rows = std::move(rows);
   }
@@ -509,6 +528,8 @@ CommonIr from_wire(const WireIr& w) {
             w.format_version() == 1 ? " (version 1 is read by cohaptic builds before the body framework)" : "");
   if (w.format_version() < 3 && w.has_fem() && w.fem().rows_generation() > 0)
     invalid("format version {} cannot carry compliance rows (version 3 can)", w.format_version());
+  if (w.format_version() < 4 && w.has_fem() && w.fem().truncated_node_ids_size() > 0)
+    invalid("format version {} cannot carry truncated held nodes (version 4 can)", w.format_version());
   CommonIr ir;
   ir.epoch = w.epoch();
   if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());

@@ -9,7 +9,8 @@
 #     the sphere contact model (scenes/tradeoff/cube_two_spheres.yaml), run here with the real server and
 #     clients on loopback (protocol 3, the development key);
 #   - ir also from text_seeds/ir/*.txtpb (protoc --encode): bodies no recorded session has
-#     yet (the home-spring and separation bodies).
+#     yet (the home-spring and separation bodies), and compliance rows under B truncation
+#     (rows_truncated: a held node the IR leaves out).
 # Seeds that fuzzing found (crash-*, regression-*) are kept. Run from a configured build:
 #   BUILD_DIR=build tests/fuzz/make_seeds.sh
 set -euo pipefail
