@@ -50,7 +50,10 @@ LocalGrowth local_growth_order(const SeparationPatch& patch, const SeparationSta
     for (int i = 0; i < region.count; ++i) {
       if (!crack_may_grow(patch, region.triangles[i], share)) continue;
       const double distance = (patch.centroids[region.triangles[i]] - origin).squaredNorm();
-      if (distance < best_distance || (distance == best_distance && region.triangles[i] < region.triangles[best])) {
+      // The first candidate is taken whatever its distance: an IR's far-off centroid gives
+      // an infinite one, which no other distance beats.
+      if (best < 0 || distance < best_distance ||
+          (distance == best_distance && region.triangles[i] < region.triangles[best])) {
         best = i;
         best_distance = distance;
       }
