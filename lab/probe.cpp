@@ -13,6 +13,7 @@
 #include "common/mesh/write_vtu.h"
 #include "common/model/compliance_setup.h"
 #include "common/model/model.h"
+#include "common/model/sphere_contact_reference.h"
 #include "common/model/static_contact.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
@@ -37,10 +38,6 @@ struct ProbedTool {
   int boundary_nodes = 0;
   double condition_estimate = 0;
 };
-
-const char* model_name(ContactModel model) {
-  return model == ContactModel::node_translation ? "translation" : "point";
-}
 
 // Parses "x,y,z" (three finite numbers separated by commas).
 std::string parse_point(const std::string& text, Eigen::Vector3d& point) {
@@ -95,8 +92,14 @@ void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& o
   }
   if (options.reference) {
     const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
-    const std::vector<ToolReaction> reactions = contact_reactions_reference(body, contacts, held, contact_model);
-    for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].force = reactions[i].reaction;
+    std::vector<Eigen::Vector3d> reactions;
+    if (contact_model == ContactModel::sphere) {
+      reactions = SphereContactReference(body).solve(pressed, held).reactions;
+    } else {
+      for (const ToolReaction& reaction : contact_reactions_reference(body, contacts, held, contact_model))
+        reactions.push_back(reaction.reaction);
+    }
+    for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].force = reactions[i];
   } else {
     for (int u : users) tools[u].force = simulation.force(u).force;
   }
@@ -121,7 +124,7 @@ nlohmann::json probe_json(const Model& model, const ProbeOptions& options, Conta
                      {"poisson_ratio", body.spec.material.poisson_ratio},
                      {"element", formulation_name(body.spec.material.formulation)}};
   out["method"] = options.reference ? "reference" : "ir";
-  out["contact_model"] = model_name(contact_model);
+  out["contact_model"] = contact_model_name(contact_model);
   out["ir_precision"] = options.precision == IrPrecision::f32 ? "f32" : "f64";
   out["patch_rings"] = options.patch_rings.value_or(model.scene.haptic.patch_rings);
   out["tools_pressed"] = options.separately ? "separately" : "together";
@@ -177,7 +180,7 @@ void print_table(const Model& model, const ProbeOptions& options, ContactModel c
              options.reference ? "full sparse solve (--reference)"
                                : fmt::format("IR ({}, patch rings {})", options.precision == IrPrecision::f32 ? "f32" : "f64",
                                              options.patch_rings.value_or(model.scene.haptic.patch_rings)),
-             model_name(contact_model), options.separately ? "one at a time" : "together",
+             contact_model_name(contact_model), options.separately ? "one at a time" : "together",
              tools.empty() ? 0 : tools.front().boundary_nodes);
   fmt::print("\n{:<4} {:<28} {:>10} {:<20} {:<28} {:<30} {:>9} {:>9}\n", "tool", fmt::format("position ({})", u),
              fmt::format("depth ({})", u), "triangle (node ids)", fmt::format("node displacement ({})", u),
@@ -260,7 +263,10 @@ int run_probe(const ProbeOptions& options) {
       std::vector<PressedTool> pressed;
       for (const ProbedTool& probed : tools) pressed.push_back(probed.tool);
       Eigen::VectorXd u;
-      contact_reactions_reference(body, find_tool_contacts(body, pressed), {}, contact_model, &u);
+      if (contact_model == ContactModel::sphere)
+        SphereContactReference(body).solve(pressed, {}, &u);
+      else
+        contact_reactions_reference(body, find_tool_contacts(body, pressed), {}, contact_model, &u);
       u /= scene.metres_per_unit;
       write_vtu(options.export_vtu, in_scene_units,
                 {{"displacement", Eigen::Map<const Eigen::Matrix3Xd>(u.data(), 3, body.mesh.node_count())}});
@@ -295,9 +301,10 @@ LabCommand add_probe_command(CLI::App& lab) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command->add_option("--contact-model", line->contact_model,
-                      "translation (the paper's: the triangle's nodes follow the tool) or point (the contact point "
-                      "follows it with least energy); default: the scene's")
-      ->check(CLI::IsMember({"translation", "point"}));
+                      "translation (the paper's: the triangle's nodes follow the tool), point (the contact point "
+                      "follows it with least energy) or sphere (every surface node inside a sphere tool is held on its "
+                      "surface); default: the scene's")
+      ->check(CLI::IsMember({"translation", "point", "sphere"}));
   command->add_option("--ir-precision", line->precision, "Storage of M~ and u_B in the IR: f64 or f32 (inversion is always double)")
       ->check(CLI::IsMember({"f64", "f32"}))
       ->capture_default_str();
@@ -325,7 +332,8 @@ LabCommand add_probe_command(CLI::App& lab) {
             if (!line->no_disk_cache) options.cache_directory = line->cache_dir;
             if (!line->contact_model.empty())
               options.contact_model = line->contact_model == "translation" ? ContactModel::node_translation
-                                                                           : ContactModel::point_constraint;
+                                      : line->contact_model == "point"     ? ContactModel::point_constraint
+                                                                           : ContactModel::sphere;
             options.precision = line->precision == "f32" ? IrPrecision::f32 : IrPrecision::f64;
             return run_probe(options);
           }};

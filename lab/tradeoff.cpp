@@ -31,10 +31,6 @@ namespace {
 
 constexpr double kSimulationRateHz = 1000;
 
-const char* contact_model_name(ContactModel model) {
-  return model == ContactModel::node_translation ? "translation" : model == ContactModel::point_constraint ? "point" : "sphere";
-}
-
 bool all_spheres(const Scene& scene) {
   return std::all_of(scene.tools.begin(), scene.tools.end(), [](const ToolSpec& tool) { return tool.radius > 0; });
 }

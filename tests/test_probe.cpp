@@ -176,6 +176,29 @@ TEST_F(CubeProbe, TheProgramPrintsOneJsonObjectWithTheSameForces) {
   fs::remove_all(dir);
 }
 
+// On a scene of sphere tools the program names the sphere model, and --reference solves the
+// sphere model's unilateral problem in full (SphereContactReference), which the IR answers
+// exactly: both spheres' forces agree to 1e-9 (the point model's would not).
+TEST(ProbeProgram, OnASphereSceneItsReferenceIsTheSphereModelsFullSolve) {
+  const std::string arguments = "probe --scene " + testing::source_path("scenes/tradeoff/cube_two_spheres.yaml") +
+                                " --tool 30,25,36 --tool -20,-10,37 --json --no-disk-cache";
+  const testing::ProgramRun ir = run(arguments);
+  const testing::ProgramRun reference = run(arguments + " --reference");
+  ASSERT_EQ(ir.exit_code, 0) << ir.out;
+  ASSERT_EQ(reference.exit_code, 0) << reference.out;
+  const nlohmann::json by_ir = nlohmann::json::parse(ir.out), by_reference = nlohmann::json::parse(reference.out);
+  EXPECT_EQ(by_ir["contact_model"], "sphere");
+  EXPECT_EQ(by_reference["method"], "reference");
+  for (int t = 0; t < 2; ++t) {
+    const auto force = [t](const nlohmann::json& json) {
+      const nlohmann::json& f = json["tools"][t]["force"];
+      return Eigen::Vector3d(f[0], f[1], f[2]);
+    };
+    EXPECT_GT(force(by_reference).z(), 1.0) << "tool " << t << " presses the cube's top face";
+    EXPECT_LE((force(by_ir) - force(by_reference)).norm(), 1e-9 * force(by_reference).norm()) << "tool " << t;
+  }
+}
+
 TEST(ProbeProgram, BadInputGivesAClearErrorAndANonZeroExit) {
   const std::string cube = testing::source_path("scenes/cube.yaml");
   EXPECT_EQ(run("probe --scene " + cube + " --tool 1,2").exit_code, 2);

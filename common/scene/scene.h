@@ -30,6 +30,10 @@ enum class ToolShape { point, sphere, probe, forceps };
 /// contact point alone) and the sphere model (every node a sphere tool has passed, held on
 /// its surface; common/contact/sphere_contact.h), the default for sphere tools.
 enum class ContactModel { node_translation, point_constraint, sphere };
+/// The scene file's name of a contact model.
+inline const char* contact_model_name(ContactModel model) {
+  return model == ContactModel::node_translation ? "translation" : model == ContactModel::point_constraint ? "point" : "sphere";
+}
 
 struct BoxMeshSpec {
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();  ///< [m]
