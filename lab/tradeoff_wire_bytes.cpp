@@ -1,14 +1,16 @@
 #include "lab/tradeoff_wire_bytes.h"
 
+#include "common/mesh/tet_mesh.h"
 #include "proto/wire/ir_convert.h"
 
 namespace cohaptic {
 
 TradeoffWireBytes::TradeoffWireBytes(const ElasticBody& body, ComplianceSource& columns, std::size_t users)
-    : body_(body), columns_(columns), senders_(users), streams_(users) {
-  for (std::size_t node = 0; node < body.mesh.node_tags.size(); ++node)
-    node_of_tag_.emplace(body.mesh.node_tags[node], static_cast<int>(node));
-}
+    : body_(body),
+      columns_(columns),
+      senders_(users),
+      streams_(users),
+      node_of_tag_(node_indices_by_tag(body.mesh)) {}
 
 std::size_t TradeoffWireBytes::published(const IntermediateRepresentation& ir, std::size_t user) {
   const auto* fem = std::get_if<CondensedFemIr>(&ir.body);

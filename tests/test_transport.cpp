@@ -309,24 +309,21 @@ TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWin
   pair.server.set_option(asio::socket_base::send_buffer_size(64 * 1024));
   constexpr auto kTimeout = 300ms;
   WatchedSender watched(pair, key, kTimeout);
-  const std::optional<CloseCause>& cause = watched.cause;
-  const std::string& why = watched.why;
-  FramedConnection& sender = *watched.connection;
   wire::FrameSealer sealer(key, kTransportSession, 0);
   const std::string payload(100'000, 'i');
   const auto started = std::chrono::steady_clock::now();
   // Newest-wins frames only, which the queue may always drop: without the timeout it would never close.
-  while (!cause && std::chrono::steady_clock::now() - started < 10s) {
+  while (!watched.cause && std::chrono::steady_clock::now() - started < 10s) {
     wire::Control control = event("ir", payload);
-    sender.send(sealer.seal(control), FrameKind::newest_wins);
+    watched.connection->send(sealer.seal(control), FrameKind::newest_wins);
     pair.io.restart();
     pair.io.run_for(20ms);
   }
-  ASSERT_TRUE(cause) << "still open after 10 s";
-  EXPECT_EQ(*cause, CloseCause::write_stalled);
-  EXPECT_NE(why.find("the peer stopped reading"), std::string::npos) << why;
+  ASSERT_TRUE(watched.cause) << "still open after 10 s";
+  EXPECT_EQ(*watched.cause, CloseCause::write_stalled);
+  EXPECT_NE(watched.why.find("the peer stopped reading"), std::string::npos) << watched.why;
   EXPECT_GE(std::chrono::steady_clock::now() - started, kTimeout) << "closed before any write could have stalled that long";
-  EXPECT_LE(sender.frames_waiting(), kMaxWaitingFrames);
+  EXPECT_LE(watched.connection->frames_waiting(), kMaxWaitingFrames);
 }
 
 // Small must-arrive frames, which the kernel's buffers take for minutes: the connection
@@ -337,9 +334,6 @@ TEST(FramedConnection, ClosesWhenThePeerStopsTakingFramesThatTheKernelStillTakes
   TcpPair pair(4096);  // the peer's kernel takes a few frames, then acknowledges nothing unread
   constexpr auto kTimeout = 200ms;
   WatchedSender watched(pair, key, kTimeout);
-  const std::optional<CloseCause>& cause = watched.cause;
-  const std::string& why = watched.why;
-  FramedConnection& sender = *watched.connection;
   wire::FrameSealer sealer(key, kTransportSession, 0);
   // The peer reads in pieces of 512 bytes, one every 10 ms: its TCP acknowledges as it goes.
   bool reading = true;
@@ -355,25 +349,25 @@ TEST(FramedConnection, ClosesWhenThePeerStopsTakingFramesThatTheKernelStillTakes
   read_a_little();
   const auto send_for = [&](std::chrono::milliseconds span) {
     const auto end = std::chrono::steady_clock::now() + span;
-    while (!cause && std::chrono::steady_clock::now() < end) {
+    while (!watched.cause && std::chrono::steady_clock::now() < end) {
       wire::Control control = event("ir", std::string(500, 'r'));
-      sender.send(sealer.seal(control), FrameKind::must_arrive);
+      watched.connection->send(sealer.seal(control), FrameKind::must_arrive);
       pair.io.restart();
       pair.io.run_for(20ms);
     }
   };
   send_for(8 * kTimeout);
-  EXPECT_FALSE(cause) << "closed while the peer read: " << why;
-  EXPECT_LE(sender.frames_waiting(), 2u) << "the kernel took the frames";
+  EXPECT_FALSE(watched.cause) << "closed while the peer read: " << watched.why;
+  EXPECT_LE(watched.connection->frames_waiting(), 2u) << "the kernel took the frames";
 
   reading = false;  // the read in flight completes; no other follows
   const auto stopped = std::chrono::steady_clock::now();
   send_for(20 * kTimeout);
-  ASSERT_TRUE(cause) << "still open after " << 20 * kTimeout.count() << " ms";
-  EXPECT_EQ(*cause, CloseCause::write_stalled);
-  EXPECT_NE(why.find("the peer stopped reading"), std::string::npos) << why;
+  ASSERT_TRUE(watched.cause) << "still open after " << 20 * kTimeout.count() << " ms";
+  EXPECT_EQ(*watched.cause, CloseCause::write_stalled);
+  EXPECT_NE(watched.why.find("the peer stopped reading"), std::string::npos) << watched.why;
   EXPECT_GE(std::chrono::steady_clock::now() - stopped, 2 * kTimeout);
-  EXPECT_LT(sender.frames_waiting(), kMaxWaitingFrames) << "closed for the kernel's count, not the queue";
+  EXPECT_LT(watched.connection->frames_waiting(), kMaxWaitingFrames) << "closed for the kernel's count, not the queue";
 }
 
 // ---- the UDP endpoint ----
