@@ -15,23 +15,23 @@ constexpr double kSmallestFreeNormal = 1e-6;   // below it the node's support ho
 
 std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, AxisMask fixed,
                                                   std::span<const SphereTool> tools) noexcept {
-  std::optional<SphereConstraint> held;
+  std::optional<SphereConstraint> nearest;
   for (int t = 0; t < static_cast<int>(tools.size()); ++t) {
     const SphereTool& tool = tools[static_cast<std::size_t>(t)];
     if (!tool.centre.allFinite() || !(tool.radius > 0)) continue;
     const Eigen::Vector3d offset = rest - tool.centre;
     const double distance = offset.norm();
     const double gap = distance - tool.radius;
-    if (!(gap < 0) || distance <= kCentreTolerance * tool.radius) continue;
-    if (held && !(gap < held->gap)) continue;
+    if (distance <= kCentreTolerance * tool.radius) continue;
+    if (nearest && !(gap < nearest->gap)) continue;
     const Eigen::Vector3d normal = offset / distance;
     Eigen::Vector3d free_part = normal;
     for (int axis = 0; axis < 3; ++axis)
       if ((fixed >> axis) & 1u) free_part[axis] = 0;
     if (free_part.norm() < kSmallestFreeNormal) continue;
-    held = SphereConstraint{t, gap, normal};
+    nearest = SphereConstraint{t, gap, normal};
   }
-  return held;
+  return nearest;
 }
 
 std::vector<int> triangle_nodes(const BoundarySurface& surface, std::span<const int> triangles) {
@@ -43,11 +43,23 @@ std::vector<int> triangle_nodes(const BoundarySurface& surface, std::span<const 
   return nodes;
 }
 
-HeldBySpheres nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, std::span<const int> nodes,
-                                    std::span<const SphereTool> tools) {
-  HeldBySpheres held;
+SphereCandidates sphere_candidates(const TetMesh& mesh, const DofMap& dofs, std::span<const int> nodes,
+                                   std::span<const SphereTool> tools) {
+  SphereCandidates candidates;
   for (int node : nodes)
     if (const auto constraint = sphere_constraint(mesh.nodes.col(node), dofs.fixed_axes[node], tools)) {
+      candidates.nodes.push_back(node);
+      candidates.constraints.push_back(*constraint);
+    }
+  return candidates;
+}
+
+SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, std::span<const int> nodes,
+                                       std::span<const SphereTool> tools) {
+  SphereCandidates held;
+  for (int node : nodes)
+    if (const auto constraint = sphere_constraint(mesh.nodes.col(node), dofs.fixed_axes[node], tools);
+        constraint && constraint->gap < 0) {
       held.nodes.push_back(node);
       held.constraints.push_back(*constraint);
     }
@@ -60,7 +72,7 @@ std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surfac
   for (int t = 0; t < surface.triangle_count(); ++t) {
     if (!allowed[t] || t == nearest) continue;
     for (int node : surface.triangles[t])
-      if ((mesh.nodes.col(node) - tool.centre).norm() - tool.radius < 0) {  // as sphere_constraint decides
+      if ((mesh.nodes.col(node) - tool.centre).norm() - tool.radius < 0) {  // held at rest, as nodes_held_by_spheres decides
         seeds.push_back(t);
         break;
       }

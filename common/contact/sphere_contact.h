@@ -1,18 +1,21 @@
-// The sphere contact model's geometry: which surface nodes a rigid sphere tool holds, and
-// along which normal.
+// The sphere contact model's geometry: which surface nodes a rigid sphere tool may hold,
+// and along which normal.
 //
-// A sphere of radius r centred at c holds every touchable surface node it has passed (a
-// node whose rest position x lies inside it) on its surface along the sphere's normal,
-// frictionless: the node may slide along the surface, and it is released when holding it
-// would pull (unilateral_contact_solve.h decides which). As the FEM is linear, so is the
-// constraint: the normal n = (x - c) / |x - c| and the gap g = |x - c| - r < 0 are taken
-// at rest, and the node's displacement u must satisfy n . u >= -g (it ends on or outside
-// the sphere along n); the tool pushes it with lambda n, lambda >= 0.
+// Every touchable surface node is a candidate of the sphere nearest it (the smallest gap;
+// ties to the lower tool index): held on that sphere's surface along the sphere's normal,
+// frictionless (the node may slide along the surface), and released when holding it would
+// pull (unilateral_contact_solve.h decides which). As the FEM is linear, so is the
+// constraint: the normal n = (x - c) / |x - c| and the gap g = |x - c| - r are taken at
+// rest, and the node's displacement u must satisfy g + n . u >= 0 (it ends on or outside
+// the sphere along n); the tool pushes it with lambda n, lambda >= 0. A node inside a
+// sphere at rest has g < 0 and the sphere "holds" it; one outside (g > 0) is pushed only
+// when the deformation carries it in, so the force is continuous in the tool's position.
+// Most candidates are far and never pushed: working_set_contact_solve.h solves over the
+// few that are.
 //
-// A node passed by several spheres is held by the deepest (smallest gap; ties to the lower
-// tool index). A node the model cannot hold is left free: one within 1e-9 r of a centre
-// (it has no normal), or one whose normal lies (to 1e-6) along its fixed axes (the support
-// holds it there). Units: m.
+// A node the model cannot hold is no candidate: one within 1e-9 r of a centre (it has no
+// normal), or one whose normal lies (to 1e-6) along its fixed axes (the support holds it
+// there). Units: m.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,15 +35,15 @@ struct SphereTool {
   double radius = 0;                                 ///< [m]
 };
 
-/// One held node's constraint.
+/// One candidate node's constraint.
 struct SphereConstraint {
-  int tool = -1;                                     ///< index of the sphere holding it
-  double gap = 0;                                    ///< |x - c| - r < 0 [m]
+  int tool = -1;                                     ///< index of the sphere nearest it
+  double gap = 0;                                    ///< |x - c| - r [m]: negative inside, positive outside
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit, from c through x: the push's direction
 };
 
-/// The constraint on a node at rest position `rest`, with `fixed` axes, from the deepest
-/// of `tools` that passed it; none if no sphere holds it (see above).
+/// The constraint on a node at rest position `rest`, with `fixed` axes, from the nearest of
+/// `tools`; none if there is no sphere or the model cannot hold the node (see above).
 std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, AxisMask fixed,
                                                   std::span<const SphereTool> tools) noexcept;
 
@@ -48,19 +51,25 @@ std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, A
 /// triangles, say).
 std::vector<int> triangle_nodes(const BoundarySurface& surface, std::span<const int> triangles);
 
-/// Of `nodes` (volume node indices), those that `tools` hold, in order, with their constraints.
-struct HeldBySpheres {
+/// Nodes (volume node indices) with their constraints.
+struct SphereCandidates {
   std::vector<int> nodes;
   std::vector<SphereConstraint> constraints;
 };
-HeldBySpheres nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, std::span<const int> nodes,
-                                    std::span<const SphereTool> tools);
+
+/// Of `nodes`, every candidate of `tools`, in order.
+SphereCandidates sphere_candidates(const TetMesh& mesh, const DofMap& dofs, std::span<const int> nodes,
+                                   std::span<const SphereTool> tools);
+
+/// Of `nodes`, those that `tools` hold at rest (the candidates inside a sphere), in order.
+SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, std::span<const int> nodes,
+                                       std::span<const SphereTool> tools);
 
 /// The patch of a sphere tool: `nearest` (the allowed triangle nearest the centre) first,
 /// then every allowed triangle with a node inside the sphere, then `rings` rings of allowed
 /// neighbours around them (contact_patch.h). Its nodes are the tool's candidate nodes in
-/// an intermediate representation: every node the sphere holds, and those it may reach
-/// before the next one.
+/// an intermediate representation: every node the sphere holds at rest, and those it may
+/// reach, or the deformation may carry into it, before the next one.
 std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface, int nearest, const SphereTool& tool,
                               int rings, const std::vector<bool>& allowed);
 

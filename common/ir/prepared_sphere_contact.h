@@ -19,7 +19,7 @@
 namespace cohaptic {
 
 constexpr int kMaxSphereCandidates = 128;  ///< contact nodes of a sphere IR
-constexpr int kMaxSphereContacts = 64;     ///< nodes the spheres hold at once, in one tick
+constexpr int kMaxSphereContacts = 64;     ///< the working set of one tick's contact solve (nodes)
 
 /// The active set of the last sphere contact solve, one bit per contact node: the next
 /// tick's warm start, held in the evaluator's EvaluationState. Only the path to the answer

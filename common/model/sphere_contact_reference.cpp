@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "common/contact/unilateral_contact_solve.h"
+#include "common/contact/working_set_contact_solve.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -70,13 +70,13 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   std::vector<int> free_candidates;
   for (int node : candidates_)
     if (!is_held[static_cast<std::size_t>(node)]) free_candidates.push_back(node);
-  const HeldBySpheres holding = nodes_held_by_spheres(body_.mesh, body_.dofs, free_candidates, spheres);
+  const SphereCandidates candidates = sphere_candidates(body_.mesh, body_.dofs, free_candidates, spheres);
 
   SphereContactSolution solution;
-  solution.candidates = holding.nodes;
-  solution.constraints = holding.constraints;
+  solution.candidates = candidates.nodes;
+  solution.constraints = candidates.constraints;
   solution.reactions.assign(tools.size(), Eigen::Vector3d::Zero());
-  const auto m = static_cast<Eigen::Index>(holding.nodes.size());
+  const auto m = static_cast<Eigen::Index>(candidates.nodes.size());
   solution.pushes = Eigen::VectorXd::Zero(m);
 
   // u0: the displacement under the held nodes' displacements alone.
@@ -91,36 +91,40 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
     if (displacement) *displacement = u0;
     return solution;
   }
-  compute_columns(holding.nodes);
-  Eigen::MatrixXd a(m, m);
   Eigen::VectorXd q(m);
   for (Eigen::Index j = 0; j < m; ++j) {
-    const Eigen::MatrixXd& column = columns_of(holding.nodes[static_cast<std::size_t>(j)]);
-    const Eigen::Vector3d& n_j = holding.constraints[static_cast<std::size_t>(j)].normal;
-    for (Eigen::Index i = 0; i < m; ++i) {
-      const int row = candidate_row_[static_cast<std::size_t>(holding.nodes[static_cast<std::size_t>(i)])];
-      a(i, j) = holding.constraints[static_cast<std::size_t>(i)].normal.dot(column.middleRows<3>(row) * n_j);
-    }
-    const int node = holding.nodes[static_cast<std::size_t>(j)];
-    q[j] = holding.constraints[static_cast<std::size_t>(j)].gap + n_j.dot(u0.segment<3>(3 * node));
+    const SphereConstraint& c = candidates.constraints[static_cast<std::size_t>(j)];
+    q[j] = c.gap + c.normal.dot(u0.segment<3>(3 * candidates.nodes[static_cast<std::size_t>(j)]));
   }
-  a = 0.5 * (a + a.transpose()).eval();
 
-  std::vector<std::uint8_t> active(static_cast<std::size_t>(m), 1);
-  Eigen::MatrixXd factor(m, m);
-  std::vector<int> order(static_cast<std::size_t>(m));
-  const UnilateralSolveResult result = solve_unilateral_contact(a, q, active, solution.pushes, factor, order,
-                                                                std::numeric_limits<double>::infinity());
-  if (!result.solved) throw NumericalError("sphere contact: the candidates' normal compliance is not positive definite");
+  // Which touch: the working set over every candidate, columns only for its members.
+  const auto entry = [&](int i, int j) {
+    const Eigen::MatrixXd& column = columns_of(candidates.nodes[static_cast<std::size_t>(j)]);
+    const int row = candidate_row_[static_cast<std::size_t>(candidates.nodes[static_cast<std::size_t>(i)])];
+    const Eigen::Vector3d moved = column.middleRows<3>(row) * candidates.constraints[static_cast<std::size_t>(j)].normal;
+    return candidates.constraints[static_cast<std::size_t>(i)].normal.dot(moved);
+  };
+  const auto prepare_columns = [&](std::span<const int> set) {
+    std::vector<int> nodes;
+    for (int i : set) nodes.push_back(candidates.nodes[static_cast<std::size_t>(i)]);
+    compute_columns(nodes);
+  };
+  std::vector<std::uint8_t> active(static_cast<std::size_t>(m), 0), member_active(active.size()), in_set(active.size());
+  std::vector<int> members(active.size()), order(active.size());
+  WorkingSetScratch<Eigen::MatrixXd, Eigen::VectorXd> scratch{{}, {}, {}, {}, members, member_active, order, in_set};
+  const WorkingSetSolveResult result =
+      solve_unilateral_over_candidates(q, entry, prepare_columns, static_cast<int>(m), active, solution.pushes, scratch,
+                                       std::numeric_limits<double>::infinity());
+  if (!result.inner.solved) throw NumericalError("sphere contact: the candidates' normal compliance is not positive definite");
   for (Eigen::Index i = 0; i < m; ++i) {
-    const SphereConstraint& c = holding.constraints[static_cast<std::size_t>(i)];
+    const SphereConstraint& c = candidates.constraints[static_cast<std::size_t>(i)];
     solution.reactions[static_cast<std::size_t>(c.tool)] -= solution.pushes[i] * c.normal;
   }
   if (displacement) {
     Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * body_.mesh.node_count());
     for (Eigen::Index i = 0; i < m; ++i)
-      loads.segment<3>(3 * holding.nodes[static_cast<std::size_t>(i)]) +=
-          solution.pushes[i] * holding.constraints[static_cast<std::size_t>(i)].normal;
+      loads.segment<3>(3 * candidates.nodes[static_cast<std::size_t>(i)]) +=
+          solution.pushes[i] * candidates.constraints[static_cast<std::size_t>(i)].normal;
     *displacement = solver_->solve(held_values, loads).displacement;
   }
   return solution;

@@ -1,16 +1,18 @@
 // The reference answer for sphere tools under the sphere contact model
 // (common/contact/sphere_contact.h): full sparse FEM solves of the unilateral problem.
 //
-// The candidates are the nodes of the touchable triangles that the spheres hold, less the
-// held boundary nodes B. K is factored (CHOLMOD) with B's dofs prescribed; one solve gives
-// the candidates' displacement u0 under B's displacements alone, and one multi-right-hand-
-// side solve their compliance L under unit forces at their free dofs. With A = N^T L N and
-// q = g + N^T u0 the unilateral problem (unilateral_contact_solve.h) is solved from the
-// set of all candidates, without a work limit; its pushes lambda_i n_i are the tools'
-// forces on the nodes, and -sum lambda_i n_i over a tool's nodes the force on the tool.
+// The candidates are the nodes of the touchable triangles, less the held boundary nodes B,
+// each of the sphere nearest it. K is factored (CHOLMOD) with B's dofs prescribed; one
+// solve gives the candidates' displacement u0 under B's displacements alone, and
+// multi-right-hand-side solves the compliance L under unit forces at the free dofs of the
+// working set's nodes (working_set_contact_solve.h), over the rows of every candidate. With
+// A = N^T L N and q = g + N^T u0 the unilateral problem is solved over every candidate,
+// without a work limit; its pushes lambda_i n_i are the tools' forces on the nodes, and
+// -sum lambda_i n_i over a tool's nodes the force on the tool.
 //
 // This is the slow path the intermediate representation is checked against: it shares
-// neither the condensation nor the evaluator with it. Compliance columns are cached per
+// neither the condensation nor the evaluator with it (only the working-set solve, which
+// tests check against a dense solve over every candidate). Compliance columns are cached per
 // node until the held set changes (then K is factored again), so a motion costs one
 // factorisation per held set. Units: m, N. Not thread-safe (the cache grows).
 #pragma once
@@ -27,7 +29,7 @@
 namespace cohaptic {
 
 struct SphereContactSolution {
-  std::vector<int> candidates;                 ///< volume nodes the spheres hold, ascending
+  std::vector<int> candidates;                 ///< every candidate (volume node), ascending
   std::vector<SphereConstraint> constraints;   ///< per candidate
   Eigen::VectorXd pushes;                      ///< lambda per candidate [N]; 0: released
   std::vector<Eigen::Vector3d> reactions;      ///< force on each tool [N] (zero if it holds nothing)

@@ -110,7 +110,7 @@ class Simulation {
     int nearest = -1;
     std::optional<ToolContact> contact;
     bool pressing = false;
-    std::vector<int> sphere_holds;  ///< sphere contact model: the nodes its sphere holds
+    std::vector<int> sphere_holds;  ///< sphere contact model: the nodes its sphere holds at rest
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
   };

@@ -10,18 +10,15 @@
 
 namespace cohaptic {
 
-StateSolution solve_sphere_state(ComplianceColumns& columns, IncrementalCondensation& condensation, const TetMesh& mesh,
-                                 const DofMap& dofs, std::span<const int> candidates, std::span<const SphereTool> spheres,
-                                 const Eigen::VectorXd& boundary_displacement) {
-  StateSolution state;
-  state.tool_forces.assign(spheres.size(), Eigen::Vector3d::Zero());
-  std::vector<bool> held_as_boundary(static_cast<std::size_t>(mesh.node_count()), false);
-  for (int node : condensation.boundary_nodes()) held_as_boundary[static_cast<std::size_t>(node)] = true;
-  std::vector<int> free_candidates;
-  for (int node : candidates)
-    if (!held_as_boundary[static_cast<std::size_t>(node)]) free_candidates.push_back(node);
-  const HeldBySpheres holding = nodes_held_by_spheres(mesh, dofs, free_candidates, spheres);
+namespace {
 
+// The state with the candidates of `holding` as the working set: they are condensed with B
+// held and their unilateral problem solved; every other node is free.
+StateSolution solve_over_sphere_set(ComplianceColumns& columns, IncrementalCondensation& condensation, const DofMap& dofs,
+                                    const SphereCandidates& holding, std::size_t tool_count,
+                                    const Eigen::VectorXd& boundary_displacement) {
+  StateSolution state;
+  state.tool_forces.assign(tool_count, Eigen::Vector3d::Zero());
   const auto m = static_cast<Eigen::Index>(holding.nodes.size());
   state.contact_dofs = free_dofs_of_nodes(dofs, holding.nodes);
   state.contact_forces = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(state.contact_dofs.size()));
@@ -50,7 +47,8 @@ StateSolution solve_sphere_state(ComplianceColumns& columns, IncrementalCondensa
     Eigen::VectorXd q = normals.transpose() * free_displacement;
     for (Eigen::Index i = 0; i < m; ++i) q[i] += holding.constraints[static_cast<std::size_t>(i)].gap;
 
-    std::vector<std::uint8_t> active(static_cast<std::size_t>(m), 1);
+    std::vector<std::uint8_t> active(static_cast<std::size_t>(m), 0);
+    for (Eigen::Index i = 0; i < m; ++i) active[static_cast<std::size_t>(i)] = q[i] < 0;  // a warm start only
     Eigen::VectorXd pushes(m);
     Eigen::MatrixXd factor(m, m);
     std::vector<int> order(static_cast<std::size_t>(m));
@@ -64,6 +62,47 @@ StateSolution solve_sphere_state(ComplianceColumns& columns, IncrementalCondensa
   }
   solve_boundary_forces(columns, condensation, dofs, boundary_displacement, state);
   return state;
+}
+
+}  // namespace
+
+StateSolution solve_sphere_state(ComplianceColumns& columns, IncrementalCondensation& condensation, const TetMesh& mesh,
+                                 const DofMap& dofs, std::span<const int> candidates, std::span<const SphereTool> spheres,
+                                 const Eigen::VectorXd& boundary_displacement) {
+  std::vector<bool> held_as_boundary(static_cast<std::size_t>(mesh.node_count()), false);
+  for (int node : condensation.boundary_nodes()) held_as_boundary[static_cast<std::size_t>(node)] = true;
+  std::vector<int> free_candidates;
+  for (int node : candidates)
+    if (!held_as_boundary[static_cast<std::size_t>(node)]) free_candidates.push_back(node);
+  const SphereCandidates all = sphere_candidates(mesh, dofs, free_candidates, spheres);
+
+  // The working set (working_set_contact_solve.h), checked by displacement: it starts as the
+  // nodes the spheres hold at rest, and every other candidate that the solved state carries
+  // into its sphere joins it, until none does.
+  std::vector<bool> in_set(all.nodes.size());
+  for (std::size_t i = 0; i < all.nodes.size(); ++i) in_set[i] = all.constraints[i].gap < 0;
+  for (;;) {
+    SphereCandidates set;
+    std::vector<std::size_t> others;
+    for (std::size_t i = 0; i < all.nodes.size(); ++i)
+      if (in_set[i]) {
+        set.nodes.push_back(all.nodes[i]);
+        set.constraints.push_back(all.constraints[i]);
+      } else {
+        others.push_back(i);
+      }
+    StateSolution state = solve_over_sphere_set(columns, condensation, dofs, set, spheres.size(), boundary_displacement);
+    if (others.empty()) return state;
+    std::vector<int> other_nodes;
+    for (std::size_t i : others) other_nodes.push_back(all.nodes[i]);
+    const Eigen::Matrix3Xd u = displacement_of_nodes(columns, state, other_nodes);
+    bool joined = false;
+    for (std::size_t k = 0; k < others.size(); ++k) {
+      const SphereConstraint& c = all.constraints[others[k]];
+      if (c.gap + c.normal.dot(u.col(static_cast<Eigen::Index>(k))) < 0) in_set[others[k]] = joined = true;
+    }
+    if (!joined) return state;
+  }
 }
 
 }  // namespace cohaptic
