@@ -302,8 +302,8 @@ LabCommand add_probe_command(CLI::App& lab) {
       ->capture_default_str();
   command->add_option("--contact-model", line->contact_model,
                       "translation (the paper's: the triangle's nodes follow the tool), point (the contact point "
-                      "follows it with least energy) or sphere (every surface node inside a sphere tool is held on its "
-                      "surface); default: the scene's")
+                      "follows it with least energy) or sphere (the surface nodes a sphere tool pushes are held on its "
+                      "surface, frictionless and unilateral); default: the scene's")
       ->check(CLI::IsMember({"translation", "point", "sphere"}));
   command->add_option("--ir-precision", line->precision, "Storage of M~ and u_B in the IR: f64 or f32 (inversion is always double)")
       ->check(CLI::IsMember({"f64", "f32"}))
