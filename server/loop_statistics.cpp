@@ -18,6 +18,7 @@ void LoopStatistics::record_step(const StepFigures& step, double elapsed_s) {
   totals_.forces_sent += step.forces_sent;
   totals_.max_boundary_nodes = std::max(totals_.max_boundary_nodes, step.report.boundary_nodes);
   totals_.max_obstacle_nodes = std::max(totals_.max_obstacle_nodes, step.report.obstacle_nodes);
+  totals_.sphere_nodes_outside_patches += static_cast<std::uint64_t>(step.report.sphere_nodes_outside_patches);
   totals_.elapsed_s = elapsed_s;
 }
 

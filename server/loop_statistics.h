@@ -30,6 +30,8 @@ struct LoopSummary {
   double ir_build_p50_ms = 0, ir_build_p99_ms = 0;
   std::uint64_t ir_builds = 0;  ///< steps that computed M~
   int max_boundary_nodes = 0, max_obstacle_nodes = 0;
+  /// Sphere model: over all steps, nodes the state had a sphere push that no IR's patch held
+  std::uint64_t sphere_nodes_outside_patches = 0;
   double max_surface_displacement_m = 0;  ///< in the display frames
   std::uint64_t failed_steps = 0;
   int max_consecutive_failures = 0;

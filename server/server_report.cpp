@@ -22,6 +22,7 @@ nlohmann::json server_report(const ServerFigures& figures) {
   server["ir_bytes_sent"] = loop.ir_bytes_sent;
   server["ir_bytes_built"] = loop.ir_bytes;
   server["boundary_nodes"] = {{"max", loop.max_boundary_nodes}, {"obstacle_max", loop.max_obstacle_nodes}};
+  server["sphere_nodes_outside_patches"] = loop.sphere_nodes_outside_patches;
   server["forces_sent"] = loop.forces_sent;
   server["max_surface_displacement_mm"] = loop.max_surface_displacement_m * 1e3;
   server["failed_steps"] = {{"count", loop.failed_steps},

@@ -75,8 +75,8 @@ Fixture& fixture(int boundary_nodes) {
     for (int node : tri) reserved[node] = true;
   }
   const std::vector<UserTool> tools = {
-      {0, f.own, 0, nearest_touchable_triangle(body, f.own)},
-      {1, f.remote, 0, nearest_touchable_triangle(body, f.remote)}};
+      {0, f.own, 0, nearest_touchable_triangle(body, f.own), {}},
+      {1, f.remote, 0, nearest_touchable_triangle(body, f.remote), {}}};
   for (const UserTool& tool : tools)
     for (int node : body.surface.triangles[tool.nearest_triangle]) reserved[node] = true;
   f.boundary = nearest_surface_nodes(body.mesh, body.surface, body.dofs, std::vector<Eigen::Vector3d>{f.own}, boundary_nodes, reserved);

@@ -52,7 +52,7 @@ class GeneratedSession {
     const std::array<Eigen::Vector3d, 2> tools = {mm(25 * std::cos(angle), 25 * std::sin(angle), -1) + lift,
                                                   mm(-20 + 12 * std::sin(0.7 * angle), 18 * std::cos(angle), -0.5) + lift};
     std::vector<UserTool> users;
-    for (int u = 0; u < 2; ++u) users.push_back({u, tools[u], radius_, nearest_touchable_triangle(body, tools[u])});
+    for (int u = 0; u < 2; ++u) users.push_back({u, tools[u], radius_, nearest_touchable_triangle(body, tools[u]), {}});
     if (step % 4 == 0) {
       // Surface nodes at least 45 mm from both tools (none of them in a patch), a random
       // part of them: B both gains and loses nodes.

@@ -238,7 +238,7 @@ IntermediateRepresentation front_ir(const FoldedFront& folded_front, ComplianceS
                                     const Eigen::Vector3d& tool) {
   const ElasticBody& a = folded_front.push.rig.front;
   IncrementalCondensation condensation(columns, a.dofs);
-  const std::vector<UserTool> users{{0, tool, 0.0, nearest_touchable_triangle(a, tool)}};
+  const std::vector<UserTool> users{{0, tool, 0.0, nearest_touchable_triangle(a, tool), {}}};
   IrBuildOptions options;
   options.force_limit = 1000;  // compare forces, not the limit
   return build_ir(a, condensation, users, 0, {}, options, 1, 0.0);

@@ -126,7 +126,7 @@ TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
   const Model& model = *rig.model;
   const ElasticBody& body = single_elastic_body(model);
   const Eigen::Vector3d tool = mm(4, -1, -2);
-  const UserTool user{0, tool, 0, nearest_touchable_triangle(body, tool)};
+  const UserTool user{0, tool, 0, nearest_touchable_triangle(body, tool), {}};
   std::vector<bool> under_tool(static_cast<std::size_t>(body.mesh.node_count()), false);
   for (int v : body.surface.triangles[user.nearest_triangle]) under_tool[v] = true;
   IncrementalCondensation condensation(*rig.columns, body.dofs);

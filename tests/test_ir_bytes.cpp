@@ -30,7 +30,7 @@ TEST(IrBytes, CountsWhatEachOptionWouldSendOnARecording) {
   const testing::CubeRig rig(cube);
   const ElasticBody& body = rig.body;
   const Eigen::Vector3d tool(0.004, -0.001, -0.002);
-  const std::vector<UserTool> users = {{0, tool, 0, nearest_touchable_triangle(body, tool)}};
+  const std::vector<UserTool> users = {{0, tool, 0, nearest_touchable_triangle(body, tool), {}}};
   IncrementalCondensation condensation(*rig.columns, body.dofs);
   const auto build = [&](std::span<const Eigen::Vector3d> held, std::uint64_t epoch) {
     return wire::to_wire(build_ir(body, condensation, users, 0, held, IrBuildOptions{}, epoch, 0.0));

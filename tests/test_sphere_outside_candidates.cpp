@@ -36,12 +36,12 @@ using testing::relative_error;
 constexpr double kColumnSphereRadius = 10e-3;    // both spheres [m]
 constexpr double kColumnStandoff = 0.3e-3;  // B's clearance from its face at rest [m]
 
-// 20 x 20 x 100 mm, 5 mm cells, foot fixed, touchable on its -x and +x faces.
+// 20 x 20 x 100 mm, 2.5 mm cells, foot fixed, touchable on its -x and +x faces.
 const std::string kColumnScene = R"(
 units: mm
 objects:
   - name: column
-    mesh: {box: {min: [-10, -10, -100], size: [20, 20, 100], divisions: [4, 4, 20]}}
+    mesh: {box: {min: [-10, -10, -100], size: [20, 20, 100], divisions: [8, 8, 40]}}
     material: {youngs_modulus: 1.0e6, poisson_ratio: 0.4}
     fixed: [{plane: {point: [0, 0, -100], normal: [0, 0, 1]}}]
     touchable: [{plane: {point: [-10, 0, 0], normal: [-1, 0, 0]}}, {plane: {point: [10, 0, 0], normal: [1, 0, 0]}}]
@@ -165,12 +165,18 @@ std::vector<std::int64_t> column_ir_contact_tags(const PreparedIR& prepared, con
   return tags;
 }
 
-TEST(SphereOutsideCandidates, ANodeTheColumnCarriesIntoASphereIsHeldAsTheFullSparseSolveHoldsIt) {
+// Patch rings 1 (the scenes' default) and 0: with 0 rings B's patch is its nearest triangle
+// alone (B holds no node at rest), so every other node B pushes reaches the IR only because
+// the server adds the triangles of the nodes its solved state has a sphere push.
+class SphereOutsideCandidates : public ::testing::TestWithParam<int> {};
+
+TEST_P(SphereOutsideCandidates, ANodeTheColumnCarriesIntoASphereIsHeldAsTheFullSparseSolveHoldsIt) {
+  const int patch_rings = GetParam();
   testing::CubeRig rig(kColumnScene);
   const ElasticBody& body = rig.body;
   const ColumnTouchableCompliance compliance = column_touchable_compliance(body);
   const Eigen::Vector3d b_centre = mm(10, 0, -5) + Eigen::Vector3d(kColumnSphereRadius + kColumnStandoff, 0, 0);
-  int b_pushed = 0, carried_in = 0;
+  int b_pushed = 0, carried_in = 0, b_beyond_one_triangle = 0;
   double worst = 0;
   for (int k = 0; k <= 4; ++k) {
     const double depth = 0.5 + 0.5 * k;  // A's press into the -x face [mm]
@@ -187,12 +193,16 @@ TEST(SphereOutsideCandidates, ANodeTheColumnCarriesIntoASphereIsHeldAsTheFullSpa
       if (expected.push[static_cast<Eigen::Index>(p)] > 0 && expected.gap[static_cast<Eigen::Index>(p)] > 0) ++carried_in;
     }
     if (expected.force[1].norm() > 1e-3 * expected.force[0].norm()) ++b_pushed;
+    int b_contacts = 0;
+    for (std::size_t p = 0; p < expected.node.size(); ++p)
+      b_contacts += expected.tool[p] == 1 && expected.push[static_cast<Eigen::Index>(p)] > 0;
+    if (b_contacts > 3) ++b_beyond_one_triangle;  // more than B's nearest triangle holds
 
     // The server's simulation and each user's IR, evaluated at the tools' positions.
     Simulation simulation(body, rig.model->obstacles, *rig.columns, rig.model->scene.tools,
-                          testing::unlimited_options(ContactModel::sphere));
+                          testing::unlimited_options(ContactModel::sphere, 0, patch_rings));
     for (int user = 0; user < 2; ++user) simulation.set_tool(user, centres[static_cast<std::size_t>(user)]);
-    simulation.step(0);
+    EXPECT_EQ(simulation.step(0).sphere_nodes_outside_patches, 0);
     for (int user = 0; user < 2; ++user) {
       const PreparedIR& prepared = *simulation.ir(user);
       std::vector<Eigen::Vector3d> remotes;
@@ -222,7 +232,11 @@ TEST(SphereOutsideCandidates, ANodeTheColumnCarriesIntoASphereIsHeldAsTheFullSpa
   // Not vacuous: the model that holds only nodes inside a sphere at rest gives B no force.
   EXPECT_GE(b_pushed, 3);
   EXPECT_GT(carried_in, 0);
+  EXPECT_GT(b_beyond_one_triangle, 0) << "with 0 rings, B's IR needs the carried nodes' triangles";
 }
+
+INSTANTIATE_TEST_SUITE_P(PatchRings, SphereOutsideCandidates, ::testing::Values(1, 0),
+                         [](const ::testing::TestParamInfo<int>& rings) { return "Rings" + std::to_string(rings.param); });
 
 }  // namespace
 }  // namespace cohaptic

@@ -67,12 +67,14 @@ SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, 
 }
 
 std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface, int nearest, const SphereTool& tool,
-                              int rings, const std::vector<bool>& allowed) {
+                              int rings, const std::vector<bool>& allowed, std::span<const int> carried) {
   std::vector<int> seeds{nearest};
+  const auto is_carried = [&](int node) { return std::find(carried.begin(), carried.end(), node) != carried.end(); };
   for (int t = 0; t < surface.triangle_count(); ++t) {
     if (!allowed[t] || t == nearest) continue;
     for (int node : surface.triangles[t])
-      if ((mesh.nodes.col(node) - tool.centre).norm() - tool.radius < 0) {  // held at rest, as nodes_held_by_spheres decides
+      // held at rest, as nodes_held_by_spheres decides, or carried in
+      if ((mesh.nodes.col(node) - tool.centre).norm() - tool.radius < 0 || is_carried(node)) {
         seeds.push_back(t);
         break;
       }

@@ -66,11 +66,13 @@ SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, 
                                        std::span<const SphereTool> tools);
 
 /// The patch of a sphere tool: `nearest` (the allowed triangle nearest the centre) first,
-/// then every allowed triangle with a node inside the sphere, then `rings` rings of allowed
-/// neighbours around them (contact_patch.h). Its nodes are the tool's candidate nodes in
-/// an intermediate representation: every node the sphere holds at rest, and those it may
-/// reach, or the deformation may carry into it, before the next one.
+/// then every allowed triangle with a node inside the sphere or among `carried`, then
+/// `rings` rings of allowed neighbours around them (contact_patch.h). Its nodes are the
+/// tool's candidate nodes in an intermediate representation: every node the sphere holds
+/// at rest, and those it may reach, or the deformation may carry into it, before the next
+/// one. `carried`: nodes outside the sphere at rest that the solved state has it push
+/// (the simulation finds them: a bulge can carry a node in beyond the rings).
 std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface, int nearest, const SphereTool& tool,
-                              int rings, const std::vector<bool>& allowed);
+                              int rings, const std::vector<bool>& allowed, std::span<const int> carried = {});
 
 }  // namespace cohaptic

@@ -71,7 +71,7 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
   const bool sphere = options.contact_model == ContactModel::sphere;
   const auto patch_of = [&](const UserTool& user) {
     return sphere ? sphere_patch(body.mesh, body.surface, user.nearest_triangle, {user.position, user.radius},
-                                 options.patch_rings, allowed)
+                                 options.patch_rings, allowed, user.carried_nodes)
                   : contact_patch(body.surface, user.nearest_triangle, options.patch_rings, allowed);
   };
   const std::vector<int> patch = patch_of(own);

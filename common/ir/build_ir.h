@@ -25,6 +25,9 @@ struct UserTool {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();    ///< [m]
   double radius = 0;                                     ///< [m]
   int nearest_triangle = -1;  ///< touchable surface triangle nearest the tool (see nearest_touchable_triangle)
+  /// Sphere model: nodes outside the sphere at rest that the simulation's state has it push;
+  /// their triangles join its patch (sphere_patch).
+  std::vector<int> carried_nodes;
 };
 
 struct IrBuildOptions {

@@ -103,11 +103,61 @@ StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) con
 void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
                              const std::vector<bool>& touchable) const {
   const SphereTool sphere{user.position, user.radius};
-  const std::vector<int> patch = sphere_patch(body_.mesh, body_.surface, user.nearest, sphere, options_.ir.patch_rings, touchable);
-  const std::vector<int> nodes = triangle_nodes(body_.surface, patch);
+  const int rings = options_.ir.patch_rings;
+  user.sphere_patch_nodes = triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, user.nearest, sphere, rings, touchable));
+  // Carried nodes the patch now holds anyway are no longer carried.
+  std::erase_if(user.sphere_carried, [&](int node) {
+    return std::find(user.sphere_patch_nodes.begin(), user.sphere_patch_nodes.end(), node) != user.sphere_patch_nodes.end();
+  });
+  const std::vector<int> nodes =
+      user.sphere_carried.empty()
+          ? user.sphere_patch_nodes
+          : triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, user.nearest, sphere, rings, touchable,
+                                                       user.sphere_carried));
   for (int node : nodes) under_tool[node] = in_patch[node] = true;
   user.sphere_holds = nodes_held_by_spheres(body_.mesh, body_.dofs, nodes, std::span(&sphere, 1)).nodes;
-  user.pressing = !user.sphere_holds.empty();
+  user.pressing = !user.sphere_holds.empty() || !user.sphere_carried.empty();
+}
+
+bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, std::vector<bool>& in_patch,
+                                                 StepReport& report) {
+  constexpr int kMaxCarryPasses = 4;  // each pass only adds nodes; in practice one settles it
+  std::vector<int> user_of_sphere;    // spheres() lists the known users in order
+  for (std::size_t u = 0; u < users_.size(); ++u)
+    if (users_[u].known) user_of_sphere.push_back(static_cast<int>(u));
+  const std::vector<SphereTool> tools = spheres();
+  bool boundary_changed = false;
+  for (int pass = 0;; ++pass) {
+    const StateSolution state = solve();
+    // The pushed nodes of this state, each with the user whose sphere pushes it, that no
+    // patch holds (a node in another user's patch is a contact node of this user's IR too).
+    std::vector<int> pushed;
+    std::vector<std::pair<int, int>> left_out;
+    for (std::size_t i = 0; i < state.contact_dofs.size(); ++i) {
+      const int node = state.contact_dofs[i] / 3;
+      if (state.contact_forces[static_cast<Eigen::Index>(i)] == 0.0 || (!pushed.empty() && pushed.back() == node))
+        continue;  // not pushed, or its other axes
+      pushed.push_back(node);
+      if (in_patch[node]) continue;
+      const SphereConstraint constraint =
+          sphere_constraint(body_.mesh.nodes.col(node), body_.dofs.fixed_axes[node], tools).value();
+      left_out.emplace_back(node, user_of_sphere[static_cast<std::size_t>(constraint.tool)]);
+    }
+    if (left_out.empty()) {
+      // A carried node the state no longer pushes leaves its patch from the next step on.
+      for (UserState& user : users_)
+        std::erase_if(user.sphere_carried,
+                      [&](int node) { return std::find(pushed.begin(), pushed.end(), node) == pushed.end(); });
+      return boundary_changed;
+    }
+    if (pass == kMaxCarryPasses) {
+      report.sphere_nodes_outside_patches = static_cast<int>(left_out.size());
+      return boundary_changed;
+    }
+    for (const auto& [node, user] : left_out) users_[static_cast<std::size_t>(user)].sphere_carried.push_back(node);
+    for (const auto& [node, user] : left_out) mark_sphere(users_[static_cast<std::size_t>(user)], under_tool, in_patch, touchable_triangle_);
+    boundary_changed |= update_boundary(under_tool, in_patch);
+  }
 }
 
 Eigen::Matrix3Xd Simulation::displacement_of(std::span<const int> nodes) const {
@@ -208,6 +258,7 @@ StepReport Simulation::step(double time) {
     UserState& user = users_[u];
     if (!user.known) {
       user.pressing = false;
+      user.sphere_carried.clear();
       user.contact.reset();
       user.ir.reset();
       continue;
@@ -227,8 +278,11 @@ StepReport Simulation::step(double time) {
       for (int t : contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable_triangle_))
         for (int node : body_.surface.triangles[t]) in_patch[node] = true;
     if (sphere_model()) mark_sphere(user, under_tool, in_patch, touchable_triangle_);
-    tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest});
   }
+
+  Stopwatch watch;
+  bool boundary_changed = update_boundary(under_tool, in_patch);
+  if (sphere_model()) boundary_changed |= carry_pushed_nodes_into_patches(under_tool, in_patch, report);
   std::vector<int>& nearest = step_nearest_;
   std::vector<std::vector<int>>& sphere_holds = step_sphere_holds_;
   nearest.clear();
@@ -236,14 +290,12 @@ StepReport Simulation::step(double time) {
   for (std::size_t u = 0; u < users_.size(); ++u) {
     const UserState& user = users_[u];
     nearest.push_back(user.known ? user.nearest : -1);
-    if (user.known)
-      sphere_holds[u] = user.sphere_holds;
-    else
-      sphere_holds[u].clear();
+    sphere_holds[u].clear();
+    if (!user.known) continue;
+    tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest, user.sphere_carried});
+    sphere_holds[u] = user.sphere_holds;
+    sphere_holds[u].insert(sphere_holds[u].end(), user.sphere_carried.begin(), user.sphere_carried.end());
   }
-
-  Stopwatch watch;
-  const bool boundary_changed = update_boundary(under_tool, in_patch);
   // Under naive_every_step M~ is computed again every step, as the paper's conventional loop
   // did (that cost is the step delay), but with unchanged sets it is the same IR: a new one
   // (a new epoch) is published only when a set changed.

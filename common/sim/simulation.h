@@ -111,6 +111,10 @@ class Simulation {
     std::optional<ToolContact> contact;
     bool pressing = false;
     std::vector<int> sphere_holds;  ///< sphere contact model: the nodes its sphere holds at rest
+    /// Sphere contact model: nodes outside its sphere at rest that the state has it push and
+    /// that its patch would not hold otherwise; their triangles join the patch.
+    std::vector<int> sphere_carried;
+    std::vector<int> sphere_patch_nodes;  ///< its patch's nodes without the carried nodes' triangles
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
   };
@@ -125,6 +129,12 @@ class Simulation {
   /// and in the patch, and it presses when its sphere holds a node.
   void mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
                    const std::vector<bool>& touchable) const;
+  /// The sphere model's check of the patches against the solved state: a node that the
+  /// state has a sphere push and that its user's patch leaves out (a bulge carried it in,
+  /// beyond the rings) joins that patch, B is updated again, and the state solved again.
+  /// Returns whether B changed; counts in `report` the pushed nodes still left out after
+  /// kMaxCarryPasses passes.
+  bool carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, std::vector<bool>& in_patch, StepReport& report);
   std::vector<SphereTool> spheres() const;  ///< every known user's tool
   StateSolution solve_spheres(std::span<const SphereTool> spheres) const;
   bool update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch);
@@ -146,7 +156,7 @@ class Simulation {
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
-  std::vector<std::vector<int>> built_sphere_holds_;  // nodes each sphere held when they were built
+  std::vector<std::vector<int>> built_sphere_holds_;  // nodes each sphere held or carried when they were built
   std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
   std::vector<SphereTool> previous_spheres_;        // the sphere model's: the spheres of the previous step
   std::vector<int> sphere_candidates_;              // the touchable triangles' nodes

@@ -13,6 +13,9 @@ struct StepReport {
   std::size_t ir_bytes = 0;   ///< total size of the IRs rebuilt
   int boundary_nodes = 0;     ///< |B| after the step
   int obstacle_nodes = 0;     ///< of which held by obstacles
+  /// Sphere model: nodes the state has a sphere push that no IR's patch holds (its client
+  /// cannot feel them); 0 unless the patches failed to settle in a step.
+  int sphere_nodes_outside_patches = 0;
 
   /// Adds another body's report to this one.
   StepReport& operator+=(const StepReport& other) {
@@ -22,6 +25,7 @@ struct StepReport {
     ir_bytes += other.ir_bytes;
     boundary_nodes += other.boundary_nodes;
     obstacle_nodes += other.obstacle_nodes;
+    sphere_nodes_outside_patches += other.sphere_nodes_outside_patches;
     return *this;
   }
 };
