@@ -23,6 +23,7 @@
 #include "common/sim/simulation.h"
 #include "support/cube_scene.h"
 #include "support/measures.h"
+#include "support/test_meshes.h"
 #include "support/unlimited_options.h"
 
 namespace cohaptic {
@@ -245,14 +246,14 @@ struct SphereComparison {
 };
 
 void compare(const ElasticBody& body, const Simulation& simulation, const std::vector<Eigen::Vector3d>& tools, int user,
-             SphereComparison& comparison) {
+             SphereComparison& comparison, double radius = kSphereRadius) {
   const PreparedIR& prepared = *simulation.ir(user);
   std::vector<Eigen::Vector3d> remotes;
   for (int r = 0; r < remote_count(prepared.ir); ++r) remotes.push_back(tools[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
   EvaluationState state = make_evaluation_state(prepared);
   const ForceSample sample = evaluate_force(prepared, state, tools[static_cast<std::size_t>(user)], remotes, 1e-3);
   std::vector<PressedTool> pressed;
-  for (const Eigen::Vector3d& p : tools) pressed.push_back({p, kSphereRadius});
+  for (const Eigen::Vector3d& p : tools) pressed.push_back({p, radius});
   const SphereContactSolution reference = sphere_reactions_reference(body, pressed, held_nodes(simulation));
   const Eigen::Vector3d expected = reference.reactions[static_cast<std::size_t>(user)];
   ASSERT_FALSE(sample.flags & (kOutsidePatch | kContactUnresolved | kNonFinite));
@@ -322,6 +323,55 @@ TEST(SphereContact, TwoSpheresAndHeldNodesEqualTheFullSparseSolve) {
                 comparison.checked, comparison.worst);
     EXPECT_EQ(comparison.checked, 26);
   }
+}
+
+// One or two spheres pressed 0.2-6 mm (cube) or 0.2-4 mm (brain) into the surface at random
+// places, each from rest in one step, as `cohaptic-lab probe` does: every IR's force and
+// contact set equal the full sparse solve of the same unilateral problem. On the brain the
+// skull holds nodes (B) and the tips are 7 mm spheres on 9 mm elements.
+void press_at_random_places(const ElasticBody& body, const Model& model, ComplianceColumns& columns, double radius,
+                            double max_depth, int positions, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_int_distribution<std::size_t> any_node(0, body.touchable_nodes.size() - 1);
+  std::uniform_real_distribution<double> depth(0.2e-3, max_depth);
+  SphereComparison comparison;
+  int two_spheres = 0;
+  for (int k = 0; k < positions; ++k) {
+    // A sphere of `radius` whose surface reaches `depth` below a touchable node, along its normal.
+    const auto pressed_at = [&] {
+      const int node = body.touchable_nodes[any_node(random)];
+      return Eigen::Vector3d(body.mesh.nodes.col(node) + body.normals.vertex.col(node) * (radius - depth(random)));
+    };
+    std::vector<Eigen::Vector3d> tools = {pressed_at()};
+    if (k % 2 == 1) tools.push_back(pressed_at());
+    two_spheres += tools.size() == 2;
+    Simulation simulation(body, model.obstacles, columns, std::vector<ToolSpec>(tools.size(), model.scene.tools[0]),
+                          unlimited_options(ContactModel::sphere));
+    for (std::size_t user = 0; user < tools.size(); ++user) simulation.set_tool(static_cast<int>(user), tools[user]);
+    const StepReport report = simulation.step(0);
+    EXPECT_EQ(report.sphere_nodes_outside_patches, 0);
+    for (std::size_t user = 0; user < tools.size(); ++user) {
+      SCOPED_TRACE("position " + std::to_string(k) + ", user " + std::to_string(user));
+      ASSERT_TRUE(simulation.ir(static_cast<int>(user)));
+      compare(body, simulation, tools, static_cast<int>(user), comparison, radius);
+    }
+  }
+  std::printf("  %d IRs (%d positions with two spheres): worst relative force error %.2e; %d node contacts, %d held "
+              "nodes released\n",
+              comparison.checked, two_spheres, comparison.worst, comparison.contact_nodes, comparison.released_nodes);
+  EXPECT_GT(comparison.contact_nodes, positions) << "the spheres pressed too little to test anything";
+}
+
+TEST(SphereContact, AtRandomPlacesOnTheCubeEqualsTheFullSparseSolve) {
+  testing::CubeRig& rig = shared_rig();
+  press_at_random_places(rig.body, *rig.model, *rig.columns, kSphereRadius, 6e-3, 24, 5);
+}
+
+TEST(SphereContact, AtRandomPlacesOnTheBrainEqualsTheFullSparseSolve) {
+  const Model model = build_model(load_scene(testing::source_path("scenes/brain.yaml")));
+  const ElasticBody& body = single_elastic_body(model);
+  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  press_at_random_places(body, model, columns, model.scene.tools[0].radius, 4e-3, 16, 9);
 }
 
 TEST(SphereContact, TheReferenceMeetsTheContactConditionsOnAnIndependentSolve) {
