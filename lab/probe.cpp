@@ -36,8 +36,12 @@ struct ProbedTool {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();  // reaction on the tool [N]
   std::size_t ir_bytes = 0;
   int boundary_nodes = 0;
+  int steps = 0;  // simulation steps taken (approach and settling)
   double condition_estimate = 0;
 };
+
+// At most this many steps at the final positions after an approach, for the sets to settle.
+constexpr int kMaxSettlingSteps = 50;
 
 // Parses "x,y,z" (three finite numbers separated by commas).
 std::string parse_point(const std::string& text, Eigen::Vector3d& point) {
@@ -73,18 +77,33 @@ void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& o
   sim_options.step_delay_nodes = options.boundary_nodes;
   Simulation simulation(body, model.obstacles, columns, model.scene.tools, sim_options);
   std::vector<PressedTool> pressed;
-  for (int u : users) {
-    simulation.set_tool(u, tools[u].tool.position);
-    pressed.push_back(tools[u].tool);
-  }
+  for (int u : users) pressed.push_back(tools[u].tool);
   const std::vector<ContactQuery> contacts = find_tool_contacts(body, pressed);
   for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].query = contacts[i];
 
   Stopwatch watch;
-  const StepReport report = simulation.step(0.0);
+  // Each tool goes in a straight line from where its contact point touches the rest
+  // surface (its position less the contact's displacement) to its position.
+  StepReport report;
+  int steps = 0;
+  for (int k = 1; k <= options.approach_steps; ++k, ++steps) {
+    const double fraction = static_cast<double>(k) / options.approach_steps;
+    for (std::size_t i = 0; i < users.size(); ++i) {
+      const Eigen::Vector3d& position = pressed[i].position;
+      const Eigen::Vector3d travel = contacts[i].contact ? contacts[i].contact->displacement : Eigen::Vector3d::Zero();
+      simulation.set_tool(users[i], position - (1 - fraction) * travel);
+    }
+    report = simulation.step(steps * 1e-3);
+  }
+  if (options.approach_steps > 1)
+    for (int settling = 0; report.rebuilt && settling < kMaxSettlingSteps; ++settling, ++steps)
+      report = simulation.step(steps * 1e-3);
+  if (report.rebuilt && options.approach_steps > 1)
+    spdlog::warn("probe: the sets still changed after {} steps at the final positions", kMaxSettlingSteps);
   timings.ir_build_ms += watch.lap_ms();
   for (int u : users) {
     tools[u].boundary_nodes = report.boundary_nodes;
+    tools[u].steps = steps;
     if (const auto ir = simulation.ir(u)) {
       tools[u].ir_bytes = ir->ir.size_bytes();
       tools[u].condition_estimate = ir->condition_estimate;
@@ -150,6 +169,7 @@ nlohmann::json probe_json(const Model& model, const ProbeOptions& options, Conta
     tool["force"] = vector_json(probed.force);
     tool["ir"] = {{"bytes", probed.ir_bytes},
                   {"boundary_nodes", probed.boundary_nodes},
+                  {"steps", probed.steps},
                   {"condition_estimate", probed.condition_estimate}};
     out["tools"].push_back(tool);
   }
@@ -176,12 +196,13 @@ void print_table(const Model& model, const ProbeOptions& options, ContactModel c
              fixed_node_tags(body).size(), body.touchable_nodes.size());
   fmt::print("material  E = {:g} Pa, nu = {:g}, {}\n", material.youngs_modulus, material.poisson_ratio,
              formulation_name(material.formulation));
-  fmt::print("method    {}; contact model {}; tools pressed {}; {} boundary nodes held\n",
+  fmt::print("method    {}; contact model {}; tools pressed {}; {} boundary nodes held after {} step{}\n",
              options.reference ? "full sparse solve (--reference)"
                                : fmt::format("IR ({}, patch rings {})", options.precision == IrPrecision::f32 ? "f32" : "f64",
                                              options.patch_rings.value_or(model.scene.haptic.patch_rings)),
              contact_model_name(contact_model), options.separately ? "one at a time" : "together",
-             tools.empty() ? 0 : tools.front().boundary_nodes);
+             tools.empty() ? 0 : tools.front().boundary_nodes, tools.empty() ? 0 : tools.front().steps,
+             !tools.empty() && tools.front().steps == 1 ? "" : "s");
   fmt::print("\n{:<4} {:<28} {:>10} {:<20} {:<28} {:<30} {:>9} {:>9}\n", "tool", fmt::format("position ({})", u),
              fmt::format("depth ({})", u), "triangle (node ids)", fmt::format("node displacement ({})", u),
              "reaction force on tool (N)", "|F| (N)", "IR bytes");
@@ -296,6 +317,12 @@ LabCommand add_probe_command(CLI::App& lab) {
                    "Tool k takes the shape of the scene's k-th tool (the last one if there are fewer)")
       ->required();
   command->add_flag("--separately", probe.separately, "Press each tool alone (one solve per tool) instead of all tools at once");
+  command->add_option("--approach-steps", probe.approach_steps,
+                      "Simulation steps that bring each tool from touching the rest surface to its position; with "
+                      "more than 1 the last position is stepped again until no set changes (obstacles hold the nodes "
+                      "where they reach them, so a one-step press from rest can hold more)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   command->add_option("--boundary-nodes", probe.boundary_nodes,
                       "Hold the N surface nodes nearest the tools at rest (the paper's step-delay T150/T300 sets)")
       ->check(CLI::NonNegativeNumber)

@@ -23,6 +23,10 @@ struct ProbeOptions {
   bool json = false;
   bool reference = false;              ///< full sparse solve instead of the IR
   int boundary_nodes = 0;              ///< step-delay boundary nodes held at rest
+  /// Simulation steps that bring each tool from touching to its position (1: one step from
+  /// rest). Obstacles hold the nodes where they reach them, so their set depends on the path;
+  /// with more than one, the last position is stepped again until no set changes.
+  int approach_steps = 1;
   std::optional<int> patch_rings;      ///< default: the scene's
   std::optional<ContactModel> contact_model;  ///< default: the scene's
   IrPrecision precision = IrPrecision::f64;

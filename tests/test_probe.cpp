@@ -179,6 +179,12 @@ TEST_F(CubeProbe, TheProgramPrintsOneJsonObjectWithTheSameForces) {
 // On a scene of sphere tools the program names the sphere model, and --reference solves the
 // sphere model's unilateral problem in full (SphereContactReference), which the IR answers
 // exactly: both spheres' forces agree to 1e-9 (the point model's would not).
+// Tool t's force in `cohaptic-lab probe --json`'s output [N].
+Eigen::Vector3d probed_force(const nlohmann::json& json, int t) {
+  const nlohmann::json& f = json["tools"][t]["force"];
+  return Eigen::Vector3d(f[0], f[1], f[2]);
+}
+
 TEST(ProbeProgram, OnASphereSceneItsReferenceIsTheSphereModelsFullSolve) {
   const std::string arguments = "probe --scene " + testing::source_path("scenes/tradeoff/cube_two_spheres.yaml") +
                                 " --tool 30,25,36 --tool -20,-10,37 --json --no-disk-cache";
@@ -190,12 +196,29 @@ TEST(ProbeProgram, OnASphereSceneItsReferenceIsTheSphereModelsFullSolve) {
   EXPECT_EQ(by_ir["contact_model"], "sphere");
   EXPECT_EQ(by_reference["method"], "reference");
   for (int t = 0; t < 2; ++t) {
-    const auto force = [t](const nlohmann::json& json) {
-      const nlohmann::json& f = json["tools"][t]["force"];
-      return Eigen::Vector3d(f[0], f[1], f[2]);
-    };
+    const auto force = [t](const nlohmann::json& json) { return probed_force(json, t); };
     EXPECT_GT(force(by_reference).z(), 1.0) << "tool " << t << " presses the cube's top face";
     EXPECT_LE((force(by_ir) - force(by_reference)).norm(), 1e-9 * force(by_reference).norm()) << "tool " << t;
+  }
+}
+
+// Without obstacles or held nodes the sphere model's answer depends on the positions only,
+// so an approach in steps (each tool from touching to its position, then settling) ends where
+// one step from rest does.
+TEST(ProbeProgram, AnApproachInStepsEndsWhereOneStepDoesWhenNothingIsHeldOnTheWay) {
+  const std::string arguments = "probe --scene " + testing::source_path("scenes/tradeoff/cube_two_spheres.yaml") +
+                                " --tool 30,25,36 --tool -20,-10,37 --json --no-disk-cache";
+  const testing::ProgramRun one = run(arguments);
+  const testing::ProgramRun stepped = run(arguments + " --approach-steps 6");
+  ASSERT_EQ(one.exit_code, 0) << one.out;
+  ASSERT_EQ(stepped.exit_code, 0) << stepped.out;
+  const nlohmann::json by_one = nlohmann::json::parse(one.out), by_steps = nlohmann::json::parse(stepped.out);
+  EXPECT_EQ(by_one["tools"][0]["ir"]["steps"], 1);
+  EXPECT_GE(by_steps["tools"][0]["ir"]["steps"], 6);
+  for (int t = 0; t < 2; ++t) {
+    const auto force = [t](const nlohmann::json& json) { return probed_force(json, t); };
+    EXPECT_GT(force(by_one).z(), 1.0) << "tool " << t << " presses the cube's top face";
+    EXPECT_LE((force(by_steps) - force(by_one)).norm(), 1e-9 * force(by_one).norm()) << "tool " << t;
   }
 }
 
@@ -204,6 +227,7 @@ TEST(ProbeProgram, BadInputGivesAClearErrorAndANonZeroExit) {
   EXPECT_EQ(run("probe --scene " + cube + " --tool 1,2").exit_code, 2);
   EXPECT_NE(run("probe --scene /no/such/scene.yaml --tool 1,2,3").exit_code, 0);
   EXPECT_NE(run("probe --scene " + cube + " --tool nan,0,0").exit_code, 0);
+  EXPECT_NE(run("probe --scene " + cube + " --tool 1,2,3 --approach-steps 0").exit_code, 0);
   const std::string usage = run("probe --help").out;
   EXPECT_NE(usage.find("--export-vtu"), std::string::npos);
   EXPECT_NE(usage.find("--separately"), std::string::npos);
