@@ -185,41 +185,48 @@ Eigen::Vector3d probed_force(const nlohmann::json& json, int t) {
   return Eigen::Vector3d(f[0], f[1], f[2]);
 }
 
+// Two 40 mm spheres pressing the cube's top face, answered as JSON.
+std::string two_sphere_probe() {
+  return "probe --scene " + testing::source_path("scenes/tradeoff/cube_two_spheres.yaml") +
+         " --tool 30,25,36 --tool -20,-10,37 --json --no-disk-cache";
+}
+
+// Runs `cohaptic-lab ARGUMENTS` and parses its JSON (failing the test on a non-zero exit).
+nlohmann::json probe_json_of(const std::string& arguments) {
+  const testing::ProgramRun probe = run(arguments);
+  EXPECT_EQ(probe.exit_code, 0) << probe.out;
+  return probe.exit_code == 0 ? nlohmann::json::parse(probe.out) : nlohmann::json();
+}
+
+// Both tools of two_sphere_probe press the top face and feel the same in `actual` as in
+// `expected`, to 1e-9.
+void expect_same_two_sphere_forces(const nlohmann::json& expected, const nlohmann::json& actual) {
+  for (int t = 0; t < 2; ++t) {
+    const Eigen::Vector3d force = probed_force(expected, t);
+    EXPECT_GT(force.z(), 1.0) << "tool " << t << " presses the cube's top face";
+    EXPECT_LE((probed_force(actual, t) - force).norm(), 1e-9 * force.norm()) << "tool " << t;
+  }
+}
+
 TEST(ProbeProgram, OnASphereSceneItsReferenceIsTheSphereModelsFullSolve) {
-  const std::string arguments = "probe --scene " + testing::source_path("scenes/tradeoff/cube_two_spheres.yaml") +
-                                " --tool 30,25,36 --tool -20,-10,37 --json --no-disk-cache";
-  const testing::ProgramRun ir = run(arguments);
-  const testing::ProgramRun reference = run(arguments + " --reference");
-  ASSERT_EQ(ir.exit_code, 0) << ir.out;
-  ASSERT_EQ(reference.exit_code, 0) << reference.out;
-  const nlohmann::json by_ir = nlohmann::json::parse(ir.out), by_reference = nlohmann::json::parse(reference.out);
+  const nlohmann::json by_ir = probe_json_of(two_sphere_probe()),
+                       by_reference = probe_json_of(two_sphere_probe() + " --reference");
+  ASSERT_FALSE(by_ir.is_null() || by_reference.is_null());
   EXPECT_EQ(by_ir["contact_model"], "sphere");
   EXPECT_EQ(by_reference["method"], "reference");
-  for (int t = 0; t < 2; ++t) {
-    const auto force = [t](const nlohmann::json& json) { return probed_force(json, t); };
-    EXPECT_GT(force(by_reference).z(), 1.0) << "tool " << t << " presses the cube's top face";
-    EXPECT_LE((force(by_ir) - force(by_reference)).norm(), 1e-9 * force(by_reference).norm()) << "tool " << t;
-  }
+  expect_same_two_sphere_forces(by_reference, by_ir);
 }
 
 // Without obstacles or held nodes the sphere model's answer depends on the positions only,
 // so an approach in steps (each tool from touching to its position, then settling) ends where
 // one step from rest does.
 TEST(ProbeProgram, AnApproachInStepsEndsWhereOneStepDoesWhenNothingIsHeldOnTheWay) {
-  const std::string arguments = "probe --scene " + testing::source_path("scenes/tradeoff/cube_two_spheres.yaml") +
-                                " --tool 30,25,36 --tool -20,-10,37 --json --no-disk-cache";
-  const testing::ProgramRun one = run(arguments);
-  const testing::ProgramRun stepped = run(arguments + " --approach-steps 6");
-  ASSERT_EQ(one.exit_code, 0) << one.out;
-  ASSERT_EQ(stepped.exit_code, 0) << stepped.out;
-  const nlohmann::json by_one = nlohmann::json::parse(one.out), by_steps = nlohmann::json::parse(stepped.out);
+  const nlohmann::json by_one = probe_json_of(two_sphere_probe()),
+                       by_steps = probe_json_of(two_sphere_probe() + " --approach-steps 6");
+  ASSERT_FALSE(by_one.is_null() || by_steps.is_null());
   EXPECT_EQ(by_one["tools"][0]["ir"]["steps"], 1);
   EXPECT_GE(by_steps["tools"][0]["ir"]["steps"], 6);
-  for (int t = 0; t < 2; ++t) {
-    const auto force = [t](const nlohmann::json& json) { return probed_force(json, t); };
-    EXPECT_GT(force(by_one).z(), 1.0) << "tool " << t << " presses the cube's top face";
-    EXPECT_LE((force(by_steps) - force(by_one)).norm(), 1e-9 * force(by_one).norm()) << "tool " << t;
-  }
+  expect_same_two_sphere_forces(by_one, by_steps);
 }
 
 TEST(ProbeProgram, BadInputGivesAClearErrorAndANonZeroExit) {
