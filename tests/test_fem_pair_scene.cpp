@@ -1,0 +1,250 @@
+// FEM against FEM in a scene (issue 11; common/sim/fem_pair_interaction.h): the paired
+// boxes (support/paired_boxes.h, A E = 0.1 MPa in front of the paper's box B, both linear
+// elastic) with `interactions: [{front: front, behind: behind}]`, run by SceneSimulation
+// as the server runs it, a scripted point tool pressing A's front face towards B under the
+// translation contact model. Against independent answers:
+// - the server's force on the tool (P0: from the user's IR), A's displayed displacement and
+//   B's equal one sparse solve of A and B together (support/joint_pair_solve.h: the tool's
+//   triangle held at the tool's displacement, the contacts as Lagrange multipliers, its own
+//   candidates from A's free state by brute force and its own active set), 1e-9;
+// - the client's force from that IR through the wire equals the server's (1e-9): B is in
+//   the IR's M~, which travels whole (rows of A's own L would lose B);
+// - through the scene, free (no interaction) < on B < fixed (A's back face fixed);
+// - the loader and SceneSimulation refuse the pairs they cannot run, saying where.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <optional>
+#include <string>
+#include <unordered_map>
+
+#include "common/fem/static_solve.h"
+#include "common/ir/build_ir.h"
+#include "common/ir/evaluate_force.h"
+#include "common/model/scene_compliance.h"
+#include "common/scene/load_scene.h"
+#include "common/sim/scene_simulation.h"
+#include "proto/wire/ir_convert.h"
+#include "support/fem_pair_rig.h"
+#include "support/joint_pair_solve.h"
+
+namespace cohaptic {
+namespace {
+
+constexpr const char* kFemPairInteraction = "interactions:\n  - {front: front, behind: behind}\n";
+
+testing::PairedBoxesOptions fem_pair_scene_options(double gap_mm) {
+  testing::PairedBoxesOptions options;
+  options.gap_mm = gap_mm;
+  return options;
+}
+
+// The paired boxes with `extra` YAML appended (the interaction, a contact model).
+Scene fem_pair_scene(double gap_mm, const std::string& extra) {
+  return parse_scene(testing::paired_boxes_scene_yaml(fem_pair_scene_options(gap_mm)) + extra, "fem-pair.yaml");
+}
+
+// `scene` with A's back face (x = -gap, towards B) fixed: the fixed condition.
+Scene with_back_fixed(Scene scene, double gap_mm) {
+  auto& front = std::get<ElasticObjectSpec>(scene.objects.front().body);
+  FixedRegion back;
+  back.nodes.kind = NodeSelector::Kind::plane;
+  back.nodes.plane_point = Eigen::Vector3d(-gap_mm * 1e-3, 0, 0);
+  back.nodes.plane_normal = Eigen::Vector3d::UnitX();
+  back.nodes.where = "test: A's back face";
+  front.fixed.push_back(back);
+  return scene;
+}
+
+struct FemPairRun {
+  Model model;
+  SceneCompliance compliance;
+  SceneSimulation simulation;
+  explicit FemPairRun(Scene scene)
+      : model(build_model(std::move(scene))),
+        compliance(prepare_scene_compliance(model, true, std::nullopt)),
+        simulation(model, compliance.per_body, model.scene.tools, [this] {
+          SimulationOptions options;
+          options.ir = ir_build_options(model.scene.haptic);
+          options.ir.force_limit = 1000;  // compare forces, not the haptic limit
+          return options;
+        }()) {}
+  // Two steps with the tool held still: the first forms the pushing set, the second keeps it.
+  ForceSample press(const Eigen::Vector3d& tool) {
+    for (double time : {0.0, 1e-3}) {
+      simulation.set_tool(0, tool);
+      simulation.step(time);
+    }
+    return simulation.force(0);
+  }
+  const Simulation& fem(int body) const { return std::get<Simulation>(simulation.body(body)); }
+};
+
+// The tool `depth` [m] into A's front face near its centre, a quarter and a half into a cell
+// of the face: inside a triangle, away from its edges, whichever way the cell is split.
+Eigen::Vector3d fem_pair_tool(double gap_mm, double depth) {
+  return Eigen::Vector3d((-57.5 - gap_mm) * 1e-3 + depth, (15.95 + 2.25 * 98.9 / 5) * 1e-3, (1.5 * 57.5 / 3) * 1e-3);
+}
+
+// The joint solve for a tool at `tool` under the translation model: the nearest triangle's
+// nodes all moved by the tool's offset from the triangle's plane.
+struct ExpectedPress {
+  std::vector<PolygonCollision> candidates;  // A's back face at A's state alone, against B
+  testing::JointPairSolution joint;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  // on the tool, as ForceSample gives it: -sum_i w_i f_i [N]
+};
+
+ExpectedPress expected_press(const testing::PairedBoxesRig& rig, const Eigen::Vector3d& tool) {
+  const ElasticBody& a = rig.front;
+  const Triangle& triangle = a.surface.triangles[static_cast<std::size_t>(nearest_touchable_triangle(a, tool))];
+  const Eigen::Vector3d p0 = a.mesh.nodes.col(triangle[0]), p1 = a.mesh.nodes.col(triangle[1]),
+                        p2 = a.mesh.nodes.col(triangle[2]);
+  const Eigen::Vector3d cross = (p1 - p0).cross(p2 - p0);
+  const Eigen::Vector3d normal = cross.normalized();
+  const Eigen::Vector3d d = (tool - p0).dot(normal) * normal;
+  const Eigen::Vector3d foot = tool - d;
+  const Eigen::Vector3d weights((p1 - foot).cross(p2 - foot).dot(cross) / cross.squaredNorm(),
+                                (p2 - foot).cross(p0 - foot).dot(cross) / cross.squaredNorm(),
+                                (p0 - foot).cross(p1 - foot).dot(cross) / cross.squaredNorm());
+  EXPECT_GT(weights.minCoeff(), 0.05);  // well inside the triangle
+  std::vector<int> held;
+  std::vector<double> values;
+  for (int node : triangle)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!a.dofs.is_fixed(node, axis)) {
+        held.push_back(3 * node + axis);
+        values.push_back(d[axis]);
+      }
+  const Eigen::VectorXd held_values = Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  const StaticSolution alone = ConstrainedStaticSolver(a.stiffness, a.dofs, held).solve(held_values);
+  ExpectedPress expected;
+  expected.candidates = testing::back_face_candidates(rig, alone.displacement);
+  expected.joint = testing::joint_pair_solve(a, rig.behind, held, held_values, expected.candidates);
+  for (int k = 0; k < 3; ++k)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!a.dofs.is_fixed(triangle[static_cast<std::size_t>(k)], axis))
+        expected.force[axis] -= weights[k] * expected.joint.front_reaction[3 * triangle[static_cast<std::size_t>(k)] + axis];
+  return expected;
+}
+
+// The largest difference of `simulation`'s displacement at `body`'s surface from `expected`
+// (3 per node), and the largest expected displacement there [m].
+std::pair<double, double> surface_difference(const Simulation& simulation, const ElasticBody& body,
+                                             const Eigen::VectorXd& expected) {
+  const Eigen::Matrix3Xd u = simulation.displacement_of(body.surface.nodes);
+  double error = 0, largest = 0;
+  for (std::size_t i = 0; i < body.surface.nodes.size(); ++i) {
+    const Eigen::Vector3d reference = expected.segment<3>(3 * body.surface.nodes[i]);
+    largest = std::max(largest, reference.norm());
+    error = std::max(error, (u.col(static_cast<Eigen::Index>(i)) - reference).norm());
+  }
+  return {error, largest};
+}
+
+TEST(FemPairScene, TheServersForceAndBothBodiesShapesAreTheJointSparseSolves) {
+  for (const double gap_mm : {0.0, 0.5}) {
+    SCOPED_TRACE(gap_mm);
+    FemPairRun run(fem_pair_scene(gap_mm, kFemPairInteraction));
+    const testing::PairedBoxesRig rig(fem_pair_scene_options(gap_mm));
+    ASSERT_EQ(rig.front.mesh.nodes, elastic_body(run.model, 0).mesh.nodes);
+    ASSERT_EQ(rig.behind.mesh.nodes, elastic_body(run.model, 1).mesh.nodes);
+    const Eigen::Vector3d tool = fem_pair_tool(gap_mm, 4e-3);
+    const ForceSample felt = run.press(tool);
+    const ExpectedPress expected = expected_press(rig, tool);
+
+    // The pushes, by A's node: the scene found the same pushing nodes and pushes.
+    const FemPairInteraction& pair = run.simulation.fem_pair(0);
+    std::unordered_map<int, double> joint_push;  // by A's node
+    for (std::size_t j = 0; j < expected.candidates.size(); ++j)
+      if (const double push = expected.joint.pushes[static_cast<Eigen::Index>(j)]; push > 0)
+        joint_push[expected.candidates[j].active] = push;
+    const double push_scale = expected.joint.pushes.maxCoeff();
+    ASSERT_GT(push_scale, 0);
+    int pushing = 0;
+    for (std::size_t j = 0; j < pair.collisions.size(); ++j)
+      if (const double push = pair.contact.pushes[static_cast<Eigen::Index>(j)]; push > 0) {
+        ++pushing;
+        ASSERT_TRUE(joint_push.count(pair.collisions[j].active)) << pair.collisions[j].active;
+        EXPECT_NEAR(push, joint_push.at(pair.collisions[j].active), 1e-9 * push_scale);
+      }
+    EXPECT_EQ(pushing, static_cast<int>(joint_push.size()));
+    EXPECT_TRUE(run.simulation.condenses_over_support(0));
+    EXPECT_FALSE(run.simulation.condenses_over_support(1));
+
+    // The server's state: the tool's force with B's pushes applied to A.
+    EXPECT_GT(expected.force.norm(), 0);
+    const Eigen::Vector3d state_force = -run.fem(0).solve().tool_forces.at(0);
+    EXPECT_LE((state_force - expected.force).norm(), 1e-9 * expected.force.norm());
+    // The server's force, from the user's IR: B felt through A's M~. Exact when the pushing
+    // nodes touch B at rest; across a gap the IR's support lacks the gap's preload.
+    if (gap_mm == 0) {
+      EXPECT_LE((felt.force - expected.force).norm(), 1e-9 * expected.force.norm())
+          << felt.force.transpose() << " vs " << expected.force.transpose();
+    }
+    RecordProperty(fmt::format("ir_force_error_gap_{}mm", gap_mm),
+                   fmt::format("{:.3e}", (felt.force - expected.force).norm() / expected.force.norm()));
+    // A shows B's support and B shows A's pushes.
+    const auto [front_error, front_largest] = surface_difference(run.fem(0), rig.front, expected.joint.front);
+    EXPECT_LE(front_error, 1e-9 * front_largest);
+    const auto [behind_error, behind_largest] = surface_difference(run.fem(1), rig.behind, expected.joint.behind);
+    EXPECT_GT(behind_largest, 0);
+    EXPECT_LE(behind_error, 1e-9 * behind_largest);
+  }
+}
+
+TEST(FemPairScene, TheClientFeelsBThroughAsIrAsTheServerDoes) {
+  FemPairRun run(fem_pair_scene(0.0, kFemPairInteraction));
+  const Eigen::Vector3d tool = fem_pair_tool(0.0, 4e-3);
+  const ForceSample on_server = run.press(tool);
+  const auto ir = run.simulation.ir(0);
+  ASSERT_TRUE(ir);
+  ASSERT_TRUE(run.simulation.condenses_over_support(0));
+  // M~ whole through the wire, as the server sends an IR that condenses over a support.
+  const PreparedIR on_client = prepare_ir(wire::from_wire(wire::to_wire(ir->ir)));
+  EvaluationState state = make_evaluation_state(on_client);
+  const ForceSample felt = evaluate_force(on_client, state, tool, {}, 1e-3);
+  EXPECT_GT(on_server.force.norm(), 0);
+  EXPECT_LE((felt.force - on_server.force).norm(), 1e-9 * on_server.force.norm());
+  // And for another tool position within the same pushing set and patch.
+  const Eigen::Vector3d moved = tool + Eigen::Vector3d(0.5e-3, 0.3e-3, -0.2e-3);
+  run.simulation.set_tool(0, moved);
+  run.simulation.step(2e-3);
+  ASSERT_EQ(run.simulation.ir(0), ir);  // no rebuild: the sets stayed
+  const ForceSample server_moved = run.simulation.force(0);
+  EXPECT_LE((evaluate_force(on_client, state, moved, {}, 1e-3).force - server_moved.force).norm(),
+            1e-9 * server_moved.force.norm());
+}
+
+TEST(FemPairScene, APushOnBFeelsMoreThanFreeAndLessThanFixed) {
+  FemPairRun on_behind(fem_pair_scene(0.0, kFemPairInteraction));
+  FemPairRun free(fem_pair_scene(0.0, ""));
+  FemPairRun fixed(with_back_fixed(fem_pair_scene(0.0, ""), 0.0));
+  for (const double depth : {1e-3, 4e-3, 8e-3}) {
+    SCOPED_TRACE(depth);
+    const Eigen::Vector3d tool = fem_pair_tool(0.0, depth);
+    const double f_free = -free.press(tool).force.x();
+    const double f_on_behind = -on_behind.press(tool).force.x();
+    const double f_fixed = -fixed.press(tool).force.x();
+    EXPECT_GT(f_free, 0);
+    EXPECT_LT(f_free, f_on_behind);
+    EXPECT_LT(f_on_behind, f_fixed);
+  }
+}
+
+TEST(FemPairScene, RefusesPairsItCannotRunSayingWhere) {
+  try {
+    fem_pair_scene(0.0, std::string(kFemPairInteraction) + "haptic: {contact_model: point}\n");
+    ADD_FAILURE() << "no error for the point contact model";
+  } catch (const SceneError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("fem-pair.yaml:"), std::string::npos) << what;
+    EXPECT_NE(what.find("translation contact model only"), std::string::npos) << what;
+  }
+  // SceneSimulation says the same of a scene built in code.
+  Scene scene = fem_pair_scene(0.0, kFemPairInteraction);
+  scene.haptic.contact_model = ContactModel::point_constraint;
+  EXPECT_THROW(FemPairRun{std::move(scene)}, Error);
+}
+
+}  // namespace
+}  // namespace cohaptic
