@@ -10,15 +10,18 @@
 // - the client's force from that IR through the wire equals the server's (1e-9): B is in
 //   the IR's M~, which travels whole (rows of A's own L would lose B);
 // - through the scene, free (no interaction) < on B < fixed (A's back face fixed);
+// - the shipped scene's scripted surgeons feel B through A;
 // - the loader and SceneSimulation refuse the pairs they cannot run, saying where.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <unordered_map>
 
 #include "common/fem/static_solve.h"
+#include "common/haptics/trajectory.h"
 #include "common/ir/build_ir.h"
 #include "common/ir/evaluate_force.h"
 #include "common/model/scene_compliance.h"
@@ -27,6 +30,7 @@
 #include "proto/wire/ir_convert.h"
 #include "support/fem_pair_rig.h"
 #include "support/joint_pair_solve.h"
+#include "support/test_meshes.h"
 
 namespace cohaptic {
 namespace {
@@ -229,6 +233,43 @@ TEST(FemPairScene, APushOnBFeelsMoreThanFreeAndLessThanFixed) {
     EXPECT_LT(f_free, f_on_behind);
     EXPECT_LT(f_on_behind, f_fixed);
   }
+}
+
+// The shipped scene (scenes/objects/fem_pair.yaml) with its two scripted surgeons, stepped
+// every 10 ms (the bodies are static) to the middle of A's first hold: both press A, B
+// gives way under A, and each feels more than on A alone (the scene without its interaction).
+TEST(FemPairScene, TheShippedScenesSurgeonsFeelBThroughA) {
+  const std::filesystem::path file = testing::source_path("scenes/objects/fem_pair.yaml");
+  const Trajectory surgeon_a = load_trajectory(testing::source_path("scenes/objects/fem_pair/surgeon_a.yaml"));
+  const Trajectory surgeon_b = load_trajectory(testing::source_path("scenes/objects/fem_pair/surgeon_b.yaml"));
+  Scene alone_scene = load_scene(file);
+  alone_scene.interactions.clear();
+  FemPairRun on_behind(load_scene(file));
+  FemPairRun alone(std::move(alone_scene));
+  const double hold = 2.8;  // s: surgeon A 4 mm deep, surgeon B 3 mm deep and sliding
+  for (FemPairRun* run : {&on_behind, &alone})
+    for (double time = 0; time <= hold + 1e-9; time += 0.01) {
+      run->simulation.set_tool(0, surgeon_a.position(time));
+      run->simulation.set_tool(1, surgeon_b.position(time));
+      run->simulation.step(time);
+    }
+  for (int user = 0; user < 2; ++user) {
+    SCOPED_TRACE(user);
+    ASSERT_TRUE(on_behind.simulation.pressing(user));
+    EXPECT_EQ(on_behind.simulation.body_of(user), 0);
+    const double felt = on_behind.simulation.force(user).force.z();
+    const double without_b = alone.simulation.force(user).force.z();
+    EXPECT_GT(without_b, 0);
+    EXPECT_GT(felt, without_b);
+    RecordProperty(fmt::format("user_{}_force_on_b_alone_n", user), fmt::format("{:.4f} {:.4f}", felt, without_b));
+  }
+  EXPECT_TRUE(on_behind.simulation.condenses_over_support(0));
+  const FemPairInteraction& pair = on_behind.simulation.fem_pair(0);
+  EXPECT_GT((pair.contact.pushes.array() > 0).count(), 2);
+  EXPECT_EQ(pair.failures, 0);
+  // B sinks under A: its upper face's lowest point is below rest.
+  const ElasticBody& b = elastic_body(on_behind.model, 1);
+  EXPECT_LT(on_behind.fem(1).displacement_of(b.touchable_nodes).row(2).minCoeff(), -1e-4);
 }
 
 TEST(FemPairScene, RefusesPairsItCannotRunSayingWhere) {
