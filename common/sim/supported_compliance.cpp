@@ -24,11 +24,14 @@ SupportedCompliance::SupportedCompliance(ComplianceSource& base, const DofMap& d
         dofs_.push_back(3 * node + axis);
         entries.emplace_back(s, normals(axis, s));
       }
-  normals_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(dofs_.size()), count);
+  std::vector<Eigen::Triplet<double>> triplets;
   for (std::size_t row = 0; row < entries.size(); ++row)
-    normals_(static_cast<Eigen::Index>(row), entries[row].first) = entries[row].second;
+    triplets.emplace_back(static_cast<Eigen::Index>(row), entries[row].first, entries[row].second);
+  normals_.resize(static_cast<Eigen::Index>(dofs_.size()), count);
+  normals_.setFromTriplets(triplets.begin(), triplets.end());
   base_.compute_columns(nodes_);
-  const Eigen::MatrixXd coupled = support_compliance + normals_.transpose() * base_.dof_block(dofs_, dofs_) * normals_;
+  const Eigen::MatrixXd block_times_normals = base_.dof_block(dofs_, dofs_) * normals_;
+  const Eigen::MatrixXd coupled = support_compliance + normals_.transpose() * block_times_normals;
   coupled_.compute((coupled + coupled.transpose()) / 2);
   if (coupled_.info() != Eigen::Success)
     throw Error(fmt::format("supported compliance: the {} supporting nodes' coupled compliance is not positive definite "
@@ -38,8 +41,8 @@ SupportedCompliance::SupportedCompliance(ComplianceSource& base, const DofMap& d
 void SupportedCompliance::compute_columns(const std::vector<int>& nodes) { base_.compute_columns(nodes); }
 
 Eigen::MatrixXd SupportedCompliance::dof_block(std::span<const int> row_dofs, std::span<const int> col_dofs) {
-  const Eigen::MatrixXd rows = base_.dof_block(row_dofs, dofs_) * normals_;  // L_XS N
-  const Eigen::MatrixXd cols = base_.dof_block(col_dofs, dofs_) * normals_;  // L_YS N = (N^T L_SY)^T, L symmetric
+  const Eigen::MatrixXd rows = Eigen::MatrixXd(base_.dof_block(row_dofs, dofs_) * normals_);  // L_XS N
+  const Eigen::MatrixXd cols = Eigen::MatrixXd(base_.dof_block(col_dofs, dofs_) * normals_);  // L_YS N = (N^T L_SY)^T, L symmetric
   return base_.dof_block(row_dofs, col_dofs) - rows * coupled_.solve(cols.transpose());
 }
 

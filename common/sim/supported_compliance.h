@@ -16,6 +16,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <span>
 #include <vector>
 
@@ -42,7 +43,7 @@ class SupportedCompliance final : public ComplianceSource {
   ComplianceSource& base_;
   std::vector<int> nodes_;
   std::vector<int> dofs_;            // the support nodes' free dofs
-  Eigen::MatrixXd normals_;          // N over those dofs, |dofs_| x |S|
+  Eigen::SparseMatrix<double> normals_;  // N over those dofs, |dofs_| x |S|: one entry per dof
   Eigen::LLT<Eigen::MatrixXd> coupled_;  // of A_S + N^T L_SS N
 };
 
