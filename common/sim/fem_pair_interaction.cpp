@@ -100,10 +100,12 @@ FemPairLoads step_fem_pair(FemPairInteraction& interaction, const ElasticBody& f
   const auto count = static_cast<Eigen::Index>(pushing.size());
   loads.support_normals.resize(3, count);
   loads.support_compliance.resize(count, count);
+  loads.support_gaps.resize(count);
   for (Eigen::Index a = 0; a < count; ++a) {
     const PolygonCollision& collision = interaction.collisions[static_cast<std::size_t>(pushing[static_cast<std::size_t>(a)])];
     loads.support_nodes.push_back(collision.active);
     loads.support_normals.col(a) = collision.normal;
+    loads.support_gaps[a] = (front_body.mesh.nodes.col(collision.active) - collision.target).dot(collision.normal);
     for (Eigen::Index b = 0; b < count; ++b)
       loads.support_compliance(a, b) = interaction.contact.behind_compliance(pushing[static_cast<std::size_t>(a)],
                                                                              pushing[static_cast<std::size_t>(b)]);
@@ -128,7 +130,8 @@ void couple_fem_pair(FemPairInteraction& interaction, Simulation& front, const E
   front.set_support(loads.support_nodes.empty()
                         ? nullptr
                         : std::make_unique<SupportedCompliance>(front_columns, front_body.dofs, loads.support_nodes,
-                                                                loads.support_normals, loads.support_compliance));
+                                                                loads.support_normals, loads.support_compliance,
+                                                                loads.support_gaps));
 }
 
 }  // namespace cohaptic

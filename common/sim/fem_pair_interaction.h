@@ -12,9 +12,9 @@
 // folded into the compliance A's IRs condense over as a support on the pushing set S
 // (supported_compliance.h), rebuilt when S changes, so a user feels B through A.
 // Exact for both bodies' linear elasticity about rest with B's polygons fixed over a step,
-// frictionless; the IR's support is B's compliance at the targets S had when it formed,
-// bilateral, and without the preload of a node that closed a gap before it pushed (exact
-// for nodes that touch B at rest).
+// frictionless. The IR's support is B's compliance at the targets S had when it formed and
+// bilateral (a node that would release is not seen until S changes); a node that closed a
+// gap before it pushed is held on B's plane by it, which the IR carries as rest forces.
 // Units: m, N. A step allocates (server side, not the haptic path).
 #pragma once
 
@@ -52,6 +52,7 @@ struct FemPairLoads {
   std::vector<int> support_nodes;      ///< S: A's nodes that push, in candidate order
   Eigen::Matrix3Xd support_normals;    ///< B's outward normal at each
   Eigen::MatrixXd support_compliance;  ///< A_B,SS [m/N]
+  Eigen::VectorXd support_gaps;        ///< g0 per node of S: its gap to its polygon's plane at rest [m]
 };
 
 /// Pairs every surface node of A at rest with the nearest surface node of B.

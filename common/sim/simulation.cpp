@@ -280,9 +280,13 @@ StepReport Simulation::step(double time) {
   if (sets_changed || options_.naive_every_step) {
     IncrementalCondensation& condensation = ir_condensation();
     const std::vector<Eigen::Vector3d> held = boundary_displacement(condensation);
+    RestDisplacement rest_displacement;  // the support's load at rest, if any
+    if (support_ && support_->loads_at_rest())
+      rest_displacement = [support = support_.get()](std::span<const int> dofs) { return support->rest_displacement(dofs); };
     for (std::size_t i = 0; i < tools.size(); ++i) {
       UserState& user = users_[tools[i].user];
-      IntermediateRepresentation ir = build_ir(body_, condensation, tools, i, held, options_.ir, user.epoch + 1, time);
+      IntermediateRepresentation ir = build_ir(body_, condensation, tools, i, held, options_.ir, user.epoch + 1, time,
+                                               rest_displacement);
       if (!sets_changed) continue;
       ++user.epoch;
       report.ir_bytes += ir.size_bytes();

@@ -9,12 +9,15 @@
 namespace cohaptic {
 
 SupportedCompliance::SupportedCompliance(ComplianceSource& base, const DofMap& dofs, std::vector<int> nodes,
-                                         const Eigen::Matrix3Xd& normals, const Eigen::MatrixXd& support_compliance)
+                                         const Eigen::Matrix3Xd& normals, const Eigen::MatrixXd& support_compliance,
+                                         const Eigen::VectorXd& rest_gaps)
     : base_(base), nodes_(std::move(nodes)) {
   const auto count = static_cast<Eigen::Index>(nodes_.size());
-  if (normals.cols() != count || support_compliance.rows() != count || support_compliance.cols() != count)
-    throw Error(fmt::format("supported compliance: {} support nodes, {} normals, a {}x{} support compliance", count,
-                            normals.cols(), support_compliance.rows(), support_compliance.cols()));
+  if (normals.cols() != count || support_compliance.rows() != count || support_compliance.cols() != count ||
+      (rest_gaps.size() != 0 && rest_gaps.size() != count))
+    throw Error(fmt::format("supported compliance: {} support nodes, {} normals, a {}x{} support compliance, {} rest gaps",
+                            count, normals.cols(), support_compliance.rows(), support_compliance.cols(),
+                            rest_gaps.size()));
   // A fixed axis of A has no row (its L is zero): the support's spring along it does
   // nothing, as K_ff leaves it out. N keeps the free axes only.
   std::vector<std::pair<Eigen::Index, double>> entries;  // (support, normal component) per free dof
@@ -36,6 +39,13 @@ SupportedCompliance::SupportedCompliance(ComplianceSource& base, const DofMap& d
   if (coupled_.info() != Eigen::Success)
     throw Error(fmt::format("supported compliance: the {} supporting nodes' coupled compliance is not positive definite "
                             "(neither A nor the support gives way along a normal)", count));
+  if (rest_gaps.size() != 0 && !rest_gaps.isZero(0))
+    rest_loads_ = normals_ * Eigen::VectorXd(-coupled_.solve(rest_gaps));
+}
+
+Eigen::VectorXd SupportedCompliance::rest_displacement(std::span<const int> dofs) {
+  if (!loads_at_rest()) return Eigen::VectorXd::Zero(static_cast<Eigen::Index>(dofs.size()));
+  return base_.dof_block(dofs, dofs_) * rest_loads_;
 }
 
 void SupportedCompliance::compute_columns(const std::vector<int>& nodes) { base_.compute_columns(nodes); }
