@@ -185,6 +185,8 @@ TEST(FemPairScene, TheServersForceAndBothBodiesShapesAreTheJointSparseSolves) {
     EXPECT_LE((felt.force - expected.force).norm(), 1e-9 * expected.force.norm())
         << felt.force.transpose() << " vs " << expected.force.transpose();
     EXPECT_EQ(condensed_fem(run.simulation.ir(0)->ir).rest_forces.size() == 0, gap_mm == 0);
+    RecordProperty(fmt::format("ir_force_relative_error_gap_{}mm", gap_mm),
+                   fmt::format("{:.2e}", (felt.force - expected.force).norm() / expected.force.norm()));
     // A shows B's support and B shows A's pushes.
     const auto [front_error, front_largest] = surface_difference(run.fem(0), rig.front, expected.joint.front);
     EXPECT_LE(front_error, 1e-9 * front_largest);
