@@ -109,7 +109,7 @@ StateSolution Simulation::solve(std::span<const PressingContact> contacts) const
 StateSolution Simulation::solve() const { return sphere_model() ? solve_spheres(spheres()) : solve(pressing_contacts()); }
 
 StateSolution Simulation::solve_unloaded() const {
-  if (sphere_model()) return solve_spheres(spheres());  // never loaded (set_coupling)
+  if (sphere_model()) return solve_spheres(spheres());  // in no FEM pair (refused), so never loaded
   return solve_state(columns_, condensation_, body_.dofs, pressing_contacts(), boundary_dof_displacement(),
                      options_.ir.contact_model);
 }
