@@ -10,6 +10,8 @@
 //   touching B at rest and across a 0.5 mm gap (the IR's rest forces);
 // - the client's force from that IR through the wire equals the server's (1e-9): B is in
 //   the IR's M~ and rest forces, which travel whole (rows of A's own L would lose B);
+// - the state solve with applied loads (the pushes) beside a tool and held nodes equals
+//   CHOLMOD's full solve with the loads applied;
 // - through the scene, free (no interaction) < on B < fixed (A's back face fixed);
 // - the shipped scene's scripted surgeons feel B through A;
 // - the loader and SceneSimulation refuse the pairs they cannot run, saying where.
@@ -21,6 +23,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "common/condense/incremental_condensation.h"
 #include "common/fem/static_solve.h"
 #include "common/haptics/trajectory.h"
 #include "common/ir/build_ir.h"
@@ -28,6 +31,7 @@
 #include "common/model/scene_compliance.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/scene_simulation.h"
+#include "common/sim/state_solve.h"
 #include "proto/wire/ir_convert.h"
 #include "support/fem_pair_rig.h"
 #include "support/joint_pair_solve.h"
@@ -144,6 +148,81 @@ std::pair<double, double> surface_difference(const Simulation& simulation, const
     error = std::max(error, (u.col(static_cast<Eigen::Index>(i)) - reference).norm());
   }
   return {error, largest};
+}
+
+// The state solve with applied loads (what an FEM pair's pushes are to each body) beside a
+// pressing tool and held nodes, against CHOLMOD's full solve with those dofs prescribed and
+// the loads applied: the drawn displacement, the holding forces and the tool's force, 1e-9.
+TEST(FemPairScene, AppliedLoadsBesideAToolAndHeldNodesAreTheFullSolves) {
+  const testing::PairedBoxesRig rig(fem_pair_scene_options(0.0));
+  const ElasticBody& a = rig.front;
+  ComplianceColumns columns(*a.free_factor, a.dofs, a.surface.nodes);
+  IncrementalCondensation condensation(columns, a.dofs);
+  std::vector<int> free_back;  // A's back-face nodes off its fixed bottom
+  for (int node : rig.front_face)
+    if (a.dofs.fixed_axes[static_cast<std::size_t>(node)] == 0) free_back.push_back(node);
+  ASSERT_GE(free_back.size(), 10u);
+  const std::vector<int> held{free_back[1], free_back[4]};
+  for (int node : held) condensation.add_boundary_node(node);
+  const Eigen::Vector3d tool = fem_pair_tool(0.0, 3e-3);
+  const Triangle& triangle = a.surface.triangles[static_cast<std::size_t>(nearest_touchable_triangle(a, tool))];
+  const PressingContact contact{{triangle[0], triangle[1], triangle[2]}, Eigen::Vector3d(0.2, 0.3, 0.5),
+                                Eigen::Vector3d(3e-3, 0.4e-3, -0.2e-3)};
+  AppliedLoads applied;  // on three back-face nodes, none held
+  std::vector<double> forces;
+  for (int node : {free_back[2], free_back[7], free_back[9]})
+    for (int axis = 0; axis < 3; ++axis)
+      if (!a.dofs.is_fixed(node, axis)) {
+        applied.dofs.push_back(3 * node + axis);
+        forces.push_back(0.3 * (axis + 1) - 0.1 * (node % 5));
+      }
+  applied.forces = Eigen::Map<const Eigen::VectorXd>(forces.data(), static_cast<Eigen::Index>(forces.size()));
+  std::vector<int> prescribed;
+  std::vector<double> values;
+  Eigen::VectorXd held_displacement(0);
+  std::vector<double> held_values;
+  for (std::size_t k = 0; k < held.size(); ++k)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!a.dofs.is_fixed(held[k], axis)) {
+        prescribed.push_back(3 * held[k] + axis);
+        values.push_back((k == 0 ? 1e-4 : -2e-4) * (axis + 1));
+        held_values.push_back(values.back());
+      }
+  held_displacement = Eigen::Map<const Eigen::VectorXd>(held_values.data(), static_cast<Eigen::Index>(held_values.size()));
+  for (int node : triangle)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!a.dofs.is_fixed(node, axis)) {
+        prescribed.push_back(3 * node + axis);
+        values.push_back(contact.displacement[axis]);
+      }
+  ASSERT_EQ(applied.dofs.size(), 9u);
+  ASSERT_EQ(held_values.size(), 6u);
+  const StateSolution state = solve_state(columns, condensation, a.dofs, std::span(&contact, 1), held_displacement,
+                                          ContactModel::node_translation, applied);
+  Eigen::VectorXd loads = Eigen::VectorXd::Zero(a.stiffness.rows());
+  for (std::size_t k = 0; k < applied.dofs.size(); ++k) loads[applied.dofs[k]] = applied.forces[static_cast<Eigen::Index>(k)];
+  const StaticSolution full =
+      ConstrainedStaticSolver(a.stiffness, a.dofs, prescribed)
+          .solve(Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())), loads);
+
+  const Eigen::Matrix3Xd u = displacement_of_nodes(columns, state, a.surface.nodes);
+  double error = 0, largest = 0;
+  for (std::size_t i = 0; i < a.surface.nodes.size(); ++i) {
+    const Eigen::Vector3d expected = full.displacement.segment<3>(3 * a.surface.nodes[i]);
+    largest = std::max(largest, expected.norm());
+    error = std::max(error, (u.col(static_cast<Eigen::Index>(i)) - expected).norm());
+  }
+  EXPECT_LE(error, 1e-9 * largest);
+  ASSERT_EQ(state.boundary_dofs.size(), held_values.size());
+  for (std::size_t k = 0; k < state.boundary_dofs.size(); ++k)
+    EXPECT_NEAR(state.boundary_forces[static_cast<Eigen::Index>(k)], full.reaction[state.boundary_dofs[k]],
+                1e-9 * full.reaction.cwiseAbs().maxCoeff());
+  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k)
+    for (int axis = 0; axis < 3; ++axis)
+      if (!a.dofs.is_fixed(triangle[static_cast<std::size_t>(k)], axis))
+        tool_force[axis] += contact.weights[k] * full.reaction[3 * triangle[static_cast<std::size_t>(k)] + axis];
+  EXPECT_LE((state.tool_forces.at(0) - tool_force).norm(), 1e-9 * tool_force.norm());
 }
 
 TEST(FemPairScene, TheServersForceAndBothBodiesShapesAreTheJointSparseSolves) {
