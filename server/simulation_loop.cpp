@@ -138,6 +138,10 @@ bool SimulationLoop::to_compliance_rows(IntermediateRepresentation& ir, int user
   auto* fem = std::get_if<CondensedFemIr>(&ir.body);
   const auto object = static_cast<std::size_t>(ir.object);
   if (!compliance_rows_ || !fem || object >= columns_.size() || !columns_[object]) return false;
+  // An FEM pair's front condenses over B folded in (supported_compliance.h): rows of its own
+  // L would give the client A without B, and every held row changes with the pushing set,
+  // so its M~ travels whole. The client keeps the rows it holds for the IRs after.
+  if (simulation_.condenses_over_support(ir.object)) return false;
   const auto& body = std::get<ElasticBody>(model_.bodies[object]);
   ComplianceRowsSender& sender = rows_senders_[static_cast<std::size_t>(user)];
   // Node tags are per body: the user's IR moving to another body starts the client afresh.

@@ -1,10 +1,10 @@
 // FEM against FEM (fem_pair_coupling.h) on the paired boxes (tests/support/fem_pair_rig.h:
 // front A and behind B both linear elastic), against independent answers:
 // - the pushes and the tool's force equal one sparse solve of A and B together, the
-//   contact constraints as Lagrange multipliers (Eigen's SparseLU on the saddle-point
-//   system, no compliance columns and no CHOLMOD), its contact set found by its own
-//   active-set loop; the answer meets every condition of the unilateral problem, which has
-//   one solution, so the set is the set (1e-9);
+//   contact constraints as Lagrange multipliers (support/joint_pair_solve.h: Eigen's
+//   SparseLU on the saddle-point system, no compliance columns and no CHOLMOD), its contact
+//   set found by its own active-set loop; the answer meets every condition of the
+//   unilateral problem, which has one solution, so the set is the set (1e-9);
 // - B's displacement under the pushes equals that solve's (1e-9);
 // - A's M~ condensed over its compliance with B folded in as a support (Woodbury,
 //   supported_compliance.h) equals M~ condensed over CHOLMOD's factor of K_A with the
@@ -16,7 +16,6 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -25,7 +24,6 @@
 
 #include "common/condense/incremental_condensation.h"
 #include "common/condense/naive_condensation.h"
-#include "common/fem/assemble_stiffness.h"
 #include "common/fem/sparse_cholesky.h"
 #include "common/ir/build_ir.h"
 #include "common/ir/client_condensation.h"
@@ -35,125 +33,29 @@
 #include "common/sim/supported_compliance.h"
 #include "proto/wire/ir_convert.h"
 #include "support/fem_pair_rig.h"
+#include "support/joint_pair_solve.h"
 
 namespace cohaptic {
 namespace {
 
-// The sparse solve of A and B together: unknowns A's free dofs but the tool's, B's free
-// dofs, and one multiplier (push) per collision of the set; each pushing collision's gap is
-// zero. Gaps measured as the collisions measure them (normal offset from the polygon's plane).
-struct JointSolution {
-  Eigen::VectorXd pushes;  // per collision, zero outside the set [N]
-  Eigen::VectorXd gaps;    // per collision [m]
-  Eigen::VectorXd front, behind;  // 3N each [m]
-  Eigen::Vector3d tool_force;     // on A by the tool [N]
+// The joint sparse solve (support/joint_pair_solve.h) of the rig's push: the tool's node held.
+struct JointPush {
+  testing::JointPairSolution solution;
+  Eigen::Vector3d tool_force;  // on A by the tool [N]
 };
 
-JointSolution joint_sparse_solve(const testing::PairedBoxesRig& rig, const testing::FreePush& push,
-                                 const std::vector<PolygonCollision>& collisions, const std::vector<bool>& in_set) {
-  const ElasticBody& a = rig.front;
-  const ElasticBody& b = rig.behind;
-  std::vector<int> a_index(static_cast<std::size_t>(3 * a.mesh.node_count()), -1);
-  std::vector<int> b_index(static_cast<std::size_t>(3 * b.mesh.node_count()), -1);
-  int unknowns = 0;
-  std::vector<bool> is_tool(a_index.size(), false);
-  for (int dof : push.tool_dofs) is_tool[static_cast<std::size_t>(dof)] = true;
-  for (int dof : a.dofs.free_dofs)
-    if (!is_tool[static_cast<std::size_t>(dof)]) a_index[static_cast<std::size_t>(dof)] = unknowns++;
-  for (int dof : b.dofs.free_dofs) b_index[static_cast<std::size_t>(dof)] = unknowns++;
-  std::vector<int> multiplier(collisions.size(), -1);
-  for (std::size_t j = 0; j < collisions.size(); ++j)
-    if (in_set[j]) multiplier[j] = unknowns++;
-
-  std::vector<Eigen::Triplet<double>> entries;
-  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns);
-  Eigen::VectorXd tool = Eigen::VectorXd::Zero(a.stiffness.rows());
-  for (std::size_t k = 0; k < push.tool_dofs.size(); ++k) tool[push.tool_dofs[k]] = push.tool_values[static_cast<Eigen::Index>(k)];
-  const Eigen::VectorXd tool_load = a.stiffness * tool;
-  for (int outer = 0; outer < a.stiffness.outerSize(); ++outer)
-    for (SparseMatrix::InnerIterator it(a.stiffness, outer); it; ++it) {
-      const int row = a_index[static_cast<std::size_t>(it.row())], col = a_index[static_cast<std::size_t>(it.col())];
-      if (row >= 0 && col >= 0) entries.emplace_back(row, col, it.value());
-    }
-  for (std::size_t dof = 0; dof < a_index.size(); ++dof)
-    if (a_index[dof] >= 0) rhs[a_index[dof]] = -tool_load[static_cast<Eigen::Index>(dof)];
-  for (int outer = 0; outer < b.stiffness.outerSize(); ++outer)
-    for (SparseMatrix::InnerIterator it(b.stiffness, outer); it; ++it) {
-      const int row = b_index[static_cast<std::size_t>(it.row())], col = b_index[static_cast<std::size_t>(it.col())];
-      if (row >= 0 && col >= 0) entries.emplace_back(row, col, it.value());
-    }
-  // K_A u_A - n lambda = ..., K_B u_B + w n lambda = 0, -n.u_A + n.(sum w u_B) = g0.
-  for (std::size_t j = 0; j < collisions.size(); ++j) {
-    if (multiplier[j] < 0) continue;
-    const PolygonCollision& c = collisions[j];
-    for (int axis = 0; axis < 3; ++axis) {
-      if (const int row = a_index[static_cast<std::size_t>(3 * c.active + axis)]; row >= 0) {
-        entries.emplace_back(row, multiplier[j], -c.normal[axis]);
-        entries.emplace_back(multiplier[j], row, -c.normal[axis]);
-      }
-      for (int k = 0; k < 3; ++k)
-        if (const int row = b_index[static_cast<std::size_t>(3 * c.polygon[static_cast<std::size_t>(k)] + axis)]; row >= 0) {
-          entries.emplace_back(row, multiplier[j], c.weights[k] * c.normal[axis]);
-          entries.emplace_back(multiplier[j], row, c.weights[k] * c.normal[axis]);
-        }
-    }
-    const Eigen::Vector3d rest = a.mesh.nodes.col(c.active) + tool.segment<3>(3 * c.active);
-    rhs[multiplier[j]] = (rest - c.target).dot(c.normal);
-  }
-  Eigen::SparseMatrix<double> system(unknowns, unknowns);
-  system.setFromTriplets(entries.begin(), entries.end());
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(system);
-  EXPECT_EQ(lu.info(), Eigen::Success);
-  const Eigen::VectorXd x = lu.solve(rhs);
-
-  JointSolution solution;
-  solution.front = tool;
-  solution.behind = Eigen::VectorXd::Zero(b.stiffness.rows());
-  for (std::size_t dof = 0; dof < a_index.size(); ++dof)
-    if (a_index[dof] >= 0) solution.front[static_cast<Eigen::Index>(dof)] = x[a_index[dof]];
-  for (std::size_t dof = 0; dof < b_index.size(); ++dof)
-    if (b_index[dof] >= 0) solution.behind[static_cast<Eigen::Index>(dof)] = x[b_index[dof]];
-  const auto count = static_cast<Eigen::Index>(collisions.size());
-  solution.pushes = Eigen::VectorXd::Zero(count);
-  solution.gaps.resize(count);
-  for (Eigen::Index j = 0; j < count; ++j) {
-    const PolygonCollision& c = collisions[static_cast<std::size_t>(j)];
-    if (multiplier[static_cast<std::size_t>(j)] >= 0) solution.pushes[j] = x[multiplier[static_cast<std::size_t>(j)]];
-    Eigen::Vector3d target = c.target;
-    for (int k = 0; k < 3; ++k) target += c.weights[k] * solution.behind.segment<3>(3 * c.polygon[static_cast<std::size_t>(k)]);
-    solution.gaps[j] = (a.mesh.nodes.col(c.active) + solution.front.segment<3>(3 * c.active) - target).dot(c.normal);
-  }
-  const Eigen::VectorXd reaction = a.stiffness * solution.front;
-  for (int axis = 0; axis < 3; ++axis) solution.tool_force[axis] = reaction[push.tool_dofs[static_cast<std::size_t>(axis)]];
-  return solution;
+JointPush joint_contact_solve(const testing::PairedBoxesRig& rig, const testing::FreePush& push,
+                              const std::vector<PolygonCollision>& collisions) {
+  JointPush joint{testing::joint_pair_solve(rig.front, rig.behind, push.tool_dofs, push.tool_values, collisions), {}};
+  for (int axis = 0; axis < 3; ++axis)
+    joint.tool_force[axis] = joint.solution.front_reaction[push.tool_dofs[static_cast<std::size_t>(axis)]];
+  return joint;
 }
-
-// The joint solve's own active set: start from the penetrating candidates, drop pulling
-// ones, add penetrating ones, until none is left to move.
-JointSolution joint_contact_solve(const testing::PairedBoxesRig& rig, const testing::FreePush& push,
-                                  const std::vector<PolygonCollision>& collisions) {
-  std::vector<bool> in_set(collisions.size());
-  for (std::size_t j = 0; j < collisions.size(); ++j) in_set[j] = collisions[j].gap.dot(collisions[j].normal) < 0;
-  for (int pass = 0; pass < 50; ++pass) {
-    JointSolution solution = joint_sparse_solve(rig, push, collisions, in_set);
-    bool moved = false;
-    for (std::size_t j = 0; j < collisions.size(); ++j) {
-      const auto i = static_cast<Eigen::Index>(j);
-      if (in_set[j] ? solution.pushes[i] < 0 : solution.gaps[i] < 0) {
-        in_set[j] = !in_set[j];
-        moved = true;
-      }
-    }
-    if (!moved) return solution;
-  }
-  ADD_FAILURE() << "the joint solve's active set did not settle";
-  return {};
-}
-
 
 void expect_joint_solve(const testing::CoupledPush& push) {
   ASSERT_TRUE(push.contact.solved);
-  const JointSolution joint = joint_contact_solve(push.rig, push.free, push.collisions);
+  const JointPush joint_push = joint_contact_solve(push.rig, push.free, push.collisions);
+  const testing::JointPairSolution& joint = joint_push.solution;
   const double push_scale = joint.pushes.cwiseAbs().maxCoeff();
   ASSERT_GT(push_scale, 0);
   // The joint answer meets every condition of the unilateral problem.
@@ -162,7 +64,7 @@ void expect_joint_solve(const testing::CoupledPush& push) {
   EXPECT_LE(joint.pushes.cwiseProduct(joint.gaps).cwiseAbs().maxCoeff(), 1e-9 * push_scale * 1e-3);
   EXPECT_LE((push.contact.pushes - joint.pushes).cwiseAbs().maxCoeff(), 1e-9 * push_scale);
   EXPECT_LE((push.contact.gaps - joint.gaps).cwiseAbs().maxCoeff(), 1e-9 * joint.gaps.cwiseAbs().maxCoeff() + 1e-15);
-  EXPECT_LE((push.tool_force() - joint.tool_force).norm(), 1e-9 * joint.tool_force.norm());
+  EXPECT_LE((push.tool_force() - joint_push.tool_force).norm(), 1e-9 * joint_push.tool_force.norm());
   const Eigen::VectorXd behind = behind_pair_displacement(push.collisions, push.contact.pushes, *push.rig.behind_columns);
   double largest = 0, error = 0;
   const std::vector<int>& rows = push.rig.behind_columns->row_nodes();

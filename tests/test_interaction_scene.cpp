@@ -57,7 +57,7 @@ TEST(InteractionScene, ParsesThePairsAndRejectsWhatCannotPress) {
   EXPECT_TRUE(parse_scene(with_interactions(""), "paired.yaml").interactions.empty());
   expect_scene_error("interactions:\n  - {front: A, behind: C}\n", "no object named 'C' (the scene's objects: A, B)");
   expect_scene_error("interactions:\n  - {front: A, behind: A}\n", "an object other than the front one");
-  expect_scene_error("interactions:\n  - {front: B, behind: A}\n", "object 'B' is not a mass-spring object");
+  expect_scene_error("interactions:\n  - {front: B, behind: A}\n", "object 'A' is not linear elastic");
   expect_scene_error("interactions:\n  - {front: A, behind: B}\n  - {front: A, behind: B}\n",
                      "object 'A' is the front of an earlier interaction already");
   expect_scene_error("interactions:\n  - {front: A, behind: B, friction: 1}\n", "friction");

@@ -1,6 +1,6 @@
 // The live view on every body kind a scene can have (view/shown_scene.h, body_frame_state.h):
 // the shipped scenes of a mass-spring noodle, of two objects (a mass-spring box on an FEM box),
-// of a laparoscopy tissue and of separating tissue, stepped by SceneSimulation as the server
+// of an FEM pair (a slab pressing a block), of a laparoscopy tissue and of separating tissue, stepped by SceneSimulation as the server
 // steps them. Each frame's displacement is checked against what the body's own simulation
 // says by another way: a mass-spring node's state position minus its rest position, an FEM
 // body's displacement_of (the display's gathered solve, not the view's loaded columns), the
@@ -175,6 +175,26 @@ TEST(ViewBodies, ThePairedBoxesShowTheNetworkAndTheElasticBoxEachFromItsOwnState
   const double largest = expected.cwiseAbs().maxCoeff();
   EXPECT_GT(largest, 1e-4) << "tool B dents B";
   EXPECT_LT((frame_part_displacement(frame, box) - expected).cwiseAbs().maxCoeff(), 1e-6 * largest);
+}
+
+// The FEM pair (scenes/objects/fem_pair.yaml): tool A presses the slab A 4 mm onto the block
+// B; no tool touches B, yet the view shows B dented under A (the pushes are loads in B's
+// state), as B's own displacement_of says, and A as its own.
+TEST(ViewBodies, TheFemPairShowsBDentedByAsPushes) {
+  ViewedShippedScene pair(load_shipped_view_scene("scenes/objects/fem_pair.yaml"));
+  ASSERT_EQ(pair.shown.parts.size(), 2u);
+  pair.press({Eigen::Vector3d(-0.005, -0.006, 0.016)}, 0.05);
+  ASSERT_TRUE(pair.simulation.pressing(0));
+  ASSERT_EQ(pair.simulation.body_of(0), 0);
+  const view::Frame frame = pair.frame();
+  for (int body = 0; body < 2; ++body) {
+    SCOPED_TRACE(body);
+    const view::ShownPart& part = pair.shown.parts[static_cast<std::size_t>(body)];
+    const Eigen::Matrix3Xd expected = std::get<Simulation>(pair.simulation.body(body)).displacement_of(part.nodes);
+    const double largest = expected.cwiseAbs().maxCoeff();
+    EXPECT_GT(largest, body == 0 ? 3e-3 : 1e-4);  // B sinks under A by a tenth of a millimetre or more
+    EXPECT_LT((frame_part_displacement(frame, part) - expected).cwiseAbs().maxCoeff(), 1e-6 * largest);
+  }
 }
 
 TEST(ViewBodies, TheTissuesFrameIsItsDisplayedDent) {

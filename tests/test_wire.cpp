@@ -1107,6 +1107,7 @@ void expect_same_ir(const cohaptic::IntermediateRepresentation& envelope_a,
   }
   EXPECT_TRUE(bit_equal(a.m_tilde, b.m_tilde));
   EXPECT_TRUE(bit_equal(a.boundary_displacement, b.boundary_displacement));
+  EXPECT_TRUE(bit_equal(a.rest_forces, b.rest_forces));
 }
 
 // Through bytes, as it travels: to_wire, a Control frame, FrameReader, from_wire.
@@ -1132,8 +1133,10 @@ TEST(WireIr, RoundTripIsBitExactInDouble) {
   ir.object = 3;
   ir.force_limit = std::numeric_limits<double>::infinity();  // "no limit" travels too
   fem.m_tilde(0, 0) = std::nextafter(fem.m_tilde(0, 0), 0.0);  // a value float would not keep
+  fem.rest_forces = Eigen::VectorXd::LinSpaced(fem.m_tilde.rows(), -0.1, 1.0 / 7.0);  // format 5
   const IntermediateRepresentation wire_ir = to_wire(ir);
-  EXPECT_EQ(wire_ir.format_version(), 4u);
+  EXPECT_EQ(wire_ir.format_version(), 5u);
+  EXPECT_EQ(wire_ir.fem().rest_forces_size(), fem.m_tilde.rows());
   const CondensedFem& w = wire_ir.fem();
   EXPECT_EQ(w.m_tilde_f64_size(), fem.m_tilde.size());
   EXPECT_EQ(w.m_tilde_f32_size(), 0);
@@ -1206,6 +1209,10 @@ TEST(WireIr, FromWireRejectsEveryInconsistency) {
       {"M~ length", [](auto& w) { w.mutable_fem()->mutable_m_tilde_f64()->RemoveLast(); }, "M~ has"},
       {"NaN in M~", [nan](auto& w) { w.mutable_fem()->set_m_tilde_f64(5, nan); }, "m_tilde_f64[5] is not finite"},
       {"u_B length", [](auto& w) { w.mutable_fem()->add_boundary_displacement_f64(0); }, "u_B has 1 values, expected 0"},
+      {"rest forces length", [](auto& w) { w.mutable_fem()->add_rest_forces(0); }, "rest_forces has 1 values, expected m_rows"},
+      {"NaN rest force", [nan](auto& w) {
+         for (std::uint32_t i = 0; i < w.fem().m_rows(); ++i) w.mutable_fem()->add_rest_forces(i == 2 ? nan : 0.0);
+       }, "rest_forces[2] is not finite"},
       {"mixed precision", [](auto& w) { w.mutable_fem()->add_boundary_displacement_f32(0); }, "mix f64 and f32"},
       {"M~ in both", [](auto& w) { w.mutable_fem()->add_m_tilde_f32(1); }, "mix f64 and f32"},
       {"user", [](auto& w) { w.set_user(0x80000000u); }, "user = 2147483648"},

@@ -1,8 +1,13 @@
 #include "common/interaction/compliance_backing.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
+
+#include "common/util/error.h"
 
 namespace cohaptic {
 
@@ -14,15 +19,31 @@ Eigen::MatrixXd target_normal_compliance(std::span<const PolygonCollision> colli
   std::sort(polygon_nodes.begin(), polygon_nodes.end());
   polygon_nodes.erase(std::unique(polygon_nodes.begin(), polygon_nodes.end()), polygon_nodes.end());
   columns.compute_columns(polygon_nodes);
+  // Each polygon node's column and row once (not a lookup per block: with 117 targets that
+  // was most of the time), read as ComplianceColumns::block reads them.
+  std::vector<std::array<const ComplianceColumn*, 3>> polygon_columns(collisions.size());
+  std::vector<std::array<Eigen::Index, 3>> polygon_rows(collisions.size());
+  for (std::size_t j = 0; j < collisions.size(); ++j)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const int node = collisions[j].polygon[k];
+      const int position = columns.row_position(node);
+      if (position < 0) throw Error(fmt::format("compliance: node {} is not a row node", node));
+      polygon_columns[j][k] = &columns.column(node);
+      polygon_rows[j][k] = 3 * static_cast<Eigen::Index>(position);
+    }
   Eigen::MatrixXd compliance(count, count);
   for (Eigen::Index j = 0; j < count; ++j) {
     const PolygonCollision& cj = collisions[static_cast<std::size_t>(j)];
     for (Eigen::Index i = 0; i <= j; ++i) {
       const PolygonCollision& ci = collisions[static_cast<std::size_t>(i)];
       double value = 0;
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b)
-          value += ci.weights[a] * cj.weights[b] * ci.normal.dot(columns.block(ci.polygon[a], cj.polygon[b]) * cj.normal);
+      for (std::size_t a = 0; a < 3; ++a)
+        for (std::size_t b = 0; b < 3; ++b) {
+          const Eigen::Matrix3d block =
+              polygon_columns[static_cast<std::size_t>(j)][b]->middleRows<3>(polygon_rows[static_cast<std::size_t>(i)][a]);
+          value += ci.weights[static_cast<Eigen::Index>(a)] * cj.weights[static_cast<Eigen::Index>(b)] *
+                   ci.normal.dot(block * cj.normal);
+        }
       compliance(i, j) = value;
       compliance(j, i) = value;  // exactly symmetric, as the wire and the check want
     }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <unordered_map>
 
+#include "common/condense/dof_blocks.h"
 #include "common/contact/contact_patch.h"
 #include "common/contact/find_contact.h"
 #include "common/contact/sphere_contact.h"
@@ -47,7 +48,8 @@ int nearest_touchable_triangle(const ElasticBody& body, const Eigen::Vector3d& p
 IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensation& condensation,
                                     std::span<const UserTool> users, std::size_t user_index,
                                     std::span<const Eigen::Vector3d> boundary_displacement,
-                                    const IrBuildOptions& options, std::uint64_t epoch, double simulation_time) {
+                                    const IrBuildOptions& options, std::uint64_t epoch, double simulation_time,
+                                    const RestDisplacement& rest) {
   const UserTool& own = users[user_index];
   const std::vector<int>& boundary = condensation.boundary_nodes();
   if (boundary_displacement.size() != boundary.size())
@@ -178,6 +180,13 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
   fem.m_tilde.leftCols(op.m_cc.cols()) = op.m_cc;
   for (Eigen::Index k = 0; k < kept_count; ++k) fem.m_tilde.col(op.m_cc.cols() + k) = op.m_cb.col(kept_columns[k]);
   fem.boundary_displacement = Eigen::Map<const Eigen::VectorXd>(kept_displacement.data(), kept_count);
+  if (rest) {  // f = M~ (u - u0) over C and all of B
+    std::vector<int> dofs = free_dofs_of_nodes(body.dofs, contact_nodes);
+    const std::vector<int> held_dofs = free_dofs_of_nodes(body.dofs, boundary);
+    dofs.insert(dofs.end(), held_dofs.begin(), held_dofs.end());
+    const Eigen::VectorXd u0 = rest(dofs);
+    fem.rest_forces = -(op.m_cc * u0.head(op.m_cc.cols()) + op.m_cb * u0.tail(op.m_cb.cols()));
+  }
   if (options.precision == IrPrecision::f32) {
     fem.m_tilde = fem.m_tilde.cast<float>().cast<double>();
     fem.boundary_displacement = fem.boundary_displacement.cast<float>().cast<double>();

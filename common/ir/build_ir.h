@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -54,12 +55,19 @@ std::vector<bool> kept_boundary_nodes(const DofMap& dofs, std::span<const int> b
 /// The touchable triangle nearest `position` (ties to the one it is deepest below).
 int nearest_touchable_triangle(const ElasticBody& body, const Eigen::Vector3d& position);
 
+/// Loads a body carries besides its tools and held nodes, as build_ir reads them: the
+/// displacement u0 they cause at the given free dofs with nothing held [m] (an FEM pair's
+/// support closing the gaps its nodes had at rest, supported_compliance.h).
+using RestDisplacement = std::function<Eigen::VectorXd(std::span<const int> dofs)>;
+
 /// IR for users[user_index]. `boundary_displacement` gives u for each node of
-/// condensation.boundary_nodes(), in that order. Throws Error if the user's nearest
-/// triangle is unknown or holds a boundary node.
+/// condensation.boundary_nodes(), in that order. With `rest`, the IR carries the rest forces
+/// f_rest = -M~ u0 over its nodes (every held node's, truncated or not). Throws Error if the
+/// user's nearest triangle is unknown or holds a boundary node.
 IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensation& condensation,
                                     std::span<const UserTool> users, std::size_t user_index,
                                     std::span<const Eigen::Vector3d> boundary_displacement,
-                                    const IrBuildOptions& options, std::uint64_t epoch, double simulation_time);
+                                    const IrBuildOptions& options, std::uint64_t epoch, double simulation_time,
+                                    const RestDisplacement& rest = {});
 
 }  // namespace cohaptic

@@ -92,7 +92,10 @@ PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, 
   if (ir.m_tilde.rows() != x || ir.m_tilde.cols() != x + b || ir.boundary_displacement.size() != b)
     throw Error(fmt::format("intermediate representation: M~ is {}x{} and u_B {} long, expected {}x{} and {}",
                             ir.m_tilde.rows(), ir.m_tilde.cols(), ir.boundary_displacement.size(), x, x + b, b));
-  if (!ir.m_tilde.allFinite() || !ir.boundary_displacement.allFinite() || !ir.rest_positions.allFinite())
+  if (ir.rest_forces.size() != 0 && ir.rest_forces.size() != x)
+    throw Error(fmt::format("intermediate representation: {} rest forces for {} contact dofs", ir.rest_forces.size(), x));
+  if (!ir.m_tilde.allFinite() || !ir.boundary_displacement.allFinite() || !ir.rest_positions.allFinite() ||
+      !ir.rest_forces.allFinite())
     throw Error("intermediate representation: non-finite values");
   for (const IrTriangle& tri : ir.patch)
     for (int k = 0; k < 3; ++k)
@@ -117,7 +120,10 @@ PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, 
   if (llt.info() != Eigen::Success) throw Error("intermediate representation: M_CC is not positive definite");
   prepared.compliance = llt.solve(Eigen::MatrixXd::Identity(x, x));
   prepared.compliance = 0.5 * (prepared.compliance + prepared.compliance.transpose()).eval();
-  prepared.free_displacement = -prepared.compliance * (ir.m_tilde.rightCols(b) * ir.boundary_displacement);
+  // Unloaded by the tools, C carries no force: M_CC u0 + M_CB u_B + f_rest = 0.
+  Eigen::VectorXd held_load = ir.m_tilde.rightCols(b) * ir.boundary_displacement;
+  if (ir.rest_forces.size() != 0) held_load += ir.rest_forces;
+  prepared.free_displacement = -prepared.compliance * held_load;
   condition_estimate = cholesky_condition_estimate(llt.matrixL());
 
   prepared.dof_index.assign(static_cast<std::size_t>(rows), {-1, -1, -1});

@@ -18,7 +18,8 @@
 // The condensed FEM body:
 // prepare_ir() runs once per IR, off the haptic thread: it checks the IR and inverts the
 // contact block of M~ (in double) to the condensed compliance L~ = M_CC^-1 of the contact
-// nodes with B held, and u0 = -L~ M_CB u_B, their displacement when they carry no force.
+// nodes with B held, and u0 = -L~ (M_CB u_B + f_rest), their displacement when they carry
+// no force (f_rest: the IR's rest forces, zero unless the body carries other loads).
 // Per tick the evaluator then:
 //   1. finds the patch triangle nearest the own tool and whether it presses: signed
 //      distance below the tool radius, the sign from the whole surface's pseudo-normals

@@ -21,6 +21,7 @@ std::size_t CondensedFemIr::size_bytes() const {
                                guard.size() * 4 * 3 * sizeof(double);
   const std::size_t remote = remotes.size() * (sizeof(std::int32_t) * 4 + (1 + 7 * 3) * sizeof(double));
   const std::size_t matrix = static_cast<std::size_t>(m_tilde.size() + boundary_displacement.size()) * scalar +
+                             static_cast<std::size_t>(rest_forces.size()) * sizeof(double) +
                              (compliance_rows ? 8 + static_cast<std::size_t>(compliance_rows->rows.size()) * sizeof(double) : 0);
   const std::size_t truncated =  // sent with compliance rows only
       compliance_rows ? truncated_node_ids.size() * (sizeof(std::int64_t) + sizeof(AxisMask)) : 0;

@@ -11,8 +11,9 @@
 // (nodes not already in the patch), then the colliding boundary nodes B. The first
 // `row_node_count` nodes (patch and remote contacts) are the contact nodes C: M~ has a row
 // per free dof of C and a column per free dof of every node, node-major, axes x, y, z,
-// fixed axes left out. With f = M~ (u_C, u_B): the forces on C for prescribed displacements
-// of C and B, every other node unloaded. u_B is where the boundary nodes are held.
+// fixed axes left out. With f = M~ (u_C, u_B) (+ f_rest, rest_forces, when the body carries
+// other loads): the forces on C for prescribed displacements of C and B, every other node
+// unloaded. u_B is where the boundary nodes are held.
 //
 // Units: m, N, N/m, s. A plain value type: the wire format (next layer) mirrors it field by
 // field. With precision f32 the M~ and u_B values are rounded to float (as they travel);
@@ -83,6 +84,10 @@ struct CondensedFemIr {
 
   Eigen::MatrixXd m_tilde;                ///< rows: free dofs of C; columns: free dofs of all nodes [N/m]
   Eigen::VectorXd boundary_displacement;  ///< u_B, free dofs of B [m]
+  /// f_rest, per free dof of C, or empty (none): loads the body carries besides the tools
+  /// and B act on C as f = M~ (u_C, u_B) + f_rest. An FEM pair's front: the support of the
+  /// body behind it closing the gaps its pushing nodes had at rest [N]. Always in f64.
+  Eigen::VectorXd rest_forces;
   /// Sent instead of M~ (then empty) to a client that condenses itself (compliance_rows.h);
   /// the client's ClientCondensation fills M~ from them and clears them.
   std::optional<ComplianceRows> compliance_rows;
@@ -106,8 +111,9 @@ using IrBody = std::variant<CondensedFemIr, MassSpringIr, HomeSpringPatch, Separ
 struct IntermediateRepresentation {
   /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone);
   /// 3: a condensed FEM body may come as compliance rows instead of M~;
-  /// 4: compliance rows may name held nodes that B truncation leaves out (still reads 2, 3).
-  static constexpr std::uint32_t kFormatVersion = 4;
+  /// 4: compliance rows may name held nodes that B truncation leaves out (still reads 2, 3);
+  /// 5: a condensed FEM body may carry rest forces (still reads 2 to 4).
+  static constexpr std::uint32_t kFormatVersion = 5;
   static constexpr std::uint32_t kOldestReadableVersion = 2;
 
   std::uint64_t epoch = 0;         ///< increases with every IR built for this user

@@ -281,6 +281,14 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
     contact_model->fail_message(fmt::format("the sphere contact model needs sphere tools, and tool '{}' is a point "
                                             "(give it shape: sphere and a radius, or use translation or point)",
                                             point->name));
+  for (const InteractionSpec& interaction : scene.interactions)
+    if (const auto front = std::find_if(scene.objects.begin(), scene.objects.end(),
+                                        [&](const ObjectSpec& o) { return o.name == interaction.front; });
+        std::holds_alternative<ElasticObjectSpec>(front->body) && scene.haptic.contact_model != ContactModel::node_translation)
+      throw SceneError(fmt::format("{}: the linear elastic front object '{}' presses on '{}' under the translation "
+                                   "contact model only, and this scene's is '{}' (haptic: {{contact_model: translation}})",
+                                   interaction.where, interaction.front, interaction.behind,
+                                   contact_model_name(scene.haptic.contact_model)));
   scene.network.max_participants = static_cast<int>(scene.tools.size());
   if (auto network = top.find("network")) scene.network = parse_network(*network, scene.tools.size());
   return scene;

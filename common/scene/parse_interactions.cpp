@@ -33,9 +33,10 @@ std::vector<InteractionSpec> parse_interactions(const YamlCursor& list, const st
     const ObjectSpec& front_object = named_object(front, objects);
     const ObjectSpec& behind_object = named_object(behind, objects);
     if (&front_object == &behind_object) behind.fail("an object other than the front one");
-    if (!std::holds_alternative<MassSpringObjectSpec>(front_object.body))
-      front.fail_message(fmt::format("object '{}' is not a mass-spring object (model: mass_spring): only a mass-spring "
-                                     "front body presses on another object",
+    if (!std::holds_alternative<MassSpringObjectSpec>(front_object.body) &&
+        !std::holds_alternative<ElasticObjectSpec>(front_object.body))
+      front.fail_message(fmt::format("object '{}' is neither a mass-spring nor a linear elastic object: only those "
+                                     "front bodies press on another object",
                                      front_object.name));
     if (!std::holds_alternative<ElasticObjectSpec>(behind_object.body))
       behind.fail_message(fmt::format("object '{}' is not linear elastic: only a condensed linear elastic body can be "

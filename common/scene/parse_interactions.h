@@ -1,8 +1,8 @@
 // The scene's `interactions:` list (README.md, "Objects that press on each other"): pairs
 // of objects that press on each other, each `{front: NAME, behind: NAME}`, validated with
 // the scene loader's errors (file:line: key.path: expected ..., found ...) against the
-// objects already parsed: both names exist, differ, the front is a mass-spring object and
-// the behind one linear elastic, and no front is paired twice.
+// objects already parsed: both names exist, differ, the front is a mass-spring or a linear
+// elastic object and the behind one linear elastic, and no front is paired twice.
 #pragma once
 
 #include <vector>

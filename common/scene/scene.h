@@ -114,9 +114,9 @@ struct NetworkSettings {
 
 /// Two objects that press on each other (the several-objects paper): the front object's
 /// nodes collide with the behind object's surface, which is displaced to hold them and
-/// pushes back. Today: a mass-spring front on a linear elastic behind object.
+/// pushes back. A mass-spring or a linear elastic front on a linear elastic behind object.
 struct InteractionSpec {
-  std::string front;   ///< object name (model: mass_spring)
+  std::string front;   ///< object name (model: mass_spring or linear_elastic)
   std::string behind;  ///< object name (model: linear_elastic)
   std::string where;   ///< file:line of the entry, for errors
 };

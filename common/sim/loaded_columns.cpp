@@ -19,9 +19,10 @@ void add_loads(ComplianceColumns& columns, const std::vector<int>& dofs, const E
 
 std::vector<LoadedColumn> loaded_columns(ComplianceColumns& columns, const StateSolution& state) {
   std::vector<LoadedColumn> loads;
-  loads.reserve(state.contact_dofs.size() + state.boundary_dofs.size());
+  loads.reserve(state.contact_dofs.size() + state.boundary_dofs.size() + state.applied.dofs.size());
   add_loads(columns, state.contact_dofs, state.contact_forces, loads);
   add_loads(columns, state.boundary_dofs, state.boundary_forces, loads);
+  add_loads(columns, state.applied.dofs, state.applied.forces, loads);
   return loads;
 }
 

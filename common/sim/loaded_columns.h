@@ -1,8 +1,8 @@
-// LoadedColumns: a solved state's nodal forces (the pressing tools' and the held nodes'),
-// each with the column of the compliance L it acts through. That is all the displacement of
-// every row node needs, u = sum_j L[rows, j] f_j, without the ComplianceColumns object: a
-// snapshot the simulation thread takes in microseconds and another thread (the live view's)
-// turns into a surface's displacement.
+// LoadedColumns: a solved state's nodal forces (the pressing tools', the held nodes' and any
+// applied loads), each with the column of the compliance L it acts through. That is all the
+// displacement of every row node needs, u = sum_j L[rows, j] f_j, without the
+// ComplianceColumns object: a snapshot the simulation thread takes in microseconds and
+// another thread (the live view's) turns into a surface's displacement.
 //
 // Thread safety: a column, once cached by ComplianceColumns, is never changed or moved (its
 // map keeps elements in place as it grows), so the pointers stay valid and their numbers

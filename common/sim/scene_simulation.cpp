@@ -54,12 +54,49 @@ SceneSimulation::SceneSimulation(const Model& model, std::span<ComplianceColumns
   for (const InteractionSpec& spec : model.scene.interactions) {
     const int front = body_index(model, spec.front);
     const int behind = body_index(model, spec.behind);
-    const auto* front_body = std::get_if<MassSpringModel>(&model.bodies[static_cast<std::size_t>(front)]);
+    const BodyModel& front_model = model.bodies[static_cast<std::size_t>(front)];
     const auto* behind_body = std::get_if<ElasticBody>(&model.bodies[static_cast<std::size_t>(behind)]);
-    if (!front_body || !behind_body)
-      throw Error(fmt::format("{}: the interaction needs a mass-spring front and a linear elastic behind object", spec.where));
-    interactions_.push_back(make_body_interaction(front, *front_body, behind, *behind_body));
+    if (const auto* network = std::get_if<MassSpringModel>(&front_model); network && behind_body)
+      interactions_.push_back(make_body_interaction(front, *network, behind, *behind_body));
+    else if (std::holds_alternative<ElasticBody>(front_model) && behind_body)
+      add_fem_pair(spec, front, behind, options);
+    else
+      throw Error(fmt::format("{}: the interaction needs a mass-spring or linear elastic front and a linear elastic "
+                              "behind object",
+                              spec.where));
   }
+}
+
+void SceneSimulation::add_fem_pair(const InteractionSpec& spec, int front, int behind, const SimulationOptions& options) {
+  // The coupled solve holds each tool's dofs where they are: the translation model's contact.
+  if (options.ir.contact_model != ContactModel::node_translation)
+    throw Error(fmt::format("{}: a linear elastic front object presses on another under the translation contact model "
+                            "only, and this scene's is '{}' (haptic: {{contact_model: translation}})",
+                            spec.where, contact_model_name(options.ir.contact_model)));
+  // Each pair sets both bodies' applied loads: a body in two pairs would lose one's.
+  for (const auto& pair : fem_pairs_)
+    for (const int body : {front, behind})
+      if (body == pair->front || body == pair->behind)
+        throw Error(fmt::format("{}: object '{}' is in an earlier pair of linear elastic objects already (one such pair "
+                                "per object)",
+                                spec.where, body_name(model_, body)));
+  const auto& front_body = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(front)]);
+  const auto& behind_body = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(behind)]);
+  auto& pair = *fem_pairs_.emplace_back(
+      std::make_unique<FemPairInteraction>(make_fem_pair_interaction(front, front_body, behind, behind_body)));
+  Simulation& behind_simulation = std::get<Simulation>(*bodies_[static_cast<std::size_t>(behind)]);
+  ComplianceColumns* front_columns = columns_[static_cast<std::size_t>(front)];
+  ComplianceColumns* behind_columns = columns_[static_cast<std::size_t>(behind)];
+  std::get<Simulation>(*bodies_[static_cast<std::size_t>(front)])
+      .set_coupling([&pair, &front_body, front_columns, &behind_simulation, &behind_body,
+                     behind_columns](Simulation& simulation) {
+        couple_fem_pair(pair, simulation, front_body, *front_columns, behind_simulation, behind_body, *behind_columns);
+      });
+}
+
+bool SceneSimulation::condenses_over_support(int body_index) const {
+  const auto* fem = std::get_if<Simulation>(&body(body_index));
+  return fem && fem->support();
 }
 
 void SceneSimulation::run_interactions() {

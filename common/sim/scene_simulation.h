@@ -12,6 +12,9 @@
 // The scene's interactions (a mass-spring body pressing on a linear elastic one behind it,
 // body_interaction.h) run at the start of each step, before the bodies advance: the
 // front body then integrates the behind body's reaction as a backing (node_backing.h).
+// A linear elastic body pressing on another (an FEM pair, fem_pair_interaction.h) runs
+// within the front body's step, once its tools are known: both bodies are loaded by the
+// pushes and the front body's IRs condense over B folded in as a support.
 // Units: SI; times in s of the simulation's clock.
 #pragma once
 
@@ -24,6 +27,7 @@
 
 #include "common/model/model.h"
 #include "common/sim/body_interaction.h"
+#include "common/sim/fem_pair_interaction.h"
 #include "common/sim/home_spring_simulation.h"
 #include "common/sim/mass_spring_simulation.h"
 #include "common/sim/separation_simulation.h"
@@ -70,6 +74,12 @@ class SceneSimulation {
   const Simulation& single_elastic() const;
   /// The scene's interactions in scene order, as of the latest step.
   const std::vector<BodyInteraction>& interactions() const { return interactions_; }
+  /// The scene's FEM pairs in scene order, as of the latest step.
+  int fem_pair_count() const { return static_cast<int>(fem_pairs_.size()); }
+  const FemPairInteraction& fem_pair(int i) const { return *fem_pairs_[static_cast<std::size_t>(i)]; }
+  /// True when `body`'s IRs condense over a support (the front of an FEM pair that pushes):
+  /// their M~ is not of the body's own compliance.
+  bool condenses_over_support(int body) const;
 
  private:
   struct UserState {
@@ -80,6 +90,7 @@ class SceneSimulation {
     std::shared_ptr<const PreparedIR> ir;
     bool changed = false;
   };
+  void add_fem_pair(const InteractionSpec& spec, int front, int behind, const SimulationOptions& options);
   void assign_bodies();
   void run_interactions();
   double distance_to_body(int body, const Eigen::Vector3d& point) const;
@@ -89,6 +100,7 @@ class SceneSimulation {
   std::vector<UserState> users_;
   std::vector<ComplianceColumns*> columns_;  // per body, null unless linear elastic
   std::vector<BodyInteraction> interactions_;
+  std::vector<std::unique_ptr<FemPairInteraction>> fem_pairs_;  // at fixed addresses: the front's coupling holds one
   bool started_ = false;
   double time_ = 0;    // of the latest step [s]
   double period_ = 0;  // of the latest step [s]

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 
 #include "common/contact/contact_patch.h"
 #include "common/contact/find_contact.h"
@@ -57,10 +58,29 @@ void Simulation::release(int node) {
   boundary_dirty_ = true;
 }
 
-std::vector<Eigen::Vector3d> Simulation::boundary_displacement() const {
+std::vector<Eigen::Vector3d> Simulation::boundary_displacement() const { return boundary_displacement(condensation_); }
+
+std::vector<Eigen::Vector3d> Simulation::boundary_displacement(const IncrementalCondensation& condensation) const {
   std::vector<Eigen::Vector3d> out;
-  for (int node : condensation_.boundary_nodes()) out.push_back(held_.at(node).displacement);
+  for (int node : condensation.boundary_nodes()) out.push_back(held_.at(node).displacement);
   return out;
+}
+
+void Simulation::set_support(std::unique_ptr<SupportedCompliance> support) {
+  supported_condensation_.reset();  // it reads the old support
+  support_ = std::move(support);
+  if (support_) {
+    IncrementalCondensation::Options options;
+    options.naive = options_.naive_every_step;
+    supported_condensation_ = std::make_unique<IncrementalCondensation>(*support_, body_.dofs, options);
+  }
+  support_changed_ = true;
+}
+
+IncrementalCondensation& Simulation::ir_condensation() {
+  if (!supported_condensation_) return condensation_;
+  supported_condensation_->set_boundary_nodes(condensation_.boundary_nodes());
+  return *supported_condensation_;
 }
 
 Eigen::VectorXd Simulation::boundary_dof_displacement() const {
@@ -83,10 +103,16 @@ std::vector<PressingContact> Simulation::pressing_contacts() const {
 
 StateSolution Simulation::solve(std::span<const PressingContact> contacts) const {
   return solve_state(columns_, condensation_, body_.dofs, contacts, boundary_dof_displacement(),
-                     options_.ir.contact_model);
+                     options_.ir.contact_model, applied_);
 }
 
 StateSolution Simulation::solve() const { return sphere_model() ? solve_spheres(spheres()) : solve(pressing_contacts()); }
+
+StateSolution Simulation::solve_unloaded() const {
+  if (sphere_model()) return solve_spheres(spheres());  // in no FEM pair (refused), so never loaded
+  return solve_state(columns_, condensation_, body_.dofs, pressing_contacts(), boundary_dof_displacement(),
+                     options_.ir.contact_model);
+}
 
 std::vector<SphereTool> Simulation::spheres() const {
   std::vector<SphereTool> out;
@@ -283,6 +309,7 @@ StepReport Simulation::step(double time) {
   Stopwatch watch;
   bool boundary_changed = update_boundary(under_tool, in_patch);
   if (sphere_model()) boundary_changed |= carry_pushed_nodes_into_patches(under_tool, in_patch, report);
+  if (coupling_) coupling_(*this);
   std::vector<int>& nearest = step_nearest_;
   std::vector<std::vector<int>>& sphere_holds = step_sphere_holds_;
   nearest.clear();
@@ -299,12 +326,19 @@ StepReport Simulation::step(double time) {
   // Under naive_every_step M~ is computed again every step, as the paper's conventional loop
   // did (that cost is the step delay), but with unchanged sets it is the same IR: a new one
   // (a new epoch) is published only when a set changed.
-  const bool sets_changed = boundary_changed || nearest != built_nearest_ || sphere_holds != built_sphere_holds_;
+  const bool support_changed = std::exchange(support_changed_, false);
+  const bool sets_changed =
+      boundary_changed || support_changed || nearest != built_nearest_ || sphere_holds != built_sphere_holds_;
   if (sets_changed || options_.naive_every_step) {
-    const std::vector<Eigen::Vector3d> held = boundary_displacement();
+    IncrementalCondensation& condensation = ir_condensation();
+    const std::vector<Eigen::Vector3d> held = boundary_displacement(condensation);
+    RestDisplacement rest_displacement;  // the support's load at rest, if any
+    if (support_ && support_->loads_at_rest())
+      rest_displacement = [support = support_.get()](std::span<const int> dofs) { return support->rest_displacement(dofs); };
     for (std::size_t i = 0; i < tools.size(); ++i) {
       UserState& user = users_[tools[i].user];
-      IntermediateRepresentation ir = build_ir(body_, condensation_, tools, i, held, options_.ir, user.epoch + 1, time);
+      IntermediateRepresentation ir = build_ir(body_, condensation, tools, i, held, options_.ir, user.epoch + 1, time,
+                                               rest_displacement);
       if (!sets_changed) continue;
       ++user.epoch;
       report.ir_bytes += ir.size_bytes();

@@ -19,10 +19,16 @@
 //      every step all the same, for its cost, and publishes it only when a set changed).
 // force() evaluates a user's force from its IR and the current tool positions: the P0
 // protocol's server-side force, the same function the P1 client runs. surface
-// displacement() solves the whole state for display. Units: SI.
+// displacement() solves the whole state for display.
+// Another body pressing on this one (an FEM pair, fem_pair_interaction.h) acts through a
+// coupling called in each step before the IRs are built: it sets loads applied in every
+// state solve, and may set a support (this body's compliance with the other body folded in
+// on the nodes that push on it, supported_compliance.h) that the IRs condense over from then
+// on; a change of support rebuilds them, as a change of the sets does. Units: SI.
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -40,6 +46,7 @@
 #include "common/model/elastic_body.h"
 #include "common/sim/state_solve.h"
 #include "common/sim/step_report.h"
+#include "common/sim/supported_compliance.h"
 
 namespace cohaptic {
 
@@ -86,8 +93,22 @@ class Simulation {
   std::vector<Eigen::Vector3d> remote_positions(const IntermediateRepresentation& ir) const;
   bool pressing(int user) const { return users_[static_cast<std::size_t>(user)].pressing; }
 
-  /// The whole state solved at the current tool positions.
+  /// The whole state solved at the current tool positions, with the applied loads.
   StateSolution solve() const;
+  /// The same without the applied loads: the body as it would be alone.
+  StateSolution solve_unloaded() const;
+
+  /// Loads another body applies to this one, in every state solve from now on.
+  void set_applied_loads(AppliedLoads loads) { applied_ = std::move(loads); }
+  /// Called in each step once the tools' contacts and the held set B are known, before the
+  /// IRs are built (SceneSimulation's FEM pairs). Not under the sphere contact model.
+  void set_coupling(std::function<void(Simulation&)> coupling) { coupling_ = std::move(coupling); }
+  /// The IRs condense over `support` (built over this body's columns) from the next build on;
+  /// null: over the body's own compliance again. Either way they are rebuilt at this step.
+  void set_support(std::unique_ptr<SupportedCompliance> support);
+  /// The support the IRs condense over, or null: while there is one, their M~ is not of the
+  /// body's own L (compliance rows of L would not give it).
+  const SupportedCompliance* support() const { return support_.get(); }
   /// Displacement of `nodes` (row nodes) in the current state [m].
   Eigen::Matrix3Xd displacement_of(std::span<const int> nodes) const;
 
@@ -139,6 +160,9 @@ class Simulation {
   StateSolution solve_spheres(std::span<const SphereTool> spheres) const;
   bool update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch);
   bool update_obstacle_contacts(const std::vector<bool>& under_tool);
+  /// The condensation the IRs are built over: the support's, with B synchronised, or the body's.
+  IncrementalCondensation& ir_condensation();
+  std::vector<Eigen::Vector3d> boundary_displacement(const IncrementalCondensation& condensation) const;
   void hold(int node, const HeldNode& held);
   void release(int node);
   Eigen::VectorXd boundary_dof_displacement() const;
@@ -167,6 +191,11 @@ class Simulation {
   std::vector<std::vector<int>> step_sphere_holds_;
   std::vector<bool> under_tool_, in_patch_;
   bool boundary_dirty_ = false;
+  AppliedLoads applied_;                            // see set_applied_loads
+  std::function<void(Simulation&)> coupling_;       // see set_coupling
+  std::unique_ptr<SupportedCompliance> support_;    // see set_support
+  std::unique_ptr<IncrementalCondensation> supported_condensation_;  // over *support_
+  bool support_changed_ = false;                    // since the IRs were last built
 };
 
 }  // namespace cohaptic

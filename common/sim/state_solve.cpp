@@ -12,11 +12,12 @@ namespace cohaptic {
 
 StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& condensation, const DofMap& dofs,
                           std::span<const PressingContact> contacts, const Eigen::VectorXd& boundary_displacement,
-                          ContactModel contact_model) {
+                          ContactModel contact_model, const AppliedLoads& applied) {
   if (static_cast<int>(contacts.size()) > kMaxUsers)
     throw Error(fmt::format("solve_state: {} pressing tools, at most {}", contacts.size(), kMaxUsers));
   StateSolution state;
   state.tool_forces.assign(contacts.size(), Eigen::Vector3d::Zero());
+  state.applied = applied;
 
   std::vector<int> nodes;
   std::vector<ContactDof> contact_dofs;
@@ -37,7 +38,17 @@ StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& c
     const CondensedOperator op = condensation.condense(nodes);
     const Eigen::LLT<Eigen::MatrixXd> llt(op.m_cc);
     const SmallMatrix compliance = llt.solve(Eigen::MatrixXd::Identity(op.m_cc.rows(), op.m_cc.cols()));
-    const SmallVector free_displacement = -compliance * (op.m_cb * boundary_displacement);
+    // Z's displacement unloaded by the tools: -L~ M_CB u_B = Z_C^T u_B; the applied loads
+    // add L_ZP F_P and move B's held displacement relative to them by -L_BP F_P.
+    SmallVector free_displacement;
+    if (applied.dofs.empty()) {
+      free_displacement = -compliance * (op.m_cb * boundary_displacement);
+    } else {
+      const std::vector<int> boundary_dofs = free_dofs_of_nodes(dofs, condensation.boundary_nodes());
+      const Eigen::VectorXd boundary_load = gather_compliance(columns, boundary_dofs, applied.dofs) * applied.forces;
+      free_displacement = -compliance * (op.m_cb * (boundary_displacement - boundary_load)) +
+                          gather_compliance(columns, state.contact_dofs, applied.dofs) * applied.forces;
+    }
     SmallVector nodal;
     if (!solve_contact_forces(contact_model, compliance, free_displacement, contact_dofs, displacement, nodal,
                               state.tool_forces))
@@ -52,6 +63,8 @@ void solve_boundary_forces(ComplianceColumns& columns, const IncrementalCondensa
                            const Eigen::VectorXd& boundary_displacement, StateSolution& state) {
   state.boundary_dofs = free_dofs_of_nodes(dofs, condensation.boundary_nodes());
   Eigen::VectorXd rhs = boundary_displacement;
+  if (!state.applied.dofs.empty() && !state.boundary_dofs.empty())
+    rhs -= gather_compliance(columns, state.boundary_dofs, state.applied.dofs) * state.applied.forces;
   if (!state.contact_dofs.empty())
     rhs -= gather_compliance(columns, state.boundary_dofs, state.contact_dofs) * state.contact_forces;
   state.boundary_forces = condensation.solve_boundary(rhs);

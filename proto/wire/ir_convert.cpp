@@ -177,6 +177,7 @@ void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
     add_values<double>(ir.boundary_displacement.data(), ir.boundary_displacement.size(),
                        out->mutable_boundary_displacement_f64());
   }
+  add_values<double>(ir.rest_forces.data(), ir.rest_forces.size(), out->mutable_rest_forces());
 }
 
 void mass_spring_to_wire(const MassSpringIr& ir, MassSpringPatch* out) {
@@ -382,6 +383,12 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   } else {
     read_values(w.m_tilde_f64(), ir.m_tilde, "m_tilde_f64");
     read_values(w.boundary_displacement_f64(), ir.boundary_displacement, "boundary_displacement_f64");
+  }
+  if (w.rest_forces_size() > 0) {
+    if (static_cast<std::uint64_t>(w.rest_forces_size()) != w.m_rows())
+      invalid("rest_forces has {} values, expected m_rows = {}", w.rest_forces_size(), w.m_rows());
+    ir.rest_forces.resize(static_cast<Eigen::Index>(w.m_rows()));
+    read_values(w.rest_forces(), ir.rest_forces, "rest_forces");
   }
   if (rows_form) {
     ComplianceRows rows{w.rows_generation(), Eigen::MatrixXd(static_cast<Eigen::Index>(w.compliance_row_count()),

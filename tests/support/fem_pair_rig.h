@@ -12,12 +12,10 @@
 #include "common/fem/compliance.h"
 #include "common/interaction/forcible_displacement.h"
 #include "common/sim/fem_pair_coupling.h"
+#include "common/sim/fem_pair_interaction.h"
 #include "support/paired_boxes.h"
 
 namespace cohaptic::testing {
-
-/// Candidates: A's back-face nodes this close in front of B or behind its surface [m].
-inline constexpr double kFemPairReach = 2e-3;
 
 std::vector<int> node_dofs(int node);
 
@@ -33,7 +31,8 @@ struct FreePush {
 /// the fixed condition).
 FreePush push_without_behind(const ElasticBody& front, double depth, const std::vector<int>& also_held = {});
 
-/// A's back-face nodes at `displacement` against B's rest surface, within kFemPairReach.
+/// A's back-face nodes at `displacement` against B's rest surface, within kFemPairReach (the
+/// scenes' candidates), each against the polygons around B's nearest surface node.
 std::vector<PolygonCollision> back_face_candidates(const PairedBoxesRig& rig, const Eigen::VectorXd& displacement);
 
 /// The push, its candidates and the coupled contact (A's columns over its surface).
