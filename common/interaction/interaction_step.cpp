@@ -43,6 +43,16 @@ std::vector<PolygonCollision> find_polygons_within(const NodePairList& list, con
   });
 }
 
+std::vector<PolygonCollision> keep_pairs_and_find_within(NodePairList& list, const InteractingBodies& bodies,
+                                                         double reach) {
+  update_node_pairs(list, bodies.active_positions, bodies.passive_positions, bodies.passive_surface);
+  std::vector<int> colliding;
+  for (const PolygonCollision& collision : find_polygon_collisions(list, bodies)) colliding.push_back(collision.pair);
+  add_neighbour_pairs(list, colliding, bodies.active_positions, bodies.active_surface, bodies.passive_positions,
+                      bodies.passive_surface);
+  return find_polygons_within(list, bodies, reach);
+}
+
 Eigen::VectorXd convey_reaction(const ForcibleDisplacement& displacement, const Eigen::VectorXd& passive_forces) {
   return -displacement.map.transpose() * passive_forces;
 }

@@ -66,6 +66,11 @@ std::vector<PolygonCollision> find_polygon_collisions(const NodePairList& list, 
 std::vector<PolygonCollision> find_polygons_within(const NodePairList& list, const InteractingBodies& bodies,
                                                    double reach);
 
+/// The pairs as a server step keeps them (Sec. 2.5): each walked to the nearest passive node,
+/// then grown from the neighbours of every colliding node; then find_polygons_within(reach).
+std::vector<PolygonCollision> keep_pairs_and_find_within(NodePairList& list, const InteractingBodies& bodies,
+                                                         double reach);
+
 /// Reaction on the active nodes: -map^T passive_forces, 3 per collision [N].
 Eigen::VectorXd convey_reaction(const ForcibleDisplacement& displacement, const Eigen::VectorXd& passive_forces);
 

@@ -23,18 +23,10 @@ NodeBacking step_body_interaction(BodyInteraction& interaction, const Eigen::Mat
                                     ComplianceColumns& columns) {
   const InteractingBodies bodies{front_positions,     interaction.front_surface, behind_body.mesh.nodes,
                                  interaction.behind_surface, behind_body.dofs, columns};
-  // The pairs as interaction_step keeps them (Sec. 2.5): walked to the nearest node, then
-  // grown from the neighbours of every colliding node. B's own response to the collisions
-  // is not solved here: the front body feels B through the backing alone.
-  NodePairList& pairs = interaction.pairs;
-  update_node_pairs(pairs, front_positions, behind_body.mesh.nodes, interaction.behind_surface);
-  std::vector<int> colliding;
-  for (const PolygonCollision& collision : find_polygon_collisions(pairs, bodies)) colliding.push_back(collision.pair);
-  add_neighbour_pairs(pairs, colliding, front_positions, interaction.front_surface, behind_body.mesh.nodes,
-                      interaction.behind_surface);
-  // The backing holds every node that collided or may collide before the next step; its
-  // contact set is solved at every substep (node_backing.h).
-  const std::vector<PolygonCollision> within = find_polygons_within(pairs, bodies, kBackingReach);
+  // B's own response to the collisions is not solved here: the front body feels B through
+  // the backing alone. The backing holds every node that collided or may collide before the
+  // next step; its contact set is solved at every substep (node_backing.h).
+  const std::vector<PolygonCollision> within = keep_pairs_and_find_within(interaction.pairs, bodies, kBackingReach);
   if (within.empty()) return {};
   const MassSpringNetwork& network = front_body.network;
   return compliance_backing(within, columns, network.mass, network.parameters.time_step, kBackingDampingRatio);

@@ -54,15 +54,7 @@ FemPairLoads step_fem_pair(FemPairInteraction& interaction, const ElasticBody& f
   const Eigen::Matrix3Xd positions = fem_pair_front_positions(front_body, front_columns, front_alone);
   const InteractingBodies bodies{positions,          interaction.front_surface, behind_body.mesh.nodes,
                                  interaction.behind_surface, behind_body.dofs, behind_columns};
-  // The pairs as body_interaction keeps them: walked to the nearest node, grown from the
-  // neighbours of every colliding node.
-  NodePairList& pairs = interaction.pairs;
-  update_node_pairs(pairs, positions, behind_body.mesh.nodes, interaction.behind_surface);
-  std::vector<int> colliding;
-  for (const PolygonCollision& collision : find_polygon_collisions(pairs, bodies)) colliding.push_back(collision.pair);
-  add_neighbour_pairs(pairs, colliding, positions, interaction.front_surface, behind_body.mesh.nodes,
-                      interaction.behind_surface);
-  interaction.collisions = find_polygons_within(pairs, bodies, kFemPairReach);
+  interaction.collisions = keep_pairs_and_find_within(interaction.pairs, bodies, kFemPairReach);
   interaction.contact = {};
   FemPairLoads loads;
   if (interaction.collisions.empty()) return loads;
