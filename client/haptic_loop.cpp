@@ -36,7 +36,8 @@ std::uint64_t skip_missed_deadlines(std::int64_t& deadline, std::int64_t woke, s
 
 IrSlot make_ir_slot(std::unique_ptr<const PreparedIR> ir, std::int64_t arrival_ns) {
   auto state = std::make_unique<EvaluationState>(make_evaluation_state(*ir));
-  return IrSlot{std::move(ir), std::move(state), arrival_ns};
+  auto alone_state = std::make_unique<EvaluationState>(*state);
+  return IrSlot{std::move(ir), std::move(state), std::move(alone_state), arrival_ns};
 }
 
 HapticClock HapticClock::monotonic() {
@@ -101,20 +102,19 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       record.ir_epoch = ir.epoch;
       record.dt = dt;
       // The coupling figure (the force without the remote tools) needs a second evaluation,
-      // which would advance a dynamic body's state a second time: static bodies only. A sphere's
-      // warm start is no body state: it is left alone by evaluating on an empty state (a cold
-      // solve, the same answer).
+      // which would advance a dynamic body's state a second time: static bodies only. A sphere
+      // body's contact solve is no body state: the second evaluation keeps one of its own.
       const bool static_body = std::holds_alternative<std::monostate>(slot.state->body) ||
-                               std::holds_alternative<SphereWarmStart>(slot.state->body);
+                               std::holds_alternative<SphereContactState>(slot.state->body);
       // Measured only in contact: a user that passed by a static body without touching it
       // (e.g. on its way to a mass-spring object lying on it) measured nothing. A home-spring
       // body's users never couple (each feels its own vertex's springs): nothing to measure.
       const bool couples = static_body && !std::holds_alternative<HomeSpringPatch>(slot.ir->ir.body);
       metrics_.coupling_measured = metrics_.coupling_measured || (couples && (sample.flags & kInContact));
       if (count > 0 && (sample.flags & kInContact) && static_body) {
-        EvaluationState cold;
-        const ForceSample alone = evaluate_force(*slot.ir, cold, own, {}, dt);
-        metrics_.peak_coupling = std::max(metrics_.peak_coupling, (sample.force - alone.force).norm());
+        const ForceSample alone = evaluate_force(*slot.ir, *slot.alone_state, own, {}, dt);
+        if (!(alone.flags & kContactUnresolved))
+          metrics_.peak_coupling = std::max(metrics_.peak_coupling, (sample.force - alone.force).norm());
       }
     }
   } else {

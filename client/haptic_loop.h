@@ -47,11 +47,14 @@ struct HapticLoopSettings {
   double passivity_mass_kg = 0.2;  ///< the lightest mass expected at the tool (caps its damping)
 };
 
-/// An IR handed to the haptic thread with its fresh evaluation state (made on the I/O
-/// thread; after the swap the haptic thread is its only user) and when it arrived.
+/// An IR handed to the haptic thread with its fresh evaluation states (made on the I/O
+/// thread; after the swap the haptic thread is their only user) and when it arrived.
 struct IrSlot {
   std::unique_ptr<const PreparedIR> ir;
   std::unique_ptr<EvaluationState> state;
+  /// The coupling figure's evaluation without the remote tools: its own state, so that
+  /// neither evaluation disturbs the other's (a sphere body's contact solve is kept).
+  std::unique_ptr<EvaluationState> alone_state;
   std::int64_t arrival_ns = 0;
 };
 

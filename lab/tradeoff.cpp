@@ -238,6 +238,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
   const int per_tick = samples_per(reference.sample_rate_hz, setting.haptic_rate_hz, "haptic rate");
   const std::size_t users = varied.tools.size();
   std::vector<std::shared_ptr<const PreparedIR>> published(users);
+  std::vector<EvaluationState> client_states(users);  // each published IR's, as a client keeps it
   std::vector<double> last_published(users, -INFINITY);
   std::vector<Eigen::Vector3d> held(users, Eigen::Vector3d::Zero());
   std::vector<Eigen::Vector3d> remotes;
@@ -258,6 +259,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
         const bool due = setting.ir_rate_hz <= 0 || t - last_published[u] >= 1 / setting.ir_rate_hz - 1e-9;
         if (ir && ir != published[u] && due) {
           published[u] = ir;
+          client_states[u] = make_evaluation_state(*ir);
           last_published[u] = t;
           tally.published(wire_bytes.published(ir->ir, u));
         }
@@ -269,8 +271,8 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
         remotes.clear();
         for (int r = 0; r < remote_count(published[u]->ir); ++r) remotes.push_back(positions[remote_user(published[u]->ir, r)]);
         const Stopwatch evaluation;
-        EvaluationState stateless;  // the condensed FEM body keeps none and ignores dt
-        held[u] = evaluate_force(*published[u], stateless, positions[u], remotes, 0).force;
+        // The condensed FEM body ignores dt; under the sphere model its state keeps the contact solve.
+        held[u] = evaluate_force(*published[u], client_states[u], positions[u], remotes, 0).force;
         tally.evaluation(1000 * evaluation.elapsed_ms());
       }
     for (std::size_t u = 0; u < users; ++u) pressed[u] = {positions[u], varied.tools[u].radius};

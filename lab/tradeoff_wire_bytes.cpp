@@ -10,11 +10,17 @@ TradeoffWireBytes::TradeoffWireBytes(const ElasticBody& body, ComplianceSource& 
       columns_(columns),
       senders_(users),
       streams_(users),
+      stream_started_(users, false),
       node_of_tag_(node_indices_by_tag(body.mesh)) {}
 
 std::size_t TradeoffWireBytes::published(const IntermediateRepresentation& ir, std::size_t user) {
   const auto* fem = std::get_if<CondensedFemIr>(&ir.body);
   if (!fem) return wire::to_wire(ir).ByteSizeLong();
+  if (fem->sphere) {  // whole, in the stream (as the server sends it)
+    const bool fresh = !stream_started_.at(user);
+    stream_started_.at(user) = true;
+    return streams_.at(user).compress(wire::to_wire(ir), fresh).ByteSizeLong();
+  }
   IntermediateRepresentation sent = ir;
   auto& sent_fem = std::get<CondensedFemIr>(sent.body);
   std::vector<int> mesh_nodes;

@@ -3,8 +3,8 @@
 // (common/ir/compliance_rows.h: the rows of L for the nodes the user's client does not hold
 // yet instead of M~, one ComplianceRowsSender per user) compressed in the user's IR stream
 // (proto/wire/ir_stream.h), B truncation or not (a truncated IR lists the held nodes it
-// leaves out); counted as the protobuf message's size (what the server's ir_bytes_sent
-// counts). Bytes.
+// leaves out); a sphere body's IR whole in the same stream; counted as the protobuf
+// message's size (what the server's ir_bytes_sent counts). Bytes.
 #pragma once
 
 #include <cstddef>
@@ -33,6 +33,7 @@ class TradeoffWireBytes {
   ComplianceSource& columns_;
   std::vector<ComplianceRowsSender> senders_;
   std::vector<wire::IrStreamWriter> streams_;
+  std::vector<bool> stream_started_;  // per user: a block sent
   std::unordered_map<std::int64_t, int> node_of_tag_;
 };
 

@@ -47,6 +47,7 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       rows_senders_(static_cast<std::size_t>(simulation_.user_count())),
       ir_streams_(static_cast<std::size_t>(simulation_.user_count())),
       rows_objects_(static_cast<std::size_t>(simulation_.user_count()), -1),
+      stream_started_(static_cast<std::size_t>(simulation_.user_count()), 0),
       joins_seen_(static_cast<std::size_t>(simulation_.user_count()), 0),
       node_of_tag_(model.bodies.size()) {
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
@@ -94,6 +95,7 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
     if (slot < joins_seen_.size() && tool.joins != joins_seen_[slot]) {  // a new user holds no rows
       joins_seen_[slot] = tool.joins;
       rows_senders_[slot].restart();
+      stream_started_[slot] = 0;
     }
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
     if (used_[slot]) {
@@ -120,15 +122,21 @@ std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox, std::
     if (!send) continue;
     IntermediateRepresentation ir = prepared->ir;
     const bool rows = to_compliance_rows(ir, user);
+    // A sphere body's IR repeats most of the last one's normal compliance: it travels in
+    // the stream too, whole.
+    const auto* fem = std::get_if<CondensedFemIr>(&ir.body);
+    const bool streamed = rows || (fem && fem->sphere);
     wire::Control control;
-    if (rows) {  // in the user's stream, which starts afresh with the rows
-      const bool fresh = std::get<CondensedFemIr>(ir.body).compliance_rows->generation == 1;
-      *control.mutable_compressed_ir() = ir_streams_[static_cast<std::size_t>(user)].compress(wire::to_wire(ir), fresh);
+    if (streamed) {  // in the user's stream, which starts afresh with the rows or its first IR
+      const auto u = static_cast<std::size_t>(user);
+      const bool fresh = rows ? fem->compliance_rows->generation == 1 : !stream_started_[u];
+      *control.mutable_compressed_ir() = ir_streams_[u].compress(wire::to_wire(ir), fresh);
+      stream_started_[u] = 1;
     } else {
       *control.mutable_ir() = wire::to_wire(ir);
     }
-    bytes += rows ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
-    outbox.irs.push_back({user, std::move(control), rows});
+    bytes += streamed ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
+    outbox.irs.push_back({user, std::move(control), streamed});
     ++sent;
   }
   return sent;
@@ -137,7 +145,7 @@ std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox, std::
 bool SimulationLoop::to_compliance_rows(IntermediateRepresentation& ir, int user) {
   auto* fem = std::get_if<CondensedFemIr>(&ir.body);
   const auto object = static_cast<std::size_t>(ir.object);
-  if (!compliance_rows_ || !fem || object >= columns_.size() || !columns_[object]) return false;
+  if (!compliance_rows_ || !fem || fem->sphere || object >= columns_.size() || !columns_[object]) return false;
   // An FEM pair's front condenses over B folded in (supported_compliance.h): rows of its own
   // L would give the client A without B, and every held row changes with the pushing set,
   // so its M~ travels whole. The client keeps the rows it holds for the IRs after.
@@ -148,6 +156,7 @@ bool SimulationLoop::to_compliance_rows(IntermediateRepresentation& ir, int user
   if (rows_objects_[static_cast<std::size_t>(user)] != ir.object) {
     rows_objects_[static_cast<std::size_t>(user)] = ir.object;
     sender.restart();
+    stream_started_[static_cast<std::size_t>(user)] = 0;
   }
   std::vector<int> mesh_nodes;
   for (const std::int64_t tag : fem->held_node_ids()) mesh_nodes.push_back(node_of_tag_[object].at(tag));

@@ -127,6 +127,7 @@ class SimulationLoop {
   std::vector<ComplianceRowsSender> rows_senders_;
   std::vector<wire::IrStreamWriter> ir_streams_;
   std::vector<int> rows_objects_;  // per user: the body its held rows are of
+  std::vector<std::uint8_t> stream_started_;  // per user: its IR stream has a block the client holds
   std::vector<std::uint64_t> joins_seen_;
   std::vector<std::unordered_map<std::int64_t, int>> node_of_tag_;
 };

@@ -335,8 +335,8 @@ TEST(ForceEvaluator, AllocatesNothingUnderTheSphereModel) {
   simulation.step(0);
   const PreparedIR& prepared = *simulation.ir(0);
   const std::vector<Eigen::Vector3d> remotes = simulation.remote_positions(prepared.ir);
-  EvaluationState state = make_evaluation_state(prepared);  // the warm start, sized here
-  ASSERT_TRUE(std::holds_alternative<SphereWarmStart>(state.body));
+  EvaluationState state = make_evaluation_state(prepared);  // its contact solve, sized here
+  ASSERT_TRUE(std::holds_alternative<SphereContactState>(state.body));
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   allocations = 0;
   counting = true;

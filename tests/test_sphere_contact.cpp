@@ -175,31 +175,65 @@ TEST(UnilateralContactSolve, TheWorkingSetEqualsTheDenseSolveOverEveryCandidate)
 // ---------------------------------------------------------------------------------------
 // The geometry.
 
-TEST(SphereContact, TakesEveryNodeAlongTheNormalOfTheNearestSphere) {
+TEST(SphereContact, TakesEveryNodeAlongItsOwnNormalFromTheSphereWithTheLeastGap) {
+  const Eigen::Vector3d down(0, 0, -1);  // the inward normal of a surface facing +z
   const std::vector<SphereTool> one = {{Eigen::Vector3d(0, 0, 1), 2}};
-  const auto held = sphere_constraint(Eigen::Vector3d(0, 0, 0), 0, one);
+  const auto held = sphere_constraint(Eigen::Vector3d(0, 0, 0), down, 0, one);
   ASSERT_TRUE(held.has_value());
-  EXPECT_DOUBLE_EQ(held->gap, -1);
-  EXPECT_TRUE(held->normal.isApprox(Eigen::Vector3d(0, 0, -1)));
-  const auto outside = sphere_constraint(Eigen::Vector3d(0, 0, -1.5), 0, one);
+  EXPECT_DOUBLE_EQ(held->gap, -1) << "inside: it must move down to the sphere's bottom";
+  EXPECT_TRUE(held->normal.isApprox(down));
+  const auto outside = sphere_constraint(Eigen::Vector3d(0, 0, -1.5), down, 0, one);
   ASSERT_TRUE(outside.has_value()) << "outside the sphere: a candidate the deformation may carry in";
   EXPECT_DOUBLE_EQ(outside->gap, 0.5);
-  EXPECT_TRUE(outside->normal.isApprox(Eigen::Vector3d(0, 0, -1)));
-  EXPECT_EQ(sphere_constraint(Eigen::Vector3d(0, 0, -1), 0, one)->gap, 0) << "exactly on it";
-  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(0, 0, 1), 0, one).has_value()) << "at the centre: no normal";
-  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(0, 0, 0), 0b100, one).has_value()) << "normal along its fixed axis";
-  EXPECT_TRUE(sphere_constraint(Eigen::Vector3d(1, 0, 0), 0b100, one).has_value()) << "a free part of the normal";
+  EXPECT_EQ(sphere_constraint(Eigen::Vector3d(0, 0, -1), down, 0, one)->gap, 0) << "exactly on it";
+  EXPECT_DOUBLE_EQ(sphere_constraint(Eigen::Vector3d(0, 0, 1), down, 0, one)->gap, -2) << "at the centre: a radius";
+  // Off the axis the gap is measured along the node's normal, not towards the centre: the
+  // sphere's bottom above (1.5, 0) is at z = 1 - sqrt(4 - 2.25).
+  EXPECT_NEAR(sphere_constraint(Eigen::Vector3d(1.5, 0, 0), down, 0, one)->gap, 1 - std::sqrt(1.75), 1e-15);
+  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(3, 0, 0), down, 0, one).has_value()) << "its line misses the sphere";
+  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(0, 0, 5), down, 0, one).has_value())
+      << "the sphere lies wholly ahead of it, inside the body";
+  EXPECT_DOUBLE_EQ(sphere_constraint(Eigen::Vector3d(0, 0, 5), -down, 0, one)->gap, 2)
+      << "a surface facing -z above the sphere: clear by 2";
+  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(0, 0, 0), down, 0b100, one).has_value()) << "normal along its fixed axis";
+  const Eigen::Vector3d tilted(-0.6, 0, -0.8);
+  EXPECT_TRUE(sphere_constraint(Eigen::Vector3d(0, 0, 0), tilted, 0b100, one).has_value()) << "a free part of the normal";
+  EXPECT_FALSE(sphere_constraint(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d::Zero(), 0, one).has_value())
+      << "no touchable triangle: no normal";
   const std::vector<SphereTool> two = {{Eigen::Vector3d(0, 0, 1), 2},
                                        {Eigen::Vector3d(0.5, 0, 0.5), 2},
                                        {Eigen::Vector3d::Constant(std::nan("")), 5}};
-  const auto deepest = sphere_constraint(Eigen::Vector3d(0, 0, 0), 0, two);
+  const auto deepest = sphere_constraint(Eigen::Vector3d(0, 0, 0), down, 0, two);
   ASSERT_TRUE(deepest.has_value());
   EXPECT_EQ(deepest->tool, 1);
-  EXPECT_NEAR(deepest->gap, std::sqrt(0.5) - 2, 1e-15);
-  const auto nearer = sphere_constraint(Eigen::Vector3d(3, 0, 1), 0, two);  // outside both
+  EXPECT_NEAR(deepest->gap, 0.5 - std::sqrt(3.75), 1e-15);
+  const auto nearer = sphere_constraint(Eigen::Vector3d(0, 0, -2), down, 0, two);  // outside both
   ASSERT_TRUE(nearer.has_value());
   EXPECT_EQ(nearer->tool, 1);
-  EXPECT_NEAR(nearer->gap, std::sqrt(6.5) - 2, 1e-15);
+  EXPECT_NEAR(nearer->gap, 2.5 - std::sqrt(3.75), 1e-15);
+}
+
+TEST(SphereContact, ANodesNormalIsItsTouchableTrianglesOnly) {
+  const TetMesh mesh = testing::distorted_box_mesh(1.0, 3, 0.0, 1);
+  const BoundarySurface surface = extract_boundary_surface(mesh);
+  std::vector<int> top;  // the face z = 1 alone is touchable
+  for (int t = 0; t < surface.triangle_count(); ++t) {
+    bool on_top = true;
+    for (int node : surface.triangles[static_cast<std::size_t>(t)]) on_top &= mesh.nodes(2, node) == 1.0;
+    if (on_top) top.push_back(t);
+  }
+  const Eigen::Matrix3Xd normals = contact_normals(mesh, surface, top);
+  int edge_nodes = 0;
+  for (int node = 0; node < mesh.node_count(); ++node) {
+    if (mesh.nodes(2, node) != 1.0) {
+      EXPECT_EQ(normals.col(node).norm(), 0) << "node " << node << " has no touchable triangle";
+      continue;
+    }
+    // On the top's rim too, where the whole surface's normal leans over the side.
+    EXPECT_LE((normals.col(node) - Eigen::Vector3d(0, 0, -1)).norm(), 1e-15) << "node " << node;
+    edge_nodes += mesh.nodes(0, node) == 0.0 || mesh.nodes(0, node) == 1.0;
+  }
+  EXPECT_GT(edge_nodes, 0);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -222,7 +256,8 @@ testing::CubeRig& shared_rig() {
 std::vector<std::int64_t> ir_contact_tags(const PreparedIR& prepared, const EvaluationState& state) {
   std::vector<std::int64_t> tags;
   for (int i = 0; i < condensed_fem(prepared.ir).row_node_count; ++i)
-    if (std::get<SphereWarmStart>(state.body).active(i)) tags.push_back(condensed_fem(prepared.ir).node_ids[static_cast<std::size_t>(i)]);
+    if (std::get<SphereContactState>(state.body).solve.push(i) > 0)
+      tags.push_back(condensed_fem(prepared.ir).node_ids[static_cast<std::size_t>(i)]);
   std::sort(tags.begin(), tags.end());
   return tags;
 }
@@ -251,6 +286,7 @@ void compare(const ElasticBody& body, const Simulation& simulation, const std::v
   std::vector<Eigen::Vector3d> remotes;
   for (int r = 0; r < remote_count(prepared.ir); ++r) remotes.push_back(tools[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
   EvaluationState state = make_evaluation_state(prepared);
+  std::get<SphereContactState>(state.body).work_budget = std::numeric_limits<double>::infinity();
   const ForceSample sample = evaluate_force(prepared, state, tools[static_cast<std::size_t>(user)], remotes, 1e-3);
   std::vector<PressedTool> pressed;
   for (const Eigen::Vector3d& p : tools) pressed.push_back({p, radius});

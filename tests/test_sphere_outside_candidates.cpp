@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -53,8 +54,8 @@ haptic: {force_limit: 1000}
 // The linearised unilateral problem over (node, sphere) pairs, solved on the whole body.
 struct ColumnPairProblem {
   std::vector<int> node, tool;
-  std::vector<Eigen::Vector3d> normal;  // unit, from the centre through the node's rest position
-  Eigen::VectorXd gap;                  // |x - c| - r [m], either sign
+  std::vector<Eigen::Vector3d> normal;  // unit, the node's face's inward normal
+  Eigen::VectorXd gap;                  // along it to the sphere's far side [m], either sign
   Eigen::VectorXd push;                 // lambda [N]
   std::vector<Eigen::Vector3d> force;   // on each sphere [N]
   std::vector<int> contact_nodes() const {
@@ -93,16 +94,22 @@ ColumnPairProblem solve_every_column_pair(const ElasticBody& body, const ColumnT
                              const std::vector<Eigen::Vector3d>& centres) {
   ColumnPairProblem problem;
   std::vector<double> gaps;
-  for (int node : c.nodes)
+  for (int node : c.nodes) {
+    const Eigen::Vector3d x = body.mesh.nodes.col(node);
+    const Eigen::Vector3d inward(x.x() < 0 ? 1 : -1, 0, 0);  // the -x face's, or the +x face's
     for (int t = 0; t < static_cast<int>(centres.size()); ++t) {
-      const Eigen::Vector3d offset = body.mesh.nodes.col(node) - centres[static_cast<std::size_t>(t)];
-      const double gap = offset.norm() - kColumnSphereRadius;
+      // x + s n on the sphere: s = -b -+ sqrt(b^2 - c); the node must reach the far crossing.
+      const Eigen::Vector3d offset = x - centres[static_cast<std::size_t>(t)];
+      const double b = inward.dot(offset), c2 = offset.squaredNorm() - kColumnSphereRadius * kColumnSphereRadius;
+      if (b * b - c2 < 0 || -b - std::sqrt(b * b - c2) > 0) continue;  // missed, or the sphere is ahead
+      const double gap = b - std::sqrt(b * b - c2);
       if (gap >= kColumnSphereRadius) continue;  // far beyond anything the press can carry in
       problem.node.push_back(node);
       problem.tool.push_back(t);
-      problem.normal.push_back(offset.normalized());
+      problem.normal.push_back(inward);
       gaps.push_back(gap);
     }
+  }
   const auto m = static_cast<Eigen::Index>(gaps.size());
   problem.gap = Eigen::Map<const Eigen::VectorXd>(gaps.data(), m);
   Eigen::MatrixXd a(m, m);
@@ -160,7 +167,7 @@ std::vector<std::int64_t> column_ir_contact_tags(const PreparedIR& prepared, con
   const CondensedFemIr& fem = condensed_fem(prepared.ir);
   std::vector<std::int64_t> tags;
   for (int i = 0; i < fem.row_node_count; ++i)
-    if (std::get<SphereWarmStart>(state.body).active(i)) tags.push_back(fem.node_ids[static_cast<std::size_t>(i)]);
+    if (std::get<SphereContactState>(state.body).solve.push(i) > 0) tags.push_back(fem.node_ids[static_cast<std::size_t>(i)]);
   std::sort(tags.begin(), tags.end());
   return tags;
 }

@@ -1,20 +1,25 @@
-// The sphere contact model's geometry: which surface nodes a rigid sphere tool may hold,
-// and along which normal.
+// The sphere contact model's geometry: which surface nodes a rigid sphere tool may push,
+// along which direction, and how far each is from it.
 //
-// Every touchable surface node is a candidate of the sphere nearest it (the smallest gap;
-// ties to the lower tool index): held on that sphere's surface along the sphere's normal,
-// frictionless (the node may slide along the surface), and released when holding it would
-// pull (unilateral_contact_solve.h decides which). As the FEM is linear, so is the
-// constraint: the normal n = (x - c) / |x - c| and the gap g = |x - c| - r are taken at
-// rest, and the node's displacement u must satisfy g + n . u >= 0 (it ends on or outside
-// the sphere along n); the tool pushes it with lambda n, lambda >= 0. A node inside a
-// sphere at rest has g < 0 and the sphere "holds" it; one outside (g > 0) is pushed only
-// when the deformation carries it in, so the force is continuous in the tool's position.
-// Most candidates are far and never pushed: working_set_contact_solve.h solves over the
-// few that are.
+// The model is the linear elastic contact problem of Signorini, the one Hertz solved: the
+// constraint is taken on the body's rest surface, along its own normal. Each touchable node
+// has an inward unit normal n (its touchable triangles' angle-weighted normal, reversed): the
+// direction a tool pushes it, frictionless, so that it may slide along the surface. Its gap
+// g to a sphere is how far it must move along n to leave the sphere (g < 0: it lies inside)
+// or may move before it reaches it (g > 0), measured along the line x + s n through its
+// rest position: g = -s+, with s+ the far crossing of that line with the sphere. The node's
+// displacement u must keep g + n . u >= 0, and the sphere pushes it with lambda n,
+// lambda >= 0, released when holding it would pull (unilateral_contact_solve.h decides
+// which). A node whose line misses the sphere, or meets it only ahead of the node (the
+// sphere is inside the body beyond it), has no constraint from that sphere. Of several
+// spheres the one with the least gap holds the node.
 //
-// A node the model cannot hold is no candidate: one within 1e-9 r of a centre (it has no
-// normal), or one whose normal lies (to 1e-6) along its fixed axes (the support holds it
+// As n does not depend on where the tools are, neither does the normal compliance between
+// the nodes (W = N^T L N): a server computes it once per set of candidate nodes, and the
+// gaps alone follow the tools.
+//
+// A node the model cannot hold is no candidate: one without a touchable triangle (zero
+// normal), or whose normal lies (to 1e-6) along its fixed axes (the support holds it
 // there). Units: m.
 #pragma once
 
@@ -37,15 +42,29 @@ struct SphereTool {
 
 /// One candidate node's constraint.
 struct SphereConstraint {
-  int tool = -1;                                     ///< index of the sphere nearest it
-  double gap = 0;                                    ///< |x - c| - r [m]: negative inside, positive outside
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit, from c through x: the push's direction
+  int tool = -1;                                     ///< index of the sphere with the least gap
+  double gap = 0;                                    ///< [m]: negative inside, positive outside
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< the node's inward unit normal: the push's direction
 };
 
-/// The constraint on a node at rest position `rest`, with `fixed` axes, from the nearest of
-/// `tools`; none if there is no sphere or the model cannot hold the node (see above).
-std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, AxisMask fixed,
-                                                  std::span<const SphereTool> tools) noexcept;
+/// The gap [m] of a node at `rest` with inward unit `normal` to `tool`: +inf when the line
+/// along the normal misses the sphere or meets it only ahead of the node, or the tool is
+/// absent (non-finite centre, no radius).
+double sphere_gap(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal, const SphereTool& tool) noexcept;
+
+/// Whether the model can hold a node with inward `normal` and `fixed` axes (see above).
+bool holdable(const Eigen::Vector3d& normal, AxisMask fixed) noexcept;
+
+/// The constraint on a node at `rest` with inward `normal` and `fixed` axes, from the
+/// sphere of `tools` with the least gap (ties to the lower index); none if no sphere
+/// constrains it or the model cannot hold it.
+std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
+                                                  AxisMask fixed, std::span<const SphereTool> tools) noexcept;
+
+/// The inward unit normal of every node of `triangles` (a body's touchable triangles): the
+/// angle-weighted mean of their outward normals, reversed; zero for every other node (one
+/// column per volume node).
+Eigen::Matrix3Xd contact_normals(const TetMesh& mesh, const BoundarySurface& surface, std::span<const int> triangles);
 
 /// The distinct nodes of surface `triangles`, ascending (the candidates of the touchable
 /// triangles, say).
@@ -57,13 +76,13 @@ struct SphereCandidates {
   std::vector<SphereConstraint> constraints;
 };
 
-/// Of `nodes`, every candidate of `tools`, in order.
-SphereCandidates sphere_candidates(const TetMesh& mesh, const DofMap& dofs, std::span<const int> nodes,
-                                   std::span<const SphereTool> tools);
+/// Of `nodes`, every candidate of `tools`, in order; `normals` per volume node (contact_normals).
+SphereCandidates sphere_candidates(const TetMesh& mesh, const DofMap& dofs, const Eigen::Matrix3Xd& normals,
+                                   std::span<const int> nodes, std::span<const SphereTool> tools);
 
 /// Of `nodes`, those that `tools` hold at rest (the candidates inside a sphere), in order.
-SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, std::span<const int> nodes,
-                                       std::span<const SphereTool> tools);
+SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, const Eigen::Matrix3Xd& normals,
+                                       std::span<const int> nodes, std::span<const SphereTool> tools);
 
 /// The patch of a sphere tool: `nearest` (the allowed triangle nearest the centre) first,
 /// then every allowed triangle with a node inside the sphere or among `carried`, then

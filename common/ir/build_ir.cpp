@@ -45,11 +45,59 @@ int nearest_touchable_triangle(const ElasticBody& body, const Eigen::Vector3d& p
   return nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, position).triangle;
 }
 
+namespace {
+
+// node_ids and fixed_axes of `nodes`, and the rest positions of the first row_node_count.
+void fill_node_lists(const ElasticBody& body, std::span<const int> nodes, CondensedFemIr& fem) {
+  for (int node : nodes) {
+    fem.node_ids.push_back(body.mesh.node_tags[node]);
+    fem.fixed_axes.push_back(body.dofs.fixed_axes[node]);
+  }
+  fem.rest_positions.resize(3, fem.row_node_count);
+  for (int i = 0; i < fem.row_node_count; ++i) fem.rest_positions.col(i) = body.mesh.nodes.col(nodes[i]);
+}
+
+// The sphere model's part: the row nodes' normals, and W and q0 cut from the server's.
+void fill_sphere_contact(const ElasticBody& body, std::span<const int> boundary, const SphereIrSource& source,
+                         std::span<const int> nodes, IrPrecision precision, CondensedFemIr& fem) {
+  if (!source.normal) throw Error("build_ir: the sphere contact model needs the server's normal compliance");
+  const NormalCompliance& normal = *source.normal;
+  fill_node_lists(body, nodes, fem);
+  const auto n = static_cast<Eigen::Index>(nodes.size());
+  SphereContactIr& sphere = fem.sphere.emplace();
+  sphere.normals = Eigen::Matrix3Xd::Zero(3, n);
+  sphere.free_clearance = Eigen::VectorXd::Zero(n);
+  sphere.normal_compliance = Eigen::MatrixXd::Zero(n, n);
+  std::vector<int> slots(nodes.size(), -1);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const int node = nodes[static_cast<std::size_t>(i)];
+    if (!holdable(body.contact_normals.col(node), body.dofs.fixed_axes[node])) continue;  // no candidate: zero
+    const int slot = normal.slot_of(node);
+    if (slot < 0) throw Error(fmt::format("build_ir: row node {} has no normal compliance", body.mesh.node_tags[node]));
+    slots[static_cast<std::size_t>(i)] = slot;
+    sphere.normals.col(i) = normal.normal(slot);
+    sphere.free_clearance[i] = normal.free_clearance()[slot];
+  }
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (slots[static_cast<std::size_t>(i)] >= 0 && slots[static_cast<std::size_t>(j)] >= 0)
+        sphere.normal_compliance(i, j) = normal.w()(slots[static_cast<std::size_t>(i)], slots[static_cast<std::size_t>(j)]);
+  if (precision == IrPrecision::f32) sphere.normal_compliance = sphere.normal_compliance.cast<float>().cast<double>();
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (slots[static_cast<std::size_t>(i)] >= 0 &&
+        std::find(source.contact_slots.begin(), source.contact_slots.end(), slots[static_cast<std::size_t>(i)]) !=
+            source.contact_slots.end())
+      sphere.contacts.push_back(static_cast<int>(i));
+  for (int node : boundary) sphere.held_node_ids.push_back(body.mesh.node_tags[node]);
+}
+
+}  // namespace
+
 IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensation& condensation,
                                     std::span<const UserTool> users, std::size_t user_index,
                                     std::span<const Eigen::Vector3d> boundary_displacement,
                                     const IrBuildOptions& options, std::uint64_t epoch, double simulation_time,
-                                    const RestDisplacement& rest) {
+                                    const RestDisplacement& rest, const SphereIrSource& sphere_source) {
   const UserTool& own = users[user_index];
   const std::vector<int>& boundary = condensation.boundary_nodes();
   if (boundary_displacement.size() != boundary.size())
@@ -142,6 +190,10 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
     fem.remotes.push_back(remote);
   }
   fem.row_node_count = static_cast<int>(nodes.size());
+  if (sphere) {
+    fill_sphere_contact(body, boundary, sphere_source, nodes, options.precision, fem);
+    return ir;
+  }
   const std::vector<int> contact_nodes = nodes;
   const CondensedOperator op = condensation.condense(contact_nodes);
 
@@ -168,12 +220,7 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
     }
   }
 
-  for (int node : nodes) {
-    fem.node_ids.push_back(body.mesh.node_tags[node]);
-    fem.fixed_axes.push_back(body.dofs.fixed_axes[node]);
-  }
-  fem.rest_positions.resize(3, fem.row_node_count);
-  for (int i = 0; i < fem.row_node_count; ++i) fem.rest_positions.col(i) = body.mesh.nodes.col(nodes[i]);
+  fill_node_lists(body, nodes, fem);
 
   const auto kept_count = static_cast<Eigen::Index>(kept_columns.size());
   fem.m_tilde.resize(op.m_cc.rows(), op.m_cc.cols() + kept_count);

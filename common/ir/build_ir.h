@@ -5,7 +5,9 @@
 // included as remote contacts; M~ comes from the incremental condensation for
 // C = patch nodes + remote contact nodes and the current boundary set B. Under the sphere
 // contact model the patch also holds every touchable triangle with a node inside the
-// sphere (sphere_patch), and every remote sphere's patch nodes are contact nodes too.
+// sphere (sphere_patch), every remote sphere's patch nodes are contact nodes too, and the
+// IR carries their normal compliance, cut from the server's (normal_compliance.h), instead
+// of M~.
 #pragma once
 
 #include <Eigen/Core>
@@ -15,6 +17,7 @@
 #include <vector>
 
 #include "common/condense/incremental_condensation.h"
+#include "common/condense/normal_compliance.h"
 #include "common/ir/intermediate_representation.h"
 #include "common/model/elastic_body.h"
 
@@ -60,14 +63,23 @@ int nearest_touchable_triangle(const ElasticBody& body, const Eigen::Vector3d& p
 /// support closing the gaps its nodes had at rest, supported_compliance.h).
 using RestDisplacement = std::function<Eigen::VectorXd(std::span<const int> dofs)>;
 
+/// Under the sphere contact model: the server's normal compliance, over every node the IR
+/// can hold (its row nodes), and the slots of it that the server's state pushes.
+struct SphereIrSource {
+  const NormalCompliance* normal = nullptr;
+  std::span<const int> contact_slots;
+};
+
 /// IR for users[user_index]. `boundary_displacement` gives u for each node of
 /// condensation.boundary_nodes(), in that order. With `rest`, the IR carries the rest forces
-/// f_rest = -M~ u0 over its nodes (every held node's, truncated or not). Throws Error if the
-/// user's nearest triangle is unknown or holds a boundary node.
+/// f_rest = -M~ u0 over its nodes (every held node's, truncated or not). Under the sphere
+/// contact model `sphere` must be given (and `rest` not). Throws Error if the user's nearest
+/// triangle is unknown or holds a boundary node, or a row node the sphere model can hold has
+/// no slot in sphere.normal.
 IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensation& condensation,
                                     std::span<const UserTool> users, std::size_t user_index,
                                     std::span<const Eigen::Vector3d> boundary_displacement,
                                     const IrBuildOptions& options, std::uint64_t epoch, double simulation_time,
-                                    const RestDisplacement& rest = {});
+                                    const RestDisplacement& rest = {}, const SphereIrSource& sphere = {});
 
 }  // namespace cohaptic

@@ -77,26 +77,13 @@ PatchPoint nearest_on_patch(const CondensedFemIr& ir, const PreparedFem& prepare
   return best;
 }
 
-PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, double& condition_estimate) {
-  PreparedFem prepared;
+// The checks every condensed FEM body passes: its nodes, patch, remotes and geometry.
+void check_fem_geometry(const CondensedFemIr& ir) {
   const int rows = ir.row_node_count;
   if (ir.node_count() < rows || rows < ir.patch_node_count || ir.patch.empty() ||
       static_cast<int>(ir.fixed_axes.size()) != ir.node_count() || ir.rest_positions.cols() != rows)
     throw Error("intermediate representation: inconsistent node counts");
-  if (ir.compliance_rows)
-    throw Error("intermediate representation: it carries compliance rows, not M~ (a ClientCondensation completes it first)");
-  const std::vector<int> row_dofs = ir_dofs(ir, 0, rows);
-  const std::vector<int> boundary_dofs = ir_dofs(ir, rows, ir.node_count());
-  const auto x = static_cast<Eigen::Index>(row_dofs.size());
-  const auto b = static_cast<Eigen::Index>(boundary_dofs.size());
-  if (ir.m_tilde.rows() != x || ir.m_tilde.cols() != x + b || ir.boundary_displacement.size() != b)
-    throw Error(fmt::format("intermediate representation: M~ is {}x{} and u_B {} long, expected {}x{} and {}",
-                            ir.m_tilde.rows(), ir.m_tilde.cols(), ir.boundary_displacement.size(), x, x + b, b));
-  if (ir.rest_forces.size() != 0 && ir.rest_forces.size() != x)
-    throw Error(fmt::format("intermediate representation: {} rest forces for {} contact dofs", ir.rest_forces.size(), x));
-  if (!ir.m_tilde.allFinite() || !ir.boundary_displacement.allFinite() || !ir.rest_positions.allFinite() ||
-      !ir.rest_forces.allFinite())
-    throw Error("intermediate representation: non-finite values");
+  if (!ir.rest_positions.allFinite()) throw Error("intermediate representation: non-finite values");
   for (const IrTriangle& tri : ir.patch)
     for (int k = 0; k < 3; ++k)
       if (tri.nodes[k] < 0 || tri.nodes[k] >= ir.patch_node_count || tri.neighbours[k] >= static_cast<int>(ir.patch.size()))
@@ -106,6 +93,27 @@ PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, 
   for (const IrRemoteContact& remote : ir.remotes)
     for (int node : remote.nodes)
       if (node < 0 || node >= rows) throw Error("intermediate representation: a remote contact refers to a non-contact node");
+  if (ir.patch_vertex_normals.cols() != ir.patch_node_count || !ir.patch_vertex_normals.allFinite())
+    throw Error("intermediate representation: patch vertex normals missing or not finite");
+}
+
+// M~ checked, and L~ and u0 from it.
+void prepare_m_tilde(const CondensedFemIr& ir, PreparedFem& prepared, double& condition_estimate) {
+  const int rows = ir.row_node_count;
+  if (ir.compliance_rows)
+    throw Error("intermediate representation: it carries compliance rows, not M~ (a ClientCondensation completes it first)");
+  if (ir.sphere) throw Error("intermediate representation: a sphere contact part under another contact model");
+  const std::vector<int> row_dofs = ir_dofs(ir, 0, rows);
+  const std::vector<int> boundary_dofs = ir_dofs(ir, rows, ir.node_count());
+  const auto x = static_cast<Eigen::Index>(row_dofs.size());
+  const auto b = static_cast<Eigen::Index>(boundary_dofs.size());
+  if (ir.m_tilde.rows() != x || ir.m_tilde.cols() != x + b || ir.boundary_displacement.size() != b)
+    throw Error(fmt::format("intermediate representation: M~ is {}x{} and u_B {} long, expected {}x{} and {}",
+                            ir.m_tilde.rows(), ir.m_tilde.cols(), ir.boundary_displacement.size(), x, x + b, b));
+  if (ir.rest_forces.size() != 0 && ir.rest_forces.size() != x)
+    throw Error(fmt::format("intermediate representation: {} rest forces for {} contact dofs", ir.rest_forces.size(), x));
+  if (!ir.m_tilde.allFinite() || !ir.boundary_displacement.allFinite() || !ir.rest_forces.allFinite())
+    throw Error("intermediate representation: non-finite values");
 
   // M_CC is symmetric as every server builds it (to round-off at most): an asymmetric one
   // is refused, not silently replaced by its symmetric part.
@@ -128,14 +136,19 @@ PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, 
 
   prepared.dof_index.assign(static_cast<std::size_t>(rows), {-1, -1, -1});
   for (int i = 0; i < static_cast<int>(row_dofs.size()); ++i) prepared.dof_index[row_dofs[i] / 3][row_dofs[i] % 3] = i;
+}
 
-  if (ir.patch_vertex_normals.cols() != ir.patch_node_count || !ir.patch_vertex_normals.allFinite())
-    throw Error("intermediate representation: patch vertex normals missing or not finite");
+PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, double& condition_estimate) {
+  check_fem_geometry(ir);
+  PreparedFem prepared;
+  if (ir.contact_model == ContactModel::sphere)
+    prepared.sphere = prepare_sphere_contact(ir, tool_radius, condition_estimate);
+  else
+    prepare_m_tilde(ir, prepared, condition_estimate);
   prepared.on_patch_border.assign(static_cast<std::size_t>(ir.patch_node_count), false);
   for (const IrTriangle& tri : ir.patch)
     for (int k = 0; k < 3; ++k)
       if (tri.neighbours[k] < 0) prepared.on_patch_border[tri.nodes[k]] = prepared.on_patch_border[tri.nodes[(k + 1) % 3]] = true;
-  if (ir.contact_model == ContactModel::sphere) prepared.sphere = prepare_sphere_contact(ir, tool_radius);
   return prepared;
 }
 
@@ -298,7 +311,7 @@ EvaluationState make_evaluation_state(const PreparedIR& prepared) {
   if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
     state.body = make_mass_spring_state(*network, std::get<PreparedMassSpring>(prepared.body));
   else if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body); fem && fem->contact_model == ContactModel::sphere)
-    state.body = SphereWarmStart{};
+    state.body = make_sphere_contact_state(std::get<PreparedFem>(prepared.body).sphere, fem->row_node_count);
   else if (const auto* separation = std::get_if<SeparationIr>(&prepared.ir.body))
     state.body = SeparationEvaluation{separation->state, separation->tool_state};
   return state;
@@ -310,7 +323,7 @@ ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, c
   if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body))
     if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body)) {
       if (fem->contact_model == ContactModel::sphere)
-        return evaluate_sphere_contact(prepared.ir, *fem, *prepared_fem, std::get_if<SphereWarmStart>(&state.body),
+        return evaluate_sphere_contact(prepared.ir, *fem, *prepared_fem, std::get_if<SphereContactState>(&state.body),
                                        own_tool, remote_tools);
       return evaluate_condensed_fem(prepared.ir, *fem, *prepared_fem, own_tool, remote_tools);
     }

@@ -32,8 +32,10 @@
 //   4. returns -F, set to zero if not finite and scaled down to the IR's force limit.
 // Exactly the full FEM solve's answer for the same tool positions, as long as every tool
 // stays on its IR triangles (the own tool within its patch).
-// Under the sphere contact model step 3 is the unilateral problem over every contact node
-// the spheres pass instead (evaluate_sphere_contact.h).
+// Under the sphere contact model the IR carries the normal compliance of its row nodes
+// instead of M~, prepare_ir checks it and factors it over the server's contacts, and the
+// evaluator solves the unilateral problem over every node the spheres reach
+// (evaluate_sphere_contact.h), keeping its solve in the EvaluationState.
 #pragma once
 
 #include <Eigen/Core>
@@ -52,8 +54,8 @@ namespace cohaptic {
 
 /// What prepare_ir derives from a CondensedFemIr.
 struct PreparedFem {
-  Eigen::MatrixXd compliance;         ///< L~ over the free dofs of the contact nodes [m/N]
-  Eigen::VectorXd free_displacement;  ///< u0 over the same dofs [m]
+  Eigen::MatrixXd compliance;         ///< L~ over the free dofs of the contact nodes [m/N] (not for spheres)
+  Eigen::VectorXd free_displacement;  ///< u0 over the same dofs [m] (not for spheres)
   std::vector<std::array<int, 3>> dof_index;  ///< per contact node and axis: row in L~, or -1 if fixed
   std::vector<bool> on_patch_border;  ///< per patch node
   PreparedSphereContact sphere;       ///< the sphere contact model's (evaluate_sphere_contact.h)
@@ -80,17 +82,16 @@ struct PreparedIR {
 PreparedIR prepare_ir(IntermediateRepresentation ir);
 
 /// The mutable side of one evaluator of one prepared IR: nothing for a static body (FEM),
-/// the last tick's active set for an FEM body under the sphere contact model (only a warm
-/// start: an empty state solves cold, to the same answer), the sub-network's state for a
-/// mass-spring body, the separated state and the instrument for a separation body. Made off
-/// the haptic thread, sized there.
+/// its contact solve for an FEM body under the sphere contact model (whose evaluation needs
+/// it), the sub-network's state for a mass-spring body, the separated state and the
+/// instrument for a separation body. Made off the haptic thread, sized there.
 struct SeparationEvaluation {
   SeparationState state;
   SeparationToolState tool;
 };
 
 struct EvaluationState {
-  std::variant<std::monostate, MassSpringPatchState, SphereWarmStart, SeparationEvaluation> body;
+  std::variant<std::monostate, MassSpringPatchState, SphereContactState, SeparationEvaluation> body;
 };
 
 /// The state an evaluator of `prepared` starts from (the server's state at the IR's time).

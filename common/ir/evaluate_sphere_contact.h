@@ -1,22 +1,21 @@
 // The force on a sphere tool under the sphere contact model, from a prepared IR
 // (common/contact/sphere_contact.h): the evaluator's sphere case, per haptic tick.
 //
-// Every contact node of the IR is a candidate of the sphere nearest it (the own sphere and
-// the remote ones at their given positions), whether inside it at rest or not: a node the
-// deformation carries into a sphere is pushed too. Each candidate's clearance
-// q = g + n . u0 comes from its rest position and the IR's free displacement u0; which of
-// them touch and with what push is the unilateral problem (working_set_contact_solve.h),
-// with the normal compliance A = N^T L~ N read from the IR's condensed compliance L~ (B
-// held) only against the working set, warm started from the evaluator's last tick on the
-// same IR (cold without a warm start). The force on the own tool is -sum lambda_i n_i over
-// its candidates: exactly the full FEM solve's, as long as every node that touches a
-// sphere is a contact node of the IR.
+// Every row node of the IR that the model can hold is a candidate of the sphere (own, or a
+// remote one at its given position) with the least gap along the node's normal; its
+// clearance is q = g + q0, with q0 from the IR. Which of them touch and with what push is the
+// unilateral problem over the IR's normal compliance W, solved from where the evaluator's
+// last tick on the same IR left it (incremental_contact_solve.h; the first tick starts from
+// the server's contacts). The force on the own tool is -sum lambda_i n_i over the nodes its
+// sphere pushes: exactly the full FEM solve's, as long as every node that touches a sphere
+// is a row node of the IR.
 // Flags: kInContact when the own sphere holds a node at rest or pushes one; kOutsidePatch
 // when it reaches a surface node outside the IR (the force then leaves that node out until
-// the next IR); kContactUnresolved (zero force) when the working set outgrows
-// kMaxSphereContacts nodes or the solve did not finish within its budget (a few hundred
-// microseconds): the haptic loop holds its last force and counts the tick. noexcept,
-// lock-free, allocation-free.
+// the next IR); kContactUnresolved when the solve did not finish within the state's work
+// budget (kSphereSolveWork a tick): the force is then zero, the haptic loop holds the last
+// resolved force and counts the tick, and the next tick goes on from where this one
+// stopped; kNonFinite (zero force) for a non-finite tool or a state that is not this IR's.
+// noexcept, lock-free, allocation-free.
 #pragma once
 
 #include <Eigen/Core>
@@ -26,14 +25,11 @@
 
 namespace cohaptic {
 
-/// Work budget of one tick's contact solve, in multiply-adds.
-constexpr double kSphereSolveWork = 5e5;
-
 /// `envelope` holds the own tool's radius and the force limit; `ir` is its body, `prepared`
-/// what prepare_ir derived from it; `warm_start` (may be null: a cold solve) is read and
-/// replaced by this tick's active set.
+/// what prepare_ir derived from it; `state` (made for this IR by make_evaluation_state) is
+/// read and advanced.
 ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
-                                    const PreparedFem& prepared, SphereWarmStart* warm_start,
+                                    const PreparedFem& prepared, SphereContactState* state,
                                     const Eigen::Vector3d& own_tool,
                                     std::span<const Eigen::Vector3d> remote_tools) noexcept;
 

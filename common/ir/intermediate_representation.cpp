@@ -25,7 +25,14 @@ std::size_t CondensedFemIr::size_bytes() const {
                              (compliance_rows ? 8 + static_cast<std::size_t>(compliance_rows->rows.size()) * sizeof(double) : 0);
   const std::size_t truncated =  // sent with compliance rows only
       compliance_rows ? truncated_node_ids.size() * (sizeof(std::int64_t) + sizeof(AxisMask)) : 0;
-  return kHeader + nodes + triangles + remote + matrix + truncated;
+  std::size_t sphere_bytes = 0;
+  if (sphere) {  // W as its upper triangle, at the stored precision (f64 as rows)
+    const auto n = static_cast<std::size_t>(sphere->normal_compliance.rows());
+    sphere_bytes = static_cast<std::size_t>(sphere->normals.size() + sphere->free_clearance.size()) * sizeof(double) +
+                   n * (n + 1) / 2 * scalar + sphere->contacts.size() * sizeof(std::int32_t) +
+                   sphere->held_node_ids.size() * sizeof(std::int64_t);
+  }
+  return kHeader + nodes + triangles + remote + matrix + truncated + sphere_bytes;
 }
 
 std::vector<std::int64_t> CondensedFemIr::held_node_ids() const {

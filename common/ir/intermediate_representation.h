@@ -67,6 +67,22 @@ struct IrRemoteContact {
   double tool_radius = 0;               ///< [m]
 };
 
+/// The sphere contact model's part of a condensed FEM body (common/contact/sphere_contact.h),
+/// instead of M~ and u_B: every row node is a candidate, pushed along its own inward normal
+/// by the sphere (own or remote) with the least gap to it. With B held where it is, W is the
+/// compliance between the row nodes' normal pushes and q0 their normal displacement under
+/// no push, so that under pushes lambda a node's clearance is g + q0 + (W lambda); neither
+/// depends on where the tools are. B itself travels only as its tags.
+struct SphereContactIr {
+  Eigen::Matrix3Xd normals;            ///< per row node: inward unit normal, zero for a node the model cannot hold
+  Eigen::VectorXd free_clearance;      ///< q0 per row node [m]
+  /// W, row nodes square, symmetric [m/N]; the rows and columns of a node the model cannot
+  /// hold are zero. Empty while it travels as compliance rows (then rows of W, one per node).
+  Eigen::MatrixXd normal_compliance;
+  std::vector<int> contacts;           ///< row nodes the server's state pushes (ascending): the first tick's set
+  std::vector<std::int64_t> held_node_ids;  ///< B's tags: the nodes W and q0 hold where they are
+};
+
 struct CondensedFemIr {
   ContactModel contact_model = ContactModel::node_translation;
   IrPrecision precision = IrPrecision::f64;
@@ -97,6 +113,9 @@ struct CondensedFemIr {
   /// only; the nodes past row_node_count are the held nodes kept, as the server chose them.
   std::vector<std::int64_t> truncated_node_ids;
   std::vector<AxisMask> truncated_fixed_axes;
+  /// Under the sphere contact model (and only then): its part, instead of M~ and u_B (both
+  /// empty; node_ids are the row nodes alone).
+  std::optional<SphereContactIr> sphere;
 
   int node_count() const { return static_cast<int>(node_ids.size()); }
   /// The nodes a client condensing itself holds after this IR: node_ids, then truncated_node_ids.
@@ -112,8 +131,10 @@ struct IntermediateRepresentation {
   /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone);
   /// 3: a condensed FEM body may come as compliance rows instead of M~;
   /// 4: compliance rows may name held nodes that B truncation leaves out (still reads 2, 3);
-  /// 5: a condensed FEM body may carry rest forces (still reads 2 to 4).
-  static constexpr std::uint32_t kFormatVersion = 5;
+  /// 5: a condensed FEM body may carry rest forces (still reads 2 to 4);
+  /// 6: under the sphere contact model it carries its normal compliance instead of M~ (still
+  /// reads 2 to 5, but for sphere bodies, whose earlier form it refuses).
+  static constexpr std::uint32_t kFormatVersion = 6;
   static constexpr std::uint32_t kOldestReadableVersion = 2;
 
   std::uint64_t epoch = 0;         ///< increases with every IR built for this user

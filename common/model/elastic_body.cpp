@@ -107,6 +107,7 @@ ElasticBody build_elastic_body(const ObjectSpec& object, const ElasticObjectSpec
   if (body.touchable_triangles.empty())
     throw SceneError(fmt::format("{}.touchable: selects {} surface nodes but no whole surface triangle", object.where,
                                  body.touchable_nodes.size()));
+  body.contact_normals = contact_normals(body.mesh, body.surface, body.touchable_triangles);
 
   body.timings.mesh_ms = watch.lap_ms();
 

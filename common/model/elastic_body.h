@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "common/contact/sphere_contact.h"
 #include "common/contact/surface_distance.h"
 #include "common/fem/assemble_stiffness.h"
 #include "common/fem/dof_map.h"
@@ -41,6 +42,9 @@ struct ElasticBody {
   std::unique_ptr<SparseCholesky> free_factor;    ///< K_ff
   std::vector<int> touchable_nodes;               ///< sorted volume node indices
   std::vector<int> touchable_triangles;           ///< surface triangle indices
+  /// Per volume node: the inward unit normal of its touchable triangles, the direction a
+  /// sphere tool pushes it (contact_normals, sphere_contact.h); zero off them.
+  Eigen::Matrix3Xd contact_normals;
   ElasticBodyTimings timings;
 
   /// "node <tag> axis <x|y|z>" for global dof `dof`, for messages.

@@ -70,7 +70,7 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   std::vector<int> free_candidates;
   for (int node : candidates_)
     if (!is_held[static_cast<std::size_t>(node)]) free_candidates.push_back(node);
-  const SphereCandidates candidates = sphere_candidates(body_.mesh, body_.dofs, free_candidates, spheres);
+  const SphereCandidates candidates = sphere_candidates(body_.mesh, body_.dofs, body_.contact_normals, free_candidates, spheres);
 
   SphereContactSolution solution;
   solution.candidates = candidates.nodes;

@@ -27,7 +27,11 @@ Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstac
   for (int t : body.touchable_triangles) touchable_triangle_[t] = true;
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
-  if (sphere_model()) sphere_candidates_ = triangle_nodes(body.surface, body.touchable_triangles);
+  if (sphere_model()) {
+    sphere_solve_ = std::make_unique<SphereStateSolve>(body, columns);
+    node_of_tag_ = node_indices_by_tag(body.mesh);
+  }
+  p0_states_.resize(users_.size());
   if (!obstacles.empty()) {
     Eigen::Matrix3Xd surface_points(3, static_cast<Eigen::Index>(body.surface.nodes.size()));
     for (std::size_t i = 0; i < body.surface.nodes.size(); ++i)
@@ -122,8 +126,20 @@ std::vector<SphereTool> Simulation::spheres() const {
 }
 
 StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) const {
-  return solve_sphere_state(columns_, condensation_, body_.mesh, body_.dofs, sphere_candidates_, spheres,
-                            boundary_dof_displacement());
+  std::vector<int> candidates;
+  for (const UserState& user : users_)
+    if (user.known) candidates.insert(candidates.end(), user.sphere_nodes.begin(), user.sphere_nodes.end());
+  return sphere_solve_->solve(condensation_, candidates, spheres, boundary_dof_displacement());
+}
+
+bool Simulation::sphere_rows_cover_holds() const {
+  for (const UserState& user : users_) {
+    if (!user.known) continue;
+    for (const std::vector<int>* nodes : {&user.sphere_holds, &user.sphere_carried})
+      for (int node : *nodes)
+        if (built_sphere_rows_.empty() || !built_sphere_rows_[static_cast<std::size_t>(node)]) return false;
+  }
+  return true;
 }
 
 void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
@@ -141,7 +157,8 @@ void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool, std
           : triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, user.nearest, sphere, rings, touchable,
                                                        user.sphere_carried));
   for (int node : nodes) under_tool[node] = in_patch[node] = true;
-  user.sphere_holds = nodes_held_by_spheres(body_.mesh, body_.dofs, nodes, std::span(&sphere, 1)).nodes;
+  user.sphere_nodes = nodes;
+  user.sphere_holds = nodes_held_by_spheres(body_.mesh, body_.dofs, body_.contact_normals, nodes, std::span(&sphere, 1)).nodes;
   user.pressing = !user.sphere_holds.empty() || !user.sphere_carried.empty();
 }
 
@@ -166,7 +183,8 @@ bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, 
       pushed.push_back(node);
       if (in_patch[node]) continue;
       const SphereConstraint constraint =
-          sphere_constraint(body_.mesh.nodes.col(node), body_.dofs.fixed_axes[node], tools).value();
+          sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node), body_.dofs.fixed_axes[node], tools)
+              .value();
       left_out.emplace_back(node, user_of_sphere[static_cast<std::size_t>(constraint.tool)]);
     }
     if (left_out.empty()) {
@@ -311,41 +329,45 @@ StepReport Simulation::step(double time) {
   if (sphere_model()) boundary_changed |= carry_pushed_nodes_into_patches(under_tool, in_patch, report);
   if (coupling_) coupling_(*this);
   std::vector<int>& nearest = step_nearest_;
-  std::vector<std::vector<int>>& sphere_holds = step_sphere_holds_;
   nearest.clear();
-  sphere_holds.resize(users_.size());
   for (std::size_t u = 0; u < users_.size(); ++u) {
     const UserState& user = users_[u];
     nearest.push_back(user.known ? user.nearest : -1);
-    sphere_holds[u].clear();
-    if (!user.known) continue;
-    tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest, user.sphere_carried});
-    sphere_holds[u] = user.sphere_holds;
-    sphere_holds[u].insert(sphere_holds[u].end(), user.sphere_carried.begin(), user.sphere_carried.end());
+    if (user.known) tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest, user.sphere_carried});
   }
   // Under naive_every_step M~ is computed again every step, as the paper's conventional loop
   // did (that cost is the step delay), but with unchanged sets it is the same IR: a new one
   // (a new epoch) is published only when a set changed.
   const bool support_changed = std::exchange(support_changed_, false);
-  const bool sets_changed =
-      boundary_changed || support_changed || nearest != built_nearest_ || sphere_holds != built_sphere_holds_;
+  // Under the sphere model an IR holds for every position of the spheres as long as every
+  // node they hold or carry is one of its row nodes (its normal compliance does not depend
+  // on where they are): it is rebuilt when one is not.
+  const bool sets_changed = boundary_changed || support_changed || nearest != built_nearest_ ||
+                            (sphere_model() && !sphere_rows_cover_holds());
   if (sets_changed || options_.naive_every_step) {
     IncrementalCondensation& condensation = ir_condensation();
     const std::vector<Eigen::Vector3d> held = boundary_displacement(condensation);
     RestDisplacement rest_displacement;  // the support's load at rest, if any
     if (support_ && support_->loads_at_rest())
       rest_displacement = [support = support_.get()](std::span<const int> dofs) { return support->rest_displacement(dofs); };
+    SphereIrSource sphere;
+    if (sphere_model()) {
+      sphere = {&sphere_solve_->normal_compliance(), sphere_solve_->contact_slots()};
+      built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
+    }
     for (std::size_t i = 0; i < tools.size(); ++i) {
       UserState& user = users_[tools[i].user];
       IntermediateRepresentation ir = build_ir(body_, condensation, tools, i, held, options_.ir, user.epoch + 1, time,
-                                               rest_displacement);
+                                               rest_displacement, sphere);
       if (!sets_changed) continue;
       ++user.epoch;
       report.ir_bytes += ir.size_bytes();
+      if (sphere_model())
+        for (const std::int64_t tag : condensed_fem(ir).node_ids) built_sphere_rows_[static_cast<std::size_t>(node_of_tag_.at(tag))] = 1;
       user.ir = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
+      p0_states_[static_cast<std::size_t>(tools[i].user)] = make_evaluation_state(*user.ir);
     }
     built_nearest_ = nearest;
-    built_sphere_holds_ = sphere_holds;
     report.rebuilt = sets_changed;
     report.recomputed = true;
   }
@@ -369,8 +391,9 @@ std::vector<Eigen::Vector3d> Simulation::remote_positions(const IntermediateRepr
 ForceSample Simulation::force(int user) const {
   const UserState& state = users_[user];
   if (!state.ir) return {};
-  EvaluationState stateless;  // the condensed FEM body ignores dt; without a warm start a sphere solve runs cold
-  return evaluate_force(*state.ir, stateless, state.position, remote_positions(state.ir->ir), 0);
+  // The condensed FEM body ignores dt; the sphere model's state keeps its contact solve.
+  return evaluate_force(*state.ir, p0_states_[static_cast<std::size_t>(user)], state.position,
+                        remote_positions(state.ir->ir), 0);
 }
 
 }  // namespace cohaptic

@@ -44,6 +44,7 @@
 #include "common/ir/build_ir.h"
 #include "common/ir/evaluate_force.h"
 #include "common/model/elastic_body.h"
+#include "common/sim/sphere_state_solve.h"
 #include "common/sim/state_solve.h"
 #include "common/sim/step_report.h"
 #include "common/sim/supported_compliance.h"
@@ -136,6 +137,7 @@ class Simulation {
     /// that its patch would not hold otherwise; their triangles join the patch.
     std::vector<int> sphere_carried;
     std::vector<int> sphere_patch_nodes;  ///< its patch's nodes without the carried nodes' triangles
+    std::vector<int> sphere_nodes;        ///< its patch's nodes with them: its candidates
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
   };
@@ -147,7 +149,7 @@ class Simulation {
   StateSolution solve(std::span<const PressingContact> contacts) const;
   bool sphere_model() const { return options_.ir.contact_model == ContactModel::sphere; }
   /// The sphere contact model's part of a user's step: its patch's nodes are under the tool
-  /// and in the patch, and it presses when its sphere holds a node.
+  /// and in the patch (its candidates), and it presses when its sphere holds a node.
   void mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
                    const std::vector<bool>& touchable) const;
   /// The sphere model's check of the patches against the solved state: a node that the
@@ -158,6 +160,8 @@ class Simulation {
   bool carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, std::vector<bool>& in_patch, StepReport& report);
   std::vector<SphereTool> spheres() const;  ///< every known user's tool
   StateSolution solve_spheres(std::span<const SphereTool> spheres) const;
+  /// Sphere model: whether the IRs last built hold every node a sphere holds or carries now.
+  bool sphere_rows_cover_holds() const;
   bool update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch);
   bool update_obstacle_contacts(const std::vector<bool>& under_tool);
   /// The condensation the IRs are built over: the support's, with B synchronised, or the body's.
@@ -180,15 +184,16 @@ class Simulation {
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
-  std::vector<std::vector<int>> built_sphere_holds_;  // nodes each sphere held or carried when they were built
+  std::vector<char> built_sphere_rows_;             // per node: a row node of the IRs last built (sphere model)
+  std::unordered_map<std::int64_t, int> node_of_tag_;  // sphere model: to read the IRs' row nodes
   std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
   std::vector<SphereTool> previous_spheres_;        // the sphere model's: the spheres of the previous step
-  std::vector<int> sphere_candidates_;              // the touchable triangles' nodes
+  mutable std::unique_ptr<SphereStateSolve> sphere_solve_;  // the sphere model's state solve, kept step to step
+  mutable std::vector<EvaluationState> p0_states_;  // per user: force()'s evaluation of its IR
   // step()'s scratch: the known tools, their nearest triangles and sphere-held nodes, the
   // nodes under them and in their patches.
   std::vector<UserTool> step_tools_;
   std::vector<int> step_nearest_;
-  std::vector<std::vector<int>> step_sphere_holds_;
   std::vector<bool> under_tool_, in_patch_;
   bool boundary_dirty_ = false;
   AppliedLoads applied_;                            // see set_applied_loads

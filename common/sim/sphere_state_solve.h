@@ -1,30 +1,62 @@
 // The simulation's own solve of the state under the sphere contact model
 // (common/contact/sphere_contact.h): every sphere at once with the boundary nodes B held.
 //
-// Every touchable node (less B) is a candidate of its nearest sphere. A working set of them
-// is condensed with B held (M_CC, M_CB from the incremental condensation); its compliance
-// L~ = M_CC^-1 and free displacement u0 = -L~ M_CB u_B give the unilateral problem over its
-// normal pushes (unilateral_contact_solve.h), and then f_B and any node's displacement as for
-// the other models (state_solve.h). The set starts as the nodes the spheres hold at rest;
-// every other candidate that the solved state carries into its sphere joins it, until none
-// does: the answer over all candidates. Units: m, N.
+// Its candidates are the nodes of the users' patches (those their IRs carry), each pushed
+// along its own normal by the sphere with the least gap; their normal compliance W with B
+// held (normal_compliance.h) gives the unilateral problem over the normal pushes, solved
+// from the last solve's set and factor (incremental_contact_solve.h), so that a step whose
+// contact set barely changes costs O(|K|^2). The nodal forces lambda n then give f_B and any
+// node's displacement as for the other models (state_solve.h). A touchable node outside
+// the patches that the solved state carries into a sphere (checked among those whose gap is
+// less than twice the deepest push's penetration) joins the candidates and the state is
+// solved again, until none does; the simulation then widens that user's patch
+// (Simulation::carry_pushed_nodes_into_patches). Units: m, N. Not thread-safe.
 #pragma once
 
 #include <Eigen/Core>
 #include <span>
+#include <vector>
 
+#include "common/condense/normal_compliance.h"
+#include "common/contact/incremental_contact_solve.h"
 #include "common/contact/sphere_contact.h"
+#include "common/model/elastic_body.h"
 #include "common/sim/state_solve.h"
-#include "common/mesh/tet_mesh.h"
 
 namespace cohaptic {
 
-/// `candidates`: the nodes the spheres may hold (the touchable triangles' nodes); u_B over
-/// the free dofs of B in the condensation's order. contact_dofs are the free dofs of the
-/// final working set (zero force where released); tool_forces[t] is sphere t's force on the
-/// object. Throws NumericalError if the problem cannot be solved.
-StateSolution solve_sphere_state(ComplianceColumns& columns, IncrementalCondensation& condensation, const TetMesh& mesh,
-                                 const DofMap& dofs, std::span<const int> candidates, std::span<const SphereTool> spheres,
-                                 const Eigen::VectorXd& boundary_displacement);
+class SphereStateSolve {
+ public:
+  /// `body` and `columns` (whose rows include every touchable node and every node B may
+  /// hold) must outlive it.
+  SphereStateSolve(const ElasticBody& body, ComplianceColumns& columns);
+
+  /// The state with `spheres` pressing, over the candidates `patch_nodes` (any order,
+  /// repeats allowed; nodes in B or that the model cannot hold are left out), u_B over the
+  /// free dofs of B in the condensation's order. contact_dofs are the free dofs of the
+  /// pushed nodes; tool_forces[t] is sphere t's force on the object. Throws NumericalError if
+  /// the problem cannot be solved.
+  StateSolution solve(IncrementalCondensation& condensation, std::span<const int> patch_nodes,
+                      std::span<const SphereTool> spheres, const Eigen::VectorXd& boundary_displacement);
+
+  /// The normal compliance over the last solve's candidates.
+  const NormalCompliance& normal_compliance() const { return normal_; }
+  /// The slots of normal_compliance() the last solve pushes.
+  std::span<const int> contact_slots() const { return contact_.members(); }
+
+ private:
+  /// The candidates become `nodes`: members leaving the set leave the contact solve first,
+  /// and a change of W under the members refactors it.
+  void set_candidates(const std::vector<int>& nodes, IncrementalCondensation& condensation,
+                      const Eigen::VectorXd& boundary_displacement);
+
+  const ElasticBody& body_;
+  ComplianceColumns& columns_;
+  std::vector<int> touchable_;  // the touchable triangles' nodes: all that can be pushed
+  NormalCompliance normal_;
+  IncrementalContactSolve contact_;
+  Eigen::VectorXd clearance_;   // per slot, this solve's q
+  std::vector<int> tool_;       // per slot, the sphere with the least gap (-1: none)
+};
 
 }  // namespace cohaptic

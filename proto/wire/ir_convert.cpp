@@ -122,6 +122,23 @@ void read_values(const Field& values, Target& out, const char* what) {
 
 namespace {
 
+void sphere_to_wire(const SphereContactIr& sphere, IrPrecision precision, SphereContact* out) {
+  add_xyz(sphere.normals, out->mutable_normals());
+  add_values<double>(sphere.free_clearance.data(), sphere.free_clearance.size(), out->mutable_free_clearance());
+  const Eigen::MatrixXd& w = sphere.normal_compliance;
+  const auto add_upper = [&](auto* field) {
+    field->Reserve(static_cast<int>(w.rows() * (w.rows() + 1) / 2));
+    for (Eigen::Index j = 0; j < w.cols(); ++j)
+      for (Eigen::Index i = 0; i <= j; ++i) field->AddAlreadyReserved(static_cast<typename std::decay_t<decltype(*field)>::value_type>(w(i, j)));
+  };
+  if (precision == IrPrecision::f32)
+    add_upper(out->mutable_normal_compliance_f32());
+  else
+    add_upper(out->mutable_normal_compliance_f64());
+  for (int node : sphere.contacts) out->add_contacts(static_cast<std::uint32_t>(node));
+  out->mutable_held_node_ids()->Add(sphere.held_node_ids.begin(), sphere.held_node_ids.end());
+}
+
 void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
   out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? CondensedFem::POINT
                          : ir.contact_model == ContactModel::sphere         ? CondensedFem::SPHERE
@@ -178,6 +195,7 @@ void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
                        out->mutable_boundary_displacement_f64());
   }
   add_values<double>(ir.rest_forces.data(), ir.rest_forces.size(), out->mutable_rest_forces());
+  if (ir.sphere) sphere_to_wire(*ir.sphere, ir.precision, out->mutable_sphere());
 }
 
 void mass_spring_to_wire(const MassSpringIr& ir, MassSpringPatch* out) {
@@ -276,6 +294,43 @@ WireIr to_wire(const CommonIr& ir) {
 
 namespace {
 
+SphereContactIr sphere_from_wire(const SphereContact& w, std::uint32_t nodes, IrPrecision& precision) {
+  SphereContactIr sphere;
+  sphere.normals = read_xyz(w.normals(), nodes, "sphere.normals");
+  if (static_cast<std::uint32_t>(w.free_clearance_size()) != nodes)
+    invalid("sphere.free_clearance has {} values for {} row nodes", w.free_clearance_size(), nodes);
+  sphere.free_clearance.resize(static_cast<Eigen::Index>(nodes));
+  read_values(w.free_clearance(), sphere.free_clearance, "sphere.free_clearance");
+  const std::uint64_t upper = std::uint64_t{nodes} * (nodes + 1) / 2;
+  const bool f32 = w.normal_compliance_f32_size() > 0;
+  if (f32 && w.normal_compliance_f64_size() > 0) invalid("sphere.normal_compliance in both f64 and f32");
+  if (static_cast<std::uint64_t>(f32 ? w.normal_compliance_f32_size() : w.normal_compliance_f64_size()) != upper)
+    invalid("sphere.normal_compliance has {} values, expected the upper triangle of {} row nodes, {}",
+            f32 ? w.normal_compliance_f32_size() : w.normal_compliance_f64_size(), nodes, upper);
+  if (f32) precision = IrPrecision::f32;
+  const auto n = static_cast<Eigen::Index>(nodes);
+  sphere.normal_compliance.resize(n, n);
+  const auto read_upper = [&](const auto& field, const char* what) {
+    int k = 0;
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = 0; i <= j; ++i, ++k) {
+        const auto v = static_cast<double>(field[k]);
+        if (!std::isfinite(v)) invalid("{}[{}] is not finite ({})", what, k, v);
+        sphere.normal_compliance(i, j) = sphere.normal_compliance(j, i) = v;
+      }
+  };
+  if (f32)
+    read_upper(w.normal_compliance_f32(), "sphere.normal_compliance_f32");
+  else
+    read_upper(w.normal_compliance_f64(), "sphere.normal_compliance_f64");
+  for (std::uint32_t node : w.contacts()) {
+    if (node >= nodes) invalid("sphere.contacts names row node {} of {}", node, nodes);
+    sphere.contacts.push_back(static_cast<int>(node));
+  }
+  sphere.held_node_ids.assign(w.held_node_ids().begin(), w.held_node_ids().end());
+  return sphere;
+}
+
 CondensedFemIr fem_from_wire(const CondensedFem& w) {
   CondensedFemIr ir;
   switch (w.contact_model()) {
@@ -338,6 +393,18 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
       invalid("{}.tool_radius {} is not a finite length >= 0", what, r.tool_radius());
     remote.tool_radius = r.tool_radius();
     ir.remotes.push_back(remote);
+  }
+
+  if (w.has_sphere() && ir.contact_model != ContactModel::sphere) invalid("a sphere contact part under another contact model");
+  if (ir.contact_model == ContactModel::sphere) {
+    if (!w.has_sphere()) invalid("a sphere body without its normal compliance (format 6 carries it instead of M~)");
+    if (nodes != w.row_node_count() || w.m_rows() != 0 || w.m_cols() != 0 || w.m_tilde_f64_size() > 0 ||
+        w.m_tilde_f32_size() > 0 || w.boundary_displacement_f64_size() > 0 || w.boundary_displacement_f32_size() > 0 ||
+        w.rows_generation() > 0 || w.rest_forces_size() > 0 || w.truncated_node_ids_size() > 0)
+      invalid("a sphere body carries its row nodes and its normal compliance only ({} nodes, {} row nodes, M~ {} x {})",
+              nodes, w.row_node_count(), w.m_rows(), w.m_cols());
+    ir.sphere = sphere_from_wire(w.sphere(), nodes, ir.precision);
+    return ir;
   }
 
   // M~ and u_B: sizes follow from the free dofs of the contact and boundary nodes.
@@ -537,6 +604,10 @@ CommonIr from_wire(const WireIr& w) {
     invalid("format version {} cannot carry compliance rows (version 3 can)", w.format_version());
   if (w.format_version() < 4 && w.has_fem() && w.fem().truncated_node_ids_size() > 0)
     invalid("format version {} cannot carry truncated held nodes (version 4 can)", w.format_version());
+  if (w.format_version() < 6 && w.has_fem() && w.fem().contact_model() == CondensedFem::SPHERE)
+    invalid("format version {} carries a sphere body as M~, which this build no longer evaluates (version 6 carries its "
+            "normal compliance)",
+            w.format_version());
   CommonIr ir;
   ir.epoch = w.epoch();
   if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());

@@ -1,18 +1,21 @@
 // The force of a static IR body (the condensed FEM body) for the tests: evaluate_force with
-// the empty evaluation state such a body has (under the sphere contact model: a cold solve);
-// dt is unused by it.
+// a fresh evaluation state (under the sphere contact model: its solve from the server's
+// contacts, with no work budget); dt is unused by it.
 #pragma once
 
+#include <limits>
 #include <span>
+#include <variant>
 
 #include "common/ir/evaluate_force.h"
 
 namespace cohaptic::testing {
 
 inline ForceSample evaluate_static(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
-                                   std::span<const Eigen::Vector3d> remote_tools) noexcept {
-  EvaluationState stateless;
-  return evaluate_force(prepared, stateless, own_tool, remote_tools, 0);
+                                   std::span<const Eigen::Vector3d> remote_tools) {
+  EvaluationState fresh = make_evaluation_state(prepared);
+  if (auto* sphere = std::get_if<SphereContactState>(&fresh.body)) sphere->work_budget = std::numeric_limits<double>::infinity();
+  return evaluate_force(prepared, fresh, own_tool, remote_tools, 0);
 }
 
 }  // namespace cohaptic::testing
