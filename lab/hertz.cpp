@@ -8,6 +8,7 @@
 
 #include "common/mesh/read_gmsh.h"
 #include "common/mesh/tet_mesh.h"
+#include "common/model/compliance_setup.h"
 #include "common/model/model.h"
 #include "common/model/sphere_contact_reference.h"
 #include "common/model/static_contact.h"
@@ -120,18 +121,26 @@ haptic: {{contact_model: sphere}}
       fmt::arg("element", formulation_name(block.material.formulation)), fmt::arg("radius", fmt::format("{:.17g}", r_mm)));
 }
 
+GmshScript hertz_quarter_block_script(const std::filesystem::path& geo, double fine) {
+  return {geo, {{"fine", fine}, {"growth", kHertzGmshGrowth}}};
+}
+
 double hertz_force(const LinearElasticMaterial& material, double radius, double depth) {
   const double nu = material.poisson_ratio;
   return 4.0 / 3.0 * material.youngs_modulus / (1 - nu * nu) * std::sqrt(radius) * std::pow(depth, 1.5);
 }
 
-HertzMesh measure_hertz(const HertzBlock& block, const std::vector<double>& depth_ratios) {
+HertzMesh measure_hertz(const HertzBlock& given, const std::vector<double>& depth_ratios) {
   for (double ratio : depth_ratios)
     if (!(ratio > 0 && ratio <= 0.5)) throw Error(fmt::format("hertz: depth ratio d/R = {} is not in (0, 0.5]", ratio));
+  HertzBlock block = given;
+  if (block.mesh.empty() && block.gmsh) block.mesh = mesh_with_gmsh(*block.gmsh, default_cache_directory() / "meshes");
   const Model model = build_model(parse_scene(hertz_block_yaml(block), "hertz.yaml"));
   const ElasticBody& body = single_elastic_body(model);
   HertzMesh mesh;
-  mesh.name = block.mesh.empty() ? fmt::format("{} cells", block.divisions) : block.mesh.filename().string();
+  mesh.name = block.mesh.empty() ? fmt::format("{} cells", block.divisions)
+              : given.gmsh      ? fmt::format("gmsh, {:g} R at the contact", given.gmsh->parameters.at("fine"))
+                                : block.mesh.filename().string();
   mesh.side = quarter_block_side(block) / block.radius;
   mesh.nodes = body.mesh.node_count();
   mesh.tets = body.mesh.tet_count();
@@ -152,10 +161,10 @@ HertzMesh measure_hertz(const HertzBlock& block, const std::vector<double>& dept
 std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh>& meshes) {
   const HertzBlock& block = options.block;
   std::string out = fmt::format(
-      "Sphere of R = {:g} mm into a block twice the quarter's side wide and one side deep, fixed at its bottom "
-      "(a graded quarter; box meshes: core {:g} R), E = {:g} Pa, nu = {:g}, {}.\nF / F_Hertz, sphere model (full "
-      "solve of the unilateral problem) | node translation:\n\n",
-      block.radius * 1e3, block.core, block.material.youngs_modulus, block.material.poisson_ratio,
+      "Sphere of R = {:g} mm into a block twice the quarter's side wide and one side deep, fixed at its bottom, E = {:g} "
+      "Pa, nu = {:g}, {}.\nF / F_Hertz for the sphere model (full solve of the unilateral problem; in brackets the nodes "
+      "it pushes in the quarter) and node translation:\n\n",
+      block.radius * 1e3, block.material.youngs_modulus, block.material.poisson_ratio,
       formulation_name(block.material.formulation));
   out += "| mesh | quarter side / R | nodes | contact cell / R |";
   for (const char* model : {"sphere", "translation"})
@@ -165,10 +174,13 @@ std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh
   out += "\n";
   for (const HertzMesh& mesh : meshes) {
     out += fmt::format("| {} | {:g} | {} | {:.4f} |", mesh.name, mesh.side, mesh.nodes, mesh.contact_cell);
-    for (const std::vector<double>* forces : {&mesh.sphere_force, &mesh.translation_force})
-      for (std::size_t j = 0; j < options.depth_ratios.size(); ++j)
-        out += fmt::format(" {:.4f} |", (*forces)[j] / hertz_force(block.material, block.radius,
-                                                                    options.depth_ratios[j] * block.radius));
+    for (std::size_t j = 0; j < options.depth_ratios.size(); ++j)
+      out += fmt::format(" {:.4f} ({}) |", mesh.sphere_force[j] / hertz_force(block.material, block.radius,
+                                                                           options.depth_ratios[j] * block.radius),
+                         mesh.contact_nodes[j]);
+    for (std::size_t j = 0; j < options.depth_ratios.size(); ++j)
+      out += fmt::format(" {:.4f} |", mesh.translation_force[j] / hertz_force(block.material, block.radius,
+                                                                            options.depth_ratios[j] * block.radius));
     out += "\n";
   }
   if (meshes.size() >= 2) {
@@ -184,19 +196,46 @@ std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh
   for (double d : options.depth_ratios)
     out += fmt::format(" {:.5g} at d/R = {:g};", hertz_force(block.material, block.radius, d * block.radius), d);
   out.back() = '\n';
+  switch (options.meshes_from) {
+    case HertzOptions::Meshes::gmsh:
+      out += fmt::format("Meshes: {} (a quarter block 40 R a side) meshed by gmsh, the element size at the contact as "
+                         "given in R and growing by {:g} per unit distance from it.\n",
+                         options.geo.string(), kHertzGmshGrowth);
+      break;
+    case HertzOptions::Meshes::boxes:
+      out += fmt::format("Meshes: box meshes of the quarter block 20 R a side, half the cells uniform in a core {:g} R "
+                         "a side at the contact, the others growing geometrically.\n",
+                         block.core);
+      break;
+    case HertzOptions::Meshes::files: out += "Meshes: the files named.\n"; break;
+  }
   return out;
 }
 
 int run_hertz(const HertzOptions& options) {
   std::vector<HertzBlock> blocks;
-  for (int divisions : options.divisions) {
-    blocks.push_back(options.block);
-    blocks.back().divisions = divisions;
-  }
-  if (!options.meshes.empty()) blocks.clear();
-  for (const std::filesystem::path& file : options.meshes) {
-    blocks.push_back(options.block);
-    blocks.back().mesh = file;
+  switch (options.meshes_from) {
+    case HertzOptions::Meshes::gmsh:
+      if (!std::filesystem::exists(options.geo))
+        throw Error(fmt::format("hertz: no quarter block script at {} (run from the repository, or give --geo)",
+                                options.geo.string()));
+      for (double fine : options.gmsh_fine) {
+        blocks.push_back(options.block);
+        blocks.back().gmsh = hertz_quarter_block_script(options.geo, fine);
+      }
+      break;
+    case HertzOptions::Meshes::boxes:
+      for (int divisions : options.divisions) {
+        blocks.push_back(options.block);
+        blocks.back().divisions = divisions;
+      }
+      break;
+    case HertzOptions::Meshes::files:
+      for (const std::filesystem::path& file : options.meshes) {
+        blocks.push_back(options.block);
+        blocks.back().mesh = file;
+      }
+      break;
   }
   std::vector<HertzMesh> meshes;
   for (const HertzBlock& block : blocks) {
@@ -239,7 +278,9 @@ LabCommand add_hertz_command(CLI::App& lab) {
   auto options = std::make_shared<HertzOptions>();
   CLI::App* command = lab.add_subcommand(
       "hertz", "Press a sphere into a graded block and compare the force with Hertz's, mesh by mesh, for the sphere "
-               "contact model and node translation; prints the table (and writes hertz.md, hertz.svg to --out)");
+               "contact model and node translation; prints the table (and writes hertz.md, hertz.svg to --out). By "
+               "default the blocks are scenes/hertz/quarter_block.geo meshed by gmsh at 0.05 R and 0.025 R under the "
+               "contact (R = 10 mm: 0.5 and 0.25 mm)");
   command->add_option("--poisson-ratio", options->block.material.poisson_ratio, "The block's Poisson ratio")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.499));
@@ -247,19 +288,34 @@ LabCommand add_hertz_command(CLI::App& lab) {
       ->transform(CLI::CheckedTransformer(std::map<std::string, ElementFormulation>{
           {"linear_tet", ElementFormulation::linear_tet}, {"nodal_pressure_tet", ElementFormulation::nodal_pressure_tet}}))
       ->capture_default_str();
-  command->add_option("--divisions", options->divisions, "Cells per side of the quarter block, one mesh each")
-      ->capture_default_str()
-      ->check(CLI::Range(2, 60));
-  command->add_option("--mesh", options->meshes,
-                      "Quarter-block mesh files (millimetres, R = 10 mm: scenes/hertz/quarter_block.geo meshed by gmsh; the build writes two into build/scenes/hertz/) instead of boxes, one each")
-      ->check(CLI::ExistingFile);
+  CLI::Option* gmsh_fine =
+      command->add_option("--gmsh-fine", options->gmsh_fine,
+                          "Element size at the contact, in sphere radii, of each gmsh-graded quarter block (the default "
+                          "meshes)")
+          ->capture_default_str()
+          ->check(CLI::Range(0.005, 0.5));
+  command->add_option("--geo", options->geo, "The quarter block's Gmsh script, for --gmsh-fine")->capture_default_str();
+  CLI::Option* divisions =
+      command->add_option("--divisions", options->divisions, "Box meshes instead: cells per side of the quarter block")
+          ->check(CLI::Range(2, 60));
+  CLI::Option* meshes =
+      command->add_option("--mesh", options->meshes,
+                          "Quarter-block mesh files instead (millimetres, R = 10 mm, [0, s]^2 x [-s, 0], e.g. "
+                          "scenes/hertz/quarter_block.geo meshed by gmsh)")
+          ->check(CLI::ExistingFile);
+  gmsh_fine->excludes(divisions)->excludes(meshes);
+  divisions->excludes(meshes);
   command->add_option("--depths", options->depth_ratios, "Depths d/R")->capture_default_str()->check(CLI::Range(1e-4, 0.5));
   command->add_option("--core", options->block.core,
                       "Side of the uniformly meshed core under the sphere, in sphere radii (half the cells)")
       ->capture_default_str()
       ->check(CLI::Range(0.05, 5.0));
   command->add_option("--out", options->out, "Also write hertz.md and hertz.svg here");
-  return {command, [options] { return run_hertz(*options); }};
+  return {command, [options, divisions, meshes] {
+            if (*divisions) options->meshes_from = HertzOptions::Meshes::boxes;
+            if (*meshes) options->meshes_from = HertzOptions::Meshes::files;
+            return run_hertz(*options);
+          }};
 }
 
 }  // namespace cohaptic

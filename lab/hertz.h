@@ -11,9 +11,9 @@
 // other half grow geometrically from there to the block's far sides. The growth ratio r
 // solves the fill; as n grows, r^(n/2) tends to a constant, so every mesh of the study
 // refines the same map of the block. A tensor-product grading spends most of its nodes on
-// fine columns far from the contact; the alternative is a quarter block meshed by gmsh
-// with a size field around the contact point (scenes/hertz/, deploy/remesh-hertz.sh),
-// read from its file.
+// fine columns far from the contact; the default is a quarter block meshed by gmsh with a
+// size field around the contact point (scenes/hertz/quarter_block.geo, its element size at
+// the contact given in R), or any quarter block's mesh file.
 //
 // At each depth the sphere model's force is the full sparse solve of its unilateral
 // problem (sphere_contact_reference.h); beside it the paper's node translation model's
@@ -23,10 +23,12 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/fem/linear_elastic_material.h"
+#include "common/mesh/mesh_with_gmsh.h"
 #include "lab/lab_command.h"
 
 namespace cohaptic {
@@ -40,6 +42,8 @@ struct HertzBlock {
   /// If set, the quarter block's mesh instead of the box: a .msh of [0, s]^2 x [-s, 0] with
   /// s >= 20 R, in millimetres, the contact point at the origin (scenes/hertz/quarter_block.geo).
   std::filesystem::path mesh;
+  /// If set (and no `mesh`), the script gmsh meshes into that file (mesh_with_gmsh.h).
+  std::optional<GmshScript> gmsh;
 };
 
 /// The growth ratio of the cells outside the core along a side of `block`'s quarter.
@@ -55,7 +59,7 @@ double hertz_force(const LinearElasticMaterial& material, double radius, double 
 
 /// One mesh of the study: forces on the whole block (four quarters) at each depth.
 struct HertzMesh {
-  std::string name;                        ///< "16 cells" or the mesh file's name
+  std::string name;                        ///< "16 cells", "gmsh 0.05 R" or the mesh file's name
   double side = 0;                         ///< the quarter block's side, over R (20 for box meshes)
   int nodes = 0, tets = 0;
   /// Under the sphere, over R: the core's cell side for a box mesh; the mean edge of the
@@ -70,22 +74,33 @@ struct HertzMesh {
 /// not in (0, 0.5].
 HertzMesh measure_hertz(const HertzBlock& block, const std::vector<double>& depth_ratios);
 
+/// The gmsh quarter block (scenes/hertz/quarter_block.geo) with element size `fine` R at
+/// the contact, growing by `kHertzGmshGrowth` per unit distance.
+constexpr double kHertzGmshGrowth = 0.07;
+GmshScript hertz_quarter_block_script(const std::filesystem::path& geo, double fine);
+
 struct HertzOptions {
   HertzBlock block;
+  /// Where the meshes come from: the gmsh quarter block at each element size `gmsh_fine`
+  /// (in R) by default; box meshes with these `divisions`; or these mesh files.
+  enum class Meshes { gmsh, boxes, files } meshes_from = Meshes::gmsh;
+  std::filesystem::path geo = "scenes/hertz/quarter_block.geo";
+  std::vector<double> gmsh_fine = {0.05, 0.025};
   std::vector<int> divisions = {8, 12, 16, 24};
-  std::vector<std::filesystem::path> meshes;  ///< if any, these mesh files instead of `divisions`
-  std::vector<double> depth_ratios = {0.02, 0.05, 0.1};
+  std::vector<std::filesystem::path> meshes;
+  std::vector<double> depth_ratios = {0.05, 0.1};
   std::filesystem::path out;  ///< empty: the table on stdout only; else also hertz.md, hertz.svg
 };
 
-/// The study's table (markdown): F / F_Hertz per mesh and depth for both models, and the
-/// change between the two finest meshes.
+/// The study's table (markdown): F / F_Hertz and the nodes in contact per mesh and depth
+/// for both models, the change between the two finest meshes, and where the meshes come from.
 std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh>& meshes);
 
 /// Measures every mesh, prints the table, writes the files. Returns the exit code.
 int run_hertz(const HertzOptions& options);
 
-/// `cohaptic-lab hertz [--poisson-ratio NU] [--element E] [--divisions N... | --mesh FILE...] [--depths D...] [--out DIR]`.
+/// `cohaptic-lab hertz [--poisson-ratio NU] [--element E] [--gmsh-fine F... | --divisions N... | --mesh FILE...]
+/// [--depths D...] [--out DIR]`.
 LabCommand add_hertz_command(CLI::App& lab);
 
 }  // namespace cohaptic

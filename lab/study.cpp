@@ -23,7 +23,7 @@
 #include "common/util/stopwatch.h"
 #include "common/util/regular_file.h"
 #include "common/util/yaml_cursor.h"
-#include "lab/child_process.h"
+#include "common/util/child_process.h"
 #include "proto/record/recording.h"
 #include "proto/wire/vec3_convert.h"
 

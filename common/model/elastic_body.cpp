@@ -6,6 +6,7 @@
 
 #include "common/mesh/box_mesher.h"
 #include "common/mesh/read_gmsh.h"
+#include "common/model/compliance_setup.h"
 #include "common/model/elastic_body.h"
 #include "common/scene/load_scene.h"
 #include "common/util/stopwatch.h"
@@ -16,9 +17,11 @@ namespace {
 TetMesh load_mesh(const MeshSpec& spec, double metres_per_unit) {
   if (spec.box) return make_box_mesh(spec.box->min_corner, spec.box->size, spec.box->divisions, spec.box->grading,
                                        spec.box->uniform_cells);
-  GmshMesh gmsh = read_gmsh(spec.file);
+  const std::filesystem::path file =
+      spec.gmsh ? mesh_with_gmsh(*spec.gmsh, default_cache_directory() / "meshes") : spec.file;
+  GmshMesh gmsh = read_gmsh(file);
   if (gmsh.unused_nodes_dropped > 0)
-    spdlog::info("{}: dropped {} nodes that no tetrahedron uses", spec.file.string(), gmsh.unused_nodes_dropped);
+    spdlog::info("{}: dropped {} nodes that no tetrahedron uses", file.string(), gmsh.unused_nodes_dropped);
   gmsh.mesh.nodes *= metres_per_unit;
   return std::move(gmsh.mesh);
 }

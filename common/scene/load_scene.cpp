@@ -45,15 +45,31 @@ AxisMask parse_axes(const Cursor& c) {
 }
 
 MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
-  c.only_keys({"file", "box"});
+  c.only_keys({"file", "gmsh", "set", "box"});
   MeshSpec mesh;
   const auto file = c.find("file");
+  const auto gmsh = c.find("gmsh");
   const auto box = c.find("box");
-  if (static_cast<bool>(file) == static_cast<bool>(box)) c.fail("exactly one of file or box");
-  if (file) {
-    mesh.file = file->text();
-    if (mesh.file.is_relative()) mesh.file = scene_dir / mesh.file;
-    if (const auto why = why_not_a_regular_file(mesh.file)) file->fail_message(fmt::format("mesh file {} {}", mesh.file.string(), *why));
+  if (static_cast<int>(static_cast<bool>(file)) + static_cast<bool>(gmsh) + static_cast<bool>(box) != 1)
+    c.fail("exactly one of file, gmsh or box");
+  const auto set = c.find("set");
+  if (set && !gmsh) set->fail("only with gmsh (the script's parameters)");
+  if (file || gmsh) {
+    const Cursor& path = file ? *file : *gmsh;
+    std::filesystem::path resolved = path.text();
+    if (resolved.is_relative()) resolved = scene_dir / resolved;
+    if (const auto why = why_not_a_regular_file(resolved))
+      path.fail_message(fmt::format("{} {} {}", file ? "mesh file" : "gmsh script", resolved.string(), *why));
+    if (file) {
+      mesh.file = resolved;
+    } else {
+      GmshScript script{resolved, {}};
+      if (set) {
+        if (!set->is_map()) set->fail("a map of the script's parameters to numbers");
+        for (const std::string& name : set->keys()) script.parameters[name] = set->at(name).number();
+      }
+      mesh.gmsh = std::move(script);
+    }
   } else {
     box->only_keys({"min", "size", "divisions", "grading", "uniform_cells"});
     BoxMeshSpec spec;

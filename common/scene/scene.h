@@ -18,6 +18,7 @@
 #include "common/fem/linear_elastic_material.h"
 #include "common/laparoscopy/home_spring_spec.h"
 #include "common/mass_spring/mass_spring_spec.h"
+#include "common/mesh/mesh_with_gmsh.h"
 #include "common/mesh/node_selector.h"
 #include "common/separation/separation_object_spec.h"
 
@@ -43,9 +44,11 @@ struct BoxMeshSpec {
   Eigen::Vector3i uniform_cells = Eigen::Vector3i::Zero();  ///< per axis: equal cells on the fine side first
 };
 
-/// Exactly one of a mesh file (.msh 2.2/4.1, resolved against the scene's directory) or a generator.
+/// Exactly one of a mesh file (.msh 2.2/4.1, resolved against the scene's directory), a
+/// Gmsh script that gmsh meshes when the scene is built (mesh_with_gmsh.h), or a box.
 struct MeshSpec {
   std::filesystem::path file;
+  std::optional<GmshScript> gmsh;
   std::optional<BoxMeshSpec> box;
 };
 

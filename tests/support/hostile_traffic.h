@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "lab/child_process.h"
+#include "common/util/child_process.h"
 
 namespace cohaptic::testing {
 

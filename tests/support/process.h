@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <string>
 
-#include "lab/child_process.h"
+#include "common/util/child_process.h"
 #include "support/wait.h"
 
 namespace cohaptic::testing {

@@ -1,4 +1,4 @@
-#include "lab/child_process.h"
+#include "common/util/child_process.h"
 
 #include <fcntl.h>
 #include <fmt/format.h>
