@@ -47,7 +47,7 @@ class GeneratedSession {
   std::array<IntermediateRepresentation, 2> step(int step) {
     const ElasticBody& body = rig_.body;
     const double angle = 0.31 * step;
-    // Centres: a point tool 1 mm deep, a sphere 2 mm deep (it must reach a node or two).
+    // Centres: a point tool 1 mm deep, a sphere's 2 mm deep.
     const Eigen::Vector3d lift(0, 0, radius_ > 0 ? radius_ - 2e-3 : 0);
     const std::array<Eigen::Vector3d, 2> tools = {mm(25 * std::cos(angle), 25 * std::sin(angle), -1) + lift,
                                                   mm(-20 + 12 * std::sin(0.7 * angle), 18 * std::cos(angle), -0.5) + lift};
@@ -178,11 +178,13 @@ TEST(ComplianceRows, ClientMTildeAndForcesEqualTheFullIrWithTranslation) {
   run_session(ContactModel::node_translation, 0);
 }
 
-TEST(ComplianceRows, ClientMTildeAndForcesEqualTheFullIrWithSpheres) { run_session(ContactModel::sphere, 30e-3); }
+TEST(ComplianceRows, ClientMTildeAndForcesEqualTheFullIrWithThePointConstraint) {
+  run_session(ContactModel::point_constraint, 0);
+}
 
 // B truncation: the client's M~ (its kept columns only) and forces still equal the server's.
-TEST(ComplianceRows, ClientMTildeAndForcesEqualTheTruncatedIrWithSpheres) {
-  run_session(ContactModel::sphere, 30e-3, 0.2);
+TEST(ComplianceRows, ClientMTildeAndForcesEqualTheTruncatedIrWithThePointConstraint) {
+  run_session(ContactModel::point_constraint, 0, 0.2);
 }
 
 // `all` (every held node kept) with only the held nodes `keep` says kept, as the server
@@ -226,9 +228,14 @@ TEST(ComplianceRows, TheClientKeepsTheServersChoiceAndCondensesOverEveryHeldNode
   testing::CubeSceneOptions cube;
   cube.divisions = 8;
   const testing::CubeRig rig(cube);
-  GeneratedSession truncating(rig, ContactModel::sphere, 30e-3, 0.2), untruncated(rig, ContactModel::sphere, 30e-3);
-  const IntermediateRepresentation truncated = truncating.step(0)[0];
-  const IntermediateRepresentation all = untruncated.step(0)[0];  // the same state: the same random draws
+  GeneratedSession truncating(rig, ContactModel::point_constraint, 0, 0.2),
+      untruncated(rig, ContactModel::point_constraint, 0);
+  // The first step whose IR leaves held nodes out; both sessions draw the same states.
+  IntermediateRepresentation truncated, all;
+  for (int step = 0; step < 40 && condensed_fem(truncated).truncated_node_ids.empty(); ++step) {
+    truncated = truncating.step(step)[0];
+    all = untruncated.step(step)[0];
+  }
   const CondensedFemIr& fem = condensed_fem(truncated);
   ASSERT_FALSE(fem.truncated_node_ids.empty());
   ASSERT_GT(fem.node_count(), fem.row_node_count);
@@ -357,8 +364,9 @@ TEST(ComplianceRows, TheWireCarriesTruncatedNodesWithRowsOnly) {
   testing::CubeSceneOptions cube;
   cube.divisions = 8;
   const testing::CubeRig rig(cube);
-  GeneratedSession session(rig, ContactModel::sphere, 30e-3, 0.2);
-  const IntermediateRepresentation full = session.step(0)[0];
+  GeneratedSession session(rig, ContactModel::point_constraint, 0, 0.2);
+  IntermediateRepresentation full;  // the first step whose IR leaves held nodes out
+  for (int step = 0; step < 40 && condensed_fem(full).truncated_node_ids.empty(); ++step) full = session.step(step)[0];
   ASSERT_FALSE(condensed_fem(full).truncated_node_ids.empty());
   // M~ whole: complete without them, so they are not sent.
   EXPECT_EQ(wire::to_wire(full).fem().truncated_node_ids_size(), 0);
