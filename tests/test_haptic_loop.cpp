@@ -239,6 +239,70 @@ TEST(HapticLoop, NonFiniteInputGivesZeroForceAndAnEvent) {
   EXPECT_EQ(zero_after, 99) << "the ticks at 101 to 199 ms";
 }
 
+// A sphere contact solve that runs out of its tick's work budget has no force of its own
+// (the evaluator flags the tick): the loop holds the last resolved force (it does not move
+// at the miss), never above the force limit, and counts the tick; the next ticks go on
+// where the solve stopped, so the exact force returns within a few ticks. Here the tool
+// jumps 3.5 mm deeper in one tick, a budget of 200 multiply-adds a tick (the haptic loop's
+// is 1.5 million) makes the solve take many ticks, and the force is checked at every one.
+TEST(HapticLoop, ASphereSolvePastItsBudgetHoldsTheLastResolvedForceAndCatchesUp) {
+  testing::CubeSceneOptions cube;
+  cube.divisions = 24;
+  cube.tools = "[{name: A, shape: sphere, radius: 30}]";
+  const testing::CubeRig rig(cube);
+  SimulationOptions options;
+  options.ir.contact_model = ContactModel::sphere;
+  options.ir.patch_rings = 3;  // the deeper press stays within the IR's rows
+  options.ir.force_limit = 1000;
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, rig.model->scene.tools, options);
+  const Eigen::Vector3d shallow(0.001, 0.002, 0.0295), deep(0.001, 0.002, 0.026);  // 0.5 and 4 mm deep
+  simulation.set_tool(0, shallow);
+  simulation.step(0);
+  const std::shared_ptr<const PreparedIR> ir = simulation.ir(0);
+  const Eigen::Vector3d shallow_force = testing::evaluate_static(*ir, shallow, {}).force;
+  const Eigen::Vector3d deep_force = testing::evaluate_static(*ir, deep, {}).force;
+  ASSERT_GT(deep_force.norm(), 5 * shallow_force.norm());
+
+  DrivenClock clock;
+  auto channels = std::make_unique<HapticChannels>();
+  channels->tracing = true;
+  channels->ir.back() = make_ir_slot(std::make_unique<const PreparedIR>(*ir), clock.now);
+  std::get<SphereContactState>(channels->ir.back().state->body).work_budget = 200;
+  channels->ir.publish();
+  ScriptedDevice device(parse_trajectory("units: mm\nstart: [1, 2, 29.5]\nsegments: [{hold: 0.05}, {move_to: [1, 2, 26], "
+                                         "speed: 1e6}, {hold: 0.15}]\n",
+                                         "jump"),
+                        1000);
+  HapticLoopSettings settings;
+  settings.duration_s = 0.2;
+  settings.realtime = false;
+  settings.max_age_s = 10;
+  settings.force_limit = 30;
+  HapticLoop loop(device, *channels, settings, clock.haptic());
+  const std::vector<TickRecord> ticks = run_to_end(loop, *channels);
+  ASSERT_GT(ticks.size(), 150u);
+  int unresolved = 0, first_resolved_deep = -1;
+  for (std::size_t i = 0; i < ticks.size(); ++i) {
+    const TickRecord& t = ticks[i];
+    ASSERT_TRUE(t.force.allFinite()) << "tick " << i;
+    ASSERT_LE(t.force.norm(), settings.force_limit * (1 + 1e-12)) << "tick " << i;
+    if (t.flags & kContactUnresolved) {
+      ++unresolved;
+      ASSERT_GT(i, 0u);
+      EXPECT_EQ(t.evaluated, ticks[i - 1].evaluated) << "tick " << i << ": the last resolved force is held";
+    } else if ((t.own - deep).norm() < 1e-12 && first_resolved_deep < 0) {
+      first_resolved_deep = static_cast<int>(i);
+    }
+  }
+  std::printf("  %d ticks unresolved after the jump; resolved again %d ticks after it\n", unresolved,
+              first_resolved_deep - 50);
+  EXPECT_GT(unresolved, 2) << "the budget was never short";
+  EXPECT_EQ(loop.metrics().contact_unresolved, static_cast<std::uint64_t>(unresolved));
+  ASSERT_GE(first_resolved_deep, 0) << "the solve never caught up";
+  EXPECT_LE((ticks.back().evaluated - deep_force).norm(), 1e-9 * deep_force.norm()) << "the exact force returned";
+  EXPECT_LE((ticks[40].evaluated - shallow_force).norm(), 1e-9 * shallow_force.norm());
+}
+
 // A device that stalls once, at its first read after 50 ms, like a host preempting the VM.
 class StallingDevice final : public HapticDevice {
  public:
