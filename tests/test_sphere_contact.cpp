@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <random>
 
@@ -21,6 +22,8 @@
 #include "common/model/sphere_contact_reference.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
+#include "common/util/error.h"
+#include "proto/wire/ir_convert.h"
 #include "support/cube_scene.h"
 #include "support/measures.h"
 #include "support/test_meshes.h"
@@ -445,6 +448,122 @@ TEST(SphereContact, TheReferenceMeetsTheContactConditionsOnAnIndependentSolve) {
   std::printf("  %d nodes touch the sphere, %d passed nodes released; |F| = %.4f N\n", touching, released,
               solution.reactions[0].norm());
   EXPECT_GT(released, 0);
+}
+
+// ---------------------------------------------------------------------------------------
+// The sphere IR on the wire and its checks.
+
+// A sphere IR of the first of two spheres with 150 step-delay nodes held (B).
+IntermediateRepresentation two_sphere_ir() {
+  testing::CubeRig& rig = shared_rig();
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, rig.model->scene.tools,
+                        unlimited_options(ContactModel::sphere, 150));
+  simulation.set_tool(0, mm(-6, 2, 26));
+  simulation.set_tool(1, mm(20, -4, 27));
+  simulation.step(0);
+  return simulation.ir(0)->ir;
+}
+
+// Refused with a message holding `reason`, by from_wire or else by prepare_ir.
+void expect_refused(const wire::IntermediateRepresentation& w, const std::string& reason) {
+  try {
+    prepare_ir(wire::from_wire(w));
+    ADD_FAILURE() << "accepted: " << reason;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
+  }
+}
+
+void expect_refused(const IntermediateRepresentation& ir, const std::string& reason) {
+  try {
+    prepare_ir(ir);
+    ADD_FAILURE() << "accepted: " << reason;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
+  }
+}
+
+TEST(SphereIr, TravelsBitForBitWithItsUpperTriangleAndFloatRoundsW) {
+  const IntermediateRepresentation ir = two_sphere_ir();
+  const CondensedFemIr& fem = condensed_fem(ir);
+  ASSERT_TRUE(fem.sphere);
+  const SphereContactIr& sphere = *fem.sphere;
+  ASSERT_FALSE(sphere.contacts.empty());
+  ASSERT_EQ(sphere.held_node_ids.size(), 150u);
+  ASSERT_EQ(fem.m_tilde.size(), 0);
+  const auto n = static_cast<std::size_t>(fem.row_node_count);
+  const wire::IntermediateRepresentation w = wire::to_wire(ir);
+  EXPECT_EQ(static_cast<std::size_t>(w.fem().sphere().normal_compliance_f64_size()), n * (n + 1) / 2);
+  const IntermediateRepresentation back = wire::from_wire(w);
+  const SphereContactIr& received = *condensed_fem(back).sphere;
+  EXPECT_TRUE(received.normal_compliance == sphere.normal_compliance);
+  EXPECT_TRUE(received.normals == sphere.normals);
+  EXPECT_TRUE(received.free_clearance == sphere.free_clearance);
+  EXPECT_EQ(received.contacts, sphere.contacts);
+  EXPECT_EQ(received.held_node_ids, sphere.held_node_ids);
+  const PreparedIR a = prepare_ir(ir), b = prepare_ir(back);
+  EvaluationState state_a = make_evaluation_state(a), state_b = make_evaluation_state(b);
+  const std::vector<Eigen::Vector3d> remote = {mm(20, -4, 27)};
+  EXPECT_EQ(evaluate_force(a, state_a, mm(-6, 2, 26), remote, 1e-3).force, evaluate_force(b, state_b, mm(-6, 2, 26), remote, 1e-3).force);
+
+  IntermediateRepresentation single = ir;
+  condensed_fem(single).precision = IrPrecision::f32;
+  const IntermediateRepresentation rounded = wire::from_wire(wire::to_wire(single));
+  EXPECT_EQ(condensed_fem(rounded).precision, IrPrecision::f32);
+  EXPECT_TRUE(condensed_fem(rounded).sphere->normal_compliance == sphere.normal_compliance.cast<float>().cast<double>());
+}
+
+TEST(SphereIr, EveryInconsistencyIsRefusedNamingIt) {
+  const IntermediateRepresentation ir = two_sphere_ir();
+  const wire::IntermediateRepresentation valid = wire::to_wire(ir);
+  ASSERT_NO_THROW(prepare_ir(wire::from_wire(valid)));
+  wire::IntermediateRepresentation w = valid;
+  w.mutable_fem()->mutable_sphere()->mutable_normal_compliance_f64()->RemoveLast();
+  expect_refused(w, "sphere.normal_compliance has");
+  w = valid;
+  w.mutable_fem()->mutable_sphere()->set_normal_compliance_f64(3, std::nan(""));
+  expect_refused(w, "sphere.normal_compliance_f64[3] is not finite");
+  w = valid;
+  w.mutable_fem()->mutable_sphere()->add_normal_compliance_f32(1.0f);
+  expect_refused(w, "in both f64 and f32");
+  w = valid;
+  w.mutable_fem()->mutable_sphere()->set_contacts(0, static_cast<std::uint32_t>(w.fem().row_node_count()));
+  expect_refused(w, "sphere.contacts names row node");
+  w = valid;
+  w.mutable_fem()->mutable_sphere()->mutable_free_clearance()->RemoveLast();
+  expect_refused(w, "sphere.free_clearance has");
+  w = valid;
+  w.set_format_version(5);
+  expect_refused(w, "format version 5 carries a sphere body as M~");
+  w = valid;
+  w.mutable_fem()->clear_sphere();
+  expect_refused(w, "a sphere body without its normal compliance");
+  w = valid;
+  w.mutable_fem()->set_contact_model(wire::CondensedFem::TRANSLATION);
+  expect_refused(w, "a sphere contact part under another contact model");
+  w = valid;
+  w.mutable_fem()->set_m_rows(3);
+  expect_refused(w, "carries its row nodes and its normal compliance only");
+
+  const auto tampered = [&](const std::function<void(SphereContactIr&)>& change) {
+    IntermediateRepresentation copy = ir;
+    change(*condensed_fem(copy).sphere);
+    return copy;
+  };
+  const int contact = condensed_fem(ir).sphere->contacts.front();
+  expect_refused(tampered([&](SphereContactIr& s) { s.normals.col(contact) *= 0.5; }), "normal has length");
+  expect_refused(tampered([&](SphereContactIr& s) { s.normal_compliance(contact, contact) = 0; }), "not positive");
+  expect_refused(tampered([&](SphereContactIr& s) { s.normal_compliance(contact, contact == 0 ? 1 : 0) *= 2; }),
+                 "W is not symmetric");
+  expect_refused(tampered([&](SphereContactIr& s) { s.contacts.push_back(s.contacts.front()); }), "in ascending order");
+  expect_refused(tampered([&](SphereContactIr& s) {
+                   // Two contacts coupled more than their own compliances allow: W over them indefinite.
+                   ASSERT_GE(s.contacts.size(), 2u);
+                   const int a = s.contacts[0], b = s.contacts[1];
+                   s.normal_compliance(a, b) = s.normal_compliance(b, a) =
+                       2 * std::sqrt(s.normal_compliance(a, a) * s.normal_compliance(b, b));
+                 }),
+                 "is not positive definite");
 }
 
 TEST(SphereContact, IsTheSceneDefaultForSphereToolsAndNeedsThem) {
