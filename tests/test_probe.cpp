@@ -2,7 +2,10 @@
 // sparse solve and against an independent FEM, physical properties of the answer, and the
 // command-line program itself (its JSON, its exports, its errors).
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 #include <unistd.h>
+
+#include <cmath>
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -227,6 +230,29 @@ TEST(ProbeProgram, AnApproachInStepsEndsWhereOneStepDoesWhenNothingIsHeldOnTheWa
   EXPECT_EQ(by_one["tools"][0]["ir"]["steps"], 1);
   EXPECT_GE(by_steps["tools"][0]["ir"]["steps"], 6);
   expect_same_two_sphere_forces(by_one, by_steps);
+}
+
+// A 10 mm sphere pressed 0.5 and 1 mm into the block that gmsh grades to 0.6 mm under it
+// (scenes/block/two_spheres.yaml, one tool): the probe serves its IR (a few hundred row
+// nodes, no cap) and lands within 5 % of Hertz (F = 4/3 E / (1 - nu^2) sqrt(R) d^1.5, E =
+// 100 kPa, nu = 0.3); pressed 1 mm, the same block graded to 1.2 mm (two_spheres_coarse.yaml)
+// agrees to 5 % (0.5 mm deep its contact spans two of its cells, and it is 5.5 % stiffer).
+TEST(ProbeProgram, ASpherePressedIntoTheGradedBlockLandsWithinFivePercentOfHertzOnBothMeshes) {
+  const auto force_at = [](const char* scene, double depth_mm) {
+    const nlohmann::json json = probe_json_of(fmt::format("probe --scene {} --tool=-25,0,{} --json",
+                                                          testing::source_path(scene), 10 - depth_mm));
+    EXPECT_EQ(json["contact_model"], "sphere");
+    return json.is_null() ? 0.0 : probed_force(json, 0).z();
+  };
+  for (const double depth_mm : {0.5, 1.0}) {
+    const double depth = depth_mm * 1e-3, hertz = 4.0 / 3.0 * 1e5 / (1 - 0.3 * 0.3) * std::sqrt(0.01) * std::pow(depth, 1.5);
+    const double fine = force_at("scenes/block/two_spheres.yaml", depth_mm);
+    const double coarse = force_at("scenes/block/two_spheres_coarse.yaml", depth_mm);
+    std::printf("  %.1f mm deep: 0.6 mm mesh %.4f N, 1.2 mm mesh %.4f N, Hertz %.4f N (%.3f, %.3f)\n", depth_mm, fine,
+                coarse, hertz, fine / hertz, coarse / hertz);
+    EXPECT_NEAR(fine / hertz, 1, 0.05) << depth_mm << " mm";
+    if (depth_mm == 1.0) EXPECT_NEAR(coarse / fine, 1, 0.05);
+  }
 }
 
 TEST(ProbeProgram, BadInputGivesAClearErrorAndANonZeroExit) {
