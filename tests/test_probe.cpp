@@ -251,7 +251,9 @@ TEST(ProbeProgram, ASpherePressedIntoTheGradedBlockLandsWithinFivePercentOfHertz
     std::printf("  %.1f mm deep: 0.6 mm mesh %.4f N, 1.2 mm mesh %.4f N, Hertz %.4f N (%.3f, %.3f)\n", depth_mm, fine,
                 coarse, hertz, fine / hertz, coarse / hertz);
     EXPECT_NEAR(fine / hertz, 1, 0.05) << depth_mm << " mm";
-    if (depth_mm == 1.0) EXPECT_NEAR(coarse / fine, 1, 0.05);
+    if (depth_mm == 1.0) {
+      EXPECT_NEAR(coarse / fine, 1, 0.05);
+    }
   }
 }
 
