@@ -183,6 +183,55 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
   return row;
 }
 
+SphereIrBytesRow measure_sphere_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body) {
+  const record::Recording rec = record::read_recording(recording);
+  const std::unordered_map<std::int64_t, int> node_of_tag = node_indices_by_tag(body.mesh);
+  SphereIrBytesRow row;
+  row.recording = recording.string();
+  wire::IrStreamWriter stream;
+  std::unordered_set<std::int64_t> held;  // the nodes a client of compliance rows would hold
+  std::int64_t first_ns = 0, last_ns = 0;
+  for (const record::RecordedIr& recorded : rec.irs) {
+    if (!recorded.ir().has_fem() || !recorded.ir().fem().has_sphere()) continue;
+    const wire::CondensedFem& fem = recorded.ir().fem();
+    row.stream_bytes += static_cast<double>(stream.compress(recorded.ir(), row.irs == 0).ByteSizeLong());
+    row.sent_bytes += static_cast<double>(recorded.ir().ByteSizeLong());
+    if (row.irs == 0) first_ns = recorded.time_ns();
+    last_ns = recorded.time_ns();
+    const auto nodes = static_cast<double>(fem.node_ids_size());
+    row.row_nodes_mean += nodes;
+    row.row_nodes_max = std::max(row.row_nodes_max, nodes);
+    row.pushed_max = std::max(row.pushed_max, static_cast<double>(fem.sphere().contacts_size()));
+
+    // The format before: the same geometry with M~ (and u_B) instead of the sphere's part.
+    wire::IntermediateRepresentation geometry = recorded.ir();
+    geometry.mutable_fem()->clear_sphere();
+    const auto rest = static_cast<double>(geometry.ByteSizeLong());
+    double row_dofs = 0, held_dofs = 0;
+    for (const char mask : fem.fixed_axes())
+      for (int axis = 0; axis < 3; ++axis) row_dofs += ((static_cast<unsigned char>(mask) >> axis) & 1u) ? 0 : 1;
+    for (const std::int64_t tag : fem.sphere().held_node_ids()) {
+      const auto found = node_of_tag.find(tag);
+      if (found == node_of_tag.end())
+        throw Error(fmt::format("ir-bytes: {}: IR epoch {} holds node {}, which the scene's body does not have",
+                                recording.string(), recorded.ir().epoch(), tag));
+      for (int axis = 0; axis < 3; ++axis) held_dofs += body.dofs.is_fixed(found->second, axis) ? 0 : 1;
+    }
+    row.m_tilde_bytes += rest + 8 * (row_dofs * (row_dofs + held_dofs) + held_dofs);
+    std::unordered_set<std::int64_t> now(fem.node_ids().begin(), fem.node_ids().end());
+    now.insert(fem.sphere().held_node_ids().begin(), fem.sphere().held_node_ids().end());
+    double added = 0;
+    for (const std::int64_t tag : now) added += held.contains(tag) ? 0 : 1;
+    row.rows_bytes += rest + 8 * compliance_row_values(static_cast<double>(now.size()), added);
+    held = std::move(now);
+    ++row.irs;
+  }
+  if (row.irs == 0) throw Error(fmt::format("ir-bytes: {} holds no sphere IR", recording.string()));
+  row.span_s = static_cast<double>(last_ns - first_ns) * 1e-9;
+  row.row_nodes_mean /= static_cast<double>(row.irs);
+  return row;
+}
+
 LabCommand add_ir_bytes_command(CLI::App& lab) {
   struct Options {
     std::filesystem::path scene;
@@ -202,6 +251,19 @@ LabCommand add_ir_bytes_command(CLI::App& lab) {
   return {command, [options] {
             const Model model = build_model(load_scene(options->scene));
             const ElasticBody& body = single_elastic_body(model);
+            if (model.scene.haptic.contact_model == ContactModel::sphere) {
+              fmt::print("| recording | IRs | span s | row nodes per IR (largest) | pushed, largest | as sent: W whole in "
+                         "the zstd stream, kB/s | uncompressed kB/s | before: M~ whole kB/s | before: compliance rows "
+                         "kB/s |\n|---|---|---|---|---|---|---|---|---|\n");
+              for (const std::filesystem::path& recording : options->recordings) {
+                const SphereIrBytesRow r = measure_sphere_ir_bytes(recording, body);
+                const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;
+                fmt::print("| {} | {} | {:.1f} | {:.0f} ({:.0f}) | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} |\n", r.recording,
+                           r.irs, r.span_s, r.row_nodes_mean, r.row_nodes_max, r.pushed_max, r.stream_bytes * per_s,
+                           r.sent_bytes * per_s, r.m_tilde_bytes * per_s, r.rows_bytes * per_s);
+              }
+              return 0;
+            }
             ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
             fmt::print("| recording | IRs | span s | nodes per IR | new nodes per IR | sent kB/s | without M~ kB/s | f32 kB/s | "
                        "M~ delta kB/s | compliance rows kB/s | rows: client CPU µs p50 / max | rows: M~ difference | "

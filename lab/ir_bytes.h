@@ -23,7 +23,13 @@
 //     stream) put through a new IR stream (proto/wire/ir_stream.h) as the server does, its
 //     bytes, and the client's CPU to take each out of it (p50 / max).
 // `--frames DIR` also writes every IR as sent, one file each (frame_NNNNNN.bin), to measure a
-// general-purpose compressor on them (e.g. zstd). Units: bytes, kB = 1000 bytes, s, µs.
+// general-purpose compressor on them (e.g. zstd).
+// A recording of sphere IRs (the sphere contact model, which carries the normal compliance W
+// of its row nodes instead of M~) gets a table of its own: the IRs as they travelled (whole,
+// in the connection's zstd stream) and uncompressed, beside what the format before it would
+// have sent for the same IRs, uncompressed: M~ whole (3 rows per row node, a column per free
+// dof of the row and held nodes, f64) and compliance rows (the rows of L_AA of the nodes new
+// to the client, each pair once, f64). Units: bytes, kB = 1000 bytes, s, µs.
 #pragma once
 
 #include <filesystem>
@@ -59,6 +65,22 @@ struct IrBytesRow {
 /// the IRs as sent into.
 IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body, ComplianceColumns& columns,
                             const std::filesystem::path& frames);
+
+/// A recording of sphere IRs, measured as above.
+struct SphereIrBytesRow {
+  std::string recording;
+  std::size_t irs = 0;
+  double span_s = 0;
+  double row_nodes_mean = 0, row_nodes_max = 0;  ///< candidates per IR
+  double pushed_max = 0;                         ///< nodes the server's state pushed, largest over the IRs
+  double stream_bytes = 0;                       ///< as travelled: whole, in the zstd stream
+  double sent_bytes = 0;                         ///< the same, uncompressed
+  double m_tilde_bytes = 0, rows_bytes = 0;      ///< the format before: M~ whole, compliance rows
+};
+
+/// Measures a recording whose condensed FEM IRs are sphere IRs (Error if it holds none);
+/// `body`: the recorded session's body (the held nodes' free dofs).
+SphereIrBytesRow measure_sphere_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body);
 
 /// `cohaptic-lab ir-bytes --scene SCENE RECORDING... [--frames DIR]`: a Markdown table on stdout.
 LabCommand add_ir_bytes_command(CLI::App& lab);

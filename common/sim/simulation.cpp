@@ -11,6 +11,12 @@
 #include "common/util/stopwatch.h"
 
 namespace cohaptic {
+namespace {
+
+// In the nearest triangles an IR was built for: a sphere that held nodes then.
+constexpr int kHoldingSphere = -2;
+
+}  // namespace
 
 Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstacles, ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
                        SimulationOptions options)
@@ -332,7 +338,10 @@ StepReport Simulation::step(double time) {
   nearest.clear();
   for (std::size_t u = 0; u < users_.size(); ++u) {
     const UserState& user = users_[u];
-    nearest.push_back(user.known ? user.nearest : -1);
+    // A sphere that holds nothing follows its nearest triangle, so that its IR is there when
+    // it touches; once it holds nodes, their being row nodes is what counts (below).
+    const bool follows_nearest = !sphere_model() || (user.sphere_holds.empty() && user.sphere_carried.empty());
+    nearest.push_back(!user.known ? -1 : follows_nearest ? user.nearest : kHoldingSphere);
     if (user.known) tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest, user.sphere_carried});
   }
   // Under naive_every_step M~ is computed again every step, as the paper's conventional loop
@@ -341,7 +350,8 @@ StepReport Simulation::step(double time) {
   const bool support_changed = std::exchange(support_changed_, false);
   // Under the sphere model an IR holds for every position of the spheres as long as every
   // node they hold or carry is one of its row nodes (its normal compliance does not depend
-  // on where they are): it is rebuilt when one is not.
+  // on where they are): it is rebuilt when one is not, or when a sphere holding nothing
+  // comes nearest another triangle.
   const bool sets_changed = boundary_changed || support_changed || nearest != built_nearest_ ||
                             (sphere_model() && !sphere_rows_cover_holds());
   if (sets_changed || options_.naive_every_step) {
