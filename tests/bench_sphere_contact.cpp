@@ -1,47 +1,57 @@
-// The sphere contact model's cost, each method beside the one it replaced, in the same run:
+// The sphere contact model's cost, each method beside the one it replaced, in the same run
+// (tests/sphere_contact_tables.sh prints them as tables; make bench-sphere):
 //   BM_SphereTick/incremental/<contacts>  one haptic tick (evaluate_force) on the IR's normal
 //                            compliance W, its contact solve kept from tick to tick
-//                            (incremental_contact_solve.h)
+//                            (incremental_contact_solve.h), under the default work budget
 //   BM_SphereTick/dense/<contacts>  the same tick as the client did it before W came on the
 //                            wire: A = N^T L~ N formed every tick over the working set from the
 //                            3x3 blocks of the condensed compliance L~, and
 //                            solve_unilateral_over_candidates, which factors A_SS afresh in
 //                            every pass (warm started from the last tick's set, no budget)
-//   BM_SphereStep/incremental/400  the server's state solve, SphereStateSolve::solve (W and
-//                            its contact solve kept from step to step)
-//   BM_SphereStep/condensed/400  the same state solved as the server did before: the working
-//                            set condensed over B, M_CC inverted, A = N^T L~ N and
-//                            solve_unilateral_contact, the set grown until no other candidate
-//                            penetrates (condensed_state_solve below)
+//   BM_SphereStep/incremental/400  the server's state solve, SphereStateSolve::solve over the
+//                            user's patch (W and its contact solve kept from step to step)
+//   BM_SphereStep/condensed/400  the same state solved as the server did before, over every
+//                            touchable node: the working set condensed over B, M_CC inverted,
+//                            A = N^T L~ N and solve_unilateral_contact, the set grown until no
+//                            other candidate penetrates (condensed_state_solve below); it takes
+//                            seconds, so it runs three times
 //   BM_SphereStep/simulation/400  a whole Simulation::step with the new solve: the state, the
 //                            patch check, and the IR rebuilt when the patch changes
 //   BM_PrepareIr/sphere/<contacts>  what a client does once per IR received
+// <contacts> is about how many nodes the sphere pushes: 50, 200 and 400 (the issue's
+// sizes), and 700, whose IR holds over 1000 candidates (the most a client must hold a tool).
 // The tool moves every tick (or step) along one path, 2 um sideways and 0.5 um deeper a
 // tick, back and forth, so that nodes join and leave the contact now and then, as under a hand.
 // Counters: contacts, the nodes pushed at the path's start; candidates, the IR's row nodes
-// (for the server's solves, its candidates); p99_us, the 99th percentile of the iterations'
-// wall times (Google Benchmark reports means, the issue asks for the p99); unresolved, ticks
-// past the evaluator's work budget (kSphereSolveWork; their force is zero); rebuilt, the
-// share of steps that rebuilt the IR.
+// (for the server's solves, their candidates); p99_us, the 99th percentile of the
+// iterations' wall times (Google Benchmark reports means, the issue asks for the p99);
+// unresolved, ticks past the evaluator's work budget (kSphereSolveWork; their force is
+// zero); rebuilt, the share of steps that rebuilt the IR; difference, the largest relative
+// difference between the two methods' forces found by the check below.
 // The body is scenes/block/block.geo graded to 0.4 mm under a 20 mm sphere, B empty (no
 // obstacle, no step delay): L~ is L. Before timing, each setting checks that both methods
-// give the same force to 1e-9 at points along the path, and reports an error if not. The
-// set-up (gmsh, the touchable nodes' compliance) is cached on disk: about a minute the first
+// give the same force to 1e-9 at points along the path, and fails with an error if not. The
+// set-up (gmsh, the touchable nodes' compliance) is cached on disk: one to two minutes the first
 // time, seconds after. BLAS runs on one thread, as in the server.
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <limits>
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "common/condense/dof_blocks.h"
@@ -64,7 +74,7 @@ constexpr double kRadius = 0.02;  // the sphere [m]
 constexpr double kAgreement = 1e-9;  // relative force difference allowed between the methods
 
 // The block of scenes/block/two_spheres.yaml, graded to 0.4 mm at (-25, 0, 0), touchable
-// within 12 mm of that point: the largest setting's sphere reaches about 10 mm from it.
+// within 12 mm of that point: the largest setting's patch reaches about 9 mm from it.
 constexpr const char* kSceneYaml = R"(
 units: mm
 objects:
@@ -105,14 +115,17 @@ Eigen::Vector3d along_path(const Eigen::Vector3d& start, std::size_t tick) {
   return start + s * Eigen::Vector3d(1.6e-4, 1.2e-4, -5e-5);
 }
 
-bool agree(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  return (a - b).norm() <= kAgreement * std::max(a.norm(), b.norm());
+double relative_difference(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double scale = std::max(a.norm(), b.norm());
+  return scale > 0 ? (a - b).norm() / scale : 0.0;
 }
 
 // Per-iteration wall times of one benchmark run, for their 99th percentile.
 class IterationTimes {
  public:
-  explicit IterationTimes(const benchmark::State& state) { times_.reserve(static_cast<std::size_t>(state.max_iterations)); }
+  explicit IterationTimes(const benchmark::State& state) {
+    times_.reserve(static_cast<std::size_t>(state.max_iterations));
+  }
   template <class Work>
   void time(Work&& work) {
     const auto start = std::chrono::steady_clock::now();
@@ -149,7 +162,8 @@ struct BlockRig {
   }
   std::vector<int> row_nodes(const CondensedFemIr& ir) const {
     std::vector<int> nodes;
-    for (int i = 0; i < ir.row_node_count; ++i) nodes.push_back(node_of_tag.at(ir.node_ids[static_cast<std::size_t>(i)]));
+    for (int i = 0; i < ir.row_node_count; ++i)
+      nodes.push_back(node_of_tag.at(ir.node_ids[static_cast<std::size_t>(i)]));
     return nodes;
   }
 };
@@ -166,7 +180,8 @@ std::unique_ptr<Simulation> simulation_at(const Eigen::Vector3d& start) {
   options.ir.contact_model = ContactModel::sphere;
   options.ir.patch_rings = 1;
   options.ir.force_limit = kInfinity;
-  auto simulation = std::make_unique<Simulation>(rig.body, rig.model->obstacles, *rig.columns, rig.model->scene.tools, options);
+  auto simulation =
+      std::make_unique<Simulation>(rig.body, rig.model->obstacles, *rig.columns, rig.model->scene.tools, options);
   simulation->set_tool(0, start);
   simulation->step(0);
   if (!simulation->condensation().boundary_nodes().empty()) throw Error("the block holds boundary nodes: L~ is not L");
@@ -249,11 +264,12 @@ struct TickRig {
   Eigen::MatrixXd compliance;
   Eigen::Vector3d start;
   int contacts = 0;
+  double difference = 0;     // the largest relative force difference between the methods
   std::string disagreement;  // empty when both methods gave the same forces
 };
 
 // Both methods at every 20th tick of the path's first half (each is exact from any start).
-std::string compare_ticks(const TickRig& rig, int& contacts) {
+std::string compare_ticks(const TickRig& rig, int& contacts, double& difference) {
   EvaluationState state = make_evaluation_state(*rig.prepared);
   std::get<SphereContactState>(state.body).work_budget = kInfinity;
   DenseTick dense(rig.prepared->ir, rig.compliance);
@@ -264,24 +280,24 @@ std::string compare_ticks(const TickRig& rig, int& contacts) {
     const std::optional<Eigen::Vector3d> expected = dense.force(tool, &pushed);
     if (tick == 0) contacts = pushed;
     if (!expected || (sample.flags & (kContactUnresolved | kNonFinite)))
-      return "tick " + std::to_string(tick) + ": a solve failed";
-    if (!agree(sample.force, *expected))
-      return "tick " + std::to_string(tick) + ": the incremental force differs from the dense one by " +
-             std::to_string((sample.force - *expected).norm() / expected->norm()) + " relative";
+      return fmt::format("tick {}: a solve failed", tick);
+    difference = std::max(difference, relative_difference(sample.force, *expected));
+    if (difference > kAgreement)
+      return fmt::format("tick {}: the incremental force differs from the dense one by {:.1e} relative", tick,
+                         difference);
   }
   return {};
 }
 
 const TickRig& tick_rig(int contacts) {
   static std::map<int, TickRig> built;
-  TickRig& rig = built[contacts];
-  if (!rig.prepared) {
-    rig.start = start_of(case_of(contacts));
-    rig.prepared = simulation_at(rig.start)->ir(0);
-    rig.compliance = block_rig().columns->gather(block_rig().row_nodes(condensed_fem(rig.prepared->ir)));
-    rig.disagreement = compare_ticks(rig, rig.contacts);
-  }
-  return rig;
+  if (const auto found = built.find(contacts); found != built.end()) return found->second;
+  TickRig rig;
+  rig.start = start_of(case_of(contacts));
+  rig.prepared = simulation_at(rig.start)->ir(0);
+  rig.compliance = block_rig().columns->gather(block_rig().row_nodes(condensed_fem(rig.prepared->ir)));
+  rig.disagreement = compare_ticks(rig, rig.contacts, rig.difference);
+  return built.emplace(contacts, std::move(rig)).first->second;
 }
 
 // The rig of a setting, or null with the benchmark skipped if it could not be built or
@@ -337,6 +353,7 @@ void BM_SphereTickDense(benchmark::State& state, int contacts) {
   }
   size_counters(state, *rig);
   state.counters["p99_us"] = times.p99_us();
+  state.counters["difference"] = rig->difference;
 }
 
 void BM_PrepareSphereIr(benchmark::State& state, int contacts) {
@@ -440,6 +457,7 @@ struct StepRig {
   // the last run left them rather than jump back to the start.
   std::array<std::size_t, 3> next_step{};
   int contacts = 0;
+  double difference = 0;  // as TickRig's
   std::string disagreement;
 };
 
@@ -460,10 +478,10 @@ std::string compare_steps(StepRig& rig) {
     const StateSolution today = condensed_state_solve(*block.columns, *rig.condensation, block.body, block.touchable,
                                                       std::span(&sphere, 1), rig.boundary_displacement);
     if (step == 0) rig.contacts = pushed_nodes(today);
-    if (!agree(fresh.tool_forces[0], today.tool_forces[0]))
-      return "step " + std::to_string(step) + ": the incremental state's force differs from the condensed one's by " +
-             std::to_string((fresh.tool_forces[0] - today.tool_forces[0]).norm() / today.tool_forces[0].norm()) +
-             " relative";
+    rig.difference = std::max(rig.difference, relative_difference(fresh.tool_forces[0], today.tool_forces[0]));
+    if (rig.difference > kAgreement)
+      return fmt::format("step {}: the incremental state's force differs from the condensed one's by {:.1e} relative",
+                         step, rig.difference);
   }
   rig.next_step[static_cast<std::size_t>(StepKind::incremental)] = 101;
   return {};
@@ -529,6 +547,7 @@ void BM_SphereStep(benchmark::State& state, StepKind kind) {
   state.counters["candidates"] = kind == StepKind::condensed ? static_cast<double>(block.touchable.size())
                                                               : static_cast<double>(rig->patch.size());
   state.counters["p99_us"] = times.p99_us();
+  if (kind == StepKind::condensed) state.counters["difference"] = rig->difference;
   if (kind == StepKind::simulation)
     state.counters["rebuilt"] = static_cast<double>(rebuilt) / static_cast<double>(state.iterations());
 }
@@ -547,12 +566,10 @@ void register_sphere_contact_benchmarks() {
   }
   for (const auto& [name, kind] : {std::pair{"incremental", StepKind::incremental},
                                    std::pair{"condensed", StepKind::condensed},
-                                   std::pair{"simulation", StepKind::simulation}})
-  {
+                                   std::pair{"simulation", StepKind::simulation}}) {
+    const std::string full_name = std::string("BM_SphereStep/") + name + "/" + std::to_string(kStepContacts);
     benchmark::internal::Benchmark* step =
-        benchmark::RegisterBenchmark((std::string("BM_SphereStep/") + name + "/" + std::to_string(kStepContacts)).c_str(),
-                                     BM_SphereStep, kind)
-            ->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(full_name.c_str(), BM_SphereStep, kind)->Unit(benchmark::kMillisecond);
     // Today's solve takes seconds at this size: a few calls give its spread.
     if (kind == StepKind::condensed) step->Iterations(3);
   }

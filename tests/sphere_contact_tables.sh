@@ -25,17 +25,18 @@ jq -r '
   def fmt: if . >= 100 then (. | round | tostring) elif . >= 10 then ((. * 10 | round) / 10 | tostring)
            else ((. * 100 | round) / 100 | tostring) end;
   def ms: . / 1000 | fmt;
+  def sci: if . == 0 then "0" else (log10 | floor) as $e | "\((. / pow(10; $e) * 10 | round) / 10)e\($e)" end;
   def failed($b): $b == null or ($b.error_occurred // false);
   def why($b): if $b == null then "not run" else "error: \($b.error_message)" end;
-  [.benchmarks[] | {key: .name, value: .}] | from_entries as $b
-  | ([.benchmarks[].name | select(startswith("BM_SphereTick/incremental/")) | ltrimstr("BM_SphereTick/incremental/")]) as $sizes
-  | "| nodes in contact | candidates | incremental tick, mean µs | p99 µs | dense tick (today), mean µs | p99 µs | speed-up (mean) |",
-    "|---|---|---|---|---|---|---|",
+  [.benchmarks[].name | select(startswith("BM_SphereTick/incremental/")) | ltrimstr("BM_SphereTick/incremental/")] as $sizes
+  | [.benchmarks[] | {key: (.name | sub("/iterations:[0-9]+$"; "")), value: .}] | from_entries as $b
+  | "| nodes in contact | candidates | incremental tick, mean µs | p99 µs | dense tick (today), mean µs | p99 µs | speed-up (mean) | forces differ by |",
+    "|---|---|---|---|---|---|---|---|",
     ( $sizes[] as $n
       | $b["BM_SphereTick/incremental/" + $n] as $i
       | $b["BM_SphereTick/dense/" + $n] as $d
-      | if failed($i) or failed($d) then "| ~\($n) | \(why(if failed($i) then $i else $d end)) | | | | | |"
-        else "| \($i.contacts) | \($i.candidates) | \(micro($i; "real_time") | fmt) | \($i.p99_us | fmt) | \(micro($d; "real_time") | fmt) | \($d.p99_us | fmt) | \(micro($d; "real_time") / micro($i; "real_time") | round)× |"
+      | if failed($i) or failed($d) then "| ~\($n) | \(why(if failed($i) then $i else $d end)) | | | | | | |"
+        else "| \($i.contacts) | \($i.candidates) | \(micro($i; "real_time") | fmt) | \($i.p99_us | fmt) | \(micro($d; "real_time") | fmt) | \($d.p99_us | fmt) | \(micro($d; "real_time") / micro($i; "real_time") | round)× | \($d.difference | sci) |"
         end ),
     ( [$sizes[] | $b["BM_SphereTick/incremental/" + .] | select(failed(.) | not) | .unresolved] | add // 0
       | if . > 0 then "", "\(.) incremental ticks ran past the work budget (kSphereSolveWork): their force was zero." else empty end ),
@@ -44,13 +45,13 @@ jq -r '
     "|---|---|---|---|",
     ( [["incremental", "state solve, incremental (SphereStateSolve)"],
        ["condensed", "state solve, condensed (today)"],
-       ["simulation", "whole Simulation::step, incremental"]][] as [$kind, $label]
+       ["simulation", "whole Simulation::step, incremental"]][] as [$kind, $title]
       | $b["BM_SphereStep/" + $kind + "/400"] as $s
-      | if failed($s) then "| \($label) | \(why($s)) | | |"
-        else "| \($label)\(if $s.rebuilt != null then " (IR rebuilt in \($s.rebuilt * 100 | round) % of steps)" else "" end) | \($s.candidates) | \(micro($s; "real_time") | ms) | \($s.p99_us | ms) |"
+      | if failed($s) then "| \($title) | \(why($s)) | | |"
+        else "| \($title)\(if $s.rebuilt != null then " (IR rebuilt in \($s.rebuilt * 100 | round) % of steps)" else "" end) | \($s.candidates) | \(micro($s; "real_time") | ms) | \($s.p99_us | ms) |"
         end ),
     ( $b["BM_SphereStep/incremental/400"] as $i | $b["BM_SphereStep/condensed/400"] as $c
       | if failed($i) or failed($c) then empty
-        else "", "State solve speed-up (mean): \(micro($c; "real_time") / micro($i; "real_time") | round)×, at \($i.contacts) nodes in contact."
+        else "", "State solve speed-up (mean): \(micro($c; "real_time") / micro($i; "real_time") | round)×, at \($i.contacts) nodes in contact; the forces of the two states differ by \($c.difference | sci) (relative)."
         end )
 ' <<<"$json"

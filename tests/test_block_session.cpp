@@ -8,7 +8,6 @@
 // from the IRs it received (the offline evaluation of what it held), the server's steps
 // from the tools it was given.
 #include <gtest/gtest.h>
-#include <signal.h>
 
 #include <fmt/format.h>
 
@@ -49,25 +48,9 @@ TEST(BlockSession, TwoUsersPushHundredsOfNodesHealthyAndTheirRecordingsVerify) {
   const fs::path dir = testing::scratch_directory("block-session");
   write_block_press(dir / "a.yaml", -25);
   write_block_press(dir / "b.yaml", 25);
-  testing::ChildProcess server(
-      testing::server_program(),
-      {"--scene", (fs::path(COHAPTIC_SOURCE_DIR) / "scenes/block/two_spheres.yaml").string(), "--listen", "127.0.0.1:0",
-       "--duration", "400", "--report", (dir / "server.json").string(), "--record", (dir / "server.mcap").string()},
-      dir / "server.log");
-  ASSERT_TRUE(testing::wait_for_output(server, "listening on", kColdLoad)) << server.log_text();
-  const int port = testing::listening_port(server.log_text());
-  std::vector<std::unique_ptr<testing::ChildProcess>> clients;
-  for (const auto& [user, slot] : {std::pair{"a", 0}, std::pair{"b", 1}})
-    clients.push_back(std::make_unique<testing::ChildProcess>(
-        testing::client_program(),
-        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot",
-                                 std::to_string(slot), "--device", "script:" + (dir / (std::string(user) + ".yaml")).string(),
-                                 "--report", (dir / (std::string(user) + ".json")).string(), "--record",
-                                 (dir / (std::string(user) + ".mcap")).string()},
-        dir / (std::string(user) + ".log")));
-  for (const auto& client : clients) ASSERT_EQ(client->wait(testing::kPatience), 0) << client->log_text();
-  server.signal(SIGINT);
-  ASSERT_EQ(server.wait(testing::kPatience), 0) << server.log_text();
+  testing::run_scripted_session(dir, fs::path(COHAPTIC_SOURCE_DIR) / "scenes/block/two_spheres.yaml", {"--duration", "400"},
+                                {{"a", dir / "a.yaml"}, {"b", dir / "b.yaml"}}, kColdLoad);
+  if (HasFatalFailure()) return;
 
   const nlohmann::json server_report = nlohmann::json::parse(std::ifstream(dir / "server.json"));
   std::vector<nlohmann::json> client_reports;

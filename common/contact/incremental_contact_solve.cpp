@@ -126,8 +126,8 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
   const double push_tolerance = kRelativeTolerance * push_scale;
 
   // Every call makes one pass and one move at least, so that calls with a small budget
-  // still progress; the count of block moves without progress carries over to the next
-  // call, which goes on where this one stopped rather than repeat it.
+  // still progress; the pivot rule's counts carry over to the next call, which goes on
+  // where this one stopped rather than repeat it.
   do {
     ++result.trials;
     const Eigen::Index k = size_;
@@ -155,24 +155,12 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
       result.work += static_cast<double>(k);
       if (clearance < -clearance_tolerance) offending_.push_back(j);
     }
-    const auto offending = static_cast<int>(offending_.size());
-    if (offending == 0) {
-      fewest_offending_ = std::numeric_limits<int>::max();
-      block_moves_left_ = kBlockMovesWithoutProgress;
+    if (offending_.empty()) {
+      rule_.reset();
       result.solved = true;
       return result;
     }
-
-    bool block_move = true;
-    if (offending < fewest_offending_) {
-      fewest_offending_ = offending;
-      block_moves_left_ = kBlockMovesWithoutProgress;
-    } else if (block_moves_left_ > 0) {
-      --block_moves_left_;
-    } else {
-      block_move = false;
-    }
-    if (!block_move) {  // Murty: only the offending candidate of largest index
+    if (!rule_.block_move(static_cast<int>(offending_.size()))) {  // Murty: only the candidate of largest index
       const auto largest = std::max_element(offending_.begin(), offending_.end());
       const bool leaves = largest - offending_.begin() < leaving;
       offending_.assign(1, *largest);

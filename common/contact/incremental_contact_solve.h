@@ -30,7 +30,6 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <limits>
 #include <span>
 #include <vector>
 
@@ -79,13 +78,8 @@ class IncrementalContactSolve {
   /// Removes the member at factor position p (rank-one update of the rows below).
   void leave(int p) noexcept;
 
-  // Block moves allowed in a row without fewer offending nodes before single moves take
-  // over (Judice and Pires' p), as in unilateral_contact_solve.cpp.
-  static constexpr int kBlockMovesWithoutProgress = 3;
-
   int size_ = 0;
-  int fewest_offending_ = std::numeric_limits<int>::max();  // since the last solved call
-  int block_moves_left_ = kBlockMovesWithoutProgress;
+  PivotRule rule_;  // since the last solved call
   Eigen::MatrixXd factor_;       // lower triangle of the top-left size_ x size_: L, W_KK = L L^T
   Eigen::VectorXd push_;         // per factor position: the pushes of the last solve
   Eigen::VectorXd scratch_;      // a column for borders and updates

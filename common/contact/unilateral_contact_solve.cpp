@@ -6,9 +6,6 @@
 namespace cohaptic {
 namespace {
 
-// Block moves allowed in a row without fewer offending nodes before single moves take over
-// (Judice and Pires' p).
-constexpr int kBlockMovesWithoutProgress = 3;
 // Round-off allowance of the complementarity checks, relative to the problem's scales.
 constexpr double kRelativeTolerance = 1e-12;
 
@@ -49,6 +46,24 @@ void solve_active_block(const Eigen::Ref<const Eigen::VectorXd>& q, std::span<co
 
 }  // namespace
 
+bool PivotRule::block_move(int offending) noexcept {
+  if (offending < fewest_offending_) {
+    fewest_offending_ = offending;
+    block_moves_left_ = kBlockMovesWithoutProgress;
+    return true;
+  }
+  if (block_moves_left_ > 0) {
+    --block_moves_left_;
+    return true;
+  }
+  return false;
+}
+
+void PivotRule::reset() noexcept {
+  fewest_offending_ = std::numeric_limits<int>::max();
+  block_moves_left_ = kBlockMovesWithoutProgress;
+}
+
 UnilateralSolveResult solve_unilateral_contact(const Eigen::Ref<const Eigen::MatrixXd>& a,
                                                const Eigen::Ref<const Eigen::VectorXd>& q,
                                                std::span<std::uint8_t> active, Eigen::Ref<Eigen::VectorXd> lambda,
@@ -65,8 +80,7 @@ UnilateralSolveResult solve_unilateral_contact(const Eigen::Ref<const Eigen::Mat
   const double clearance_tolerance = kRelativeTolerance * clearance_scale;
   const double push_tolerance = kRelativeTolerance * push_scale;
 
-  int fewest_offending = m + 1;
-  int block_moves_left = kBlockMovesWithoutProgress;
+  PivotRule rule;
   while (result.work <= max_work) {
     int k = 0;
     for (int i = 0; i < m; ++i)
@@ -94,17 +108,8 @@ UnilateralSolveResult solve_unilateral_contact(const Eigen::Ref<const Eigen::Mat
         last_offending = i;
       }
     }
-    bool block_move = true;
-    if (offending == 0) {
-      result.solved = true;
-    } else if (offending < fewest_offending) {
-      fewest_offending = offending;
-      block_moves_left = kBlockMovesWithoutProgress;
-    } else if (block_moves_left > 0) {
-      --block_moves_left;
-    } else {
-      block_move = false;
-    }
+    result.solved = offending == 0;
+    const bool block_move = result.solved || rule.block_move(offending);
     for (int i = 0; i < m; ++i) {
       const bool moves = (active[i] & 2) && (block_move || i == last_offending);
       active[i] = static_cast<std::uint8_t>((active[i] & 1) ^ (moves ? 1 : 0));

@@ -22,9 +22,29 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <span>
 
 namespace cohaptic {
+
+/// Judice and Pires' choice of move in block principal pivoting: every offending node at
+/// once while that lowers the count of offending nodes below the fewest seen, and for
+/// three more passes without that; then only one (Murty's rule: the offending node of
+/// largest index) until the count falls below the fewest seen again. Ends for every
+/// positive definite matrix.
+class PivotRule {
+ public:
+  /// After a pass that left `offending` (> 0) nodes offending: true to move them all,
+  /// false to move only the one of largest index.
+  bool block_move(int offending) noexcept;
+  /// A new problem (or a solved one): no count seen yet.
+  void reset() noexcept;
+
+ private:
+  static constexpr int kBlockMovesWithoutProgress = 3;  // Judice and Pires' p
+  int fewest_offending_ = std::numeric_limits<int>::max();
+  int block_moves_left_ = kBlockMovesWithoutProgress;
+};
 
 struct UnilateralSolveResult {
   bool solved = false;  ///< false: A_SS was not positive definite, or the work budget ran out

@@ -1,6 +1,10 @@
 #include "support/process.h"
 
+#include <fmt/format.h>
+#include <signal.h>
 #include <unistd.h>
+
+#include <memory>
 
 namespace cohaptic::testing {
 
@@ -32,6 +36,31 @@ std::string client_program() { return std::string(COHAPTIC_BINARY_DIR) + "/clien
                                          << ") before its output showed '" << text << "'; its output:\n"
                                          << process.log_text();
   return waited << "; its output:\n" << process.log_text();
+}
+
+void run_scripted_session(const std::filesystem::path& dir, const std::filesystem::path& scene,
+                          const std::vector<std::string>& server_arguments,
+                          const std::vector<std::pair<std::string, std::filesystem::path>>& users,
+                          std::chrono::milliseconds load_timeout) {
+  std::vector<std::string> arguments = {"--scene", scene.string(), "--listen", "127.0.0.1:0", "--report",
+                                        (dir / "server.json").string(), "--record", (dir / "server.mcap").string()};
+  arguments.insert(arguments.end(), server_arguments.begin(), server_arguments.end());
+  ChildProcess server(server_program(), arguments, dir / "server.log");
+  ASSERT_TRUE(wait_for_output(server, "listening on", load_timeout)) << server.log_text();
+  const int port = listening_port(server.log_text());
+  std::vector<std::unique_ptr<ChildProcess>> clients;
+  for (std::size_t slot = 0; slot < users.size(); ++slot) {
+    const std::string& user = users[slot].first;
+    clients.push_back(std::make_unique<ChildProcess>(
+        client_program(),
+        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot",
+                                 std::to_string(slot), "--device", "script:" + users[slot].second.string(), "--report",
+                                 (dir / (user + ".json")).string(), "--record", (dir / (user + ".mcap")).string()},
+        dir / (user + ".log")));
+  }
+  for (const auto& client : clients) ASSERT_EQ(client->wait(kPatience), 0) << client->log_text();
+  server.signal(SIGINT);
+  ASSERT_EQ(server.wait(kPatience), 0) << server.log_text();
 }
 
 }  // namespace cohaptic::testing

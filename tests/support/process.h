@@ -7,6 +7,8 @@
 #include <chrono>
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "common/util/child_process.h"
 #include "support/wait.h"
@@ -27,5 +29,16 @@ std::string client_program();
 /// failure says what was awaited, whether the process ended first, and its output.
 ::testing::AssertionResult wait_for_output(ChildProcess& process, const std::string& text,
                                            std::chrono::milliseconds timeout = kPatience);
+
+/// A session on loopback in `dir`: cohaptic-server serving `scene` on port 0 with
+/// `server_arguments` after its report (server.json), recording (server.mcap) and log
+/// (server.log); one cohaptic-client per (user, trajectory), in slots 0, 1, ..., with a
+/// scripted device and its report, recording and log named after the user; then the
+/// clients' ends, and the server's on SIGINT, each asserted to exit 0. `load_timeout`: how
+/// long the server may take to listen (a cold compliance cache takes long).
+void run_scripted_session(const std::filesystem::path& dir, const std::filesystem::path& scene,
+                          const std::vector<std::string>& server_arguments,
+                          const std::vector<std::pair<std::string, std::filesystem::path>>& users,
+                          std::chrono::milliseconds load_timeout = kPatience);
 
 }  // namespace cohaptic::testing
