@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The IR bytes of the sphere contact model as they travel, beside the format before them:
+# The IR bytes of the sphere contact model as they travel, beside M~'s forms:
 # runs the two-surgeon demo on the graded block (scenes/block/two_spheres.yaml) with the
 # scripted tools (DEMO_DEVICE=script: each sphere exactly where its script puts it, 1.2 mm
 # deep at the deepest, a few hundred nodes pushed per IR), then `cohaptic-lab ir-bytes` on
@@ -19,9 +19,9 @@ scripted surgeons press the graded block (`scenes/block/two_spheres.yaml`, 10 mm
 0.6 mm under each) with `make demo`'s scripts, then `cohaptic-lab ir-bytes` reads what each
 client received. "As sent" is the IRs as they travelled (each whole, W's upper triangle in
 f64, in the connection's zstd stream); "uncompressed" the same IRs alone; the last two are
-what the format before them would have sent for the same IRs, uncompressed: M̃ whole (three
-rows per row node, f64) and compliance rows (the rows of the compliance of the nodes new to
-the client). See [the sphere contact model](../sphere-contact.md).
+what the same contacts would cost in the forms the other contact models send,
+uncompressed: M̃ whole (three rows per row node, f64) and compliance rows (the rows of the
+compliance of the nodes new to the client). See [the sphere contact model](../sphere-contact.md).
 
 HEADER
 "$build/lab/cohaptic-lab" ir-bytes --scene scenes/block/two_spheres.yaml "$out/client_a.mcap" "$out/client_b.mcap" \

@@ -203,7 +203,7 @@ SphereIrBytesRow measure_sphere_ir_bytes(const std::filesystem::path& recording,
     row.row_nodes_max = std::max(row.row_nodes_max, nodes);
     row.pushed_max = std::max(row.pushed_max, static_cast<double>(fem.sphere().contacts_size()));
 
-    // The format before: the same geometry with M~ (and u_B) instead of the sphere's part.
+    // M~'s forms: the same geometry with M~ (and u_B) instead of the sphere's part.
     wire::IntermediateRepresentation geometry = recorded.ir();
     geometry.mutable_fem()->clear_sphere();
     const auto rest = static_cast<double>(geometry.ByteSizeLong());
@@ -253,8 +253,7 @@ LabCommand add_ir_bytes_command(CLI::App& lab) {
             const ElasticBody& body = single_elastic_body(model);
             if (model.scene.haptic.contact_model == ContactModel::sphere) {
               fmt::print("| recording | IRs | span s | row nodes per IR (largest) | pushed, largest | as sent: W whole in "
-                         "the zstd stream, kB/s | uncompressed kB/s | before: M~ whole kB/s | before: compliance rows "
-                         "kB/s |\n|---|---|---|---|---|---|---|---|---|\n");
+                         "the zstd stream, kB/s | uncompressed kB/s | as M~ whole kB/s | as compliance rows kB/s |\n|---|---|---|---|---|---|---|---|---|\n");
               for (const std::filesystem::path& recording : options->recordings) {
                 const SphereIrBytesRow r = measure_sphere_ir_bytes(recording, body);
                 const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;

@@ -26,10 +26,10 @@
 // general-purpose compressor on them (e.g. zstd).
 // A recording of sphere IRs (the sphere contact model, which carries the normal compliance W
 // of its row nodes instead of M~) gets a table of its own: the IRs as they travelled (whole,
-// in the connection's zstd stream) and uncompressed, beside what the format before it would
-// have sent for the same IRs, uncompressed: M~ whole (3 rows per row node, a column per free
-// dof of the row and held nodes, f64) and compliance rows (the rows of L_AA of the nodes new
-// to the client, each pair once, f64). Units: bytes, kB = 1000 bytes, s, µs.
+// in the connection's zstd stream) and uncompressed, beside what M~'s forms would send for
+// the same IRs, uncompressed: M~ whole (3 rows per row node, a column per free dof of the
+// row and held nodes, f64) and compliance rows (the rows of L_AA of the nodes new to the
+// client, each pair once, f64). Units: bytes, kB = 1000 bytes, s, µs.
 #pragma once
 
 #include <filesystem>
@@ -75,7 +75,7 @@ struct SphereIrBytesRow {
   double pushed_max = 0;                         ///< nodes the server's state pushed, largest over the IRs
   double stream_bytes = 0;                       ///< as travelled: whole, in the zstd stream
   double sent_bytes = 0;                         ///< the same, uncompressed
-  double m_tilde_bytes = 0, rows_bytes = 0;      ///< the format before: M~ whole, compliance rows
+  double m_tilde_bytes = 0, rows_bytes = 0;      ///< M~'s forms: whole, compliance rows
 };
 
 /// Measures a recording whose condensed FEM IRs are sphere IRs (Error if it holds none);

@@ -1,17 +1,17 @@
-// The sphere contact model's cost, each method beside the one it replaced, in the same run
+// The sphere contact model's cost, each method beside the naive one, in the same run
 // (tests/sphere_contact_tables.sh prints them as tables; make bench-sphere):
 //   BM_SphereTick/incremental/<contacts>  one haptic tick (evaluate_force) on the IR's normal
 //                            compliance W, its contact solve kept from tick to tick
 //                            (incremental_contact_solve.h), under the default work budget
-//   BM_SphereTick/dense/<contacts>  the same tick as the client did it before W came on the
-//                            wire: A = N^T L~ N formed every tick over the working set from the
-//                            3x3 blocks of the condensed compliance L~, and
+//   BM_SphereTick/dense/<contacts>  the same tick done densely from the condensed compliance:
+//                            A = N^T L~ N formed every tick over the working set from the
+//                            3x3 blocks of L~, and
 //                            solve_unilateral_over_candidates, which factors A_SS afresh in
 //                            every pass (warm started from the last tick's set, no budget)
 //   BM_SphereStep/incremental/400  the server's state solve, SphereStateSolve::solve over the
 //                            user's patch (W and its contact solve kept from step to step)
-//   BM_SphereStep/condensed/400  the same state solved as the server did before, over every
-//                            touchable node: the working set condensed over B, M_CC inverted,
+//   BM_SphereStep/condensed/400  the same state solved by condensation, over every touchable
+//                            node: the working set condensed over B, M_CC inverted,
 //                            A = N^T L~ N and solve_unilateral_contact, the set grown until no
 //                            other candidate penetrates (condensed_state_solve below); it takes
 //                            seconds, so it runs three times
@@ -148,7 +148,7 @@ struct BlockRig {
   const ElasticBody& body;
   std::unique_ptr<ComplianceColumns> columns;
   std::unordered_map<std::int64_t, int> node_of_tag;
-  std::vector<int> touchable;  // the touchable triangles' nodes: today's server candidates
+  std::vector<int> touchable;  // the touchable triangles' nodes: the condensed solve's candidates
 
   BlockRig()
       : model(std::make_unique<Model>(
@@ -188,7 +188,7 @@ std::unique_ptr<Simulation> simulation_at(const Eigen::Vector3d& start) {
   return simulation;
 }
 
-// Today's tick (the client's before its IR carried W): every row node the sphere reaches is
+// The dense tick: every row node the sphere reaches is
 // a candidate with q = g + q0, and A_ij = n_i^T L~_ij n_j is formed against the working set
 // only, from L~ over the row nodes' dofs (3 a node, a fixed axis's rows and columns zero).
 class DenseTick {
@@ -366,7 +366,7 @@ void BM_PrepareSphereIr(benchmark::State& state, int contacts) {
   size_counters(state, *rig);
 }
 
-// Today's server state solve (the one before NormalCompliance): the candidates' working set
+// The condensed state solve: the candidates' working set
 // K, first the nodes the spheres hold at rest, is condensed over B (M_CC and M_CB), M_CC
 // inverted back to L~ (LLT), A = N^T L~ N and q = g + N^T u0 formed, and the unilateral
 // problem solved afresh; every other candidate that the solved state carries into its
@@ -445,7 +445,8 @@ StateSolution condensed_state_solve(ComplianceColumns& columns, IncrementalConde
 enum class StepKind { incremental, condensed, simulation };
 
 // The server's side at the 400-contact setting: a simulation for whole steps, and both state
-// solves over the user's patch (the new one's candidates) or every touchable node (today's).
+// solves over the user's patch (the incremental one's candidates) or every touchable node
+// (the condensed one's).
 struct StepRig {
   Eigen::Vector3d start;
   std::unique_ptr<Simulation> simulation;
@@ -475,10 +476,10 @@ std::string compare_steps(StepRig& rig) {
     const SphereTool sphere{along_path(rig.start, step), kRadius};
     const StateSolution fresh =
         rig.incremental->solve(*rig.condensation, rig.patch, std::span(&sphere, 1), rig.boundary_displacement);
-    const StateSolution today = condensed_state_solve(*block.columns, *rig.condensation, block.body, block.touchable,
+    const StateSolution condensed = condensed_state_solve(*block.columns, *rig.condensation, block.body, block.touchable,
                                                       std::span(&sphere, 1), rig.boundary_displacement);
-    if (step == 0) rig.contacts = pushed_nodes(today);
-    rig.difference = std::max(rig.difference, relative_difference(fresh.tool_forces[0], today.tool_forces[0]));
+    if (step == 0) rig.contacts = pushed_nodes(condensed);
+    rig.difference = std::max(rig.difference, relative_difference(fresh.tool_forces[0], condensed.tool_forces[0]));
     if (rig.difference > kAgreement)
       return fmt::format("step {}: the incremental state's force differs from the condensed one's by {:.1e} relative",
                          step, rig.difference);
@@ -570,7 +571,7 @@ void register_sphere_contact_benchmarks() {
     const std::string full_name = std::string("BM_SphereStep/") + name + "/" + std::to_string(kStepContacts);
     benchmark::internal::Benchmark* step =
         benchmark::RegisterBenchmark(full_name.c_str(), BM_SphereStep, kind)->Unit(benchmark::kMillisecond);
-    // Today's solve takes seconds at this size: a few calls give its spread.
+    // The condensed solve takes seconds at this size: a few calls give its spread.
     if (kind == StepKind::condensed) step->Iterations(3);
   }
 }

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# The sphere contact model's cost beside the dense solve it replaced, measured in the same
-# run (tests/bench_sphere_contact.cpp): runs cohaptic_bench's BM_Sphere benchmarks once and
-# prints, as Markdown, (1) the client's haptic tick at about 50, 200, 400 and 700 nodes in
-# contact, the incremental solve on the IR's normal compliance beside today's dense one;
-# (2) the server's state solve at 400, the incremental one beside today's condensed one,
+# The sphere contact model's cost beside the naive dense solve, measured in the same run
+# (tests/bench_sphere_contact.cpp): runs cohaptic_bench's BM_Sphere benchmarks once and
+# prints, as Markdown, the page docs/results/sphere-contact-speed.md holds: (1) the client's
+# haptic tick at about 50, 200, 400 and 700 nodes in contact, the incremental solve on the
+# IR's normal compliance beside the dense one; (2) the server's state solve at 400, the
+# incremental one beside the condensed one,
 # and the whole simulation step. Means are Google Benchmark's wall time per call, p99 the
 # 99th percentile of the calls' wall times; on a loaded machine both grow, so the load
 # average is printed first. The first run meshes the block and solves its compliance
@@ -16,6 +17,21 @@ bench=${1:-build/tests/cohaptic_bench}
 command -v jq >/dev/null || { echo "sphere_contact_tables: needs jq (deploy/install-deps.sh installs it)" >&2; exit 2; }
 
 json=$("$bench" --benchmark_filter='^BM_Sphere' --benchmark_format=json)
+cat <<'HEADER'
+# Sphere contact: speed
+
+`make bench-sphere > docs/results/sphere-contact-speed.md` writes this page
+(`tests/bench_sphere_contact.cpp`, `tests/sphere_contact_tables.sh`). A 20 mm sphere presses
+`scenes/block/block.geo` graded to 0.4 mm, moving a little every tick. The client's tick: the
+incremental solve on the IR's normal compliance W, its active set and factor kept from tick
+to tick, beside the dense one, which forms the working set's normal compliance from the 3x3
+blocks of the condensed compliance every tick and factors it afresh in every pass. The
+server's state solve: the incremental one over the users' patches, beside the condensed one
+(the working set condensed over B, M_CC inverted, the problem solved afresh). Means are wall
+time per call; p99 the 99th percentile of the calls. See
+[the sphere contact model](../sphere-contact.md).
+
+HEADER
 echo "load average: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores; $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
 echo
 jq -r '
@@ -30,7 +46,7 @@ jq -r '
   def why($b): if $b == null then "not run" else "error: \($b.error_message)" end;
   [.benchmarks[].name | select(startswith("BM_SphereTick/incremental/")) | ltrimstr("BM_SphereTick/incremental/")] as $sizes
   | [.benchmarks[] | {key: (.name | sub("/iterations:[0-9]+$"; "")), value: .}] | from_entries as $b
-  | "| nodes in contact | candidates | incremental tick, mean µs | p99 µs | dense tick (today), mean µs | p99 µs | speed-up (mean) | forces differ by |",
+  | "| nodes in contact | candidates | incremental tick, mean µs | p99 µs | dense tick, mean µs | p99 µs | speed-up (mean) | forces differ by |",
     "|---|---|---|---|---|---|---|---|",
     ( $sizes[] as $n
       | $b["BM_SphereTick/incremental/" + $n] as $i
@@ -44,7 +60,7 @@ jq -r '
     "| server, 400 in contact | candidates | mean ms | p99 ms |",
     "|---|---|---|---|",
     ( [["incremental", "state solve, incremental (SphereStateSolve)"],
-       ["condensed", "state solve, condensed (today)"],
+       ["condensed", "state solve, condensed"],
        ["simulation", "whole Simulation::step, incremental"]][] as [$kind, $title]
       | $b["BM_SphereStep/" + $kind + "/400"] as $s
       | if failed($s) then "| \($title) | \(why($s)) | | |"

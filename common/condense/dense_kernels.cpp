@@ -151,6 +151,16 @@ COHAPTIC_CPU_CLONES void narrow_backward_substitution(Eigen::Index n, const doub
   if (columns == 3) backward_substitution<3>(n, g, ld, x, ldx);
 }
 
+COHAPTIC_CPU_CLONES double gathered_dot_kernel(const double* __restrict column, const int* __restrict index,
+                                               const double* __restrict values, Eigen::Index n) {
+  double sum[kLanes] = {};
+  Eigen::Index p = 0;
+  for (; p + kLanes <= n; p += kLanes)
+    for (int l = 0; l < kLanes; ++l) sum[l] += column[index[p + l]] * values[p + l];
+  for (; p < n; ++p) sum[0] += column[index[p]] * values[p];
+  return (sum[0] + sum[1]) + (sum[2] + sum[3]);
+}
+
 int blas_size(Eigen::Index size) { return static_cast<int>(size); }
 // BLAS wants a leading dimension of at least 1, even for an empty block.
 int leading_dimension(const ConstMatrixRef& m) {
@@ -202,6 +212,10 @@ void multiply(double alpha, const ConstMatrixRef& a, Transposed transposed_a, co
   cblas_dgemm(CblasColMajor, blas_transpose(transposed_a), blas_transpose(transposed_b), blas_size(rows),
               blas_size(cols), blas_size(inner), alpha, a.data(), leading_dimension(a), b.data(),
               leading_dimension(b), beta, c.data(), leading_dimension(c));
+}
+
+double gathered_dot(const double* column, const int* index, const double* values, Eigen::Index n) noexcept {
+  return gathered_dot_kernel(column, index, values, n);
 }
 
 void cholesky_rank_update(const ConstMatrixRef& g, MatrixRef w, MatrixRef updated) {

@@ -43,4 +43,9 @@ void multiply(double alpha, const ConstMatrixRef& a, Transposed transposed_a, co
 /// triangles are read or written; `w` (n x k) is overwritten.
 void cholesky_rank_update(const ConstMatrixRef& g, MatrixRef w, MatrixRef updated);
 
+/// sum over p < n of column[index[p]] * values[p], summed in four interleaved partial sums
+/// (so the result does not depend on the CPU the kernel was built for): a row of a
+/// symmetric matrix, read down its column, against a vector on some of its entries.
+double gathered_dot(const double* column, const int* index, const double* values, Eigen::Index n) noexcept;
+
 }  // namespace cohaptic

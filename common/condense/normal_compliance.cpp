@@ -109,7 +109,7 @@ bool NormalCompliance::update(std::span<const int> nodes, const IncrementalConde
   free_clearance_.setZero();
   if (!boundary_dofs_.empty())
     for (int slot : every_slot) free_clearance_[slot] = q_.col(slot).dot(boundary_displacement);
-  find_nonnegative_rows();
+  find_nonnegative_rows(joined, boundary_changed);
   const bool kept_slots = static_cast<Eigen::Index>(every_slot.size()) > static_cast<Eigen::Index>(joined.size());
   return boundary_changed && kept_slots;
 }
@@ -162,12 +162,24 @@ void NormalCompliance::condense(std::span<const int> slots) {
       if (node_of(a) >= 0 && !(listed[static_cast<std::size_t>(a)] && a > b)) pair(a, b);
 }
 
-void NormalCompliance::find_nonnegative_rows() {
-  for (int a = 0; a < slot_count(); ++a) {
+void NormalCompliance::find_nonnegative_rows(std::span<const int> joined, bool all) {
+  const auto scan = [&](int a) {
     bool nonnegative = true;
     if (node_of(a) >= 0)
       for (int b = 0; b < slot_count() && nonnegative; ++b) nonnegative = node_of(b) < 0 || w_(a, b) >= 0;
     nonnegative_[static_cast<std::size_t>(a)] = nonnegative;
+  };
+  if (all) {
+    for (int a = 0; a < slot_count(); ++a) scan(a);
+    return;
+  }
+  // A joining slot's row is scanned; in the other rows only its column is new. A row that
+  // lost its only negative entry to a leaving slot stays flagged: that costs a check, never
+  // an answer.
+  for (int b : joined) {
+    scan(b);
+    for (int a = 0; a < slot_count(); ++a)
+      if (node_of(a) >= 0 && w_(a, b) < 0) nonnegative_[static_cast<std::size_t>(a)] = 0;
   }
 }
 

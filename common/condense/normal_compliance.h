@@ -55,7 +55,8 @@ class NormalCompliance {
   const Eigen::MatrixXd& w() const { return w_; }
   /// q0 per slot (capacity() entries, zero for free slots) [m].
   const Eigen::VectorXd& free_clearance() const { return free_clearance_; }
-  /// Per slot: 1 if its row of W has no negative entry (capacity() entries).
+  /// Per slot: 1 if its row of W has no negative entry (capacity() entries; a row may be
+  /// flagged 0 that no longer has one, since a slot left).
   const std::vector<std::uint8_t>& nonnegative_rows() const { return nonnegative_; }
 
  private:
@@ -64,7 +65,8 @@ class NormalCompliance {
   void add_columns(std::span<const int> slots, std::span<const int> joined);
   /// W and Q for the pairs with a slot of `slots` (all pairs: every slot), from W0 and P.
   void condense(std::span<const int> slots);
-  void find_nonnegative_rows();
+  /// The rows without a negative entry: all of them anew (`all`), or after `joined` slots.
+  void find_nonnegative_rows(std::span<const int> joined, bool all);
 
   ComplianceColumns& columns_;
   const DofMap& dofs_;

@@ -150,10 +150,9 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
       if (position_[static_cast<std::size_t>(j)] >= 0 || !std::isfinite(q[j])) continue;
       // With no negative push, a row of W without negative entries only moves j away.
       if (!any_negative && q[j] >= 0 && nonnegative_row[static_cast<std::size_t>(j)]) continue;
-      double clearance = q[j];
-      for (Eigen::Index p = 0; p < k; ++p) clearance += w(members_[static_cast<std::size_t>(p)], j) * push_[p];
       result.work += static_cast<double>(k);
-      if (clearance < -clearance_tolerance) offending_.push_back(j);
+      // W_jK lambda_K, read down column j (W is symmetric).
+      if (q[j] + gathered_dot(w.col(j).data(), members_.data(), push_.data(), k) < -clearance_tolerance) offending_.push_back(j);
     }
     if (offending_.empty()) {
       rule_.reset();

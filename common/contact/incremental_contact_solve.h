@@ -78,6 +78,7 @@ class IncrementalContactSolve {
   /// Removes the member at factor position p (rank-one update of the rows below).
   void leave(int p) noexcept;
 
+
   int size_ = 0;
   PivotRule rule_;  // since the last solved call
   Eigen::MatrixXd factor_;       // lower triangle of the top-left size_ x size_: L, W_KK = L L^T

@@ -39,11 +39,24 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
   const auto add = [&](int node) {
     if (listed[static_cast<std::size_t>(node)] || condensation.in_boundary(node) ||
         !holdable(body_.contact_normals.col(node), dofs.fixed_axes[static_cast<std::size_t>(node)]))
-      return;
+      return false;
     listed[static_cast<std::size_t>(node)] = 1;
     candidates.push_back(node);
+    return true;
+  };
+  // The touchable nodes within `band` of a sphere (their gap) join the candidates.
+  const auto add_band = [&](double band) {
+    bool added = false;
+    for (int node : touchable_)
+      if (!listed[static_cast<std::size_t>(node)])
+        if (const auto constraint = sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
+                                                      dofs.fixed_axes[static_cast<std::size_t>(node)], spheres);
+            constraint && constraint->gap < band)
+          added |= add(node);
+    return added;
   };
   for (int node : patch_nodes) add(node);
+  add_band(band_);
 
   for (;;) {
     set_candidates(candidates, condensation, boundary_displacement);
@@ -83,28 +96,15 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
     for (int slot = 0; slot < normal_.slot_count(); ++slot)
       if (normal_.node_of(slot) >= 0) deepest = std::max(deepest, std::abs(normal_.free_clearance()[slot]));
     state.contact_forces = Eigen::Map<const Eigen::VectorXd>(forces.data(), static_cast<Eigen::Index>(forces.size()));
-    solve_boundary_forces(columns_, condensation, dofs, boundary_displacement, state);
-
-    // Touchable nodes outside the candidates that the state carries into a sphere join them.
-    std::vector<int> checked;
-    std::vector<SphereConstraint> constraints;
-    for (int node : touchable_) {
-      if (listed[static_cast<std::size_t>(node)] || condensation.in_boundary(node)) continue;
-      const auto constraint = sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
-                                                dofs.fixed_axes[static_cast<std::size_t>(node)], spheres);
-      if (!constraint || !(constraint->gap < 2 * deepest)) continue;
-      checked.push_back(node);
-      constraints.push_back(*constraint);
+    // Done when every touchable node within twice that of a sphere was a candidate; else
+    // they join and the state is solved again.
+    const double band = kBandPerDepth * deepest;
+    const bool wider = band > band_;
+    band_ = band;
+    if (!wider || !add_band(band)) {
+      solve_boundary_forces(columns_, condensation, dofs, boundary_displacement, state);
+      return state;
     }
-    if (checked.empty()) return state;
-    const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, checked);
-    bool joined = false;
-    for (std::size_t k = 0; k < checked.size(); ++k)
-      if (constraints[k].gap + constraints[k].normal.dot(u.col(static_cast<Eigen::Index>(k))) < 0) {
-        add(checked[k]);
-        joined = true;
-      }
-    if (!joined) return state;
   }
 }
 

@@ -1,15 +1,18 @@
 // The simulation's own solve of the state under the sphere contact model
 // (common/contact/sphere_contact.h): every sphere at once with the boundary nodes B held.
 //
-// Its candidates are the nodes of the users' patches (those their IRs carry), each pushed
-// along its own normal by the sphere with the least gap; their normal compliance W with B
-// held (normal_compliance.h) gives the unilateral problem over the normal pushes, solved
-// from the last solve's set and factor (incremental_contact_solve.h), so that a step whose
-// contact set barely changes costs O(|K|^2). The nodal forces lambda n then give f_B and any
-// node's displacement as for the other models (state_solve.h). A touchable node outside
-// the patches that the solved state carries into a sphere (checked among those whose gap is
-// less than twice the deepest push's penetration) joins the candidates and the state is
-// solved again, until none does; the simulation then widens that user's patch
+// Its candidates are the nodes of the users' patches (those their IRs carry) and every
+// touchable node whose gap to a sphere is less than twice the deepest penetration of a
+// pushed node (or of B's largest normal move): the nodes the deformation could carry into
+// a sphere. Each is pushed along its own normal by the sphere with the least gap; their
+// normal compliance W with B held (normal_compliance.h) gives the unilateral problem over
+// the normal pushes, solved from the last solve's set and factor
+// (incremental_contact_solve.h), so that a step whose contact set barely changes costs
+// O(|K|^2), and a candidate well outside a sphere costs nothing (its row of W has no
+// negative entry). If a solve pushes deeper than the candidates allowed for, the wider band
+// joins and the state is solved again. The nodal forces lambda n then give f_B and any
+// node's displacement as for the other models (state_solve.h). A pushed node outside the
+// patches makes the simulation widen that user's patch
 // (Simulation::carry_pushed_nodes_into_patches). Units: m, N. Not thread-safe.
 #pragma once
 
@@ -55,6 +58,10 @@ class SphereStateSolve {
   std::vector<int> touchable_;  // the touchable triangles' nodes: all that can be pushed
   NormalCompliance normal_;
   IncrementalContactSolve contact_;
+  /// The band of the candidates: twice the deepest penetration.
+  static constexpr double kBandPerDepth = 2;
+
+  double band_ = 0;             // [m], as of the last solve
   Eigen::VectorXd clearance_;   // per slot, this solve's q
   std::vector<int> tool_;       // per slot, the sphere with the least gap (-1: none)
 };
