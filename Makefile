@@ -4,7 +4,7 @@
 #   make tradeoff  the same set-up, then the speed/accuracy grid on the cube
 #   make bench  the same set-up, then the benchmarks (BENCH_ARGS passes arguments through)
 #   make bench-thin  the mass-spring benchmarks beside the thin-objects paper's Table 2
-#   make bench-sphere  the sphere contact model's client tick and server step beside today's dense solve
+#   make bench-sphere  the sphere contact model's client tick and server step beside the dense solve
 #   make fuzz       build the fuzz targets with clang (libFuzzer, ASan, UBSan) in build-asan
 #                   and run each for FUZZ_SECONDS (default 15; 0 builds only), FUZZ_JOBS at once
 #   make test-asan  the suite (ASAN_TESTS: all by default) built with clang, ASan + UBSan, in
@@ -113,7 +113,7 @@ bench-thin:
 	@tests/mass_spring_tables.sh $(BUILD_DIR)/tests/cohaptic_bench
 
 # The sphere contact model's client tick (50 to 700 nodes in contact) and server step (400),
-# each beside today's dense solve in the same run, as Markdown (about a minute; the first
+# each beside the dense solve in the same run, as Markdown (about a minute; the first
 # run meshes the block and solves its compliance, another minute, cached on disk).
 bench-sphere:
 	@$(MAKE) --no-print-directory build >&2

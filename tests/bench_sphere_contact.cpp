@@ -18,13 +18,14 @@
 //   BM_SphereStep/simulation/400  a whole Simulation::step with the new solve: the state, the
 //                            patch check, and the IR rebuilt when the patch changes
 //   BM_PrepareIr/sphere/<contacts>  what a client does once per IR received
-// <contacts> is about how many nodes the sphere pushes: 50, 200 and 400 (the issue's
-// sizes), and 700, whose IR holds over 1000 candidates (the most a client must hold a tool).
+// <contacts> is about how many nodes the sphere pushes: 50, 200 and 400, and 700, whose IR
+// holds over 1000 candidates (the most a client must hold a tool).
 // The tool moves every tick (or step) along one path, 2 um sideways and 0.5 um deeper a
 // tick, back and forth, so that nodes join and leave the contact now and then, as under a hand.
 // Counters: contacts, the nodes pushed at the path's start; candidates, the IR's row nodes
 // (for the server's solves, their candidates); p99_us, the 99th percentile of the
-// iterations' wall times (Google Benchmark reports means, the issue asks for the p99);
+// iterations' wall times (Google Benchmark reports means; a haptic deadline is about the
+// slow ticks);
 // unresolved, ticks past the evaluator's work budget (kSphereSolveWork; their force is
 // zero); rebuilt, the share of steps that rebuilt the IR; difference, the largest relative
 // difference between the two methods' forces found by the check below.

@@ -77,7 +77,7 @@ struct SphereContactIr {
   Eigen::Matrix3Xd normals;            ///< per row node: inward unit normal, zero for a node the model cannot hold
   Eigen::VectorXd free_clearance;      ///< q0 per row node [m]
   /// W, row nodes square, symmetric [m/N]; the rows and columns of a node the model cannot
-  /// hold are zero. Empty while it travels as compliance rows (then rows of W, one per node).
+  /// hold are zero.
   Eigen::MatrixXd normal_compliance;
   std::vector<int> contacts;           ///< row nodes the server's state pushes (ascending): the first tick's set
   std::vector<std::int64_t> held_node_ids;  ///< B's tags: the nodes W and q0 hold where they are

@@ -22,7 +22,7 @@ constexpr double kUnitTolerance = 1e-9;
 PreparedSphereContact prepare_sphere_contact(const CondensedFemIr& ir, double tool_radius, double& condition_estimate) {
   if (!ir.sphere) throw Error("intermediate representation: the sphere contact model without its normal compliance");
   if (ir.compliance_rows)
-    throw Error("intermediate representation: it carries rows of W, not W (a ClientCondensation completes it first)");
+    throw Error("intermediate representation: a sphere body carries its normal compliance, never compliance rows");
   const SphereContactIr& sphere = *ir.sphere;
   const auto n = static_cast<Eigen::Index>(ir.row_node_count);
   if (ir.node_count() != n || ir.m_tilde.size() != 0 || ir.boundary_displacement.size() != 0 || ir.rest_forces.size() != 0)

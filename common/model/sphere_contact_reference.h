@@ -2,7 +2,7 @@
 // (common/contact/sphere_contact.h): full sparse FEM solves of the unilateral problem.
 //
 // The candidates are the nodes of the touchable triangles, less the held boundary nodes B,
-// each of the sphere nearest it. K is factored (CHOLMOD) with B's dofs prescribed; one
+// each of the sphere with the least gap along its normal. K is factored (CHOLMOD) with B's dofs prescribed; one
 // solve gives the candidates' displacement u0 under B's displacements alone, and
 // multi-right-hand-side solves the compliance L under unit forces at the free dofs of the
 // working set's nodes (working_set_contact_solve.h), over the rows of every candidate. With

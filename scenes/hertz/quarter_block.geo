@@ -1,4 +1,4 @@
-// The quarter of a large elastic block that `cohaptic-lab hertz --mesh` presses a sphere into
+// The quarter of a large elastic block that `cohaptic-lab hertz` presses a sphere into
 // (lab/hertz.h): [0, s]^2 x [-s, 0] in millimetres, the sphere's contact point at the origin
 // where the two symmetry planes x = 0 and y = 0 meet the top face z = 0. Gmsh 4.8 script.
 //
@@ -6,12 +6,11 @@
 // the distance beyond: the cells keep the same size relative to their distance from the
 // contact, the grading a point-like load's field asks for (its strains fall off with the
 // distance). A box mesh's tensor-product grading spends most of its nodes on fine columns
-// far from the contact; this one does not (the coarse block's 20,767 nodes hold the contact
-// as finely as the 40-cell box's 68,921).
+// far from the contact; this one does not.
 //
-// The build meshes it twice (CMakeLists.txt: build/scenes/hertz/quarter_block_{coarse,fine}.msh):
-//   gmsh quarter_block.geo -3 -nt 1 -setnumber fine 0.03 -setnumber growth 0.07 -o quarter_block_coarse.msh
-//   gmsh quarter_block.geo -3 -nt 1 -setnumber fine 0.015 -setnumber growth 0.06 -o quarter_block_fine.msh
+// `cohaptic-lab hertz` meshes it with gmsh at the sizes it is given (--gmsh-fine, in R; by
+// default 0.05 and 0.025) and growth 0.07, as
+//   gmsh quarter_block.geo -3 -nt 1 -setnumber fine 0.05 -setnumber growth 0.07 -o quarter_block.msh
 SetFactory("OpenCASCADE");
 DefineConstant[ R = {10, Name "Sphere radius (mm)"} ];
 DefineConstant[ side_over_R = {40, Name "Side of the quarter block, over R (at least 20)"} ];
