@@ -113,7 +113,8 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       metrics_.coupling_measured = metrics_.coupling_measured || (couples && (sample.flags & kInContact));
       if (count > 0 && (sample.flags & kInContact) && static_body) {
         const ForceSample alone = evaluate_force(*slot.ir, *slot.alone_state, own, {}, dt);
-        if (!(alone.flags & kContactUnresolved))
+        // A solve past its budget has no force to compare (the tick held the last one).
+        if (!((sample.flags | alone.flags) & kContactUnresolved))
           metrics_.peak_coupling = std::max(metrics_.peak_coupling, (sample.force - alone.force).norm());
       }
     }

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The IR bytes of the sphere contact model as they travel, beside M~'s forms:
 # runs the two-surgeon demo on the graded block (scenes/block/two_spheres.yaml) with the
-# scripted tools (DEMO_DEVICE=script: each sphere exactly where its script puts it, 1.2 mm
-# deep at the deepest, a few hundred nodes pushed per IR), then `cohaptic-lab ir-bytes` on
+# scripted tools (DEMO_DEVICE=script: each sphere exactly where its script puts it, 2 mm
+# deep at the deepest, some 400 nodes pushed per IR), then `cohaptic-lab ir-bytes` on
 # the two clients' recordings, and prints the Markdown page docs/results/sphere-contact-bytes.md
 # holds. About a minute (longer the first time: the scene's compliance is computed at load
 # and cached). Environment: BUILD_DIR (default build), DEMO_PORT, OUT (default out/sphere-bytes).

@@ -118,22 +118,28 @@ std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox, std::
     const auto prepared = simulation_.ir(user);
     if (!prepared || !simulation_.ir_changed(user)) continue;
     // The recording keeps the IR whole (M~ as built), whatever form it travels in.
-    if (recorder_) recorder_->ir(now_ns, wire::to_wire(prepared->ir));
+    const wire::IntermediateRepresentation whole = wire::to_wire(prepared->ir);
+    if (recorder_) recorder_->ir(now_ns, whole);
     if (!send) continue;
-    IntermediateRepresentation ir = prepared->ir;
-    const bool rows = to_compliance_rows(ir, user);
     // A sphere body's IR repeats most of the last one's normal compliance: it travels in
-    // the stream too, whole.
-    const auto* fem = std::get_if<CondensedFemIr>(&ir.body);
-    const bool streamed = rows || (fem && fem->sphere);
+    // the stream too, whole. Another condensed FEM body's may go as compliance rows.
+    const auto* fem = std::get_if<CondensedFemIr>(&prepared->ir.body);
+    const bool sphere = fem && fem->sphere;
+    IntermediateRepresentation as_rows;
+    bool rows = false;
+    if (!sphere) {
+      as_rows = prepared->ir;
+      rows = to_compliance_rows(as_rows, user);
+    }
+    const bool streamed = rows || sphere;
     wire::Control control;
     if (streamed) {  // in the user's stream, which starts afresh with the rows or its first IR
       const auto u = static_cast<std::size_t>(user);
-      const bool fresh = rows ? fem->compliance_rows->generation == 1 : !stream_started_[u];
-      *control.mutable_compressed_ir() = ir_streams_[u].compress(wire::to_wire(ir), fresh);
+      const bool fresh = rows ? condensed_fem(as_rows).compliance_rows->generation == 1 : !stream_started_[u];
+      *control.mutable_compressed_ir() = ir_streams_[u].compress(rows ? wire::to_wire(as_rows) : whole, fresh);
       stream_started_[u] = 1;
     } else {
-      *control.mutable_ir() = wire::to_wire(ir);
+      *control.mutable_ir() = whole;
     }
     bytes += streamed ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
     outbox.irs.push_back({user, std::move(control), streamed});
@@ -145,7 +151,7 @@ std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox, std::
 bool SimulationLoop::to_compliance_rows(IntermediateRepresentation& ir, int user) {
   auto* fem = std::get_if<CondensedFemIr>(&ir.body);
   const auto object = static_cast<std::size_t>(ir.object);
-  if (!compliance_rows_ || !fem || fem->sphere || object >= columns_.size() || !columns_[object]) return false;
+  if (!compliance_rows_ || !fem || object >= columns_.size() || !columns_[object]) return false;
   // An FEM pair's front condenses over B folded in (supported_compliance.h): rows of its own
   // L would give the client A without B, and every held row changes with the pushing set,
   // so its M~ travels whole. The client keeps the rows it holds for the IRs after.
