@@ -74,9 +74,15 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
   if (settings_.protocol == HapticProtocol::p1) {
     const IrSlot& slot = channels_.ir.front();
     if (slot.ir) {
+      // Its age runs from its arrival or its last confirmation: the confirmations of a newer
+      // IR (still on its way) do not make the one in use older than that.
       const IrConfirmation& confirmed = channels_.confirmation.front();
-      const bool fresh = confirmed.epoch == slot.ir->ir.epoch && confirmed.arrival_ns > slot.arrival_ns;
-      age = now - (fresh ? confirmed.arrival_ns : slot.arrival_ns);
+      if (confirmed_ir_ != slot.ir.get()) {
+        confirmed_ir_ = slot.ir.get();
+        confirmed_ns_ = slot.arrival_ns;
+      }
+      if (confirmed.epoch == slot.ir->ir.epoch) confirmed_ns_ = std::max(confirmed_ns_, confirmed.arrival_ns);
+      age = now - confirmed_ns_;
       const IntermediateRepresentation& ir = slot.ir->ir;
       std::array<Eigen::Vector3d, kMaxUsers - 1> remotes;
       const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(remote_count(ir)), remotes.size());

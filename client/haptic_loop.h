@@ -9,8 +9,10 @@
 // Late ticks: if it wakes after the next deadline, the missed ticks are skipped and counted
 // and the schedule keeps its phase (no catch-up burst, no drift).
 // Safety: the force is limited to min(device, scene) limit; an IR the server has not
-// confirmed (P1), or a force (P0), older than `max_age` fades the force to zero over
-// `fade`; any non-finite value gives zero and an event. Units: s, m, N; times are CLOCK_MONOTONIC ns
+// confirmed for `max_age` (P1: since its last confirmation, or its arrival; while the
+// server's newer IR is on its way the one in use is confirmed no more), or a force (P0)
+// older than that, fades the force to zero over `fade`; any non-finite value gives zero and
+// an event. Units: s, m, N; times are CLOCK_MONOTONIC ns
 // (HapticClock::monotonic(); a test may give the loop a clock it drives instead).
 #pragma once
 
@@ -185,6 +187,8 @@ class HapticLoop {
   std::array<RemoteToolBuffer, kMaxUsers> remote_buffers_;
   Eigen::Vector3d last_force_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d last_evaluated_ = Eigen::Vector3d::Zero();  // the IR's last resolved force
+  const PreparedIR* confirmed_ir_ = nullptr;  // the IR in use, and when the server last confirmed it
+  std::int64_t confirmed_ns_ = 0;
   PassivityController passivity_;
   HapticClock clock_;
 };

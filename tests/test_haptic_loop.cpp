@@ -152,6 +152,33 @@ TEST(HapticLoop, FadesTheForceLinearlyFromMaxAgeToZeroOnADrivenClock) {
   EXPECT_EQ(device.last_force(), Eigen::Vector3d::Zero()) << "the loop leaves the device at zero force";
 }
 
+// On a driven clock: the server confirms the IR every 10 ms until 200 ms, then builds a newer
+// one and confirms that, which never arrives. The IR in use ages from its last confirmation,
+// not from its arrival 200 ms before: full force until 300 ms (max_age 100 ms), then the fade.
+TEST(HapticLoop, WhileANewerIrIsOnItsWayTheOneInUseAgesFromItsLastConfirmation) {
+  const Fixture fixture;
+  DrivenClock clock;
+  const std::int64_t start = clock.now;
+  const std::unique_ptr<HapticChannels> channels = fixture.channels_with_ir(start);
+  clock.at = [&](std::int64_t now) {
+    if ((now - start) % (10 * kMs) != 0 || now - start > 400 * kMs) return;
+    channels->confirmation.back() = {fixture.ir->ir.epoch + (now - start <= 200 * kMs ? 0 : 1), now};
+    channels->confirmation.publish();
+  };
+  ScriptedDevice device = Fixture::holding_device();
+  HapticLoopSettings settings;
+  settings.force_limit = 10;
+  settings.max_age_s = 0.1;
+  settings.fade_s = 0.05;
+  settings.duration_s = 0.4;
+  settings.realtime = false;
+  HapticLoop loop(device, *channels, settings, clock.haptic());
+  const std::vector<TickRecord> ticks = run_to_end(loop, *channels);
+  ASSERT_EQ(ticks.size(), 399u);
+  for (const auto& [ms, fade] : {std::pair{150, 1.0f}, {250, 1.0f}, {300, 1.0f}, {310, 0.8f}, {325, 0.5f}, {350, 0.0f}})
+    EXPECT_FLOAT_EQ(ticks[static_cast<std::size_t>(ms - 1)].fade, fade) << ms << " ms";
+}
+
 // On the real clock (CLOCK_MONOTONIC, a thread confirming), with the force limited. The
 // confirmations come when the machine lets them, so each tick is judged by the ones it
 // surely saw: full force within max_age of a confirmation published before the tick woke,
