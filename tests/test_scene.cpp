@@ -162,7 +162,8 @@ TEST(SceneLoad, CubeSceneFieldsInSIUnits) {
 TEST(SceneModel, EveryShippedSceneAndMotionLoads) {
   for (const char* file : {"scenes/cube.yaml", "scenes/brain.yaml", "scenes/tradeoff/cube_two_users.yaml",
                            "scenes/tradeoff/brain.yaml", "scenes/tradeoff/brain_fine.yaml",
-                           "scenes/tradeoff/brain_spheres.yaml"}) {
+                           "scenes/tradeoff/brain_spheres.yaml", "scenes/block/two_spheres.yaml",
+                           "scenes/block/two_spheres_coarse.yaml"}) {
     const Model model = build_model(load_scene(testing::source_path(file)));
     const ElasticBody& body = single_elastic_body(model);
     EXPECT_GT(body.touchable_nodes.size(), 10u) << file;
