@@ -121,8 +121,8 @@ std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox, std::
     const wire::IntermediateRepresentation whole = wire::to_wire(prepared->ir);
     if (recorder_) recorder_->ir(now_ns, whole);
     if (!send) continue;
-    // A sphere body's IR repeats most of the last one's normal compliance: it travels in
-    // the stream too, whole. Another condensed FEM body's may go as compliance rows.
+    // A sphere body's IR travels whole in the stream too (its normal compliance repeats
+    // some of the last one's). Another condensed FEM body's may go as compliance rows.
     const auto* fem = std::get_if<CondensedFemIr>(&prepared->ir.body);
     const bool sphere = fem && fem->sphere;
     IntermediateRepresentation as_rows;
