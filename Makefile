@@ -76,7 +76,8 @@ build: configure
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
 test: build
-	ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS)
+	@status=0; ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS) || status=$$?; \
+	  tests/report_skipped.sh $(BUILD_DIR); exit $$status
 
 # The main job: the two-surgeon brain demo. A server and two haptic clients (hand models
 # following the surgeons' scripted motions) on loopback, P1, about 20 s; prints a summary

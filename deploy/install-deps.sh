@@ -24,10 +24,11 @@ packages=(
   clang libclang-rt-14-dev llvm
 )
 
-# Node.js and npm, for the live view's page libraries (three.js, protobufjs), the official
-# MCAP reader (@mcap/core) a test checks our recordings with, and playwright-core, which
-# drives Chromium in the view's browser test: Debian's packages, unless some Node.js is
-# already there (NodeSource's brings its own npm and conflicts with Debian's).
+# Node.js and npm, for two test tools only: the official MCAP reader (@mcap/core) a test
+# checks our recordings with, and playwright-core, which drives Chromium in the view's
+# browser tests (the live view's own libraries ship in view/web/lib; nothing at run time
+# needs npm). Debian's packages, unless some Node.js is already there (NodeSource's brings
+# its own npm and conflicts with Debian's).
 if ! command -v node >/dev/null 2>&1 && ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi
 
 missing=()
@@ -36,33 +37,21 @@ for p in "${packages[@]}"; do
   [[ "$status" == "install ok installed" ]] || missing+=("$p")
 done
 
-# npm packages, each set from its lock file (npm ci), so every machine gets the same:
-#   view/web     three, protobufjs: the live view's page, served by cohaptic-server --view
-#                (no CDN at run time);
-#   deploy/node  @mcap/core (the recording-format test), playwright-core (the view's
-#                browser test).
-# If npm cannot reach its registry: the view cannot serve its page (it says so), and the
-# tests that need the others are skipped, saying how to get them.
+# The test tools, set from deploy/node/package-lock.json (npm ci), so every machine gets
+# the same. If npm cannot reach its registry, the tests that need them are skipped, each
+# naming the package and the command that gets it; npm's own words are shown here.
 install_node_tools() {
-  local here root
-  here="$(cd "$(dirname "$0")" && pwd)"
-  root="$(dirname "$here")"
+  local node_dir
+  node_dir="$(cd "$(dirname "$0")" && pwd)/node"
   command -v npm >/dev/null 2>&1 || return 0
-  local -A wanted=(
-    ["$root/view/web"]="three protobufjs"
-    ["$here/node"]="@mcap/core playwright-core"
-  )
-  local dir package
-  for dir in "${!wanted[@]}"; do
-    for package in ${wanted[$dir]}; do
-      if [[ ! -d "$dir/node_modules/$package" ]]; then
-        echo "install-deps: npm ci in ${dir#"$root"/} (${wanted[$dir]})"
-        npm ci --prefix "$dir" --no-audit --no-fund --loglevel=error >/dev/null 2>&1 ||
-          echo "install-deps: npm ci in ${dir#"$root"/} failed: what needs ${wanted[$dir]} will say so"
-        break
-      fi
-    done
-  done
+  [[ -d "$node_dir/node_modules/@mcap/core" && -d "$node_dir/node_modules/playwright-core" ]] && return 0
+  echo "install-deps: npm ci in deploy/node (@mcap/core playwright-core, for the tests)"
+  local said
+  if ! said=$(npm ci --prefix "$node_dir" --no-audit --no-fund --loglevel=error --fetch-retries=1 \
+      --fetch-timeout=30000 2>&1); then
+    echo "install-deps: npm ci in deploy/node failed (the tests that need @mcap/core or playwright-core will be skipped); npm said:"
+    printf '%s\n' "$said" | grep -v '^\s*$' | head -n 6 | sed 's/^/  /'
+  fi
 }
 
 if [[ ${#missing[@]} -eq 0 ]]; then

@@ -16,7 +16,9 @@
 # a scene of one linear elastic object).
 #
 # The server serves the live view (cohaptic-server --view) on 127.0.0.1:DEMO_VIEW_PORT and
-# the demo prints its address: open it in a browser to watch the session.
+# the demo prints its address: open it in a browser to watch the session. If the view
+# cannot serve its page (the port taken, say), the session runs without it and the demo
+# says why.
 #
 # Environment: BUILD_DIR (default build), DEMO_PORT (default 7431), DEMO_DURATION (s, default
 # 20), DEMO_PROTOCOL (P1), DEMO_DEVICE (hand or script), DEMO_OUT (out/demo), DEMO_VIEW_PORT
@@ -66,7 +68,11 @@ for _ in $(seq 1 300); do
 done
 grep -q "listening on" "$out/server.log" || { echo "demo: the server did not start listening" >&2; exit 1; }
 echo "demo: server up on 127.0.0.1:$port ($protocol); two surgeons for ${duration} s ..."
-if [[ ${#view[@]} -gt 0 ]]; then
+# A view that cannot serve its page is off; the session goes on and the summary says why.
+view_off=$(sed -n 's/.*live view off: //p' "$out/server.log" | head -n 1)
+if [[ -n "$view_off" ]]; then
+  echo "demo: the live view is off: $view_off"
+elif [[ ${#view[@]} -gt 0 ]]; then
   url=$(sed -n 's/.*live view at \(http[^ ]*\).*/\1/p' "$out/server.log" | head -n 1)
   echo "demo: live view at $url (open it in a browser; replay it afterwards with: $lab_bin replay $out/server.mcap --view 127.0.0.1:$view_port)"
   if [[ -n "$screenshot" ]]; then
@@ -106,5 +112,6 @@ verified=0
 for client in client_a client_b; do
   "$lab_bin" replay "$out/$client.mcap" --verify --log-level warn || verified=1
 done
+[[ -z "$view_off" ]] || echo "demo: the live view was off: $view_off"
 [[ $healthy -eq 0 ]] || exit "$healthy"
 exit "$verified"

@@ -62,7 +62,7 @@ const std::vector<std::string> kTrialColumns = {"trial", "repetition", "conditio
 std::vector<std::string> value_columns() {
   std::vector<std::string> names;
   for (const NamedMeasure& m : named_measures(TrialMeasures{})) names.emplace_back(m.name);
-  names.insert(names.end(), {"contact_sim_rate_hz", "server_sim_rate_hz"});
+  names.insert(names.end(), {"contact_sim_rate_hz", "server_sim_rate_hz", "fades", "fade_s"});
   return names;
 }
 
@@ -90,6 +90,18 @@ double server_sim_rate_hz(const std::filesystem::path& report_file) {
   } catch (const std::exception& e) {
     spdlog::warn("no simulation rate in {}: {}", report_file.string(), e.what());
     return std::nan("");
+  }
+}
+
+// The fades the participant felt (client report "fades": count, total_s): a trial the
+// machine could not keep up with shows them. NaN when the report has none.
+std::pair<double, double> client_fades(const std::filesystem::path& report_file) {
+  try {
+    const nlohmann::json fades = nlohmann::json::parse(read_text_file(report_file.string())).at("fades");
+    return {fades.at("count").get<double>(), fades.at("total_s").get<double>()};
+  } catch (const std::exception& e) {
+    spdlog::warn("no fades in {}: {}", report_file.string(), e.what());
+    return {std::nan(""), std::nan("")};
   }
 }
 
@@ -293,6 +305,9 @@ std::vector<std::vector<std::string>> run_trial(const Study& study, const StudyT
         measured.push_back(m.value);
       measured.push_back(server_recording ? contact_sim_rate_hz(*server_recording, p.slot) : std::nan(""));
       measured.push_back(sim_rate_hz);
+      const auto [fades, fade_s] = client_fades(dir / (p.name + ".json"));
+      measured.push_back(fades);
+      measured.push_back(fade_s);
       values = std::move(measured);
     } catch (const Error& e) {
       status = fmt::format("no measures: {}", e.what());
@@ -448,10 +463,14 @@ int run_study(const std::filesystem::path& file, const StudyRunOptions& given) {
                                        fmt::format("error: {}", e.what())));
     }
     const auto value = [&](const char* name) { return std::stod(trial_rows.front()[column(name)]); };
+    const std::string faded =
+        value("fades") > 0 ? fmt::format(", the force faded {:.0f}x ({:.0f} ms: the machine did not keep up)",
+                                         value("fades"), value("fade_s") * 1e3)
+                           : "";
     fmt::print("{:.1f} s: force updates {:.0f}/s (simulation {:.0f}/s in contact), terminal force ratio {:.3f}, "
-               "peak {:.2f} N, {}\n",
+               "peak {:.2f} N{}, {}\n",
                watch.elapsed_ms() / 1000, value("force_update_rate_hz"), value("contact_sim_rate_hz"),
-               value("terminal_force_ratio"), value("peak_force_n"), trial_rows.front().back());
+               value("terminal_force_ratio"), value("peak_force_n"), faded, trial_rows.front().back());
     rows.insert(rows.end(), trial_rows.begin(), trial_rows.end());
     write_rows(trials_file, header, rows);  // after every trial: an interruption loses at most one
   }

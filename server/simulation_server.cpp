@@ -124,8 +124,13 @@ struct SimulationServer::Impl {
       settings.port = options.view_port;
       settings.token_file = options.view_token_file;
       settings.rate_hz = options.view_rate_hz;
-      view = std::make_unique<view::LiveView>(*model, compliance.per_body, wire_protocol(options), injected_delays(options),
-                                              settings, recorder.get());
+      // The session needs no browser: a view that cannot serve its page is off, said once.
+      try {
+        view = std::make_unique<view::LiveView>(*model, compliance.per_body, wire_protocol(options),
+                                                injected_delays(options), settings, recorder.get());
+      } catch (const std::exception& e) {
+        spdlog::warn("live view off: {}; the session goes on without it", e.what());
+      }
     }
     loop = std::make_unique<SimulationLoop>(*model, compliance.per_body, options, *tools, statistics, display.get(), view.get(),
                                             recorder.get(), start_ns);

@@ -150,6 +150,10 @@ TEST(HapticLoop, FadesTheForceLinearlyFromMaxAgeToZeroOnADrivenClock) {
   for (const auto& [ms, fade] : {std::pair{300, 1.0f}, {310, 0.8f}, {325, 0.5f}, {340, 0.2f}, {350, 0.0f}})
     EXPECT_FLOAT_EQ(ticks[static_cast<std::size_t>(ms - 1)].fade, fade) << ms << " ms";
   EXPECT_EQ(device.last_force(), Eigen::Vector3d::Zero()) << "the loop leaves the device at zero force";
+  // The user felt one fade, from 301 ms to the end (499 ms), the faded-out ticks included.
+  EXPECT_EQ(loop.metrics().fades, 1u);
+  EXPECT_NEAR(loop.metrics().fade_total_s, 0.199, 1e-9);
+  EXPECT_NEAR(loop.metrics().fade_longest_s, 0.199, 1e-9);
 }
 
 // On a driven clock: the server confirms the IR every 10 ms until 200 ms, then builds a newer

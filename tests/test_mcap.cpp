@@ -957,10 +957,10 @@ NodeRun run_mcap_check(const fs::path& file, const fs::path& errors) {
 TEST(McapWriter, TheOfficialReaderReadsOurFiles) {
   if (std::system("node --version > /dev/null 2>&1") != 0) {
     GTEST_SKIP() << "node is not installed; this check needs node (v18 or later) and @mcap/core: "
-                    "npm install --prefix deploy/node";
+                    "install Debian's nodejs and npm, then npm ci --prefix deploy/node (deploy/install-deps.sh does both)";
   }
   if (!fs::exists(testing::source_path("deploy/node/node_modules/@mcap/core/package.json"))) {
-    GTEST_SKIP() << "@mcap/core is not installed; from the source tree run: npm install --prefix deploy/node";
+    GTEST_SKIP() << "@mcap/core is not installed; from the source tree run: npm ci --prefix deploy/node (deploy/install-deps.sh does)";
   }
   const fs::path dir = testing::scratch_directory("mcap-official");
   constexpr std::uint32_t kCount = 2400;

@@ -96,6 +96,25 @@ TEST(MeasureTrace, StrokesAreTheRunsAboveTheThreshold) {
   EXPECT_TRUE(find_strokes(ForceTrace{}).empty());
 }
 
+TEST(MeasureTrace, AForceThatFadesToZeroBrieflyWithinAPressIsOneStroke) {
+  // 1 kHz: a press from 0.1 s to 0.9 s whose force fades to zero from 0.40 s to 0.52 s (a
+  // stalled server), then a second press from 1.1 s, after a release of 0.2 s.
+  const ForceTrace trace = sample(
+      1400, 1e-3,
+      [](std::size_t k, double) {
+        const bool pressing = (k >= 100 && k < 900) || k >= 1100;
+        const bool faded = k >= 400 && k < 520;
+        return Eigen::Vector3d((pressing && !faded ? 1.0 : 0.0) * kAxis);
+      },
+      still);
+  const std::vector<Stroke> strokes = find_strokes(trace);
+  ASSERT_EQ(strokes.size(), 2u);
+  EXPECT_EQ(strokes[0].begin, 100u);
+  EXPECT_EQ(strokes[0].end, 900u);  // the dip inside
+  EXPECT_EQ(strokes[1].begin, 1100u);
+  EXPECT_EQ(measure_trial(trace).n_strokes, 2u);
+}
+
 TEST(MeasureLowpass, KeepsLinesAndConstantsAndFiltersAtTwentyHertz) {
   const auto signal = [](double hz) {
     return sample(

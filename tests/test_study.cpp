@@ -1,16 +1,20 @@
 // The study runner: study files are parsed and checked (errors name the key), the trial
 // order is what the file asks for (a seeded shuffle, or a balanced Latin square), and a
 // two-condition study runs with the real programs: P0 renders at the rate of the slowed
-// simulation, P1 at its haptic rate; an interrupted study continues where it stopped.
+// simulation, P1 at its haptic rate; an interrupted study continues where it stopped; on a
+// machine slowed by busy processes a press is still one stroke, and a fade is reported.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
+#include <sched.h>
 
 #include <algorithm>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "common/util/csv.h"
 #include "common/util/error.h"
@@ -227,6 +231,50 @@ TEST(Study, TwoConditionsRunWithTheRealProgramsAndAnInterruptedStudyContinues) {
   // The same output directory with a different plan is refused.
   write_study_files(dir, study_text("  step_nodes: [150]\n  protocol: [P1, P0]"));
   EXPECT_THROW(run_study(dir / "study.yaml", options), Error);
+}
+
+// Three processes spin on the one CPU this thread, and the programs it starts, may use: the
+// server builds the step-delayed IR late, so the client's force may fade in mid-press (its
+// IR unconfirmed past the fade age) and come back. Each trial counts its one press as one
+// stroke all the same, and reports its fades.
+TEST(Study, OnAMachineSlowedByBusyProcessesAPressIsStillOneStroke) {
+  cpu_set_t allowed;
+  ASSERT_EQ(sched_getaffinity(0, sizeof allowed, &allowed), 0);
+  int cpu = 0;
+  while (!CPU_ISSET(cpu, &allowed)) ++cpu;
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  CPU_SET(cpu, &one);
+  ASSERT_EQ(sched_setaffinity(0, sizeof one, &one), 0);
+  struct RestoreAffinity {
+    cpu_set_t& allowed;
+    ~RestoreAffinity() { sched_setaffinity(0, sizeof allowed, &allowed); }
+  } restore{allowed};
+
+  const fs::path dir = testing::scratch_directory("study-slowed");
+  std::vector<std::unique_ptr<ChildProcess>> busy;
+  for (int i = 0; i < 3; ++i)
+    busy.push_back(std::make_unique<ChildProcess>("/bin/sh", std::vector<std::string>{"-c", "while :; do :; done"},
+                                                  dir / fmt::format("busy{}.log", i)));
+  write_study_files(dir, study_text("  step_nodes: [150]\n  protocol: [P1, P0]", "{kind: sequential}", 2));
+  StudyRunOptions options;
+  options.out = dir / "out";
+  options.server_program = testing::server_program();
+  options.client_program = testing::client_program();
+  ASSERT_EQ(run_study(dir / "study.yaml", options), 0);
+  busy.clear();  // killed
+
+  const auto rows = read_table(options.out / "trials.csv");
+  ASSERT_EQ(rows.size(), 4u);
+  for (const auto& row : rows) {
+    const std::string trial = row.at("condition") + " #" + row.at("repetition");
+    std::printf("  %s: %s stroke(s), %s fade(s) (%s s), peak %s N\n", trial.c_str(), row.at("n_strokes").c_str(),
+                row.at("fades").c_str(), row.at("fade_s").c_str(), row.at("peak_force_n").c_str());
+    EXPECT_EQ(row.at("status"), "ok") << trial;
+    EXPECT_EQ(std::stod(row.at("n_strokes")), 1) << trial;
+    EXPECT_GE(std::stod(row.at("fades")), 0) << trial << ": the client's report counts its fades";
+    EXPECT_GE(std::stod(row.at("fade_s")), 0) << trial;
+  }
 }
 
 }  // namespace

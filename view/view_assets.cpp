@@ -12,17 +12,16 @@ struct AssetFile {
   const char* url;
   const char* path;  // under its root
   const char* content_type;
-  bool from_npm;     // installed by npm into view/web/node_modules
+  bool library;      // shipped in view/web/lib by deploy/refresh-view-libs.sh
 };
 
 constexpr AssetFile kWebFiles[] = {
     {"/", "index.html", "text/html; charset=utf-8", false},
     {"/view.js", "view.js", "text/javascript; charset=utf-8", false},
     {"/style.css", "style.css", "text/css; charset=utf-8", false},
-    {"/lib/three.module.js", "node_modules/three/build/three.module.js", "text/javascript; charset=utf-8", true},
-    {"/lib/OrbitControls.js", "node_modules/three/examples/jsm/controls/OrbitControls.js",
-     "text/javascript; charset=utf-8", true},
-    {"/lib/protobuf.min.js", "node_modules/protobufjs/dist/protobuf.min.js", "text/javascript; charset=utf-8", true},
+    {"/lib/three.module.min.js", "lib/three.module.min.js", "text/javascript; charset=utf-8", true},
+    {"/lib/OrbitControls.js", "lib/OrbitControls.js", "text/javascript; charset=utf-8", true},
+    {"/lib/protobuf.min.js", "lib/protobuf.min.js", "text/javascript; charset=utf-8", true},
 };
 
 constexpr AssetFile kProtoFiles[] = {
@@ -31,12 +30,12 @@ constexpr AssetFile kProtoFiles[] = {
     {"/proto/cohaptic/recording.proto", "cohaptic/recording.proto", "text/plain; charset=utf-8", false},
 };
 
-std::string read_file(const std::filesystem::path& file, bool from_npm, const std::filesystem::path& web) {
+std::string read_file(const std::filesystem::path& file, bool library) {
   std::ifstream in(file, std::ios::binary);
   if (!in) {
-    std::string how = from_npm ? " (the view's libraries are missing: run deploy/install-deps.sh, or npm ci --prefix " +
-                                     web.string() + ")"
-                               : "";
+    const std::string how = library ? " (the view's libraries ship in view/web/lib: restore them from git, or run "
+                                      "deploy/refresh-view-libs.sh)"
+                                    : "";
     throw Error("view: cannot read " + file.string() + how);
   }
   std::ostringstream content;
@@ -49,9 +48,9 @@ std::string read_file(const std::filesystem::path& file, bool from_npm, const st
 AssetTable load_assets(const std::filesystem::path& web, const std::filesystem::path& proto) {
   AssetTable table;
   for (const AssetFile& file : kWebFiles)
-    table[file.url] = {file.content_type, read_file(web / file.path, file.from_npm, web)};
+    table[file.url] = {file.content_type, read_file(web / file.path, file.library)};
   for (const AssetFile& file : kProtoFiles)
-    table[file.url] = {file.content_type, read_file(proto / file.path, false, web)};
+    table[file.url] = {file.content_type, read_file(proto / file.path, false)};
   table["/index.html"] = table.at("/");
   return table;
 }

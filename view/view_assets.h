@@ -1,6 +1,6 @@
 // The files the view's page is made of, as the view server serves them: its own page
-// (view/web: index.html, view.js, style.css), the libraries npm installed beside it from
-// view/web/package-lock.json (three.js, protobufjs; no CDN at run time), and the schema the
+// (view/web: index.html, view.js, style.css), the two libraries shipped beside it in
+// view/web/lib (three.js, protobufjs; no npm and no CDN at run time), and the schema the
 // page decodes (proto/cohaptic/view.proto and the two files it imports). Every file is
 // read once, at start, so a missing one is an error before any browser comes.
 #pragma once
@@ -16,11 +16,11 @@ struct Asset {
   std::string body;
 };
 
-/// URL path ("/", "/view.js", "/lib/three.module.js", ...) -> the file's content.
+/// URL path ("/", "/view.js", "/lib/three.module.min.js", ...) -> the file's content.
 using AssetTable = std::map<std::string, Asset>;
 
 /// Reads every asset from `web` (view/web) and `proto` (proto/). Throws Error naming the
-/// first missing file, and for a library the command that installs it.
+/// first missing file, and for a library how to restore it.
 AssetTable load_assets(const std::filesystem::path& web, const std::filesystem::path& proto);
 
 /// The asset for a request's path, query string ignored; null when there is none.

@@ -32,7 +32,7 @@ struct ViewServerOptions {
   std::string host = "127.0.0.1";
   std::uint16_t port = 0;                  ///< 0: any free port
   std::string token;                       ///< required on the WebSocket when not empty
-  std::filesystem::path assets;            ///< view/web, with its node_modules (view_assets.h)
+  std::filesystem::path assets;            ///< view/web, with its libraries in lib/ (view_assets.h)
   std::filesystem::path proto;             ///< the proto/ directory (the page decodes its view.proto)
   std::size_t max_command_bytes = 1024;
   std::size_t max_buffered_bytes = 2u << 20;  ///< per browser: beyond this, new frames are dropped

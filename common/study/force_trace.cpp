@@ -43,7 +43,10 @@ std::vector<Stroke> find_strokes(const ForceTrace& trace, double threshold_n) {
     Stroke stroke{k, k};
     while (k < n && trace.force[k].norm() > threshold_n) ++k;
     stroke.end = k;
-    strokes.push_back(stroke);
+    if (!strokes.empty() && trace.time_s[stroke.begin] - trace.time_s[strokes.back().end - 1] < kMinReleaseS)
+      strokes.back().end = stroke.end;  // a dip within one press
+    else
+      strokes.push_back(stroke);
   }
   return strokes;
 }

@@ -6,11 +6,14 @@
 // finite. The rate is nearly uniform (the haptic loop), but nothing here needs it exact except
 // the low-pass filter of roughness() (measures.h), which uses the median sample interval.
 //
-// A stroke is a maximal run of consecutive samples with |F(k)| > threshold (strictly above),
-// stored as the half-open index range [begin, end). The default threshold is 1 % of the trace's
-// peak |F|, so a trace that never pushes (peak 0) has no stroke. Strokes are disjoint, ordered
-// and separated by at least one sample at or below the threshold. "During contact" in the
-// measures means "in some stroke".
+// A stroke is one press of the hand: a maximal run of consecutive samples with |F(k)| >
+// threshold (strictly above), stored as the half-open index range [begin, end), where two runs
+// less than kMinReleaseS apart (from the last sample of one to the first of the next) are one
+// stroke, the dip between them included. A hand cannot let go and press again that fast, but
+// the force can dip that briefly while the hand presses on (a fade while the server is slow):
+// that is one press, not two. The default threshold is 1 % of the trace's peak |F|, so a trace
+// that never pushes (peak 0) has no stroke. Strokes are disjoint and ordered. "During contact"
+// in the measures means "in some stroke".
 #pragma once
 
 #include <Eigen/Core>
@@ -38,6 +41,9 @@ struct Stroke {
 
 /// The contact threshold used when none is given: this fraction of the peak |F|.
 inline constexpr double kDefaultContactFraction = 0.01;
+
+/// Runs above the threshold closer than this are one stroke [s].
+inline constexpr double kMinReleaseS = 0.15;
 
 /// Throws Error naming the first broken invariant (lengths, order of times, finiteness).
 void validate(const ForceTrace& trace);
