@@ -121,8 +121,11 @@ int main(int argc, char** argv) {
     report["missed_deadlines"] = m.missed_deadlines;
     report["timer_floor"] = floors.report();
     report["realtime"] = m.realtime;
+    // Of the IR in use (P1) or the force (P0), every tick that had one; it fades past fade_after.
     report["ir_age_ms"] = {{"p50", static_cast<double>(m.ir_age_ns.quantile(0.5)) * 1e-6},
-                           {"p99", static_cast<double>(m.ir_age_ns.quantile(0.99)) * 1e-6}};
+                           {"p99", static_cast<double>(m.ir_age_ns.quantile(0.99)) * 1e-6},
+                           {"max", static_cast<double>(m.ir_age_ns.max()) * 1e-6},
+                           {"fade_after", settings.max_age_s * 1e3}};
     report["force_n"] = {{"peak", m.peak_force}, {"clamped_ticks", m.clamped}};
     report["coupling_n"] = {{"peak", m.peak_coupling}, {"measured", m.coupling_measured}};
     report["force_step_on_ir_switch_n"] = m.largest_step_on_ir_switch;

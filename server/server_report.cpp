@@ -15,6 +15,9 @@ nlohmann::json server_report(const ServerFigures& figures) {
   server["scene"] = figures.scene_name;
   server["protocol"] = options.protocol == ServeProtocol::p1 ? "P1" : "P0";
   server["sim_rate_hz"] = loop.rate_hz();
+  // What the verdict holds the rate to, whatever step delay was injected: the users feel it.
+  server["target_sim_rate_hz"] = figures.min_sim_rate_hz;
+  server["ir_max_age_ms"] = options.ir_max_age_s * 1e3;
   server["steps"] = loop.steps;
   server["step_ms"] = {{"p50", loop.step_p50_ms}, {"p99", loop.step_p99_ms}, {"max", loop.step_max_ms}};
   server["ir_build_ms"] = {{"p50", loop.ir_build_p50_ms}, {"p99", loop.ir_build_p99_ms}, {"count", loop.ir_builds}};

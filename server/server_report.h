@@ -17,6 +17,7 @@ namespace cohaptic {
 struct ServerFigures {
   const ServeOptions& options;
   const std::string& scene_name;
+  double min_sim_rate_hz;  ///< the scene's (haptic.min_sim_rate_hz)
   LoopSummary loop;
   ConnectionCounters connections;
   const wire::RejectionCounters& datagrams;

@@ -153,7 +153,12 @@ struct SimulationServer::Impl {
   }
 
   ServerFigures figures() const {
-    return {options, model->scene.name, statistics.summary(), connections->counters(), connections->datagram_counters()};
+    return {options,
+            model->scene.name,
+            model->scene.haptic.min_sim_rate_hz,
+            statistics.summary(),
+            connections->counters(),
+            connections->datagram_counters()};
   }
 
   void print_status() {

@@ -122,5 +122,57 @@ TEST(SessionSummary, FailedSimulationStepsMakeTheSessionUnhealthyNamingCountAndL
   EXPECT_TRUE(mentions(verdict.problems, "contact solve: singular")) << verdict.problems.front();
 }
 
+// What the users felt: a starved server, fades, the force limit and stale IRs each make the
+// session unhealthy, naming the cause; each criterion is in the report with its threshold.
+TEST(SessionSummary, AStarvedServerFadesTheForceLimitAndStaleIrsAreNamed) {
+  nlohmann::json server = healthy_server();
+  server["server"]["target_sim_rate_hz"] = 20.0;
+  server["server"]["sim_rate_hz"] = 900.0;
+  nlohmann::json client = healthy_client("a");
+  client["ir_age_ms"] = {{"p50", 2.0}, {"p99", 12.0}, {"max", 180.0}, {"fade_after", 500.0}};
+  client["fades"] = {{"count", 0}, {"total_s", 0.0}, {"longest_s", 0.0}};
+  client["force_n"]["clamped_ticks"] = 16;  // 0.1 %
+  SessionVerdict verdict = summarize_session(server, {client});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
+  const nlohmann::json& criteria = verdict.report["criteria"];
+  const auto criterion = [&](const std::string& who, const std::string& what) {
+    for (const nlohmann::json& c : criteria)
+      if (c["who"] == who && c["criterion"] == what) return c;
+    return nlohmann::json();
+  };
+  EXPECT_EQ(criterion("server", "simulation step rate")["threshold"], ">= 18.0 Hz") << criteria.dump();
+  EXPECT_EQ(criterion("a", "IR age p99")["threshold"], "<= 200 ms") << criteria.dump();  // 4 steps at 20 Hz
+  EXPECT_EQ(criterion("a", "IR age max")["value"], "180.0 ms") << criteria.dump();
+  EXPECT_EQ(criterion("a", "force fades while pushing")["ok"], true) << criteria.dump();
+
+  server["server"]["sim_rate_hz"] = 0.34;
+  server["server"]["step_ms"] = {{"p99", 2900.0}, {"max", 3100.0}};
+  client["fades"] = {{"count", 2}, {"total_s", 0.376}, {"longest_s", 0.3}};
+  client["force_n"]["clamped_ticks"] = 17;
+  client["ir_age_ms"]["p99"] = 201.0;
+  client["ir_age_ms"]["max"] = 500.0;
+  verdict = summarize_session(server, {client});
+  EXPECT_FALSE(verdict.report["healthy"].get<bool>());
+  for (const char* text : {"server: the simulation stepped at 0.3 Hz, below 90 % of its target 20 Hz: the server is starved",
+                           "a: the force faded 2 time(s) while pushing (376 ms in all, the longest 300 ms)",
+                           "a: 17 ticks (0.11 %) held at the force limit", "a: IR age p99 201.0 ms, above 200 ms",
+                           "a: IR age reached 500 ms, the age at which the force fades"})
+    EXPECT_TRUE(mentions(verdict.problems, text)) << text << " in " << verdict.report["problems"].dump();
+  EXPECT_EQ(verdict.problems.size(), 5u) << verdict.report["problems"].dump();
+  server["server"]["injected"] = {{"sim_rate_hz", 0.34}};  // a study capped it: the users feel it all the same
+  verdict = summarize_session(server, {client});
+  EXPECT_TRUE(mentions(verdict.problems, "below 90 % of its target 20 Hz: capped by --sim-rate-hz 0.34"))
+      << verdict.report["problems"].dump();
+
+  // Shift delay injected on the links lengthens the IR age the session is held to.
+  server["server"]["sim_rate_hz"] = 900.0;
+  server["server"]["injected"] = {{"shift_delay_ms", 50.0}, {"jitter_ms", 0.0}};
+  client["fades"]["count"] = 0;
+  client["force_n"]["clamped_ticks"] = 0;
+  client["ir_age_ms"]["max"] = 400.0;
+  verdict = summarize_session(server, {client});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
+}
+
 }  // namespace
 }  // namespace cohaptic

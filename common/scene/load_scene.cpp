@@ -210,7 +210,7 @@ ToolSpec parse_tool(const Cursor& c, double scale) {
 }
 
 HapticSettings parse_haptic(const Cursor& c) {
-  c.only_keys({"rate_hz", "force_limit", "contact_model", "patch_rings", "boundary_truncation"});
+  c.only_keys({"rate_hz", "force_limit", "contact_model", "patch_rings", "boundary_truncation", "min_sim_rate_hz"});
   HapticSettings haptic;
   if (auto rate = c.find("rate_hz")) haptic.rate_hz = rate->number_in(1, 100000, false, false, "a rate from 1 to 100000 Hz");
   if (auto limit = c.find("force_limit")) haptic.force_limit_n = limit->number_in(0, 1000, true, false, "a force limit in N, in (0, 1000]");
@@ -219,6 +219,8 @@ HapticSettings parse_haptic(const Cursor& c) {
     if (value < 0 || value > 4) rings->fail("an integer from 0 to 4");
     haptic.patch_rings = static_cast<int>(value);
   }
+  if (auto rate = c.find("min_sim_rate_hz"))
+    haptic.min_sim_rate_hz = rate->number_in(0, 100000, true, false, "a rate from 0 to 100000 Hz");
   if (auto truncation = c.find("boundary_truncation"))
     haptic.boundary_truncation = truncation->number_in(0, 1, false, true, "a fraction in [0, 1)");
   if (auto model = c.find("contact_model")) {

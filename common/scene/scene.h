@@ -106,6 +106,10 @@ struct HapticSettings {
   /// B truncation threshold in [0, 1): held nodes coupled to the contact rows more weakly
   /// than this fraction of the strongest are left out of the IR (0: none).
   double boundary_truncation = 0;
+  /// The simulation's step rate below which the session is unhealthy [Hz]: slower, the IRs
+  /// (P1) or forces (P0) the users feel go stale, whether the machine starved the server or
+  /// a study capped it (--sim-rate-hz).
+  double min_sim_rate_hz = 20;
 };
 
 /// How the session is served.
