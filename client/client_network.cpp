@@ -313,9 +313,11 @@ WelcomeInfo ClientNetwork::start(double timeout_s) {
   std::unique_lock lock(s.welcome_mutex);
   s.welcome_ready.wait_for(lock, std::chrono::duration<double>(timeout_s), [&s] { return s.welcome || !s.refusal.empty(); });
   if (!s.refusal.empty()) throw Error("the server refused to join: " + s.refusal);
-  if (!s.welcome)
-    throw Error(fmt::format("no welcome from {}:{} within {:g} s (is the server running, with the same key?)",
-                            s.options.host, s.options.port, timeout_s));
+  if (!s.welcome) {
+    const std::string why = s.connection.join_failure();
+    throw Error(fmt::format("cannot join {}:{} (no welcome within {:g} s): {}", s.options.host, s.options.port, timeout_s,
+                            why.empty() ? "no answer (is the address right, and the server running?)" : why));
+  }
   return *s.welcome;
 }
 

@@ -4,10 +4,12 @@
 #include <spdlog/spdlog.h>
 
 #include <fstream>
+#include <optional>
 #include <thread>
 
 #include "client/client_network.h"
 #include "client/device/make_device.h"
+#include "client/device/trajectory_reach.h"
 #include "client/haptic_loop.h"
 #include "client/timer_floors.h"
 #include "common/net/host_port.h"
@@ -81,8 +83,13 @@ int main(int argc, char** argv) {
     options.requested_slot = slot;
     options.encrypt = !no_encryption;
     auto channels = std::make_unique<cohaptic::HapticChannels>();
+    // The device's spec and file are checked before we join: a typo takes no seat.
+    const std::optional<cohaptic::Trajectory> path = cohaptic::device_path(device_spec);
     cohaptic::ClientNetwork network(options, *channels);
     const cohaptic::WelcomeInfo welcome = network.start(join_timeout_s);
+    if (path)
+      if (const std::string far = cohaptic::trajectory_reach_warning(*path, welcome.surface_bounds); !far.empty())
+        spdlog::warn("{}", far);
 
     std::unique_ptr<cohaptic::HapticDevice> device = cohaptic::make_device(device_spec, welcome.force_limit);
     device->start();

@@ -1,5 +1,6 @@
 #include "client/server_connection.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 namespace cohaptic {
@@ -28,6 +29,7 @@ void ServerConnection::connect() {
   const auto endpoints = resolver.resolve(host_, std::to_string(port_), error);
   if (error) {
     spdlog::warn("cannot resolve {}: {}", host_, error.message());
+    failed_to_join(fmt::format("cannot resolve {}: {}", host_, error.message()));
     schedule_reconnect();
     return;
   }
@@ -36,6 +38,12 @@ void ServerConnection::connect() {
     if (socket != connecting_ || stopped_) return;  // superseded or stopped meanwhile
     connecting_.reset();
     if (e) {
+      if (e == asio::error::connection_refused)
+        failed_to_join("connection refused: nothing listens there (is the server running, on this port?)");
+      else if (e == asio::error::host_unreachable || e == asio::error::network_unreachable || e == asio::error::timed_out)
+        failed_to_join(fmt::format("unreachable ({}): check the address and the network", e.message()));
+      else
+        failed_to_join(e.message());
       schedule_reconnect();
       return;
     }
@@ -49,9 +57,17 @@ void ServerConnection::connect() {
     handlers.on_control = [this](const wire::Control& control) { handle(control); };
     handlers.on_close = [this](net::CloseCause cause, const std::string& why) {
       switch (cause) {
-        case net::CloseCause::peer_closed: drop("closed"); return;
+        case net::CloseCause::peer_closed:
+          if (join_sent_ && !welcomed_)
+            failed_to_join("the server rejected the key: it closed the connection on our join (is it using the same "
+                           "--key-file?)");
+          drop("closed");
+          return;
         case net::CloseCause::rejected_frame:
           spdlog::error("control channel: {}", why);
+          if (!welcomed_)
+            failed_to_join("the server rejected the key: its frames do not authenticate with ours (is it using the "
+                           "same --key-file?)");
           drop("protocol error");
           return;
         case net::CloseCause::io_error:
@@ -70,7 +86,11 @@ void ServerConnection::handle(const wire::Control& control) {
   if (control.has_hello()) {
     greeted(control.hello());
   } else if (control.has_welcome()) {
-    if (welcomed(control)) handlers_.on_control(control);
+    if (welcomed(control)) {
+      welcomed_ = true;
+      failed_to_join("");
+      handlers_.on_control(control);
+    }
   } else {
     handlers_.on_control(control);
   }
@@ -126,6 +146,16 @@ void ServerConnection::drop(const std::string& why) {
 void ServerConnection::send(wire::Control& control) {
   if (!connection_ || connection_->closed()) return;
   connection_->send(sealer_.seal(control), net::FrameKind::must_arrive);
+}
+
+void ServerConnection::failed_to_join(std::string why) {
+  std::lock_guard lock(failure_mutex_);
+  join_failure_ = std::move(why);
+}
+
+std::string ServerConnection::join_failure() const {
+  std::lock_guard lock(failure_mutex_);
+  return join_failure_;
 }
 
 void ServerConnection::stop() {

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "cohaptic/messages.pb.h"
@@ -58,8 +59,13 @@ class ServerConnection {
   const wire::TrafficKey& key() const { return key_; }
   /// The server's address on the open connection.
   asio::ip::address server_address() const;
+  /// Why no connection has been welcomed yet: "connection refused ...", "unreachable ...",
+  /// "the server rejected the key ...", or empty when nothing failed (or one was welcomed).
+  /// Any thread may read it.
+  std::string join_failure() const;
 
  private:
+  void failed_to_join(std::string why);
   void connect();
   void schedule_reconnect();
   void handle(const wire::Control& control);
@@ -80,6 +86,9 @@ class ServerConnection {
   std::shared_ptr<asio::ip::tcp::socket> connecting_;  // the socket being connected
   std::shared_ptr<net::FramedConnection> connection_;
   bool stopped_ = false;
+  bool welcomed_ = false;  // on some connection
+  mutable std::mutex failure_mutex_;
+  std::string join_failure_;  // guarded by failure_mutex_
 };
 
 }  // namespace cohaptic

@@ -30,6 +30,11 @@ WelcomeInfo welcome_info(const wire::Welcome& welcome) {
   info.haptic_rate_hz = welcome.haptic_rate_hz();
   info.ir_max_age_s = welcome.ir_max_age_s();
   info.user_count = welcome.users_size();
+  const auto& v = welcome.surface().vertices();
+  for (int i = 0; i + 2 < v.size(); i += 3) {
+    const Eigen::Vector3d vertex(v[i], v[i + 1], v[i + 2]);
+    if (vertex.allFinite()) info.surface_bounds.extend(vertex);
+  }
   return info;
 }
 

@@ -5,8 +5,10 @@
 // sends: a slot that is not among the users, an unspecified protocol, a force limit that is
 // not in (0, 1000] N, a haptic rate outside [1, 100000] Hz (the scene's ranges), or an IR
 // age limit that is not a positive, finite time. A NaN force limit, for one, would switch
-// the haptic loop's limiting off. Units: N, Hz, s.
+// the haptic loop's limiting off. Units: N, Hz, s, m.
 #pragma once
+
+#include <Eigen/Geometry>
 
 #include <string>
 
@@ -25,6 +27,7 @@ struct WelcomeInfo {
   double haptic_rate_hz = 1000;
   double ir_max_age_s = 0.5;
   int user_count = 0;
+  Eigen::AlignedBox3d surface_bounds;  ///< of the scene's surface's finite vertices; empty if none
 };
 
 /// The Welcome's content, validated as described above.

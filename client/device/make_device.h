@@ -12,14 +12,22 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/haptics/haptic_device.h"
+#include "common/haptics/trajectory.h"
 
 namespace cohaptic {
 
 std::unique_ptr<HapticDevice> make_device(const std::string& spec, double force_limit);
+
+/// The path the device `spec` names will follow (script, hand: its trajectory, the hand
+/// parameters checked too; replay: the recorded motion), or nullopt for a device a person
+/// moves (bridge). Checks the spec and its file as make_device does, throwing the same
+/// errors, without building the device: a client calls it before it joins.
+std::optional<Trajectory> device_path(const std::string& spec);
 
 /// The accepted forms, one "kind:ARGS  what" line each, for --help texts and errors.
 std::vector<std::string> device_spec_forms();
