@@ -48,7 +48,15 @@ server_bin=$build/server/cohaptic-server
 client_bin=$build/client/cohaptic-client
 lab_bin=$build/lab/cohaptic-lab
 mkdir -p "$out"
-rm -rf "$out"/*.json "$out"/*.log "$out"/*.mcap "$out/display"
+rm -rf "$out"/*.json "$out"/*.log "$out"/*.mcap "$out"/surgeon_*.yaml "$out/display"
+
+# The surgeons keep moving for the whole session: each plays a copy of its script whose
+# `repeat` lasts past the duration even if one pass took a second (the client stops at
+# --duration), so someone who opens the live view late still sees them press.
+passes=$(awk -v d="$duration" 'BEGIN { n = int(d) + 2; print (n > 100000 ? 100000 : n) }')
+for surgeon in surgeon_a surgeon_b; do
+  { grep -v '^repeat:' "$scripts/$surgeon.yaml"; echo "repeat: $passes"; } >"$out/$surgeon.yaml"
+done
 
 pids=()
 cleanup() { for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done; }
@@ -84,10 +92,10 @@ elif [[ ${#view[@]} -gt 0 ]]; then
   fi
 fi
 
-"$client_bin" --server "127.0.0.1:$port" --user surgeon-A --slot 0 --device "$device:$scripts/surgeon_a.yaml" \
+"$client_bin" --server "127.0.0.1:$port" --user surgeon-A --slot 0 --device "$device:$out/surgeon_a.yaml" \
   --duration "$duration" --report "$out/client_a.json" --record "$out/client_a.mcap" >"$out/client_a.log" 2>&1 &
 pids+=($!)
-"$client_bin" --server "127.0.0.1:$port" --user surgeon-B --slot 1 --device "$device:$scripts/surgeon_b.yaml" \
+"$client_bin" --server "127.0.0.1:$port" --user surgeon-B --slot 1 --device "$device:$out/surgeon_b.yaml" \
   --duration "$duration" --report "$out/client_b.json" --record "$out/client_b.mcap" >"$out/client_b.log" 2>&1 &
 pids+=($!)
 status=0
