@@ -140,14 +140,7 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
   float fade = 1;
   if (age_s > settings_.max_age_s) fade = static_cast<float>(std::max(0.0, 1.0 - (age_s - settings_.max_age_s) / settings_.fade_s));
   record.fade = fade;
-  if (fade < 1 && force.squaredNorm() > 0) {
-    if (fade_run_s_ == 0) ++metrics_.fades;
-    fade_run_s_ += 1 / settings_.rate_hz;
-    metrics_.fade_total_s += 1 / settings_.rate_hz;
-    metrics_.fade_longest_s = std::max(metrics_.fade_longest_s, fade_run_s_);
-  } else {
-    fade_run_s_ = 0;
-  }
+  metrics_.fades.tick(fade, force.squaredNorm() > 0, 1 / settings_.rate_hz);
   force *= static_cast<double>(fade);
   return force;
 }

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "common/haptics/fade_tally.h"
 #include "common/haptics/haptic_device.h"
 #include "common/haptics/passivity_controller.h"
 #include "common/ir/evaluate_force.h"
@@ -149,10 +150,7 @@ struct HapticMetrics {
   /// keeps no state (a second evaluation would advance a dynamic body twice).
   bool coupling_measured = false;
   double largest_step_on_ir_switch = 0;  ///< [N]
-  /// Fades the user felt: runs of ticks in which a pushing force was faded because its IR
-  /// (P1) or force (P0) was older than max_age_s. Durations count ticks at the nominal rate.
-  std::uint64_t fades = 0;
-  double fade_total_s = 0, fade_longest_s = 0;
+  FadeTally fades;  ///< the fades the user felt, ticks counted at the nominal period
   double elapsed_s = 0;
   bool realtime = false;      ///< SCHED_FIFO and mlockall in effect
 };
@@ -193,7 +191,6 @@ class HapticLoop {
   Eigen::Vector3d last_evaluated_ = Eigen::Vector3d::Zero();  // the IR's last resolved force
   const PreparedIR* confirmed_ir_ = nullptr;  // the IR in use, and when the server last confirmed it
   std::int64_t confirmed_ns_ = 0;
-  double fade_run_s_ = 0;  // how long the current fade has lasted [s]
   PassivityController passivity_;
   HapticClock clock_;
 };

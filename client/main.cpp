@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
     report["force_n"] = {{"peak", m.peak_force}, {"clamped_ticks", m.clamped}};
     report["coupling_n"] = {{"peak", m.peak_coupling}, {"measured", m.coupling_measured}};
     report["force_step_on_ir_switch_n"] = m.largest_step_on_ir_switch;
-    report["fades"] = {{"count", m.fades}, {"total_s", m.fade_total_s}, {"longest_s", m.fade_longest_s}};
+    report["fades"] = {{"count", m.fades.count}, {"total_s", m.fades.total_s}, {"longest_s", m.fades.longest_s}};
     if (settings.passivity_control)
       report["passivity_controller"] = {{"active_ticks", loop.passivity().active_ticks()},
                                         {"dissipated_j", loop.passivity().dissipated_energy()}};
@@ -148,9 +148,9 @@ int main(int argc, char** argv) {
                  "coupling {:.3f} N",
                  m.ticks, report["haptic_rate_hz"].get<double>(), report["period_us"]["p99"].get<double>(),
                  report["timer_floor"]["period_us"]["p99"].get<double>(), m.peak_force, m.peak_coupling);
-    if (m.fades > 0)
+    if (m.fades.count > 0)
       spdlog::warn("the force faded {} time(s) while pushing ({:.0f} ms in all, the longest {:.0f} ms): its {} came too late",
-                   m.fades, m.fade_total_s * 1e3, m.fade_longest_s * 1e3,
+                   m.fades.count, m.fades.total_s * 1e3, m.fades.longest_s * 1e3,
                    settings.protocol == cohaptic::HapticProtocol::p1 ? "IR" : "force");
     if (!report_path.empty()) {
       if (report_path.has_parent_path()) std::filesystem::create_directories(report_path.parent_path());

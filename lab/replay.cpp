@@ -4,10 +4,12 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <map>
 #include <memory>
+#include <vector>
 
 #include "common/ir/client_condensation.h"
 #include "common/model/model.h"
@@ -16,6 +18,7 @@
 #include "common/scene/load_scene.h"
 #include "common/sim/elastic_states.h"
 #include "common/sim/scene_simulation.h"
+#include "common/haptics/fade_tally.h"
 #include "common/util/atomic_file.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
@@ -217,9 +220,23 @@ void print_summary(const Recording& rec) {
     fmt::print("view        {} frames, {} client status reports{}\n", rec.view_frames.size(), rec.client_statuses.size(),
                rec.view_frames.empty() ? " (recorded without --view: replay --view has no frames to show)" : "");
   if (!rec.ticks.empty()) {
+    // The client report's counters, from the ticks: each tick counts as the median period.
+    std::vector<std::int64_t> periods;
+    for (std::size_t k = 1; k < rec.ticks.size(); ++k) periods.push_back(rec.ticks[k].time_ns() - rec.ticks[k - 1].time_ns());
+    std::nth_element(periods.begin(), periods.begin() + static_cast<std::ptrdiff_t>(periods.size() / 2), periods.end());
+    const double period_s = periods.empty() ? 0.0 : static_cast<double>(periods[periods.size() / 2]) * 1e-9;
     double peak = 0;
-    for (const auto& t : rec.ticks) peak = std::max(peak, wire::from_wire(t.force()).norm());
-    fmt::print("force       peak {:.4f} N\n", peak);
+    std::size_t at_limit = 0;
+    FadeTally fades;
+    for (const auto& t : rec.ticks) {
+      const double force = wire::from_wire(t.force()).norm();
+      peak = std::max(peak, force);
+      if (c.force_limit() > 0 && force >= c.force_limit() * (1 - 1e-9)) ++at_limit;
+      fades.tick(t.fade(), wire::from_wire(t.evaluated()).squaredNorm() > 0, period_s);
+    }
+    fmt::print("force       peak {:.4f} N; {} ticks at the force limit ({:g} N)\n", peak, at_limit, c.force_limit());
+    fmt::print("fades       {} while pushing ({:.0f} ms in all, the longest {:.0f} ms)\n", fades.count, fades.total_s * 1e3,
+               fades.longest_s * 1e3);
   }
   for (const auto& e : rec.events) fmt::print("event       {:9.3f} s  {}: {}\n", seconds(e.time_ns(), c.start_time_ns()), e.kind(), e.text());
 }

@@ -151,9 +151,9 @@ TEST(HapticLoop, FadesTheForceLinearlyFromMaxAgeToZeroOnADrivenClock) {
     EXPECT_FLOAT_EQ(ticks[static_cast<std::size_t>(ms - 1)].fade, fade) << ms << " ms";
   EXPECT_EQ(device.last_force(), Eigen::Vector3d::Zero()) << "the loop leaves the device at zero force";
   // The user felt one fade, from 301 ms to the end (499 ms), the faded-out ticks included.
-  EXPECT_EQ(loop.metrics().fades, 1u);
-  EXPECT_NEAR(loop.metrics().fade_total_s, 0.199, 1e-9);
-  EXPECT_NEAR(loop.metrics().fade_longest_s, 0.199, 1e-9);
+  EXPECT_EQ(loop.metrics().fades.count, 1u);
+  EXPECT_NEAR(loop.metrics().fades.total_s, 0.199, 1e-9);
+  EXPECT_NEAR(loop.metrics().fades.longest_s, 0.199, 1e-9);
 }
 
 // On a driven clock: the server confirms the IR every 10 ms until 200 ms, then builds a newer
