@@ -16,6 +16,11 @@ wire::ClientStatus client_status(const HapticProgress& progress, const HapticMet
   status.set_ticks(progress.ticks);
   status.set_elapsed_s(progress.elapsed_s);
   status.set_final(progress.finished);
+  status.set_fades(progress.fades.count);
+  status.set_fade_total_s(progress.fades.total_s);
+  status.set_fade_longest_s(progress.fades.longest_s);
+  status.set_clamped_ticks(progress.clamped);
+  status.set_ir_age_max_ms(static_cast<double>(metrics.ir_age_ns.max()) * 1e-6);
   return status;
 }
 

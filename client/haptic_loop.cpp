@@ -146,7 +146,8 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
 }
 
 void HapticLoop::publish_progress(double elapsed_s, bool finished) {
-  channels_.progress.back() = {metrics_.ticks, metrics_.missed_deadlines, elapsed_s, metrics_.peak_force, finished};
+  channels_.progress.back() = {metrics_.ticks,      metrics_.missed_deadlines, metrics_.clamped, elapsed_s,
+                               metrics_.peak_force, metrics_.fades,           finished};
   channels_.progress.publish();
 }
 

@@ -120,9 +120,10 @@ struct HapticEvent {
 /// for the status the I/O thread reports to the server (client_status.h). Its histograms
 /// are read from HapticLoop::metrics() directly (Histogram allows a concurrent reader).
 struct HapticProgress {
-  std::uint64_t ticks = 0, missed_deadlines = 0;
+  std::uint64_t ticks = 0, missed_deadlines = 0, clamped = 0;
   double elapsed_s = 0;    ///< since the loop started; when finished, HapticMetrics::elapsed_s
   double peak_force = 0;   ///< [N]
+  FadeTally fades;
   bool finished = false;
 };
 
