@@ -49,6 +49,7 @@ TEST(FemPairSession, TwoUsersFeelBThroughAAndTheirRecordingsVerify) {
     SCOPED_TRACE(user);
     const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / (std::string(user) + ".json")));
     EXPECT_EQ(report["non_finite_ticks"], 0);
+    EXPECT_EQ(report["fades"]["count"], 0) << "the force faded while the user pushed";
     EXPECT_GT(report["force_n"]["peak"].get<double>(), 0.2);  // B felt: on A alone a 4 mm press gives 0.10 N
     const int received = report["ir"]["received"], as_rows = report["ir"]["condensed"];
     EXPECT_EQ(report["ir"]["rejected"], 0);

@@ -129,6 +129,7 @@ TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
     // Each feels its own vertex's springs: the users do not couple, and the client says it
     // measured no coupling (the demo's health check then asks for none).
     EXPECT_FALSE(read_json(dir / (user + ".json"))["coupling_n"]["measured"].get<bool>()) << user;
+    EXPECT_EQ(read_json(dir / (user + ".json"))["fades"]["count"], 0) << user << ": the force faded while pushing";
     if (user == "grasper") {
       EXPECT_GT(grasp_ticks, 500) << "the forceps grasped";
       EXPECT_GT(pulled_back, 200) << "the pull is pulled back";

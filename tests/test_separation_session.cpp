@@ -13,7 +13,9 @@
 #include <signal.h>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
+#include <fstream>
 #include <map>
 
 #include "common/ir/evaluate_force.h"
@@ -112,6 +114,9 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
     EXPECT_GT(user->in_contact, 500);
     ASSERT_GE(user->irs.size(), 3u);
   }
+  for (const char* user : {"alice", "bob"})
+    EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / (std::string(user) + ".json")))["fades"]["count"], 0)
+        << user << ": the force faded while pushing";
   const double f_n = std::get<SeparationIr>(alice.irs.front()->ir.body).patch->normal_threshold;
   EXPECT_GT(alice.peak_force, 0.8 * f_n) << "the forceps' pull reached the tear";
   EXPECT_GT(bob.peak_force, 0.1);

@@ -8,6 +8,7 @@
 #include <signal.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fmt/format.h>
 #include <fstream>
@@ -50,14 +51,14 @@ std::string missing_browser() {
   return "";
 }
 
-// Runs view_check.mjs with `arguments`; its JSON result.
-json check_page(const fs::path& dir, const std::string& name, const std::vector<std::string>& arguments) {
+// Runs view_check.mjs with `arguments`, expecting it to exit with `expected_status`; its JSON result.
+json check_page(const fs::path& dir, const std::string& name, const std::vector<std::string>& arguments, int expected_status = 0) {
   std::vector<std::string> all = {(kSource / "tests/support/view_check.mjs").string()};
   all.insert(all.end(), arguments.begin(), arguments.end());
   ChildProcess node(node_program(), all, dir / (name + ".log"));
   const std::optional<int> status = node.wait(kBrowserPatience);
   const std::string output = node.log_text();
-  EXPECT_EQ(status, 0) << output;
+  EXPECT_EQ(status, expected_status) << output;
   const std::size_t start = output.rfind("\n{\"");
   const json result = json::parse(output.substr(start == std::string::npos ? 0 : start + 1), nullptr, false);
   EXPECT_FALSE(result.is_discarded()) << output;
@@ -223,6 +224,10 @@ TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClients
     EXPECT_TRUE(shows(panel["period_p99_us"], report["timer_floor"]["period_us"]["p99"], 1));
     EXPECT_TRUE(shows(panel["missed_deadlines"], report["missed_deadlines"]));
     EXPECT_TRUE(shows(panel["ir_age_p99_ms"], report["ir_age_ms"]["p99"]));
+    EXPECT_TRUE(shows(panel["ir_age_p99_ms"], report["ir_age_ms"]["max"], 1));
+    EXPECT_TRUE(shows(panel["clamped_ticks"], report["force_n"]["clamped_ticks"]));
+    EXPECT_TRUE(shows(panel["fades"], report["fades"]["count"]));
+    EXPECT_TRUE(shows(panel["fades"], 1e3 * report["fades"]["longest_s"].get<double>(), 1));
     EXPECT_TRUE(shows(panel["one_way_delay_p99_ms"], report["one_way_delay_ms"]["p99"]));
     EXPECT_TRUE(shows(panel["peak_force"], report["force_n"]["peak"]));
     EXPECT_EQ(panel["protocol"], "P1");
@@ -251,18 +256,79 @@ TEST(ViewInBrowser, TheDemosBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
   EXPECT_GT(shown["meshTriangles"].get<int>(), 1000);
   EXPECT_EQ(shown["scene"]["obstacles"], json::array({"inner_skull"}));
   EXPECT_GT(pixels["mesh"]["matching"].get<double>(), 0.3 * pixels["mesh"]["sampled"].get<double>());
+  const json& screen = brain["screen"];
   ASSERT_EQ(shown["users"].size(), 2u);
+  double largest_force = 0;
   for (int slot = 0; slot < 2; ++slot) {
     const json& user = shown["users"][slot];
     const json& seen = pixels["users"][slot];
-    SCOPED_TRACE("user " + std::to_string(slot) + ": " + seen.dump());
+    const json& drawn = screen["users"][slot];
+    SCOPED_TRACE("user " + std::to_string(slot) + ": " + seen.dump() + " " + drawn.dump());
     EXPECT_TRUE(user["pressing"].get<bool>());
     EXPECT_GE(user["forceMagnitude"].get<double>(), 0.01);
-    EXPECT_GT(seen["tool"]["matching"].get<int>(), 10);
+    largest_force = std::max(largest_force, user["forceMagnitude"].get<double>());
+    // The translucent tool's outline, in the user's colour.
+    EXPECT_GE(seen["tool"]["matching"].get<double>(), 0.3 * seen["tool"]["sampled"].get<double>());
+    // Its arrow, a few hundredths of a newton, drawn long enough to read and reaching well
+    // outside the tool, its pixels in the user's colour along its length.
     EXPECT_TRUE(user["arrowVisible"].get<bool>());
+    EXPECT_GE(drawn["arrowPixels"].get<double>(), 20);
+    EXPECT_TRUE(drawn["tipOutsideTool"].get<bool>());
+    EXPECT_GT(drawn["tipFromToolPixels"].get<double>(), drawn["toolRadiusPixels"].get<double>() + 5);
     ASSERT_TRUE(seen["arrow"].is_object());
     EXPECT_GE(seen["arrow"]["matching"].get<double>(), 0.75 * seen["arrow"]["sampled"].get<double>());
   }
+  // The arrow scale in the legend: a round length for a round force at or above the largest seen.
+  std::smatch scale;
+  const std::string arrow_scale = screen["arrowScale"];
+  ASSERT_TRUE(std::regex_match(arrow_scale, scale, std::regex(R"(arrow: ([0-9.]+) mm = ([0-9.]+) N)"))) << arrow_scale;
+  EXPECT_GE(std::stod(scale[2].str()), largest_force);
+  EXPECT_LE(std::stod(scale[2].str()), 10 * largest_force);
+  EXPECT_EQ(screen["legendTitle"], "displacement |u| [mm]");
+  EXPECT_FALSE(screen["rigidMotionRemoved"].get<bool>());
+  // The scale bar: a round length, drawn as long on the screen as that length is at the tools
+  // (their 7 mm radius on the screen gives the pixels per mm there; the camera orbits their midpoint).
+  const json& bar = screen["scaleBar"];
+  std::smatch bar_text;
+  const std::string bar_label = bar["text"];
+  ASSERT_TRUE(std::regex_match(bar_label, bar_text, std::regex(R"(([0-9.]+) mm)"))) << bar.dump();
+  EXPECT_GE(bar["pixels"].get<double>(), 40) << bar.dump();
+  EXPECT_LE(bar["pixels"].get<double>(), 120) << bar.dump();
+  EXPECT_NEAR(bar["pixels"].get<double>(), shown["scaleBar"]["pixels"].get<double>(), 1);
+  const double pixels_per_mm = screen["users"][0]["toolRadiusPixels"].get<double>() / 7;
+  EXPECT_NEAR(bar["pixels"].get<double>() / std::stod(bar_text[1].str()), pixels_per_mm, 0.2 * pixels_per_mm) << bar.dump();
+  EXPECT_GE(pixels["scaleBar"]["sampled"].get<int>(), 15);
+  EXPECT_GE(pixels["scaleBar"]["matching"].get<double>(), 0.9 * pixels["scaleBar"]["sampled"].get<double>());
+
+  // The same with the rigid motion removed (the page's D key): the brain swings on its stem
+  // as the tools push it, the colour shows what is left, the dent, smaller but not gone.
+  const json rigid = check_page(dir, "rigid", {"--url", session.url, "--screenshot", (dir / "rigid.png").string(),
+                                               "--min-force", "0.01", "--focus-tools", "1", "--rigid-removed", "1"});
+  ASSERT_FALSE(rigid.contains("error")) << rigid.dump();
+  EXPECT_TRUE(rigid["errors"].empty()) << rigid["errors"].dump();
+  EXPECT_TRUE(rigid["screen"]["rigidMotionRemoved"].get<bool>());
+  EXPECT_TRUE(rigid["shown"]["rigidMotionRemoved"].get<bool>());
+  EXPECT_EQ(rigid["screen"]["legendTitle"], "deformation, rigid motion removed [mm]");
+  const json& frame = rigid["shown"]["frame"];
+  ASSERT_TRUE(frame["maxDeformationMm"].is_number()) << frame.dump();
+  std::printf("  largest displacement %.2f mm, deformation with the rigid motion removed %.2f mm\n",
+              frame["maxDisplacementMm"].get<double>(), frame["maxDeformationMm"].get<double>());
+  EXPECT_LT(frame["maxDeformationMm"].get<double>(), 0.8 * frame["maxDisplacementMm"].get<double>()) << frame.dump();
+  EXPECT_GT(frame["maxDeformationMm"].get<double>(), 0.5) << frame.dump();
+
+  // A screenshot whose condition is never met (no surgeon presses with 100 N): the script
+  // gives up in its time (30 s by default; 10 s here), still writes the picture and says
+  // which condition failed.
+  const auto asked = std::chrono::steady_clock::now();
+  const json unmet = check_page(dir, "unmet", {"--url", session.url, "--screenshot", (dir / "unmet.png").string(),
+                                               "--min-force", "100", "--give-up", "10"}, 1);
+  EXPECT_LT(std::chrono::steady_clock::now() - asked, std::chrono::seconds(25));
+  EXPECT_TRUE(fs::exists(dir / "unmet.png"));
+  ASSERT_TRUE(unmet.contains("error")) << unmet.dump();
+  EXPECT_NE(unmet["error"].get<std::string>().find("gave up after 10 s: "), std::string::npos) << unmet["error"];
+  EXPECT_NE(unmet["error"].get<std::string>().find("pressing with at least 100 N"), std::string::npos) << unmet["error"];
+  ASSERT_EQ(unmet["unmet"]["users"].size(), 2u) << unmet.dump();
+  for (const json& user : unmet["unmet"]["users"]) EXPECT_LT(user["forceN"].get<double>(), 100) << user.dump();
   a->signal(SIGINT);
   b->signal(SIGINT);
   EXPECT_EQ(a->wait(testing::kPatience), 0) << a->log_text();

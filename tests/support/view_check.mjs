@@ -3,28 +3,36 @@
 // and what a screenshot of it holds. tests/test_view.cpp runs it and judges the result.
 //
 //   node view_check.mjs --url URL --screenshot FILE.png [--seek SECONDS | --jump peak | --final 1]
-//                       [--min-force N] [--stay SECONDS] [--focus-tools 1] [--width W --height H]
+//                       [--min-force N [--give-up SECONDS]] [--stay SECONDS] [--focus-tools 1] [--rigid-removed 1]
+//                       [--width W --height H]
 //
 // Live: waits for frames with every tool present, takes the page's state, waits 1.5 s and
 // takes it again at the next frame drawn (the strip chart must have moved on), freezes the drawing, takes a third
 // state and a screenshot of that same picture. With --seek (a recording): asks the page to
 // seek there and waits until the frame shown is the one at that time; with --jump peak, to
 // jump to the largest force. Live with --min-force (instead of the two looks): the
-// screenshot waits until every tool presses with at least N newtons; --stay keeps the page open and drawing that long after
-// the screenshot (make demo's watching browser); --focus-tools moves the camera close to
-// the tools first (the page's T key). With --final: waits until every user's status panel shows its
+// screenshot waits until every tool presses with at least N newtons, for 30 s (--give-up) at most: then
+// it takes the screenshot anyway and exits 1, its "error" saying which condition failed and
+// "unmet" the values it saw; --stay keeps the page open and drawing that long after the
+// screenshot (make demo's watching browser); --focus-tools moves the camera close to the
+// tools first (the page's T key); --rigid-removed colours the deformation without the rigid
+// motion (the page's D key). With --final: waits until every user's status panel shows its
 // final report (its client has finished).
 // Pixels: the screenshot is decoded by the browser itself (an <img> drawn on a 2-D canvas)
 // and counted: non-background pixels inside the projected box of the mesh, pixels of each
-// user's colour around its tool and along its force arrow.
+// user's colour on its tool's outline and along its force arrow, and of the scale bar's line.
+// "screen": what the page shows, in CSS pixels: per user the arrow's length, its tip's
+// distance from its tool's centre and the tool's radius on the screen; the legend's title,
+// the arrow scale, the rigid-motion checkbox, the scale bar's text and length.
 // Exit status 0 with {"skipped": reason} when no Chromium can be started; 1 on a timeout,
-// naming what was awaited.
+// naming what was awaited (the screenshot is still taken, of whatever the page shows).
 import { chromium } from '../../deploy/node/node_modules/playwright-core/index.mjs';
 import { existsSync, writeFileSync } from 'node:fs';
 
 const args = Object.fromEntries(
   process.argv.slice(2).reduce((pairs, a, i, all) => (a.startsWith('--') ? [...pairs, [a.slice(2), all[i + 1]]] : pairs), []));
 const width = Number(args.width || 1280), height = Number(args.height || 760);
+const GIVE_UP_S = Number(args['give-up'] || 30);  // for the --min-force screenshot, from the browser's start
 const executable = process.env.CHROMIUM || ['/usr/bin/chromium', '/usr/bin/chromium-browser'].find((p) => existsSync(p));
 if (!executable) {
   console.log(JSON.stringify({ skipped: 'no Chromium (install the Debian package chromium)' }));
@@ -35,22 +43,29 @@ const browser = await chromium.launch({
   executablePath: executable,
   args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
 });
+const started = Date.now();
 const result = { errors: [] };
+let page = null, pictured = false;
 try {
-  const page = await browser.newPage({ viewport: { width, height } });
+  page = await browser.newPage({ viewport: { width, height } });
   page.on('pageerror', (e) => result.errors.push(e.message));
   page.on('console', (m) => { if (m.type() === 'error') result.errors.push(m.text()); });
-  await page.goto(args.url);
+  await page.goto(args.url, { timeout: GIVE_UP_S * 1000 });
   const snapshot = () => page.evaluate(() => window.cohapticView.snapshot());
-  const waitFor = async (what, test, seconds = 60) => {
-    const until = Date.now() + seconds * 1000;
+  // The page's last state, and whether it passed `test` before `until` (a time in ms).
+  const poll = async (test, until) => {
     for (;;) {
       const s = await page.evaluate(() => (window.cohapticView ? window.cohapticView.snapshot() : null));
-      if (s && test(s)) return s;
-      if (Date.now() > until) throw new Error(`timed out after ${seconds} s waiting for ${what}; last state: ` +
-        JSON.stringify(s && { connected: s.connected, frames: s.framesDrawn, frame: s.frame, users: s.users.map((u) => u.present) }));
+      if (s && test(s)) return { s, met: true };
+      if (Date.now() > until) return { s, met: false };
       await page.waitForTimeout(100);
     }
+  };
+  const waitFor = async (what, test, seconds = 60) => {
+    const { s, met } = await poll(test, Date.now() + seconds * 1000);
+    if (!met) throw new Error(`timed out after ${seconds} s waiting for ${what}; last state: ` +
+      JSON.stringify(s && { connected: s.connected, frames: s.framesDrawn, frame: s.frame, users: s.users.map((u) => u.present) }));
+    return s;
   };
   const everyToolPresent = (s) => s.framesDrawn >= 3 && s.users.length > 0 && s.users.every((u) => u.present);
   if (args.final !== undefined) {
@@ -62,8 +77,21 @@ try {
     result.after = await waitFor('the frame of the largest force',
       (s) => s.timeline && s.timeline.time === s.timeline.peakForceTime && s.frame && s.frame.time === s.timeline.time);
   } else if (args['min-force'] !== undefined) {
-    result.after = await waitFor(`every tool pressing with at least ${args['min-force']} N`,
-      (s) => everyToolPresent(s) && s.users.every((u) => u.pressing && u.forceMagnitude >= Number(args['min-force'])), 120);
+    const least = Number(args['min-force']);
+    const { s, met } = await poll((s) => everyToolPresent(s) && s.users.every((u) => u.pressing && u.forceMagnitude >= least),
+      started + GIVE_UP_S * 1000);
+    result.after = s;
+    if (!met) {
+      const users = s ? s.users.map((u) => ({ slot: u.slot, tool: u.tool, present: u.present, pressing: u.pressing, forceN: u.forceMagnitude })) : [];
+      const failed = !s ? 'the page never started (no window.cohapticView)'
+        : !s.connected ? 'the page is not connected to the view server'
+        : s.framesDrawn < 3 ? `fewer than 3 frames drawn (${s.framesDrawn})`
+        : !s.users.length ? 'the scene has no tools'
+        : `not every tool present and pressing with at least ${least} N: ` +
+          users.map((u) => `${u.tool} ${u.present ? (u.pressing ? 'pressing' : 'not pressing') : 'absent'} with ${u.forceN.toFixed(4)} N`).join(', ');
+      result.error = `gave up after ${GIVE_UP_S} s: ${failed}`;
+      result.unmet = { minForceN: least, connected: s ? s.connected : false, framesDrawn: s ? s.framesDrawn : 0, users };
+    }
   } else if (args.seek === undefined) {
     result.before = await waitFor('frames with every tool present', (s) => everyToolPresent(s) && s.users.every((u) => u.chart));
     await page.waitForTimeout(1500);
@@ -80,12 +108,19 @@ try {
       (s) => s.timeline && Math.abs(s.timeline.time - target) < 1e-6 && s.frame && s.frame.time <= target + 1e-6 &&
         target - s.frame.time < 1.5 / s.scene.frameRateHz && s.users.every((u) => u.chart));
   }
-  if (args['focus-tools'] !== undefined) await page.keyboard.press('t');
-  await page.evaluate(() => window.cohapticView.freeze(true));
-  await page.waitForTimeout(300);  // the frame being drawn lands
-  result.shown = await snapshot();
+  // The screenshot is taken even when its condition was not met (the page may not have started).
+  const ready = await page.evaluate(() => !!window.cohapticView);
+  if (ready) {
+    if (args['focus-tools'] !== undefined) await page.keyboard.press('t');
+    if (args['rigid-removed'] !== undefined) await page.keyboard.press('d');
+    await page.evaluate(() => window.cohapticView.freeze(true));
+    await page.waitForTimeout(300);  // the frame being drawn lands
+    result.shown = await snapshot();
+    result.screen = await screen(page, result.shown);
+  }
   const png = await page.screenshot({ path: args.screenshot });
-  result.pixels = await page.evaluate(async ({ data, shown }) => {
+  pictured = true;
+  if (ready) result.pixels = await page.evaluate(async ({ data, shown, screen }) => {
     const image = new Image();
     image.src = `data:image/png;base64,${data}`;
     await image.decode();
@@ -117,25 +152,44 @@ try {
     const users = shown.users.map((u) => {
       const colour = hex(u.colour);
       const near = (p) => distance(p, colour) < 60;
-      const tool = u.toolScreen ? count(clip({ x0: u.toolScreen.x0 - 12, y0: u.toolScreen.y0 - 12, x1: u.toolScreen.x0 + 12, y1: u.toolScreen.y0 + 12 }), near) : null;
-      let arrow = null;
-      if (u.arrowTipScreen && u.toolScreen) {
-        // Along the arrow, from a third of the way (past the tool's sphere) to the tip.
+      const nearby = (x, y) => {
+        for (let dy = -2; dy <= 2; ++dy) for (let dx = -2; dx <= 2; ++dx) if (near(at(x + dx, y + dy))) return true;
+        return false;
+      };
+      // The tool's outline, a ring at its radius on the screen.
+      let tool = null;
+      if (u.toolScreen) {
         let on = 0, sampled = 0;
-        for (let f = 0.35; f <= 0.95; f += 0.05) {
-          const x = u.toolScreen.x0 + f * (u.arrowTipScreen.x0 - u.toolScreen.x0), y = u.toolScreen.y0 + f * (u.arrowTipScreen.y0 - u.toolScreen.y0);
+        for (let k = 0; k < 48; ++k) {
+          const x = u.toolScreen.x0 + 0.97 * u.toolScreenRadius * Math.cos(k * Math.PI / 24), y = u.toolScreen.y0 + 0.97 * u.toolScreenRadius * Math.sin(k * Math.PI / 24);
+          if (x < shown.canvas.x || y < shown.canvas.y || x >= shown.canvas.x + shown.canvas.width || y >= shown.canvas.y + shown.canvas.height) continue;
           ++sampled;
-          let hit = false;
-          for (let dy = -2; dy <= 2 && !hit; ++dy) for (let dx = -2; dx <= 2 && !hit; ++dx) hit = near(at(x + dx, y + dy));
-          if (hit) ++on;
+          if (nearby(x, y)) ++on;
+        }
+        tool = { matching: on, sampled };
+      }
+      let arrow = null;
+      if (u.arrowTipScreen) {
+        // Along the arrow, from its origin on the tool's surface to its tip.
+        const a = u.arrowOriginScreen, b = u.arrowTipScreen;
+        let on = 0, sampled = 0;
+        for (let f = 0.1; f <= 0.95; f += 0.05) {
+          const x = a.x0 + f * (b.x0 - a.x0), y = a.y0 + f * (b.y0 - a.y0);
+          ++sampled;
+          if (nearby(x, y)) ++on;
         }
         arrow = { matching: on, sampled };
       }
       return { slot: u.slot, tool, arrow };
     });
-    return { mesh, corner: outside, users };
-  }, { data: png.toString('base64'), shown: result.shown });
-  if (args.stay !== undefined) {
+    // The scale bar's line: its lowest row, its bottom border.
+    const bar = screen.scaleBar.box;
+    const row = Math.floor(bar.y + bar.height) - 1;
+    const scaleBar = count({ x0: bar.x + 1, y0: row, x1: bar.x + bar.width - 2, y1: row },
+      (p) => distance(p, [0xe6, 0xe6, 0xe6]) < 40);
+    return { mesh, corner: outside, users, scaleBar };
+  }, { data: png.toString('base64'), shown: result.shown, screen: result.screen });
+  if (args.stay !== undefined && !result.error) {
     // Watching on, drawing every frame, for as long as asked (the demo's browser).
     await page.evaluate(() => window.cohapticView.freeze(false));
     await page.waitForTimeout(Number(args.stay) * 1000);
@@ -143,7 +197,27 @@ try {
   }
 } catch (e) {
   result.error = e.message;
+  // The picture as it is, to see why.
+  if (page && !pictured) await page.screenshot({ path: args.screenshot }).catch(() => {});
 }
 await browser.close();
 console.log(JSON.stringify(result));
 process.exit(result.error ? 1 : 0);
+
+// What the page shows, in CSS pixels (see the header).
+async function screen(page, shown) {
+  const dom = await page.evaluate(() => {
+    const text = (id) => document.getElementById(id).textContent;
+    const line = document.getElementById('scale-bar-line').getBoundingClientRect();
+    return {
+      legendTitle: text('legend-title'), arrowScale: text('arrow-scale'), rigidMotionRemoved: document.getElementById('rigid-removed').checked,
+      scaleBar: { text: text('scale-bar-text'), pixels: line.width, box: { x: line.left, y: line.top, width: line.width, height: line.height } },
+    };
+  });
+  const apart = (a, b) => Math.hypot(a.x0 - b.x0, a.y0 - b.y0);
+  const users = shown.users.map((u) => (u.toolScreen && u.arrowTipScreen ? {
+    slot: u.slot, arrowPixels: apart(u.arrowOriginScreen, u.arrowTipScreen), tipFromToolPixels: apart(u.toolScreen, u.arrowTipScreen),
+    toolRadiusPixels: u.toolScreenRadius, tipOutsideTool: apart(u.toolScreen, u.arrowTipScreen) > u.toolScreenRadius,
+  } : { slot: u.slot, arrowPixels: 0 }));
+  return { ...dom, users };
+}

@@ -1,8 +1,9 @@
 // cohaptic's live view: decodes the view server's messages (proto/cohaptic/view.proto, with
-// protobufjs) and draws them with three.js: the deformed surface coloured by |u|, each
-// user's tool, force arrow, patch and contact nodes, the held nodes, the obstacles; a strip
-// chart and a status table per user; for a recording, a timeline whose controls send
-// Commands back. Lengths arrive in m and are drawn in the scene's unit; forces in N.
+// protobufjs) and draws them with three.js: the deformed surface coloured by |u| (or by the
+// deformation, the best-fit rigid motion removed), each user's translucent tool, force arrow,
+// patch and contact nodes, the held nodes, the obstacles, a scale bar; a strip chart and a
+// status table per user; for a recording, a timeline whose controls send Commands back.
+// Lengths arrive in m and are drawn in the scene's unit; forces in N.
 // window.cohapticView exposes the page's state (the browser test reads it).
 import * as THREE from 'three';
 import { OrbitControls } from '/lib/OrbitControls.js';
@@ -11,6 +12,10 @@ const USER_COLOURS = ['#e4572e', '#17bebb', '#ffc914', '#76b041', '#b07bd8', '#f
 const CHART_SPAN_S = 10;
 // The displacement colour map (viridis at five stops), as the legend's gradient.
 const COLOUR_STOPS = [[0x44, 0x01, 0x54], [0x3b, 0x52, 0x8b], [0x21, 0x91, 0x8c], [0x5e, 0xc9, 0x62], [0xfd, 0xe7, 0x25]];
+// A non-zero force's arrow is at least this fraction of the arrow scale's length (and the
+// tool's radius), so that a small force still shows well outside its tool.
+const ARROW_MIN_FRACTION = 0.25;
+const SCALE_BAR_PX = 120;  // the scale bar's longest length
 
 const $ = (id) => document.getElementById(id);
 
@@ -36,16 +41,85 @@ function niceCeiling(x) {
   return 10 * power;
 }
 
+function niceFloor(x) {
+  if (!(x > 0)) return 1;
+  const power = Math.pow(10, Math.floor(Math.log10(x)));
+  for (const step of [5, 2, 1]) if (step * power <= x * (1 + 1e-9)) return step * power;
+  return power;
+}
+
+// A round length or force as text, without float noise (0.30000000000000004).
+const round = (x) => String(Number(x.toPrecision(3)));
+
 function colourOf(t, out, offset) {
   const x = Math.min(Math.max(t, 0), 1) * (COLOUR_STOPS.length - 1);
   const i = Math.min(Math.floor(x), COLOUR_STOPS.length - 2), f = x - i;
   for (let c = 0; c < 3; ++c) out[offset + c] = (COLOUR_STOPS[i][c] * (1 - f) + COLOUR_STOPS[i + 1][c] * f) / 255;
 }
 
-// protobufjs gives 64-bit integers as {low, high} objects.
-const num = (x) => (typeof x === 'object' && x !== null ? x.high * 4294967296 + (x.low >>> 0) : Number(x));
+// protobufjs gives 64-bit integers as {low, high} objects, and a field at its default (0)
+// not at all.
+const num = (x) => (x === undefined ? 0 : typeof x === 'object' && x !== null ? x.high * 4294967296 + (x.low >>> 0) : Number(x));
 const norm3 = (v) => (v && v.length === 3 ? Math.hypot(v[0], v[1], v[2]) : 0);
 const fmt = (x, digits) => (Number.isFinite(x) ? x.toFixed(digits) : '–');
+
+// ---- the rigid motion ----
+
+// The unit eigenvector of a symmetric 4x4 matrix's largest eigenvalue (cyclic Jacobi; `a` is overwritten).
+function largestEigenvector(a) {
+  const v = [0, 1, 2, 3].map((i) => [0, 1, 2, 3].map((j) => (i === j ? 1 : 0)));
+  for (let sweep = 0; sweep < 50; ++sweep) {
+    let off = 0, all = 0;
+    for (let p = 0; p < 4; ++p) for (let q = 0; q < 4; ++q) { all += a[p][q] * a[p][q]; if (p !== q) off += a[p][q] * a[p][q]; }
+    if (off <= 1e-28 * all) break;
+    for (let p = 0; p < 3; ++p) for (let q = p + 1; q < 4; ++q) {
+      if (a[p][q] === 0) continue;
+      const theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+      const t = (theta >= 0 ? 1 : -1) / (Math.abs(theta) + Math.sqrt(theta * theta + 1));
+      const c = 1 / Math.sqrt(t * t + 1), s = t * c;
+      for (let k = 0; k < 4; ++k) {
+        const kp = a[k][p], kq = a[k][q];
+        a[k][p] = c * kp - s * kq; a[k][q] = s * kp + c * kq;
+      }
+      for (let k = 0; k < 4; ++k) {
+        const pk = a[p][k], qk = a[q][k];
+        a[p][k] = c * pk - s * qk; a[q][k] = s * pk + c * qk;
+      }
+      for (let k = 0; k < 4; ++k) {
+        const kp = v[k][p], kq = v[k][q];
+        v[k][p] = c * kp - s * kq; v[k][q] = s * kp + c * kq;
+      }
+    }
+  }
+  let best = 0;
+  for (let i = 1; i < 4; ++i) if (a[i][i] > a[best][best]) best = i;
+  return v.map((row) => row[best]);
+}
+
+// Writes to `out` the displacement `u` of nodes first..first+count-1 less the rigid motion
+// that best carries their rest positions `rest` to rest + u (least squares: Horn's
+// quaternion method), what is left being the deformation.
+function removeRigidMotion(rest, u, first, count, out) {
+  const restCentre = [0, 0, 0], movedCentre = [0, 0, 0];
+  for (let i = first; i < first + count; ++i)
+    for (let c = 0; c < 3; ++c) { restCentre[c] += rest[3 * i + c] / count; movedCentre[c] += (rest[3 * i + c] + u[3 * i + c]) / count; }
+  const S = [[0, 0, 0], [0, 0, 0], [0, 0, 0]];  // sum of (rest - its centre)(moved - its centre)^T
+  for (let i = first; i < first + count; ++i)
+    for (let a = 0; a < 3; ++a) for (let b = 0; b < 3; ++b)
+      S[a][b] += (rest[3 * i + a] - restCentre[a]) * (rest[3 * i + b] + u[3 * i + b] - movedCentre[b]);
+  const [[xx, xy, xz], [yx, yy, yz], [zx, zy, zz]] = S;
+  const q = largestEigenvector([
+    [xx + yy + zz, yz - zy, zx - xz, xy - yx],
+    [yz - zy, xx - yy - zz, xy + yx, zx + xz],
+    [zx - xz, xy + yx, -xx + yy - zz, yz + zy],
+    [xy - yx, zx + xz, yz + zy, -xx - yy + zz]]);
+  const R = new THREE.Matrix4().makeRotationFromQuaternion(new THREE.Quaternion(q[1], q[2], q[3], q[0])).elements;
+  for (let i = first; i < first + count; ++i) {
+    const r = [0, 1, 2].map((c) => rest[3 * i + c] - restCentre[c]);
+    for (let c = 0; c < 3; ++c)
+      out[3 * i + c] = rest[3 * i + c] + u[3 * i + c] - movedCentre[c] - (R[c] * r[0] + R[4 + c] * r[1] + R[8 + c] * r[2]);
+  }
+}
 
 // ---- the page ----
 
@@ -54,7 +128,8 @@ class View {
     this.schema = schema;
     this.state = {
       connected: false, frozen: false, softwareRenderer: false, scene: null, replay: false, framesReceived: 0, framesDrawn: 0, frame: null,
-      status: {}, timeline: null, drawFps: 0, messageBytes: 0, displacementScaleMm: 0.1, closedReason: '',
+      status: {}, timeline: null, drawFps: 0, messageBytes: 0, displacementScaleMm: 0.1, deformationScaleMm: 0.1, closedReason: '',
+      rigidMotionRemoved: false, forceScaleN: 0.01, arrowScale: null, scaleBar: null,
     };
     this.history = new Map();  // slot -> [{t, f}] (live: from frames)
     this.pendingFrame = null;
@@ -104,6 +179,7 @@ class View {
     $('scrub').addEventListener('input', (e) => send({ seek: Number(e.target.value) }));
     $('jump-peak').addEventListener('click', () => send({ jump: 1 }));
     $('jump-step').addEventListener('click', () => send({ jump: 2 }));
+    $('rigid-removed').addEventListener('change', (e) => this.setRigidMotionRemoved(e.target.checked));
     window.addEventListener('keydown', (e) => {
       if (e.target.tagName === 'INPUT' || e.target.tagName === 'SELECT') return;
       const t = this.state.timeline;
@@ -112,6 +188,7 @@ class View {
       else if (key === 'o') this.toggleObstacles();
       else if (key === 'f') this.frozen = !this.frozen;
       else if (key === 't') this.focusTools();
+      else if (key === 'd') this.setRigidMotionRemoved(!this.state.rigidMotionRemoved);
       else if (!this.state.replay || !t) return;
       else if (e.key === ' ') send(t.playing ? { pause: {} } : { play: {} });
       else if (e.key === 'ArrowLeft' || e.key === 'ArrowRight')
@@ -170,6 +247,7 @@ class View {
   setScene(scene) {
     const unit = 1 / scene.metres_per_unit;
     this.unit = unit;
+    this.units = scene.units;
     this.state.scene = {
       name: scene.scene_name, units: scene.units, source: scene.source, nodes: scene.rest_positions.length / 3,
       triangles: scene.triangles.length / 3, tools: scene.tools.map((t) => ({ slot: t.slot, name: t.name, radius: t.radius })),
@@ -188,6 +266,10 @@ class View {
 
     const n = scene.rest_positions.length / 3;
     this.rest = Float32Array.from(scene.rest_positions, (x) => x * unit);
+    this.restMetres = Float64Array.from(scene.rest_positions);
+    // Each object moves as a body of its own (a recording made before the objects were listed: one body).
+    this.bodies = scene.objects.length ? scene.objects.map((o) => [o.first_node, o.node_count]) : [[0, n]];
+    this.lastFrame = null;
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute('position', new THREE.BufferAttribute(this.rest.slice(), 3));
     geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
@@ -199,9 +281,11 @@ class View {
     this.root.add(this.surface);
     this.box = geometry.boundingBox.clone();
     this.size = this.box.getSize(new THREE.Vector3()).length();
-    // Forces are drawn as arrows of a fixed scale: 1 N is a quarter of the object's diagonal.
-    this.arrowUnitsPerN = niceCeiling(this.size / 4);
-    $('arrow-scale').textContent = `arrow: ${this.arrowUnitsPerN} ${scene.units} = 1 N`;
+    // A force arrow starts at its tool's surface; the round force at or above the largest seen
+    // (a recording's from the start) is a round twentieth of the object's diagonal long.
+    this.arrowReference = niceCeiling(this.size / 20);
+    for (const s of this.series.values()) for (const m of s.magnitudes) this.growForceScale(m);
+    this.showArrowScale();
 
     this.obstacleGroup = new THREE.Group();
     for (const obstacle of scene.obstacles) {
@@ -229,12 +313,16 @@ class View {
     this.users = scene.tools.map((tool, k) => {
       const colour = new THREE.Color(USER_COLOURS[k % USER_COLOURS.length]);
       const radius = tool.radius > 0 ? tool.radius * unit : this.size / 150;
-      const sphere = new THREE.Mesh(new THREE.SphereGeometry(radius, 24, 16), new THREE.MeshPhongMaterial({ color: colour }));
+      // Translucent, so that the dent under the tool shows through it, and outlined by a ring
+      // that faces the camera.
+      const sphere = new THREE.Mesh(new THREE.SphereGeometry(radius, 24, 16),
+        new THREE.MeshPhongMaterial({ color: colour, transparent: true, opacity: 0.35, depthWrite: false }));
       sphere.visible = false;
+      sphere.renderOrder = 1;
+      const outline = new THREE.Mesh(new THREE.RingGeometry(radius * 0.94, radius, 48), new THREE.MeshBasicMaterial({ color: colour, side: THREE.DoubleSide }));
+      sphere.add(outline);
       this.root.add(sphere);
-      const arrow = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 1, colour, 1, 1);
-      arrow.visible = false;
-      arrow.traverse((o) => { if (o.material) { o.material.depthTest = false; } o.renderOrder = 3; });
+      const arrow = this.makeArrow(colour);
       this.root.add(arrow);
       const patch = points(colour.clone().lerp(new THREE.Color(0xffffff), 0.55), pointSize);
       const contact = points(0xffffff, pointSize * 1.8);
@@ -243,7 +331,7 @@ class View {
       label.style.background = USER_COLOURS[k % USER_COLOURS.length];
       label.textContent = tool.name;
       $('labels').appendChild(label);
-      return { slot: tool.slot, tool: tool.name, colour: USER_COLOURS[k % USER_COLOURS.length], sphere, arrow, patch, contact, label,
+      return { slot: tool.slot, tool: tool.name, colour: USER_COLOURS[k % USER_COLOURS.length], sphere, outline, radius, arrow, patch, contact, label,
                present: false, force: [0, 0, 0], position: null, pressing: false };
     });
     for (const old of [...$('labels').children]) if (!this.users.some((u) => u.label === old)) old.remove();
@@ -258,6 +346,47 @@ class View {
     $('injected').textContent = `injected: shift ${fmt(injected.shift_delay_ms || 0, 1)} ms, jitter ${fmt(injected.jitter_ms || 0, 1)} ms, ` +
       `loss ${fmt(100 * (injected.loss || 0), 1)} %, step nodes ${injected.step_nodes || 0}, ` +
       `sim cap ${injected.sim_rate_hz ? fmt(injected.sim_rate_hz, 0) + ' Hz' : 'none'}`;
+  }
+
+  // An arrow along +y from its origin, of unit length until placed: a shaft and a head, drawn
+  // over everything (after the translucent tools) in the user's own colour.
+  makeArrow(colour) {
+    const material = new THREE.MeshBasicMaterial({ color: colour, depthTest: false, transparent: true });
+    const shaft = new THREE.Mesh(new THREE.CylinderGeometry(1, 1, 1, 12).translate(0, 0.5, 0), material);
+    const head = new THREE.Mesh(new THREE.ConeGeometry(1, 1, 16).translate(0, -0.5, 0), material);
+    const arrow = new THREE.Group();
+    arrow.add(shaft, head);
+    arrow.traverse((o) => { o.renderOrder = 3; });
+    arrow.visible = false;
+    return arrow;
+  }
+
+  placeArrow(arrow, origin, direction, length) {
+    const ref = this.arrowReference;
+    const [shaft, head] = arrow.children;
+    const headLength = Math.min(0.2 * ref, 0.5 * length);
+    arrow.position.copy(origin);
+    arrow.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), direction);
+    shaft.scale.set(0.02 * ref, length - headLength, 0.02 * ref);
+    head.position.y = length;
+    head.scale.set(0.3 * headLength, headLength, 0.3 * headLength);
+  }
+
+  growForceScale(magnitude) {
+    if (magnitude > 0) this.state.forceScaleN = Math.max(this.state.forceScaleN, niceCeiling(magnitude));
+  }
+
+  showArrowScale() {
+    const text = `arrow: ${round(this.arrowReference)} ${this.units} = ${round(this.state.forceScaleN)} N`;
+    this.state.arrowScale = { text, length: this.arrowReference, forceN: this.state.forceScaleN };
+    $('arrow-scale').textContent = text;
+  }
+
+  setRigidMotionRemoved(on) {
+    this.state.rigidMotionRemoved = on;
+    $('rigid-removed').checked = on;
+    if (this.lastFrame) this.applyFrame(this.lastFrame);
+    this.needsRender = true;
   }
 
   resetCamera() {
@@ -307,9 +436,11 @@ class View {
           <tr><td>haptic rate</td><td data-field="haptic_rate_hz"></td></tr>
           <tr><td>period p99 (timer floor p99)</td><td data-field="period_p99_us"></td></tr>
           <tr><td>missed deadlines</td><td data-field="missed_deadlines"></td></tr>
-          <tr><td>IR age p99</td><td data-field="ir_age_p99_ms"></td></tr>
+          <tr><td>IR age p99 (max)</td><td data-field="ir_age_p99_ms"></td></tr>
           <tr><td>one-way delay p99</td><td data-field="one_way_delay_p99_ms"></td></tr>
           <tr><td>peak force</td><td data-field="peak_force"></td></tr>
+          <tr><td>ticks at the force limit</td><td data-field="clamped_ticks"></td></tr>
+          <tr><td>fades while pushing (longest)</td><td data-field="fades"></td></tr>
           <tr><td>protocol</td><td data-field="protocol"></td></tr>
         </table>`;
       card.querySelector('.name').textContent = `tool ${user.tool}`;
@@ -349,9 +480,11 @@ class View {
     cell('haptic_rate_hz').textContent = `${fmt(s.haptic_rate_hz, 1)} Hz`;
     cell('period_p99_us').textContent = `${fmt(s.period_p99_us, 0)} µs (${fmt(s.timer_floor_p99_us, 0)} µs)`;
     cell('missed_deadlines').textContent = `${num(s.missed_deadlines)}`;
-    cell('ir_age_p99_ms').textContent = `${fmt(s.ir_age_p99_ms, 1)} ms`;
+    cell('ir_age_p99_ms').textContent = `${fmt(s.ir_age_p99_ms, 1)} ms (${fmt(num(s.ir_age_max_ms), 1)} ms)`;
     cell('one_way_delay_p99_ms').textContent = `${fmt(s.one_way_delay_p99_ms, 2)} ms`;
     cell('peak_force').textContent = `${fmt(s.peak_force, 3)} N${s.final ? ' (final)' : ''}`;
+    cell('clamped_ticks').textContent = `${num(s.clamped_ticks)}`;
+    cell('fades').textContent = `${num(s.fades)} (${fmt(num(s.fade_longest_s) * 1e3, 0)} ms)`;
   }
 
   setTimeline(timeline) {
@@ -376,25 +509,37 @@ class View {
     const unit = this.unit;
     const positions = this.surface.geometry.attributes.position.array;
     const colours = this.surface.geometry.attributes.color.array;
-    const u = frame.displacement;
+    this.lastFrame = frame;
     const n = positions.length / 3;
-    let largest = 0;
-    for (let i = 0; i < n && 3 * i + 2 < u.length; ++i) largest = Math.max(largest, Math.hypot(u[3 * i], u[3 * i + 1], u[3 * i + 2]));
-    // The colour scale grows to the largest displacement seen, in round millimetres.
-    this.state.displacementScaleMm = Math.max(this.state.displacementScaleMm, niceCeiling(largest * 1e3));
-    const scale = this.state.displacementScaleMm / 1e3;
+    const u = Float64Array.from({ length: 3 * n }, (_, k) => frame.displacement[k] || 0);
+    const largestOf = (field) => {
+      let largest = 0;
+      for (let i = 0; i < n; ++i) largest = Math.max(largest, Math.hypot(field[3 * i], field[3 * i + 1], field[3 * i + 2]));
+      return largest;
+    };
+    const largest = largestOf(u);
+    // A body swinging as a whole hides its dent: with the rigid motion removed, the colour is
+    // what is left of u once each body's best-fit rigid motion is taken away.
+    const removed = this.state.rigidMotionRemoved;
+    const coloured = removed ? u.slice() : u;
+    if (removed) for (const [first, count] of this.bodies) removeRigidMotion(this.restMetres, u, first, count, coloured);
+    const largestColoured = removed ? largestOf(coloured) : largest;
+    // The colour scale grows to the largest seen, in round millimetres.
+    const scaleKey = removed ? 'deformationScaleMm' : 'displacementScaleMm';
+    this.state[scaleKey] = Math.max(this.state[scaleKey], niceCeiling(largestColoured * 1e3));
+    const scaleMm = this.state[scaleKey];
     for (let i = 0; i < n; ++i) {
-      const ux = u[3 * i] || 0, uy = u[3 * i + 1] || 0, uz = u[3 * i + 2] || 0;
-      positions[3 * i] = this.rest[3 * i] + ux * unit;
-      positions[3 * i + 1] = this.rest[3 * i + 1] + uy * unit;
-      positions[3 * i + 2] = this.rest[3 * i + 2] + uz * unit;
-      colourOf(Math.hypot(ux, uy, uz) / scale, colours, 3 * i);
+      for (let c = 0; c < 3; ++c) positions[3 * i + c] = this.rest[3 * i + c] + u[3 * i + c] * unit;
+      colourOf(Math.hypot(coloured[3 * i], coloured[3 * i + 1], coloured[3 * i + 2]) * 1e3 / scaleMm, colours, 3 * i);
     }
     this.surface.geometry.attributes.position.needsUpdate = true;
     this.surface.geometry.attributes.color.needsUpdate = true;
     this.surface.geometry.computeVertexNormals();
-    $('legend-max').textContent = fmt(this.state.displacementScaleMm, this.state.displacementScaleMm < 1 ? 2 : 1);
-    $('legend-mid').textContent = fmt(this.state.displacementScaleMm / 2, this.state.displacementScaleMm < 1 ? 2 : 1);
+    $('legend-title').textContent = removed ? 'deformation, rigid motion removed [mm]' : 'displacement |u| [mm]';
+    $('legend-max').textContent = fmt(scaleMm, scaleMm < 1 ? 2 : 1);
+    $('legend-mid').textContent = fmt(scaleMm / 2, scaleMm < 1 ? 2 : 1);
+    for (const data of frame.users) if (data.present) this.growForceScale(norm3(data.force));
+    this.showArrowScale();
 
     const placeNodes = (points, nodes) => {
       const array = points.geometry.attributes.position.array;
@@ -422,14 +567,15 @@ class View {
       user.pressing = data.pressing;
       user.sphere.position.copy(p);
       const magnitude = norm3(data.force);
-      const length = Math.min(magnitude * this.arrowUnitsPerN, this.size * 0.6);
-      user.arrow.visible = length > this.size / 500;
+      user.arrow.visible = magnitude > 0;
+      user.arrowLength = 0;
       if (user.arrow.visible) {
-        user.arrow.position.copy(p);
-        user.arrow.setDirection(new THREE.Vector3(...data.force).normalize());
-        user.arrow.setLength(length, Math.min(length * 0.3, this.size / 25), Math.min(length * 0.15, this.size / 60));
+        const direction = new THREE.Vector3(...data.force).normalize();
+        user.arrowLength = Math.max(this.arrowReference * Math.max(magnitude / this.state.forceScaleN, ARROW_MIN_FRACTION), user.radius);
+        user.arrowOrigin = p.clone().addScaledVector(direction, user.radius);
+        user.arrowTip = user.arrowOrigin.clone().addScaledVector(direction, user.arrowLength);
+        this.placeArrow(user.arrow, user.arrowOrigin, direction, user.arrowLength);
       }
-      user.arrowLength = user.arrow.visible ? length : 0;
       placeNodes(user.patch, data.patch_nodes);
       placeNodes(user.contact, data.contact_nodes);
       user.card.querySelector('.force').textContent = `${fmt(magnitude, 3)} N`;
@@ -438,7 +584,7 @@ class View {
     $('frame-info').textContent = `t = ${fmt(frame.time, 2)} s · simulation ${fmt(frame.sim_rate_hz, 0)} steps/s · |B| = ${boundary}`;
     this.state.frame = {
       time: frame.time, sequence: num(frame.sequence), boundaryNodes: boundary, heldShown: frame.held_nodes.length,
-      simRateHz: frame.sim_rate_hz, maxDisplacementMm: largest * 1e3,
+      simRateHz: frame.sim_rate_hz, maxDisplacementMm: largest * 1e3, maxDeformationMm: removed ? largestColoured * 1e3 : null,
     };
   }
 
@@ -509,14 +655,36 @@ class View {
     }
   }
 
+  // Each tool's name beside its outline, on the side away from its arrow (above without one),
+  // so that the arrow stays in sight.
   placeLabels() {
     const rect = this.canvas.getBoundingClientRect();
     for (const user of this.users || []) {
       if (!user.present || !user.position) continue;
-      const p = user.position.clone().project(this.camera);
-      user.label.style.left = `${((p.x + 1) / 2) * rect.width}px`;
-      user.label.style.top = `${((1 - p.y) / 2) * rect.height}px`;
+      const centre = this.screenBox([user.position]);
+      let dx = 0, dy = -1;
+      if (user.arrow.visible) {
+        const tip = this.screenBox([user.arrowTip]);
+        const apart = Math.hypot(tip.x0 - centre.x0, tip.y0 - centre.y0);
+        if (apart > 1) { dx = (centre.x0 - tip.x0) / apart; dy = (centre.y0 - tip.y0) / apart; }
+      }
+      const reach = this.screenRadius(user.position, user.radius) + 6 +
+        Math.abs(dx) * user.label.offsetWidth / 2 + Math.abs(dy) * user.label.offsetHeight / 2;
+      user.label.style.left = `${centre.x0 - rect.left + dx * reach}px`;
+      user.label.style.top = `${centre.y0 - rect.top + dy * reach}px`;
     }
+  }
+
+  // The length of SCALE_BAR_PX pixels or less, rounded, at the depth the camera orbits about.
+  placeScaleBar() {
+    const depth = this.camera.position.distanceTo(this.orbit.target);
+    const unitsPerPixel = (2 * depth * Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2))) / Math.max(this.canvas.clientHeight, 1);
+    const length = niceFloor(SCALE_BAR_PX * unitsPerPixel);
+    const pixels = length / unitsPerPixel;
+    const text = `${round(length)} ${this.units}`;
+    $('scale-bar-line').style.width = `${pixels}px`;
+    $('scale-bar-text').textContent = text;
+    this.state.scaleBar = { text, length, pixels };
   }
 
   draw(time) {
@@ -536,11 +704,13 @@ class View {
     this.needsRender = false;
     this.light.position.copy(this.camera.position);
     this.light.target.position.copy(this.orbit.target);
+    for (const user of this.users || []) user.outline.quaternion.copy(this.camera.quaternion);
     this.renderer.render(this.scene3d, this.camera);
     this.placeLabels();
+    this.placeScaleBar();
   }
 
-  // ---- for tests: where things are on the screen (CSS pixels of the page) ----
+  // ---- where things are on the screen (CSS pixels of the page; the browser test reads them too) ----
 
   screenBox(points) {
     const rect = this.canvas.getBoundingClientRect();
@@ -551,6 +721,14 @@ class View {
       x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
     }
     return { x0, y0, x1, y1 };
+  }
+
+  // A sphere's silhouette radius on the screen [CSS pixels].
+  screenRadius(centre, radius) {
+    const distance = this.camera.position.distanceTo(centre);
+    const up = new THREE.Vector3(0, 1, 0).applyQuaternion(this.camera.quaternion);
+    const a = this.screenBox([centre]), b = this.screenBox([centre.clone().addScaledVector(up, radius)]);
+    return (Math.hypot(b.x0 - a.x0, b.y0 - a.y0) * distance) / Math.sqrt(Math.max(distance * distance - radius * radius, 1e-12));
   }
 
   snapshot() {
@@ -568,8 +746,9 @@ class View {
         slot: u.slot, tool: u.tool, colour: u.colour, present: u.present, pressing: u.pressing, force: u.force,
         forceMagnitude: norm3(u.force), arrowVisible: u.arrow.visible, arrowLength: u.arrowLength || 0,
         toolScreen: u.present && u.position ? this.screenBox([u.position]) : null,
-        arrowTipScreen: u.arrow.visible ? this.screenBox([u.position.clone().add(
-          new THREE.Vector3(...u.force).normalize().multiplyScalar(u.arrowLength))]) : null,
+        toolScreenRadius: u.present && u.position ? this.screenRadius(u.position, u.radius) : null,
+        arrowOriginScreen: u.arrow.visible ? this.screenBox([u.arrowOrigin]) : null,
+        arrowTipScreen: u.arrow.visible ? this.screenBox([u.arrowTip]) : null,
         chart: u.chartState || null,
         panel: u.card ? Object.fromEntries([...u.card.querySelectorAll('[data-field]')].map((c) => [c.dataset.field, c.textContent])) : {},
       })),
