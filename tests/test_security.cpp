@@ -130,13 +130,13 @@ TEST(Security, EachParticipantKeyOpensItsOwnSlotOnly) {
   EXPECT_EQ(a["datagrams"]["rejected"], 0);
 
   // A client refuses a --slot its key file does not open, and a key file others may read.
-  const auto mismatch = session.client("carol", 0, write_press(session.dir, "c", 0, 0, 1, 0),
+  const auto mismatch = session.client("carol", 0, write_press(session.dir, "c", 0, 0, 1, 1),
                                        {"--key-file", (keys / "p1.key").string()});
   EXPECT_EQ(mismatch->wait(testing::kPatience), 1);
   EXPECT_NE(mismatch->log_text().find("--slot 0, but the key file is participant 1's"), std::string::npos)
       << mismatch->log_text();
   ::chmod((keys / "p1.key").c_str(), 0644);
-  const auto readable = session.client("dave", -1, write_press(session.dir, "d", 0, 0, 1, 0),
+  const auto readable = session.client("dave", -1, write_press(session.dir, "d", 0, 0, 1, 1),
                                        {"--key-file", (keys / "p1.key").string()});
   EXPECT_EQ(readable->wait(testing::kPatience), 1);
   EXPECT_NE(readable->log_text().find("mode 0644"), std::string::npos) << readable->log_text();
@@ -204,7 +204,7 @@ TEST(Security, TheWireCarriesNoPlaintextAndStaleOrOldPeersAreRefused) {
   reader.join();
   EXPECT_TRUE(contains(reader.received_bytes(), "soft-cube"));
   EXPECT_TRUE(contains(reader.received_bytes(), "youngs_modulus"));
-  const auto strict = clear.client("erin", 1, write_press(clear.dir, "e", 0, 0, 1, 0), {"--join-timeout", "3"});
+  const auto strict = clear.client("erin", 1, write_press(clear.dir, "e", 0, 0, 1, 1), {"--join-timeout", "3"});
   EXPECT_EQ(strict->wait(testing::kPatience), 1);
   EXPECT_NE(strict->log_text().find("a frame in clear, and this side requires encryption"), std::string::npos)
       << strict->log_text();
