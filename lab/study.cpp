@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <random>
@@ -84,26 +85,19 @@ std::filesystem::path program_beside(const std::string& relative) {
 }
 
 // The simulation's server steps per second, from its report.
-double server_sim_rate_hz(const std::filesystem::path& report_file) {
+// A figure of a process's JSON report, at `keys` (e.g. {"server", "sim_rate_hz"}); NaN,
+// with a warning, when the report has none.
+double report_figure(const std::filesystem::path& report_file, std::initializer_list<const char*> keys) {
   try {
-    return nlohmann::json::parse(read_text_file(report_file.string())).at("server").at("sim_rate_hz").get<double>();
+    nlohmann::json node = nlohmann::json::parse(read_text_file(report_file.string()));
+    for (const char* key : keys) node = node.at(key);
+    return node.get<double>();
   } catch (const std::exception& e) {
-    spdlog::warn("no simulation rate in {}: {}", report_file.string(), e.what());
+    spdlog::warn("no {} in {}: {}", fmt::join(keys, "."), report_file.string(), e.what());
     return std::nan("");
   }
 }
 
-// The fades the participant felt (client report "fades": count, total_s): a trial the
-// machine could not keep up with shows them. NaN when the report has none.
-std::pair<double, double> client_fades(const std::filesystem::path& report_file) {
-  try {
-    const nlohmann::json fades = nlohmann::json::parse(read_text_file(report_file.string())).at("fades");
-    return {fades.at("count").get<double>(), fades.at("total_s").get<double>()};
-  } catch (const std::exception& e) {
-    spdlog::warn("no fades in {}: {}", report_file.string(), e.what());
-    return {std::nan(""), std::nan("")};
-  }
-}
 
 // The simulation's step rate while `slot`'s tool pressed the object: the steps of the
 // server's recording in which it pressed, over the time from each to the next step. This is
@@ -288,7 +282,7 @@ std::vector<std::vector<std::string>> run_trial(const Study& study, const StudyT
   server.signal(SIGINT);
   if (server.wait(30s) != 0) trial_status = fmt::format("the server failed (see {})", (dir / "server.log").string());
 
-  const double sim_rate_hz = server_sim_rate_hz(dir / "server.json");
+  const double sim_rate_hz = report_figure(dir / "server.json", {"server", "sim_rate_hz"});
   std::optional<record::Recording> server_recording;
   try {
     server_recording = record::read_recording(dir / "server.mcap");
@@ -305,9 +299,9 @@ std::vector<std::vector<std::string>> run_trial(const Study& study, const StudyT
         measured.push_back(m.value);
       measured.push_back(server_recording ? contact_sim_rate_hz(*server_recording, p.slot) : std::nan(""));
       measured.push_back(sim_rate_hz);
-      const auto [fades, fade_s] = client_fades(dir / (p.name + ".json"));
-      measured.push_back(fades);
-      measured.push_back(fade_s);
+      // The fades the participant felt: a trial the machine could not keep up with shows them.
+      measured.push_back(report_figure(dir / (p.name + ".json"), {"fades", "count"}));
+      measured.push_back(report_figure(dir / (p.name + ".json"), {"fades", "total_s"}));
       values = std::move(measured);
     } catch (const Error& e) {
       status = fmt::format("no measures: {}", e.what());

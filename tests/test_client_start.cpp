@@ -4,11 +4,7 @@
 // from the scene (a file in metres read as millimetres' worth, say) is warned of at start.
 #include <gtest/gtest.h>
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <signal.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -20,24 +16,12 @@
 #include "proto/wire/session_key.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
+#include "support/taken_port.h"
 
 namespace cohaptic {
 namespace {
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-
-// A loopback TCP port nothing listens on (bound, then released).
-int closed_port() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t size = sizeof address;
-  bind(fd, reinterpret_cast<sockaddr*>(&address), size);
-  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size);
-  close(fd);
-  return ntohs(address.sin_port);
-}
 
 // The client's log once it has ended (it must end within the patience).
 std::string client_log(const fs::path& dir, const std::string& name, std::vector<std::string> arguments) {
@@ -55,7 +39,7 @@ std::string write_hold(const fs::path& dir, const std::string& name, const std::
 
 TEST(ClientStart, ABadDeviceFileIsNamedBeforeJoining) {
   const fs::path dir = testing::scratch_directory("client-bad-device");
-  const std::string log = client_log(dir, "client", {"--server", fmt::format("127.0.0.1:{}", closed_port()), "--user", "a",
+  const std::string log = client_log(dir, "client", {"--server", fmt::format("127.0.0.1:{}", testing::closed_port()), "--user", "a",
                                                      "--device", "script:" + (dir / "missing.yaml").string()});
   EXPECT_NE(log.find("missing.yaml: cannot open the file"), std::string::npos) << log;
   EXPECT_EQ(log.find("cannot join"), std::string::npos) << "it tried to join first\n" << log;
@@ -64,7 +48,7 @@ TEST(ClientStart, ABadDeviceFileIsNamedBeforeJoining) {
 TEST(ClientStart, NobodyListeningAndARejectedKeyAreDifferentMessagesAndAFarPathIsWarned) {
   const fs::path dir = testing::scratch_directory("client-start");
   const std::string hold = write_hold(dir, "hold", "mm");
-  std::string log = client_log(dir, "refused", {"--server", fmt::format("127.0.0.1:{}", closed_port()), "--user", "a",
+  std::string log = client_log(dir, "refused", {"--server", fmt::format("127.0.0.1:{}", testing::closed_port()), "--user", "a",
                                                 "--device", "script:" + hold, "--join-timeout", "2"});
   EXPECT_NE(log.find("connection refused: nothing listens there"), std::string::npos) << log;
 

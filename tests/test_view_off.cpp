@@ -2,44 +2,21 @@
 // taken by another program) says once that the view is off and why, and the session goes on.
 #include <gtest/gtest.h>
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <fstream>
 #include <string>
 
 #include "support/cube_scene.h"
 #include "support/process.h"
+#include "support/taken_port.h"
 
 namespace cohaptic {
 namespace {
 
 namespace fs = std::filesystem;
 
-// A TCP port on 127.0.0.1 that this object listens on (so nobody else can) until destroyed.
-struct TakenPort {
-  int fd = socket(AF_INET, SOCK_STREAM, 0);
-  int port = -1;
-  TakenPort() {
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    socklen_t size = sizeof address;
-    if (fd < 0 || bind(fd, reinterpret_cast<sockaddr*>(&address), size) != 0 || listen(fd, 1) != 0 ||
-        getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size) != 0)
-      return;
-    port = ntohs(address.sin_port);
-  }
-  ~TakenPort() {
-    if (fd >= 0) close(fd);
-  }
-};
-
 TEST(LiveView, AViewThatCannotServeItsPageIsOffAndTheSessionGoesOn) {
-  const TakenPort taken;
-  ASSERT_GT(taken.port, 0);
+  const testing::TakenPort taken;
+  ASSERT_GT(taken.port(), 0);
   const fs::path dir = testing::scratch_directory("view-off");
   testing::CubeSceneOptions cube;
   cube.divisions = 4;
@@ -47,11 +24,11 @@ TEST(LiveView, AViewThatCannotServeItsPageIsOffAndTheSessionGoesOn) {
   std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(cube);
   std::ofstream(dir / "a.yaml") << "units: mm\nstart: [0, 0, 80]\nsegments:\n  - {hold: 1}\n";
 
-  testing::run_scripted_session(dir, dir / "cube.yaml", {"--view", "127.0.0.1:" + std::to_string(taken.port)},
+  testing::run_scripted_session(dir, dir / "cube.yaml", {"--view", "127.0.0.1:" + std::to_string(taken.port())},
                                 {{"a", dir / "a.yaml"}});
   std::ifstream in(dir / "server.log");
   const std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string off = "live view off: view: cannot listen on 127.0.0.1:" + std::to_string(taken.port);
+  const std::string off = "live view off: view: cannot listen on 127.0.0.1:" + std::to_string(taken.port());
   EXPECT_NE(log.find(off), std::string::npos) << log;
   EXPECT_EQ(log.find("live view off"), log.rfind("live view off")) << "said once\n" << log;
   EXPECT_EQ(log.find("live view at"), std::string::npos) << log;
