@@ -94,7 +94,7 @@ probe-demo: build
 	@$(LAB) probe --scene scenes/cube.yaml --tool 30,-20,-5 --tool -60,60,-3 --contact-model point \
 	  --boundary-nodes 300 --ir-precision f32 --log-level warn
 
-# Speed against accuracy on the paper's cube (README "Speed versus accuracy"): every
+# Speed against accuracy on the paper's cube (docs/speed-versus-accuracy.md "Speed versus accuracy"): every
 # setting against the full solve on an 18-division mesh; about a minute.
 tradeoff: build
 	$(LAB) tradeoff --scene scenes/tradeoff/cube_two_users.yaml --motion scenes/tradeoff/cube_press_slide.yaml \

@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
   app.add_flag("--best-effort", best_effort, "Do not try SCHED_FIFO and mlockall");
   app.add_flag("--passivity-control", settings.passivity_control,
                "Filter the force through a passivity observer/controller (stable against stiff, delayed or stepwise "
-               "forces, at some cost in transparency; README \"Stability\")");
+               "forces, at some cost in transparency; docs/stability.md \"Stability\")");
   app.add_option("--passivity-mass", settings.passivity_mass_kg,
                  "The lightest mass expected at the tool [kg]: caps the controller's damping at m / (2 T)")
       ->capture_default_str()

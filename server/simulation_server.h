@@ -43,7 +43,7 @@ class SimulationServer {
 
   std::uint16_t tcp_port() const;
   std::uint16_t udp_port() const;
-  /// The report (README.md, "Reports"); complete once run() has returned.
+  /// The report (docs/programs.md, "Reports"); complete once run() has returned.
   nlohmann::json report() const;
 
  private:

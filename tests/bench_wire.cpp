@@ -1,4 +1,4 @@
-// What sealing costs on the wire (README "Security and robustness"): one tool-sample
+// What sealing costs on the wire (docs/security.md "Security and robustness"): one tool-sample
 // datagram and one IR frame, each sealed by the sender and opened by the receiver, in
 // three modes side by side in one run:
 //   none       serialize and parse only, no envelope and no tag: the cost without protection;

@@ -1,4 +1,4 @@
-// The one-way rule of the layout (README.md, "Layout"), read from the sources: every
+// The one-way rule of the layout (docs/layout.md, "Layout"), read from the sources: every
 // `#include "..."` of common/, proto/, net/, view/, server/, client/ and lab/ is resolved to
 // the directory (the floor) it comes from, and each floor may include only the floors listed
 // for it: server/ and client/ never include each other or lab/, net/ and view/ no program's

@@ -245,7 +245,7 @@ TEST(ViewInBrowser, TheDemosBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
 
   // As make demo's picture: once both surgeons press with 0.01 N, the camera close to the
   // tools. Held at their deepest, the 7 mm spheres feel about 0.038 N (A) and 0.029 N (B)
-  // (README "The brain scene": this soft a brain gives no more to a tip that fits the corridor).
+  // (docs/brain-scene.md "The brain scene": this soft a brain gives no more to a tip that fits the corridor).
   const json brain = check_page(dir, "brain", {"--url", session.url, "--screenshot", (dir / "brain.png").string(),
                                                "--min-force", "0.01", "--focus-tools", "1"});
   ASSERT_FALSE(brain.contains("error")) << brain.dump();

@@ -1,5 +1,5 @@
 // ReplayPlayer: a server recording played back in the live view's page
-// (`cohaptic-lab replay FILE --view HOST:PORT`, README.md, "The live view"). It holds what
+// (`cohaptic-lab replay FILE --view HOST:PORT`, docs/live-view.md, "The live view"). It holds what
 // the recording has for the page (the view's Scene, with every frame's force magnitudes
 // added for the charts, every Frame, the users' status reports, all in simulation time) and a playback position: play, pause, speed, seek, and jumps to
 // the frame with the largest force and to the largest force step between two frames. One

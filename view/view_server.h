@@ -1,4 +1,4 @@
-// ViewServer: the web server of the live view (README.md, "The live view"). On its own
+// ViewServer: the web server of the live view (docs/live-view.md, "The live view"). On its own
 // thread and io_context it serves, on one TCP port:
 //   - HTTP GET of the page and its assets (view_assets.h), held in memory;
 //   - a WebSocket at /ws for the data: binary view.proto ServerMessages out, Commands in.

@@ -1,5 +1,5 @@
 // Who may watch: the live view is bound to loopback unless told otherwise, and on any other
-// address a browser must present a token (README.md, "The live view"). The token comes
+// address a browser must present a token (docs/live-view.md, "The live view"). The token comes
 // from a file (first line, at least 16 characters) or is drawn at random and printed in
 // the page's address.
 #pragma once

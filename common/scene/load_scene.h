@@ -1,4 +1,4 @@
-// Loading and validating a YAML scene file (format in README.md, "Scene files").
+// Loading and validating a YAML scene file (format in docs/scene-files.md, "Scene files").
 //
 // Every problem is reported as a SceneError whose message names the file, the line,
 // the key path (e.g. objects[0].material.poisson_ratio), what was expected and what was

@@ -1,5 +1,5 @@
 // The keys of a `model: home_spring` scene object and of an instrument tool (`shape: probe`
-// or `shape: forceps`) (README.md, "Laparoscopic instruments"), validated with the scene
+// or `shape: forceps`) (docs/laparoscopy.md, "Laparoscopic instruments"), validated with the scene
 // loader's errors (file:line: key.path: expected ..., found ...).
 #pragma once
 

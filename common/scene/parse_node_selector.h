@@ -1,4 +1,4 @@
-// The scene file's node selectors (README.md, "Scene files": surface, box, plane or nodes),
+// The scene file's node selectors (docs/scene-files.md, "Scene files": surface, box, plane or nodes),
 // validated with the scene loader's errors (file:line: key.path: expected ..., found ...).
 #pragma once
 

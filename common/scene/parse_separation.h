@@ -1,4 +1,4 @@
-// The keys of a `model: separation` scene object (README.md, "Separating tissue"),
+// The keys of a `model: separation` scene object (docs/separation.md, "Separating tissue"),
 // validated with the scene loader's errors (file:line: key.path: expected ..., found ...).
 #pragma once
 

@@ -3,7 +3,7 @@
 // Everything here is in SI units (lengths converted from the file's `units` on load;
 // moduli in Pa, forces in N, rates in Hz). A Scene is validated when loaded (see
 // load_scene.h) and compiled into a Model (model.h); only what it lists is built.
-// The file format is documented in README.md, "Scene files".
+// The file format is documented in docs/scene-files.md, "Scene files".
 #pragma once
 
 #include <Eigen/Core>

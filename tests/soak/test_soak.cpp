@@ -1,6 +1,6 @@
 // The soak: hours of use compressed into a session with four participants and churn, under
 // 10 % datagram loss and 10 ms jitter (injected by the server), for COHAPTIC_SOAK_MINUTES
-// minutes (5 by default, as CI runs it; README "Security and robustness" runs 60):
+// minutes (5 by default, as CI runs it; docs/security.md "Security and robustness" runs 60):
 //   - alice and bob, real clients, press and slide on the cube for the whole run;
 //   - carol, a real client, joins, presses and leaves, again and again: a new process, a
 //     new report and a new recording every few seconds;
