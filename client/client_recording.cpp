@@ -37,6 +37,7 @@ record::HapticTick haptic_tick_record(const TickRecord& tick) {
   record.set_fade(tick.fade);
   record.set_own_valid(tick.own_valid);
   record.set_buttons(tick.buttons);
+  if (tick.ir_age_ns >= 0) record.set_ir_age_ns(tick.ir_age_ns);
   return record;
 }
 

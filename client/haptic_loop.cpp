@@ -132,7 +132,10 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       record.ir_epoch = slot.epoch;
     }
   }
-  if (age != std::numeric_limits<std::int64_t>::max()) metrics_.ir_age_ns.record(age);
+  if (age != std::numeric_limits<std::int64_t>::max()) {
+    metrics_.ir_age_ns.record(age);
+    record.ir_age_ns = age;
+  }
   record.evaluated = force;
 
   // Stale data fades out.

@@ -21,6 +21,7 @@
 #include <memory>
 
 #include "common/haptics/fade_tally.h"
+#include "common/haptics/ir_age_histogram.h"
 #include "common/haptics/haptic_device.h"
 #include "common/haptics/passivity_controller.h"
 #include "common/ir/evaluate_force.h"
@@ -107,6 +108,7 @@ struct TickRecord {
   double dt = 0;                                         ///< the period the evaluation advanced by [s] (P1)
   std::uint8_t flags = 0;
   float fade = 1;
+  std::int64_t ir_age_ns = -1;                           ///< of the IR or force used (-1: none yet)
 };
 
 enum class HapticEventKind : std::uint8_t { non_finite, ir_switched, fading, started_realtime, realtime_refused };
@@ -142,7 +144,7 @@ struct HapticChannels {
 
 struct HapticMetrics {
   Histogram period_ns{1000, 50000};   ///< 1 us bins up to 50 ms
-  Histogram ir_age_ns{100000, 20000}; ///< 0.1 ms bins up to 2 s
+  Histogram ir_age_ns = ir_age_histogram();
   std::uint64_t ticks = 0, missed_deadlines = 0, non_finite = 0, clamped = 0, ir_switches = 0;
   std::uint64_t contact_unresolved = 0;  ///< ticks that held the last force (sphere solve unfinished)
   double peak_force = 0;      ///< [N]

@@ -64,7 +64,7 @@ trap cleanup EXIT
 
 view=()
 [[ "$view_port" == off ]] || view=(--view "127.0.0.1:$view_port")
-# The server outlives the clients by a few seconds so that both can say goodbye.
+# The server outlives the clients (stopped once both are done) so that both can say goodbye.
 "$server_bin" --scene "$scene" --listen "127.0.0.1:$port" --protocol "$protocol" --ir-form "$ir_form" \
   --duration $((duration + 6)) --report "$out/server.json" --record "$out/server.mcap" "${display[@]}" \
   "${view[@]}" >"$out/server.log" 2>&1 &
@@ -101,6 +101,8 @@ pids+=($!)
 status=0
 wait "${pids[-2]}" || status=$?
 wait "${pids[-1]}" || status=$?
+# Both surgeons have said goodbye: the server stops now (its --duration is the backstop).
+kill -INT "${pids[0]}" 2>/dev/null || true
 wait "${pids[0]}" || status=$?
 if [[ ${#pids[@]} -gt 3 ]]; then
   wait "${pids[1]}" && echo "demo: screenshot of the live view in $screenshot" || echo "demo: no screenshot (see $out/view_check.json)"

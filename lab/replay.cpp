@@ -19,6 +19,7 @@
 #include "common/sim/elastic_states.h"
 #include "common/sim/scene_simulation.h"
 #include "common/haptics/fade_tally.h"
+#include "common/haptics/ir_age_histogram.h"
 #include "common/util/atomic_file.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
@@ -228,7 +229,9 @@ void print_summary(const Recording& rec) {
     double peak = 0;
     std::size_t at_limit = 0;
     FadeTally fades;
+    Histogram ir_ages = ir_age_histogram();
     for (const auto& t : rec.ticks) {
+      if (t.has_ir_age_ns()) ir_ages.record(t.ir_age_ns());
       const double force = wire::from_wire(t.force()).norm();
       peak = std::max(peak, force);
       if (c.force_limit() > 0 && force >= c.force_limit() * (1 - 1e-9)) ++at_limit;
@@ -237,6 +240,12 @@ void print_summary(const Recording& rec) {
     fmt::print("force       peak {:.4f} N; {} ticks at the force limit ({:g} N)\n", peak, at_limit, c.force_limit());
     fmt::print("fades       {} while pushing ({:.0f} ms in all, the longest {:.0f} ms)\n", fades.count, fades.total_s * 1e3,
                fades.longest_s * 1e3);
+    const auto ms = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-6; };
+    if (ir_ages.count() > 0)
+      fmt::print("IR age      p50 {:.1f} ms, p99 {:.1f} ms, max {:.1f} ms\n", ms(ir_ages.quantile(0.5)), ms(ir_ages.quantile(0.99)),
+                 ms(ir_ages.max()));
+    else
+      fmt::print("IR age      not recorded (no tick had an IR yet, or the recording predates IR ages)\n");
   }
   for (const auto& e : rec.events) fmt::print("event       {:9.3f} s  {}: {}\n", seconds(e.time_ns(), c.start_time_ns()), e.kind(), e.text());
 }
@@ -246,14 +255,16 @@ void export_csv(const Recording& rec, const std::filesystem::path& dir) {
   const std::int64_t start = rec.config.start_time_ns();
   if (!rec.ticks.empty()) {
     AtomicFile out(dir / "haptic.csv");
-    out.write("time_s,own_x,own_y,own_z,own_valid,force_x,force_y,force_z,evaluated_x,evaluated_y,evaluated_z,ir_epoch,flags,fade");
+    out.write("time_s,own_x,own_y,own_z,own_valid,force_x,force_y,force_z,evaluated_x,evaluated_y,evaluated_z,ir_epoch,flags,fade,ir_age_ms");
     out.write(",remote_x,remote_y,remote_z\n");
     for (const auto& t : rec.ticks) {
       const Eigen::Vector3d o = wire::from_wire(t.own()), f = wire::from_wire(t.force()), e = wire::from_wire(t.evaluated());
       const Eigen::Vector3d r = t.remotes_size() ? wire::from_wire(t.remotes(0)) : Eigen::Vector3d::Constant(std::nan(""));
-      out.print("{:.9f},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{},{:.17g},{:.17g},{:.17g}\n",
+      out.print("{:.9f},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{},{},{:.17g},{:.17g},{:.17g}\n",
                 seconds(t.time_ns(), start), o.x(), o.y(), o.z(), t.own_valid() ? 1 : 0, f.x(), f.y(), f.z(), e.x(), e.y(),
-                e.z(), t.ir_epoch(), t.flags(), t.fade(), r.x(), r.y(), r.z());
+                e.z(), t.ir_epoch(), t.flags(), t.fade(),
+                t.has_ir_age_ns() ? fmt::format("{:.4f}", static_cast<double>(t.ir_age_ns()) * 1e-6) : std::string(), r.x(),
+                r.y(), r.z());
     }
     out.commit();
   }

@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
 
 #include "client/device/make_device.h"
 #include "client/device/recorded_motion.h"
@@ -66,7 +68,7 @@ struct RecordedSession {
         testing::client_program(),
         std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot", std::to_string(slot),
                                  "--device", device.empty() ? "script:" + (dir / (user + ".yaml")).string() : device,
-                                 "--record", (dir / (user + ".mcap")).string()},
+                                 "--record", (dir / (user + ".mcap")).string(), "--report", (dir / (user + ".json")).string()},
         dir / (user + ".log"));
   }
   void stop() {
@@ -102,6 +104,23 @@ TEST(Replay, ATwoUserSessionVerifiesBitForBit) {
   for (const auto& tick : a_recording.ticks) saw_remote |= tick.remotes_size() > 0 && std::isfinite(tick.remotes(0).x());
   EXPECT_TRUE(saw_remote);
   EXPECT_FALSE(a_recording.truncated);
+
+  // The summary of a client's recording shows its report's counters, recomputed from the ticks.
+  for (const std::string user : {"a", "b"}) {
+    ChildProcess replay(COHAPTIC_LAB_EXE, {"replay", (session.dir / (user + ".mcap")).string(), "--summary"},
+                        session.dir / ("summary-" + user + ".log"));
+    ASSERT_EQ(replay.wait(testing::kPatience), 0) << replay.log_text();
+    const std::string summary = replay.log_text();
+    const nlohmann::json report = nlohmann::json::parse(std::ifstream(session.dir / (user + ".json")));
+    std::smatch fades, ages;
+    ASSERT_TRUE(std::regex_search(summary, fades, std::regex(R"(fades +(\d+) while pushing)"))) << summary;
+    EXPECT_EQ(std::stoi(fades[1].str()), report["fades"]["count"].get<int>()) << summary;
+    ASSERT_TRUE(std::regex_search(summary, ages, std::regex(R"(IR age +p50 ([0-9.]+) ms, p99 ([0-9.]+) ms, max ([0-9.]+) ms)")))
+        << summary;
+    EXPECT_NEAR(std::stod(ages[2].str()), report["ir_age_ms"]["p99"].get<double>(), 0.051) << summary;
+    EXPECT_NEAR(std::stod(ages[3].str()), report["ir_age_ms"]["max"].get<double>(), 0.051) << summary;
+    EXPECT_GT(report["ir_age_ms"]["max"].get<double>(), 0) << "an IR age the summary could match by accident";
+  }
 }
 
 // With B truncation the client receives compliance rows that list the held nodes left out;

@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "proto/record/recording.h"
+#include "support/browser.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
 
@@ -31,31 +32,11 @@ constexpr std::chrono::milliseconds kBrowserPatience{240'000};
 
 const fs::path kSource = COHAPTIC_SOURCE_DIR;
 
-// node, from the PATH; empty if there is none.
-std::string node_program() {
-  const char* path = std::getenv("PATH");
-  std::stringstream directories(path ? path : "");
-  for (std::string directory; std::getline(directories, directory, ':');)
-    if (fs::exists(fs::path(directory) / "node")) return (fs::path(directory) / "node").string();
-  return "";
-}
-
-// Why the browser test cannot run here, or empty.
-std::string missing_browser() {
-  const char* chosen = std::getenv("CHROMIUM");
-  const bool chromium = (chosen && fs::exists(chosen)) || fs::exists("/usr/bin/chromium") || fs::exists("/usr/bin/chromium-browser");
-  if (node_program().empty()) return "no node on the PATH: install Node.js (deploy/install-deps.sh does)";
-  if (!chromium) return "no Chromium: install the Debian package chromium (deploy/install-deps.sh does)";
-  if (!fs::exists(kSource / "deploy/node/node_modules/playwright-core"))
-    return "no playwright-core in deploy/node/node_modules: run deploy/install-deps.sh (npm ci --prefix deploy/node)";
-  return "";
-}
-
 // Runs view_check.mjs with `arguments`, expecting it to exit with `expected_status`; its JSON result.
 json check_page(const fs::path& dir, const std::string& name, const std::vector<std::string>& arguments, int expected_status = 0) {
   std::vector<std::string> all = {(kSource / "tests/support/view_check.mjs").string()};
   all.insert(all.end(), arguments.begin(), arguments.end());
-  ChildProcess node(node_program(), all, dir / (name + ".log"));
+  ChildProcess node(testing::node_program(), all, dir / (name + ".log"));
   const std::optional<int> status = node.wait(kBrowserPatience);
   const std::string output = node.log_text();
   EXPECT_EQ(status, expected_status) << output;
@@ -165,7 +146,7 @@ std::pair<double, int> shown_number(const std::string& text, int which = 0) {
 }
 
 TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClientsFigures) {
-  if (const std::string why = missing_browser(); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = testing::missing_browser(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = cube_session("view-live", 4, 600);  // they hold until told to stop
   ViewSession session(dir, dir / "cube.yaml");
   ASSERT_FALSE(session.url.empty()) << session.server->log_text();
@@ -236,7 +217,7 @@ TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClients
 }
 
 TEST(ViewInBrowser, TheDemosBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
-  if (const std::string why = missing_browser(); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = testing::missing_browser(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = brain_session("view-brain");
   ViewSession session(dir, kSource / "scenes/brain.yaml");
   ASSERT_FALSE(session.url.empty()) << session.server->log_text();
@@ -337,7 +318,7 @@ TEST(ViewInBrowser, TheDemosBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
 }
 
 TEST(ViewInBrowser, AReplayScrubsToAGivenTimeShowingThatTimesForceAndJumpsToThePeak) {
-  if (const std::string why = missing_browser(); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = testing::missing_browser(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = cube_session("view-replay", 3, 1);
   ViewSession session(dir, dir / "cube.yaml");
   {
@@ -413,7 +394,7 @@ double largest_frame_displacement(const view::Frame& frame) {
 // below that. Live, the page draws the frame the server recorded; replayed, the frame at the
 // time asked for, both with the network's displacement.
 TEST(ViewInBrowser, TheMassSpringNoodleIsDrawnPressedLiveAndInItsReplay) {
-  if (const std::string why = missing_browser(); !why.empty()) GTEST_SKIP() << why;
+  if (const std::string why = testing::missing_browser(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = testing::scratch_directory("view-noodle");
   for (const auto& [user, x] : {std::pair{"a", 29}, std::pair{"b", 58}})
     std::ofstream(dir / (std::string(user) + ".yaml")) << fmt::format(R"(
