@@ -5,6 +5,7 @@
 #   make bench  the same set-up, then the benchmarks (BENCH_ARGS passes arguments through)
 #   make bench-thin  the mass-spring benchmarks beside the thin-objects paper's Table 2
 #   make bench-sphere  the sphere contact model's client tick and server step beside the dense solve
+#   make bench-compliance  the brain's compliance by solves and by the Schur complement, same run
 #   make fuzz       build the fuzz targets with clang (libFuzzer, ASan, UBSan) in build-asan
 #                   and run each for FUZZ_SECONDS (default 15; 0 builds only), FUZZ_JOBS at once
 #   make test-asan  the suite (ASAN_TESTS: all by default) built with clang, ASan + UBSan, in
@@ -60,7 +61,7 @@ SANITIZER_CMAKE = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
 SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
   TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
 
-.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere fuzz test-asan test-tsan clean
+.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance fuzz test-asan test-tsan clean
 
 all: build
 
@@ -119,6 +120,12 @@ bench-thin:
 bench-sphere:
 	@$(MAKE) --no-print-directory build >&2
 	@tests/sphere_contact_tables.sh $(BUILD_DIR)/tests/cohaptic_bench
+
+# The compliance of the brain's row nodes by solves and by the Schur complement, in the same
+# run, on each brain mesh, as Markdown (a few minutes).
+bench-compliance:
+	@$(MAKE) --no-print-directory build >&2
+	@tests/compliance_tables.sh $(BUILD_DIR)/tests/cohaptic_bench
 
 $(ASAN_BUILD_DIR)/CMakeCache.txt: | deps
 	cmake -S . -B $(ASAN_BUILD_DIR) $(SANITIZER_CMAKE) -DCOHAPTIC_FUZZ=ON

@@ -73,11 +73,11 @@ TEST(Compliance, AColumnsBitsDoNotDependOnWhatElseWasAskedFor) {
   }
 }
 
-TEST(ComplianceCache, KeyChangesWithMeshMaterialBoundaryConditionsAndRows) {
+TEST(ComplianceCache, KeyChangesWithMeshMaterialBoundaryConditionsRowsAndRoute) {
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
   const ElasticBody& body = single_elastic_body(model);
   const auto key = [&](const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
-                       const std::vector<int>& rows) { return compliance_cache_key(mesh, material, dofs, rows); };
+                       const std::vector<int>& rows) { return compliance_cache_key(mesh, material, dofs, rows, ComplianceRoute::solves); };
   const LinearElasticMaterial material = body.spec.material;
   const Digest base = key(body.mesh, material, body.dofs, body.touchable_nodes);
   EXPECT_EQ(base, key(body.mesh, material, body.dofs, body.touchable_nodes));
@@ -95,6 +95,7 @@ TEST(ComplianceCache, KeyChangesWithMeshMaterialBoundaryConditionsAndRows) {
   EXPECT_NE(base, key(body.mesh, material, make_dof_map(fixed), body.touchable_nodes));
   std::vector<int> fewer_rows(body.touchable_nodes.begin() + 1, body.touchable_nodes.end());
   EXPECT_NE(base, key(body.mesh, material, body.dofs, fewer_rows));
+  EXPECT_NE(base, compliance_cache_key(body.mesh, material, body.dofs, body.touchable_nodes, ComplianceRoute::schur));
 }
 
 TEST(ComplianceCache, RoundTripsBitExactlyAndIsUsedOnTheSecondRun) {
@@ -121,7 +122,7 @@ TEST(ComplianceCache, TruncatedOrCorruptedFilesAreDetectedAndRebuilt) {
   ComplianceColumns reference(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
   const fs::path file = prepare_compliance(body, reference, dir.path).cache_file;
   const auto size = fs::file_size(file);
-  const Digest key = compliance_cache_key(body.mesh, body.spec.material, body.dofs, reference.row_nodes());
+  const Digest key = compliance_cache_key(body.mesh, body.spec.material, body.dofs, reference.row_nodes(), ComplianceRoute::schur);
 
   const auto expect_rebuilt = [&](const std::string& what) {
     ComplianceColumns probe(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
@@ -164,7 +165,7 @@ TEST(ComplianceCache, AFileForAnotherMaterialIsNotUsed) {
   const fs::path soft_file = prepare_compliance(soft, soft_columns, dir.path).cache_file;
   // Put the soft cache where the stiff one would be: its embedded key still tells them apart.
   ComplianceColumns stiff_columns(*stiff.free_factor, stiff.dofs, compliance_row_nodes(stiff, false));
-  const Digest stiff_key = compliance_cache_key(stiff.mesh, stiff.spec.material, stiff.dofs, stiff_columns.row_nodes());
+  const Digest stiff_key = compliance_cache_key(stiff.mesh, stiff.spec.material, stiff.dofs, stiff_columns.row_nodes(), ComplianceRoute::schur);
   fs::copy_file(soft_file, compliance_cache_file(dir.path, stiff_key));
   const ComplianceCacheLoad load = load_compliance_cache(compliance_cache_file(dir.path, stiff_key), stiff_key, stiff_columns);
   EXPECT_FALSE(load.loaded);

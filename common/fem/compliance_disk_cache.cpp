@@ -43,7 +43,7 @@ struct Reader {
 }  // namespace
 
 Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
-                            const std::vector<int>& row_nodes) {
+                            const std::vector<int>& row_nodes, ComplianceRoute route) {
   ContentHasher h;
   h.text("cohaptic compliance cache").value(kComplianceCacheFormatVersion);
   h.matrix(mesh.nodes);
@@ -51,6 +51,7 @@ Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& ma
   h.value(material.youngs_modulus).value(material.poisson_ratio).value(static_cast<int>(material.formulation));
   h.values(std::span<const AxisMask>(dofs.fixed_axes));
   h.values(std::span<const int>(row_nodes));
+  h.value(static_cast<int>(route));
   return h.finish();
 }
 

@@ -1,7 +1,8 @@
 // On-disk cache of compliance columns, so a scene's precomputation is paid once.
 //
 // A cache file is valid only for the exact mesh, material, boundary conditions, row
-// nodes and file-format version it was computed for: all of them go into its key (a
+// nodes, route (solves or the Schur complement: their columns differ in the last bits) and
+// file-format version it was computed for: all of them go into its key (a
 // BLAKE2b content hash), which is also the file name. The payload carries its own
 // checksum, so a truncated or corrupted file is detected and the caller rebuilds it.
 //
@@ -21,11 +22,16 @@
 
 namespace cohaptic {
 
-// 2: columns solved in fixed groups; 3: groups of 4 (a column's bits depend on its group's size)
-constexpr std::uint32_t kComplianceCacheFormatVersion = 3;
+// 2: columns solved in fixed groups; 3: groups of 4 (a column's bits depend on its group's
+// size); 4: the route in the key
+constexpr std::uint32_t kComplianceCacheFormatVersion = 4;
+
+/// How the columns were computed: solves in fixed groups (ComplianceColumns), or every row
+/// node's at once by the Schur complement (schur_compliance.h).
+enum class ComplianceRoute : int { solves = 0, schur = 1 };
 
 Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
-                            const std::vector<int>& row_nodes);
+                            const std::vector<int>& row_nodes, ComplianceRoute route);
 
 /// The file for `key` inside `directory`.
 std::filesystem::path compliance_cache_file(const std::filesystem::path& directory, const Digest& key);

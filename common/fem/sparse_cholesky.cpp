@@ -1,47 +1,18 @@
 #include "common/fem/sparse_cholesky.h"
 
-#include <cholmod.h>
 #include <fmt/format.h>
 
+#include "common/fem/cholmod_view.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
-
-namespace {
-
-void start_common(cholmod_common& common) {
-  cholmod_start(&common);
-  common.supernodal = CHOLMOD_SUPERNODAL;
-  common.print = 0;  // errors are reported through exceptions, not stdout
-  common.error_handler = nullptr;
-}
-
-// A read-only CHOLMOD view of an Eigen compressed column matrix (no copy).
-cholmod_sparse view_of(const SparseMatrix& matrix) {
-  cholmod_sparse view{};
-  view.nrow = static_cast<std::size_t>(matrix.rows());
-  view.ncol = static_cast<std::size_t>(matrix.cols());
-  view.nzmax = static_cast<std::size_t>(matrix.nonZeros());
-  view.p = const_cast<int*>(matrix.outerIndexPtr());
-  view.i = const_cast<int*>(matrix.innerIndexPtr());
-  view.x = const_cast<double*>(matrix.valuePtr());
-  view.stype = -1;  // symmetric, lower triangle used
-  view.itype = CHOLMOD_INT;
-  view.xtype = CHOLMOD_REAL;
-  view.dtype = CHOLMOD_DOUBLE;
-  view.sorted = 1;
-  view.packed = 1;
-  return view;
-}
-
-}  // namespace
 
 // The factor with the common it was analysed and factored with (read-only afterwards).
 struct SparseCholesky::Impl {
   cholmod_common common{};
   cholmod_factor* factor = nullptr;
 
-  Impl() { start_common(common); }
+  Impl() { start_cholmod_common(common); }
   ~Impl() {
     cholmod_free_factor(&factor, &common);
     cholmod_finish(&common);
@@ -55,7 +26,7 @@ struct CholeskyWorkspace::Impl {
   cholmod_dense* work_y = nullptr;
   cholmod_dense* work_e = nullptr;
 
-  Impl() { start_common(common); }
+  Impl() { start_cholmod_common(common); }
   ~Impl() {
     cholmod_free_dense(&solution, &common);
     cholmod_free_dense(&work_y, &common);
@@ -74,7 +45,7 @@ SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_
   if (matrix.rows() != matrix.cols())
     throw NumericalError(fmt::format("cannot factor a {}x{} matrix: not square", matrix.rows(), matrix.cols()));
   if (!matrix.isCompressed()) throw NumericalError("cannot factor an uncompressed sparse matrix");
-  cholmod_sparse view = view_of(matrix);
+  cholmod_sparse view = cholmod_view_of(matrix);
   cholmod_common& c = impl_->common;
   impl_->factor = cholmod_analyze(&view, &c);
   if (impl_->factor == nullptr || c.status < CHOLMOD_OK)

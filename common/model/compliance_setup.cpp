@@ -2,9 +2,12 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <thread>
 
 #include "common/fem/compliance_disk_cache.h"
+#include "common/fem/schur_compliance.h"
 #include "common/mesh/compact_groups.h"
 #include "common/util/error.h"
 #include "common/util/stopwatch.h"
@@ -24,8 +27,29 @@ std::filesystem::path default_cache_directory() {
 
 namespace {
 
+// Precomputed touchable columns that are at least half of the row nodes come by the Schur
+// complement (every row node's at once, on every core); any others by solves.
+ComplianceRoute route_of(const ElasticBody& body, const ComplianceColumns& columns) {
+  return body.spec.compliance.precompute_touchable && 2 * body.touchable_nodes.size() >= columns.row_nodes().size()
+             ? ComplianceRoute::schur
+             : ComplianceRoute::solves;
+}
+
 Digest cache_key(const ElasticBody& body, const ComplianceColumns& columns) {
-  return compliance_cache_key(body.mesh, body.spec.material, body.dofs, columns.row_nodes());
+  return compliance_cache_key(body.mesh, body.spec.material, body.dofs, columns.row_nodes(), route_of(body, columns));
+}
+
+void precompute_touchable_columns(const ElasticBody& body, ComplianceColumns& columns) {
+  std::size_t missing = 0;
+  for (int node : body.touchable_nodes) missing += columns.has_column(node) ? 0 : 1;
+  if (missing == 0) return;
+  if (route_of(body, columns) == ComplianceRoute::solves) {
+    columns.compute_columns(body.touchable_nodes);
+    return;
+  }
+  const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  spdlog::info("compliance: {} row nodes at once (Schur complement, {} threads)", columns.row_nodes().size(), threads);
+  compute_row_columns_by_schur(columns, restrict_to_dofs(body.stiffness, body.dofs.free_dofs), body.dofs, threads);
 }
 
 }  // namespace
@@ -47,7 +71,7 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
   }
   const bool want_all = body.spec.compliance.precompute_touchable;
   const std::size_t before = columns.column_count();
-  if (want_all) columns.compute_columns(body.touchable_nodes);
+  if (want_all) precompute_touchable_columns(body, columns);
   if (use_disk && columns.column_count() > before) {
     save_compliance(body, columns, *cache_directory);
     setup.note += fmt::format("; computed {} columns and saved them", columns.column_count() - before);

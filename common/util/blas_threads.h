@@ -1,13 +1,28 @@
-// Keeping BLAS (OpenBLAS, behind CHOLMOD) on the calling thread.
+// Keeping BLAS (OpenBLAS, behind CHOLMOD) on the calling thread, and letting it use more
+// for a while.
 //
 // The server shares the machine with haptic clients, whose 1 kHz loops must not compete
 // with BLAS worker threads spinning on every core; and a single thread makes every solve's
-// rounding the same from run to run, which bit-exact replay relies on.
+// rounding the same from run to run, which bit-exact replay relies on. A long computation
+// at load (the Schur complement's factorisation) may use more threads, always the same
+// number of them: OpenBLAS's rounding depends on it.
 #pragma once
 
 namespace cohaptic {
 
 /// Asks OpenBLAS for one thread. A no-op with a BLAS that has no such control.
 void use_single_blas_thread();
+
+/// OpenBLAS on `threads` threads while this object lives, then as many as before.
+class ScopedBlasThreads {
+ public:
+  explicit ScopedBlasThreads(int threads);
+  ~ScopedBlasThreads();
+  ScopedBlasThreads(const ScopedBlasThreads&) = delete;
+  ScopedBlasThreads& operator=(const ScopedBlasThreads&) = delete;
+
+ private:
+  int before_ = 1;
+};
 
 }  // namespace cohaptic

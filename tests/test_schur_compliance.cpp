@@ -1,0 +1,138 @@
+// The Schur-complement route to the compliance among a set of dofs (schur_compliance.h)
+// against the dense inverse of K and against ComplianceColumns' solves, on a cube whose
+// bottom is fixed: equal to round-off, exactly symmetric, the same bits run to run, and a
+// K that is not positive definite refused.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+
+#include "common/fem/schur_compliance.h"
+#include "common/fem/spd_inverse_from_factor.h"
+#include "common/model/model.h"
+#include "common/scene/load_scene.h"
+#include "common/util/error.h"
+
+namespace cohaptic {
+namespace {
+
+Model soft_cube(int divisions) {
+  return build_model(parse_scene(fmt::format(R"(
+units: mm
+objects:
+  - name: cube
+    mesh: {{box: {{min: [-65, -65, -130], size: [130, 130, 130], divisions: [{0}, {0}, {0}]}}}}
+    material: {{youngs_modulus: 1.0e6, poisson_ratio: 0.4}}
+    fixed: [{{plane: {{point: [0, 0, -130], normal: [0, 0, 1]}}}}]
+    touchable: [{{plane: {{point: [0, 0, 0], normal: [0, 0, 1]}}}}]
+    compliance: {{precompute: on_demand, disk_cache: false}}
+tools: [{{name: A}}]
+)",
+                                                 divisions),
+                                     "cube.yaml"));
+}
+
+TEST(SchurCompliance, EqualsTheDenseInverseAmongAnySetOfDofsAndIsExactlySymmetric) {
+  const Model model = soft_cube(4);
+  const ElasticBody& body = single_elastic_body(model);
+  const SparseMatrix k_ff = restrict_to_dofs(body.stiffness, body.dofs.free_dofs);
+  const Eigen::MatrixXd dense(k_ff);
+  const Eigen::MatrixXd inverse = dense.llt().solve(Eigen::MatrixXd::Identity(dense.rows(), dense.cols()));
+  const int n = static_cast<int>(k_ff.rows());
+  // Scattered dofs out of order, a contiguous block, a single dof, and every dof (no interior).
+  std::vector<std::vector<int>> sets = {{n - 1, 5, 17, 2, 60, 33, n / 2}, {}, {n / 3}, {}};
+  for (int i = 40; i < 100; ++i) sets[1].push_back(i);
+  for (int i = 0; i < n; ++i) sets[3].push_back(i);
+  for (const std::vector<int>& rows : sets) {
+    SCOPED_TRACE(fmt::format("{} rows", rows.size()));
+    const Eigen::MatrixXd l = schur_compliance(k_ff, rows);
+    ASSERT_EQ(l.rows(), static_cast<Eigen::Index>(rows.size()));
+    Eigen::MatrixXd expected(l.rows(), l.cols());
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      for (std::size_t j = 0; j < rows.size(); ++j)
+        expected(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = inverse(rows[i], rows[j]);
+    EXPECT_LE((l - expected).norm(), 1e-10 * expected.norm());
+    EXPECT_EQ(l, l.transpose());
+    EXPECT_EQ(l, schur_compliance(k_ff, rows)) << "not the same bits a second time";
+    EXPECT_EQ(l, schur_compliance(k_ff, rows, 3)) << "not the same bits on 3 threads";
+  }
+}
+
+TEST(SchurCompliance, FillsTheRowNodesColumnsAsTheSolvesDoWithFixedAxesZero) {
+  const Model model = soft_cube(5);
+  const ElasticBody& body = single_elastic_body(model);
+  const SparseMatrix k_ff = restrict_to_dofs(body.stiffness, body.dofs.free_dofs);
+  // Rows: the top face and a few nodes of the fixed bottom (their columns and rows are zero).
+  std::vector<int> rows = body.touchable_nodes;
+  int fixed_rows = 0;
+  for (int node = 0; node < body.mesh.node_count() && fixed_rows < 3; ++node)
+    if (body.dofs.is_fixed(node, 0)) {
+      rows.push_back(node);
+      ++fixed_rows;
+    }
+  ASSERT_EQ(fixed_rows, 3);
+  ComplianceColumns solved(*body.free_factor, body.dofs, rows);
+  solved.compute_columns(rows);
+  ComplianceColumns schur(*body.free_factor, body.dofs, rows);
+  schur.insert_column(rows[1], solved.column(rows[1]));  // one known already: kept, not recomputed
+  EXPECT_EQ(compute_row_columns_by_schur(schur, k_ff, body.dofs), rows.size() - 1);
+  EXPECT_EQ(schur.column(rows[1]), solved.column(rows[1]));
+  for (int node : rows) {
+    const ComplianceColumn& expected = solved.column(node);
+    EXPECT_LE((schur.column(node) - expected).norm(), 1e-10 * expected.norm() + 1e-300) << "node " << node;
+    if (body.dofs.is_fixed(node, 0)) {
+      EXPECT_TRUE(schur.column(node).isZero(0)) << "fixed node " << node;
+    }
+  }
+  EXPECT_EQ(compute_row_columns_by_schur(schur, k_ff, body.dofs), 0u) << "nothing left to compute";
+}
+
+// Large enough that the inverse has several blocks and BLAS threads the factorisation: the
+// same bits whatever the number of threads asked for.
+TEST(SchurCompliance, TheSameBitsOnOneThreadOrSeveral) {
+  const Model model = soft_cube(10);
+  const ElasticBody& body = single_elastic_body(model);
+  const SparseMatrix k_ff = restrict_to_dofs(body.stiffness, body.dofs.free_dofs);
+  std::vector<int> rows;
+  for (int node : body.surface.nodes)
+    for (int axis = 0; axis < 3; ++axis)
+      if (const int free = body.dofs.free_index[static_cast<std::size_t>(3 * node + axis)]; free >= 0) rows.push_back(free);
+  ASSERT_GT(rows.size(), 1000u);
+  const Eigen::MatrixXd one = schur_compliance(k_ff, rows, 1);
+  EXPECT_EQ(schur_compliance(k_ff, rows, 2), one);
+}
+
+// The dense inverse from a factor, in blocks on threads, against Eigen's own (one thread):
+// sizes below a block, a few blocks with a ragged last one.
+TEST(SchurCompliance, TheBlockedInverseFromAFactorEqualsADirectInverseOnAnyNumberOfThreads) {
+  for (int m : {1, 7, 500}) {
+    SCOPED_TRACE(fmt::format("m = {}", m));
+    const Eigen::MatrixXd a = Eigen::MatrixXd::Random(m, m);
+    const Eigen::MatrixXd s = a * a.transpose() + m * Eigen::MatrixXd::Identity(m, m);
+    const Eigen::LLT<Eigen::MatrixXd> llt(s);
+    const Eigen::MatrixXd expected = llt.solve(Eigen::MatrixXd::Identity(m, m));
+    Eigen::MatrixXd one = llt.matrixL();
+    invert_spd_from_factor(one, 1);
+    EXPECT_LE((one - expected).norm(), 1e-12 * expected.norm());
+    EXPECT_EQ(one, one.transpose());
+    for (int threads : {2, 5}) {
+      Eigen::MatrixXd several = llt.matrixL();
+      invert_spd_from_factor(several, threads);
+      EXPECT_EQ(several, one) << threads << " threads";
+    }
+  }
+}
+
+TEST(SchurCompliance, AMatrixThatIsNotPositiveDefiniteIsRefused) {
+  SparseMatrix k(3, 3);
+  k.insert(0, 0) = 1;
+  k.insert(1, 1) = -1;
+  k.insert(2, 2) = 1;
+  k.makeCompressed();
+  EXPECT_THROW(schur_compliance(k, std::vector<int>{2}), NumericalError);
+  EXPECT_THROW(schur_compliance(k, std::vector<int>{1}), NumericalError);
+  EXPECT_THROW(schur_compliance(k, std::vector<int>{1, 1}), Error);
+  EXPECT_THROW(schur_compliance(k, std::vector<int>{3}), Error);
+}
+
+}  // namespace
+}  // namespace cohaptic
