@@ -6,6 +6,7 @@
 #   make bench-thin  the mass-spring benchmarks beside the thin-objects paper's Table 2
 #   make bench-sphere  the sphere contact model's client tick and server step beside the dense solve
 #   make bench-compliance  the brain's compliance by solves and by the Schur complement, same run
+#   make brain-convergence  the brain's forces on its meshes against a finer reference mesh
 #   make fuzz       build the fuzz targets with clang (libFuzzer, ASan, UBSan) in build-asan
 #                   and run each for FUZZ_SECONDS (default 15; 0 builds only), FUZZ_JOBS at once
 #   make test-asan  the suite (ASAN_TESTS: all by default) built with clang, ASan + UBSan, in
@@ -61,7 +62,7 @@ SANITIZER_CMAKE = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
 SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
   TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
 
-.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance fuzz test-asan test-tsan clean
+.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance brain-convergence fuzz test-asan test-tsan clean
 
 all: build
 
@@ -126,6 +127,13 @@ bench-sphere:
 bench-compliance:
 	@$(MAKE) --no-print-directory build >&2
 	@tests/compliance_tables.sh $(BUILD_DIR)/tests/cohaptic_bench
+
+# The brain's forces on its 9 mm and graded meshes against a mesh twice as fine near the
+# tools, both tools pressing, along their presses, as Markdown (tens of minutes: the
+# reference's compliance is solved for on demand).
+brain-convergence:
+	@$(MAKE) --no-print-directory build >&2
+	@tests/brain_convergence_table.sh $(BUILD_DIR)/lab/cohaptic-lab
 
 $(ASAN_BUILD_DIR)/CMakeCache.txt: | deps
 	cmake -S . -B $(ASAN_BUILD_DIR) $(SANITIZER_CMAKE) -DCOHAPTIC_FUZZ=ON

@@ -1,15 +1,26 @@
 #!/usr/bin/env bash
 # Regenerates scenes/brain/brain.msh, the coarse tetrahedral mesh of the Colin27 brain,
-# from the public-domain surface in ../shared/data/colin27 (see scenes/brain/README.md).
+# and scenes/brain/brain_graded.msh, the mesh graded towards the tools, from the
+# public-domain surface in ../shared/data/colin27 (see scenes/brain/README.md).
 #
-# A maintenance tool, not part of the build: the generated mesh is committed.
+# A maintenance tool, not part of the build: the generated meshes are committed (all but
+# the reference mesh below, which is too big).
 # Needs gmsh (4.8; Debian 12's `gmsh` package) and python3 (for the surface step).
 #
 #   deploy/remesh-brain.sh [DATA_DIR] [OUTPUT]
 #     DATA_DIR  holds brain_surface.asc (default: ../shared/data/colin27 next to the repository)
-#     OUTPUT    the mesh to write (default: scenes/brain/brain.msh)
-#   H=8 deploy/remesh-brain.sh          another element size in mm (default 9, see remesh.geo)
+#     OUTPUT    the mesh to write (default: scenes/brain/brain.msh; with FINE=2,
+#               scenes/brain/brain_graded.msh; any other FINE needs it)
+#   H=8 deploy/remesh-brain.sh          another element size in mm (default 9, see remesh.geo);
+#                                       in the graded mode, the size far from the tools
 #   CORRIDOR=0 deploy/remesh-brain.sh   the plain surface, without the corridor (below)
+#   FINE=2 deploy/remesh-brain.sh       the graded mesh, brain_graded.msh: size 2 mm in the
+#                                       tools' working region (both 7 mm spheres swept along
+#                                       their press paths) and within MARGIN mm of it,
+#                                       growing linearly to H over the next GROW mm
+#   FINE=1 deploy/remesh-brain.sh ../shared/data/colin27 out/brain_reference.msh
+#                                       the reference mesh: twice as fine near the tools
+#   MARGIN=20 GROW=30                   the graded mode's region, mm (these are the defaults)
 #
 # Steps:
 #  1. python3 reads the FreeSurfer surface and writes it as STL. Unless CORRIDOR=0, it first
@@ -23,13 +34,20 @@
 #     behind y = -75 mm). The map is one-to-one, so the surface stays closed and free of
 #     self-intersections; its lower wall faces up (the cerebellum's side) and its upper
 #     wall faces down (the occipital lobes' side).
-#  2. gmsh runs remesh.geo (classify, reparametrise, remesh at size h, tetrahedralise).
+#  2. gmsh runs remesh.geo (classify, reparametrise, remesh at size h or graded from
+#     FINE to h, tetrahedralise).
 #  3. The $Parametrizations section is dropped: nothing reads it, and it would triple the file.
 set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 data=${1:-$repo/../shared/data/colin27}
-out=${2:-$repo/scenes/brain/brain.msh}
+fine=${FINE:-0}
+case $fine in
+  0) out=${2:-$repo/scenes/brain/brain.msh} ;;
+  2) out=${2:-$repo/scenes/brain/brain_graded.msh} ;;
+  *) [[ $# -ge 2 ]] || { echo "remesh-brain: FINE=$fine needs DATA_DIR and OUTPUT" >&2; exit 1; }
+     out=$2 ;;
+esac
 geo=$repo/scenes/brain/remesh.geo
 asc=$data/brain_surface.asc
 
@@ -92,6 +110,9 @@ PY
 cp "$geo" "$work/remesh.geo"
 args=()
 [[ -n ${H:-} ]] && args+=(-setnumber h "$H")
+[[ $fine != 0 ]] && args+=(-setnumber fine "$fine")
+[[ -n ${MARGIN:-} ]] && args+=(-setnumber margin "$MARGIN")
+[[ -n ${GROW:-} ]] && args+=(-setnumber grow "$GROW")
 (cd "$work" && gmsh remesh.geo "${args[@]}" -3 -nt 1 -format msh41 -o raw.msh > gmsh.log 2>&1) || {
   cat "$work/gmsh.log" >&2; echo "remesh-brain: gmsh failed" >&2; exit 1; }
 grep -E "^Info    : [0-9]+ nodes [0-9]+ elements|Warning|Error" "$work/gmsh.log" >&2 || true

@@ -26,7 +26,7 @@ namespace {
 
 const std::filesystem::path kScenes = std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes";
 
-const char* const kMeshes[] = {"brain.msh", "brain_fine.msh"};
+const char* const kMeshes[] = {"brain.msh", "brain_fine.msh", "brain_graded.msh"};
 
 const Model& brain_model(int mesh) {
   static std::map<int, std::unique_ptr<Model>> models;
@@ -77,7 +77,7 @@ void BM_BrainRowCompliance(benchmark::State& state) {
 
 BENCHMARK(BM_BrainRowCompliance)
     ->ArgNames({"route", "mesh"})
-    ->ArgsProduct({{0, 1, 2}, {0, 1}})
+    ->ArgsProduct({{0, 1, 2}, {0, 1, 2}})
     ->Iterations(1)
     ->UseRealTime()
     ->Unit(benchmark::kSecond);

@@ -36,8 +36,8 @@ jq -r '
            else ((. * 100 | round) / 100 | tostring) end;
   def failed($b): $b == null or ($b.error_occurred // false);
   def why($b): if $b == null then "not run" else "error: \($b.error_message)" end;
-  [.benchmarks[] | {key: (.name | sub("/iterations:[0-9]+/real_time$"; "")), value: .}] | from_entries as $b
-  | ([.benchmarks[].name | capture("mesh:(?<m>[0-9]+)").m] | unique) as $meshes
+  ([.benchmarks[].name | capture("mesh:(?<m>[0-9]+)").m] | unique) as $meshes
+  | [.benchmarks[] | {key: (.name | sub("/iterations:[0-9]+/real_time$"; "")), value: .}] | from_entries as $b
   | "| mesh | nodes | row nodes | solves, s | row nodes/s | Schur, 1 thread, s | Schur, 2 threads, s | row nodes/s | speed-up | result MB | peak MB (solves, Schur) |",
     "|---|---|---|---|---|---|---|---|---|---|---|",
     ( $meshes[] as $m

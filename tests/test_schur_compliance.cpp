@@ -1,6 +1,5 @@
 // The Schur-complement route to the compliance among a set of dofs (schur_compliance.h)
-// against the dense inverse of K and against ComplianceColumns' solves, on a cube whose
-// bottom is fixed: equal to round-off, exactly symmetric, the same bits run to run, and a
+// against the dense inverse of K and against ComplianceColumns' solves, on the paper's cube: equal to round-off, exactly symmetric, the same bits run to run, and a
 // K that is not positive definite refused.
 #include <gtest/gtest.h>
 
@@ -11,24 +10,16 @@
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/util/error.h"
+#include "support/cube_scene.h"
 
 namespace cohaptic {
 namespace {
 
+// The paper's cube, its rear face fixed, its top touchable.
 Model soft_cube(int divisions) {
-  return build_model(parse_scene(fmt::format(R"(
-units: mm
-objects:
-  - name: cube
-    mesh: {{box: {{min: [-65, -65, -130], size: [130, 130, 130], divisions: [{0}, {0}, {0}]}}}}
-    material: {{youngs_modulus: 1.0e6, poisson_ratio: 0.4}}
-    fixed: [{{plane: {{point: [0, 0, -130], normal: [0, 0, 1]}}}}]
-    touchable: [{{plane: {{point: [0, 0, 0], normal: [0, 0, 1]}}}}]
-    compliance: {{precompute: on_demand, disk_cache: false}}
-tools: [{{name: A}}]
-)",
-                                                 divisions),
-                                     "cube.yaml"));
+  testing::CubeSceneOptions cube;
+  cube.divisions = divisions;
+  return build_model(parse_scene(testing::cube_scene_yaml(cube), "cube.yaml"));
 }
 
 TEST(SchurCompliance, EqualsTheDenseInverseAmongAnySetOfDofsAndIsExactlySymmetric) {

@@ -38,10 +38,6 @@ std::vector<int> fill_reducing_order(const SparseMatrix& k_ii) {
   return std::vector<int>(perm, perm + k_ii.rows());
 }
 
-// BLAS threads for the factorisation: always this many, whatever the machine, since
-// OpenBLAS's rounding depends on its thread count.
-constexpr int kFactorBlasThreads = 2;
-
 }  // namespace
 
 Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> rows, int threads) {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "common/fem/cholmod_view.h"
+#include "common/util/blas_threads.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -50,7 +51,11 @@ SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_
   impl_->factor = cholmod_analyze(&view, &c);
   if (impl_->factor == nullptr || c.status < CHOLMOD_OK)
     throw NumericalError(fmt::format("CHOLMOD analysis of a {0}x{0} matrix failed (status {1})", size_, c.status));
-  const int ok = cholmod_factorize(&view, impl_->factor, &c);
+  int ok = 0;
+  {
+    const ScopedBlasThreads blas(kFactorBlasThreads);
+    ok = cholmod_factorize(&view, impl_->factor, &c);
+  }
   if (c.status == CHOLMOD_NOT_POSDEF) {
     const auto failed_column = static_cast<std::size_t>(impl_->factor->minor);
     const int row = failed_column < static_cast<std::size_t>(size_)

@@ -13,7 +13,8 @@ namespace cohaptic {
 /// Asks OpenBLAS for one thread. A no-op with a BLAS that has no such control.
 void use_single_blas_thread();
 
-/// OpenBLAS on `threads` threads while this object lives, then as many as before.
+/// OpenBLAS on `threads` threads while this object lives, then as many as before. The count
+/// is the process's: use it only where no other thread calls BLAS meanwhile (loading a scene).
 class ScopedBlasThreads {
  public:
   explicit ScopedBlasThreads(int threads);

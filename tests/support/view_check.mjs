@@ -114,7 +114,11 @@ try {
     if (args['focus-tools'] !== undefined) await page.keyboard.press('t');
     if (args['rigid-removed'] !== undefined) await page.keyboard.press('d');
     await page.evaluate(() => window.cohapticView.freeze(true));
-    await page.waitForTimeout(300);  // the frame being drawn lands
+    // The frame being drawn lands, and the page renders what the keys changed: two animation
+    // frames later its draw has run since (a software renderer on a loaded machine may take
+    // longer than the wait to get one).
+    await page.waitForTimeout(300);
+    await page.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
     result.shown = await snapshot();
     result.screen = await screen(page, result.shown);
   }

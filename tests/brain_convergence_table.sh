@@ -1,0 +1,89 @@
+#!/usr/bin/env bash
+# The brain's forces against a mesh twice as fine where the tools work: both tools pressing
+# together, at points along their presses (fractions of the 6 mm press of
+# scenes/brain/surgeon_a.yaml and surgeon_b.yaml; the deepest is 1), probed on each mesh
+# with `cohaptic-lab probe --approach-steps 10` (through the IR, as served), printed as the
+# Markdown page docs/results/brain-convergence.md holds. The skull is left out: it holds
+# the nodes it reaches where they reach it, so what it holds depends on the path and the
+# mesh; the tools' own forces are what must converge.
+#
+# Meshes: scenes/brain/brain.msh (9 mm), scenes/brain/brain_graded.msh (2 mm near the
+# tools), and the reference (1 mm near the tools): $REFERENCE, default out/brain_reference.msh,
+# made by `FINE=1 deploy/remesh-brain.sh` when missing (needs gmsh). Compliance caches go
+# to out/convergence-cache.
+#
+# Usage: tests/brain_convergence_table.sh [path/to/cohaptic-lab]   (make brain-convergence runs it)
+#   FRACTIONS="0.4 0.7 1" to choose the points (default 0.4 0.6 0.8 1).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+lab=${1:-build/lab/cohaptic-lab}
+[[ -x "$lab" ]] || { echo "brain_convergence_table: no cohaptic-lab at $lab (build it: make build)" >&2; exit 2; }
+command -v jq >/dev/null || { echo "brain_convergence_table: needs jq (deploy/install-deps.sh installs it)" >&2; exit 2; }
+reference=${REFERENCE:-out/brain_reference.msh}
+fractions=${FRACTIONS:-0.4 0.6 0.8 1}
+if [[ ! -f "$reference" ]]; then
+  echo "brain_convergence_table: making the reference mesh $reference (FINE=1 deploy/remesh-brain.sh)" >&2
+  mkdir -p "$(dirname "$reference")"
+  FINE=1 deploy/remesh-brain.sh ../shared/data/colin27 "$reference" >&2
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cache=out/convergence-cache
+mkdir -p "$cache"
+
+# A copy of scenes/brain.yaml with mesh $1, without the skull, touchable within 25 mm of
+# the tools' deepest centres, its compliance solved for on demand.
+scene_with() {
+  sed -e "s#file: brain/[^ ]*\.msh#file: $(realpath "$1")#" -e '/^obstacles:/,/inner_skull/d' \
+      -e 's#- surface: true#- box: {min: [-41, -111, -75], max: [26, -51, -5]}#' \
+      -e "s#precompute: [a-z_]*#precompute: on_demand#" scenes/brain.yaml
+}
+scene_with scenes/brain/brain.msh >"$work/coarse.yaml"
+scene_with scenes/brain/brain_graded.msh >"$work/graded.yaml"
+scene_with "$reference" >"$work/reference.yaml"
+
+# Start (where each tool stops before pressing) and deepest centre of each tool, mm.
+a0=(-15.4 -79.9 -45.0); a1=(-15.943 -75.736 -49.285)
+b0=(0.9 -89.8 -34.5);   b1=(0.119 -85.715 -30.175)
+at() { awk -v f="$1" -v x0="$2" -v y0="$3" -v z0="$4" -v x1="$5" -v y1="$6" -v z1="$7" \
+  'BEGIN { printf "%.4f,%.4f,%.4f", x0 + f * (x1 - x0), y0 + f * (y1 - y0), z0 + f * (z1 - z0) }'; }
+
+rows=()
+for f in $fractions; do
+  a=$(at "$f" "${a0[@]}" "${a1[@]}"); b=$(at "$f" "${b0[@]}" "${b1[@]}")
+  for mesh in coarse graded reference; do
+    echo "brain_convergence_table: fraction $f on the $mesh mesh ..." >&2
+    "$lab" probe --scene "$work/$mesh.yaml" --tool="$a" --tool="$b" --approach-steps 10 --json --cache-dir "$cache" \
+      --log-level warn >"$work/$mesh-$f.json"
+  done
+  rows+=("$f")
+done
+
+cat <<'HEADER'
+# The brain's forces against a finer mesh
+
+`make brain-convergence > docs/results/brain-convergence.md` writes this page
+(`tests/brain_convergence_table.sh`). Both tools press the brain together (the demo's
+scene, `scenes/brain.yaml`, with each mesh in turn, without the skull: it holds the nodes
+it reaches where they reach it, which depends on the path), at points along their presses: the
+fraction of the 6 mm press of `scenes/brain/surgeon_a.yaml` and `surgeon_b.yaml` (A meets
+the tissue at about 0.2, B at once; 1 is the deepest). Each force is `cohaptic-lab probe
+--approach-steps 10` through the IR. Meshes: `brain.msh` (9 mm everywhere), `brain_graded.msh`
+(2 mm within 20 mm of the tools' spheres along their presses, growing to 9 mm), and the
+reference, twice as fine near the tools (`FINE=1 deploy/remesh-brain.sh`). |F| in mN; the
+differences are from the reference.
+
+HEADER
+echo "| fraction | A: 9 mm | A: graded | A: reference | A: graded − ref. | A: 9 mm − ref. | B: 9 mm | B: graded | B: reference | B: graded − ref. | B: 9 mm − ref. |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
+for f in "${rows[@]}"; do
+  jq -r -n --arg f "$f" --slurpfile c "$work/coarse-$f.json" --slurpfile g "$work/graded-$f.json" --slurpfile r "$work/reference-$f.json" '
+    def mag(t): (t.force | map(. * .) | add | sqrt) * 1000;
+    def pct(a; b): if b == 0 then "—" else "\(((a - b) / b * 1000 | round) / 10) %" end;
+    def cell(v): (v * 100 | round) / 100 | tostring;
+    [0, 1] | map(. as $k | [mag($c[0].tools[$k]), mag($g[0].tools[$k]), mag($r[0].tools[$k])]) as $m
+    | "| \($f) | \(cell($m[0][0])) | \(cell($m[0][1])) | \(cell($m[0][2])) | \(pct($m[0][1]; $m[0][2])) | \(pct($m[0][0]; $m[0][2])) | \(cell($m[1][0])) | \(cell($m[1][1])) | \(cell($m[1][2])) | \(pct($m[1][1]; $m[1][2])) | \(pct($m[1][0]; $m[1][2])) |"'
+done
+echo
+jq -r -n --slurpfile c "$work/coarse-1.json" --slurpfile g "$work/graded-1.json" --slurpfile r "$work/reference-1.json" \
+  '"Meshes: \($c[0].nodes), \($g[0].nodes) and \($r[0].nodes) nodes."' 2>/dev/null || true
