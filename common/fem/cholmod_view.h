@@ -1,6 +1,6 @@
 // CHOLMOD glue shared by the factorisations in common/fem: a common set up the way cohaptic
 // uses CHOLMOD (supernodal, silent: errors become exceptions), the BLAS threads a
-// factorisation runs on, and a read-only CHOLMOD view of an Eigen compressed-column matrix's
+// factorisation runs on, a factor that frees itself, and a read-only CHOLMOD view of an Eigen compressed-column matrix's
 // lower triangle (no copy).
 #pragma once
 
@@ -20,6 +20,19 @@ inline void start_cholmod_common(cholmod_common& common) {
   common.print = 0;  // errors are reported through exceptions, not stdout
   common.error_handler = nullptr;
 }
+
+/// A CHOLMOD common and the factor analysed and factored with it, freed together.
+struct OwnedCholmodFactor {
+  cholmod_common common{};
+  cholmod_factor* factor = nullptr;
+  OwnedCholmodFactor() { start_cholmod_common(common); }
+  ~OwnedCholmodFactor() {
+    cholmod_free_factor(&factor, &common);
+    cholmod_finish(&common);
+  }
+  OwnedCholmodFactor(const OwnedCholmodFactor&) = delete;
+  OwnedCholmodFactor& operator=(const OwnedCholmodFactor&) = delete;
+};
 
 /// `matrix` as a symmetric CHOLMOD matrix whose lower triangle is read; it must outlive the view.
 inline cholmod_sparse cholmod_view_of(const SparseMatrix& matrix) {

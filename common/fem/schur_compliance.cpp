@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <memory>
 #include <vector>
 
 #include "common/fem/cholmod_view.h"
@@ -14,22 +13,9 @@ namespace cohaptic {
 
 namespace {
 
-// A CHOLMOD common and the factor made with it, freed together.
-struct OwnedFactor {
-  cholmod_common common{};
-  cholmod_factor* factor = nullptr;
-  OwnedFactor() { start_cholmod_common(common); }
-  ~OwnedFactor() {
-    cholmod_free_factor(&factor, &common);
-    cholmod_finish(&common);
-  }
-  OwnedFactor(const OwnedFactor&) = delete;
-  OwnedFactor& operator=(const OwnedFactor&) = delete;
-};
-
 // CHOLMOD's own fill-reducing order of `k_ii` (AMD, or METIS where AMD fills badly).
 std::vector<int> fill_reducing_order(const SparseMatrix& k_ii) {
-  OwnedFactor analysis;
+  OwnedCholmodFactor analysis;
   cholmod_sparse view = cholmod_view_of(k_ii);
   analysis.factor = cholmod_analyze(&view, &analysis.common);
   if (analysis.factor == nullptr || analysis.common.status < CHOLMOD_OK)
@@ -63,7 +49,7 @@ Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> row
     for (int position : fill_reducing_order(restrict_to_dofs(k, interior))) order.push_back(interior[static_cast<std::size_t>(position)]);
   order.insert(order.end(), rows.begin(), rows.end());
 
-  OwnedFactor owned;
+  OwnedCholmodFactor owned;
   cholmod_common& c = owned.common;
   c.nmethods = 1;
   c.method[0].ordering = CHOLMOD_GIVEN;

@@ -9,16 +9,7 @@
 namespace cohaptic {
 
 // The factor with the common it was analysed and factored with (read-only afterwards).
-struct SparseCholesky::Impl {
-  cholmod_common common{};
-  cholmod_factor* factor = nullptr;
-
-  Impl() { start_cholmod_common(common); }
-  ~Impl() {
-    cholmod_free_factor(&factor, &common);
-    cholmod_finish(&common);
-  }
-};
+struct SparseCholesky::Impl : OwnedCholmodFactor {};
 
 // cholmod_solve2's reusable outputs and the common whose workspace the solve uses.
 struct CholeskyWorkspace::Impl {
