@@ -20,10 +20,11 @@
 # cannot serve its page (the port taken, say), the session runs without it and the demo
 # says why.
 #
-# Environment: BUILD_DIR (default build), DEMO_PORT (default 7431), DEMO_DURATION (s, default
-# 20), DEMO_PROTOCOL (P1), DEMO_DEVICE (hand or script), DEMO_OUT (out/demo), DEMO_VIEW_PORT
-# (default 7480; "off": no live view), DEMO_IR_FORM (rows or m_tilde, the server's --ir-form;
-# default rows), DEMO_VIEW_SCREENSHOT (a PNG file: a headless Chromium
+# Environment: BUILD_DIR (default build), DEMO_PORT (default 7431; 0: one the system
+# chooses), DEMO_DURATION (s, default 20), DEMO_PROTOCOL (P1), DEMO_DEVICE (hand or script),
+# DEMO_OUT (out/demo), DEMO_VIEW_PORT (default 7480; 0: one the system chooses; "off": no
+# live view), DEMO_IR_FORM (rows or m_tilde, the server's --ir-form; default rows),
+# DEMO_VIEW_SCREENSHOT (a PNG file: a headless Chromium
 # watches the whole session and takes this screenshot once both surgeons press with 0.01 N;
 # the README's picture is taken so).
 set -euo pipefail
@@ -75,6 +76,12 @@ for _ in $(seq 1 300); do
   sleep 0.1
 done
 grep -q "listening on" "$out/server.log" || { echo "demo: the server did not start listening" >&2; exit 1; }
+# The port it listens on (DEMO_PORT=0: one the system chose), and the live view's word.
+port=$(sed -n 's/.*listening on [^ ]*:\([0-9][0-9]*\) .*/\1/p' "$out/server.log" | head -n 1)
+for _ in $(seq 1 50); do
+  [[ ${#view[@]} -eq 0 ]] || grep -q "live view at\|live view off" "$out/server.log" && break
+  sleep 0.1
+done
 echo "demo: server up on 127.0.0.1:$port ($protocol); two surgeons for ${duration} s ..."
 # A view that cannot serve its page is off; the session goes on and the summary says why.
 view_off=$(sed -n 's/.*live view off: //p' "$out/server.log" | head -n 1)
@@ -82,7 +89,7 @@ if [[ -n "$view_off" ]]; then
   echo "demo: the live view is off: $view_off"
 elif [[ ${#view[@]} -gt 0 ]]; then
   url=$(sed -n 's/.*live view at \(http[^ ]*\).*/\1/p' "$out/server.log" | head -n 1)
-  echo "demo: live view at $url (open it in a browser; replay it afterwards with: $lab_bin replay $out/server.mcap --view 127.0.0.1:$view_port)"
+  echo "demo: live view at $url (open it in a browser; replay it afterwards with: $lab_bin replay $out/server.mcap --view 127.0.0.1:${view_port/#0/7480})"
   if [[ -n "$screenshot" ]]; then
     # Chromium draws in software here; at the lowest priority it takes what the haptic
     # loops leave, as a browser on another machine would take nothing.

@@ -17,7 +17,6 @@
 
 #include "support/browser.h"
 #include "support/process.h"
-#include "support/taken_port.h"
 
 namespace cohaptic {
 namespace {
@@ -49,8 +48,7 @@ std::string run_demo(const std::string& scene, const fs::path& out, bool watched
   const fs::path scene_file = kSource / "scenes" / (scene + ".yaml");
   std::vector<std::string> arguments = {
       fmt::format("BUILD_DIR={}", COHAPTIC_BINARY_DIR), fmt::format("DEMO_OUT={}", out.string()),
-      fmt::format("DEMO_PORT={}", testing::closed_port()), fmt::format("DEMO_DURATION={}", kSessionSeconds),
-      fmt::format("DEMO_VIEW_PORT={}", watched ? std::to_string(testing::closed_port()) : "off"),
+      "DEMO_PORT=0", fmt::format("DEMO_DURATION={}", kSessionSeconds), fmt::format("DEMO_VIEW_PORT={}", watched ? "0" : "off"),
       "bash", (kSource / "deploy/run-demo.sh").string(), scene_file.string()};
   ChildProcess demo("/usr/bin/env", arguments, out / "demo.txt");
   std::unique_ptr<ChildProcess> browser;
