@@ -89,7 +89,7 @@ if [[ -n "$view_off" ]]; then
   echo "demo: the live view is off: $view_off"
 elif [[ ${#view[@]} -gt 0 ]]; then
   url=$(sed -n 's/.*live view at \(http[^ ]*\).*/\1/p' "$out/server.log" | head -n 1)
-  echo "demo: live view at $url (open it in a browser; replay it afterwards with: $lab_bin replay $out/server.mcap --view 127.0.0.1:${view_port/#0/7480})"
+  echo "demo: live view at $url (open it in a browser; replay it afterwards with: $lab_bin replay $out/server.mcap --view 127.0.0.1:$(sed 's#.*:\([0-9]*\)/.*#\1#' <<<"$url"))"
   if [[ -n "$screenshot" ]]; then
     # Chromium draws in software here; at the lowest priority it takes what the haptic
     # loops leave, as a browser on another machine would take nothing.
