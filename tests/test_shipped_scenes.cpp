@@ -1,6 +1,6 @@
 // Every shipped scene with two surgeons' scripts (scenes/<scene>/surgeon_a.yaml and
 // surgeon_b.yaml beside scenes/<scene>.yaml) served as `make demo SCENE=...` serves it
-// (deploy/run-demo.sh, the real programs on loopback, a cold compliance cache), for a
+// (deploy/run-demo.sh, the real programs on loopback, the user's compliance cache), for a
 // few seconds of the scripted surgeons, once without a browser and once with headless
 // Chromium watching the live view at normal priority, as a user's browser would. Judged
 // by what the surgeons felt: no force faded while either pushed, each touched its body,
