@@ -11,6 +11,7 @@
 
 #include "common/mesh/write_gmsh.h"
 #include "common/mesh/write_vtu.h"
+#include "common/contact/obstacle_constraints.h"
 #include "common/model/compliance_setup.h"
 #include "common/model/model.h"
 #include "common/model/sphere_contact_reference.h"
@@ -113,7 +114,9 @@ void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& o
     const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
     std::vector<Eigen::Vector3d> reactions;
     if (contact_model == ContactModel::sphere) {
-      reactions = SphereContactReference(body).solve(pressed, held).reactions;
+      reactions = SphereContactReference(body, obstacle_constraints(body.mesh, body.surface, body.dofs, model.obstacles))
+                      .solve(pressed, held)
+                      .reactions;
     } else {
       for (const ToolReaction& reaction : contact_reactions_reference(body, contacts, held, contact_model))
         reactions.push_back(reaction.reaction);
@@ -285,7 +288,8 @@ int run_probe(const ProbeOptions& options) {
       for (const ProbedTool& probed : tools) pressed.push_back(probed.tool);
       Eigen::VectorXd u;
       if (contact_model == ContactModel::sphere)
-        SphereContactReference(body).solve(pressed, {}, &u);
+        SphereContactReference(body, obstacle_constraints(body.mesh, body.surface, body.dofs, model.obstacles))
+            .solve(pressed, {}, &u);
       else
         contact_reactions_reference(body, find_tool_contacts(body, pressed), {}, contact_model, &u);
       u /= scene.metres_per_unit;

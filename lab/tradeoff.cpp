@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 
+#include "common/contact/obstacle_constraints.h"
 #include "common/fem/compliance.h"
 #include "common/ir/build_ir.h"
 #include "common/ir/evaluate_force.h"
@@ -47,13 +48,15 @@ int samples_per(double sample_rate_hz, double rate_hz, const std::string& what) 
 }
 
 // The full sparse solve of a contact model on one mesh: the sphere model's unilateral
-// problem (SphereContactReference), or node translation (ContactReference) for the paper's
-// two models, which share it as their reference.
+// problem with the obstacles' constraints (SphereContactReference), or node translation
+// (ContactReference) for the paper's two models, which share it as their reference.
 class FullSolve {
  public:
-  FullSolve(const ElasticBody& body, ContactModel model) {
+  FullSolve(const ElasticBody& body, ContactModel model, std::span<const Obstacle> obstacles) {
     if (model == ContactModel::sphere)
-      sphere_ = std::make_unique<SphereContactReference>(body);
+      sphere_ = std::make_unique<SphereContactReference>(
+          body, obstacles.empty() ? std::vector<SphereConstraint>{}
+                                  : obstacle_constraints(body.mesh, body.surface, body.dofs, obstacles));
     else
       translation_ = std::make_unique<ContactReference>(body);
   }
@@ -161,12 +164,13 @@ ReferenceTrace reference_trace(const Scene& reference, const std::vector<Traject
   const Stopwatch watch;
   const Model model = build_model(reference);
   const ElasticBody& body = single_elastic_body(model);
-  FullSolve solver(body, reference.haptic.contact_model);
-  // With obstacles, which nodes rest on them at each moment comes from the simulation's
-  // active set on this mesh; the forces then from the full solve with those nodes held.
+  FullSolve solver(body, reference.haptic.contact_model, model.obstacles);
+  // With obstacles under the translation and point models, which nodes rest on them at each
+  // moment comes from the simulation's active set on this mesh; the forces then from the
+  // full solve with those nodes held. The sphere model's full solve holds them itself.
   std::unique_ptr<ComplianceColumns> columns;
   std::unique_ptr<Simulation> active_set;
-  if (!reference.obstacles.empty()) {
+  if (!reference.obstacles.empty() && reference.haptic.contact_model != ContactModel::sphere) {
     columns = std::make_unique<ComplianceColumns>(*body.free_factor, body.dofs, compliance_row_nodes(body, true));
     prepare_compliance(body, *columns, std::nullopt);
     SimulationOptions options;
@@ -231,7 +235,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
   options.ir.precision = setting.precision;
   options.ir.force_limit = std::numeric_limits<double>::infinity();  // compare the physics, not the limiter
   Simulation simulation(body, model.obstacles, columns, varied.tools, options);
-  FullSolve own_mesh(body, setting.contact_model);
+  FullSolve own_mesh(body, setting.contact_model, model.obstacles);
   std::vector<PressedTool> pressed(varied.tools.size());
 
   const int per_step = samples_per(reference.sample_rate_hz, kSimulationRateHz, "simulation rate");

@@ -15,6 +15,7 @@
 #include "common/laparoscopy/home_spring_contact.h"
 #include "common/util/error.h"
 #include "proto/wire/ir_convert.h"
+#include "support/expect_refused.h"
 #include "support/ir_seed.h"
 #include "support/tissue_sheet.h"
 
@@ -22,6 +23,7 @@ namespace cohaptic {
 namespace {
 
 using Eigen::Vector3d;
+using testing::expect_refused;
 
 HomeSpringPatch sheet_patch() {
   const TriangleSurface sheet = testing::equilateral_sheet(24, 24, 0.003);
@@ -133,15 +135,6 @@ TEST(LaparoscopyIr, FuzzSeedsReachTheEvaluation) {
       evaluate_force(grasped, state, patch.grasp.tool_at_grasp + Vector3d(0, 0, delta), {}, 1e-3);
   EXPECT_NEAR(pull.force.z(), -(k1 * delta + 6 * k2 * delta * (1 - h / std::sqrt(h * h + delta * delta))), 1e-12);
   EXPECT_NEAR(pull.force.head<2>().norm(), 0, 1e-12);
-}
-
-void expect_refused(const wire::IntermediateRepresentation& message, const std::string& fragment) {
-  try {
-    wire::from_wire(message);
-    ADD_FAILURE() << "accepted; expected an error containing \"" << fragment << "\"";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
-  }
 }
 
 TEST(LaparoscopyIr, LyingMessagesAreRefusedByName) {

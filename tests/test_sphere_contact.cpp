@@ -14,6 +14,7 @@
 #include <limits>
 #include <random>
 
+#include "common/contact/obstacle_constraints.h"
 #include "common/contact/sphere_contact.h"
 #include "common/contact/unilateral_contact_solve.h"
 #include "common/contact/working_set_contact_solve.h"
@@ -25,6 +26,7 @@
 #include "common/util/error.h"
 #include "proto/wire/ir_convert.h"
 #include "support/cube_scene.h"
+#include "support/expect_refused.h"
 #include "support/measures.h"
 #include "support/test_meshes.h"
 #include "support/unlimited_options.h"
@@ -32,6 +34,7 @@
 namespace cohaptic {
 namespace {
 
+using testing::expect_refused;
 using testing::mm;
 using testing::relative_error;
 using testing::unlimited_options;
@@ -284,7 +287,8 @@ struct SphereComparison {
 };
 
 void compare(const ElasticBody& body, const Simulation& simulation, const std::vector<Eigen::Vector3d>& tools, int user,
-             SphereComparison& comparison, double radius = kSphereRadius) {
+             SphereComparison& comparison, double radius = kSphereRadius,
+             const std::vector<SphereConstraint>& obstacles = {}) {
   const PreparedIR& prepared = *simulation.ir(user);
   std::vector<Eigen::Vector3d> remotes;
   for (int r = 0; r < remote_count(prepared.ir); ++r) remotes.push_back(tools[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
@@ -293,7 +297,7 @@ void compare(const ElasticBody& body, const Simulation& simulation, const std::v
   const ForceSample sample = evaluate_force(prepared, state, tools[static_cast<std::size_t>(user)], remotes, 1e-3);
   std::vector<PressedTool> pressed;
   for (const Eigen::Vector3d& p : tools) pressed.push_back({p, radius});
-  const SphereContactSolution reference = sphere_reactions_reference(body, pressed, held_nodes(simulation));
+  const SphereContactSolution reference = sphere_reactions_reference(body, pressed, held_nodes(simulation), nullptr, obstacles);
   const Eigen::Vector3d expected = reference.reactions[static_cast<std::size_t>(user)];
   ASSERT_FALSE(sample.flags & (kOutsidePatch | kContactUnresolved | kNonFinite));
   if (expected.norm() == 0) {
@@ -367,7 +371,8 @@ TEST(SphereContact, TwoSpheresAndHeldNodesEqualTheFullSparseSolve) {
 // One or two spheres pressed 0.2-6 mm (cube) or 0.2-4 mm (brain) into the surface at random
 // places, each from rest in one step, as `cohaptic-lab probe` does: every IR's force and
 // contact set equal the full sparse solve of the same unilateral problem. On the brain the
-// skull holds nodes (B) and the tips are 7 mm spheres on 9 mm elements.
+// skull holds nodes, sliding (the obstacles' constraints), and the tips are 7 mm spheres on
+// 9 mm elements.
 void press_at_random_places(const ElasticBody& body, const Model& model, ComplianceColumns& columns, double radius,
                             double max_depth, int positions, unsigned seed) {
   std::mt19937 random(seed);
@@ -375,6 +380,9 @@ void press_at_random_places(const ElasticBody& body, const Model& model, Complia
   std::uniform_real_distribution<double> depth(0.2e-3, max_depth);
   SphereComparison comparison;
   int two_spheres = 0;
+  const std::vector<SphereConstraint> obstacles =
+      model.obstacles.empty() ? std::vector<SphereConstraint>{}
+                              : obstacle_constraints(body.mesh, body.surface, body.dofs, model.obstacles);
   for (int k = 0; k < positions; ++k) {
     // A sphere of `radius` whose surface reaches `depth` below a touchable node, along its normal.
     const auto pressed_at = [&] {
@@ -392,7 +400,7 @@ void press_at_random_places(const ElasticBody& body, const Model& model, Complia
     for (std::size_t user = 0; user < tools.size(); ++user) {
       SCOPED_TRACE("position " + std::to_string(k) + ", user " + std::to_string(user));
       ASSERT_TRUE(simulation.ir(static_cast<int>(user)));
-      compare(body, simulation, tools, static_cast<int>(user), comparison, radius);
+      compare(body, simulation, tools, static_cast<int>(user), comparison, radius, obstacles);
     }
   }
   std::printf("  %d IRs (%d positions with two spheres): worst relative force error %.2e; %d node contacts, %d held "
@@ -462,25 +470,6 @@ IntermediateRepresentation two_sphere_ir() {
   simulation.set_tool(1, mm(20, -4, 27));
   simulation.step(0);
   return simulation.ir(0)->ir;
-}
-
-// Refused with a message holding `reason`, by from_wire or else by prepare_ir.
-void expect_refused(const wire::IntermediateRepresentation& w, const std::string& reason) {
-  try {
-    prepare_ir(wire::from_wire(w));
-    ADD_FAILURE() << "accepted: " << reason;
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
-  }
-}
-
-void expect_refused(const IntermediateRepresentation& ir, const std::string& reason) {
-  try {
-    prepare_ir(ir);
-    ADD_FAILURE() << "accepted: " << reason;
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(reason), std::string::npos) << e.what();
-  }
 }
 
 TEST(SphereIr, TravelsBitForBitWithItsUpperTriangleAndFloatRoundsW) {

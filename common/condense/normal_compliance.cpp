@@ -14,16 +14,21 @@ constexpr Eigen::Index kFirstCapacity = 64;
 
 }  // namespace
 
-NormalCompliance::NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& normals)
+NormalCompliance::NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& directions)
     : columns_(columns),
       dofs_(dofs),
-      normals_(normals),
-      slot_of_node_(static_cast<std::size_t>(normals.cols()), -1) {
+      directions_(directions),
+      slot_of_node_(static_cast<std::size_t>(directions.cols()), -1) {
   grow(kFirstCapacity);
 }
 
 int NormalCompliance::slot_of(int node) const {
   return node >= 0 && node < static_cast<int>(slot_of_node_.size()) ? slot_of_node_[static_cast<std::size_t>(node)] : -1;
+}
+
+bool NormalCompliance::current(int node) const {
+  const int slot = slot_of(node);
+  return slot >= 0 && slot_direction_.col(slot) == directions_.col(node);
 }
 
 void NormalCompliance::grow(Eigen::Index capacity) {
@@ -40,6 +45,9 @@ void NormalCompliance::grow(Eigen::Index capacity) {
     grown.leftCols(old) = *m;
     *m = std::move(grown);
   }
+  Eigen::Matrix3Xd directions = Eigen::Matrix3Xd::Zero(3, capacity);
+  directions.leftCols(old) = slot_direction_;
+  slot_direction_ = std::move(directions);
   Eigen::VectorXd clearance = Eigen::VectorXd::Zero(capacity);
   clearance.head(old) = free_clearance_;
   free_clearance_ = std::move(clearance);
@@ -57,10 +65,11 @@ bool NormalCompliance::update(std::span<const int> nodes, const IncrementalConde
       throw Error(fmt::format("normal compliance: candidate node {} is held as a boundary node", node));
     wanted[static_cast<std::size_t>(node)] = 1;
   }
-  // Leaving nodes free their slots; joining nodes take the lowest free slot, or a new one.
+  // Leaving nodes (and those with a new direction) free their slots; joining nodes take the
+  // lowest free slot, or a new one.
   for (int slot = 0; slot < slot_count(); ++slot) {
     const int node = node_of_slot_[static_cast<std::size_t>(slot)];
-    if (node < 0 || wanted[static_cast<std::size_t>(node)]) continue;
+    if (node < 0 || (wanted[static_cast<std::size_t>(node)] && current(node))) continue;
     node_of_slot_[static_cast<std::size_t>(slot)] = -1;
     slot_of_node_[static_cast<std::size_t>(node)] = -1;
     free_slots_.push_back(slot);
@@ -86,6 +95,7 @@ bool NormalCompliance::update(std::span<const int> nodes, const IncrementalConde
     }
     node_of_slot_[static_cast<std::size_t>(slot)] = node;
     slot_of_node_[static_cast<std::size_t>(node)] = slot;
+    slot_direction_.col(slot) = directions_.col(node);
     joined.push_back(slot);
   }
   std::sort(joined.begin(), joined.end());

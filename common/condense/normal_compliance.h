@@ -1,8 +1,9 @@
 // NormalCompliance: the sphere contact model's normal compliance between candidate nodes,
 // kept by the server while the candidates and the held boundary nodes B change.
 //
-// For candidate nodes with inward unit normals n (common/contact/sphere_contact.h), the
-// compliance between their normal pushes with B held at its displacement u_B:
+// For candidate nodes each pushed along a unit direction n (a sphere's: the node's inward
+// normal; an obstacle's: the obstacle's normal, common/contact/sphere_contact.h), the
+// compliance between their pushes with B held at its displacement u_B:
 //   W_ab = n_a^T L~_ab n_b,  L~ = L_CC - L_CB L_BB^-1 L_BC,
 // so W = W0 - P^T Q with W0_ab = n_a^T L_ab n_b, P = L_BC N (B's free dofs x candidates)
 // and Q = L_BB^-1 P; and each candidate's free clearance q0_a = n_a . u0_a = (Q^T u_B)_a,
@@ -32,12 +33,13 @@ namespace cohaptic {
 
 class NormalCompliance {
  public:
-  /// `columns`, `dofs` and `normals` (per volume node, ElasticBody::contact_normals) must
-  /// outlive it; every candidate and every node of B must be a row node of `columns`.
-  NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& normals);
+  /// `columns`, `dofs` and `directions` (per volume node: the direction it is pushed along)
+  /// must outlive it; every candidate and every node of B must be a row node of `columns`.
+  NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& directions);
 
   /// The candidates become `nodes` (each once, none in B), under the held set of
-  /// `condensation` held at `boundary_displacement` (free dofs of B in its order). Returns
+  /// `condensation` held at `boundary_displacement` (free dofs of B in its order). A node
+  /// whose direction changed since it took its slot leaves it and joins again. Returns
   /// whether W changed between slots that stay (B changed): a factor kept over them is void.
   bool update(std::span<const int> nodes, const IncrementalCondensation& condensation,
               const Eigen::VectorXd& boundary_displacement);
@@ -48,7 +50,11 @@ class NormalCompliance {
   Eigen::Index capacity() const { return w_.rows(); }
   int node_of(int slot) const { return node_of_slot_[static_cast<std::size_t>(slot)]; }  ///< -1: free
   int slot_of(int node) const;  ///< -1 if not a candidate
-  Eigen::Vector3d normal(int slot) const { return normals_.col(node_of(slot)); }
+  /// The direction the slot's node was taken with.
+  Eigen::Vector3d normal(int slot) const { return slot_direction_.col(slot); }
+  /// Whether `node` is a candidate taken along its current direction (false: it is none, or
+  /// the next update moves it to a new slot).
+  bool current(int node) const;
 
   /// W over the slots (capacity() square; free slots' rows and columns are zero but for a
   /// unit diagonal) [m/N].
@@ -70,7 +76,8 @@ class NormalCompliance {
 
   ComplianceColumns& columns_;
   const DofMap& dofs_;
-  const Eigen::Matrix3Xd& normals_;
+  const Eigen::Matrix3Xd& directions_;
+  Eigen::Matrix3Xd slot_direction_;  // per slot: its node's direction when it joined
   std::vector<int> node_of_slot_;
   std::vector<int> slot_of_node_;  // per volume node
   std::vector<int> free_slots_;

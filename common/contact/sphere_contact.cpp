@@ -47,6 +47,15 @@ std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, c
   return nearest;
 }
 
+std::optional<SphereConstraint> node_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
+                                                AxisMask fixed, std::span<const SphereTool> tools,
+                                                const SphereConstraint& obstacle) noexcept {
+  std::optional<SphereConstraint> constraint = sphere_constraint(rest, normal, fixed, tools);
+  if (obstacle.gap < std::numeric_limits<double>::infinity() && (!constraint || obstacle.gap < constraint->gap))
+    constraint = obstacle;
+  return constraint;
+}
+
 Eigen::Matrix3Xd contact_normals(const TetMesh& mesh, const BoundarySurface& surface, std::span<const int> triangles) {
   Eigen::Matrix3Xd normals = Eigen::Matrix3Xd::Zero(3, mesh.node_count());
   for (int t : triangles) {

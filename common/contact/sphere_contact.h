@@ -18,9 +18,17 @@
 // the nodes (W = N^T L N): a server computes it once per set of candidate nodes, and the
 // gaps alone follow the tools.
 //
+// A rigid obstacle (the inner skull) constrains a surface node the same way, taken at rest
+// and linear: with p the closest point to the node's rest position x on the nearest
+// obstacle and m the obstacle's unit normal there (towards the allowed side), the node must
+// keep g + m . u >= 0, g = m . (x - p) its signed distance; the obstacle pushes it with
+// lambda m, lambda >= 0, frictionless, so that it slides along the obstacle's tangent plane
+// at p and leaves it when holding it would pull. Of the spheres and the obstacle, the one
+// with the least gap holds the node (ties to a sphere), along its own direction.
+//
 // A node the model cannot hold is no candidate: one without a touchable triangle (zero
 // normal), or whose normal lies (to 1e-6) along its fixed axes (the support holds it
-// there). Units: m.
+// there); for an obstacle, one whose obstacle normal does. Units: m.
 #pragma once
 
 #include <Eigen/Core>
@@ -42,9 +50,10 @@ struct SphereTool {
 
 /// One candidate node's constraint.
 struct SphereConstraint {
-  int tool = -1;                                     ///< index of the sphere with the least gap
+  int tool = -1;                                     ///< index of the sphere with the least gap, or -1
   double gap = 0;                                    ///< [m]: negative inside, positive outside
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< the node's inward unit normal: the push's direction
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< the push's unit direction
+  int obstacle = -1;                                 ///< the obstacle holding it (then tool = -1), or -1
 };
 
 /// The gap [m] of a node at `rest` with inward unit `normal` to `tool`: +inf when the line
@@ -60,6 +69,12 @@ bool holdable(const Eigen::Vector3d& normal, AxisMask fixed) noexcept;
 /// constrains it or the model cannot hold it.
 std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
                                                   AxisMask fixed, std::span<const SphereTool> tools) noexcept;
+
+/// The constraint on a node from `tools` (sphere_constraint) or from its `obstacle`
+/// constraint (gap +inf: none), whichever has the least gap, ties to a sphere.
+std::optional<SphereConstraint> node_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
+                                                AxisMask fixed, std::span<const SphereTool> tools,
+                                                const SphereConstraint& obstacle) noexcept;
 
 /// The inward unit normal of every node of `triangles` (a body's touchable triangles): the
 /// angle-weighted mean of their outward normals, reversed; zero for every other node (one

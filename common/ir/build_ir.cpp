@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 #include <unordered_map>
 
 #include "common/condense/dof_blocks.h"
@@ -68,15 +69,19 @@ void fill_sphere_contact(const ElasticBody& body, std::span<const int> boundary,
   sphere.normals = Eigen::Matrix3Xd::Zero(3, n);
   sphere.free_clearance = Eigen::VectorXd::Zero(n);
   sphere.normal_compliance = Eigen::MatrixXd::Zero(n, n);
+  sphere.obstacle_gaps = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
   std::vector<int> slots(nodes.size(), -1);
   for (Eigen::Index i = 0; i < n; ++i) {
     const int node = nodes[static_cast<std::size_t>(i)];
-    if (!holdable(body.contact_normals.col(node), body.dofs.fixed_axes[node])) continue;  // no candidate: zero
+    const auto obstacle = std::lower_bound(source.obstacle_nodes.begin(), source.obstacle_nodes.end(), node);
+    const bool obstacle_row = obstacle != source.obstacle_nodes.end() && *obstacle == node;
+    if (!obstacle_row && !holdable(body.contact_normals.col(node), body.dofs.fixed_axes[node])) continue;  // no candidate: zero
     const int slot = normal.slot_of(node);
     if (slot < 0) throw Error(fmt::format("build_ir: row node {} has no normal compliance", body.mesh.node_tags[node]));
     slots[static_cast<std::size_t>(i)] = slot;
     sphere.normals.col(i) = normal.normal(slot);
     sphere.free_clearance[i] = normal.free_clearance()[slot];
+    if (obstacle_row) sphere.obstacle_gaps[i] = source.obstacle_gaps[static_cast<std::size_t>(obstacle - source.obstacle_nodes.begin())];
   }
   for (Eigen::Index j = 0; j < n; ++j)
     for (Eigen::Index i = 0; i < n; ++i)
@@ -189,6 +194,8 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
     remote.tool_radius = users[j].radius;
     fem.remotes.push_back(remote);
   }
+  if (sphere)  // the nodes the server's state holds against an obstacle
+    for (int node : sphere_source.obstacle_nodes) add_node(node);
   fem.row_node_count = static_cast<int>(nodes.size());
   if (sphere) {
     fill_sphere_contact(body, boundary, sphere_source, nodes, options.precision, fem);

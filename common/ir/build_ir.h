@@ -5,9 +5,10 @@
 // included as remote contacts; M~ comes from the incremental condensation for
 // C = patch nodes + remote contact nodes and the current boundary set B. Under the sphere
 // contact model the patch also holds every touchable triangle with a node inside the
-// sphere (sphere_patch), every remote sphere's patch nodes are contact nodes too, and the
-// IR carries their normal compliance, cut from the server's (normal_compliance.h), instead
-// of M~.
+// sphere (sphere_patch), every remote sphere's patch nodes are contact nodes too, so are
+// the nodes the server's state solve holds against a rigid obstacle (its obstacle rows), and
+// the IR carries their normal compliance, cut from the server's (normal_compliance.h),
+// instead of M~.
 #pragma once
 
 #include <Eigen/Core>
@@ -64,10 +65,13 @@ int nearest_touchable_triangle(const ElasticBody& body, const Eigen::Vector3d& p
 using RestDisplacement = std::function<Eigen::VectorXd(std::span<const int> dofs)>;
 
 /// Under the sphere contact model: the server's normal compliance, over every node the IR
-/// can hold (its row nodes), and the slots of it that the server's state pushes.
+/// can hold (its row nodes), the slots of it that the server's state pushes, and its
+/// candidates an obstacle holds (ascending) with their gaps at rest [m].
 struct SphereIrSource {
   const NormalCompliance* normal = nullptr;
   std::span<const int> contact_slots;
+  std::span<const int> obstacle_nodes;
+  std::span<const double> obstacle_gaps;
 };
 
 /// IR for users[user_index]. `boundary_displacement` gives u for each node of

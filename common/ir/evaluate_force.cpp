@@ -18,10 +18,6 @@
 namespace cohaptic {
 namespace {
 
-// Asymmetry of M_CC tolerated, relative to its largest entry: round-off of another
-// producer's arithmetic, far below any physical meaning.
-constexpr double kMaxRelativeAsymmetry = 1e-9;
-
 // One pressing tool during a tick.
 struct PressingTool {
   std::array<int, 3> nodes{};  // local node indices

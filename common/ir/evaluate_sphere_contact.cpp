@@ -33,11 +33,15 @@ ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, 
     tools[tool_count++] = {remote_tools[r], ir.remotes[r].tool_radius};
   }
 
-  // Each row node's clearance from the sphere with the least gap along its normal.
+  // Each row node's clearance from the sphere with the least gap along its normal, or from
+  // the rigid obstacle that holds it (its gap does not depend on the tools).
+  const bool obstacles = sphere.obstacle_gaps.size() == m;
   for (int i = 0; i < m; ++i) {
     double gap = std::numeric_limits<double>::infinity();
     std::int8_t holder = -1;
-    if (sphere.normals.col(i).squaredNorm() > 0)
+    if (obstacles && sphere.obstacle_gaps[i] < gap)
+      gap = sphere.obstacle_gaps[i];
+    else if (sphere.normals.col(i).squaredNorm() > 0)
       for (std::size_t t = 0; t < tool_count; ++t)
         if (const double g = sphere_gap(ir.rest_positions.col(i), sphere.normals.col(i), tools[t]); g < gap) {
           gap = g;

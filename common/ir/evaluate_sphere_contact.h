@@ -3,7 +3,9 @@
 //
 // Every row node of the IR that the model can hold is a candidate of the sphere (own, or a
 // remote one at its given position) with the least gap along the node's normal; its
-// clearance is q = g + q0, with q0 from the IR. Which of them touch and with what push is the
+// clearance is q = g + q0, with q0 from the IR; a row node a rigid obstacle holds (the IR's
+// obstacle rows) has the obstacle's gap instead, along the obstacle's normal, and pushes
+// back on no tool directly. Which of them touch and with what push is the
 // unilateral problem over the IR's normal compliance W, solved from where the evaluator's
 // last tick on the same IR left it (incremental_contact_solve.h; the first tick starts from
 // the server's contacts). The force on the own tool is -sum lambda_i n_i over the nodes its

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <limits>
+
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -30,7 +32,9 @@ std::size_t CondensedFemIr::size_bytes() const {
     const auto n = static_cast<std::size_t>(sphere->normal_compliance.rows());
     sphere_bytes = static_cast<std::size_t>(sphere->normals.size() + sphere->free_clearance.size()) * sizeof(double) +
                    n * (n + 1) / 2 * scalar + sphere->contacts.size() * sizeof(std::int32_t) +
-                   sphere->held_node_ids.size() * sizeof(std::int64_t);
+                   sphere->held_node_ids.size() * sizeof(std::int64_t) +
+                   static_cast<std::size_t>((sphere->obstacle_gaps.array() < std::numeric_limits<double>::infinity()).count()) *
+                       (sizeof(std::uint32_t) + sizeof(double));
   }
   return kHeader + nodes + triangles + remote + matrix + truncated + sphere_bytes;
 }

@@ -73,12 +73,19 @@ struct IrRemoteContact {
 /// compliance between the row nodes' normal pushes and q0 their normal displacement under
 /// no push, so that under pushes lambda a node's clearance is g + q0 + (W lambda); neither
 /// depends on where the tools are. B itself travels only as its tags.
+/// Asymmetry tolerated in a received matrix that must be symmetric (M_CC, W), relative to
+/// its largest entry: round-off of another producer's arithmetic, far below any physical meaning.
+inline constexpr double kMaxRelativeAsymmetry = 1e-9;
+
 struct SphereContactIr {
   Eigen::Matrix3Xd normals;            ///< per row node: inward unit normal, zero for a node the model cannot hold
   Eigen::VectorXd free_clearance;      ///< q0 per row node [m]
   /// W, row nodes square, symmetric [m/N]; the rows and columns of a node the model cannot
   /// hold are zero.
   Eigen::MatrixXd normal_compliance;
+  /// Per row node: the gap at rest [m] to the rigid obstacle that holds it, along its normal
+  /// (then the obstacle's), or +inf for a node the spheres hold (sphere_contact.h).
+  Eigen::VectorXd obstacle_gaps;
   std::vector<int> contacts;           ///< row nodes the server's state pushes (ascending): the first tick's set
   std::vector<std::int64_t> held_node_ids;  ///< B's tags: the nodes W and q0 hold where they are
 };

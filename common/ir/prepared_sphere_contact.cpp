@@ -12,9 +12,7 @@
 namespace cohaptic {
 namespace {
 
-// Asymmetry of W tolerated, relative to its largest entry (as for M_CC, evaluate_force.cpp),
-// and how far from 1 a normal's length may be.
-constexpr double kMaxRelativeAsymmetry = 1e-9;
+// How far from 1 a normal's length may be.
 constexpr double kUnitTolerance = 1e-9;
 
 }  // namespace
@@ -34,6 +32,13 @@ PreparedSphereContact prepare_sphere_contact(const CondensedFemIr& ir, double to
                             sphere.normal_compliance.cols(), n));
   if (!sphere.normals.allFinite() || !sphere.free_clearance.allFinite() || !sphere.normal_compliance.allFinite())
     throw Error("intermediate representation: non-finite values in the sphere contact's normals, clearances or W");
+  if (sphere.obstacle_gaps.size() != 0 && sphere.obstacle_gaps.size() != n)
+    throw Error(fmt::format("intermediate representation: {} obstacle gaps for {} row nodes", sphere.obstacle_gaps.size(), n));
+  for (Eigen::Index i = 0; i < sphere.obstacle_gaps.size(); ++i)
+    if (const double gap = sphere.obstacle_gaps[i]; gap != std::numeric_limits<double>::infinity() &&
+                                                    (!std::isfinite(gap) || sphere.normals.col(i).squaredNorm() == 0))
+      throw Error(fmt::format("intermediate representation: row node {}'s obstacle gap is {}{}", i, gap,
+                              std::isfinite(gap) ? " but it has no normal" : ""));
   if (!(tool_radius > 0)) throw Error("intermediate representation: the sphere model needs a sphere tool (radius > 0)");
   for (const IrRemoteContact& remote : ir.remotes)
     if (!(remote.tool_radius > 0))

@@ -33,7 +33,7 @@ struct PreparedSphereContact {
 struct SphereContactState {
   IncrementalContactSolve solve;
   Eigen::VectorXd clearance;        ///< per row node: this tick's q [m] (+inf: no sphere reaches it)
-  std::vector<std::int8_t> holder;  ///< per row node: the sphere holding it (0 own, 1 + r remote r), or -1
+  std::vector<std::int8_t> holder;  ///< per row node: the sphere holding it (0 own, 1 + r remote r), or -1 (none, or an obstacle)
   double work_budget = kSphereSolveWork;  ///< per tick; a test or an offline tool may lift it
 };
 

@@ -17,10 +17,15 @@ std::vector<int> SphereContactSolution::contact_nodes() const {
   return nodes;
 }
 
-SphereContactReference::SphereContactReference(const ElasticBody& body)
+SphereContactReference::SphereContactReference(const ElasticBody& body, std::vector<SphereConstraint> obstacles)
     : body_(body),
+      obstacles_(std::move(obstacles)),
       candidates_(triangle_nodes(body.surface, body.touchable_triangles)),
       candidate_row_(static_cast<std::size_t>(body.mesh.node_count()), -1) {
+  for (std::size_t node = 0; node < obstacles_.size(); ++node)
+    if (obstacles_[node].obstacle >= 0) candidates_.push_back(static_cast<int>(node));
+  std::sort(candidates_.begin(), candidates_.end());
+  candidates_.erase(std::unique(candidates_.begin(), candidates_.end()), candidates_.end());
   for (int node : candidates_) {
     candidate_row_[static_cast<std::size_t>(node)] = static_cast<int>(row_dofs_.size());
     for (int axis = 0; axis < 3; ++axis) row_dofs_.push_back(3 * node + axis);
@@ -67,10 +72,17 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
 
   std::vector<bool> is_held(static_cast<std::size_t>(body_.mesh.node_count()), false);
   for (int node : held.nodes) is_held[static_cast<std::size_t>(node)] = true;
-  std::vector<int> free_candidates;
+  SphereConstraint no_obstacle;
+  no_obstacle.gap = std::numeric_limits<double>::infinity();
+  SphereCandidates candidates;
   for (int node : candidates_)
-    if (!is_held[static_cast<std::size_t>(node)]) free_candidates.push_back(node);
-  const SphereCandidates candidates = sphere_candidates(body_.mesh, body_.dofs, body_.contact_normals, free_candidates, spheres);
+    if (!is_held[static_cast<std::size_t>(node)])
+      if (const auto constraint = node_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
+                                                  body_.dofs.fixed_axes[static_cast<std::size_t>(node)], spheres,
+                                                  obstacles_.empty() ? no_obstacle : obstacles_[static_cast<std::size_t>(node)])) {
+        candidates.nodes.push_back(node);
+        candidates.constraints.push_back(*constraint);
+      }
 
   SphereContactSolution solution;
   solution.candidates = candidates.nodes;
@@ -118,7 +130,7 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   if (!result.inner.solved) throw NumericalError("sphere contact: the candidates' normal compliance is not positive definite");
   for (Eigen::Index i = 0; i < m; ++i) {
     const SphereConstraint& c = candidates.constraints[static_cast<std::size_t>(i)];
-    solution.reactions[static_cast<std::size_t>(c.tool)] -= solution.pushes[i] * c.normal;
+    if (c.tool >= 0) solution.reactions[static_cast<std::size_t>(c.tool)] -= solution.pushes[i] * c.normal;
   }
   if (displacement) {
     Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * body_.mesh.node_count());
@@ -131,8 +143,9 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
 }
 
 SphereContactSolution sphere_reactions_reference(const ElasticBody& body, const std::vector<PressedTool>& tools,
-                                                 const HeldNodes& held, Eigen::VectorXd* displacement) {
-  return SphereContactReference(body).solve(tools, held, displacement);
+                                                 const HeldNodes& held, Eigen::VectorXd* displacement,
+                                                 std::vector<SphereConstraint> obstacles) {
+  return SphereContactReference(body, std::move(obstacles)).solve(tools, held, displacement);
 }
 
 }  // namespace cohaptic

@@ -1,14 +1,16 @@
 // The reference answer for sphere tools under the sphere contact model
 // (common/contact/sphere_contact.h): full sparse FEM solves of the unilateral problem.
 //
-// The candidates are the nodes of the touchable triangles, less the held boundary nodes B,
-// each of the sphere with the least gap along its normal. K is factored (CHOLMOD) with B's dofs prescribed; one
+// The candidates are the nodes of the touchable triangles and those a rigid obstacle
+// constrains (obstacle_constraints.h), less the held boundary nodes B, each held by the
+// sphere or obstacle with the least gap (node_constraint). K is factored (CHOLMOD) with B's dofs prescribed; one
 // solve gives the candidates' displacement u0 under B's displacements alone, and
 // multi-right-hand-side solves the compliance L under unit forces at the free dofs of the
 // working set's nodes (working_set_contact_solve.h), over the rows of every candidate. With
 // A = N^T L N and q = g + N^T u0 the unilateral problem is solved over every candidate,
 // without a work limit; its pushes lambda_i n_i are the tools' forces on the nodes, and
-// -sum lambda_i n_i over a tool's nodes the force on the tool.
+// -sum lambda_i n_i over a tool's nodes the force on the tool (an obstacle's pushes are no
+// tool's).
 //
 // This is the slow path the intermediate representation is checked against: it shares
 // neither the condensation nor the evaluator with it (only the working-set solve, which
@@ -40,8 +42,9 @@ struct SphereContactSolution {
 
 class SphereContactReference {
  public:
-  /// `body` must outlive the reference.
-  explicit SphereContactReference(const ElasticBody& body);
+  /// `body` must outlive the reference. `obstacles`: per volume node, its obstacle
+  /// constraint (obstacle_constraints.h), or empty for none.
+  explicit SphereContactReference(const ElasticBody& body, std::vector<SphereConstraint> obstacles = {});
   ~SphereContactReference();
 
   /// Every tool is a sphere (radius > 0). Also returns the displacement field (3N) if asked.
@@ -57,7 +60,8 @@ class SphereContactReference {
   void compute_columns(const std::vector<int>& nodes);
 
   const ElasticBody& body_;
-  std::vector<int> candidates_;      // nodes of the touchable triangles, ascending
+  std::vector<SphereConstraint> obstacles_;  // per volume node, or empty
+  std::vector<int> candidates_;      // nodes of the touchable triangles and the obstacles', ascending
   std::vector<int> candidate_row_;   // per volume node: its first row (3 per candidate), or -1
   std::vector<int> row_dofs_;        // global dof of each row
   std::vector<int> held_key_;
@@ -66,8 +70,9 @@ class SphereContactReference {
   std::size_t factorisations_ = 0;
 };
 
-/// One-shot: SphereContactReference(body).solve(tools, held).
+/// One-shot: SphereContactReference(body, obstacles).solve(tools, held).
 SphereContactSolution sphere_reactions_reference(const ElasticBody& body, const std::vector<PressedTool>& tools,
-                                                 const HeldNodes& held = {}, Eigen::VectorXd* displacement = nullptr);
+                                                 const HeldNodes& held = {}, Eigen::VectorXd* displacement = nullptr,
+                                                 std::vector<SphereConstraint> obstacles = {});
 
 }  // namespace cohaptic

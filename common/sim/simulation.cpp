@@ -7,6 +7,7 @@
 #include "common/contact/contact_patch.h"
 #include "common/contact/find_contact.h"
 #include "common/contact/nearest_surface_nodes.h"
+#include "common/contact/obstacle_constraints.h"
 #include "common/sim/sphere_state_solve.h"
 #include "common/util/stopwatch.h"
 
@@ -33,17 +34,18 @@ Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstac
   for (int t : body.touchable_triangles) touchable_triangle_[t] = true;
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
-  if (sphere_model()) {
-    sphere_solve_ = std::make_unique<SphereStateSolve>(body, columns);
-    node_of_tag_ = node_indices_by_tag(body.mesh);
-  }
   p0_states_.resize(users_.size());
   if (!obstacles.empty()) {
-    Eigen::Matrix3Xd surface_points(3, static_cast<Eigen::Index>(body.surface.nodes.size()));
-    for (std::size_t i = 0; i < body.surface.nodes.size(); ++i)
-      surface_points.col(static_cast<Eigen::Index>(i)) = body.mesh.nodes.col(body.surface.nodes[i]);
+    const Eigen::Matrix3Xd surface_points = surface_rest_points(body.mesh, body.surface);
     for (const Obstacle& obstacle : obstacles) obstacles_.emplace_back(obstacle, surface_points);
-    clearance_ = ObstacleClearance(obstacles_, surface_points);
+    if (!sphere_model()) clearance_ = ObstacleClearance(obstacles_, surface_points);
+  }
+  if (sphere_model()) {
+    sphere_solve_ = std::make_unique<SphereStateSolve>(
+        body, columns,
+        obstacles_.empty() ? std::vector<SphereConstraint>{}
+                           : obstacle_constraints(body.mesh, body.surface, body.dofs, obstacles_));
+    node_of_tag_ = node_indices_by_tag(body.mesh);
   }
 }
 
@@ -182,12 +184,13 @@ bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, 
     // patch holds (a node in another user's patch is a contact node of this user's IR too).
     std::vector<int> pushed;
     std::vector<std::pair<int, int>> left_out;
+    const std::span<const int> obstacle_rows = sphere_solve_->obstacle_rows();
     for (std::size_t i = 0; i < state.contact_dofs.size(); ++i) {
       const int node = state.contact_dofs[i] / 3;
       if (state.contact_forces[static_cast<Eigen::Index>(i)] == 0.0 || (!pushed.empty() && pushed.back() == node))
         continue;  // not pushed, or its other axes
       pushed.push_back(node);
-      if (in_patch[node]) continue;
+      if (in_patch[node] || std::binary_search(obstacle_rows.begin(), obstacle_rows.end(), node)) continue;
       const SphereConstraint constraint =
           sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node), body_.dofs.fixed_axes[node], tools)
               .value();
@@ -289,7 +292,8 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
     for (int node : step_nodes) release(node);
   }
 
-  for (int pass = 0; pass < options_.obstacle_iterations && !obstacles_.empty(); ++pass)
+  // Under the sphere contact model the state solve holds the obstacles' nodes itself.
+  for (int pass = 0; pass < options_.obstacle_iterations && !obstacles_.empty() && !sphere_model(); ++pass)
     if (!update_obstacle_contacts(under_tool)) break;
   return boundary_dirty_;
 }
@@ -352,8 +356,9 @@ StepReport Simulation::step(double time) {
   // node they hold or carry is one of its row nodes (its normal compliance does not depend
   // on where they are): it is rebuilt when one is not, or when a sphere holding nothing
   // comes nearest another triangle.
-  const bool sets_changed = boundary_changed || support_changed || nearest != built_nearest_ ||
-                            (sphere_model() && !sphere_rows_cover_holds());
+  const bool sets_changed =
+      boundary_changed || support_changed || nearest != built_nearest_ ||
+      (sphere_model() && (!sphere_rows_cover_holds() || !std::ranges::equal(sphere_solve_->obstacle_rows(), built_obstacle_rows_)));
   if (sets_changed || options_.naive_every_step) {
     IncrementalCondensation& condensation = ir_condensation();
     const std::vector<Eigen::Vector3d> held = boundary_displacement(condensation);
@@ -362,7 +367,8 @@ StepReport Simulation::step(double time) {
       rest_displacement = [support = support_.get()](std::span<const int> dofs) { return support->rest_displacement(dofs); };
     SphereIrSource sphere;
     if (sphere_model()) {
-      sphere = {&sphere_solve_->normal_compliance(), sphere_solve_->contact_slots()};
+      sphere = {&sphere_solve_->normal_compliance(), sphere_solve_->contact_slots(), sphere_solve_->obstacle_rows(),
+                sphere_solve_->obstacle_row_gaps()};
       built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
     }
     for (std::size_t i = 0; i < tools.size(); ++i) {
@@ -378,6 +384,7 @@ StepReport Simulation::step(double time) {
       p0_states_[static_cast<std::size_t>(tools[i].user)] = make_evaluation_state(*user.ir);
     }
     built_nearest_ = nearest;
+    if (sphere_model()) built_obstacle_rows_.assign(sphere_solve_->obstacle_rows().begin(), sphere_solve_->obstacle_rows().end());
     report.rebuilt = sets_changed;
     report.recomputed = true;
   }
@@ -386,6 +393,7 @@ StepReport Simulation::step(double time) {
   previous_spheres_ = spheres();
   report.boundary_nodes = static_cast<int>(condensation_.boundary_nodes().size());
   for (const auto& [node, held] : held_) report.obstacle_nodes += held.obstacle >= 0;
+  if (sphere_model()) report.obstacle_nodes = sphere_solve_->obstacle_pushed();
   return report;
 }
 

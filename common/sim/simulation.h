@@ -7,10 +7,13 @@
 //        nodes nearest the pressing tools, outside every user's patch, join B when contact
 //        begins, held where they were at the previous step (before the touch), and leave
 //        when no tool presses;
-//      - rigid obstacles: a surface node whose displaced position penetrates an obstacle
-//        joins B, held at its closest point on the obstacle; a held node whose holding
-//        force would pull it into the obstacle is released. The active set is iterated up
-//        to `obstacle_iterations` times per step (and keeps converging over steps);
+//      - rigid obstacles, under the translation and point contact models: a surface node
+//        whose displaced position penetrates an obstacle joins B, held at its closest point
+//        on the obstacle; a held node whose holding force would pull it into the obstacle is
+//        released. The active set is iterated up to `obstacle_iterations` times per step
+//        (and keeps converging over steps). Under the sphere contact model the obstacles
+//        are unilateral constraints of the state solve instead (sphere_state_solve.h): their
+//        nodes slide along them, and the IRs carry them as rows of their own;
 //      - a node of a tool's nearest triangle is never held: the tool wins (under the
 //        sphere contact model, no node of the sphere's patch);
 //   3. rebuilds every user's IR when a set changed (nearest triangles, the nodes each
@@ -117,7 +120,7 @@ class Simulation {
   /// ObstacleClearance::estimate) options.near_obstacle_distance or less from an obstacle
   /// in the last step's last obstacle pass, with that estimate: should one reach the
   /// obstacle, the step that holds it solves its columns first. A caller may have them
-  /// solved ahead (the server's CompliancePrefetch).
+  /// solved ahead (the server's CompliancePrefetch). Empty under the sphere contact model.
   const std::vector<NodeDistance>& nodes_near_obstacles() const { return near_obstacles_; }
 
   const IncrementalCondensation& condensation() const { return condensation_; }
@@ -185,6 +188,7 @@ class Simulation {
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
   std::vector<char> built_sphere_rows_;             // per node: a row node of the IRs last built (sphere model)
+  std::vector<int> built_obstacle_rows_;            // sphere model: the obstacle rows of the IRs last built
   std::unordered_map<std::int64_t, int> node_of_tag_;  // sphere model: to read the IRs' row nodes
   std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
   std::vector<SphereTool> previous_spheres_;        // the sphere model's: the spheres of the previous step

@@ -1,19 +1,30 @@
 // The simulation's own solve of the state under the sphere contact model
-// (common/contact/sphere_contact.h): every sphere at once with the boundary nodes B held.
+// (common/contact/sphere_contact.h): every sphere and every rigid obstacle at once, with the
+// boundary nodes B held.
 //
-// Its candidates are the nodes of the users' patches (those their IRs carry) and every
+// Its candidates are the nodes of the users' patches (those their IRs carry), every
 // touchable node whose gap to a sphere is less than twice the deepest penetration of a
 // pushed node (or of B's largest normal move): the nodes the deformation could carry into
-// a sphere. Each is pushed along its own normal by the sphere with the least gap; their
+// a sphere, and the obstacles' candidates (below). Each is pushed along the direction of its
+// constraint, the sphere's or obstacle's with the least gap (node_constraint); their
 // normal compliance W with B held (normal_compliance.h) gives the unilateral problem over
-// the normal pushes, solved from the last solve's set and factor
-// (incremental_contact_solve.h), so that a step whose contact set barely changes costs
-// O(|K|^2), and a candidate well outside a sphere costs nothing (its row of W has no
-// negative entry). If a solve pushes deeper than the candidates allowed for, the wider band
-// joins and the state is solved again. The nodal forces lambda n then give f_B and any
-// node's displacement as for the other models (state_solve.h). A pushed node outside the
-// patches makes the simulation widen that user's patch
-// (Simulation::carry_pushed_nodes_into_patches). Units: m, N. Not thread-safe.
+// the pushes, solved from the last solve's set and factor (incremental_contact_solve.h), so
+// that a step whose contact set barely changes costs O(|K|^2), and a candidate well clear
+// of everything costs nothing (its row of W has no negative entry). If a solve pushes deeper
+// than the candidates allowed for, the wider band joins and the state is solved again.
+//
+// The obstacles' candidates are the surface nodes within kObstacleJoin of their obstacle in
+// the solved state (g + m . u): after each solve, the nodes within that same reach of the
+// deepest push whose rest gap says they could have come that near are checked, and any that
+// did join and the state is solved again; a candidate leaves once it is kObstacleLeave clear
+// and not pushed. The answer is therefore that of the problem over every node (a constraint
+// the solution keeps is one it would not change), whatever the path: the obstacle lets the
+// nodes slide and releases them as the unilateral problem says, in one step or many.
+//
+// The nodal forces lambda n then give f_B and any node's displacement as for the other models
+// (state_solve.h). A node a sphere pushes outside the patches makes the simulation widen
+// that user's patch (Simulation::carry_pushed_nodes_into_patches). Units: m, N. Not
+// thread-safe.
 #pragma once
 
 #include <Eigen/Core>
@@ -30,15 +41,21 @@ namespace cohaptic {
 
 class SphereStateSolve {
  public:
-  /// `body` and `columns` (whose rows include every touchable node and every node B may
-  /// hold) must outlive it.
-  SphereStateSolve(const ElasticBody& body, ComplianceColumns& columns);
+  /// A candidate this near its obstacle in the solved state joins [m].
+  static constexpr double kObstacleJoin = 0.5e-3;
+  /// A candidate this clear of its obstacle, and not pushed, leaves [m].
+  static constexpr double kObstacleLeave = 1e-3;
+
+  /// `body` and `columns` (whose rows include every touchable node, every node an obstacle
+  /// may hold and every node B may hold) must outlive it. `obstacles`: per volume node, its
+  /// obstacle constraint (obstacle_constraints.h), or empty for none.
+  SphereStateSolve(const ElasticBody& body, ComplianceColumns& columns, std::vector<SphereConstraint> obstacles = {});
 
   /// The state with `spheres` pressing, over the candidates `patch_nodes` (any order,
   /// repeats allowed; nodes in B or that the model cannot hold are left out), u_B over the
   /// free dofs of B in the condensation's order. contact_dofs are the free dofs of the
-  /// pushed nodes; tool_forces[t] is sphere t's force on the object. Throws NumericalError if
-  /// the problem cannot be solved.
+  /// pushed nodes (by spheres and by obstacles); tool_forces[t] is sphere t's force on the
+  /// object. Throws NumericalError if the problem cannot be solved.
   StateSolution solve(IncrementalCondensation& condensation, std::span<const int> patch_nodes,
                       std::span<const SphereTool> spheres, const Eigen::VectorXd& boundary_displacement);
 
@@ -46,16 +63,25 @@ class SphereStateSolve {
   const NormalCompliance& normal_compliance() const { return normal_; }
   /// The slots of normal_compliance() the last solve pushes.
   std::span<const int> contact_slots() const { return contact_.members(); }
+  /// The last solve's candidates an obstacle holds (whose slots push along its normal),
+  /// ascending, and their gaps at rest [m].
+  std::span<const int> obstacle_rows() const { return obstacle_rows_; }
+  std::span<const double> obstacle_row_gaps() const { return obstacle_row_gaps_; }
+  /// How many nodes the obstacles push in the last solve.
+  int obstacle_pushed() const { return obstacle_pushed_; }
 
  private:
-  /// The candidates become `nodes`: members leaving the set leave the contact solve first,
-  /// and a change of W under the members refactors it.
+  /// The candidates become `nodes`: members leaving the set, or taking a new direction,
+  /// leave the contact solve first, and a change of W under the members refactors it.
   void set_candidates(const std::vector<int>& nodes, IncrementalCondensation& condensation,
                       const Eigen::VectorXd& boundary_displacement);
 
   const ElasticBody& body_;
   ComplianceColumns& columns_;
-  std::vector<int> touchable_;  // the touchable triangles' nodes: all that can be pushed
+  std::vector<int> touchable_;  // the touchable triangles' nodes: all that spheres can push
+  std::vector<SphereConstraint> obstacle_;  // per volume node (empty: no obstacles)
+  std::vector<int> obstacle_nodes_;         // the nodes with an obstacle constraint, ascending
+  Eigen::Matrix3Xd directions_;             // per volume node: its push's direction as of the last solve
   NormalCompliance normal_;
   IncrementalContactSolve contact_;
   /// The band of the candidates: twice the deepest penetration.
@@ -63,7 +89,11 @@ class SphereStateSolve {
 
   double band_ = 0;             // [m], as of the last solve
   Eigen::VectorXd clearance_;   // per slot, this solve's q
-  std::vector<int> tool_;       // per slot, the sphere with the least gap (-1: none)
+  std::vector<int> tool_;       // per slot, the sphere holding it (-1: none, or an obstacle)
+  std::vector<int> obstacle_candidates_;  // obstacle-held candidates kept for the next solve
+  std::vector<int> obstacle_rows_;
+  std::vector<double> obstacle_row_gaps_;
+  int obstacle_pushed_ = 0;
 };
 
 }  // namespace cohaptic

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <limits>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -137,6 +138,11 @@ void sphere_to_wire(const SphereContactIr& sphere, IrPrecision precision, Sphere
     add_upper(out->mutable_normal_compliance_f64());
   for (int node : sphere.contacts) out->add_contacts(static_cast<std::uint32_t>(node));
   out->mutable_held_node_ids()->Add(sphere.held_node_ids.begin(), sphere.held_node_ids.end());
+  for (Eigen::Index i = 0; i < sphere.obstacle_gaps.size(); ++i)
+    if (std::isfinite(sphere.obstacle_gaps[i])) {
+      out->add_obstacle_rows(static_cast<std::uint32_t>(i));
+      out->add_obstacle_gaps(sphere.obstacle_gaps[i]);
+    }
 }
 
 void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
@@ -328,6 +334,16 @@ SphereContactIr sphere_from_wire(const SphereContact& w, std::uint32_t nodes, Ir
     sphere.contacts.push_back(static_cast<int>(node));
   }
   sphere.held_node_ids.assign(w.held_node_ids().begin(), w.held_node_ids().end());
+  if (w.obstacle_rows_size() != w.obstacle_gaps_size())
+    invalid("sphere.obstacle_rows has {} values, sphere.obstacle_gaps {}", w.obstacle_rows_size(), w.obstacle_gaps_size());
+  sphere.obstacle_gaps = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
+  for (int k = 0; k < w.obstacle_rows_size(); ++k) {
+    const std::uint32_t row = w.obstacle_rows(k);
+    if (row >= nodes || (k > 0 && row <= w.obstacle_rows(k - 1)))
+      invalid("sphere.obstacle_rows[{}] = {} is not an ascending row node of {}", k, row, nodes);
+    if (!std::isfinite(w.obstacle_gaps(k))) invalid("sphere.obstacle_gaps[{}] is not finite ({})", k, w.obstacle_gaps(k));
+    sphere.obstacle_gaps[row] = w.obstacle_gaps(k);
+  }
   return sphere;
 }
 
