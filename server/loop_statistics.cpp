@@ -6,6 +6,7 @@ namespace cohaptic {
 
 void LoopStatistics::record_step(const StepFigures& step, double elapsed_s) {
   std::lock_guard lock(mutex_);
+  if (totals_.steps == 0) totals_.first_step_s = elapsed_s - static_cast<double>(step.duration_ns) * 1e-9;
   step_ns_.record(step.duration_ns);
   if (step.report.recomputed) ir_build_ns_.record(static_cast<std::int64_t>(step.report.rebuild_ms * 1e6));
   if (step.report.rebuilt) {

@@ -36,8 +36,12 @@ struct LoopSummary {
   std::uint64_t failed_steps = 0;
   int max_consecutive_failures = 0;
   std::string last_failure;
-  double elapsed_s = 0;  ///< from the server's start to the end of the last step
-  double rate_hz() const { return elapsed_s > 0 ? static_cast<double>(steps) / elapsed_s : 0.0; }
+  double elapsed_s = 0;     ///< from the server's start to the end of the last step
+  double first_step_s = 0;  ///< from the server's start to the start of the first step (the scene loaded)
+  /// Steps per second since the first step: the loading of the scene is no part of it.
+  double rate_hz() const {
+    return elapsed_s > first_step_s ? static_cast<double>(steps) / (elapsed_s - first_step_s) : 0.0;
+  }
 };
 
 class LoopStatistics {

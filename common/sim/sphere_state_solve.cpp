@@ -29,6 +29,7 @@ SphereStateSolve::SphereStateSolve(const ElasticBody& body, ComplianceColumns& c
       contact_(static_cast<int>(normal_.capacity())) {
   for (std::size_t node = 0; node < obstacle_.size(); ++node)
     if (obstacle_[node].obstacle >= 0) obstacle_nodes_.push_back(static_cast<int>(node));
+  near_obstacle_.assign(static_cast<std::size_t>(body.mesh.node_count()), 0);
 }
 
 void SphereStateSolve::set_candidates(const std::vector<int>& nodes, IncrementalCondensation& condensation,
@@ -82,9 +83,20 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
           added |= add(node);
     return added;
   };
+  // The obstacles' nodes whose rest gap is within `band` (plus kObstacleLeave) join too.
+  // Their band never narrows: a node that joined stays, so that the many nodes along an
+  // obstacle do not leave and join again as the presses deepen and ease.
+  const auto add_obstacle_band = [&](double band) {
+    obstacle_band_ = std::max(obstacle_band_, band);
+    bool added = false;
+    for (int node : obstacle_nodes_)
+      if (!listed[static_cast<std::size_t>(node)] && obstacle_of(node).gap < obstacle_band_ + kObstacleLeave)
+        added |= add(node);
+    return added;
+  };
   for (int node : patch_nodes) add(node);
   add_band(band_);
-  for (int node : obstacle_candidates_) add(node);
+  add_obstacle_band(band_);
 
   for (;;) {
     // Each candidate pushes along its constraint's direction (its own normal if none holds it).
@@ -96,13 +108,15 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
     set_candidates(candidates, condensation, boundary_displacement);
     std::vector<int> index_of(static_cast<std::size_t>(body_.mesh.node_count()), -1);
     for (std::size_t i = 0; i < candidates.size(); ++i) index_of[static_cast<std::size_t>(candidates[i])] = static_cast<int>(i);
+    const auto constraint_of_slot = [&](int slot) -> const std::optional<SphereConstraint>& {
+      return constraints[static_cast<std::size_t>(index_of[static_cast<std::size_t>(normal_.node_of(slot))])];
+    };
     const Eigen::Index capacity = normal_.capacity();
     clearance_.setConstant(capacity, kNone);
     tool_.assign(static_cast<std::size_t>(capacity), -1);
     for (int slot = 0; slot < normal_.slot_count(); ++slot) {
-      const int node = normal_.node_of(slot);
-      if (node < 0) continue;
-      if (const auto& constraint = constraints[static_cast<std::size_t>(index_of[static_cast<std::size_t>(node)])]) {
+      if (normal_.node_of(slot) < 0) continue;
+      if (const auto& constraint = constraint_of_slot(slot)) {
         clearance_[slot] = constraint->gap + normal_.free_clearance()[slot];
         tool_[static_cast<std::size_t>(slot)] = constraint->tool;
       }
@@ -113,7 +127,6 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
     StateSolution state;
     state.tool_forces.assign(spheres.size(), Eigen::Vector3d::Zero());
     std::vector<double> forces;
-    std::vector<char> pushed(listed.size(), 0);
     obstacle_pushed_ = 0;
     double deepest = 0;  // [m]: the deepest pushed node's penetration, or B's largest normal move
     for (int p = 0; p < static_cast<int>(contact_.members().size()); ++p) {
@@ -121,7 +134,6 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
       const double push = contact_.member_push(p);
       if (!(push > 0)) continue;
       const int node = normal_.node_of(slot);
-      pushed[static_cast<std::size_t>(node)] = 1;
       const Eigen::Vector3d force = push * normal_.normal(slot);
       for (int axis = 0; axis < 3; ++axis)
         if (!dofs.is_fixed(node, axis)) {
@@ -137,47 +149,39 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
     for (int slot = 0; slot < normal_.slot_count(); ++slot)
       if (normal_.node_of(slot) >= 0) deepest = std::max(deepest, std::abs(normal_.free_clearance()[slot]));
     state.contact_forces = Eigen::Map<const Eigen::VectorXd>(forces.data(), static_cast<Eigen::Index>(forces.size()));
-    // Every touchable node within twice that of a sphere must have been a candidate; else
-    // they join and the state is solved again.
+    // Every touchable node within twice that of a sphere, and every obstacle node within it
+    // of its obstacle, must have been a candidate; else they join and the state is solved again.
     const double band = kBandPerDepth * deepest;
     const bool wider = band > band_;
     band_ = band;
-    if (wider && add_band(band)) continue;
+    if (wider && (add_band(band) | add_obstacle_band(band))) continue;
     solve_boundary_forces(columns_, condensation, dofs, boundary_displacement, state);
-    if (obstacle_nodes_.empty()) return state;
-
-    // The obstacles: every candidate, and every node that could have come within
-    // kObstacleJoin of its obstacle (its rest gap less than the band, plus the margin), is
-    // checked in the solved state.
-    std::vector<int> checked;
-    for (int node : obstacle_nodes_)
-      if (listed[static_cast<std::size_t>(node)] || obstacle_of(node).gap < band + kObstacleLeave) checked.push_back(node);
-    const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, checked);
-    bool joined = false;
-    std::vector<int> kept;
-    for (std::size_t k = 0; k < checked.size(); ++k) {
-      const int node = checked[k];
-      const SphereConstraint& obstacle = obstacle_of(node);
-      const double clearance = obstacle.gap + obstacle.normal.dot(u.col(static_cast<Eigen::Index>(k)));
-      if (!listed[static_cast<std::size_t>(node)]) {
-        if (clearance < kObstacleJoin) joined |= add(node);
-        continue;
-      }
-      const int index = index_of[static_cast<std::size_t>(node)];
-      const bool held_by_obstacle = constraints[static_cast<std::size_t>(index)] &&
-                                    constraints[static_cast<std::size_t>(index)]->obstacle >= 0;
-      if (held_by_obstacle && (clearance < kObstacleLeave || pushed[static_cast<std::size_t>(node)])) kept.push_back(node);
-    }
-    if (joined) continue;
-    obstacle_candidates_ = std::move(kept);
-    obstacle_rows_.clear();
-    obstacle_row_gaps_.clear();
-    for (std::size_t i = 0; i < candidates.size(); ++i)
-      if (constraints[i] && constraints[i]->obstacle >= 0) obstacle_rows_.push_back(candidates[i]);
-    std::sort(obstacle_rows_.begin(), obstacle_rows_.end());
-    for (int node : obstacle_rows_) obstacle_row_gaps_.push_back(obstacle_of(node).gap);
+    if (!obstacle_nodes_.empty()) find_obstacle_rows(patch_nodes);
     return state;
   }
+}
+
+void SphereStateSolve::find_obstacle_rows(std::span<const int> patch_nodes) {
+  // Each obstacle candidate's clearance in the solved state, w = q + W lambda.
+  const std::span<const int> members = contact_.members();
+  std::vector<char> near(near_obstacle_.size(), 0), in_patch(near_obstacle_.size(), 0);
+  for (int node : patch_nodes) in_patch[static_cast<std::size_t>(node)] = 1;
+  obstacle_rows_.clear();
+  for (int slot = 0; slot < normal_.slot_count(); ++slot) {
+    const int node = normal_.node_of(slot);
+    if (node < 0 || tool_[static_cast<std::size_t>(slot)] >= 0 || clearance_[slot] == kNone) continue;  // no obstacle's
+    double clearance = clearance_[slot];
+    for (int p = 0; p < static_cast<int>(members.size()); ++p)
+      clearance += normal_.w()(slot, members[static_cast<std::size_t>(p)]) * contact_.member_push(p);
+    const bool pushed = contact_.push(slot) > 0;
+    near[static_cast<std::size_t>(node)] =
+        pushed || clearance < kObstacleJoin || (near_obstacle_[static_cast<std::size_t>(node)] && clearance < kObstacleLeave);
+    if (near[static_cast<std::size_t>(node)] || in_patch[static_cast<std::size_t>(node)]) obstacle_rows_.push_back(node);
+  }
+  near_obstacle_ = std::move(near);
+  std::sort(obstacle_rows_.begin(), obstacle_rows_.end());
+  obstacle_row_gaps_.clear();
+  for (int node : obstacle_rows_) obstacle_row_gaps_.push_back(obstacle_[static_cast<std::size_t>(node)].gap);
 }
 
 }  // namespace cohaptic

@@ -13,13 +13,13 @@
 // of everything costs nothing (its row of W has no negative entry). If a solve pushes deeper
 // than the candidates allowed for, the wider band joins and the state is solved again.
 //
-// The obstacles' candidates are the surface nodes within kObstacleJoin of their obstacle in
-// the solved state (g + m . u): after each solve, the nodes within that same reach of the
-// deepest push whose rest gap says they could have come that near are checked, and any that
-// did join and the state is solved again; a candidate leaves once it is kObstacleLeave clear
-// and not pushed. The answer is therefore that of the problem over every node (a constraint
-// the solution keeps is one it would not change), whatever the path: the obstacle lets the
-// nodes slide and releases them as the unilateral problem says, in one step or many.
+// The obstacles' candidates are, in the same way, the surface nodes whose gap to their
+// obstacle at rest is less than that band (plus kObstacleLeave): the nodes the deformation
+// could carry onto it; their band is the widest so far, so that they join once. The answer is that of the problem over every node, whatever the
+// path: the obstacle lets its nodes slide and releases them as the unilateral problem says,
+// in one step or many. The IRs carry the obstacle candidates near their obstacle in the
+// solved state (pushed, or within kObstacleJoin; one stays until kObstacleLeave clear) and
+// any the patches hold: the obstacle rows.
 //
 // The nodal forces lambda n then give f_B and any node's displacement as for the other models
 // (state_solve.h). A node a sphere pushes outside the patches makes the simulation widen
@@ -41,9 +41,9 @@ namespace cohaptic {
 
 class SphereStateSolve {
  public:
-  /// A candidate this near its obstacle in the solved state joins [m].
+  /// An obstacle candidate this near its obstacle in the solved state is an obstacle row [m].
   static constexpr double kObstacleJoin = 0.5e-3;
-  /// A candidate this clear of its obstacle, and not pushed, leaves [m].
+  /// An obstacle row this clear of its obstacle, and not pushed, is one no longer [m].
   static constexpr double kObstacleLeave = 1e-3;
 
   /// `body` and `columns` (whose rows include every touchable node, every node an obstacle
@@ -63,8 +63,8 @@ class SphereStateSolve {
   const NormalCompliance& normal_compliance() const { return normal_; }
   /// The slots of normal_compliance() the last solve pushes.
   std::span<const int> contact_slots() const { return contact_.members(); }
-  /// The last solve's candidates an obstacle holds (whose slots push along its normal),
-  /// ascending, and their gaps at rest [m].
+  /// The last solve's obstacle rows (above): candidates an obstacle holds (their slots push
+  /// along its normal), ascending, and their gaps at rest [m].
   std::span<const int> obstacle_rows() const { return obstacle_rows_; }
   std::span<const double> obstacle_row_gaps() const { return obstacle_row_gaps_; }
   /// How many nodes the obstacles push in the last solve.
@@ -75,6 +75,8 @@ class SphereStateSolve {
   /// leave the contact solve first, and a change of W under the members refactors it.
   void set_candidates(const std::vector<int>& nodes, IncrementalCondensation& condensation,
                       const Eigen::VectorXd& boundary_displacement);
+  /// The obstacle rows of the solved state.
+  void find_obstacle_rows(std::span<const int> patch_nodes);
 
   const ElasticBody& body_;
   ComplianceColumns& columns_;
@@ -88,9 +90,10 @@ class SphereStateSolve {
   static constexpr double kBandPerDepth = 2;
 
   double band_ = 0;             // [m], as of the last solve
+  double obstacle_band_ = 0;    // [m], the widest band so far
   Eigen::VectorXd clearance_;   // per slot, this solve's q
-  std::vector<int> tool_;       // per slot, the sphere holding it (-1: none, or an obstacle)
-  std::vector<int> obstacle_candidates_;  // obstacle-held candidates kept for the next solve
+  std::vector<int> tool_;       // per slot, the sphere holding it (-1: none, or an obstacle: then q is finite)
+  std::vector<char> near_obstacle_;  // per volume node: an obstacle row for being near, as of the last solve
   std::vector<int> obstacle_rows_;
   std::vector<double> obstacle_row_gaps_;
   int obstacle_pushed_ = 0;
