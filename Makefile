@@ -129,8 +129,8 @@ bench-compliance:
 	@tests/compliance_tables.sh $(BUILD_DIR)/tests/cohaptic_bench
 
 # The brain's forces on its 9 mm and graded meshes against a mesh twice as fine near the
-# tools, both tools pressing, along their presses, as Markdown (tens of minutes: the
-# reference's compliance is solved for on demand).
+# tools, both tools pressing, the skull holding the brain, along their presses, as Markdown
+# (the reference by the full sparse solve, minutes per point).
 brain-convergence:
 	@$(MAKE) --no-print-directory build >&2
 	@tests/brain_convergence_table.sh $(BUILD_DIR)/lab/cohaptic-lab

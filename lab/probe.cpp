@@ -65,53 +65,65 @@ struct ProbeCommandLine {
   bool no_disk_cache = false;
 };
 
-// Presses `tools` at once (every other scene tool absent) and fills in their answers.
-void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& options, ContactModel contact_model,
+// Whether the probe needs no simulation: the sphere model's full solve with nothing held
+// (no step-delay nodes) takes the obstacles' constraints itself, so --reference then
+// needs neither the simulation nor its compliance columns.
+bool reference_alone(const ProbeOptions& options, ContactModel contact_model) {
+  return options.reference && contact_model == ContactModel::sphere && options.boundary_nodes == 0;
+}
+
+// Presses `tools` at once (every other scene tool absent) and fills in their answers;
+// `columns` is null when reference_alone().
+void press(const Model& model, ComplianceColumns* columns, const ProbeOptions& options, ContactModel contact_model,
            std::vector<ProbedTool>& tools, const std::vector<int>& users, ProbeTimings& timings) {
   const ElasticBody& body = single_elastic_body(model);
-  SimulationOptions sim_options;
-  sim_options.ir = ir_build_options(model.scene.haptic);
-  sim_options.ir.patch_rings = options.patch_rings.value_or(model.scene.haptic.patch_rings);
-  sim_options.ir.precision = options.precision;
-  sim_options.ir.contact_model = contact_model;
-  sim_options.ir.force_limit = std::numeric_limits<double>::infinity();  // the probe reports physics
-  sim_options.step_delay_nodes = options.boundary_nodes;
-  Simulation simulation(body, model.obstacles, columns, model.scene.tools, sim_options);
   std::vector<PressedTool> pressed;
   for (int u : users) pressed.push_back(tools[u].tool);
   const std::vector<ContactQuery> contacts = find_tool_contacts(body, pressed);
   for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].query = contacts[i];
 
   Stopwatch watch;
-  // Each tool goes in a straight line from where its contact point touches the rest
-  // surface (its position less the contact's displacement) to its position.
-  StepReport report;
-  int steps = 0;
-  for (int k = 1; k <= options.approach_steps; ++k, ++steps) {
-    const double fraction = static_cast<double>(k) / options.approach_steps;
-    for (std::size_t i = 0; i < users.size(); ++i) {
-      const Eigen::Vector3d& position = pressed[i].position;
-      const Eigen::Vector3d travel = contacts[i].contact ? contacts[i].contact->displacement : Eigen::Vector3d::Zero();
-      simulation.set_tool(users[i], position - (1 - fraction) * travel);
+  std::unique_ptr<Simulation> simulation;
+  HeldNodes held;
+  if (columns) {
+    SimulationOptions sim_options;
+    sim_options.ir = ir_build_options(model.scene.haptic);
+    sim_options.ir.patch_rings = options.patch_rings.value_or(model.scene.haptic.patch_rings);
+    sim_options.ir.precision = options.precision;
+    sim_options.ir.contact_model = contact_model;
+    sim_options.ir.force_limit = std::numeric_limits<double>::infinity();  // the probe reports physics
+    sim_options.step_delay_nodes = options.boundary_nodes;
+    simulation = std::make_unique<Simulation>(body, model.obstacles, *columns, model.scene.tools, sim_options);
+    // Each tool goes in a straight line from where its contact point touches the rest
+    // surface (its position less the contact's displacement) to its position.
+    StepReport report;
+    int steps = 0;
+    for (int k = 1; k <= options.approach_steps; ++k, ++steps) {
+      const double fraction = static_cast<double>(k) / options.approach_steps;
+      for (std::size_t i = 0; i < users.size(); ++i) {
+        const Eigen::Vector3d& position = pressed[i].position;
+        const Eigen::Vector3d travel = contacts[i].contact ? contacts[i].contact->displacement : Eigen::Vector3d::Zero();
+        simulation->set_tool(users[i], position - (1 - fraction) * travel);
+      }
+      report = simulation->step(steps * 1e-3);
     }
-    report = simulation.step(steps * 1e-3);
-  }
-  if (options.approach_steps > 1)
-    for (int settling = 0; report.rebuilt && settling < kMaxSettlingSteps; ++settling, ++steps)
-      report = simulation.step(steps * 1e-3);
-  if (report.rebuilt && options.approach_steps > 1)
-    spdlog::warn("probe: the sets still changed after {} steps at the final positions", kMaxSettlingSteps);
-  timings.ir_build_ms += watch.lap_ms();
-  for (int u : users) {
-    tools[u].boundary_nodes = report.boundary_nodes;
-    tools[u].steps = steps;
-    if (const auto ir = simulation.ir(u)) {
-      tools[u].ir_bytes = ir->ir.size_bytes();
-      tools[u].condition_estimate = ir->condition_estimate;
+    if (options.approach_steps > 1)
+      for (int settling = 0; report.rebuilt && settling < kMaxSettlingSteps; ++settling, ++steps)
+        report = simulation->step(steps * 1e-3);
+    if (report.rebuilt && options.approach_steps > 1)
+      spdlog::warn("probe: the sets still changed after {} steps at the final positions", kMaxSettlingSteps);
+    timings.ir_build_ms += watch.lap_ms();
+    for (int u : users) {
+      tools[u].boundary_nodes = report.boundary_nodes;
+      tools[u].steps = steps;
+      if (const auto ir = simulation->ir(u)) {
+        tools[u].ir_bytes = ir->ir.size_bytes();
+        tools[u].condition_estimate = ir->condition_estimate;
+      }
     }
+    held = {simulation->condensation().boundary_nodes(), simulation->boundary_displacement()};
   }
   if (options.reference) {
-    const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
     std::vector<Eigen::Vector3d> reactions;
     if (contact_model == ContactModel::sphere) {
       reactions = SphereContactReference(body, obstacle_constraints(body.mesh, body.surface, body.dofs, model.obstacles))
@@ -123,7 +135,7 @@ void press(const Model& model, ComplianceColumns& columns, const ProbeOptions& o
     }
     for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].force = reactions[i];
   } else {
-    for (int u : users) tools[u].force = simulation.force(u).force;
+    for (int u : users) tools[u].force = simulation->force(u).force;
   }
   timings.solve_ms += watch.lap_ms();
 }
@@ -256,8 +268,13 @@ int run_probe(const ProbeOptions& options) {
   timings.load_ms = elapsed_build - body.timings.assemble_ms - body.timings.factor_ms;
   timings.precompute_ms = body.timings.assemble_ms + body.timings.factor_ms;
 
-  ComplianceColumns columns(*body.free_factor, body.dofs, compliance_row_nodes(body, options.boundary_nodes > 0 || !model.obstacles.empty()));
-  const ComplianceSetup setup = prepare_compliance(body, columns, options.cache_directory);
+  std::unique_ptr<ComplianceColumns> columns;
+  std::string compliance_note = "no compliance columns: the full solve alone";
+  if (!reference_alone(options, contact_model)) {
+    columns = std::make_unique<ComplianceColumns>(
+        *body.free_factor, body.dofs, compliance_row_nodes(body, options.boundary_nodes > 0 || !model.obstacles.empty()));
+    compliance_note = prepare_compliance(body, *columns, options.cache_directory).note;
+  }
   timings.precompute_ms += watch.lap_ms();
 
   std::vector<ProbedTool> tools;
@@ -267,11 +284,11 @@ int run_probe(const ProbeOptions& options) {
     tools.push_back(probed);
   }
   if (options.separately) {
-    for (int u = 0; u < static_cast<int>(tools.size()); ++u) press(model, columns, options, contact_model, tools, {u}, timings);
+    for (int u = 0; u < static_cast<int>(tools.size()); ++u) press(model, columns.get(), options, contact_model, tools, {u}, timings);
   } else {
     std::vector<int> all(tools.size());
     for (std::size_t u = 0; u < all.size(); ++u) all[u] = static_cast<int>(u);
-    press(model, columns, options, contact_model, tools, all, timings);
+    press(model, columns.get(), options, contact_model, tools, all, timings);
   }
 
   if (!options.export_vtu.empty() || !options.export_msh.empty()) {
@@ -302,7 +319,7 @@ int run_probe(const ProbeOptions& options) {
   if (options.json)
     fmt::print("{}\n", probe_json(model, options, contact_model, tools, timings).dump());
   else
-    print_table(model, options, contact_model, tools, timings, setup.note);
+    print_table(model, options, contact_model, tools, timings, compliance_note);
   return 0;
 }
 

@@ -26,7 +26,7 @@ std::vector<int> fill_reducing_order(const SparseMatrix& k_ii) {
 
 }  // namespace
 
-Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> rows, int threads) {
+Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> rows, int threads, ProgressLog* progress) {
   const auto n = static_cast<int>(k.rows());
   const auto m = static_cast<int>(rows.size());
   std::vector<char> is_row(static_cast<std::size_t>(n), 0);
@@ -63,11 +63,17 @@ Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> row
   for (int i = 0; i < n; ++i)
     if (perm[i] != order[static_cast<std::size_t>(i)])
       throw NumericalError("CHOLMOD did not keep the order given for the Schur complement");
+  const double factor_flops = c.fl;  // as the analysis counts them
+  if (progress) {
+    progress->set_total(factor_flops + spd_inverse_flops(m));
+    progress->set_phase(fmt::format("factorising K ({} dofs, the {} rows last)", n, m));
+  }
   bool factored = false;
   {
     const ScopedBlasThreads blas(kFactorBlasThreads);
     factored = cholmod_factorize(&view, &f, &c) != 0;
   }
+  if (progress) progress->add(factor_flops);
   if (!factored || c.status != CHOLMOD_OK)
     throw NumericalError(c.status == CHOLMOD_NOT_POSDEF
                              ? fmt::format("the stiffness matrix is not positive definite (first failure at row {})",
@@ -96,11 +102,13 @@ Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> row
       }
   }
 
-  invert_spd_from_factor(l_rr, threads);
+  if (progress) progress->set_phase("inverting the rows' Schur complement");
+  invert_spd_from_factor(l_rr, threads, progress);
   return l_rr;
 }
 
-std::size_t compute_row_columns_by_schur(ComplianceColumns& columns, const SparseMatrix& k_ff, const DofMap& dofs, int threads) {
+std::size_t compute_row_columns_by_schur(ComplianceColumns& columns, const SparseMatrix& k_ff, const DofMap& dofs, int threads,
+                                         ProgressLog* progress) {
   const std::vector<int>& nodes = columns.row_nodes();
   bool missing = false;
   for (int node : nodes) missing = missing || !columns.has_column(node);
@@ -113,7 +121,7 @@ std::size_t compute_row_columns_by_schur(ComplianceColumns& columns, const Spars
         free_rows.push_back(free);
         position.push_back(static_cast<int>(3 * r) + axis);
       }
-  const Eigen::MatrixXd l = schur_compliance(k_ff, free_rows, threads);
+  const Eigen::MatrixXd l = schur_compliance(k_ff, free_rows, threads, progress);
   std::vector<Eigen::Index> first_free(nodes.size() * 3, -1);
   for (std::size_t k = 0; k < position.size(); ++k) first_free[static_cast<std::size_t>(position[k])] = static_cast<Eigen::Index>(k);
   std::size_t added = 0;

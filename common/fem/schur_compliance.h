@@ -20,19 +20,22 @@
 
 #include "common/fem/assemble_stiffness.h"
 #include "common/fem/compliance.h"
+#include "common/util/progress_log.h"
 
 namespace cohaptic {
 
 /// (K^-1)[rows, rows] in `rows`' order for the symmetric positive definite `k` (its lower
 /// triangle read). `rows`: distinct indices into k. The inverse runs on `threads` threads.
-/// Throws NumericalError if K is not positive
-/// definite or CHOLMOD fails.
-Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> rows, int threads = 1);
+/// `progress`, if given, is told the flops of the whole (the factorisation's, as CHOLMOD's
+/// analysis counts them, and the inverse's) and each part as it is done. Throws
+/// NumericalError if K is not positive definite or CHOLMOD fails.
+Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> rows, int threads = 1,
+                                 ProgressLog* progress = nullptr);
 
 /// Every row node's column block of `columns` that is missing, all at once by the Schur route
 /// on K_ff (`k_ff`, in `dofs`' free indices): L[row_nodes, row_nodes] in one go. Returns the
 /// columns added.
 std::size_t compute_row_columns_by_schur(ComplianceColumns& columns, const SparseMatrix& k_ff, const DofMap& dofs,
-                                         int threads = 1);
+                                         int threads = 1, ProgressLog* progress = nullptr);
 
 }  // namespace cohaptic

@@ -32,14 +32,36 @@ void run_tasks(int count, int threads, const std::function<void(int)>& task) {
   for (std::thread& helper : helpers) helper.join();
 }
 
+int block_count(int m) { return (m + kBlock - 1) / kBlock; }
+int block_start(int block) { return block * kBlock; }
+int block_width(int m, int block) { return std::min(kBlock, m - block * kBlock); }
+
+// Flops of the triangular solve of block column J, and of block (I, J) of Z^T Z.
+double solve_flops(int m, int block) {
+  const double rows = m - block_start(block);
+  return rows * rows * block_width(m, block);
+}
+double product_flops(int m, int i, int j) {
+  return 2.0 * block_width(m, i) * block_width(m, j) * (m - block_start(i));
+}
+
 }  // namespace
 
-void invert_spd_from_factor(Eigen::MatrixXd& factor, int threads) {
+double spd_inverse_flops(int m) {
+  double flops = 0;
+  for (int i = 0; i < block_count(m); ++i) {
+    flops += solve_flops(m, i);
+    for (int j = 0; j <= i; ++j) flops += product_flops(m, i, j);
+  }
+  return flops;
+}
+
+void invert_spd_from_factor(Eigen::MatrixXd& factor, int threads, ProgressLog* progress) {
   const int m = static_cast<int>(factor.rows());
   if (m == 0) return;
-  const int blocks = (m + kBlock - 1) / kBlock;
-  const auto start = [](int block) { return block * kBlock; };
-  const auto width = [&](int block) { return std::min(kBlock, m - block * kBlock); };
+  const int blocks = block_count(m);
+  const auto start = block_start;
+  const auto width = [&](int block) { return block_width(m, block); };
   const double one = 1, zero = 0;
 
   // Z = L^-1, lower triangular: block column J solves L[j0:, j0:] Z[j0:, J] = I[j0:, J].
@@ -50,6 +72,7 @@ void invert_spd_from_factor(Eigen::MatrixXd& factor, int threads) {
     for (int j = 0; j < b; ++j) inverse_factor(j0 + j, j0 + j) = 1;
     dtrsm_("L", "L", "N", "N", &rows, &b, &one, factor.data() + j0 + static_cast<Eigen::Index>(j0) * m, &m,
            inverse_factor.data() + j0 + static_cast<Eigen::Index>(j0) * m, &m);
+    if (progress) progress->add(solve_flops(m, block));
   });
 
   // S^-1 = Z^T Z: block (I, J), I at or below J, sums Z's rows from i0 on (Z is zero above).
@@ -62,6 +85,7 @@ void invert_spd_from_factor(Eigen::MatrixXd& factor, int threads) {
     dgemm_("T", "N", &bi, &bj, &depth, &one, inverse_factor.data() + i0 + static_cast<Eigen::Index>(i0) * m, &m,
            inverse_factor.data() + i0 + static_cast<Eigen::Index>(j0) * m, &m, &zero,
            factor.data() + i0 + static_cast<Eigen::Index>(j0) * m, &m);
+    if (progress) progress->add(product_flops(m, i, j));
   });
   factor.triangularView<Eigen::StrictlyUpper>() = factor.transpose().triangularView<Eigen::StrictlyUpper>();
 }

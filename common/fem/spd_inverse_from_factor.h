@@ -7,10 +7,16 @@
 
 #include <Eigen/Core>
 
+#include "common/util/progress_log.h"
+
 namespace cohaptic {
 
 /// Replaces `factor` (m x m; its lower triangle read, L) by S^-1 (full, exactly symmetric),
 /// using `threads` threads (at least 1). BLAS must run one thread per call (use_single_blas_thread).
-void invert_spd_from_factor(Eigen::MatrixXd& factor, int threads);
+/// Each finished block adds its flops to `progress`, if given.
+void invert_spd_from_factor(Eigen::MatrixXd& factor, int threads, ProgressLog* progress = nullptr);
+
+/// The flops invert_spd_from_factor spends on an m x m factor (its blocks', as it counts them).
+double spd_inverse_flops(int m);
 
 }  // namespace cohaptic

@@ -10,6 +10,7 @@
 #include "common/fem/schur_compliance.h"
 #include "common/mesh/compact_groups.h"
 #include "common/util/error.h"
+#include "common/util/progress_log.h"
 #include "common/util/stopwatch.h"
 
 namespace cohaptic {
@@ -39,17 +40,18 @@ Digest cache_key(const ElasticBody& body, const ComplianceColumns& columns) {
   return compliance_cache_key(body.mesh, body.spec.material, body.dofs, columns.row_nodes(), route_of(body, columns));
 }
 
-void precompute_touchable_columns(const ElasticBody& body, ComplianceColumns& columns) {
+void precompute_touchable_columns(const ElasticBody& body, ComplianceColumns& columns, ProgressLog& progress) {
   std::size_t missing = 0;
   for (int node : body.touchable_nodes) missing += columns.has_column(node) ? 0 : 1;
   if (missing == 0) return;
   if (route_of(body, columns) == ComplianceRoute::solves) {
+    progress.set_phase(fmt::format("solving for {} nodes' columns", missing));
     columns.compute_columns(body.touchable_nodes);
     return;
   }
   const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   spdlog::info("compliance: {} row nodes at once (Schur complement, {} threads)", columns.row_nodes().size(), threads);
-  compute_row_columns_by_schur(columns, restrict_to_dofs(body.stiffness, body.dofs.free_dofs), body.dofs, threads);
+  compute_row_columns_by_schur(columns, restrict_to_dofs(body.stiffness, body.dofs.free_dofs), body.dofs, threads, &progress);
 }
 
 }  // namespace
@@ -58,10 +60,12 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
                                    const std::optional<std::filesystem::path>& cache_directory) {
   ComplianceSetup setup;
   Stopwatch watch;
+  ProgressLog progress("compliance");
   const bool use_disk = cache_directory.has_value() && body.spec.compliance.disk_cache;
   if (use_disk) {
     const Digest key = cache_key(body, columns);
     setup.cache_file = compliance_cache_file(*cache_directory, key);
+    progress.set_phase("loading " + setup.cache_file.string());
     const ComplianceCacheLoad load = load_compliance_cache(setup.cache_file, key, columns);
     setup.from_disk = load.loaded;
     setup.note = load.loaded ? fmt::format("loaded {} columns from {}", load.columns, setup.cache_file.string())
@@ -71,8 +75,9 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
   }
   const bool want_all = body.spec.compliance.precompute_touchable;
   const std::size_t before = columns.column_count();
-  if (want_all) precompute_touchable_columns(body, columns);
+  if (want_all) precompute_touchable_columns(body, columns, progress);
   if (use_disk && columns.column_count() > before) {
+    progress.set_phase("saving the columns to " + setup.cache_file.string());
     save_compliance(body, columns, *cache_directory);
     setup.note += fmt::format("; computed {} columns and saved them", columns.column_count() - before);
   }
