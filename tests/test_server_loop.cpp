@@ -57,6 +57,18 @@ int movable_surface_node_count(const Model& model) {
 
 // ---- pacing ----
 
+TEST(LoopStatistics, TheStepRateCountsFromTheFirstStepNotFromTheServersStart) {
+  // A scene that took 10 s to load, then 100 steps of 1 ms back to back: 1 kHz, not 10 Hz.
+  LoopStatistics statistics;
+  StepFigures step;
+  step.duration_ns = 1'000'000;
+  for (int k = 1; k <= 100; ++k) statistics.record_step(step, 10.0 + 1e-3 * k);
+  const LoopSummary summary = statistics.summary();
+  EXPECT_NEAR(summary.rate_hz(), 1000.0, 1e-6);
+  EXPECT_NEAR(summary.elapsed_s, 10.1, 1e-12);
+  EXPECT_EQ(LoopSummary{}.rate_hz(), 0.0) << "no step yet";
+}
+
 TEST(StepFailures, LogsTheFirstThenOneLineASecondWhoseCountsAddUpAndEndsAfterAHundredInARow) {
   StepFailures failures;
   std::vector<std::string> lines;
