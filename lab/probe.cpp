@@ -340,8 +340,9 @@ LabCommand add_probe_command(CLI::App& lab) {
   command->add_flag("--separately", probe.separately, "Press each tool alone (one solve per tool) instead of all tools at once");
   command->add_option("--approach-steps", probe.approach_steps,
                       "Simulation steps that bring each tool from touching the rest surface to its position; with "
-                      "more than 1 the last position is stepped again until no set changes (obstacles hold the nodes "
-                      "where they reach them, so a one-step press from rest can hold more)")
+                      "more than 1 the last position is stepped again until no set changes (under the translation and "
+                      "point models obstacles hold the nodes where they reach them, so a one-step press from rest can "
+                      "hold more)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   command->add_option("--boundary-nodes", probe.boundary_nodes,

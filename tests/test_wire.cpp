@@ -1135,7 +1135,7 @@ TEST(WireIr, RoundTripIsBitExactInDouble) {
   fem.m_tilde(0, 0) = std::nextafter(fem.m_tilde(0, 0), 0.0);  // a value float would not keep
   fem.rest_forces = Eigen::VectorXd::LinSpaced(fem.m_tilde.rows(), -0.1, 1.0 / 7.0);  // format 5
   const IntermediateRepresentation wire_ir = to_wire(ir);
-  EXPECT_EQ(wire_ir.format_version(), 6u);
+  EXPECT_EQ(wire_ir.format_version(), 7u);
   EXPECT_EQ(wire_ir.fem().rest_forces_size(), fem.m_tilde.rows());
   const CondensedFem& w = wire_ir.fem();
   EXPECT_EQ(w.m_tilde_f64_size(), fem.m_tilde.size());

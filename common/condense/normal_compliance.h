@@ -9,10 +9,10 @@
 // and Q = L_BB^-1 P; and each candidate's free clearance q0_a = n_a . u0_a = (Q^T u_B)_a,
 // u0 the displacement that B's held displacement alone gives. A candidate's row of W is
 // one number per other candidate where M~ would hold nine per pair of nodes, and none of
-// it depends on where the tools are.
+// it depends on where the tools are, only on each node's direction.
 //
-// Candidates live in slots: a node keeps its slot while it stays a candidate, and a
-// leaving node's slot is reused, so W's entries and the indices of a contact solve over
+// Candidates live in slots: a node keeps its slot while it stays a candidate along the same
+// direction, and a leaving node's slot is reused, so W's entries and the indices of a contact solve over
 // the slots (incremental_contact_solve.h) stay put while the set changes. A joining node
 // costs one column solve (cached in ComplianceColumns) and its row of W0, P and Q,
 // O(|C| + |B|^2); a change of B recomputes P, Q and W, O(|B|^2 |C| + |B| |C|^2), keeping W0;

@@ -67,18 +67,20 @@ struct IrRemoteContact {
   double tool_radius = 0;               ///< [m]
 };
 
-/// The sphere contact model's part of a condensed FEM body (common/contact/sphere_contact.h),
-/// instead of M~ and u_B: every row node is a candidate, pushed along its own inward normal
-/// by the sphere (own or remote) with the least gap to it. With B held where it is, W is the
-/// compliance between the row nodes' normal pushes and q0 their normal displacement under
-/// no push, so that under pushes lambda a node's clearance is g + q0 + (W lambda); neither
-/// depends on where the tools are. B itself travels only as its tags.
 /// Asymmetry tolerated in a received matrix that must be symmetric (M_CC, W), relative to
 /// its largest entry: round-off of another producer's arithmetic, far below any physical meaning.
 inline constexpr double kMaxRelativeAsymmetry = 1e-9;
 
+/// The sphere contact model's part of a condensed FEM body (common/contact/sphere_contact.h),
+/// instead of M~ and u_B: every row node is a candidate, pushed along its own inward normal
+/// by the sphere (own or remote) with the least gap to it, or, an obstacle row, along a
+/// rigid obstacle's normal by that obstacle, with a gap that does not depend on the tools.
+/// With B held where it is, W is the compliance between the row nodes' pushes and q0 their
+/// displacement along their directions under no push, so that under pushes lambda a node's
+/// clearance is g + q0 + (W lambda); neither depends on where the tools are. B itself
+/// travels only as its tags.
 struct SphereContactIr {
-  Eigen::Matrix3Xd normals;            ///< per row node: inward unit normal, zero for a node the model cannot hold
+  Eigen::Matrix3Xd normals;            ///< per row node: its push's unit direction, zero for a node the model cannot hold
   Eigen::VectorXd free_clearance;      ///< q0 per row node [m]
   /// W, row nodes square, symmetric [m/N]; the rows and columns of a node the model cannot
   /// hold are zero.
@@ -140,8 +142,9 @@ struct IntermediateRepresentation {
   /// 4: compliance rows may name held nodes that B truncation leaves out (still reads 2, 3);
   /// 5: a condensed FEM body may carry rest forces (still reads 2 to 4);
   /// 6: under the sphere contact model it carries its normal compliance instead of M~ (still
-  /// reads 2 to 5, but for sphere bodies, whose earlier form it refuses).
-  static constexpr std::uint32_t kFormatVersion = 6;
+  /// reads 2 to 5, but for sphere bodies, whose earlier form it refuses);
+  /// 7: a sphere body may carry obstacle rows (still reads 2 to 6; a sphere body of 6 has none).
+  static constexpr std::uint32_t kFormatVersion = 7;
   static constexpr std::uint32_t kOldestReadableVersion = 2;
 
   std::uint64_t epoch = 0;         ///< increases with every IR built for this user

@@ -353,9 +353,10 @@ StepReport Simulation::step(double time) {
   // (a new epoch) is published only when a set changed.
   const bool support_changed = std::exchange(support_changed_, false);
   // Under the sphere model an IR holds for every position of the spheres as long as every
-  // node they hold or carry is one of its row nodes (its normal compliance does not depend
-  // on where they are): it is rebuilt when one is not, or when a sphere holding nothing
-  // comes nearest another triangle.
+  // node they hold or carry is one of its row nodes, each held by what held it at the build
+  // (its normal compliance does not depend on where they are): it is rebuilt when one is
+  // not, when the obstacle rows change (a node near an obstacle, or one whose holder
+  // changed), or when a sphere holding nothing comes nearest another triangle.
   const bool sets_changed =
       boundary_changed || support_changed || nearest != built_nearest_ ||
       (sphere_model() && (!sphere_rows_cover_holds() || !std::ranges::equal(sphere_solve_->obstacle_rows(), built_obstacle_rows_)));

@@ -54,6 +54,8 @@ void SphereStateSolve::set_candidates(const std::vector<int>& nodes, Incremental
 StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std::span<const int> patch_nodes,
                                       std::span<const SphereTool> spheres, const Eigen::VectorXd& boundary_displacement) {
   const DofMap& dofs = body_.dofs;
+  obstacle_rows_.clear();  // until this solve finds them (a solve that throws leaves none)
+  obstacle_row_gaps_.clear();
   const auto obstacle_of = [&](int node) -> const SphereConstraint& {
     return obstacle_.empty() ? no_obstacle() : obstacle_[static_cast<std::size_t>(node)];
   };

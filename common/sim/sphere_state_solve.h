@@ -15,11 +15,15 @@
 //
 // The obstacles' candidates are, in the same way, the surface nodes whose gap to their
 // obstacle at rest is less than that band (plus kObstacleLeave): the nodes the deformation
-// could carry onto it; their band is the widest so far, so that they join once. The answer is that of the problem over every node, whatever the
-// path: the obstacle lets its nodes slide and releases them as the unilateral problem says,
-// in one step or many. The IRs carry the obstacle candidates near their obstacle in the
-// solved state (pushed, or within kObstacleJoin; one stays until kObstacleLeave clear) and
-// any the patches hold: the obstacle rows.
+// could carry onto it; their band is the widest so far, so that they join once. As long as
+// no node beyond the bands reaches a sphere or an obstacle (the bands' assumption, which
+// the tests check against the full solve), the answer is that of the problem over every
+// node, whatever the path: the obstacle lets its nodes slide and releases them as the
+// unilateral problem says, in one step or many. The IRs carry the obstacle candidates near
+// their obstacle in the solved state (pushed, or within kObstacleJoin; one stays until
+// kObstacleLeave clear) and any the patches hold: the obstacle rows. Under on-demand
+// compliance the first widening of the band solves the columns of every obstacle node it
+// takes in, within that step.
 //
 // The nodal forces lambda n then give f_B and any node's displacement as for the other models
 // (state_solve.h). A node a sphere pushes outside the patches makes the simulation widen
@@ -50,6 +54,8 @@ class SphereStateSolve {
   /// may hold and every node B may hold) must outlive it. `obstacles`: per volume node, its
   /// obstacle constraint (obstacle_constraints.h), or empty for none.
   SphereStateSolve(const ElasticBody& body, ComplianceColumns& columns, std::vector<SphereConstraint> obstacles = {});
+  SphereStateSolve(const SphereStateSolve&) = delete;  // normal_ refers to directions_
+  SphereStateSolve& operator=(const SphereStateSolve&) = delete;
 
   /// The state with `spheres` pressing, over the candidates `patch_nodes` (any order,
   /// repeats allowed; nodes in B or that the model cannot hold are left out), u_B over the

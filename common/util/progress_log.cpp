@@ -43,8 +43,12 @@ void ProgressLog::add(double work) {
 
 void ProgressLog::log_every_second() {
   std::unique_lock lock(mutex_);
-  while (!stopping_.wait_for(lock, kLineEvery, [this] { return stop_; }))
-    spdlog::info("{}", line(phase_.empty() ? what_ : what_ + ", " + phase_, done_, total_, watch_.elapsed_ms() / 1000));
+  while (!stopping_.wait_for(lock, kLineEvery, [this] { return stop_; })) {
+    const std::string text = line(phase_.empty() ? what_ : what_ + ", " + phase_, done_, total_, watch_.elapsed_ms() / 1000);
+    lock.unlock();  // the reporting threads do not wait on the log's output
+    spdlog::info("{}", text);
+    lock.lock();
+  }
 }
 
 std::string ProgressLog::line(const std::string& what, double done, double total, double elapsed_s) {
