@@ -6,20 +6,19 @@ namespace cohaptic {
 
 std::vector<SphereConstraint> obstacle_constraints(const TetMesh& mesh, const BoundarySurface& surface,
                                                    const DofMap& dofs, std::span<const ObstacleDistance> obstacles) {
-  SphereConstraint none;
-  none.gap = std::numeric_limits<double>::infinity();
-  std::vector<SphereConstraint> constraints(static_cast<std::size_t>(mesh.node_count()), none);
+  std::vector<SphereConstraint> constraints(static_cast<std::size_t>(mesh.node_count()));
   for (int node : surface.nodes) {
-    SphereConstraint& constraint = constraints[static_cast<std::size_t>(node)];
+    SphereConstraint nearest_obstacle;
+    nearest_obstacle.gap = std::numeric_limits<double>::infinity();
     for (int o = 0; o < static_cast<int>(obstacles.size()); ++o) {
       const ObstaclePoint nearest = obstacles[static_cast<std::size_t>(o)].closest_point(mesh.nodes.col(node));
-      if (!(nearest.signed_distance < constraint.gap)) continue;
-      constraint.gap = nearest.signed_distance;
-      constraint.normal = nearest.normal;
-      constraint.obstacle = o;
+      if (!(nearest.signed_distance < nearest_obstacle.gap)) continue;
+      nearest_obstacle.gap = nearest.signed_distance;
+      nearest_obstacle.normal = nearest.normal;
+      nearest_obstacle.obstacle = o;
     }
-    if (constraint.obstacle >= 0 && !holdable(constraint.normal, dofs.fixed_axes[static_cast<std::size_t>(node)]))
-      constraint = none;
+    if (nearest_obstacle.obstacle >= 0 && holdable(nearest_obstacle.normal, dofs.fixed_axes[static_cast<std::size_t>(node)]))
+      constraints[static_cast<std::size_t>(node)] = nearest_obstacle;
   }
   return constraints;
 }

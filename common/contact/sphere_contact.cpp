@@ -49,10 +49,9 @@ std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, c
 
 std::optional<SphereConstraint> node_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
                                                 AxisMask fixed, std::span<const SphereTool> tools,
-                                                const SphereConstraint& obstacle) noexcept {
+                                                const SphereConstraint* obstacle) noexcept {
   std::optional<SphereConstraint> constraint = sphere_constraint(rest, normal, fixed, tools);
-  if (obstacle.gap < std::numeric_limits<double>::infinity() && (!constraint || obstacle.gap < constraint->gap))
-    constraint = obstacle;
+  if (obstacle && (!constraint || obstacle->gap < constraint->gap)) constraint = *obstacle;
   return constraint;
 }
 

@@ -71,10 +71,10 @@ std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, c
                                                   AxisMask fixed, std::span<const SphereTool> tools) noexcept;
 
 /// The constraint on a node from `tools` (sphere_constraint) or from its `obstacle`
-/// constraint (gap +inf: none), whichever has the least gap, ties to a sphere.
+/// constraint (null: none), whichever has the least gap, ties to a sphere.
 std::optional<SphereConstraint> node_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
                                                 AxisMask fixed, std::span<const SphereTool> tools,
-                                                const SphereConstraint& obstacle) noexcept;
+                                                const SphereConstraint* obstacle) noexcept;
 
 /// The inward unit normal of every node of `triangles` (a body's touchable triangles): the
 /// angle-weighted mean of their outward normals, reversed; zero for every other node (one

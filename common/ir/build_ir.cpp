@@ -73,15 +73,14 @@ void fill_sphere_contact(const ElasticBody& body, std::span<const int> boundary,
   std::vector<int> slots(nodes.size(), -1);
   for (Eigen::Index i = 0; i < n; ++i) {
     const int node = nodes[static_cast<std::size_t>(i)];
-    const auto obstacle = std::lower_bound(source.obstacle_nodes.begin(), source.obstacle_nodes.end(), node);
-    const bool obstacle_row = obstacle != source.obstacle_nodes.end() && *obstacle == node;
+    const bool obstacle_row = std::binary_search(source.obstacle_nodes.begin(), source.obstacle_nodes.end(), node);
     if (!obstacle_row && !holdable(body.contact_normals.col(node), body.dofs.fixed_axes[node])) continue;  // no candidate: zero
     const int slot = normal.slot_of(node);
     if (slot < 0) throw Error(fmt::format("build_ir: row node {} has no normal compliance", body.mesh.node_tags[node]));
     slots[static_cast<std::size_t>(i)] = slot;
     sphere.normals.col(i) = normal.normal(slot);
     sphere.free_clearance[i] = normal.free_clearance()[slot];
-    if (obstacle_row) sphere.obstacle_gaps[i] = source.obstacle_gaps[static_cast<std::size_t>(obstacle - source.obstacle_nodes.begin())];
+    if (obstacle_row) sphere.obstacle_gaps[i] = source.obstacles[static_cast<std::size_t>(node)].gap;
   }
   for (Eigen::Index j = 0; j < n; ++j)
     for (Eigen::Index i = 0; i < n; ++i)

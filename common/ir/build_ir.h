@@ -65,13 +65,14 @@ int nearest_touchable_triangle(const ElasticBody& body, const Eigen::Vector3d& p
 using RestDisplacement = std::function<Eigen::VectorXd(std::span<const int> dofs)>;
 
 /// Under the sphere contact model: the server's normal compliance, over every node the IR
-/// can hold (its row nodes), the slots of it that the server's state pushes, and its
-/// candidates an obstacle holds (ascending) with their gaps at rest [m].
+/// can hold (its row nodes), the slots of it that the server's state pushes, its candidates
+/// an obstacle holds (ascending), and per volume node the obstacle constraints
+/// (obstacle_constraints.h) that give their gaps.
 struct SphereIrSource {
   const NormalCompliance* normal = nullptr;
   std::span<const int> contact_slots;
   std::span<const int> obstacle_nodes;
-  std::span<const double> obstacle_gaps;
+  std::span<const SphereConstraint> obstacles;
 };
 
 /// IR for users[user_index]. `boundary_displacement` gives u for each node of

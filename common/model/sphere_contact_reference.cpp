@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <limits>
 
+#include "common/contact/obstacle_constraints.h"
 #include "common/contact/working_set_contact_solve.h"
 #include "common/util/error.h"
 
@@ -72,14 +73,12 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
 
   std::vector<bool> is_held(static_cast<std::size_t>(body_.mesh.node_count()), false);
   for (int node : held.nodes) is_held[static_cast<std::size_t>(node)] = true;
-  SphereConstraint no_obstacle;
-  no_obstacle.gap = std::numeric_limits<double>::infinity();
   SphereCandidates candidates;
   for (int node : candidates_)
     if (!is_held[static_cast<std::size_t>(node)])
       if (const auto constraint = node_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
                                                   body_.dofs.fixed_axes[static_cast<std::size_t>(node)], spheres,
-                                                  obstacles_.empty() ? no_obstacle : obstacles_[static_cast<std::size_t>(node)])) {
+                                                  obstacle_at(obstacles_, node))) {
         candidates.nodes.push_back(node);
         candidates.constraints.push_back(*constraint);
       }

@@ -369,7 +369,7 @@ StepReport Simulation::step(double time) {
     SphereIrSource sphere;
     if (sphere_model()) {
       sphere = {&sphere_solve_->normal_compliance(), sphere_solve_->contact_slots(), sphere_solve_->obstacle_rows(),
-                sphere_solve_->obstacle_row_gaps()};
+                sphere_solve_->obstacle_constraints()};
       built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
     }
     for (std::size_t i = 0; i < tools.size(); ++i) {

@@ -4,17 +4,13 @@
 #include <limits>
 #include <optional>
 
+#include "common/contact/obstacle_constraints.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
 namespace {
 
 constexpr double kNone = std::numeric_limits<double>::infinity();
-
-const SphereConstraint& no_obstacle() {
-  static const SphereConstraint none{-1, kNone, Eigen::Vector3d::Zero(), -1};
-  return none;
-}
 
 }  // namespace
 
@@ -55,22 +51,19 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
                                       std::span<const SphereTool> spheres, const Eigen::VectorXd& boundary_displacement) {
   const DofMap& dofs = body_.dofs;
   obstacle_rows_.clear();  // until this solve finds them (a solve that throws leaves none)
-  obstacle_row_gaps_.clear();
-  const auto obstacle_of = [&](int node) -> const SphereConstraint& {
-    return obstacle_.empty() ? no_obstacle() : obstacle_[static_cast<std::size_t>(node)];
-  };
   const auto constraint_of = [&](int node) {
     return node_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
-                           dofs.fixed_axes[static_cast<std::size_t>(node)], spheres, obstacle_of(node));
+                           dofs.fixed_axes[static_cast<std::size_t>(node)], spheres, obstacle_at(obstacle_, node));
   };
-  std::vector<char> listed(static_cast<std::size_t>(body_.mesh.node_count()), 0);
   std::vector<int> candidates;
+  std::vector<int> index_of(static_cast<std::size_t>(body_.mesh.node_count()), -1);  // among the candidates
+  const auto listed = [&](int node) { return index_of[static_cast<std::size_t>(node)] >= 0; };
   const auto add = [&](int node) {
-    if (listed[static_cast<std::size_t>(node)] || condensation.in_boundary(node) ||
+    if (listed(node) || condensation.in_boundary(node) ||
         (!holdable(body_.contact_normals.col(node), dofs.fixed_axes[static_cast<std::size_t>(node)]) &&
-         obstacle_of(node).obstacle < 0))
+         !obstacle_at(obstacle_, node)))
       return false;
-    listed[static_cast<std::size_t>(node)] = 1;
+    index_of[static_cast<std::size_t>(node)] = static_cast<int>(candidates.size());
     candidates.push_back(node);
     return true;
   };
@@ -78,7 +71,7 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
   const auto add_band = [&](double band) {
     bool added = false;
     for (int node : touchable_)
-      if (!listed[static_cast<std::size_t>(node)])
+      if (!listed(node))
         if (const auto constraint = sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
                                                       dofs.fixed_axes[static_cast<std::size_t>(node)], spheres);
             constraint && constraint->gap < band)
@@ -92,7 +85,7 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
     obstacle_band_ = std::max(obstacle_band_, band);
     bool added = false;
     for (int node : obstacle_nodes_)
-      if (!listed[static_cast<std::size_t>(node)] && obstacle_of(node).gap < obstacle_band_ + kObstacleLeave)
+      if (!listed(node) && obstacle_[static_cast<std::size_t>(node)].gap < obstacle_band_ + kObstacleLeave)
         added |= add(node);
     return added;
   };
@@ -108,8 +101,6 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
       directions_.col(node) = constraints.back() ? constraints.back()->normal : body_.contact_normals.col(node);
     }
     set_candidates(candidates, condensation, boundary_displacement);
-    std::vector<int> index_of(static_cast<std::size_t>(body_.mesh.node_count()), -1);
-    for (std::size_t i = 0; i < candidates.size(); ++i) index_of[static_cast<std::size_t>(candidates[i])] = static_cast<int>(i);
     const auto constraint_of_slot = [&](int slot) -> const std::optional<SphereConstraint>& {
       return constraints[static_cast<std::size_t>(index_of[static_cast<std::size_t>(normal_.node_of(slot))])];
     };
@@ -182,8 +173,6 @@ void SphereStateSolve::find_obstacle_rows(std::span<const int> patch_nodes) {
   }
   near_obstacle_ = std::move(near);
   std::sort(obstacle_rows_.begin(), obstacle_rows_.end());
-  obstacle_row_gaps_.clear();
-  for (int node : obstacle_rows_) obstacle_row_gaps_.push_back(obstacle_[static_cast<std::size_t>(node)].gap);
 }
 
 }  // namespace cohaptic

@@ -70,9 +70,10 @@ class SphereStateSolve {
   /// The slots of normal_compliance() the last solve pushes.
   std::span<const int> contact_slots() const { return contact_.members(); }
   /// The last solve's obstacle rows (above): candidates an obstacle holds (their slots push
-  /// along its normal), ascending, and their gaps at rest [m].
+  /// along its normal), ascending.
   std::span<const int> obstacle_rows() const { return obstacle_rows_; }
-  std::span<const double> obstacle_row_gaps() const { return obstacle_row_gaps_; }
+  /// Per volume node, its obstacle constraint as given (empty: no obstacles).
+  std::span<const SphereConstraint> obstacle_constraints() const { return obstacle_; }
   /// How many nodes the obstacles push in the last solve.
   int obstacle_pushed() const { return obstacle_pushed_; }
 
@@ -101,7 +102,6 @@ class SphereStateSolve {
   std::vector<int> tool_;       // per slot, the sphere holding it (-1: none, or an obstacle: then q is finite)
   std::vector<char> near_obstacle_;  // per volume node: an obstacle row for being near, as of the last solve
   std::vector<int> obstacle_rows_;
-  std::vector<double> obstacle_row_gaps_;
   int obstacle_pushed_ = 0;
 };
 
