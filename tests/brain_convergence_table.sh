@@ -32,14 +32,10 @@ trap 'rm -rf "$work"' EXIT
 cache=out/convergence-cache
 mkdir -p "$cache"
 
-# A copy of scenes/brain.yaml with mesh $1 (and the skull's file by its full path).
-scene_with() {
-  sed -e "s#file: brain/[^ ]*\.msh#file: $(realpath "$1")#" \
-      -e "s#surface: brain/inner_skull.asc#surface: $(realpath scenes/brain/inner_skull.asc)#" scenes/brain.yaml
-}
-scene_with scenes/brain/brain.msh >"$work/coarse.yaml"
-scene_with scenes/brain/brain_graded.msh >"$work/graded.yaml"
-scene_with "$reference" >"$work/reference.yaml"
+# The demo's scene with each mesh.
+deploy/brain-scene-with-mesh.sh scenes/brain/brain.msh >"$work/coarse.yaml"
+deploy/brain-scene-with-mesh.sh scenes/brain/brain_graded.msh >"$work/graded.yaml"
+deploy/brain-scene-with-mesh.sh "$reference" >"$work/reference.yaml"
 
 # Start (where each tool stops before pressing) and deepest centre of each tool, mm.
 a0=(-15.4 -79.9 -45.0); a1=(-15.943 -75.736 -49.285)
