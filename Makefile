@@ -1,7 +1,6 @@
 # cohaptic: the two commands (see README.md).
 #   make test   install missing packages, configure, build (Release), run every test
 #   make demo   the same set-up, then the main job (SCENE=scenes/thin/noodle.yaml: the noodle's)
-#   make demo-graded  the demo on the graded brain (2 mm near the tools), written to out/graded/
 #   make tradeoff  the same set-up, then the speed/accuracy grid on the cube
 #   make bench  the same set-up, then the benchmarks (BENCH_ARGS passes arguments through)
 #   make bench-thin  the mass-spring benchmarks beside the thin-objects paper's Table 2
@@ -63,7 +62,7 @@ SANITIZER_CMAKE = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
 SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
   TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
 
-.PHONY: all deps configure build test demo demo-graded probe-demo tradeoff bench bench-thin bench-sphere bench-compliance brain-convergence fuzz test-asan test-tsan clean
+.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance brain-convergence fuzz test-asan test-tsan clean
 
 all: build
 
@@ -88,13 +87,6 @@ test: build
 # another scene with surgeons' scripts beside it (scenes/thin/noodle.yaml: the noodle's demo).
 demo: build
 	@BUILD_DIR=$(BUILD_DIR) ./deploy/run-demo.sh $(SCENE)
-
-# The demo on the graded brain (scenes/brain/brain_graded.msh, 2 mm near the tools): the
-# brain scene with that mesh, written to out/graded/, and the same two surgeons.
-demo-graded: build
-	@mkdir -p out/graded/brain && cp scenes/brain/surgeon_a.yaml scenes/brain/surgeon_b.yaml out/graded/brain/
-	@deploy/brain-scene-with-mesh.sh scenes/brain/brain_graded.msh >out/graded/brain.yaml
-	@BUILD_DIR=$(BUILD_DIR) DEMO_VIEW_PORT=$${DEMO_VIEW_PORT:-off} ./deploy/run-demo.sh out/graded/brain.yaml
 
 # The probe on the paper's cube, through the intermediate representation: a tool pressed
 # 1, 2, 5 and 10 mm into the front face's centre, then two tools together.

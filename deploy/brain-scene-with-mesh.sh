@@ -3,7 +3,7 @@
 # with another mesh, its file paths made absolute so that the copy may live anywhere.
 #
 # Usage: deploy/brain-scene-with-mesh.sh MESH.msh > scene.yaml
-#   e.g. deploy/brain-scene-with-mesh.sh scenes/brain/brain_graded.msh (make demo-graded uses it)
+#   e.g. deploy/brain-scene-with-mesh.sh scenes/brain/brain.msh (make brain-convergence uses it)
 set -euo pipefail
 [[ $# -eq 1 && -f $1 ]] || { echo "usage: deploy/brain-scene-with-mesh.sh MESH.msh > scene.yaml (an existing mesh)" >&2; exit 2; }
 root=$(cd "$(dirname "$0")/.." && pwd)

@@ -263,7 +263,7 @@ LabCommand add_ir_bytes_command(CLI::App& lab) {
               }
               return 0;
             }
-            ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+            ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
             fmt::print("| recording | IRs | span s | nodes per IR | new nodes per IR | sent kB/s | without M~ kB/s | f32 kB/s | "
                        "M~ delta kB/s | compliance rows kB/s | rows: client CPU µs p50 / max | rows: M~ difference | "
                        "as sent: client CPU µs p50 / max / first | zstd stream kB/s | zstd stream: client CPU µs p50 / max |\n"

@@ -119,7 +119,7 @@ PushRig::PushRig(const Scene& scene, const PushVariation& variation)
       front(spring_front(std::get<MassSpringModel>(model->bodies[static_cast<std::size_t>(layout.front)]), layout,
                          push_point(scene, layout))),
       behind_surface(make_surface_adjacency(behind().surface.triangles, behind().mesh.node_count())),
-      behind_columns(std::make_unique<ComplianceColumns>(*behind().free_factor, behind().dofs, behind().surface.nodes)) {}
+      behind_columns(std::make_unique<ComplianceColumns>(behind().free_factor, behind().dofs, behind().surface.nodes)) {}
 
 const ElasticBody& PushRig::behind() const { return elastic_body(*model, layout.behind); }
 

@@ -171,7 +171,7 @@ ReferenceTrace reference_trace(const Scene& reference, const std::vector<Traject
   std::unique_ptr<ComplianceColumns> columns;
   std::unique_ptr<Simulation> active_set;
   if (!reference.obstacles.empty() && reference.haptic.contact_model != ContactModel::sphere) {
-    columns = std::make_unique<ComplianceColumns>(*body.free_factor, body.dofs, compliance_row_nodes(body, true));
+    columns = std::make_unique<ComplianceColumns>(body.free_factor, body.dofs, compliance_row_nodes(body, true));
     prepare_compliance(body, *columns, std::nullopt);
     SimulationOptions options;
     options.ir = ir_build_options(reference.haptic);
@@ -224,7 +224,7 @@ TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, cons
   const Stopwatch precompute;
   const Model model = build_model(varied);
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, compliance_row_nodes(body, !varied.obstacles.empty()));
+  ComplianceColumns columns(body.free_factor, body.dofs, compliance_row_nodes(body, !varied.obstacles.empty()));
   prepare_compliance(body, columns, std::nullopt);
   row.precompute_s = precompute.elapsed_ms() / 1000;
   row.nodes = body.mesh.node_count();

@@ -7,7 +7,7 @@
 namespace cohaptic {
 
 CompliancePrefetch::CompliancePrefetch(const ElasticBody& body, const std::vector<int>& row_nodes)
-    : solver_(*body.free_factor, body.dofs, row_nodes),
+    : solver_(body.free_factor, body.dofs, row_nodes),
       row_positions_(body.mesh.nodes(Eigen::all, row_nodes)),
       taken_(static_cast<std::size_t>(ComplianceColumns::group_of(static_cast<int>(row_nodes.size()) - 1) + 1), 0),
       distance_(taken_.size(), kNotQueued),

@@ -13,18 +13,14 @@
 #include <fstream>
 #include <map>
 #include <memory>
-#include <regex>
-#include <sstream>
 
 #include "common/fem/schur_compliance.h"
 #include "common/model/compliance_setup.h"
 #include "common/model/model.h"
-#include "common/scene/load_scene.h"
+#include "support/brain_scene.h"
 
 namespace cohaptic {
 namespace {
-
-const std::filesystem::path kScenes = std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes";
 
 const char* const kMeshes[] = {"brain.msh", "brain_fine.msh", "brain_graded.msh"};
 
@@ -32,11 +28,7 @@ const Model& brain_model(int mesh) {
   static std::map<int, std::unique_ptr<Model>> models;
   auto& slot = models[mesh];
   if (!slot) {
-    std::stringstream text;
-    text << std::ifstream(kScenes / "brain.yaml").rdbuf();
-    const std::string yaml = std::regex_replace(text.str(), std::regex(R"(file: brain/\S+\.msh)"),
-                                                std::string("file: brain/") + kMeshes[mesh]);
-    slot = std::make_unique<Model>(build_model(parse_scene(yaml, kScenes / "brain.yaml")));
+    slot = std::make_unique<Model>(build_model(testing::brain_scene(kMeshes[mesh])));
   }
   return *slot;
 }
@@ -58,7 +50,7 @@ void BM_BrainRowCompliance(benchmark::State& state) {
   const SparseMatrix k_ff = restrict_to_dofs(brain.stiffness, brain.dofs.free_dofs);
   reset_peak_memory();
   for (auto _ : state) {
-    ComplianceColumns columns(*brain.free_factor, brain.dofs, rows);
+    ComplianceColumns columns(brain.free_factor, brain.dofs, rows);
     if (route > 0)
       compute_row_columns_by_schur(columns, k_ff, brain.dofs, route);
     else

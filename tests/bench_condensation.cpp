@@ -55,7 +55,7 @@ Fixture& fixture(int boundary_nodes) {
   testing::CubeSceneOptions scene;
   scene.divisions = boundary_nodes > 500 ? 16 : 11;
   f.model = std::make_unique<Model>(build_model(parse_scene(testing::cube_scene_yaml(scene), "bench-cube.yaml")));
-  f.columns = std::make_unique<ComplianceColumns>(*f.body().free_factor, f.body().dofs, f.body().surface.nodes);
+  f.columns = std::make_unique<ComplianceColumns>(f.body().free_factor, f.body().dofs, f.body().surface.nodes);
   const Model& model = *f.model;
   const ElasticBody& body = single_elastic_body(model);
 

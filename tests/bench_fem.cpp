@@ -70,7 +70,7 @@ void BM_ComplianceColumn(benchmark::State& state) {
   const ElasticBody& body = single_elastic_body(model);
   const int node = body.touchable_nodes[body.touchable_nodes.size() / 2];
   for (auto _ : state) {
-    ComplianceColumns columns(*body.free_factor, body.dofs, body.touchable_nodes);
+    ComplianceColumns columns(body.free_factor, body.dofs, body.touchable_nodes);
     benchmark::DoNotOptimize(columns.column(node).data());
   }
   set_mesh_counters(state, model);
@@ -81,7 +81,7 @@ void BM_ComplianceSurfaceBlock_batched(benchmark::State& state) {
   const Model& model = cube_model(static_cast<int>(state.range(0)));
   const ElasticBody& body = single_elastic_body(model);
   for (auto _ : state) {
-    ComplianceColumns columns(*body.free_factor, body.dofs, body.touchable_nodes);
+    ComplianceColumns columns(body.free_factor, body.dofs, body.touchable_nodes);
     columns.compute_columns(body.touchable_nodes);
     benchmark::DoNotOptimize(columns.column_count());
   }
@@ -94,7 +94,7 @@ void BM_ComplianceSurfaceBlock_per_node(benchmark::State& state) {
   const Model& model = cube_model(static_cast<int>(state.range(0)));
   const ElasticBody& body = single_elastic_body(model);
   for (auto _ : state) {
-    ComplianceColumns columns(*body.free_factor, body.dofs, body.touchable_nodes);
+    ComplianceColumns columns(body.free_factor, body.dofs, body.touchable_nodes);
     for (int node : body.touchable_nodes) columns.column(node);
     benchmark::DoNotOptimize(columns.column_count());
   }
@@ -109,7 +109,7 @@ void BM_ComplianceGroupSolve(benchmark::State& state) {
   const std::vector<int> rows = compliance_row_nodes(brain, true);
   const std::vector<int> group(rows.begin(), rows.begin() + state.range(0));
   for (auto _ : state) {
-    ComplianceColumns columns(*brain.free_factor, brain.dofs, group);
+    ComplianceColumns columns(brain.free_factor, brain.dofs, group);
     columns.compute_columns(group);  // one solve: the group is the whole row set
     benchmark::DoNotOptimize(columns.column_count());
   }

@@ -155,7 +155,7 @@ struct BlockRig {
       : model(std::make_unique<Model>(
             build_model(parse_scene(kSceneYaml, COHAPTIC_SOURCE_DIR "/scenes/block/bench_sphere_contact.yaml")))),
         body(single_elastic_body(*model)),
-        columns(std::make_unique<ComplianceColumns>(*body.free_factor, body.dofs, compliance_row_nodes(body, false))),
+        columns(std::make_unique<ComplianceColumns>(body.free_factor, body.dofs, compliance_row_nodes(body, false))),
         touchable(triangle_nodes(body.surface, body.touchable_triangles)) {
     prepare_compliance(body, *columns, default_cache_directory());
     for (int node = 0; node < body.mesh.node_count(); ++node)

@@ -77,7 +77,7 @@ struct BrainRig {
     use_single_blas_thread();
     model = std::make_unique<Model>(build_model(load_scene(kBrain / "brain.yaml")));
     const ElasticBody& body = single_elastic_body(*model);
-    columns = std::make_unique<ComplianceColumns>(*body.free_factor, body.dofs,
+    columns = std::make_unique<ComplianceColumns>(body.free_factor, body.dofs,
                                                   compliance_row_nodes(body, !model->obstacles.empty()));
     prepare_compliance(body, *columns, default_cache_directory());
     for (const char* user : {"surgeon_a.yaml", "surgeon_b.yaml"}) motions.push_back(load_trajectory(kBrain / "brain" / user));

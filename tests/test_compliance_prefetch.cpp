@@ -40,7 +40,7 @@ std::set<int> nodes_of_groups_near(const ElasticBody& body, const ComplianceColu
 TEST(CompliancePrefetch, SolvesTheGroupsNearAToolBitForBitAsTheSimulationWould) {
   const testing::CubeRig rig;
   const ElasticBody& body = rig.body;
-  ComplianceColumns columns(*body.free_factor, body.dofs, rig.columns->row_nodes());
+  ComplianceColumns columns(body.free_factor, body.dofs, rig.columns->row_nodes());
   CompliancePrefetch prefetch(body, columns.row_nodes());
   const Eigen::Vector3d tool(0.01, -0.02, 0.004);  // 4 mm above the front face
   const std::set<int> expected = nodes_of_groups_near(body, columns, tool, CompliancePrefetch::kToolReach);
@@ -54,7 +54,7 @@ TEST(CompliancePrefetch, SolvesTheGroupsNearAToolBitForBitAsTheSimulationWould) 
   EXPECT_EQ(delivered, expected);
 
   // The same columns solved here, on this thread, as the simulation solves a node it needs.
-  ComplianceColumns here(*body.free_factor, body.dofs, columns.row_nodes());
+  ComplianceColumns here(body.free_factor, body.dofs, columns.row_nodes());
   for (int node : expected) {
     const ComplianceColumn& mine = here.column(node);
     const ComplianceColumn& prefetched = columns.columns().at(node);
@@ -66,7 +66,7 @@ TEST(CompliancePrefetch, SolvesTheGroupsNearAToolBitForBitAsTheSimulationWould) 
 TEST(CompliancePrefetch, NeverReplacesAColumnTheCallerHasAndSkipsWhatItHas) {
   const testing::CubeRig rig;
   const ElasticBody& body = rig.body;
-  ComplianceColumns columns(*body.free_factor, body.dofs, rig.columns->row_nodes());
+  ComplianceColumns columns(body.free_factor, body.dofs, rig.columns->row_nodes());
   CompliancePrefetch prefetch(body, columns.row_nodes());
   const int first = columns.row_nodes()[0];
   const ComplianceColumn* held = &columns.column(first);  // the caller solved the first group itself

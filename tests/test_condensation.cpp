@@ -68,7 +68,7 @@ double expect_equals_naive(IncrementalCondensation& incremental, ComplianceColum
 TEST(Condensation, ForcesEqualTheFullSparseSolveForRandomActiveSets) {
   const Model model = cube_model(8, 0.4);
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
   const std::vector<int> candidates = movable_surface_nodes(model);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> displacement(-2e-3, 2e-3);
@@ -98,7 +98,7 @@ TEST(Condensation, ForcesEqualTheFullSparseSolveForRandomActiveSets) {
 void incremental_matches_naive_after_random_updates(double nu) {
   const Model model = cube_model(6, nu);
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
   const std::vector<int> candidates = movable_surface_nodes(model);
   IncrementalCondensation incremental(columns, body.dofs);
   std::mt19937 rng(nu < 0.4 ? 17 : 29);
@@ -157,7 +157,7 @@ TEST(Condensation, JoinsAndLeavesAtTheFirstMiddleAndLastPositionEqualNaive) {
   for (double nu : {0.3, 0.499}) {
     const Model model = cube_model(6, nu, true);
     const ElasticBody& body = single_elastic_body(model);
-    ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+    ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
     const std::vector<int> candidates = movable_surface_nodes(model);
     std::vector<int> shuffled = candidates;
     std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(5));
@@ -194,7 +194,7 @@ TEST(Condensation, JoinsAndLeavesAtTheFirstMiddleAndLastPositionEqualNaive) {
 TEST(Condensation, ContactSetChangesEqualNaive) {
   const Model model = cube_model(6, 0.45, true);
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
   std::vector<int> candidates = movable_surface_nodes(model);
   std::vector<int> sliding;
   for (int node : candidates)
@@ -247,7 +247,7 @@ TEST(Condensation, ContactSetChangesEqualNaive) {
 TEST(Condensation, RefactoringKeepsTheCondensationExact) {
   const Model model = cube_model(5, 0.4);
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
   const std::vector<int> candidates = movable_surface_nodes(model);
   IncrementalCondensation::Options options;
   options.drift_tolerance = -1;
@@ -273,7 +273,7 @@ TEST(Condensation, RefactoringKeepsTheCondensationExact) {
 TEST(Condensation, ANodeInBothSetsOrTwiceInBIsAClearError) {
   const Model model = cube_model(4, 0.4);
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
   const std::vector<int> nodes = movable_surface_nodes(model);
   IncrementalCondensation incremental(columns, body.dofs);
   incremental.add_boundary_node(nodes[0]);

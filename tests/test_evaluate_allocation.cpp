@@ -70,7 +70,7 @@ TEST(ForceEvaluator, AllocatesNothing) {
 
   const Model model = build_model(parse_scene(testing::cube_scene_yaml(), "cube.yaml"));
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
   for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
     SimulationOptions options;
     options.ir.contact_model = contact_model;
@@ -324,7 +324,7 @@ TEST(ForceEvaluator, AllocatesNothingUnderTheSphereModel) {
   cube.tools = "[{name: A, shape: sphere, radius: 30}, {name: B, shape: sphere, radius: 30}]";
   const Model model = build_model(parse_scene(testing::cube_scene_yaml(cube), "cube.yaml"));
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
   SimulationOptions options;
   options.ir.contact_model = ContactModel::sphere;
   options.ir.patch_rings = 2;

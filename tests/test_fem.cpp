@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "common/fem/assemble_stiffness.h"
+#include "common/fem/deferred_cholesky.h"
 #include "common/fem/sparse_cholesky.h"
 #include "common/fem/static_solve.h"
 #include "common/fem/tet_stiffness.h"
@@ -117,6 +118,51 @@ TEST(SparseCholesky, AnIndefiniteMatrixIsATypedErrorNamingTheRow) {
     EXPECT_NE(std::string(e.what()).find("not positive definite"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("first failure at node "), std::string::npos) << e.what();
   }
+}
+
+TEST(DeferredCholesky, FactorsOnceOnFirstUseSharedByCopiesAndThreadsAndEqualsTheDirectFactor) {
+  const TetMesh mesh = testing::distorted_box_mesh(0.05, 3, 0.2, 9);
+  std::vector<AxisMask> fixed(static_cast<std::size_t>(mesh.node_count()), 0);
+  for (int i = 0; i < mesh.node_count(); ++i)
+    if (mesh.nodes(2, i) < 1e-12) fixed[i] = kAllAxes;
+  const SparseMatrix k_ff = restrict_to_dofs(assemble_stiffness(mesh, kSoft), make_dof_map(fixed).free_dofs);
+  const DeferredCholesky deferred(k_ff, {});
+  const DeferredCholesky copy = deferred;
+  EXPECT_FALSE(deferred.factored());
+  EXPECT_EQ(deferred.factor_ms(), 0);
+
+  // Threads asking at once all get the one factor the first of them made.
+  std::vector<const SparseCholesky*> seen(4, nullptr);
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < seen.size(); ++t) threads.emplace_back([&, t] { seen[t] = &(t % 2 ? copy : deferred).factor(); });
+  for (std::thread& thread : threads) thread.join();
+  for (const SparseCholesky* factor : seen) EXPECT_EQ(factor, seen.front());
+  EXPECT_TRUE(copy.factored());
+  EXPECT_GT(deferred.factor_ms(), 0);
+
+  const Eigen::MatrixXd rhs = Eigen::MatrixXd::Ones(k_ff.rows(), 2);
+  EXPECT_EQ(deferred->solve(rhs), SparseCholesky(k_ff).solve(rhs));
+  const SparseCholesky direct(k_ff);
+  EXPECT_EQ(&DeferredCholesky::borrowing(direct).factor(), &direct);
+}
+
+TEST(DeferredCholesky, AMatrixThatIsNotPositiveDefiniteFailsAtEveryUseNamingTheRow) {
+  const TetMesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1), Eigen::Vector3i::Constant(2));
+  std::vector<AxisMask> fixed(static_cast<std::size_t>(mesh.node_count()), 0);
+  fixed[0] = fixed[1] = fixed[3] = kAllAxes;
+  const DofMap dofs = make_dof_map(fixed);
+  const DeferredCholesky deferred(restrict_to_dofs(-assemble_stiffness(mesh, kSoft), dofs.free_dofs),  // negative definite
+                                  [&](int row) { return "node " + std::to_string(mesh.node_tags[dofs.free_dofs[row] / 3]); });
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    try {
+      deferred.factor();
+      FAIL() << "no error";
+    } catch (const NumericalError& e) {
+      EXPECT_NE(std::string(e.what()).find("first failure at node "), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(deferred.factored());
+  }
+  EXPECT_THROW(DeferredCholesky().factor(), Error);
 }
 
 TEST(PatchTest, ALinearFieldOnTheBoundaryIsReproducedInsideADistortedMesh) {

@@ -156,7 +156,7 @@ std::pair<double, double> surface_difference(const Simulation& simulation, const
 TEST(FemPairScene, AppliedLoadsBesideAToolAndHeldNodesAreTheFullSolves) {
   const testing::PairedBoxesRig rig(fem_pair_scene_options(0.0));
   const ElasticBody& a = rig.front;
-  ComplianceColumns columns(*a.free_factor, a.dofs, a.surface.nodes);
+  ComplianceColumns columns(a.free_factor, a.dofs, a.surface.nodes);
   IncrementalCondensation condensation(columns, a.dofs);
   std::vector<int> free_back;  // A's back-face nodes off its fixed bottom
   for (int node : rig.front_face)

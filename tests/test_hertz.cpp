@@ -144,7 +144,7 @@ TEST(Hertz, OnTheGradedSymmetricBlockTheIrEqualsTheFullSolve) {
   block.divisions = 8;
   const Model model = build_model(parse_scene(hertz_block_yaml(block), "hertz.yaml"));
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
+  ComplianceColumns columns(body.free_factor, body.dofs, compliance_row_nodes(body, false));
   prepare_compliance(body, columns, std::nullopt);
   SimulationOptions options;
   options.ir.contact_model = ContactModel::sphere;

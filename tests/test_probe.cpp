@@ -32,7 +32,7 @@ class CubeProbe : public ::testing::Test {
   static void SetUpTestSuite() {
     model_ = new Model(build_model(load_scene(testing::source_path("scenes/cube.yaml"))));
     const ElasticBody& body = single_elastic_body(*model_);
-    columns_ = new ComplianceColumns(*body.free_factor, body.dofs, compliance_row_nodes(body, false));
+    columns_ = new ComplianceColumns(body.free_factor, body.dofs, compliance_row_nodes(body, false));
   }
   static void TearDownTestSuite() {
     delete columns_;

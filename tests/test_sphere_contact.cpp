@@ -25,6 +25,7 @@
 #include "common/sim/simulation.h"
 #include "common/util/error.h"
 #include "proto/wire/ir_convert.h"
+#include "support/brain_scene.h"
 #include "support/cube_scene.h"
 #include "support/expect_refused.h"
 #include "support/measures.h"
@@ -415,9 +416,9 @@ TEST(SphereContact, AtRandomPlacesOnTheCubeEqualsTheFullSparseSolve) {
 }
 
 TEST(SphereContact, AtRandomPlacesOnTheBrainEqualsTheFullSparseSolve) {
-  const Model model = build_model(load_scene(testing::source_path("scenes/brain.yaml")));
+  const Model model = build_model(testing::brain_scene(testing::kCoarseBrainMesh));
   const ElasticBody& body = single_elastic_body(model);
-  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
   press_at_random_places(body, model, columns, model.scene.tools[0].radius, 4e-3, 16, 9);
 }
 

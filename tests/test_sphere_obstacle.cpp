@@ -13,14 +13,13 @@
 
 #include "common/contact/obstacle_constraints.h"
 #include "common/model/sphere_contact_reference.h"
-#include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
 #include "proto/wire/ir_convert.h"
+#include "support/brain_scene.h"
 #include "support/cube_scene.h"
 #include "support/evaluate_static.h"
 #include "support/expect_refused.h"
 #include "support/measures.h"
-#include "support/test_meshes.h"
 #include "support/unlimited_options.h"
 
 namespace cohaptic {
@@ -191,10 +190,10 @@ TEST(SphereObstacle, TheIrsWallRowsTravelBitForBitAndTheirInconsistenciesAreRefu
 TEST(SphereObstacle, TheBrainOnItsSkullPressedInOneStepOrTenEqualsTheFullSparseSolve) {
   // The demo's two spatula tips at their deepest (scenes/brain/surgeon_*.yaml), the skull
   // holding the brain as they push.
-  const Model model = build_model(load_scene(testing::source_path("scenes/brain.yaml")));
+  const Model model = build_model(testing::brain_scene(testing::kCoarseBrainMesh));
   const ElasticBody& body = single_elastic_body(model);
   ASSERT_FALSE(model.obstacles.empty());
-  ComplianceColumns columns(*body.free_factor, body.dofs, body.surface.nodes);
+  ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
   const std::vector<Eigen::Vector3d> deepest = {mm(-15.943, -75.736, -49.285), mm(0.119, -85.715, -30.175)};
   const Eigen::Vector3d lift = mm(0, 0, 15);
   const auto run = [&](int steps) {

@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "proto/record/recording.h"
+#include "support/brain_scene.h"
 #include "support/browser.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
@@ -80,7 +81,7 @@ segments:
   return dir;
 }
 
-// The demo's session (scenes/brain.yaml): a directory holding each surgeon's script (a.yaml,
+// The demo's session (scenes/brain/surgeon_*.yaml): a directory holding each surgeon's script (a.yaml,
 // b.yaml) as the demo's, but holding its press until told to stop.
 fs::path brain_session(const std::string& name) {
   const fs::path dir = testing::scratch_directory(name);
@@ -216,17 +217,18 @@ TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClients
   session.stop();
 }
 
-TEST(ViewInBrowser, TheDemosBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
+TEST(ViewInBrowser, TheBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
   if (const std::string why = testing::missing_browser(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = brain_session("view-brain");
-  ViewSession session(dir, kSource / "scenes/brain.yaml");
+  ViewSession session(dir, testing::write_brain_scene(dir, testing::kCoarseBrainMesh));
   ASSERT_FALSE(session.url.empty()) << session.server->log_text();
   const auto a = session.client("a", 0);
   const auto b = session.client("b", 1);
 
-  // As make demo's picture: once both surgeons press with 0.01 N, the camera close to the
-  // tools. Held at their deepest, the 7 mm spheres feel about 0.038 N (A) and 0.029 N (B)
-  // (docs/brain-scene.md "The brain scene": this soft a brain gives no more to a tip that fits the corridor).
+  // As make demo's picture, on the brain's 9 mm mesh: once both surgeons press with 0.01 N,
+  // the camera close to the tools. Held at their deepest, the 7 mm spheres feel a few
+  // hundredths of a newton (docs/results/brain-convergence.md): this soft a brain gives no
+  // more to a tip that fits the corridor.
   const json brain = check_page(dir, "brain", {"--url", session.url, "--screenshot", (dir / "brain.png").string(),
                                                "--min-force", "0.01", "--focus-tools", "1"});
   ASSERT_FALSE(brain.contains("error")) << brain.dump();

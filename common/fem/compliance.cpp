@@ -8,7 +8,7 @@
 
 namespace cohaptic {
 
-ComplianceColumns::ComplianceColumns(const SparseCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes)
+ComplianceColumns::ComplianceColumns(const DeferredCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes)
     : factor_(factor), dofs_(dofs), row_nodes_(std::move(row_nodes)), row_position_(static_cast<std::size_t>(dofs.node_count()), -1) {
   for (int i = 0; i < static_cast<int>(row_nodes_.size()); ++i) {
     const int node = row_nodes_[i];
@@ -50,13 +50,14 @@ void ComplianceColumns::compute_columns(const std::vector<int>& nodes) {
 void ComplianceColumns::solve_chunk(std::span<const int> nodes) {
   // One right-hand side per axis of every node: a unit force on that dof.
   const auto count = static_cast<Eigen::Index>(nodes.size());
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(factor_.size(), 3 * count);
+  const SparseCholesky& factor = factor_.factor();
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(factor.size(), 3 * count);
   for (Eigen::Index k = 0; k < count; ++k)
     for (int axis = 0; axis < 3; ++axis) {
       const int free = dofs_.free_index[3 * nodes[k] + axis];
       if (free >= 0) rhs(free, 3 * k + axis) = 1.0;
     }
-  const Eigen::MatrixXd solution = factor_.solve(rhs, workspace_);
+  const Eigen::MatrixXd solution = factor.solve(rhs, workspace_);
   const auto rows = static_cast<Eigen::Index>(3 * row_nodes_.size());
   for (Eigen::Index k = 0; k < count; ++k) {
     ComplianceColumn column = ComplianceColumn::Zero(rows, 3);

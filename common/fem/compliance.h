@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/fem/compliance_source.h"
+#include "common/fem/deferred_cholesky.h"
 #include "common/fem/dof_map.h"
 #include "common/fem/sparse_cholesky.h"
 
@@ -30,8 +31,12 @@ class ComplianceColumns : public ComplianceSource {
   /// at once (one that an obstacle starts to hold).
   static constexpr int kGroupSize = 4;
 
-  /// `factor` and `dofs` must outlive this object; `row_nodes` are volume node indices.
-  ComplianceColumns(const SparseCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes);
+  /// `factor` (a body's K_ff, factored at the first column solved, if any) and `dofs` must
+  /// outlive this object; `row_nodes` are volume node indices.
+  ComplianceColumns(const DeferredCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes);
+  /// The same with a factor already made.
+  ComplianceColumns(const SparseCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes)
+      : ComplianceColumns(DeferredCholesky::borrowing(factor), dofs, std::move(row_nodes)) {}
 
   const std::vector<int>& row_nodes() const { return row_nodes_; }
   /// Nodes of the whole volume mesh (the range of column nodes), not the row count.
@@ -66,7 +71,7 @@ class ComplianceColumns : public ComplianceSource {
  private:
   void solve_chunk(std::span<const int> nodes);
 
-  const SparseCholesky& factor_;
+  DeferredCholesky factor_;
   CholeskyWorkspace workspace_;  // the solves' scratch: the factor itself stays immutable
   const DofMap& dofs_;
   std::vector<int> row_nodes_;

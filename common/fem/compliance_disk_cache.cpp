@@ -1,7 +1,6 @@
 #include "common/fem/compliance_disk_cache.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <cstring>
 #include <fmt/format.h>
 #include <fstream>
@@ -26,14 +25,17 @@ struct Writer {
   void value(const T& v) { bytes(&v, sizeof v); }
 };
 
-// Reads plain values from a byte buffer; every read is bounds-checked.
-struct Reader {
-  const std::vector<char>& buffer;
-  std::size_t offset = 0;
+// Reads plain values from a cache file, up to its checksum, hashing every byte it reads: the
+// columns go straight from the file into their matrices, and the checksum is known when
+// the last one is read (one pass, no copy of the file in memory).
+struct HashingReader {
+  std::ifstream& in;
+  std::uintmax_t remaining;  // bytes left before the checksum
+  ContentHasher hasher;
   bool bytes(void* out, std::size_t size) {
-    if (size > buffer.size() - offset) return false;
-    std::memcpy(out, buffer.data() + offset, size);
-    offset += size;
+    if (size > remaining || !in.read(static_cast<char*>(out), static_cast<std::streamsize>(size))) return false;
+    hasher.bytes(out, size);
+    remaining -= size;
     return true;
   }
   template <typename T>
@@ -60,36 +62,25 @@ std::filesystem::path compliance_cache_file(const std::filesystem::path& directo
 }
 
 ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, const Digest& key,
-                                          ComplianceColumns& columns) {
+                                          ComplianceColumns& columns, ProgressLog* progress) {
   ComplianceCacheLoad result;
   std::ifstream in(file, std::ios::binary);
-  if (!in) {
+  std::error_code size_error;
+  const std::uintmax_t file_size = std::filesystem::file_size(file, size_error);
+  if (!in || size_error) {
     result.problem = "no cache file";
     return result;
   }
-  const std::vector<char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) {
-    result.problem = fmt::format("read error: {}", std::strerror(errno));
-    return result;
-  }
   Digest stored_checksum{};
-  if (data.size() < sizeof kMagic + stored_checksum.size()) {
-    result.problem = fmt::format("truncated ({} bytes)", data.size());
+  if (file_size < sizeof kMagic + stored_checksum.size()) {
+    result.problem = fmt::format("truncated ({} bytes)", file_size);
     return result;
   }
-  const std::size_t body_size = data.size() - stored_checksum.size();
-  std::memcpy(stored_checksum.data(), data.data() + body_size, stored_checksum.size());
-  if (digest_of(data.data(), body_size) != stored_checksum) {
-    result.problem = "checksum mismatch (truncated or corrupted)";
-    return result;
-  }
-
-  Reader r{data};
+  HashingReader r{in, file_size - stored_checksum.size(), {}};
   char magic[sizeof kMagic];
   std::uint32_t version = 0;
   Digest stored_key{};
-  r.bytes(magic, sizeof magic);
-  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0) {
+  if (!r.bytes(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0) {
     result.problem = "not a cohaptic compliance cache";
     return result;
   }
@@ -116,8 +107,14 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
     result.problem = "truncated column count";
     return result;
   }
+  const std::uintmax_t column_bytes = sizeof(int) + 9 * std::uintmax_t{row_count} * sizeof(double);
+  if (column_count > r.remaining / column_bytes) {
+    result.problem = fmt::format("{} columns announced, {} bytes left for them", column_count, r.remaining);
+    return result;
+  }
   std::vector<std::pair<int, ComplianceColumn>> loaded;
   loaded.reserve(column_count);
+  if (progress) progress->set_total(column_count);
   for (std::uint32_t c = 0; c < column_count; ++c) {
     int node = 0;
     ComplianceColumn column(3 * static_cast<Eigen::Index>(row_count), 3);
@@ -130,9 +127,15 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
       return result;
     }
     loaded.emplace_back(node, std::move(column));
+    if (progress) progress->add(1);
   }
-  if (r.offset != body_size) {
+  if (r.remaining != 0) {
     result.problem = "trailing bytes after the last column";
+    return result;
+  }
+  if (!in.read(reinterpret_cast<char*>(stored_checksum.data()), stored_checksum.size()) ||
+      r.hasher.finish() != stored_checksum) {
+    result.problem = "checksum mismatch (truncated or corrupted)";
     return result;
   }
   for (auto& [node, column] : loaded) columns.insert_column(node, std::move(column));

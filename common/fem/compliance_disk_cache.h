@@ -19,6 +19,7 @@
 #include "common/fem/linear_elastic_material.h"
 #include "common/mesh/tet_mesh.h"
 #include "common/util/content_hash.h"
+#include "common/util/progress_log.h"
 
 namespace cohaptic {
 
@@ -44,8 +45,9 @@ struct ComplianceCacheLoad {
 
 /// Inserts the cached columns into `columns` if `file` is a complete, uncorrupted cache for
 /// `key`; otherwise leaves `columns` untouched and says why. Never throws for a bad file.
+/// `progress`, if given, counts the columns read.
 ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, const Digest& key,
-                                          ComplianceColumns& columns);
+                                          ComplianceColumns& columns, ProgressLog* progress = nullptr);
 
 /// Writes every cached column, atomically (temporary file, then rename). Throws Error
 /// naming the file and the reason (e.g. a full disk); an existing cache is left intact.

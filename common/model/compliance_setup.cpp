@@ -66,12 +66,20 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
     const Digest key = cache_key(body, columns);
     setup.cache_file = compliance_cache_file(*cache_directory, key);
     progress.set_phase("loading " + setup.cache_file.string());
-    const ComplianceCacheLoad load = load_compliance_cache(setup.cache_file, key, columns);
+    const ComplianceCacheLoad load = load_compliance_cache(setup.cache_file, key, columns, &progress);
     setup.from_disk = load.loaded;
     setup.note = load.loaded ? fmt::format("loaded {} columns from {}", load.columns, setup.cache_file.string())
                              : fmt::format("cache {}: {}", setup.cache_file.string(), load.problem);
     if (!load.loaded && load.problem != "no cache file")
       spdlog::warn("compliance {}; rebuilding it", setup.note);
+  }
+  // K_ff's factor solves any column the cache did not hold, now or on demand: factored
+  // here, where a body that is not held against rigid motion is reported, rather than at
+  // a first touch. With every column cached, it is never needed.
+  const auto& rows = columns.row_nodes();
+  if (!std::all_of(rows.begin(), rows.end(), [&](int node) { return columns.has_column(node); })) {
+    progress.set_phase("factoring the stiffness matrix");
+    body.free_factor.factor();
   }
   const bool want_all = body.spec.compliance.precompute_touchable;
   const std::size_t before = columns.column_count();

@@ -26,11 +26,14 @@ TetMesh load_mesh(const MeshSpec& spec, double metres_per_unit) {
   return std::move(gmsh.mesh);
 }
 
+// "node <tag> axis <x|y|z>" for global dof `dof`.
+std::string dof_name(const std::vector<std::int64_t>& node_tags, int dof) {
+  return fmt::format("node {} axis {}", node_tags[static_cast<std::size_t>(dof / 3)], "xyz"[dof % 3]);
+}
+
 }  // namespace
 
-std::string ElasticBody::describe_dof(int dof) const {
-  return fmt::format("node {} axis {}", mesh.node_tags[dof / 3], "xyz"[dof % 3]);
-}
+std::string ElasticBody::describe_dof(int dof) const { return dof_name(mesh.node_tags, dof); }
 
 std::vector<int> select_nodes(const NodeSelector& selector, const TetMesh& mesh, const BoundarySurface& surface,
                               bool surface_only) {
@@ -117,10 +120,12 @@ ElasticBody build_elastic_body(const ObjectSpec& object, const ElasticObjectSpec
   body.stiffness = assemble_stiffness(body.mesh, spec.material);
   body.timings.assemble_ms = watch.lap_ms();
 
-  body.free_factor = std::make_unique<SparseCholesky>(
+  // The namer outlives this function's `body` (moved into the model): it keeps what it reads.
+  body.free_factor = DeferredCholesky(
       restrict_to_dofs(body.stiffness, body.dofs.free_dofs),
-      [&body](int row) { return body.describe_dof(body.dofs.free_dofs[row]); });
-  body.timings.factor_ms = watch.lap_ms();
+      [tags = body.mesh.node_tags, free_dofs = body.dofs.free_dofs](int row) {
+        return dof_name(tags, free_dofs[static_cast<std::size_t>(row)]);
+      });
 
   spdlog::info("object '{}' (linear elastic): {} nodes, {} tetrahedra, {} surface triangles, {} free dofs, {} touchable nodes",
                object.name, body.mesh.node_count(), body.mesh.tet_count(), body.surface.triangle_count(),

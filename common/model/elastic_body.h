@@ -1,7 +1,7 @@
 // ElasticBody: a linear elastic FEM solid compiled from its scene object (`model:
 // linear_elastic`), never changed afterwards: the mesh in metres, its boundary surface and
-// pseudo-normals, the dof map, the stiffness K and the CHOLMOD factor of K_ff, and the
-// touchable region. One of the body kinds a Model holds (model.h).
+// pseudo-normals, the dof map, the stiffness K and the CHOLMOD factor of K_ff (computed
+// when first asked for: see DeferredCholesky), and the touchable region. One of the body kinds a Model holds (model.h).
 //
 // Functions that only need the body take it as const&; what the loops mutate (tool
 // positions, active sets, compliance columns computed on demand) lives elsewhere.
@@ -17,7 +17,7 @@
 #include "common/contact/surface_distance.h"
 #include "common/fem/assemble_stiffness.h"
 #include "common/fem/dof_map.h"
-#include "common/fem/sparse_cholesky.h"
+#include "common/fem/deferred_cholesky.h"
 #include "common/mesh/boundary_surface.h"
 #include "common/mesh/mesh_checks.h"
 #include "common/scene/scene.h"
@@ -27,7 +27,6 @@ namespace cohaptic {
 struct ElasticBodyTimings {
   double mesh_ms = 0;      ///< read or generate, check, extract the surface
   double assemble_ms = 0;  ///< K
-  double factor_ms = 0;    ///< CHOLMOD analysis + factorisation of K_ff
 };
 
 struct ElasticBody {
@@ -39,7 +38,7 @@ struct ElasticBody {
   MeshCheckReport mesh_report;
   DofMap dofs;
   SparseMatrix stiffness;                         ///< K, 3N x 3N [N/m]
-  std::unique_ptr<SparseCholesky> free_factor;    ///< K_ff
+  DeferredCholesky free_factor;                   ///< K_ff's factor (factor_ms(): its time)
   std::vector<int> touchable_nodes;               ///< sorted volume node indices
   std::vector<int> touchable_triangles;           ///< surface triangle indices
   /// Per volume node: the inward unit normal of its touchable triangles, the direction a
@@ -53,8 +52,9 @@ struct ElasticBody {
 
 /// Compiles the FEM object `object` whose spec is `spec` (its alternative of object.body);
 /// mesh files are scaled by `metres_per_unit`. Throws SceneError (a selector that selects
-/// nothing, an unknown node id), MeshError or NumericalError (K_ff not positive definite)
-/// with a message naming the cause and object.where. Logs mesh warnings through spdlog.
+/// nothing, an unknown node id) or MeshError with a message naming the cause and
+/// object.where. Logs mesh warnings through spdlog. K_ff is factored when first asked for
+/// (NumericalError then if it is not positive definite).
 ElasticBody build_elastic_body(const ObjectSpec& object, const ElasticObjectSpec& spec, double metres_per_unit);
 
 /// Nodes chosen by `selector`; `surface_only` restricts to boundary nodes. Sorted.

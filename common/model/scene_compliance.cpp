@@ -14,7 +14,7 @@ SceneCompliance prepare_scene_compliance(const Model& model, bool whole_surface,
       continue;
     }
     auto& columns = compliance.owned.emplace_back(
-        std::make_unique<ComplianceColumns>(*body->free_factor, body->dofs, compliance_row_nodes(*body, whole_surface)));
+        std::make_unique<ComplianceColumns>(body->free_factor, body->dofs, compliance_row_nodes(*body, whole_surface)));
     prepare_compliance(*body, *columns, cache_directory);
     compliance.per_body.push_back(columns.get());
   }

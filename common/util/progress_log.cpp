@@ -34,6 +34,7 @@ void ProgressLog::set_phase(std::string phase) {
 void ProgressLog::set_total(double total) {
   const std::lock_guard lock(mutex_);
   total_ = total;
+  done_ = 0;
 }
 
 void ProgressLog::add(double work) {

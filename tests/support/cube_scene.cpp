@@ -29,6 +29,6 @@ CubeRig::CubeRig(const CubeSceneOptions& options) : CubeRig(cube_scene_yaml(opti
 CubeRig::CubeRig(const std::string& scene_yaml)
     : model(std::make_unique<Model>(build_model(parse_scene(scene_yaml, "cube.yaml")))),
       body(single_elastic_body(*model)),
-      columns(std::make_unique<ComplianceColumns>(*body.free_factor, body.dofs, body.surface.nodes)) {}
+      columns(std::make_unique<ComplianceColumns>(body.free_factor, body.dofs, body.surface.nodes)) {}
 
 }  // namespace cohaptic::testing

@@ -74,7 +74,7 @@ CoupledPush::CoupledPush(double gap_mm, double depth)
     : rig(fem_pair_options(gap_mm)),
       free(push_without_behind(rig.front, depth)),
       collisions(back_face_candidates(rig, free.displacement)),
-      front_columns(std::make_unique<ComplianceColumns>(*rig.front.free_factor, rig.front.dofs, rig.front.surface.nodes)),
+      front_columns(std::make_unique<ComplianceColumns>(rig.front.free_factor, rig.front.dofs, rig.front.surface.nodes)),
       contact(solve_fem_pair_contact(collisions, *front_columns, free.tool_dofs, *rig.behind_columns)) {}
 
 PushingSupport pushing_support(const CoupledPush& push) {
