@@ -9,18 +9,22 @@
 #
 #   deploy/remesh-brain.sh [DATA_DIR] [OUTPUT]
 #     DATA_DIR  holds brain_surface.asc (default: ../shared/data/colin27 next to the repository)
-#     OUTPUT    the mesh to write (default: scenes/brain/brain.msh; with FINE=2,
-#               scenes/brain/brain_graded.msh; any other FINE needs it)
+#     OUTPUT    the mesh to write (default: scenes/brain/brain.msh; with GRADED=1,
+#               scenes/brain/brain_graded.msh; with REFINE, it must be given)
 #   H=8 deploy/remesh-brain.sh          another element size in mm (default 9, see remesh.geo);
 #                                       in the graded mode, the size far from the tools
 #   CORRIDOR=0 deploy/remesh-brain.sh   the plain surface, without the corridor (below)
-#   FINE=2 deploy/remesh-brain.sh       the graded mesh, brain_graded.msh: size 2 mm in the
+#   GRADED=1 deploy/remesh-brain.sh     the graded mesh, brain_graded.msh: size FINE in the
 #                                       tools' working region (both 7 mm spheres swept along
 #                                       their press paths) and within MARGIN mm of it,
-#                                       growing linearly to H over the next GROW mm
-#   FINE=1 deploy/remesh-brain.sh ../shared/data/colin27 out/brain_reference.msh
-#                                       the reference mesh: twice as fine near the tools
-#   MARGIN=20 GROW=30                   the graded mode's region, mm (these are the defaults)
+#                                       growing linearly to H over the next GROW mm; size
+#                                       NEAR within NEAR_MARGIN mm of the swept spheres, where
+#                                       the tips touch, growing to FINE over NEAR_GROW mm
+#   GRADED=1 REFINE=2 deploy/remesh-brain.sh ../shared/data/colin27 out/brain_reference.msh
+#                                       the convergence reference: FINE and NEAR divided by
+#                                       REFINE, the regions and H unchanged
+#   FINE=2.5 NEAR=1.2 MARGIN=20 GROW=30 NEAR_MARGIN=3 NEAR_GROW=5
+#                                       the graded mode's sizes and regions, mm (the defaults)
 #
 # Steps:
 #  1. python3 reads the FreeSurfer surface and writes it as STL. Unless CORRIDOR=0, it first
@@ -41,13 +45,16 @@ set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 data=${1:-$repo/../shared/data/colin27}
-fine=${FINE:-0}
-case $fine in
-  0) out=${2:-$repo/scenes/brain/brain.msh} ;;
-  2) out=${2:-$repo/scenes/brain/brain_graded.msh} ;;
-  *) [[ $# -ge 2 ]] || { echo "remesh-brain: FINE=$fine needs DATA_DIR and OUTPUT" >&2; exit 1; }
-     out=$2 ;;
-esac
+graded=${GRADED:-0}
+refine=${REFINE:-1}
+if [[ $graded == 0 ]]; then
+  out=${2:-$repo/scenes/brain/brain.msh}
+elif [[ $refine == 1 ]]; then
+  out=${2:-$repo/scenes/brain/brain_graded.msh}
+else
+  [[ $# -ge 2 ]] || { echo "remesh-brain: REFINE=$refine needs DATA_DIR and OUTPUT" >&2; exit 1; }
+  out=$2
+fi
 geo=$repo/scenes/brain/remesh.geo
 asc=$data/brain_surface.asc
 
@@ -110,9 +117,14 @@ PY
 cp "$geo" "$work/remesh.geo"
 args=()
 [[ -n ${H:-} ]] && args+=(-setnumber h "$H")
-[[ $fine != 0 ]] && args+=(-setnumber fine "$fine")
-[[ -n ${MARGIN:-} ]] && args+=(-setnumber margin "$MARGIN")
-[[ -n ${GROW:-} ]] && args+=(-setnumber grow "$GROW")
+if [[ $graded != 0 ]]; then
+  divide() { awk -v size="$1" -v by="$refine" 'BEGIN { printf "%g", size / by }'; }
+  args+=(-setnumber fine "$(divide "${FINE:-2.5}")" -setnumber near "$(divide "${NEAR:-1.2}")")
+  [[ -n ${MARGIN:-} ]] && args+=(-setnumber margin "$MARGIN")
+  [[ -n ${GROW:-} ]] && args+=(-setnumber grow "$GROW")
+  [[ -n ${NEAR_MARGIN:-} ]] && args+=(-setnumber nearMargin "$NEAR_MARGIN")
+  [[ -n ${NEAR_GROW:-} ]] && args+=(-setnumber nearGrow "$NEAR_GROW")
+fi
 (cd "$work" && gmsh remesh.geo "${args[@]}" -3 -nt 1 -format msh41 -o raw.msh > gmsh.log 2>&1) || {
   cat "$work/gmsh.log" >&2; echo "remesh-brain: gmsh failed" >&2; exit 1; }
 grep -E "^Info    : [0-9]+ nodes [0-9]+ elements|Warning|Error" "$work/gmsh.log" >&2 || true

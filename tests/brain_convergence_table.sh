@@ -8,10 +8,11 @@
 # which needs no compliance columns, so that its whole surface (every node may reach the
 # skull) costs a factorisation and the columns of the nodes in contact only.
 #
-# Meshes: scenes/brain/brain.msh (9 mm), scenes/brain/brain_graded.msh (2 mm near the
-# tools), and the reference (1 mm near the tools): $REFERENCE, default out/brain_reference.msh,
-# made by `FINE=1 deploy/remesh-brain.sh` when missing (needs gmsh). Compliance caches go
-# to out/convergence-cache.
+# Meshes: scenes/brain/brain.msh (9 mm), scenes/brain/brain_graded.msh (the scene's: 1.2 mm
+# where the tips touch, 2.5 mm around them), and the reference, with every graded size
+# halved: $REFERENCE, default out/brain_reference.msh, made by `GRADED=1 REFINE=2
+# deploy/remesh-brain.sh` when missing (needs gmsh). Compliance caches go to
+# out/convergence-cache.
 #
 # Usage: tests/brain_convergence_table.sh [path/to/cohaptic-lab]   (make brain-convergence runs it)
 #   FRACTIONS="0.4 0.7 1" to choose the points (default 0.4 0.6 0.8 1).
@@ -23,9 +24,9 @@ command -v jq >/dev/null || { echo "brain_convergence_table: needs jq (deploy/in
 reference=${REFERENCE:-out/brain_reference.msh}
 fractions=${FRACTIONS:-0.4 0.6 0.8 1}
 if [[ ! -f "$reference" ]]; then
-  echo "brain_convergence_table: making the reference mesh $reference (FINE=1 deploy/remesh-brain.sh)" >&2
+  echo "brain_convergence_table: making the reference mesh $reference (GRADED=1 REFINE=2 deploy/remesh-brain.sh)" >&2
   mkdir -p "$(dirname "$reference")"
-  FINE=1 deploy/remesh-brain.sh ../shared/data/colin27 "$reference" >&2
+  GRADED=1 REFINE=2 deploy/remesh-brain.sh ../shared/data/colin27 "$reference" >&2
 fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -66,9 +67,10 @@ presses: the fraction of the 6 mm press of `scenes/brain/surgeon_a.yaml` and `su
 (A meets the tissue at about 0.2, B at once; 1 is the deepest). The shipped meshes' forces
 are `cohaptic-lab probe` through the IR, as served; the reference's, `cohaptic-lab probe
 --reference`, the full sparse solve of the same unilateral problem. Meshes: `brain.msh`
-(9 mm everywhere), `brain_graded.msh` (2 mm within 20 mm of the tools' spheres along their
-presses, growing to 9 mm), and the reference, twice as fine near the tools (`FINE=1
-deploy/remesh-brain.sh`). |F| in mN; the differences are from the reference.
+(9 mm everywhere); `brain_graded.msh`, the scene's (1.2 mm within 3 mm of the tools'
+spheres along their presses, 2.5 mm within 20 mm, growing to 9 mm); and the reference, its
+graded sizes halved in the same regions (`GRADED=1 REFINE=2 deploy/remesh-brain.sh`). |F| in
+mN; the differences are from the reference.
 
 HEADER
 echo "| fraction | A: 9 mm | A: graded | A: reference | A: graded − ref. | A: 9 mm − ref. | B: 9 mm | B: graded | B: reference | B: graded − ref. | B: 9 mm − ref. |"

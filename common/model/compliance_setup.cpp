@@ -73,17 +73,17 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
     if (!load.loaded && load.problem != "no cache file")
       spdlog::warn("compliance {}; rebuilding it", setup.note);
   }
-  // K_ff's factor solves any column the cache did not hold, now or on demand: factored
-  // here, where a body that is not held against rigid motion is reported, rather than at
-  // a first touch. With every column cached, it is never needed.
+  const bool want_all = body.spec.compliance.precompute_touchable;
+  const std::size_t before = columns.column_count();
+  if (want_all) precompute_touchable_columns(body, columns, progress);
+  // K_ff's factor solves any row's column that is still missing, on demand: factored here,
+  // before the session, rather than at a first touch. With every row's column cached or
+  // made by the Schur complement, it is never needed.
   const auto& rows = columns.row_nodes();
   if (!std::all_of(rows.begin(), rows.end(), [&](int node) { return columns.has_column(node); })) {
     progress.set_phase("factoring the stiffness matrix");
     body.free_factor.factor();
   }
-  const bool want_all = body.spec.compliance.precompute_touchable;
-  const std::size_t before = columns.column_count();
-  if (want_all) precompute_touchable_columns(body, columns, progress);
   if (use_disk && columns.column_count() > before) {
     progress.set_phase("saving the columns to " + setup.cache_file.string());
     save_compliance(body, columns, *cache_directory);
