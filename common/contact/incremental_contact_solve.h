@@ -48,6 +48,8 @@ class IncrementalContactSolve {
   std::span<const int> members() const { return {members_.data(), static_cast<std::size_t>(size_)}; }
   /// The last solve's push [N] of members()[p].
   double member_push(int p) const { return push_[static_cast<Eigen::Index>(p)]; }
+  /// All of them, in members() order.
+  std::span<const double> member_pushes() const { return {push_.data(), static_cast<std::size_t>(size_)}; }
   /// The push of candidate i [N] (zero outside K).
   double push(int candidate) const;
   bool in_set(int candidate) const { return position_[static_cast<std::size_t>(candidate)] >= 0; }

@@ -1,9 +1,13 @@
 #include "common/fem/compliance_disk_cache.h"
 
 #include <algorithm>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <fmt/format.h>
 #include <fstream>
+#include <mutex>
+#include <thread>
 
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
@@ -25,17 +29,93 @@ struct Writer {
   void value(const T& v) { bytes(&v, sizeof v); }
 };
 
+// A digest computed on a thread of its own from the pieces handed to it, in order, so that
+// reading the next piece overlaps hashing the last. A piece is either copied (small
+// values) or kept by pointer (a column, whose memory stays put until finish()).
+class PipelinedHasher {
+ public:
+  PipelinedHasher() : thread_([this] { hash_pieces(); }) {}
+  ~PipelinedHasher() { stop(); }
+  PipelinedHasher(const PipelinedHasher&) = delete;
+  PipelinedHasher& operator=(const PipelinedHasher&) = delete;
+
+  void copy(const void* data, std::size_t size) {
+    const auto* bytes = static_cast<const char*>(data);
+    push({nullptr, 0, std::vector<char>(bytes, bytes + size)});
+  }
+  void keep(const void* data, std::size_t size) { push({data, size, {}}); }
+  /// The digest of every piece; the thread has stopped.
+  Digest finish() {
+    stop();
+    return hasher_.finish();
+  }
+
+ private:
+  struct Piece {
+    const void* kept;
+    std::size_t size;
+    std::vector<char> copied;
+  };
+  void push(Piece piece) {
+    {
+      const std::lock_guard lock(mutex_);
+      pieces_.push_back(std::move(piece));
+    }
+    ready_.notify_one();
+  }
+  void stop() {
+    {
+      const std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    ready_.notify_one();
+    if (thread_.joinable()) thread_.join();
+  }
+  void hash_pieces() {
+    std::unique_lock lock(mutex_);
+    while (true) {
+      ready_.wait(lock, [this] { return stopping_ || !pieces_.empty(); });
+      if (pieces_.empty()) return;  // stopping, and everything handed over is hashed
+      const Piece piece = std::move(pieces_.front());
+      pieces_.pop_front();
+      lock.unlock();
+      if (piece.kept)
+        hasher_.bytes(piece.kept, piece.size);
+      else
+        hasher_.bytes(piece.copied.data(), piece.copied.size());
+      lock.lock();
+    }
+  }
+
+  ContentHasher hasher_;
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::deque<Piece> pieces_;
+  bool stopping_ = false;
+  std::thread thread_;  // last: it starts once the rest is ready
+};
+
 // Reads plain values from a cache file, up to its checksum, hashing every byte it reads: the
-// columns go straight from the file into their matrices, and the checksum is known when
-// the last one is read (one pass, no copy of the file in memory).
+// columns go straight from the file into their matrices while the last one is hashed, and
+// the checksum is known soon after the last one is read (one pass, no copy of the file).
 struct HashingReader {
   std::ifstream& in;
   std::uintmax_t remaining;  // bytes left before the checksum
-  ContentHasher hasher;
-  bool bytes(void* out, std::size_t size) {
+  PipelinedHasher hasher;
+  bool read(void* out, std::size_t size) {
     if (size > remaining || !in.read(static_cast<char*>(out), static_cast<std::streamsize>(size))) return false;
-    hasher.bytes(out, size);
     remaining -= size;
+    return true;
+  }
+  bool bytes(void* out, std::size_t size) {
+    if (!read(out, size)) return false;
+    hasher.copy(out, size);
+    return true;
+  }
+  /// A column's values, hashed from where they were read to: `out` must stay put.
+  bool column(double* out, std::size_t count) {
+    if (!read(out, count * sizeof(double))) return false;
+    hasher.keep(out, count * sizeof(double));
     return true;
   }
   template <typename T>
@@ -76,6 +156,8 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
     result.problem = fmt::format("truncated ({} bytes)", file_size);
     return result;
   }
+  // Declared before the reader, so that its hashing thread, which reads them, stops first.
+  std::vector<std::pair<int, ComplianceColumn>> loaded;
   HashingReader r{in, file_size - stored_checksum.size(), {}};
   char magic[sizeof kMagic];
   std::uint32_t version = 0;
@@ -112,13 +194,11 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
     result.problem = fmt::format("{} columns announced, {} bytes left for them", column_count, r.remaining);
     return result;
   }
-  std::vector<std::pair<int, ComplianceColumn>> loaded;
   loaded.reserve(column_count);
   if (progress) progress->set_total(column_count);
   for (std::uint32_t c = 0; c < column_count; ++c) {
     int node = 0;
-    ComplianceColumn column(3 * static_cast<Eigen::Index>(row_count), 3);
-    if (!r.value(node) || !r.bytes(column.data(), static_cast<std::size_t>(column.size()) * sizeof(double))) {
+    if (!r.value(node)) {
       result.problem = fmt::format("truncated at column {}", c);
       return result;
     }
@@ -126,7 +206,11 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
       result.problem = fmt::format("column {} names node {}, outside the mesh", c, node);
       return result;
     }
-    loaded.emplace_back(node, std::move(column));
+    ComplianceColumn& column = loaded.emplace_back(node, ComplianceColumn(3 * static_cast<Eigen::Index>(row_count), 3)).second;
+    if (!r.column(column.data(), static_cast<std::size_t>(column.size()))) {
+      result.problem = fmt::format("truncated at column {}", c);
+      return result;
+    }
     if (progress) progress->add(1);
   }
   if (r.remaining != 0) {

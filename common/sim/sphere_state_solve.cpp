@@ -4,6 +4,7 @@
 #include <limits>
 #include <optional>
 
+#include "common/condense/dense_kernels.h"
 #include "common/contact/obstacle_constraints.h"
 #include "common/util/error.h"
 
@@ -155,17 +156,18 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
 }
 
 void SphereStateSolve::find_obstacle_rows(std::span<const int> patch_nodes) {
-  // Each obstacle candidate's clearance in the solved state, w = q + W lambda.
+  // Each obstacle candidate's clearance in the solved state, w = q + W lambda, read down
+  // the candidate's column of W (symmetric: contiguous, where its row is not).
   const std::span<const int> members = contact_.members();
+  const std::span<const double> pushes = contact_.member_pushes();
   std::vector<char> near(near_obstacle_.size(), 0), in_patch(near_obstacle_.size(), 0);
   for (int node : patch_nodes) in_patch[static_cast<std::size_t>(node)] = 1;
   obstacle_rows_.clear();
   for (int slot = 0; slot < normal_.slot_count(); ++slot) {
     const int node = normal_.node_of(slot);
     if (node < 0 || tool_[static_cast<std::size_t>(slot)] >= 0 || clearance_[slot] == kNone) continue;  // no obstacle's
-    double clearance = clearance_[slot];
-    for (int p = 0; p < static_cast<int>(members.size()); ++p)
-      clearance += normal_.w()(slot, members[static_cast<std::size_t>(p)]) * contact_.member_push(p);
+    const double clearance = clearance_[slot] + gathered_dot(normal_.w().col(slot).data(), members.data(), pushes.data(),
+                                                             static_cast<Eigen::Index>(members.size()));
     const bool pushed = contact_.push(slot) > 0;
     near[static_cast<std::size_t>(node)] =
         pushed || clearance < kObstacleJoin || (near_obstacle_[static_cast<std::size_t>(node)] && clearance < kObstacleLeave);
