@@ -19,6 +19,7 @@ constexpr double kRelativeTolerance = 1e-12;
 IncrementalContactSolve::IncrementalContactSolve(int capacity)
     : factor_(Eigen::MatrixXd::Zero(std::max(capacity, 1), std::max(capacity, 1))),
       push_(Eigen::VectorXd::Zero(std::max(capacity, 1))),
+      w_push_(Eigen::VectorXd::Zero(std::max(capacity, 1))),
       scratch_(Eigen::VectorXd::Zero(std::max(capacity, 1))),
       members_(static_cast<std::size_t>(std::max(capacity, 0)), -1),
       position_(static_cast<std::size_t>(std::max(capacity, 0)), -1) {
@@ -33,6 +34,7 @@ double IncrementalContactSolve::push(int candidate) const {
 void IncrementalContactSolve::clear() noexcept {
   for (int p = 0; p < size_; ++p) position_[static_cast<std::size_t>(members_[static_cast<std::size_t>(p)])] = -1;
   size_ = 0;
+  w_push_count_ = 0;
 }
 
 void IncrementalContactSolve::remove(int candidate) noexcept {
@@ -67,6 +69,7 @@ bool IncrementalContactSolve::start_from(const Eigen::Ref<const Eigen::MatrixXd>
 }
 
 bool IncrementalContactSolve::join(const Eigen::Ref<const Eigen::MatrixXd>& w, int j) noexcept {
+  w_push_count_ = 0;
   const Eigen::Index k = size_;
   // The new row of L: l = L^-1 W_Kj, and its diagonal sqrt(W_jj - l^T l).
   for (Eigen::Index p = 0; p < k; ++p) scratch_[p] = w(members_[static_cast<std::size_t>(p)], j);
@@ -83,6 +86,7 @@ bool IncrementalContactSolve::join(const Eigen::Ref<const Eigen::MatrixXd>& w, i
 }
 
 void IncrementalContactSolve::leave(int p) noexcept {
+  w_push_count_ = 0;
   const Eigen::Index k = size_, below = k - p - 1;
   if (below > 0) {
     // The block below the row takes it in by a rank-one update, one row and column up and
@@ -139,6 +143,18 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
     }
     result.work += static_cast<double>(k) * static_cast<double>(k);
 
+    // W_jK lambda_K for the candidates: where they are many times the members (the server's
+    // whole surface against the tools' contact), once for every row, down the members'
+    // columns, which W holds contiguously; otherwise a gathered dot per candidate checked.
+    const bool down_columns = m > 4 * k;
+    w_push_count_ = 0;
+    if (down_columns) {
+      w_push_.head(m).setZero();
+      for (Eigen::Index p = 0; p < k; ++p)
+        w_push_.head(m).noalias() += push_[p] * w.col(members_[static_cast<std::size_t>(p)]).head(m);
+      w_push_count_ = m;
+    }
+
     // Offending: members with a negative push (they leave), then candidates outside K that
     // penetrate (they join).
     offending_.clear();
@@ -151,8 +167,9 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
       // With no negative push, a row of W without negative entries only moves j away.
       if (!any_negative && q[j] >= 0 && nonnegative_row[static_cast<std::size_t>(j)]) continue;
       result.work += static_cast<double>(k);
-      // W_jK lambda_K, read down column j (W is symmetric).
-      if (q[j] + gathered_dot(w.col(j).data(), members_.data(), push_.data(), k) < -clearance_tolerance) offending_.push_back(j);
+      // W_jK lambda_K, read down column j (W is symmetric), unless read down K's columns.
+      const double reach = down_columns ? w_push_[j] : gathered_dot(w.col(j).data(), members_.data(), push_.data(), k);
+      if (q[j] + reach < -clearance_tolerance) offending_.push_back(j);
     }
     if (offending_.empty()) {
       rule_.reset();

@@ -52,6 +52,10 @@ class IncrementalContactSolve {
   std::span<const double> member_pushes() const { return {push_.data(), static_cast<std::size_t>(size_)}; }
   /// The push of candidate i [N] (zero outside K).
   double push(int candidate) const;
+  /// W_iK lambda_K for every candidate i of the last solve's q, as its last pass found them
+  /// with the set it returned, when that pass read them down the members' columns (many
+  /// more candidates than members); empty otherwise.
+  std::span<const double> w_push() const { return {w_push_.data(), static_cast<std::size_t>(w_push_count_)}; }
   bool in_set(int candidate) const { return position_[static_cast<std::size_t>(candidate)] >= 0; }
   /// L, lower triangular, W_KK = L L^T (members() order).
   Eigen::Ref<const Eigen::MatrixXd> factor() const { return factor_.topLeftCorner(size_, size_); }
@@ -85,6 +89,8 @@ class IncrementalContactSolve {
   PivotRule rule_;  // since the last solved call
   Eigen::MatrixXd factor_;       // lower triangle of the top-left size_ x size_: L, W_KK = L L^T
   Eigen::VectorXd push_;         // per factor position: the pushes of the last solve
+  Eigen::VectorXd w_push_;       // per candidate: W_iK lambda_K of the last pass read down the columns
+  int w_push_count_ = 0;         // its valid length: 0 once K has changed since
   Eigen::VectorXd scratch_;      // a column for borders and updates
   std::vector<int> members_;     // per factor position: the candidate
   std::vector<int> position_;    // per candidate: its factor position, or -1

@@ -156,18 +156,23 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
 }
 
 void SphereStateSolve::find_obstacle_rows(std::span<const int> patch_nodes) {
-  // Each obstacle candidate's clearance in the solved state, w = q + W lambda, read down
-  // the candidate's column of W (symmetric: contiguous, where its row is not).
+  // Each obstacle candidate's clearance in the solved state, w = q + W lambda: from the
+  // solve's last pass where it read W lambda for every slot, else down the candidate's
+  // column of W (symmetric: contiguous, where its row is not).
   const std::span<const int> members = contact_.members();
   const std::span<const double> pushes = contact_.member_pushes();
+  const std::span<const double> w_push = contact_.w_push();
   std::vector<char> near(near_obstacle_.size(), 0), in_patch(near_obstacle_.size(), 0);
   for (int node : patch_nodes) in_patch[static_cast<std::size_t>(node)] = 1;
   obstacle_rows_.clear();
   for (int slot = 0; slot < normal_.slot_count(); ++slot) {
     const int node = normal_.node_of(slot);
     if (node < 0 || tool_[static_cast<std::size_t>(slot)] >= 0 || clearance_[slot] == kNone) continue;  // no obstacle's
-    const double clearance = clearance_[slot] + gathered_dot(normal_.w().col(slot).data(), members.data(), pushes.data(),
-                                                             static_cast<Eigen::Index>(members.size()));
+    const double clearance =
+        clearance_[slot] + (static_cast<std::size_t>(slot) < w_push.size()
+                                ? w_push[static_cast<std::size_t>(slot)]
+                                : gathered_dot(normal_.w().col(slot).data(), members.data(), pushes.data(),
+                                               static_cast<Eigen::Index>(members.size())));
     const bool pushed = contact_.push(slot) > 0;
     near[static_cast<std::size_t>(node)] =
         pushed || clearance < kObstacleJoin || (near_obstacle_[static_cast<std::size_t>(node)] && clearance < kObstacleLeave);
