@@ -149,6 +149,7 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
     const bool down_columns = m > 4 * k;
     w_push_count_ = 0;
     if (down_columns) {
+      result.work += static_cast<double>(k) * static_cast<double>(m);  // the budget sees the whole pass
       w_push_.head(m).setZero();
       for (Eigen::Index p = 0; p < k; ++p)
         w_push_.head(m).noalias() += push_[p] * w.col(members_[static_cast<std::size_t>(p)]).head(m);
@@ -166,8 +167,8 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
       if (position_[static_cast<std::size_t>(j)] >= 0 || !std::isfinite(q[j])) continue;
       // With no negative push, a row of W without negative entries only moves j away.
       if (!any_negative && q[j] >= 0 && nonnegative_row[static_cast<std::size_t>(j)]) continue;
-      result.work += static_cast<double>(k);
       // W_jK lambda_K, read down column j (W is symmetric), unless read down K's columns.
+      if (!down_columns) result.work += static_cast<double>(k);
       const double reach = down_columns ? w_push_[j] : gathered_dot(w.col(j).data(), members_.data(), push_.data(), k);
       if (q[j] + reach < -clearance_tolerance) offending_.push_back(j);
     }
