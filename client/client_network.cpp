@@ -147,10 +147,10 @@ struct ClientNetwork::Impl {
     } else if (control.has_ir()) {
       const std::int64_t arrival = now_ns();
       if (irs.receive(control.ir(), control.ByteSizeLong(), arrival) && recorder) recorder->ir(arrival, control.ir());
-    } else if (control.has_compressed_ir()) {  // recorded as it came out of the stream
+    } else if (control.has_compressed_ir()) {  // recorded as the block it came in
       const std::int64_t arrival = now_ns();
-      const auto ir = irs.receive_compressed(control.compressed_ir(), control.ByteSizeLong(), arrival);
-      if (ir && recorder) recorder->ir(arrival, *ir);
+      if (irs.receive_compressed(control.compressed_ir(), control.ByteSizeLong(), arrival) && recorder)
+        recorder->ir_block(arrival, 0, control.compressed_ir());
     } else if (control.has_event()) {
       spdlog::info("server: {}", control.event().text());
     } else if (control.has_error()) {

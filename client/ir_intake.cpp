@@ -33,9 +33,8 @@ bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::siz
   return true;
 }
 
-std::optional<wire::IntermediateRepresentation> IrIntake::receive_compressed(const wire::CompressedIr& block,
-                                                                             std::size_t bytes, std::int64_t arrival_ns) {
-  std::optional<wire::IntermediateRepresentation> message;
+bool IrIntake::receive_compressed(const wire::CompressedIr& block, std::size_t bytes, std::int64_t arrival_ns) {
+  wire::IntermediateRepresentation message;
   try {
     const double start_us = thread_cpu_us();
     message = stream_.open(block);
@@ -43,10 +42,10 @@ std::optional<wire::IntermediateRepresentation> IrIntake::receive_compressed(con
   } catch (const Error& e) {
     ++rejected_;
     spdlog::warn("IR rejected: {}", e.what());
-    return std::nullopt;
+    return false;
   }
-  if (!receive(*message, bytes, arrival_ns)) return std::nullopt;
-  return message;
+  receive(message, bytes, arrival_ns);
+  return true;
 }
 
 nlohmann::json IrIntake::report() const {

@@ -27,10 +27,11 @@ class IrIntake {
 
   /// Prepares and hands over `message` (`bytes` on the wire). False if it was rejected.
   bool receive(const wire::IntermediateRepresentation& message, std::size_t bytes, std::int64_t arrival_ns);
-  /// Decompresses `block` in this connection's IR stream, then as receive(); the IR, or
-  /// nullopt if it was rejected. A new connection's stream starts at its first block.
-  std::optional<wire::IntermediateRepresentation> receive_compressed(const wire::CompressedIr& block, std::size_t bytes,
-                                                                     std::int64_t arrival_ns);
+  /// Decompresses `block` in this connection's IR stream, then as receive(). Returns
+  /// whether the stream opened it (the IR in it accepted or not): a recording keeps every
+  /// block the stream opened, for the blocks after it. A new connection's stream starts at
+  /// its first block.
+  bool receive_compressed(const wire::CompressedIr& block, std::size_t bytes, std::int64_t arrival_ns);
 
   /// The report's "ir": received, rejected, bytes, bytes_per_s (from the first IR to the
   /// last), and of those sent as compliance rows: condensed, condense_cpu_us_p50 and _max

@@ -4,7 +4,7 @@
 //   - sent: the wire IRs as received, out of the connection's stream if they came compressed
 //     (bytes and kB/s over the span from first to last IR),
 //     and of the whole-M~ form everything but M~ (geometry, node ids, u_B). An IR that came
-//     as compliance rows (the server's default since issue 14) is first completed as the
+//     as compliance rows (the server's default) is first completed as the
 //     client did (ClientCondensation); every option below is measured on that whole form;
 //   - f32: the same IRs with M~ and u_B rounded to float;
 //   - M~ delta: each IR with only the entries of M~ that differ from the previous IR's

@@ -14,13 +14,20 @@ void LoopStatistics::record_step(const StepFigures& step, double elapsed_s) {
     totals_.ir_bytes += step.report.ir_bytes;
   }
   ++totals_.steps;
-  totals_.irs_sent += step.irs_sent;
-  totals_.ir_bytes_sent += step.ir_bytes_sent;
   totals_.forces_sent += step.forces_sent;
   totals_.max_boundary_nodes = std::max(totals_.max_boundary_nodes, step.report.boundary_nodes);
   totals_.max_obstacle_nodes = std::max(totals_.max_obstacle_nodes, step.report.obstacle_nodes);
   totals_.sphere_nodes_outside_patches += static_cast<std::uint64_t>(step.report.sphere_nodes_outside_patches);
   totals_.elapsed_s = elapsed_s;
+}
+
+void LoopStatistics::record_irs_encoded(std::int64_t encode_ns, std::uint64_t irs_sent, std::uint64_t bytes_sent,
+                                        std::uint64_t superseded) {
+  std::lock_guard lock(mutex_);
+  totals_.irs_superseded += superseded;
+  ir_encode_ns_.record(encode_ns);
+  totals_.irs_sent += irs_sent;
+  totals_.ir_bytes_sent += bytes_sent;
 }
 
 void LoopStatistics::record_failure(int consecutive, const std::string& what, double elapsed_s) {
@@ -45,6 +52,8 @@ LoopSummary LoopStatistics::summary() const {
   summary.step_max_ms = ms(step_ns_.max());
   summary.ir_build_p50_ms = ms(ir_build_ns_.quantile(0.5));
   summary.ir_build_p99_ms = ms(ir_build_ns_.quantile(0.99));
+  summary.ir_encode_p50_ms = ms(ir_encode_ns_.quantile(0.5));
+  summary.ir_encode_p99_ms = ms(ir_encode_ns_.quantile(0.99));
   summary.ir_builds = ir_build_ns_.count();
   return summary;
 }

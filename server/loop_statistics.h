@@ -1,6 +1,6 @@
 // LoopStatistics: the simulation loop's figures for the status line and the report:
 // step durations, M~ build times, IRs and forces sent, |B|, surface displacement, failed
-// steps. The simulation thread records; the I/O thread (status line) and the main thread
+// steps. The simulation thread (and the IR encoder's) records; the I/O thread (status line) and the main thread
 // (report) read a summary. A mutex guards them (held for a few additions per step).
 // Units: the histograms record ns; the summary gives ms, s and m.
 #pragma once
@@ -18,17 +18,17 @@ namespace cohaptic {
 struct StepFigures {
   std::int64_t duration_ns = 0;
   StepReport report;
-  std::uint64_t irs_sent = 0;     ///< IRs put in the outbox
-  std::uint64_t ir_bytes_sent = 0;  ///< their bytes as they travel (compliance rows or M~ whole)
   std::uint64_t forces_sent = 0;  ///< P0 forces put in the outbox
 };
 
 /// The figures so far.
 struct LoopSummary {
   std::uint64_t steps = 0, rebuilds = 0, ir_bytes = 0, irs_sent = 0, ir_bytes_sent = 0, forces_sent = 0;
+  std::uint64_t irs_superseded = 0;  ///< built, replaced by a newer one before they were sent
   double step_p50_ms = 0, step_p99_ms = 0, step_max_ms = 0;
   double ir_build_p50_ms = 0, ir_build_p99_ms = 0;
   std::uint64_t ir_builds = 0;  ///< steps that computed M~
+  double ir_encode_p50_ms = 0, ir_encode_p99_ms = 0;  ///< per batch of IRs: convert, compress, record
   int max_boundary_nodes = 0, max_obstacle_nodes = 0;
   /// Sphere model: over all steps, nodes the state had a sphere push that no IR's patch held
   std::uint64_t sphere_nodes_outside_patches = 0;
@@ -47,6 +47,10 @@ struct LoopSummary {
 class LoopStatistics {
  public:
   void record_step(const StepFigures& step, double elapsed_s);
+  /// IRs encoded (ir_encoder.h) in `encode_ns`: those handed over to be sent, their bytes as
+  /// they travel (compliance rows, a stream block or M~ whole), and those superseded.
+  void record_irs_encoded(std::int64_t encode_ns, std::uint64_t irs_sent, std::uint64_t bytes_sent,
+                          std::uint64_t superseded);
   void record_failure(int consecutive, const std::string& what, double elapsed_s);
   void record_display_frame(double max_displacement_m);
   LoopSummary summary() const;
@@ -55,6 +59,7 @@ class LoopStatistics {
   mutable std::mutex mutex_;
   Histogram step_ns_{10'000, 100'000};      // 10 us bins up to 1 s
   Histogram ir_build_ns_{10'000, 100'000};  // steps that computed M~
+  Histogram ir_encode_ns_{10'000, 100'000};  // steps' IRs encoded
   LoopSummary totals_;                      // the counts and maxima (quantiles filled in by summary())
 };
 

@@ -21,7 +21,9 @@ nlohmann::json server_report(const ServerFigures& figures) {
   server["steps"] = loop.steps;
   server["step_ms"] = {{"p50", loop.step_p50_ms}, {"p99", loop.step_p99_ms}, {"max", loop.step_max_ms}};
   server["ir_build_ms"] = {{"p50", loop.ir_build_p50_ms}, {"p99", loop.ir_build_p99_ms}, {"count", loop.ir_builds}};
+  server["ir_encode_ms"] = {{"p50", loop.ir_encode_p50_ms}, {"p99", loop.ir_encode_p99_ms}};
   server["irs_sent"] = loop.irs_sent;
+  server["irs_superseded"] = loop.irs_superseded;
   server["ir_bytes_sent"] = loop.ir_bytes_sent;
   server["ir_bytes_built"] = loop.ir_bytes;
   server["boundary_nodes"] = {{"max", loop.max_boundary_nodes}, {"obstacle_max", loop.max_obstacle_nodes}};

@@ -45,11 +45,11 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       // out, and the client condenses over them too (common/ir/compliance_rows.h).
       compliance_rows_(options.compliance_rows),
       rows_senders_(static_cast<std::size_t>(simulation_.user_count())),
-      ir_streams_(static_cast<std::size_t>(simulation_.user_count())),
       rows_objects_(static_cast<std::size_t>(simulation_.user_count()), -1),
       stream_started_(static_cast<std::size_t>(simulation_.user_count()), 0),
       joins_seen_(static_cast<std::size_t>(simulation_.user_count()), 0),
-      node_of_tag_(model.bodies.size()) {
+      node_of_tag_(model.bodies.size()),
+      encoder_(simulation_.user_count(), recorder, statistics) {
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
     if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i])) node_of_tag_[i] = node_indices_by_tag(body->mesh);
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
@@ -62,11 +62,17 @@ void SimulationLoop::deliver_prefetched() {
 }
 
 Outbox SimulationLoop::step(std::int64_t now_ns) {
+  StepOutput output = advance(now_ns);
+  encoder_.encode(output.irs, output.outbox);
+  return std::move(output.outbox);
+}
+
+SimulationLoop::StepOutput SimulationLoop::advance(std::int64_t now_ns) {
   take_tools(now_ns);
   const StepReport report = simulation_.step(seconds_since_start(now_ns));
-  Outbox outbox;
-  std::uint64_t ir_bytes = 0;
-  const std::uint64_t irs = report.rebuilt ? add_irs(now_ns, outbox, ir_bytes) : 0;
+  StepOutput output;
+  Outbox& outbox = output.outbox;
+  if (report.rebuilt) output.irs = new_irs(now_ns);
   if (options_.protocol == ServeProtocol::p1 && now_ns - last_keep_alive_ns_ >= kKeepAlivePeriod_ns) {
     last_keep_alive_ns_ = now_ns;
     add_keep_alives(outbox);
@@ -81,12 +87,13 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
   }
   ++steps_;
   const std::int64_t end_ns = wire::monotonic_now_ns();
-  statistics_.record_step({end_ns - now_ns, report, irs, ir_bytes, forces.size()}, seconds_since_start(end_ns));
-  return outbox;
+  statistics_.record_step({end_ns - now_ns, report, forces.size()}, seconds_since_start(end_ns));
+  return output;
 }
 
 void SimulationLoop::take_tools(std::int64_t now_ns) {
   deliver_prefetched();
+  for (int user : encoder_.take_restarts()) restart_rows(user);
   tools_.copy_to(latest_);
   used_.assign(latest_.size(), false);
   const auto timeout = static_cast<std::int64_t>(options_.client_timeout_s * 1e9);
@@ -94,8 +101,7 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
     const ToolInput& tool = latest_[slot];
     if (slot < joins_seen_.size() && tool.joins != joins_seen_[slot]) {  // a new user holds no rows
       joins_seen_[slot] = tool.joins;
-      rows_senders_[slot].restart();
-      stream_started_[slot] = 0;
+      restart_rows(static_cast<int>(slot));
     }
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
     if (used_[slot]) {
@@ -109,43 +115,38 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
     prefetch.worker->request(std::get<Simulation>(simulation_.body(prefetch.body)).nodes_near_obstacles());
 }
 
-// The new IRs: sent to their users (P1), and recorded (either protocol).
-std::uint64_t SimulationLoop::add_irs(std::int64_t now_ns, Outbox& outbox, std::uint64_t& bytes) {
+// The new IRs, to be recorded (either protocol) and sent to their users (P1).
+std::vector<BuiltIr> SimulationLoop::new_irs(std::int64_t now_ns) {
   const bool send = options_.protocol == ServeProtocol::p1;
-  if (!send && !recorder_) return 0;
-  std::uint64_t sent = 0;
+  std::vector<BuiltIr> irs;
+  if (!send && !recorder_) return irs;
   for (int user = 0; user < simulation_.user_count(); ++user) {
-    const auto prepared = simulation_.ir(user);
+    auto prepared = simulation_.ir(user);
     if (!prepared || !simulation_.ir_changed(user)) continue;
-    // The recording keeps the IR whole (M~ as built), whatever form it travels in.
-    const wire::IntermediateRepresentation whole = wire::to_wire(prepared->ir);
-    if (recorder_) recorder_->ir(now_ns, whole);
-    if (!send) continue;
-    // A sphere body's IR travels whole in the stream too (its normal compliance repeats
-    // some of the last one's). Another condensed FEM body's may go as compliance rows.
-    const auto* fem = std::get_if<CondensedFemIr>(&prepared->ir.body);
-    const bool sphere = fem && fem->sphere;
-    IntermediateRepresentation as_rows;
-    bool rows = false;
-    if (!sphere) {
-      as_rows = prepared->ir;
-      rows = to_compliance_rows(as_rows, user);
+    BuiltIr& built = irs.emplace_back();
+    built.time_ns = now_ns;
+    built.user = user;
+    built.send = send;
+    if (send) {
+      // A sphere body's IR travels whole in the stream too (its normal compliance repeats
+      // some of the last one's). Another condensed FEM body's may go as compliance rows.
+      const auto* fem = std::get_if<CondensedFemIr>(&prepared->ir.body);
+      const bool sphere = fem && fem->sphere;
+      bool rows = false;
+      if (!sphere) {
+        IntermediateRepresentation as_rows = prepared->ir;
+        if ((rows = to_compliance_rows(as_rows, user))) built.as_sent = std::move(as_rows);
+      }
+      built.streamed = rows || sphere;
+      if (built.streamed) {  // the user's stream starts afresh with the rows or its first IR
+        const auto u = static_cast<std::size_t>(user);
+        built.fresh = rows ? condensed_fem(*built.as_sent).compliance_rows->generation == 1 : !stream_started_[u];
+        stream_started_[u] = 1;
+      }
     }
-    const bool streamed = rows || sphere;
-    wire::Control control;
-    if (streamed) {  // in the user's stream, which starts afresh with the rows or its first IR
-      const auto u = static_cast<std::size_t>(user);
-      const bool fresh = rows ? condensed_fem(as_rows).compliance_rows->generation == 1 : !stream_started_[u];
-      *control.mutable_compressed_ir() = ir_streams_[u].compress(rows ? wire::to_wire(as_rows) : whole, fresh);
-      stream_started_[u] = 1;
-    } else {
-      *control.mutable_ir() = whole;
-    }
-    bytes += streamed ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
-    outbox.irs.push_back({user, std::move(control), streamed});
-    ++sent;
+    built.built = std::move(prepared);
   }
-  return sent;
+  return irs;
 }
 
 bool SimulationLoop::to_compliance_rows(IntermediateRepresentation& ir, int user) {
@@ -161,13 +162,17 @@ bool SimulationLoop::to_compliance_rows(IntermediateRepresentation& ir, int user
   // Node tags are per body: the user's IR moving to another body starts the client afresh.
   if (rows_objects_[static_cast<std::size_t>(user)] != ir.object) {
     rows_objects_[static_cast<std::size_t>(user)] = ir.object;
-    sender.restart();
-    stream_started_[static_cast<std::size_t>(user)] = 0;
+    restart_rows(user);
   }
   std::vector<int> mesh_nodes;
   for (const std::int64_t tag : fem->held_node_ids()) mesh_nodes.push_back(node_of_tag_[object].at(tag));
   sender.convert(*fem, mesh_nodes, *columns_[object], body.dofs);
   return true;
+}
+
+void SimulationLoop::restart_rows(int user) {
+  rows_senders_[static_cast<std::size_t>(user)].restart();
+  stream_started_[static_cast<std::size_t>(user)] = 0;
 }
 
 void SimulationLoop::add_keep_alives(Outbox& outbox) {
@@ -251,15 +256,25 @@ void SimulationLoop::offer_display_frame(std::int64_t now_ns, Eigen::Matrix3Xd d
 
 std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,
                                                const std::function<void(Outbox&&)>& send) {
+  encoder_.start(send);
+  const std::optional<std::string> failure = step_until(running, send);
+  encoder_.stop();        // every IR built is recorded and handed over
+  deliver_prefetched();  // so that the disk cache keeps them too
+  return failure;
+}
+
+std::optional<std::string> SimulationLoop::step_until(const std::atomic<bool>& running,
+                                                      const std::function<void(Outbox&&)>& send) {
   const double rate = options_.sim_rate_hz > 0 ? options_.sim_rate_hz : kDefaultSimulationRate_hz;
   const auto period = static_cast<std::int64_t>(1e9 / rate);
   std::int64_t next = wire::monotonic_now_ns();
   while (running.load()) {
     const std::int64_t step_start = wire::monotonic_now_ns();
     try {
-      Outbox outbox = step(step_start);
+      StepOutput output = advance(step_start);
       failures_.succeeded();
-      if (!outbox.empty()) send(std::move(outbox));
+      if (!output.irs.empty()) encoder_.post(std::move(output.irs));
+      if (!output.outbox.empty()) send(std::move(output.outbox));
     } catch (const std::exception& e) {
       for (int user = 0; user < simulation_.user_count(); ++user) simulation_.clear_tool(user);
       const std::optional<std::string> line = failures_.failed(step_start, e.what());
@@ -274,7 +289,6 @@ std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,
     if (next < step_end) next = step_end;  // behind: no catch-up burst
     std::this_thread::sleep_for(std::chrono::nanoseconds(next - step_end));
   }
-  deliver_prefetched();  // so that the disk cache keeps them too
   return std::nullopt;
 }
 

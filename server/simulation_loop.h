@@ -5,17 +5,19 @@
 //      obstacles (CompliancePrefetch, one per FEM body);
 //   2. steps the SceneSimulation: each body's (FEM: contacts, active sets, M~ when a set
 //      changed; mass-spring: the whole network, and the IRs that are due);
-//   3. fills the step's Outbox: each user's new IR (P1), the IR keep-alives (P1, every
-//      kKeepAlivePeriod_ns), the forces (P0);
+//   3. fills the step's Outbox: the IR keep-alives (P1, every kKeepAlivePeriod_ns), the
+//      forces (P0); and lists the step's new IRs for the IrEncoder, which records them and
+//      (P1) turns them into each user's frames (ir_encoder.h);
 //   4. every 1/--display-rate-hz, solves the surface displacement for the DisplayWriter;
 //      every 1/--view-rate-hz, while a browser watches or the session is recorded, hands the
 //      live view the state it draws of every body (view/body_frame_state.h: an FEM body's
 //      loads, not its displacement: the view's thread computes that); one state solve per
 //      FEM body when both are due;
-//   5. records the step and the IRs it built (--record), and its figures (LoopStatistics).
+//   5. records the step (--record), and its figures (LoopStatistics).
 // run() paces the steps at the loop's rate with absolute deadlines (when behind, the next
 // step starts at once, with no catch-up burst) and hands each non-empty outbox to the I/O
-// side. It sleeps to the next deadline after every step, failed or not: a step that
+// side; the new IRs go to the encoder's thread, which hands their frames over in outboxes
+// of their own. It sleeps to the next deadline after every step, failed or not: a step that
 // throws releases every tool and is counted, and logged at a paced rate (StepFailures);
 // kMaxConsecutiveStepFailures in a row end the loop with the reason.
 // The loop owns the SceneSimulation (the mutable state); the model is shared read-only, the
@@ -41,9 +43,9 @@
 #include "common/model/model.h"
 #include "common/sim/scene_simulation.h"
 #include "proto/record/session_recorder.h"
-#include "proto/wire/ir_stream.h"
 #include "server/compliance_prefetch.h"
 #include "server/display_writer.h"
+#include "server/ir_encoder.h"
 #include "view/live_view.h"
 #include "server/loop_statistics.h"
 #include "server/outbox.h"
@@ -55,7 +57,7 @@ namespace cohaptic {
 
 /// P1: how often the server tells each client that its IR still stands. A client fades its
 /// force out when these stop for its IR's max age (--ir-max-age, 0.5 s by default).
-inline constexpr std::int64_t kKeepAlivePeriod_ns = 10'000'000;
+inline constexpr std::int64_t kKeepAlivePeriod_ns = 5'000'000;
 /// The loop's rate when --sim-rate-hz is not given.
 inline constexpr double kDefaultSimulationRate_hz = 1000;
 
@@ -69,22 +71,34 @@ class SimulationLoop {
                  LoopStatistics& statistics, DisplayWriter* display, view::LiveView* view,
                  record::SessionRecorder* recorder, std::int64_t start_ns);
 
-  /// One step at `now_ns`: returns what to send. Throws whatever the simulation's step throws.
+  /// One step at `now_ns`: returns what to send, its new IRs encoded on the calling thread.
+  /// Throws whatever the simulation's step throws. Not while run() runs.
   Outbox step(std::int64_t now_ns);
 
-  /// Steps until `running` turns false, handing each step's outbox to `send` (which must
-  /// not block). Returns why it stopped early: the last error after
-  /// kMaxConsecutiveStepFailures failed steps in a row; nullopt when `running` ended it.
+  /// Steps until `running` turns false, handing each step's outbox, and the encoder's
+  /// outboxes of IRs, to `send` (called from both threads: it must be thread-safe and not
+  /// block). Returns once every IR built is encoded and handed over: why it stopped early,
+  /// the last error after kMaxConsecutiveStepFailures failed steps in a row; nullopt when
+  /// `running` ended it.
   std::optional<std::string> run(const std::atomic<bool>& running, const std::function<void(Outbox&&)>& send);
 
   const StepFailures& failures() const { return failures_; }
 
  private:
+  /// A step's outbox, and its new IRs to encode.
+  struct StepOutput {
+    Outbox outbox;
+    std::vector<BuiltIr> irs;
+  };
+  StepOutput advance(std::int64_t now_ns);
+  std::optional<std::string> step_until(const std::atomic<bool>& running, const std::function<void(Outbox&&)>& send);
   void take_tools(std::int64_t now_ns);
-  /// Returns the IRs put in the outbox and adds their bytes (as they travel) to `bytes`.
-  std::uint64_t add_irs(std::int64_t now_ns, Outbox& outbox, std::uint64_t& bytes);
+  /// The IRs that changed this step, as the encoder takes them.
+  std::vector<BuiltIr> new_irs(std::int64_t now_ns);
   /// `ir` as compliance rows for `user`, if it is a condensed FEM body sent that way.
   bool to_compliance_rows(IntermediateRepresentation& ir, int user);
+  /// `user` holds no rows and its stream starts afresh (a new user, another body, a lost block).
+  void restart_rows(int user);
   void add_keep_alives(Outbox& outbox);
   std::vector<record::ServerForce> add_forces(Outbox& outbox);
   bool solve_display_frame(std::int64_t now_ns);
@@ -120,16 +134,16 @@ class SimulationLoop {
   std::vector<view::ToolState> view_tools_;      // this step's tools, for the view
   std::vector<Eigen::Vector3d> view_forces_;     // per user, for the view [N]
   // Compliance rows: what each user's client holds (restarted when a new user takes the
-  // slot), the zstd stream they travel in (proto/wire/ir_stream.h: afresh with the rows),
-  // and per body the mesh node of each node tag.
+  // slot), whether its zstd stream (the encoder's) has begun, and per body the mesh node
+  // of each node tag.
   const Model& model_;
   bool compliance_rows_;
   std::vector<ComplianceRowsSender> rows_senders_;
-  std::vector<wire::IrStreamWriter> ir_streams_;
   std::vector<int> rows_objects_;  // per user: the body its held rows are of
   std::vector<std::uint8_t> stream_started_;  // per user: its IR stream has a block the client holds
   std::vector<std::uint64_t> joins_seen_;
   std::vector<std::unordered_map<std::int64_t, int>> node_of_tag_;
+  IrEncoder encoder_;
 };
 
 }  // namespace cohaptic

@@ -1,4 +1,4 @@
-// Benchmarks of the laparoscopy model (issue 13, deliverable 7). The paper's floor is a
+// Benchmarks of the laparoscopy model. The paper's floor is a
 // 500 Hz - 2 kHz haptic loop (0.5 - 2 ms per tick) and >= 30 Hz graphics (33 ms per frame).
 //   HomeSpringTick/<radius mm>: one haptic tick (shaft collision through the patch's AABB
 //     tree, nearest vertex, Eq. 8) against the patch size, beside _scan, the same tick

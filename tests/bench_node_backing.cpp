@@ -6,9 +6,9 @@
 //                                         unilateral solve over B's normal compliance,
 //                                         warm-started from the previous substep's set
 //   BM_NodeBackingSubstep/dense_cold/<n>  the same from an empty set (a set that changed)
-//   BM_NodeBackingSubstep/lumped/<n>      the earlier lumped form, the naive way: one
+//   BM_NodeBackingSubstep/lumped/<n>      the lumped form, the naive way: one
 //                                         spring per node, k_i the row sum of A^-1, no
-//                                         coupling (what the dense form replaced)
+//                                         coupling
 // B's compliance decays with the distance between targets (an elastic half-space's 1/r).
 #include <benchmark/benchmark.h>
 

@@ -1,4 +1,4 @@
-// Benchmarks of the separation body (issue 12, deliverable 7): the haptic tick against the
+// Benchmarks of the separation body: the haptic tick against the
 // number of patch nodes — elastic, tearing, sliding and laser ticks — beside the
 // naive way (a live sparse FEM solve of the two layers per tick), and the precomputation
 // per field. The argument is the divisions of the 40 mm square interface: 10, 20 and 30

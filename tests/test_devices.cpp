@@ -80,7 +80,7 @@ void expect_near(const Eigen::Vector3d& actual, const Eigen::Vector3d& expected,
 // ---------------------------------------------------------------------------------------
 // Trajectories
 
-// The example of the issue. By hand, in mm and s (rows: segment, end time, end point):
+// The example. By hand, in mm and s (rows: segment, end time, end point):
 //   repetition 1: move_to 18 mm at 20 -> 0.9 (0,0,2); press 15 at 5 -> 3.9 (0,0,-13);
 //     hold -> 4.9; release 15 at 5 -> 7.9 (0,0,2); move_by 10 at 10 -> 8.9 (10,0,2)
 //   repetition 2: move_to 10 mm at 20 -> 9.4 (0,0,2); 12.4; 13.4; 16.4; 17.4 (10,0,2)

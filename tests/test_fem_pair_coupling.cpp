@@ -200,7 +200,7 @@ TEST(FemPairCoupling, AToolPushingAOnBFeelsMoreThanFreeAndLessThanFixed) {
     const double on_behind = push.tool_force().x();
     EXPECT_LT(free, on_behind) << depth;
     EXPECT_LT(on_behind, fixed) << depth;
-    // The forces [N] for the closing note (--gtest_output=xml:...).
+    // The forces [N] as test properties (--gtest_output=xml:...).
     const auto mm = static_cast<int>(std::lround(depth * 1e3));
     RecordProperty(fmt::format("force_{}mm_free_on_b_fixed", mm), fmt::format("{:.6f} {:.6f} {:.6f}", free, on_behind, fixed));
     RecordProperty(fmt::format("pushing_nodes_{}mm", mm),

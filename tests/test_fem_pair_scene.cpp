@@ -1,4 +1,4 @@
-// FEM against FEM in a scene (issue 11; common/sim/fem_pair_interaction.h): the paired
+// FEM against FEM in a scene (common/sim/fem_pair_interaction.h): the paired
 // boxes (support/paired_boxes.h, A E = 0.1 MPa in front of the paper's box B, both linear
 // elastic) with `interactions: [{front: front, behind: behind}]`, run by SceneSimulation
 // as the server runs it, a scripted point tool pressing A's front face towards B under the

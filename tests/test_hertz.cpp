@@ -41,7 +41,7 @@ constexpr int kResolvedContactNodes = 8;  // in the quarter: the contact circle 
 struct HertzCase {
   const char* name;
   LinearElasticMaterial material;
-  bool fine_mesh_within_5_percent;  // issue 14's check on the finer mesh itself
+  bool fine_mesh_within_5_percent;  // the finer mesh itself within 5 % of Hertz
 };
 
 class HertzConvergence : public ::testing::TestWithParam<HertzCase> {};
@@ -88,7 +88,7 @@ INSTANTIATE_TEST_SUITE_P(
                       HertzCase{"NodalPressureNu045", {1.0e5, 0.45, ElementFormulation::nodal_pressure_tet}, true}),
     case_name);
 
-// The gmsh-graded quarter blocks, 0.5 and 0.25 mm under the sphere: issue 27's check.
+// The gmsh-graded quarter blocks, 0.5 and 0.25 mm under the sphere.
 struct GradedCase {
   const char* name;
   LinearElasticMaterial material;

@@ -387,8 +387,8 @@ TEST(WriteVtu, FieldWithWrongNodeCountThrowsNamingIt) {
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
-// Found by fuzzing: storage was sized by the header, so 47 bytes claiming 1.8e9 vertices
-// asked for 42 GB. Now the missing lines are the error.
+// Storage is not sized by the header, or 47 bytes claiming 1.8e9 vertices would ask for
+// 42 GB: the missing lines are the error.
 TEST(ReadFreeSurfer, AHeaderClaimingBillionsOfVerticesFailsOnItsMissingLines) {
   std::istringstream in("#!ascii\n1772764997 4\n0 0 0 0\n");
   try {

@@ -3,8 +3,8 @@
 // every evaluation. Checked against independent answers: a dropped node comes to rest at
 // its weight times its compliance (statics) without ever gaining energy; a contact never
 // pulls; two coupled nodes get the closed-form pushes of the 2x2 complementarity problem,
-// and a shallow node beside a deep one is released (which one spring per node, the earlier
-// lumped form, could not do); a network of coupled nodes dropped on an undamped backing
+// and a shallow node beside a deep one is released (which one spring per node, the
+// lumped form, cannot do); a network of coupled nodes dropped on an undamped backing
 // never gains energy; a sub-network's backing with the other nodes' pushes held gives the
 // whole backing's pushes.
 #include <gtest/gtest.h>
@@ -129,7 +129,7 @@ TEST(NodeBacking, PressingOneNodeLowersTheSurfaceUnderItsNeighbour) {
   // by b deep / a = 0.4 mm, so it no longer touches and is released.
   const Eigen::VectorXd released = pushes_at(backing, Eigen::Vector2d(-deep, -0.2e-3));
   EXPECT_NEAR(released[0], deep / a, 1e-9 * deep / a);
-  EXPECT_EQ(released[1], 0);  // one spring per node (the lumped backing) pushed it back by about 0.2 mm / a
+  EXPECT_EQ(released[1], 0);  // one spring per node (the lumped backing) would push it back by about 0.2 mm / a
   // A deeper neighbour, 0.6 mm in: both touch, A lambda = depths.
   const Eigen::Vector2d both = pushes_at(backing, Eigen::Vector2d(-deep, -0.6e-3));
   const Eigen::Vector2d expected = (Eigen::Matrix2d() << a, b, b, a).finished().inverse() * Eigen::Vector2d(deep, 0.6e-3);

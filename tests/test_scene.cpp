@@ -339,14 +339,14 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
   }
 
   {
-    // Found by fuzzing: a list as a map key escaped as a YAML library exception.
+    // A list as a map key: a scene error, not a YAML library exception.
     const auto text = replaced(base, "      youngs_modulus: 1000\n", "      ? [youngs, modulus]\n      : 1000\n");
     cases.push_back({"list as a key", text, "? [youngs, modulus]",
                      {"objects[0].material", "a map whose keys are names", "found a list of 2"}});
   }
 
   {
-    // Found by fuzzing: a name the system refuses (too long) threw std::filesystem's error.
+    // A name the system refuses (too long): a scene error, not std::filesystem's error.
     const std::string long_name(5000, 'm');
     const auto text = replaced(base,
                                "      box:\n        min: [0, 0, 0]\n        size: [10, 10, 10]\n"
@@ -616,9 +616,9 @@ TEST(MassSpringScene, ErrorsNameFileLineKeyAndExpectation) {
   for (const BadScene& bad : cases) expect_scene_error(bad);
 }
 
-// Found reviewing the scene fuzz target's reach: a direction of huge components (finite
-// numbers) has a squared length that overflows, so normalize() made it the zero vector: a
-// plane without a normal, a tube ring without its orientation. Now scaled without overflow.
+// A direction of huge components (finite numbers) has a squared length that overflows, so
+// normalize() would make it the zero vector: a plane without a normal, a tube ring without
+// its orientation. It is scaled without overflow.
 TEST(Scene, DirectionsOfHugeComponentsBecomeUnitVectors) {
   const Eigen::Vector3d diagonal = Eigen::Vector3d(1, 1, 0).normalized();
   const Scene solid = parse_scene(replaced(kBaseScene, "normal: [0, 0, 1]", "normal: [1.0e200, 1.0e200, 0]"), kSceneFile);

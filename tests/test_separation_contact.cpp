@@ -1,4 +1,4 @@
-// The separation body's haptic-rate contact (issue 12, deliverables 2 and 4's evaluation):
+// The separation body's haptic-rate contact:
 // a pushing tool slides by Coulomb friction and stops at a crack edge, lets go when it
 // would pull; the evaluation allocates nothing, never outputs NaN or more than the force
 // limit, and the same inputs give the same bits on a copy of the patch (client = server).

@@ -1,4 +1,4 @@
-// The separation body's precomputed force-deflection fields (issue 12, deliverable 1):
+// The separation body's precomputed force-deflection fields:
 // the interface of two boxes, the fitted fields against full sparse FEM solves of the
 // two meshes with tied pairs merged (no condensation), the polynomial fit, the disk
 // cache, and the area blend of Eq. 2.

@@ -1,4 +1,4 @@
-// Fracture at the separating interface (issue 12, deliverables 3 and 6): the paper's
+// Fracture at the separating interface: the paper's
 // Fig. 10 normal pull with its three phases, the energy balance at other speeds and angles,
 // the tangential threshold, and that no crack means no fracture until a laser groove.
 // The answers they are checked against: the fitted fields themselves (AB, CA), the

@@ -1,4 +1,4 @@
-// The separation patch through the IR (issue 12, item 4): a SeparationIr sent as the IR's
+// The separation patch through the IR: a SeparationIr sent as the IR's
 // body (the wire's SeparationPatch, field 27) comes back bit for bit; the client's
 // evaluate_force on a received IR gives the server's authoritative force for the same tool
 // positions and buttons (grasp, a pull through fracture, a laser groove then a push that

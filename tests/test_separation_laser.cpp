@@ -1,4 +1,4 @@
-// Laser vaporisation at the separating interface (issue 12, deliverable 3): the steady
+// Laser vaporisation at the separating interface: the steady
 // speed from the energy balance (Eqs. 18–20, water's properties), the groove's area l_f L
 // below that speed and nothing above it, and the strip geometry against exact areas.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The separating-tissue body in scenes (issue 12, item 5): `model: separation` loads with
+// The separating-tissue body in scenes: `model: separation` loads with
 // its cited settings, compiles into a Model (the fields fitted to our FEM) and is stepped
 // by the server's scene simulation: two users on one interface, the server deciding fracture and
 // vaporisation, each user's IR rebuilt when the separated state changes, its epochs rising.

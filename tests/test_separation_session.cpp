@@ -1,4 +1,4 @@
-// The separating-tissue session end to end (issue 12, item 3): a cohaptic-server process
+// The separating-tissue session end to end: a cohaptic-server process
 // serving scenes/separation/two_layers.yaml and two cohaptic-client processes playing its
 // scripted users on loopback (the forceps grasp the flap's rim and pull it up, then hold
 // it; the laser tool cuts a groove across the middle, then grasps before it and pushes it

@@ -1,4 +1,4 @@
-// Nodes that the tissue carries into a sphere (issue 14 item 1). The sphere model's
+// Nodes that the tissue carries into a sphere. The sphere model's
 // unilateral problem is posed over every touchable surface node, not only over those whose
 // rest position lies inside a sphere: a node outside at rest (gap g0 > 0) that the body's
 // deformation carries in (g0 + n.u < 0, linearised) must be held like any other.

@@ -53,10 +53,10 @@ TEST(VesselOnBrain, SurgeonFeelsTheBrainThroughTheVein) {
   RecordProperty("force_vein_alone_n", std::to_string(alone));
   EXPECT_GT(alone, 0);
   // Measured: 0.052 N alone, 0.063 N on the 2 kPa brain, 0.070 N on the 4 kPa one (the
-  // tool's depth is fixed, so the vein bends more over the stiffer brain: not twice). The
-  // lumped backing this scene was first run with gave 0.097 and 0.108 N: its per-node
-  // springs summed B's stiffness over every backed node, exact only when all of them sink
-  // together, which overstates the brain under a local press.
+  // tool's depth is fixed, so the vein bends more over the stiffer brain: not twice). A
+  // lumped backing gives 0.097 and 0.108 N: its per-node springs sum B's stiffness over
+  // every backed node, exact only when all of them sink together, which overstates the
+  // brain under a local press.
   EXPECT_GT(soft, 1.15 * alone) << "the brain adds to what the vein's ends hold";
   EXPECT_GT(stiff, 1.05 * soft) << "a stiffer brain pushes back harder through the vein";
 }

@@ -585,8 +585,8 @@ TEST(WireDatagramInspector, RejectsEachHostileDatagramForItsReason) {
   empty.clear_body();
   expect_outcome(rig.inspector, rig.encode(empty), Rejection::empty, "no body");
 
-  // Clock readings outside [0, 2^61) ns: found by review while fuzzing, a pong's INT64_MIN
-  // overflowed the client's clock offset arithmetic (undefined behaviour).
+  // Clock readings outside [0, 2^61) ns: a pong's INT64_MIN would overflow the client's
+  // clock offset arithmetic (undefined behaviour).
   constexpr std::int64_t kMin = std::numeric_limits<std::int64_t>::min(), kMax = std::numeric_limits<std::int64_t>::max();
   Datagram early = tool_datagram(15);
   early.mutable_header()->set_sender_time_ns(-1);

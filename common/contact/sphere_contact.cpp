@@ -106,19 +106,27 @@ SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, 
   return held;
 }
 
-std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface, int nearest, const SphereTool& tool,
-                              int rings, const std::vector<bool>& allowed, std::span<const int> carried) {
+std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface, const AabbTree& surface_tree,
+                              int nearest, const SphereTool& tool, int rings, const std::vector<bool>& allowed,
+                              std::span<const int> carried) {
+  // Seeds beside `nearest`, ascending: the allowed triangles with a node held at rest, as
+  // nodes_held_by_spheres decides (every one has its box within the radius of the centre),
+  // or with a carried node.
+  std::vector<int> near;
+  surface_tree.triangles_near(tool.centre, tool.radius, near);
+  std::erase_if(near, [&](int t) {
+    if (!allowed[static_cast<std::size_t>(t)] || t == nearest) return true;
+    for (int node : surface.triangles[static_cast<std::size_t>(t)])
+      if ((mesh.nodes.col(node) - tool.centre).norm() - tool.radius < 0) return false;
+    return true;
+  });
+  for (int node : carried)
+    for (int t : surface.node_triangles(node))
+      if (allowed[static_cast<std::size_t>(t)] && t != nearest) near.push_back(t);
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
   std::vector<int> seeds{nearest};
-  const auto is_carried = [&](int node) { return std::find(carried.begin(), carried.end(), node) != carried.end(); };
-  for (int t = 0; t < surface.triangle_count(); ++t) {
-    if (!allowed[t] || t == nearest) continue;
-    for (int node : surface.triangles[t])
-      // held at rest, as nodes_held_by_spheres decides, or carried in
-      if ((mesh.nodes.col(node) - tool.centre).norm() - tool.radius < 0 || is_carried(node)) {
-        seeds.push_back(t);
-        break;
-      }
-  }
+  seeds.insert(seeds.end(), near.begin(), near.end());
   return contact_patch(surface, seeds, rings, allowed);
 }
 

@@ -36,6 +36,7 @@
 #include <span>
 #include <vector>
 
+#include "common/contact/aabb_tree.h"
 #include "common/fem/dof_map.h"
 #include "common/mesh/boundary_surface.h"
 #include "common/mesh/tet_mesh.h"
@@ -106,7 +107,10 @@ SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, 
 /// at rest, and those it may reach, or the deformation may carry into it, before the next
 /// one. `carried`: nodes outside the sphere at rest that the solved state has it push
 /// (the simulation finds them: a bulge can carry a node in beyond the rings).
-std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface, int nearest, const SphereTool& tool,
-                              int rings, const std::vector<bool>& allowed, std::span<const int> carried = {});
+/// `surface_tree`: an AabbTree over the surface's triangles (indices as in `surface`),
+/// through which only the triangles near the sphere are looked at.
+std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface, const AabbTree& surface_tree,
+                              int nearest, const SphereTool& tool, int rings, const std::vector<bool>& allowed,
+                              std::span<const int> carried = {});
 
 }  // namespace cohaptic

@@ -82,15 +82,23 @@ void fill_sphere_contact(const ElasticBody& body, std::span<const int> boundary,
     sphere.free_clearance[i] = normal.free_clearance()[slot];
     if (obstacle_row) sphere.obstacle_gaps[i] = source.obstacles[static_cast<std::size_t>(node)].gap;
   }
-  for (Eigen::Index j = 0; j < n; ++j)
-    for (Eigen::Index i = 0; i < n; ++i)
-      if (slots[static_cast<std::size_t>(i)] >= 0 && slots[static_cast<std::size_t>(j)] >= 0)
-        sphere.normal_compliance(i, j) = normal.w()(slots[static_cast<std::size_t>(i)], slots[static_cast<std::size_t>(j)]);
-  if (precision == IrPrecision::f32) sphere.normal_compliance = sphere.normal_compliance.cast<float>().cast<double>();
+  // W's entries between the rows' slots, each of W's columns read in ascending slot order
+  // (W spans every candidate of the server's solve: far larger than the cache).
+  std::vector<Eigen::Index> by_slot;
   for (Eigen::Index i = 0; i < n; ++i)
-    if (slots[static_cast<std::size_t>(i)] >= 0 &&
-        std::find(source.contact_slots.begin(), source.contact_slots.end(), slots[static_cast<std::size_t>(i)]) !=
-            source.contact_slots.end())
+    if (slots[static_cast<std::size_t>(i)] >= 0) by_slot.push_back(i);
+  std::sort(by_slot.begin(), by_slot.end(), [&](Eigen::Index a, Eigen::Index b) {
+    return slots[static_cast<std::size_t>(a)] < slots[static_cast<std::size_t>(b)];
+  });
+  for (const Eigen::Index j : by_slot) {
+    const double* column = normal.w().col(slots[static_cast<std::size_t>(j)]).data();
+    for (const Eigen::Index i : by_slot) sphere.normal_compliance(i, j) = column[slots[static_cast<std::size_t>(i)]];
+  }
+  if (precision == IrPrecision::f32) sphere.normal_compliance = sphere.normal_compliance.cast<float>().cast<double>();
+  std::vector<char> pushes(static_cast<std::size_t>(normal.capacity()), 0);
+  for (int slot : source.contact_slots) pushes[static_cast<std::size_t>(slot)] = 1;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (slots[static_cast<std::size_t>(i)] >= 0 && pushes[static_cast<std::size_t>(slots[static_cast<std::size_t>(i)])])
       sphere.contacts.push_back(static_cast<int>(i));
   for (int node : boundary) sphere.held_node_ids.push_back(body.mesh.node_tags[node]);
 }
@@ -124,7 +132,7 @@ IntermediateRepresentation build_ir(const ElasticBody& body, IncrementalCondensa
   // The sphere model's patch covers every node the sphere holds (sphere_contact.h).
   const bool sphere = options.contact_model == ContactModel::sphere;
   const auto patch_of = [&](const UserTool& user) {
-    return sphere ? sphere_patch(body.mesh, body.surface, user.nearest_triangle, {user.position, user.radius},
+    return sphere ? sphere_patch(body.mesh, body.surface, body.surface_tree, user.nearest_triangle, {user.position, user.radius},
                                  options.patch_rings, allowed, user.carried_nodes)
                   : contact_patch(body.surface, user.nearest_triangle, options.patch_rings, allowed);
   };

@@ -1,4 +1,4 @@
-// Compliance rows: a condensed FEM IR sent without its M~ (issue 14, "IR bytes"). The
+// Compliance rows: a condensed FEM IR sent without its M~. The
 // client keeps the compliance block L_HH of the nodes it holds (H: the nodes of the last
 // IR it took) and condenses it itself, with the server's own code (common/condense), so
 // the server sends only the rows of L for the nodes H gains.

@@ -94,6 +94,7 @@ ElasticBody build_elastic_body(const ObjectSpec& object, const ElasticObjectSpec
   body.surface = extract_boundary_surface(body.mesh);
   for (const std::string& finding : check_boundary_surface(body.mesh, body.surface)) spdlog::warn("mesh: {}", finding);
   body.normals = compute_pseudo_normals(body.mesh, body.surface);
+  body.surface_tree = AabbTree(body.mesh.nodes, body.surface.triangles);
 
   std::vector<AxisMask> fixed_axes(static_cast<std::size_t>(body.mesh.node_count()), 0);
   for (const FixedRegion& region : spec.fixed)

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "common/contact/aabb_tree.h"
 #include "common/contact/sphere_contact.h"
 #include "common/contact/surface_distance.h"
 #include "common/fem/assemble_stiffness.h"
@@ -35,6 +36,7 @@ struct ElasticBody {
   TetMesh mesh;
   BoundarySurface surface;
   SurfacePseudoNormals normals;
+  AabbTree surface_tree;  ///< over surface.triangles (same indices), for queries near a point
   MeshCheckReport mesh_report;
   DofMap dofs;
   SparseMatrix stiffness;                         ///< K, 3N x 3N [N/m]

@@ -1,4 +1,4 @@
-// FEM against FEM (issue 11, item 2): a linear elastic front body A pressing on a linear
+// FEM against FEM: a linear elastic front body A pressing on a linear
 // elastic body B behind it, both condensed through their compliance columns.
 //
 // Contact: the collisions' active nodes P of A against B's rest surface, each at a target

@@ -1,5 +1,5 @@
 // FemPairInteraction: one `interactions:` entry of a scene whose front and behind objects
-// are both linear elastic (issue 11, FEM against FEM), run in the server's step.
+// are both linear elastic (FEM against FEM), run in the server's step.
 //
 // Each step, once the front body A's tools and held nodes are known: A's surface at its
 // state without B (what A does alone) against B's surface at rest, through the pairs of

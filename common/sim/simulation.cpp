@@ -140,13 +140,18 @@ StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) con
   return sphere_solve_->solve(condensation_, candidates, spheres, boundary_dof_displacement());
 }
 
-bool Simulation::sphere_rows_cover_holds() const {
+bool Simulation::sphere_irs_stand() const {
+  if (built_sphere_rows_.empty()) return false;
+  const auto built_row = [&](int node) { return built_sphere_rows_[static_cast<std::size_t>(node)] != 0; };
   for (const UserState& user : users_) {
     if (!user.known) continue;
     for (const std::vector<int>* nodes : {&user.sphere_holds, &user.sphere_carried})
-      for (int node : *nodes)
-        if (built_sphere_rows_.empty() || !built_sphere_rows_[static_cast<std::size_t>(node)]) return false;
+      if (!std::ranges::all_of(*nodes, built_row)) return false;
   }
+  if (!std::ranges::all_of(sphere_solve_->obstacle_contacts(), built_row)) return false;
+  const NormalCompliance& normal = sphere_solve_->normal_compliance();
+  for (const auto& [node, direction] : built_row_directions_)
+    if (const int slot = normal.slot_of(node); slot >= 0 && normal.normal(slot) != direction) return false;
   return true;
 }
 
@@ -154,7 +159,7 @@ void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool, std
                              const std::vector<bool>& touchable) const {
   const SphereTool sphere{user.position, user.radius};
   const int rings = options_.ir.patch_rings;
-  user.sphere_patch_nodes = triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, user.nearest, sphere, rings, touchable));
+  user.sphere_patch_nodes = triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, body_.surface_tree, user.nearest, sphere, rings, touchable));
   // Carried nodes the patch now holds anyway are no longer carried.
   std::erase_if(user.sphere_carried, [&](int node) {
     return std::find(user.sphere_patch_nodes.begin(), user.sphere_patch_nodes.end(), node) != user.sphere_patch_nodes.end();
@@ -162,7 +167,7 @@ void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool, std
   const std::vector<int> nodes =
       user.sphere_carried.empty()
           ? user.sphere_patch_nodes
-          : triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, user.nearest, sphere, rings, touchable,
+          : triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, body_.surface_tree, user.nearest, sphere, rings, touchable,
                                                        user.sphere_carried));
   for (int node : nodes) under_tool[node] = in_patch[node] = true;
   user.sphere_nodes = nodes;
@@ -353,13 +358,12 @@ StepReport Simulation::step(double time) {
   // (a new epoch) is published only when a set changed.
   const bool support_changed = std::exchange(support_changed_, false);
   // Under the sphere model an IR holds for every position of the spheres as long as every
-  // node they hold or carry is one of its row nodes, each held by what held it at the build
-  // (its normal compliance does not depend on where they are): it is rebuilt when one is
-  // not, when the obstacle rows change (a node near an obstacle, or one whose holder
-  // changed), or when a sphere holding nothing comes nearest another triangle.
-  const bool sets_changed =
-      boundary_changed || support_changed || nearest != built_nearest_ ||
-      (sphere_model() && (!sphere_rows_cover_holds() || !std::ranges::equal(sphere_solve_->obstacle_rows(), built_obstacle_rows_)));
+  // node they hold or carry, and every obstacle contact, is one of its row nodes, each
+  // pushed along the direction it had at the build (its normal compliance does not depend
+  // on where they are): it is rebuilt when one is not, or when a sphere holding nothing
+  // comes nearest another triangle.
+  const bool sets_changed = boundary_changed || support_changed || nearest != built_nearest_ ||
+                            (sphere_model() && !sphere_irs_stand());
   if (sets_changed || options_.naive_every_step) {
     IncrementalCondensation& condensation = ir_condensation();
     const std::vector<Eigen::Vector3d> held = boundary_displacement(condensation);
@@ -370,7 +374,7 @@ StepReport Simulation::step(double time) {
     if (sphere_model()) {
       sphere = {&sphere_solve_->normal_compliance(), sphere_solve_->contact_slots(), sphere_solve_->obstacle_rows(),
                 sphere_solve_->obstacle_constraints()};
-      built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
+      if (sets_changed) built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
     }
     for (std::size_t i = 0; i < tools.size(); ++i) {
       UserState& user = users_[tools[i].user];
@@ -385,7 +389,13 @@ StepReport Simulation::step(double time) {
       p0_states_[static_cast<std::size_t>(tools[i].user)] = make_evaluation_state(*user.ir);
     }
     built_nearest_ = nearest;
-    if (sphere_model()) built_obstacle_rows_.assign(sphere_solve_->obstacle_rows().begin(), sphere_solve_->obstacle_rows().end());
+    if (sphere_model() && sets_changed) {
+      built_row_directions_.clear();
+      const NormalCompliance& normal = sphere_solve_->normal_compliance();
+      for (int node = 0; node < body_.mesh.node_count(); ++node)
+        if (const int slot = built_sphere_rows_[static_cast<std::size_t>(node)] ? normal.slot_of(node) : -1; slot >= 0)
+          built_row_directions_.emplace_back(node, normal.normal(slot));
+    }
     report.rebuilt = sets_changed;
     report.recomputed = true;
   }

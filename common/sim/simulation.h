@@ -163,8 +163,9 @@ class Simulation {
   bool carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, std::vector<bool>& in_patch, StepReport& report);
   std::vector<SphereTool> spheres() const;  ///< every known user's tool
   StateSolution solve_spheres(std::span<const SphereTool> spheres) const;
-  /// Sphere model: whether the IRs last built hold every node a sphere holds or carries now.
-  bool sphere_rows_cover_holds() const;
+  /// Sphere model: whether the IRs last built stand: they hold every node a sphere holds or
+  /// carries now and every obstacle contact, each pushed along its direction at the build.
+  bool sphere_irs_stand() const;
   bool update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch);
   bool update_obstacle_contacts(const std::vector<bool>& under_tool);
   /// The condensation the IRs are built over: the support's, with B synchronised, or the body's.
@@ -188,7 +189,7 @@ class Simulation {
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
   std::vector<char> built_sphere_rows_;             // per node: a row node of the IRs last built (sphere model)
-  std::vector<int> built_obstacle_rows_;            // sphere model: the obstacle rows of the IRs last built
+  std::vector<std::pair<int, Eigen::Vector3d>> built_row_directions_;  // sphere model: those rows' nodes with a slot, and its direction then
   std::unordered_map<std::int64_t, int> node_of_tag_;  // sphere model: to read the IRs' row nodes
   std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
   std::vector<SphereTool> previous_spheres_;        // the sphere model's: the spheres of the previous step

@@ -26,7 +26,6 @@ SphereStateSolve::SphereStateSolve(const ElasticBody& body, ComplianceColumns& c
       contact_(static_cast<int>(normal_.capacity())) {
   for (std::size_t node = 0; node < obstacle_.size(); ++node)
     if (obstacle_[node].obstacle >= 0) obstacle_nodes_.push_back(static_cast<int>(node));
-  near_obstacle_.assign(static_cast<std::size_t>(body.mesh.node_count()), 0);
 }
 
 void SphereStateSolve::set_candidates(const std::vector<int>& nodes, IncrementalCondensation& condensation,
@@ -52,6 +51,7 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
                                       std::span<const SphereTool> spheres, const Eigen::VectorXd& boundary_displacement) {
   const DofMap& dofs = body_.dofs;
   obstacle_rows_.clear();  // until this solve finds them (a solve that throws leaves none)
+  obstacle_contacts_.clear();
   const auto constraint_of = [&](int node) {
     return node_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
                            dofs.fixed_axes[static_cast<std::size_t>(node)], spheres, obstacle_at(obstacle_, node));
@@ -79,14 +79,14 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
           added |= add(node);
     return added;
   };
-  // The obstacles' nodes whose rest gap is within `band` (plus kObstacleLeave) join too.
+  // The obstacles' nodes whose rest gap is within `band` (plus kObstacleBandMargin) join too.
   // Their band never narrows: a node that joined stays, so that the many nodes along an
   // obstacle do not leave and join again as the presses deepen and ease.
   const auto add_obstacle_band = [&](double band) {
     obstacle_band_ = std::max(obstacle_band_, band);
     bool added = false;
     for (int node : obstacle_nodes_)
-      if (!listed(node) && obstacle_[static_cast<std::size_t>(node)].gap < obstacle_band_ + kObstacleLeave)
+      if (!listed(node) && obstacle_[static_cast<std::size_t>(node)].gap < obstacle_band_ + kObstacleBandMargin)
         added |= add(node);
     return added;
   };
@@ -162,9 +162,10 @@ void SphereStateSolve::find_obstacle_rows(std::span<const int> patch_nodes) {
   const std::span<const int> members = contact_.members();
   const std::span<const double> pushes = contact_.member_pushes();
   const std::span<const double> w_push = contact_.w_push();
-  std::vector<char> near(near_obstacle_.size(), 0), in_patch(near_obstacle_.size(), 0);
+  std::vector<char> in_patch(static_cast<std::size_t>(body_.mesh.node_count()), 0);
   for (int node : patch_nodes) in_patch[static_cast<std::size_t>(node)] = 1;
   obstacle_rows_.clear();
+  obstacle_contacts_.clear();
   for (int slot = 0; slot < normal_.slot_count(); ++slot) {
     const int node = normal_.node_of(slot);
     if (node < 0 || tool_[static_cast<std::size_t>(slot)] >= 0 || clearance_[slot] == kNone) continue;  // no obstacle's
@@ -174,12 +175,11 @@ void SphereStateSolve::find_obstacle_rows(std::span<const int> patch_nodes) {
                                 : gathered_dot(normal_.w().col(slot).data(), members.data(), pushes.data(),
                                                static_cast<Eigen::Index>(members.size())));
     const bool pushed = contact_.push(slot) > 0;
-    near[static_cast<std::size_t>(node)] =
-        pushed || clearance < kObstacleJoin || (near_obstacle_[static_cast<std::size_t>(node)] && clearance < kObstacleLeave);
-    if (near[static_cast<std::size_t>(node)] || in_patch[static_cast<std::size_t>(node)]) obstacle_rows_.push_back(node);
+    if (pushed || clearance < kObstacleJoin) obstacle_contacts_.push_back(node);
+    if (pushed || clearance < kObstacleReach || in_patch[static_cast<std::size_t>(node)]) obstacle_rows_.push_back(node);
   }
-  near_obstacle_ = std::move(near);
   std::sort(obstacle_rows_.begin(), obstacle_rows_.end());
+  std::sort(obstacle_contacts_.begin(), obstacle_contacts_.end());
 }
 
 }  // namespace cohaptic

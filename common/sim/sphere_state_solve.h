@@ -14,14 +14,16 @@
 // than the candidates allowed for, the wider band joins and the state is solved again.
 //
 // The obstacles' candidates are, in the same way, the surface nodes whose gap to their
-// obstacle at rest is less than that band (plus kObstacleLeave): the nodes the deformation
+// obstacle at rest is less than that band (plus kObstacleBandMargin): the nodes the deformation
 // could carry onto it; their band is the widest so far, so that they join once. As long as
 // no node beyond the bands reaches a sphere or an obstacle (the bands' assumption, which
 // the tests check against the full solve), the answer is that of the problem over every
 // node, whatever the path: the obstacle lets its nodes slide and releases them as the
-// unilateral problem says, in one step or many. The IRs carry the obstacle candidates near
-// their obstacle in the solved state (pushed, or within kObstacleJoin; one stays until
-// kObstacleLeave clear) and any the patches hold: the obstacle rows. Under on-demand
+// unilateral problem says, in one step or many. The IRs carry the obstacle candidates
+// within kObstacleReach of their obstacle in the solved state (or pushed by it) and any the
+// patches hold: the obstacle rows. An IR stands while it holds every obstacle contact (a
+// candidate pushed, or within kObstacleJoin): the nodes between the two distances may come
+// and go without a new one. Under on-demand
 // compliance the first widening of the band solves the columns of every obstacle node it
 // takes in, within that step.
 //
@@ -45,10 +47,16 @@ namespace cohaptic {
 
 class SphereStateSolve {
  public:
-  /// An obstacle candidate this near its obstacle in the solved state is an obstacle row [m].
+  /// An obstacle candidate this near its obstacle in the solved state is an obstacle
+  /// contact: an IR must hold it as a row [m].
   static constexpr double kObstacleJoin = 0.5e-3;
-  /// An obstacle row this clear of its obstacle, and not pushed, is one no longer [m].
-  static constexpr double kObstacleLeave = 1e-3;
+  /// An obstacle candidate this near its obstacle in the solved state is an obstacle row: a
+  /// new IR holds it, so that the IR stands until a node farther than this comes within
+  /// kObstacleJoin [m].
+  static constexpr double kObstacleReach = 0.75e-3;
+  /// An obstacle node whose gap at rest is within the candidates' band plus this is a
+  /// candidate: a margin for the nodes the deformation could carry onto the obstacle [m].
+  static constexpr double kObstacleBandMargin = 1e-3;
 
   /// `body` and `columns` (whose rows include every touchable node, every node an obstacle
   /// may hold and every node B may hold) must outlive it. `obstacles`: per volume node, its
@@ -72,6 +80,8 @@ class SphereStateSolve {
   /// The last solve's obstacle rows (above): candidates an obstacle holds (their slots push
   /// along its normal), ascending.
   std::span<const int> obstacle_rows() const { return obstacle_rows_; }
+  /// The last solve's obstacle contacts (above), ascending: rows an IR must hold.
+  std::span<const int> obstacle_contacts() const { return obstacle_contacts_; }
   /// Per volume node, its obstacle constraint as given (empty: no obstacles).
   std::span<const SphereConstraint> obstacle_constraints() const { return obstacle_; }
   /// How many nodes the obstacles push in the last solve.
@@ -100,8 +110,7 @@ class SphereStateSolve {
   double obstacle_band_ = 0;    // [m], the widest band so far
   Eigen::VectorXd clearance_;   // per slot, this solve's q
   std::vector<int> tool_;       // per slot, the sphere holding it (-1: none, or an obstacle: then q is finite)
-  std::vector<char> near_obstacle_;  // per volume node: an obstacle row for being near, as of the last solve
-  std::vector<int> obstacle_rows_;
+  std::vector<int> obstacle_rows_, obstacle_contacts_;
   int obstacle_pushed_ = 0;
 };
 

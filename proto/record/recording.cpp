@@ -1,10 +1,14 @@
 #include "proto/record/recording.h"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <map>
 
 #include "common/util/error.h"
 #include "proto/record/mcap_reader.h"
 #include "proto/record/session_recorder.h"
+#include "proto/wire/ir_stream.h"
 
 namespace cohaptic::record {
 namespace {
@@ -15,6 +19,23 @@ void add(const McapReader& reader, const McapMessage& message, std::vector<Messa
   else ++unknown;
 }
 
+// Opens an IR recorded as a stream block (RecordedIr.compressed_ir) in its stream. A block
+// that does not open (a recording cut short mid-stream, say) is dropped and counted unknown.
+void open_block(const std::filesystem::path& file, std::map<std::uint32_t, wire::IrStreamReader>& streams,
+                Recording& recording) {
+  RecordedIr& recorded = recording.irs.back();
+  if (!recorded.has_compressed_ir()) return;
+  try {
+    *recorded.mutable_ir() = streams[recorded.stream()].open(recorded.compressed_ir());
+    recorded.clear_compressed_ir();
+  } catch (const Error& e) {
+    spdlog::warn("{}: an IR of stream {} (block {}) left out: {}", file.string(), recorded.stream(),
+                 recorded.compressed_ir().index(), e.what());
+    recording.irs.pop_back();
+    ++recording.unknown_messages;
+  }
+}
+
 }  // namespace
 
 Recording read_recording(const std::filesystem::path& file) {
@@ -22,11 +43,16 @@ Recording read_recording(const std::filesystem::path& file) {
   Recording recording;
   recording.file = file;
   std::vector<SessionConfig> configs;
+  std::map<std::uint32_t, wire::IrStreamReader> ir_streams;
   while (const auto message = reader.next()) {
     const std::string& topic = reader.channel_of(*message).topic;
     if (topic == topic::kConfig) add(reader, *message, configs, recording.unknown_messages);
     else if (topic == topic::kDatagramsIn) add(reader, *message, recording.datagrams, recording.unknown_messages);
-    else if (topic == topic::kIr) add(reader, *message, recording.irs, recording.unknown_messages);
+    else if (topic == topic::kIr) {
+      const std::size_t before = recording.irs.size();
+      add(reader, *message, recording.irs, recording.unknown_messages);
+      if (recording.irs.size() > before) open_block(file, ir_streams, recording);
+    }
     else if (topic == topic::kHaptic) add(reader, *message, recording.ticks, recording.unknown_messages);
     else if (topic == topic::kSteps) add(reader, *message, recording.steps, recording.unknown_messages);
     else if (topic == topic::kEvents) add(reader, *message, recording.events, recording.unknown_messages);

@@ -59,6 +59,14 @@ void SessionRecorder::ir(std::int64_t time_ns, const wire::IntermediateRepresent
   write(ir_, time_ns, record);
 }
 
+void SessionRecorder::ir_block(std::int64_t time_ns, std::uint32_t stream, const wire::CompressedIr& block) {
+  RecordedIr record;
+  record.set_time_ns(time_ns);
+  *record.mutable_compressed_ir() = block;
+  record.set_stream(stream);
+  write(ir_, time_ns, record);
+}
+
 void SessionRecorder::tick(const HapticTick& tick) { write(haptic_, tick.time_ns(), tick); }
 
 void SessionRecorder::step(const SimulationStep& step) { write(steps_, step.time_ns(), step); }

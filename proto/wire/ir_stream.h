@@ -1,8 +1,10 @@
-// IR streams: the compliance rows IRs of one user's connection (common/ir/compliance_rows.h),
-// compressed as one zstd stream, each IR a flushed block of it. Rows IRs already travel
-// must-arrive and in order over TCP, and consecutive IRs repeat most of each other (node ids,
-// patch geometry, the held nodes' displacements), so the stream costs a few per cent of the
-// IRs' bytes where each IR alone would keep about two thirds (issue 14, note "IR bytes").
+// IR streams: the compliance rows IRs (common/ir/compliance_rows.h), or the sphere contact
+// model's IRs, of one user's connection, compressed as one zstd stream, each IR a flushed
+// block of it. They already travel must-arrive and in order over TCP, and consecutive IRs
+// repeat most of each other (node ids, patch geometry, the held nodes' displacements, the
+// normal compliance between rows both hold), so the stream costs a small part of the IRs'
+// bytes where each IR alone would keep about two thirds (`cohaptic-lab ir-bytes` measures
+// it). A sphere IR's repeats lie hundreds of kB back: long-distance matching finds them.
 //
 // The stream starts afresh where the rows do (generation 1): the writer resets and the IR
 // is index 1; the reader resets on index 1 and opens index k + 1 only after k, so a reader

@@ -1,0 +1,132 @@
+#include "server/ir_encoder.h"
+
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <iterator>
+#include <map>
+#include <utility>
+
+#include "proto/wire/header.h"
+#include "proto/wire/ir_convert.h"
+
+namespace cohaptic {
+
+IrEncoder::IrEncoder(int users, record::SessionRecorder* recorder, LoopStatistics& statistics)
+    : recorder_(recorder), statistics_(statistics), streams_(static_cast<std::size_t>(users)) {}
+
+IrEncoder::~IrEncoder() { stop(); }
+
+namespace {
+
+// Whether the IR travels whole (not as compliance rows, each of which builds on the last).
+bool travels_whole(const BuiltIr& built) { return built.send && !built.as_sent; }
+
+}  // namespace
+
+void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
+  if (irs.empty()) return;
+  const std::int64_t start_ns = wire::monotonic_now_ns();
+  // An IR that travels whole and is followed by another of its user's that does too is
+  // superseded: it is recorded, not sent; a fresh start of the stream passes to the next.
+  std::vector<char> superseded(irs.size(), 0);
+  std::map<int, bool> next_whole;  // per user, scanning back
+  for (std::size_t i = irs.size(); i-- > 0;) {
+    bool& next = next_whole[irs[i].user];
+    superseded[i] = travels_whole(irs[i]) && next;
+    next = travels_whole(irs[i]);
+  }
+  std::map<int, bool> carried_fresh;
+  for (std::size_t i = 0; i < irs.size(); ++i) {
+    bool& carried = carried_fresh[irs[i].user];
+    if (superseded[i]) carried = carried || irs[i].fresh;
+    else irs[i].fresh = std::exchange(carried, false) || irs[i].fresh;
+  }
+  std::uint64_t sent = 0, bytes = 0, skipped = 0;
+  for (std::size_t i = 0; i < irs.size(); ++i) {
+    const BuiltIr& built = irs[i];
+    const wire::IntermediateRepresentation whole = wire::to_wire(built.built->ir);
+    if (!built.send || superseded[i]) {
+      if (superseded[i]) ++skipped;
+      if (recorder_) recorder_->ir(built.time_ns, whole);
+      continue;
+    }
+    wire::Control control;
+    try {
+      if (built.streamed)
+        *control.mutable_compressed_ir() = streams_[static_cast<std::size_t>(built.user)].compress(
+            built.as_sent ? wire::to_wire(*built.as_sent) : whole, built.fresh);
+      else
+        *control.mutable_ir() = built.as_sent ? wire::to_wire(*built.as_sent) : whole;
+    } catch (const std::exception& e) {
+      spdlog::error("user {}'s IR (epoch {}) not sent: {}; the next starts its stream afresh", built.user,
+                    built.built->ir.epoch, e.what());
+      if (recorder_) recorder_->ir(built.time_ns, whole);
+      std::lock_guard lock(mutex_);
+      restarts_.push_back(built.user);
+      continue;
+    }
+    // The recording keeps the IR whole (M~ as built), whatever form it travels in: the
+    // block itself when it holds the IR whole (recorded blocks open in order, as a
+    // client's do), else the IR.
+    if (recorder_) {
+      if (built.streamed && !built.as_sent)
+        recorder_->ir_block(built.time_ns, static_cast<std::uint32_t>(built.user), control.compressed_ir());
+      else
+        recorder_->ir(built.time_ns, whole);
+    }
+    bytes += built.streamed ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
+    outbox.irs.push_back({built.user, std::move(control), built.streamed});
+    ++sent;
+  }
+  statistics_.record_irs_encoded(wire::monotonic_now_ns() - start_ns, sent, bytes, skipped);
+}
+
+void IrEncoder::start(std::function<void(Outbox&&)> send) {
+  stop();
+  send_ = std::move(send);
+  stopping_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void IrEncoder::post(std::vector<BuiltIr> irs) {
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [this] { return queue_.size() < kMaxQueuedSteps; });
+  queue_.push_back(std::move(irs));
+  changed_.notify_all();
+}
+
+void IrEncoder::stop() {
+  if (!thread_.joinable()) return;
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  thread_.join();
+}
+
+std::vector<int> IrEncoder::take_restarts() {
+  std::lock_guard lock(mutex_);
+  return std::exchange(restarts_, {});
+}
+
+void IrEncoder::run() {
+  for (;;) {
+    std::vector<BuiltIr> irs;
+    {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) return;  // stopping, and nothing left
+      // Every step waiting, at once: a user's IR that a newer one replaces is not sent.
+      for (std::vector<BuiltIr>& step : queue_) std::move(step.begin(), step.end(), std::back_inserter(irs));
+      queue_.clear();
+    }
+    changed_.notify_all();  // room for post()
+    Outbox outbox;
+    encode(irs, outbox);
+    if (!outbox.empty()) send_(std::move(outbox));
+  }
+}
+
+}  // namespace cohaptic
