@@ -14,12 +14,13 @@ constexpr Eigen::Index kFirstCapacity = 64;
 
 }  // namespace
 
-NormalCompliance::NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& directions)
+NormalCompliance::NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& directions,
+                                   Eigen::Index expected_candidates)
     : columns_(columns),
       dofs_(dofs),
       directions_(directions),
       slot_of_node_(static_cast<std::size_t>(directions.cols()), -1) {
-  grow(kFirstCapacity);
+  grow(std::clamp(expected_candidates, kFirstCapacity, kMaxInitialCapacity));
 }
 
 int NormalCompliance::slot_of(int node) const {

@@ -17,7 +17,10 @@
 // costs one column solve (cached in ComplianceColumns) and its row of W0, P and Q,
 // O(|C| + |B|^2); a change of B recomputes P, Q and W, O(|B|^2 |C| + |B| |C|^2), keeping W0;
 // a change of u_B only q0, O(|B| |C|). W is exactly symmetric (each pair is computed once).
-// Units: m/N, m. Not thread-safe: the simulation loop owns it.
+// The slots' capacity doubles when they run out, copying W0, W, P and Q: a step that has
+// to grow a large capacity stalls (the first wide press against an obstacle, say), so the
+// owner gives, at construction, as many slots as candidates can ever be, up to
+// kMaxInitialCapacity. Units: m/N, m. Not thread-safe: the simulation loop owns it.
 #pragma once
 
 #include <Eigen/Core>
@@ -33,9 +36,16 @@ namespace cohaptic {
 
 class NormalCompliance {
  public:
+  /// Slots made at construction at most: W0, W and a contact solve's factor are each this
+  /// many squared doubles (134 MB at 4096).
+  static constexpr Eigen::Index kMaxInitialCapacity = 4096;
+
   /// `columns`, `dofs` and `directions` (per volume node: the direction it is pushed along)
   /// must outlive it; every candidate and every node of B must be a row node of `columns`.
-  NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& directions);
+  /// `expected_candidates`: how many candidates there may be at once (the capacity made
+  /// now: at least 64, at most kMaxInitialCapacity).
+  NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& directions,
+                   Eigen::Index expected_candidates = 0);
 
   /// The candidates become `nodes` (each once, none in B), under the held set of
   /// `condensation` held at `boundary_displacement` (free dofs of B in its order). A node

@@ -142,17 +142,22 @@ StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) con
 
 bool Simulation::sphere_irs_stand() const {
   if (built_sphere_rows_.empty()) return false;
-  const auto built_row = [&](int node) { return built_sphere_rows_[static_cast<std::size_t>(node)] != 0; };
+  // A node must be a row of the IRs, pushed along the direction its slot had then: only
+  // where it is held or pushed does the direction matter (elsewhere it pushes nothing).
+  const NormalCompliance& normal = sphere_solve_->normal_compliance();
+  const auto stands = [&](int node) {
+    if (!built_sphere_rows_[static_cast<std::size_t>(node)]) return false;
+    const int slot = normal.slot_of(node);
+    const auto built = std::lower_bound(built_row_directions_.begin(), built_row_directions_.end(), node,
+                                        [](const auto& entry, int n) { return entry.first < n; });
+    return slot < 0 || built == built_row_directions_.end() || built->first != node || normal.normal(slot) == built->second;
+  };
   for (const UserState& user : users_) {
     if (!user.known) continue;
     for (const std::vector<int>* nodes : {&user.sphere_holds, &user.sphere_carried})
-      if (!std::ranges::all_of(*nodes, built_row)) return false;
+      if (!std::ranges::all_of(*nodes, stands)) return false;
   }
-  if (!std::ranges::all_of(sphere_solve_->obstacle_contacts(), built_row)) return false;
-  const NormalCompliance& normal = sphere_solve_->normal_compliance();
-  for (const auto& [node, direction] : built_row_directions_)
-    if (const int slot = normal.slot_of(node); slot >= 0 && normal.normal(slot) != direction) return false;
-  return true;
+  return std::ranges::all_of(sphere_solve_->obstacle_contacts(), stands);
 }
 
 void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,

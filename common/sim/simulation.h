@@ -189,7 +189,7 @@ class Simulation {
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
   std::vector<char> built_sphere_rows_;             // per node: a row node of the IRs last built (sphere model)
-  std::vector<std::pair<int, Eigen::Vector3d>> built_row_directions_;  // sphere model: those rows' nodes with a slot, and its direction then
+  std::vector<std::pair<int, Eigen::Vector3d>> built_row_directions_;  // sphere model: those rows' nodes with a slot, ascending, and its direction then
   std::unordered_map<std::int64_t, int> node_of_tag_;  // sphere model: to read the IRs' row nodes
   std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
   std::vector<SphereTool> previous_spheres_;        // the sphere model's: the spheres of the previous step

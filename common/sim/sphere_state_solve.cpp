@@ -1,6 +1,7 @@
 #include "common/sim/sphere_state_solve.h"
 
 #include <algorithm>
+#include <iterator>
 #include <limits>
 #include <optional>
 
@@ -13,6 +14,21 @@ namespace {
 
 constexpr double kNone = std::numeric_limits<double>::infinity();
 
+// The nodes that `obstacles` constrain, ascending.
+std::vector<int> obstacle_nodes_of(std::span<const SphereConstraint> obstacles) {
+  std::vector<int> nodes;
+  for (std::size_t node = 0; node < obstacles.size(); ++node)
+    if (obstacles[node].obstacle >= 0) nodes.push_back(static_cast<int>(node));
+  return nodes;
+}
+
+// How many nodes can be candidates at once: the touchable ones and the obstacles'.
+Eigen::Index candidate_bound(std::span<const int> touchable, std::span<const int> obstacle_nodes) {
+  std::vector<int> all;
+  std::set_union(touchable.begin(), touchable.end(), obstacle_nodes.begin(), obstacle_nodes.end(), std::back_inserter(all));
+  return static_cast<Eigen::Index>(all.size());
+}
+
 }  // namespace
 
 SphereStateSolve::SphereStateSolve(const ElasticBody& body, ComplianceColumns& columns,
@@ -21,12 +37,10 @@ SphereStateSolve::SphereStateSolve(const ElasticBody& body, ComplianceColumns& c
       columns_(columns),
       touchable_(triangle_nodes(body.surface, body.touchable_triangles)),
       obstacle_(std::move(obstacles)),
+      obstacle_nodes_(obstacle_nodes_of(obstacle_)),
       directions_(body.contact_normals),
-      normal_(columns, body.dofs, directions_),
-      contact_(static_cast<int>(normal_.capacity())) {
-  for (std::size_t node = 0; node < obstacle_.size(); ++node)
-    if (obstacle_[node].obstacle >= 0) obstacle_nodes_.push_back(static_cast<int>(node));
-}
+      normal_(columns, body.dofs, directions_, candidate_bound(touchable_, obstacle_nodes_)),
+      contact_(static_cast<int>(normal_.capacity())) {}
 
 void SphereStateSolve::set_candidates(const std::vector<int>& nodes, IncrementalCondensation& condensation,
                                       const Eigen::VectorXd& boundary_displacement) {

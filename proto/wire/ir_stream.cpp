@@ -11,7 +11,7 @@
 namespace cohaptic::wire {
 namespace {
 
-constexpr int kIrStreamLevel = 3;  // zstd's default
+constexpr int kIrStreamLevel = 1;  // zstd's fastest: long-distance matching finds the repeats
 
 void check_zstd(std::size_t code, const char* what) {
   if (ZSTD_isError(code)) throw cohaptic::Error(fmt::format("IR stream: {}: {}", what, ZSTD_getErrorName(code)));
