@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
   app.add_option("--cache-dir", serve_cache_dir, "Directory of the on-disk compliance cache")->capture_default_str();
   app.add_flag("--no-disk-cache", serve_no_disk_cache, "Neither read nor write the on-disk compliance cache");
 
-  // The offline tools were subcommands here: their old spellings fail, naming the new one.
+  // The offline tools are cohaptic-lab subcommands: naming one here fails, with the cohaptic-lab spelling.
   // Parsing stops at the first argument it does not know, which is then checked.
   app.prefix_command();
 

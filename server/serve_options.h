@@ -26,7 +26,7 @@ struct ServeOptions {
   bool naive_condensation = false;      ///< rebuild M~ from scratch every step (the paper's loop)
   IrPrecision precision = IrPrecision::f64;
   /// Condensed FEM IRs as compliance rows (common/ir/compliance_rows.h; the client condenses),
-  /// B truncation or not; false: M~ whole, as before.
+  /// B truncation or not; false: M~ whole.
   bool compliance_rows = true;
   double duration_s = 0;                ///< 0: until SIGINT/SIGTERM
   std::filesystem::path report;         ///< JSON report at exit; empty: none
