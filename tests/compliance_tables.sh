@@ -20,14 +20,15 @@ cat <<'HEADER'
 of every row node of the brain (its whole surface: the scene has the skull as an obstacle),
 by two routes in the same run: one CHOLMOD solve per group of 4 row nodes on one thread
 (`ComplianceColumns`, what on-demand compliance does), and the Schur-complement route
-(`common/fem/schur_compliance.h`: one factorisation with the row dofs ordered last, BLAS on
-2 threads, then the inverse of its trailing block in fixed blocks on 1 or 2 threads). Times
+(`common/fem/schur_compliance.h`: one factorisation with the row dofs ordered last, then the
+inverse of its trailing block by LAPACK's dtrtri and dlauum, BLAS on 2 threads). Times
 are wall time; peak memory is the process's resident high-water mark during the run; the
-result is the dense block of 3 x row nodes squared doubles. See
-[the compliance cache](../compliance-cache.md).
+result is the dense block of 3 x row nodes squared doubles. Both routes run on the BLAS
+kernels OpenBLAS picks for the CPU, or those `OPENBLAS_CORETYPE` names; the line below says
+which. See [the compliance cache](../compliance-cache.md).
 
 HEADER
-echo "load average: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores; $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
+echo "load average: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores; $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'); OpenBLAS's $(jq -r '.context.blas_kernels // "unknown"' <<<"$json") kernels"
 echo
 jq -r '
   def secs($b): $b.real_time as $v
@@ -38,13 +39,12 @@ jq -r '
   def why($b): if $b == null then "not run" else "error: \($b.error_message)" end;
   ([.benchmarks[].name | capture("mesh:(?<m>[0-9]+)").m] | unique) as $meshes
   | [.benchmarks[] | {key: (.name | sub("/iterations:[0-9]+/real_time$"; "")), value: .}] | from_entries as $b
-  | "| mesh | nodes | row nodes | solves, s | row nodes/s | Schur, 1 thread, s | Schur, 2 threads, s | row nodes/s | speed-up | result MB | peak MB (solves, Schur) |",
-    "|---|---|---|---|---|---|---|---|---|---|---|",
+  | "| mesh | nodes | row nodes | solves, s | row nodes/s | Schur, s | row nodes/s | speed-up | result MB | peak MB (solves, Schur) |",
+    "|---|---|---|---|---|---|---|---|---|---|",
     ( $meshes[] as $m
       | $b["BM_BrainRowCompliance/route:0/mesh:" + $m] as $s
-      | $b["BM_BrainRowCompliance/route:1/mesh:" + $m] as $one
-      | $b["BM_BrainRowCompliance/route:2/mesh:" + $m] as $two
-      | if failed($s) or failed($one) or failed($two) then "| \($m) | \(why(if failed($s) then $s elif failed($one) then $one else $two end)) | | | | | | | | | |"
-        else "| \($s.label) | \($s.nodes) | \($s.row_nodes) | \(secs($s) | fmt) | \($s.row_nodes_per_s | fmt) | \(secs($one) | fmt) | \(secs($two) | fmt) | \($two.row_nodes_per_s | fmt) | \(secs($s) / secs($two) | fmt)× | \($two.columns_MB | round) | \($s.peak_MB | round), \($two.peak_MB | round) |"
+      | $b["BM_BrainRowCompliance/route:1/mesh:" + $m] as $schur
+      | if failed($s) or failed($schur) then "| \($m) | \(why(if failed($s) then $s else $schur end)) | | | | | | | | |"
+        else "| \($s.label) | \($s.nodes) | \($s.row_nodes) | \(secs($s) | fmt) | \($s.row_nodes_per_s | fmt) | \(secs($schur) | fmt) | \($schur.row_nodes_per_s | fmt) | \(secs($s) / secs($schur) | fmt)× | \($schur.columns_MB | round) | \($s.peak_MB | round), \($schur.peak_MB | round) |"
         end )
 ' <<<"$json"

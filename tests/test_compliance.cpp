@@ -9,6 +9,7 @@
 #include "common/fem/compliance_disk_cache.h"
 #include "common/model/compliance_setup.h"
 #include "common/model/model.h"
+#include "common/model/scene_compliance.h"
 #include "common/scene/load_scene.h"
 #include "support/scratch_directory.h"
 
@@ -247,6 +248,20 @@ TEST(ComplianceCache, OnDemandModeComputesNothingUpFrontAndSavesWhatItComputed) 
   EXPECT_EQ(again.column_count(), static_cast<std::size_t>(ComplianceColumns::kGroupSize));  // that group's columns
   EXPECT_LT(again.column_count(), body.touchable_nodes.size());
   EXPECT_TRUE(again.has_column(columns.row_nodes()[2]));
+}
+
+// At a session's end the cache is written only when the session computed columns: a
+// precomputed scene's session leaves its cache file alone.
+TEST(ComplianceCache, ASessionThatComputedNoColumnsWritesNoCache) {
+  const ScratchDirectory dir;
+  const Model model = build_model(parse_scene(small_cube_yaml(1e6, 4, "on_demand"), "cube.yaml"));
+  const SceneCompliance compliance = prepare_scene_compliance(model, false, dir.path);
+  save_scene_compliance(model, compliance, dir.path);
+  EXPECT_TRUE(fs::is_empty(dir.path)) << "nothing computed, nothing saved";
+  ComplianceColumns& columns = *compliance.per_body[0];
+  columns.column(columns.row_nodes()[1]);
+  save_scene_compliance(model, compliance, dir.path);
+  EXPECT_FALSE(fs::is_empty(dir.path)) << "the columns computed on demand are saved";
 }
 
 }  // namespace

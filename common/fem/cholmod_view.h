@@ -1,7 +1,6 @@
 // CHOLMOD glue shared by the factorisations in common/fem: a common set up the way cohaptic
-// uses CHOLMOD (supernodal, silent: errors become exceptions), the BLAS threads a
-// factorisation runs on, a factor that frees itself, and a read-only CHOLMOD view of an Eigen compressed-column matrix's
-// lower triangle (no copy).
+// uses CHOLMOD (supernodal, silent: errors become exceptions), a factor that frees itself,
+// and a read-only CHOLMOD view of an Eigen compressed-column matrix's lower triangle (no copy).
 #pragma once
 
 #include <cholmod.h>
@@ -9,10 +8,6 @@
 #include "common/fem/assemble_stiffness.h"
 
 namespace cohaptic {
-
-/// BLAS threads for a factorisation: always this many, whatever the machine, since
-/// OpenBLAS's rounding depends on its thread count and a replay must factor as the session did.
-constexpr int kFactorBlasThreads = 2;
 
 inline void start_cholmod_common(cholmod_common& common) {
   cholmod_start(&common);

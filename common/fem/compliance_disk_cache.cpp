@@ -18,17 +18,6 @@ namespace {
 constexpr char kMagic[8] = {'C', 'H', 'C', 'O', 'M', 'P', 'L', '\0'};
 
 // Appends plain values to a byte buffer.
-struct Writer {
-  std::vector<char> buffer;
-  void bytes(const void* data, std::size_t size) {
-    const std::size_t offset = buffer.size();
-    buffer.resize(offset + size);
-    std::memcpy(buffer.data() + offset, data, size);
-  }
-  template <typename T>
-  void value(const T& v) { bytes(&v, sizeof v); }
-};
-
 // A digest computed on a thread of its own from the pieces handed to it, in order, so that
 // reading the next piece overlaps hashing the last. A piece is either copied (small
 // values) or kept by pointer (a column, whose memory stays put until finish()).
@@ -120,6 +109,23 @@ struct HashingReader {
   }
   template <typename T>
   bool value(T& v) { return bytes(&v, sizeof v); }
+};
+
+// Writes plain values to a cache file through `out`, hashing every byte written, on the
+// hasher's thread: a column is hashed from where it lies (it must stay put until finish()).
+struct HashingWriter {
+  AtomicFile& out;
+  PipelinedHasher hasher;
+  void bytes(const void* data, std::size_t size) {
+    out.write(std::string_view(static_cast<const char*>(data), size));
+    hasher.copy(data, size);
+  }
+  void column(const double* data, std::size_t count) {
+    out.write(std::string_view(reinterpret_cast<const char*>(data), count * sizeof(double)));
+    hasher.keep(data, count * sizeof(double));
+  }
+  template <typename T>
+  void value(const T& v) { bytes(&v, sizeof v); }
 };
 
 }  // namespace
@@ -228,32 +234,35 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
   return result;
 }
 
-void save_compliance_cache(const std::filesystem::path& file, const Digest& key, const ComplianceColumns& columns) {
-  Writer w;
+void save_compliance_cache(const std::filesystem::path& file, const Digest& key, const ComplianceColumns& columns,
+                           ProgressLog* progress) {
+  std::error_code ec;
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
+  if (ec) throw Error(fmt::format("{}: cannot create the cache directory: {}", file.parent_path().string(), ec.message()));
+  // Sorted by node so the same columns always give the same file.
+  std::vector<int> nodes;
+  for (const auto& entry : columns.columns()) nodes.push_back(entry.first);
+  std::sort(nodes.begin(), nodes.end());
+  if (progress) progress->set_total(static_cast<double>(nodes.size()));
+
+  AtomicFile out(file);
+  HashingWriter w{out, {}};
   w.bytes(kMagic, sizeof kMagic);
   w.value(kComplianceCacheFormatVersion);
   w.value(key);
   const auto& rows = columns.row_nodes();
   w.value(static_cast<std::uint32_t>(rows.size()));
   w.bytes(rows.data(), rows.size() * sizeof(int));
-  // Sorted by node so the same columns always give the same file.
-  std::vector<int> nodes;
-  for (const auto& entry : columns.columns()) nodes.push_back(entry.first);
-  std::sort(nodes.begin(), nodes.end());
   w.value(static_cast<std::uint32_t>(nodes.size()));
   for (int node : nodes) {
     const ComplianceColumn& column = columns.columns().at(node);
     w.value(node);
-    w.bytes(column.data(), static_cast<std::size_t>(column.size()) * sizeof(double));
+    w.column(column.data(), static_cast<std::size_t>(column.size()));
+    if (progress) progress->add(1);
   }
-  const Digest checksum = digest_of(w.buffer.data(), w.buffer.size());
-  w.value(checksum);
-
-  std::error_code ec;
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
-  if (ec) throw Error(fmt::format("{}: cannot create the cache directory: {}", file.parent_path().string(), ec.message()));
-  AtomicFile out(file);
-  out.write(std::string_view(w.buffer.data(), w.buffer.size()));
+  const Digest checksum = w.hasher.finish();
+  out.write(std::string_view(reinterpret_cast<const char*>(checksum.data()), checksum.size()));
+  if (progress) progress->set_phase("syncing " + file.string() + " to disk");
   out.commit();
 }
 

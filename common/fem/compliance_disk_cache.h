@@ -24,8 +24,9 @@
 namespace cohaptic {
 
 // 2: columns solved in fixed groups; 3: groups of 4 (a column's bits depend on its group's
-// size); 4: the route in the key
-constexpr std::uint32_t kComplianceCacheFormatVersion = 4;
+// size); 4: the route in the key; 5: the Schur route's interior order and dense inverse
+// (its bits)
+constexpr std::uint32_t kComplianceCacheFormatVersion = 5;
 
 /// How the columns were computed: solves in fixed groups (ComplianceColumns), or every row
 /// node's at once by the Schur complement (schur_compliance.h).
@@ -51,6 +52,8 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
 
 /// Writes every cached column, atomically (temporary file, then rename). Throws Error
 /// naming the file and the reason (e.g. a full disk); an existing cache is left intact.
-void save_compliance_cache(const std::filesystem::path& file, const Digest& key, const ComplianceColumns& columns);
+/// `progress`, if given, counts the columns written, then shows the sync to disk.
+void save_compliance_cache(const std::filesystem::path& file, const Digest& key, const ComplianceColumns& columns,
+                           ProgressLog* progress = nullptr);
 
 }  // namespace cohaptic

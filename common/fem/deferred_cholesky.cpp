@@ -32,13 +32,13 @@ DeferredCholesky DeferredCholesky::borrowing(const SparseCholesky& factor) {
   return handle;
 }
 
-const SparseCholesky& DeferredCholesky::factor() const {
+const SparseCholesky& DeferredCholesky::factor(ProgressLog* progress) const {
   if (!state_) throw Error("no matrix to factor");
   if (const SparseCholesky* ready = state_->ready.load(std::memory_order_acquire)) return *ready;
   const std::lock_guard lock(state_->mutex);
   if (!state_->ready.load(std::memory_order_relaxed)) {
     const Stopwatch watch;
-    state_->factor = std::make_unique<const SparseCholesky>(state_->matrix, state_->name_row);
+    state_->factor = std::make_unique<const SparseCholesky>(state_->matrix, state_->name_row, progress);
     state_->factor_ms = watch.elapsed_ms();
     spdlog::info("factored the {0}x{0} stiffness matrix ({1:.3g} nonzeros in the factor) in {2:.0f} ms",
                  state_->factor->size(), state_->factor->factor_nonzeros(), state_->factor_ms);

@@ -26,8 +26,9 @@ class DeferredCholesky {
   static DeferredCholesky borrowing(const SparseCholesky& factor);
 
   /// The factor, computed on the first call (SparseCholesky's constructor: it throws
-  /// NumericalError naming the row where positive definiteness failed).
-  const SparseCholesky& factor() const;
+  /// NumericalError naming the row where positive definiteness failed), which reports to
+  /// `progress` if given.
+  const SparseCholesky& factor(ProgressLog* progress = nullptr) const;
   const SparseCholesky& operator*() const { return factor(); }
   const SparseCholesky* operator->() const { return &factor(); }
 

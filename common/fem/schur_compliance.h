@@ -10,9 +10,8 @@
 // the factor and the m x m result (8 m^2 bytes).
 //
 // Units: those of K^-1 (m/N for K in N/m). Invariants: the result is symmetric, exactly;
-// the same K and R give the same bits on a machine, whatever the number of threads asked
-// for: the factorisation always runs BLAS on 2 threads (OpenBLAS's rounding depends on its
-// thread count), the inverse in fixed blocks (spd_inverse_from_factor.h).
+// the same K and R give the same bits on a machine: the factorisation and the inverse
+// always run BLAS on kFactorBlasThreads threads (OpenBLAS's rounding depends on their number).
 #pragma once
 
 #include <Eigen/Core>
@@ -25,17 +24,16 @@
 namespace cohaptic {
 
 /// (K^-1)[rows, rows] in `rows`' order for the symmetric positive definite `k` (its lower
-/// triangle read). `rows`: distinct indices into k. The inverse runs on `threads` threads.
-/// `progress`, if given, is told the flops of the whole (the factorisation's, as CHOLMOD's
-/// analysis counts them, and the inverse's) and each part as it is done. Throws
-/// NumericalError if K is not positive definite or CHOLMOD fails.
-Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> rows, int threads = 1,
-                                 ProgressLog* progress = nullptr);
+/// triangle read). `rows`: distinct indices into k. `progress`, if given, is told the flops
+/// of the whole (the factorisation's, as CHOLMOD's analysis counts them, and the inverse's),
+/// the machine's dense flop rate, and each part as it begins and ends. Throws NumericalError
+/// if K is not positive definite or CHOLMOD fails.
+Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> rows, ProgressLog* progress = nullptr);
 
 /// Every row node's column block of `columns` that is missing, all at once by the Schur route
 /// on K_ff (`k_ff`, in `dofs`' free indices): L[row_nodes, row_nodes] in one go. Returns the
 /// columns added.
 std::size_t compute_row_columns_by_schur(ComplianceColumns& columns, const SparseMatrix& k_ff, const DofMap& dofs,
-                                         int threads = 1, ProgressLog* progress = nullptr);
+                                         ProgressLog* progress = nullptr);
 
 }  // namespace cohaptic

@@ -32,7 +32,7 @@ CholeskyWorkspace::~CholeskyWorkspace() = default;
 CholeskyWorkspace::CholeskyWorkspace(CholeskyWorkspace&&) noexcept = default;
 CholeskyWorkspace& CholeskyWorkspace::operator=(CholeskyWorkspace&&) noexcept = default;
 
-SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row)
+SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row, ProgressLog* progress)
     : impl_(std::make_unique<Impl>()), size_(static_cast<int>(matrix.rows())) {
   if (matrix.rows() != matrix.cols())
     throw NumericalError(fmt::format("cannot factor a {}x{} matrix: not square", matrix.rows(), matrix.cols()));
@@ -42,11 +42,17 @@ SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_
   impl_->factor = cholmod_analyze(&view, &c);
   if (impl_->factor == nullptr || c.status < CHOLMOD_OK)
     throw NumericalError(fmt::format("CHOLMOD analysis of a {0}x{0} matrix failed (status {1})", size_, c.status));
+  if (progress) {
+    progress->set_total(c.fl);
+    progress->set_expected_rate(dense_flop_rate());
+    progress->begin_part(c.fl);
+  }
   int ok = 0;
   {
     const ScopedBlasThreads blas(kFactorBlasThreads);
     ok = cholmod_factorize(&view, impl_->factor, &c);
   }
+  if (progress) progress->add(c.fl);
   if (c.status == CHOLMOD_NOT_POSDEF) {
     const auto failed_column = static_cast<std::size_t>(impl_->factor->minor);
     const int row = failed_column < static_cast<std::size_t>(size_)

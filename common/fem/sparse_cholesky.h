@@ -13,6 +13,7 @@
 #include <string>
 
 #include "common/fem/assemble_stiffness.h"
+#include "common/util/progress_log.h"
 
 namespace cohaptic {
 
@@ -36,9 +37,11 @@ class SparseCholesky {
   /// Names row i for error messages, e.g. "node 812 axis y".
   using RowNamer = std::function<std::string(int row)>;
 
-  /// Analyses and factors `matrix` (only its lower triangle is read). Throws
-  /// NumericalError naming the row where positive definiteness failed.
-  explicit SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row = {});
+  /// Analyses and factors `matrix` (only its lower triangle is read). `progress`, if given,
+  /// is told the factorisation's flops (as CHOLMOD's analysis counts them) as its total, the
+  /// machine's dense flop rate, and the part's begin and end. Throws NumericalError naming
+  /// the row where positive definiteness failed.
+  explicit SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row = {}, ProgressLog* progress = nullptr);
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;

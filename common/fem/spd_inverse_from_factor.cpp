@@ -1,93 +1,57 @@
 #include "common/fem/spd_inverse_from_factor.h"
 
-#include <algorithm>
-#include <atomic>
-#include <functional>
-#include <thread>
-#include <vector>
+#include <fmt/format.h>
 
-// BLAS (OpenBLAS), Fortran interface.
+#include <algorithm>
+
+#include "common/fem/cholmod_view.h"
+#include "common/util/blas_threads.h"
+#include "common/util/error.h"
+
+// LAPACK (OpenBLAS's own, parallel dtrtri and dlauum), Fortran interface.
 extern "C" {
-void dtrsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n,
-            const double* alpha, const double* a, const int* lda, double* b, const int* ldb);
-void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const double* alpha,
-            const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c, const int* ldc);
+void dtrtri_(const char* uplo, const char* diag, const int* n, double* a, const int* lda, int* info);
+void dlauum_(const char* uplo, const int* n, double* a, const int* lda, int* info);
 }
 
 namespace cohaptic {
 
 namespace {
 
-constexpr int kBlock = 192;  // columns per block: large enough for BLAS's own blocking, small enough to balance
+double triangular_part_flops(int m) { return static_cast<double>(m) * m * m / 3; }
 
-// Runs task(0), ..., task(count - 1), each once, on `threads` threads, in order of taking.
-void run_tasks(int count, int threads, const std::function<void(int)>& task) {
-  std::atomic<int> next{0};
-  const auto work = [&] {
-    for (int t = next.fetch_add(1); t < count; t = next.fetch_add(1)) task(t);
-  };
-  std::vector<std::thread> helpers;
-  for (int k = 1; k < std::min(threads, count); ++k) helpers.emplace_back(work);
-  work();
-  for (std::thread& helper : helpers) helper.join();
-}
-
-int block_count(int m) { return (m + kBlock - 1) / kBlock; }
-int block_start(int block) { return block * kBlock; }
-int block_width(int m, int block) { return std::min(kBlock, m - block * kBlock); }
-
-// Flops of the triangular solve of block column J, and of block (I, J) of Z^T Z.
-double solve_flops(int m, int block) {
-  const double rows = m - block_start(block);
-  return rows * rows * block_width(m, block);
-}
-double product_flops(int m, int i, int j) {
-  return 2.0 * block_width(m, i) * block_width(m, j) * (m - block_start(i));
+// The strict upper triangle of `a` from its lower one, tile by tile: a tile's writes, along
+// rows of a column-major matrix, stay within the cache lines it has just loaded.
+void mirror_lower_to_upper(Eigen::MatrixXd& a) {
+  constexpr Eigen::Index kTile = 32;
+  const Eigen::Index m = a.rows();
+  for (Eigen::Index j0 = 0; j0 < m; j0 += kTile)
+    for (Eigen::Index i0 = j0; i0 < m; i0 += kTile)
+      for (Eigen::Index j = j0; j < std::min(j0 + kTile, m); ++j)
+        for (Eigen::Index i = std::max(i0, j + 1); i < std::min(i0 + kTile, m); ++i) a(j, i) = a(i, j);
 }
 
 }  // namespace
 
-double spd_inverse_flops(int m) {
-  double flops = 0;
-  for (int i = 0; i < block_count(m); ++i) {
-    flops += solve_flops(m, i);
-    for (int j = 0; j <= i; ++j) flops += product_flops(m, i, j);
-  }
-  return flops;
-}
+double spd_inverse_flops(int m) { return 2 * triangular_part_flops(m); }
 
-void invert_spd_from_factor(Eigen::MatrixXd& factor, int threads, ProgressLog* progress) {
+void invert_spd_from_factor(Eigen::MatrixXd& factor, ProgressLog* progress) {
   const int m = static_cast<int>(factor.rows());
   if (m == 0) return;
-  const int blocks = block_count(m);
-  const auto start = block_start;
-  const auto width = [&](int block) { return block_width(m, block); };
-  const double one = 1, zero = 0;
-
-  // Z = L^-1, lower triangular: block column J solves L[j0:, j0:] Z[j0:, J] = I[j0:, J].
-  // The widest solves (the first columns) go first.
-  Eigen::MatrixXd inverse_factor = Eigen::MatrixXd::Zero(m, m);
-  run_tasks(blocks, threads, [&](int block) {
-    const int j0 = start(block), b = width(block), rows = m - j0;
-    for (int j = 0; j < b; ++j) inverse_factor(j0 + j, j0 + j) = 1;
-    dtrsm_("L", "L", "N", "N", &rows, &b, &one, factor.data() + j0 + static_cast<Eigen::Index>(j0) * m, &m,
-           inverse_factor.data() + j0 + static_cast<Eigen::Index>(j0) * m, &m);
-    if (progress) progress->add(solve_flops(m, block));
-  });
-
-  // S^-1 = Z^T Z: block (I, J), I at or below J, sums Z's rows from i0 on (Z is zero above).
-  std::vector<std::pair<int, int>> pairs;
-  for (int i = 0; i < blocks; ++i)
-    for (int j = 0; j <= i; ++j) pairs.emplace_back(i, j);
-  run_tasks(static_cast<int>(pairs.size()), threads, [&](int task) {
-    const auto [i, j] = pairs[static_cast<std::size_t>(task)];
-    const int i0 = start(i), j0 = start(j), bi = width(i), bj = width(j), depth = m - i0;
-    dgemm_("T", "N", &bi, &bj, &depth, &one, inverse_factor.data() + i0 + static_cast<Eigen::Index>(i0) * m, &m,
-           inverse_factor.data() + i0 + static_cast<Eigen::Index>(j0) * m, &m, &zero,
-           factor.data() + i0 + static_cast<Eigen::Index>(j0) * m, &m);
-    if (progress) progress->add(product_flops(m, i, j));
-  });
-  factor.triangularView<Eigen::StrictlyUpper>() = factor.transpose().triangularView<Eigen::StrictlyUpper>();
+  int info = 0;
+  const ScopedBlasThreads blas(kFactorBlasThreads);
+  // Z = L^-1, lower triangular, in place.
+  if (progress) progress->begin_part(triangular_part_flops(m));
+  dtrtri_("L", "N", &m, factor.data(), &m, &info);
+  if (info != 0)
+    throw NumericalError(fmt::format("the {0}x{0} Cholesky factor cannot be inverted: LAPACK dtrtri returned {1}", m, info));
+  if (progress) progress->add(triangular_part_flops(m));
+  // S^-1 = Z^T Z: its lower triangle, in place.
+  if (progress) progress->begin_part(triangular_part_flops(m));
+  dlauum_("L", &m, factor.data(), &m, &info);
+  if (info != 0) throw NumericalError(fmt::format("LAPACK dlauum returned {} on a {}x{} matrix", info, m, m));
+  if (progress) progress->add(triangular_part_flops(m));
+  mirror_lower_to_upper(factor);
 }
 
 }  // namespace cohaptic

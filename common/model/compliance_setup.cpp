@@ -4,11 +4,11 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <thread>
 
 #include "common/fem/compliance_disk_cache.h"
 #include "common/fem/schur_compliance.h"
 #include "common/mesh/compact_groups.h"
+#include "common/util/blas_threads.h"
 #include "common/util/error.h"
 #include "common/util/progress_log.h"
 #include "common/util/stopwatch.h"
@@ -29,7 +29,7 @@ std::filesystem::path default_cache_directory() {
 namespace {
 
 // Precomputed touchable columns that are at least half of the row nodes come by the Schur
-// complement (every row node's at once, on every core); any others by solves.
+// complement (every row node's at once, BLAS on kFactorBlasThreads threads); any others by solves.
 ComplianceRoute route_of(const ElasticBody& body, const ComplianceColumns& columns) {
   return body.spec.compliance.precompute_touchable && 2 * body.touchable_nodes.size() >= columns.row_nodes().size()
              ? ComplianceRoute::schur
@@ -49,9 +49,9 @@ void precompute_touchable_columns(const ElasticBody& body, ComplianceColumns& co
     columns.compute_columns(body.touchable_nodes);
     return;
   }
-  const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  spdlog::info("compliance: {} row nodes at once (Schur complement, {} threads)", columns.row_nodes().size(), threads);
-  compute_row_columns_by_schur(columns, restrict_to_dofs(body.stiffness, body.dofs.free_dofs), body.dofs, threads, &progress);
+  spdlog::info("compliance: {} row nodes at once (Schur complement, BLAS on {} threads, OpenBLAS's {} kernels)",
+               columns.row_nodes().size(), kFactorBlasThreads, blas_kernels());
+  compute_row_columns_by_schur(columns, restrict_to_dofs(body.stiffness, body.dofs.free_dofs), body.dofs, &progress);
 }
 
 }  // namespace
@@ -82,11 +82,11 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
   const auto& rows = columns.row_nodes();
   if (!std::all_of(rows.begin(), rows.end(), [&](int node) { return columns.has_column(node); })) {
     progress.set_phase("factoring the stiffness matrix");
-    body.free_factor.factor();
+    body.free_factor.factor(&progress);
   }
   if (use_disk && columns.column_count() > before) {
     progress.set_phase("saving the columns to " + setup.cache_file.string());
-    save_compliance(body, columns, *cache_directory);
+    save_compliance(body, columns, *cache_directory, &progress);
     setup.note += fmt::format("; computed {} columns and saved them", columns.column_count() - before);
   }
   setup.columns = columns.column_count();
@@ -96,10 +96,11 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
   return setup;
 }
 
-void save_compliance(const ElasticBody& body, const ComplianceColumns& columns, const std::filesystem::path& cache_directory) {
+void save_compliance(const ElasticBody& body, const ComplianceColumns& columns, const std::filesystem::path& cache_directory,
+                     ProgressLog* progress) {
   const Digest key = cache_key(body, columns);
   try {
-    save_compliance_cache(compliance_cache_file(cache_directory, key), key, columns);
+    save_compliance_cache(compliance_cache_file(cache_directory, key), key, columns, progress);
   } catch (const Error& e) {
     spdlog::warn("compliance cache not saved (the results are unaffected): {}", e.what());
   }

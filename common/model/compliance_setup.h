@@ -9,6 +9,7 @@
 
 #include "common/fem/compliance.h"
 #include "common/model/elastic_body.h"
+#include "common/util/progress_log.h"
 
 namespace cohaptic {
 
@@ -35,7 +36,9 @@ std::filesystem::path default_cache_directory();
 ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& columns,
                                    const std::optional<std::filesystem::path>& cache_directory);
 
-/// Saves the columns computed so far (e.g. on-demand columns at shutdown). Logs failures.
-void save_compliance(const ElasticBody& body, const ComplianceColumns& columns, const std::filesystem::path& cache_directory);
+/// Saves the columns computed so far (e.g. on-demand columns at shutdown), reporting to
+/// `progress` if given. Logs failures.
+void save_compliance(const ElasticBody& body, const ComplianceColumns& columns, const std::filesystem::path& cache_directory,
+                     ProgressLog* progress = nullptr);
 
 }  // namespace cohaptic

@@ -16,6 +16,7 @@ namespace cohaptic {
 struct SceneCompliance {
   std::vector<std::unique_ptr<ComplianceColumns>> owned;
   std::vector<ComplianceColumns*> per_body;  ///< body i's columns; null when it is not linear elastic
+  std::vector<std::size_t> columns_at_load;  ///< body i's column count once prepared (0 for the other kinds)
 };
 
 /// `whole_surface`: keep every surface node's rows (compliance_row_nodes), for obstacles or
@@ -23,8 +24,8 @@ struct SceneCompliance {
 SceneCompliance prepare_scene_compliance(const Model& model, bool whole_surface,
                                          const std::optional<std::filesystem::path>& cache_directory);
 
-/// Saves what each FEM body computed on demand (save_compliance), for bodies whose scene
-/// settings keep a disk cache.
+/// Saves the columns of each FEM body that computed some on demand since it was prepared
+/// (save_compliance), for bodies whose scene settings keep a disk cache.
 void save_scene_compliance(const Model& model, const SceneCompliance& compliance, const std::filesystem::path& cache_directory);
 
 }  // namespace cohaptic

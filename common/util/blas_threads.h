@@ -8,7 +8,23 @@
 // number of them: OpenBLAS's rounding depends on it.
 #pragma once
 
+#include <string>
+
 namespace cohaptic {
+
+/// BLAS threads for a factorisation or a dense inverse at load: always this many, whatever
+/// the machine, since OpenBLAS's rounding depends on its thread count and a replay must
+/// factor as the session did.
+constexpr int kFactorBlasThreads = 2;
+
+/// The kernels BLAS chose for this CPU ("Haswell", "SkylakeX", ...: OpenBLAS's core name,
+/// which OPENBLAS_CORETYPE overrides), or "unknown" with another BLAS.
+std::string blas_kernels();
+
+/// The dense flop rate [flop/s] BLAS reaches here on kFactorBlasThreads threads: a matrix
+/// product's, measured once per process (a few milliseconds) and remembered. An estimate
+/// for a progress line's time left, not a promise.
+double dense_flop_rate();
 
 /// Asks OpenBLAS for one thread. A no-op with a BLAS that has no such control.
 void use_single_blas_thread();

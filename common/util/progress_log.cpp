@@ -12,6 +12,7 @@ namespace {
 
 constexpr std::chrono::seconds kLineEvery{1};  // and the first line after it: a shorter task logs nothing
 constexpr int kBarWidth = 20;
+constexpr double kPartShownAtMost = 0.95;  // of a part's work, until it reports its end
 
 }  // namespace
 
@@ -35,29 +36,49 @@ void ProgressLog::set_total(double total) {
   const std::lock_guard lock(mutex_);
   total_ = total;
   done_ = 0;
+  part_work_ = 0;
+  total_watch_ = Stopwatch();
 }
 
 void ProgressLog::add(double work) {
   const std::lock_guard lock(mutex_);
   done_ += work;
+  part_work_ = 0;
+}
+
+void ProgressLog::begin_part(double work) {
+  const std::lock_guard lock(mutex_);
+  part_work_ = work;
+  part_watch_ = Stopwatch();
+}
+
+void ProgressLog::set_expected_rate(double work_per_s) {
+  const std::lock_guard lock(mutex_);
+  expected_rate_ = work_per_s;
 }
 
 void ProgressLog::log_every_second() {
   std::unique_lock lock(mutex_);
   while (!stopping_.wait_for(lock, kLineEvery, [this] { return stop_; })) {
-    const std::string text = line(phase_.empty() ? what_ : what_ + ", " + phase_, done_, total_, watch_.elapsed_ms() / 1000);
+    const double done = shown_done(done_, part_work_, expected_rate_, part_watch_.elapsed_ms() / 1000);
+    const std::string text = line(phase_.empty() ? what_ : what_ + ", " + phase_, done, total_, watch_.elapsed_ms() / 1000,
+                                  total_watch_.elapsed_ms() / 1000);
     lock.unlock();  // the reporting threads do not wait on the log's output
     spdlog::info("{}", text);
     lock.lock();
   }
 }
 
-std::string ProgressLog::line(const std::string& what, double done, double total, double elapsed_s) {
+double ProgressLog::shown_done(double done, double part_work, double expected_rate, double part_elapsed_s) {
+  return done + std::min(kPartShownAtMost * part_work, expected_rate * part_elapsed_s);
+}
+
+std::string ProgressLog::line(const std::string& what, double done, double total, double elapsed_s, double counting_s) {
   const double share = total > 0 ? std::clamp(done / total, 0.0, 1.0) : 0.0;
   const int filled = static_cast<int>(std::lround(share * kBarWidth));
   std::string text = fmt::format("{} [{}{}] {:3.0f} %, {:.1f} s", what, std::string(static_cast<std::size_t>(filled), '#'),
                                  std::string(static_cast<std::size_t>(kBarWidth - filled), '.'), 100 * share, elapsed_s);
-  if (share > 0 && share < 1) text += fmt::format(", about {:.0f} s left", elapsed_s * (1 - share) / share);
+  if (share > 0 && share < 1) text += fmt::format(", about {:.0f} s left", counting_s * (1 - share) / share);
   return text;
 }
 

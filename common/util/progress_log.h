@@ -3,7 +3,9 @@
 // done, the time spent and the time left (from the rate so far; none while nothing is
 // counted done yet); nothing for a task that ends within its first second. Its own thread
 // writes the lines, so that a step that reports nothing for a while (a factorisation) still
-// shows the time going on; any thread may report (a mutex guards the counts).
+// shows the time going on; any thread may report (a mutex guards the counts). A part that
+// reports only when it ends (begin_part, then add) moves the bar meanwhile at the rate the
+// machine is expected to reach (set_expected_rate), never past the part's own end.
 #pragma once
 
 #include <condition_variable>
@@ -25,13 +27,23 @@ class ProgressLog {
 
   /// What the task is doing now ("factorising K"), shown after its name.
   void set_phase(std::string phase);
-  /// The total work, in any unit (flops, columns); done so far starts at 0.
+  /// The total work, in any unit (flops, columns); done so far starts at 0, and the rate
+  /// for the time left is counted from now.
   void set_total(double total);
-  /// `work` more of it is done.
+  /// `work` more of it is done; ends the part begun, if any.
   void add(double work);
+  /// A part of `work` starts now that reports nothing until it ends (a factorisation).
+  void begin_part(double work);
+  /// The rate [work per second] a part is expected to run at; 0 (the default): a part
+  /// shows no progress until it ends.
+  void set_expected_rate(double work_per_s);
 
-  /// The line for `done` of `total` after `elapsed_s` [s]: bar, per cent, time spent, time left.
-  static std::string line(const std::string& what, double done, double total, double elapsed_s);
+  /// The work shown as done `part_elapsed_s` [s] into a part of `part_work` that began after
+  /// `done`, at `expected_rate`: short of the part's end until it reports it.
+  static double shown_done(double done, double part_work, double expected_rate, double part_elapsed_s);
+  /// The line for `done` of `total` after `elapsed_s` [s] in all and `counting_s` [s] since
+  /// the total was set: bar, per cent, time spent, and time left at the rate since then.
+  static std::string line(const std::string& what, double done, double total, double elapsed_s, double counting_s);
 
  private:
   void log_every_second();
@@ -42,6 +54,8 @@ class ProgressLog {
   std::condition_variable stopping_;
   bool stop_ = false;
   double total_ = 0, done_ = 0;
+  double part_work_ = 0, expected_rate_ = 0;
+  Stopwatch total_watch_, part_watch_;
   std::thread logger_;  // last: it starts once the rest is ready
 };
 
