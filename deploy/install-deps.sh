@@ -9,8 +9,9 @@ set -euo pipefail
 packages=(
   # toolchain
   build-essential cmake pkg-config git ca-certificates
-  # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it
-  libeigen3-dev libsuitesparse-dev libopenblas-dev
+  # numerics: Eigen, CHOLMOD (SuiteSparse) with OpenBLAS behind it; Boost.Math (headers: the
+  # F and studentized range distributions of the paired-comparison analysis)
+  libeigen3-dev libsuitesparse-dev libopenblas-dev libboost-dev
   # networking and the wire format (zstd: the IR streams); the live view's web server
   libasio-dev libprotobuf-dev protobuf-compiler libsodium-dev libzstd-dev libwebsocketpp-dev
   # configuration, command line, logging, JSON output
