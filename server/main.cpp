@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
   if (const std::vector<std::string> rest = app.remaining(); !rest.empty()) {
     for (const char* tool : {"probe", "replay", "study", "tradeoff", "stability", "summarize", "keygen"})
       if (rest.front() == tool) {
-        fmt::print(stderr, "cohaptic-server {0}: the offline tools moved to their own program: run `cohaptic-lab {0} ...`\n",
+        fmt::print(stderr, "cohaptic-server {0}: {0} is a cohaptic-lab command: run `cohaptic-lab {0} ...`\n",
                    tool);
         return 2;
       }

@@ -25,7 +25,7 @@ TEST(LabProgram, EveryToolIsASubcommandWithItsOwnHelp) {
   EXPECT_NE(testing::run_program(COHAPTIC_LAB_EXE, "serve").exit_code, 0);
 }
 
-TEST(LabProgram, TheServersOldSpellingsFailWithOneLineNamingTheNewOne) {
+TEST(LabProgram, ALabToolNamedToTheServerFailsWithOneLineNamingTheLabCommand) {
   for (const std::string tool : kLabTools) {
     for (const std::string& arguments : {tool + " --help", "--log-level warn " + tool + " --scene /no/such.yaml"}) {
       const testing::ProgramRun run = testing::run_program(COHAPTIC_SERVER_EXE, arguments, true);
