@@ -17,7 +17,6 @@ namespace {
 
 constexpr char kMagic[8] = {'C', 'H', 'C', 'O', 'M', 'P', 'L', '\0'};
 
-// Appends plain values to a byte buffer.
 // A digest computed on a thread of its own from the pieces handed to it, in order, so that
 // reading the next piece overlaps hashing the last. A piece is either copied (small
 // values) or kept by pointer (a column, whose memory stays put until finish()).

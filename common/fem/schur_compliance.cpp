@@ -76,9 +76,8 @@ Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> row
   const double factor_flops = c.fl;  // as the analysis counts them
   if (progress) {
     progress->set_total(factor_flops + spd_inverse_flops(m));
-    progress->set_expected_rate(dense_flop_rate());
     progress->set_phase(fmt::format("factorising K ({} dofs, the {} rows last)", n, m));
-    progress->begin_part(factor_flops);
+    progress->begin_part(factor_flops, dense_flop_rate());
   }
   bool factored = false;
   {

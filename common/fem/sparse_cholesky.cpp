@@ -44,8 +44,7 @@ SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_
     throw NumericalError(fmt::format("CHOLMOD analysis of a {0}x{0} matrix failed (status {1})", size_, c.status));
   if (progress) {
     progress->set_total(c.fl);
-    progress->set_expected_rate(dense_flop_rate());
-    progress->begin_part(c.fl);
+    progress->begin_part(c.fl, dense_flop_rate());
   }
   int ok = 0;
   {

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 
-#include "common/fem/cholmod_view.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
 
@@ -41,13 +40,13 @@ void invert_spd_from_factor(Eigen::MatrixXd& factor, ProgressLog* progress) {
   int info = 0;
   const ScopedBlasThreads blas(kFactorBlasThreads);
   // Z = L^-1, lower triangular, in place.
-  if (progress) progress->begin_part(triangular_part_flops(m));
+  if (progress) progress->begin_part(triangular_part_flops(m), dense_flop_rate());
   dtrtri_("L", "N", &m, factor.data(), &m, &info);
   if (info != 0)
     throw NumericalError(fmt::format("the {0}x{0} Cholesky factor cannot be inverted: LAPACK dtrtri returned {1}", m, info));
   if (progress) progress->add(triangular_part_flops(m));
   // S^-1 = Z^T Z: its lower triangle, in place.
-  if (progress) progress->begin_part(triangular_part_flops(m));
+  if (progress) progress->begin_part(triangular_part_flops(m), dense_flop_rate());
   dlauum_("L", &m, factor.data(), &m, &info);
   if (info != 0) throw NumericalError(fmt::format("LAPACK dlauum returned {} on a {}x{} matrix", info, m, m));
   if (progress) progress->add(triangular_part_flops(m));

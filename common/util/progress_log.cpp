@@ -46,21 +46,17 @@ void ProgressLog::add(double work) {
   part_work_ = 0;
 }
 
-void ProgressLog::begin_part(double work) {
+void ProgressLog::begin_part(double work, double work_per_s) {
   const std::lock_guard lock(mutex_);
   part_work_ = work;
+  part_rate_ = work_per_s;
   part_watch_ = Stopwatch();
-}
-
-void ProgressLog::set_expected_rate(double work_per_s) {
-  const std::lock_guard lock(mutex_);
-  expected_rate_ = work_per_s;
 }
 
 void ProgressLog::log_every_second() {
   std::unique_lock lock(mutex_);
   while (!stopping_.wait_for(lock, kLineEvery, [this] { return stop_; })) {
-    const double done = shown_done(done_, part_work_, expected_rate_, part_watch_.elapsed_ms() / 1000);
+    const double done = shown_done(done_, part_work_, part_rate_, part_watch_.elapsed_ms() / 1000);
     const std::string text = line(phase_.empty() ? what_ : what_ + ", " + phase_, done, total_, watch_.elapsed_ms() / 1000,
                                   total_watch_.elapsed_ms() / 1000);
     lock.unlock();  // the reporting threads do not wait on the log's output

@@ -5,7 +5,7 @@
 // writes the lines, so that a step that reports nothing for a while (a factorisation) still
 // shows the time going on; any thread may report (a mutex guards the counts). A part that
 // reports only when it ends (begin_part, then add) moves the bar meanwhile at the rate the
-// machine is expected to reach (set_expected_rate), never past the part's own end.
+// machine is expected to reach for it, never past the part's own end.
 #pragma once
 
 #include <condition_variable>
@@ -32,11 +32,9 @@ class ProgressLog {
   void set_total(double total);
   /// `work` more of it is done; ends the part begun, if any.
   void add(double work);
-  /// A part of `work` starts now that reports nothing until it ends (a factorisation).
-  void begin_part(double work);
-  /// The rate [work per second] a part is expected to run at; 0 (the default): a part
-  /// shows no progress until it ends.
-  void set_expected_rate(double work_per_s);
+  /// A part of `work` starts now that reports nothing until it ends (a factorisation),
+  /// expected to run at `work_per_s` (0: it shows no progress until it ends).
+  void begin_part(double work, double work_per_s);
 
   /// The work shown as done `part_elapsed_s` [s] into a part of `part_work` that began after
   /// `done`, at `expected_rate`: short of the part's end until it reports it.
@@ -54,7 +52,7 @@ class ProgressLog {
   std::condition_variable stopping_;
   bool stop_ = false;
   double total_ = 0, done_ = 0;
-  double part_work_ = 0, expected_rate_ = 0;
+  double part_work_ = 0, part_rate_ = 0;
   Stopwatch total_watch_, part_watch_;
   std::thread logger_;  // last: it starts once the rest is ready
 };
