@@ -18,7 +18,8 @@ namespace cohaptic::testing {
 using cohaptic::ChildProcess;
 using cohaptic::listening_port;
 
-/// A fresh directory under the test temp dir.
+/// A fresh directory under the test temp dir, removed when the test that made it passes
+/// (kept, and named on stdout, when it fails).
 std::filesystem::path scratch_directory(const std::string& name);
 
 /// Path of a built program (server or client).
