@@ -1,6 +1,7 @@
 #include "common/sim/simulation.h"
 
 #include <algorithm>
+#include <future>
 #include <limits>
 #include <utility>
 
@@ -381,17 +382,43 @@ StepReport Simulation::step(double time) {
                 sphere_solve_->obstacle_constraints()};
       if (sets_changed) built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
     }
-    for (std::size_t i = 0; i < tools.size(); ++i) {
+    // One user's IR, and (when the sets changed) prepared for the server's own evaluation.
+    struct BuiltIr {
+      std::shared_ptr<const PreparedIR> ir;
+      EvaluationState state;
+      std::size_t bytes = 0;
+    };
+    const auto build = [&](std::size_t i) {
+      IntermediateRepresentation ir = build_ir(body_, condensation, tools, i, held, options_.ir,
+                                               users_[tools[i].user].epoch + 1, time, rest_displacement, sphere);
+      BuiltIr built;
+      if (!sets_changed) return built;
+      built.bytes = ir.size_bytes();
+      built.ir = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
+      built.state = make_evaluation_state(*built.ir);
+      return built;
+    };
+    std::vector<BuiltIr> built(tools.size());
+    if (sphere_model() && tools.size() > 1) {
+      // A sphere IR is cut from W and the body alone (neither the condensation nor a
+      // support's load is touched), so the users' IRs are built side by side, one thread per
+      // further user, joined here: a rebuild that changes every IR costs about one build.
+      std::vector<std::future<BuiltIr>> others;
+      for (std::size_t i = 1; i < tools.size(); ++i) others.push_back(std::async(std::launch::async, build, i));
+      built[0] = build(0);  // should it throw, the futures' destructors join their threads first
+      for (std::size_t i = 1; i < tools.size(); ++i) built[i] = others[i - 1].get();
+    } else {
+      for (std::size_t i = 0; i < tools.size(); ++i) built[i] = build(i);  // condense() updates the condensation
+    }
+    for (std::size_t i = 0; i < tools.size() && sets_changed; ++i) {
       UserState& user = users_[tools[i].user];
-      IntermediateRepresentation ir = build_ir(body_, condensation, tools, i, held, options_.ir, user.epoch + 1, time,
-                                               rest_displacement, sphere);
-      if (!sets_changed) continue;
       ++user.epoch;
-      report.ir_bytes += ir.size_bytes();
+      report.ir_bytes += built[i].bytes;
       if (sphere_model())
-        for (const std::int64_t tag : condensed_fem(ir).node_ids) built_sphere_rows_[static_cast<std::size_t>(node_of_tag_.at(tag))] = 1;
-      user.ir = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
-      p0_states_[static_cast<std::size_t>(tools[i].user)] = make_evaluation_state(*user.ir);
+        for (const std::int64_t tag : condensed_fem(built[i].ir->ir).node_ids)
+          built_sphere_rows_[static_cast<std::size_t>(node_of_tag_.at(tag))] = 1;
+      user.ir = std::move(built[i].ir);
+      p0_states_[static_cast<std::size_t>(tools[i].user)] = std::move(built[i].state);
     }
     built_nearest_ = nearest;
     if (sphere_model() && sets_changed) {
