@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <functional>
 #include <fstream>
 #include <initializer_list>
 #include <memory>
@@ -129,7 +130,8 @@ Study load_study(const std::filesystem::path& file) { return parse_study(read_te
 Study parse_study(const std::string& yaml_text, const std::filesystem::path& file) {
   const std::string name = file.string();
   const YamlCursor top(load_yaml(yaml_text, name), "", &name, 1);
-  top.only_keys({"name", "scene", "trial_duration", "condensation", "participants", "factors", "repetitions", "order", "session"});
+  top.only_keys({"name", "scene", "trial_duration", "condensation", "participants", "factors", "repetitions", "order",
+                 "session", "paired_comparison"});
   const std::filesystem::path base = file.has_parent_path() ? file.parent_path() : ".";
   Study study;
   study.file = file;
@@ -200,6 +202,13 @@ Study parse_study(const std::string& yaml_text, const std::filesystem::path& fil
         session->at(key).fail_message(fmt::format("'{}' is a column of trials.csv already: give the session field another name", key));
       study.session[key] = session->at(key).text();
     }
+
+  if (auto paired = top.find("paired_comparison")) {
+    study.paired = parse_paired_comparison(*paired);
+    if (study.conditions.size() < 3)
+      paired->fail_message(fmt::format("a paired comparison needs at least 3 conditions; the factors give {}",
+                                       study.conditions.size()));
+  }
 
   const int n = static_cast<int>(study.conditions.size());
   for (int rep = 1; rep <= study.repetitions; ++rep) {
@@ -381,6 +390,55 @@ void write_figures(const Study& study, const std::filesystem::path& out, const s
   }
 }
 
+// The factors that vary across the conditions (a full factorial: parse_study makes every
+// combination), each condition's level of each.
+StudyFactors factors_of(const std::vector<StudyCondition>& conditions) {
+  const std::vector<std::pair<std::string, std::function<std::string(const StudyCondition&)>>> fields = {
+      {"shift_ms", [](const StudyCondition& c) { return number(c.shift_ms); }},
+      {"jitter_ms", [](const StudyCondition& c) { return number(c.jitter_ms); }},
+      {"loss", [](const StudyCondition& c) { return number(c.loss); }},
+      {"step_nodes", [](const StudyCondition& c) { return std::to_string(c.step_nodes); }},
+      {"sim_rate_hz", [](const StudyCondition& c) { return number(c.sim_rate_hz); }},
+      {"protocol", [](const StudyCondition& c) { return c.protocol; }}};
+  StudyFactors factors;
+  factors.level_of.resize(conditions.size());
+  for (const auto& [name, level_text] : fields) {
+    std::vector<std::string> levels;
+    std::vector<int> level_of;
+    for (const StudyCondition& condition : conditions) {
+      const std::string text = level_text(condition);
+      auto at = std::find(levels.begin(), levels.end(), text);
+      if (at == levels.end()) at = levels.insert(levels.end(), text);
+      level_of.push_back(static_cast<int>(at - levels.begin()));
+    }
+    if (levels.size() < 2) continue;
+    factors.names.push_back(name);
+    factors.level_count.push_back(static_cast<int>(levels.size()));
+    for (std::size_t c = 0; c < conditions.size(); ++c) factors.level_of[c].push_back(level_of[c]);
+  }
+  return factors;
+}
+
+// measures[r][c]: condition c's measures in repetition r + 1, from the first participant's
+// rows of trials.csv (all ok: the caller has checked).
+std::vector<std::vector<TrialMeasures>> measures_by_repetition(const Study& study, const std::vector<std::string>& header,
+                                                               const std::vector<std::vector<std::string>>& rows) {
+  const auto column = [&](const std::string& name) { return column_of(header, name); };
+  std::vector<std::vector<TrialMeasures>> measures(static_cast<std::size_t>(study.repetitions),
+                                                   std::vector<TrialMeasures>(study.conditions.size()));
+  const std::string& participant = study.participants.front().name;
+  for (const auto& row : rows) {
+    if (row[column("participant")] != participant) continue;
+    const auto condition = std::find_if(study.conditions.begin(), study.conditions.end(),
+                                        [&](const StudyCondition& c) { return c.name() == row[column("condition")]; });
+    if (condition == study.conditions.end()) continue;
+    measures[static_cast<std::size_t>(std::stoi(row[column("repetition")]) - 1)]
+            [static_cast<std::size_t>(condition - study.conditions.begin())] =
+        trial_measures_from([&](std::string_view name) { return std::stod(row[column(std::string(name))]); });
+  }
+  return measures;
+}
+
 }  // namespace
 
 int run_study(const std::filesystem::path& file, const StudyRunOptions& given) {
@@ -484,6 +542,14 @@ int run_study(const std::filesystem::path& file, const StudyRunOptions& given) {
   write_figures(study, options.out, header, rows);
   fmt::print("wrote {}, {} and {}\n", trials_file.string(), (options.out / "summary.csv").string(),
              (options.out / "figures").string());
+  if (study.paired && failed_now.empty()) {
+    std::vector<std::string> names;
+    for (const StudyCondition& condition : study.conditions) names.push_back(condition.name());
+    run_paired_comparisons(*study.paired, study.name, names, factors_of(study.conditions),
+                           measures_by_repetition(study, header, rows), options.out);
+    fmt::print("wrote {}, {} and {}\n", (options.out / "ratings.csv").string(), (options.out / "analysis").string(),
+               (options.out / "figures" / "scale.svg").string());
+  }
   if (failed_now.empty()) return 0;
   fmt::print(stderr, "{} trial(s) failed (their status in {} says why): run the study again to retry them\n",
              failed_now.size(), trials_file.string());

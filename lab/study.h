@@ -11,15 +11,19 @@
 // the figures: DIR/figures/fig4.svg (normalised force against time under step delay, P0
 // and P1, the paper's Fig. 4) and DIR/figures/<measure>.svg (each measure per condition).
 // Interrupted and run again with the same study file and DIR, it continues where it
-// stopped: trials already in trials.csv are not run again.
+// stopped: trials already in trials.csv are not run again. A study with a
+// `paired_comparison` block then has its pairs rated and analysed by Scheffe's method
+// (lab/paired_comparison_study.h).
 #pragma once
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lab/lab_command.h"
+#include "lab/paired_comparison_study.h"
 
 namespace cohaptic {
 
@@ -57,6 +61,9 @@ struct Study {
   unsigned seed = 1;
   std::map<std::string, std::string> session;  ///< participant/session fields, copied to every row
   std::vector<StudyTrial> trials;              ///< in run order
+  /// A paired-comparison study: its trials measure every condition `repetitions` times, then
+  /// its subjects rate every pair (lab/paired_comparison_study.h).
+  std::optional<PairedComparisonDesign> paired;
 };
 
 /// Parses and validates a study file (errors name the file, line and key). Trials are

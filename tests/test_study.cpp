@@ -82,6 +82,17 @@ std::vector<std::map<std::string, std::string>> read_table(const fs::path& file)
   return rows;
 }
 
+// The error loading a study file with `body` gives ("no error" if none).
+std::string study_file_error(const fs::path& dir, const std::string& body) {
+  write_study_files(dir, body);
+  try {
+    load_study(dir / "study.yaml");
+  } catch (const Error& e) {
+    return std::string(e.what());
+  }
+  return std::string("no error");
+}
+
 TEST(StudyFile, CrossesTheFactorsAndOrdersTheTrialsAsAsked) {
   const fs::path dir = testing::scratch_directory("study-file");
   write_study_files(dir, study_text("  shift_ms: [0, 30]\n  step_nodes: [0, 150]\n  protocol: [P0, P1]",
@@ -126,15 +137,7 @@ TEST(StudyFile, ALatinSquareBalancesPositionsAndSuccessions) {
 
 TEST(StudyFile, MistakesAreNamedWithTheirKey) {
   const fs::path dir = testing::scratch_directory("study-errors");
-  const auto error_of = [&](const std::string& body) {
-    write_study_files(dir, body);
-    try {
-      load_study(dir / "study.yaml");
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  const auto error_of = [&](const std::string& body) { return study_file_error(dir, body); };
   std::string e = error_of(study_text("  shift_ms: [0, -5]"));
   EXPECT_NE(e.find("study.yaml"), std::string::npos) << e;
   EXPECT_NE(e.find("factors.shift_ms"), std::string::npos) << e;
@@ -275,6 +278,110 @@ TEST(Study, OnAMachineSlowedByBusyProcessesAPressIsStillOneStroke) {
     EXPECT_GE(std::stod(row.at("fades")), 0) << trial << ": the client's report counts its fades";
     EXPECT_GE(std::stod(row.at("fade_s")), 0) << trial;
   }
+}
+
+
+// A paired-comparison block: the conditions' trials, then simulated subjects' ratings.
+std::string paired_study_text(const std::string& factors, int subjects) {
+  return study_text(factors) + fmt::format(R"(paired_comparison:
+  quality: finer
+  subjects: {}
+  rater: {{kind: simulated, seed: 7}}
+)",
+                                           subjects);
+}
+
+TEST(PairedComparisonStudyFile, MistakesAreNamedWithTheirKey) {
+  const fs::path dir = testing::scratch_directory("paired-errors");
+  const auto error_of = [&](const std::string& body) { return study_file_error(dir, body); };
+  std::string e = error_of(paired_study_text("  protocol: [P0, P1]", 4));
+  EXPECT_NE(e.find("at least 3 conditions; the factors give 2"), std::string::npos) << e;
+  e = error_of(paired_study_text("  step_nodes: [0, 300]\n  protocol: [P0, P1]", 1));
+  EXPECT_NE(e.find("subjects"), std::string::npos) << e;
+  EXPECT_NE(e.find("two subjects"), std::string::npos) << e;
+  std::string text = paired_study_text("  step_nodes: [0, 300]\n  protocol: [P0, P1]", 4);
+  text.replace(text.find("quality: finer"), 14, "quality: smoother");
+  e = error_of(text);
+  EXPECT_NE(e.find("quality"), std::string::npos) << e;
+  EXPECT_NE(e.find("smoother"), std::string::npos) << e;
+  text = paired_study_text("  step_nodes: [0, 300]\n  protocol: [P0, P1]", 4);
+  text.replace(text.find("subjects: 4"), 11, "subjects: 4\n  labels: [a, b, c]");
+  e = error_of(text);
+  EXPECT_NE(e.find("5 labels, from +2 down to -2"), std::string::npos) << e;
+}
+
+TEST(PairedComparisonStudyFile, EverySubjectMeetsEveryPairOnceInABalancedOrder) {
+  constexpr int kConditions = 4, kSubjects = 6;
+  const std::vector<PresentedPair> plan = presentation_plan(kConditions, kSubjects);
+  ASSERT_EQ(plan.size(), static_cast<std::size_t>(kSubjects * 6));
+  std::map<std::pair<int, int>, int> presented;     // (first, second) -> subjects
+  std::map<std::pair<int, int>, int> first_position;  // (low, high) -> subjects that met it first
+  for (int subject = 0; subject < kSubjects; ++subject) {
+    std::set<std::pair<int, int>> met;
+    for (const PresentedPair& pair : plan) {
+      if (pair.subject != subject) continue;
+      EXPECT_NE(pair.first, pair.second);
+      met.emplace(std::min(pair.first, pair.second), std::max(pair.first, pair.second));
+      ++presented[{pair.first, pair.second}];
+      if (pair.position == 0) ++first_position[{std::min(pair.first, pair.second), std::max(pair.first, pair.second)}];
+    }
+    EXPECT_EQ(met.size(), 6u) << "subject " << subject << " meets every pair once";
+  }
+  // Each pair is presented each way round by half the subjects.
+  for (int i = 0; i < kConditions; ++i)
+    for (int j = i + 1; j < kConditions; ++j) {
+      EXPECT_EQ((presented[{i, j}]), kSubjects / 2) << i << " first, then " << j;
+      EXPECT_EQ((presented[{j, i}]), kSubjects / 2) << j << " first, then " << i;
+    }
+  // Not the same pair first for everyone.
+  EXPECT_GT(first_position.size(), 1u);
+}
+
+// With 150 nodes held P0's force changes only at the slowed simulation's rate, P1's at every
+// haptic tick: simulated subjects, rating from the trials' measures, find P1 finer, and
+// Scheffe's analysis says so beyond its 5 % yardstick.
+TEST(PairedComparisonStudy, SimulatedSubjectsRateEveryPairOnceAndTheAnalysisFindsP1FinerUnderStepDelay) {
+  const fs::path dir = testing::scratch_directory("paired-run");
+  constexpr int kSubjects = 4;
+  write_study_files(dir, paired_study_text("  step_nodes: [0, 150]\n  protocol: [P0, P1]", kSubjects));
+  StudyRunOptions options;
+  options.out = dir / "out";
+  options.server_program = testing::server_program();
+  options.client_program = testing::client_program();
+  ASSERT_EQ(run_study(dir / "study.yaml", options), 0);
+
+  const auto ratings = read_table(options.out / "ratings.csv");
+  ASSERT_EQ(ratings.size(), static_cast<std::size_t>(kSubjects * 6));
+  for (const auto& row : ratings) {
+    const int rating = std::stoi(row.at("rating"));
+    EXPECT_GE(rating, -2);
+    EXPECT_LE(rating, 2);
+    EXPECT_EQ(row.at("rated_by"), "simulated");
+  }
+  std::map<std::string, double> scale;
+  for (const auto& row : read_table(options.out / "analysis" / "scale.csv"))
+    scale[row.at("condition")] = std::stod(row.at("scale_value"));
+  ASSERT_EQ(scale.size(), 4u);
+  double sum = 0;
+  for (const auto& [name, value] : scale) sum += value;
+  EXPECT_NEAR(sum, 0, 1e-12);
+  double yardstick_05 = 0;
+  for (const auto& row : read_table(options.out / "analysis" / "yardsticks.csv"))
+    if (std::stod(row.at("level")) == 0.05) yardstick_05 = std::stod(row.at("yardstick"));
+  ASSERT_GT(yardstick_05, 0);
+  std::printf("  scale values: T0-P0 %.3f, T0-P1 %.3f, T150-P0 %.3f, T150-P1 %.3f; Y(0.05) %.3f\n",
+              scale.at("S0-T0-P0"), scale.at("S0-T0-P1"), scale.at("S0-T150-P0"), scale.at("S0-T150-P1"), yardstick_05);
+  EXPECT_GT(scale.at("S0-T150-P1") - scale.at("S0-T150-P0"), yardstick_05);
+  bool found = false;
+  for (const auto& row : read_table(options.out / "analysis" / "differences.csv"))
+    if ((row.at("first") == "S0-T150-P0" && row.at("second") == "S0-T150-P1") ||
+        (row.at("first") == "S0-T150-P1" && row.at("second") == "S0-T150-P0")) {
+      found = true;
+      EXPECT_EQ(row.at("significant_05"), "yes");
+    }
+  EXPECT_TRUE(found);
+  for (const char* file : {"analysis/anova.csv", "analysis/table.txt", "figures/scale.svg"})
+    EXPECT_TRUE(fs::exists(options.out / file)) << file;
 }
 
 }  // namespace

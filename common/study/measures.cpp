@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "common/study/zero_phase_lowpass.h"
 #include "common/util/error.h"
@@ -251,21 +252,40 @@ TrialMeasures measure_trial(const ForceTrace& trace, const MeasureSettings& sett
   return m;
 }
 
+namespace {
+
+// Every field of TrialMeasures with its name, in declaration order: the one list both
+// directions (to names, from names) read.
+template <typename Measures, typename Visit>
+void for_each_measure(Measures& m, Visit&& visit) {
+  visit("duration_s", m.duration_s);
+  visit("contact_time_s", m.contact_time_s);
+  visit("peak_force_n", m.peak_force_n);
+  visit("force_update_rate_hz", m.force_update_rate_hz);
+  visit("p99_force_step_ratio", m.p99_force_step_ratio);
+  visit("roughness", m.roughness);
+  visit("n_strokes", m.n_strokes);
+  visit("terminal_force_ratio", m.terminal_force_ratio);
+  visit("effective_stiffness_n_per_m", m.effective_stiffness_n_per_m);
+  visit("hysteresis_energy_j", m.hysteresis_energy_j);
+  visit("energy_given_to_hand_j", m.energy_given_to_hand_j);
+  visit("oscillation_episodes", m.oscillation_episodes);
+}
+
+}  // namespace
+
 std::vector<NamedMeasure> named_measures(const TrialMeasures& m) {
-  return {
-      {"duration_s", m.duration_s},
-      {"contact_time_s", m.contact_time_s},
-      {"peak_force_n", m.peak_force_n},
-      {"force_update_rate_hz", m.force_update_rate_hz},
-      {"p99_force_step_ratio", m.p99_force_step_ratio},
-      {"roughness", m.roughness},
-      {"n_strokes", static_cast<double>(m.n_strokes)},
-      {"terminal_force_ratio", m.terminal_force_ratio},
-      {"effective_stiffness_n_per_m", m.effective_stiffness_n_per_m},
-      {"hysteresis_energy_j", m.hysteresis_energy_j},
-      {"energy_given_to_hand_j", m.energy_given_to_hand_j},
-      {"oscillation_episodes", static_cast<double>(m.oscillation_episodes)},
-  };
+  std::vector<NamedMeasure> named;
+  for_each_measure(m, [&](std::string_view name, const auto& value) { named.push_back({name, static_cast<double>(value)}); });
+  return named;
+}
+
+TrialMeasures trial_measures_from(const std::function<double(std::string_view)>& value_of) {
+  TrialMeasures m;
+  for_each_measure(m, [&](std::string_view name, auto& value) {
+    value = static_cast<std::remove_reference_t<decltype(value)>>(value_of(name));
+  });
+  return m;
 }
 
 }  // namespace cohaptic

@@ -60,6 +60,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <functional>
 #include <string_view>
 #include <vector>
 
@@ -127,5 +128,7 @@ struct NamedMeasure {
 };
 /// All fields of TrialMeasures in declaration order.
 std::vector<NamedMeasure> named_measures(const TrialMeasures& measures);
+/// The measures back from their names (a table's row): `value_of(name)` for every field.
+TrialMeasures trial_measures_from(const std::function<double(std::string_view)>& value_of);
 
 }  // namespace cohaptic

@@ -13,8 +13,6 @@
 namespace cohaptic {
 namespace {
 
-constexpr std::array<const char*, 10> kPalette = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
-                                                  "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
 constexpr double kLeft = 80, kTop = 50, kBottom = 60, kRight = 25;
 constexpr double kCharWidth = 7;  // rough width of a 12 px sans-serif character
 
@@ -63,7 +61,7 @@ std::string tick_label(double v, const std::vector<double>& ticks) {
 }
 
 std::string colour_of(const std::string& colour, std::size_t index) {
-  return colour.empty() ? kPalette[index % kPalette.size()] : colour;
+  return colour.empty() ? palette_colour(index) : colour;
 }
 
 class Canvas {
@@ -217,6 +215,12 @@ std::string render(const BarChart& chart) {
 }
 
 }  // namespace
+
+std::string palette_colour(std::size_t index) {
+  static constexpr std::array<const char*, 10> kPalette = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+                                                           "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
+  return kPalette[index % kPalette.size()];
+}
 
 std::string xml_escape(std::string_view text) {
   std::string out;

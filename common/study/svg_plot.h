@@ -57,6 +57,9 @@ std::string render_svg(const Plot& plot);
 /// render_svg() written atomically to `path` (AtomicFile). Throws Error if it cannot be written.
 void write_svg(const std::filesystem::path& path, const Plot& plot);
 
+/// The index-th colour (cyclic) of the plots' 10-colour palette, as an SVG colour.
+std::string palette_colour(std::size_t index);
+
 /// Text made safe for XML character data and attribute values: & < > " ' become entities and
 /// control characters other than tab, line feed and carriage return are dropped.
 std::string xml_escape(std::string_view text);
