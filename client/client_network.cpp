@@ -151,6 +151,16 @@ struct ClientNetwork::Impl {
       const std::int64_t arrival = now_ns();
       if (irs.receive_compressed(control.compressed_ir(), control.ByteSizeLong(), arrival) && recorder)
         recorder->ir_block(arrival, 0, control.compressed_ir());
+    } else if (control.has_protocol_switch()) {
+      const wire::Protocol protocol = control.protocol_switch().protocol();
+      if (protocol != wire::P0 && protocol != wire::P1) {
+        spdlog::warn("the server switched to protocol {}, neither P0 nor P1: ignored", static_cast<int>(protocol));
+        return;
+      }
+      const HapticProtocol now_served = protocol == wire::P1 ? HapticProtocol::p1 : HapticProtocol::p0;
+      serve_protocol(now_served);
+      spdlog::info("the server serves {} from now on", now_served == HapticProtocol::p1 ? "P1" : "P0");
+      if (recorder) recorder->event(now_ns(), "protocol", now_served == HapticProtocol::p1 ? "P1" : "P0");
     } else if (control.has_event()) {
       spdlog::info("server: {}", control.event().text());
     } else if (control.has_error()) {
@@ -161,6 +171,12 @@ struct ClientNetwork::Impl {
     } else if (control.has_bye()) {
       connection.drop("server said goodbye: " + control.bye().reason());
     }
+  }
+
+  // The haptic loop changes over to `protocol` once what it needs has arrived after now.
+  void serve_protocol(HapticProtocol protocol) {
+    channels.protocol.back() = {protocol, now_ns()};
+    channels.protocol.publish();
   }
 
   void joined(const wire::Welcome& message, std::uint64_t session) {
@@ -193,6 +209,7 @@ struct ClientNetwork::Impl {
     clock.restart();
     session_id = session;
     welcomed = info;
+    serve_protocol(info.protocol);  // a server met again may serve another one
     if (recorder) recorder->event(now_ns(), "joined", fmt::format("session {:016x}, slot {}", session, info.slot));
     std::lock_guard lock(welcome_mutex);
     welcome = info;

@@ -38,6 +38,7 @@ record::HapticTick haptic_tick_record(const TickRecord& tick) {
   record.set_own_valid(tick.own_valid);
   record.set_buttons(tick.buttons);
   if (tick.ir_age_ns >= 0) record.set_ir_age_ns(tick.ir_age_ns);
+  record.set_protocol(tick.protocol == HapticProtocol::p1 ? wire::P1 : wire::P0);
   return record;
 }
 

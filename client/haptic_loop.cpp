@@ -60,6 +60,7 @@ HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoo
     : device_(device),
       channels_(channels),
       settings_(settings),
+      protocol_(settings.protocol),
       remote_buffers_{RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
                       RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
@@ -67,11 +68,32 @@ HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoo
       passivity_(settings.passivity_mass_kg, settings.force_limit),
       clock_(clock) {}
 
+bool HapticLoop::take_in_server_updates() {
+  // Both channels are taken in while a switch waits, so that what arrived before the switch
+  // is not mistaken for what the new protocol needs.
+  const bool ir_new = channels_.ir.update();
+  const bool force_new = channels_.force.update();
+  channels_.protocol.update();
+  const ProtocolChange& change = channels_.protocol.front();
+  if (change.since_ns > 0 && change.protocol != protocol_) {
+    const bool ready = change.protocol == HapticProtocol::p1
+                           ? channels_.ir.front().ir && channels_.ir.front().arrival_ns >= change.since_ns
+                           : channels_.force.front().valid && channels_.force.front().arrival_ns >= change.since_ns;
+    if (ready) {
+      protocol_ = change.protocol;
+      ++metrics_.protocol_switches;
+      return true;
+    }
+  }
+  return protocol_ == HapticProtocol::p1 ? ir_new : force_new;
+}
+
 Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record) {
   std::int64_t age = std::numeric_limits<std::int64_t>::max();
   Eigen::Vector3d force = Eigen::Vector3d::Zero();
   record.remotes.fill(Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
-  if (settings_.protocol == HapticProtocol::p1) {
+  record.protocol = protocol_;
+  if (protocol_ == HapticProtocol::p1) {
     const IrSlot& slot = channels_.ir.front();
     if (slot.ir) {
       // Its age runs from its arrival or its last confirmation: the confirmations of a newer
@@ -178,9 +200,7 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     channels_.own_samples.push({woke, state.position, state.buttons, state.valid});
     while (const auto remote = channels_.remote_samples.pop())
       remote_buffers_[remote->user % kMaxUsers].add(remote->sample_time_ns, remote->arrival_ns, remote->position, remote->valid);
-    if (settings_.protocol == HapticProtocol::p1 ? channels_.ir.update() : channels_.force.update()) {
-      ++metrics_.ir_switches;
-    }
+    if (take_in_server_updates()) ++metrics_.ir_switches;
     channels_.confirmation.update();
 
     TickRecord record;
@@ -189,7 +209,7 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     record.buttons = state.buttons;
     record.own_valid = state.valid;
     Eigen::Vector3d force = state.valid ? compute_force(woke, state.position, record) : Eigen::Vector3d::Zero();
-    if (settings_.protocol == HapticProtocol::p1 && record.ir_epoch != epoch_in_use) {
+    if (protocol_ == HapticProtocol::p1 && record.ir_epoch != epoch_in_use) {
       if (epoch_in_use != 0) metrics_.largest_step_on_ir_switch = std::max(metrics_.largest_step_on_ir_switch, (force - last_force_).norm());
       epoch_in_use = record.ir_epoch;
     }

@@ -71,6 +71,14 @@ struct IrConfirmation {
   std::int64_t arrival_ns = 0;
 };
 
+/// The protocol the server serves from `since_ns` on (a session switching conditions), as
+/// the I/O thread learnt it. The loop changes over once the first IR (P1) or force (P0) that
+/// arrived at or after `since_ns` is there, so the force never lapses.
+struct ProtocolChange {
+  HapticProtocol protocol = HapticProtocol::p1;
+  std::int64_t since_ns = 0;
+};
+
 /// A P0 force from the server, with when it arrived.
 struct ForceSlot {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();
@@ -109,6 +117,7 @@ struct TickRecord {
   std::uint8_t flags = 0;
   float fade = 1;
   std::int64_t ir_age_ns = -1;                           ///< of the IR or force used (-1: none yet)
+  HapticProtocol protocol = HapticProtocol::p1;          ///< the protocol the tick used
 };
 
 enum class HapticEventKind : std::uint8_t { non_finite, ir_switched, fading, started_realtime, realtime_refused };
@@ -134,6 +143,7 @@ struct HapticChannels {
   TripleBuffer<IrSlot> ir;                     // I/O -> haptic (P1)
   TripleBuffer<IrConfirmation> confirmation;   // I/O -> haptic (P1)
   TripleBuffer<ForceSlot> force;               // I/O -> haptic (P0)
+  TripleBuffer<ProtocolChange> protocol;       // I/O -> haptic: a switch of the protocol served
   SpscRing<RemoteSample, 4096> remote_samples; // I/O -> haptic
   SpscRing<OwnSample, 4096> own_samples;       // haptic -> I/O
   SpscRing<TickRecord, 8192> trace;            // haptic -> I/O (only if tracing: recording)
@@ -146,6 +156,7 @@ struct HapticMetrics {
   Histogram period_ns{1000, 50000};   ///< 1 us bins up to 50 ms
   Histogram ir_age_ns = ir_age_histogram();
   std::uint64_t ticks = 0, missed_deadlines = 0, non_finite = 0, clamped = 0, ir_switches = 0;
+  std::uint64_t protocol_switches = 0;  ///< changes of the protocol in use (the server switched it)
   std::uint64_t contact_unresolved = 0;  ///< ticks that held the last force (sphere solve unfinished)
   double peak_force = 0;      ///< [N]
   double peak_coupling = 0;   ///< [N], |F - F without the remote tools|
@@ -182,12 +193,16 @@ class HapticLoop {
 
  private:
   Eigen::Vector3d compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record);
+  /// Takes in the newest IR (P1) or force (P0), changing protocols when the server switched
+  /// and what the new one needs has arrived; true if what the tick uses is new.
+  bool take_in_server_updates();
   void publish_progress(double elapsed_s, bool finished);
   std::int64_t now() const { return clock_.now_ns(clock_.context); }
 
   HapticDevice& device_;
   HapticChannels& channels_;
   HapticLoopSettings settings_;
+  HapticProtocol protocol_;  // in use: settings_.protocol until the server switches it
   HapticMetrics metrics_;
   std::array<RemoteToolBuffer, kMaxUsers> remote_buffers_;
   Eigen::Vector3d last_force_ = Eigen::Vector3d::Zero();

@@ -120,7 +120,8 @@ int main(int argc, char** argv) {
     report["user"] = options.user_name;
     report["slot"] = welcome.slot;
     report["device"] = device->describe();
-    report["protocol"] = welcome.protocol == cohaptic::HapticProtocol::p1 ? "P1" : "P0";
+    report["protocol"] = welcome.protocol == cohaptic::HapticProtocol::p1 ? "P1" : "P0";  // at the join
+    report["protocol_switches"] = m.protocol_switches;  // the server switched conditions
     report["rate_setting_hz"] = settings.rate_hz;
     report["haptic_rate_hz"] = m.elapsed_s > 0 ? static_cast<double>(m.ticks) / m.elapsed_s : 0.0;
     report["ticks"] = m.ticks;

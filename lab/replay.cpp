@@ -21,6 +21,7 @@
 #include "common/haptics/fade_tally.h"
 #include "common/haptics/ir_age_histogram.h"
 #include "common/util/atomic_file.h"
+#include "common/util/csv.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
 #include "proto/record/recording.h"
@@ -51,7 +52,7 @@ Eigen::Vector3d output_force(const Eigen::Vector3d& evaluated, float fade, doubl
 VerifyResult verify_client(const Recording& rec) {
   VerifyResult result;
   const std::int64_t start = rec.config.start_time_ns();
-  const bool p1 = rec.config.protocol() != wire::P0;
+  const bool session_p1 = rec.config.protocol() != wire::P0;
   // IRs by epoch, in arrival order (epochs restart when the server does).
   // IRs sent as compliance rows are completed in arrival order, as the client did (it
   // records only those it took, so the held rows follow the same sequence).
@@ -81,6 +82,8 @@ VerifyResult verify_client(const Recording& rec) {
     const record::HapticTick& tick = rec.ticks[i];
     const Eigen::Vector3d evaluated = wire::from_wire(tick.evaluated());
     Eigen::Vector3d expected = Eigen::Vector3d::Zero();
+    // The protocol the tick used: the session's, unless the server switched it.
+    const bool p1 = tick.protocol() == wire::PROTOCOL_UNSPECIFIED ? session_p1 : tick.protocol() == wire::P1;
     if (tick.own_valid() && tick.ir_epoch() != 0) {
       if (p1) {
         // The newest IR of that epoch received by then.
@@ -127,8 +130,11 @@ VerifyResult verify_server(const Recording& rec) {
   const std::int64_t start = config.start_time_ns();
   const Scene scene = parse_scene(config.scene_yaml(), config.scene_file());
   const Model model = build_model(scene);
-  const bool whole_surface =
-      config.injected().step_nodes() > 0 || !model.obstacles.empty() || !model.scene.interactions.empty();
+  // As the server loaded it: the whole surface when any condition it served held nodes.
+  bool holds_nodes = config.injected().step_nodes() > 0;
+  for (const record::SimulationStep& step : rec.steps)
+    holds_nodes = holds_nodes || step.condition_switch().injected().step_nodes() > 0;
+  const bool whole_surface = holds_nodes || !model.obstacles.empty() || !model.scene.interactions.empty();
   const SceneCompliance compliance = prepare_scene_compliance(model, whole_surface, std::nullopt);
   SimulationOptions options;
   options.ir = ir_build_options(scene.haptic);
@@ -145,6 +151,7 @@ VerifyResult verify_server(const Recording& rec) {
       result.ok = false;
       result.first_difference = fmt::format("simulation step {} (t = {:.6f} s): {}", i, seconds(step.time_ns(), start), what);
     };
+    if (step.has_condition_switch()) simulation.set_step_delay_nodes(static_cast<int>(step.condition_switch().injected().step_nodes()));
     for (const record::ToolInput& tool : step.tools()) {
       if (tool.known()) simulation.set_tool(static_cast<int>(tool.slot()), wire::from_wire(tool.position()), tool.buttons());
       else simulation.clear_tool(static_cast<int>(tool.slot()));
@@ -166,6 +173,7 @@ VerifyResult verify_server(const Recording& rec) {
       for (int user = 0; user < simulation.user_count() && result.ok; ++user) {
         const auto prepared = simulation.ir(user);
         if (!prepared || !simulation.ir_changed(user)) continue;
+        while (next_ir < rec.irs.size() && rec.irs[next_ir].repeat()) ++next_ir;  // sent again, built before
         if (next_ir >= rec.irs.size()) {
           fail(fmt::format("the replay built an IR for user {} that was not recorded", user));
           break;
@@ -256,26 +264,27 @@ void export_csv(const Recording& rec, const std::filesystem::path& dir) {
   if (!rec.ticks.empty()) {
     AtomicFile out(dir / "haptic.csv");
     out.write("time_s,own_x,own_y,own_z,own_valid,force_x,force_y,force_z,evaluated_x,evaluated_y,evaluated_z,ir_epoch,flags,fade,ir_age_ms");
-    out.write(",remote_x,remote_y,remote_z\n");
+    out.write(",remote_x,remote_y,remote_z,protocol\n");
     for (const auto& t : rec.ticks) {
       const Eigen::Vector3d o = wire::from_wire(t.own()), f = wire::from_wire(t.force()), e = wire::from_wire(t.evaluated());
       const Eigen::Vector3d r = t.remotes_size() ? wire::from_wire(t.remotes(0)) : Eigen::Vector3d::Constant(std::nan(""));
-      out.print("{:.9f},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{},{},{:.17g},{:.17g},{:.17g}\n",
+      out.print("{:.9f},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{},{},{:.17g},{:.17g},{:.17g},{}\n",
                 seconds(t.time_ns(), start), o.x(), o.y(), o.z(), t.own_valid() ? 1 : 0, f.x(), f.y(), f.z(), e.x(), e.y(),
                 e.z(), t.ir_epoch(), t.flags(), t.fade(),
                 t.has_ir_age_ns() ? fmt::format("{:.4f}", static_cast<double>(t.ir_age_ns()) * 1e-6) : std::string(), r.x(),
-                r.y(), r.z());
+                r.y(), r.z(), t.protocol() == wire::P0 ? "P0" : t.protocol() == wire::P1 ? "P1" : "");
     }
     out.commit();
   }
   if (!rec.steps.empty()) {
     AtomicFile out(dir / "steps.csv");
-    out.write("time_s,simulation_time_s,slot,known,x,y,z,rebuilt,boundary_nodes\n");
+    out.write("time_s,simulation_time_s,slot,known,x,y,z,rebuilt,boundary_nodes,condition_switch\n");
     for (const auto& s : rec.steps)
       for (const auto& tool : s.tools()) {
         const Eigen::Vector3d p = wire::from_wire(tool.position());
-        out.print("{:.9f},{:.9f},{},{},{:.17g},{:.17g},{:.17g},{},{}\n", seconds(s.time_ns(), start), s.simulation_time(),
-                  tool.slot(), tool.known() ? 1 : 0, p.x(), p.y(), p.z(), s.rebuilt() ? 1 : 0, s.boundary_nodes());
+        out.print("{:.9f},{:.9f},{},{},{:.17g},{:.17g},{:.17g},{},{},{}\n", seconds(s.time_ns(), start), s.simulation_time(),
+                  tool.slot(), tool.known() ? 1 : 0, p.x(), p.y(), p.z(), s.rebuilt() ? 1 : 0, s.boundary_nodes(),
+                  csv_field(s.condition_switch().name()));
       }
     out.commit();
   }

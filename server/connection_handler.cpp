@@ -72,7 +72,8 @@ ConnectionHandler::ConnectionHandler(asio::io_context& io, const ServeOptions& o
       tcp_port_(acceptor_.local_endpoint().port()),
       udp_(io, udp::endpoint(acceptor_.local_endpoint().address(), tcp_port_),
            std::make_unique<wire::DatagramInspector>(session, !options.encrypt)),
-      slots_(static_cast<std::size_t>(welcome_.users_size())) {
+      slots_(static_cast<std::size_t>(welcome_.users_size())),
+      link_delay_(options.shift) {
   welcome_.set_server_udp_port(udp_.port());
 }
 
@@ -131,7 +132,7 @@ void ConnectionHandler::accept() {
     }
     socket.set_option(tcp::no_delay(true));
     socket.set_option(asio::socket_base::send_buffer_size(kControlSendBufferBytes));
-    auto participant = std::make_shared<Participant>(io_, session_, options_.shift, options_.encrypt);
+    auto participant = std::make_shared<Participant>(io_, session_, link_delay_, options_.encrypt);
     const std::weak_ptr<Participant> weak = participant;
     net::FramedConnection::Handlers handlers;
     handlers.on_control = [this, weak](const wire::Control& control) {
@@ -371,7 +372,24 @@ void ConnectionHandler::close_all(const std::string& why) {
   for (const ParticipantPtr& participant : std::vector(participants_)) leave(participant, why);
 }
 
+void ConnectionHandler::set_link_delay(const LinkDelaySettings& settings) {
+  validate(settings);
+  link_delay_ = settings;
+  for (const ParticipantPtr& participant : participants_)
+    for (LinkDelay* link : {&participant->to_client_udp, &participant->to_client_tcp, &participant->from_client_udp})
+      link->set_settings(settings);
+}
+
 void ConnectionHandler::send(Outbox outbox) {
+  if (outbox.protocol_switch) {
+    welcome_.set_protocol(*outbox.protocol_switch);  // users who join later are told it too
+    for (const ParticipantPtr& participant : slots_)
+      if (participant) {
+        wire::Control control;
+        control.mutable_protocol_switch()->set_protocol(*outbox.protocol_switch);
+        send_control(participant, control);
+      }
+  }
   for (ToSlot<wire::Control>& ir : outbox.irs)
     if (const ParticipantPtr& participant = slots_[static_cast<std::size_t>(ir.slot)])
       send_control(participant, ir.message, !ir.must_arrive);

@@ -104,6 +104,9 @@ class ConnectionHandler {
   void say_goodbye(const std::string& reason);
   /// Closes every connection and the UDP socket.
   void close_all(const std::string& why);
+  /// The injected shift delay on every link from now on, and for users who join later (a
+  /// switched condition). On the I/O thread.
+  void set_link_delay(const LinkDelaySettings& settings);
 
   std::uint16_t tcp_port() const { return tcp_port_; }
   std::uint16_t udp_port() const { return udp_.port(); }
@@ -155,6 +158,7 @@ class ConnectionHandler {
   std::int64_t last_warning_ns_ = 0;
   std::uint64_t warnings_held_ = 0;
   StatusHandler on_status_;
+  LinkDelaySettings link_delay_;  // options_.shift until a condition switches it
 };
 
 }  // namespace cohaptic

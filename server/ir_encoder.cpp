@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <exception>
 #include <iterator>
 #include <map>
@@ -43,12 +44,14 @@ void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
     else irs[i].fresh = std::exchange(carried, false) || irs[i].fresh;
   }
   std::uint64_t sent = 0, bytes = 0, skipped = 0;
+  if (std::any_of(irs.begin(), irs.end(), [](const BuiltIr& built) { return built.announces_p1; }))
+    outbox.protocol_switch = wire::P1;
   for (std::size_t i = 0; i < irs.size(); ++i) {
     const BuiltIr& built = irs[i];
     const wire::IntermediateRepresentation whole = wire::to_wire(built.built->ir);
     if (!built.send || superseded[i]) {
       if (superseded[i]) ++skipped;
-      if (recorder_) recorder_->ir(built.time_ns, whole);
+      if (recorder_) recorder_->ir(built.time_ns, whole, built.repeat);
       continue;
     }
     wire::Control control;
@@ -61,7 +64,7 @@ void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
     } catch (const std::exception& e) {
       spdlog::error("user {}'s IR (epoch {}) not sent: {}; the next starts its stream afresh", built.user,
                     built.built->ir.epoch, e.what());
-      if (recorder_) recorder_->ir(built.time_ns, whole);
+      if (recorder_) recorder_->ir(built.time_ns, whole, built.repeat);
       std::lock_guard lock(mutex_);
       restarts_.push_back(built.user);
       continue;
@@ -71,9 +74,9 @@ void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
     // client's do), else the IR.
     if (recorder_) {
       if (built.streamed && !built.as_sent)
-        recorder_->ir_block(built.time_ns, static_cast<std::uint32_t>(built.user), control.compressed_ir());
+        recorder_->ir_block(built.time_ns, static_cast<std::uint32_t>(built.user), control.compressed_ir(), built.repeat);
       else
-        recorder_->ir(built.time_ns, whole);
+        recorder_->ir(built.time_ns, whole, built.repeat);
     }
     bytes += built.streamed ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
     outbox.irs.push_back({built.user, std::move(control), built.streamed});

@@ -47,6 +47,10 @@ struct BuiltIr {
   bool send = false;      ///< P1: to the user; else recorded only
   bool streamed = false;  ///< in the user's IR stream
   bool fresh = false;     ///< the stream starts afresh with it
+  bool repeat = false;    ///< built by an earlier step, sent again (a switch to P1)
+  /// The step switched to P1: the outbox tells every user so before its IRs, on the same
+  /// connection, so that each client has the switch before the IR it changes over with.
+  bool announces_p1 = false;
 };
 
 class IrEncoder {

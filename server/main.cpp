@@ -55,6 +55,15 @@ int main(int argc, char** argv) {
   app.add_option("--sim-rate-hz", serve.sim_rate_hz, "Step delay, the capped kind: simulation loop rate (0: up to 1 kHz)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  std::vector<std::string> condition_texts;
+  app.add_option("--condition", condition_texts,
+                 "A condition the session switches between while it runs (repeat it; the first is served at the "
+                 "start): NAME:protocol=P0|P1,shift_ms=S,jitter_ms=J,loss=L,step_nodes=N,sim_rate_hz=R (unset: P1 "
+                 "and 0); instead of --protocol, --shift-delay-ms, --jitter-ms, --loss, --step-nodes, --sim-rate-hz")
+      ->take_all();
+  std::string control_path;
+  app.add_option("--control", control_path,
+                 "Listen for control commands (switch the condition served: {\"serve\": NAME}) on this Unix socket");
   app.add_option("--condensation", condensation,
                  "incremental (M~ updated when a set changes) or naive (M~ computed from scratch every step, as the "
                  "paper's conventional loop; a new IR is still sent only when a set changes)")
@@ -128,6 +137,20 @@ int main(int argc, char** argv) {
       serve.view = true;
     }
     serve.protocol = protocol == "P0" ? cohaptic::ServeProtocol::p0 : cohaptic::ServeProtocol::p1;
+    if (!condition_texts.empty()) {
+      for (const char* option : {"--protocol", "--shift-delay-ms", "--jitter-ms", "--loss", "--step-nodes", "--sim-rate-hz"})
+        if (app.count(option) > 0) {
+          fmt::print(stderr, "cohaptic-server: {} and --condition: give the setting in each --condition instead\n", option);
+          return 2;
+        }
+      for (const std::string& text : condition_texts) serve.conditions.push_back(cohaptic::parse_served_condition(text));
+      const cohaptic::ServedCondition& first = serve.conditions.front();
+      serve.protocol = first.protocol;
+      serve.shift = first.link_delay(serve.shift);
+      serve.step_nodes = first.step_nodes;
+      serve.sim_rate_hz = first.sim_rate_hz;
+    }
+    if (!control_path.empty()) serve.control = control_path;
     serve.naive_condensation = condensation == "naive";
     serve.compliance_rows = ir_form == "rows";
     serve.precision = serve_precision == "f32" ? cohaptic::IrPrecision::f32 : cohaptic::IrPrecision::f64;

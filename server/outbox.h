@@ -4,6 +4,7 @@
 // in its slot (a slot left empty in the meantime gets nothing).
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "cohaptic/messages.pb.h"
@@ -20,10 +21,13 @@ struct ToSlot {
 };
 
 struct Outbox {
+  /// The protocol served from this step on, told to every user before anything else of the
+  /// outbox (a switched condition, served_conditions.h); unset: unchanged.
+  std::optional<wire::Protocol> protocol_switch;
   std::vector<ToSlot<wire::Control>> irs;         ///< P1: new IRs, over TCP (newest wins unless must_arrive)
   std::vector<ToSlot<wire::Datagram>> datagrams;  ///< P1: IR keep-alives; P0: forces (UDP)
 
-  bool empty() const { return irs.empty() && datagrams.empty(); }
+  bool empty() const { return !protocol_switch && irs.empty() && datagrams.empty(); }
 };
 
 }  // namespace cohaptic

@@ -5,13 +5,13 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "common/ir/intermediate_representation.h"
 #include "common/net/link_delay.h"
+#include "server/served_conditions.h"
 
 namespace cohaptic {
-
-enum class ServeProtocol { p0, p1 };
 
 struct ServeOptions {
   std::filesystem::path scene;
@@ -23,6 +23,11 @@ struct ServeOptions {
   LinkDelaySettings shift;              ///< injected on every link, each direction
   int step_nodes = 0;                   ///< step-delay boundary nodes (the paper's T150/T300)
   double sim_rate_hz = 0;               ///< cap of the simulation loop; 0: up to 1 kHz
+  /// --condition: the conditions the session switches between (the first is served at the
+  /// start, and protocol, shift delay, jitter, loss, step_nodes and sim_rate_hz above are
+  /// its); empty: the one condition the options above give.
+  std::vector<ServedCondition> conditions;
+  std::optional<std::filesystem::path> control;  ///< --control: the control socket's path
   bool naive_condensation = false;      ///< rebuild M~ from scratch every step (the paper's loop)
   IrPrecision precision = IrPrecision::f64;
   /// Condensed FEM IRs as compliance rows (common/ir/compliance_rows.h; the client condenses),

@@ -13,7 +13,13 @@ nlohmann::json server_report(const ServerFigures& figures) {
   const ServeOptions& options = figures.options;
   nlohmann::json server;
   server["scene"] = figures.scene_name;
-  server["protocol"] = options.protocol == ServeProtocol::p1 ? "P1" : "P0";
+  server["protocol"] = options.protocol == ServeProtocol::p1 ? "P1" : "P0";  // at the start
+  if (!options.conditions.empty()) {
+    std::vector<std::string> names;
+    for (const ServedCondition& condition : options.conditions) names.push_back(condition.name);
+    server["conditions"] = names;
+    server["condition_switches"] = figures.condition_switches;
+  }
   server["sim_rate_hz"] = loop.rate_hz();
   // What the verdict holds the rate to, whatever step delay was injected: the users feel it.
   server["target_sim_rate_hz"] = figures.min_sim_rate_hz;

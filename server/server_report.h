@@ -21,6 +21,7 @@ struct ServerFigures {
   LoopSummary loop;
   ConnectionCounters connections;
   const wire::RejectionCounters& datagrams;
+  std::uint64_t condition_switches = 0;  ///< switches of the served condition (--condition, --control)
 };
 
 nlohmann::json server_report(const ServerFigures& figures);

@@ -28,9 +28,14 @@ SimulationOptions simulation_options(const Model& model, const ServeOptions& opt
 }  // namespace
 
 SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns,
-                               const ServeOptions& options, const ToolInputs& tools, LoopStatistics& statistics, DisplayWriter* display,
-                               view::LiveView* view, record::SessionRecorder* recorder, std::int64_t start_ns)
+                               const ServeOptions& options, const ToolInputs& tools, LoopStatistics& statistics,
+                               DisplayWriter* display,
+                               view::LiveView* view, record::SessionRecorder* recorder, std::int64_t start_ns,
+                               const ConditionSwitch* conditions)
     : options_(options),
+      conditions_(conditions),
+      protocol_(options.protocol),
+      rate_hz_(options.sim_rate_hz > 0 ? options.sim_rate_hz : kDefaultSimulationRate_hz),
       tools_(tools),
       statistics_(statistics),
       display_(display),
@@ -67,22 +72,57 @@ Outbox SimulationLoop::step(std::int64_t now_ns) {
   return std::move(output.outbox);
 }
 
+std::optional<record::ConditionSwitch> SimulationLoop::apply_condition_switch(Outbox& outbox) {
+  if (!conditions_) return std::nullopt;
+  const ConditionSwitch::Served served = conditions_->served();
+  if (served.switches == switches_applied_) return std::nullopt;
+  switches_applied_ = served.switches;
+  const ServedCondition& condition = conditions_->conditions()[static_cast<std::size_t>(served.index)];
+  simulation_.set_step_delay_nodes(condition.step_nodes);
+  rate_hz_ = condition.sim_rate_hz > 0 ? condition.sim_rate_hz : kDefaultSimulationRate_hz;
+  if (condition.protocol != protocol_) {
+    protocol_ = condition.protocol;
+    // To P1 the switch goes with the IRs sent again (advance()), in the encoder's outbox.
+    if (protocol_ == ServeProtocol::p0) outbox.protocol_switch = wire::P0;
+    resend_irs_ = protocol_ == ServeProtocol::p1;
+  }
+  spdlog::info("serving condition '{}' ({})", condition.name, condition.describe());
+  record::ConditionSwitch recorded;
+  recorded.set_name(condition.name);
+  recorded.set_index(static_cast<std::uint32_t>(served.index));
+  recorded.set_protocol(protocol_ == ServeProtocol::p1 ? wire::P1 : wire::P0);
+  ServeOptions as_options = options_;
+  as_options.shift = condition.link_delay(options_.shift);
+  as_options.step_nodes = condition.step_nodes;
+  as_options.sim_rate_hz = condition.sim_rate_hz;
+  *recorded.mutable_injected() = injected_delays(as_options);
+  return recorded;
+}
+
 SimulationLoop::StepOutput SimulationLoop::advance(std::int64_t now_ns) {
-  take_tools(now_ns);
-  const StepReport report = simulation_.step(seconds_since_start(now_ns));
   StepOutput output;
   Outbox& outbox = output.outbox;
-  if (report.rebuilt) output.irs = new_irs(now_ns);
-  if (options_.protocol == ServeProtocol::p1 && now_ns - last_keep_alive_ns_ >= kKeepAlivePeriod_ns) {
+  const std::optional<record::ConditionSwitch> switched = apply_condition_switch(outbox);
+  take_tools(now_ns);
+  const StepReport report = simulation_.step(seconds_since_start(now_ns));
+  const bool to_p1 = resend_irs_;
+  if (report.rebuilt || resend_irs_) output.irs = new_irs(now_ns);
+  if (to_p1) {  // told before the IRs on the same connection, or at once if there are none yet
+    if (output.irs.empty()) outbox.protocol_switch = wire::P1;
+    else output.irs.front().announces_p1 = true;
+  }
+  if (protocol_ == ServeProtocol::p1 && now_ns - last_keep_alive_ns_ >= kKeepAlivePeriod_ns) {
     last_keep_alive_ns_ = now_ns;
     add_keep_alives(outbox);
   }
   const std::vector<record::ServerForce> forces =
-      options_.protocol == ServeProtocol::p0 ? add_forces(outbox) : std::vector<record::ServerForce>{};
+      protocol_ == ServeProtocol::p0 ? add_forces(outbox) : std::vector<record::ServerForce>{};
   const bool display_frame = solve_display_frame(now_ns);
   if (recorder_) {
-    recorder_->step(simulation_step_record(now_ns, seconds_since_start(now_ns), latest_, used_, simulation_, report,
-                                           display_frame, forces));
+    record::SimulationStep step = simulation_step_record(now_ns, seconds_since_start(now_ns), latest_, used_, simulation_,
+                                                         report, display_frame, forces);
+    if (switched) *step.mutable_condition_switch() = *switched;
+    recorder_->step(step);
     recorder_->flush_if_due();
   }
   ++steps_;
@@ -117,16 +157,20 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
 
 // The new IRs, to be recorded (either protocol) and sent to their users (P1).
 std::vector<BuiltIr> SimulationLoop::new_irs(std::int64_t now_ns) {
-  const bool send = options_.protocol == ServeProtocol::p1;
+  const bool send = protocol_ == ServeProtocol::p1;
+  // After a switch to P1 every user's IR goes out, changed or not: its client changes over
+  // with it (the IRs built under P0 were recorded, not sent).
+  const bool every_user = std::exchange(resend_irs_, false);
   std::vector<BuiltIr> irs;
   if (!send && !recorder_) return irs;
   for (int user = 0; user < simulation_.user_count(); ++user) {
     auto prepared = simulation_.ir(user);
-    if (!prepared || !simulation_.ir_changed(user)) continue;
+    if (!prepared || !(simulation_.ir_changed(user) || every_user)) continue;
     BuiltIr& built = irs.emplace_back();
     built.time_ns = now_ns;
     built.user = user;
     built.send = send;
+    built.repeat = !simulation_.ir_changed(user);
     if (send) {
       // A sphere body's IR travels whole in the stream too (its normal compliance repeats
       // some of the last one's). Another condensed FEM body's may go as compliance rows.
@@ -241,7 +285,7 @@ bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
 }
 
 const std::vector<Eigen::Vector3d>& SimulationLoop::view_forces() {
-  if (options_.protocol == ServeProtocol::p1)
+  if (protocol_ == ServeProtocol::p1)
     for (int user = 0; user < simulation_.user_count(); ++user)
       view_forces_[static_cast<std::size_t>(user)] =
           used_[static_cast<std::size_t>(user)] ? simulation_.force(user).force : Eigen::Vector3d::Zero();
@@ -265,8 +309,6 @@ std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,
 
 std::optional<std::string> SimulationLoop::step_until(const std::atomic<bool>& running,
                                                       const std::function<void(Outbox&&)>& send) {
-  const double rate = options_.sim_rate_hz > 0 ? options_.sim_rate_hz : kDefaultSimulationRate_hz;
-  const auto period = static_cast<std::int64_t>(1e9 / rate);
   std::int64_t next = wire::monotonic_now_ns();
   while (running.load()) {
     const std::int64_t step_start = wire::monotonic_now_ns();
@@ -284,7 +326,7 @@ std::optional<std::string> SimulationLoop::step_until(const std::atomic<bool>& r
         return fmt::format("the simulation failed {} steps in a row, the last with: {}", failures_.consecutive(),
                            e.what());
     }
-    next += period;
+    next += static_cast<std::int64_t>(1e9 / rate_hz_);  // a switched condition may change the rate
     const std::int64_t step_end = wire::monotonic_now_ns();
     if (next < step_end) next = step_end;  // behind: no catch-up burst
     std::this_thread::sleep_for(std::chrono::nanoseconds(next - step_end));

@@ -14,6 +14,10 @@
 //      loads, not its displacement: the view's thread computes that); one state solve per
 //      FEM body when both are due;
 //   5. records the step (--record), and its figures (LoopStatistics).
+// A switch of the served condition (ConditionSwitch, served_conditions.h) takes effect at the
+// start of the next step: the held nodes' count, the loop's rate and the protocol (the
+// outbox tells every user; on a switch to P1 each user's current IR is sent again, so that
+// its client has one to change over with), recorded with that step.
 // run() paces the steps at the loop's rate with absolute deadlines (when behind, the next
 // step starts at once, with no catch-up burst) and hands each non-empty outbox to the I/O
 // side; the new IRs go to the encoder's thread, which hands their frames over in outboxes
@@ -66,10 +70,12 @@ class SimulationLoop {
   /// `display`, `view` and `recorder` may be null (no --display, --view, --record).
   /// Everything given must outlive the loop.
   /// columns[i]: body i's compliance columns (null unless it is linear elastic).
+  /// `conditions` (may be null: the options' condition throughout): the condition served
+  /// now, whose first is what `options` give.
   SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns, const ServeOptions& options,
                  const ToolInputs& tools,
                  LoopStatistics& statistics, DisplayWriter* display, view::LiveView* view,
-                 record::SessionRecorder* recorder, std::int64_t start_ns);
+                 record::SessionRecorder* recorder, std::int64_t start_ns, const ConditionSwitch* conditions = nullptr);
 
   /// One step at `now_ns`: returns what to send, its new IRs encoded on the calling thread.
   /// Throws whatever the simulation's step throws. Not while run() runs.
@@ -91,6 +97,9 @@ class SimulationLoop {
     std::vector<BuiltIr> irs;
   };
   StepOutput advance(std::int64_t now_ns);
+  /// Applies a switch of the served condition made since the last step, if any: what the
+  /// step records of it.
+  std::optional<record::ConditionSwitch> apply_condition_switch(Outbox& outbox);
   std::optional<std::string> step_until(const std::atomic<bool>& running, const std::function<void(Outbox&&)>& send);
   void take_tools(std::int64_t now_ns);
   /// The IRs that changed this step, as the encoder takes them.
@@ -117,6 +126,11 @@ class SimulationLoop {
   void deliver_prefetched();
 
   const ServeOptions& options_;
+  const ConditionSwitch* conditions_;
+  std::uint64_t switches_applied_ = 0;
+  ServeProtocol protocol_;  // served now
+  double rate_hz_;          // the loop's rate now
+  bool resend_irs_ = false; // the next new_irs() sends every user's IR, changed or not
   const ToolInputs& tools_;
   LoopStatistics& statistics_;
   DisplayWriter* display_;

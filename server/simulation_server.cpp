@@ -1,5 +1,6 @@
 #include "server/simulation_server.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <asio.hpp>
@@ -20,6 +21,7 @@
 #include "proto/wire/session_key.h"
 #include "proto/wire/surface_mesh_message.h"
 #include "server/connection_handler.h"
+#include "server/control_socket.h"
 #include "server/display_writer.h"
 #include "server/loop_statistics.h"
 #include "server/server_recording.h"
@@ -59,6 +61,20 @@ wire::Welcome welcome_template(const ServeOptions& options, const Model& model, 
   return welcome;
 }
 
+// The conditions served: the --condition list, or the one the options give.
+std::vector<ServedCondition> served_conditions(const ServeOptions& options) {
+  if (!options.conditions.empty()) return options.conditions;
+  ServedCondition condition;
+  condition.name = "session";
+  condition.protocol = options.protocol;
+  condition.shift_delay_ms = options.shift.delay_ms;
+  condition.jitter_ms = options.shift.jitter_ms;
+  condition.loss = options.shift.loss;
+  condition.step_nodes = options.step_nodes;
+  condition.sim_rate_hz = options.sim_rate_hz;
+  return {condition};
+}
+
 }  // namespace
 
 struct SimulationServer::Impl {
@@ -74,16 +90,18 @@ struct SimulationServer::Impl {
   LoopStatistics statistics;
   std::unique_ptr<DisplayWriter> display;  // with --display
   std::unique_ptr<view::LiveView> view;    // with --view
+  ConditionSwitch conditions;
   std::unique_ptr<SimulationLoop> loop;
   asio::io_context io;
   std::unique_ptr<ConnectionHandler> connections;
+  std::unique_ptr<ControlSocket> control;  // with --control
   asio::signal_set signals{io, SIGINT, SIGTERM};
   asio::steady_timer status_timer{io}, duration_timer{io};
   std::atomic<bool> running{true};
   std::thread sim_thread;
   std::optional<std::string> failure;  // why the simulation loop ended the session; read after it joined
 
-  explicit Impl(ServeOptions o) : options(std::move(o)) {}
+  explicit Impl(ServeOptions o) : options(std::move(o)), conditions(served_conditions(options)) {}
 
   void load() {
     Stopwatch watch;
@@ -94,8 +112,9 @@ struct SimulationServer::Impl {
       scene_yaml.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     }
     model = std::make_unique<Model>(build_model(scene));
-    const bool whole_surface =
-        options.step_nodes > 0 || !model->obstacles.empty() || !model->scene.interactions.empty();
+    bool holds_nodes = false;  // under any condition served
+    for (const ServedCondition& condition : conditions.conditions()) holds_nodes = holds_nodes || condition.step_nodes > 0;
+    const bool whole_surface = holds_nodes || !model->obstacles.empty() || !model->scene.interactions.empty();
     compliance = prepare_scene_compliance(*model, whole_surface, options.cache_directory);
     // The display shows one linear elastic object (single_elastic_body says why it refuses
     // another scene) or one home-spring tissue; the live view shows every body.
@@ -132,8 +151,8 @@ struct SimulationServer::Impl {
         spdlog::warn("live view off: {}; the session goes on without it", e.what());
       }
     }
-    loop = std::make_unique<SimulationLoop>(*model, compliance.per_body, options, *tools, statistics, display.get(), view.get(),
-                                            recorder.get(), start_ns);
+    loop = std::make_unique<SimulationLoop>(*model, compliance.per_body, options, *tools, statistics, display.get(),
+                                            view.get(), recorder.get(), start_ns, &conditions);
   }
 
   void bind() {
@@ -144,6 +163,13 @@ struct SimulationServer::Impl {
                  connections->tcp_port(), options.protocol == ServeProtocol::p1 ? "P1" : "P0", session_id);
     if (options.shift.active()) spdlog::info("injected shift delay on every link, each direction: {}", options.shift.describe());
     if (!options.encrypt) spdlog::warn("--no-encryption: frames and datagrams travel in clear (authenticated, readable by anyone on the path)");
+    if (options.conditions.size() > 1)
+      spdlog::info("conditions served: {} (starting with '{}')", condition_list(), options.conditions.front().name);
+    if (options.control) {
+      control = std::make_unique<ControlSocket>(io, *options.control,
+                                                [this](const nlohmann::json& command) { return control_command(command); });
+      spdlog::info("control socket at {}", options.control->string());
+    }
     if (view) {
       connections->on_client_status([this](int slot, const std::string& user, const wire::ClientStatus& status) {
         view->publish_status(slot, user, status, static_cast<double>(wire::monotonic_now_ns() - start_ns) * 1e-9);
@@ -158,7 +184,31 @@ struct SimulationServer::Impl {
             model->scene.haptic.min_sim_rate_hz,
             statistics.summary(),
             connections->counters(),
-            connections->datagram_counters()};
+            connections->datagram_counters(),
+            conditions.served().switches};
+  }
+
+  std::string condition_list() const {
+    std::vector<std::string> described;
+    for (const ServedCondition& condition : conditions.conditions())
+      described.push_back(fmt::format("'{}' ({})", condition.name, condition.describe()));
+    return fmt::format("{}", fmt::join(described, ", "));
+  }
+
+  // One command of the control socket (control_socket.h), on the I/O thread.
+  nlohmann::json control_command(const nlohmann::json& command) {
+    if (command.contains("serve")) {
+      if (!command["serve"].is_string()) throw Error("\"serve\" takes a condition's name");
+      const int index = conditions.serve(command["serve"].get<std::string>());
+      // The links change now; the simulation takes the rest at its next step.
+      connections->set_link_delay(conditions.conditions()[static_cast<std::size_t>(index)].link_delay(options.shift));
+    } else if (!command.contains("status")) {
+      throw Error(fmt::format("unknown command {} (the commands: {{\"serve\": NAME}}, {{\"status\": true}})", command.dump()));
+    }
+    const ConditionSwitch::Served served = conditions.served();
+    return {{"served", conditions.conditions()[static_cast<std::size_t>(served.index)].name},
+            {"switches", served.switches},
+            {"time_s", static_cast<double>(wire::monotonic_now_ns() - start_ns) * 1e-9}};
   }
 
   void print_status() {
@@ -182,6 +232,7 @@ struct SimulationServer::Impl {
   void shutdown(const std::string& reason) {
     if (!running.exchange(false)) return;
     spdlog::info("shutting down");
+    if (control) control->close();
     connections->say_goodbye(reason);
     status_timer.cancel();
     duration_timer.cancel();

@@ -306,6 +306,57 @@ TEST(SimulationLoop, SendsComplianceRowsUnderBTruncation) {
 
 // ---- the real server program ----
 
+// A switch of the served condition takes effect at the next step: the held nodes and the
+// protocol change there, the outbox tells the users, and a switch to P1 sends the user's IR
+// in the same outbox as, and after, the announcement (its client changes over with it).
+TEST(SimulationLoop, ASwitchedConditionChangesHeldNodesAndProtocolAtTheNextStep) {
+  LoopRig rig(10, ServeProtocol::p0);
+  ServedCondition held_p0, free_p1;
+  held_p0.name = "A";
+  held_p0.protocol = ServeProtocol::p0;
+  held_p0.step_nodes = 10;
+  free_p1.name = "B";
+  free_p1.protocol = ServeProtocol::p1;
+  ConditionSwitch conditions({held_p0, free_p1});
+  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
+                      nullptr, nullptr, wire::monotonic_now_ns(), &conditions);
+  const auto forces = [](const Outbox& outbox) {
+    return std::count_if(outbox.datagrams.begin(), outbox.datagrams.end(),
+                         [](const ToSlot<wire::Datagram>& d) { return d.message.has_force(); });
+  };
+  for (int step = 0; step < 5; ++step) {
+    const Outbox outbox = loop.step(wire::monotonic_now_ns());
+    EXPECT_FALSE(outbox.protocol_switch.has_value());
+    EXPECT_TRUE(outbox.irs.empty()) << "P0 sends no IR";
+    EXPECT_EQ(forces(outbox), 1);
+  }
+  EXPECT_EQ(rig.statistics.summary().max_boundary_nodes, 10);
+
+  conditions.serve("B");
+  const Outbox switched = loop.step(wire::monotonic_now_ns());
+  ASSERT_TRUE(switched.protocol_switch.has_value());
+  EXPECT_EQ(*switched.protocol_switch, wire::P1);
+  EXPECT_EQ(forces(switched), 0);
+  ASSERT_EQ(switched.irs.size(), 1u) << "the user's IR, announced before it";
+  wire::IrStreamReader stream;
+  IntermediateRepresentation ir = wire::from_wire(stream.open(switched.irs[0].message.compressed_ir()));
+  const CondensedFemIr& fem = condensed_fem(ir);
+  EXPECT_EQ(fem.node_ids.size(), static_cast<std::size_t>(fem.row_node_count)) << "B holds no nodes, from the step it took effect";
+  EXPECT_TRUE(fem.truncated_node_ids.empty());
+  for (int step = 0; step < 5; ++step) {
+    const Outbox outbox = loop.step(wire::monotonic_now_ns());
+    EXPECT_FALSE(outbox.protocol_switch.has_value());
+    EXPECT_EQ(forces(outbox), 0);
+  }
+
+  conditions.serve("A");
+  const Outbox back = loop.step(wire::monotonic_now_ns());
+  ASSERT_TRUE(back.protocol_switch.has_value());
+  EXPECT_EQ(*back.protocol_switch, wire::P0);
+  EXPECT_EQ(forces(back), 1) << "P0's forces from the step the switch took effect";
+  EXPECT_TRUE(back.irs.empty());
+}
+
 TEST(ServerProgram, EndsTheSessionWithAnErrorWhenEveryStepFails) {
   const fs::path dir = testing::scratch_directory("server-step-failures");
   testing::CubeSceneOptions scene = LoopRig::soft_cube();

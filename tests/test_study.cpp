@@ -27,18 +27,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A small cube pressed open loop (a scripted device), so every trial presses the same. The
-// whole surface is touchable, so its compliance is computed when the scene loads: the
-// nodes that step delay holds need no columns computed at the first contact, which on a
-// loaded machine could stall the server past the client's fade age and split the stroke.
+// A small cube pressed open loop (a scripted device), so every trial presses the same.
 void write_study_files(const fs::path& dir, const std::string& study_body) {
-  testing::CubeSceneOptions cube;
-  cube.divisions = 7;
-  cube.youngs_modulus = 2.0e5;
-  cube.touchable = "{surface: true}";
-  cube.compliance = "{precompute: touchable, disk_cache: false}";
-  cube.tools = "[{name: A}]";
-  std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(cube);
+  std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(testing::pressed_cube_options());
   std::ofstream(dir / "press.yaml") << R"(
 units: mm
 start: [4, 3, 4]

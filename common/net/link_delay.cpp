@@ -29,6 +29,11 @@ LinkDelay::LinkDelay(const LinkDelaySettings& settings, bool ordered)
   validate(settings_);
 }
 
+void LinkDelay::set_settings(const LinkDelaySettings& settings) {
+  validate(settings);
+  settings_ = settings;
+}
+
 std::optional<std::int64_t> LinkDelay::delay_ns(std::int64_t now_ns) {
   ++counters_.messages;
   std::uniform_real_distribution<double> unit(0.0, 1.0);

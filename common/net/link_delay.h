@@ -43,6 +43,11 @@ class LinkDelay {
   /// now_ns + delay is strictly above every earlier message's.
   std::optional<std::int64_t> delay_ns(std::int64_t now_ns);
 
+  /// Delay, jitter, loss and reorder from the next message on (a session switching
+  /// conditions); the seeded stream, the order kept and the counters go on. Throws Error as
+  /// validate() does.
+  void set_settings(const LinkDelaySettings& settings);
+
   const LinkDelaySettings& settings() const { return settings_; }
   const LinkDelayCounters& counters() const { return counters_; }
 

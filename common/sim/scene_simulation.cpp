@@ -150,6 +150,11 @@ void SceneSimulation::assign_bodies() {
   }
 }
 
+void SceneSimulation::set_step_delay_nodes(int nodes) {
+  for (const std::unique_ptr<BodySimulation>& body : bodies_)
+    if (auto* fem = std::get_if<Simulation>(body.get())) fem->set_step_delay_nodes(nodes);
+}
+
 StepReport SceneSimulation::step(double time) {
   period_ = started_ ? time - time_ : 0;
   started_ = true;

@@ -56,6 +56,8 @@ class SceneSimulation {
   void clear_tool(int user);
 
   StepReport step(double time);
+  /// Every FEM body's step delay from the next step on (Simulation::set_step_delay_nodes).
+  void set_step_delay_nodes(int nodes);
 
   /// The user's latest IR; null until its body built one.
   std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }

@@ -1,5 +1,7 @@
 #include "common/sim/simulation.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <future>
 #include <limits>
@@ -10,6 +12,7 @@
 #include "common/contact/nearest_surface_nodes.h"
 #include "common/contact/obstacle_constraints.h"
 #include "common/sim/sphere_state_solve.h"
+#include "common/util/error.h"
 #include "common/util/stopwatch.h"
 
 namespace cohaptic {
@@ -274,13 +277,29 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
   return !pulling.empty() || !penetrating.empty();
 }
 
+void Simulation::set_step_delay_nodes(int nodes) {
+  if (nodes < 0) throw Error(fmt::format("set_step_delay_nodes: {} nodes", nodes));
+  if (nodes == options_.step_delay_nodes) return;
+  options_.step_delay_nodes = nodes;
+  step_delay_changed_ = true;
+}
+
+void Simulation::release_step_delay_nodes() {
+  std::vector<int> step_nodes;
+  for (const auto& [node, held] : held_)
+    if (held.obstacle < 0) step_nodes.push_back(node);
+  for (int node : step_nodes) release(node);
+}
+
 bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch) {
   boundary_dirty_ = false;
   const std::vector<int> current = condensation_.boundary_nodes();
   for (int node : current)
     if (under_tool[node]) release(node);  // the tool's triangle wins
 
-  // Step delay: hold the N nodes nearest the pressing tools while any presses.
+  // Step delay: hold the N nodes nearest the pressing tools while any presses; a new N
+  // (set_step_delay_nodes) chooses them afresh.
+  if (std::exchange(step_delay_changed_, false)) release_step_delay_nodes();
   std::vector<Eigen::Vector3d> contact_points;
   for (const UserState& user : users_)
     if (user.pressing) contact_points.push_back(user.position);
@@ -297,10 +316,7 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
         displacement_of_nodes(columns_, sphere_model() ? solve_spheres(previous_spheres_) : solve(previous_contacts_), fresh);
     for (std::size_t i = 0; i < fresh.size(); ++i) hold(fresh[i], {u.col(static_cast<Eigen::Index>(i)), -1});
   } else if (contact_points.empty() && step_delay_held) {
-    std::vector<int> step_nodes;
-    for (const auto& [node, held] : held_)
-      if (held.obstacle < 0) step_nodes.push_back(node);
-    for (int node : step_nodes) release(node);
+    release_step_delay_nodes();
   }
 
   // Under the sphere contact model the state solve holds the obstacles' nodes itself.

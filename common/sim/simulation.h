@@ -89,6 +89,10 @@ class Simulation {
 
   StepReport step(double time);
 
+  /// Step delay from the next step on: hold `nodes` surface nodes while any tool presses (0:
+  /// none). The nodes held now are released there and, if a tool presses, chosen afresh.
+  void set_step_delay_nodes(int nodes);
+
   /// Latest IR of `user`; null until its tool position is known.
   std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
   /// Reaction force on `user`'s tool now (zero if it has no IR).
@@ -151,6 +155,7 @@ class Simulation {
   std::vector<PressingContact> pressing_contacts() const;
   StateSolution solve(std::span<const PressingContact> contacts) const;
   bool sphere_model() const { return options_.ir.contact_model == ContactModel::sphere; }
+  void release_step_delay_nodes();
   /// The sphere contact model's part of a user's step: its patch's nodes are under the tool
   /// and in the patch (its candidates), and it presses when its sphere holds a node.
   void mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
@@ -178,6 +183,7 @@ class Simulation {
   const ElasticBody& body_;
   ComplianceColumns& columns_;
   SimulationOptions options_;
+  bool step_delay_changed_ = false;  // set_step_delay_nodes() since the last step
   mutable IncrementalCondensation condensation_;  // its Z cache changes on const queries
   std::vector<ObstacleDistance> obstacles_;
   NearestTriangleCandidates candidates_;          // the few triangles each tool's nearest-triangle scans visit

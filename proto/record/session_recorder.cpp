@@ -52,16 +52,18 @@ void SessionRecorder::datagram_in(std::int64_t receive_ns, const wire::Datagram&
   write(datagrams_, receive_ns, record);
 }
 
-void SessionRecorder::ir(std::int64_t time_ns, const wire::IntermediateRepresentation& ir) {
+void SessionRecorder::ir(std::int64_t time_ns, const wire::IntermediateRepresentation& ir, bool repeat) {
   RecordedIr record;
   record.set_time_ns(time_ns);
+  record.set_repeat(repeat);
   *record.mutable_ir() = ir;
   write(ir_, time_ns, record);
 }
 
-void SessionRecorder::ir_block(std::int64_t time_ns, std::uint32_t stream, const wire::CompressedIr& block) {
+void SessionRecorder::ir_block(std::int64_t time_ns, std::uint32_t stream, const wire::CompressedIr& block, bool repeat) {
   RecordedIr record;
   record.set_time_ns(time_ns);
+  record.set_repeat(repeat);
   *record.mutable_compressed_ir() = block;
   record.set_stream(stream);
   write(ir_, time_ns, record);

@@ -6,6 +6,16 @@
 
 namespace cohaptic::testing {
 
+CubeSceneOptions pressed_cube_options() {
+  CubeSceneOptions cube;
+  cube.divisions = 7;
+  cube.youngs_modulus = 2.0e5;
+  cube.touchable = "{surface: true}";
+  cube.compliance = "{precompute: touchable, disk_cache: false}";
+  cube.tools = "[{name: A}]";
+  return cube;
+}
+
 std::string cube_scene_yaml(const CubeSceneOptions& o) {
   return fmt::format(R"(
 units: mm

@@ -24,6 +24,12 @@ struct CubeSceneOptions {
 /// A 130 mm cube (z from -130 to 0 mm), rear face fixed, in millimetres.
 std::string cube_scene_yaml(const CubeSceneOptions& options = {});
 
+/// The small cube a lab session presses with one tool, open loop: its whole surface is
+/// touchable and its compliance computed when the scene loads, so that the nodes step delay
+/// holds need no columns computed at the first contact (which on a loaded machine could
+/// stall the server past the client's fade age and split the stroke).
+CubeSceneOptions pressed_cube_options();
+
 /// The cube's model and its compliance columns over the whole surface (any node may be held).
 struct CubeRig {
   std::unique_ptr<Model> model;

@@ -1,0 +1,67 @@
+// The conditions a session can switch between while it runs (a paired-comparison study's
+// pair: `cohaptic-server --condition A:... --condition B:...`), and which one is served.
+//
+// A condition is what the paper's factors set: the protocol, the shift delay on every link
+// (delay, jitter, loss), the step delay's held nodes, and the simulation rate's cap. The
+// first condition is served from the start; a switch (ConditionSwitch::serve, from the
+// control socket, control_socket.h) takes effect on the I/O thread at once (the link
+// delays) and on the simulation thread at its next step (protocol, held nodes, rate), where
+// it is recorded. Nothing a client is told names a condition: the clients learn only the
+// protocol (wire::ProtocolSwitch), so a subject cannot tell which condition is which.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "common/net/link_delay.h"
+
+namespace cohaptic {
+
+enum class ServeProtocol { p0, p1 };
+
+struct ServedCondition {
+  std::string name;
+  ServeProtocol protocol = ServeProtocol::p1;
+  double shift_delay_ms = 0, jitter_ms = 0, loss = 0;
+  int step_nodes = 0;      ///< the step delay's held surface nodes (0: none)
+  double sim_rate_hz = 0;  ///< the simulation loop's rate cap (0: up to 1 kHz)
+
+  /// The link delay settings under this condition; reorder and seed are the session's.
+  LinkDelaySettings link_delay(const LinkDelaySettings& session) const;
+  std::string describe() const;  ///< e.g. "P1, shift 30 ms, 150 held nodes"
+};
+
+/// Parses `NAME:key=value,...` (keys protocol, shift_ms, jitter_ms, loss, step_nodes,
+/// sim_rate_hz; unset keys: P1 and 0). Throws Error naming the text and the bad key or value.
+ServedCondition parse_served_condition(const std::string& text);
+
+/// The condition served now, shared by the I/O thread (which switches) and the simulation
+/// thread (which applies a switch at its next step). Thread-safe.
+class ConditionSwitch {
+ public:
+  /// `conditions`: at least one, names distinct (throws Error otherwise); the first is served.
+  explicit ConditionSwitch(std::vector<ServedCondition> conditions);
+
+  const std::vector<ServedCondition>& conditions() const { return conditions_; }
+
+  /// Serves the condition named `name` from now; returns its index. Throws Error naming the
+  /// known conditions when there is none of that name.
+  int serve(const std::string& name);
+
+  /// The condition served and how many switches led to it (0 at the start).
+  struct Served {
+    int index = 0;
+    std::uint64_t switches = 0;
+  };
+  Served served() const;
+
+ private:
+  const std::vector<ServedCondition> conditions_;
+  mutable std::mutex mutex_;
+  Served served_;
+};
+
+}  // namespace cohaptic

@@ -1,0 +1,145 @@
+// A session that switches conditions while it runs, as a paired comparison does: a real
+// cohaptic-server serving two conditions (P0 with held nodes; P1 with a shift delay) and a
+// control socket, a real cohaptic-client pressing and holding, and an experimenter's
+// switches over the socket. Each switch takes effect in the server (held nodes, link delay,
+// protocol) and in the client (its protocol, without a fade), is recorded, and both
+// recordings re-run bit for bit.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+#include <signal.h>
+
+#include <asio.hpp>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <thread>
+
+#include "lab/replay.h"
+#include "proto/record/recording.h"
+#include "support/cube_scene.h"
+#include "support/process.h"
+
+namespace cohaptic {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+constexpr double kShiftMs = 25;
+constexpr int kHeldNodes = 60;
+
+double median(std::vector<double> values) {
+  if (values.empty()) return std::nan("");
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
+
+TEST(ConditionSwitchSession, EachSwitchTakesEffectInServerAndClientIsRecordedAndReplaysBitForBit) {
+  const fs::path dir = testing::scratch_directory("condition-switch");
+  std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(testing::pressed_cube_options());
+  std::ofstream(dir / "press.yaml") << R"(
+units: mm
+start: [4, 3, 4]
+segments:
+  - {move_to: [4, 3, 0.5], speed: 20}
+  - {press: 0.75, speed: 1.5, direction: [0, 0, -1]}
+  - {hold: 5}
+  - {release: 0.75, speed: 1.5}
+)";
+  testing::ChildProcess server(
+      testing::server_program(),
+      {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--condensation", "naive", "--condition",
+       fmt::format("A:protocol=P0,step_nodes={}", kHeldNodes), "--condition", fmt::format("B:protocol=P1,shift_ms={}", kShiftMs),
+       "--control", (dir / "control").string(), "--duration", "60", "--record", (dir / "server.mcap").string(), "--report",
+       (dir / "server.json").string()},
+      dir / "server.log");
+  ASSERT_TRUE(testing::wait_for_output(server, "listening on")) << server.log_text();
+  const int port = testing::listening_port(server.log_text());
+  testing::ChildProcess client(testing::client_program(),
+                               {"--server", fmt::format("127.0.0.1:{}", port), "--user", "subject", "--slot", "0", "--device",
+                                "script:" + (dir / "press.yaml").string(), "--duration", "6.5", "--record",
+                                (dir / "subject.mcap").string(), "--report", (dir / "subject.json").string()},
+                               dir / "subject.log");
+  ASSERT_TRUE(testing::wait_for_output(client, "haptic thread")) << client.log_text();
+
+  // The experimenter switches while the subject presses and holds: B, A, B, A, B.
+  asio::io_context io;
+  asio::local::stream_protocol::socket control(io);
+  control.connect(asio::local::stream_protocol::endpoint((dir / "control").string()));
+  asio::streambuf input;
+  const auto ask = [&](const std::string& line) {
+    asio::write(control, asio::buffer(line + "\n"));
+    const std::size_t size = asio::read_until(control, input, '\n');
+    const std::string reply(asio::buffers_begin(input.data()), asio::buffers_begin(input.data()) + static_cast<std::ptrdiff_t>(size));
+    input.consume(size);
+    return nlohmann::json::parse(reply);
+  };
+  std::this_thread::sleep_for(1500ms);  // pressing by now
+  const std::vector<std::string> switches = {"B", "A", "B", "A", "B"};
+  for (std::size_t i = 0; i < switches.size(); ++i) {
+    const nlohmann::json reply = ask(fmt::format(R"({{"serve": "{}"}})", switches[i]));
+    EXPECT_EQ(reply.value("served", ""), switches[i]) << reply;
+    EXPECT_EQ(reply.value("switches", 0u), i + 1) << reply;
+    std::this_thread::sleep_for(700ms);
+  }
+  EXPECT_NE(ask(R"({"serve": "C"})").value("error", "").find("no condition named 'C'"), std::string::npos);
+  control.close();
+  ASSERT_EQ(client.wait(30s), 0) << client.log_text();
+  server.signal(SIGINT);
+  ASSERT_EQ(server.wait(30s), 0) << server.log_text();
+
+  // The server: each switch on the step it took effect, in order, with its settings; the
+  // held nodes and the tool samples' delay follow the condition served.
+  const record::Recording served = record::read_recording(dir / "server.mcap");
+  std::vector<std::string> recorded;
+  std::string condition = "A";
+  std::map<std::string, std::vector<double>> sample_age_ms;
+  std::map<std::string, std::set<std::uint32_t>> held;
+  for (const record::SimulationStep& step : served.steps) {
+    if (step.has_condition_switch()) {
+      const record::ConditionSwitch& s = step.condition_switch();
+      recorded.push_back(s.name());
+      condition = s.name();
+      EXPECT_EQ(s.protocol(), condition == "A" ? wire::P0 : wire::P1);
+      EXPECT_EQ(s.injected().shift_delay_ms(), condition == "A" ? 0 : kShiftMs);
+      EXPECT_EQ(s.injected().step_nodes(), condition == "A" ? static_cast<unsigned>(kHeldNodes) : 0u);
+      continue;  // the step a switch took effect mixes both
+    }
+    if (step.pressing_slots_size() == 0) continue;
+    held[condition].insert(step.boundary_nodes());
+    for (const record::ToolInput& tool : step.tools())
+      if (tool.known()) sample_age_ms[condition].push_back(static_cast<double>(step.time_ns() - tool.sample_time_ns()) * 1e-6);
+  }
+  EXPECT_EQ(recorded, switches);
+  EXPECT_EQ(held["A"], (std::set<std::uint32_t>{kHeldNodes})) << "A holds its nodes whenever the tool presses";
+  EXPECT_EQ(held["B"], (std::set<std::uint32_t>{0})) << "B holds none";
+  const double age_a = median(sample_age_ms["A"]), age_b = median(sample_age_ms["B"]);
+  std::printf("  tool samples' age at the server (median): A %.1f ms, B %.1f ms (B's links delayed %g ms)\n", age_a, age_b,
+              kShiftMs);
+  EXPECT_GE(age_b, kShiftMs);
+  EXPECT_LT(age_a, kShiftMs / 2);
+  const nlohmann::json server_report = nlohmann::json::parse(std::ifstream(dir / "server.json"));
+  EXPECT_EQ(server_report["server"]["condition_switches"], switches.size());
+
+  // The client: one change of protocol per switch, each without a fade.
+  const nlohmann::json client_report = nlohmann::json::parse(std::ifstream(dir / "subject.json"));
+  EXPECT_EQ(client_report["protocol_switches"], switches.size());
+  EXPECT_EQ(client_report["fades"]["count"], 0) << "the force never lapsed";
+  const record::Recording felt = record::read_recording(dir / "subject.mcap");
+  std::size_t changes = 0;
+  for (std::size_t i = 1; i < felt.ticks.size(); ++i) changes += felt.ticks[i].protocol() != felt.ticks[i - 1].protocol();
+  EXPECT_EQ(changes, switches.size());
+
+  for (const char* file : {"server.mcap", "subject.mcap"}) {
+    const VerifyResult result = verify_recording(dir / file);
+    EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
+    EXPECT_GT(result.checked, 100u) << file;
+  }
+}
+
+}  // namespace
+}  // namespace cohaptic
