@@ -2,7 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
+#include <fstream>
 #include <random>
+#include <stdexcept>
 
 #include "common/study/paired_comparison_analysis.h"
 #include "common/study/paired_comparison_report.h"
@@ -13,6 +17,8 @@
 namespace cohaptic {
 
 namespace {
+
+constexpr std::array<const char*, 6> kRatingColumns = {"subject", "position", "first", "second", "rating", "rated_by"};
 
 // The default labels: "first clearly finer", "first slightly finer", "no difference", ...
 std::vector<std::string> default_labels(RatedQuality quality, int grades) {
@@ -32,7 +38,8 @@ std::vector<std::string> default_labels(RatedQuality quality, int grades) {
 }  // namespace
 
 PairedComparisonDesign parse_paired_comparison(const YamlCursor& block) {
-  block.only_keys({"question", "quality", "grades", "labels", "subjects", "rater"});
+  block.only_keys({"question", "quality", "grades", "labels", "subjects", "rater", "practice_pairs", "show_object",
+                   "pair_duration"});
   PairedComparisonDesign design;
   design.quality = parse_rated_quality(block.at("quality").choice({"finer", "harder"}));
   design.question = block.find("question") ? block.at("question").text()
@@ -56,9 +63,18 @@ PairedComparisonDesign parse_paired_comparison(const YamlCursor& block) {
   }
   design.rater = default_rater_settings(design.quality);
   design.rater.grades = design.grades;
+  if (auto practice = block.find("practice_pairs")) {
+    const std::int64_t n = practice->integer();
+    if (n < 0 || n > 100) practice->fail("an integer from 0 to 100");
+    design.practice_pairs = static_cast<int>(n);
+  }
+  if (auto shown = block.find("show_object")) design.show_object = shown->choice({"practice", "always", "never"});
+  if (auto duration = block.find("pair_duration"))
+    design.pair_duration_s = duration->number_in(1, 3600, false, false, "seconds, 1 to 3600");
   if (auto rater = block.find("rater")) {
     rater->only_keys({"kind", "jnd", "noise", "seed"});
-    if (auto kind = rater->find("kind")) kind->choice({"simulated"});
+    if (auto kind = rater->find("kind"))
+      design.rater_kind = kind->choice({"simulated", "person"}) == "person" ? RaterKind::person : RaterKind::simulated;
     if (auto jnd = rater->find("jnd"))
       design.rater.just_noticeable_difference = jnd->number_in(0, 10, false, false, "a Weber fraction above 0");
     if (auto noise = rater->find("noise"))
@@ -86,23 +102,53 @@ std::vector<PresentedPair> presentation_plan(int conditions, int subjects) {
   return plan;
 }
 
-void run_paired_comparisons(const PairedComparisonDesign& design, const std::string& study_name,
-                            const std::vector<std::string>& condition_names, const StudyFactors& factors,
-                            const std::vector<std::vector<TrialMeasures>>& measures, const std::filesystem::path& out) {
-  const int conditions = static_cast<int>(condition_names.size());
-  if (conditions < 3)
-    throw Error(fmt::format("a paired-comparison study needs at least 3 conditions (it has {})", conditions));
-  if (measures.empty()) throw Error("a paired-comparison study needs the measures of at least one repetition");
+void write_pair_plan(const std::filesystem::path& file, const std::vector<std::string>& condition_names, int subjects) {
+  AtomicFile csv(file);
+  csv.write("subject,position,first,second\n");
+  for (const PresentedPair& pair : presentation_plan(static_cast<int>(condition_names.size()), subjects))
+    csv.print("{},{},{},{}\n", pair.subject + 1, pair.position + 1, csv_field(condition_names[static_cast<std::size_t>(pair.first)]),
+              csv_field(condition_names[static_cast<std::size_t>(pair.second)]));
+  csv.commit();
+}
 
-  PairedComparisonRatings ratings;
-  ratings.conditions = conditions;
-  ratings.ratings.assign(static_cast<std::size_t>(design.subjects),
-                         std::vector<double>(static_cast<std::size_t>(pair_count(conditions)), 0.0));
-  AtomicFile csv(out / "ratings.csv");
-  csv.write("subject,position,first,second,rating,rated_by\n");
+std::vector<PairRatingRow> read_ratings(const std::filesystem::path& file) {
+  std::vector<PairRatingRow> rows;
+  if (!std::filesystem::exists(file)) return rows;
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  if (split_csv_line(line) != std::vector<std::string>(kRatingColumns.begin(), kRatingColumns.end()))
+    throw Error(fmt::format("{}: not a ratings table (its header is '{}')", file.string(), line));
+  for (int number = 2; std::getline(in, line); ++number) {
+    if (line.empty()) continue;
+    const std::vector<std::string> fields = split_csv_line(line);
+    try {
+      if (fields.size() != kRatingColumns.size()) throw std::invalid_argument("field count");
+      rows.push_back({std::stoi(fields[0]), std::stoi(fields[1]), fields[2], fields[3], std::stoi(fields[4]), fields[5]});
+    } catch (const std::exception&) {
+      throw Error(fmt::format("{}:{}: not a row of {} fields: {}", file.string(), number, kRatingColumns.size(), line));
+    }
+  }
+  return rows;
+}
+
+void write_ratings(const std::filesystem::path& file, const std::vector<PairRatingRow>& rows) {
+  AtomicFile csv(file);
+  csv.print("{}\n", fmt::join(kRatingColumns, ","));
+  for (const PairRatingRow& row : rows)
+    csv.print("{},{},{},{},{},{}\n", row.subject, row.position, csv_field(row.first), csv_field(row.second), row.rating,
+              row.rated_by);
+  csv.commit();
+}
+
+std::vector<PairRatingRow> simulated_ratings(const PairedComparisonDesign& design,
+                                             const std::vector<std::string>& condition_names,
+                                             const std::vector<std::vector<TrialMeasures>>& measures) {
+  if (measures.empty()) throw Error("a paired-comparison study needs the measures of at least one repetition");
+  std::vector<PairRatingRow> rows;
   std::mt19937 rng;
   int subject = -1;
-  for (const PresentedPair& pair : presentation_plan(conditions, design.subjects)) {
+  for (const PresentedPair& pair : presentation_plan(static_cast<int>(condition_names.size()), design.subjects)) {
     if (pair.subject != subject) {
       subject = pair.subject;
       rng.seed(design.rater.seed + static_cast<unsigned>(subject));
@@ -110,16 +156,46 @@ void run_paired_comparisons(const PairedComparisonDesign& design, const std::str
     const std::vector<TrialMeasures>& felt = measures[static_cast<std::size_t>(subject) % measures.size()];
     const int rating = rate_pair(design.rater, felt[static_cast<std::size_t>(pair.first)],
                                  felt[static_cast<std::size_t>(pair.second)], rng);
-    // Nakaya's x_ij (i < j) is positive when i felt more: a pair presented the other way round
-    // enters with its sign turned.
-    const int low = std::min(pair.first, pair.second), high = std::max(pair.first, pair.second);
-    ratings.ratings[static_cast<std::size_t>(subject)][static_cast<std::size_t>(pair_index(low, high, conditions))] =
-        pair.first == low ? rating : -rating;
-    csv.print("{},{},{},{},{},simulated\n", subject + 1, pair.position + 1,
-              csv_field(condition_names[static_cast<std::size_t>(pair.first)]),
-              csv_field(condition_names[static_cast<std::size_t>(pair.second)]), rating);
+    rows.push_back({subject + 1, pair.position + 1, condition_names[static_cast<std::size_t>(pair.first)],
+                    condition_names[static_cast<std::size_t>(pair.second)], rating, "simulated"});
   }
-  csv.commit();
+  return rows;
+}
+
+void analyse_ratings(const PairedComparisonDesign& design, const std::string& study_name,
+                     const std::vector<std::string>& condition_names, const StudyFactors& factors,
+                     const std::vector<PairRatingRow>& rows, const std::filesystem::path& out) {
+  const int conditions = static_cast<int>(condition_names.size());
+  if (conditions < 3)
+    throw Error(fmt::format("a paired-comparison study needs at least 3 conditions (it has {})", conditions));
+  const auto index_of = [&](const std::string& name) {
+    const auto at = std::find(condition_names.begin(), condition_names.end(), name);
+    if (at == condition_names.end()) throw Error(fmt::format("ratings.csv names a condition '{}' the study has not", name));
+    return static_cast<int>(at - condition_names.begin());
+  };
+  PairedComparisonRatings ratings;
+  ratings.conditions = conditions;
+  ratings.ratings.assign(static_cast<std::size_t>(design.subjects),
+                         std::vector<double>(static_cast<std::size_t>(pair_count(conditions)), 0.0));
+  std::vector<std::vector<char>> rated(static_cast<std::size_t>(design.subjects),
+                                       std::vector<char>(static_cast<std::size_t>(pair_count(conditions)), 0));
+  for (const PairRatingRow& row : rows) {
+    if (row.subject < 1 || row.subject > design.subjects)
+      throw Error(fmt::format("ratings.csv: subject {} is not one of the study's 1 to {}", row.subject, design.subjects));
+    const int first = index_of(row.first), second = index_of(row.second);
+    const int low = std::min(first, second), high = std::max(first, second);
+    const auto s = static_cast<std::size_t>(row.subject - 1);
+    const auto k = static_cast<std::size_t>(pair_index(low, high, conditions));
+    if (rated[s][k]) throw Error(fmt::format("ratings.csv: subject {} rated {} and {} twice", row.subject, row.first, row.second));
+    rated[s][k] = 1;
+    // Nakaya's x_ij (i < j) is positive when i felt more: a pair presented the other way
+    // round enters with its sign turned.
+    ratings.ratings[s][k] = first == low ? row.rating : -row.rating;
+  }
+  for (std::size_t s = 0; s < rated.size(); ++s) {
+    const auto missing = std::count(rated[s].begin(), rated[s].end(), 0);
+    if (missing > 0) throw Error(fmt::format("subject {} has not rated {} of the {} pairs yet", s + 1, missing, rated[s].size()));
+  }
 
   const PairedComparisonAnalysis analysis = analyse_paired_comparisons(ratings);
   std::vector<FactorEffect> effects;
@@ -133,7 +209,8 @@ void run_paired_comparisons(const PairedComparisonDesign& design, const std::str
   fmt::print("{}", table);
 
   ScaleLineFigure figure;
-  figure.title = fmt::format("{}: Scheffe's paired comparisons, {} subjects (simulated)", study_name, design.subjects);
+  figure.title = fmt::format("{}: Scheffe's paired comparisons, {} subjects ({})", study_name, design.subjects,
+                             design.rater_kind == RaterKind::person ? "people" : "simulated");
   figure.question = fmt::format("{}  (a higher scale value: felt {})", design.question, to_string(design.quality));
   figure.names = condition_names;
   figure.scale = analysis.scale;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <functional>
 #include <fstream>
+#include <iostream>
 #include <initializer_list>
 #include <memory>
 #include <optional>
@@ -17,6 +18,7 @@
 
 #include "common/scene/load_scene.h"
 #include "common/study/measures.h"
+#include "common/study/paired_comparison_analysis.h"
 #include "common/study/summary.h"
 #include "common/study/svg_plot.h"
 #include "common/util/atomic_file.h"
@@ -26,6 +28,7 @@
 #include "common/util/regular_file.h"
 #include "common/util/yaml_cursor.h"
 #include "common/util/child_process.h"
+#include "lab/person_pairs.h"
 #include "proto/record/recording.h"
 #include "proto/wire/vec3_convert.h"
 
@@ -142,24 +145,32 @@ Study parse_study(const std::string& yaml_text, const std::filesystem::path& fil
   if (auto duration = top.find("trial_duration")) study.trial_duration_s = duration->number_in(0.5, 3600, false, false, "seconds, 0.5 to 3600");
   if (auto condensation = top.find("condensation")) study.condensation = condensation->choice({"naive", "incremental"});
 
-  for (const YamlCursor& item : top.at("participants").items()) {
-    item.only_keys({"name", "device", "trajectory"});
-    StudyParticipant p;
-    p.name = item.at("name").text();
-    p.device = item.find("device") ? item.at("device").choice({"hand", "script"}) : "hand";
-    const YamlCursor trajectory = item.at("trajectory");
-    p.trajectory = base / trajectory.text();
-    if (const auto why = why_not_a_regular_file(p.trajectory))
-      trajectory.fail_message(fmt::format("trajectory file {} {}", p.trajectory.string(), *why));
-    p.slot = static_cast<int>(study.participants.size());
-    study.participants.push_back(p);
+  // A study rated by people has no simulated participants: the subject holds the device.
+  if (auto paired = top.find("paired_comparison")) study.paired = parse_paired_comparison(*paired);
+  const bool rated_by_people = study.paired && study.paired->rater_kind == RaterKind::person;
+  if (rated_by_people) {
+    if (auto participants = top.find("participants"))
+      participants->fail_message("a study rated by people has no simulated participants (the subject holds the device: "
+                                 "cohaptic-lab study --subject N --device SPEC)");
+  } else {
+    for (const YamlCursor& item : top.at("participants").items()) {
+      item.only_keys({"name", "device", "trajectory"});
+      StudyParticipant p;
+      p.name = item.at("name").text();
+      p.device = item.find("device") ? item.at("device").choice({"hand", "script"}) : "hand";
+      const YamlCursor trajectory = item.at("trajectory");
+      p.trajectory = base / trajectory.text();
+      if (const auto why = why_not_a_regular_file(p.trajectory))
+        trajectory.fail_message(fmt::format("trajectory file {} {}", p.trajectory.string(), *why));
+      p.slot = static_cast<int>(study.participants.size());
+      study.participants.push_back(p);
+    }
+    if (study.participants.empty()) top.at("participants").fail("at least one participant");
+    const std::size_t tools = load_scene(study.scene).tools.size();
+    if (study.participants.size() > tools)
+      top.at("participants").fail_message(fmt::format("{} participants, but the scene {} has {} tool(s): one participant holds one tool",
+                                                      study.participants.size(), study.scene.string(), tools));
   }
-  if (study.participants.empty()) top.at("participants").fail("at least one participant");
-  const std::size_t tools = load_scene(study.scene).tools.size();
-  if (study.participants.size() > tools)
-    top.at("participants").fail_message(fmt::format("{} participants, but the scene {} has {} tool(s): one participant holds one tool",
-                                                    study.participants.size(), study.scene.string(), tools));
-
   const YamlCursor factors = top.at("factors");
   factors.only_keys({"shift_ms", "jitter_ms", "loss", "step_nodes", "sim_rate_hz", "protocol"});
   const auto non_negative = [](const YamlCursor& c) { return c.number_in(0, 1e6, false, false, "a number >= 0"); };
@@ -204,7 +215,6 @@ Study parse_study(const std::string& yaml_text, const std::filesystem::path& fil
     }
 
   if (auto paired = top.find("paired_comparison")) {
-    study.paired = parse_paired_comparison(*paired);
     if (study.conditions.size() < 3)
       paired->fail_message(fmt::format("a paired comparison needs at least 3 conditions; the factors give {}",
                                        study.conditions.size()));
@@ -439,6 +449,51 @@ std::vector<std::vector<TrialMeasures>> measures_by_repetition(const Study& stud
   return measures;
 }
 
+// The settings of a --condition of cohaptic-server for `c` (after "NAME:").
+std::string condition_settings(const StudyCondition& c) {
+  return fmt::format("protocol={},shift_ms={},jitter_ms={},loss={},step_nodes={},sim_rate_hz={}", c.protocol,
+                     number(c.shift_ms), number(c.jitter_ms), number(c.loss), c.step_nodes, number(c.sim_rate_hz));
+}
+
+// A study rated by people: one subject's unrated pairs, then the analysis if every subject
+// has rated every pair.
+int run_person_study(const Study& study, const StudyRunOptions& options) {
+  if (options.subject == 0 || options.device.empty())
+    throw Error(fmt::format("{} is rated by people, one subject at a time: give --subject N (1 to {}) and --device SPEC "
+                            "(the subject's device, as cohaptic-client --device takes it)",
+                            study.file.string(), study.paired->subjects));
+  PersonSessionSetup setup;
+  setup.study_name = study.name;
+  setup.scene = study.scene;
+  setup.condensation = study.condensation;
+  for (const StudyCondition& condition : study.conditions) {
+    setup.condition_names.push_back(condition.name());
+    setup.condition_settings.push_back(condition_settings(condition));
+  }
+  setup.design = *study.paired;
+  setup.out = options.out;
+  setup.server_program = options.server_program;
+  setup.client_program = options.client_program;
+  setup.subject = options.subject;
+  setup.device = options.device;
+  write_pair_plan(options.out / "pair_plan.csv", setup.condition_names, study.paired->subjects);
+  std::ostream& out = options.output ? *options.output : std::cout;
+  if (!run_person_pairs(setup, options.input ? *options.input : std::cin, out)) {
+    out << fmt::format("stopped: run the same command again to continue with subject {}'s next pair\n", options.subject);
+    return 0;
+  }
+  const std::vector<PairRatingRow> rows = read_ratings(options.out / "ratings.csv");
+  const std::size_t expected = static_cast<std::size_t>(study.paired->subjects * pair_count(static_cast<int>(study.conditions.size())));
+  if (rows.size() < expected) {
+    out << fmt::format("{} of {} ratings in {}: the analysis follows once every subject has rated every pair\n", rows.size(),
+                       expected, (options.out / "ratings.csv").string());
+    return 0;
+  }
+  analyse_ratings(*study.paired, study.name, setup.condition_names, factors_of(study.conditions), rows, options.out);
+  out << fmt::format("wrote {} and {}\n", (options.out / "analysis").string(), (options.out / "figures" / "scale.svg").string());
+  return 0;
+}
+
 }  // namespace
 
 int run_study(const std::filesystem::path& file, const StudyRunOptions& given) {
@@ -451,6 +506,7 @@ int run_study(const std::filesystem::path& file, const StudyRunOptions& given) {
     if (!std::filesystem::exists(program))
       throw Error(fmt::format("the program {} does not exist (build it, or give {})", program, option));
   std::filesystem::create_directories(options.out);
+  if (study.paired && study.paired->rater_kind == RaterKind::person) return run_person_study(study, options);
 
   // The plan: the trials in run order; a re-run must find the same plan.
   std::vector<std::vector<std::string>> plan;
@@ -545,8 +601,11 @@ int run_study(const std::filesystem::path& file, const StudyRunOptions& given) {
   if (study.paired && failed_now.empty()) {
     std::vector<std::string> names;
     for (const StudyCondition& condition : study.conditions) names.push_back(condition.name());
-    run_paired_comparisons(*study.paired, study.name, names, factors_of(study.conditions),
-                           measures_by_repetition(study, header, rows), options.out);
+    write_pair_plan(options.out / "pair_plan.csv", names, study.paired->subjects);
+    write_ratings(options.out / "ratings.csv",
+                  simulated_ratings(*study.paired, names, measures_by_repetition(study, header, rows)));
+    analyse_ratings(*study.paired, study.name, names, factors_of(study.conditions),
+                    read_ratings(options.out / "ratings.csv"), options.out);
     fmt::print("wrote {}, {} and {}\n", (options.out / "ratings.csv").string(), (options.out / "analysis").string(),
                (options.out / "figures" / "scale.svg").string());
   }
@@ -564,13 +623,20 @@ LabCommand add_study_command(CLI::App& lab) {
   auto line = std::make_shared<StudyCommandLine>();
   CLI::App* command = lab.add_subcommand(
       "study", "Run a lab study: every trial with real server and client processes, recorded; trials.csv, summary.csv "
-               "and figures in --out (re-run to continue an interrupted study)");
+               "and figures in --out (re-run to continue an interrupted study); with a paired_comparison block, the "
+               "pairs rated by simulated subjects, or by a person (--subject, --device) at the terminal, and Scheffe's "
+               "analysis");
   command->add_option("file", line->file, "The study file (YAML)")->required()->check(CLI::ExistingFile);
   command->add_option("--out", line->options.out, "Output directory")->required();
   command->add_option("--server-program", line->options.server_program,
                       "cohaptic-server to run (default: the one of this build)");
   command->add_option("--client-program", line->options.client_program,
                       "cohaptic-client to run (default: the one of this build)");
+  command->add_option("--subject", line->options.subject,
+                      "A study rated by people: the subject (1, 2, ...) who sits now; their unrated pairs are served")
+      ->check(CLI::PositiveNumber);
+  command->add_option("--device", line->options.device,
+                      "A study rated by people: the subject's haptic device, as cohaptic-client --device takes it");
   return {command, [line] { return run_study(line->file, line->options); }};
 }
 

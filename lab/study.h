@@ -18,6 +18,7 @@
 
 #include <filesystem>
 #include <map>
+#include <iosfwd>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,10 +78,17 @@ struct StudyRunOptions {
   std::filesystem::path out;
   std::string server_program;  ///< empty: cohaptic-server beside this program's build
   std::string client_program;  ///< empty: cohaptic-client beside this program's build
+  // A study rated by people (lab/person_pairs.h) runs one subject at a time:
+  int subject = 0;             ///< 1-based
+  std::string device;          ///< that subject's cohaptic-client --device
+  std::istream* input = nullptr;   ///< the subject's commands; null: standard input
+  std::ostream* output = nullptr;  ///< what the subject reads; null: standard output
 };
 
 /// Runs the trials not yet in out/trials.csv (and those that failed), then writes the
-/// summary and the figures. Returns the exit code: 0, or 1 if a trial failed.
+/// summary and the figures. Returns the exit code: 0, or 1 if a trial failed. A study rated
+/// by people runs options.subject's unrated pairs instead, and the analysis once every
+/// subject has rated every pair.
 int run_study(const std::filesystem::path& file, const StudyRunOptions& options);
 
 /// `cohaptic-lab study FILE --out DIR [--server-program P] [--client-program P]`.

@@ -9,7 +9,6 @@
 #include <fmt/format.h>
 #include <signal.h>
 
-#include <asio.hpp>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -18,6 +17,7 @@
 #include <set>
 #include <thread>
 
+#include "lab/control_client.h"
 #include "lab/replay.h"
 #include "proto/record/recording.h"
 #include "support/cube_scene.h"
@@ -67,27 +67,16 @@ segments:
   ASSERT_TRUE(testing::wait_for_output(client, "haptic thread")) << client.log_text();
 
   // The experimenter switches while the subject presses and holds: B, A, B, A, B.
-  asio::io_context io;
-  asio::local::stream_protocol::socket control(io);
-  control.connect(asio::local::stream_protocol::endpoint((dir / "control").string()));
-  asio::streambuf input;
-  const auto ask = [&](const std::string& line) {
-    asio::write(control, asio::buffer(line + "\n"));
-    const std::size_t size = asio::read_until(control, input, '\n');
-    const std::string reply(asio::buffers_begin(input.data()), asio::buffers_begin(input.data()) + static_cast<std::ptrdiff_t>(size));
-    input.consume(size);
-    return nlohmann::json::parse(reply);
-  };
+  ControlClient control(dir / "control");
   std::this_thread::sleep_for(1500ms);  // pressing by now
   const std::vector<std::string> switches = {"B", "A", "B", "A", "B"};
   for (std::size_t i = 0; i < switches.size(); ++i) {
-    const nlohmann::json reply = ask(fmt::format(R"({{"serve": "{}"}})", switches[i]));
+    const nlohmann::json reply = control.serve(switches[i]);
     EXPECT_EQ(reply.value("served", ""), switches[i]) << reply;
     EXPECT_EQ(reply.value("switches", 0u), i + 1) << reply;
     std::this_thread::sleep_for(700ms);
   }
-  EXPECT_NE(ask(R"({"serve": "C"})").value("error", "").find("no condition named 'C'"), std::string::npos);
-  control.close();
+  EXPECT_NE(control.ask({{"serve", "C"}}).value("error", "").find("no condition named 'C'"), std::string::npos);
   ASSERT_EQ(client.wait(30s), 0) << client.log_text();
   server.signal(SIGINT);
   ASSERT_EQ(server.wait(30s), 0) << server.log_text();

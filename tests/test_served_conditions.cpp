@@ -11,6 +11,7 @@
 
 #include "common/net/link_delay.h"
 #include "common/util/error.h"
+#include "lab/control_client.h"
 #include "server/control_socket.h"
 #include "server/served_conditions.h"
 #include "support/cube_scene.h"
@@ -82,26 +83,6 @@ TEST(ConditionSwitch, ServesAKnownConditionAndCountsTheSwitches) {
   EXPECT_THROW(ConditionSwitch({}), Error);
 }
 
-// A client of the control socket, one line out and one in.
-class ControlClient {
- public:
-  ControlClient(asio::io_context& io, const std::filesystem::path& path) : socket_(io) {
-    socket_.connect(asio::local::stream_protocol::endpoint(path.string()));
-  }
-  nlohmann::json ask(const std::string& line) {
-    asio::write(socket_, asio::buffer(line + "\n"));
-    const std::size_t size = asio::read_until(socket_, input_, '\n');
-    std::string reply(asio::buffers_begin(input_.data()), asio::buffers_begin(input_.data()) + static_cast<std::ptrdiff_t>(size));
-    input_.consume(size);
-    return nlohmann::json::parse(reply);
-  }
-  asio::local::stream_protocol::socket& socket() { return socket_; }
-
- private:
-  asio::local::stream_protocol::socket socket_;
-  asio::streambuf input_;
-};
-
 TEST(ControlSocket, AnswersEachLineAndSurvivesBadOnes) {
   const std::filesystem::path dir = testing::scratch_directory("control-socket");
   const std::filesystem::path path = dir / "control";
@@ -116,16 +97,15 @@ TEST(ControlSocket, AnswersEachLineAndSurvivesBadOnes) {
       << "only the server's user may connect";
   std::thread io_thread([&] { io.run(); });
   {
-    asio::io_context client_io;
-    ControlClient client(client_io, path);
-    EXPECT_EQ(client.ask(R"({"serve": "B"})"), (nlohmann::json{{"served", "B"}}));
-    EXPECT_EQ(client.ask("not json").at("error"), "not a JSON object on one line, e.g. {\"serve\": \"B\"}");
-    EXPECT_EQ(client.ask(R"({"foo": 1})").at("error"), "unknown command");
-    EXPECT_EQ(client.ask(R"({"serve": "A"})"), (nlohmann::json{{"served", "A"}})) << "the connection stays open";
-    ControlClient second(client_io, path);
-    EXPECT_EQ(second.ask(R"({"serve": "B"})"), (nlohmann::json{{"served", "B"}}));
+    ControlClient client(path);
+    EXPECT_EQ(client.ask_line(R"({"serve": "B"})"), (nlohmann::json{{"served", "B"}}));
+    EXPECT_EQ(client.ask_line("not json").at("error"), "not a JSON object on one line, e.g. {\"serve\": \"B\"}");
+    EXPECT_EQ(client.ask_line(R"({"foo": 1})").at("error"), "unknown command");
+    EXPECT_EQ(client.serve("A"), (nlohmann::json{{"served", "A"}})) << "the connection stays open";
+    ControlClient second(path);
+    EXPECT_EQ(second.ask({{"serve", "B"}}), (nlohmann::json{{"served", "B"}}));
     // A line over 4 KiB is answered, and the connection closed.
-    const nlohmann::json reply = client.ask(std::string(5000, 'x'));
+    const nlohmann::json reply = client.ask_line(std::string(5000, 'x'));
     EXPECT_NE(reply.at("error").get<std::string>().find("at most 4096 bytes"), std::string::npos) << reply;
   }
   asio::post(io, [&] { control.close(); });

@@ -19,6 +19,7 @@
 #include "common/util/csv.h"
 #include "common/util/error.h"
 #include "lab/study.h"
+#include "proto/record/recording.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
 
@@ -373,6 +374,88 @@ TEST(PairedComparisonStudy, SimulatedSubjectsRateEveryPairOnceAndTheAnalysisFind
   EXPECT_TRUE(found);
   for (const char* file : {"analysis/anova.csv", "analysis/table.txt", "figures/scale.svg"})
     EXPECT_TRUE(fs::exists(options.out / file)) << file;
+}
+
+// A study rated by people: no simulated participants, a pair served per session.
+std::string person_study_text(int subjects) {
+  return fmt::format(R"(name: people
+scene: cube.yaml
+condensation: naive
+factors:
+  step_nodes: [0, 150]
+  protocol: [P0, P1]
+paired_comparison:
+  quality: finer
+  subjects: {}
+  practice_pairs: 1
+  show_object: never
+  pair_duration: 4
+  rater: {{kind: person}}
+)",
+                     subjects);
+}
+
+// A study rated by people, rehearsed with a scripted subject at the terminal: a practice pair
+// first (felt, not rated), then each pair in one session where the subject switches back and
+// forth without being told which condition is which; a session stopped midway continues at
+// the next unrated pair; once both subjects have rated every pair, the analysis. Each switch
+// is in switches.csv and in the pair's server recording.
+TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionContinues) {
+  const fs::path dir = testing::scratch_directory("paired-people");
+  write_study_files(dir, person_study_text(2));
+  StudyRunOptions options;
+  options.out = dir / "out";
+  options.server_program = testing::server_program();
+  options.client_program = testing::client_program();
+  options.device = "script:" + (dir / "press.yaml").string();
+  const auto session = [&](int subject, const std::string& commands) {
+    std::istringstream in(commands);
+    std::ostringstream out;
+    options.subject = subject;
+    options.input = &in;
+    options.output = &out;
+    EXPECT_EQ(run_study(dir / "study.yaml", options), 0) << out.str();
+    return out.str();
+  };
+  EXPECT_NE(study_file_error(dir, person_study_text(2) + "participants: []\n").find("has no simulated participants"),
+            std::string::npos);
+  write_study_files(dir, person_study_text(2));
+  options.subject = 0;
+  EXPECT_THROW(run_study(dir / "study.yaml", options), Error) << "no --subject";
+
+  // Subject 1: practice (two switches, then on), two pairs rated, then stops.
+  std::string said = session(1, "s\ns\nn\ns\n+1\n\ns\ns\n-2\n+2\ny\nq\n");
+  EXPECT_NE(said.find("Practice pair 1 of 1 (not rated)"), std::string::npos) << said;
+  EXPECT_NE(said.find("You are feeling: SECOND"), std::string::npos) << said;
+  EXPECT_NE(said.find("stopped: run the same command again"), std::string::npos) << said;
+  for (const char* secret : {"S0-T", "P0", "P1", "step", "150"})
+    EXPECT_EQ(said.find(secret), std::string::npos) << "the terminal names no condition: " << secret << "\n" << said;
+  auto ratings = read_table(options.out / "ratings.csv");
+  ASSERT_EQ(ratings.size(), 2u);
+  EXPECT_EQ(ratings[0].at("rating"), "1");
+  EXPECT_EQ(ratings[1].at("rating"), "2") << "the grade confirmed, not the one replaced";
+  EXPECT_EQ(ratings[1].at("rated_by"), "person");
+
+  // Run again: no practice, the four pairs left; then subject 2 (practice, six pairs).
+  said = session(1, "1\n\n0\n\ns\n-1\n\n2\ny\n");
+  EXPECT_EQ(said.find("Practice"), std::string::npos) << said;
+  EXPECT_NE(said.find("2 rated"), std::string::npos) << said;
+  EXPECT_NE(said.find("6 of 12 ratings"), std::string::npos) << "the analysis waits for subject 2\n" << said;
+  said = session(2, "n\n1\n\n1\n\n1\n\ns\n1\n\n1\n\n1\n\n");
+  EXPECT_NE(said.find("wrote"), std::string::npos) << said;
+  ratings = read_table(options.out / "ratings.csv");
+  EXPECT_EQ(ratings.size(), 12u);
+  EXPECT_TRUE(fs::exists(options.out / "analysis" / "scale.csv"));
+  EXPECT_TRUE(fs::exists(options.out / "figures" / "scale.svg"));
+
+  // Every "s" is a switch, in switches.csv and in its pair's server recording.
+  const auto switches = read_table(options.out / "switches.csv");
+  EXPECT_EQ(switches.size(), 2u + 3u + 1u + 1u) << "practice 2, pairs 1 + 2, then 1, then 1";
+  const record::Recording pair = record::read_recording(options.out / "pairs" / "s01-p01" / "server.mcap");
+  std::vector<std::string> served;
+  for (const record::SimulationStep& step : pair.steps)
+    if (step.has_condition_switch()) served.push_back(step.condition_switch().name());
+  EXPECT_EQ(served, (std::vector<std::string>{"second"}));
 }
 
 }  // namespace
