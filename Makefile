@@ -7,6 +7,7 @@
 #   make bench-sphere  the sphere contact model's client tick and server step beside the dense solve
 #   make bench-compliance  the brain's compliance by solves and by the Schur complement, same run
 #   make brain-convergence  the brain's forces on its meshes against a finer reference mesh
+#   make paired-rehearsal   the paper's experiments 1 and 2 as paired comparisons, simulated subjects
 #   make fuzz       build the fuzz targets with clang (libFuzzer, ASan, UBSan) in build-asan
 #                   and run each for FUZZ_SECONDS (default 15; 0 builds only), FUZZ_JOBS at once
 #   make test-asan  the suite (ASAN_TESTS: all by default) built with clang, ASan + UBSan, in
@@ -62,7 +63,7 @@ SANITIZER_CMAKE = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
 SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
   TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
 
-.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance brain-convergence fuzz test-asan test-tsan clean
+.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance brain-convergence paired-rehearsal fuzz test-asan test-tsan clean
 
 all: build
 
@@ -134,6 +135,12 @@ bench-compliance:
 brain-convergence:
 	@$(MAKE) --no-print-directory build >&2
 	@tests/brain_convergence_table.sh $(BUILD_DIR)/lab/cohaptic-lab
+
+# The paper's first two experiments as paired comparisons rated by simulated subjects:
+# `make paired-rehearsal > docs/results/paired-comparisons.md`.
+paired-rehearsal:
+	@$(MAKE) --no-print-directory build >&2
+	@tests/paired_rehearsal_page.sh $(BUILD_DIR)/lab/cohaptic-lab
 
 $(ASAN_BUILD_DIR)/CMakeCache.txt: | deps
 	cmake -S . -B $(ASAN_BUILD_DIR) $(SANITIZER_CMAKE) -DCOHAPTIC_FUZZ=ON
