@@ -381,6 +381,7 @@ void ConnectionHandler::set_link_delay(const LinkDelaySettings& settings) {
 }
 
 void ConnectionHandler::send(Outbox outbox) {
+  if (outbox.link_delay) set_link_delay(*outbox.link_delay);
   if (outbox.protocol_switch) {
     welcome_.set_protocol(*outbox.protocol_switch);  // users who join later are told it too
     for (const ParticipantPtr& participant : slots_)

@@ -104,9 +104,6 @@ class ConnectionHandler {
   void say_goodbye(const std::string& reason);
   /// Closes every connection and the UDP socket.
   void close_all(const std::string& why);
-  /// The injected shift delay on every link from now on, and for users who join later (a
-  /// switched condition). On the I/O thread.
-  void set_link_delay(const LinkDelaySettings& settings);
 
   std::uint16_t tcp_port() const { return tcp_port_; }
   std::uint16_t udp_port() const { return udp_.port(); }
@@ -139,6 +136,9 @@ class ConnectionHandler {
   void handle_datagram(const wire::Datagram& datagram, int slot, std::int64_t arrival_ns);
   /// Logs a warning about hostile or broken input at most once a second (the counters keep the rest).
   void warn_throttled(const std::string& message);
+  /// The injected shift delay on every link from now on, and for users who join later (a
+  /// switched condition, from an outbox).
+  void set_link_delay(const LinkDelaySettings& settings);
 
   asio::io_context& io_;
   const ServeOptions& options_;

@@ -61,6 +61,10 @@ int main(int argc, char** argv) {
                  "start): NAME:protocol=P0|P1,shift_ms=S,jitter_ms=J,loss=L,step_nodes=N,sim_rate_hz=R (unset: P1 "
                  "and 0); instead of --protocol, --shift-delay-ms, --jitter-ms, --loss, --step-nodes, --sim-rate-hz")
       ->take_all();
+  int switch_button = -1;
+  app.add_option("--switch-button", switch_button,
+                 "With --condition: a press of this device button (0, 1, ...: any user's) serves the next condition")
+      ->check(CLI::Range(0, 31));
   std::string control_path;
   app.add_option("--control", control_path,
                  "Listen for control commands (switch the condition served: {\"serve\": NAME}) on this Unix socket");
@@ -151,6 +155,13 @@ int main(int argc, char** argv) {
       serve.sim_rate_hz = first.sim_rate_hz;
     }
     if (!control_path.empty()) serve.control = control_path;
+    if (switch_button >= 0) {
+      if (serve.conditions.size() < 2) {
+        fmt::print(stderr, "cohaptic-server: --switch-button switches between conditions: give two or more --condition\n");
+        return 2;
+      }
+      serve.switch_button = switch_button;
+    }
     serve.naive_condensation = condensation == "naive";
     serve.compliance_rows = ir_form == "rows";
     serve.precision = serve_precision == "f32" ? cohaptic::IrPrecision::f32 : cohaptic::IrPrecision::f64;

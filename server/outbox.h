@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cohaptic/messages.pb.h"
+#include "common/net/link_delay.h"
 
 namespace cohaptic {
 
@@ -24,10 +25,12 @@ struct Outbox {
   /// The protocol served from this step on, told to every user before anything else of the
   /// outbox (a switched condition, served_conditions.h); unset: unchanged.
   std::optional<wire::Protocol> protocol_switch;
+  /// The injected shift delay on every link from now on (a switched condition); unset: unchanged.
+  std::optional<LinkDelaySettings> link_delay;
   std::vector<ToSlot<wire::Control>> irs;         ///< P1: new IRs, over TCP (newest wins unless must_arrive)
   std::vector<ToSlot<wire::Datagram>> datagrams;  ///< P1: IR keep-alives; P0: forces (UDP)
 
-  bool empty() const { return !protocol_switch && irs.empty() && datagrams.empty(); }
+  bool empty() const { return !protocol_switch && !link_delay && irs.empty() && datagrams.empty(); }
 };
 
 }  // namespace cohaptic

@@ -28,6 +28,7 @@ struct ServeOptions {
   /// its); empty: the one condition the options above give.
   std::vector<ServedCondition> conditions;
   std::optional<std::filesystem::path> control;  ///< --control: the control socket's path
+  int switch_button = -1;  ///< --switch-button: a press of this device button (any user's) serves the next condition
   bool naive_condensation = false;      ///< rebuild M~ from scratch every step (the paper's loop)
   IrPrecision precision = IrPrecision::f64;
   /// Condensed FEM IRs as compliance rows (common/ir/compliance_rows.h; the client condenses),

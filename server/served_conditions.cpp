@@ -101,6 +101,13 @@ int ConditionSwitch::serve(const std::string& name) {
   throw Error(fmt::format("no condition named '{}' (this session serves {})", name, fmt::join(known, ", ")));
 }
 
+int ConditionSwitch::serve_next() {
+  const std::lock_guard lock(mutex_);
+  served_.index = (served_.index + 1) % static_cast<int>(conditions_.size());
+  ++served_.switches;
+  return served_.index;
+}
+
 ConditionSwitch::Served ConditionSwitch::served() const {
   const std::lock_guard lock(mutex_);
   return served_;

@@ -3,10 +3,10 @@
 //
 // A condition is what the paper's factors set: the protocol, the shift delay on every link
 // (delay, jitter, loss), the step delay's held nodes, and the simulation rate's cap. The
-// first condition is served from the start; a switch (ConditionSwitch::serve, from the
-// control socket, control_socket.h) takes effect on the I/O thread at once (the link
-// delays) and on the simulation thread at its next step (protocol, held nodes, rate), where
-// it is recorded. Nothing a client is told names a condition: the clients learn only the
+// first condition is served from the start; a switch (ConditionSwitch::serve from the
+// control socket, control_socket.h, or serve_next from a device button) takes effect at the
+// simulation's next step, where it is recorded: protocol, held nodes and rate there, the
+// links' delays with that step's outbox. Nothing a client is told names a condition: the clients learn only the
 // protocol (wire::ProtocolSwitch), so a subject cannot tell which condition is which.
 #pragma once
 
@@ -50,6 +50,8 @@ class ConditionSwitch {
   /// Serves the condition named `name` from now; returns its index. Throws Error naming the
   /// known conditions when there is none of that name.
   int serve(const std::string& name);
+  /// Serves the condition after the one served now (the first after the last); returns it.
+  int serve_next();
 
   /// The condition served and how many switches led to it (0 at the start).
   struct Served {

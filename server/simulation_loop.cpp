@@ -31,7 +31,7 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
                                const ServeOptions& options, const ToolInputs& tools, LoopStatistics& statistics,
                                DisplayWriter* display,
                                view::LiveView* view, record::SessionRecorder* recorder, std::int64_t start_ns,
-                               const ConditionSwitch* conditions)
+                               ConditionSwitch* conditions)
     : options_(options),
       conditions_(conditions),
       protocol_(options.protocol),
@@ -79,6 +79,7 @@ std::optional<record::ConditionSwitch> SimulationLoop::apply_condition_switch(Ou
   switches_applied_ = served.switches;
   const ServedCondition& condition = conditions_->conditions()[static_cast<std::size_t>(served.index)];
   simulation_.set_step_delay_nodes(condition.step_nodes);
+  outbox.link_delay = condition.link_delay(options_.shift);
   rate_hz_ = condition.sim_rate_hz > 0 ? condition.sim_rate_hz : kDefaultSimulationRate_hz;
   if (condition.protocol != protocol_) {
     protocol_ = condition.protocol;
@@ -136,6 +137,7 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
   for (int user : encoder_.take_restarts()) restart_rows(user);
   tools_.copy_to(latest_);
   used_.assign(latest_.size(), false);
+  buttons_seen_.resize(latest_.size(), 0);
   const auto timeout = static_cast<std::int64_t>(options_.client_timeout_s * 1e9);
   for (std::size_t slot = 0; slot < latest_.size(); ++slot) {
     const ToolInput& tool = latest_[slot];
@@ -144,6 +146,11 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
       restart_rows(static_cast<int>(slot));
     }
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
+    if (conditions_ && options_.switch_button >= 0 && used_[slot]) {
+      const std::uint32_t bit = 1u << options_.switch_button;
+      if ((tool.buttons & bit) && !(buttons_seen_[slot] & bit)) conditions_->serve_next();
+    }
+    buttons_seen_[slot] = used_[slot] ? tool.buttons : 0;
     if (used_[slot]) {
       simulation_.set_tool(static_cast<int>(slot), tool.position, tool.buttons);
       for (BodyPrefetch& prefetch : prefetch_) prefetch.worker->request_near(tool.position, *prefetch.columns);

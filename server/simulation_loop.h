@@ -17,7 +17,9 @@
 // A switch of the served condition (ConditionSwitch, served_conditions.h) takes effect at the
 // start of the next step: the held nodes' count, the loop's rate and the protocol (the
 // outbox tells every user; on a switch to P1 each user's current IR is sent again, so that
-// its client has one to change over with), recorded with that step.
+// its client has one to change over with) and the links' delays (with the outbox), recorded
+// with that step. With --switch-button, a user's press of that button serves the next
+// condition from the following step.
 // run() paces the steps at the loop's rate with absolute deadlines (when behind, the next
 // step starts at once, with no catch-up burst) and hands each non-empty outbox to the I/O
 // side; the new IRs go to the encoder's thread, which hands their frames over in outboxes
@@ -75,7 +77,7 @@ class SimulationLoop {
   SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns, const ServeOptions& options,
                  const ToolInputs& tools,
                  LoopStatistics& statistics, DisplayWriter* display, view::LiveView* view,
-                 record::SessionRecorder* recorder, std::int64_t start_ns, const ConditionSwitch* conditions = nullptr);
+                 record::SessionRecorder* recorder, std::int64_t start_ns, ConditionSwitch* conditions = nullptr);
 
   /// One step at `now_ns`: returns what to send, its new IRs encoded on the calling thread.
   /// Throws whatever the simulation's step throws. Not while run() runs.
@@ -126,11 +128,12 @@ class SimulationLoop {
   void deliver_prefetched();
 
   const ServeOptions& options_;
-  const ConditionSwitch* conditions_;
+  ConditionSwitch* conditions_;  // switched from here too: a device button
   std::uint64_t switches_applied_ = 0;
   ServeProtocol protocol_;  // served now
   double rate_hz_;          // the loop's rate now
   bool resend_irs_ = false; // the next new_irs() sends every user's IR, changed or not
+  std::vector<std::uint32_t> buttons_seen_;  // per slot, as of the last step: a press is a new bit
   const ToolInputs& tools_;
   LoopStatistics& statistics_;
   DisplayWriter* display_;

@@ -199,9 +199,9 @@ struct SimulationServer::Impl {
   nlohmann::json control_command(const nlohmann::json& command) {
     if (command.contains("serve")) {
       if (!command["serve"].is_string()) throw Error("\"serve\" takes a condition's name");
-      const int index = conditions.serve(command["serve"].get<std::string>());
-      // The links change now; the simulation takes the rest at its next step.
-      connections->set_link_delay(conditions.conditions()[static_cast<std::size_t>(index)].link_delay(options.shift));
+      // The simulation takes it at its next step, and hands the links' new delay over with
+      // that step's outbox.
+      conditions.serve(command["serve"].get<std::string>());
     } else if (!command.contains("status")) {
       throw Error(fmt::format("unknown command {} (the commands: {{\"serve\": NAME}}, {{\"status\": true}})", command.dump()));
     }

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <thread>
@@ -38,10 +39,51 @@ double median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+// Conditions A (P0, held nodes) and B (P1, shift delay) served to one scripted subject on
+// the small cube, with a control socket, recorded in a scratch directory.
+struct SwitchingSession {
+  fs::path dir;
+  std::unique_ptr<testing::ChildProcess> server, client;
+
+  SwitchingSession(const std::string& name, const std::string& trajectory, const std::vector<std::string>& server_extra,
+                   double client_s)
+      : dir(testing::scratch_directory(name)) {
+    std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(testing::pressed_cube_options());
+    std::ofstream(dir / "press.yaml") << trajectory;
+    std::vector<std::string> arguments = {
+        "--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--condensation", "naive", "--condition",
+        fmt::format("A:protocol=P0,step_nodes={}", kHeldNodes), "--condition", fmt::format("B:protocol=P1,shift_ms={}", kShiftMs),
+        "--control", (dir / "control").string(), "--duration", "60", "--record", (dir / "server.mcap").string(), "--report",
+        (dir / "server.json").string()};
+    arguments.insert(arguments.end(), server_extra.begin(), server_extra.end());
+    server = std::make_unique<testing::ChildProcess>(testing::server_program(), arguments, dir / "server.log");
+    EXPECT_TRUE(testing::wait_for_output(*server, "listening on")) << server->log_text();
+    const int port = testing::listening_port(server->log_text());
+    client = std::make_unique<testing::ChildProcess>(
+        testing::client_program(),
+        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", "subject", "--slot", "0", "--device",
+                                 "script:" + (dir / "press.yaml").string(), "--duration", fmt::format("{:g}", client_s),
+                                 "--record", (dir / "subject.mcap").string(), "--report", (dir / "subject.json").string()},
+        dir / "subject.log");
+    EXPECT_TRUE(testing::wait_for_output(*client, "haptic thread")) << client->log_text();
+  }
+  // Waits for the client's end, then stops the server: both exit 0.
+  void finish() {
+    EXPECT_EQ(client->wait(30s), 0) << client->log_text();
+    server->signal(SIGINT);
+    EXPECT_EQ(server->wait(30s), 0) << server->log_text();
+  }
+  // The conditions the server's recording marks as switched to, in order.
+  std::vector<std::string> recorded_switches() const {
+    std::vector<std::string> names;
+    for (const record::SimulationStep& step : record::read_recording(dir / "server.mcap").steps)
+      if (step.has_condition_switch()) names.push_back(step.condition_switch().name());
+    return names;
+  }
+};
+
 TEST(ConditionSwitchSession, EachSwitchTakesEffectInServerAndClientIsRecordedAndReplaysBitForBit) {
-  const fs::path dir = testing::scratch_directory("condition-switch");
-  std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(testing::pressed_cube_options());
-  std::ofstream(dir / "press.yaml") << R"(
+  SwitchingSession session("condition-switch", R"(
 units: mm
 start: [4, 3, 4]
 segments:
@@ -49,22 +91,9 @@ segments:
   - {press: 0.75, speed: 1.5, direction: [0, 0, -1]}
   - {hold: 5}
   - {release: 0.75, speed: 1.5}
-)";
-  testing::ChildProcess server(
-      testing::server_program(),
-      {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--condensation", "naive", "--condition",
-       fmt::format("A:protocol=P0,step_nodes={}", kHeldNodes), "--condition", fmt::format("B:protocol=P1,shift_ms={}", kShiftMs),
-       "--control", (dir / "control").string(), "--duration", "60", "--record", (dir / "server.mcap").string(), "--report",
-       (dir / "server.json").string()},
-      dir / "server.log");
-  ASSERT_TRUE(testing::wait_for_output(server, "listening on")) << server.log_text();
-  const int port = testing::listening_port(server.log_text());
-  testing::ChildProcess client(testing::client_program(),
-                               {"--server", fmt::format("127.0.0.1:{}", port), "--user", "subject", "--slot", "0", "--device",
-                                "script:" + (dir / "press.yaml").string(), "--duration", "6.5", "--record",
-                                (dir / "subject.mcap").string(), "--report", (dir / "subject.json").string()},
-                               dir / "subject.log");
-  ASSERT_TRUE(testing::wait_for_output(client, "haptic thread")) << client.log_text();
+)",
+                           {}, 6.5);
+  const fs::path& dir = session.dir;
 
   // The experimenter switches while the subject presses and holds: B, A, B, A, B.
   ControlClient control(dir / "control");
@@ -77,9 +106,8 @@ segments:
     std::this_thread::sleep_for(700ms);
   }
   EXPECT_NE(control.ask({{"serve", "C"}}).value("error", "").find("no condition named 'C'"), std::string::npos);
-  ASSERT_EQ(client.wait(30s), 0) << client.log_text();
-  server.signal(SIGINT);
-  ASSERT_EQ(server.wait(30s), 0) << server.log_text();
+  session.finish();
+  ASSERT_FALSE(::testing::Test::HasFailure());
 
   // The server: each switch on the step it took effect, in order, with its settings; the
   // held nodes and the tool samples' delay follow the condition served.
@@ -104,6 +132,7 @@ segments:
       if (tool.known()) sample_age_ms[condition].push_back(static_cast<double>(step.time_ns() - tool.sample_time_ns()) * 1e-6);
   }
   EXPECT_EQ(recorded, switches);
+  EXPECT_EQ(session.recorded_switches(), switches);
   EXPECT_EQ(held["A"], (std::set<std::uint32_t>{kHeldNodes})) << "A holds its nodes whenever the tool presses";
   EXPECT_EQ(held["B"], (std::set<std::uint32_t>{0})) << "B holds none";
   const double age_a = median(sample_age_ms["A"]), age_b = median(sample_age_ms["B"]);
@@ -127,6 +156,35 @@ segments:
     const VerifyResult result = verify_recording(dir / file);
     EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
     EXPECT_GT(result.checked, 100u) << file;
+  }
+}
+
+// A subject with one hand on the device switches with its button: each press serves the
+// next condition, as a command on the control socket would.
+TEST(ConditionSwitchSession, EachPressOfTheSwitchButtonServesTheNextCondition) {
+  SwitchingSession session("button-switch", R"(
+units: mm
+start: [4, 3, 4]
+segments:
+  - {move_to: [4, 3, 0.5], speed: 20}
+  - {press: 0.75, speed: 1.5, direction: [0, 0, -1]}
+  - {hold: 1}
+  - {hold: 0.2, buttons: 1}
+  - {hold: 1}
+  - {hold: 0.2, buttons: 1}
+  - {hold: 1}
+  - {release: 0.75, speed: 1.5}
+)",
+                           {"--switch-button", "0"}, 5);
+  session.finish();
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  EXPECT_EQ(session.recorded_switches(), (std::vector<std::string>{"B", "A"}));
+  const nlohmann::json client_report = nlohmann::json::parse(std::ifstream(session.dir / "subject.json"));
+  EXPECT_EQ(client_report["protocol_switches"], 2);
+  EXPECT_EQ(client_report["fades"]["count"], 0);
+  for (const char* file : {"server.mcap", "subject.mcap"}) {
+    const VerifyResult result = verify_recording(session.dir / file);
+    EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
   }
 }
 

@@ -61,7 +61,7 @@ TEST(ServedCondition, ParsesItsCommandLineFormAndNamesWhatIsWrong) {
   EXPECT_NE(parse_error("a:shift_ms=1x").find("--condition 'a:shift_ms=1x'"), std::string::npos);
 }
 
-TEST(ConditionSwitch, ServesAKnownConditionAndCountsTheSwitches) {
+TEST(ConditionSwitch, ServesAKnownConditionOrTheNextAndCountsTheSwitches) {
   ServedCondition a, b;
   a.name = "A";
   b.name = "B";
@@ -79,6 +79,9 @@ TEST(ConditionSwitch, ServesAKnownConditionAndCountsTheSwitches) {
     EXPECT_NE(std::string(e.what()).find("no condition named 'C' (this session serves A, B)"), std::string::npos) << e.what();
   }
   EXPECT_EQ(conditions.served().index, 1) << "an unknown name switches nothing";
+  EXPECT_EQ(conditions.serve_next(), 0) << "after the last, the first";
+  EXPECT_EQ(conditions.serve_next(), 1);
+  EXPECT_EQ(conditions.served().switches, 4u);
   EXPECT_THROW(ConditionSwitch({a, a}), Error);
   EXPECT_THROW(ConditionSwitch({}), Error);
 }
