@@ -69,23 +69,20 @@ HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoo
       clock_(clock) {}
 
 bool HapticLoop::take_in_server_updates() {
-  // Both channels are taken in while a switch waits, so that what arrived before the switch
-  // is not mistaken for what the new protocol needs.
-  const bool ir_new = channels_.ir.update();
-  const bool force_new = channels_.force.update();
+  const bool p1 = protocol_ == HapticProtocol::p1;
+  const bool in_use_new = p1 ? channels_.ir.update() : channels_.force.update();
   channels_.protocol.update();
   const ProtocolChange& change = channels_.protocol.front();
-  if (change.since_ns > 0 && change.protocol != protocol_) {
-    const bool ready = change.protocol == HapticProtocol::p1
-                           ? channels_.ir.front().ir && channels_.ir.front().arrival_ns >= change.since_ns
-                           : channels_.force.front().valid && channels_.force.front().arrival_ns >= change.since_ns;
-    if (ready) {
-      protocol_ = change.protocol;
-      ++metrics_.protocol_switches;
-      return true;
-    }
-  }
-  return protocol_ == HapticProtocol::p1 ? ir_new : force_new;
+  if (change.since_ns == 0 || change.protocol == protocol_) return in_use_new;
+  // A switch waits: the other protocol's channel is taken in too, and the loop changes over
+  // once what arrived after the switch is there (what arrived before it is not enough).
+  const bool ready = p1 ? (channels_.force.update(), channels_.force.front().valid &&
+                                                         channels_.force.front().arrival_ns >= change.since_ns)
+                        : (channels_.ir.update(), channels_.ir.front().ir && channels_.ir.front().arrival_ns >= change.since_ns);
+  if (!ready) return in_use_new;
+  protocol_ = change.protocol;
+  ++metrics_.protocol_switches;
+  return true;
 }
 
 Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record) {

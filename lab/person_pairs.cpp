@@ -62,8 +62,8 @@ std::string trimmed(const std::string& line) {
 // The pair's two conditions served to one client, until destroyed.
 class PairServing {
  public:
-  PairServing(const PersonSessionSetup& setup, int first, int second, bool show_object, const std::filesystem::path& dir)
-      : dir_(dir) {
+  PairServing(const PersonSessionSetup& setup, int first, int second, bool show_object,
+              const std::filesystem::path& dir) {
     std::filesystem::create_directories(dir);
     const double duration = setup.design.pair_duration_s;
     std::vector<std::string> server_arguments = {
@@ -108,7 +108,6 @@ class PairServing {
   const std::string& view_url() const { return view_url_; }
 
  private:
-  std::filesystem::path dir_;
   std::optional<ChildProcess> server_, client_;
   std::optional<ControlClient> control_;
   std::string view_url_;

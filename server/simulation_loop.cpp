@@ -92,11 +92,13 @@ std::optional<record::ConditionSwitch> SimulationLoop::apply_condition_switch(Ou
   recorded.set_name(condition.name);
   recorded.set_index(static_cast<std::uint32_t>(served.index));
   recorded.set_protocol(protocol_ == ServeProtocol::p1 ? wire::P1 : wire::P0);
-  ServeOptions as_options = options_;
-  as_options.shift = condition.link_delay(options_.shift);
-  as_options.step_nodes = condition.step_nodes;
-  as_options.sim_rate_hz = condition.sim_rate_hz;
-  *recorded.mutable_injected() = injected_delays(as_options);
+  record::InjectedDelays& injected = *recorded.mutable_injected();
+  injected = injected_delays(options_);  // reorder, seed and condensation: the session's
+  injected.set_shift_delay_ms(condition.shift_delay_ms);
+  injected.set_jitter_ms(condition.jitter_ms);
+  injected.set_loss(condition.loss);
+  injected.set_step_nodes(static_cast<std::uint32_t>(condition.step_nodes));
+  injected.set_sim_rate_hz(condition.sim_rate_hz);
   return recorded;
 }
 
