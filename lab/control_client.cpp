@@ -25,10 +25,15 @@ nlohmann::json ControlClient::ask_line(const std::string& line) {
   return answer;
 }
 
-nlohmann::json ControlClient::serve(const std::string& name) {
-  nlohmann::json answer = ask({{"serve", name}});
-  if (answer.contains("error")) throw Error(fmt::format("the server refused to serve '{}': {}", name, answer["error"].get<std::string>()));
+nlohmann::json ControlClient::obey(const nlohmann::json& command) {
+  nlohmann::json answer = ask(command);
+  if (answer.contains("error"))
+    throw Error(fmt::format("the server refused {}: {}", command.dump(), answer["error"].get<std::string>()));
   return answer;
 }
+
+nlohmann::json ControlClient::serve(const std::string& name) { return obey({{"serve", name}}); }
+
+nlohmann::json ControlClient::serve_next() { return obey({{"serve_next", true}}); }
 
 }  // namespace cohaptic

@@ -19,11 +19,15 @@ class ControlClient {
   /// connection fails or the answer is not JSON.
   nlohmann::json ask_line(const std::string& line);
   nlohmann::json ask(const nlohmann::json& command) { return ask_line(command.dump()); }
-  /// Switches the condition served to `name`; returns the answer, or throws Error with the
+  /// Switches the condition served to `name`, or to the one after the condition served now;
+  /// returns the answer ({"served", "switches", "time_s"}), or throws Error with the
   /// server's "error" when it refused.
   nlohmann::json serve(const std::string& name);
+  nlohmann::json serve_next();
 
  private:
+  nlohmann::json obey(const nlohmann::json& command);
+
   std::filesystem::path path_;
   asio::io_context io_;
   asio::local::stream_protocol::socket socket_;

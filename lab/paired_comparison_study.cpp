@@ -39,7 +39,7 @@ std::vector<std::string> default_labels(RatedQuality quality, int grades) {
 
 PairedComparisonDesign parse_paired_comparison(const YamlCursor& block) {
   block.only_keys({"question", "quality", "grades", "labels", "subjects", "rater", "practice_pairs", "show_object",
-                   "pair_duration"});
+                   "pair_duration", "switch_button"});
   PairedComparisonDesign design;
   design.quality = parse_rated_quality(block.at("quality").choice({"finer", "harder"}));
   design.question = block.find("question") ? block.at("question").text()
@@ -71,6 +71,11 @@ PairedComparisonDesign parse_paired_comparison(const YamlCursor& block) {
   if (auto shown = block.find("show_object")) design.show_object = shown->choice({"practice", "always", "never"});
   if (auto duration = block.find("pair_duration"))
     design.pair_duration_s = duration->number_in(1, 3600, false, false, "seconds, 1 to 3600");
+  if (auto button = block.find("switch_button")) {
+    const std::int64_t n = button->integer();
+    if (n < 0 || n > 31) button->fail("a device button, 0 to 31");
+    design.switch_button = static_cast<int>(n);
+  }
   if (auto rater = block.find("rater")) {
     rater->only_keys({"kind", "jnd", "noise", "seed"});
     if (auto kind = rater->find("kind"))
@@ -81,6 +86,8 @@ PairedComparisonDesign parse_paired_comparison(const YamlCursor& block) {
       design.rater.noise_sd = noise->number_in(0, 100, false, false, "a standard deviation >= 0, in JNDs");
     if (auto seed = rater->find("seed")) design.rater.seed = static_cast<unsigned>(seed->integer());
   }
+  if (design.switch_button >= 0 && design.rater_kind != RaterKind::person)
+    block.at("switch_button").fail("a key of a study rated by people (rater: {kind: person}): simulated subjects press no button");
   return design;
 }
 

@@ -40,6 +40,7 @@ struct PairedComparisonDesign {
   int practice_pairs = 1;           ///< pairs felt before the rated ones, not rated
   std::string show_object = "practice";  ///< the live view served: practice, always or never
   double pair_duration_s = 60;      ///< the longest a pair is served
+  int switch_button = -1;           ///< a device button that switches too (person rater); -1: none
 };
 
 /// Parses a `paired_comparison` block (errors name the file, line and key).

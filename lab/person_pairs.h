@@ -6,12 +6,16 @@
 // The subject feels the first condition, switches between the two as often as wanted, and
 // rates the pair on the study's scale; nothing on the terminal says which condition is which,
 // only "first" and "second". First come the practice pairs (felt, not rated; the object
-// shown unless show_object is never). Each switch goes to DIR/switches.csv (subject,
-// position, time_s in the server's session, serving) and to the pair's server recording
-// (DIR/pairs/sNN-pMM/); each rating to DIR/ratings.csv when confirmed, so an interrupted
-// session (q, or the input ending) continues at the next unrated pair when run again.
+// shown unless show_object is never). With switch_button the device's button switches too
+// (cohaptic-server --switch-button). Each switch, however made, goes to the pair's server
+// recording and report (DIR/pairs/sNN-pMM/) and, when the pair ends, from the report to
+// DIR/switches.csv (subject, pair, time_s in the server's session, serving); each rating to
+// DIR/ratings.csv when confirmed, so an interrupted session (q, or the input ending)
+// continues at the next unrated pair when run again.
 //
-// The terminal, one command a line (so a scripted input drives it as a person would):
+// The subject's commands come from the terminal, or with a rating page (lab/rating_page.h)
+// from the page only, the terminal then logging them. The terminal, one command a line (so a
+// scripted input drives it as a person would):
 //   s                 switch to the other condition
 //   +2 ... -2 (or 2)  choose a grade; an empty line or y confirms it, another grade replaces it
 //   n                 (practice) go on to the next pair
@@ -27,6 +31,8 @@
 
 namespace cohaptic {
 
+class RatingPage;
+
 struct PersonSessionSetup {
   std::string study_name;
   std::filesystem::path scene;
@@ -41,8 +47,9 @@ struct PersonSessionSetup {
   std::string device;  ///< the client's --device for this subject
 };
 
-/// Runs the subject's unrated pairs. Returns true when the subject has rated every pair,
-/// false when stopped first. Throws Error when a program cannot start.
-bool run_person_pairs(const PersonSessionSetup& setup, std::istream& in, std::ostream& out);
+/// Runs the subject's unrated pairs, taking commands from `page` when given, else from `in`.
+/// Returns true when the subject has rated every pair, false when stopped first. Throws Error
+/// when a program cannot start.
+bool run_person_pairs(const PersonSessionSetup& setup, std::istream& in, std::ostream& out, RatingPage* page = nullptr);
 
 }  // namespace cohaptic

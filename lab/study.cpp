@@ -16,6 +16,7 @@
 #include <random>
 #include <set>
 
+#include "common/net/host_port.h"
 #include "common/scene/load_scene.h"
 #include "common/study/measures.h"
 #include "common/study/paired_comparison_analysis.h"
@@ -29,6 +30,7 @@
 #include "common/util/yaml_cursor.h"
 #include "common/util/child_process.h"
 #include "lab/person_pairs.h"
+#include "lab/rating_page.h"
 #include "proto/record/recording.h"
 #include "proto/wire/vec3_convert.h"
 
@@ -478,7 +480,16 @@ int run_person_study(const Study& study, const StudyRunOptions& options) {
   setup.device = options.device;
   write_pair_plan(options.out / "pair_plan.csv", setup.condition_names, study.paired->subjects);
   std::ostream& out = options.output ? *options.output : std::cout;
-  if (!run_person_pairs(setup, options.input ? *options.input : std::cin, out)) {
+  std::optional<RatingPage> page;
+  if (!options.rating_page.empty()) {
+    std::string host;
+    std::uint16_t port = 0;
+    if (const std::string problem = parse_host_port(options.rating_page, host, port, true); !problem.empty())
+      throw Error("--rating-page: " + problem);
+    page.emplace(host, port);
+    out << fmt::format("rating page at {} (open it in a browser; the terminal only reports)\n", page->url()) << std::flush;
+  }
+  if (!run_person_pairs(setup, options.input ? *options.input : std::cin, out, page ? &*page : nullptr)) {
     out << fmt::format("stopped: run the same command again to continue with subject {}'s next pair\n", options.subject);
     return 0;
   }
@@ -507,6 +518,9 @@ int run_study(const std::filesystem::path& file, const StudyRunOptions& given) {
       throw Error(fmt::format("the program {} does not exist (build it, or give {})", program, option));
   std::filesystem::create_directories(options.out);
   if (study.paired && study.paired->rater_kind == RaterKind::person) return run_person_study(study, options);
+  if (!options.rating_page.empty())
+    throw Error(fmt::format("--rating-page: {} is not rated by people (its paired_comparison rater is not person)",
+                            file.string()));
 
   // The plan: the trials in run order; a re-run must find the same plan.
   std::vector<std::vector<std::string>> plan;
@@ -637,6 +651,10 @@ LabCommand add_study_command(CLI::App& lab) {
       ->check(CLI::PositiveNumber);
   command->add_option("--device", line->options.device,
                       "A study rated by people: the subject's haptic device, as cohaptic-client --device takes it");
+  command->add_option("--rating-page", line->options.rating_page,
+                      "A study rated by people: serve the rating page at HOST:PORT (port 0: any free port; off "
+                      "loopback a token is printed in its address) and take the subject's commands from it, not from "
+                      "the terminal");
   return {command, [line] { return run_study(line->file, line->options); }};
 }
 

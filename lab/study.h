@@ -81,6 +81,7 @@ struct StudyRunOptions {
   // A study rated by people (lab/person_pairs.h) runs one subject at a time:
   int subject = 0;             ///< 1-based
   std::string device;          ///< that subject's cohaptic-client --device
+  std::string rating_page;     ///< HOST:PORT: commands from a rating page served there, not the terminal
   std::istream* input = nullptr;   ///< the subject's commands; null: standard input
   std::ostream* output = nullptr;  ///< what the subject reads; null: standard output
 };

@@ -3,6 +3,8 @@
 // JSON object per line and answers each with one line:
 //   {"serve": "B"}   switch to condition B (served_conditions.h)
 //                    -> {"served": "B", "switches": 3, "time_s": 12.345}
+//   {"serve_next": true}  switch to the condition after the one served now (a device button's
+//                    switch: served_conditions.h) -> as for "serve"
 //   {"status": true} -> {"served": "A", "switches": 2, "time_s": 20.1}
 // Anything else (malformed JSON, an unknown command or condition, a line over 4 KiB) gets
 // {"error": "..."} naming what was wrong; the connection stays open, the session goes on.

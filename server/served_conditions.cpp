@@ -5,6 +5,7 @@
 #include <set>
 
 #include "common/util/error.h"
+#include "proto/wire/header.h"
 
 namespace cohaptic {
 
@@ -92,9 +93,7 @@ int ConditionSwitch::serve(const std::string& name) {
   for (std::size_t i = 0; i < conditions_.size(); ++i)
     if (conditions_[i].name == name) {
       const std::lock_guard lock(mutex_);
-      served_.index = static_cast<int>(i);
-      ++served_.switches;
-      return served_.index;
+      return switch_to(static_cast<int>(i));
     }
   std::vector<std::string> known;
   for (const ServedCondition& condition : conditions_) known.push_back(condition.name);
@@ -103,14 +102,24 @@ int ConditionSwitch::serve(const std::string& name) {
 
 int ConditionSwitch::serve_next() {
   const std::lock_guard lock(mutex_);
-  served_.index = (served_.index + 1) % static_cast<int>(conditions_.size());
+  return switch_to((served_.index + 1) % static_cast<int>(conditions_.size()));
+}
+
+int ConditionSwitch::switch_to(int index) {
+  served_.index = index;
   ++served_.switches;
-  return served_.index;
+  history_.push_back({wire::monotonic_now_ns(), index});
+  return index;
 }
 
 ConditionSwitch::Served ConditionSwitch::served() const {
   const std::lock_guard lock(mutex_);
   return served_;
+}
+
+std::vector<ConditionSwitch::Switch> ConditionSwitch::history() const {
+  const std::lock_guard lock(mutex_);
+  return history_;
 }
 
 }  // namespace cohaptic

@@ -60,10 +60,21 @@ class ConditionSwitch {
   };
   Served served() const;
 
+  /// One switch asked for: when (wire::monotonic_now_ns), and the condition it serves.
+  struct Switch {
+    std::int64_t time_ns = 0;
+    int index = 0;
+  };
+  /// Every switch asked for so far, in order (the report's switch log).
+  std::vector<Switch> history() const;
+
  private:
+  int switch_to(int index);  // with mutex_ held
+
   const std::vector<ServedCondition> conditions_;
   mutable std::mutex mutex_;
   Served served_;
+  std::vector<Switch> history_;
 };
 
 }  // namespace cohaptic

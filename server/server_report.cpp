@@ -19,6 +19,9 @@ nlohmann::json server_report(const ServerFigures& figures) {
     for (const ServedCondition& condition : options.conditions) names.push_back(condition.name);
     server["conditions"] = names;
     server["condition_switches"] = figures.condition_switches;
+    nlohmann::json log = nlohmann::json::array();
+    for (const auto& [time_s, served] : figures.switch_log) log.push_back({{"time_s", time_s}, {"served", served}});
+    server["switch_log"] = log;
   }
   server["sim_rate_hz"] = loop.rate_hz();
   // What the verdict holds the rate to, whatever step delay was injected: the users feel it.

@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "proto/wire/rejection.h"
 #include "server/connection_handler.h"
@@ -22,6 +24,8 @@ struct ServerFigures {
   ConnectionCounters connections;
   const wire::RejectionCounters& datagrams;
   std::uint64_t condition_switches = 0;  ///< switches of the served condition (--condition, --control)
+  /// Each switch: the server's session time [s] and the condition it served.
+  std::vector<std::pair<double, std::string>> switch_log = {};
 };
 
 nlohmann::json server_report(const ServerFigures& figures);

@@ -179,13 +179,18 @@ struct SimulationServer::Impl {
   }
 
   ServerFigures figures() const {
+    std::vector<std::pair<double, std::string>> switch_log;
+    for (const ConditionSwitch::Switch& made : conditions.history())
+      switch_log.emplace_back(static_cast<double>(made.time_ns - start_ns) * 1e-9,
+                              conditions.conditions()[static_cast<std::size_t>(made.index)].name);
     return {options,
             model->scene.name,
             model->scene.haptic.min_sim_rate_hz,
             statistics.summary(),
             connections->counters(),
             connections->datagram_counters(),
-            conditions.served().switches};
+            conditions.served().switches,
+            std::move(switch_log)};
   }
 
   std::string condition_list() const {
@@ -202,8 +207,12 @@ struct SimulationServer::Impl {
       // The simulation takes it at its next step, and hands the links' new delay over with
       // that step's outbox.
       conditions.serve(command["serve"].get<std::string>());
+    } else if (command.contains("serve_next")) {
+      conditions.serve_next();  // the one after the one served now, whoever switched last
     } else if (!command.contains("status")) {
-      throw Error(fmt::format("unknown command {} (the commands: {{\"serve\": NAME}}, {{\"status\": true}})", command.dump()));
+      throw Error(fmt::format(
+          "unknown command {} (the commands: {{\"serve\": NAME}}, {{\"serve_next\": true}}, {{\"status\": true}})",
+          command.dump()));
     }
     const ConditionSwitch::Served served = conditions.served();
     return {{"served", conditions.conditions()[static_cast<std::size_t>(served.index)].name},

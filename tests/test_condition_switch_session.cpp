@@ -95,12 +95,13 @@ segments:
                            {}, 6.5);
   const fs::path& dir = session.dir;
 
-  // The experimenter switches while the subject presses and holds: B, A, B, A, B.
+  // The experimenter switches while the subject presses and holds: B, A, B, A by name, then
+  // B as the next condition.
   ControlClient control(dir / "control");
   std::this_thread::sleep_for(1500ms);  // pressing by now
   const std::vector<std::string> switches = {"B", "A", "B", "A", "B"};
   for (std::size_t i = 0; i < switches.size(); ++i) {
-    const nlohmann::json reply = control.serve(switches[i]);
+    const nlohmann::json reply = i + 1 < switches.size() ? control.serve(switches[i]) : control.serve_next();
     EXPECT_EQ(reply.value("served", ""), switches[i]) << reply;
     EXPECT_EQ(reply.value("switches", 0u), i + 1) << reply;
     std::this_thread::sleep_for(700ms);
@@ -142,6 +143,14 @@ segments:
   EXPECT_LT(age_a, kShiftMs / 2);
   const nlohmann::json server_report = nlohmann::json::parse(std::ifstream(dir / "server.json"));
   EXPECT_EQ(server_report["server"]["condition_switches"], switches.size());
+  std::vector<std::string> logged;
+  double previous_s = 0;
+  for (const nlohmann::json& made : server_report["server"]["switch_log"]) {
+    logged.push_back(made["served"]);
+    EXPECT_GT(made["time_s"].get<double>(), previous_s + 0.5) << "the switches came 0.7 s apart";
+    previous_s = made["time_s"];
+  }
+  EXPECT_EQ(logged, switches);
 
   // The client: one change of protocol per switch, each without a fade.
   const nlohmann::json client_report = nlohmann::json::parse(std::ifstream(dir / "subject.json"));

@@ -8,6 +8,9 @@
 #include <fmt/format.h>
 #include <sched.h>
 
+#include <nlohmann/json.hpp>
+#include <regex>
+
 #include <algorithm>
 #include <fstream>
 #include <map>
@@ -20,6 +23,7 @@
 #include "common/util/error.h"
 #include "lab/study.h"
 #include "proto/record/recording.h"
+#include "support/browser.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
 
@@ -300,6 +304,11 @@ TEST(PairedComparisonStudyFile, MistakesAreNamedWithTheirKey) {
   text.replace(text.find("subjects: 4"), 11, "subjects: 4\n  labels: [a, b, c]");
   e = error_of(text);
   EXPECT_NE(e.find("5 labels, from +2 down to -2"), std::string::npos) << e;
+  text = paired_study_text("  step_nodes: [0, 300]\n  protocol: [P0, P1]", 4);
+  text.replace(text.find("subjects: 4"), 11, "subjects: 4\n  switch_button: 0");
+  e = error_of(text);
+  EXPECT_NE(e.find("switch_button"), std::string::npos) << e;
+  EXPECT_NE(e.find("simulated subjects press no button"), std::string::npos) << e;
 }
 
 TEST(PairedComparisonStudyFile, EverySubjectMeetsEveryPairOnceInABalancedOrder) {
@@ -376,8 +385,9 @@ TEST(PairedComparisonStudy, SimulatedSubjectsRateEveryPairOnceAndTheAnalysisFind
     EXPECT_TRUE(fs::exists(options.out / file)) << file;
 }
 
-// A study rated by people: no simulated participants, a pair served per session.
-std::string person_study_text(int subjects) {
+// A study rated by people: no simulated participants, a pair served per session; `extra`:
+// further keys of its paired_comparison block.
+std::string person_study_text(int subjects, const std::string& extra = "") {
   return fmt::format(R"(name: people
 scene: cube.yaml
 condensation: naive
@@ -391,8 +401,8 @@ paired_comparison:
   show_object: never
   pair_duration: 4
   rater: {{kind: person}}
-)",
-                     subjects);
+{})",
+                     subjects, extra);
 }
 
 // A study rated by people, rehearsed with a scripted subject at the terminal: a practice pair
@@ -452,6 +462,78 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
   const auto switches = read_table(options.out / "switches.csv");
   EXPECT_EQ(switches.size(), 2u + 3u + 1u + 1u) << "practice 2, pairs 1 + 2, then 1, then 1";
   const record::Recording pair = record::read_recording(options.out / "pairs" / "s01-p01" / "server.mcap");
+  std::vector<std::string> served;
+  for (const record::SimulationStep& step : pair.steps)
+    if (step.has_condition_switch()) served.push_back(step.condition_switch().name());
+  EXPECT_EQ(served, (std::vector<std::string>{"second"}));
+}
+
+// The rating page in headless Chromium: the subject's hand on buttons and keys, the lab as
+// its own process. A practice pair, two pairs rated (by a click and by the arrow keys), a stop;
+// run again, the four pairs left, and the analysis. The page never names a condition, and
+// what it sent is what ratings.csv and the pairs' server recordings hold.
+TEST(PairedComparisonStudy, ASubjectRatesOnTheRatingPageInABrowserAndAStoppedSessionContinues) {
+  if (const std::string why = testing::missing_browser(); !why.empty()) GTEST_SKIP() << why;
+  const fs::path dir = testing::scratch_directory("rating-page");
+  write_study_files(dir, person_study_text(2, "  switch_button: 0\n"));  // the page follows the server's condition
+  const fs::path out = dir / "out";
+  const auto session = [&](const std::string& name, const std::string& script) {
+    ChildProcess lab(COHAPTIC_LAB_EXE,
+                     {"study", (dir / "study.yaml").string(), "--out", out.string(), "--subject", "1", "--device",
+                      "script:" + (dir / "press.yaml").string(), "--rating-page", "127.0.0.1:0", "--server-program",
+                      testing::server_program(), "--client-program", testing::client_program()},
+                     dir / (name + "-lab.log"));
+    EXPECT_TRUE(testing::wait_for_output(lab, "rating page at"));
+    std::smatch match;
+    const std::string log = lab.log_text();
+    EXPECT_TRUE(std::regex_search(log, match, std::regex(R"(rating page at (http://\S+))"))) << log;
+    ChildProcess node(testing::node_program(),
+                      {(fs::path(COHAPTIC_SOURCE_DIR) / "tests/support/rating_check.mjs").string(), "--url", match[1].str(),
+                       "--script", script, "--screenshot", (dir / (name + ".png")).string()},
+                      dir / (name + "-browser.log"));
+    EXPECT_EQ(node.wait(std::chrono::minutes(5)), 0) << node.log_text();
+    EXPECT_EQ(lab.wait(std::chrono::minutes(1)), 0) << lab.log_text();
+    const std::string output = node.log_text();
+    const nlohmann::json result = nlohmann::json::parse(output.substr(output.rfind("\n{\"") + 1), nullptr, false);
+    EXPECT_FALSE(result.is_discarded()) << output;
+    EXPECT_TRUE(result.value("errors", nlohmann::json::array()).empty()) << output;
+    for (const auto& text : result.value("texts", nlohmann::json::array()))
+      for (const char* secret : {"S0-T", "P0", "P1", "T150", "step"})
+        EXPECT_EQ(text.get<std::string>().find(secret), std::string::npos) << "the page names no condition: " << text;
+    return std::make_pair(result, lab.log_text());
+  };
+
+  // Practice (switched by click and by key, then on), a pair rated 0 after choosing +1, a
+  // pair rated +2 by the arrow keys and Enter, then a stop with a grade chosen.
+  auto [first, log] = session("first", "switch,key-switch,key-next;switch,choose:+1,choose:0,screenshot,confirm;"
+                                       "key-down,key-down,key-up,key-enter;choose:-2,stop");
+  ASSERT_EQ(first["steps"].size(), 4u) << first.dump();
+  EXPECT_EQ(first["steps"][0]["title"], "Practice pair 1 of 1 (not rated)");
+  EXPECT_EQ(first["steps"][0]["screens"][0]["feeling"], "second");
+  EXPECT_EQ(first["steps"][0]["screens"][1]["feeling"], "first");
+  EXPECT_EQ(first["steps"][1]["screens"][2]["chosen_grade"], 0);
+  EXPECT_NE(first["final"]["note"].get<std::string>().find("Stopped"), std::string::npos) << first.dump();
+  EXPECT_NE(log.find("(rating page)"), std::string::npos) << "the terminal logs the page's commands\n" << log;
+  auto ratings = read_table(out / "ratings.csv");
+  ASSERT_EQ(ratings.size(), 2u);
+  EXPECT_EQ(ratings[0].at("rating"), "0");
+  EXPECT_EQ(ratings[1].at("rating"), "2");
+
+  // Again: no practice, pairs 3 to 6; the analysis waits for subject 2.
+  auto [second, second_log] = session("second", "choose:-1,confirm;switch,choose:+1,confirm;choose:+2,confirm;key-up,key-enter");
+  ASSERT_EQ(second["steps"].size(), 4u) << second.dump();
+  EXPECT_EQ(second["steps"][0]["title"], "Pair 3 of 6");
+  EXPECT_NE(second["final"]["note"].get<std::string>().find("Every pair is rated"), std::string::npos) << second.dump();
+  EXPECT_EQ(second["final"]["rated"], 6);
+  ratings = read_table(out / "ratings.csv");
+  ASSERT_EQ(ratings.size(), 6u);
+  const std::vector<std::string> expected = {"0", "2", "-1", "1", "2", "-2"};
+  for (std::size_t k = 0; k < expected.size(); ++k) EXPECT_EQ(ratings[k].at("rating"), expected[k]) << k;
+  EXPECT_NE(second_log.find("6 of 12 ratings"), std::string::npos) << second_log;
+
+  // The page's switches are the server's: pair 1 switched once, to "second".
+  EXPECT_EQ(read_table(out / "switches.csv").size(), 2u + 1u + 1u);
+  const record::Recording pair = record::read_recording(out / "pairs" / "s01-p01" / "server.mcap");
   std::vector<std::string> served;
   for (const record::SimulationStep& step : pair.steps)
     if (step.has_condition_switch()) served.push_back(step.condition_switch().name());

@@ -114,6 +114,7 @@ void ReplayPlayer::command(const Command& command) {
       else if (command.jump() == Command::LARGEST_STEP) seek(largest_step_time_);
       playing_ = false;
       break;
+    case Command::kRating:  // the rating page's
     case Command::BODY_NOT_SET: break;
   }
 }

@@ -15,12 +15,18 @@ struct AssetFile {
   bool library;      // shipped in view/web/lib by deploy/refresh-view-libs.sh
 };
 
-constexpr AssetFile kWebFiles[] = {
+constexpr AssetFile kLiveViewFiles[] = {
     {"/", "index.html", "text/html; charset=utf-8", false},
     {"/view.js", "view.js", "text/javascript; charset=utf-8", false},
     {"/style.css", "style.css", "text/css; charset=utf-8", false},
     {"/lib/three.module.min.js", "lib/three.module.min.js", "text/javascript; charset=utf-8", true},
     {"/lib/OrbitControls.js", "lib/OrbitControls.js", "text/javascript; charset=utf-8", true},
+    {"/lib/protobuf.min.js", "lib/protobuf.min.js", "text/javascript; charset=utf-8", true},
+};
+
+constexpr AssetFile kRatingFiles[] = {
+    {"/", "rate.html", "text/html; charset=utf-8", false},
+    {"/rate.js", "rate.js", "text/javascript; charset=utf-8", false},
     {"/lib/protobuf.min.js", "lib/protobuf.min.js", "text/javascript; charset=utf-8", true},
 };
 
@@ -45,10 +51,13 @@ std::string read_file(const std::filesystem::path& file, bool library) {
 
 }  // namespace
 
-AssetTable load_assets(const std::filesystem::path& web, const std::filesystem::path& proto) {
+AssetTable load_assets(const std::filesystem::path& web, const std::filesystem::path& proto, ViewPage page) {
   AssetTable table;
-  for (const AssetFile& file : kWebFiles)
-    table[file.url] = {file.content_type, read_file(web / file.path, file.library)};
+  const auto add_web_files = [&](const auto& files) {
+    for (const AssetFile& file : files) table[file.url] = {file.content_type, read_file(web / file.path, file.library)};
+  };
+  if (page == ViewPage::live_view) add_web_files(kLiveViewFiles);
+  else add_web_files(kRatingFiles);
   for (const AssetFile& file : kProtoFiles)
     table[file.url] = {file.content_type, read_file(proto / file.path, false)};
   table["/index.html"] = table.at("/");

@@ -58,7 +58,7 @@ struct ViewServer::Impl {
   ViewCounters counters;
 
   Impl(ViewServerOptions o, CommandHandler handler)
-      : options(std::move(o)), on_command(std::move(handler)), assets(load_assets(options.assets, options.proto)) {
+      : options(std::move(o)), on_command(std::move(handler)), assets(load_assets(options.assets, options.proto, options.page)) {
     server.clear_access_channels(websocketpp::log::alevel::all);
     server.clear_error_channels(websocketpp::log::elevel::all);
     server.init_asio(&io);

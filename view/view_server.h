@@ -1,11 +1,13 @@
-// ViewServer: the web server of the live view (docs/live-view.md, "The live view"). On its own
-// thread and io_context it serves, on one TCP port:
+// ViewServer: the web server of the live view (docs/live-view.md, "The live view"), and of a
+// study's rating page (lab/rating_page.h). On its own thread and io_context it serves, on
+// one TCP port:
 //   - HTTP GET of the page and its assets (view_assets.h), held in memory;
 //   - a WebSocket at /ws for the data: binary view.proto ServerMessages out, Commands in.
 // Data is published per Channel, newest wins: publish() keeps only the newest message of
 // each channel (one pointer swap under a mutex, from any thread, never waiting on a
 // browser) and wakes the server's thread, which sends each browser the newest message of
-// every channel it has not had yet, the scene first. A browser with more than
+// every channel it has not had yet, the scene first (the rating page's one message is its
+// scene). A browser with more than
 // max_buffered_bytes still waiting to leave gets nothing new until it has caught up: its
 // frames are dropped (counted), never queued without bound.
 // Safety: a non-empty token must be given as /ws?token=... or the handshake is refused
@@ -24,6 +26,8 @@
 #include <memory>
 #include <string>
 
+#include "view/view_assets.h"
+
 namespace cohaptic::view {
 
 class Command;
@@ -36,6 +40,7 @@ struct ViewServerOptions {
   std::filesystem::path proto;             ///< the proto/ directory (the page decodes its view.proto)
   std::size_t max_command_bytes = 1024;
   std::size_t max_buffered_bytes = 2u << 20;  ///< per browser: beyond this, new frames are dropped
+  ViewPage page = ViewPage::live_view;     ///< the page served at "/" (and what it needs)
 };
 
 /// The kinds of message a browser gets, in the order it gets them.
