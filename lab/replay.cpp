@@ -264,40 +264,40 @@ void export_csv(const Recording& rec, const std::filesystem::path& dir) {
   if (!rec.ticks.empty()) {
     AtomicFile out(dir / "haptic.csv");
     out.write("time_s,own_x,own_y,own_z,own_valid,force_x,force_y,force_z,evaluated_x,evaluated_y,evaluated_z,ir_epoch,flags,fade,ir_age_ms");
-    out.write(",remote_x,remote_y,remote_z,protocol\n");
+    out.write(",remote_x,remote_y,remote_z,protocol,buttons\n");
     for (const auto& t : rec.ticks) {
       const Eigen::Vector3d o = wire::from_wire(t.own()), f = wire::from_wire(t.force()), e = wire::from_wire(t.evaluated());
       const Eigen::Vector3d r = t.remotes_size() ? wire::from_wire(t.remotes(0)) : Eigen::Vector3d::Constant(std::nan(""));
-      out.print("{:.9f},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{},{},{:.17g},{:.17g},{:.17g},{}\n",
+      out.print("{:.9f},{:.17g},{:.17g},{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{},{},{},{},{:.17g},{:.17g},{:.17g},{},{}\n",
                 seconds(t.time_ns(), start), o.x(), o.y(), o.z(), t.own_valid() ? 1 : 0, f.x(), f.y(), f.z(), e.x(), e.y(),
                 e.z(), t.ir_epoch(), t.flags(), t.fade(),
                 t.has_ir_age_ns() ? fmt::format("{:.4f}", static_cast<double>(t.ir_age_ns()) * 1e-6) : std::string(), r.x(),
-                r.y(), r.z(), t.protocol() == wire::P0 ? "P0" : t.protocol() == wire::P1 ? "P1" : "");
+                r.y(), r.z(), t.protocol() == wire::P0 ? "P0" : t.protocol() == wire::P1 ? "P1" : "", t.buttons());
     }
     out.commit();
   }
   if (!rec.steps.empty()) {
     AtomicFile out(dir / "steps.csv");
-    out.write("time_s,simulation_time_s,slot,known,x,y,z,rebuilt,boundary_nodes,condition_switch\n");
+    out.write("time_s,simulation_time_s,slot,known,x,y,z,buttons,rebuilt,boundary_nodes,condition_switch\n");
     for (const auto& s : rec.steps)
       for (const auto& tool : s.tools()) {
         const Eigen::Vector3d p = wire::from_wire(tool.position());
-        out.print("{:.9f},{:.9f},{},{},{:.17g},{:.17g},{:.17g},{},{},{}\n", seconds(s.time_ns(), start), s.simulation_time(),
-                  tool.slot(), tool.known() ? 1 : 0, p.x(), p.y(), p.z(), s.rebuilt() ? 1 : 0, s.boundary_nodes(),
+        out.print("{:.9f},{:.9f},{},{},{:.17g},{:.17g},{:.17g},{},{},{},{}\n", seconds(s.time_ns(), start), s.simulation_time(),
+                  tool.slot(), tool.known() ? 1 : 0, p.x(), p.y(), p.z(), tool.buttons(), s.rebuilt() ? 1 : 0, s.boundary_nodes(),
                   csv_field(s.condition_switch().name()));
       }
     out.commit();
   }
   {
     AtomicFile out(dir / "tool_samples.csv");
-    out.write("receive_time_s,sender,sequence,sender_time_ns,user,sample_time_ns,x,y,z,valid\n");
+    out.write("receive_time_s,sender,sequence,sender_time_ns,user,sample_time_ns,x,y,z,valid,buttons\n");
     for (const auto& d : rec.datagrams) {
       if (!d.datagram().has_tool()) continue;
       const wire::ToolSample& t = d.datagram().tool();
       const Eigen::Vector3d p = wire::from_wire(t.position());
-      out.print("{:.9f},{},{},{},{},{},{:.17g},{:.17g},{:.17g},{}\n", seconds(d.receive_time_ns(), start),
+      out.print("{:.9f},{},{},{},{},{},{:.17g},{:.17g},{:.17g},{},{}\n", seconds(d.receive_time_ns(), start),
                 d.datagram().header().sender(), d.datagram().header().sequence(), d.datagram().header().sender_time_ns(),
-                t.user(), t.sample_time_ns(), p.x(), p.y(), p.z(), t.valid() ? 1 : 0);
+                t.user(), t.sample_time_ns(), p.x(), p.y(), p.z(), t.valid() ? 1 : 0, t.buttons());
     }
     out.commit();
   }

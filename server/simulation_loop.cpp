@@ -28,7 +28,7 @@ SimulationOptions simulation_options(const Model& model, const ServeOptions& opt
 }  // namespace
 
 SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns,
-                               const ServeOptions& options, const ToolInputs& tools, LoopStatistics& statistics,
+                               const ServeOptions& options, ToolInputs& tools, LoopStatistics& statistics,
                                DisplayWriter* display,
                                view::LiveView* view, record::SessionRecorder* recorder, std::int64_t start_ns,
                                ConditionSwitch* conditions)
@@ -137,9 +137,8 @@ SimulationLoop::StepOutput SimulationLoop::advance(std::int64_t now_ns) {
 void SimulationLoop::take_tools(std::int64_t now_ns) {
   deliver_prefetched();
   for (int user : encoder_.take_restarts()) restart_rows(user);
-  tools_.copy_to(latest_);
+  tools_.take(latest_);
   used_.assign(latest_.size(), false);
-  buttons_seen_.resize(latest_.size(), 0);
   const auto timeout = static_cast<std::int64_t>(options_.client_timeout_s * 1e9);
   for (std::size_t slot = 0; slot < latest_.size(); ++slot) {
     const ToolInput& tool = latest_[slot];
@@ -148,11 +147,8 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
       restart_rows(static_cast<int>(slot));
     }
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
-    if (conditions_ && options_.switch_button >= 0 && used_[slot]) {
-      const std::uint32_t bit = 1u << options_.switch_button;
-      if ((tool.buttons & bit) && !(buttons_seen_[slot] & bit)) conditions_->serve_next();
-    }
-    buttons_seen_[slot] = used_[slot] ? tool.buttons : 0;
+    if (conditions_ && options_.switch_button >= 0 && used_[slot] && (tool.pressed & (1u << options_.switch_button)))
+      conditions_->serve_next();
     if (used_[slot]) {
       simulation_.set_tool(static_cast<int>(slot), tool.position, tool.buttons);
       for (BodyPrefetch& prefetch : prefetch_) prefetch.worker->request_near(tool.position, *prefetch.columns);

@@ -18,8 +18,9 @@
 // start of the next step: the held nodes' count, the loop's rate and the protocol (the
 // outbox tells every user; on a switch to P1 each user's current IR is sent again, so that
 // its client has one to change over with) and the links' delays (with the outbox), recorded
-// with that step. With --switch-button, a user's press of that button serves the next
-// condition from the following step.
+// with that step. With --switch-button, a user's press of that button (counted as its
+// samples arrive, so one between two steps counts too) serves the next condition from the
+// following step.
 // run() paces the steps at the loop's rate with absolute deadlines (when behind, the next
 // step starts at once, with no catch-up burst) and hands each non-empty outbox to the I/O
 // side; the new IRs go to the encoder's thread, which hands their frames over in outboxes
@@ -75,7 +76,7 @@ class SimulationLoop {
   /// `conditions` (may be null: the options' condition throughout): the condition served
   /// now, whose first is what `options` give.
   SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns, const ServeOptions& options,
-                 const ToolInputs& tools,
+                 ToolInputs& tools,
                  LoopStatistics& statistics, DisplayWriter* display, view::LiveView* view,
                  record::SessionRecorder* recorder, std::int64_t start_ns, ConditionSwitch* conditions = nullptr);
 
@@ -133,8 +134,7 @@ class SimulationLoop {
   ServeProtocol protocol_;  // served now
   double rate_hz_;          // the loop's rate now
   bool resend_irs_ = false; // the next new_irs() sends every user's IR, changed or not
-  std::vector<std::uint32_t> buttons_seen_;  // per slot, as of the last step: a press is a new bit
-  const ToolInputs& tools_;
+  ToolInputs& tools_;  // taken each step (which restarts its press counts)
   LoopStatistics& statistics_;
   DisplayWriter* display_;
   view::LiveView* view_;

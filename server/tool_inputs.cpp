@@ -21,15 +21,17 @@ bool ToolInputs::update(int slot, bool valid, const Eigen::Vector3d& position, s
   if (sample_time_ns <= tool.sample_time_ns) return false;
   tool.valid = valid;
   tool.position = position;
+  tool.pressed |= buttons & ~tool.buttons;
   tool.buttons = buttons;
   tool.sample_time_ns = sample_time_ns;
   tool.received_ns = received_ns;
   return true;
 }
 
-void ToolInputs::copy_to(std::vector<ToolInput>& out) const {
+void ToolInputs::take(std::vector<ToolInput>& out) {
   std::lock_guard lock(mutex_);
   out = tools_;
+  for (ToolInput& tool : tools_) tool.pressed = 0;
 }
 
 }  // namespace cohaptic

@@ -1,8 +1,11 @@
 // ToolInputs: the newest tool sample of each user slot, the one piece of state the
 // server's I/O thread and simulation thread share. The I/O thread (ConnectionHandler)
 // writes a slot as its user joins, sends samples and leaves; the simulation thread
-// (SimulationLoop) copies all of them once per step. A small mutex guards them: both
+// (SimulationLoop) takes all of them once per step. A small mutex guards them: both
 // sides hold it only to copy a few numbers. Units: m; ns of wire::monotonic_now_ns().
+// A step sees only the newest sample, so a button press is also counted as it arrives
+// (`pressed`): one shorter than a step, or in a burst of samples a stalled link let through
+// at once, is not lost.
 #pragma once
 
 #include <Eigen/Core>
@@ -18,6 +21,7 @@ struct ToolInput {
   bool valid = false;   ///< the device reported a position
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   std::uint32_t buttons = 0;        ///< the device's buttons (bit i = button i)
+  std::uint32_t pressed = 0;        ///< buttons that went down in a sample since the previous take()
   std::int64_t sample_time_ns = 0;  ///< the server's clock, as stamped by the client
   std::int64_t received_ns = 0;     ///< when the server took it in
 };
@@ -34,8 +38,9 @@ class ToolInputs {
   /// the one held, as a reordered datagram would be.
   bool update(int slot, bool valid, const Eigen::Vector3d& position, std::uint32_t buttons, std::int64_t sample_time_ns,
               std::int64_t received_ns);
-  /// Copies every slot into `out` (resized to the number of slots).
-  void copy_to(std::vector<ToolInput>& out) const;
+  /// Copies every slot into `out` (resized to the number of slots) and starts counting
+  /// presses afresh.
+  void take(std::vector<ToolInput>& out);
 
   std::size_t size() const { return tools_.size(); }
 

@@ -21,6 +21,7 @@
 #include "lab/control_client.h"
 #include "lab/replay.h"
 #include "proto/record/recording.h"
+#include "support/csv_table.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
 
@@ -188,6 +189,32 @@ segments:
   session.finish();
   ASSERT_FALSE(::testing::Test::HasFailure());
   EXPECT_EQ(session.recorded_switches(), (std::vector<std::string>{"B", "A"}));
+  // From the CSV exports: each switch took effect within 50 ms after the server received
+  // the sample in which the button went down, however the samples came.
+  for (const char* file : {"server.mcap", "subject.mcap"}) {
+    ReplayOptions export_csv;
+    export_csv.file = session.dir / file;
+    export_csv.export_csv = session.dir / (std::string(file) + "-csv");
+    EXPECT_EQ(run_replay(export_csv), 0);
+  }
+  std::vector<double> pressed_s, switched_s;
+  std::string before = "0";
+  for (const testing::CsvRow& sample : testing::read_csv_table(session.dir / "server.mcap-csv" / "tool_samples.csv")) {
+    if (sample.at("buttons") == "1" && before == "0") pressed_s.push_back(std::stod(sample.at("receive_time_s")));
+    before = sample.at("buttons");
+  }
+  for (const testing::CsvRow& step : testing::read_csv_table(session.dir / "server.mcap-csv" / "steps.csv"))
+    if (!step.at("condition_switch").empty()) switched_s.push_back(std::stod(step.at("time_s")));
+  ASSERT_EQ(pressed_s.size(), 2u);
+  ASSERT_EQ(switched_s.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_GT(switched_s[k], pressed_s[k]);
+    EXPECT_LT(switched_s[k], pressed_s[k] + 0.05);
+  }
+  int ticks_pressed = 0;
+  for (const testing::CsvRow& tick : testing::read_csv_table(session.dir / "subject.mcap-csv" / "haptic.csv"))
+    ticks_pressed += tick.at("buttons") == "1";
+  EXPECT_NEAR(ticks_pressed, 2 * 200, 10) << "two presses of 0.2 s at 1 kHz";
   const nlohmann::json client_report = nlohmann::json::parse(std::ifstream(session.dir / "subject.json"));
   EXPECT_EQ(client_report["protocol_switches"], 2);
   EXPECT_EQ(client_report["fades"]["count"], 0);

@@ -106,6 +106,33 @@ TEST(StepFailures, LogsTheFirstThenOneLineASecondWhoseCountsAddUpAndEndsAfterAHu
   EXPECT_EQ(failures.last_error(), "stuck");
 }
 
+// A step takes only the newest sample, so presses are counted as samples arrive: a press
+// and release both between two takes is one press; a button held across takes is one press
+// (in the take after it went down); a reordered older sample changes nothing.
+TEST(ToolInputs, APressBetweenTwoTakesIsCountedOnceAndAHeldButtonOnce) {
+  ToolInputs tools{1};
+  std::vector<ToolInput> taken;
+  tools.join(0);
+  const Eigen::Vector3d at = Eigen::Vector3d::Zero();
+  std::int64_t t = 1;
+  const auto sample = [&](std::uint32_t buttons) { return tools.update(0, true, at, buttons, t++, 0); };
+  for (const std::uint32_t buttons : {0u, 0b10u, 0b10u, 0u}) sample(buttons);  // button 1 pressed and released in a burst
+  tools.take(taken);
+  EXPECT_EQ(taken[0].buttons, 0u);
+  EXPECT_EQ(taken[0].pressed, 0b10u);
+  tools.take(taken);
+  EXPECT_EQ(taken[0].pressed, 0u) << "counted once";
+  sample(0b1);
+  tools.take(taken);
+  EXPECT_EQ(taken[0].pressed, 0b1u);
+  for (int k = 0; k < 2; ++k) sample(0b1);
+  tools.take(taken);
+  EXPECT_EQ(taken[0].pressed, 0u) << "held, not pressed again";
+  EXPECT_FALSE(tools.update(0, true, at, 0b100, 1, 0)) << "an older sample";
+  tools.take(taken);
+  EXPECT_EQ(taken[0].pressed, 0u);
+}
+
 // ---- the loop, in process ----
 
 struct LoopRig {

@@ -24,6 +24,7 @@
 #include "lab/study.h"
 #include "proto/record/recording.h"
 #include "support/browser.h"
+#include "support/csv_table.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
 
@@ -61,21 +62,6 @@ order: {}
 session: {{site: ci}}
 )",
                      factors, repetitions, order);
-}
-
-std::vector<std::map<std::string, std::string>> read_table(const fs::path& file) {
-  std::ifstream in(file);
-  std::string line;
-  std::getline(in, line);
-  const std::vector<std::string> header = split_csv_line(line);
-  std::vector<std::map<std::string, std::string>> rows;
-  while (std::getline(in, line)) {
-    const std::vector<std::string> fields = split_csv_line(line);
-    EXPECT_EQ(fields.size(), header.size()) << line;
-    std::map<std::string, std::string>& row = rows.emplace_back();
-    for (std::size_t i = 0; i < header.size() && i < fields.size(); ++i) row[header[i]] = fields[i];
-  }
-  return rows;
 }
 
 // The error loading a study file with `body` gives ("no error" if none).
@@ -163,7 +149,7 @@ TEST(Study, TwoConditionsRunWithTheRealProgramsAndAnInterruptedStudyContinues) {
   options.client_program = testing::client_program();
   ASSERT_EQ(run_study(dir / "study.yaml", options), 0);
 
-  auto rows = read_table(options.out / "trials.csv");
+  auto rows = testing::read_csv_table(options.out / "trials.csv");
   ASSERT_EQ(rows.size(), 2u);
   std::map<std::string, std::map<std::string, std::string>> by_protocol;
   for (const auto& row : rows) {
@@ -196,7 +182,7 @@ TEST(Study, TwoConditionsRunWithTheRealProgramsAndAnInterruptedStudyContinues) {
   }
 
   // summary.csv: mean of one trial = its value, n = 1, for every measure.
-  const auto summary = read_table(options.out / "summary.csv");
+  const auto summary = testing::read_csv_table(options.out / "summary.csv");
   bool found = false;
   for (const auto& row : summary)
     if (row.at("condition") == "S0-T150-P1" && row.at("measure") == "force_update_rate_hz") {
@@ -221,7 +207,7 @@ TEST(Study, TwoConditionsRunWithTheRealProgramsAndAnInterruptedStudyContinues) {
   }
   const auto first_recording_time = fs::last_write_time(options.out / "trials" / "001" / "s1.mcap");
   ASSERT_EQ(run_study(dir / "study.yaml", options), 0);
-  rows = read_table(options.out / "trials.csv");
+  rows = testing::read_csv_table(options.out / "trials.csv");
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[0].at("trial"), "1");
   EXPECT_EQ(rows[1].at("trial"), "2");
@@ -263,7 +249,7 @@ TEST(Study, OnAMachineSlowedByBusyProcessesAPressIsStillOneStroke) {
   ASSERT_EQ(run_study(dir / "study.yaml", options), 0);
   busy.clear();  // killed
 
-  const auto rows = read_table(options.out / "trials.csv");
+  const auto rows = testing::read_csv_table(options.out / "trials.csv");
   ASSERT_EQ(rows.size(), 4u);
   for (const auto& row : rows) {
     const std::string trial = row.at("condition") + " #" + row.at("repetition");
@@ -351,7 +337,7 @@ TEST(PairedComparisonStudy, SimulatedSubjectsRateEveryPairOnceAndTheAnalysisFind
   options.client_program = testing::client_program();
   ASSERT_EQ(run_study(dir / "study.yaml", options), 0);
 
-  const auto ratings = read_table(options.out / "ratings.csv");
+  const auto ratings = testing::read_csv_table(options.out / "ratings.csv");
   ASSERT_EQ(ratings.size(), static_cast<std::size_t>(kSubjects * 6));
   for (const auto& row : ratings) {
     const int rating = std::stoi(row.at("rating"));
@@ -360,21 +346,21 @@ TEST(PairedComparisonStudy, SimulatedSubjectsRateEveryPairOnceAndTheAnalysisFind
     EXPECT_EQ(row.at("rated_by"), "simulated");
   }
   std::map<std::string, double> scale;
-  for (const auto& row : read_table(options.out / "analysis" / "scale.csv"))
+  for (const auto& row : testing::read_csv_table(options.out / "analysis" / "scale.csv"))
     scale[row.at("condition")] = std::stod(row.at("scale_value"));
   ASSERT_EQ(scale.size(), 4u);
   double sum = 0;
   for (const auto& [name, value] : scale) sum += value;
   EXPECT_NEAR(sum, 0, 1e-12);
   double yardstick_05 = 0;
-  for (const auto& row : read_table(options.out / "analysis" / "yardsticks.csv"))
+  for (const auto& row : testing::read_csv_table(options.out / "analysis" / "yardsticks.csv"))
     if (std::stod(row.at("level")) == 0.05) yardstick_05 = std::stod(row.at("yardstick"));
   ASSERT_GT(yardstick_05, 0);
   std::printf("  scale values: T0-P0 %.3f, T0-P1 %.3f, T150-P0 %.3f, T150-P1 %.3f; Y(0.05) %.3f\n",
               scale.at("S0-T0-P0"), scale.at("S0-T0-P1"), scale.at("S0-T150-P0"), scale.at("S0-T150-P1"), yardstick_05);
   EXPECT_GT(scale.at("S0-T150-P1") - scale.at("S0-T150-P0"), yardstick_05);
   bool found = false;
-  for (const auto& row : read_table(options.out / "analysis" / "differences.csv"))
+  for (const auto& row : testing::read_csv_table(options.out / "analysis" / "differences.csv"))
     if ((row.at("first") == "S0-T150-P0" && row.at("second") == "S0-T150-P1") ||
         (row.at("first") == "S0-T150-P1" && row.at("second") == "S0-T150-P0")) {
       found = true;
@@ -440,7 +426,7 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
   EXPECT_NE(said.find("stopped: run the same command again"), std::string::npos) << said;
   for (const char* secret : {"S0-T", "P0", "P1", "step", "150"})
     EXPECT_EQ(said.find(secret), std::string::npos) << "the terminal names no condition: " << secret << "\n" << said;
-  auto ratings = read_table(options.out / "ratings.csv");
+  auto ratings = testing::read_csv_table(options.out / "ratings.csv");
   ASSERT_EQ(ratings.size(), 2u);
   EXPECT_EQ(ratings[0].at("rating"), "1");
   EXPECT_EQ(ratings[1].at("rating"), "2") << "the grade confirmed, not the one replaced";
@@ -453,13 +439,13 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
   EXPECT_NE(said.find("6 of 12 ratings"), std::string::npos) << "the analysis waits for subject 2\n" << said;
   said = session(2, "n\n1\n\n1\n\n1\n\ns\n1\n\n1\n\n1\n\n");
   EXPECT_NE(said.find("wrote"), std::string::npos) << said;
-  ratings = read_table(options.out / "ratings.csv");
+  ratings = testing::read_csv_table(options.out / "ratings.csv");
   EXPECT_EQ(ratings.size(), 12u);
   EXPECT_TRUE(fs::exists(options.out / "analysis" / "scale.csv"));
   EXPECT_TRUE(fs::exists(options.out / "figures" / "scale.svg"));
 
   // Every "s" is a switch, in switches.csv and in its pair's server recording.
-  const auto switches = read_table(options.out / "switches.csv");
+  const auto switches = testing::read_csv_table(options.out / "switches.csv");
   EXPECT_EQ(switches.size(), 2u + 3u + 1u + 1u) << "practice 2, pairs 1 + 2, then 1, then 1";
   const record::Recording pair = record::read_recording(options.out / "pairs" / "s01-p01" / "server.mcap");
   std::vector<std::string> served;
@@ -469,18 +455,29 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
 }
 
 // The rating page in headless Chromium: the subject's hand on buttons and keys, the lab as
-// its own process. A practice pair, two pairs rated (by a click and by the arrow keys), a stop;
-// run again, the four pairs left, and the analysis. The page never names a condition, and
-// what it sent is what ratings.csv and the pairs' server recordings hold.
+// its own process, and the device's button switching too. A practice pair, two pairs rated
+// (by a click and by the arrow keys), a stop; run again, the four pairs left. The page never
+// names a condition, follows the button, and what it sent is what ratings.csv holds; every
+// switch, clicked or pressed, is in switches.csv and the pairs' server recordings.
 TEST(PairedComparisonStudy, ASubjectRatesOnTheRatingPageInABrowserAndAStoppedSessionContinues) {
   if (const std::string why = testing::missing_browser(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = testing::scratch_directory("rating-page");
-  write_study_files(dir, person_study_text(2, "  switch_button: 0\n"));  // the page follows the server's condition
+  write_study_files(dir, person_study_text(2, "  switch_button: 0\n"));
+  // In every pair the subject presses and, 1.2 s in, presses the device's button once.
+  std::ofstream(dir / "button.yaml") << R"(
+units: mm
+start: [4, 3, 4]
+segments:
+  - {move_to: [4, 3, 0.5], speed: 20}
+  - {press: 0.75, speed: 0.75, direction: [0, 0, -1]}
+  - {hold: 0.2, buttons: 1}
+  - {release: 0.75, speed: 0.75}
+)";
   const fs::path out = dir / "out";
   const auto session = [&](const std::string& name, const std::string& script) {
     ChildProcess lab(COHAPTIC_LAB_EXE,
                      {"study", (dir / "study.yaml").string(), "--out", out.string(), "--subject", "1", "--device",
-                      "script:" + (dir / "press.yaml").string(), "--rating-page", "127.0.0.1:0", "--server-program",
+                      "script:" + (dir / "button.yaml").string(), "--rating-page", "127.0.0.1:0", "--server-program",
                       testing::server_program(), "--client-program", testing::client_program()},
                      dir / (name + "-lab.log"));
     EXPECT_TRUE(testing::wait_for_output(lab, "rating page at"));
@@ -503,41 +500,52 @@ TEST(PairedComparisonStudy, ASubjectRatesOnTheRatingPageInABrowserAndAStoppedSes
     return std::make_pair(result, lab.log_text());
   };
 
-  // Practice (switched by click and by key, then on), a pair rated 0 after choosing +1, a
-  // pair rated +2 by the arrow keys and Enter, then a stop with a grade chosen.
-  auto [first, log] = session("first", "switch,key-switch,key-next;switch,choose:+1,choose:0,screenshot,confirm;"
-                                       "key-down,key-down,key-up,key-enter;choose:-2,stop");
+  // Each pair starts with the button's switch to SECOND. Practice: back by click, again by
+  // key, then on; a pair rated 0 after choosing +1; a pair rated +2 by the arrow keys and
+  // Enter; then a stop with a grade chosen.
+  auto [first, log] = session("first", "await:second,switch,key-switch,key-next;"
+                                       "await:second,switch,choose:+1,choose:0,screenshot,confirm;"
+                                       "await:second,key-down,key-down,key-up,key-enter;await:second,choose:-2,stop");
   ASSERT_EQ(first["steps"].size(), 4u) << first.dump();
   EXPECT_EQ(first["steps"][0]["title"], "Practice pair 1 of 1 (not rated)");
-  EXPECT_EQ(first["steps"][0]["screens"][0]["feeling"], "second");
   EXPECT_EQ(first["steps"][0]["screens"][1]["feeling"], "first");
-  EXPECT_EQ(first["steps"][1]["screens"][2]["chosen_grade"], 0);
+  EXPECT_EQ(first["steps"][0]["screens"][2]["feeling"], "second");
+  EXPECT_EQ(first["steps"][1]["screens"][1]["feeling"], "first");
+  EXPECT_EQ(first["steps"][1]["screens"][3]["chosen_grade"], 0);
   EXPECT_NE(first["final"]["note"].get<std::string>().find("Stopped"), std::string::npos) << first.dump();
   EXPECT_NE(log.find("(rating page)"), std::string::npos) << "the terminal logs the page's commands\n" << log;
-  auto ratings = read_table(out / "ratings.csv");
+  EXPECT_NE(log.find("(button) You are feeling: SECOND"), std::string::npos) << log;
+  auto ratings = testing::read_csv_table(out / "ratings.csv");
   ASSERT_EQ(ratings.size(), 2u);
   EXPECT_EQ(ratings[0].at("rating"), "0");
   EXPECT_EQ(ratings[1].at("rating"), "2");
 
   // Again: no practice, pairs 3 to 6; the analysis waits for subject 2.
-  auto [second, second_log] = session("second", "choose:-1,confirm;switch,choose:+1,confirm;choose:+2,confirm;key-up,key-enter");
+  auto [second, second_log] = session("second", "await:second,choose:-1,confirm;await:second,switch,choose:+1,confirm;"
+                                                 "await:second,choose:+2,confirm;await:second,key-up,key-enter");
   ASSERT_EQ(second["steps"].size(), 4u) << second.dump();
   EXPECT_EQ(second["steps"][0]["title"], "Pair 3 of 6");
   EXPECT_NE(second["final"]["note"].get<std::string>().find("Every pair is rated"), std::string::npos) << second.dump();
   EXPECT_EQ(second["final"]["rated"], 6);
-  ratings = read_table(out / "ratings.csv");
+  ratings = testing::read_csv_table(out / "ratings.csv");
   ASSERT_EQ(ratings.size(), 6u);
   const std::vector<std::string> expected = {"0", "2", "-1", "1", "2", "-2"};
   for (std::size_t k = 0; k < expected.size(); ++k) EXPECT_EQ(ratings[k].at("rating"), expected[k]) << k;
   EXPECT_NE(second_log.find("6 of 12 ratings"), std::string::npos) << second_log;
 
-  // The page's switches are the server's: pair 1 switched once, to "second".
-  EXPECT_EQ(read_table(out / "switches.csv").size(), 2u + 1u + 1u);
+  // Every switch, pressed or clicked: the button's in each of the 8 pairs served (pair 3
+  // twice), and 2 + 1 + 1 clicks or keys. Pair 1: the button's, then the click's.
+  const auto switches = testing::read_csv_table(out / "switches.csv");
+  EXPECT_EQ(switches.size(), 8u + 4u);
+  std::vector<std::string> pair_1;
+  for (const auto& row : switches)
+    if (row.at("pair") == "1") pair_1.push_back(row.at("serving"));
+  EXPECT_EQ(pair_1, (std::vector<std::string>{"second", "first"}));
   const record::Recording pair = record::read_recording(out / "pairs" / "s01-p01" / "server.mcap");
   std::vector<std::string> served;
   for (const record::SimulationStep& step : pair.steps)
     if (step.has_condition_switch()) served.push_back(step.condition_switch().name());
-  EXPECT_EQ(served, (std::vector<std::string>{"second"}));
+  EXPECT_EQ(served, pair_1);
 }
 
 }  // namespace

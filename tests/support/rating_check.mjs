@@ -11,6 +11,8 @@
 //   confirm     click Confirm                  key-enter   press Enter
 //   next        click Next pair                key-next    press N
 //   stop        click Stop twice               screenshot  take the screenshot now
+//   await:F     nothing: wait until the page shows F (first, second) felt, as after a
+//               switch made by the device's button
 // After the last step it waits until the page serves nothing (every pair rated, or stopped).
 // Result: {steps: [{title, screens: [screen after each action]}], final: screen, texts: [the
 // page's visible text after each action], errors}. Exit 1 on a timeout, naming what was
@@ -64,6 +66,12 @@ try {
     for (const action of step.split(',').filter(Boolean)) {
       if (action === 'screenshot') {
         if (args.screenshot) await page.screenshot({ path: args.screenshot });
+        continue;
+      }
+      if (action.startsWith('await:')) {
+        const felt = action.slice(6);
+        record.screens.push((await waitFor(`${felt} felt`, (s) => s.screen.feeling === felt)).screen);
+        result.texts.push(await page.evaluate(() => document.body.innerText));
         continue;
       }
       const before = (await snapshot()).screens;
