@@ -17,6 +17,7 @@
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
 #include "common/util/log_to_stderr.h"
+#include "proto/wire/user_name.h"
 
 int main(int argc, char** argv) {
   cohaptic::log_to_stderr();
@@ -78,6 +79,10 @@ int main(int argc, char** argv) {
   try {
     if (const std::string problem = cohaptic::parse_host_port(server, options.host, options.port, false); !problem.empty()) {
       fmt::print(stderr, "cohaptic-client: --server: {}\n", problem);
+      return 2;
+    }
+    if (const std::string problem = cohaptic::wire::user_name_problem(options.user_name); !problem.empty()) {
+      fmt::print(stderr, "cohaptic-client: --user: {}\n", problem);
       return 2;
     }
     options.requested_slot = slot;

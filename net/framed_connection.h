@@ -64,6 +64,9 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
   Sent send(std::vector<std::uint8_t> frame, FrameKind kind);
   /// Closes the socket; pending operations end, no handler is called any more.
   void close();
+  /// The largest frame body the peer may send from now on (a frame declaring more closes
+  /// the connection as rejected: oversized). On the I/O thread.
+  void set_max_frame_bytes(std::size_t bytes) { reader_.set_max_body_bytes(bytes); }
 
   bool closed() const { return closed_; }
   /// The peer as "address:port" (kept from the start: still known after closing).

@@ -11,6 +11,7 @@
 #include "net/delayed_delivery.h"
 #include "proto/wire/header.h"
 #include "proto/wire/traffic_keys.h"
+#include "proto/wire/user_name.h"
 #include "proto/wire/vec3_convert.h"
 
 namespace cohaptic {
@@ -69,6 +70,7 @@ ConnectionHandler::ConnectionHandler(asio::io_context& io, const ServeOptions& o
         acceptor.listen();
         return acceptor;
       }()),
+      accept_retry_(io),
       tcp_port_(acceptor_.local_endpoint().port()),
       udp_(io, udp::endpoint(acceptor_.local_endpoint().address(), tcp_port_),
            std::make_unique<wire::DatagramInspector>(session, !options.encrypt)),
@@ -114,8 +116,14 @@ void ConnectionHandler::warn_throttled(const std::string& message) {
 
 void ConnectionHandler::accept() {
   acceptor_.async_accept([this](std::error_code error, tcp::socket socket) {
+    if (error == asio::error::operation_aborted || !acceptor_.is_open()) return;  // closing
     if (error) {
-      if (error != asio::error::operation_aborted) spdlog::warn("accept failed: {}", error.message());
+      ++counters_.accept_errors;
+      warn_throttled(fmt::format("accept failed: {}; accepting again in {} ms", error.message(), kAcceptRetry.count()));
+      accept_retry_.expires_after(kAcceptRetry);
+      accept_retry_.async_wait([this](std::error_code timer_error) {
+        if (!timer_error) accept();
+      });
       return;
     }
     ++counters_.connections;
@@ -146,7 +154,7 @@ void ConnectionHandler::accept() {
           const ParticipantPtr p = weak.lock();
           return p ? key_for(*p, sender) : nullptr;
         },
-        {.expect_greeting = false, .allow_cleartext = !options_.encrypt, .max_body_bytes = kMaxClientFrameBytes});
+        {.expect_greeting = false, .allow_cleartext = !options_.encrypt, .max_body_bytes = kMaxJoinFrameBytes});
     participant->connection = net::FramedConnection::start(std::move(socket), std::move(reader), std::move(handlers));
     participants_.push_back(participant);
     send_bytes(participant, wire::encode_greeting(participant->challenge), net::FrameKind::must_arrive, false);
@@ -231,9 +239,11 @@ int ConnectionHandler::take_slot(const ParticipantPtr& participant, const wire::
   const auto refuse = [&](const std::string& code, const std::string& text) {
     ++counters_.joins_refused;
     send_error(participant, code, text);
-    spdlog::warn("{} ('{}') refused: {}", participant->connection->peer(), request.user_name(), text);
+    spdlog::warn("{} ('{}') refused: {}", participant->connection->peer(), wire::printable(request.user_name()), text);
     return -1;
   };
+  if (const std::string problem = wire::user_name_problem(request.user_name()); !problem.empty())
+    return refuse("bad_user_name", problem);
   int wanted = request.requested_slot() > 0 ? static_cast<int>(request.requested_slot() - 1) : -1;
   if (sender != wire::kJoiningSender) {  // a participant key: its slot, and no other
     const int own = static_cast<int>(sender - 1);
@@ -271,6 +281,7 @@ void ConnectionHandler::join(const ParticipantPtr& participant, const wire::Cont
   if (slot < 0) return;
   const wire::TrafficKey& key = slot_keys_[static_cast<std::size_t>(slot)];
   participant->slot = slot;
+  participant->connection->set_max_frame_bytes(kMaxClientFrameBytes);
   participant->user_name = request.user_name();
   participant->udp_endpoint =
       udp::endpoint(participant->connection->peer_address(), static_cast<std::uint16_t>(request.udp_port()));
@@ -365,6 +376,7 @@ void ConnectionHandler::say_goodbye(const std::string& reason) {
     }
   std::error_code ignored;
   acceptor_.close(ignored);
+  accept_retry_.cancel();
 }
 
 void ConnectionHandler::close_all(const std::string& why) {

@@ -53,6 +53,9 @@ namespace cohaptic {
 inline constexpr std::int64_t kLeftSenderGrace_ms = 500;
 /// A connection that has not joined within this time is closed.
 inline constexpr std::chrono::seconds kJoinTimeout{10};
+/// After an accept() that failed (out of file descriptors, say), the listener waits this
+/// long and accepts again: it never stops, and never spins on a failure that persists.
+inline constexpr std::chrono::milliseconds kAcceptRetry{100};
 /// Connections that have not joined, at most; more are closed as they come.
 inline constexpr std::size_t kMaxUnjoinedConnections = 16;
 /// The kernel's send buffer of a control connection, fixed rather than grown without a
@@ -60,9 +63,11 @@ inline constexpr std::size_t kMaxUnjoinedConnections = 16;
 /// its writes stall (net::kWriteTimeout) within seconds. A few IRs' worth at any link speed.
 inline constexpr int kControlSendBufferBytes = 1 << 20;
 /// The largest frame body a client may send: its frames (Join, Event, Bye, ClientStatus) are
-/// small, and a frame declared larger is refused (oversized) before its body is buffered,
-/// so that a connection that has not even joined cannot make the server hold megabytes.
+/// small, and a frame declared larger is refused (oversized) before its body is buffered.
+/// Until it has joined, a connection may send a Join only (about 100 bytes): kMaxJoinFrameBytes,
+/// so that the unjoined connections together cannot make the server hold more than a few KiB.
 inline constexpr std::size_t kMaxClientFrameBytes = std::size_t{64} << 10;
+inline constexpr std::size_t kMaxJoinFrameBytes = 1024;
 
 struct ConnectionCounters {
   std::uint64_t datagrams_sent = 0, datagrams_relayed = 0;
@@ -74,6 +79,7 @@ struct ConnectionCounters {
   std::uint64_t joins_refused = 0;     ///< session full, slot taken, or a key for another slot
   std::uint64_t turned_away = 0;       ///< closed at once: too many connections not joined
   std::uint64_t join_timeouts = 0;     ///< closed: not joined within kJoinTimeout
+  std::uint64_t accept_errors = 0;     ///< accept() failed (e.g. out of file descriptors): tried again after kAcceptRetry
   std::uint64_t write_stalls = 0;      ///< closed: the user stopped reading (write timeout)
   std::uint64_t queue_overflows = 0;   ///< closed: frames that must arrive piled up unread
 };
@@ -150,6 +156,7 @@ class ConnectionHandler {
   ToolInputs& tools_;
   record::SessionRecorder* recorder_;
   asio::ip::tcp::acceptor acceptor_;
+  asio::steady_timer accept_retry_;
   std::uint16_t tcp_port_ = 0;
   net::DatagramEndpoint udp_;
   std::vector<ParticipantPtr> participants_;  // every connection

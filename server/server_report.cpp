@@ -61,6 +61,7 @@ nlohmann::json server_report(const ServerFigures& figures) {
                            {"joins_refused", connections.joins_refused},
                            {"turned_away", connections.turned_away},
                            {"join_timeouts", connections.join_timeouts},
+                           {"accept_errors", connections.accept_errors},
                            {"write_stalls", connections.write_stalls},
                            {"queue_overflows", connections.queue_overflows}};
   server["encrypted"] = options.encrypt;

@@ -174,7 +174,11 @@ struct SimulationServer::Impl {
       connections->on_client_status([this](int slot, const std::string& user, const wire::ClientStatus& status) {
         view->publish_status(slot, user, status, static_cast<double>(wire::monotonic_now_ns() - start_ns) * 1e-9);
       });
-      spdlog::info("live view at {} (open it in a browser)", view->url());
+      if (options.view_token_file)  // the operator has the token: it stays out of the log
+        spdlog::info("live view at {} (open it in a browser, adding ?token= and the token in {})", view->url(false),
+                     options.view_token_file->string());
+      else
+        spdlog::info("live view at {} (open it in a browser)", view->url());
     }
   }
 

@@ -26,6 +26,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -43,6 +44,7 @@
 #include "support/hostile_traffic.h"
 #include "support/process.h"
 #include "support/raw_participant.h"
+#include "support/run_program.h"
 
 namespace cohaptic {
 namespace {
@@ -185,16 +187,24 @@ TEST(Security, TheWireCarriesNoPlaintextAndStaleOrOldPeersAreRefused) {
   Bytes bulky_start(wire::kFrameClearBytes, 0);
   wire::write_le(1u << 20, wire::kFrameLengthBytes, bulky_start.data());
   asio::write(bulky, asio::buffer(bulky_start));
+  // Before its join a connection may send a Join only: a frame declared 2 KiB is refused too.
+  asio::ip::tcp::socket chatty(io);
+  chatty.connect(asio::ip::tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  Bytes chatty_start(wire::kFrameClearBytes, 0);
+  wire::write_le(2048, wire::kFrameLengthBytes, chatty_start.data());
+  asio::write(chatty, asio::buffer(chatty_start));
   ASSERT_TRUE(testing::wait_until(
-      [&] { return closed_by_server(replay) && closed_by_server(old_peer) && closed_by_server(bulky); },
-      "the server to close the replaying, the protocol 2 peer's and the bulky connections"))
+      [&] {
+        return closed_by_server(replay) && closed_by_server(old_peer) && closed_by_server(bulky) && closed_by_server(chatty);
+      },
+      "the server to close the replaying, the protocol 2 peer's, the bulky and the chatty connections"))
       << session.server->log_text();
   first.stop();
   session.stop_server();
   const nlohmann::json server = session.report("server")["server"];
   EXPECT_EQ(count(server, {"control_frames", "rejected_by_reason", "replayed"}), 1u) << server["control_frames"].dump();
   EXPECT_EQ(count(server, {"control_frames", "rejected_by_reason", "bad_version"}), 1u) << server["control_frames"].dump();
-  EXPECT_EQ(count(server, {"control_frames", "rejected_by_reason", "oversized"}), 1u) << server["control_frames"].dump();
+  EXPECT_EQ(count(server, {"control_frames", "rejected_by_reason", "oversized"}), 2u) << server["control_frames"].dump();
   EXPECT_EQ(count(server, {"datagrams", "rejected_by_reason", "bad_version"}), 1u) << server["datagrams"].dump();
   EXPECT_EQ(count(server, {"connections", "joins"}), 1u);
 
@@ -211,6 +221,59 @@ TEST(Security, TheWireCarriesNoPlaintextAndStaleOrOldPeersAreRefused) {
   reader.stop();
   clear.stop_server();
   EXPECT_FALSE(clear.report("server")["server"]["encrypted"].get<bool>());
+}
+
+// A user name is shown to others and logged: one that could forge a log line or drive a
+// terminal (a newline, an escape sequence, C1's CSI), is empty or too long is refused, and
+// what the log shows of it is escaped, on one line. A name in another script is a name.
+TEST(Security, AUserNameThatCouldForgeALogLineIsRefusedAndLoggedEscaped) {
+  CubeSession session("security-names", {"--duration", "60"});
+  const std::uint16_t port = static_cast<std::uint16_t>(session.port);
+  const wire::ClientKeys dev(wire::development_key());
+  const std::string forged = "mallory\n[12:00:00.000] [info] user 'admin' joined";
+  for (const std::string& name : {forged, std::string("\x1b[2Jwiped"), std::string("csi\xc2\x9b" "31m"), std::string(),
+                                  std::string(65, 'n')}) {
+    RawParticipant raw({.server_port = port, .slot = 0, .name = name}, dev);
+    try {
+      raw.join();
+      ADD_FAILURE() << "joined as '" << name << "'";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("(bad_user_name)"), std::string::npos) << e.what();
+    }
+  }
+  RawParticipant zoe({.server_port = port, .slot = 0, .name = "Zoë Ångström"}, dev);
+  zoe.join();
+  zoe.stop();
+  session.stop_server();
+  const std::string log = session.server->log_text();
+  EXPECT_NE(log.find("mallory\\x0a[12:00:00.000] [info] user 'admin' joined"), std::string::npos) << log;
+  EXPECT_EQ(log.find("\n[12:00:00.000]"), std::string::npos) << "a forged line\n" << log;
+  EXPECT_EQ(log.find('\x1b'), std::string::npos) << log;
+  EXPECT_NE(log.find("user 'Zoë Ångström' joined"), std::string::npos) << log;
+  EXPECT_EQ(count(session.report("server")["server"], {"connections", "joins_refused"}), 5u);
+  EXPECT_EQ(log.find("\xc2\x9b"), std::string::npos) << log;
+  // The client refuses such a name before it connects.
+  const testing::ProgramRun newline = testing::run_program(
+      testing::client_program(), "--server 127.0.0.1:1 --device script:none.yaml --user \"$(printf 'two\\nlines')\"", true);
+  EXPECT_EQ(newline.exit_code, 2) << newline.out;
+  EXPECT_NE(newline.out.find("--user: a user name is UTF-8 text without control characters"), std::string::npos)
+      << newline.out;
+}
+
+// A view token the operator gave in a file is theirs: the log gives the page's address
+// without it (a random token, which only the log can tell, is logged).
+TEST(Security, AViewTokenReadFromAFileIsNotLogged) {
+  const fs::path token_dir = testing::scratch_directory("security-token-file");
+  const std::string token = "7f3c9a0e5b1d4c2a8e6f0b9d3a7c5e1f";
+  std::ofstream(token_dir / "token") << token << "\n";
+  fs::permissions(token_dir / "token", fs::perms::owner_read | fs::perms::owner_write);
+  CubeSession session("security-token", {"--duration", "60", "--view", "127.0.0.1:0", "--view-token-file",
+                                         (token_dir / "token").string()});
+  ASSERT_TRUE(testing::wait_for_output(*session.server, "live view at")) << session.server->log_text();
+  session.stop_server();
+  const std::string log = session.server->log_text();
+  EXPECT_EQ(log.find(token), std::string::npos) << log;
+  EXPECT_NE(log.find("adding ?token= and the token in " + (token_dir / "token").string()), std::string::npos) << log;
 }
 
 TEST(Security, ASessionRefusesParticipantsBeyondItsScenesMaximum) {
@@ -378,6 +441,44 @@ TEST(Robustness, AMillionHostileDatagramsLeaveTheSimulationRateAndEveryLegitimat
   EXPECT_GE(accepted + kernel_drops, sent_by_users) << "a legitimate datagram was refused, or lost with no queue full";
   EXPECT_GE(datagrams["rejected"].get<std::uint64_t>(), kFlood * 99 / 100) << "the kernel dropped much of the flood";
   EXPECT_EQ(server_report["failed_steps"]["count"], 0);
+}
+
+// Out of file descriptors (the live view's port held by 150 connections that send nothing,
+// the server limited to 96 descriptors): a client's connection fails to be accepted. Once
+// the descriptors are free again the listener accepts it: it was waiting, not dead.
+TEST(Robustness, TheListenerAcceptsAgainOnceFileDescriptorsAreFree) {
+  const fs::path prlimit = "/usr/bin/prlimit";
+  if (!fs::exists(prlimit)) GTEST_SKIP() << "no prlimit (the Debian package util-linux)";
+  const fs::path dir = testing::scratch_directory("fd-exhaustion");
+  testing::write_cube_scene(dir);
+  ChildProcess server(prlimit.string(),
+                      {"--nofile=96", "--", testing::server_program(), "--scene", (dir / "cube.yaml").string(), "--listen",
+                       "127.0.0.1:0", "--view", "127.0.0.1:0", "--report", (dir / "server.json").string(), "--duration",
+                       "60", "--no-disk-cache"},
+                      dir / "server.log");
+  ASSERT_TRUE(testing::wait_for_output(server, "listening on"));
+  ASSERT_TRUE(testing::wait_for_output(server, "live view at"));
+  std::smatch match;
+  const std::string started = server.log_text();
+  ASSERT_TRUE(std::regex_search(started, match, std::regex(R"(live view at http://127\.0\.0\.1:(\d+)/)"))) << started;
+  const asio::ip::tcp::endpoint view(asio::ip::make_address("127.0.0.1"), static_cast<std::uint16_t>(std::stoi(match[1])));
+  asio::io_context io;
+  std::vector<asio::ip::tcp::socket> hogs;
+  for (int k = 0; k < 150; ++k) {
+    std::error_code error;
+    hogs.emplace_back(io).connect(view, error);
+  }
+  const auto alice = testing::scripted_client(dir, testing::listening_port(started), "alice", 0,
+                                              write_press(dir, "a", 3, 2, 2, 0.5));
+  ASSERT_TRUE(testing::wait_for_output(server, "accept failed")) << server.log_text();
+  hogs.clear();  // the descriptors come free as the view's connections close
+  EXPECT_TRUE(testing::wait_for_output(*alice, "haptic loop at")) << alice->log_text() << server.log_text();
+  EXPECT_EQ(alice->wait(testing::kPatience), 0) << alice->log_text();
+  server.signal(SIGINT);
+  ASSERT_EQ(server.wait(testing::kPatience), 0) << server.log_text();
+  const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / "server.json"));
+  EXPECT_GE(count(report["server"], {"connections", "accept_errors"}), 1u);
+  EXPECT_EQ(count(report["server"], {"connections", "joins"}), 1u);
 }
 
 }  // namespace

@@ -59,7 +59,7 @@ class LiveView {
 
   void start() { server_.start(); }
   void stop() { server_.stop(); }
-  std::string url() const { return server_.url(); }
+  std::string url(bool with_token = true) const { return server_.url(with_token); }
   std::uint16_t port() const { return server_.port(); }
   ViewCounters counters() const { return server_.counters(); }
 

@@ -217,11 +217,11 @@ void ViewServer::stop() {
 
 std::uint16_t ViewServer::port() const { return impl_->port; }
 
-std::string ViewServer::url() const {
+std::string ViewServer::url(bool with_token) const {
   const Impl& s = *impl_;
   const bool v6 = s.options.host.find(':') != std::string::npos;
   std::string url = "http://" + (v6 ? "[" + s.options.host + "]" : s.options.host) + ":" + std::to_string(s.port) + "/";
-  if (!s.options.token.empty()) url += "?token=" + s.options.token;
+  if (with_token && !s.options.token.empty()) url += "?token=" + s.options.token;
   return url;
 }
 

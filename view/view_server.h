@@ -75,8 +75,9 @@ class ViewServer {
   void stop();
 
   std::uint16_t port() const;
-  /// The page's address, with the token when there is one.
-  std::string url() const;
+  /// The page's address, with the token when there is one and `with_token` (a token the
+  /// operator gave in a file is not for the logs).
+  std::string url(bool with_token = true) const;
 
   /// Makes `message` (a serialized ServerMessage) the newest of `channel`. Any thread.
   void publish(Channel channel, std::string message);

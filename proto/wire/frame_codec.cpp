@@ -50,9 +50,13 @@ bool is_challenge(const std::string& bytes, const Challenge& challenge) {
 
 FrameReader::FrameReader(KeyFor key_for, FrameReaderOptions options) : key_for_(std::move(key_for)), options_(options) {
   ensure_sodium();
-  if (options.max_body_bytes > static_cast<std::size_t>(INT_MAX))
-    throw cohaptic::Error(
-        fmt::format("FrameReader: a limit of {} bytes exceeds protobuf's {}", options.max_body_bytes, INT_MAX));
+  set_max_body_bytes(options.max_body_bytes);
+}
+
+void FrameReader::set_max_body_bytes(std::size_t bytes) {
+  if (bytes > static_cast<std::size_t>(INT_MAX))
+    throw cohaptic::Error(fmt::format("FrameReader: a limit of {} bytes exceeds protobuf's {}", bytes, INT_MAX));
+  options_.max_body_bytes = bytes;
 }
 
 void FrameReader::feed(std::span<const std::uint8_t> bytes) {

@@ -86,6 +86,8 @@ class FrameReader {
   /// The next complete, verified frame's message (or the greeting's Hello), or nullopt if
   /// more bytes are needed. Throws FrameError as described above.
   std::optional<Control> next();
+  /// The largest body the frames from now on may declare (FrameReaderOptions::max_body_bytes).
+  void set_max_body_bytes(std::size_t bytes);
   /// The envelope sender of the frame next() returned last: whose key opened it.
   std::uint32_t last_sender() const { return last_sender_; }
 

@@ -66,6 +66,11 @@ CubeSession::CubeSession(const std::string& name, const std::vector<std::string>
 
 std::unique_ptr<ChildProcess> CubeSession::client(const std::string& user, int slot, const fs::path& trajectory,
                                                   const std::vector<std::string>& extra) const {
+  return scripted_client(dir, port, user, slot, trajectory, extra);
+}
+
+std::unique_ptr<ChildProcess> scripted_client(const fs::path& dir, int port, const std::string& user, int slot,
+                                              const fs::path& trajectory, const std::vector<std::string>& extra) {
   std::vector<std::string> arguments = {"--server", fmt::format("127.0.0.1:{}", port), "--user", user,
                                         "--device", "script:" + trajectory.string(),
                                         "--report", (dir / (user + ".json")).string(), "--record", (dir / (user + ".mcap")).string()};

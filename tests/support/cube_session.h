@@ -27,6 +27,12 @@ std::filesystem::path write_press(const std::filesystem::path& dir, const std::s
 /// 150 us, and never less than 1.1 ms (a 1 kHz period and a tenth).
 double period_p99_allowance_us(const nlohmann::json& client_report);
 
+/// A client of the server at 127.0.0.1:`port` with a scripted device, its report, recording
+/// and log in `dir` named after `user`; `slot` -1: the first free one.
+std::unique_ptr<ChildProcess> scripted_client(const std::filesystem::path& dir, int port, const std::string& user, int slot,
+                                              const std::filesystem::path& trajectory,
+                                              const std::vector<std::string>& extra = {});
+
 struct CubeSession {
   std::filesystem::path dir;
   std::unique_ptr<ChildProcess> server;
