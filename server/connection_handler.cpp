@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "common/net/link_delay.h"
+#include "common/util/printable.h"
 #include "net/delayed_delivery.h"
 #include "proto/wire/header.h"
 #include "proto/wire/traffic_keys.h"
@@ -239,7 +240,7 @@ int ConnectionHandler::take_slot(const ParticipantPtr& participant, const wire::
   const auto refuse = [&](const std::string& code, const std::string& text) {
     ++counters_.joins_refused;
     send_error(participant, code, text);
-    spdlog::warn("{} ('{}') refused: {}", participant->connection->peer(), wire::printable(request.user_name()), text);
+    spdlog::warn("{} ('{}') refused: {}", participant->connection->peer(), printable(request.user_name()), text);
     return -1;
   };
   if (const std::string problem = wire::user_name_problem(request.user_name()); !problem.empty())

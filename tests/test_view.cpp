@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -26,6 +27,7 @@
 #include "support/wait.h"
 #include "support/websocket_client.h"
 #include "view/live_view.h"
+#include "view/browser_input.h"
 #include "view/replay_player.h"
 #include "view/view_server.h"
 #include "view/view_token.h"
@@ -144,6 +146,62 @@ TEST(ViewServer, OffLoopbackATokenIsRequiredAndAForeignPageIsRefused) {
   ASSERT_TRUE(right.wait_messages(1, 10s));
   EXPECT_EQ(right.messages().front(), "scene");
   EXPECT_EQ(server.counters().refused, 3u);
+}
+
+// DNS rebinding: a web page on a name made to resolve to 127.0.0.1 sends that name as Host
+// (and as Origin). Without a token only this machine's names are served the data.
+TEST(ViewServer, WithoutATokenOnlyThisMachinesNamesGetTheData) {
+  for (const char* host : {"127.0.0.1", "127.0.0.1:7480", "localhost:7480", "LOCALHOST", "[::1]:7480", "::1", "127.9.9.9"})
+    EXPECT_TRUE(view::names_this_machine(host)) << host;
+  for (const char* host : {"evil.example", "evil.example:7480", "localhost.evil.example", "10.0.0.1:7480", "[::2]:80",
+                           "[::1", "", "127.0.0.1.nip.io:7480"})
+    EXPECT_FALSE(view::names_this_machine(host)) << host;
+  EXPECT_NE(view::handshake_refusal("/ws", "http://evil.example:7480", "evil.example:7480", "").find("evil.example"),
+            std::string::npos);
+  EXPECT_EQ(view::handshake_refusal("/ws?token=abcdef0123456789abcd", "", "evil.example:7480", "abcdef0123456789abcd"), "")
+      << "with a token, the token decides";
+
+  view::ViewServer server(local_options());
+  server.publish(view::Channel::scene, "scene");
+  server.start();
+  const auto upgrade = [&](const std::string& host) {
+    return testing::http_exchange("127.0.0.1", server.port(),
+                                  "GET /ws HTTP/1.1\r\nHost: " + host + "\r\nOrigin: http://" + host +
+                                      "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: "
+                                      "dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n",
+                                  true);
+  };
+  const std::string port = std::to_string(server.port());
+  EXPECT_EQ(upgrade("evil.example:" + port).rfind("HTTP/1.1 403", 0), 0u);
+  EXPECT_EQ(upgrade("127.0.0.1:" + port).rfind("HTTP/1.1 101", 0), 0u);
+  EXPECT_EQ(upgrade("localhost:" + port).rfind("HTTP/1.1 101", 0), 0u);
+  EXPECT_EQ(server.counters().refused, 1u);
+}
+
+// Nobody makes the server buffer a body (a GET has none), and browsers are capped.
+TEST(ViewServer, ARequestWithABodyIsRefusedUnreadAndBrowsersBeyondTheCapAreTurnedAway) {
+  view::ViewServerOptions options = local_options();
+  options.max_browsers = 3;
+  view::ViewServer server(options);
+  server.publish(view::Channel::scene, "scene");
+  server.start();
+  const std::string post = testing::http_exchange(
+      "127.0.0.1", server.port(),
+      "POST / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 33554432\r\nConnection: close\r\n\r\n" +
+          std::string(4096, 'x'));
+  EXPECT_EQ(post.rfind("HTTP/1.1 413", 0), 0u) << post.substr(0, 200);
+  std::vector<std::unique_ptr<WebSocketClient>> browsers;
+  for (int k = 0; k < 3; ++k) {
+    browsers.push_back(std::make_unique<WebSocketClient>(data_url(server)));
+    ASSERT_TRUE(browsers.back()->wait_open(10s));
+  }
+  WebSocketClient fourth(data_url(server));
+  EXPECT_FALSE(fourth.wait_open(10s));
+  EXPECT_EQ(fourth.refused_status(), 503);
+  browsers.pop_back();  // one leaves: another may come
+  ASSERT_TRUE(testing::wait_until([&] { return server.counters().browsers == 2; }, "the browser to leave"));
+  WebSocketClient fifth(data_url(server));
+  EXPECT_TRUE(fifth.wait_open(10s));
 }
 
 TEST(ViewServer, AMalformedOrOversizedMessageClosesThatBrowserAndNothingElse) {

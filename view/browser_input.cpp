@@ -1,7 +1,10 @@
 #include "view/browser_input.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstddef>
+
+#include "view/view_token.h"
 
 namespace cohaptic::view {
 namespace {
@@ -28,10 +31,26 @@ std::string query_value(const std::string& resource, const std::string& name) {
   return "";
 }
 
+bool names_this_machine(const std::string& host) {
+  std::string name = host;
+  if (!name.empty() && name.front() == '[') {  // [v6]:port
+    const std::size_t close = name.find(']');
+    if (close == std::string::npos) return false;
+    name = name.substr(1, close - 1);
+  } else if (std::count(name.begin(), name.end(), ':') == 1) {
+    name = name.substr(0, name.find(':'));
+  }
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return name == "localhost" || is_loopback(name);
+}
+
 std::string handshake_refusal(const std::string& resource, const std::string& origin, const std::string& host,
                               const std::string& token) {
   if (resource.substr(0, resource.find('?')) != "/ws") return "not the data path /ws";
   if (!token.empty() && !same_secret(query_value(resource, "token"), token)) return "wrong or missing token";
+  // Without a token only this machine's browsers may watch: a page whose name was made to
+  // resolve here (DNS rebinding) sends its own name as Host.
+  if (token.empty() && !names_this_machine(host)) return "a request for the host '" + host + "' (not this machine's name)";
   if (!origin.empty() && origin != "http://" + host) return "a page from " + origin;
   return "";
 }

@@ -16,9 +16,15 @@ namespace cohaptic::view {
 /// absent.
 std::string query_value(const std::string& resource, const std::string& name);
 
+/// Whether a Host header ("localhost:8080", "127.0.0.1", "[::1]:80") names this machine
+/// by a loopback address or "localhost".
+bool names_this_machine(const std::string& host);
+
 /// Why a WebSocket handshake for `resource` (path and query) with these Origin and Host
 /// headers is refused when the view requires `token` (empty: none); empty if it is
-/// accepted. The token is compared in a time that does not depend on where it differs.
+/// accepted. Without a token the Host must name this machine (names_this_machine), so a
+/// page on a name rebound to 127.0.0.1 cannot read the session. The token is compared in a
+/// time that does not depend on where it differs.
 std::string handshake_refusal(const std::string& resource, const std::string& origin, const std::string& host,
                               const std::string& token);
 

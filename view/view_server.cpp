@@ -15,6 +15,7 @@
 
 #include "cohaptic/view.pb.h"
 #include "common/util/error.h"
+#include "common/util/printable.h"
 #include "view/browser_input.h"
 #include "view/view_assets.h"
 
@@ -64,6 +65,7 @@ struct ViewServer::Impl {
     server.init_asio(&io);
     server.set_reuse_addr(true);
     server.set_max_message_size(options.max_command_bytes);
+    server.set_max_http_body_size(0);  // a GET has none: nobody makes the server buffer one
     server.set_http_handler([this](connection_hdl hdl) { http(hdl); });
     server.set_validate_handler([this](connection_hdl hdl) { return validate(hdl); });
     server.set_open_handler([this](connection_hdl hdl) { opened(hdl); });
@@ -108,11 +110,13 @@ struct ViewServer::Impl {
     const std::string resource = connection->get_resource();
     const std::string origin = connection->get_request_header("Origin");
     const std::string host = connection->get_request_header("Host");
-    const std::string refusal = handshake_refusal(resource, origin, host, options.token);
+    std::string refusal = handshake_refusal(resource, origin, host, options.token);
+    const bool full = refusal.empty() && static_cast<int>(browsers.size()) >= options.max_browsers;
+    if (full) refusal = "already " + std::to_string(browsers.size()) + " browsers connected";
     if (refusal.empty()) return true;
     count([](ViewCounters& c) { ++c.refused; });
-    spdlog::warn("view: refused a browser from {}: {}", connection->get_remote_endpoint(), refusal);
-    connection->set_status(websocketpp::http::status_code::forbidden);
+    spdlog::warn("view: refused a browser from {}: {}", connection->get_remote_endpoint(), printable(refusal, 200));
+    connection->set_status(full ? websocketpp::http::status_code::service_unavailable : websocketpp::http::status_code::forbidden);
     return false;
   }
 

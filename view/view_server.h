@@ -11,7 +11,10 @@
 // max_buffered_bytes still waiting to leave gets nothing new until it has caught up: its
 // frames are dropped (counted), never queued without bound.
 // Safety: a non-empty token must be given as /ws?token=... or the handshake is refused
-// (403); a handshake from another web page (its Origin not this server) is refused too.
+// (403); a handshake from another web page (its Origin not this server) is refused too, and
+// without a token so is one whose Host does not name this machine (browser_input.h). Only
+// GET is served, and no request may carry a body (413, before it is read); at most
+// max_browsers are connected at once (503 beyond).
 // A browser's message longer than max_command_bytes, not binary, or not a view Command
 // closes that browser's connection and nothing else.
 // Built on websocketpp over standalone asio; this header exposes neither (its translation
@@ -39,6 +42,7 @@ struct ViewServerOptions {
   std::filesystem::path assets;            ///< view/web, with its libraries in lib/ (view_assets.h)
   std::filesystem::path proto;             ///< the proto/ directory (the page decodes its view.proto)
   std::size_t max_command_bytes = 1024;
+  int max_browsers = 64;                   ///< connected at once; beyond, a handshake is refused (503)
   std::size_t max_buffered_bytes = 2u << 20;  ///< per browser: beyond this, new frames are dropped
   ViewPage page = ViewPage::live_view;     ///< the page served at "/" (and what it needs)
 };

@@ -2,58 +2,22 @@
 
 #include <fmt/format.h>
 
+#include "common/util/printable.h"
+
 namespace cohaptic::wire {
-namespace {
-
-// The length of the UTF-8 sequence at `text[i]` if it is a well-formed one whose code point
-// is not a control character (C0, DEL, C1); 0 otherwise.
-std::size_t printable_sequence(std::string_view text, std::size_t i) {
-  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
-  const unsigned char lead = byte(i);
-  if (lead < 0x20 || lead == 0x7f) return 0;
-  if (lead < 0x80) return 1;
-  const std::size_t length = lead >= 0xf0 ? 4 : lead >= 0xe0 ? 3 : lead >= 0xc2 ? 2 : 0;
-  if (length == 0 || lead > 0xf4 || i + length > text.size()) return 0;
-  char32_t code = lead & (0x7f >> length);
-  for (std::size_t k = 1; k < length; ++k) {
-    if ((byte(i + k) & 0xc0) != 0x80) return 0;
-    code = (code << 6) | (byte(i + k) & 0x3f);
-  }
-  const char32_t smallest[] = {0, 0, 0x80, 0x800, 0x10000};
-  if (code < smallest[length] || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return 0;  // overlong, surrogate
-  if (code >= 0x80 && code <= 0x9f) return 0;  // C1 controls (U+009B is a terminal's CSI)
-  return length;
-}
-
-}  // namespace
 
 std::string user_name_problem(std::string_view name) {
   if (name.empty()) return "a user name is required";
   if (name.size() > kMaxUserNameBytes)
     return fmt::format("a user name is at most {} bytes (this one has {})", kMaxUserNameBytes, name.size());
   for (std::size_t i = 0; i < name.size();) {
-    const std::size_t length = printable_sequence(name, i);
+    const std::size_t length = printable_sequence_at(name, i);
     if (length == 0)
       return fmt::format("a user name is UTF-8 text without control characters (byte {} is 0x{:02x})", i,
                          static_cast<unsigned char>(name[i]));
     i += length;
   }
   return "";
-}
-
-std::string printable(std::string_view text, std::size_t max_bytes) {
-  std::string shown;
-  for (std::size_t i = 0; i < text.size();) {
-    if (shown.size() >= max_bytes) return shown + "...";
-    if (const std::size_t length = printable_sequence(text, i); length > 0) {
-      shown.append(text.substr(i, length));
-      i += length;
-    } else {
-      shown += fmt::format("\\x{:02x}", static_cast<unsigned char>(text[i]));
-      ++i;
-    }
-  }
-  return shown;
 }
 
 }  // namespace cohaptic::wire

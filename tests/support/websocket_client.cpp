@@ -170,14 +170,18 @@ StalledWebSocket::StalledWebSocket(const std::string& host, std::uint16_t port) 
 StalledWebSocket::~StalledWebSocket() = default;
 
 std::string http_get(const std::string& host, std::uint16_t port, const std::string& path) {
+  return http_exchange(host, port, "GET " + path + " HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n");
+}
+
+std::string http_exchange(const std::string& host, std::uint16_t port, const std::string& request, bool head_only) {
   asio::io_context io;
   asio::ip::tcp::socket socket(io);
   socket.connect({asio::ip::make_address(host), port});
-  const std::string request = "GET " + path + " HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n";
   asio::write(socket, asio::buffer(request));
   std::string response;
   asio::error_code error;
-  asio::read(socket, asio::dynamic_buffer(response), error);  // to the end: the server closes
+  if (head_only) asio::read_until(socket, asio::dynamic_buffer(response), "\r\n\r\n", error);
+  else asio::read(socket, asio::dynamic_buffer(response), error);  // to the end: the server closes
   return response;
 }
 

@@ -68,5 +68,9 @@ class StalledWebSocket {
 
 /// GET `path` from `host`:`port`; the whole response (status line, headers, body).
 std::string http_get(const std::string& host, std::uint16_t port, const std::string& path);
+/// Sends `request` (a whole HTTP request, as is) to host:port; the response to the server's
+/// close, or with `head_only` its status line and headers (an upgrade keeps the connection).
+std::string http_exchange(const std::string& host, std::uint16_t port, const std::string& request,
+                          bool head_only = false);
 
 }  // namespace cohaptic::testing
