@@ -39,7 +39,7 @@ struct PairedComparisonDesign {
   // A person's session (lab/person_pairs.h):
   int practice_pairs = 1;           ///< pairs felt before the rated ones, not rated
   std::string show_object = "practice";  ///< the live view served: practice, always or never
-  double pair_duration_s = 60;      ///< the longest a pair is served
+  double pair_duration_s = 60;      ///< the longest a pair is felt (then it is rated, not switched)
   int switch_button = -1;           ///< a device button that switches too (person rater); -1: none
 };
 

@@ -78,6 +78,11 @@ std::string trimmed(const std::string& line) {
   return line.substr(begin, line.find_last_not_of(" \t\r") - begin + 1);
 }
 
+// A subject may deliberate after the pair's time is up: the server (the control socket, the
+// switch log) stays this long beyond it, unless the pair ends first (it usually does: the
+// session stops the server then). Only a lab process killed outright leaves it to end itself.
+constexpr double kServerBeyondPair_s = 3600;
+
 // The pair's two conditions served to one client, until destroyed.
 class PairServing {
  public:
@@ -89,7 +94,7 @@ class PairServing {
         "--scene", setup.scene.string(), "--listen", "127.0.0.1:0", "--condensation", setup.condensation,
         "--condition", "first:" + setup.condition_settings[static_cast<std::size_t>(first)],
         "--condition", "second:" + setup.condition_settings[static_cast<std::size_t>(second)],
-        "--control", (dir / "control").string(), "--duration", fmt::format("{:g}", duration + 30),
+        "--control", (dir / "control").string(), "--duration", fmt::format("{:g}", duration + kServerBeyondPair_s),
         "--record", (dir / "server.mcap").string(), "--report", (dir / "server.json").string()};
     if (setup.design.switch_button >= 0)
       server_arguments.insert(server_arguments.end(), {"--switch-button", std::to_string(setup.design.switch_button)});
@@ -106,6 +111,8 @@ class PairServing {
                     dir / "subject.log");
     if (!client_->wait_for_log("haptic thread", 60s))
       throw Error(fmt::format("the client did not start (see {})", (dir / "subject.log").string()));
+    ends_ = std::chrono::steady_clock::now() +
+            std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(duration));
     control_.emplace(dir / "control");
     if (show_object) {
       static const std::regex kView(R"(live view at (\S+))");
@@ -130,9 +137,12 @@ class PairServing {
   std::string switch_over() { return control_->serve_next().value("served", ""); }
   /// The condition served now.
   std::string served() { return control_->ask({{"status", true}}).value("served", ""); }
+  /// Whether the pair's time (pair_duration) is over: the client has stopped.
+  bool time_up() const { return std::chrono::steady_clock::now() >= ends_; }
   const std::string& view_url() const { return view_url_; }
 
  private:
+  std::chrono::steady_clock::time_point ends_;
   std::optional<ChildProcess> server_, client_;
   std::optional<ControlClient> control_;
   std::string view_url_;
@@ -224,7 +234,10 @@ PairEnd present_pair(const PersonSessionSetup& setup, PairServing& serving, view
   std::optional<int> chosen;
   while (const std::optional<std::string> line = input.next(out, follow_button)) {
     follow_button();
-    if (*line == "s") {
+    if (*line == "s" && serving.time_up()) {
+      screen.set_note(practice ? "The pair's time is up: go on to the next pair" : "The pair's time is up: rate it");
+      out << fmt::format("  {}\n> ", screen.note()) << std::flush;
+    } else if (*line == "s") {
       feeling(serving.switch_over(), "");
     } else if (*line == "q") {
       return PairEnd::stopped;

@@ -12,11 +12,14 @@
 #include <regex>
 
 #include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <map>
 #include <memory>
 #include <set>
 #include <sstream>
+#include <streambuf>
+#include <thread>
 #include <vector>
 
 #include "common/util/csv.h"
@@ -385,7 +388,7 @@ paired_comparison:
   subjects: {}
   practice_pairs: 1
   show_object: never
-  pair_duration: 4
+  pair_duration: 20
   rater: {{kind: person}}
 {})",
                      subjects, extra);
@@ -452,6 +455,53 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
   for (const record::SimulationStep& step : pair.steps)
     if (step.has_condition_switch()) served.push_back(step.condition_switch().name());
   EXPECT_EQ(served, (std::vector<std::string>{"second"}));
+}
+
+// A subject's lines, each after a pause: a person typing, not a script read at once.
+class TypedLines : public std::streambuf {
+ public:
+  explicit TypedLines(std::vector<std::pair<std::chrono::milliseconds, std::string>> lines) : lines_(std::move(lines)) {}
+
+ protected:
+  int_type underflow() override {
+    if (next_ == lines_.size()) return traits_type::eof();
+    std::this_thread::sleep_for(lines_[next_].first);
+    current_ = lines_[next_++].second + "\n";
+    setg(current_.data(), current_.data(), current_.data() + current_.size());
+    return traits_type::to_int_type(current_.front());
+  }
+
+ private:
+  std::vector<std::pair<std::chrono::milliseconds, std::string>> lines_;
+  std::size_t next_ = 0;
+  std::string current_;
+};
+
+// Once the pair's time (pair_duration) is up its client has stopped: a switch is refused,
+// saying so, and the subject rates (or goes on) with the server still there to ask.
+TEST(PairedComparisonStudy, AfterThePairsTimeASwitchIsRefusedAndTheSubjectStillRates) {
+  const fs::path dir = testing::scratch_directory("paired-time-up");
+  std::string study = person_study_text(2);
+  study.replace(study.find("pair_duration: 20"), 17, "pair_duration: 1");
+  write_study_files(dir, study);
+  StudyRunOptions options;
+  options.out = dir / "out";
+  options.server_program = testing::server_program();
+  options.client_program = testing::client_program();
+  options.device = "script:" + (dir / "press.yaml").string();
+  options.subject = 1;
+  using std::chrono::milliseconds;
+  TypedLines typed({{milliseconds(0), "s"}, {milliseconds(1500), "s"}, {milliseconds(0), "n"}, {milliseconds(0), "+1"},
+                    {milliseconds(0), "y"}, {milliseconds(0), "q"}});
+  std::istream in(&typed);
+  std::ostringstream out;
+  options.input = &in;
+  options.output = &out;
+  ASSERT_EQ(run_study(dir / "study.yaml", options), 0) << out.str();
+  EXPECT_NE(out.str().find("You are feeling: SECOND"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("The pair's time is up: go on to the next pair"), std::string::npos) << out.str();
+  EXPECT_EQ(testing::read_csv_table(options.out / "switches.csv").size(), 1u) << "the late switch was not made";
+  EXPECT_EQ(testing::read_csv_table(options.out / "ratings.csv").size(), 1u);
 }
 
 // The rating page in headless Chromium: the subject's hand on buttons and keys, the lab as
