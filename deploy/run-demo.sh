@@ -26,7 +26,8 @@
 # live view), DEMO_IR_FORM (rows or m_tilde, the server's --ir-form; default rows),
 # DEMO_VIEW_SCREENSHOT (a PNG file: a headless Chromium
 # watches the whole session and takes this screenshot once both surgeons press with 0.01 N;
-# the README's picture is taken so).
+# the README's picture is taken so), DEMO_WAIT_FOR_BROWSER (1: the surgeons start once a
+# browser has connected to the live view, at most 120 s after the server listens).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scene=${1:-scenes/brain.yaml}
@@ -44,6 +45,7 @@ device=${DEMO_DEVICE:-hand}
 out=${DEMO_OUT:-out/demo}
 view_port=${DEMO_VIEW_PORT:-$default_view_port}
 screenshot=${DEMO_VIEW_SCREENSHOT:-}
+wait_for_browser=${DEMO_WAIT_FOR_BROWSER:-}
 ir_form=${DEMO_IR_FORM:-rows}
 server_bin=$build/server/cohaptic-server
 client_bin=$build/client/cohaptic-client
@@ -67,7 +69,7 @@ view=()
 [[ "$view_port" == off ]] || view=(--view "127.0.0.1:$view_port")
 # The server outlives the clients (stopped once both are done) so that both can say goodbye.
 "$server_bin" --scene "$scene" --listen "127.0.0.1:$port" --protocol "$protocol" --ir-form "$ir_form" \
-  --duration $((duration + 6)) --report "$out/server.json" --record "$out/server.mcap" "${display[@]}" \
+  --duration $((duration + ${wait_for_browser:+120} + 6)) --report "$out/server.json" --record "$out/server.mcap" "${display[@]}" \
   "${view[@]}" >"$out/server.log" 2>&1 &
 pids+=($!)
 # A cold start computes the compliance (a minute or more on a busy machine), printing its
@@ -101,6 +103,14 @@ elif [[ ${#view[@]} -gt 0 ]]; then
       >"$out/view_check.json" 2>"$out/view_check.log" &
     pids+=($!)
   fi
+fi
+
+# A browser started alongside (Chromium's start takes seconds of CPU) watches from the first press.
+if [[ -n "$wait_for_browser" && -z "$view_off" && ${#view[@]} -gt 0 ]]; then
+  for _ in $(seq 1 1200); do
+    grep -q "view: a browser connected" "$out/server.log" && break
+    sleep 0.1
+  done
 fi
 
 "$client_bin" --server "127.0.0.1:$port" --user surgeon-A --slot 0 --device "$device:$out/surgeon_a.yaml" \
