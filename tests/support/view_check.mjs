@@ -27,25 +27,7 @@
 // Exit status 0 with {"skipped": reason} when no Chromium can be started; 1 on a timeout,
 // naming what was awaited (the screenshot is still taken, of whatever the page shows).
 import { chromium } from '../../deploy/node/node_modules/playwright-core/index.mjs';
-import { existsSync, readdirSync, readFileSync, writeFileSync } from 'node:fs';
-
-// Playwright starts Chromium in a session of its own, so under Linux's autogroup scheduling
-// it gets a whole share of the CPU however nice this process is: on two cores, drawing in
-// software, it took enough from the server to fade the surgeons' forces on the brain. Its
-// session's group gets nice 5 (a third of a normal share when the CPU is contended): as a
-// browser on the operator's own machine would, it leaves the server and the haptic loops
-// what they need, and still draws enough to be checked (at 19 it drew 3 frames in 30 s).
-function lowerBrowserPriority() {
-  for (const pid of readdirSync('/proc').filter((name) => /^\d+$/.test(name))) {
-    try {
-      const stat = readFileSync(`/proc/${pid}/stat`, 'utf8');
-      const parent = Number(stat.slice(stat.lastIndexOf(')') + 2).split(' ')[1]);
-      if (parent === process.pid) writeFileSync(`/proc/${pid}/autogroup`, '5');
-    } catch {
-      // gone, not ours, or no autogroup scheduling: nothing to lower
-    }
-  }
-}
+import { existsSync, writeFileSync } from 'node:fs';
 
 const args = Object.fromEntries(
   process.argv.slice(2).reduce((pairs, a, i, all) => (a.startsWith('--') ? [...pairs, [a.slice(2), all[i + 1]]] : pairs), []));
@@ -61,7 +43,6 @@ const browser = await chromium.launch({
   executablePath: executable,
   args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
 });
-lowerBrowserPriority();
 const started = Date.now();
 const result = { errors: [] };
 let page = null, pictured = false;
