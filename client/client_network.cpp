@@ -131,6 +131,7 @@ struct ClientNetwork::Impl {
     control.mutable_join()->set_requested_slot(slot_asked >= 0 ? static_cast<std::uint32_t>(slot_asked + 1) : 0);
     control.mutable_join()->set_datagram_salt(udp_sealer.salt());
     control.mutable_join()->set_datagram_sequence(udp_sealer.stamp().last_sequence());
+    control.mutable_join()->set_haptic_rate_hz(options.haptic_rate_hz);
     return control;
   }
 
@@ -390,7 +391,8 @@ nlohmann::json ClientNetwork::report() const {
   out["datagrams"] = {{"sent", s.udp.sent()},
                       {"received", rejections.accepted() + rejections.rejected()},
                       {"rejected", rejections.rejected()},
-                      {"rejected_by_reason", rejections.snapshot()}};
+                      {"rejected_by_reason", rejections.snapshot()},
+                      {"dropped_by_kernel", s.udp.kernel_dropped()}};
   out["ir"] = s.irs.report();
   out["forces_received"] = s.forces_received;
   out["remote_samples_received"] = s.remote_samples;

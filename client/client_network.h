@@ -38,6 +38,7 @@ struct ClientOptions {
   std::optional<std::filesystem::path> key_file;  ///< session or participant key; empty: the public development key
   bool encrypt = true;                            ///< false: send in clear (authenticated), and accept the server's so
   int requested_slot = -1;                        ///< -1: any free slot (a participant key: its own)
+  double haptic_rate_hz = 0;                      ///< the loop's rate, told the server; 0: the scene's
 };
 
 class ClientNetwork {

@@ -43,7 +43,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-encryption", no_encryption,
                "Send frames and datagrams in clear (still authenticated), and accept the server's in clear; the server "
                "must be run with --no-encryption too");
-  app.add_option("--rate-hz", rate_hz, "Haptic loop rate (default: the scene's, usually 1000)");
+  app.add_option("--rate-hz", rate_hz, "Haptic loop rate (default: the scene's, usually 1000)")
+      ->check(CLI::Range(0.0, 10000.0));
   app.add_option("--duration", settings.duration_s, "Stop after S seconds (0: when the device's script ends, or SIGINT)")
       ->capture_default_str();
   app.add_option("--playout", playout, "Remote tool playout: newest, fixed or adaptive")
@@ -86,6 +87,7 @@ int main(int argc, char** argv) {
       return 2;
     }
     options.requested_slot = slot;
+    options.haptic_rate_hz = rate_hz;
     options.encrypt = !no_encryption;
     auto channels = std::make_unique<cohaptic::HapticChannels>();
     // The device's spec and file are checked before we join: a typo takes no seat.

@@ -123,12 +123,12 @@ VerifyResult verify_client(const Recording& rec) {
   return result;
 }
 
-VerifyResult verify_server(const Recording& rec) {
+VerifyResult verify_server(const Recording& rec, const SceneFileAccess& scene_files) {
   use_single_blas_thread();  // as the server ran: the same rounding in every solve
   VerifyResult result;
   const record::SessionConfig& config = rec.config;
   const std::int64_t start = config.start_time_ns();
-  const Scene scene = parse_scene(config.scene_yaml(), config.scene_file());
+  const Scene scene = parse_scene(config.scene_yaml(), config.scene_file(), scene_files);
   const Model model = build_model(scene);
   // As the server loaded it: the whole surface when any condition it served held nodes.
   bool holds_nodes = config.injected().step_nodes() > 0;
@@ -327,6 +327,10 @@ void export_csv(const Recording& rec, const std::filesystem::path& dir) {
 }  // namespace
 
 VerifyResult verify_recording(const std::filesystem::path& file) {
+  return verify_recording(file, {.confined_to = std::filesystem::absolute(file).parent_path(), .gmsh_scripts = false});
+}
+
+VerifyResult verify_recording(const std::filesystem::path& file, const SceneFileAccess& scene_files) {
   const Recording rec = record::read_recording(file);
   if (!rec.has_config) throw Error(fmt::format("{}: the recording has no configuration: it cannot be verified", file.string()));
   // Re-running needs this build's IR format; a recording of another is refused, never misread.
@@ -338,7 +342,7 @@ VerifyResult verify_recording(const std::filesystem::path& file) {
                               "several bodies; 2: before compliance rows)",
                               file.string(), recorded.ir().format_version(), IntermediateRepresentation::kFormatVersion,
                               IntermediateRepresentation::kOldestReadableVersion));
-  return rec.config.role() == "server" ? verify_server(rec) : verify_client(rec);
+  return rec.config.role() == "server" ? verify_server(rec, scene_files) : verify_client(rec);
 }
 
 int run_replay(const ReplayOptions& options) {
@@ -354,7 +358,9 @@ int run_replay(const ReplayOptions& options) {
     return serve_replay(rec, view);
   }
   if (options.verify) {
-    const VerifyResult result = verify_recording(options.file);
+    const VerifyResult result =
+        options.scene_dir ? verify_recording(options.file, {.confined_to = *options.scene_dir, .gmsh_scripts = true})
+                          : verify_recording(options.file);
     if (!result.ok) {
       fmt::print("verify: DIFFERENT after {} identical values: {}\n", result.checked, result.first_difference);
       return 1;
@@ -373,6 +379,11 @@ LabCommand add_replay_command(CLI::App& lab) {
   command->add_flag("--verify", options->verify,
                     "Re-run the recorded inputs through the same computations and compare every force (and IR) bit "
                     "for bit; exit 1 naming the first difference");
+  command->add_option("--scene-dir", options->scene_dir,
+                      "With --verify of a server recording: the folder its scene's files (meshes, surfaces, gmsh "
+                      "scripts) may be read from (default: the recording's own folder, and no gmsh script: a "
+                      "recording may come from anyone)")
+      ->check(CLI::ExistingDirectory);
   command->add_option("--export-csv", options->export_csv, "Write its records as CSV files in this directory");
   command->add_option("--view", options->view,
                       "Serve a server recording made with --view in the live view's page at HOST:PORT, with a "

@@ -19,6 +19,7 @@
 #include <optional>
 #include <string>
 
+#include "common/scene/scene_files.h"
 #include "lab/lab_command.h"
 
 namespace cohaptic {
@@ -30,6 +31,9 @@ struct ReplayOptions {
   std::filesystem::path export_csv;  ///< empty: no export
   std::string view;                  ///< HOST:PORT of the page; empty: none
   std::optional<std::filesystem::path> view_token_file;
+  /// The folder a server recording's scene may read its files from, gmsh scripts included;
+  /// nullopt: the recording's own folder, and no gmsh script.
+  std::optional<std::filesystem::path> scene_dir;
 };
 
 /// Returns the process exit code: 0, or 1 if verification found a difference.
@@ -42,6 +46,10 @@ struct VerifyResult {
   std::string first_difference;
 };
 
+/// Re-runs `file`. A server recording's scene reads its files as `scene_files` allows
+/// (common/scene/scene_files.h); without it, from the recording's own folder only, and no
+/// gmsh script: a recording may come from anyone (the command line without --scene-dir).
+VerifyResult verify_recording(const std::filesystem::path& file, const SceneFileAccess& scene_files);
 VerifyResult verify_recording(const std::filesystem::path& file);
 
 /// `cohaptic-lab replay FILE [--summary|--verify|--export-csv DIR]`.

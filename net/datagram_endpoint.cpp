@@ -1,6 +1,10 @@
 #include "net/datagram_endpoint.h"
 
+#include <sys/socket.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <span>
 
 #include "proto/wire/header.h"
@@ -17,6 +21,8 @@ DatagramEndpoint::DatagramEndpoint(asio::io_context& io, const udp::endpoint& lo
   std::error_code ignored;  // a smaller queue is still a queue
   socket_.set_option(asio::socket_base::receive_buffer_size(kReceiveBufferBytes), ignored);
   socket_.non_blocking(true);  // the drain after each wake-up must not wait
+  const int on = 1;            // each datagram read carries the socket's count of kernel drops
+  ::setsockopt(socket_.native_handle(), SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on);
   port_ = socket_.local_endpoint().port();
 }
 
@@ -26,18 +32,39 @@ void DatagramEndpoint::start(Handler on_datagram) {
 }
 
 void DatagramEndpoint::receive_next() {
-  socket_.async_receive_from(asio::buffer(buffer_), from_, [this](std::error_code error, std::size_t n) {
-    if (error == asio::error::operation_aborted) return;  // closed
-    // Other errors (an ICMP "port unreachable" for an earlier send, say) concern no one
-    // datagram: keep receiving.
-    if (!error) take(n);
-    for (int read = 1; read < kReadsPerWakeUp && socket_.is_open(); ++read) {
-      n = socket_.receive_from(asio::buffer(buffer_), from_, 0, error);
-      if (error == asio::error::would_block) break;
-      if (!error) take(n);
-    }
+  socket_.async_wait(udp::socket::wait_read, [this](std::error_code error) {
+    if (error == asio::error::operation_aborted || !socket_.is_open()) return;  // closed
+    for (int read = 0; read < kReadsPerWakeUp && socket_.is_open(); ++read)
+      if (!read_one()) break;
     if (socket_.is_open()) receive_next();
   });
+}
+
+// recvmsg rather than asio's receive_from: asio passes no ancillary data, and the kernel's
+// count of the datagrams it dropped (SO_RXQ_OVFL) comes as ancillary data.
+bool DatagramEndpoint::read_one() {
+  iovec payload{buffer_.data(), buffer_.size()};
+  alignas(cmsghdr) std::array<char, CMSG_SPACE(sizeof(std::uint32_t))> control{};
+  msghdr message{};
+  message.msg_name = from_.data();
+  message.msg_namelen = static_cast<socklen_t>(from_.capacity());
+  message.msg_iov = &payload;
+  message.msg_iovlen = 1;
+  message.msg_control = control.data();
+  message.msg_controllen = control.size();
+  const ssize_t n = ::recvmsg(socket_.native_handle(), &message, MSG_DONTWAIT);
+  // EAGAIN: drained. Other errors (an ICMP "port unreachable" for an earlier send, say)
+  // concern no one datagram: the next wake-up reads on.
+  if (n < 0) return errno != EAGAIN && errno != EWOULDBLOCK;
+  from_.resize(message.msg_namelen);
+  for (cmsghdr* header = CMSG_FIRSTHDR(&message); header; header = CMSG_NXTHDR(&message, header))
+    if (header->cmsg_level == SOL_SOCKET && header->cmsg_type == SO_RXQ_OVFL) {
+      std::uint32_t dropped = 0;
+      std::memcpy(&dropped, CMSG_DATA(header), sizeof dropped);
+      kernel_dropped_.store(dropped, std::memory_order_relaxed);
+    }
+  take(static_cast<std::size_t>(n));
+  return true;
 }
 
 void DatagramEndpoint::take(std::size_t bytes) {
@@ -47,10 +74,12 @@ void DatagramEndpoint::take(std::size_t bytes) {
     inspector_->count_unread(wire::Rejection::rate_limited);
     return;
   }
-  if (std::optional<wire::Datagram> datagram = inspector_->inspect(std::span(buffer_.data(), bytes)))
+  if (std::optional<wire::Datagram> datagram = inspector_->inspect(std::span(buffer_.data(), bytes))) {
+    if (!admitted) limiter_.prove(from_.address(), arrival);
     on_datagram_(std::move(*datagram), from_, arrival);
-  else if (!admitted)
+  } else if (!admitted) {
     limiter_.charge(from_.address(), arrival);
+  }
 }
 
 bool DatagramEndpoint::trusted(const udp::endpoint& peer) const {

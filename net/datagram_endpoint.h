@@ -11,7 +11,8 @@
 // this side has admitted (trust(): a joined user's, the server's) are never limited, so a
 // flood from their host never silences them. After each wake-up the socket is drained of
 // what is already queued before waiting again, and its receive buffer is asked to be
-// kReceiveBufferBytes, so that a burst does not overflow the kernel's queue.
+// kReceiveBufferBytes, so that a burst does not overflow the kernel's queue; what the
+// kernel still drops from a full queue is counted (kernel_dropped(): SO_RXQ_OVFL).
 // It holds no keys and decides nothing about messages: the inspector (with its keys and
 // allowed senders) is given, the datagrams come sealed. Counters: read them on the I/O
 // thread, or after it stopped; the inspector's rejection counters from any thread.
@@ -65,9 +66,14 @@ class DatagramEndpoint {
   const wire::DatagramInspector& inspector() const { return *inspector_; }
   /// Datagrams the kernel took (a send aborted by close() or failed is not counted).
   std::uint64_t sent() const { return sent_->load(std::memory_order_relaxed); }
+  /// Datagrams the kernel dropped for this socket because its receive queue was full, as
+  /// of the last datagram read (the kernel's count: it wraps at 2^32). From any thread.
+  std::uint64_t kernel_dropped() const { return kernel_dropped_.load(std::memory_order_relaxed); }
 
  private:
   void receive_next();
+  /// Reads one datagram if one is queued (false: none was).
+  bool read_one();
   void take(std::size_t bytes);
   bool trusted(const asio::ip::udp::endpoint& peer) const;
 
@@ -81,6 +87,7 @@ class DatagramEndpoint {
   std::uint16_t port_ = 0;
   // Shared with pending sends' handlers, which may run after this endpoint is gone.
   std::shared_ptr<std::atomic<std::uint64_t>> sent_ = std::make_shared<std::atomic<std::uint64_t>>(0);
+  std::atomic<std::uint64_t> kernel_dropped_{0};
 };
 
 }  // namespace cohaptic::net

@@ -6,9 +6,14 @@
 
 namespace cohaptic::net {
 
-SourceRateLimiter::SourceRateLimiter(RateLimit limit) : limit_(limit) {
-  if (!(limit.burst >= 1) || !(limit.refill_per_s > 0) || limit.max_sources == 0)
-    throw Error("SourceRateLimiter: the burst must be at least 1, the refill positive, and one source tracked");
+SourceRateLimiter::SourceRateLimiter(RateLimit limit)
+    : limit_(limit),
+      all_sources_{limit.all_sources_burst, limit.all_sources_refill_per_s, limit.all_sources_burst, 0} {
+  if (!(limit.burst >= 1) || !(limit.first_burst >= 1) || limit.first_burst > limit.burst ||
+      !(limit.refill_per_s > 0) || !(limit.all_sources_burst >= 1) || !(limit.all_sources_refill_per_s > 0) ||
+      limit.max_sources == 0 || limit.max_proven == 0)
+    throw Error("SourceRateLimiter: the bursts must be at least 1 (the first at most the burst), the refills "
+                "positive, and one source tracked");
 }
 
 SourceRateLimiter::Bucket* SourceRateLimiter::find(const asio::ip::address& source) {
@@ -17,32 +22,45 @@ SourceRateLimiter::Bucket* SourceRateLimiter::find(const asio::ip::address& sour
   return nullptr;
 }
 
-void SourceRateLimiter::refill(Bucket& bucket, std::int64_t now_ns) const {
-  if (now_ns <= bucket.updated_ns) return;
-  bucket.tokens = std::min(limit_.burst, bucket.tokens + static_cast<double>(now_ns - bucket.updated_ns) * 1e-9 * limit_.refill_per_s);
-  bucket.updated_ns = now_ns;
+bool SourceRateLimiter::proven(const asio::ip::address& source) const {
+  return std::any_of(proven_.begin(), proven_.end(), [&](const Proven& p) { return p.source == source; });
 }
 
 bool SourceRateLimiter::limited(const asio::ip::address& source, std::int64_t now_ns) {
+  if (!proven(source) && all_sources_.empty(now_ns)) return true;
   Bucket* bucket = find(source);
-  if (!bucket) return false;
-  refill(*bucket, now_ns);
-  return bucket->tokens < 1;
+  return bucket && bucket->tokens.empty(now_ns);
 }
 
 void SourceRateLimiter::charge(const asio::ip::address& source, std::int64_t now_ns) {
+  all_sources_.spend(now_ns);
   Bucket* bucket = find(source);
   if (!bucket) {
     if (buckets_.size() < limit_.max_sources) {
       bucket = &buckets_.emplace_back();
     } else {
-      bucket = &*std::min_element(buckets_.begin(), buckets_.end(),
-                                  [](const Bucket& a, const Bucket& b) { return a.updated_ns < b.updated_ns; });
+      bucket = &*std::min_element(buckets_.begin(), buckets_.end(), [](const Bucket& a, const Bucket& b) {
+        return a.tokens.updated_ns < b.tokens.updated_ns;
+      });
     }
-    *bucket = Bucket{source, limit_.burst, now_ns};
+    const double tokens = proven(source) ? limit_.burst : limit_.first_burst;
+    *bucket = Bucket{source, TokenBucket{limit_.burst, limit_.refill_per_s, tokens, now_ns}};
   }
-  refill(*bucket, now_ns);
-  bucket->tokens = std::max(0.0, bucket->tokens - 1);
+  bucket->tokens.spend(now_ns);
+}
+
+void SourceRateLimiter::prove(const asio::ip::address& source, std::int64_t now_ns) {
+  for (Proven& p : proven_)
+    if (p.source == source) {
+      p.heard_ns = now_ns;
+      return;
+    }
+  if (proven_.size() < limit_.max_proven) {
+    proven_.push_back({source, now_ns});
+    return;
+  }
+  *std::min_element(proven_.begin(), proven_.end(),
+                    [](const Proven& a, const Proven& b) { return a.heard_ns < b.heard_ns; }) = {source, now_ns};
 }
 
 }  // namespace cohaptic::net

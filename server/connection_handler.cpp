@@ -31,6 +31,7 @@ struct ConnectionHandler::Participant {
   udp::endpoint udp_endpoint;
   LinkDelay to_client_udp, to_client_tcp, from_client_udp;
   asio::steady_timer join_timer;
+  net::TokenBucket datagram_budget;  // set at the join, from the user's haptic rate
   bool gone = false;
   Participant(asio::io_context& io, std::uint64_t session, const LinkDelaySettings& shift, bool encrypt)
       : sealer(session, wire::kServerSender, encrypt),
@@ -98,6 +99,7 @@ int ConnectionHandler::users() const {
 ConnectionCounters ConnectionHandler::counters() const {
   ConnectionCounters counters = counters_;
   counters.datagrams_sent = udp_.sent();
+  counters.datagrams_dropped_by_kernel = udp_.kernel_dropped();
   return counters;
 }
 
@@ -128,17 +130,9 @@ void ConnectionHandler::accept() {
       return;
     }
     ++counters_.connections;
-    const auto unjoined = std::count_if(participants_.begin(), participants_.end(),
-                                        [](const ParticipantPtr& p) { return p->slot < 0; });
-    if (static_cast<std::size_t>(unjoined) >= kMaxUnjoinedConnections) {
-      ++counters_.turned_away;
-      std::error_code ignored;
-      warn_throttled(fmt::format("connection from {} closed at once: {} connections have not joined yet",
-                                 socket.remote_endpoint(ignored).address().to_string(), unjoined));
-      socket.close(ignored);
-      accept();
-      return;
-    }
+    std::error_code ignored;
+    const asio::ip::address source = socket.remote_endpoint(ignored).address();
+    make_room_for_unjoined(source);
     socket.set_option(tcp::no_delay(true));
     socket.set_option(asio::socket_base::send_buffer_size(kControlSendBufferBytes));
     auto participant = std::make_shared<Participant>(io_, session_, link_delay_, options_.encrypt);
@@ -169,6 +163,32 @@ void ConnectionHandler::accept() {
     });
     accept();
   });
+}
+
+// The unjoined connections are bounded per source address and in all. A full source, or a
+// full server, closes its oldest unjoined connection rather than refusing the new one: a
+// client joins within a round trip, so an attacker would have to open connections faster
+// than that to push it out, and one source can only ever push out its own.
+void ConnectionHandler::make_room_for_unjoined(const asio::ip::address& source) {
+  std::size_t from_source = 0, in_all = 0;
+  ParticipantPtr oldest_from_source, oldest;  // participants_ is in the order accepted
+  for (const ParticipantPtr& participant : participants_) {
+    if (participant->slot >= 0) continue;
+    ++in_all;
+    if (!oldest) oldest = participant;
+    if (participant->connection->peer_address() == source) {
+      ++from_source;
+      if (!oldest_from_source) oldest_from_source = participant;
+    }
+  }
+  const ParticipantPtr evicted = from_source >= kMaxUnjoinedPerSource ? oldest_from_source
+                                 : in_all >= kMaxUnjoinedConnections  ? oldest
+                                                                      : nullptr;
+  if (!evicted) return;
+  ++counters_.unjoined_evicted;
+  warn_throttled(fmt::format("connection from {} closed before its join to make room: {} not joined from {}, {} in all",
+                             evicted->connection->peer(), from_source, source.to_string(), in_all));
+  leave(evicted, "closed to make room for a newer connection");
 }
 
 void ConnectionHandler::closed(const ParticipantPtr& participant, net::CloseCause cause, const std::string& why) {
@@ -245,6 +265,9 @@ int ConnectionHandler::take_slot(const ParticipantPtr& participant, const wire::
   };
   if (const std::string problem = wire::user_name_problem(request.user_name()); !problem.empty())
     return refuse("bad_user_name", problem);
+  const double rate = request.haptic_rate_hz();
+  if (!(rate >= 0 && rate <= kMaxClientHapticRateHz))
+    return refuse("bad_rate", fmt::format("a haptic rate of {} Hz: it must be at most {:.0f} Hz", rate, kMaxClientHapticRateHz));
   int wanted = request.requested_slot() > 0 ? static_cast<int>(request.requested_slot() - 1) : -1;
   if (sender != wire::kJoiningSender) {  // a participant key: its slot, and no other
     const int own = static_cast<int>(sender - 1);
@@ -287,6 +310,8 @@ void ConnectionHandler::join(const ParticipantPtr& participant, const wire::Cont
   participant->udp_endpoint =
       udp::endpoint(participant->connection->peer_address(), static_cast<std::uint16_t>(request.udp_port()));
   participant->datagram_sealer.emplace(key, session_, wire::kServerSender, options_.encrypt);
+  const double rate = request.haptic_rate_hz() > 0 ? request.haptic_rate_hz() : welcome_.haptic_rate_hz();
+  participant->datagram_budget = {rate, kUserDatagramsPerTick * rate, rate, wire::monotonic_now_ns()};
   slots_[static_cast<std::size_t>(slot)] = participant;
   udp_.inspector().allow_sender(wire::sender_of_slot(static_cast<std::uint32_t>(slot)), key, request.datagram_salt(),
                                 request.datagram_sequence());
@@ -426,8 +451,15 @@ void ConnectionHandler::receive_datagram(wire::Datagram&& datagram, std::int64_t
   // The inspector only accepts the senders of joined slots (or of slots left a moment ago).
   const int slot = static_cast<int>(datagram.header().sender()) - 1;
   if (slot < 0 || slot >= slots() || !slots_[static_cast<std::size_t>(slot)]) return;
+  Participant& user = *slots_[static_cast<std::size_t>(slot)];
+  if (!user.datagram_budget.try_take(arrival_ns)) {
+    ++counters_.datagrams_over_budget;
+    warn_throttled(fmt::format("datagrams of '{}' (slot {}) dropped: more than {:.0f} a second", user.user_name,
+                               slot, user.datagram_budget.refill_per_s));
+    return;
+  }
   const bool delivered = net::deliver_over(
-      slots_[static_cast<std::size_t>(slot)]->from_client_udp, io_, arrival_ns,
+      user.from_client_udp, io_, arrival_ns,
       [this, slot, datagram = std::move(datagram)](std::int64_t delivered_ns) { handle_datagram(datagram, slot, delivered_ns); });
   if (!delivered) ++counters_.dropped_from_clients;
 }

@@ -12,9 +12,11 @@
 //     (wire/traffic_keys.h). A connection's frames are opened with the key of the sender
 //     they name: before its join, any slot's or the joining key; after it, its slot's only.
 //     What the server sends a user is sealed with that user's key;
-//   - the limits: at most the scene's network.max_participants users at once; at most
-//     kMaxUnjoinedConnections connections that have not joined, each closed if it has not
-//     joined within kJoinTimeout; a user that stops reading is dropped by its connection
+//   - the limits: at most the scene's network.max_participants users at once, each sending
+//     at most kUserDatagramsPerTick datagrams a tick of its haptic loop; at most
+//     kMaxUnjoinedPerSource connections that have not joined from one address and
+//     kMaxUnjoinedConnections in all (a new one past either closes the oldest), each closed
+//     if it has not joined within kJoinTimeout; a user that stops reading is dropped by its connection
 //     (newest-wins IRs, then net::kWriteTimeout);
 //   - its counters, for the status line and the report.
 // It decides slots and what to relay; sealing is the codec's (wire::FrameSealer,
@@ -37,6 +39,7 @@
 #include "cohaptic/messages.pb.h"
 #include "net/datagram_endpoint.h"
 #include "net/framed_connection.h"
+#include "net/token_bucket.h"
 #include "proto/record/session_recorder.h"
 #include "proto/wire/rejection.h"
 #include "proto/wire/sealer.h"
@@ -56,8 +59,10 @@ inline constexpr std::chrono::seconds kJoinTimeout{10};
 /// After an accept() that failed (out of file descriptors, say), the listener waits this
 /// long and accepts again: it never stops, and never spins on a failure that persists.
 inline constexpr std::chrono::milliseconds kAcceptRetry{100};
-/// Connections that have not joined, at most; more are closed as they come.
-inline constexpr std::size_t kMaxUnjoinedConnections = 16;
+/// Connections that have not joined, at most, from one source address and in all: a new
+/// one past either bound closes the oldest unjoined one (of that source, or of all).
+inline constexpr std::size_t kMaxUnjoinedPerSource = 4;
+inline constexpr std::size_t kMaxUnjoinedConnections = 64;
 /// The kernel's send buffer of a control connection, fixed rather than grown without a
 /// say: with kMaxWaitingFrames, what a user that stops reading can hold up is bounded, and
 /// its writes stall (net::kWriteTimeout) within seconds. A few IRs' worth at any link speed.
@@ -68,16 +73,24 @@ inline constexpr int kControlSendBufferBytes = 1 << 20;
 /// so that the unjoined connections together cannot make the server hold more than a few KiB.
 inline constexpr std::size_t kMaxClientFrameBytes = std::size_t{64} << 10;
 inline constexpr std::size_t kMaxJoinFrameBytes = 1024;
+/// The datagrams a joined user may send a second: this many times its haptic rate (a
+/// tool sample a tick, and its clock's pings), with a second's samples banked for a burst
+/// after a stall. Past it they are dropped before anything uses, relays or records them
+/// (over_budget). A join asking for a rate above kMaxClientHapticRateHz is refused.
+inline constexpr double kUserDatagramsPerTick = 2;
+inline constexpr double kMaxClientHapticRateHz = 10000;
 
 struct ConnectionCounters {
   std::uint64_t datagrams_sent = 0, datagrams_relayed = 0;
+  std::uint64_t datagrams_over_budget = 0;        ///< a user's, past kUserDatagramsPerTick a tick
+  std::uint64_t datagrams_dropped_by_kernel = 0;  ///< the receive queue was full (SO_RXQ_OVFL)
   std::uint64_t frames_sent = 0, frames_rejected = 0, frames_dropped = 0;
   std::array<std::uint64_t, wire::kRejectionCount> frames_rejected_by_reason{};
   std::uint64_t dropped_to_clients = 0, dropped_from_clients = 0;  ///< by the injected loss
   std::uint64_t connections = 0;       ///< accepted
   std::uint64_t joins = 0;             ///< welcomed
   std::uint64_t joins_refused = 0;     ///< session full, slot taken, or a key for another slot
-  std::uint64_t turned_away = 0;       ///< closed at once: too many connections not joined
+  std::uint64_t unjoined_evicted = 0;  ///< closed before joining: a newer connection needed the room
   std::uint64_t join_timeouts = 0;     ///< closed: not joined within kJoinTimeout
   std::uint64_t accept_errors = 0;     ///< accept() failed (e.g. out of file descriptors): tried again after kAcceptRetry
   std::uint64_t write_stalls = 0;      ///< closed: the user stopped reading (write timeout)
@@ -125,6 +138,7 @@ class ConnectionHandler {
   using ParticipantPtr = std::shared_ptr<Participant>;
 
   void accept();
+  void make_room_for_unjoined(const asio::ip::address& source);
   void closed(const ParticipantPtr& participant, net::CloseCause cause, const std::string& why);
   const wire::TrafficKey* key_for(const Participant& participant, std::uint32_t sender) const;
   void handle_control(const ParticipantPtr& participant, const wire::Control& control);

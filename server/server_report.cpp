@@ -46,6 +46,8 @@ nlohmann::json server_report(const ServerFigures& figures) {
                          {"accepted", figures.datagrams.accepted()},
                          {"rejected", figures.datagrams.rejected()},
                          {"rejected_by_reason", figures.datagrams.snapshot()},
+                         {"over_budget", connections.datagrams_over_budget},
+                         {"dropped_by_kernel", connections.datagrams_dropped_by_kernel},
                          {"sent", connections.datagrams_sent},
                          {"relayed", connections.datagrams_relayed}};
   std::map<std::string, std::uint64_t> frame_rejections;
@@ -59,7 +61,7 @@ nlohmann::json server_report(const ServerFigures& figures) {
   server["connections"] = {{"accepted", connections.connections},
                            {"joins", connections.joins},
                            {"joins_refused", connections.joins_refused},
-                           {"turned_away", connections.turned_away},
+                           {"unjoined_evicted", connections.unjoined_evicted},
                            {"join_timeouts", connections.join_timeouts},
                            {"accept_errors", connections.accept_errors},
                            {"write_stalls", connections.write_stalls},

@@ -81,7 +81,7 @@ TEST(BlockSession, TwoUsersPushHundredsOfNodesHealthyAndTheirRecordingsVerify) {
   const SessionVerdict verdict = summarize_session(server_report, client_reports);
   EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
   for (const auto& [file, least] : {std::pair{"server.mcap", 3u}, {"a.mcap", 1000u}, {"b.mcap", 1000u}}) {
-    const VerifyResult result = verify_recording(dir / file);
+    const VerifyResult result = verify_recording(dir / file, SceneFileAccess{});
     EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
     EXPECT_GT(result.checked, least) << file;
   }

@@ -163,7 +163,7 @@ segments:
   EXPECT_EQ(changes, switches.size());
 
   for (const char* file : {"server.mcap", "subject.mcap"}) {
-    const VerifyResult result = verify_recording(dir / file);
+    const VerifyResult result = verify_recording(dir / file, SceneFileAccess{});
     EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
     EXPECT_GT(result.checked, 100u) << file;
   }
@@ -219,7 +219,7 @@ segments:
   EXPECT_EQ(client_report["protocol_switches"], 2);
   EXPECT_EQ(client_report["fades"]["count"], 0);
   for (const char* file : {"server.mcap", "subject.mcap"}) {
-    const VerifyResult result = verify_recording(session.dir / file);
+    const VerifyResult result = verify_recording(session.dir / file, SceneFileAccess{});
     EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
   }
 }

@@ -56,7 +56,7 @@ TEST(FemPairSession, TwoUsersFeelBThroughAAndTheirRecordingsVerify) {
     EXPECT_GT(received - as_rows, 0);  // M~ whole while A pushes B
   }
   for (const char* file : {"server.mcap", "a.mcap", "b.mcap"}) {
-    const VerifyResult result = verify_recording(dir / file);
+    const VerifyResult result = verify_recording(dir / file, SceneFileAccess{});
     EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
     EXPECT_GT(result.checked, 3u) << file;
   }

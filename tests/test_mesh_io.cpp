@@ -123,6 +123,20 @@ TEST(ReadGmsh, WindowsLineEndingsAndSourceNameInMessages) {
   }
 }
 
+// A mesh larger than any body cohaptic builds fails at the first node past the bound, with
+// its line, before more is stored.
+TEST(ReadGmsh, MoreNodesThanAnyBodyAreRefusedAtTheFirstOnePast) {
+  std::string text = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n300000\n";
+  for (int k = 1; k <= 300000; ++k) text += std::to_string(k) + " 0 0 0\n";
+  std::istringstream in(text);
+  try {
+    parse_gmsh(in, "huge.msh");
+    FAIL() << "no ParseError";
+  } catch (const ParseError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("huge.msh:250006: more than 250000 nodes"));
+  }
+}
+
 TEST(ReadGmsh, MissingFileNamesPathAndReason) {
   const std::string path = data_file("no_such_mesh.msh");
   try {
@@ -387,16 +401,24 @@ TEST(WriteVtu, FieldWithWrongNodeCountThrowsNamingIt) {
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 
-// Storage is not sized by the header, or 47 bytes claiming 1.8e9 vertices would ask for
-// 42 GB: the missing lines are the error.
-TEST(ReadFreeSurfer, AHeaderClaimingBillionsOfVerticesFailsOnItsMissingLines) {
-  std::istringstream in("#!ascii\n1772764997 4\n0 0 0 0\n");
-  try {
-    parse_freesurfer_ascii(in, "claims.asc");
-    FAIL() << "no ParseError";
-  } catch (const ParseError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("claims.asc:3: the file ends after 1 of the 1772764997 vertices"));
-  }
+// 47 bytes claiming 1.8e9 vertices would ask for 42 GB: a claim beyond the largest body is
+// refused at the header, and within it storage is not sized by the header: the missing
+// lines are the error.
+TEST(ReadFreeSurfer, AHeaderClaimingBillionsOfVerticesIsRefusedAndStorageFollowsTheLines) {
+  const auto error_of = [](const std::string& text) {
+    std::istringstream in(text);
+    try {
+      parse_freesurfer_ascii(in, "claims.asc");
+    } catch (const ParseError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no ParseError");
+  };
+  EXPECT_THAT(error_of("#!ascii\n1772764997 4\n0 0 0 0\n"),
+              HasSubstr("claims.asc:2: bad header: 1772764997 vertices and 4 triangles; a surface may have at most "
+                        "250000 vertices"));
+  EXPECT_THAT(error_of("#!ascii\n250000 4\n0 0 0 0\n"),
+              HasSubstr("claims.asc:3: the file ends after 1 of the 250000 vertices"));
 }
 
 TEST(ReadFreeSurfer, TetrahedronSurface) {

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <asio.hpp>
 #include <chrono>
 #include <fstream>
@@ -32,7 +33,9 @@
 #include <thread>
 
 #include "common/util/error.h"
+#include "lab/replay.h"
 #include "proto/record/recording.h"
+#include "proto/record/session_recorder.h"
 #include "proto/wire/datagram_codec.h"
 #include "proto/wire/envelope.h"
 #include "proto/wire/frame_codec.h"
@@ -40,9 +43,11 @@
 #include "proto/wire/sealer.h"
 #include "proto/wire/session_key.h"
 #include "proto/wire/traffic_keys.h"
+#include "support/cube_scene.h"
 #include "support/cube_session.h"
 #include "support/hostile_traffic.h"
 #include "support/process.h"
+#include "support/process_usage.h"
 #include "support/raw_participant.h"
 #include "support/run_program.h"
 
@@ -276,6 +281,48 @@ TEST(Security, AViewTokenReadFromAFileIsNotLogged) {
   EXPECT_NE(log.find("adding ?token= and the token in " + (token_dir / "token").string()), std::string::npos) << log;
 }
 
+// A server recording made by hand whose scene text is `scene_yaml` (as if served from
+// `dir`/scene.yaml), and what verifying it throws ("" if nothing).
+std::string verify_crafted_recording(const fs::path& dir, const std::string& scene_yaml) {
+  record::SessionConfig config;
+  config.set_role("server");
+  config.set_scene_yaml(scene_yaml);
+  config.set_scene_file((dir / "scene.yaml").string());
+  {
+    record::SessionRecorder recorder(dir / "crafted.mcap");
+    recorder.config(config);
+  }
+  try {
+    verify_recording(dir / "crafted.mcap");
+  } catch (const Error& error) {
+    return error.what();
+  }
+  return "";
+}
+
+// A recording comes from anyone, and `replay --verify` builds the scene it carries. That
+// scene reads no file outside the recording's folder (a secret beside it is neither read
+// nor quoted), runs no gmsh script, and builds no body too large to allocate.
+TEST(Security, AReplayedRecordingsSceneReadsNothingOutsideItsFolderAndBuildsNothingHuge) {
+  const fs::path dir = testing::scratch_directory("crafted-recording");
+  fs::create_directories(dir / "recording");
+  std::ofstream(dir / "secret.msh") << "root:SECRET-HASH:19000:0:99999:7:::\n";
+  std::ofstream(dir / "recording" / "block.geo") << "Box(1) = {0, 0, 0, 1, 1, 1};\n";
+  const auto cube_with_mesh = [](const std::string& mesh) {
+    return std::regex_replace(testing::cube_scene_yaml(), std::regex(R"(mesh: \{box: .*\}\})"), "mesh: " + mesh);
+  };
+  for (const std::string& file : {std::string("../secret.msh"), (dir / "secret.msh").string()}) {
+    const std::string why = verify_crafted_recording(dir / "recording", cube_with_mesh("{file: " + file + "}"));
+    EXPECT_NE(why.find("is outside"), std::string::npos) << why;
+    EXPECT_EQ(why.find("SECRET"), std::string::npos) << why;
+  }
+  const std::string gmsh = verify_crafted_recording(dir / "recording", cube_with_mesh("{gmsh: block.geo}"));
+  EXPECT_NE(gmsh.find("gmsh script"), std::string::npos) << gmsh;
+  const std::string huge = verify_crafted_recording(
+      dir / "recording", cube_with_mesh("{box: {min: [0, 0, 0], size: [1, 1, 1], divisions: [400, 400, 400]}}"));
+  EXPECT_NE(huge.find("at most 250000 nodes"), std::string::npos) << huge;
+}
+
 TEST(Security, ASessionRefusesParticipantsBeyondItsScenesMaximum) {
   CubeSession session("security-full", {"--duration", "60"}, "network: {max_participants: 1}\n");
   const auto a = session.client("alice", -1, write_press(session.dir, "a", 3, 2, 2, 2.0));
@@ -443,9 +490,105 @@ TEST(Robustness, AMillionHostileDatagramsLeaveTheSimulationRateAndEveryLegitimat
   EXPECT_EQ(server_report["failed_steps"]["count"], 0);
 }
 
+// A participant sends valid samples ten times as fast as its haptic rate (about 20,000 a
+// second): past twice its rate, with a second's burst, they are dropped before the server
+// uses, relays or records them, and bob, a real client, keeps his period.
+TEST(Robustness, AParticipantsSamplesBeyondTwiceItsHapticRateAreNeitherRelayedNorRecorded) {
+  CubeSession session("sample-flood", {"--duration", "120", "--record", "server.mcap"});
+  const auto bob = session.client("bob", 1, write_press(session.dir, "b", 3, 2, 2, 100.0));
+  ASSERT_TRUE(testing::wait_for_output(*bob, "haptic loop at")) << bob->log_text();
+  RawParticipant flooder({.server_port = static_cast<std::uint16_t>(session.port), .slot = 0},
+                         wire::ClientKeys(wire::development_key()));
+  const wire::Welcome welcome = flooder.join();
+  const double rate = welcome.haptic_rate_hz();
+  const auto started = std::chrono::steady_clock::now();
+  const auto until = started + 3s;
+  while (std::chrono::steady_clock::now() < until) {
+    for (int k = 0; k < 20; ++k) flooder.send_sample({0.003, 0.002, 0.001});
+    std::this_thread::sleep_for(1ms);
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::this_thread::sleep_for(500ms);  // the last of them are read
+  bob->signal(SIGINT);
+  ASSERT_EQ(bob->wait(testing::kPatience), 0) << bob->log_text();
+  session.stop_server();
+  const nlohmann::json server = session.report("server")["server"];
+  const nlohmann::json b = session.report("bob");
+  const record::Recording recording = record::read_recording(session.dir / "server.mcap");
+  const auto recorded = std::count_if(recording.datagrams.begin(), recording.datagrams.end(),
+                                      [](const record::ReceivedDatagram& d) { return d.datagram().header().sender() == 1; });
+  const double budget = rate + 2 * rate * (seconds + 0.5);  // the burst, and twice the rate while it was read
+  std::printf("  %lu samples in %.2f s from one participant: %lu over its budget, %ld recorded (budget %.0f); bob "
+              "received %lu remote samples; bob's period p99 %.0f us\n",
+              static_cast<unsigned long>(flooder.samples_sent()), seconds,
+              static_cast<unsigned long>(count(server, {"datagrams", "over_budget"})), static_cast<long>(recorded), budget,
+              static_cast<unsigned long>(b["remote_samples_received"].get<std::uint64_t>()),
+              b["period_us"]["p99"].get<double>());
+  EXPECT_GE(count(server, {"datagrams", "over_budget"}), flooder.samples_sent() - static_cast<std::uint64_t>(budget));
+  EXPECT_LE(static_cast<double>(recorded), budget);
+  EXPECT_LE(static_cast<double>(b["remote_samples_received"].get<std::uint64_t>()), budget);
+  EXPECT_LE(b["period_us"]["p99"].get<double>(), testing::period_p99_allowance_us(b));
+}
+
+// Connections that never join, from 8 source addresses (127.0.0.2 to 127.0.0.9), 8 from
+// each, each reopened as soon as the server closes it: more than the server keeps unjoined
+// from one source or in all. A client from 127.0.0.1 still joins, and joins again after
+// its link dropped (the process killed); the attacker's connections were the ones closed.
+TEST(Robustness, ConnectionsThatNeverJoinLockNoClientOut) {
+  CubeSession session("unjoined-flood", {"--duration", "120"});
+  const asio::ip::tcp::endpoint server(asio::ip::make_address("127.0.0.1"), static_cast<std::uint16_t>(session.port));
+  std::atomic<bool> attacking{true};
+  std::atomic<std::uint64_t> reopened{0};
+  std::thread attacker([&] {
+    asio::io_context io;
+    constexpr int kSources = 8, kPerSource = 8;
+    std::vector<asio::ip::tcp::socket> held;
+    std::vector<asio::ip::address> source_of;
+    const auto open = [&](const asio::ip::address& source) {
+      asio::ip::tcp::socket socket(io);
+      std::error_code error;
+      socket.open(asio::ip::tcp::v4(), error);
+      socket.bind({source, 0}, error);
+      socket.connect(server, error);
+      return socket;
+    };
+    for (int s = 0; s < kSources; ++s)
+      for (int k = 0; k < kPerSource; ++k) {
+        source_of.push_back(asio::ip::make_address_v4(0x7f000002u + static_cast<unsigned>(s)));
+        held.push_back(open(source_of.back()));
+      }
+    while (attacking) {
+      for (std::size_t k = 0; k < held.size(); ++k)
+        if (closed_by_server(held[k])) {
+          held[k] = open(source_of[k]);
+          ++reopened;
+        }
+      std::this_thread::sleep_for(20ms);  // at most 50 rounds a second: bounded, yet faster than the join timer
+    }
+  });
+  std::this_thread::sleep_for(1s);
+  const auto first = session.client("alice", 0, write_press(session.dir, "a", 3, 2, 2, 30.0));
+  EXPECT_TRUE(testing::wait_for_output(*first, "haptic loop at")) << first->log_text();
+  first->signal(SIGKILL);  // the link drops without a goodbye
+  first->wait(testing::kPatience);
+  const auto again = session.client("alice-again", 0, write_press(session.dir, "b", 3, 2, 2, 0.5));
+  EXPECT_TRUE(testing::wait_for_output(*again, "haptic loop at")) << again->log_text();
+  EXPECT_EQ(again->wait(testing::kPatience), 0) << again->log_text();
+  attacking = false;
+  attacker.join();
+  session.stop_server();
+  const nlohmann::json connections = session.report("server")["server"]["connections"];
+  std::printf("  attacker's connections reopened %lu times; server: %lu evicted unjoined, %lu joins\n",
+              static_cast<unsigned long>(reopened.load()), static_cast<unsigned long>(connections["unjoined_evicted"].get<std::uint64_t>()),
+              static_cast<unsigned long>(connections["joins"].get<std::uint64_t>()));
+  EXPECT_EQ(connections["joins"].get<std::uint64_t>(), 2u);
+  EXPECT_GE(connections["unjoined_evicted"].get<std::uint64_t>(), 8u * 4u);  // each source's surplus, at least
+}
+
 // Out of file descriptors (the live view's port held by 150 connections that send nothing,
-// the server limited to 96 descriptors): a client's connection fails to be accepted. Once
-// the descriptors are free again the listener accepts it: it was waiting, not dead.
+// the server limited to 96 descriptors): a client's connection fails to be accepted, and
+// neither the control listener nor the view's spins meanwhile. Once the descriptors are
+// free again the listener accepts it: it was waiting, not dead.
 TEST(Robustness, TheListenerAcceptsAgainOnceFileDescriptorsAreFree) {
   const fs::path prlimit = "/usr/bin/prlimit";
   if (!fs::exists(prlimit)) GTEST_SKIP() << "no prlimit (the Debian package util-linux)";
@@ -471,6 +614,14 @@ TEST(Robustness, TheListenerAcceptsAgainOnceFileDescriptorsAreFree) {
   const auto alice = testing::scripted_client(dir, testing::listening_port(started), "alice", 0,
                                               write_press(dir, "a", 3, 2, 2, 0.5));
   ASSERT_TRUE(testing::wait_for_output(server, "accept failed")) << server.log_text();
+  // Out of descriptors, both listeners wait between attempts: neither spins.
+  const auto before = testing::usage_of(server.pid());
+  std::this_thread::sleep_for(2s);
+  const auto after = testing::usage_of(server.pid());
+  ASSERT_TRUE(before && after);
+  const double cpu_share = (after->cpu_seconds - before->cpu_seconds) / 2.0;
+  std::printf("  out of file descriptors: the server used %.0f %% of a core for 2 s\n", 100 * cpu_share);
+  EXPECT_LT(cpu_share, 0.25);
   hogs.clear();  // the descriptors come free as the view's connections close
   EXPECT_TRUE(testing::wait_for_output(*alice, "haptic loop at")) << alice->log_text() << server.log_text();
   EXPECT_EQ(alice->wait(testing::kPatience), 0) << alice->log_text();

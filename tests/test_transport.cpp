@@ -440,7 +440,7 @@ TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) 
 // ---- rate limits ----
 
 TEST(SourceRateLimiter, FollowsATokenBucketPerAddressOnADrivenClock) {
-  SourceRateLimiter limiter({.burst = 4, .refill_per_s = 2, .max_sources = 2});
+  SourceRateLimiter limiter({.burst = 4, .first_burst = 4, .refill_per_s = 2, .max_sources = 2});
   const auto a = asio::ip::make_address("10.0.0.1"), b = asio::ip::make_address("10.0.0.2"),
              c = asio::ip::make_address("10.0.0.3");
   constexpr std::int64_t s = 1'000'000'000;
@@ -473,7 +473,37 @@ TEST(SourceRateLimiter, FollowsATokenBucketPerAddressOnADrivenClock) {
   EXPECT_EQ(limiter.sources(), 2u);
   limiter.charge(c, now + 1);
   EXPECT_EQ(limiter.sources(), 2u);
-  EXPECT_FALSE(limiter.limited(a, now + 1)) << "a was evicted: a new source starts with a full bucket";
+  EXPECT_FALSE(limiter.limited(a, now + 1)) << "a was evicted: a new source starts with its first burst";
+}
+
+// A flood that rotates through 800 source addresses, one failing datagram each per round,
+// 100 rounds a second for 5 s. Each new source starts with a small burst and all of them
+// share one budget, so the datagrams inspected are bounded by that budget, not by the
+// number of addresses. A proven source (it sent a valid datagram) is never limited by it.
+TEST(SourceRateLimiter, RotatingSourceAddressesShareOneBudgetThatSparesAProvenSource) {
+  const RateLimit limit{.burst = 64, .first_burst = 4, .refill_per_s = 16, .all_sources_burst = 256,
+                        .all_sources_refill_per_s = 256, .max_sources = 256, .max_proven = 16};
+  SourceRateLimiter limiter(limit);
+  const auto genuine = asio::ip::make_address("10.1.0.1");
+  constexpr std::int64_t kRound = 10'000'000;  // 10 ms
+  limiter.prove(genuine, 0);
+  std::uint64_t inspected = 0, genuine_limited = 0;
+  std::int64_t now = 0;
+  for (int round = 0; round < 500; ++round, now += kRound) {
+    for (std::uint32_t k = 0; k < 800; ++k) {
+      const auto source = asio::ip::address_v4(0x0a020000u + k);
+      if (limiter.limited(source, now)) continue;
+      ++inspected;
+      limiter.charge(source, now);
+    }
+    genuine_limited += limiter.limited(genuine, now);
+  }
+  const double seconds = static_cast<double>(now) * 1e-9;
+  std::printf("  400,000 failing datagrams from 800 rotating sources in %.0f s: %lu inspected (budget %.0f)\n", seconds,
+              static_cast<unsigned long>(inspected), limit.all_sources_burst + limit.all_sources_refill_per_s * seconds);
+  EXPECT_LE(static_cast<double>(inspected), limit.all_sources_burst + limit.all_sources_refill_per_s * seconds + 1);
+  EXPECT_GE(static_cast<double>(inspected), limit.all_sources_refill_per_s * seconds * 0.9) << "the budget is spent";
+  EXPECT_EQ(genuine_limited, 0u);
 }
 
 TEST(DatagramEndpoint, AFloodingSourceIsRateLimitedAndAnAdmittedPeerOnItsAddressLosesNothing) {

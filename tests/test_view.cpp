@@ -4,6 +4,7 @@
 // up here, and a frame against the simulation it is built from. The page in a real
 // browser is tests/test_view_browser.cpp's.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -24,6 +25,7 @@
 #include "server/simulation_loop.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
+#include "support/process_usage.h"
 #include "support/wait.h"
 #include "support/websocket_client.h"
 #include "view/live_view.h"
@@ -266,6 +268,37 @@ TEST(ViewServer, AStalledBrowserGetsNothingNewWhileItsQueueIsFullAndTheOthersGet
               static_cast<unsigned long long>(counters.dropped));
   EXPECT_LT(to_stalled, static_cast<std::uint64_t>(kFrames / 4));
   EXPECT_GT(counters.dropped, static_cast<std::uint64_t>(kFrames / 2));
+}
+
+// As many browsers as the server takes, none reading, while 1 MB frames are published: each
+// frame is held once for all of them, so the server's memory grows by a few frames, not by
+// a queue per browser (64 queues of 2 MB and more, were each frame copied per browser).
+TEST(ViewServer, BrowsersThatStopReadingShareOneCopyOfEachFrame) {
+  view::ViewServerOptions options = local_options();
+  view::ViewServer server(options);
+  server.publish(view::Channel::scene, "scene");
+  server.start();
+  std::vector<std::unique_ptr<testing::StalledWebSocket>> stalled;
+  for (int k = 0; k < options.max_browsers; ++k) {
+    stalled.push_back(std::make_unique<testing::StalledWebSocket>("127.0.0.1", server.port()));
+    ASSERT_TRUE(stalled.back()->upgraded());
+  }
+  ASSERT_TRUE(testing::wait_until([&] { return server.counters().browsers == options.max_browsers; }, "every browser"));
+  const std::size_t rss_before = testing::usage_of(getpid()).value().rss_bytes;
+  constexpr int kFrames = 40;
+  for (int k = 1; k <= kFrames; ++k) {
+    server.publish(view::Channel::frame, std::to_string(k) + std::string(1 << 20, 'x'));
+    std::this_thread::sleep_for(20ms);
+  }
+  std::this_thread::sleep_for(500ms);  // every send the server will make is made
+  const std::size_t rss_after = testing::usage_of(getpid()).value().rss_bytes;
+  const double grown_mb = (static_cast<double>(rss_after) - static_cast<double>(rss_before)) / 1e6;
+  std::printf("  %d browsers not reading, %d frames of 1 MB published: the process grew by %.1f MB; %llu frames "
+              "sent, %llu dropped\n",
+              options.max_browsers, kFrames, grown_mb, static_cast<unsigned long long>(server.counters().messages_sent),
+              static_cast<unsigned long long>(server.counters().dropped));
+  EXPECT_GE(server.counters().messages_sent, static_cast<std::uint64_t>(2 * options.max_browsers)) << "frames were sent";
+  EXPECT_LT(grown_mb, 48.0);
 }
 
 // ---- the recording's player ----

@@ -27,6 +27,22 @@ using websocketpp::connection_hdl;
 
 /// Time the closing handshakes get at stop().
 constexpr auto kCloseGrace = std::chrono::milliseconds(200);
+/// After an accept() that failed (out of file descriptors, say), the wait before the next.
+constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
+/// The kernel's send buffer of a browser's socket: a browser that stops reading holds at
+/// most this in the kernel (and max_buffered_bytes, shared with the others, in the server).
+constexpr int kBrowserSendBufferBytes = 256 << 10;
+
+// A binary WebSocket frame of `payload`, framed once (a server's frames are not masked) and
+// marked prepared, so that every browser's connection sends this one buffer, not a copy.
+WsServer::message_ptr prepared_frame(const WsServer::connection_ptr& connection, const std::string& payload) {
+  WsServer::message_ptr frame = connection->get_message(websocketpp::frame::opcode::binary, payload.size());
+  const websocketpp::frame::basic_header basic(websocketpp::frame::opcode::binary, payload.size(), true, false);
+  frame->set_header(websocketpp::frame::prepare_header(basic, websocketpp::frame::extended_header(payload.size())));
+  frame->set_payload(payload);
+  frame->set_prepared(true);
+  return frame;
+}
 
 }  // namespace
 
@@ -41,6 +57,8 @@ struct ViewServer::Impl {
   AssetTable assets;
   asio::io_context io;
   WsServer server;
+  asio::steady_timer accept_retry{io};
+  std::int64_t last_accept_warning_ns = 0;
   std::uint16_t port = 0;
   std::thread thread;
   bool stopped = false;
@@ -66,6 +84,10 @@ struct ViewServer::Impl {
     server.set_reuse_addr(true);
     server.set_max_message_size(options.max_command_bytes);
     server.set_max_http_body_size(0);  // a GET has none: nobody makes the server buffer one
+    server.set_socket_init_handler([](connection_hdl, asio::ip::tcp::socket& socket) {
+      asio::error_code ignored;
+      socket.set_option(asio::socket_base::send_buffer_size(kBrowserSendBufferBytes), ignored);
+    });
     server.set_http_handler([this](connection_hdl hdl) { http(hdl); });
     server.set_validate_handler([this](connection_hdl hdl) { return validate(hdl); });
     server.set_open_handler([this](connection_hdl hdl) { opened(hdl); });
@@ -78,9 +100,44 @@ struct ViewServer::Impl {
     if (address_error) throw Error("view: '" + options.host + "' is not an IP address");
     server.listen(asio::ip::tcp::endpoint(address, options.port), error);
     if (error) throw Error("view: cannot listen on " + options.host + ":" + std::to_string(options.port) + ": " + error.message());
-    server.start_accept(error);
-    if (error) throw Error("view: cannot accept connections: " + error.message());
     port = server.get_local_endpoint(error).port();
+    accept();
+  }
+
+  // websocketpp's own accept loop (start_accept) accepts again at once after a failure, so
+  // out of file descriptors it spins; this one waits kAcceptRetry first.
+  void accept() {
+    const WsServer::connection_ptr connection = server.get_connection();
+    websocketpp::lib::error_code error;
+    if (connection)
+      server.async_accept(connection, [this, connection](const websocketpp::lib::error_code& accept_error) {
+        if (!accept_error) {
+          connection->start();
+          accept();
+        } else {
+          connection->terminate(accept_error);
+          accept_failed(accept_error);
+        }
+      }, error);
+    if (!connection || error) {
+      if (connection) connection->terminate(error);
+      accept_failed(error);
+    }
+  }
+
+  void accept_failed(const websocketpp::lib::error_code& error) {
+    if (!server.is_listening()) return;  // stopping
+    count([](ViewCounters& c) { ++c.accept_errors; });
+    const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                 std::chrono::steady_clock::now().time_since_epoch()).count();
+    if (now - last_accept_warning_ns > 1'000'000'000) {  // once a second at most: the counter has the rest
+      spdlog::warn("view: accept failed: {}; accepting again in {} ms", error.message(), kAcceptRetry.count());
+      last_accept_warning_ns = now;
+    }
+    accept_retry.expires_after(kAcceptRetry);
+    accept_retry.async_wait([this](const asio::error_code& timer_error) {
+      if (!timer_error) accept();
+    });
   }
 
   template <class Change>
@@ -168,6 +225,7 @@ struct ViewServer::Impl {
     }
     if (!messages[static_cast<std::size_t>(Channel::scene)]) return;
     std::uint64_t sent = 0, bytes = 0, dropped = 0;
+    std::array<WsServer::message_ptr, kChannels> frames;  // framed on first use, shared by every browser
     for (auto& [hdl, browser] : browsers) {
       websocketpp::lib::error_code error;
       const WsServer::connection_ptr connection = server.get_con_from_hdl(hdl, error);
@@ -181,7 +239,8 @@ struct ViewServer::Impl {
         }
         if (channel != static_cast<std::size_t>(Channel::scene) && connection->get_buffered_amount() > options.max_buffered_bytes)
           continue;  // caught up later, with whatever is newest then
-        error = connection->send(*messages[channel], websocketpp::frame::opcode::binary);
+        if (!frames[channel]) frames[channel] = prepared_frame(connection, *messages[channel]);
+        error = connection->send(frames[channel]);
         if (error) break;
         browser.sent[channel] = browser.accounted[channel] = sequences[channel];
         ++sent;
@@ -212,6 +271,7 @@ void ViewServer::stop() {
   asio::post(s.io, [&s] {
     websocketpp::lib::error_code error;
     s.server.stop_listening(error);
+    s.accept_retry.cancel();
     for (const auto& [hdl, browser] : s.browsers) s.server.close(hdl, websocketpp::close::status::going_away, "server stopped", error);
     auto timer = std::make_shared<asio::steady_timer>(s.io, kCloseGrace);
     timer->async_wait([&s, timer](const asio::error_code&) { s.io.stop(); });

@@ -9,7 +9,9 @@
 // every channel it has not had yet, the scene first (the rating page's one message is its
 // scene). A browser with more than
 // max_buffered_bytes still waiting to leave gets nothing new until it has caught up: its
-// frames are dropped (counted), never queued without bound.
+// frames are dropped (counted), never queued without bound. Each message is framed once and
+// the same buffer queued for every browser. An accept() that fails (out of file
+// descriptors) is tried again after a pause, never in a spin.
 // Safety: a non-empty token must be given as /ws?token=... or the handshake is refused
 // (403); a handshake from another web page (its Origin not this server) is refused too, and
 // without a token so is one whose Host does not name this machine (browser_input.h). Only
@@ -58,6 +60,7 @@ struct ViewCounters {
   std::uint64_t closed_for_bad_message = 0;
   std::uint64_t messages_sent = 0, bytes_sent = 0;
   std::uint64_t dropped = 0;               ///< messages superseded before a slow browser got them
+  std::uint64_t accept_errors = 0;         ///< accept() failed (out of file descriptors, say): tried again later
   std::uint64_t http_requests = 0;
 };
 

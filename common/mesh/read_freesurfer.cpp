@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/mesh/mesh_limits.h"
 #include "common/util/line_reader.h"
 
 namespace cohaptic {
@@ -53,6 +54,10 @@ TriangleSurface parse_freesurfer_ascii(std::istream& in, const std::string& sour
   if (vertex_count < 3 || triangle_count < 1 || vertex_count > INT_MAX || triangle_count > INT_MAX)
     reader.fail(fmt::format("bad header: a surface needs at least 3 vertices and 1 triangle, found {} and {}",
                             vertex_count, triangle_count));
+  if (vertex_count > kMaxBodyNodes || triangle_count > 2 * kMaxBodyNodes)
+    reader.fail(fmt::format("bad header: {} vertices and {} triangles; a surface may have at most {} vertices and "
+                            "twice as many triangles",
+                            vertex_count, triangle_count, kMaxBodyNodes));
 
   // Storage grows with the lines actually read: the header's counts are only a claim, and
   // a short file claiming billions must fail on its missing lines, not on memory.

@@ -12,6 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "common/mesh/mesh_limits.h"
 #include "common/util/error.h"
 #include "common/util/line_reader.h"
 
@@ -194,7 +195,8 @@ void GmshParser::add_node(std::int64_t tag, double x, double y, double z) {
   const auto [it, inserted] = node_index_.emplace(tag, static_cast<int>(node_tags_.size()));
   if (!inserted)
     reader_.fail(fmt::format("duplicate node tag {} (first defined on line {})", tag, node_lines_[it->second]));
-  if (node_tags_.size() >= static_cast<std::size_t>(INT_MAX)) reader_.fail("too many nodes");
+  if (node_tags_.size() >= static_cast<std::size_t>(kMaxBodyNodes))
+    reader_.fail(fmt::format("more than {} nodes: larger than any body cohaptic builds", kMaxBodyNodes));
   node_tags_.push_back(tag);
   node_lines_.push_back(reader_.line_number());
   coordinates_.insert(coordinates_.end(), {x, y, z});
@@ -216,6 +218,8 @@ void GmshParser::add_element(int type, std::int64_t tag, std::span<const std::st
   const auto [it, inserted] = tet_tag_lines_.emplace(tag, tet.line);
   if (!inserted)
     reader_.fail(fmt::format("duplicate element tag {} (first used on line {})", tag, it->second));
+  if (tets_.size() >= static_cast<std::size_t>(kMaxBodyTetrahedra))
+    reader_.fail(fmt::format("more than {} tetrahedra: larger than any body cohaptic builds", kMaxBodyTetrahedra));
   tets_.push_back(tet);
 }
 

@@ -1,11 +1,11 @@
 #include "common/scene/load_scene.h"
 
+#include "common/mesh/mesh_limits.h"
 #include "common/scene/parse_home_spring.h"
 #include "common/scene/parse_interactions.h"
 #include "common/scene/parse_mass_spring.h"
 #include "common/scene/parse_node_selector.h"
 #include "common/scene/parse_separation.h"
-#include "common/util/regular_file.h"
 #include "common/util/yaml_cursor.h"
 
 
@@ -44,7 +44,7 @@ AxisMask parse_axes(const Cursor& c) {
   return mask;
 }
 
-MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
+MeshSpec parse_mesh(const Cursor& c, double scale, const SceneFiles& files) {
   c.only_keys({"file", "gmsh", "set", "box"});
   MeshSpec mesh;
   const auto file = c.find("file");
@@ -56,10 +56,8 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
   if (set && !gmsh) set->fail("only with gmsh (the script's parameters)");
   if (file || gmsh) {
     const Cursor& path = file ? *file : *gmsh;
-    std::filesystem::path resolved = path.text();
-    if (resolved.is_relative()) resolved = scene_dir / resolved;
-    if (const auto why = why_not_a_regular_file(resolved))
-      path.fail_message(fmt::format("{} {} {}", file ? "mesh file" : "gmsh script", resolved.string(), *why));
+    if (gmsh) files.require_gmsh_allowed(path);
+    const std::filesystem::path resolved = files.resolve(path, file ? "mesh file" : "gmsh script");
     if (file) {
       mesh.file = resolved;
     } else {
@@ -85,6 +83,9 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
       if (d < 1 || d > 400) parts[i].fail("an integer from 1 to 400");
       spec.divisions[i] = static_cast<int>(d);
     }
+    const std::int64_t nodes = (spec.divisions.cast<std::int64_t>().array() + 1).prod();
+    if (nodes > kMaxBodyNodes)
+      divisions.fail(fmt::format("divisions giving at most {} nodes, not {}", kMaxBodyNodes, nodes));
     if (auto grading = box->find("grading")) {
       if (!grading->is_sequence() || grading->items().size() != 3) grading->fail("a list of 3 ratios");
       const auto ratios = grading->items();
@@ -106,10 +107,10 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const std::filesystem::path& 
 }
 
 // `model: linear_elastic` (also the default): the keys of an FEM solid.
-ElasticObjectSpec parse_elastic_object(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
+ElasticObjectSpec parse_elastic_object(const Cursor& c, double scale, const SceneFiles& files) {
   c.only_keys({"name", "model", "mesh", "material", "fixed", "touchable", "compliance"});
   ElasticObjectSpec object;
-  object.mesh = parse_mesh(c.at("mesh"), scale, scene_dir);
+  object.mesh = parse_mesh(c.at("mesh"), scale, files);
 
   const Cursor material = c.at("material");
   material.only_keys({"model", "youngs_modulus", "poisson_ratio", "element"});
@@ -152,21 +153,21 @@ ElasticObjectSpec parse_elastic_object(const Cursor& c, double scale, const std:
   return object;
 }
 
-ObjectSpec parse_object(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
+ObjectSpec parse_object(const Cursor& c, double scale, const SceneFiles& files) {
   if (!c.is_map()) c.fail("a map describing a deformable object");
   ObjectSpec object;
   object.where = c.location();
   object.name = c.at("name").text();
   const std::string model =
       c.find("model") ? c.at("model").choice({"linear_elastic", "mass_spring", "home_spring", "separation"}) : "linear_elastic";
-  if (model == "linear_elastic") object.body = parse_elastic_object(c, scale, scene_dir);
+  if (model == "linear_elastic") object.body = parse_elastic_object(c, scale, files);
   else if (model == "mass_spring") object.body = parse_mass_spring_object(c, scale);
-  else if (model == "home_spring") object.body = parse_home_spring_object(c, scale, scene_dir);
+  else if (model == "home_spring") object.body = parse_home_spring_object(c, scale, files);
   else object.body = parse_separation_object(c, scale);
   return object;
 }
 
-ObstacleSpec parse_obstacle(const Cursor& c, double scale, const std::filesystem::path& scene_dir) {
+ObstacleSpec parse_obstacle(const Cursor& c, double scale, const SceneFiles& files) {
   c.only_keys({"name", "surface", "plane"});
   ObstacleSpec obstacle;
   obstacle.name = c.at("name").text();
@@ -174,10 +175,7 @@ ObstacleSpec parse_obstacle(const Cursor& c, double scale, const std::filesystem
   const auto plane = c.find("plane");
   if (static_cast<bool>(surface) == static_cast<bool>(plane)) c.fail("exactly one of surface (a file) or plane");
   if (surface) {
-    obstacle.surface_file = surface->text();
-    if (obstacle.surface_file.is_relative()) obstacle.surface_file = scene_dir / obstacle.surface_file;
-    if (const auto why = why_not_a_regular_file(obstacle.surface_file))
-      surface->fail_message(fmt::format("surface file {} {}", obstacle.surface_file.string(), *why));
+    obstacle.surface_file = files.resolve(*surface, "surface file");
   } else {
     plane->only_keys({"point", "normal"});
     const Cursor normal = plane->at("normal");
@@ -247,7 +245,7 @@ NetworkSettings parse_network(const Cursor& c, std::size_t tools) {
 
 }  // namespace
 
-Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file) {
+Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file, const SceneFileAccess& access) {
   const std::string file_name = file.string();
   const Cursor top(load_yaml(yaml_text, file_name, raise_scene_error), "", &file_name, 1, raise_scene_error);
   if (!top.is_map()) top.fail("a map of scene settings");
@@ -261,19 +259,19 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
     scene.units = units->text();
   }
   const double scale = scene.metres_per_unit;
-  const std::filesystem::path scene_dir = file.has_parent_path() ? file.parent_path() : std::filesystem::path(".");
+  const SceneFiles files{file.has_parent_path() ? file.parent_path() : std::filesystem::path("."), access};
 
   const Cursor objects = top.at("objects");
   std::set<std::string> object_names;
   for (const Cursor& item : objects.items()) {
-    scene.objects.push_back(parse_object(item, scale, scene_dir));
+    scene.objects.push_back(parse_object(item, scale, files));
     if (!object_names.insert(scene.objects.back().name).second) item.at("name").fail("an object name not used before");
   }
   if (scene.objects.empty()) objects.fail("at least one object");
   if (auto interactions = top.find("interactions")) scene.interactions = parse_interactions(*interactions, scene.objects);
 
   if (auto obstacles = top.find("obstacles"))
-    for (const Cursor& item : obstacles->items()) scene.obstacles.push_back(parse_obstacle(item, scale, scene_dir));
+    for (const Cursor& item : obstacles->items()) scene.obstacles.push_back(parse_obstacle(item, scale, files));
 
   const Cursor tools = top.at("tools");
   std::set<std::string> tool_names;

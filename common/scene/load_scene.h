@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/scene/scene.h"
+#include "common/scene/scene_files.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -20,7 +21,8 @@ class SceneError : public Error {
 
 Scene load_scene(const std::filesystem::path& file);
 
-/// Parses scene text; `file` names it in messages and resolves relative mesh paths.
-Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file);
+/// Parses scene text; `file` names it in messages and resolves relative mesh paths; the
+/// files it names are read as `access` allows (scene_files.h).
+Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file, const SceneFileAccess& access = {});
 
 }  // namespace cohaptic

@@ -1,11 +1,12 @@
 #include "common/scene/parse_home_spring.h"
 
+#include "common/mesh/mesh_limits.h"
+
 #include <fmt/format.h>
 
 #include <cmath>
 #include <numbers>
 
-#include "common/util/regular_file.h"
 
 namespace cohaptic {
 namespace {
@@ -27,12 +28,15 @@ TissueGridSpec parse_tissue_grid(const YamlCursor& c, double scale) {
     if (d < 1 || d > 1000) count.fail("an integer from 1 to 1000");
     grid.divisions[axis] = static_cast<int>(d);
   }
+  const std::int64_t vertices = (grid.divisions.cast<std::int64_t>().array() + 1).prod();
+  if (vertices > kMaxBodyNodes)
+    divisions.fail(fmt::format("divisions giving at most {} vertices, not {}", kMaxBodyNodes, vertices));
   return grid;
 }
 
 }  // namespace
 
-HomeSpringObjectSpec parse_home_spring_object(const YamlCursor& c, double scale, const std::filesystem::path& scene_dir) {
+HomeSpringObjectSpec parse_home_spring_object(const YamlCursor& c, double scale, const SceneFiles& files) {
   c.only_keys({"name", "model", "surface", "stiffness", "patch_radius", "display"});
   HomeSpringObjectSpec object;
 
@@ -42,10 +46,7 @@ HomeSpringObjectSpec parse_home_spring_object(const YamlCursor& c, double scale,
   const auto grid = surface.find("grid");
   if (static_cast<bool>(file) == static_cast<bool>(grid)) surface.fail("exactly one of file (a FreeSurfer .asc surface) or grid");
   if (file) {
-    object.surface_file = file->text();
-    if (object.surface_file.is_relative()) object.surface_file = scene_dir / object.surface_file;
-    if (const auto why = why_not_a_regular_file(object.surface_file))
-      file->fail_message(fmt::format("surface file {} {}", object.surface_file.string(), *why));
+    object.surface_file = files.resolve(*file, "surface file");
   } else {
     object.grid = parse_tissue_grid(*grid, scale);
   }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/mesh/mesh_limits.h"
 #include "common/scene/parse_node_selector.h"
 
 namespace cohaptic {
@@ -72,6 +73,8 @@ SpringLatticeSpec parse_lattice(const YamlCursor& c, double scale) {
     if (d < 1 || d > 100) parts[static_cast<std::size_t>(i)].fail("an integer from 1 to 100");
     lattice.divisions[i] = static_cast<int>(d);
   }
+  const std::int64_t nodes = (lattice.divisions.cast<std::int64_t>().array() + 1).prod();
+  if (nodes > kMaxBodyNodes) divisions.fail(fmt::format("divisions giving at most {} nodes, not {}", kMaxBodyNodes, nodes));
   lattice.spring_stiffness = c.at("spring_stiffness").positive("a positive stiffness in N/m");
   lattice.spring_damping = c.at("spring_damping").number_in(0, INFINITY, false, true, "a damping in N s/m, >= 0");
   lattice.node_mass = c.at("node_mass").positive("a positive mass in kg");

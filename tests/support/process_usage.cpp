@@ -1,7 +1,11 @@
 #include "support/process_usage.h"
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string>
 #include <system_error>
 
@@ -22,6 +26,19 @@ std::optional<ProcessUsage> usage_of(pid_t pid) {
   for (std::filesystem::directory_iterator fd(proc / "fd", error), end; !error && fd != end; fd.increment(error))
     ++usage.open_fds;
   if (error) return std::nullopt;
+  // stat: "pid (comm) state ..." with utime and stime the 12th and 13th fields after comm,
+  // which may itself hold spaces: count from its closing parenthesis.
+  std::ifstream stat(proc / "stat");
+  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  const std::size_t after_name = text.rfind(')');
+  if (after_name == std::string::npos) return std::nullopt;
+  std::istringstream fields(text.substr(after_name + 1));
+  std::string field;
+  unsigned long long utime = 0, stime = 0;
+  for (int k = 1; k <= 13 && fields >> field; ++k)
+    if (k == 12) utime = std::stoull(field);
+    else if (k == 13) stime = std::stoull(field);
+  usage.cpu_seconds = static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
   return usage;
 }
 

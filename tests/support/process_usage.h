@@ -1,5 +1,5 @@
 // What a running process holds, read from Linux's /proc: its resident set (VmRSS, bytes)
-// and its open file descriptors (the entries of /proc/PID/fd). The soak samples both for
+// its open file descriptors (the entries of /proc/PID/fd) and its CPU time (/proc/PID/stat). The soak samples both for
 // the server and its clients to show that nothing grows with time.
 #pragma once
 
@@ -13,6 +13,7 @@ namespace cohaptic::testing {
 struct ProcessUsage {
   std::size_t rss_bytes = 0;
   std::size_t open_fds = 0;
+  double cpu_seconds = 0;  ///< user and system time used so far, all threads
 };
 
 /// `pid`'s usage now; nullopt if it has ended (or /proc cannot be read).
