@@ -6,8 +6,9 @@
 // joins, presses and leaves (after the file-descriptor attack, and after alice's link
 // drops, alice joins again). Throughout, the server's resident set is sampled.
 //
-// It prints one line per attack (what was sent, what the server counted, whether bob
-// joined) and a verdict, and exits 1 if a legitimate client could not join or lost its
+// It prints a Markdown page (docs/results/attacks.md): a row per attack (what was sent, what
+// the server did, whether bob joined), what alice felt, what the server counted, and a
+// verdict; it exits 1 if a legitimate client could not join or lost its
 // haptic rate, the server's resident set passed 200 MB, or a file outside a recording's
 // folder was read. Loopback only: it binds 127.0.0.0/8 addresses and talks to 127.0.0.1.
 #include <signal.h>
@@ -327,7 +328,13 @@ int run() {
   target.view_port = static_cast<std::uint16_t>(std::stoi(match[1]));
   target.session = testing::session_id(server);
   RssWatch rss(server.pid());
-  fmt::print("server on 127.0.0.1:{} (view {}), files in {}\n", target.port, target.view_port, target.dir.string());
+  fmt::print(stderr, "server on 127.0.0.1:{} (view {}), files in {}\n", target.port, target.view_port, target.dir.string());
+  fmt::print("# Attacks from the network, replayed\n\n"
+             "`make attacks > docs/results/attacks.md` writes this page (`tests/attacks/cohaptic_attacks.cpp`). A "
+             "cohaptic-server on loopback serves a three-tool cube with the live view, limited to 256 file descriptors. "
+             "alice, a real client, presses and holds through every attack; during each, bob, another, joins, presses "
+             "and leaves. The limits each attack meets are in [security](../security.md), \"Limits\".\n\n"
+             "| | attack | what was sent, and what the server did | bob |\n|---|---|---|---|\n");
 
   auto alice = testing::scripted_client(target.dir, target.port, "alice", 0,
                                         testing::write_press(target.dir, "a", 3, 2, 2, 900));
@@ -340,7 +347,9 @@ int run() {
                      outcome.find("bob's client failed") != std::string::npos || outcome.find("NOT") != std::string::npos ||
                      outcome.find("JOINED") != std::string::npos || outcome.find("verified!") != std::string::npos;
     failed = failed || bad;
-    fmt::print("{:2}. {:<28} {}{}\n", number, name, bad ? "FAILED: " : "", outcome);
+    const std::size_t bob = outcome.rfind("; bob");
+    const std::string what = outcome.substr(0, bob), joined = bob == std::string::npos ? "" : outcome.substr(bob + 2);
+    fmt::print("| {} | {} | {}{} | {} |\n", number, name, bad ? "**FAILED**: " : "", what, joined);
     std::fflush(stdout);
   };
   report(1, "connections never joining", unjoined_connections(target));
@@ -372,21 +381,21 @@ int run() {
   const double peak = rss.peak_mb();
   const double rate = throughout["haptic_rate_hz"].get<double>();
   const double faded_s = throughout["fades"]["total_s"].get<double>();
-  fmt::print("alice, pressing through every attack: haptic rate {:.0f} Hz, period p99 {:.0f} us, IR age p99 {:.0f} ms, "
+  fmt::print("\nalice, pressing through every attack: haptic rate {:.0f} Hz, period p99 {:.0f} us, IR age p99 {:.0f} ms, "
              "force faded for {:.2f} s in all; carol, her link dropped, joined again: {}\n",
              rate, throughout["period_us"]["p99"].get<double>(), throughout["ir_age_ms"]["p99"].get<double>(), faded_s,
              rejoined ? "yes" : "NO");
-  fmt::print("server: {} unjoined connections evicted, {} accept errors, {} datagrams rate limited, {} over a user's "
+  fmt::print("\nserver: {} unjoined connections evicted, {} accept errors, {} datagrams rate limited, {} over a user's "
              "budget, {} dropped by the kernel; steps failed {}\n",
              counted["connections"]["unjoined_evicted"].get<std::uint64_t>(),
              counted["connections"]["accept_errors"].get<std::uint64_t>(),
              counted["datagrams"]["rejected_by_reason"]["rate_limited"].get<std::uint64_t>(),
              counted["datagrams"]["over_budget"].get<std::uint64_t>(), counted["datagrams"]["dropped_by_kernel"].get<std::uint64_t>(),
              counted["failed_steps"]["count"].get<std::uint64_t>());
-  fmt::print("server's largest resident set: {:.1f} MB (at most {:.0f})\n", peak, kMaxServerRssMb);
+  fmt::print("\nserver's largest resident set: {:.1f} MB (at most {:.0f})\n", peak, kMaxServerRssMb);
   const std::uint64_t failed_steps = counted["failed_steps"]["count"].get<std::uint64_t>();
   failed = failed || failed_steps > 0 || !alice_ended || !rejoined || rate < 900 || faded_s > 0 || peak > kMaxServerRssMb || read_outside;
-  fmt::print("{}\n", failed ? "VERDICT: an attack got through (see FAILED above)" : "VERDICT: every attack held");
+  fmt::print("\n**Verdict: {}**\n", failed ? "an attack got through (see FAILED above)" : "every attack held");
   return failed ? 1 : 0;
 }
 
