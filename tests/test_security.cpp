@@ -14,7 +14,12 @@
 //     while the other user's haptic loop keeps its period;
 //   - a flood of 10^6 hostile datagrams of every kind leaves the simulation rate within 5 %
 //     of the rate just before it, measured from the server's recording, and every datagram
-//     the real clients sent is accepted.
+//     the real clients sent is accepted;
+//   - a participant's samples past twice its haptic rate are neither relayed nor recorded;
+//     connections that never join, from many addresses, lock no client out; out of file
+//     descriptors, neither listener spins, and both accept again once they are free;
+//   - a recording's scene, built by replay --verify, reads nothing outside the recording's
+//     folder, runs no gmsh script and builds no body too large to allocate.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
