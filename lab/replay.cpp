@@ -213,6 +213,7 @@ void print_summary(const Recording& rec) {
   for (const auto& s : rec.steps) see(s.time_ns());
   for (const auto& d : rec.datagrams) see(d.receive_time_ns());
   fmt::print("recording   {}{}\n", rec.file.string(), rec.truncated ? fmt::format(" (TRUNCATED: {})", rec.truncation) : "");
+  if (rec.truncated) fmt::print("integrity   {}\n", record::describe_cut(rec));
   fmt::print("role        {}{}\n", c.role(), c.role() == "client" ? fmt::format(", user '{}' in slot {}, device {}", c.user(), c.slot(), c.device()) : "");
   fmt::print("scene       {} ({})\n", c.scene_name(), c.scene_file().empty() ? "as served" : c.scene_file());
   fmt::print("protocol    {}; session {:016x}\n", c.protocol() == wire::P0 ? "P0" : "P1", c.session());
@@ -358,6 +359,7 @@ int run_replay(const ReplayOptions& options) {
     return serve_replay(rec, view);
   }
   if (options.verify) {
+    if (rec.truncated) fmt::print("verify: {}\n", record::describe_cut(rec));
     const VerifyResult result =
         options.scene_dir ? verify_recording(options.file, {.confined_to = *options.scene_dir, .gmsh_scripts = true})
                           : verify_recording(options.file);

@@ -1,6 +1,7 @@
 // `cohaptic-lab replay FILE`: looking at a recorded session, re-running it, exporting it.
 //
-//   --summary     what is in the recording (the default)
+//   --summary     what is in the recording (the default); of one cut short, how far its
+//                 chunks' CRCs vouch for it
 //   --verify      re-run the recorded inputs through the same computations and compare
 //                 every force bit for bit:
 //                   a client recording: each haptic tick's force from the IR it used (or the
@@ -9,7 +10,8 @@
 //                   a server recording: the simulation re-run step by step from the recorded
 //                   tool inputs (same model, same compliance), every IR it built and every
 //                   P0 force it sent;
-//                 exits non-zero and names the first difference;
+//                 exits non-zero and names the first difference; of a recording cut short
+//                 it first says how far its chunks' CRCs vouch for it (describe_cut);
 //   --export-csv  every kind of record as a CSV file in DIR;
 //   --view        a server recording made with --view, in the live view's page with a
 //                 timeline (lab/replay_view.h), until SIGINT.
@@ -49,6 +51,8 @@ struct VerifyResult {
 /// Re-runs `file`. A server recording's scene reads its files as `scene_files` allows
 /// (common/scene/scene_files.h); without it, from the recording's own folder only, and no
 /// gmsh script: a recording may come from anyone (the command line without --scene-dir).
+/// Throws cohaptic::Error naming the file if it cannot be read as a recording (a chunk
+/// whose CRC does not match, for one) or not re-run.
 VerifyResult verify_recording(const std::filesystem::path& file, const SceneFileAccess& scene_files);
 VerifyResult verify_recording(const std::filesystem::path& file);
 

@@ -1,10 +1,14 @@
 // Recordings (proto/record/): the MCAP writer and reader. A round trip of thousands of
-// protobuf messages; the bytes on disk checked field by field against the spec with a
-// parser and a CRC written here, independent of the library; the protobuf schema decoding a
-// recorded message through DynamicMessageFactory; truncation at thousands of cut points;
-// a writer killed mid-session (fork + SIGKILL / _exit); write errors (/dev/full, a file
-// size limit hit mid-session); files the reader must reject or skip over; and the official
-// TypeScript reader (@mcap/core) reading our files (tests/support/mcap_check.mjs).
+// protobuf messages in chunks; the bytes on disk (chunks and their CRCs, Message and Chunk
+// Indexes, summary, footer) checked field by field against the spec with a parser and a CRC
+// independent of the library (tests/support/mcap_layout.h); the protobuf schema decoding a
+// recorded message through DynamicMessageFactory; truncation at thousands of cut points of
+// a chunked file and of its unchunked copy, with the messages each CRC covers; a writer
+// killed mid-session (fork + SIGKILL / _exit); write errors (/dev/full, a file size limit
+// hit mid-session); damaged chunks and other files the reader must reject or skip over;
+// and the official TypeScript reader (@mcap/core) reading our files, through their indexes
+// too, and refusing the damaged ones (tests/support/mcap_check.mjs).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <google/protobuf/api.pb.h>
 #include <google/protobuf/descriptor.h>
@@ -22,6 +26,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -30,6 +35,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "cohaptic/messages.pb.h"
@@ -38,6 +44,7 @@
 #include "proto/record/mcap_reader.h"
 #include "proto/record/mcap_writer.h"
 #include "proto/record/protobuf_schema.h"
+#include "support/mcap_layout.h"
 #include "support/process.h"
 #include "support/test_meshes.h"
 
@@ -45,65 +52,21 @@ namespace cohaptic::record {
 namespace {
 
 namespace fs = std::filesystem;
-using Bytes = std::vector<std::uint8_t>;
 using namespace std::chrono_literals;
 
-// ---- independent helpers: byte access, CRC and record walking written here ----
-
-Bytes read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return Bytes(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-void write_bytes(const fs::path& path, const Bytes& bytes) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-}
-
-std::uint64_t le(const Bytes& b, std::size_t at, int width) {
-  std::uint64_t value = 0;
-  for (int i = width - 1; i >= 0; --i) value = (value << 8) | b.at(at + static_cast<std::size_t>(i));
-  return value;
-}
-std::uint16_t le16(const Bytes& b, std::size_t at) { return static_cast<std::uint16_t>(le(b, at, 2)); }
-std::uint32_t le32(const Bytes& b, std::size_t at) { return static_cast<std::uint32_t>(le(b, at, 4)); }
-std::uint64_t le64(const Bytes& b, std::size_t at) { return le(b, at, 8); }
-std::string text(const Bytes& b, std::size_t at, std::size_t n) {
-  return std::string(reinterpret_cast<const char*>(b.data() + at), n);
-}
-
-// Bit by bit, as the definition goes (the library uses tables).
-std::uint32_t reference_crc(const Bytes& b, std::size_t begin, std::size_t end) {
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::size_t i = begin; i < end; ++i) {
-    c ^= b[i];
-    for (int bit = 0; bit < 8; ++bit) c = (c & 1u) ? (c >> 1) ^ 0xEDB88320u : c >> 1;
-  }
-  return ~c;
-}
-
-const std::string kMagic("\x89MCAP0\r\n", 8);
-
-struct RawRecord {
-  std::size_t offset;
-  std::uint8_t opcode;
-  std::uint64_t length;  // content
-  std::size_t content() const { return offset + 9; }
-  std::size_t end() const { return offset + 9 + static_cast<std::size_t>(length); }
-};
-
-// The records after the opening magic, up to and including the Footer.
-std::vector<RawRecord> walk(const Bytes& b) {
-  std::vector<RawRecord> records;
-  std::size_t at = 8;
-  while (at + 9 <= b.size()) {
-    RawRecord r{at, b[at], le64(b, at + 1)};
-    records.push_back(r);
-    at = r.end();
-    if (r.opcode == 0x02) break;
-  }
-  return records;
-}
+using Bytes = testing::Bytes;
+using testing::le16;
+using testing::le32;
+using testing::le64;
+using testing::RawChunk;
+using testing::RawRecord;
+using testing::read_chunk;
+using testing::read_bytes;
+using testing::reference_crc;
+using testing::text;
+using testing::walk;
+using testing::write_bytes;
+const std::string& kMagic = testing::kMcapMagicText;
 
 // Appends MCAP fields for hand-made files.
 struct Builder {
@@ -223,8 +186,12 @@ void write_messages(McapWriter& writer, const Channels& c, std::uint32_t first, 
   }
 }
 
-Channels record_session(const fs::path& path, std::uint32_t count) {
-  McapWriter writer(path);
+// Chunks of about 4 kB (some 50 messages), flushed by size only: where they end does not
+// depend on timing.
+const McapWriterOptions kSmallChunks{std::chrono::hours(1), 4096};
+
+Channels record_session(const fs::path& path, std::uint32_t count, McapWriterOptions options = kSmallChunks) {
+  McapWriter writer(path, options);
   const Channels c = open_channels(writer);
   write_messages(writer, c, 0, count);
   writer.close();
@@ -331,11 +298,24 @@ TEST(McapRoundTrip, SchemasChannelsAndThousandsOfMessages) {
   EXPECT_EQ(s.message_count, kCount);
   EXPECT_EQ(s.schema_count, 3);
   EXPECT_EQ(s.channel_count, 3u);
-  EXPECT_EQ(s.chunk_count, 0u);
+  const Bytes b = read_bytes(file);
+  const std::vector<RawRecord> records = walk(b);
+  const auto chunks = std::count_if(records.begin(), records.end(), [](const RawRecord& r) { return r.opcode == 0x06; });
+  EXPECT_GT(chunks, 50) << "4 kB chunks";
+  EXPECT_EQ(s.chunk_count, static_cast<std::uint32_t>(chunks));
   EXPECT_EQ(s.message_start_time_ns, kEpochNs);
   EXPECT_EQ(s.message_end_time_ns, kEpochNs + std::uint64_t{kCount - 1} * 1'000'000);
   EXPECT_EQ(s.channel_message_counts, per_channel);
   EXPECT_FALSE(reader.next().has_value()) << "next() after the end stays at the end";
+
+  // Every message in a chunk whose CRC matched, and the whole data section under Data End's.
+  const McapCrcCoverage& crc = reader.crc_coverage();
+  EXPECT_EQ(crc.checked_messages, kCount);
+  EXPECT_EQ(crc.unchecked_messages, 0u);
+  const auto data_end = std::find_if(records.begin(), records.end(), [](const RawRecord& r) { return r.opcode == 0x0F; });
+  ASSERT_NE(data_end, records.end());
+  EXPECT_EQ(crc.checked_through_offset, data_end->end());
+  EXPECT_EQ(crc.checked_end_time_ns, s.message_end_time_ns);
 }
 
 TEST(McapRoundTrip, AnEmptySessionIsAValidFile) {
@@ -351,17 +331,21 @@ TEST(McapRoundTrip, AnEmptySessionIsAValidFile) {
 
 // ---- the bytes on disk ----
 
-TEST(McapLayout, RecordsSummaryAndFooterFollowTheSpec) {
+TEST(McapLayout, ChunksIndexesSummaryAndFooterFollowTheSpec) {
   const fs::path file = testing::scratch_directory("mcap-layout") / "layout.mcap";
   const std::string schema_data = protobuf_schema_data(wire::ToolSample::descriptor());
   {
-    McapWriter writer(file);
+    McapWriter writer(file, McapWriterOptions{std::chrono::hours(1), std::size_t{1} << 20});
     EXPECT_EQ(writer.add_protobuf_schema(wire::ToolSample::descriptor()), 1);
     EXPECT_EQ(writer.add_channel(1, "/tool", "protobuf", {{"user", "0"}}), 1);
     writer.write(1, 7, 0x0102030405060708ull, 0x0102030405060700ull, Bytes{0xAA, 0xBB, 0xCC});
     writer.write(1, 8, 2000, 1900, Bytes{});
-    EXPECT_EQ(writer.message_count(), 2u);
-    writer.close();
+    writer.flush();  // the first chunk
+    EXPECT_EQ(writer.add_channel(0, "/raw", "application/octet-stream"), 2);
+    writer.write(2, 9, 3000, 3000, Bytes{0x01});
+    writer.write(1, 10, 2500, 2500, Bytes{0x02, 0x03});
+    EXPECT_EQ(writer.message_count(), 4u);
+    writer.close();  // the second chunk, then the summary
     EXPECT_TRUE(writer.is_closed());
   }
   const Bytes b = read_bytes(file);
@@ -370,23 +354,46 @@ TEST(McapLayout, RecordsSummaryAndFooterFollowTheSpec) {
   EXPECT_EQ(text(b, b.size() - 8, 8), kMagic);
 
   const std::vector<RawRecord> r = walk(b);
-  // Header, Schema, Channel, 2 Messages, Data End; summary: Schema, Channel, Statistics;
-  // 3 Summary Offsets; Footer.
+  // Header; Chunk, its Message Index; Chunk, its two Message Indexes (channels 1, 2); Data
+  // End; summary: Schema, 2 Channels, Statistics, 2 Chunk Indexes; 4 Summary Offsets; Footer.
   std::vector<int> opcodes;
   for (const auto& record : r) opcodes.push_back(record.opcode);
-  EXPECT_EQ(opcodes, (std::vector<int>{0x01, 0x03, 0x04, 0x05, 0x05, 0x0F, 0x03, 0x04, 0x0B, 0x0E, 0x0E, 0x0E, 0x02}));
-  ASSERT_EQ(r.size(), 13u);
+  EXPECT_EQ(opcodes, (std::vector<int>{0x01, 0x06, 0x07, 0x06, 0x07, 0x07, 0x0F, 0x03, 0x04, 0x04, 0x0B, 0x08, 0x08,
+                                       0x0E, 0x0E, 0x0E, 0x0E, 0x02}));
+  ASSERT_EQ(r.size(), 18u);
   EXPECT_EQ(r.back().end() + 8, b.size()) << "the Footer is followed by the magic and nothing else";
+  const auto bytes_of = [&](std::size_t begin, std::size_t end) {
+    return Bytes(b.begin() + static_cast<long>(begin), b.begin() + static_cast<long>(end));
+  };
+  const auto record_bytes = [&](const RawRecord& record) { return bytes_of(record.offset, record.end()); };
 
-  // Header: profile "", library "cohaptic".
+  // Header: profile "", library "cohaptic"; outside any chunk, as the first record must be.
   EXPECT_EQ(r[0].offset, 8u);
   EXPECT_EQ(r[0].length, 4u + 0 + 4 + 8);
   EXPECT_EQ(le32(b, r[0].content()), 0u);
   EXPECT_EQ(le32(b, r[0].content() + 4), 8u);
   EXPECT_EQ(text(b, r[0].content() + 8, 8), "cohaptic");
 
+  // The first Chunk: message start and end time, uncompressed size, the CRC of its records,
+  // compression "" (none), the records' u64 length, then the records.
+  const RawChunk first = read_chunk(b, r[1]);
+  EXPECT_EQ(first.message_start_time, 2000u);
+  EXPECT_EQ(first.message_end_time, 0x0102030405060708ull);
+  EXPECT_EQ(first.compression, "");
+  EXPECT_EQ(first.records_begin, r[1].content() + 40);
+  EXPECT_EQ(first.records_end, r[1].end()) << "the records fill the rest of the Chunk";
+  EXPECT_EQ(first.uncompressed_size, first.records_end - first.records_begin);
+  EXPECT_EQ(first.uncompressed_crc, reference_crc(b, first.records_begin, first.records_end));
+  const std::vector<RawRecord> in_first = testing::records_between(b, first.records_begin, first.records_end);
+  ASSERT_EQ(in_first.size(), 4u);
+  EXPECT_EQ(in_first.back().end(), first.records_end);
+  EXPECT_EQ(in_first[0].opcode, 0x03);
+  EXPECT_EQ(in_first[1].opcode, 0x04);
+  EXPECT_EQ(in_first[2].opcode, 0x05);
+  EXPECT_EQ(in_first[3].opcode, 0x05);
+
   // Schema: id, name, encoding, u32-prefixed data.
-  std::size_t at = r[1].content();
+  std::size_t at = in_first[0].content();
   EXPECT_EQ(le16(b, at), 1);
   const std::string name = "cohaptic.wire.ToolSample";
   EXPECT_EQ(le32(b, at + 2), name.size());
@@ -397,10 +404,10 @@ TEST(McapLayout, RecordsSummaryAndFooterFollowTheSpec) {
   at += 12;
   EXPECT_EQ(le32(b, at), schema_data.size());
   EXPECT_EQ(text(b, at + 4, schema_data.size()), schema_data);
-  EXPECT_EQ(r[1].length, 2 + 4 + name.size() + 4 + 8 + 4 + schema_data.size());
+  EXPECT_EQ(in_first[0].length, 2 + 4 + name.size() + 4 + 8 + 4 + schema_data.size());
 
   // Channel: id, schema id, topic, message encoding, Map<string, string>.
-  at = r[2].content();
+  at = in_first[1].content();
   EXPECT_EQ(le16(b, at), 1);
   EXPECT_EQ(le16(b, at + 2), 1);
   EXPECT_EQ(le32(b, at + 4), 5u);
@@ -412,64 +419,120 @@ TEST(McapLayout, RecordsSummaryAndFooterFollowTheSpec) {
   EXPECT_EQ(text(b, at + 33, 4), "user");
   EXPECT_EQ(le32(b, at + 37), 1u);
   EXPECT_EQ(text(b, at + 41, 1), "0");
-  EXPECT_EQ(r[2].length, 42u);
+  EXPECT_EQ(in_first[1].length, 42u);
 
   // Message: channel, sequence, log time, publish time, data; little-endian on disk.
-  at = r[3].content();
-  EXPECT_EQ(r[3].length, 22u + 3);
+  at = in_first[2].content();
+  EXPECT_EQ(in_first[2].length, 22u + 3);
   EXPECT_EQ(le16(b, at), 1);
   EXPECT_EQ(le32(b, at + 2), 7u);
-  EXPECT_EQ((Bytes(b.begin() + static_cast<long>(at) + 6, b.begin() + static_cast<long>(at) + 14)),
-            (Bytes{0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01}));
+  EXPECT_EQ(bytes_of(at + 6, at + 14), (Bytes{0x08, 0x07, 0x06, 0x05, 0x04, 0x03, 0x02, 0x01}));
   EXPECT_EQ(le64(b, at + 14), 0x0102030405060700ull);
-  EXPECT_EQ((Bytes(b.begin() + static_cast<long>(at) + 22, b.begin() + static_cast<long>(r[3].end()))),
-            (Bytes{0xAA, 0xBB, 0xCC}));
-  EXPECT_EQ(r[4].length, 22u);
-  EXPECT_EQ(le32(b, r[4].content() + 2), 8u);
+  EXPECT_EQ(bytes_of(at + 22, in_first[2].end()), (Bytes{0xAA, 0xBB, 0xCC}));
+  EXPECT_EQ(in_first[3].length, 22u);
+  EXPECT_EQ(le32(b, in_first[3].content() + 2), 8u);
+
+  // Message Index: channel, then (log time, offset from the start of the chunk's records)
+  // for each of its messages in the chunk.
+  const auto expect_index = [&](const RawRecord& index, std::uint16_t channel,
+                                const std::vector<std::pair<std::uint64_t, const RawRecord*>>& entries,
+                                const RawChunk& chunk) {
+    EXPECT_EQ(le16(b, index.content()), channel);
+    EXPECT_EQ(le32(b, index.content() + 2), entries.size() * 16);
+    EXPECT_EQ(index.length, 2 + 4 + entries.size() * 16);
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      EXPECT_EQ(le64(b, index.content() + 6 + 16 * k), entries[k].first) << "entry " << k;
+      EXPECT_EQ(le64(b, index.content() + 14 + 16 * k), entries[k].second->offset - chunk.records_begin) << "entry " << k;
+    }
+  };
+  expect_index(r[2], 1, {{0x0102030405060708ull, &in_first[2]}, {2000, &in_first[3]}}, first);
+
+  // The second Chunk: the channel added after the first flush, then its messages.
+  const RawChunk second = read_chunk(b, r[3]);
+  EXPECT_EQ(r[3].offset, r[2].end());
+  EXPECT_EQ(second.message_start_time, 2500u);
+  EXPECT_EQ(second.message_end_time, 3000u);
+  EXPECT_EQ(second.uncompressed_crc, reference_crc(b, second.records_begin, second.records_end));
+  const std::vector<RawRecord> in_second = testing::records_between(b, second.records_begin, second.records_end);
+  ASSERT_EQ(in_second.size(), 3u);
+  EXPECT_EQ(in_second[0].opcode, 0x04);
+  EXPECT_EQ(le16(b, in_second[0].content()), 2);
+  EXPECT_EQ(le16(b, in_second[0].content() + 2), 0) << "no schema";
+  EXPECT_EQ(le32(b, in_second[1].content() + 2), 9u);
+  EXPECT_EQ(le32(b, in_second[2].content() + 2), 10u);
+  expect_index(r[4], 1, {{2500, &in_second[2]}}, second);
+  expect_index(r[5], 2, {{3000, &in_second[1]}}, second);
 
   // Data End: the CRC of every byte before it.
-  EXPECT_EQ(r[5].length, 4u);
-  EXPECT_EQ(le32(b, r[5].content()), reference_crc(b, 0, r[5].offset));
+  EXPECT_EQ(r[6].length, 4u);
+  EXPECT_EQ(le32(b, r[6].content()), reference_crc(b, 0, r[6].offset));
 
   // Summary: the Schema and Channel records again, byte for byte, then Statistics.
-  const auto bytes_of = [&](const RawRecord& record) {
-    return Bytes(b.begin() + static_cast<long>(record.offset), b.begin() + static_cast<long>(record.end()));
-  };
-  EXPECT_EQ(bytes_of(r[6]), bytes_of(r[1]));
-  EXPECT_EQ(bytes_of(r[7]), bytes_of(r[2]));
-  at = r[8].content();
-  EXPECT_EQ(le64(b, at), 2u) << "message_count";
+  EXPECT_EQ(record_bytes(r[7]), record_bytes(in_first[0]));
+  EXPECT_EQ(record_bytes(r[8]), record_bytes(in_first[1]));
+  EXPECT_EQ(record_bytes(r[9]), record_bytes(in_second[0]));
+  at = r[10].content();
+  EXPECT_EQ(le64(b, at), 4u) << "message_count";
   EXPECT_EQ(le16(b, at + 8), 1) << "schema_count";
-  EXPECT_EQ(le32(b, at + 10), 1u) << "channel_count";
+  EXPECT_EQ(le32(b, at + 10), 2u) << "channel_count";
   EXPECT_EQ(le32(b, at + 14), 0u) << "attachment_count";
   EXPECT_EQ(le32(b, at + 18), 0u) << "metadata_count";
-  EXPECT_EQ(le32(b, at + 22), 0u) << "chunk_count";
+  EXPECT_EQ(le32(b, at + 22), 2u) << "chunk_count";
   EXPECT_EQ(le64(b, at + 26), 2000u) << "message_start_time";
   EXPECT_EQ(le64(b, at + 34), 0x0102030405060708ull) << "message_end_time";
-  EXPECT_EQ(le32(b, at + 42), 10u) << "channel_message_counts byte length";
+  EXPECT_EQ(le32(b, at + 42), 20u) << "channel_message_counts byte length";
   EXPECT_EQ(le16(b, at + 46), 1);
-  EXPECT_EQ(le64(b, at + 48), 2u);
-  EXPECT_EQ(r[8].length, 56u);
+  EXPECT_EQ(le64(b, at + 48), 3u);
+  EXPECT_EQ(le16(b, at + 56), 2);
+  EXPECT_EQ(le64(b, at + 58), 1u);
+  EXPECT_EQ(r[10].length, 66u);
+
+  // Chunk Index, one per chunk: its time range, where it is and how long, where each of its
+  // Message Index records is and their length, compression and sizes.
+  const auto expect_chunk_index = [&](const RawRecord& index, const RawRecord& chunk_record, const RawChunk& chunk,
+                                      const std::vector<std::pair<std::uint16_t, const RawRecord*>>& indexes) {
+    at = index.content();
+    EXPECT_EQ(le64(b, at), chunk.message_start_time);
+    EXPECT_EQ(le64(b, at + 8), chunk.message_end_time);
+    EXPECT_EQ(le64(b, at + 16), chunk_record.offset) << "chunk_start_offset";
+    EXPECT_EQ(le64(b, at + 24), chunk_record.end() - chunk_record.offset) << "chunk_length, prefix included";
+    EXPECT_EQ(le32(b, at + 32), indexes.size() * 10) << "message_index_offsets byte length";
+    at += 36;
+    for (const auto& [channel, message_index] : indexes) {
+      EXPECT_EQ(le16(b, at), channel);
+      EXPECT_EQ(le64(b, at + 2), message_index->offset);
+      at += 10;
+    }
+    EXPECT_EQ(le64(b, at), indexes.back().second->end() - chunk_record.end()) << "message_index_length";
+    EXPECT_EQ(le32(b, at + 8), 0u) << "compression \"\"";
+    EXPECT_EQ(le64(b, at + 12), chunk.records_end - chunk.records_begin) << "compressed_size";
+    EXPECT_EQ(le64(b, at + 20), chunk.uncompressed_size) << "uncompressed_size";
+    EXPECT_EQ(at + 28, index.end());
+  };
+  expect_chunk_index(r[11], r[1], first, {{1, &r[2]}});
+  expect_chunk_index(r[12], r[3], second, {{1, &r[4]}, {2, &r[5]}});
 
   // Summary Offsets: one per group, pointing at it.
-  const std::vector<std::pair<int, const RawRecord*>> groups = {{0x03, &r[6]}, {0x04, &r[7]}, {0x0B, &r[8]}};
+  const std::vector<std::tuple<int, const RawRecord*, const RawRecord*>> groups = {
+      {0x03, &r[7], &r[7]}, {0x04, &r[8], &r[9]}, {0x0B, &r[10], &r[10]}, {0x08, &r[11], &r[12]}};
   for (std::size_t g = 0; g < groups.size(); ++g) {
-    const RawRecord& offset = r[9 + g];
+    const auto& [op, group_first, group_last] = groups[g];
+    const RawRecord& offset = r[13 + g];
     EXPECT_EQ(offset.length, 17u);
-    EXPECT_EQ(b[offset.content()], groups[g].first);
-    EXPECT_EQ(le64(b, offset.content() + 1), groups[g].second->offset);
-    EXPECT_EQ(le64(b, offset.content() + 9), groups[g].second->end() - groups[g].second->offset);
+    EXPECT_EQ(b[offset.content()], op);
+    EXPECT_EQ(le64(b, offset.content() + 1), group_first->offset);
+    EXPECT_EQ(le64(b, offset.content() + 9), group_last->end() - group_first->offset);
   }
 
   // Footer: summary start, summary offset start, and the CRC from the summary through
   // the Footer's summary_offset_start field.
-  const RawRecord& footer = r[12];
+  const RawRecord& footer = r[17];
   EXPECT_EQ(footer.offset, b.size() - 8 - 29) << "the Footer is the last record";
   EXPECT_EQ(footer.length, 20u);
-  EXPECT_EQ(le64(b, footer.content()), r[6].offset);
-  EXPECT_EQ(r[6].offset, r[5].end()) << "the summary starts right after Data End";
-  EXPECT_EQ(le64(b, footer.content() + 8), r[9].offset);
-  EXPECT_EQ(le32(b, footer.content() + 16), reference_crc(b, r[6].offset, footer.content() + 16));
+  EXPECT_EQ(le64(b, footer.content()), r[7].offset);
+  EXPECT_EQ(r[7].offset, r[6].end()) << "the summary starts right after Data End";
+  EXPECT_EQ(le64(b, footer.content() + 8), r[13].offset);
+  EXPECT_EQ(le32(b, footer.content() + 16), reference_crc(b, r[7].offset, footer.content() + 16));
 }
 
 // ---- protobuf schemas ----
@@ -541,34 +604,37 @@ TEST(McapSchema, TheDescriptorSetHoldsEveryImportOnceBeforeItsImporters) {
 
 // ---- truncation ----
 
-TEST(McapTruncation, EveryCutYieldsExactlyTheMessagesCompleteBeforeIt) {
-  const fs::path dir = testing::scratch_directory("mcap-truncation");
-  const fs::path file = dir / "full.mcap";
-  constexpr std::uint32_t kCount = 1000;
-  const Channels c = record_session(file, kCount);
-  const Bytes b = read_bytes(file);
+// Cuts `b`, a file of the messages `expected` in order of log time, at thousands of points
+// (shortening one file): each cut yields exactly the messages whose top-level record (their
+// Chunk, or themselves outside chunks) is complete before it; the readable prefix ends with
+// the last complete record; and crc_coverage() counts them as checked when a Chunk's CRC
+// covers them (or Data End's, once the cut leaves it), as unchecked otherwise.
+void expect_every_cut_yields_the_messages_complete_before_it(const fs::path& dir, const Bytes& b,
+                                                             const std::vector<McapMessage>& expected) {
   const std::vector<RawRecord> records = walk(b);
-
-  std::vector<std::size_t> message_ends;
+  std::vector<std::size_t> readable_from;
+  for (const testing::RawMessage& m : testing::messages_of(b)) readable_from.push_back(m.readable_from);
+  ASSERT_EQ(readable_from.size(), expected.size());
   std::vector<std::size_t> record_ends = {8};
+  std::vector<std::size_t> chunk_ends = {0};
   for (const auto& r : records) {
-    if (r.opcode == 0x05) message_ends.push_back(r.end());
     record_ends.push_back(r.end());
+    if (r.opcode == 0x06) chunk_ends.push_back(r.end());
   }
   record_ends.push_back(b.size());
-  ASSERT_EQ(message_ends.size(), kCount);
-  std::vector<McapMessage> expected;
-  for (std::uint32_t i = 0; i < kCount; ++i) expected.push_back(expected_message(c, i));
+  const bool chunked = chunk_ends.size() > 1;
+  const auto first_of = [&](int opcode) {
+    return std::find_if(records.begin(), records.end(), [&](const RawRecord& r) { return r.opcode == opcode; });
+  };
+  ASSERT_NE(first_of(0x0F), records.end());
+  const RawRecord data_end = *first_of(0x0F);
 
   // Cut points: every byte of the first records and of the summary, footer and magic; the
   // edges of every 10th record (start, inside the prefix, just past it, last byte); and
   // every 37th byte elsewhere.
   std::set<std::size_t> cuts;
   for (std::size_t k = 0; k < 600 && k <= b.size(); ++k) cuts.insert(k);
-  const auto first_of = [&](int opcode) {
-    return std::find_if(records.begin(), records.end(), [&](const RawRecord& r) { return r.opcode == opcode; });
-  };
-  for (std::size_t k = message_ends.back() - 1; k <= first_of(0x0F)->end() + 200; ++k) cuts.insert(k);
+  for (std::size_t k = readable_from.back() - 1; k <= data_end.end() + 200; ++k) cuts.insert(k);
   for (std::size_t k = first_of(0x0B)->offset; k <= b.size(); ++k) cuts.insert(k);
   for (std::size_t i = 0; i < records.size(); i += (i < 20 || i + 20 > records.size()) ? 1 : 10) {
     for (std::size_t d : {0, 1, 8, 9, 10}) cuts.insert(records[i].offset + d);
@@ -577,7 +643,7 @@ TEST(McapTruncation, EveryCutYieldsExactlyTheMessagesCompleteBeforeIt) {
   for (std::size_t k = 0; k < b.size(); k += 37) cuts.insert(k);
 
   const fs::path cut_file = dir / "cut.mcap";
-  fs::copy_file(file, cut_file);
+  write_bytes(cut_file, b);
   std::size_t checked = 0;
   for (auto it = cuts.rbegin(); it != cuts.rend(); ++it) {  // from the longest, shortening one file
     const std::size_t cut = *it;
@@ -585,7 +651,7 @@ TEST(McapTruncation, EveryCutYieldsExactlyTheMessagesCompleteBeforeIt) {
     fs::resize_file(cut_file, cut);
     SCOPED_TRACE("cut at byte " + std::to_string(cut) + " of " + std::to_string(b.size()));
     const std::size_t complete_messages =
-        static_cast<std::size_t>(std::upper_bound(message_ends.begin(), message_ends.end(), cut) - message_ends.begin());
+        static_cast<std::size_t>(std::upper_bound(readable_from.begin(), readable_from.end(), cut) - readable_from.begin());
     const std::size_t valid = cut < 8 ? 0 : *(std::upper_bound(record_ends.begin(), record_ends.end(), cut) - 1);
 
     McapReader reader(cut_file);
@@ -599,24 +665,83 @@ TEST(McapTruncation, EveryCutYieldsExactlyTheMessagesCompleteBeforeIt) {
     if (cut >= 8 + 9 + 16) {
       EXPECT_EQ(reader.library(), "cohaptic");
     }
+
+    McapCrcCoverage coverage;
+    if (cut >= data_end.end()) {
+      coverage.checked_messages = expected.size();
+      coverage.checked_through_offset = data_end.end();
+    } else if (chunked) {
+      coverage.checked_messages = complete_messages;
+      coverage.checked_through_offset = *(std::upper_bound(chunk_ends.begin(), chunk_ends.end(), cut) - 1);
+    } else {
+      coverage.unchecked_messages = complete_messages;
+    }
+    if (coverage.checked_messages > 0) coverage.checked_end_time_ns = expected[coverage.checked_messages - 1].log_time_ns;
+    ASSERT_EQ(reader.crc_coverage(), coverage);
     ++checked;
   }
   EXPECT_GT(checked, 3000u);
   std::printf("checked %zu cut points of a %zu-byte file\n", checked, b.size());
+}
 
-  // The descriptions say where the file ends.
+std::vector<McapMessage> expected_messages(const Channels& c, std::uint32_t count) {
+  std::vector<McapMessage> expected;
+  for (std::uint32_t i = 0; i < count; ++i) expected.push_back(expected_message(c, i));
+  return expected;
+}
+
+TEST(McapTruncation, EveryCutOfAChunkedFileYieldsExactlyTheMessagesOfItsCompleteChunks) {
+  const fs::path dir = testing::scratch_directory("mcap-truncation");
+  const fs::path file = dir / "full.mcap";
+  constexpr std::uint32_t kCount = 1000;
+  const Channels c = record_session(file, kCount);
+  const Bytes b = read_bytes(file);
+  expect_every_cut_yields_the_messages_complete_before_it(dir, b, expected_messages(c, kCount));
+
+  // The descriptions say where the file ends: inside the fifth chunk, or right after it.
+  const std::vector<RawRecord> records = walk(b);
+  std::vector<RawRecord> chunks;
+  std::copy_if(records.begin(), records.end(), std::back_inserter(chunks), [](const RawRecord& r) { return r.opcode == 0x06; });
+  ASSERT_GT(chunks.size(), 10u);
+  const fs::path cut_file = dir / "cut.mcap";
   const auto cut_copy = [&](std::size_t n) { write_bytes(cut_file, Bytes(b.begin(), b.begin() + static_cast<long>(n))); };
-  cut_copy(message_ends[499] + 12);
+  const std::size_t in_first_four = testing::messages_of(Bytes(b.begin(), b.begin() + static_cast<long>(chunks[4].offset))).size();
+  cut_copy(chunks[4].offset + 9 + 100);
+  McapReader mid(cut_file);
+  EXPECT_EQ(read_all(mid).size(), in_first_four);
+  EXPECT_EQ(mid.truncation(), "file ends 100 bytes into the content of a " + std::to_string(chunks[4].length) +
+                                  "-byte Chunk record at offset " + std::to_string(chunks[4].offset));
+  cut_copy(chunks[4].end());
+  McapReader boundary(cut_file);
+  EXPECT_GT(read_all(boundary).size(), in_first_four);
+  EXPECT_EQ(boundary.truncation(), "file ends after the complete record ending at offset " +
+                                       std::to_string(chunks[4].end()) + ", without a Footer");
+}
+
+// A file without chunks (a recording written unchunked) reads record by record; no CRC
+// covers its messages until Data End.
+TEST(McapTruncation, EveryCutOfAnUnchunkedFileYieldsExactlyTheMessagesCompleteBeforeIt) {
+  const fs::path dir = testing::scratch_directory("mcap-truncation-unchunked");
+  constexpr std::uint32_t kCount = 1000;
+  const Channels c = record_session(dir / "chunked.mcap", kCount);
+  const Bytes b = testing::unchunked(read_bytes(dir / "chunked.mcap"));
+  const std::vector<RawRecord> records = walk(b);
+  ASSERT_TRUE(std::none_of(records.begin(), records.end(), [](const RawRecord& r) { return r.opcode == 0x06 || r.opcode == 0x07; }));
+  expect_every_cut_yields_the_messages_complete_before_it(dir, b, expected_messages(c, kCount));
+
+  const std::vector<testing::RawMessage> messages = testing::messages_of(b);
+  const fs::path cut_file = dir / "cut.mcap";
+  const auto cut_copy = [&](std::size_t n) { write_bytes(cut_file, Bytes(b.begin(), b.begin() + static_cast<long>(n))); };
+  cut_copy(messages[499].record.end() + 12);
   McapReader mid(cut_file);
   EXPECT_EQ(read_all(mid).size(), 500u);
-  EXPECT_EQ(mid.truncation(), "file ends 3 bytes into the content of a " +
-                                  std::to_string(records[7 + 500].length) + "-byte Message record at offset " +
-                                  std::to_string(message_ends[499]));
-  cut_copy(message_ends[499]);
+  EXPECT_EQ(mid.truncation(), "file ends 3 bytes into the content of a " + std::to_string(messages[500].record.length) +
+                                  "-byte Message record at offset " + std::to_string(messages[499].record.end()));
+  cut_copy(messages[499].record.end());
   McapReader boundary(cut_file);
   EXPECT_EQ(read_all(boundary).size(), 500u);
   EXPECT_EQ(boundary.truncation(), "file ends after the complete record ending at offset " +
-                                       std::to_string(message_ends[499]) + ", without a Footer");
+                                       std::to_string(messages[499].record.end()) + ", without a Footer");
 }
 
 // ---- a writer that dies ----
@@ -662,6 +787,8 @@ void expect_crash_leaves_flushed_messages(bool kill) {
   EXPECT_TRUE(reader.truncated());
   EXPECT_FALSE(reader.complete());
   EXPECT_EQ(reader.valid_bytes(), fs::file_size(file)) << "flushed records are whole";
+  EXPECT_EQ(reader.crc_coverage().checked_messages, kFlushed) << "each flush left a chunk with its CRC";
+  EXPECT_EQ(reader.crc_coverage().unchecked_messages, 0u);
 }
 
 TEST(McapCrash, AWriterKilledMidSessionLeavesEveryFlushedMessage) { expect_crash_leaves_flushed_messages(true); }
@@ -784,7 +911,10 @@ TEST(McapWriter, AWriteErrorMidSessionThrowsAndTheFileStaysReadable) {
   McapReader reader(file);
   const std::vector<McapMessage> got = read_all(reader);
   EXPECT_TRUE(reader.truncated());
-  EXPECT_GT(got.size(), 500u);
+  // Every message of the chunks written whole before the limit bit (the schemas take 20 kB).
+  EXPECT_EQ(got.size(), testing::messages_of(read_bytes(file)).size());
+  EXPECT_GT(got.size(), 300u);
+  EXPECT_EQ(reader.crc_coverage().checked_messages, got.size());
   Channels c;
   c.tool = 1;
   c.datagram = 2;
@@ -845,19 +975,86 @@ Bytes message_content(std::uint16_t channel, std::uint32_t sequence, const std::
 }
 Bytes footer_content() { return Builder{}.uint(0, 8).uint(0, 8).uint(0, 4).out; }
 
-TEST(McapReader, RejectsChunkedFiles) {
-  const fs::path file = testing::scratch_directory("mcap-chunked") / "chunked.mcap";
+// A Chunk's content around `records`: uncompressed unless `compression` says otherwise,
+// with their CRC unless `crc` is given (0: none computed).
+Bytes chunk_content(const Bytes& records, std::optional<std::uint32_t> crc = std::nullopt,
+                    const std::string& compression = "", std::optional<std::uint64_t> uncompressed_size = std::nullopt) {
+  Builder chunk;
+  chunk.uint(100, 8).uint(101, 8).uint(uncompressed_size.value_or(records.size()), 8);
+  chunk.uint(crc.value_or(reference_crc(records, 0, records.size())), 4).str(compression).uint(records.size(), 8);
+  chunk.out.insert(chunk.out.end(), records.begin(), records.end());
+  return chunk.out;
+}
+
+TEST(McapReader, ReadsChunksCheckingTheirCrcs) {
+  const fs::path file = testing::scratch_directory("mcap-chunks") / "chunks.mcap";
   Builder b;
   b.magic().record(0x01, header_content());
-  const Bytes records = Builder{}.record(0x03, schema_content(1)).record(0x04, channel_content(1, 1)).out;
-  Builder chunk;
-  chunk.uint(100, 8).uint(100, 8).uint(records.size(), 8).uint(0, 4).str("").uint(records.size(), 8);
-  chunk.out.insert(chunk.out.end(), records.begin(), records.end());
-  b.record(0x06, chunk.out).record(0x0F, Builder{}.uint(0, 4).out).record(0x02, footer_content()).magic();
+  Builder first;
+  first.record(0x03, schema_content(1)).record(0x04, channel_content(1, 1));
+  first.record(0x05, message_content(1, 1, "first")).record(0x80, Bytes{7, 7});  // a record of a later spec: skipped
+  first.record(0x05, message_content(1, 2, "second"));
+  b.record(0x06, chunk_content(first.out));
+  b.record(0x07, Builder{}.uint(1, 2).uint(0, 4).out);  // a Message Index: of no use when reading in order
+  const std::size_t unchecked_chunk = b.out.size();
+  b.record(0x06, chunk_content(Builder{}.record(0x05, message_content(1, 3, "third")).out, 0));
+  b.record(0x05, message_content(1, 4, "fourth"));  // outside any chunk
+  b.record(0x0F, Builder{}.uint(0, 4).out).record(0x02, footer_content()).magic();
   write_bytes(file, b.out);
+
   McapReader reader(file);
-  expect_error([&] { reader.next(); }, {file.string(), "chunked MCAP files are not supported", "offset 34"});
-  expect_error([&] { reader.next(); }, {"chunked"});  // and it stays failed
+  const std::vector<McapMessage> got = read_all(reader);
+  ASSERT_EQ(got.size(), 4u);
+  EXPECT_EQ(std::string(got[0].data.begin(), got[0].data.end()), "first");
+  EXPECT_EQ(got[1].sequence, 2u);
+  EXPECT_EQ(std::string(got[2].data.begin(), got[2].data.end()), "third");
+  EXPECT_EQ(got[3].log_time_ns, 104u);
+  EXPECT_EQ(reader.channels().size(), 1u);
+  EXPECT_TRUE(reader.complete());
+  // The first chunk's CRC matched; the second has none (0), the last message is outside
+  // chunks, and Data End carries no CRC either.
+  McapCrcCoverage coverage;
+  coverage.checked_messages = 2;
+  coverage.unchecked_messages = 2;
+  coverage.checked_through_offset = 34 + 9 + chunk_content(first.out).size();
+  coverage.checked_end_time_ns = 102;
+  EXPECT_EQ(reader.crc_coverage(), coverage);
+  EXPECT_LT(coverage.checked_through_offset, unchecked_chunk);
+}
+
+TEST(McapReader, RejectsDamagedAndMalformedChunksNamingThem) {
+  const fs::path dir = testing::scratch_directory("mcap-bad-chunks");
+  const Bytes records = Builder{}.record(0x03, schema_content(1)).record(0x04, channel_content(1, 1))
+                            .record(0x05, message_content(1, 1, "x")).out;
+  const auto expect_rejected = [&](const std::string& name, const Bytes& content, const std::vector<std::string>& parts) {
+    const fs::path file = dir / name;
+    Builder b;
+    b.magic().record(0x01, header_content()).record(0x06, content);
+    b.record(0x0F, Builder{}.uint(0, 4).out).record(0x02, footer_content()).magic();
+    write_bytes(file, b.out);
+    McapReader reader(file);
+    std::vector<std::string> all = parts;
+    all.push_back(file.string());
+    expect_error([&] { reader.next(); }, all);
+    expect_error([&] { reader.next(); }, all);  // and it stays failed
+  };
+  // The chunk at offset 34 (magic 8, Header 9 + 17): a wrong CRC yields none of its messages.
+  const std::uint32_t crc = reference_crc(records, 0, records.size());
+  expect_rejected("crc.mcap", chunk_content(records, crc ^ 0x10u),
+                  {"Chunk record at offset 34", "messages logged from 100 to 101 ns",
+                   fmt::format("recorded as {:08x} but computes to {:08x}", crc ^ 0x10u, crc)});
+  expect_rejected("zstd.mcap", chunk_content(records, std::nullopt, "zstd"),
+                  {"Chunk record at offset 34", "compressed ('zstd')"});
+  expect_rejected("size.mcap", chunk_content(records, std::nullopt, "", records.size() + 1),
+                  {"Chunk record at offset 34", fmt::format("uncompressed_size is {}", records.size() + 1)});
+  Bytes overrun = records;
+  overrun.resize(overrun.size() - 1);  // the message's content runs past the chunk's records
+  expect_rejected("overrun.mcap", chunk_content(overrun),
+                  {"Message record at offset", "inside the Chunk at offset 34", "run past the end of the chunk's records"});
+  expect_rejected("header.mcap", chunk_content(Builder{}.record(0x01, header_content()).out),
+                  {"Header record at offset 83 inside the Chunk at offset 34", "only Schema, Channel and Message"});
+  expect_rejected("orphan.mcap", chunk_content(Builder{}.record(0x05, message_content(1, 1, "x")).out),
+                  {"Message record at offset 83 inside the Chunk at offset 34", "which no earlier Channel record defines"});
 }
 
 TEST(McapReader, SkipsRecordTypesItDoesNotKnowAndFieldsAddedLater) {
@@ -919,14 +1116,32 @@ TEST(McapReader, RejectsMalformedAndCorruptFiles) {
   no_header.magic().record(0x03, schema_content(1));
   expect_rejected("no-header.mcap", no_header.out, "expected a Header record");
 
-  // One flipped bit inside a message's data: the structure holds, the data-section CRC does not.
+  // One flipped bit inside a message's data: the structure holds, its chunk's CRC does not,
+  // and none of that chunk's messages is returned.
   const fs::path good = dir / "good.mcap";
   record_session(good, 100);
-  Bytes corrupt = read_bytes(good);
-  const std::vector<RawRecord> records = walk(corrupt);
-  corrupt[records[60].content() + 23] ^= 0x04;
-  expect_rejected("corrupt.mcap", corrupt, "data section CRC-32");
-  Bytes corrupt_summary = read_bytes(good);
+  const Bytes intact = read_bytes(good);
+  const std::vector<RawRecord> records = walk(intact);
+  const std::vector<testing::RawMessage> messages = testing::messages_of(intact);
+  const auto first_chunk = std::find_if(records.begin(), records.end(),
+                                        [&](const RawRecord& r) { return r.end() == messages.front().readable_from; });
+  ASSERT_NE(first_chunk, records.end());
+  ASSERT_EQ(first_chunk->opcode, 0x06) << "the first message is in a chunk";
+  Bytes corrupt = intact;
+  corrupt[messages[5].record.content() + 23] ^= 0x04;
+  ASSERT_EQ(messages[5].readable_from, first_chunk->end());
+  expect_rejected("corrupt.mcap", corrupt, "Chunk record at offset " + std::to_string(first_chunk->offset));
+  {
+    McapReader reader(dir / "corrupt.mcap");
+    EXPECT_THROW(reader.next(), Error) << "the first message comes from the damaged chunk";
+  }
+  // A Message Index lies outside chunks: the data-section CRC covers it.
+  const RawRecord& index = *(first_chunk + 1);
+  ASSERT_EQ(index.opcode, 0x07);
+  Bytes corrupt_index = intact;
+  corrupt_index[index.content() + 10] ^= 0x01;
+  expect_rejected("corrupt-index.mcap", corrupt_index, "data section CRC-32");
+  Bytes corrupt_summary = intact;
   corrupt_summary[corrupt_summary.size() - 8 - 29 - 40] ^= 0x01;  // a group_start in the Summary Offsets
   expect_rejected("corrupt-summary.mcap", corrupt_summary, "summary CRC-32");
 }
@@ -994,13 +1209,19 @@ TEST(McapWriter, TheOfficialReaderReadsOurFiles) {
     nlohmann::json& indexed = j["indexed"];
     EXPECT_EQ(indexed["channels"].get<std::vector<std::string>>(), topics);
     EXPECT_EQ(indexed["schemas"].get<std::vector<std::string>>(), schemas);
-    EXPECT_EQ(indexed["chunkCount"], 0);
-    EXPECT_EQ(indexed["summaryOffsetOpcodes"].get<std::vector<int>>(), (std::vector<int>{0x03, 0x04, 0x0B}));
+    const std::vector<RawRecord> records = walk(read_bytes(full));
+    const auto chunks = std::count_if(records.begin(), records.end(), [](const RawRecord& r) { return r.opcode == 0x06; });
+    EXPECT_GT(chunks, 10);
+    EXPECT_EQ(indexed["chunkCount"], chunks);
+    EXPECT_EQ(indexed["summaryOffsetOpcodes"].get<std::vector<int>>(), (std::vector<int>{0x03, 0x04, 0x08, 0x0B}));
     EXPECT_EQ(indexed["statistics"]["messageCount"], kCount);
     EXPECT_EQ(indexed["statistics"]["channelCount"], 3);
     EXPECT_EQ(indexed["statistics"]["messageStartTime"], std::to_string(kEpochNs));
+    // The indexed reader finds every message through the Chunk Index and Message Index records.
+    EXPECT_EQ(indexed["messageCount"], kCount);
     for (const auto& topic : topics) {
       EXPECT_EQ(indexed["statistics"]["channelMessageCounts"][topic], kCount / 3) << topic;
+      EXPECT_EQ(indexed["channelMessageCounts"][topic], kCount / 3) << topic;
       EXPECT_EQ(j["channelMessageCounts"][topic], kCount / 3) << topic;
     }
     // Recomputed with Node's zlib when it has crc32 (Node 20.15 and later).
@@ -1008,7 +1229,7 @@ TEST(McapWriter, TheOfficialReaderReadsOurFiles) {
   }
 
   const Bytes b = read_bytes(full);
-  const std::vector<RawRecord> records = walk(b);
+  const std::vector<testing::RawMessage> messages = testing::messages_of(b);
   const auto official_and_ours_agree_on_a_cut = [&](std::size_t cut, const std::string& name) {
     SCOPED_TRACE(name + " at byte " + std::to_string(cut));
     const fs::path file = dir / name;
@@ -1024,12 +1245,42 @@ TEST(McapWriter, TheOfficialReaderReadsOurFiles) {
     EXPECT_EQ(j["channels"].get<std::vector<std::string>>(), topics);
     return ours;
   };
-  // Inside the 1501st message (records: Header, 3 Schemas, 3 Channels, then messages).
-  const RawRecord& inside = records[7 + 1500];
-  ASSERT_EQ(inside.opcode, 0x05);
-  EXPECT_EQ(official_and_ours_agree_on_a_cut(inside.offset + 20, "cut-inside.mcap"), 1500u);
-  // Right after the 1000th message, as a crashed writer leaves it.
-  EXPECT_EQ(official_and_ours_agree_on_a_cut(records[7 + 999].end(), "cut-boundary.mcap"), 1000u);
+  const auto readable_at = [&](std::size_t cut) {
+    return static_cast<std::size_t>(std::count_if(messages.begin(), messages.end(),
+                                                  [&](const testing::RawMessage& m) { return m.readable_from <= cut; }));
+  };
+  // Inside the 1501st message, so inside its chunk: that chunk is lost whole.
+  const std::size_t inside = messages[1500].record.offset + 20;
+  EXPECT_LT(readable_at(inside), 1500u);
+  EXPECT_EQ(official_and_ours_agree_on_a_cut(inside, "cut-inside.mcap"), readable_at(inside));
+  // Right after the chunk of the 1000th message, as a crashed writer leaves it.
+  const std::size_t boundary = messages[999].readable_from;
+  EXPECT_GE(readable_at(boundary), 1000u);
+  EXPECT_EQ(official_and_ours_agree_on_a_cut(boundary, "cut-boundary.mcap"), readable_at(boundary));
+
+  {  // that cut with a byte flipped in its last complete chunk: both readers check the chunk's CRC
+    const fs::path file = dir / "cut-flipped.mcap";
+    Bytes cut(b.begin(), b.begin() + static_cast<long>(boundary));
+    cut[messages[999].record.content() + 22] ^= 0x20;
+    write_bytes(file, cut);
+    McapReader reader(file);
+    EXPECT_THROW(read_all(reader), Error);
+    const NodeRun run = run_mcap_check(file, dir / "cut-flipped.stderr");
+    EXPECT_EQ(run.status, 1) << run.output << run.errors;
+    EXPECT_NE(run.output.find("Incorrect chunk CRC"), std::string::npos) << run.output;
+  }
+
+  {  // an unchunked copy, as recordings written without chunks are: valid, every message read from the front
+    const fs::path file = dir / "unchunked.mcap";
+    write_bytes(file, testing::unchunked(b));
+    nlohmann::json j = check(file);
+    EXPECT_EQ(j["complete"], true) << j.dump();
+    EXPECT_EQ(j["messageCount"], kCount);
+    EXPECT_EQ(j["indexed"]["chunkCount"], 0);
+    EXPECT_EQ(j["indexed"]["messageCount"], 0) << "no chunks: nothing indexed";
+    EXPECT_EQ(j["indexed"]["summaryOffsetOpcodes"].get<std::vector<int>>(), std::vector<int>{});
+    EXPECT_NE(j["indexed"]["dataSectionCrcOk"], false) << j.dump();
+  }
 
   {  // a session without messages
     const fs::path empty = dir / "empty.mcap";

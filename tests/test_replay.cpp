@@ -1,6 +1,7 @@
 // Replay of recorded sessions with the real programs: a two-user session's three recordings
 // verify bit for bit; a changed value is found and named; a client killed mid-session
-// leaves a recording that reads (and verifies) up to its last complete record.
+// leaves a recording that reads (and verifies) up to its last complete chunk, every message
+// checked by its chunk's CRC.
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -20,6 +21,7 @@
 #include "proto/wire/vec3_convert.h"
 #include "support/cube_scene.h"
 #include "support/process.h"
+#include "support/run_program.h"
 
 namespace cohaptic {
 namespace {
@@ -201,8 +203,21 @@ segments:
   EXPECT_GE(recording.ticks.size(), on_disk_before_kill) << "every tick flushed before the kill is still readable";
   const VerifyResult result = verify_recording(session.dir / "a.mcap");
   EXPECT_TRUE(result.ok) << result.first_difference;
-  std::printf("  killed with %zu ticks on disk: %zu ticks readable (%s), all verified\n", on_disk_before_kill,
-              recording.ticks.size(), recording.truncation.c_str());
+  // Every message read lies in a chunk whose CRC matched, and replay says so.
+  EXPECT_GT(recording.crc.checked_messages, recording.ticks.size());
+  EXPECT_EQ(recording.crc.unchecked_messages, 0u);
+  ASSERT_TRUE(recording.crc.checked_end_time_ns.has_value());
+  EXPECT_GE(*recording.crc.checked_end_time_ns, static_cast<std::uint64_t>(recording.ticks.back().time_ns()));
+  const testing::ProgramRun replay =
+      testing::run_program(COHAPTIC_LAB_EXE, "replay '" + (session.dir / "a.mcap").string() + "' --verify");
+  EXPECT_EQ(replay.exit_code, 0) << replay.out;
+  const std::string line = record::describe_cut(recording);
+  EXPECT_NE(line.find(fmt::format("cut short at byte {}: everything up to t = ", fs::file_size(session.dir / "a.mcap"))),
+            std::string::npos) << line;
+  EXPECT_NE(line.find(" s is checked by its chunks' CRCs"), std::string::npos) << line;
+  EXPECT_NE(replay.out.find("verify: " + line + "\n"), std::string::npos) << replay.out;
+  std::printf("  killed with %zu ticks on disk: %zu ticks readable (%s), all verified; %s\n", on_disk_before_kill,
+              recording.ticks.size(), recording.truncation.c_str(), line.c_str());
 }
 
 // The deepest point (smallest z) of the own tool and the peak force of a client recording.

@@ -42,6 +42,12 @@ inline constexpr std::size_t kMessageFixedBytes = 22;
 inline constexpr std::size_t kFooterContentBytes = 20;
 /// DataEnd content: data_section_crc (4).
 inline constexpr std::size_t kDataEndContentBytes = 4;
+/// Chunk content before its records when its compression is "" (none): message start and
+/// end time (8 + 8), uncompressed_size (8), uncompressed_crc (4), compression (4 + 0) and
+/// the records' u64 length (8).
+inline constexpr std::size_t kChunkFieldsBytes = 40;
+/// One entry of a Message Index record: a message's log time (8) and its offset (8).
+inline constexpr std::size_t kMessageIndexEntryBytes = 16;
 
 /// The record's name in the spec ("Message", "Chunk", ...), or "unknown (0xNN)".
 std::string mcap_opcode_name(std::uint8_t opcode);

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
+#include <utility>
 
 #include "common/util/error.h"
 #include "proto/record/mcap_bytes.h"
@@ -19,6 +21,12 @@ std::uint64_t le64(const std::uint8_t* bytes) {
   for (int i = 7; i >= 0; --i) value = (value << 8) | bytes[i];
   return value;
 }
+
+// The records the spec allows inside a Chunk; every other opcode it defines is misplaced there.
+bool belongs_in_chunk(std::uint8_t op) {
+  return op == opcode::kSchema || op == opcode::kChannel || op == opcode::kMessage;
+}
+bool defined_by_spec(std::uint8_t op) { return op >= opcode::kHeader && op <= opcode::kDataEnd; }
 
 }  // namespace
 
@@ -42,7 +50,7 @@ McapReader::McapReader(std::filesystem::path path) : path_(std::move(path)) {
     throw Error(fmt::format("{}: expected a Header record after the magic, found a {} record", path_.string(),
                             mcap_opcode_name(prefix_[0])));
   }
-  dispatch();
+  dispatch_record();
 }
 
 void McapReader::fail_io(const char* operation) {
@@ -127,9 +135,16 @@ bool McapReader::read_record() {
 std::optional<McapMessage> McapReader::next() {
   if (state_ == State::failed) throw Error(failure_);
   try {
-    while (state_ == State::reading) {
+    while (chunk_next_ < chunk_end_ || state_ == State::reading) {
+      if (chunk_next_ < chunk_end_) {
+        if (auto message = next_in_chunk()) return message;
+        continue;
+      }
       if (!read_record()) return std::nullopt;
-      if (auto message = dispatch()) return message;
+      if (auto message = dispatch_record()) {
+        count(*message, false);
+        return message;
+      }
     }
   } catch (const Error& e) {
     state_ = State::failed;
@@ -139,104 +154,189 @@ std::optional<McapMessage> McapReader::next() {
   return std::nullopt;
 }
 
-std::optional<McapMessage> McapReader::dispatch() {
-  const std::uint8_t op = prefix_[0];
-  ByteCursor cursor(content_);
+std::optional<McapMessage> McapReader::dispatch_record() {
   try {
-    switch (op) {
-      case opcode::kHeader: {
-        if (header_seen_) throw Error("a second Header record");
-        header_seen_ = true;
-        profile_ = cursor.string("profile");
-        library_ = cursor.string("library");
-        return std::nullopt;
-      }
-      case opcode::kSchema: {
-        McapSchema schema;
-        schema.id = cursor.u16("id");
-        schema.name = cursor.string("name");
-        schema.encoding = cursor.string("encoding");
-        schema.data = cursor.string("data");
-        if (schema.id == 0) return std::nullopt;  // invalid by the spec: ignored
-        const auto [it, inserted] = schemas_.try_emplace(schema.id, schema);
-        if (!inserted && it->second != schema) {
-          throw Error(fmt::format("schema {} ('{}') differs from the earlier schema with that id", schema.id,
-                                  schema.name));
-        }
-        return std::nullopt;
-      }
-      case opcode::kChannel: {
-        McapChannel channel;
-        channel.id = cursor.u16("id");
-        channel.schema_id = cursor.u16("schema_id");
-        channel.topic = cursor.string("topic");
-        channel.message_encoding = cursor.string("message_encoding");
-        channel.metadata = read_string_map(cursor, "metadata");
-        if (channel.schema_id != 0 && !schemas_.contains(channel.schema_id)) {
-          throw Error(fmt::format("channel {} ('{}') refers to schema {}, which no earlier record defines", channel.id,
-                                  channel.topic, channel.schema_id));
-        }
-        const auto [it, inserted] = channels_.try_emplace(channel.id, channel);
-        if (!inserted && it->second != channel) {
-          throw Error(fmt::format("channel {} ('{}') differs from the earlier channel with that id", channel.id,
-                                  channel.topic));
-        }
-        return std::nullopt;
-      }
-      case opcode::kMessage: {
-        McapMessage message;
-        message.channel_id = cursor.u16("channel_id");
-        message.sequence = cursor.u32("sequence");
-        message.log_time_ns = cursor.u64("log_time");
-        message.publish_time_ns = cursor.u64("publish_time");
-        const auto data = cursor.rest();
-        message.data.assign(data.begin(), data.end());
-        if (!channels_.contains(message.channel_id)) {
-          throw Error(fmt::format("message on channel {}, which no earlier Channel record defines",
-                                  message.channel_id));
-        }
-        return message;
-      }
-      case opcode::kChunk:
-        throw Error("chunked MCAP files are not supported (cohaptic writes its recordings unchunked)");
-      case opcode::kDataEnd: {
-        const std::uint32_t recorded = cursor.u32("data_section_crc");
-        if (recorded != 0 && recorded != data_crc_.value()) {
-          throw Error(fmt::format("data section CRC-32 is recorded as {:08x} but computes to {:08x}: the file is "
-                                  "corrupt",
-                                  recorded, data_crc_.value()));
-        }
-        data_end_seen_ = true;
-        summary_begin_ = offset_;
-        return std::nullopt;
-      }
-      case opcode::kStatistics: {
-        McapStatistics s;
-        s.message_count = cursor.u64("message_count");
-        s.schema_count = cursor.u16("schema_count");
-        s.channel_count = cursor.u32("channel_count");
-        s.attachment_count = cursor.u32("attachment_count");
-        s.metadata_count = cursor.u32("metadata_count");
-        s.chunk_count = cursor.u32("chunk_count");
-        s.message_start_time_ns = cursor.u64("message_start_time");
-        s.message_end_time_ns = cursor.u64("message_end_time");
-        ByteCursor counts = cursor.prefixed("channel_message_counts");
-        while (counts.remaining() > 0) {
-          const std::uint16_t channel = counts.u16("channel_message_counts");
-          s.channel_message_counts[channel] = counts.u64("channel_message_counts");
-        }
-        statistics_ = std::move(s);
-        return std::nullopt;
-      }
-      case opcode::kFooter:
-        read_footer();
-        return std::nullopt;
-      default:  // unknown records, and known ones of no use here: skipped
-        return std::nullopt;
-    }
+    return dispatch(prefix_[0], content_);
   } catch (const Error& e) {
-    throw Error(fmt::format("{}: {} record at offset {}: {}", path_.string(), mcap_opcode_name(op), record_offset_,
-                            e.what()));
+    throw Error(fmt::format("{}: {} record at offset {}: {}", path_.string(), mcap_opcode_name(prefix_[0]),
+                            record_offset_, e.what()));
+  }
+}
+
+void McapReader::open_chunk() {
+  ByteCursor cursor(content_);
+  const std::uint64_t start_time = cursor.u64("message_start_time");
+  const std::uint64_t end_time = cursor.u64("message_end_time");
+  const std::uint64_t uncompressed_size = cursor.u64("uncompressed_size");
+  const std::uint32_t recorded_crc = cursor.u32("uncompressed_crc");
+  const std::string compression = cursor.string("compression");
+  const std::uint64_t records_size = cursor.u64("records");
+  const std::size_t records_begin = content_.size() - cursor.remaining();
+  const auto records = cursor.bytes(static_cast<std::size_t>(std::min<std::uint64_t>(records_size, SIZE_MAX)), "records");
+  if (!compression.empty()) {
+    throw Error(fmt::format("its records are compressed ('{}'): only uncompressed chunks are read", compression));
+  }
+  if (uncompressed_size != records.size()) {
+    throw Error(fmt::format("uncompressed_size is {} but its records take {} bytes", uncompressed_size, records.size()));
+  }
+  chunk_checked_ = recorded_crc != 0;  // 0: no CRC computed, by the spec
+  if (chunk_checked_) {
+    const std::uint32_t computed = crc32(records);
+    if (computed != recorded_crc) {
+      throw Error(fmt::format("the CRC-32 of its records (messages logged from {} to {} ns) is recorded as {:08x} but "
+                              "computes to {:08x}: the chunk is corrupt",
+                              start_time, end_time, recorded_crc, computed));
+    }
+    coverage_.checked_through_offset = offset_;
+  }
+  chunk_offset_ = record_offset_;
+  chunk_next_ = records_begin;
+  chunk_end_ = records_begin + records.size();
+  std::swap(chunk_, content_);
+}
+
+std::optional<McapMessage> McapReader::next_in_chunk() {
+  const std::size_t at = chunk_next_;
+  const auto fail = [&](const std::string& record, const std::string& what) {
+    return Error(fmt::format("{}: {} at offset {} inside the Chunk at offset {}: {}", path_.string(), record,
+                             chunk_offset_ + kRecordPrefixBytes + at, chunk_offset_, what));
+  };
+  const std::size_t available = chunk_end_ - at;
+  if (available < kRecordPrefixBytes) {
+    throw fail("a record", fmt::format("its 9-byte prefix runs past the end of the chunk's records ({} bytes left)",
+                                       available));
+  }
+  const std::uint8_t op = chunk_[at];
+  const std::uint64_t length = le64(chunk_.data() + at + 1);
+  const auto name = [op] { return mcap_opcode_name(op) + " record"; };  // for errors only
+  if (length > available - kRecordPrefixBytes) {
+    throw fail(name(), fmt::format("its {} bytes of content run past the end of the chunk's records ({} bytes left)",
+                                 length, available - kRecordPrefixBytes));
+  }
+  chunk_next_ = at + kRecordPrefixBytes + static_cast<std::size_t>(length);
+  if (!belongs_in_chunk(op)) {
+    if (defined_by_spec(op)) throw fail(name(), "only Schema, Channel and Message records belong in a Chunk");
+    return std::nullopt;  // a record type of a later version of the spec
+  }
+  std::optional<McapMessage> message;
+  try {
+    message = dispatch(op, std::span<const std::uint8_t>(chunk_).subspan(at + kRecordPrefixBytes, length));
+  } catch (const Error& e) {
+    throw fail(name(), e.what());
+  }
+  if (message) count(*message, chunk_checked_);
+  return message;
+}
+
+void McapReader::count(const McapMessage& message, bool checked) {
+  messages_end_time_ = std::max(messages_end_time_.value_or(0), message.log_time_ns);
+  if (!checked) {
+    ++coverage_.unchecked_messages;
+    return;
+  }
+  ++coverage_.checked_messages;
+  coverage_.checked_end_time_ns = std::max(coverage_.checked_end_time_ns.value_or(0), message.log_time_ns);
+}
+
+std::optional<McapMessage> McapReader::dispatch(std::uint8_t op, std::span<const std::uint8_t> content) {
+  ByteCursor cursor(content);
+  switch (op) {
+    case opcode::kHeader: {
+      if (header_seen_) throw Error("a second Header record");
+      header_seen_ = true;
+      profile_ = cursor.string("profile");
+      library_ = cursor.string("library");
+      return std::nullopt;
+    }
+    case opcode::kSchema: {
+      McapSchema schema;
+      schema.id = cursor.u16("id");
+      schema.name = cursor.string("name");
+      schema.encoding = cursor.string("encoding");
+      schema.data = cursor.string("data");
+      if (schema.id == 0) return std::nullopt;  // invalid by the spec: ignored
+      const auto [it, inserted] = schemas_.try_emplace(schema.id, schema);
+      if (!inserted && it->second != schema) {
+        throw Error(fmt::format("schema {} ('{}') differs from the earlier schema with that id", schema.id,
+                                schema.name));
+      }
+      return std::nullopt;
+    }
+    case opcode::kChannel: {
+      McapChannel channel;
+      channel.id = cursor.u16("id");
+      channel.schema_id = cursor.u16("schema_id");
+      channel.topic = cursor.string("topic");
+      channel.message_encoding = cursor.string("message_encoding");
+      channel.metadata = read_string_map(cursor, "metadata");
+      if (channel.schema_id != 0 && !schemas_.contains(channel.schema_id)) {
+        throw Error(fmt::format("channel {} ('{}') refers to schema {}, which no earlier record defines", channel.id,
+                                channel.topic, channel.schema_id));
+      }
+      const auto [it, inserted] = channels_.try_emplace(channel.id, channel);
+      if (!inserted && it->second != channel) {
+        throw Error(fmt::format("channel {} ('{}') differs from the earlier channel with that id", channel.id,
+                                channel.topic));
+      }
+      return std::nullopt;
+    }
+    case opcode::kMessage: {
+      McapMessage message;
+      message.channel_id = cursor.u16("channel_id");
+      message.sequence = cursor.u32("sequence");
+      message.log_time_ns = cursor.u64("log_time");
+      message.publish_time_ns = cursor.u64("publish_time");
+      const auto data = cursor.rest();
+      message.data.assign(data.begin(), data.end());
+      if (!channels_.contains(message.channel_id)) {
+        throw Error(fmt::format("message on channel {}, which no earlier Channel record defines",
+                                message.channel_id));
+      }
+      return message;
+    }
+    case opcode::kChunk:
+      open_chunk();
+      return std::nullopt;
+    case opcode::kDataEnd: {
+      const std::uint32_t recorded = cursor.u32("data_section_crc");
+      if (recorded != 0 && recorded != data_crc_.value()) {
+        throw Error(fmt::format("data section CRC-32 is recorded as {:08x} but computes to {:08x}: the file is "
+                                "corrupt",
+                                recorded, data_crc_.value()));
+      }
+      data_end_seen_ = true;
+      summary_begin_ = offset_;
+      if (recorded != 0) {  // it covers every message of the data section
+        coverage_.checked_messages += coverage_.unchecked_messages;
+        coverage_.unchecked_messages = 0;
+        coverage_.checked_end_time_ns = messages_end_time_;
+        coverage_.checked_through_offset = offset_;
+      }
+      return std::nullopt;
+    }
+    case opcode::kStatistics: {
+      McapStatistics s;
+      s.message_count = cursor.u64("message_count");
+      s.schema_count = cursor.u16("schema_count");
+      s.channel_count = cursor.u32("channel_count");
+      s.attachment_count = cursor.u32("attachment_count");
+      s.metadata_count = cursor.u32("metadata_count");
+      s.chunk_count = cursor.u32("chunk_count");
+      s.message_start_time_ns = cursor.u64("message_start_time");
+      s.message_end_time_ns = cursor.u64("message_end_time");
+      ByteCursor counts = cursor.prefixed("channel_message_counts");
+      while (counts.remaining() > 0) {
+        const std::uint16_t channel = counts.u16("channel_message_counts");
+        s.channel_message_counts[channel] = counts.u64("channel_message_counts");
+      }
+      statistics_ = std::move(s);
+      return std::nullopt;
+    }
+    case opcode::kFooter:
+      read_footer();
+      return std::nullopt;
+    default:  // unknown records, and known ones of no use here: skipped
+      return std::nullopt;
   }
 }
 

@@ -6,6 +6,7 @@
 #include <compare>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,20 @@ struct McapMessage {
   std::uint64_t publish_time_ns = 0;
   std::vector<std::uint8_t> data;  ///< encoded per the channel's message_encoding
   bool operator==(const McapMessage&) const = default;
+};
+
+/// What the CRCs of a file vouch for among the messages McapReader has yielded so far. A CRC
+/// counts once the reader has checked it: a Chunk's before any of its messages is yielded,
+/// Data End's (over the whole data section) once the reader reaches it. A file cut short has
+/// no Data End: only its chunks' CRCs cover it, and its messages outside chunks are unchecked.
+struct McapCrcCoverage {
+  std::uint64_t checked_messages = 0;    ///< covered by a CRC that matched
+  std::uint64_t unchecked_messages = 0;  ///< covered by none (yet)
+  /// File offset just past the last record whose CRC matched (a Chunk, or Data End); 0: none.
+  std::uint64_t checked_through_offset = 0;
+  /// The latest log time among the checked messages (ns); absent when there are none.
+  std::optional<std::uint64_t> checked_end_time_ns;
+  bool operator==(const McapCrcCoverage&) const = default;
 };
 
 /// The Statistics record of a file's summary section.

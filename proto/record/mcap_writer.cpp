@@ -35,7 +35,7 @@ McapWriter::McapWriter(std::filesystem::path path, McapWriterOptions options)
   }
   // Our own buffer decides when bytes reach the file; stdio adds no second one.
   std::setvbuf(file_.get(), nullptr, _IONBF, 0);
-  pending_.reserve(std::min(options_.flush_bytes, std::size_t{1} << 20) + 4096);
+  chunk_.reserve(std::min(options_.flush_bytes, std::size_t{1} << 20) + 4096);
 
   ByteBuffer header;
   put_bytes(header, kMcapMagic);
@@ -43,8 +43,8 @@ McapWriter::McapWriter(std::filesystem::path path, McapWriterOptions options)
   put_string(header, "");  // profile: none of the well-known ones applies to protobuf
   put_string(header, kLibrary);
   end_record(header, start);
-  append(header);
-  flush();
+  write_now(header, true);
+  last_flush_ = std::chrono::steady_clock::now();
 }
 
 McapWriter::~McapWriter() {
@@ -67,7 +67,7 @@ void McapWriter::fail(std::string_view operation) {
   const int error = errno;
   state_ = State::failed;
   failure_ = fmt::format("cannot {} MCAP file {}: {}", operation, path_.string(), reason(error));
-  pending_.clear();
+  chunk_.clear();
   throw Error(failure_);
 }
 
@@ -116,6 +116,7 @@ std::uint16_t McapWriter::add_channel(std::uint16_t schema_id, std::string_view 
   append(record);
   channel_records_.push_back(std::move(record));
   channel_message_counts_.push_back(0);
+  chunk_entries_.emplace_back();
   maybe_flush();
   return id;
 }
@@ -126,16 +127,30 @@ void McapWriter::write(std::uint16_t channel_id, std::uint32_t sequence, std::ui
   if (channel_id == 0 || channel_id > channel_records_.size()) {
     throw Error(fmt::format("MCAP file {}: message on unknown channel {}", path_.string(), channel_id));
   }
-  const std::size_t start = pending_.size();
-  put_u8(pending_, opcode::kMessage);
-  put_u64(pending_, kMessageFixedBytes + data.size());
-  put_u16(pending_, channel_id);
-  put_u32(pending_, sequence);
-  put_u64(pending_, log_time_ns);
-  put_u64(pending_, publish_time_ns);
-  put_bytes(pending_, data);
-  data_crc_.update(std::span<const std::uint8_t>(pending_).subspan(start));
+  start_chunk();
+  const std::size_t start = chunk_.size();
+  put_u8(chunk_, opcode::kMessage);
+  put_u64(chunk_, kMessageFixedBytes + data.size());
+  put_u16(chunk_, channel_id);
+  put_u32(chunk_, sequence);
+  put_u64(chunk_, log_time_ns);
+  put_u64(chunk_, publish_time_ns);
+  put_bytes(chunk_, data);
 
+  std::vector<IndexEntry>& entries = chunk_entries_[channel_id - 1];
+  if (entries.empty()) {
+    chunk_channels_.push_back(channel_id);
+    index_bytes_ += kRecordPrefixBytes + 2 + 4;  // channel_id, the entries' byte length
+  }
+  entries.push_back({log_time_ns, start - kRecordPrefixBytes - kChunkFieldsBytes});
+  index_bytes_ += kMessageIndexEntryBytes;
+  if (chunk_message_count_ == 0) {
+    chunk_start_time_ = chunk_end_time_ = log_time_ns;
+  } else {
+    chunk_start_time_ = std::min(chunk_start_time_, log_time_ns);
+    chunk_end_time_ = std::max(chunk_end_time_, log_time_ns);
+  }
+  ++chunk_message_count_;
   if (message_count_ == 0) {
     message_start_time_ = message_end_time_ = log_time_ns;
   } else {
@@ -163,51 +178,115 @@ void McapWriter::write(std::uint16_t channel_id, std::uint32_t sequence, std::ui
 }
 
 void McapWriter::append(std::span<const std::uint8_t> record) {
-  data_crc_.update(record);
-  pending_.insert(pending_.end(), record.begin(), record.end());
+  start_chunk();
+  chunk_.insert(chunk_.end(), record.begin(), record.end());
 }
 
+void McapWriter::start_chunk() {
+  if (chunk_.empty()) chunk_.resize(kRecordPrefixBytes + kChunkFieldsBytes);
+}
+
+std::uint64_t McapWriter::buffered_bytes() const { return chunk_.empty() ? 0 : chunk_.size() + index_bytes_; }
+
 void McapWriter::maybe_flush() {
-  if (pending_.size() >= options_.flush_bytes ||
+  if (buffered_bytes() >= options_.flush_bytes ||
       std::chrono::steady_clock::now() - last_flush_ >= options_.flush_interval) {
     flush();
   }
 }
 
-void McapWriter::write_now(std::span<const std::uint8_t> bytes) {
+void McapWriter::write_now(std::span<const std::uint8_t> bytes, bool in_data_section) {
+  if (in_data_section) data_crc_.update(bytes);
   errno = 0;
   if (std::fwrite(bytes.data(), 1, bytes.size(), file_.get()) != bytes.size()) fail("write");
   if (std::fflush(file_.get()) != 0) fail("flush");
   offset_ += bytes.size();
 }
 
+void McapWriter::write_chunk() {
+  const std::uint64_t chunk_start = offset_;
+  const std::size_t head_bytes = kRecordPrefixBytes + kChunkFieldsBytes;
+  const std::uint64_t records_size = chunk_.size() - head_bytes;
+  ByteBuffer head;
+  head.reserve(head_bytes);
+  put_u8(head, opcode::kChunk);
+  put_u64(head, kChunkFieldsBytes + records_size);
+  put_u64(head, chunk_start_time_);  // both 0 in a chunk without messages, as the spec asks
+  put_u64(head, chunk_end_time_);
+  put_u64(head, records_size);
+  put_u32(head, crc32(std::span<const std::uint8_t>(chunk_).subspan(head_bytes)));
+  put_string(head, "");  // compression: none, so that every flush leaves records readable as they are
+  put_u64(head, records_size);
+  std::copy(head.begin(), head.end(), chunk_.begin());
+  const std::uint64_t chunk_length = chunk_.size();
+
+  // The Message Index records follow the chunk, by channel id.
+  std::sort(chunk_channels_.begin(), chunk_channels_.end());
+  std::vector<std::pair<std::uint16_t, std::uint64_t>> index_offsets;  // channel, file offset of its index
+  for (const std::uint16_t channel : chunk_channels_) {
+    index_offsets.emplace_back(channel, chunk_start + chunk_.size());
+    std::vector<IndexEntry>& entries = chunk_entries_[channel - 1];
+    const std::size_t start = begin_record(chunk_, opcode::kMessageIndex);
+    put_u16(chunk_, channel);
+    put_u32(chunk_, static_cast<std::uint32_t>(entries.size() * kMessageIndexEntryBytes));
+    for (const IndexEntry& entry : entries) {
+      put_u64(chunk_, entry.log_time_ns);
+      put_u64(chunk_, entry.offset);
+    }
+    end_record(chunk_, start);
+    entries.clear();
+  }
+  write_now(chunk_, true);
+
+  const std::size_t start = begin_record(chunk_indexes_, opcode::kChunkIndex);
+  put_u64(chunk_indexes_, chunk_start_time_);
+  put_u64(chunk_indexes_, chunk_end_time_);
+  put_u64(chunk_indexes_, chunk_start);
+  put_u64(chunk_indexes_, chunk_length);
+  put_u32(chunk_indexes_, static_cast<std::uint32_t>(index_offsets.size() * (2 + 8)));
+  for (const auto& [channel, offset] : index_offsets) {
+    put_u16(chunk_indexes_, channel);
+    put_u64(chunk_indexes_, offset);
+  }
+  put_u64(chunk_indexes_, chunk_.size() - chunk_length);  // message_index_length
+  put_string(chunk_indexes_, "");
+  put_u64(chunk_indexes_, records_size);  // compressed_size
+  put_u64(chunk_indexes_, records_size);  // uncompressed_size
+  end_record(chunk_indexes_, start);
+  ++chunk_count_;
+
+  chunk_.clear();
+  chunk_channels_.clear();
+  chunk_message_count_ = 0;
+  chunk_start_time_ = chunk_end_time_ = 0;
+  index_bytes_ = 0;
+}
+
 void McapWriter::flush() {
   if (state_ == State::closed) return;
   check_usable();
-  if (!pending_.empty()) {
-    write_now(pending_);
-    pending_.clear();
-  }
+  if (!chunk_.empty()) write_chunk();
   last_flush_ = std::chrono::steady_clock::now();
 }
 
 void McapWriter::flush_if_due() {
   if (state_ == State::closed) return;
   check_usable();
-  if (!pending_.empty() && std::chrono::steady_clock::now() - last_flush_ >= options_.flush_interval) flush();
+  if (!chunk_.empty() && std::chrono::steady_clock::now() - last_flush_ >= options_.flush_interval) flush();
 }
 
 void McapWriter::close() {
   if (state_ == State::closed) return;
   check_usable();
+  flush();
 
-  // Everything from here on is outside the data section: it does not feed data_crc_.
+  // Everything after Data End is outside the data section: it does not feed data_crc_.
   ByteBuffer tail;
   std::size_t start = begin_record(tail, opcode::kDataEnd);
   put_u32(tail, data_crc_.value());
   end_record(tail, start);
 
-  const std::uint64_t base = size();  // file offset of tail[0]
+  const std::uint64_t base = offset_;  // file offset of tail[0]
   const std::size_t summary_begin = tail.size();
   struct Group {
     std::uint8_t opcode;
@@ -215,32 +294,36 @@ void McapWriter::close() {
     std::uint64_t length;
   };
   std::vector<Group> groups;
-  const auto add_group = [&](std::uint8_t op, const std::vector<ByteBuffer>& records) {
-    if (records.empty()) return;
+  // Appends one group of records of opcode `op` (by calling put_records), if there are any.
+  const auto add_group = [&](std::uint8_t op, const auto& put_records) {
     const std::size_t group_begin = tail.size();
-    for (const auto& record : records) put_bytes(tail, record);
-    groups.push_back({op, base + group_begin, tail.size() - group_begin});
+    put_records();
+    if (tail.size() > group_begin) groups.push_back({op, base + group_begin, tail.size() - group_begin});
   };
-  add_group(opcode::kSchema, schema_records_);
-  add_group(opcode::kChannel, channel_records_);
-
-  ByteBuffer statistics;
-  start = begin_record(statistics, opcode::kStatistics);
-  put_u64(statistics, message_count_);
-  put_u16(statistics, static_cast<std::uint16_t>(schema_records_.size()));
-  put_u32(statistics, static_cast<std::uint32_t>(channel_records_.size()));
-  put_u32(statistics, 0);  // attachments
-  put_u32(statistics, 0);  // metadata records
-  put_u32(statistics, 0);  // chunks
-  put_u64(statistics, message_start_time_);
-  put_u64(statistics, message_end_time_);
-  put_u32(statistics, static_cast<std::uint32_t>(channel_message_counts_.size() * (2 + 8)));
-  for (std::size_t i = 0; i < channel_message_counts_.size(); ++i) {
-    put_u16(statistics, static_cast<std::uint16_t>(i + 1));
-    put_u64(statistics, channel_message_counts_[i]);
-  }
-  end_record(statistics, start);
-  add_group(opcode::kStatistics, {statistics});
+  add_group(opcode::kSchema, [&] {
+    for (const auto& record : schema_records_) put_bytes(tail, record);
+  });
+  add_group(opcode::kChannel, [&] {
+    for (const auto& record : channel_records_) put_bytes(tail, record);
+  });
+  add_group(opcode::kStatistics, [&] {
+    const std::size_t statistics = begin_record(tail, opcode::kStatistics);
+    put_u64(tail, message_count_);
+    put_u16(tail, static_cast<std::uint16_t>(schema_records_.size()));
+    put_u32(tail, static_cast<std::uint32_t>(channel_records_.size()));
+    put_u32(tail, 0);  // attachments
+    put_u32(tail, 0);  // metadata records
+    put_u32(tail, chunk_count_);
+    put_u64(tail, message_start_time_);
+    put_u64(tail, message_end_time_);
+    put_u32(tail, static_cast<std::uint32_t>(channel_message_counts_.size() * (2 + 8)));
+    for (std::size_t i = 0; i < channel_message_counts_.size(); ++i) {
+      put_u16(tail, static_cast<std::uint16_t>(i + 1));
+      put_u64(tail, channel_message_counts_[i]);
+    }
+    end_record(tail, statistics);
+  });
+  add_group(opcode::kChunkIndex, [&] { put_bytes(tail, chunk_indexes_); });
 
   const std::size_t summary_offset_begin = tail.size();
   for (const Group& group : groups) {
@@ -260,8 +343,8 @@ void McapWriter::close() {
   put_u32(tail, crc32(std::span<const std::uint8_t>(tail).subspan(summary_begin)));
   put_bytes(tail, kMcapMagic);
 
-  pending_.insert(pending_.end(), tail.begin(), tail.end());
-  flush();
+  // Data End is the data section's last record, but its own bytes are outside its CRC.
+  write_now(tail, false);
   errno = 0;
   if (std::fclose(file_.release()) != 0) fail("close");
   state_ = State::closed;

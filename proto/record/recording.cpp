@@ -69,7 +69,28 @@ Recording read_recording(const std::filesystem::path& file) {
   }
   recording.truncated = reader.truncated();
   recording.truncation = reader.truncation();
+  recording.file_bytes = reader.file_size();
+  recording.crc = reader.crc_coverage();
   return recording;
+}
+
+std::string describe_cut(const Recording& recording) {
+  if (!recording.truncated) return "";
+  const McapCrcCoverage& crc = recording.crc;
+  const std::string cut = fmt::format("cut short at byte {}", recording.file_bytes);
+  if (crc.checked_messages == 0) {
+    return fmt::format("{}: its {} messages are not covered by any CRC (they are not in chunks with a CRC, as in a "
+                       "recording written unchunked): a damaged byte in them goes unnoticed",
+                       cut, crc.unchecked_messages);
+  }
+  const double end_s =
+      static_cast<double>(static_cast<std::int64_t>(*crc.checked_end_time_ns) - recording.config.start_time_ns()) * 1e-9;
+  std::string line = fmt::format("{}: everything up to t = {:.3f} s is checked by its chunks' CRCs ({} messages, "
+                                 "through byte {})",
+                                 cut, end_s, crc.checked_messages, crc.checked_through_offset);
+  if (crc.unchecked_messages > 0)
+    line += fmt::format(", except {} messages outside them, not covered by any CRC", crc.unchecked_messages);
+  return line;
 }
 
 }  // namespace cohaptic::record

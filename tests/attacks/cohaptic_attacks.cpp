@@ -37,6 +37,7 @@
 #include "support/cube_scene.h"
 #include "support/cube_session.h"
 #include "support/hostile_traffic.h"
+#include "support/mcap_layout.h"
 #include "support/process.h"
 #include "support/process_usage.h"
 #include "support/raw_participant.h"
@@ -282,6 +283,29 @@ std::string crafted_recording(const Target& target, bool& read_outside) {
   return "replay --verify of a recording whose scene names ../secret.msh: " + (why.empty() ? "verified!" : why);
 }
 
+// A client's recording cut short inside its last chunk, with a byte changed in the chunk
+// before (the last complete one): verifying it must fail on that chunk's CRC.
+std::string altered_recording(const Target& target) {
+  testing::Bytes bytes = testing::read_bytes(target.dir / "bob-unjoined.mcap");
+  std::vector<testing::RawRecord> chunks;
+  for (const testing::RawRecord& record : testing::walk(bytes))
+    if (record.opcode == 0x06) chunks.push_back(record);
+  if (chunks.size() < 3) return "bob's recording has fewer than 3 chunks: FAILED to make the attack";
+  const testing::RawRecord& last = chunks.back();
+  bytes.resize(last.offset + static_cast<std::size_t>(last.length) / 2);
+  const testing::RawChunk altered = testing::read_chunk(bytes, chunks[chunks.size() - 2]);
+  bytes[(altered.records_begin + altered.records_end) / 2] ^= 0x01;
+  testing::write_bytes(target.dir / "received" / "altered.mcap", bytes);
+  std::string why;
+  try {
+    verify_recording(target.dir / "received" / "altered.mcap");
+  } catch (const Error& error) {
+    why = error.what();
+  }
+  return "replay --verify of a recording cut short, a byte changed in its last complete chunk: " +
+         (why.find("CRC") != std::string::npos ? "refused: " + why.substr(why.find("Chunk record")) : "NOT refused " + why);
+}
+
 // The server's resident set, sampled every 100 ms while it runs: its largest.
 class RssWatch {
  public:
@@ -362,6 +386,7 @@ int run() {
   report(8, "a participant's flood", sample_flood(target));
   report(9, "a crafted recording", crafted_recording(target, read_outside));
   report(10, "a forged log line", log_forgery(target));
+  report(11, "an altered recording", altered_recording(target));
 
   // Alice ends her press (her report: her haptic rate through every attack). Then a user's
   // link drops (the process killed) and the user joins again at once, in the same slot.

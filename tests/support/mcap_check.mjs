@@ -5,12 +5,14 @@
 // prints one line of JSON on stdout:
 //   {complete, messageCount, channels: [topics], schemas: [names], ...}
 // - McapIndexedReader opens the file from its end (trailing magic, Footer, summary with
-//   its CRC, Statistics, Summary Offsets), as Foxglove and Lichtblick do. It fails on a
-//   truncated file; its error is reported as "indexError" and is not fatal.
-// - McapStreamReader reads every record from the front, validating each; it gives the
-//   message count, and done() says whether the file ended with a Footer and the magic.
-//   (The indexed reader's readMessages() only finds messages inside chunks, and cohaptic's
-//   files have none, so messages are always counted by the stream reader.)
+//   its CRC, Statistics, Chunk Indexes, Summary Offsets), as Foxglove and Lichtblick do, and
+//   reads every message through the Chunk Index and Message Index records, checking each
+//   chunk's CRC ("indexed.messageCount"; 0 for a file without chunks, whose messages no
+//   index finds). It fails on a truncated file; its error is reported as "indexError" and
+//   is not fatal.
+// - McapStreamReader reads every record from the front, validating each (a chunk's CRC
+//   too); it gives the message count, and done() says whether the file ended with a Footer
+//   and the magic.
 // complete = the indexed reader opened the file and the stream reader finished it.
 // Exit status: 0 when the file was read (complete or not), 1 when a reader rejected it,
 // 2 on bad usage, 3 when @mcap/core is not installed (npm install --prefix deploy/node).
@@ -72,10 +74,19 @@ async function check() {
     const topicOf = (id) => indexed.channelsById.get(id)?.topic ?? `#${id}`;
     const statistics = indexed.statistics;
     const dataEnd = toNumber(indexed.dataEndOffset);
+    let indexedMessages = 0;
+    const indexedChannelMessageCounts = {};
+    for await (const message of indexed.readMessages({ validateCrcs: true })) {
+      indexedMessages += 1;
+      const topic = topicOf(message.channelId);
+      indexedChannelMessageCounts[topic] = (indexedChannelMessageCounts[topic] ?? 0) + 1;
+    }
     result.indexed = {
       channels: [...indexed.channelsById.values()].map((c) => c.topic).sort(),
       schemas: [...indexed.schemasById.values()].map((s) => s.name).sort(),
       chunkCount: indexed.chunkIndexes.length,
+      messageCount: indexedMessages,
+      channelMessageCounts: indexedChannelMessageCounts,
       summaryOffsetOpcodes: [...indexed.summaryOffsetsByOpcode.keys()].sort((a, b) => a - b),
       statistics: statistics
         ? {
