@@ -88,6 +88,7 @@ bool DatagramEndpoint::trusted(const udp::endpoint& peer) const {
 
 void DatagramEndpoint::trust(const udp::endpoint& peer) {
   if (!trusted(peer)) trusted_.push_back(peer);
+  limiter_.prove(peer.address(), wire::monotonic_now_ns());  // an admitted peer's host is a known one
 }
 
 void DatagramEndpoint::distrust(const udp::endpoint& peer) { std::erase(trusted_, peer); }

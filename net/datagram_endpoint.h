@@ -58,6 +58,7 @@ class DatagramEndpoint {
   void close();
 
   /// Datagrams from `peer` (address and port) are never rate limited; distrust() undoes it.
+  /// Its address is proven to the rate limiter from then on (source_rate_limiter.h).
   void trust(const asio::ip::udp::endpoint& peer);
   void distrust(const asio::ip::udp::endpoint& peer);
 

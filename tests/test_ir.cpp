@@ -210,6 +210,45 @@ TEST(IntermediateRepresentation, EachUserFeelsTheOther) {
   }
 }
 
+// Two tools on one triangle (or on two sharing a node): a node cannot follow both. As the
+// client leaves out a remote tool whose triangle overlaps its own (kRemoteOverlap), the
+// server's state (what the live view draws, and the held nodes' displacement under a step
+// delay) leaves out the later tool, and the earlier one presses as if alone. A node listed
+// twice would make the condensed compliance singular and fail every step a browser watched.
+TEST(IntermediateRepresentation, TwoToolsOnOneTriangleSolveTheStateWithTheEarlierAsIfAlone) {
+  Rig& rig = shared_cube();
+  Simulation alone(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
+  Simulation together(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
+  alone.set_tool(0, mm(1, 1, -2));
+  together.set_tool(0, mm(1, 1, -2));
+  together.set_tool(1, mm(1.5, 1.2, -2.5));
+  alone.step(0);
+  together.step(0);
+  ASSERT_TRUE(together.pressing(0) && together.pressing(1));
+  StateSolution state;
+  ASSERT_NO_THROW(state = together.solve());
+  const StateSolution reference = alone.solve();
+  ASSERT_EQ(state.tool_forces.size(), 1u) << "the later tool is left out";
+  EXPECT_GT(reference.tool_forces[0].norm(), 0.0);
+  EXPECT_LE((state.tool_forces[0] - reference.tool_forces[0]).norm(), 1e-9 * reference.tool_forces[0].norm());
+}
+
+// Two remote tools on one triangle, away from the own tool: the client leaves out the later
+// remote (kRemoteOverlap) and still feels its own press. With both in its system the node
+// listed twice made it singular, and the own tool's force was zero (kNonFinite).
+TEST(IntermediateRepresentation, TwoRemotesOnOneTriangleLeaveTheOwnForceResolved) {
+  Rig& rig = shared_cube();
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(3), unlimited_options(ContactModel::node_translation));
+  simulation.set_tool(0, mm(-20, 5, -3));
+  simulation.set_tool(1, mm(20, 5, -3));
+  simulation.set_tool(2, mm(20.5, 5.2, -3.5));
+  simulation.step(0);
+  const ForceSample own = simulation.force(0);
+  EXPECT_EQ(own.flags & kNonFinite, 0u);
+  EXPECT_NE(own.flags & kRemoteOverlap, 0u);
+  EXPECT_GT(own.force.norm(), 0.0);
+}
+
 TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;

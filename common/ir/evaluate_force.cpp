@@ -186,9 +186,10 @@ ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, c
                                          : feature.kind == TriangleFeature::Kind::vertex ? remote.vertex_normals[feature.index]
                                                                                           : remote.normal;
     if (!((p - q.point).dot(sign_normal) < remote.tool_radius)) continue;
-    bool overlaps = false;
-    for (int node : remote.nodes)
-      for (int own_node : own_triangle.nodes) overlaps |= node == own_node;
+    bool overlaps = false;  // with the own tool's triangle or an earlier remote's: a node follows one tool
+    for (int t = 0; t < pressing_count; ++t)
+      for (int node : remote.nodes)
+        for (int taken : pressing[t].nodes) overlaps |= node == taken;
     if (overlaps) {
       sample.flags |= kRemoteOverlap;
       continue;

@@ -102,7 +102,7 @@ enum ForceFlag : std::uint8_t {
   kClamped = 2,           ///< scaled down to the force limit
   kNonFinite = 4,         ///< a non-finite input or result: force set to zero
   kOutsidePatch = 8,      ///< the tool is past the patch border: held on it until the next IR
-  kRemoteOverlap = 16,    ///< a remote triangle shares a node with the own one: that remote ignored
+  kRemoteOverlap = 16,    ///< a remote triangle shares a node with the own one or an earlier remote's: that remote ignored
   kTooManyRemotes = 32,   ///< remotes beyond kMaxUsers - 1 ignored
   kContactUnresolved = 64,  ///< sphere model: the contact solve did not finish in its budget (zero force)
 };
