@@ -162,7 +162,11 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
     const double band = kBandPerDepth * deepest;
     const bool wider = band > band_;
     band_ = band;
-    if (wider && (add_band(band) | add_obstacle_band(band))) continue;
+    if (wider) {
+      const bool sphere_candidates_joined = add_band(band);  // both run: each adds its own candidates
+      const bool obstacle_candidates_joined = add_obstacle_band(band);
+      if (sphere_candidates_joined || obstacle_candidates_joined) continue;
+    }
     solve_boundary_forces(columns_, condensation, dofs, boundary_displacement, state);
     if (!obstacle_nodes_.empty()) find_obstacle_rows(patch_nodes);
     return state;
