@@ -26,7 +26,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <asio.hpp>
 #include <chrono>
 #include <fstream>
@@ -54,6 +53,7 @@
 #include "support/process.h"
 #include "support/process_usage.h"
 #include "support/raw_participant.h"
+#include "support/unjoined_connections.h"
 #include "support/run_program.h"
 
 namespace cohaptic {
@@ -76,15 +76,6 @@ std::uint64_t count(const nlohmann::json& report, const std::vector<std::string>
 
 bool contains(const Bytes& haystack, const std::string& needle) {
   return std::search(haystack.begin(), haystack.end(), needle.begin(), needle.end()) != haystack.end();
-}
-
-// Whether the server closed `socket` (reads what it sent before, without waiting).
-bool closed_by_server(asio::ip::tcp::socket& socket) {
-  socket.non_blocking(true);
-  std::array<std::uint8_t, 4096> sink{};
-  std::error_code error;
-  while (!error) socket.read_some(asio::buffer(sink), error);
-  return error != asio::error::would_block;
 }
 
 TEST(Security, EachParticipantKeyOpensItsOwnSlotOnly) {
@@ -205,7 +196,7 @@ TEST(Security, TheWireCarriesNoPlaintextAndStaleOrOldPeersAreRefused) {
   asio::write(chatty, asio::buffer(chatty_start));
   ASSERT_TRUE(testing::wait_until(
       [&] {
-        return closed_by_server(replay) && closed_by_server(old_peer) && closed_by_server(bulky) && closed_by_server(chatty);
+        return testing::closed_by_peer(replay) && testing::closed_by_peer(old_peer) && testing::closed_by_peer(bulky) && testing::closed_by_peer(chatty);
       },
       "the server to close the replaying, the protocol 2 peer's, the bulky and the chatty connections"))
       << session.server->log_text();
@@ -542,35 +533,9 @@ TEST(Robustness, AParticipantsSamplesBeyondTwiceItsHapticRateAreNeitherRelayedNo
 TEST(Robustness, ConnectionsThatNeverJoinLockNoClientOut) {
   CubeSession session("unjoined-flood", {"--duration", "120"});
   const asio::ip::tcp::endpoint server(asio::ip::make_address("127.0.0.1"), static_cast<std::uint16_t>(session.port));
-  std::atomic<bool> attacking{true};
-  std::atomic<std::uint64_t> reopened{0};
-  std::thread attacker([&] {
-    asio::io_context io;
-    constexpr int kSources = 8, kPerSource = 8;
-    std::vector<asio::ip::tcp::socket> held;
-    std::vector<asio::ip::address> source_of;
-    const auto open = [&](const asio::ip::address& source) {
-      asio::ip::tcp::socket socket(io);
-      std::error_code error;
-      socket.open(asio::ip::tcp::v4(), error);
-      socket.bind({source, 0}, error);
-      socket.connect(server, error);
-      return socket;
-    };
-    for (int s = 0; s < kSources; ++s)
-      for (int k = 0; k < kPerSource; ++k) {
-        source_of.push_back(asio::ip::make_address_v4(0x7f000002u + static_cast<unsigned>(s)));
-        held.push_back(open(source_of.back()));
-      }
-    while (attacking) {
-      for (std::size_t k = 0; k < held.size(); ++k)
-        if (closed_by_server(held[k])) {
-          held[k] = open(source_of[k]);
-          ++reopened;
-        }
-      std::this_thread::sleep_for(20ms);  // at most 50 rounds a second: bounded, yet faster than the join timer
-    }
-  });
+  const auto until = std::chrono::steady_clock::now() + 8s;  // past both clients' joins
+  std::uint64_t reopened = 0;
+  std::thread attacker([&] { reopened = testing::hold_connections(server, 8, 8, until); });
   std::this_thread::sleep_for(1s);
   const auto first = session.client("alice", 0, write_press(session.dir, "a", 3, 2, 2, 30.0));
   EXPECT_TRUE(testing::wait_for_output(*first, "haptic loop at")) << first->log_text();
@@ -579,12 +544,11 @@ TEST(Robustness, ConnectionsThatNeverJoinLockNoClientOut) {
   const auto again = session.client("alice-again", 0, write_press(session.dir, "b", 3, 2, 2, 0.5));
   EXPECT_TRUE(testing::wait_for_output(*again, "haptic loop at")) << again->log_text();
   EXPECT_EQ(again->wait(testing::kPatience), 0) << again->log_text();
-  attacking = false;
   attacker.join();
   session.stop_server();
   const nlohmann::json connections = session.report("server")["server"]["connections"];
   std::printf("  attacker's connections reopened %lu times; server: %lu evicted unjoined, %lu joins\n",
-              static_cast<unsigned long>(reopened.load()), static_cast<unsigned long>(connections["unjoined_evicted"].get<std::uint64_t>()),
+              static_cast<unsigned long>(reopened), static_cast<unsigned long>(connections["unjoined_evicted"].get<std::uint64_t>()),
               static_cast<unsigned long>(connections["joins"].get<std::uint64_t>()));
   EXPECT_EQ(connections["joins"].get<std::uint64_t>(), 2u);
   EXPECT_GE(connections["unjoined_evicted"].get<std::uint64_t>(), 8u * 4u);  // each source's surplus, at least

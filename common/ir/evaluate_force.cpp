@@ -187,9 +187,7 @@ ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, c
                                                                                           : remote.normal;
     if (!((p - q.point).dot(sign_normal) < remote.tool_radius)) continue;
     bool overlaps = false;  // with the own tool's triangle or an earlier remote's: a node follows one tool
-    for (int t = 0; t < pressing_count; ++t)
-      for (int node : remote.nodes)
-        for (int taken : pressing[t].nodes) overlaps |= node == taken;
+    for (int t = 0; t < pressing_count; ++t) overlaps |= share_a_node(remote.nodes, pressing[t].nodes);
     if (overlaps) {
       sample.flags |= kRemoteOverlap;
       continue;

@@ -18,6 +18,16 @@ namespace cohaptic {
 using Tet = std::array<int, 4>;
 using Triangle = std::array<int, 3>;
 
+/// Whether two triangles (node indices) have a node in common. Where two tools press such
+/// triangles, a node would have to follow both: the later tool is left out (the client's
+/// evaluation, the server's state).
+constexpr bool share_a_node(const Triangle& a, const Triangle& b) noexcept {
+  for (int x : a)
+    for (int y : b)
+      if (x == y) return true;
+  return false;
+}
+
 struct TetMesh {
   Eigen::Matrix3Xd nodes;             ///< rest positions [m], one column per node
   std::vector<Tet> tets;              ///< 0-based node indices

@@ -113,16 +113,12 @@ Eigen::VectorXd Simulation::boundary_dof_displacement() const {
 // compliance singular, and every step would fail while the two tools stay together.
 std::vector<PressingContact> Simulation::pressing_contacts() const {
   std::vector<PressingContact> contacts;
-  const auto overlaps = [&](const Triangle& tri) {
-    for (const PressingContact& taken : contacts)
-      for (int node : taken.nodes)
-        if (node == tri[0] || node == tri[1] || node == tri[2]) return true;
-    return false;
-  };
   for (const UserState& user : users_)
     if (user.pressing && user.contact) {
       const Triangle& tri = body_.surface.triangles[user.contact->triangle];
-      if (overlaps(tri)) continue;
+      if (std::any_of(contacts.begin(), contacts.end(),
+                      [&](const PressingContact& taken) { return share_a_node(taken.nodes, tri); }))
+        continue;
       contacts.push_back({{tri[0], tri[1], tri[2]}, user.contact->weights, user.contact->displacement});
     }
   return contacts;

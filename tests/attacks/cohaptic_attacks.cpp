@@ -41,6 +41,7 @@
 #include "support/process.h"
 #include "support/process_usage.h"
 #include "support/raw_participant.h"
+#include "support/unjoined_connections.h"
 #include "support/websocket_client.h"
 
 namespace cohaptic {
@@ -62,48 +63,6 @@ struct Target {
   tcp::endpoint control() const { return {asio::ip::make_address("127.0.0.1"), port}; }
   udp::endpoint datagrams() const { return {asio::ip::make_address("127.0.0.1"), port}; }
 };
-
-asio::ip::address loopback(std::uint32_t k) { return asio::ip::address_v4(0x7f000002u + k); }
-
-// A TCP connection from `source`, or a closed socket if it could not be made.
-tcp::socket connect_from(asio::io_context& io, const asio::ip::address& source, const tcp::endpoint& to) {
-  tcp::socket socket(io);
-  std::error_code error;
-  socket.open(tcp::v4(), error);
-  socket.bind({source, 0}, error);
-  socket.connect(to, error);
-  if (error) socket.close(error);
-  return socket;
-}
-
-// Whether the peer closed `socket` (what it sent is read and dropped, without waiting).
-bool closed_by_peer(tcp::socket& socket) {
-  if (!socket.is_open()) return true;
-  socket.non_blocking(true);
-  std::array<std::uint8_t, 4096> sink{};
-  std::error_code error;
-  while (!error) socket.read_some(asio::buffer(sink), error);
-  return error != asio::error::would_block;
-}
-
-// Keeps `count` connections from `sources` open to `to` until `until`, opening a new one as
-// soon as one is closed; returns how many were opened.
-std::uint64_t hold_connections(const tcp::endpoint& to, int sources, int per_source, Clock::time_point until) {
-  asio::io_context io;
-  std::vector<tcp::socket> held;
-  std::uint64_t opened = 0;
-  for (int s = 0; s < sources; ++s)
-    for (int k = 0; k < per_source; ++k, ++opened) held.push_back(connect_from(io, loopback(static_cast<std::uint32_t>(s)), to));
-  while (Clock::now() < until) {
-    for (std::size_t k = 0; k < held.size(); ++k)
-      if (closed_by_peer(held[k])) {
-        held[k] = connect_from(io, loopback(static_cast<std::uint32_t>(k) / static_cast<std::uint32_t>(per_source)), to);
-        ++opened;
-      }
-    std::this_thread::sleep_for(20ms);
-  }
-  return opened;
-}
 
 // bob, a real client in slot 1, joins, presses for half a second and leaves; the wait for
 // his welcome, or a reason he did not get one.
@@ -137,7 +96,7 @@ std::string during(const Target& target, const std::string& run, const std::func
 std::string unjoined_connections(const Target& target) {
   return during(target, "unjoined", [&](Clock::time_point until) {
     return fmt::format("{} connections from 8 addresses that never join, reopened as closed",
-                       hold_connections(target.control(), 8, 8, until));
+                       testing::hold_connections(target.control(), 8, 8, until));
   });
 }
 
@@ -147,7 +106,7 @@ std::string file_descriptors(const Target& target) {
   const tcp::endpoint view(asio::ip::make_address("127.0.0.1"), target.view_port);
   asio::io_context io;
   std::vector<tcp::socket> hogs;
-  for (int k = 0; k < 300; ++k) hogs.push_back(connect_from(io, loopback(0), view));
+  for (int k = 0; k < 300; ++k) hogs.push_back(testing::connect_from(io, testing::other_loopback(0), view));
   std::string bob;
   std::thread joining([&] { bob = bob_joins(target, "fds"); });
   std::this_thread::sleep_for(3s);
@@ -201,7 +160,7 @@ std::string rotating_udp_sources(const Target& target) {
     for (std::uint32_t k = 0; k < 800; ++k) {
       udp::socket& socket = sources.emplace_back(io);
       socket.open(udp::v4());
-      socket.bind({loopback(k), 0});
+      socket.bind({testing::other_loopback(k), 0});
     }
     std::mt19937 rng(3);
     testing::HostileDatagrams hostile(target.session, rng);
@@ -220,15 +179,15 @@ std::string rotating_udp_sources(const Target& target) {
 std::string big_join_frame(const Target& target) {
   return during(target, "frame", [&](Clock::time_point) {
     asio::io_context io;
-    tcp::socket socket = connect_from(io, loopback(0), target.control());
+    tcp::socket socket = testing::connect_from(io, testing::other_loopback(0), target.control());
     std::vector<std::uint8_t> start(wire::kFrameClearBytes, 0);
     wire::write_le(64u << 10, wire::kFrameLengthBytes, start.data());
     std::error_code error;
     asio::write(socket, asio::buffer(start), error);
     const auto deadline = Clock::now() + 5s;
-    while (!closed_by_peer(socket) && Clock::now() < deadline) std::this_thread::sleep_for(10ms);
+    while (!testing::closed_by_peer(socket) && Clock::now() < deadline) std::this_thread::sleep_for(10ms);
     return std::string("an unjoined connection declaring a 64 KiB frame: ") +
-           (closed_by_peer(socket) ? "closed before its body" : "NOT closed");
+           (testing::closed_by_peer(socket) ? "closed before its body" : "NOT closed");
   });
 }
 
