@@ -1,8 +1,9 @@
 // Every shipped scene with two surgeons' scripts (scenes/<scene>/surgeon_a.yaml and
 // surgeon_b.yaml beside scenes/<scene>.yaml) served as `make demo SCENE=...` serves it
 // (deploy/run-demo.sh, the real programs on loopback, the user's compliance cache), for a
-// few seconds of the scripted surgeons, once without a browser and once with headless
-// Chromium watching the live view at normal priority, as a user's browser would. Judged
+// few seconds of the scripted surgeons, with headless Chromium watching the live view at
+// normal priority, as a user's browser would (without a browser where none is installed:
+// the watched session is the harder of the two, the view's work beside the surgeons'). Judged
 // by what the surgeons felt: no force faded while either pushed, each touched its body,
 // and each client's recording verifies bit for bit. The verdict itself is printed, not
 // asserted: the unit tests beside this one on a 2-core machine make missed deadlines,
@@ -100,11 +101,10 @@ void expect_felt_without_fades(const std::string& scene, bool watched) {
   EXPECT_EQ(verified, 2u) << "both clients' recordings verify bit for bit:\n" << output;
 }
 
-TEST_P(ShippedScene, TwoSurgeonsFeelItWithoutAFade) { expect_felt_without_fades(GetParam(), false); }
-
 TEST_P(ShippedScene, TwoSurgeonsFeelItWithoutAFadeWhileABrowserWatches) {
-  if (const std::string why = testing::missing_browser(); !why.empty()) GTEST_SKIP() << why;
-  expect_felt_without_fades(GetParam(), true);
+  const std::string no_browser = testing::missing_browser();
+  if (!no_browser.empty()) std::printf("  unwatched: %s\n", no_browser.c_str());
+  expect_felt_without_fades(GetParam(), no_browser.empty());
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, ShippedScene, ::testing::ValuesIn(scenes_with_surgeons()),

@@ -1,6 +1,6 @@
 // The soak: hours of use compressed into a session with four participants and churn, under
 // 10 % datagram loss and 10 ms jitter (injected by the server), for COHAPTIC_SOAK_MINUTES
-// minutes (5 by default, as CI runs it; docs/security.md "Security and robustness" runs 60):
+// minutes (3 by default, as CI runs it; docs/security.md "Security and robustness" runs 60):
 //   - alice and bob, real clients, press and slide on the cube for the whole run;
 //   - carol, a real client, joins, presses and leaves, again and again: a new process, a
 //     new report and a new recording every few seconds;
@@ -61,7 +61,7 @@ using testing::ProcessUsage;
 
 double soak_minutes() {
   const char* text = std::getenv("COHAPTIC_SOAK_MINUTES");
-  if (!text) return 5;
+  if (!text) return 3;
   char* end = nullptr;
   const double minutes = std::strtod(text, &end);
   if (end == text || *end != '\0' || !(minutes >= 1 && minutes <= 24 * 60))
