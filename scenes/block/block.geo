@@ -1,7 +1,7 @@
 // An elastic block with two places graded for a 10 mm sphere each (scenes/block/two_spheres.yaml):
 // [-100, 100] x [-60, 60] x [-100, 0] in millimetres, its top face z = 0, the two contact
 // points at (-25, 0, 0) and (25, 0, 0). Gmsh 4.8 script, meshed when a scene loads it
-// (`mesh: {gmsh: ...}` in docs/scene-format.md), with its parameters set there.
+// (`mesh: {gmsh: ...}` in docs/scene-files.md), with its parameters set there.
 //
 // The element size is `fine` (mm) within fine / growth of either contact point and `growth`
 // times the distance beyond it, up to `coarse` (mm): the cells keep the same size relative
