@@ -106,8 +106,9 @@ int main(int argc, char** argv) {
     settings.max_age_s = welcome.ir_max_age_s;
     settings.playout = cohaptic::parse_playout_policy(playout);
     settings.realtime = !best_effort;
-    spdlog::info("haptic loop at {:g} Hz with {} (force limit {:g} N)", settings.rate_hz, device->describe(),
-                 settings.force_limit);
+    spdlog::info("haptic loop at {:g} Hz with {}; the force sent to it is limited to {:g} N (the smaller of the "
+                 "device's and the scene's)",
+                 settings.rate_hz, device->describe(), settings.force_limit);
 
     if (!record_path.empty()) network.record_session(record_path, device->describe(), settings.force_limit);
     cohaptic::HapticLoop loop(*device, *channels, settings);
