@@ -8,6 +8,9 @@
 #   make bench-compliance  the brain's compliance by solves and by the Schur complement, same run
 #   make brain-convergence  the brain's forces on its meshes against a finer reference mesh
 #   make paired-rehearsal   the paper's experiments 1 and 2 as paired comparisons, simulated subjects
+#   make attacks    eleven attacks from the network replayed on loopback, as a Markdown page
+#   make results    every page of docs/results/ measured again and stamped (an hour or more)
+#   make command-lines  docs/command-lines.md from the programs' --help
 #   make fuzz       build the fuzz targets with clang (libFuzzer, ASan, UBSan) in build-asan
 #                   and run each for FUZZ_SECONDS (default 15; 0 builds only), FUZZ_JOBS at once
 #   make test-asan  the suite (ASAN_TESTS: all by default) built with clang, ASan + UBSan, in
@@ -63,7 +66,7 @@ SANITIZER_CMAKE = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
 SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
   TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
 
-.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance brain-convergence paired-rehearsal attacks fuzz test-asan test-tsan clean
+.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance brain-convergence paired-rehearsal attacks results command-lines fuzz test-asan test-tsan clean
 
 all: build
 
@@ -103,10 +106,34 @@ tradeoff: build
 	$(LAB) tradeoff --scene scenes/tradeoff/cube_two_users.yaml --motion scenes/tradeoff/cube_press_slide.yaml \
 	  --motion scenes/tradeoff/cube_press_hold.yaml --out out/tradeoff/cube
 
-# Ten attacks from the network replayed against a server on loopback while real clients use
-# it (docs/security.md "Attacks replayed"); about two minutes; exit 1 if one got through.
-attacks: build
-	$(BUILD_DIR)/tests/cohaptic_attacks
+# Eleven attacks from the network replayed against a server on loopback while real clients
+# use it (docs/security.md "Attacks replayed"), as the Markdown page docs/results/attacks.md
+# holds; about two minutes; exit 1 if one got through.
+attacks:
+	@$(MAKE) --no-print-directory build >&2
+	@$(BUILD_DIR)/tests/cohaptic_attacks
+	@tests/results_stamp.sh
+
+# docs/command-lines.md from the built programs' --help (a test checks that it still is).
+command-lines:
+	@$(MAKE) --no-print-directory build >&2
+	@tests/command_lines_page.sh $(BUILD_DIR) > docs/command-lines.md
+
+# Every page of docs/results/ measured again, each by its own command above, and stamped
+# with the commit, the date and the machine (an hour or more on two cores, most of it the
+# brain's reference mesh). The paired-comparison studies run afresh.
+results:
+	@$(MAKE) --no-print-directory build
+	$(MAKE) --no-print-directory attacks > docs/results/attacks.md
+	$(MAKE) --no-print-directory bench-sphere > docs/results/sphere-contact-speed.md
+	BUILD_DIR=$(BUILD_DIR) deploy/sphere-contact-bytes.sh > docs/results/sphere-contact-bytes.md
+	$(MAKE) --no-print-directory bench-compliance > docs/results/compliance-speed.md
+	$(MAKE) --no-print-directory bench-thin > docs/results/mass-spring-speed.md
+	$(LAB) hertz --out docs/results/hertz-nu030 && tests/results_stamp.sh >> docs/results/hertz-nu030/hertz.md
+	$(LAB) hertz --element nodal_pressure_tet --poisson-ratio 0.45 --out docs/results/hertz-nu045 \
+	  && tests/results_stamp.sh >> docs/results/hertz-nu045/hertz.md
+	rm -rf out/paired && $(MAKE) --no-print-directory paired-rehearsal > docs/results/paired-comparisons.md
+	$(MAKE) --no-print-directory brain-convergence > docs/results/brain-convergence.md
 
 # BENCH_ARGS reaches the program through the environment, split at spaces and otherwise as
 # typed (no globbing, no pipes): BENCH_ARGS="--benchmark_filter=naive|incremental" works.

@@ -28,3 +28,4 @@ HEADER
   --log-level warn
 echo
 echo "Load average when measured: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores."
+"$(dirname "$0")/../tests/results_stamp.sh"

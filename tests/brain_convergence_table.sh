@@ -86,3 +86,4 @@ done
 echo
 jq -r -n --slurpfile c "$work/coarse-1.json" --slurpfile g "$work/graded-1.json" --slurpfile r "$work/reference-1.json" \
   '"Meshes: \($c[0].nodes), \($g[0].nodes) and \($r[0].nodes) nodes."' 2>/dev/null || true
+"$(dirname "$0")/results_stamp.sh"

@@ -48,3 +48,4 @@ jq -r '
         else "| \($s.label) | \($s.nodes) | \($s.row_nodes) | \(secs($s) | fmt) | \($s.row_nodes_per_s | fmt) | \(secs($schur) | fmt) | \($schur.row_nodes_per_s | fmt) | \(secs($s) / secs($schur) | fmt)× | \($schur.columns_MB | round) | \($s.peak_MB | round), \($schur.peak_MB | round) |"
         end )
 ' <<<"$json"
+"$(dirname "$0")/results_stamp.sh"

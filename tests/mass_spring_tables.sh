@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The mass-spring body's benchmarks beside the thin-objects paper's Table 2 (README,
-# "Mass-spring objects"): runs cohaptic_bench's MassSpring benchmarks once and prints, as
-# Markdown, (1) the integrator step of the whole tube and the collision search at 180, 360,
+# The mass-spring body's benchmarks beside the thin-objects paper's Table 2
+# (docs/mass-spring.md): runs cohaptic_bench's MassSpring benchmarks once and prints, as
+# Markdown, the page docs/results/mass-spring-speed.md holds: (1) the integrator step of the whole tube and the collision search at 180, 360,
 # 540 and 720 nodes beside the paper's deformation and collision loops (3.19 GHz Core i5)
 # with our speed-up, (2) the largest stable time step at the paper's two densities beside
 # its 1.8 and 0.7 ms, (3) a client's haptic tick against the sections it was sent.
@@ -15,6 +15,18 @@ bench=${1:-build/tests/cohaptic_bench}
 command -v jq >/dev/null || { echo "mass_spring_tables: needs jq (deploy/install-deps.sh installs it)" >&2; exit 2; }
 
 json=$("$bench" --benchmark_filter='^BM_MassSpring' --benchmark_format=json)
+cat <<'HEADER'
+# Mass-spring objects: speed
+
+`make bench-thin > docs/results/mass-spring-speed.md` writes this page
+(`tests/bench_mass_spring.cpp`, `tests/mass_spring_tables.sh`). The tube of the thin-objects
+paper: its integrator step and its collision search at 180 to 720 nodes beside the paper's
+deformation and collision loops (its Table 2, on a 3.19 GHz Core i5), the largest stable
+time step at the paper's two densities (found by power iteration), and a client's haptic
+tick against the sections it was sent. Times are CPU time per call, wall time in brackets:
+on a loaded machine the two differ. See [mass-spring objects](../mass-spring.md).
+
+HEADER
 echo "load average: $(cut -d' ' -f1-3 /proc/loadavg) on $(nproc) cores; $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')"
 echo
 jq -r '
@@ -42,3 +54,4 @@ jq -r '
     ( ["1", "2", "4", "8"][] as $s | $b["BM_MassSpringClientTick/" + $s] as $c
       | "| \($s) | \($c.nodes) | \($c.ir_bytes / 1000 | fmt) | \(micro($c; "cpu_time") | fmt) (\(micro($c; "real_time") | fmt)) |" )
 ' <<<"$json"
+"$(dirname "$0")/results_stamp.sh"

@@ -45,3 +45,4 @@ for n in 1 2; do
   echo '```'
   echo
 done
+tests/results_stamp.sh

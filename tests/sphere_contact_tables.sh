@@ -71,3 +71,4 @@ jq -r '
         else "", "State solve speed-up (mean): \(micro($c; "real_time") / micro($i; "real_time") | round)×, at \($i.contacts) nodes in contact; the forces of the two states differ by \($c.difference | sci) (relative)."
         end )
 ' <<<"$json"
+"$(dirname "$0")/results_stamp.sh"
