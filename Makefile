@@ -27,7 +27,7 @@ export COHAPTIC_BENCH_ARGS = $(value BENCH_ARGS)
 # Extra CMake settings for the first configure, e.g. CMAKE_ARGS=-DCOHAPTIC_WARNINGS_AS_ERRORS=ON (CI).
 CMAKE_ARGS ?=
 # Unity builds (CMake compiles each target's sources eight to a unit): a build from scratch
-# takes about 40 % less CPU, an edit recompiles its file's unit. UNITY=OFF for one file a unit.
+# takes markedly less CPU, an edit recompiles its file's unit. UNITY=OFF for one file a unit.
 UNITY ?= ON
 UNITY_CMAKE = -DCMAKE_UNITY_BUILD=$(UNITY)
 LAB := $(BUILD_DIR)/lab/cohaptic-lab
