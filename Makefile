@@ -82,7 +82,8 @@ build: configure
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
 test: build
-	@status=0; ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS) || status=$$?; \
+	@status=0; ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS) \
+	  --resource-spec-file $(BUILD_DIR)/ctest-resources.json || status=$$?; \
 	  tests/report_skipped.sh $(BUILD_DIR); exit $$status
 
 # The main job: the two-surgeon brain demo. A server and two haptic clients (hand models
@@ -102,9 +103,10 @@ probe-demo: build
 
 # Speed against accuracy on the paper's cube (docs/speed-versus-accuracy.md "Speed versus accuracy"): every
 # setting against the full solve on an 18-division mesh; about a minute.
+TRADEOFF_OUT ?= out/tradeoff/cube
 tradeoff: build
 	$(LAB) tradeoff --scene scenes/tradeoff/cube_two_users.yaml --motion scenes/tradeoff/cube_press_slide.yaml \
-	  --motion scenes/tradeoff/cube_press_hold.yaml --out out/tradeoff/cube
+	  --motion scenes/tradeoff/cube_press_hold.yaml --out $(TRADEOFF_OUT)
 
 # Eleven attacks from the network replayed against a server on loopback while real clients
 # use it (docs/security.md "Attacks replayed"), as the Markdown page docs/results/attacks.md
@@ -132,6 +134,12 @@ results:
 	$(LAB) hertz --out docs/results/hertz-nu030 && tests/results_stamp.sh >> docs/results/hertz-nu030/hertz.md
 	$(LAB) hertz --element nodal_pressure_tet --poisson-ratio 0.45 --out docs/results/hertz-nu045 \
 	  && tests/results_stamp.sh >> docs/results/hertz-nu045/hertz.md
+	$(MAKE) --no-print-directory tradeoff TRADEOFF_OUT=docs/results/tradeoff-cube \
+	  && tests/results_stamp.sh >> docs/results/tradeoff-cube/tradeoff.md
+	$(LAB) stability --out docs/results/stability && tests/results_stamp.sh >> docs/results/stability/stability.md
+	$(LAB) objects-push --out docs/results/objects-push && tests/results_stamp.sh >> docs/results/objects-push/objects_push.md
+	$(LAB) objects-push --in-time --out docs/results/objects-push \
+	  && tests/results_stamp.sh >> docs/results/objects-push/objects_push_in_time.md
 	rm -rf out/paired && $(MAKE) --no-print-directory paired-rehearsal > docs/results/paired-comparisons.md
 	$(MAKE) --no-print-directory brain-convergence > docs/results/brain-convergence.md
 

@@ -31,11 +31,11 @@ using testing::ChildProcess;
 
 constexpr std::chrono::milliseconds kBrowserPatience{240'000};
 
-const fs::path kSource = COHAPTIC_SOURCE_DIR;
+const fs::path kSourceTree = COHAPTIC_SOURCE_DIR;
 
 // Runs view_check.mjs with `arguments`, expecting it to exit with `expected_status`; its JSON result.
 json check_page(const fs::path& dir, const std::string& name, const std::vector<std::string>& arguments, int expected_status = 0) {
-  std::vector<std::string> all = {(kSource / "tests/support/view_check.mjs").string()};
+  std::vector<std::string> all = {(kSourceTree / "tests/support/view_check.mjs").string()};
   all.insert(all.end(), arguments.begin(), arguments.end());
   ChildProcess node(testing::node_program(), all, dir / (name + ".log"));
   const std::optional<int> status = node.wait(kBrowserPatience);
@@ -87,7 +87,7 @@ fs::path brain_session(const std::string& name) {
   const fs::path dir = testing::scratch_directory(name);
   for (const auto& [user, surgeon] : {std::pair{"a", "surgeon_a"}, std::pair{"b", "surgeon_b"}}) {
     std::stringstream demo;
-    demo << std::ifstream(kSource / "scenes/brain" / (std::string(surgeon) + ".yaml")).rdbuf();
+    demo << std::ifstream(kSourceTree / "scenes/brain" / (std::string(surgeon) + ".yaml")).rdbuf();
     const std::string held = std::regex_replace(demo.str(), std::regex(R"(\{hold: [0-9.]+\})"), "{hold: 600}");
     EXPECT_NE(held, demo.str()) << surgeon << ".yaml has no hold";
     std::ofstream(dir / (std::string(user) + ".yaml")) << held;
@@ -408,7 +408,7 @@ segments:
   - {{hold: 600}}
 )",
                                                                       x);
-  ViewSession session(dir, kSource / "scenes/thin/noodle.yaml");
+  ViewSession session(dir, kSourceTree / "scenes/thin/noodle.yaml");
   ASSERT_FALSE(session.url.empty()) << session.server->log_text();
   json live;
   {
