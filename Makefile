@@ -139,7 +139,8 @@ results:
 	$(LAB) stability --out docs/results/stability && tests/results_stamp.sh >> docs/results/stability/stability.md
 	$(LAB) objects-push --out docs/results/objects-push && tests/results_stamp.sh >> docs/results/objects-push/objects_push.md
 	$(LAB) objects-push --in-time --out docs/results/objects-push \
-	  && tests/results_stamp.sh >> docs/results/objects-push/objects_push_in_time.md
+	  && tests/results_stamp.sh >> docs/results/objects-push/objects_push_in_time.md \
+	  && rm docs/results/objects-push/objects_push_in_time.csv  # every step of every curve: megabytes
 	rm -rf out/paired && $(MAKE) --no-print-directory paired-rehearsal > docs/results/paired-comparisons.md
 	$(MAKE) --no-print-directory brain-convergence > docs/results/brain-convergence.md
 
