@@ -83,7 +83,7 @@ build: configure
 
 test: build
 	@status=0; ctest --test-dir $(BUILD_DIR) --output-on-failure -j $(JOBS) \
-	  --resource-spec-file $(BUILD_DIR)/ctest-resources.json || status=$$?; \
+	  --resource-spec-file $(abspath $(BUILD_DIR))/ctest-resources.json || status=$$?; \
 	  tests/report_skipped.sh $(BUILD_DIR); exit $$status
 
 # The main job: the two-surgeon brain demo. A server and two haptic clients (hand models
