@@ -9,8 +9,9 @@
 // It prints a Markdown page (docs/results/attacks.md): a row per attack (what was sent, what
 // the server did, whether bob joined), what alice felt, what the server counted, and a
 // verdict; it exits 1 if a legitimate client could not join or lost its
-// haptic rate, the server's resident set passed 200 MB, or a file outside a recording's
-// folder was read. Loopback only: it binds 127.0.0.0/8 addresses and talks to 127.0.0.1.
+// haptic rate (missed more deadlines than the bare timer beside it, plus 0.1 % of its ticks:
+// what the host's own scheduling takes from both is not the attacks'), the server's resident
+// set passed 200 MB, or a file outside a recording's folder was read. Loopback only: it binds 127.0.0.0/8 addresses and talks to 127.0.0.1.
 #include <signal.h>
 #include <sys/resource.h>
 
@@ -365,10 +366,18 @@ int run() {
   const double peak = rss.peak_mb();
   const double rate = throughout["haptic_rate_hz"].get<double>();
   const double faded_s = throughout["fades"]["total_s"].get<double>();
-  fmt::print("\nalice, pressing through every attack: haptic rate {:.0f} Hz, period p99 {:.0f} us, IR age p99 {:.0f} ms, "
-             "force faded for {:.2f} s in all; carol, her link dropped, joined again: {}\n",
-             rate, throughout["period_us"]["p99"].get<double>(), throughout["ir_age_ms"]["p99"].get<double>(), faded_s,
-             rejoined ? "yes" : "NO");
+  // Judged as the session verdict judges it: against the bare timer that ran beside her loop.
+  const double missed = throughout["missed_deadlines"].get<double>();
+  const double floor_missed = throughout["timer_floor"]["missed_deadlines"].get<double>();
+  const bool rate_held = missed <= floor_missed + 0.001 * throughout["ticks"].get<double>();
+  double host_steal_ms = 0;
+  for (const nlohmann::json& cpu : throughout["timer_floor"]["cpus"])
+    host_steal_ms = std::max(host_steal_ms, cpu["host_steal_ms"].get<double>());
+  fmt::print("\nalice, pressing through every attack: haptic rate {:.0f} Hz, period p99 {:.0f} us, {:.0f} missed deadlines "
+             "(the bare timer beside her: {:.0f}; the host took {:.0f} ms of a CPU){}, IR age p99 {:.0f} ms, force faded "
+             "for {:.2f} s in all; carol, her link dropped, joined again: {}\n",
+             rate, throughout["period_us"]["p99"].get<double>(), missed, floor_missed, host_steal_ms,
+             rate_held ? "" : " FAILED", throughout["ir_age_ms"]["p99"].get<double>(), faded_s, rejoined ? "yes" : "NO");
   fmt::print("\nserver: {} unjoined connections evicted, {} accept errors, {} datagrams rate limited, {} over a user's "
              "budget, {} dropped by the kernel; steps failed {}\n",
              counted["connections"]["unjoined_evicted"].get<std::uint64_t>(),
@@ -378,7 +387,7 @@ int run() {
              counted["failed_steps"]["count"].get<std::uint64_t>());
   fmt::print("\nserver's largest resident set: {:.1f} MB (at most {:.0f})\n", peak, kMaxServerRssMb);
   const std::uint64_t failed_steps = counted["failed_steps"]["count"].get<std::uint64_t>();
-  failed = failed || failed_steps > 0 || !alice_ended || !rejoined || rate < 900 || faded_s > 0 || peak > kMaxServerRssMb || read_outside;
+  failed = failed || failed_steps > 0 || !alice_ended || !rejoined || !rate_held || faded_s > 0 || peak > kMaxServerRssMb || read_outside;
   fmt::print("\n**Verdict: {}**\n", failed ? "an attack got through (see FAILED above)" : "every attack held");
   return failed ? 1 : 0;
 }
