@@ -34,6 +34,13 @@ double number(const nlohmann::json& j, const std::vector<std::string>& path) {
 
 }  // namespace
 
+bool misses_deadlines_of_its_own(const nlohmann::json& client_report) {
+  const double ticks = number(client_report, {"ticks"});
+  const double missed = number(client_report, {"missed_deadlines"});
+  const double floor_missed = number(client_report, {"timer_floor", "missed_deadlines"});
+  return missed > 0.001 * ticks && missed - floor_missed > 0.001 * ticks;
+}
+
 SessionVerdict summarize_session(const nlohmann::json& server, const std::vector<nlohmann::json>& clients) {
   SessionVerdict verdict;
   verdict.report["server"] = server.contains("server") ? server["server"] : server;
@@ -149,7 +156,7 @@ SessionVerdict summarize_session(const nlohmann::json& server, const std::vector
         if (cpu.contains("host_steal_ms"))
           steal += fmt::format("{}CPU {} {:.0f} ms", steal.empty() ? "; host steal time: " : ", ", cpu.value("cpu", -1),
                                number(cpu, {"host_steal_ms"}));
-    const bool own_misses = missed > 0.001 * ticks && missed - floor_missed > 0.001 * ticks;
+    const bool own_misses = misses_deadlines_of_its_own(c);
     judge(user, "missed deadlines", fmt::format("{:.0f} (floor {:.0f})", missed, floor_missed),
           "<= 0.1 % beyond the floor's", !own_misses,
           fmt::format("{:.0f} missed deadlines ({:.2f} %), the bare timer floor {:.0f}{}", missed, 100 * missed / ticks,

@@ -42,6 +42,11 @@ struct SessionVerdict {
 
 SessionVerdict summarize_session(const nlohmann::json& server, const std::vector<nlohmann::json>& clients);
 
+/// Whether a client's report shows missed deadlines of its own haptic loop: more than 0.1 % of
+/// its ticks beyond those the bare timer floor beside it missed (a stall of the whole machine,
+/// the host's steal time in a virtual machine, makes the floor miss the same deadlines).
+bool misses_deadlines_of_its_own(const nlohmann::json& client_report);
+
 /// Reads the reports, prints the table, writes `out` (if not empty); exit code 0 if healthy.
 int run_summarize(const std::filesystem::path& server_report, const std::vector<std::filesystem::path>& client_reports,
                   const std::filesystem::path& out);
