@@ -21,8 +21,9 @@ packages=(
   # tests and benchmarks; the browser the live view's test opens the page in; the mesher
   # of the Hertz study's graded block (scenes/hertz/quarter_block.geo, meshed by the build)
   libgtest-dev libgmock-dev libbenchmark-dev chromium gmsh
-  # fuzzing (libFuzzer) and sanitizer reports: make fuzz, make test-asan, make test-tsan
-  clang libclang-rt-14-dev llvm
+  # fuzzing (libFuzzer) and sanitizer reports: make fuzz, make test-asan, make test-tsan;
+  # lld, the faster linker every build uses when it is there (cmake/fast_linker.cmake)
+  clang libclang-rt-14-dev llvm lld
 )
 
 # Node.js and npm, for two test tools only: the official MCAP reader (@mcap/core) a test
