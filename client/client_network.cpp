@@ -15,6 +15,7 @@
 #include "client/ir_intake.h"
 #include "client/server_connection.h"
 #include "client/welcome.h"
+#include "common/util/monotonic_clock.h"
 #include "net/datagram_endpoint.h"
 #include "proto/record/session_recorder.h"
 #include "proto/wire/header.h"
@@ -34,7 +35,7 @@ constexpr std::chrono::milliseconds kDrainPeriod{1};
 /// Time the goodbye gets to leave before the I/O stops.
 constexpr std::chrono::milliseconds kGoodbyeGrace{50};
 
-std::int64_t now_ns() { return wire::monotonic_now_ns(); }
+std::int64_t now_ns() { return monotonic_now_ns(); }
 
 const char* event_name(HapticEventKind kind) {
   switch (kind) {

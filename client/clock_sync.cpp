@@ -1,5 +1,6 @@
 #include "client/clock_sync.h"
 
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/header.h"
 
 namespace cohaptic {
@@ -18,7 +19,7 @@ void ClockSync::restart() {
 
 void ClockSync::ping() {
   wire::Datagram datagram;
-  datagram.mutable_ping()->set_client_send_ns(wire::monotonic_now_ns());
+  datagram.mutable_ping()->set_client_send_ns(monotonic_now_ns());
   send_ping_(datagram);
 }
 

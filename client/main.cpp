@@ -12,7 +12,7 @@
 #include "client/device/trajectory_reach.h"
 #include "client/haptic_loop.h"
 #include "client/timer_floors.h"
-#include "common/net/host_port.h"
+#include "common/util/host_port.h"
 #include "common/util/atomic_file.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"

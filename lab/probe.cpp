@@ -17,6 +17,7 @@
 #include "common/model/sphere_contact_reference.h"
 #include "common/model/static_contact.h"
 #include "common/scene/load_scene.h"
+#include "common/sim/ir_build_options.h"
 #include "common/sim/simulation.h"
 #include "common/util/stopwatch.h"
 

@@ -16,7 +16,7 @@
 #include <random>
 #include <set>
 
-#include "common/net/host_port.h"
+#include "common/util/host_port.h"
 #include "common/scene/load_scene.h"
 #include "common/study/measures.h"
 #include "common/study/paired_comparison_analysis.h"

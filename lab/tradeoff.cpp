@@ -19,6 +19,7 @@
 #include "common/model/contact_reference.h"
 #include "common/model/sphere_contact_reference.h"
 #include "common/scene/load_scene.h"
+#include "common/sim/ir_build_options.h"
 #include "common/sim/simulation.h"
 #include "common/study/svg_plot.h"
 #include "common/util/atomic_file.h"

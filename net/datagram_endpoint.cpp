@@ -7,6 +7,7 @@
 #include <cstring>
 #include <span>
 
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/header.h"
 
 namespace cohaptic::net {
@@ -68,7 +69,7 @@ bool DatagramEndpoint::read_one() {
 }
 
 void DatagramEndpoint::take(std::size_t bytes) {
-  const std::int64_t arrival = wire::monotonic_now_ns();
+  const std::int64_t arrival = monotonic_now_ns();
   const bool admitted = trusted(from_);
   if (!admitted && limiter_.limited(from_.address(), arrival)) {
     inspector_->count_unread(wire::Rejection::rate_limited);
@@ -88,7 +89,7 @@ bool DatagramEndpoint::trusted(const udp::endpoint& peer) const {
 
 void DatagramEndpoint::trust(const udp::endpoint& peer) {
   if (!trusted(peer)) trusted_.push_back(peer);
-  limiter_.prove(peer.address(), wire::monotonic_now_ns());  // an admitted peer's host is a known one
+  limiter_.prove(peer.address(), monotonic_now_ns());  // an admitted peer's host is a known one
 }
 
 void DatagramEndpoint::distrust(const udp::endpoint& peer) { std::erase(trusted_, peer); }

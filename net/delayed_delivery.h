@@ -1,8 +1,8 @@
-// Delivery across a link with an injected shift delay (common/net/link_delay.h): a
+// Delivery across a link with an injected shift delay (common/delay/link_delay.h): a
 // message handed over now is delivered at once, after its delay by a timer on the I/O
 // thread, or never (lost on the link). The caller keeps one LinkDelay per link and
 // direction, and applies it where the message enters or leaves the process, so that the
-// delay is the link's and nothing else's. Times: ns of wire::monotonic_now_ns().
+// delay is the link's and nothing else's. Times: ns of monotonic_now_ns().
 #pragma once
 
 #include <asio.hpp>
@@ -11,7 +11,8 @@
 #include <memory>
 #include <optional>
 
-#include "common/net/link_delay.h"
+#include "common/delay/link_delay.h"
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/header.h"
 
 namespace cohaptic::net {
@@ -33,7 +34,7 @@ bool deliver_over(LinkDelay& link, asio::io_context& io, std::int64_t now_ns, De
   auto timer = std::make_shared<asio::steady_timer>(
       io, std::chrono::steady_clock::time_point(std::chrono::nanoseconds(now_ns + *delay)));
   timer->async_wait([timer, deliver = std::move(deliver)](std::error_code error) mutable {
-    if (!error) deliver(wire::monotonic_now_ns());
+    if (!error) deliver(monotonic_now_ns());
   });
   return true;
 }

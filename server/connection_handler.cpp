@@ -7,7 +7,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "common/net/link_delay.h"
+#include "common/delay/link_delay.h"
+#include "common/util/monotonic_clock.h"
 #include "common/util/printable.h"
 #include "net/delayed_delivery.h"
 #include "proto/wire/header.h"
@@ -104,7 +105,7 @@ ConnectionCounters ConnectionHandler::counters() const {
 }
 
 void ConnectionHandler::warn_throttled(const std::string& message) {
-  const std::int64_t now = wire::monotonic_now_ns();
+  const std::int64_t now = monotonic_now_ns();
   if (now - last_warning_ns_ < 1'000'000'000) {
     ++warnings_held_;
     return;
@@ -246,7 +247,7 @@ void ConnectionHandler::client_status(const Participant& participant, const wire
     }
   if (recorder_) {
     record::ReceivedClientStatus received;
-    received.set_receive_time_ns(wire::monotonic_now_ns());
+    received.set_receive_time_ns(monotonic_now_ns());
     received.set_slot(static_cast<std::uint32_t>(participant.slot));
     received.set_user(participant.user_name);
     *received.mutable_status() = status;
@@ -311,7 +312,7 @@ void ConnectionHandler::join(const ParticipantPtr& participant, const wire::Cont
       udp::endpoint(participant->connection->peer_address(), static_cast<std::uint16_t>(request.udp_port()));
   participant->datagram_sealer.emplace(key, session_, wire::kServerSender, options_.encrypt);
   const double rate = request.haptic_rate_hz() > 0 ? request.haptic_rate_hz() : welcome_.haptic_rate_hz();
-  participant->datagram_budget = {rate, kUserDatagramsPerTick * rate, rate, wire::monotonic_now_ns()};
+  participant->datagram_budget = {rate, kUserDatagramsPerTick * rate, rate, monotonic_now_ns()};
   slots_[static_cast<std::size_t>(slot)] = participant;
   udp_.inspector().allow_sender(wire::sender_of_slot(static_cast<std::uint32_t>(slot)), key, request.datagram_salt(),
                                 request.datagram_sequence());
@@ -357,7 +358,7 @@ void ConnectionHandler::leave(const ParticipantPtr& participant, const std::stri
 }
 
 void ConnectionHandler::broadcast_event(const std::string& kind, const std::string& text, const record::EventUser& user) {
-  if (recorder_) recorder_->event(wire::monotonic_now_ns(), kind, text, user);
+  if (recorder_) recorder_->event(monotonic_now_ns(), kind, text, user);
   for (const ParticipantPtr& participant : slots_) {
     if (!participant) continue;
     wire::Control control;
@@ -378,7 +379,7 @@ void ConnectionHandler::send_bytes(const ParticipantPtr& participant, std::vecto
                                    bool frame) {
   if (participant->gone) return;
   // The TCP link keeps order and loses nothing: every frame is delivered, perhaps later.
-  net::deliver_over(participant->to_client_tcp, io_, wire::monotonic_now_ns(),
+  net::deliver_over(participant->to_client_tcp, io_, monotonic_now_ns(),
                     [this, participant, kind, frame, bytes = std::move(bytes)](std::int64_t) mutable {
                       if (participant->gone) return;
                       counters_.frames_sent += frame;
@@ -440,7 +441,7 @@ void ConnectionHandler::send(Outbox outbox) {
 
 void ConnectionHandler::send_datagram(Participant& participant, wire::Datagram& datagram) {
   const udp::endpoint to = participant.udp_endpoint;
-  const bool delivered = net::deliver_over(participant.to_client_udp, io_, wire::monotonic_now_ns(),
+  const bool delivered = net::deliver_over(participant.to_client_udp, io_, monotonic_now_ns(),
                                            [this, to, bytes = participant.datagram_sealer->seal(datagram)](std::int64_t) mutable {
                                              udp_.send(std::move(bytes), to);
                                            });
@@ -486,7 +487,7 @@ void ConnectionHandler::handle_datagram(const wire::Datagram& datagram, int slot
     wire::Datagram pong;
     pong.mutable_pong()->set_client_send_ns(datagram.ping().client_send_ns());
     pong.mutable_pong()->set_server_receive_ns(arrival_ns);
-    pong.mutable_pong()->set_server_send_ns(wire::monotonic_now_ns());
+    pong.mutable_pong()->set_server_send_ns(monotonic_now_ns());
     send_datagram(*slots_[static_cast<std::size_t>(slot)], pong);
   }
 }

@@ -8,6 +8,7 @@
 #include <map>
 #include <utility>
 
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/header.h"
 #include "proto/wire/ir_convert.h"
 
@@ -27,7 +28,7 @@ bool travels_whole(const BuiltIr& built) { return built.send && !built.as_sent; 
 
 void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
   if (irs.empty()) return;
-  const std::int64_t start_ns = wire::monotonic_now_ns();
+  const std::int64_t start_ns = monotonic_now_ns();
   // An IR that travels whole and is followed by another of its user's that does too is
   // superseded: it is recorded, not sent; a fresh start of the stream passes to the next.
   std::vector<char> superseded(irs.size(), 0);
@@ -82,7 +83,7 @@ void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
     outbox.irs.push_back({built.user, std::move(control), built.streamed});
     ++sent;
   }
-  statistics_.record_irs_encoded(wire::monotonic_now_ns() - start_ns, sent, bytes, skipped);
+  statistics_.record_irs_encoded(monotonic_now_ns() - start_ns, sent, bytes, skipped);
 }
 
 void IrEncoder::start(std::function<void(Outbox&&)> send) {

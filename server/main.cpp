@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "common/model/compliance_setup.h"
-#include "common/net/host_port.h"
+#include "common/util/host_port.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
 #include "common/util/log_to_stderr.h"

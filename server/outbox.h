@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "cohaptic/messages.pb.h"
-#include "common/net/link_delay.h"
+#include "common/delay/link_delay.h"
 
 namespace cohaptic {
 

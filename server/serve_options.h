@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "common/ir/intermediate_representation.h"
-#include "common/net/link_delay.h"
+#include "common/delay/link_delay.h"
 #include "server/served_conditions.h"
 
 namespace cohaptic {

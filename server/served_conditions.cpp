@@ -5,6 +5,7 @@
 #include <set>
 
 #include "common/util/error.h"
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/header.h"
 
 namespace cohaptic {
@@ -108,7 +109,7 @@ int ConditionSwitch::serve_next() {
 int ConditionSwitch::switch_to(int index) {
   served_.index = index;
   ++served_.switches;
-  history_.push_back({wire::monotonic_now_ns(), index});
+  history_.push_back({monotonic_now_ns(), index});
   return index;
 }
 

@@ -16,7 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "common/net/link_delay.h"
+#include "common/delay/link_delay.h"
+#include "common/util/monotonic_clock.h"
 
 namespace cohaptic {
 
@@ -60,7 +61,7 @@ class ConditionSwitch {
   };
   Served served() const;
 
-  /// One switch asked for: when (wire::monotonic_now_ns), and the condition it serves.
+  /// One switch asked for: when (monotonic_now_ns), and the condition it serves.
   struct Switch {
     std::int64_t time_ns = 0;
     int index = 0;

@@ -7,7 +7,9 @@
 
 #include "common/mesh/tet_mesh.h"
 #include "common/sim/elastic_states.h"
+#include "common/sim/ir_build_options.h"
 #include "common/sim/loaded_columns.h"
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/header.h"
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/vec3_convert.h"
@@ -129,7 +131,7 @@ SimulationLoop::StepOutput SimulationLoop::advance(std::int64_t now_ns) {
     recorder_->flush_if_due();
   }
   ++steps_;
-  const std::int64_t end_ns = wire::monotonic_now_ns();
+  const std::int64_t end_ns = monotonic_now_ns();
   statistics_.record_step({end_ns - now_ns, report, forces.size()}, seconds_since_start(end_ns));
   return output;
 }
@@ -314,9 +316,9 @@ std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,
 
 std::optional<std::string> SimulationLoop::step_until(const std::atomic<bool>& running,
                                                       const std::function<void(Outbox&&)>& send) {
-  std::int64_t next = wire::monotonic_now_ns();
+  std::int64_t next = monotonic_now_ns();
   while (running.load()) {
-    const std::int64_t step_start = wire::monotonic_now_ns();
+    const std::int64_t step_start = monotonic_now_ns();
     try {
       StepOutput output = advance(step_start);
       failures_.succeeded();
@@ -326,13 +328,13 @@ std::optional<std::string> SimulationLoop::step_until(const std::atomic<bool>& r
       for (int user = 0; user < simulation_.user_count(); ++user) simulation_.clear_tool(user);
       const std::optional<std::string> line = failures_.failed(step_start, e.what());
       if (line) spdlog::error("{}", *line);
-      statistics_.record_failure(failures_.consecutive(), e.what(), seconds_since_start(wire::monotonic_now_ns()));
+      statistics_.record_failure(failures_.consecutive(), e.what(), seconds_since_start(monotonic_now_ns()));
       if (failures_.limit_reached())
         return fmt::format("the simulation failed {} steps in a row, the last with: {}", failures_.consecutive(),
                            e.what());
     }
     next += static_cast<std::int64_t>(1e9 / rate_hz_);  // a switched condition may change the rate
-    const std::int64_t step_end = wire::monotonic_now_ns();
+    const std::int64_t step_end = monotonic_now_ns();
     if (next < step_end) next = step_end;  // behind: no catch-up burst
     std::this_thread::sleep_for(std::chrono::nanoseconds(next - step_end));
   }

@@ -32,7 +32,7 @@
 // solves into its own, handed over at the start of a step). The live view shows every body;
 // the display a scene of one linear elastic object or of one home-spring tissue (its display
 // deformation, no solve). Times: ns of
-// wire::monotonic_now_ns(); simulation time in s from the server's start.
+// monotonic_now_ns(); simulation time in s from the server's start.
 #pragma once
 
 #include <atomic>
@@ -49,6 +49,7 @@
 #include "common/ir/compliance_rows_sender.h"
 #include "common/model/model.h"
 #include "common/sim/scene_simulation.h"
+#include "common/util/monotonic_clock.h"
 #include "proto/record/session_recorder.h"
 #include "server/compliance_prefetch.h"
 #include "server/display_writer.h"

@@ -15,6 +15,7 @@
 #include "common/scene/load_scene.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
+#include "common/util/monotonic_clock.h"
 #include "common/util/stopwatch.h"
 #include "proto/record/session_recorder.h"
 #include "proto/wire/header.h"
@@ -79,7 +80,7 @@ std::vector<ServedCondition> served_conditions(const ServeOptions& options) {
 
 struct SimulationServer::Impl {
   ServeOptions options;
-  std::int64_t start_ns = wire::monotonic_now_ns();  // time zero of the simulation and the report
+  std::int64_t start_ns = monotonic_now_ns();  // time zero of the simulation and the report
   std::unique_ptr<Model> model;
   SceneCompliance compliance;
   std::string scene_yaml;
@@ -172,7 +173,7 @@ struct SimulationServer::Impl {
     }
     if (view) {
       connections->on_client_status([this](int slot, const std::string& user, const wire::ClientStatus& status) {
-        view->publish_status(slot, user, status, static_cast<double>(wire::monotonic_now_ns() - start_ns) * 1e-9);
+        view->publish_status(slot, user, status, static_cast<double>(monotonic_now_ns() - start_ns) * 1e-9);
       });
       if (options.view_token_file)  // the operator has the token: it stays out of the log
         spdlog::info("live view at {} (open it in a browser, adding ?token= and the token in {})", view->url(false),
@@ -221,7 +222,7 @@ struct SimulationServer::Impl {
     const ConditionSwitch::Served served = conditions.served();
     return {{"served", conditions.conditions()[static_cast<std::size_t>(served.index)].name},
             {"switches", served.switches},
-            {"time_s", static_cast<double>(wire::monotonic_now_ns() - start_ns) * 1e-9}};
+            {"time_s", static_cast<double>(monotonic_now_ns() - start_ns) * 1e-9}};
   }
 
   void print_status() {

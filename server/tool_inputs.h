@@ -2,7 +2,7 @@
 // server's I/O thread and simulation thread share. The I/O thread (ConnectionHandler)
 // writes a slot as its user joins, sends samples and leaves; the simulation thread
 // (SimulationLoop) takes all of them once per step. A small mutex guards them: both
-// sides hold it only to copy a few numbers. Units: m; ns of wire::monotonic_now_ns().
+// sides hold it only to copy a few numbers. Units: m; ns of monotonic_now_ns().
 // A step sees only the newest sample, so a button press is also counted as it arrives
 // (`pressed`): one shorter than a step, or in a burst of samples a stalled link let through
 // at once, is not lost.

@@ -54,9 +54,11 @@
 #include "common/model/compliance_setup.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/elastic_states.h"
+#include "common/sim/ir_build_options.h"
 #include "common/sim/loaded_columns.h"
 #include "common/sim/scene_simulation.h"
 #include "common/util/blas_threads.h"
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/header.h"
 #include "server/server_recording.h"
 #include "server/simulation_loop.h"
@@ -100,7 +102,7 @@ void set_tools(ToolInputs& tools, const BrainRig& rig, double t) {
   for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) {
     const Trajectory& motion = rig.motions[slot];
     tools.update(static_cast<int>(slot), true, motion.position(std::fmod(t, motion.duration())), 0,
-                 wire::monotonic_now_ns(), wire::monotonic_now_ns());
+                 monotonic_now_ns(), monotonic_now_ns());
   }
 }
 
@@ -189,12 +191,12 @@ class LoopBeside {
       live_ = std::make_unique<view::LiveView>(*rig_.model, std::array{rig_.columns.get()}, wire_protocol(options_),
                                                injected_delays(options_), view::LiveViewOptions{}, nullptr);
     loop_ = std::make_unique<SimulationLoop>(*rig_.model, std::array{rig_.columns.get()}, options_, tools_, statistics_,
-                                             nullptr, live_.get(), nullptr, wire::monotonic_now_ns());
+                                             nullptr, live_.get(), nullptr, monotonic_now_ns());
     // Once along the whole motion first: every compliance column it needs is computed (or
     // loaded) before the clock runs.
     for (double t = 0; t < rig_.motions[0].duration(); t += 0.005) {
       set_tools(tools_, rig_, t);
-      loop_->step(wire::monotonic_now_ns());
+      loop_->step(monotonic_now_ns());
     }
     if (live_) {
       std::optional<PinnedThread> on_cpu1;  // the view's thread and the browsers' start there
@@ -276,7 +278,7 @@ void run_steps(benchmark::State& state, Beside beside) {
   double t = kWindowStart_s;
   for (auto _ : state) {
     set_tools(session.tools(), session.rig(), t);
-    benchmark::DoNotOptimize(session.loop().step(wire::monotonic_now_ns()));
+    benchmark::DoNotOptimize(session.loop().step(monotonic_now_ns()));
     t += kWindowStride_s;  // the motion at a fixed stride, whatever the steps cost
   }
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

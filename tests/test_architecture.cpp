@@ -36,6 +36,33 @@ const std::map<std::string, std::set<std::string>> kMayInclude = {
     {"lab", {"lab", "view", "net", "proto", "common"}},
 };
 
+// What each subdirectory of common/ may include besides itself. The bodies' physics (fem,
+// mass_spring, separation, laparoscopy) stands on mesh, contact and condense; the scene
+// describes the bodies, the model compiles a scene, the IR is built from the model, and the
+// simulation (sim) drives them all. `kinds` (vocabularies and limits every floor shares)
+// and `util` include nothing of ours, so any floor may use them: the IR's types and the
+// haptic loop's evaluator take the contact model from kinds/, not from the scene.
+const std::map<std::string, std::set<std::string>> kCommonMayInclude = {
+    {"condense", {"fem", "util"}},
+    {"contact", {"condense", "fem", "mesh", "util"}},
+    {"delay", {"util"}},
+    {"fem", {"mesh", "util"}},
+    {"haptics", {"util"}},
+    {"interaction", {"fem", "mass_spring", "mesh", "model", "util"}},
+    {"ir", {"condense", "contact", "fem", "kinds", "laparoscopy", "mass_spring", "mesh", "model", "separation", "util"}},
+    {"kinds", {}},
+    {"laparoscopy", {"contact", "mesh", "util"}},
+    {"mass_spring", {"contact", "fem", "mesh", "util"}},
+    {"mesh", {"util"}},
+    {"model", {"contact", "fem", "kinds", "laparoscopy", "mass_spring", "mesh", "scene", "separation", "util"}},
+    {"scene", {"fem", "kinds", "laparoscopy", "mass_spring", "mesh", "separation", "util"}},
+    {"separation", {"contact", "fem", "mesh", "study", "util"}},
+    {"sim", {"condense", "contact", "fem", "interaction", "ir", "kinds", "laparoscopy", "mass_spring", "model", "scene", "util"}},
+    {"study", {"util"}},
+    {"sync", {"util"}},
+    {"util", {}},
+};
+
 struct Include {
   fs::path file;       ///< relative to the source directory
   int line = 0;
@@ -143,20 +170,49 @@ TEST(Architecture, EachFloorIncludesOnlyTheFloorsItMayUse) {
   EXPECT_GT(checked, 500u) << "the walk found too few includes to be reading the sources";
 }
 
-TEST(Architecture, CommonsSubdirectoriesIncludeEachOtherWithoutACycle) {
+// common/X/... -> "X"; nothing for a file directly in common/.
+std::optional<std::string> common_subdirectory(const fs::path& path) {
+  const std::vector<fs::path> parts(path.begin(), path.end());
+  if (parts.size() < 3 || parts[0] != "common") return std::nullopt;
+  return parts[1].string();
+}
+
+// The includes between common/'s subdirectories, one include as the evidence of each edge.
+IncludeGraph common_include_graph() {
   IncludeGraph graph;
-  // common/X/... -> "common/X"; nothing for a file directly in common/.
-  const auto subdirectory = [](const fs::path& path) -> std::optional<std::string> {
-    const std::vector<fs::path> parts(path.begin(), path.end());
-    if (parts.size() < 3 || parts[0] != "common") return std::nullopt;
-    return "common/" + parts[1].string();
-  };
   for (const Include& include : quoted_includes("common")) {
-    const auto from = subdirectory(include.file), to = subdirectory(include.included);
+    const auto from = common_subdirectory(include.file), to = common_subdirectory(include.included);
     if (from && to && *from != *to) graph[*from].try_emplace(*to, include);
   }
+  return graph;
+}
+
+TEST(Architecture, CommonsSubdirectoriesIncludeEachOtherWithoutACycle) {
+  const IncludeGraph graph = common_include_graph();
   EXPECT_GE(graph.size(), 10u) << "the walk found too few subdirectories of common/";
   if (const auto cycle = find_cycle(graph)) ADD_FAILURE() << "common/ includes itself in a circle: " << describe_cycle(graph, *cycle);
+}
+
+TEST(Architecture, CommonsSubdirectoriesIncludeOnlyWhatTheirListAllows) {
+  IncludeGraph allowed;
+  for (const auto& [from, targets] : kCommonMayInclude)
+    for (const std::string& to : targets) allowed[from][to] = Include{fs::path("common") / from, 0, fs::path("common") / to};
+  if (const auto cycle = find_cycle(allowed)) ADD_FAILURE() << "the allowed list itself has a cycle: " << describe_cycle(allowed, *cycle);
+
+  for (const fs::directory_entry& entry : fs::directory_iterator(kSourceDir / "common")) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_directory() && !kCommonMayInclude.count(name))
+      ADD_FAILURE() << "common/" << name << "/ is not in kCommonMayInclude: say what it may include";
+  }
+  std::size_t edges = 0;
+  for (const auto& [from, targets] : common_include_graph())
+    for (const auto& [to, evidence] : targets) {
+      ++edges;
+      const auto listed = kCommonMayInclude.find(from);
+      if (listed == kCommonMayInclude.end() || !listed->second.count(to))
+        ADD_FAILURE() << evidence.where() << ": common/" << from << "/ may not include common/" << to << "/";
+    }
+  EXPECT_GE(edges, 30u) << "the walk found too few includes between common/'s subdirectories";
 }
 
 TEST(Architecture, NoFileCitesAPlanOutsideTheRepository) {

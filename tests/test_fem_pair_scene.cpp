@@ -30,6 +30,7 @@
 #include "common/ir/evaluate_force.h"
 #include "common/model/scene_compliance.h"
 #include "common/scene/load_scene.h"
+#include "common/sim/ir_build_options.h"
 #include "common/sim/scene_simulation.h"
 #include "common/sim/state_solve.h"
 #include "proto/wire/ir_convert.h"

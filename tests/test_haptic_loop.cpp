@@ -15,6 +15,7 @@
 #include "common/haptics/trajectory.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
+#include "common/util/monotonic_clock.h"
 #include "support/cube_scene.h"
 #include "support/evaluate_static.h"
 
@@ -191,7 +192,7 @@ TEST(HapticLoop, OutputsTheEvaluatorsForceLimitedAndFadedWhenConfirmationsStop) 
   const Fixture fixture;
   const Eigen::Vector3d& expected = fixture.pressed_force;
   ASSERT_GT(expected.norm(), 0.2);
-  const std::unique_ptr<HapticChannels> channels = fixture.channels_with_ir(wire::monotonic_now_ns());
+  const std::unique_ptr<HapticChannels> channels = fixture.channels_with_ir(monotonic_now_ns());
   ScriptedDevice device = Fixture::holding_device();
   HapticLoopSettings settings;
   settings.force_limit = 0.2;  // below the evaluated force: clamped
@@ -209,10 +210,10 @@ TEST(HapticLoop, OutputsTheEvaluatorsForceLimitedAndFadedWhenConfirmationsStop) 
   std::vector<Confirmed> confirmed(20);
   std::thread server([&] {
     for (Confirmed& c : confirmed) {
-      c.stamp_ns = wire::monotonic_now_ns();
+      c.stamp_ns = monotonic_now_ns();
       channels->confirmation.back() = {fixture.ir->ir.epoch, c.stamp_ns};
       channels->confirmation.publish();
-      c.published_ns = wire::monotonic_now_ns();
+      c.published_ns = monotonic_now_ns();
       std::this_thread::sleep_for(10ms);
     }
   });

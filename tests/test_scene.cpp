@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/haptics/trajectory.h"
+#include "common/kinds/session_limits.h"
 #include "common/mesh/box_mesher.h"
 #include "common/model/model.h"
 #include "common/mass_spring/tube_network.h"
@@ -285,6 +286,14 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
   {
     const auto text = replaced(base, "tools:\n  - name: A\n    shape: point\n", "tools: []\n");
     cases.push_back({"no tools", text, "tools: []", {"tools", "at least one tool", "found a list of 0"}});
+  }
+  {
+    // One tool more than a session holds (kMaxUsers, common/kinds/session_limits.h).
+    std::string tools = "tools:\n";
+    for (int user = 0; user <= kMaxUsers; ++user) tools += "  - {name: T" + std::to_string(user) + ", shape: point}\n";
+    const auto text = replaced(base, "tools:\n  - name: A\n    shape: point\n", tools);
+    cases.push_back({"more tools than users", text, "- {name: T0,",
+                     {"tools", "at most 4 tools", "found a list of " + std::to_string(kMaxUsers + 1)}});
   }
   {
     const auto text = replaced(base, "    shape: point\n", "    shape: point\n  - name: A\n    shape: point\n");

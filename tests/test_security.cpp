@@ -37,6 +37,7 @@
 #include <thread>
 
 #include "common/util/error.h"
+#include "common/util/monotonic_clock.h"
 #include "lab/replay.h"
 #include "proto/record/recording.h"
 #include "proto/record/session_recorder.h"
@@ -427,9 +428,9 @@ TEST(Robustness, AMillionHostileDatagramsLeaveTheSimulationRateAndEveryLegitimat
   const auto bob = session.client("bob", 1, write_press(session.dir, "b", 20, -2, 3, 300.0));
   for (auto* client : {alice.get(), bob.get()}) ASSERT_TRUE(testing::wait_for_output(*client, "haptic loop at"));
   std::this_thread::sleep_for(3s);  // stimulus: both presses reach their hold
-  const std::int64_t calm_from = wire::monotonic_now_ns();
+  const std::int64_t calm_from = monotonic_now_ns();
   std::this_thread::sleep_for(5s);  // the undisturbed window
-  const std::int64_t flood_from = wire::monotonic_now_ns();
+  const std::int64_t flood_from = monotonic_now_ns();
   const std::uint64_t kernel_drops_before = kernel_receive_queue_drops();
 
   asio::io_context io;
@@ -442,11 +443,11 @@ TEST(Robustness, AMillionHostileDatagramsLeaveTheSimulationRateAndEveryLegitimat
     socket.send_to(asio::buffer(hostile.next()), server);
     if (i % kBurst == kBurst - 1) std::this_thread::sleep_for(1ms);  // stimulus: bursts, not a wall
   }
-  const std::int64_t flood_to = wire::monotonic_now_ns();
+  const std::int64_t flood_to = monotonic_now_ns();
   std::this_thread::sleep_for(1s);  // the last of the flood is read
-  const std::int64_t calm_again_from = wire::monotonic_now_ns();
+  const std::int64_t calm_again_from = monotonic_now_ns();
   std::this_thread::sleep_for(5s);  // the undisturbed window after
-  const std::int64_t calm_again_to = wire::monotonic_now_ns();
+  const std::int64_t calm_again_to = monotonic_now_ns();
   for (const auto& client : {alice.get(), bob.get()}) client->signal(SIGINT);
   for (const auto& client : {alice.get(), bob.get()}) ASSERT_EQ(client->wait(testing::kPatience), 0) << client->log_text();
   session.stop_server();

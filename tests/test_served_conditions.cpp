@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "common/net/link_delay.h"
+#include "common/delay/link_delay.h"
 #include "common/util/error.h"
 #include "lab/control_client.h"
 #include "server/control_socket.h"

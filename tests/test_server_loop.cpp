@@ -37,6 +37,7 @@
 #include "common/fem/dof_map.h"
 #include "common/ir/client_condensation.h"
 #include "common/ir/evaluate_force.h"
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/ir_convert.h"
 #include "proto/wire/ir_stream.h"
 #include "proto/wire/header.h"
@@ -147,7 +148,7 @@ struct LoopRig {
     options.client_timeout_s = 3600;  // the one sample below stays fresh
     tools.join(0);
     // Slot 0 presses 2 mm into the top face; slot 1 stays away.
-    tools.update(0, true, Eigen::Vector3d(0.003, 0.002, -0.002), 0, 1, wire::monotonic_now_ns());
+    tools.update(0, true, Eigen::Vector3d(0.003, 0.002, -0.002), 0, 1, monotonic_now_ns());
   }
   static testing::CubeSceneOptions soft_cube() {
     testing::CubeSceneOptions options;
@@ -181,7 +182,7 @@ TEST(SimulationLoop, AStepThatKeepsFailingEndsTheLoopAfterAHundredPacedSteps) {
   LoopRig rig(0);
   rig.options.step_nodes = movable_surface_node_count(*rig.cube.model);
   SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
-                      wire::monotonic_now_ns());
+                      monotonic_now_ns());
   const auto start = std::chrono::steady_clock::now();
   const auto [stopped, outboxes] = run_for(loop, 20s);
   const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -204,7 +205,7 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
   {
     LoopRig rig(10, ServeProtocol::p0);
     SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
-                        wire::monotonic_now_ns());
+                        monotonic_now_ns());
     const auto [stopped, outboxes] = run_for(loop, 400ms);
     EXPECT_FALSE(stopped.has_value()) << *stopped;
     const LoopSummary summary = rig.statistics.summary();
@@ -225,7 +226,7 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
   {
     LoopRig rig(10, ServeProtocol::p1);
     SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
-                        wire::monotonic_now_ns());
+                        monotonic_now_ns());
     const auto [stopped, outboxes] = run_for(loop, 400ms);
     EXPECT_FALSE(stopped.has_value());
     const auto first_ir = std::find_if(outboxes.begin(), outboxes.end(), [](const Outbox& o) { return !o.irs.empty(); });
@@ -261,11 +262,11 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
 TEST(SimulationLoop, SendsComplianceRowsAndStartsEachNewUserOfASlotAfresh) {
   LoopRig rig(0, ServeProtocol::p1);
   SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
-                      nullptr, nullptr, wire::monotonic_now_ns());
+                      nullptr, nullptr, monotonic_now_ns());
   const auto first_ir = [&](const Eigen::Vector3d& tool, std::int64_t sample_time) {
-    rig.tools.update(0, true, tool, 0, sample_time, wire::monotonic_now_ns());
+    rig.tools.update(0, true, tool, 0, sample_time, monotonic_now_ns());
     for (int step = 0; step < 20; ++step) {
-      Outbox outbox = loop.step(wire::monotonic_now_ns());
+      Outbox outbox = loop.step(monotonic_now_ns());
       if (!outbox.irs.empty()) return outbox.irs.front();
     }
     ADD_FAILURE() << "no IR in 20 steps";
@@ -307,11 +308,11 @@ TEST(SimulationLoop, SendsComplianceRowsUnderBTruncation) {
   LoopRig rig(60);
   rig.cube.model->scene.haptic.boundary_truncation = 0.2;
   SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
-                      nullptr, nullptr, wire::monotonic_now_ns());
+                      nullptr, nullptr, monotonic_now_ns());
   std::vector<ToSlot<wire::Control>> sent;
   for (int step = 0; step < 40 && sent.size() < 2; ++step) {
-    if (step == 20) rig.tools.update(0, true, Eigen::Vector3d(-0.03, 0.02, -0.002), 0, 2, wire::monotonic_now_ns());
-    Outbox outbox = loop.step(wire::monotonic_now_ns());
+    if (step == 20) rig.tools.update(0, true, Eigen::Vector3d(-0.03, 0.02, -0.002), 0, 2, monotonic_now_ns());
+    Outbox outbox = loop.step(monotonic_now_ns());
     for (ToSlot<wire::Control>& ir : outbox.irs) sent.push_back(std::move(ir));
   }
   ASSERT_FALSE(sent.empty());
@@ -346,13 +347,13 @@ TEST(SimulationLoop, ASwitchedConditionChangesHeldNodesAndProtocolAtTheNextStep)
   free_p1.protocol = ServeProtocol::p1;
   ConditionSwitch conditions({held_p0, free_p1});
   SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
-                      nullptr, nullptr, wire::monotonic_now_ns(), &conditions);
+                      nullptr, nullptr, monotonic_now_ns(), &conditions);
   const auto forces = [](const Outbox& outbox) {
     return std::count_if(outbox.datagrams.begin(), outbox.datagrams.end(),
                          [](const ToSlot<wire::Datagram>& d) { return d.message.has_force(); });
   };
   for (int step = 0; step < 5; ++step) {
-    const Outbox outbox = loop.step(wire::monotonic_now_ns());
+    const Outbox outbox = loop.step(monotonic_now_ns());
     EXPECT_FALSE(outbox.protocol_switch.has_value());
     EXPECT_TRUE(outbox.irs.empty()) << "P0 sends no IR";
     EXPECT_EQ(forces(outbox), 1);
@@ -360,7 +361,7 @@ TEST(SimulationLoop, ASwitchedConditionChangesHeldNodesAndProtocolAtTheNextStep)
   EXPECT_EQ(rig.statistics.summary().max_boundary_nodes, 10);
 
   conditions.serve("B");
-  const Outbox switched = loop.step(wire::monotonic_now_ns());
+  const Outbox switched = loop.step(monotonic_now_ns());
   ASSERT_TRUE(switched.protocol_switch.has_value());
   EXPECT_EQ(*switched.protocol_switch, wire::P1);
   EXPECT_EQ(forces(switched), 0);
@@ -371,13 +372,13 @@ TEST(SimulationLoop, ASwitchedConditionChangesHeldNodesAndProtocolAtTheNextStep)
   EXPECT_EQ(fem.node_ids.size(), static_cast<std::size_t>(fem.row_node_count)) << "B holds no nodes, from the step it took effect";
   EXPECT_TRUE(fem.truncated_node_ids.empty());
   for (int step = 0; step < 5; ++step) {
-    const Outbox outbox = loop.step(wire::monotonic_now_ns());
+    const Outbox outbox = loop.step(monotonic_now_ns());
     EXPECT_FALSE(outbox.protocol_switch.has_value());
     EXPECT_EQ(forces(outbox), 0);
   }
 
   conditions.serve("A");
-  const Outbox back = loop.step(wire::monotonic_now_ns());
+  const Outbox back = loop.step(monotonic_now_ns());
   ASSERT_TRUE(back.protocol_switch.has_value());
   EXPECT_EQ(*back.protocol_switch, wire::P0);
   EXPECT_EQ(forces(back), 1) << "P0's forces from the step the switch took effect";

@@ -9,6 +9,7 @@
 #include "common/haptics/passivity_controller.h"
 #include "common/haptics/scripted_device.h"
 #include "common/study/measures.h"
+#include "common/util/monotonic_clock.h"
 #include "lab/stability.h"
 #include "proto/wire/header.h"
 
@@ -132,7 +133,7 @@ TEST(HapticLoop, PassivityControlStopsAnActiveForceFromFeedingTheHand) {
   const auto work_done = [](bool passivity_control) {
     auto channels = std::make_unique<HapticChannels>();
     channels->tracing = true;
-    channels->force.back() = ForceSlot{Eigen::Vector3d(0.5, 0, 0), wire::monotonic_now_ns(), 1, true};
+    channels->force.back() = ForceSlot{Eigen::Vector3d(0.5, 0, 0), monotonic_now_ns(), 1, true};
     channels->force.publish();
     ScriptedDevice device(Trajectory({0.0, 1.0}, {Eigen::Vector3d::Zero(), Eigen::Vector3d(0.02, 0, 0)}, "slide"), 3.3);
     HapticLoopSettings settings;

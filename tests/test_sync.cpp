@@ -6,7 +6,7 @@
 #include <random>
 #include <thread>
 
-#include "common/net/link_delay.h"
+#include "common/delay/link_delay.h"
 #include "common/sync/clock_offset.h"
 #include "common/sync/remote_tool_buffer.h"
 #include "common/util/error.h"

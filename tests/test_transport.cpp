@@ -29,6 +29,7 @@
 #include <set>
 #include <string>
 
+#include "common/util/monotonic_clock.h"
 #include "net/bounded_write_queue.h"
 #include "net/datagram_endpoint.h"
 #include "net/delayed_delivery.h"
@@ -566,7 +567,7 @@ TEST(DelayedDelivery, AnOrderedLinkWithJitterDeliversABurstInOrder) {
   std::vector<int> delivered;
   constexpr int kMessages = 5000;  // sent as fast as the loop goes: a burst, many within one jitter
   for (int i = 0; i < kMessages; ++i)
-    ASSERT_TRUE(deliver_over(link, io, wire::monotonic_now_ns(), [&delivered, i](std::int64_t) { delivered.push_back(i); }));
+    ASSERT_TRUE(deliver_over(link, io, monotonic_now_ns(), [&delivered, i](std::int64_t) { delivered.push_back(i); }));
   io.run();
   ASSERT_EQ(delivered.size(), static_cast<std::size_t>(kMessages));
   for (int i = 0; i < kMessages; ++i) ASSERT_EQ(delivered[static_cast<std::size_t>(i)], i) << "delivered out of order";

@@ -16,10 +16,12 @@
 
 #include "common/model/shown_surface.h"
 #include "common/sim/elastic_states.h"
+#include "common/sim/ir_build_options.h"
 #include "common/sim/loaded_columns.h"
 #include "common/sim/scene_simulation.h"
 #include "common/sim/simulation.h"
 #include "common/util/error.h"
+#include "common/util/monotonic_clock.h"
 #include "proto/record/recording.h"
 #include "proto/wire/header.h"
 #include "server/simulation_loop.h"
@@ -539,7 +541,7 @@ struct ViewedLoop {
   ServeOptions options = like_pressed();
   ToolInputs tools{pressed.cube.model->scene.tools.size()};
   LoopStatistics statistics;
-  std::int64_t now_ns = wire::monotonic_now_ns();  // before `loop`, which starts its clock at it
+  std::int64_t now_ns = monotonic_now_ns();  // before `loop`, which starts its clock at it
   view::LiveView live;
   SimulationLoop loop;
   explicit ViewedLoop(record::SessionRecorder* recorder)

@@ -25,6 +25,7 @@
 #include "common/ir/evaluate_force.h"
 #include "common/scene/load_scene.h"
 #include "common/sim/simulation.h"
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/aead.h"
 #include "proto/wire/datagram_codec.h"
 #include "proto/wire/envelope.h"

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "common/util/monotonic_clock.h"
 #include "proto/wire/header.h"
 #include "view/view_token.h"
 
@@ -14,7 +15,7 @@ LiveView::LiveView(const Model& model, std::span<ComplianceColumns* const> colum
       period_ns_(static_cast<std::int64_t>(1e9 / options.rate_hz)),
       server_({options.host, options.port, access_token(options.host, options.token_file), options.assets, options.proto}) {
   const Scene scene = view_scene(model, shown_, protocol, injected, options.rate_hz, "live");
-  if (recorder_) recorder_->view_scene(wire::monotonic_now_ns(), scene);
+  if (recorder_) recorder_->view_scene(monotonic_now_ns(), scene);
   server_.publish(Channel::scene, server_message(scene));
 }
 

@@ -14,15 +14,6 @@
 
 namespace cohaptic {
 
-IrBuildOptions ir_build_options(const HapticSettings& haptic) {
-  IrBuildOptions options;
-  options.patch_rings = haptic.patch_rings;
-  options.contact_model = haptic.contact_model;
-  options.force_limit = haptic.force_limit_n;
-  options.boundary_truncation = haptic.boundary_truncation;
-  return options;
-}
-
 std::vector<bool> kept_boundary_nodes(const DofMap& dofs, std::span<const int> boundary, const Eigen::MatrixXd& m_cb,
                                       double threshold) {
   std::vector<bool> kept(boundary.size(), true);

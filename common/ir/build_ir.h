@@ -48,9 +48,6 @@ struct IrBuildOptions {
   double boundary_truncation = 0;
 };
 
-/// The IR settings `haptic` (a scene's) asks for, at f64 (the precision is the server's choice).
-IrBuildOptions ir_build_options(const HapticSettings& haptic);
-
 /// Which nodes of `boundary` B truncation keeps: those whose columns of `m_cb` (free dofs
 /// of B, node by node) have a norm of at least `threshold` times the largest node's.
 std::vector<bool> kept_boundary_nodes(const DofMap& dofs, std::span<const int> boundary, const Eigen::MatrixXd& m_cb,

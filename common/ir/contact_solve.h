@@ -13,11 +13,11 @@
 #include <Eigen/Core>
 #include <span>
 
-#include "common/scene/scene.h"
+#include "common/kinds/contact_model.h"
+#include "common/kinds/session_limits.h"
 
 namespace cohaptic {
 
-constexpr int kMaxUsers = 4;
 constexpr int kMaxContactDofs = 9 * kMaxUsers;
 
 using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxContactDofs, kMaxContactDofs>;

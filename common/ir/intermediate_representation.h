@@ -31,9 +31,9 @@
 #include "common/ir/compliance_rows.h"
 #include "common/ir/mass_spring_ir.h"
 #include "common/ir/separation_ir.h"
+#include "common/kinds/contact_model.h"
 #include "common/laparoscopy/home_spring_patch.h"
 #include "common/mesh/tet_mesh.h"
-#include "common/scene/scene.h"
 
 namespace cohaptic {
 

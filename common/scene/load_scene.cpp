@@ -1,5 +1,6 @@
 #include "common/scene/load_scene.h"
 
+#include "common/kinds/session_limits.h"
 #include "common/mesh/mesh_limits.h"
 #include "common/scene/parse_home_spring.h"
 #include "common/scene/parse_interactions.h"
@@ -280,6 +281,8 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
     if (!tool_names.insert(scene.tools.back().name).second) item.at("name").fail("a tool name not used before");
   }
   if (scene.tools.empty()) tools.fail("at least one tool");
+  if (scene.tools.size() > static_cast<std::size_t>(kMaxUsers))
+    tools.fail(fmt::format("at most {} tools (one per user; the haptic loop holds that many)", kMaxUsers));
   for (const ObjectSpec& object : scene.objects)
     if (const auto* separation = std::get_if<SeparationObjectSpec>(&object.body))
       for (const SeparationInstrumentSpec& instrument : separation->instruments)

@@ -16,6 +16,7 @@
 
 #include "common/fem/dof_map.h"
 #include "common/fem/linear_elastic_material.h"
+#include "common/kinds/contact_model.h"
 #include "common/laparoscopy/home_spring_spec.h"
 #include "common/mass_spring/mass_spring_spec.h"
 #include "common/mesh/mesh_with_gmsh.h"
@@ -27,14 +28,6 @@ namespace cohaptic {
 /// probe and forceps are laparoscopic instruments (home_spring_spec.h): a shaft through a
 /// trocar; on any other body kind their tip is a point.
 enum class ToolShape { point, sphere, probe, forceps };
-/// How a tool holds the surface: the paper's two (node translation of the contact triangle, the
-/// contact point alone) and the sphere model (every node a sphere tool has passed, held on
-/// its surface; common/contact/sphere_contact.h), the default for sphere tools.
-enum class ContactModel { node_translation, point_constraint, sphere };
-/// The scene file's name of a contact model.
-inline const char* contact_model_name(ContactModel model) {
-  return model == ContactModel::node_translation ? "translation" : model == ContactModel::point_constraint ? "point" : "sphere";
-}
 
 struct BoxMeshSpec {
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();  ///< [m]

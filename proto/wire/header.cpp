@@ -1,13 +1,8 @@
 #include "proto/wire/header.h"
 
-#include <chrono>
+#include "common/util/monotonic_clock.h"
 
 namespace cohaptic::wire {
-
-std::int64_t monotonic_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 
 void HeaderStamp::stamp(Header& header) {
   header.set_protocol_version(kProtocolVersion);

@@ -4,7 +4,7 @@
 // One HeaderStamp per sending channel (e.g. the server's UDP socket, each TCP connection):
 // its sequence starts at 1 and increases by one with every stamp, so receivers can drop
 // duplicates and stale messages (a receiver's replay window treats 0 like any number).
-// Times are std::chrono::steady_clock nanoseconds. stamp() is thread-safe.
+// Times are the session clock's (common/util/monotonic_clock.h). stamp() is thread-safe.
 #pragma once
 
 #include <atomic>
@@ -24,9 +24,6 @@ constexpr std::uint32_t kProtocolVersion = 3;
 constexpr std::uint32_t kServerSender = 0;
 constexpr std::uint32_t kJoiningSender = 0xffff'ffff;
 constexpr std::uint32_t sender_of_slot(std::uint32_t slot) { return slot + 1; }
-
-/// Nanoseconds of std::chrono::steady_clock now (the clock of sender_time_ns).
-std::int64_t monotonic_now_ns();
 
 class HeaderStamp {
  public:

@@ -1,3 +1,4 @@
+#include "common/util/monotonic_clock.h"
 #include "support/raw_participant.h"
 
 #include <sys/socket.h>
@@ -89,7 +90,7 @@ void RawParticipant::send_sample(const Eigen::Vector3d& position) {
   wire::Datagram datagram;
   wire::ToolSample* sample = datagram.mutable_tool();
   sample->set_user(static_cast<std::uint32_t>(options_.slot));
-  sample->set_sample_time_ns(wire::monotonic_now_ns());  // one host: the server's clock is ours
+  sample->set_sample_time_ns(monotonic_now_ns());  // one host: the server's clock is ours
   *sample->mutable_position() = wire::to_wire(position);
   sample->set_valid(true);
   std::error_code ignored;

@@ -1,4 +1,4 @@
-#include "common/net/link_delay.h"
+#include "common/delay/link_delay.h"
 
 #include <fmt/format.h>
 

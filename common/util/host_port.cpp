@@ -1,4 +1,4 @@
-#include "common/net/host_port.h"
+#include "common/util/host_port.h"
 
 namespace cohaptic {
 
