@@ -11,6 +11,7 @@
 #   make attacks    eleven attacks from the network replayed on loopback, as a Markdown page
 #   make results    every page of docs/results/ measured again and stamped (an hour or more)
 #   make command-lines  docs/command-lines.md from the programs' --help
+#   make format     every C++ file rewritten as clang-format writes it (.clang-format)
 #   make fuzz       build the fuzz targets with clang (libFuzzer, ASan, UBSan) in build-asan
 #                   and run each for FUZZ_SECONDS (default 15; 0 builds only), FUZZ_JOBS at once
 #   make test-asan  the suite (ASAN_TESTS: all by default) built with clang, ASan + UBSan, in
@@ -66,7 +67,7 @@ SANITIZER_CMAKE = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
 SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1 UBSAN_OPTIONS=print_stacktrace=1 \
   TSAN_OPTIONS=second_deadlock_stack=1:suppressions=$(CURDIR)/tests/tsan.supp
 
-.PHONY: all deps configure build test demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance brain-convergence paired-rehearsal attacks results command-lines fuzz test-asan test-tsan clean
+.PHONY: all deps configure build test format demo probe-demo tradeoff bench bench-thin bench-sphere bench-compliance brain-convergence paired-rehearsal attacks results command-lines fuzz test-asan test-tsan clean
 
 all: build
 
@@ -115,6 +116,11 @@ attacks:
 	@$(MAKE) --no-print-directory build >&2
 	@$(BUILD_DIR)/tests/cohaptic_attacks
 	@tests/results_stamp.sh
+
+# Every C++ source and header rewritten as clang-format writes it (.clang-format); the test
+# Format.EverySourceFileIsAsClangFormatWritesIt fails on any line that differs.
+format:
+	@tests/format_sources.sh
 
 # docs/command-lines.md from the built programs' --help (a test checks that it still is).
 command-lines:

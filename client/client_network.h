@@ -1,4 +1,4 @@
-// ClientNetwork: the haptic client's I/O thread (README.md, "cohaptic-client"). It runs
+// ClientNetwork: the haptic client's I/O thread (docs/client.md "Threads"). It runs
 // an asio io_context on one thread and wires together the parts that each do one job:
 //   - ServerConnection (server_connection.h): the TCP control channel to the server (join,
 //     welcome, IRs, events, goodbye), reconnecting every 500 ms while the server is away;

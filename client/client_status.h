@@ -1,6 +1,6 @@
 // The status a client reports to the server while it runs (wire::ClientStatus, for the
 // server's live view): its haptic figures so far, computed exactly as its report computes
-// them at the end (README.md, "Client report"), so the final status equals the report.
+// them at the end (docs/reports.md "Client report"), so the final status equals the report.
 // Units on the wire: Hz, µs, ms, N, s.
 #pragma once
 

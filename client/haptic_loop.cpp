@@ -8,15 +8,13 @@
 #include <cmath>
 #include <limits>
 
+#include "common/util/monotonic_clock.h"
+
 namespace cohaptic {
 namespace {
 
-std::int64_t monotonic_now() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
+// Sleeps until `deadline_ns` of the session clock (monotonic_clock.h), whose steady_clock
+// is CLOCK_MONOTONIC.
 void sleep_until_monotonic(std::int64_t deadline_ns) {
   timespec ts{};
   ts.tv_sec = static_cast<time_t>(deadline_ns / 1'000'000'000);
@@ -41,7 +39,7 @@ IrSlot make_ir_slot(std::unique_ptr<const PreparedIR> ir, std::int64_t arrival_n
 }
 
 HapticClock HapticClock::monotonic() {
-  return {[](void*) { return monotonic_now(); }, [](void*, std::int64_t deadline_ns) { sleep_until_monotonic(deadline_ns); }, nullptr};
+  return {[](void*) { return monotonic_now_ns(); }, [](void*, std::int64_t deadline_ns) { sleep_until_monotonic(deadline_ns); }, nullptr};
 }
 
 bool lock_process_memory() {

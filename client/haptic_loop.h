@@ -1,4 +1,4 @@
-// HapticLoop: the client's real-time loop (docs/architecture.md, "Threads").
+// HapticLoop: the client's real-time loop (docs/architecture.md "2. Threads and who owns what").
 //
 // Every period, at an absolute deadline (clock_nanosleep on CLOCK_MONOTONIC), it reads the
 // device, hands the own tool sample to the I/O thread, takes in remote tool samples and the

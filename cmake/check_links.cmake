@@ -1,4 +1,4 @@
-# The one-way rule of the layout (README.md, "Layout"), checked when the build is
+# The one-way rule of the layout (docs/layout.md "Layout"), checked when the build is
 # configured: every library and program of ours may link, directly or through another of
 # ours, only the libraries listed for it here. In particular the server and the client
 # never link each other or the lab, the live view (cohaptic_view, which both the server and

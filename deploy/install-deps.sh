@@ -24,6 +24,8 @@ packages=(
   # fuzzing (libFuzzer) and sanitizer reports: make fuzz, make test-asan, make test-tsan;
   # lld, the faster linker every build uses when it is there (cmake/fast_linker.cmake)
   clang libclang-rt-14-dev llvm lld
+  # the formatter the test Format.EverySourceFileIsAsClangFormatWritesIt runs (make format)
+  clang-format
 )
 
 # Node.js and npm, for two test tools only: the official MCAP reader (@mcap/core) a test

@@ -7,7 +7,7 @@
 # client_a.mcap, client_b.mcap), the deformed brain surface for ParaView under
 # out/demo/display/ (open surface.pvd), prints the summary, verifies the clients'
 # recordings bit for bit (cohaptic-lab replay --verify), and exits non-zero if the
-# session was unhealthy (see docs/programs.md, "Reports and the demo report") or a verification
+# session was unhealthy (see docs/reports.md "The verdict and the demo report") or a verification
 # failed.
 #
 # Another scene (e.g. deploy/run-demo.sh scenes/thin/noodle.yaml) takes the surgeons'

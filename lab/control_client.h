@@ -1,5 +1,5 @@
 // ControlClient: a program's line into a running server's control socket (cohaptic-server
-// --control, docs/programs.md "Switching conditions"): one JSON command out, its one-line
+// --control, docs/server.md "Switching conditions"): one JSON command out, its one-line
 // JSON answer back, blocking. Not thread-safe; one per thread.
 #pragma once
 

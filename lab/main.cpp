@@ -1,4 +1,4 @@
-// cohaptic-lab: the offline tools, one subcommand each (README.md, "cohaptic-lab"):
+// cohaptic-lab: the offline tools, one subcommand each (docs/lab-tools.md):
 //   probe      static forces at tool positions          tradeoff   speed against accuracy
 //   replay     look at, re-run or export a recording    stability  the stability map of a wall
 //   study      a lab study, trial by trial              summarize  merge reports, judge a session

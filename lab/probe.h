@@ -38,7 +38,7 @@ struct ProbeOptions {
 /// Runs the probe, printing a table (or JSON) on stdout. Returns the process exit code.
 int run_probe(const ProbeOptions& options);
 
-/// `cohaptic-lab probe --scene FILE --tool X,Y,Z [...]` (docs/programs.md "`cohaptic-lab probe`").
+/// `cohaptic-lab probe --scene FILE --tool X,Y,Z [...]` (docs/lab-tools.md "`cohaptic-lab probe`").
 LabCommand add_probe_command(CLI::App& lab);
 
 }  // namespace cohaptic

@@ -1,6 +1,6 @@
 // `cohaptic-lab study FILE --out DIR`: a lab study with simulated participants.
 //
-// The study file (YAML, docs/programs.md "Study files") names a scene, the participants (each a
+// The study file (YAML, docs/studies.md "Study files") names a scene, the participants (each a
 // scripted or hand-model device following a trajectory), the factors (shift_ms,
 // step_nodes, sim_rate_hz, protocol, jitter_ms, loss; every combination is a condition),
 // the repetitions and the order (random with a seed, a balanced Latin square, or

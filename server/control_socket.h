@@ -6,8 +6,9 @@
 //   {"serve_next": true}  switch to the condition after the one served now (a device button's
 //                    switch: served_conditions.h) -> as for "serve"
 //   {"status": true} -> {"served": "A", "switches": 2, "time_s": 20.1}
-// Anything else (malformed JSON, an unknown command or condition, a line over 4 KiB) gets
-// {"error": "..."} naming what was wrong; the connection stays open, the session goes on.
+// Anything else (malformed JSON, an unknown command or condition) gets {"error": "..."}
+// naming what was wrong and the connection stays open; a line over 4 KiB gets that answer
+// and the connection is closed (its end cannot be found). The session goes on either way.
 // Runs on the server's I/O thread (the handler too); the socket file is removed on close.
 #pragma once
 

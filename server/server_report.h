@@ -1,6 +1,6 @@
 // The server's figures for people: the one-line status logged every --status interval
-// (I/O thread) and the JSON report written at exit (--report, under "server"; README.md
-// "Reports" lists its fields, and `summarize` and the tests read them).
+// (I/O thread) and the JSON report written at exit (--report, under "server"; docs/reports.md
+// "Server report" lists its fields, and `summarize` and the tests read them).
 #pragma once
 
 #include <nlohmann/json.hpp>

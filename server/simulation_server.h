@@ -1,5 +1,5 @@
 // SimulationServer: the networked simulation server, `cohaptic-server --scene ...`
-// (README.md, "cohaptic-server"). It loads the scene, builds the model and its compliance,
+// (docs/server.md). It loads the scene, builds the model and its compliance,
 // and wires together the parts that each do one job:
 //   - ConnectionHandler (connection_handler.h), on the I/O thread: connections, user slots,
 //     tool samples in and relayed, clock pongs, the injected shift delay, each step's
@@ -43,7 +43,7 @@ class SimulationServer {
 
   std::uint16_t tcp_port() const;
   std::uint16_t udp_port() const;
-  /// The report (docs/programs.md, "Reports"); complete once run() has returned.
+  /// The report (docs/reports.md "Server report"); complete once run() has returned.
   nlohmann::json report() const;
 
  private:

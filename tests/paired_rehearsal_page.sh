@@ -28,7 +28,7 @@ then ten simulated subjects rate every pair once on five grades from the two con
 measures (`common/study/simulated_rater.h`: the force update rate for "finer", the terminal
 force ratio for "harder", a just-noticeable difference and noise of their own), and
 Scheffé's method in Nakaya's modification gives each condition's scale value, the analysis
-of variance and the yardsticks (docs/programs.md, "Paired comparisons"). Two scale values
+of variance and the yardsticks (docs/studies.md "Paired comparisons (Scheffé's method, Nakaya's modification)"). Two scale values
 further apart than Y(0.05) differ at the 5 % level.
 
 HEADER

@@ -1,6 +1,6 @@
 // The manual's references hold, read from the tree as a reader would follow them:
 //   - every page a file cites as docs/<page>.md exists, with the heading it names after it
-//     in quotes (`docs/programs.md "Study files"`) or as an anchor (docs/<page>.md#<anchor>);
+//     in quotes (`docs/studies.md "Study files"`) or as an anchor (docs/<page>.md#<anchor>);
 //   - every heading cited on the README (README and the heading in quotes) is one of its headings;
 //   - every relative Markdown link of a page lands on a file, and on a heading of it when it
 //     names an anchor.
@@ -125,8 +125,8 @@ TEST(Docs, AnchorsAreGitHubsForHeadingsWithCodePunctuationAndDashes) {
 }
 
 TEST(Docs, EveryCitedPageHeadingAndLinkExists) {
-  static const std::regex kPageCitation(R"re((?:^|[^\w/.-])(docs/[\w/.-]+?\.md)(?: "([^"]+)"|#([\w-]+))?)re");
-  static const std::regex kReadmeCitation(R"re(README(?:\.md)?(?:'s)? "([^"]+)")re");
+  static const std::regex kPageCitation(R"re((?:^|[^\w/.-])(docs/[\w/.-]+?\.md)(?:,? "([^"]+)"|#([\w-]+))?)re");
+  static const std::regex kReadmeCitation(R"re((?:^|[^\w/.-])README(?:\.md)?(?:'s)?,? "([^"]+)")re");
   static const std::regex kMarkdownLink(R"(\]\(([^)\s]+)\))");
   std::size_t citations = 0;
   std::vector<std::string> broken;

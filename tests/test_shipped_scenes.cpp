@@ -29,8 +29,8 @@ using testing::ChildProcess;
 const fs::path kSource = COHAPTIC_SOURCE_DIR;
 constexpr int kSessionSeconds = 8;
 // Watched, the surgeons start once the browser has connected (DEMO_WAIT_FOR_BROWSER): its start
-// does not overlap their presses; longer, for Chromium drawing in software at a lowered
-// priority (view_check.mjs) to see both press.
+// does not overlap their presses; longer, for Chromium drawing in software to see both
+// press.
 constexpr int kWatchedSessionSeconds = 12;
 constexpr std::chrono::milliseconds kDemoPatience{300'000};
 

@@ -1,5 +1,5 @@
-// LiveView: the server's live view (`cohaptic-server --view HOST:PORT`, README.md, "The
-// live view"). It owns the ViewServer (view_server.h, its own thread) and turns what the
+// LiveView: the server's live view (`cohaptic-server --view HOST:PORT`, docs/live-view.md
+// "The live view"). It owns the ViewServer (view_server.h, its own thread) and turns what the
 // server has into view.proto messages:
 //   - the Scene, once (built at construction; recorded as /view_scene with --record);
 //   - a Frame every 1/rate s while a browser watches or the session is recorded (nothing is

@@ -1,4 +1,4 @@
-// The scene's `interactions:` list (docs/objects-that-press.md, "Objects that press on each other"): pairs
+// The scene's `interactions:` list (docs/objects-that-press.md "Interactions in a scene"): pairs
 // of objects that press on each other, each `{front: NAME, behind: NAME}`, validated with
 // the scene loader's errors (file:line: key.path: expected ..., found ...) against the
 // objects already parsed: both names exist, differ, the front is a mass-spring or a linear

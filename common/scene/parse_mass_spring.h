@@ -1,4 +1,4 @@
-// The keys of a `model: mass_spring` scene object (README.md, "Mass–spring objects"),
+// The keys of a `model: mass_spring` scene object (docs/mass-spring.md "Mass-spring objects"),
 // validated with the scene loader's errors (file:line: key.path: expected ..., found ...).
 #pragma once
 

@@ -1,6 +1,7 @@
 // The session's one clock: std::chrono::steady_clock, in nanoseconds. Every message header
 // carries it (Header.sender_time_ns), the clock-offset filter compares it between hosts, and
-// the loops, delays and reports time themselves by it.
+// the loops, delays and reports time themselves by it. On Linux steady_clock is
+// CLOCK_MONOTONIC, so a thread can sleep until one of its times with clock_nanosleep.
 #pragma once
 
 #include <chrono>
