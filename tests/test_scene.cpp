@@ -16,7 +16,9 @@
 #include "common/mesh/box_mesher.h"
 #include "common/model/model.h"
 #include "common/mass_spring/tube_network.h"
+#include "common/mesh/mesh_limits.h"
 #include "common/scene/load_scene.h"
+#include "common/separation/separation_bodies.h"
 #include "support/test_meshes.h"
 
 namespace cohaptic {
@@ -315,6 +317,50 @@ TEST(SceneErrors, MessagesNameFileLineKeyAndExpectation) {
     cases.push_back({"point with radius", text, "radius: 2", {"tools[0].radius", "a point tool has no radius"}});
   }
   {
+    const auto text = replaced(base, "    shape: point\n", "    shape: probe\n    trocar: [0, 0, 50]\n    radius: 2\n");
+    cases.push_back({"probe with radius", text, "radius: 2",
+                     {"tools[0].radius", "a probe tool has no radius (use shape: sphere)"}});
+  }
+  {
+    const auto text = replaced(base, "    shape: point\n", "    shape: forceps\n    trocar: [0, 0, 50]\n    radius: 2\n");
+    cases.push_back({"forceps with radius", text, "radius: 2",
+                     {"tools[0].radius", "a forceps tool has no radius (use shape: sphere)"}});
+  }
+  {
+    const auto text = replaced(replaced(base, "    shape: point\n", "    shape: probe\n    trocar: [0, 0, 50]\n"),
+                               "  rate_hz: 1000\n", "  rate_hz: 1000\n  contact_model: sphere\n");
+    cases.push_back({"sphere contact model with a probe", text, "contact_model: sphere",
+                     {"haptic.contact_model", "needs sphere tools, and tool 'A' is a probe (give it shape: sphere"}});
+  }
+  {
+    // The default closing step (0.02 rad, 1.146 degrees) would close the jaws past their opening.
+    const auto text = replaced(base, "    shape: point\n",
+                               "    shape: forceps\n    trocar: [0, 0, 50]\n    jaws:\n      open_angle_deg: 1\n");
+    cases.push_back({"forceps opening below the default closing step", text, "open_angle_deg: 1",
+                     {"tools[0].jaws.open_angle_deg",
+                      "open_angle_deg 1 is below the closing step (closing_step_deg, by default 1.146): give a "
+                      "closing_step_deg of at most 1"}});
+  }
+  {
+    const auto text = replaced(base, "  rate_hz: 1000\n", "  rate_hz: 1000\n  min_sim_rate_hz: 0\n");
+    cases.push_back({"minimum simulation rate 0", text, "min_sim_rate_hz: 0",
+                     {"haptic.min_sim_rate_hz", "expected a rate above 0 and at most 100000 Hz", "found '0'"}});
+  }
+  {
+    const auto text = replaced(base, "tools:",
+                               "obstacles:\n  - name: floor\n    plane: {point: [0, 0, -1], normal: [0, 0, 1]}\n"
+                               "  - name: floor  # again\n    plane: {point: [0, 0, 20], normal: [0, 0, -1]}\ntools:");
+    cases.push_back({"two obstacles of one name", text, "name: floor  # again",
+                     {"obstacles[1].name", "an obstacle name not used before", "found 'floor'"}});
+  }
+  {
+    const auto text = replaced(base, "tools:",
+                               "obstacles:\n  - name: floor\n    plane:\n      point: [0, 0, -1]\n"
+                               "      normal: [0, 0, 0]\ntools:");
+    cases.push_back({"obstacle plane without a normal", text, "normal: [0, 0, 0]",
+                     {"obstacles[0].plane.normal", "a non-zero normal vector", "found a list of 3"}});
+  }
+  {
     const auto text = replaced(base,
                                "    fixed:\n      - plane:\n          point: [0, 0, 0]\n          normal: [0, 0, 1]\n"
                                "        axes: xyz\n",
@@ -379,6 +425,18 @@ TEST(SceneLoad, MaxParticipantsDefaultsToOnePerToolAndMayBeFewer) {
   EXPECT_EQ(parse_scene(two_tools, kSceneFile).network.max_participants, 2);
   const std::string one_at_a_time = replaced(two_tools, "haptic:\n", "network: {max_participants: 1}\nhaptic:\n");
   EXPECT_EQ(parse_scene(one_at_a_time, kSceneFile).network.max_participants, 1);
+}
+
+TEST(SceneLoad, ForcepsClosingStepMayBeAsLargeAsTheOpenAngle) {
+  const std::string forceps = replaced(kBaseScene, "    shape: point\n",
+                                       "    shape: forceps\n    trocar: [0, 0, 50]\n    jaws: {open_angle_deg: 1, closing_step_deg: 1}\n");
+  const InstrumentSpec given = *parse_scene(forceps, kSceneFile).tools.at(0).instrument;
+  EXPECT_DOUBLE_EQ(given.closing_step, given.open_angle);
+  // Two degrees open is more than the default step of 0.02 rad.
+  const std::string defaulted = replaced(forceps, "{open_angle_deg: 1, closing_step_deg: 1}", "{open_angle_deg: 2}");
+  const InstrumentSpec instrument = *parse_scene(defaulted, kSceneFile).tools.at(0).instrument;
+  EXPECT_DOUBLE_EQ(instrument.closing_step, 0.02);
+  EXPECT_DOUBLE_EQ(instrument.open_angle, 2 * M_PI / 180);
 }
 
 TEST(SceneModel, SeveralObjectsCompileIntoOneBodyEachInTheSceneOrder) {
@@ -632,6 +690,11 @@ TEST(Scene, DirectionsOfHugeComponentsBecomeUnitVectors) {
   const Eigen::Vector3d diagonal = Eigen::Vector3d(1, 1, 0).normalized();
   const Scene solid = parse_scene(replaced(kBaseScene, "normal: [0, 0, 1]", "normal: [1.0e200, 1.0e200, 0]"), kSceneFile);
   EXPECT_TRUE(std::get<ElasticObjectSpec>(solid.objects.at(0).body).fixed.at(0).nodes.plane_normal.isApprox(diagonal));
+  const Scene walled = parse_scene(
+      replaced(kBaseScene, "tools:", "obstacles:\n  - name: wall\n    plane: {point: [0, 0, -1], normal: [1.0e200, 1.0e200, 0]}\ntools:"),
+      kSceneFile);
+  ASSERT_TRUE(walled.obstacles.at(0).plane.has_value());
+  EXPECT_TRUE(walled.obstacles.at(0).plane->second.isApprox(diagonal)) << walled.obstacles.at(0).plane->second.transpose();
   const Scene tube = parse_scene(replaced(replaced(kNoodleScene, "normal: [0, 0, 1]", "normal: [1.0e200, 1.0e200, 0]"),
                                           "radius: 5\n", "radius: 5\n      up: [0, 1.0e300, 1.0e300]\n"),
                                  kSceneFile);
@@ -639,6 +702,32 @@ TEST(Scene, DirectionsOfHugeComponentsBecomeUnitVectors) {
   EXPECT_TRUE(spec.tube.up.isApprox(Eigen::Vector3d(0, 1, 1).normalized()));
   ASSERT_TRUE(spec.plane.has_value());
   EXPECT_TRUE(spec.plane->normal.isApprox(diagonal));
+}
+
+// tube_network makes kSectionNodes nodes a section (NoodleObjectParsesInSIUnitsAndCompiles
+// checks that count): the most sections a body's node limit allows are parsed, one more is
+// refused, however the count is given. Parsed only: building the tube is not needed.
+TEST(MassSpringScene, TubeOfMoreNodesThanABodyMayHaveIsRefused) {
+  const int most = static_cast<int>(kMaxBodyNodes / kSectionNodes);
+  const std::string limit = std::to_string(kMaxBodyNodes);
+  const std::string under = replaced(kNoodleScene, "sections: 11", "sections: " + std::to_string(most));
+  EXPECT_EQ(std::get<MassSpringObjectSpec>(parse_scene(under, kSceneFile).objects.at(0).body).tube.sections, most);
+  const std::string over = replaced(kNoodleScene, "sections: 11", "sections: " + std::to_string(most + 1));
+  expect_scene_error({"one section too many", over, "sections: " + std::to_string(most + 1),
+                      {"objects[0].tube.sections",
+                       "expected sections giving at most " + limit + " nodes (9 per section), not " +
+                           std::to_string(kSectionNodes * (most + 1)) + " (" + std::to_string(most + 1) + " sections)"}});
+
+  // A centre line of L mm in 1 mm steps has L + 1 sections.
+  const std::string spaced = replaced(kNoodleScene, "      sections: 11\n", "      section_spacing: 1\n");
+  const std::string spaced_under = replaced(spaced, "[40, 0, 5]", "[" + std::to_string(most - 1) + ", 0, 5]");
+  EXPECT_EQ(std::get<MassSpringObjectSpec>(parse_scene(spaced_under, kSceneFile).objects.at(0).body).tube.sections, most);
+  const std::string spaced_over = replaced(spaced, "[40, 0, 5]", "[" + std::to_string(most) + ", 0, 5]");
+  expect_scene_error({"a spacing giving one section too many", spaced_over, "section_spacing: 1",
+                      {"objects[0].tube.section_spacing",
+                       "expected a spacing giving at most " + limit + " nodes (9 per section), not " +
+                           std::to_string(kSectionNodes * (most + 1)) + " (" + std::to_string(most + 1) + " sections)",
+                       "found '1'"}});
 }
 
 TEST(MassSpringScene, TimeStepAboveTheCriticalOneIsRefusedNamingTheObject) {
@@ -652,6 +741,80 @@ TEST(MassSpringScene, TimeStepAboveTheCriticalOneIsRefusedNamingTheObject) {
     EXPECT_EQ(message.rfind(kSceneFile + ":4: objects[0]: time_step 0.05 s", 0), 0u) << message;
     EXPECT_NE(message.find("critical step"), std::string::npos) << message;
   }
+}
+
+}  // namespace
+}  // namespace cohaptic
+
+namespace cohaptic {
+namespace {
+
+// A separating-tissue object in block style, its instruments naming the two tools.
+const std::string kLayersSceneOfSceneTests = R"(name: layers_test
+units: mm
+objects:
+  - name: layers
+    model: separation
+    layers:
+      size: [40, 40]
+      flap_thickness: 4
+      base_thickness: 10
+      divisions: [20, 20]
+      flap_layers: 2
+      base_layers: 3
+    instruments:
+      - tool: fibre
+        laser: true
+      - laser: false
+        tool: forceps
+tools:
+  - name: forceps
+  - name: fibre
+)";
+
+TEST(SeparationSceneErrors, AnInstrumentNamesAToolOfTheSceneOnceAtItsToolKey) {
+  const Scene scene = parse_scene(kLayersSceneOfSceneTests, kSceneFile);
+  const auto& spec = std::get<SeparationObjectSpec>(scene.objects.at(0).body);
+  ASSERT_EQ(spec.instruments.size(), 2u);
+  EXPECT_EQ(spec.instruments[1].tool, "forceps");
+  const BadScene cases[] = {
+      // The item starts on its `laser:` line; the message names the line of `tool:`.
+      {"unknown tool", replaced(kLayersSceneOfSceneTests, "tool: forceps", "tool: scalpel"), "tool: scalpel",
+       {"objects[0].instruments[1].tool", "expected the name of a scene tool", "found 'scalpel'"}},
+      {"a tool listed twice", replaced(kLayersSceneOfSceneTests, "tool: forceps", "tool: fibre  # again"),
+       "tool: fibre  # again",
+       {"objects[0].instruments[1].tool", "expected a tool not named by an earlier instrument", "found 'fibre'"}},
+  };
+  for (const BadScene& bad : cases) expect_scene_error(bad);
+}
+
+// make_two_layer_boxes meshes each layer as a box: (nx + 1)(ny + 1)(layers + 1) nodes, the
+// two layers together the body's nodes. The most a body may have are parsed, more are refused.
+// Parsed only: building them would fit the fields on a quarter of a million nodes.
+TEST(SeparationSceneErrors, LayersOfMoreNodesThanABodyMayHaveAreRefused) {
+  TwoLayerBoxes small;
+  small.divisions = Eigen::Vector2i(3, 2);
+  small.pulled_layers = 2;
+  small.base_layers = 1;
+  const SeparationBodies bodies = make_two_layer_boxes(small);
+  EXPECT_EQ(bodies.pulled.mesh.node_count() + bodies.base.mesh.node_count(), 4 * 3 * (3 + 2));
+
+  // 200 x (ny + 1) x (5 + 5) nodes: ny + 1 = kMaxBodyNodes / 2000 reaches the limit exactly.
+  const int rows = static_cast<int>(kMaxBodyNodes / 2000);
+  ASSERT_EQ(rows * 2000, kMaxBodyNodes);
+  ASSERT_LE(rows, 200);
+  const std::string four_and_four = replaced(replaced(kLayersSceneOfSceneTests, "flap_layers: 2", "flap_layers: 4"),
+                                             "base_layers: 3", "base_layers: 4");
+  const std::string at_limit =
+      replaced(four_and_four, "divisions: [20, 20]", "divisions: [199, " + std::to_string(rows - 1) + "]");
+  EXPECT_EQ(std::get<SeparationObjectSpec>(parse_scene(at_limit, kSceneFile).objects.at(0).body).layers.divisions.y(),
+            rows - 1);
+  const std::string over = replaced(four_and_four, "divisions: [20, 20]", "divisions: [199, " + std::to_string(rows) + "]");
+  expect_scene_error({"one row of cells too many", over, "divisions: [199,",
+                      {"objects[0].layers.divisions",
+                       "[199, " + std::to_string(rows) + "] with 4 flap and 4 base layers make " +
+                           std::to_string(200 * (rows + 1) * 10) + " nodes (200 x " + std::to_string(rows + 1) +
+                           " x (5 + 5)), more than the " + std::to_string(kMaxBodyNodes) + " a body may have"}});
 }
 
 }  // namespace

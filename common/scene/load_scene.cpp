@@ -33,6 +33,16 @@ double metres_per(const Cursor& units) {
   return u == "m" ? 1.0 : u == "cm" ? 0.01 : 0.001;
 }
 
+const char* tool_shape_name(ToolShape shape) {
+  switch (shape) {
+    case ToolShape::point: return "point";
+    case ToolShape::sphere: return "sphere";
+    case ToolShape::probe: return "probe";
+    case ToolShape::forceps: return "forceps";
+  }
+  return "?";
+}
+
 AxisMask parse_axes(const Cursor& c) {
   const std::string text = c.text();
   AxisMask mask = 0;
@@ -179,10 +189,8 @@ ObstacleSpec parse_obstacle(const Cursor& c, double scale, const SceneFiles& fil
     obstacle.surface_file = files.resolve(*surface, "surface file");
   } else {
     plane->only_keys({"point", "normal"});
-    const Cursor normal = plane->at("normal");
-    Eigen::Vector3d n = normal.vec3();
-    if (n.norm() < 1e-12) normal.fail("a non-zero normal vector");
-    obstacle.plane = std::make_pair(Eigen::Vector3d(plane->at("point").vec3() * scale), Eigen::Vector3d(n.normalized()));
+    const Eigen::Vector3d normal = plane->at("normal").direction("a non-zero normal vector");
+    obstacle.plane = std::make_pair(Eigen::Vector3d(plane->at("point").vec3() * scale), normal);
   }
   return obstacle;
 }
@@ -204,7 +212,7 @@ ToolSpec parse_tool(const Cursor& c, double scale) {
   if (tool.shape == ToolShape::sphere)
     tool.radius = c.at("radius").number_in(0, INFINITY, true, true, "a positive radius") * scale;
   else if (auto radius = c.find("radius"))
-    radius->fail_message(fmt::format("a {} tool has no radius (use shape: sphere)", tool.instrument ? "instrument" : "point"));
+    radius->fail_message(fmt::format("a {} tool has no radius (use shape: sphere)", tool_shape_name(tool.shape)));
   return tool;
 }
 
@@ -219,7 +227,7 @@ HapticSettings parse_haptic(const Cursor& c) {
     haptic.patch_rings = static_cast<int>(value);
   }
   if (auto rate = c.find("min_sim_rate_hz"))
-    haptic.min_sim_rate_hz = rate->number_in(0, 100000, true, false, "a rate from 0 to 100000 Hz");
+    haptic.min_sim_rate_hz = rate->number_in(0, 100000, true, false, "a rate above 0 and at most 100000 Hz");
   if (auto truncation = c.find("boundary_truncation"))
     haptic.boundary_truncation = truncation->number_in(0, 1, false, true, "a fraction in [0, 1)");
   if (auto model = c.find("contact_model")) {
@@ -271,8 +279,13 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
   if (scene.objects.empty()) objects.fail("at least one object");
   if (auto interactions = top.find("interactions")) scene.interactions = parse_interactions(*interactions, scene.objects);
 
-  if (auto obstacles = top.find("obstacles"))
-    for (const Cursor& item : obstacles->items()) scene.obstacles.push_back(parse_obstacle(item, scale, files));
+  if (auto obstacles = top.find("obstacles")) {
+    std::set<std::string> obstacle_names;
+    for (const Cursor& item : obstacles->items()) {
+      scene.obstacles.push_back(parse_obstacle(item, scale, files));
+      if (!obstacle_names.insert(scene.obstacles.back().name).second) item.at("name").fail("an obstacle name not used before");
+    }
+  }
 
   const Cursor tools = top.at("tools");
   std::set<std::string> tool_names;
@@ -283,11 +296,12 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
   if (scene.tools.empty()) tools.fail("at least one tool");
   if (scene.tools.size() > static_cast<std::size_t>(kMaxUsers))
     tools.fail(fmt::format("at most {} tools (one per user; the haptic loop holds that many)", kMaxUsers));
-  for (const ObjectSpec& object : scene.objects)
-    if (const auto* separation = std::get_if<SeparationObjectSpec>(&object.body))
-      for (const SeparationInstrumentSpec& instrument : separation->instruments)
-        if (!tool_names.count(instrument.tool))
-          throw SceneError(fmt::format("{}.tool: expected the name of a scene tool, found '{}'", instrument.where, instrument.tool));
+  const std::vector<Cursor> object_items = objects.items();
+  for (std::size_t i = 0; i < scene.objects.size(); ++i)
+    if (const auto* separation = std::get_if<SeparationObjectSpec>(&scene.objects[i].body))
+      for (std::size_t j = 0; j < separation->instruments.size(); ++j)
+        if (!tool_names.count(separation->instruments[j].tool))
+          object_items[i].at("instruments").items()[j].at("tool").fail("the name of a scene tool");
 
   const std::optional<Cursor> haptic = top.find("haptic");
   if (haptic) scene.haptic = parse_haptic(*haptic);
@@ -297,9 +311,9 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
                                   [](const ToolSpec& tool) { return tool.shape != ToolShape::sphere; });
   if (!contact_model && point == scene.tools.end()) scene.haptic.contact_model = ContactModel::sphere;
   if (contact_model && scene.haptic.contact_model == ContactModel::sphere && point != scene.tools.end())
-    contact_model->fail_message(fmt::format("the sphere contact model needs sphere tools, and tool '{}' is a point "
+    contact_model->fail_message(fmt::format("the sphere contact model needs sphere tools, and tool '{}' is a {} "
                                             "(give it shape: sphere and a radius, or use translation or point)",
-                                            point->name));
+                                            point->name, tool_shape_name(point->shape)));
   for (const InteractionSpec& interaction : scene.interactions)
     if (const auto front = std::find_if(scene.objects.begin(), scene.objects.end(),
                                         [&](const ObjectSpec& o) { return o.name == interaction.front; });

@@ -82,6 +82,12 @@ InstrumentSpec parse_instrument(const YamlCursor& c, double scale, bool forceps)
     instrument.closing_step =
         step->number_in(0, instrument.open_angle / kRadiansPerDegree, true, false, "an angle in degrees, positive and at most open_angle_deg") *
         kRadiansPerDegree;
+  else if (instrument.closing_step > instrument.open_angle)
+    jaws->at("open_angle_deg")
+        .fail_message(fmt::format("open_angle_deg {:g} is below the closing step (closing_step_deg, by default {:.4g}): "
+                                  "give a closing_step_deg of at most {:g}",
+                                  instrument.open_angle / kRadiansPerDegree, instrument.closing_step / kRadiansPerDegree,
+                                  instrument.open_angle / kRadiansPerDegree));
   if (auto opening = jaws->find("opening")) instrument.opening = opening->direction("a non-zero direction");
   return instrument;
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/mass_spring/tube_network.h"
 #include "common/mesh/mesh_limits.h"
 #include "common/scene/parse_node_selector.h"
 
@@ -35,6 +36,14 @@ TubeGeometry parse_tube(const YamlCursor& c, double scale) {
     const double count = std::round(length / step) + 1;
     if (count < 2 || count > 100000) spacing->fail("a spacing giving 2 to 100000 sections along the centre line");
     tube.sections = static_cast<int>(count);
+  }
+  // tube_network: a centre node and kRingNodes ring nodes per section.
+  const std::int64_t nodes = std::int64_t{kSectionNodes} * tube.sections;
+  if (nodes > kMaxBodyNodes) {
+    const std::string expected = fmt::format("at most {} nodes ({} per section), not {} ({} sections)", kMaxBodyNodes,
+                                             kSectionNodes, nodes, tube.sections);
+    if (sections) sections->fail("sections giving " + expected);
+    spacing->fail("a spacing giving " + expected);
   }
   if (auto up = c.find("up")) {
     tube.up = up->direction("a non-zero vector");

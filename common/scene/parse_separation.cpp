@@ -1,7 +1,11 @@
 #include "common/scene/parse_separation.h"
 
-#include <cmath>
+#include <fmt/format.h>
 
+#include <cmath>
+#include <set>
+
+#include "common/mesh/mesh_limits.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -47,6 +51,16 @@ TwoLayerBoxes parse_separation_layers(const YamlCursor& c, double scale) {
   layers.divisions = Eigen::Vector2i(separation_count(divisions[0], 1, 200), separation_count(divisions[1], 1, 200));
   if (auto flap = c.find("flap_layers")) layers.pulled_layers = separation_count(*flap, 1, 50);
   if (auto base = c.find("base_layers")) layers.base_layers = separation_count(*base, 1, 50);
+  // make_two_layer_boxes meshes each layer as a box of divisions x layers cells.
+  const std::int64_t nodes = std::int64_t{layers.divisions.x() + 1} * (layers.divisions.y() + 1) *
+                             (layers.pulled_layers + 1 + layers.base_layers + 1);
+  if (nodes > kMaxBodyNodes)
+    c.at("divisions").fail_message(fmt::format("[{}, {}] with {} flap and {} base layers make {} nodes ({} x {} x ({} + {})), "
+                                               "more than the {} a body may have",
+                                               layers.divisions.x(), layers.divisions.y(), layers.pulled_layers,
+                                               layers.base_layers, nodes, layers.divisions.x() + 1,
+                                               layers.divisions.y() + 1, layers.pulled_layers + 1, layers.base_layers + 1,
+                                               kMaxBodyNodes));
   if (auto material = c.find("flap_material")) layers.pulled_material = parse_separation_layer_material(*material);
   if (auto material = c.find("base_material")) layers.base_material = parse_separation_layer_material(*material);
   return layers;
@@ -102,10 +116,12 @@ SeparationObjectSpec parse_separation_object(const YamlCursor& c, double scale) 
   if (auto reach = c.find("grasp_reach"))
     object.grasp_reach = separation_reach(*reach, scale);
   if (auto instruments = c.find("instruments")) {
+    std::set<std::string> tools;
     for (const YamlCursor& item : instruments->items()) {
       item.only_keys({"tool", "laser", "grasp_reach"});
       SeparationInstrumentSpec instrument;
       instrument.tool = item.at("tool").text();
+      if (!tools.insert(instrument.tool).second) item.at("tool").fail("a tool not named by an earlier instrument");
       instrument.where = item.location();
       instrument.settings.grasp_reach = object.grasp_reach;
       if (auto laser = item.find("laser")) instrument.settings.laser = laser->boolean();
