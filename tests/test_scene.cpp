@@ -700,6 +700,9 @@ TEST(Scene, DirectionsOfHugeComponentsBecomeUnitVectors) {
                                  kSceneFile);
   const auto& spec = std::get<MassSpringObjectSpec>(tube.objects.at(0).body);
   EXPECT_TRUE(spec.tube.up.isApprox(Eigen::Vector3d(0, 1, 1).normalized()));
+  // Whose length is itself past the largest double.
+  const Scene largest = parse_scene(replaced(kBaseScene, "normal: [0, 0, 1]", "normal: [1.7e308, 1.7e308, 0]"), kSceneFile);
+  EXPECT_TRUE(std::get<ElasticObjectSpec>(largest.objects.at(0).body).fixed.at(0).nodes.plane_normal.isApprox(diagonal));
   ASSERT_TRUE(spec.plane.has_value());
   EXPECT_TRUE(spec.plane->normal.isApprox(diagonal));
 }

@@ -145,12 +145,14 @@ Eigen::Vector3d YamlCursor::vec3() const {
 }
 
 Eigen::Vector3d YamlCursor::direction(const std::string& expected) const {
-  // stableNorm, not norm: (1e200, 1e200, 0) has a finite length, but its squared norm
-  // overflows, and normalize() would then return the zero vector.
+  // Divided by its largest component first: the length of (1e200, 1e200, 0) squares past
+  // the largest double, and that of (1.7e308, 1.7e308, 0) is itself past it; either would
+  // make the unit vector zero.
   const Eigen::Vector3d v = vec3();
-  const double length = v.stableNorm();
-  if (!(length >= 1e-12)) fail(expected);
-  return v / length;
+  const double largest = v.cwiseAbs().maxCoeff();
+  const Eigen::Vector3d scaled = v / largest;
+  if (!(largest > 0) || !(largest * scaled.norm() >= 1e-12)) fail(expected);
+  return scaled.normalized();
 }
 
 std::string YamlCursor::key_text(const YAML::Node& key) const {
