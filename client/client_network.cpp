@@ -39,11 +39,16 @@ std::int64_t now_ns() { return monotonic_now_ns(); }
 
 const char* event_name(HapticEventKind kind) {
   switch (kind) {
-    case HapticEventKind::non_finite: return "non-finite force: zero output";
-    case HapticEventKind::ir_switched: return "IR switched";
-    case HapticEventKind::fading: return "stale IR: fading";
-    case HapticEventKind::started_realtime: return "haptic thread running SCHED_FIFO with locked memory";
-    case HapticEventKind::realtime_refused: return "SCHED_FIFO or mlockall refused (not permitted): running best effort";
+    case HapticEventKind::non_finite:
+      return "non-finite force: zero output";
+    case HapticEventKind::ir_switched:
+      return "IR switched";
+    case HapticEventKind::fading:
+      return "stale IR: fading";
+    case HapticEventKind::started_realtime:
+      return "haptic thread running SCHED_FIFO with locked memory";
+    case HapticEventKind::realtime_refused:
+      return "SCHED_FIFO or mlockall refused (not permitted): running best effort";
   }
   return "?";
 }
@@ -62,8 +67,9 @@ int requested_slot(const ClientOptions& options, const wire::ClientKeys& keys) {
   const std::optional<std::uint32_t> fixed = keys.fixed_slot();
   if (!fixed) return options.requested_slot;
   if (options.requested_slot >= 0 && static_cast<std::uint32_t>(options.requested_slot) != *fixed)
-    throw Error(fmt::format("--slot {}, but the key file is participant {}'s: it can only join slot {}",
-                            options.requested_slot, *fixed, *fixed));
+    throw Error(
+        fmt::format("--slot {}, but the key file is participant {}'s: it can only join slot {}",
+                    options.requested_slot, *fixed, *fixed));
   return static_cast<int>(*fixed);
 }
 
@@ -101,7 +107,7 @@ struct ClientNetwork::Impl {
   // Counters (I/O thread; read after stop()).
   std::uint64_t reconnects = 0, forces_received = 0, remote_samples = 0, non_finite_events = 0;
   std::unique_ptr<record::SessionRecorder> recorder;  // from record_session() on
-  std::optional<WelcomeInfo> welcomed;                 // the last welcome, for the recording
+  std::optional<WelcomeInfo> welcomed;                // the last welcome, for the recording
   std::uint64_t session_id = 0;
 
   Impl(ClientOptions o, HapticChannels& c, std::atomic<bool>& stop)
@@ -115,11 +121,15 @@ struct ClientNetwork::Impl {
             std::make_unique<wire::DatagramInspector>(std::nullopt, !options.encrypt)),
         udp_sealer(0, 0, options.encrypt),
         connection(io, options.host, options.port, keys, options.encrypt,
-                   {[this] { return join_request(); }, [this](const wire::Control& control) { handle_control(control); },
+                   {[this] { return join_request(); },
+                    [this](const wire::Control& control) { handle_control(control); },
                     [this](const std::string& why) { lost(why); }}),
         clock(io, [this](wire::Datagram& ping) { send_datagram(ping); }),
         irs(channels.ir) {
-    if (!options.encrypt) spdlog::warn("--no-encryption: frames and datagrams travel in clear (authenticated, readable by anyone on the path)");
+    if (!options.encrypt)
+      spdlog::warn(
+          "--no-encryption: frames and datagrams travel in clear (authenticated, readable by "
+          "anyone on the path)");
     spdlog::info("receiving datagrams on UDP port {}", udp.port());
   }
 
@@ -129,7 +139,8 @@ struct ClientNetwork::Impl {
     wire::Control control;
     control.mutable_join()->set_user_name(options.user_name);
     control.mutable_join()->set_udp_port(udp.port());
-    control.mutable_join()->set_requested_slot(slot_asked >= 0 ? static_cast<std::uint32_t>(slot_asked + 1) : 0);
+    control.mutable_join()->set_requested_slot(
+        slot_asked >= 0 ? static_cast<std::uint32_t>(slot_asked + 1) : 0);
     control.mutable_join()->set_datagram_salt(udp_sealer.salt());
     control.mutable_join()->set_datagram_sequence(udp_sealer.stamp().last_sequence());
     control.mutable_join()->set_haptic_rate_hz(options.haptic_rate_hz);
@@ -148,21 +159,27 @@ struct ClientNetwork::Impl {
       joined(control.welcome(), control.header().session());
     } else if (control.has_ir()) {
       const std::int64_t arrival = now_ns();
-      if (irs.receive(control.ir(), control.ByteSizeLong(), arrival) && recorder) recorder->ir(arrival, control.ir());
+      if (irs.receive(control.ir(), control.ByteSizeLong(), arrival) && recorder)
+        recorder->ir(arrival, control.ir());
     } else if (control.has_compressed_ir()) {  // recorded as the block it came in
       const std::int64_t arrival = now_ns();
-      if (irs.receive_compressed(control.compressed_ir(), control.ByteSizeLong(), arrival) && recorder)
+      if (irs.receive_compressed(control.compressed_ir(), control.ByteSizeLong(), arrival) &&
+          recorder)
         recorder->ir_block(arrival, 0, control.compressed_ir());
     } else if (control.has_protocol_switch()) {
       const wire::Protocol protocol = control.protocol_switch().protocol();
       if (protocol != wire::P0 && protocol != wire::P1) {
-        spdlog::warn("the server switched to protocol {}, neither P0 nor P1: ignored", static_cast<int>(protocol));
+        spdlog::warn("the server switched to protocol {}, neither P0 nor P1: ignored",
+                     static_cast<int>(protocol));
         return;
       }
-      const HapticProtocol now_served = protocol == wire::P1 ? HapticProtocol::p1 : HapticProtocol::p0;
+      const HapticProtocol now_served =
+          protocol == wire::P1 ? HapticProtocol::p1 : HapticProtocol::p0;
       serve_protocol(now_served);
-      spdlog::info("the server serves {} from now on", now_served == HapticProtocol::p1 ? "P1" : "P0");
-      if (recorder) recorder->event(now_ns(), "protocol", now_served == HapticProtocol::p1 ? "P1" : "P0");
+      spdlog::info("the server serves {} from now on",
+                   now_served == HapticProtocol::p1 ? "P1" : "P0");
+      if (recorder)
+        recorder->event(now_ns(), "protocol", now_served == HapticProtocol::p1 ? "P1" : "P0");
     } else if (control.has_event()) {
       spdlog::info("server: {}", control.event().text());
     } else if (control.has_error()) {
@@ -195,7 +212,8 @@ struct ClientNetwork::Impl {
       return;
     }
     udp.distrust(server_udp);
-    server_udp = udp::endpoint(connection.server_address(), static_cast<std::uint16_t>(message.server_udp_port()));
+    server_udp = udp::endpoint(connection.server_address(),
+                               static_cast<std::uint16_t>(message.server_udp_port()));
     udp.trust(server_udp);
     udp.inspector().set_expected_session(session);
     // The server's datagrams to us: our slot's key, its sealer's salt, a fresh replay window.
@@ -206,13 +224,15 @@ struct ClientNetwork::Impl {
     udp_sealer.stamp().set_sender(wire::sender_of_slot(message.slot()));
     if (ever_connected) ++reconnects;
     ever_connected = connected = true;
-    spdlog::info("joined '{}' as slot {} ({} protocol, force limit {:g} N)", info.scene_name, info.slot,
-                 info.protocol == HapticProtocol::p1 ? "P1" : "P0", info.force_limit);
+    spdlog::info("joined '{}' as slot {} ({} protocol, force limit {:g} N)", info.scene_name,
+                 info.slot, info.protocol == HapticProtocol::p1 ? "P1" : "P0", info.force_limit);
     clock.restart();
     session_id = session;
     welcomed = info;
     serve_protocol(info.protocol);  // a server met again may serve another one
-    if (recorder) recorder->event(now_ns(), "joined", fmt::format("session {:016x}, slot {}", session, info.slot));
+    if (recorder)
+      recorder->event(now_ns(), "joined",
+                      fmt::format("session {:016x}, slot {}", session, info.slot));
     std::lock_guard lock(welcome_mutex);
     welcome = info;
     welcome_ready.notify_all();
@@ -263,7 +283,8 @@ struct ClientNetwork::Impl {
       const std::uint32_t sender = udp_sealer.stamp().sender();
       sample->set_user(sender > 0 ? sender - 1 : 0);
       sample->set_sample_time_ns(clock.to_server(own->sample_time_ns));
-      *sample->mutable_position() = wire::to_wire(own->valid ? own->position : Eigen::Vector3d::Zero());
+      *sample->mutable_position() =
+          wire::to_wire(own->valid ? own->position : Eigen::Vector3d::Zero());
       sample->set_valid(own->valid);
       sample->set_buttons(own->buttons);
       send_datagram(datagram);
@@ -271,7 +292,8 @@ struct ClientNetwork::Impl {
     while (const auto event = channels.events.pop()) {
       if (recorder) recorder->event(event->time_ns, "haptic", event_name(event->kind));
       if (event->kind == HapticEventKind::non_finite) ++non_finite_events;
-      if (event->kind == HapticEventKind::realtime_refused || event->kind == HapticEventKind::non_finite)
+      if (event->kind == HapticEventKind::realtime_refused ||
+          event->kind == HapticEventKind::non_finite)
         spdlog::warn("haptic: {}", event_name(event->kind));
       else
         spdlog::info("haptic: {}", event_name(event->kind));
@@ -287,8 +309,8 @@ struct ClientNetwork::Impl {
     if (!haptic_metrics || !connected) return;
     channels.progress.update();
     wire::Control control;
-    *control.mutable_status() =
-        client_status(channels.progress.front(), *haptic_metrics, floors->period_p99_us(), clock.one_way_delay());
+    *control.mutable_status() = client_status(channels.progress.front(), *haptic_metrics,
+                                              floors->period_p99_us(), clock.one_way_delay());
     connection.send(control);
   }
 
@@ -325,27 +347,34 @@ WelcomeInfo ClientNetwork::start(double timeout_s) {
     s.connection.stop();
   });
   s.connection.start();
-  s.udp.start([&s](wire::Datagram&& datagram, const udp::endpoint&, std::int64_t arrival) { s.handle_datagram(datagram, arrival); });
+  s.udp.start([&s](wire::Datagram&& datagram, const udp::endpoint&, std::int64_t arrival) {
+    s.handle_datagram(datagram, arrival);
+  });
   s.schedule_drain();
   s.clock.start();
   s.thread = std::thread([&s] { s.io.run(); });
   std::unique_lock lock(s.welcome_mutex);
-  s.welcome_ready.wait_for(lock, std::chrono::duration<double>(timeout_s), [&s] { return s.welcome || !s.refusal.empty(); });
+  s.welcome_ready.wait_for(lock, std::chrono::duration<double>(timeout_s),
+                           [&s] { return s.welcome || !s.refusal.empty(); });
   if (!s.refusal.empty()) throw Error("the server refused to join: " + s.refusal);
   if (!s.welcome) {
     const std::string why = s.connection.join_failure();
-    throw Error(fmt::format("cannot join {}:{} (no welcome within {:g} s): {}", s.options.host, s.options.port, timeout_s,
-                            why.empty() ? "no answer (is the address right, and the server running?)" : why));
+    throw Error(fmt::format(
+        "cannot join {}:{} (no welcome within {:g} s): {}", s.options.host, s.options.port,
+        timeout_s,
+        why.empty() ? "no answer (is the address right, and the server running?)" : why));
   }
   return *s.welcome;
 }
 
-void ClientNetwork::record_session(const std::filesystem::path& file, const std::string& device, double force_limit) {
+void ClientNetwork::record_session(const std::filesystem::path& file, const std::string& device,
+                                   double force_limit) {
   Impl& s = *impl_;
   auto recorder = std::make_unique<record::SessionRecorder>(file);
   std::promise<void> done;
   asio::post(s.io, [&s, &recorder, &done, &device, force_limit] {
-    recorder->config(client_session_config(s.options.user_name, device, force_limit, s.session_id, s.welcomed, now_ns()));
+    recorder->config(client_session_config(s.options.user_name, device, force_limit, s.session_id,
+                                           s.welcomed, now_ns()));
     s.recorder = std::move(recorder);
     s.channels.tracing = true;
     done.set_value();

@@ -35,10 +35,11 @@ struct ClientOptions {
   std::string host = "127.0.0.1";
   std::uint16_t port = 7400;
   std::string user_name;
-  std::optional<std::filesystem::path> key_file;  ///< session or participant key; empty: the public development key
-  bool encrypt = true;                            ///< false: send in clear (authenticated), and accept the server's so
-  int requested_slot = -1;                        ///< -1: any free slot (a participant key: its own)
-  double haptic_rate_hz = 0;                      ///< the loop's rate, told the server; 0: the scene's
+  std::optional<std::filesystem::path>
+      key_file;               ///< session or participant key; empty: the public development key
+  bool encrypt = true;        ///< false: send in clear (authenticated), and accept the server's so
+  int requested_slot = -1;    ///< -1: any free slot (a participant key: its own)
+  double haptic_rate_hz = 0;  ///< the loop's rate, told the server; 0: the scene's
 };
 
 class ClientNetwork {
@@ -56,7 +57,8 @@ class ClientNetwork {
   /// Records the session from now on (MCAP, see proto/record/session_recorder.h): the
   /// configuration, every datagram and IR received, every haptic tick, every event.
   /// Throws Error if the file cannot be created.
-  void record_session(const std::filesystem::path& file, const std::string& device, double force_limit);
+  void record_session(const std::filesystem::path& file, const std::string& device,
+                      double force_limit);
   /// Reports the haptic loop's figures to the server from now on (status reports):
   /// `metrics` are the loop's, `floors` its timer floors; both must outlive stop(). The
   /// progress comes through the channels' `progress` buffer.

@@ -5,8 +5,9 @@
 
 namespace cohaptic {
 
-record::SessionConfig client_session_config(const std::string& user, const std::string& device, double force_limit,
-                                            std::uint64_t session, const std::optional<WelcomeInfo>& welcome,
+record::SessionConfig client_session_config(const std::string& user, const std::string& device,
+                                            double force_limit, std::uint64_t session,
+                                            const std::optional<WelcomeInfo>& welcome,
                                             std::int64_t start_time_ns) {
   record::SessionConfig config;
   config.set_role("client");
@@ -28,7 +29,8 @@ record::HapticTick haptic_tick_record(const TickRecord& tick) {
   record::HapticTick record;
   record.set_time_ns(tick.time_ns);
   wire::to_wire(tick.own, record.mutable_own());
-  for (int r = 0; r < tick.remote_count; ++r) wire::to_wire(tick.remotes[static_cast<std::size_t>(r)], record.add_remotes());
+  for (int r = 0; r < tick.remote_count; ++r)
+    wire::to_wire(tick.remotes[static_cast<std::size_t>(r)], record.add_remotes());
   wire::to_wire(tick.force, record.mutable_force());
   wire::to_wire(tick.evaluated, record.mutable_evaluated());
   record.set_ir_epoch(tick.ir_epoch);

@@ -17,8 +17,9 @@ namespace cohaptic {
 struct WelcomeInfo;
 
 /// The first record. `welcome`: the session joined, if any yet.
-record::SessionConfig client_session_config(const std::string& user, const std::string& device, double force_limit,
-                                            std::uint64_t session, const std::optional<WelcomeInfo>& welcome,
+record::SessionConfig client_session_config(const std::string& user, const std::string& device,
+                                            double force_limit, std::uint64_t session,
+                                            const std::optional<WelcomeInfo>& welcome,
                                             std::int64_t start_time_ns);
 
 /// One haptic tick as recorded.

@@ -4,9 +4,12 @@ namespace cohaptic {
 
 wire::ClientStatus client_status(const HapticProgress& progress, const HapticMetrics& metrics,
                                  double timer_floor_p99_us, const Histogram& one_way_delay_ns) {
-  const auto quantile = [](const Histogram& h, double scale) { return static_cast<double>(h.quantile(0.99)) * scale; };
+  const auto quantile = [](const Histogram& h, double scale) {
+    return static_cast<double>(h.quantile(0.99)) * scale;
+  };
   wire::ClientStatus status;
-  status.set_haptic_rate_hz(progress.elapsed_s > 0 ? static_cast<double>(progress.ticks) / progress.elapsed_s : 0.0);
+  status.set_haptic_rate_hz(
+      progress.elapsed_s > 0 ? static_cast<double>(progress.ticks) / progress.elapsed_s : 0.0);
   status.set_period_p99_us(quantile(metrics.period_ns, 1e-3));
   status.set_missed_deadlines(progress.missed_deadlines);
   status.set_ir_age_p99_ms(quantile(metrics.ir_age_ns, 1e-6));

@@ -42,7 +42,8 @@ void ClockSync::observe(std::int64_t sender_time_ns, std::int64_t arrival_ns) {
 
 void ClockSync::add_to_report(nlohmann::json& report) const {
   const auto ms = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-6; };
-  report["clock"] = {{"offset_ms", ms(estimate_.offset_ns())}, {"round_trip_ms", ms(estimate_.round_trip_ns())}};
+  report["clock"] = {{"offset_ms", ms(estimate_.offset_ns())},
+                     {"round_trip_ms", ms(estimate_.round_trip_ns())}};
   report["one_way_delay_ms"] = {{"p50", ms(one_way_ns_.quantile(0.5))},
                                 {"p99", ms(one_way_ns_.quantile(0.99))},
                                 {"samples", one_way_ns_.count()}};

@@ -17,12 +17,14 @@ std::vector<std::int64_t> cpu_steal_ns() {
   while (std::getline(stat, line)) {
     // "cpuN user nice system idle iowait irq softirq steal ...": the aggregate "cpu " line
     // and every other line are skipped.
-    if (line.size() < 4 || line.compare(0, 3, "cpu") != 0 || line[3] < '0' || line[3] > '9') continue;
+    if (line.size() < 4 || line.compare(0, 3, "cpu") != 0 || line[3] < '0' || line[3] > '9')
+      continue;
     std::istringstream fields(line.substr(3));
     std::size_t cpu = 0;
     std::int64_t value = 0, steal_ticks = -1;
     fields >> cpu;
-    for (int column = 0; column < 8 && fields >> value; ++column) steal_ticks = column == 7 ? value : -1;
+    for (int column = 0; column < 8 && fields >> value; ++column)
+      steal_ticks = column == 7 ? value : -1;
     if (steal_ticks < 0) continue;  // an older kernel without the column
     if (steal.size() <= cpu) steal.resize(cpu + 1, -1);
     steal[cpu] = steal_ticks * (1'000'000'000 / ticks_per_s);

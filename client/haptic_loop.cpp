@@ -25,7 +25,8 @@ void sleep_until_monotonic(std::int64_t deadline_ns) {
 
 }  // namespace
 
-std::uint64_t skip_missed_deadlines(std::int64_t& deadline, std::int64_t woke, std::int64_t period) {
+std::uint64_t skip_missed_deadlines(std::int64_t& deadline, std::int64_t woke,
+                                    std::int64_t period) {
   if (woke < deadline + period) return 0;
   const auto missed = static_cast<std::uint64_t>((woke - deadline) / period);
   deadline += static_cast<std::int64_t>(missed) * period;
@@ -39,7 +40,8 @@ IrSlot make_ir_slot(std::unique_ptr<const PreparedIR> ir, std::int64_t arrival_n
 }
 
 HapticClock HapticClock::monotonic() {
-  return {[](void*) { return monotonic_now_ns(); }, [](void*, std::int64_t deadline_ns) { sleep_until_monotonic(deadline_ns); }, nullptr};
+  return {[](void*) { return monotonic_now_ns(); },
+          [](void*, std::int64_t deadline_ns) { sleep_until_monotonic(deadline_ns); }, nullptr};
 }
 
 bool lock_process_memory() {
@@ -54,15 +56,20 @@ bool enter_realtime(int priority) {
   return fifo && lock_process_memory();
 }
 
-HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings, HapticClock clock)
+HapticLoop::HapticLoop(HapticDevice& device, HapticChannels& channels, HapticLoopSettings settings,
+                       HapticClock clock)
     : device_(device),
       channels_(channels),
       settings_(settings),
       protocol_(settings.protocol),
-      remote_buffers_{RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
-                      RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
-                      RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
-                      RemoteToolBuffer(settings.playout, static_cast<std::int64_t>(settings.playout_delay_s * 1e9))},
+      remote_buffers_{RemoteToolBuffer(settings.playout,
+                                       static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
+                      RemoteToolBuffer(settings.playout,
+                                       static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
+                      RemoteToolBuffer(settings.playout,
+                                       static_cast<std::int64_t>(settings.playout_delay_s * 1e9)),
+                      RemoteToolBuffer(settings.playout,
+                                       static_cast<std::int64_t>(settings.playout_delay_s * 1e9))},
       passivity_(settings.passivity_mass_kg, settings.force_limit),
       clock_(clock) {}
 
@@ -74,16 +81,19 @@ bool HapticLoop::take_in_server_updates() {
   if (change.since_ns == 0 || change.protocol == protocol_) return in_use_new;
   // A switch waits: the other protocol's channel is taken in too, and the loop changes over
   // once what arrived after the switch is there (what arrived before it is not enough).
-  const bool ready = p1 ? (channels_.force.update(), channels_.force.front().valid &&
-                                                         channels_.force.front().arrival_ns >= change.since_ns)
-                        : (channels_.ir.update(), channels_.ir.front().ir && channels_.ir.front().arrival_ns >= change.since_ns);
+  const bool ready =
+      p1 ? (channels_.force.update(),
+            channels_.force.front().valid && channels_.force.front().arrival_ns >= change.since_ns)
+         : (channels_.ir.update(),
+            channels_.ir.front().ir && channels_.ir.front().arrival_ns >= change.since_ns);
   if (!ready) return in_use_new;
   protocol_ = change.protocol;
   ++metrics_.protocol_switches;
   return true;
 }
 
-Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3d& own, TickRecord& record) {
+Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3d& own,
+                                          TickRecord& record) {
   std::int64_t age = std::numeric_limits<std::int64_t>::max();
   Eigen::Vector3d force = Eigen::Vector3d::Zero();
   record.remotes.fill(Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
@@ -98,20 +108,28 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
         confirmed_ir_ = slot.ir.get();
         confirmed_ns_ = slot.arrival_ns;
       }
-      if (confirmed.epoch == slot.ir->ir.epoch) confirmed_ns_ = std::max(confirmed_ns_, confirmed.arrival_ns);
+      if (confirmed.epoch == slot.ir->ir.epoch)
+        confirmed_ns_ = std::max(confirmed_ns_, confirmed.arrival_ns);
       age = now - confirmed_ns_;
       const IntermediateRepresentation& ir = slot.ir->ir;
       std::array<Eigen::Vector3d, kMaxUsers - 1> remotes;
-      const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(remote_count(ir)), remotes.size());
+      const std::size_t count =
+          std::min<std::size_t>(static_cast<std::size_t>(remote_count(ir)), remotes.size());
       for (std::size_t r = 0; r < count; ++r) {
-        const PlayoutQuery remote = remote_buffers_[static_cast<std::size_t>(remote_user(ir, static_cast<int>(r)) % kMaxUsers)].at(now);
-        remotes[r] = remote.valid ? remote.position : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+        const PlayoutQuery remote =
+            remote_buffers_[static_cast<std::size_t>(remote_user(ir, static_cast<int>(r)) %
+                                                     kMaxUsers)]
+                .at(now);
+        remotes[r] = remote.valid
+                         ? remote.position
+                         : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
         record.remotes[r] = remotes[r];
       }
       record.remote_count = static_cast<std::uint8_t>(count);
       // dt: the nominal period, so that a replay reproduces the force bit for bit.
       const double dt = 1 / settings_.rate_hz;
-      const ForceSample sample = evaluate_force(*slot.ir, *slot.state, own, std::span(remotes.data(), count), dt, record.buttons);
+      const ForceSample sample = evaluate_force(
+          *slot.ir, *slot.state, own, std::span(remotes.data(), count), dt, record.buttons);
       // A sphere contact solve that could not finish inside the tick has no answer: hold the
       // last one and count the tick.
       if (sample.flags & kContactUnresolved) {
@@ -132,13 +150,16 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       // Measured only in contact: a user that passed by a static body without touching it
       // (e.g. on its way to a mass-spring object lying on it) measured nothing. A home-spring
       // body's users never couple (each feels its own vertex's springs): nothing to measure.
-      const bool couples = static_body && !std::holds_alternative<HomeSpringPatch>(slot.ir->ir.body);
-      metrics_.coupling_measured = metrics_.coupling_measured || (couples && (sample.flags & kInContact));
+      const bool couples =
+          static_body && !std::holds_alternative<HomeSpringPatch>(slot.ir->ir.body);
+      metrics_.coupling_measured =
+          metrics_.coupling_measured || (couples && (sample.flags & kInContact));
       if (count > 0 && (sample.flags & kInContact) && static_body) {
         const ForceSample alone = evaluate_force(*slot.ir, *slot.alone_state, own, {}, dt);
         // A solve past its budget has no force to compare (the tick held the last one).
         if (!((sample.flags | alone.flags) & kContactUnresolved))
-          metrics_.peak_coupling = std::max(metrics_.peak_coupling, (sample.force - alone.force).norm());
+          metrics_.peak_coupling =
+              std::max(metrics_.peak_coupling, (sample.force - alone.force).norm());
       }
     }
   } else {
@@ -158,7 +179,9 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
   // Stale data fades out.
   const double age_s = static_cast<double>(age) * 1e-9;
   float fade = 1;
-  if (age_s > settings_.max_age_s) fade = static_cast<float>(std::max(0.0, 1.0 - (age_s - settings_.max_age_s) / settings_.fade_s));
+  if (age_s > settings_.max_age_s)
+    fade =
+        static_cast<float>(std::max(0.0, 1.0 - (age_s - settings_.max_age_s) / settings_.fade_s));
   record.fade = fade;
   metrics_.fades.tick(fade, force.squaredNorm() > 0, 1 / settings_.rate_hz);
   force *= static_cast<double>(fade);
@@ -166,15 +189,18 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
 }
 
 void HapticLoop::publish_progress(double elapsed_s, bool finished) {
-  channels_.progress.back() = {metrics_.ticks,      metrics_.missed_deadlines, metrics_.clamped, elapsed_s,
-                               metrics_.peak_force, metrics_.fades,           finished};
+  channels_.progress.back() = {metrics_.ticks, metrics_.missed_deadlines, metrics_.clamped,
+                               elapsed_s,      metrics_.peak_force,       metrics_.fades,
+                               finished};
   channels_.progress.publish();
 }
 
 void HapticLoop::run(const std::atomic<bool>& stop) {
   if (settings_.realtime) {
     metrics_.realtime = enter_realtime(80);
-    channels_.events.push({metrics_.realtime ? HapticEventKind::started_realtime : HapticEventKind::realtime_refused, now(), 0});
+    channels_.events.push(
+        {metrics_.realtime ? HapticEventKind::started_realtime : HapticEventKind::realtime_refused,
+         now(), 0});
   }
   const auto period = static_cast<std::int64_t>(1e9 / settings_.rate_hz);
   const std::int64_t start = now();
@@ -189,12 +215,14 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     metrics_.missed_deadlines += skip_missed_deadlines(deadline, woke, period);
     deadline += period;
     const double time_s = static_cast<double>(woke - start) * 1e-9;
-    if ((settings_.duration_s > 0 && time_s >= settings_.duration_s) || device_.finished(time_s)) break;
+    if ((settings_.duration_s > 0 && time_s >= settings_.duration_s) || device_.finished(time_s))
+      break;
 
     const DeviceState state = device_.read(time_s);
     channels_.own_samples.push({woke, state.position, state.buttons, state.valid});
     while (const auto remote = channels_.remote_samples.pop())
-      remote_buffers_[remote->user % kMaxUsers].add(remote->sample_time_ns, remote->arrival_ns, remote->position, remote->valid);
+      remote_buffers_[remote->user % kMaxUsers].add(remote->sample_time_ns, remote->arrival_ns,
+                                                    remote->position, remote->valid);
     if (take_in_server_updates()) ++metrics_.ir_switches;
     channels_.confirmation.update();
 
@@ -203,9 +231,12 @@ void HapticLoop::run(const std::atomic<bool>& stop) {
     record.own = state.position;
     record.buttons = state.buttons;
     record.own_valid = state.valid;
-    Eigen::Vector3d force = state.valid ? compute_force(woke, state.position, record) : Eigen::Vector3d::Zero();
+    Eigen::Vector3d force =
+        state.valid ? compute_force(woke, state.position, record) : Eigen::Vector3d::Zero();
     if (protocol_ == HapticProtocol::p1 && record.ir_epoch != epoch_in_use) {
-      if (epoch_in_use != 0) metrics_.largest_step_on_ir_switch = std::max(metrics_.largest_step_on_ir_switch, (force - last_force_).norm());
+      if (epoch_in_use != 0)
+        metrics_.largest_step_on_ir_switch =
+            std::max(metrics_.largest_step_on_ir_switch, (force - last_force_).norm());
       epoch_in_use = record.ir_epoch;
     }
     if (!force.allFinite()) {

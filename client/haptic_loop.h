@@ -38,13 +38,13 @@ enum class HapticProtocol { p0, p1 };
 struct HapticLoopSettings {
   double rate_hz = 1000;
   HapticProtocol protocol = HapticProtocol::p1;
-  double force_limit = 3.3;     ///< [N], min of the device's and the scene's
-  double max_age_s = 0.25;      ///< IR (P1) or force (P0) older than this starts to fade
-  double fade_s = 0.1;          ///< time to fade to zero
+  double force_limit = 3.3;  ///< [N], min of the device's and the scene's
+  double max_age_s = 0.25;   ///< IR (P1) or force (P0) older than this starts to fade
+  double fade_s = 0.1;       ///< time to fade to zero
   PlayoutPolicy playout = PlayoutPolicy::fixed;
   double playout_delay_s = 0.005;
-  double duration_s = 0;        ///< 0: until stopped
-  bool realtime = true;         ///< try SCHED_FIFO and mlockall
+  double duration_s = 0;  ///< 0: until stopped
+  bool realtime = true;   ///< try SCHED_FIFO and mlockall
   /// Filter the output through a passivity observer/controller (passivity_controller.h)
   /// before the force limit: keeps a stiff, delayed or stepwise force passive for the hand.
   bool passivity_control = false;
@@ -106,21 +106,28 @@ struct OwnSample {
 struct TickRecord {
   std::int64_t time_ns = 0;
   Eigen::Vector3d own = Eigen::Vector3d::Zero();
-  std::uint32_t buttons = 0;                             ///< the own tool's, as evaluated
+  std::uint32_t buttons = 0;  ///< the own tool's, as evaluated
   bool own_valid = false;
-  std::uint8_t remote_count = 0;                         ///< remote positions used
-  std::array<Eigen::Vector3d, kMaxUsers - 1> remotes{};  ///< in the IR's remotes order (NaN: unknown)
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();       ///< as written to the device
-  Eigen::Vector3d evaluated = Eigen::Vector3d::Zero();   ///< before fading and limiting
+  std::uint8_t remote_count = 0;  ///< remote positions used
+  std::array<Eigen::Vector3d, kMaxUsers - 1>
+      remotes{};                                    ///< in the IR's remotes order (NaN: unknown)
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< as written to the device
+  Eigen::Vector3d evaluated = Eigen::Vector3d::Zero();  ///< before fading and limiting
   std::uint64_t ir_epoch = 0;
-  double dt = 0;                                         ///< the period the evaluation advanced by [s] (P1)
+  double dt = 0;  ///< the period the evaluation advanced by [s] (P1)
   std::uint8_t flags = 0;
   float fade = 1;
-  std::int64_t ir_age_ns = -1;                           ///< of the IR or force used (-1: none yet)
-  HapticProtocol protocol = HapticProtocol::p1;          ///< the protocol the tick used
+  std::int64_t ir_age_ns = -1;                   ///< of the IR or force used (-1: none yet)
+  HapticProtocol protocol = HapticProtocol::p1;  ///< the protocol the tick used
 };
 
-enum class HapticEventKind : std::uint8_t { non_finite, ir_switched, fading, started_realtime, realtime_refused };
+enum class HapticEventKind : std::uint8_t {
+  non_finite,
+  ir_switched,
+  fading,
+  started_realtime,
+  realtime_refused
+};
 struct HapticEvent {
   HapticEventKind kind = HapticEventKind::non_finite;
   std::int64_t time_ns = 0;
@@ -132,41 +139,42 @@ struct HapticEvent {
 /// are read from HapticLoop::metrics() directly (Histogram allows a concurrent reader).
 struct HapticProgress {
   std::uint64_t ticks = 0, missed_deadlines = 0, clamped = 0;
-  double elapsed_s = 0;    ///< since the loop started; when finished, HapticMetrics::elapsed_s
-  double peak_force = 0;   ///< [N]
+  double elapsed_s = 0;   ///< since the loop started; when finished, HapticMetrics::elapsed_s
+  double peak_force = 0;  ///< [N]
   FadeTally fades;
   bool finished = false;
 };
 
 /// Lock-free channels between the I/O thread and the haptic thread.
 struct HapticChannels {
-  TripleBuffer<IrSlot> ir;                     // I/O -> haptic (P1)
-  TripleBuffer<IrConfirmation> confirmation;   // I/O -> haptic (P1)
-  TripleBuffer<ForceSlot> force;               // I/O -> haptic (P0)
-  TripleBuffer<ProtocolChange> protocol;       // I/O -> haptic: a switch of the protocol served
-  SpscRing<RemoteSample, 4096> remote_samples; // I/O -> haptic
-  SpscRing<OwnSample, 4096> own_samples;       // haptic -> I/O
-  SpscRing<TickRecord, 8192> trace;            // haptic -> I/O (only if tracing: recording)
-  SpscRing<HapticEvent, 1024> events;          // haptic -> I/O
-  TripleBuffer<HapticProgress> progress;       // haptic -> I/O
+  TripleBuffer<IrSlot> ir;                      // I/O -> haptic (P1)
+  TripleBuffer<IrConfirmation> confirmation;    // I/O -> haptic (P1)
+  TripleBuffer<ForceSlot> force;                // I/O -> haptic (P0)
+  TripleBuffer<ProtocolChange> protocol;        // I/O -> haptic: a switch of the protocol served
+  SpscRing<RemoteSample, 4096> remote_samples;  // I/O -> haptic
+  SpscRing<OwnSample, 4096> own_samples;        // haptic -> I/O
+  SpscRing<TickRecord, 8192> trace;             // haptic -> I/O (only if tracing: recording)
+  SpscRing<HapticEvent, 1024> events;           // haptic -> I/O
+  TripleBuffer<HapticProgress> progress;        // haptic -> I/O
   std::atomic<bool> tracing{false};
 };
 
 struct HapticMetrics {
-  Histogram period_ns{1000, 50000};   ///< 1 us bins up to 50 ms
+  Histogram period_ns{1000, 50000};  ///< 1 us bins up to 50 ms
   Histogram ir_age_ns = ir_age_histogram();
   std::uint64_t ticks = 0, missed_deadlines = 0, non_finite = 0, clamped = 0, ir_switches = 0;
   std::uint64_t protocol_switches = 0;  ///< changes of the protocol in use (the server switched it)
-  std::uint64_t contact_unresolved = 0;  ///< ticks that held the last force (sphere solve unfinished)
-  double peak_force = 0;      ///< [N]
-  double peak_coupling = 0;   ///< [N], |F - F without the remote tools|
+  std::uint64_t contact_unresolved =
+      0;                     ///< ticks that held the last force (sphere solve unfinished)
+  double peak_force = 0;     ///< [N]
+  double peak_coupling = 0;  ///< [N], |F - F without the remote tools|
   /// Whether peak_coupling was measured: only while in contact with a body whose evaluation
   /// keeps no state (a second evaluation would advance a dynamic body twice).
   bool coupling_measured = false;
   double largest_step_on_ir_switch = 0;  ///< [N]
   FadeTally fades;  ///< the fades the user felt, ticks counted at the nominal period
   double elapsed_s = 0;
-  bool realtime = false;      ///< SCHED_FIFO and mlockall in effect
+  bool realtime = false;  ///< SCHED_FIFO and mlockall in effect
 };
 
 /// Where the loop reads the time and sleeps to its deadlines, in ns. The real clock,
@@ -175,7 +183,8 @@ struct HapticMetrics {
 /// function pointers fixed at construction: two indirect calls a tick, no allocation, no lock.
 struct HapticClock {
   std::int64_t (*now_ns)(void* context);
-  void (*sleep_until_ns)(void* context, std::int64_t deadline_ns);  ///< returns at or after the deadline
+  void (*sleep_until_ns)(void* context,
+                         std::int64_t deadline_ns);  ///< returns at or after the deadline
   void* context = nullptr;
   static HapticClock monotonic();
 };
@@ -207,7 +216,8 @@ class HapticLoop {
   std::array<RemoteToolBuffer, kMaxUsers> remote_buffers_;
   Eigen::Vector3d last_force_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d last_evaluated_ = Eigen::Vector3d::Zero();  // the IR's last resolved force
-  const PreparedIR* confirmed_ir_ = nullptr;  // the IR in use, and when the server last confirmed it
+  const PreparedIR* confirmed_ir_ =
+      nullptr;  // the IR in use, and when the server last confirmed it
   std::int64_t confirmed_ns_ = 0;
   PassivityController passivity_;
   HapticClock clock_;

@@ -10,7 +10,8 @@
 
 namespace cohaptic {
 
-bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::size_t bytes, std::int64_t arrival_ns) {
+bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::size_t bytes,
+                       std::int64_t arrival_ns) {
   try {
     IntermediateRepresentation ir = wire::from_wire(message);
     if (auto* fem = std::get_if<CondensedFemIr>(&ir.body); fem && fem->compliance_rows) {
@@ -33,7 +34,8 @@ bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::siz
   return true;
 }
 
-bool IrIntake::receive_compressed(const wire::CompressedIr& block, std::size_t bytes, std::int64_t arrival_ns) {
+bool IrIntake::receive_compressed(const wire::CompressedIr& block, std::size_t bytes,
+                                  std::int64_t arrival_ns) {
   wire::IntermediateRepresentation message;
   try {
     const double start_us = thread_cpu_us();

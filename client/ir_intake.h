@@ -1,10 +1,10 @@
 // IrIntake: the IRs the server sends, on the client's I/O thread. Each is taken out of its
 // connection's zstd stream if it came compressed (proto/wire/ir_stream.h), converted from
 // the wire, completed if it came as compliance rows (its M~ condensed here from the rows
-// held, ClientCondensation), checked and prepared (prepare_ir: the factorisations the haptic loop needs,
-// done here so the haptic thread never does them) with its fresh evaluation state, then handed to the haptic thread
-// through its TripleBuffer with the time it arrived. An IR that fails its checks is
-// counted and logged, and never reaches the haptic thread.
+// held, ClientCondensation), checked and prepared (prepare_ir: the factorisations the haptic loop
+// needs, done here so the haptic thread never does them) with its fresh evaluation state, then
+// handed to the haptic thread through its TripleBuffer with the time it arrived. An IR that fails
+// its checks is counted and logged, and never reaches the haptic thread.
 #pragma once
 
 #include <cstddef>
@@ -26,12 +26,14 @@ class IrIntake {
   explicit IrIntake(TripleBuffer<IrSlot>& to_haptic) : to_haptic_(to_haptic) {}
 
   /// Prepares and hands over `message` (`bytes` on the wire). False if it was rejected.
-  bool receive(const wire::IntermediateRepresentation& message, std::size_t bytes, std::int64_t arrival_ns);
+  bool receive(const wire::IntermediateRepresentation& message, std::size_t bytes,
+               std::int64_t arrival_ns);
   /// Decompresses `block` in this connection's IR stream, then as receive(). Returns
   /// whether the stream opened it (the IR in it accepted or not): a recording keeps every
   /// block the stream opened, for the blocks after it. A new connection's stream starts at
   /// its first block.
-  bool receive_compressed(const wire::CompressedIr& block, std::size_t bytes, std::int64_t arrival_ns);
+  bool receive_compressed(const wire::CompressedIr& block, std::size_t bytes,
+                          std::int64_t arrival_ns);
 
   /// The report's "ir": received, rejected, bytes, bytes_per_s (from the first IR to the
   /// last), and of those sent as compliance rows: condensed, condense_cpu_us_p50 and _max
@@ -44,7 +46,8 @@ class IrIntake {
   ClientCondensation condensation_;
   wire::IrStreamReader stream_;
   Histogram inflate_us_{5, 20000};  // CPU of decompressing each IR that came compressed [µs]
-  Histogram condense_us_{5, 20000};  // CPU of completing each IR sent as compliance rows [µs], to 100 ms
+  Histogram condense_us_{
+      5, 20000};  // CPU of completing each IR sent as compliance rows [µs], to 100 ms
   std::uint64_t received_ = 0, rejected_ = 0, bytes_ = 0;
   std::int64_t first_ns_ = 0, last_ns_ = 0;
 };

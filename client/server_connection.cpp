@@ -7,8 +7,8 @@ namespace cohaptic {
 
 using asio::ip::tcp;
 
-ServerConnection::ServerConnection(asio::io_context& io, std::string host, std::uint16_t port, wire::ClientKeys keys,
-                                   bool encrypt, Handlers handlers)
+ServerConnection::ServerConnection(asio::io_context& io, std::string host, std::uint16_t port,
+                                   wire::ClientKeys keys, bool encrypt, Handlers handlers)
     : io_(io),
       host_(std::move(host)),
       port_(port),
@@ -34,52 +34,66 @@ void ServerConnection::connect() {
     return;
   }
   connecting_ = std::make_shared<tcp::socket>(io_);
-  asio::async_connect(*connecting_, endpoints, [this, socket = connecting_](std::error_code e, const tcp::endpoint&) {
-    if (socket != connecting_ || stopped_) return;  // superseded or stopped meanwhile
-    connecting_.reset();
-    if (e) {
-      if (e == asio::error::connection_refused)
-        failed_to_join("connection refused: nothing listens there (is the server running, on this port?)");
-      else if (e == asio::error::host_unreachable || e == asio::error::network_unreachable || e == asio::error::timed_out)
-        failed_to_join(fmt::format("unreachable ({}): check the address and the network", e.message()));
-      else
-        failed_to_join(e.message());
-      schedule_reconnect();
-      return;
-    }
-    socket->set_option(tcp::no_delay(true));
-    // Every connection starts over: the join key, until the Welcome names the slot.
-    key_ = keys_.join_key();
-    sealer_.set_key(key_);
-    sealer_.stamp().set_sender(keys_.join_sender());
-    join_sent_ = false;
-    net::FramedConnection::Handlers handlers;
-    handlers.on_control = [this](const wire::Control& control) { handle(control); };
-    handlers.on_close = [this](net::CloseCause cause, const std::string& why) {
-      switch (cause) {
-        case net::CloseCause::peer_closed:
-          if (join_sent_ && !welcomed_)
-            failed_to_join("the server rejected the key: it closed the connection on our join (is it using the same "
-                           "--key-file?)");
-          drop("closed");
+  asio::async_connect(
+      *connecting_, endpoints,
+      [this, socket = connecting_](std::error_code e, const tcp::endpoint&) {
+        if (socket != connecting_ || stopped_) return;  // superseded or stopped meanwhile
+        connecting_.reset();
+        if (e) {
+          if (e == asio::error::connection_refused)
+            failed_to_join(
+                "connection refused: nothing listens there (is the server running, on this port?)");
+          else if (e == asio::error::host_unreachable || e == asio::error::network_unreachable ||
+                   e == asio::error::timed_out)
+            failed_to_join(
+                fmt::format("unreachable ({}): check the address and the network", e.message()));
+          else
+            failed_to_join(e.message());
+          schedule_reconnect();
           return;
-        case net::CloseCause::rejected_frame:
-          spdlog::error("control channel: {}", why);
-          if (!welcomed_)
-            failed_to_join("the server rejected the key: its frames do not authenticate with ours (is it using the "
-                           "same --key-file?)");
-          drop("protocol error");
-          return;
-        case net::CloseCause::io_error:
-        case net::CloseCause::write_queue_full:
-        case net::CloseCause::write_stalled: drop(why); return;
-      }
-    };
-    wire::FrameReader reader(
-        [this](std::uint32_t sender) { return sender == wire::kServerSender ? &key_ : nullptr; },
-        {.expect_greeting = true, .allow_cleartext = !encrypt_});
-    connection_ = net::FramedConnection::start(std::move(*socket), std::move(reader), std::move(handlers));
-  });
+        }
+        socket->set_option(tcp::no_delay(true));
+        // Every connection starts over: the join key, until the Welcome names the slot.
+        key_ = keys_.join_key();
+        sealer_.set_key(key_);
+        sealer_.stamp().set_sender(keys_.join_sender());
+        join_sent_ = false;
+        net::FramedConnection::Handlers handlers;
+        handlers.on_control = [this](const wire::Control& control) { handle(control); };
+        handlers.on_close = [this](net::CloseCause cause, const std::string& why) {
+          switch (cause) {
+            case net::CloseCause::peer_closed:
+              if (join_sent_ && !welcomed_)
+                failed_to_join(
+                    "the server rejected the key: it closed the connection on our join (is it "
+                    "using the same "
+                    "--key-file?)");
+              drop("closed");
+              return;
+            case net::CloseCause::rejected_frame:
+              spdlog::error("control channel: {}", why);
+              if (!welcomed_)
+                failed_to_join(
+                    "the server rejected the key: its frames do not authenticate with ours (is it "
+                    "using the "
+                    "same --key-file?)");
+              drop("protocol error");
+              return;
+            case net::CloseCause::io_error:
+            case net::CloseCause::write_queue_full:
+            case net::CloseCause::write_stalled:
+              drop(why);
+              return;
+          }
+        };
+        wire::FrameReader reader(
+            [this](std::uint32_t sender) {
+              return sender == wire::kServerSender ? &key_ : nullptr;
+            },
+            {.expect_greeting = true, .allow_cleartext = !encrypt_});
+        connection_ = net::FramedConnection::start(std::move(*socket), std::move(reader),
+                                                   std::move(handlers));
+      });
 }
 
 void ServerConnection::handle(const wire::Control& control) {
@@ -110,7 +124,8 @@ void ServerConnection::greeted(const wire::Hello& hello) {
 bool ServerConnection::welcomed(const wire::Control& control) {
   const wire::Welcome& welcome = control.welcome();
   if (!wire::is_challenge(welcome.client_challenge(), client_challenge_)) {
-    spdlog::error("control channel: a welcome that does not answer this connection's join (replayed?)");
+    spdlog::error(
+        "control channel: a welcome that does not answer this connection's join (replayed?)");
     drop("protocol error");
     return false;
   }

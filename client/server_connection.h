@@ -35,14 +35,15 @@ inline constexpr std::chrono::milliseconds kReconnectInterval{500};
 class ServerConnection {
  public:
   struct Handlers {
-    std::function<wire::Control()> make_join;                  ///< sent on every connection, once greeted
-    std::function<void(const wire::Control&)> on_control;      ///< every verified frame (a Welcome once checked)
-    std::function<void(const std::string& why)> on_lost;       ///< an open connection was lost
+    std::function<wire::Control()> make_join;  ///< sent on every connection, once greeted
+    std::function<void(const wire::Control&)>
+        on_control;  ///< every verified frame (a Welcome once checked)
+    std::function<void(const std::string& why)> on_lost;  ///< an open connection was lost
   };
 
   /// `encrypt`: seal frames encrypted (else in clear, and accept the server's in clear).
-  ServerConnection(asio::io_context& io, std::string host, std::uint16_t port, wire::ClientKeys keys, bool encrypt,
-                   Handlers handlers);
+  ServerConnection(asio::io_context& io, std::string host, std::uint16_t port,
+                   wire::ClientKeys keys, bool encrypt, Handlers handlers);
 
   /// Starts connecting (and reconnecting).
   void start();
@@ -79,7 +80,7 @@ class ServerConnection {
   bool encrypt_;
   Handlers handlers_;
   wire::FrameSealer sealer_;
-  wire::TrafficKey key_;               ///< this connection's, for both directions
+  wire::TrafficKey key_;                ///< this connection's, for both directions
   wire::Challenge client_challenge_{};  ///< the one the Welcome must echo
   bool join_sent_ = false;
   asio::steady_timer reconnect_timer_;

@@ -19,7 +19,9 @@ bool pin_to_cpu(int cpu) {
 }
 
 std::int64_t steal_of(const std::vector<std::int64_t>& steal, int cpu) {
-  return cpu >= 0 && static_cast<std::size_t>(cpu) < steal.size() ? steal[static_cast<std::size_t>(cpu)] : -1;
+  return cpu >= 0 && static_cast<std::size_t>(cpu) < steal.size()
+             ? steal[static_cast<std::size_t>(cpu)]
+             : -1;
 }
 
 }  // namespace
@@ -64,7 +66,8 @@ void TimerFloors::start(double rate_hz, bool realtime) {
   const std::vector<std::int64_t> steal = cpu_steal_ns();
   for (OnCpu& on : floors_) {
     on.steal_at_start_ns = steal_of(steal, on.cpu);
-    threads_.emplace_back([this, &on, rate_hz, realtime] { on.floor->run(rate_hz, stop_, realtime, on.cpu); });
+    threads_.emplace_back(
+        [this, &on, rate_hz, realtime] { on.floor->run(rate_hz, stop_, realtime, on.cpu); });
   }
 }
 
@@ -79,13 +82,15 @@ void TimerFloors::stop() {
 
 double TimerFloors::period_p99_us() const {
   double worst = 0;
-  for (const OnCpu& on : floors_) worst = std::max(worst, static_cast<double>(on.floor->period_ns.quantile(0.99)) * 1e-3);
+  for (const OnCpu& on : floors_)
+    worst = std::max(worst, static_cast<double>(on.floor->period_ns.quantile(0.99)) * 1e-3);
   return worst;
 }
 
 nlohmann::json TimerFloors::report() const {
   nlohmann::json cpus = nlohmann::json::array();
-  nlohmann::json worst = {{"period_us", {{"p50", 0.0}, {"p99", 0.0}, {"max", 0.0}}}, {"missed_deadlines", 0}};
+  nlohmann::json worst = {{"period_us", {{"p50", 0.0}, {"p99", 0.0}, {"max", 0.0}}},
+                          {"missed_deadlines", 0}};
   for (const OnCpu& on : floors_) {
     const TimerFloor& floor = *on.floor;
     nlohmann::json one = {{"cpu", on.cpu},
@@ -96,8 +101,10 @@ nlohmann::json TimerFloors::report() const {
     if (on.steal_at_start_ns >= 0 && on.steal_at_stop_ns >= 0)
       one["host_steal_ms"] = static_cast<double>(on.steal_at_stop_ns - on.steal_at_start_ns) * 1e-6;
     for (const char* q : {"p50", "p99", "max"})
-      worst["period_us"][q] = std::max(worst["period_us"][q].get<double>(), one["period_us"][q].get<double>());
-    worst["missed_deadlines"] = std::max(worst["missed_deadlines"].get<std::uint64_t>(), floor.missed_deadlines);
+      worst["period_us"][q] =
+          std::max(worst["period_us"][q].get<double>(), one["period_us"][q].get<double>());
+    worst["missed_deadlines"] =
+        std::max(worst["missed_deadlines"].get<std::uint64_t>(), floor.missed_deadlines);
     cpus.push_back(std::move(one));
   }
   worst["cpus"] = std::move(cpus);

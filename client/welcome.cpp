@@ -9,9 +9,12 @@
 namespace cohaptic {
 
 WelcomeInfo welcome_info(const wire::Welcome& welcome) {
-  const auto fail = [](const std::string& what) { throw Error("welcome from the server: " + what); };
+  const auto fail = [](const std::string& what) {
+    throw Error("welcome from the server: " + what);
+  };
   if (welcome.slot() >= static_cast<std::uint32_t>(welcome.users_size()))
-    fail(fmt::format("slot {} is not one of its {} user slots", welcome.slot(), welcome.users_size()));
+    fail(fmt::format("slot {} is not one of its {} user slots", welcome.slot(),
+                     welcome.users_size()));
   if (welcome.protocol() != wire::P0 && welcome.protocol() != wire::P1)
     fail(fmt::format("protocol {} is neither P0 nor P1", static_cast<int>(welcome.protocol())));
   if (!(welcome.force_limit() > 0 && welcome.force_limit() <= 1000))
@@ -19,7 +22,8 @@ WelcomeInfo welcome_info(const wire::Welcome& welcome) {
   if (!(welcome.haptic_rate_hz() >= 1 && welcome.haptic_rate_hz() <= 100000))
     fail(fmt::format("haptic_rate_hz {} is not in [1, 100000] Hz", welcome.haptic_rate_hz()));
   if (!(welcome.ir_max_age_s() > 0 && std::isfinite(welcome.ir_max_age_s())))
-    fail(fmt::format("ir_max_age_s {} is not a positive, finite time in s", welcome.ir_max_age_s()));
+    fail(
+        fmt::format("ir_max_age_s {} is not a positive, finite time in s", welcome.ir_max_age_s()));
 
   WelcomeInfo info;
   info.slot = static_cast<int>(welcome.slot());

@@ -37,8 +37,8 @@ namespace cohaptic {
 struct HertzBlock {
   double radius = 0.01;  ///< R [m]
   LinearElasticMaterial material{1.0e5, 0.3, ElementFormulation::linear_tet};
-  int divisions = 16;    ///< cells along each side of the quarter block (>= 2)
-  double core = 0.5;     ///< side of the uniformly meshed core under the sphere, in R (0 < core < 10)
+  int divisions = 16;  ///< cells along each side of the quarter block (>= 2)
+  double core = 0.5;   ///< side of the uniformly meshed core under the sphere, in R (0 < core < 10)
   /// If set, the quarter block's mesh instead of the box: a .msh of [0, s]^2 x [-s, 0] with
   /// s >= 20 R, in millimetres, the contact point at the origin (scenes/hertz/quarter_block.geo).
   std::filesystem::path mesh;
@@ -59,15 +59,15 @@ double hertz_force(const LinearElasticMaterial& material, double radius, double 
 
 /// One mesh of the study: forces on the whole block (four quarters) at each depth.
 struct HertzMesh {
-  std::string name;                        ///< "16 cells", "gmsh 0.05 R" or the mesh file's name
-  double side = 0;                         ///< the quarter block's side, over R (20 for box meshes)
+  std::string name;  ///< "16 cells", "gmsh 0.05 R" or the mesh file's name
+  double side = 0;   ///< the quarter block's side, over R (20 for box meshes)
   int nodes = 0, tets = 0;
   /// Under the sphere, over R: the core's cell side for a box mesh; the mean edge of the
   /// tetrahedra within 0.3 R of the contact point for a mesh file.
   double contact_cell = 0;
-  std::vector<double> sphere_force;        ///< [N] per depth, the sphere model
-  std::vector<int> contact_nodes;          ///< per depth: nodes the sphere pushes (in the quarter)
-  std::vector<double> translation_force;   ///< [N] per depth, node translation
+  std::vector<double> sphere_force;       ///< [N] per depth, the sphere model
+  std::vector<int> contact_nodes;         ///< per depth: nodes the sphere pushes (in the quarter)
+  std::vector<double> translation_force;  ///< [N] per depth, node translation
 };
 
 /// Solves `block` at each depth d = ratio R of `depth_ratios`. Throws Error if a ratio is
@@ -99,7 +99,8 @@ std::string hertz_table(const HertzOptions& options, const std::vector<HertzMesh
 /// Measures every mesh, prints the table, writes the files. Returns the exit code.
 int run_hertz(const HertzOptions& options);
 
-/// `cohaptic-lab hertz [--poisson-ratio NU] [--element E] [--gmsh-fine F... | --divisions N... | --mesh FILE...]
+/// `cohaptic-lab hertz [--poisson-ratio NU] [--element E] [--gmsh-fine F... | --divisions N... |
+/// --mesh FILE...]
 /// [--depths D...] [--out DIR]`.
 LabCommand add_hertz_command(CLI::App& lab);
 

@@ -29,7 +29,9 @@ namespace {
 
 // Entries of L_AA (symmetric, 3 dofs per node) that involve at least one of `added` new
 // nodes among `nodes`: the new nodes' rows against every node, each pair once.
-double compliance_row_values(double nodes, double added) { return 9 * (added * nodes - added * (added - 1) / 2); }
+double compliance_row_values(double nodes, double added) {
+  return 9 * (added * nodes - added * (added - 1) / 2);
+}
 
 // Entries of `now` that differ from `before` bit for bit (same shape).
 std::size_t changed_entries(const google::protobuf::RepeatedField<double>& before,
@@ -42,8 +44,8 @@ std::size_t changed_entries(const google::protobuf::RepeatedField<double>& befor
 
 }  // namespace
 
-IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body, ComplianceColumns& columns,
-                            const std::filesystem::path& frames) {
+IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body,
+                            ComplianceColumns& columns, const std::filesystem::path& frames) {
   const record::Recording rec = record::read_recording(recording);
   const std::unordered_map<std::int64_t, int> node_of_tag = node_indices_by_tag(body.mesh);
   IrBytesRow row;
@@ -60,21 +62,23 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
   for (const record::RecordedIr& recorded : rec.irs) {
     if (!recorded.ir().has_fem()) continue;
     {
-      const wire::CompressedIr block = stream_out.compress(recorded.ir(), recorded.ir().fem().rows_generation() == 1);
+      const wire::CompressedIr block =
+          stream_out.compress(recorded.ir(), recorded.ir().fem().rows_generation() == 1);
       row.stream_bytes += static_cast<double>(block.ByteSizeLong());
       const double start_us = thread_cpu_us();
       const wire::IntermediateRepresentation opened = stream_in.open(block);
       inflate_us.push_back(thread_cpu_us() - start_us);
       if (opened.ByteSizeLong() != recorded.ir().ByteSizeLong())
-        throw Error(fmt::format("ir-bytes: {}: IR epoch {} came out of the IR stream changed", recording.string(),
-                                recorded.ir().epoch()));
+        throw Error(fmt::format("ir-bytes: {}: IR epoch {} came out of the IR stream changed",
+                                recording.string(), recorded.ir().epoch()));
     }
     // An IR that came as compliance rows is completed as the client did: the options are
     // measured against its whole-M~ form, "sent" is what came.
     wire::IntermediateRepresentation ir = recorded.ir();
     const std::string bytes = ir.SerializeAsString();
     // B truncation: held nodes the IR leaves out, which the client condenses over too.
-    const std::vector<std::int64_t> truncated(ir.fem().truncated_node_ids().begin(), ir.fem().truncated_node_ids().end());
+    const std::vector<std::int64_t> truncated(ir.fem().truncated_node_ids().begin(),
+                                              ir.fem().truncated_node_ids().end());
     if (ir.fem().rows_generation() > 0) {
       IntermediateRepresentation completed = wire::from_wire(ir);
       const double start_us = thread_cpu_us();
@@ -114,20 +118,28 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
     row.nodes_mean += nodes;
     row.new_nodes_mean += added;
 
-    const bool same_nodes = previous && std::equal(fem.node_ids().begin(), fem.node_ids().end(),
-                                                   previous->fem().node_ids().begin(), previous->fem().node_ids().end()) &&
-                            previous->fem().m_rows() == fem.m_rows() && previous->fem().m_cols() == fem.m_cols() &&
-                            fem.m_tilde_f64_size() > 0 && previous->fem().m_tilde_f64_size() == fem.m_tilde_f64_size();
+    const bool same_nodes =
+        previous &&
+        std::equal(fem.node_ids().begin(), fem.node_ids().end(), previous->fem().node_ids().begin(),
+                   previous->fem().node_ids().end()) &&
+        previous->fem().m_rows() == fem.m_rows() && previous->fem().m_cols() == fem.m_cols() &&
+        fem.m_tilde_f64_size() > 0 && previous->fem().m_tilde_f64_size() == fem.m_tilde_f64_size();
     const double delta_m =
-        same_nodes ? std::min(m_bytes, 12.0 * static_cast<double>(changed_entries(previous->fem().m_tilde_f64(), fem.m_tilde_f64())))
-                   : m_bytes;
+        same_nodes
+            ? std::min(m_bytes, 12.0 * static_cast<double>(changed_entries(
+                                           previous->fem().m_tilde_f64(), fem.m_tilde_f64())))
+            : m_bytes;
     row.delta_bytes += rest + delta_m;
     // Rows go to every node the client holds: with B truncation the left-out ones too.
     double held_added = 0;
-    const auto count_new = [&](std::int64_t id) { held_added += had.contains(id) || previous_truncated.contains(id) ? 0 : 1; };
+    const auto count_new = [&](std::int64_t id) {
+      held_added += had.contains(id) || previous_truncated.contains(id) ? 0 : 1;
+    };
     std::for_each(fem.node_ids().begin(), fem.node_ids().end(), count_new);
     std::for_each(truncated.begin(), truncated.end(), count_new);
-    row.rows_bytes += rest + value_bytes * compliance_row_values(nodes + static_cast<double>(truncated.size()), held_added);
+    row.rows_bytes +=
+        rest + value_bytes *
+                   compliance_row_values(nodes + static_cast<double>(truncated.size()), held_added);
 
     const CondensedFemIr& sent = condensed_fem(received);
     std::vector<std::int64_t> held = sent.node_ids;
@@ -136,8 +148,9 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
     for (const std::int64_t tag : held) {
       const auto found = node_of_tag.find(tag);
       if (found == node_of_tag.end() || columns.row_position(found->second) < 0)
-        throw Error(fmt::format("ir-bytes: {}: IR epoch {} has node {}, which is no surface node of the scene's body",
-                                recording.string(), ir.epoch(), tag));
+        throw Error(fmt::format(
+            "ir-bytes: {}: IR epoch {} has node {}, which is no surface node of the scene's body",
+            recording.string(), ir.epoch(), tag));
       mesh_nodes.push_back(found->second);
     }
     // The client's work under compliance rows: the naive condensation of L_AA (the server's
@@ -146,25 +159,29 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
     columns.compute_columns(mesh_nodes);
     const auto contact = static_cast<std::size_t>(sent.row_node_count);
     const double start_us = thread_cpu_us();
-    const CondensedOperator op = naive_condensation(columns, body.dofs, std::span(mesh_nodes).first(contact),
-                                                    std::span(mesh_nodes).subspan(contact));
+    const CondensedOperator op =
+        naive_condensation(columns, body.dofs, std::span(mesh_nodes).first(contact),
+                           std::span(mesh_nodes).subspan(contact));
     client_us.push_back(thread_cpu_us() - start_us);
     // The truncated nodes' columns (the last ones) are dropped, as the client drops them.
     const Eigen::Index kept_columns = sent.m_tilde.cols() - op.m_cc.cols();
     if (sent.m_tilde.rows() != op.m_cc.rows() || kept_columns < 0 || kept_columns > op.m_cb.cols())
-      throw Error(fmt::format("ir-bytes: {}: IR epoch {}: its M~ is {} x {}, its free dofs give {} x {} and {} held",
-                              recording.string(), ir.epoch(), sent.m_tilde.rows(), sent.m_tilde.cols(), op.m_cc.rows(),
-                              op.m_cc.cols(), op.m_cb.cols()));
+      throw Error(fmt::format(
+          "ir-bytes: {}: IR epoch {}: its M~ is {} x {}, its free dofs give {} x {} and {} held",
+          recording.string(), ir.epoch(), sent.m_tilde.rows(), sent.m_tilde.cols(), op.m_cc.rows(),
+          op.m_cc.cols(), op.m_cb.cols()));
     Eigen::MatrixXd condensed(op.m_cc.rows(), op.m_cc.cols() + kept_columns);
     condensed << op.m_cc, op.m_cb.leftCols(kept_columns);
-    row.rows_m_tilde_difference = std::max(row.rows_m_tilde_difference, (condensed - sent.m_tilde).cwiseAbs().maxCoeff() /
-                                                                             sent.m_tilde.cwiseAbs().maxCoeff());
+    row.rows_m_tilde_difference =
+        std::max(row.rows_m_tilde_difference, (condensed - sent.m_tilde).cwiseAbs().maxCoeff() /
+                                                  sent.m_tilde.cwiseAbs().maxCoeff());
 
     previous = std::move(ir);
     previous_truncated = std::unordered_set<std::int64_t>(truncated.begin(), truncated.end());
     ++row.irs;
   }
-  if (row.irs == 0) throw Error(fmt::format("ir-bytes: {} holds no condensed FEM IR", recording.string()));
+  if (row.irs == 0)
+    throw Error(fmt::format("ir-bytes: {} holds no condensed FEM IR", recording.string()));
   row.span_s = static_cast<double>(last_ns - first_ns) * 1e-9;
   row.nodes_mean /= static_cast<double>(row.irs);
   row.new_nodes_mean /= static_cast<double>(row.irs);
@@ -183,7 +200,8 @@ IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const Elasti
   return row;
 }
 
-SphereIrBytesRow measure_sphere_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body) {
+SphereIrBytesRow measure_sphere_ir_bytes(const std::filesystem::path& recording,
+                                         const ElasticBody& body) {
   const record::Recording rec = record::read_recording(recording);
   const std::unordered_map<std::int64_t, int> node_of_tag = node_indices_by_tag(body.mesh);
   SphereIrBytesRow row;
@@ -194,7 +212,8 @@ SphereIrBytesRow measure_sphere_ir_bytes(const std::filesystem::path& recording,
   for (const record::RecordedIr& recorded : rec.irs) {
     if (!recorded.ir().has_fem() || !recorded.ir().fem().has_sphere()) continue;
     const wire::CondensedFem& fem = recorded.ir().fem();
-    row.stream_bytes += static_cast<double>(stream.compress(recorded.ir(), row.irs == 0).ByteSizeLong());
+    row.stream_bytes +=
+        static_cast<double>(stream.compress(recorded.ir(), row.irs == 0).ByteSizeLong());
     row.sent_bytes += static_cast<double>(recorded.ir().ByteSizeLong());
     if (row.irs == 0) first_ns = recorded.time_ns();
     last_ns = recorded.time_ns();
@@ -209,13 +228,16 @@ SphereIrBytesRow measure_sphere_ir_bytes(const std::filesystem::path& recording,
     const auto rest = static_cast<double>(geometry.ByteSizeLong());
     double row_dofs = 0, held_dofs = 0;
     for (const char mask : fem.fixed_axes())
-      for (int axis = 0; axis < 3; ++axis) row_dofs += ((static_cast<unsigned char>(mask) >> axis) & 1u) ? 0 : 1;
+      for (int axis = 0; axis < 3; ++axis)
+        row_dofs += ((static_cast<unsigned char>(mask) >> axis) & 1u) ? 0 : 1;
     for (const std::int64_t tag : fem.sphere().held_node_ids()) {
       const auto found = node_of_tag.find(tag);
       if (found == node_of_tag.end())
-        throw Error(fmt::format("ir-bytes: {}: IR epoch {} holds node {}, which the scene's body does not have",
-                                recording.string(), recorded.ir().epoch(), tag));
-      for (int axis = 0; axis < 3; ++axis) held_dofs += body.dofs.is_fixed(found->second, axis) ? 0 : 1;
+        throw Error(fmt::format(
+            "ir-bytes: {}: IR epoch {} holds node {}, which the scene's body does not have",
+            recording.string(), recorded.ir().epoch(), tag));
+      for (int axis = 0; axis < 3; ++axis)
+        held_dofs += body.dofs.is_fixed(found->second, axis) ? 0 : 1;
     }
     row.m_tilde_bytes += rest + 8 * (row_dofs * (row_dofs + held_dofs) + held_dofs);
     std::unordered_set<std::int64_t> now(fem.node_ids().begin(), fem.node_ids().end());
@@ -239,52 +261,72 @@ LabCommand add_ir_bytes_command(CLI::App& lab) {
     std::filesystem::path frames;
   };
   auto options = std::make_shared<Options>();
-  CLI::App* command = lab.add_subcommand(
-      "ir-bytes", "IR bytes per second a client received, and what f32, M~ deltas or compliance rows would have sent");
-  command->add_option("--scene", options->scene, "The recorded session's scene (one linear elastic object)")
+  CLI::App* command = lab.add_subcommand("ir-bytes",
+                                         "IR bytes per second a client received, and what f32, M~ "
+                                         "deltas or compliance rows would have sent");
+  command
+      ->add_option("--scene", options->scene,
+                   "The recorded session's scene (one linear elastic object)")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("recordings", options->recordings, "Client recordings (cohaptic-client --record)")
+  command
+      ->add_option("recordings", options->recordings,
+                   "Client recordings (cohaptic-client --record)")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--frames", options->frames, "Also write every IR as sent into this directory, one file each");
-  return {command, [options] {
-            const Model model = build_model(load_scene(options->scene));
-            const ElasticBody& body = single_elastic_body(model);
-            if (model.scene.haptic.contact_model == ContactModel::sphere) {
-              fmt::print("| recording | IRs | span s | row nodes per IR (largest) | pushed, largest | as sent: W whole in "
-                         "the zstd stream, kB/s | uncompressed kB/s | as M~ whole kB/s | as compliance rows kB/s |\n|---|---|---|---|---|---|---|---|---|\n");
-              for (const std::filesystem::path& recording : options->recordings) {
-                const SphereIrBytesRow r = measure_sphere_ir_bytes(recording, body);
-                const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;
-                fmt::print("| {} | {} | {:.1f} | {:.0f} ({:.0f}) | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} |\n", r.recording,
-                           r.irs, r.span_s, r.row_nodes_mean, r.row_nodes_max, r.pushed_max, r.stream_bytes * per_s,
-                           r.sent_bytes * per_s, r.m_tilde_bytes * per_s, r.rows_bytes * per_s);
-              }
-              return 0;
-            }
-            ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
-            fmt::print("| recording | IRs | span s | nodes per IR | new nodes per IR | sent kB/s | without M~ kB/s | f32 kB/s | "
-                       "M~ delta kB/s | compliance rows kB/s | rows: client CPU µs p50 / max | rows: M~ difference | "
-                       "as sent: client CPU µs p50 / max / first | zstd stream kB/s | zstd stream: client CPU µs p50 / max |\n"
-                       "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-            for (std::size_t i = 0; i < options->recordings.size(); ++i) {
-              const std::filesystem::path frames =
-                  options->frames.empty() ? options->frames : options->frames / fmt::format("{}", i);
-              const IrBytesRow r = measure_ir_bytes(options->recordings[i], body, columns, frames);
-              const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;
-              fmt::print("| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.0f} / {:.0f} | "
-                         "{:.1e} | {} | {:.1f} | {:.0f} / {:.0f} |\n",
-                         r.recording, r.irs, r.span_s, r.nodes_mean, r.new_nodes_mean, r.sent_bytes * per_s,
-                         r.without_m_bytes * per_s, r.f32_bytes * per_s, r.delta_bytes * per_s, r.rows_bytes * per_s,
-                         r.rows_client_us_p50, r.rows_client_us_max, r.rows_m_tilde_difference,
-                         r.sent_rows_us_max > 0 ? fmt::format("{:.0f} / {:.0f} / {:.0f}", r.sent_rows_us_p50,
-                                                              r.sent_rows_us_max, r.sent_rows_first_us)
-                                                : std::string("M~ sent whole"),
-                         r.stream_bytes * per_s, r.stream_inflate_us_p50, r.stream_inflate_us_max);
-            }
-            return 0;
-          }};
+  command->add_option("--frames", options->frames,
+                      "Also write every IR as sent into this directory, one file each");
+  return {
+      command, [options] {
+        const Model model = build_model(load_scene(options->scene));
+        const ElasticBody& body = single_elastic_body(model);
+        if (model.scene.haptic.contact_model == ContactModel::sphere) {
+          fmt::print(
+              "| recording | IRs | span s | row nodes per IR (largest) | pushed, largest | as "
+              "sent: W whole in "
+              "the zstd stream, kB/s | uncompressed kB/s | as M~ whole kB/s | as compliance rows "
+              "kB/s |\n|---|---|---|---|---|---|---|---|---|\n");
+          for (const std::filesystem::path& recording : options->recordings) {
+            const SphereIrBytesRow r = measure_sphere_ir_bytes(recording, body);
+            const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;
+            fmt::print(
+                "| {} | {} | {:.1f} | {:.0f} ({:.0f}) | {:.0f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} "
+                "|\n",
+                r.recording, r.irs, r.span_s, r.row_nodes_mean, r.row_nodes_max, r.pushed_max,
+                r.stream_bytes * per_s, r.sent_bytes * per_s, r.m_tilde_bytes * per_s,
+                r.rows_bytes * per_s);
+          }
+          return 0;
+        }
+        ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
+        fmt::print(
+            "| recording | IRs | span s | nodes per IR | new nodes per IR | sent kB/s | without M~ "
+            "kB/s | f32 kB/s | "
+            "M~ delta kB/s | compliance rows kB/s | rows: client CPU µs p50 / max | rows: M~ "
+            "difference | "
+            "as sent: client CPU µs p50 / max / first | zstd stream kB/s | zstd stream: client CPU "
+            "µs p50 / max |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+        for (std::size_t i = 0; i < options->recordings.size(); ++i) {
+          const std::filesystem::path frames =
+              options->frames.empty() ? options->frames : options->frames / fmt::format("{}", i);
+          const IrBytesRow r = measure_ir_bytes(options->recordings[i], body, columns, frames);
+          const double per_s = r.span_s > 0 ? 1e-3 / r.span_s : 0;
+          fmt::print(
+              "| {} | {} | {:.1f} | {:.1f} | {:.2f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | {:.1f} | "
+              "{:.0f} / {:.0f} | "
+              "{:.1e} | {} | {:.1f} | {:.0f} / {:.0f} |\n",
+              r.recording, r.irs, r.span_s, r.nodes_mean, r.new_nodes_mean, r.sent_bytes * per_s,
+              r.without_m_bytes * per_s, r.f32_bytes * per_s, r.delta_bytes * per_s,
+              r.rows_bytes * per_s, r.rows_client_us_p50, r.rows_client_us_max,
+              r.rows_m_tilde_difference,
+              r.sent_rows_us_max > 0 ? fmt::format("{:.0f} / {:.0f} / {:.0f}", r.sent_rows_us_p50,
+                                                   r.sent_rows_us_max, r.sent_rows_first_us)
+                                     : std::string("M~ sent whole"),
+              r.stream_bytes * per_s, r.stream_inflate_us_p50, r.stream_inflate_us_max);
+        }
+        return 0;
+      }};
 }
 
 }  // namespace cohaptic

@@ -51,20 +51,22 @@ struct IrBytesRow {
   double sent_bytes = 0, f32_bytes = 0, delta_bytes = 0, rows_bytes = 0;  ///< totals
   double without_m_bytes = 0;  ///< everything but M~: what no way of sending M~ can save
   double rows_client_us_p50 = 0, rows_client_us_max = 0;  ///< condensing L_AA per IR
-  double rows_m_tilde_difference = 0;  ///< largest over the IRs, relative to each IR's largest |M~| entry
+  double rows_m_tilde_difference =
+      0;  ///< largest over the IRs, relative to each IR's largest |M~| entry
   /// IRs that came as compliance rows: the client's own completion (ClientCondensation,
   /// incremental), µs of CPU per IR; 0 when M~ came whole.
   double sent_rows_us_p50 = 0, sent_rows_us_max = 0, sent_rows_first_us = 0;
   double stream_bytes = 0;  ///< the IRs as recorded, through one IR stream (ir_stream.h)
-  double stream_inflate_us_p50 = 0, stream_inflate_us_max = 0;  ///< the client's CPU per IR to decompress
+  double stream_inflate_us_p50 = 0,
+         stream_inflate_us_max = 0;  ///< the client's CPU per IR to decompress
 };
 
 /// Measures one recording (throws Error naming it if it holds no condensed FEM IR, or one
 /// whose nodes `body` does not have). `body` and `columns`: the recorded session's body and
 /// its compliance (rows for every surface node). `frames`: if not empty, a directory to write
 /// the IRs as sent into.
-IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body, ComplianceColumns& columns,
-                            const std::filesystem::path& frames);
+IrBytesRow measure_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body,
+                            ComplianceColumns& columns, const std::filesystem::path& frames);
 
 /// A recording of sphere IRs, measured as above.
 struct SphereIrBytesRow {
@@ -72,15 +74,16 @@ struct SphereIrBytesRow {
   std::size_t irs = 0;
   double span_s = 0;
   double row_nodes_mean = 0, row_nodes_max = 0;  ///< candidates per IR
-  double pushed_max = 0;                         ///< nodes the server's state pushed, largest over the IRs
-  double stream_bytes = 0;                       ///< as travelled: whole, in the zstd stream
-  double sent_bytes = 0;                         ///< the same, uncompressed
-  double m_tilde_bytes = 0, rows_bytes = 0;      ///< M~'s forms: whole, compliance rows
+  double pushed_max = 0;    ///< nodes the server's state pushed, largest over the IRs
+  double stream_bytes = 0;  ///< as travelled: whole, in the zstd stream
+  double sent_bytes = 0;    ///< the same, uncompressed
+  double m_tilde_bytes = 0, rows_bytes = 0;  ///< M~'s forms: whole, compliance rows
 };
 
 /// Measures a recording whose condensed FEM IRs are sphere IRs (Error if it holds none);
 /// `body`: the recorded session's body (the held nodes' free dofs).
-SphereIrBytesRow measure_sphere_ir_bytes(const std::filesystem::path& recording, const ElasticBody& body);
+SphereIrBytesRow measure_sphere_ir_bytes(const std::filesystem::path& recording,
+                                         const ElasticBody& body);
 
 /// `cohaptic-lab ir-bytes --scene SCENE RECORDING... [--frames DIR]`: a Markdown table on stdout.
 LabCommand add_ir_bytes_command(CLI::App& lab);

@@ -32,18 +32,22 @@
 int main(int argc, char** argv) {
   cohaptic::log_to_stderr();
 
-  CLI::App app{"cohaptic-lab: the offline tools of cohaptic (probing, replay, studies, measurements)."};
+  CLI::App app{
+      "cohaptic-lab: the offline tools of cohaptic (probing, replay, studies, measurements)."};
   app.require_subcommand(1);
   app.fallthrough();  // --log-level may follow the subcommand
   std::string log_level = "info";
-  app.add_option("--log-level", log_level, "Log verbosity on stderr: trace, debug, info, warn, error, off")
+  app.add_option("--log-level", log_level,
+                 "Log verbosity on stderr: trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}))
       ->capture_default_str();
   const std::vector<cohaptic::LabCommand> commands = {
-      cohaptic::add_probe_command(app),     cohaptic::add_replay_command(app),    cohaptic::add_study_command(app),
-      cohaptic::add_tradeoff_command(app),  cohaptic::add_stability_command(app), cohaptic::add_summarize_command(app),
-      cohaptic::add_keygen_command(app),    cohaptic::add_hertz_command(app),    cohaptic::add_objects_push_command(app),
-      cohaptic::add_ir_bytes_command(app),  cohaptic::add_separation_pull_command(app)};
+      cohaptic::add_probe_command(app),          cohaptic::add_replay_command(app),
+      cohaptic::add_study_command(app),          cohaptic::add_tradeoff_command(app),
+      cohaptic::add_stability_command(app),      cohaptic::add_summarize_command(app),
+      cohaptic::add_keygen_command(app),         cohaptic::add_hertz_command(app),
+      cohaptic::add_objects_push_command(app),   cohaptic::add_ir_bytes_command(app),
+      cohaptic::add_separation_pull_command(app)};
 
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(log_level));

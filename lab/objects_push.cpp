@@ -15,7 +15,9 @@
 namespace cohaptic {
 
 std::string paired_boxes_scene_yaml(const PairedBoxesOptions& o) {
-  const auto divisions = [](const Eigen::Vector3i& d) { return fmt::format("[{}, {}, {}]", d.x(), d.y(), d.z()); };
+  const auto divisions = [](const Eigen::Vector3i& d) {
+    return fmt::format("[{}, {}, {}]", d.x(), d.y(), d.z());
+  };
   return fmt::format(R"(
 units: mm
 objects:
@@ -39,31 +41,41 @@ tools: [{{name: A}}]
 PushLayout push_layout(const Scene& scene) {
   const std::string where = scene.file.empty() ? scene.name : scene.file.string();
   if (scene.interactions.size() != 1)
-    throw Error(fmt::format("objects-push: {} has {} interactions; the pushing test needs exactly one (A in front of B)",
-                            where, scene.interactions.size()));
+    throw Error(
+        fmt::format("objects-push: {} has {} interactions; the pushing test needs exactly one (A "
+                    "in front of B)",
+                    where, scene.interactions.size()));
   PushLayout layout;
   for (int i = 0; i < static_cast<int>(scene.objects.size()); ++i) {
-    if (scene.objects[static_cast<std::size_t>(i)].name == scene.interactions[0].front) layout.front = i;
-    if (scene.objects[static_cast<std::size_t>(i)].name == scene.interactions[0].behind) layout.behind = i;
+    if (scene.objects[static_cast<std::size_t>(i)].name == scene.interactions[0].front)
+      layout.front = i;
+    if (scene.objects[static_cast<std::size_t>(i)].name == scene.interactions[0].behind)
+      layout.behind = i;
   }
-  const auto* front = std::get_if<MassSpringObjectSpec>(&scene.objects.at(static_cast<std::size_t>(layout.front)).body);
-  const auto* behind = std::get_if<ElasticObjectSpec>(&scene.objects.at(static_cast<std::size_t>(layout.behind)).body);
+  const auto* front = std::get_if<MassSpringObjectSpec>(
+      &scene.objects.at(static_cast<std::size_t>(layout.front)).body);
+  const auto* behind = std::get_if<ElasticObjectSpec>(
+      &scene.objects.at(static_cast<std::size_t>(layout.behind)).body);
   if (!front || !front->lattice || !behind || !behind->mesh.box)
-    throw Error(fmt::format("objects-push: in {}, the interaction's front object must be a mass-spring lattice and its "
-                            "behind object a linear elastic box (mesh: box)", where));
+    throw Error(fmt::format(
+        "objects-push: in {}, the interaction's front object must be a mass-spring lattice and its "
+        "behind object a linear elastic box (mesh: box)",
+        where));
   const SpringLatticeSpec& a = *front->lattice;
   const BoxMeshSpec& b = *behind->mesh.box;
   const Eigen::Vector3d towards = (b.min_corner + b.size / 2) - (a.min_corner + a.size / 2);
   towards.cwiseAbs().cwiseQuotient(a.size + b.size).maxCoeff(&layout.axis);
   if (towards[layout.axis] <= 0)
-    throw Error(fmt::format("objects-push: in {}, B must lie on the + side of A along the axis joining them", where));
+    throw Error(fmt::format(
+        "objects-push: in {}, B must lie on the + side of A along the axis joining them", where));
   layout.back = a.min_corner[layout.axis] + a.size[layout.axis];
   return layout;
 }
 
 Scene push_scene(Scene scene, const PushVariation& variation) {
   const PushLayout layout = push_layout(scene);
-  auto& behind = std::get<ElasticObjectSpec>(scene.objects[static_cast<std::size_t>(layout.behind)].body);
+  auto& behind =
+      std::get<ElasticObjectSpec>(scene.objects[static_cast<std::size_t>(layout.behind)].body);
   behind.material.youngs_modulus = variation.behind_youngs_modulus;
   behind.material.poisson_ratio = variation.behind_poisson_ratio;
   if (variation.condition == BackCondition::on_behind) return scene;
@@ -74,14 +86,18 @@ Scene push_scene(Scene scene, const PushVariation& variation) {
     back.plane_point = Eigen::Vector3d::Zero();
     back.plane_point[layout.axis] = layout.back;
     back.plane_normal = Eigen::Vector3d::Unit(layout.axis);
-    back.where = fmt::format("objects-push: A's back face ({} = {} m)", "xyz"[layout.axis], layout.back);
-    std::get<MassSpringObjectSpec>(scene.objects[static_cast<std::size_t>(layout.front)].body).fixed.push_back(back);
+    back.where =
+        fmt::format("objects-push: A's back face ({} = {} m)", "xyz"[layout.axis], layout.back);
+    std::get<MassSpringObjectSpec>(scene.objects[static_cast<std::size_t>(layout.front)].body)
+        .fixed.push_back(back);
   }
   return scene;
 }
 
 Eigen::Vector3d push_point(const Scene& scene, const PushLayout& layout) {
-  const SpringLatticeSpec& a = *std::get<MassSpringObjectSpec>(scene.objects[static_cast<std::size_t>(layout.front)].body).lattice;
+  const SpringLatticeSpec& a =
+      *std::get<MassSpringObjectSpec>(scene.objects[static_cast<std::size_t>(layout.front)].body)
+           .lattice;
   Eigen::Vector3d point = a.min_corner + a.size / 2;
   point[layout.axis] = a.min_corner[layout.axis];
   return point;
@@ -90,7 +106,8 @@ Eigen::Vector3d push_point(const Scene& scene, const PushLayout& layout) {
 namespace {
 
 // A as the quasi-static solve takes it: its network's springs at rest, its held nodes fixed.
-PushedFront spring_front(const MassSpringModel& body, const PushLayout& layout, const Eigen::Vector3d& point) {
+PushedFront spring_front(const MassSpringModel& body, const PushLayout& layout,
+                         const Eigen::Vector3d& point) {
   const MassSpringNetwork& network = body.network;
   PushedFront front;
   front.rest_positions = network.rest_positions;
@@ -113,13 +130,17 @@ PushedFront spring_front(const MassSpringModel& body, const PushLayout& layout, 
 }  // namespace
 
 PushRig::PushRig(const Scene& scene, const PushVariation& variation)
-    : model(std::make_unique<Model>(build_model(push_scene(scene, {BackCondition::on_behind, variation.behind_youngs_modulus,
-                                                                   variation.behind_poisson_ratio})))),
+    : model(std::make_unique<Model>(
+          build_model(push_scene(scene, {BackCondition::on_behind, variation.behind_youngs_modulus,
+                                         variation.behind_poisson_ratio})))),
       layout(push_layout(scene)),
-      front(spring_front(std::get<MassSpringModel>(model->bodies[static_cast<std::size_t>(layout.front)]), layout,
-                         push_point(scene, layout))),
-      behind_surface(make_surface_adjacency(behind().surface.triangles, behind().mesh.node_count())),
-      behind_columns(std::make_unique<ComplianceColumns>(behind().free_factor, behind().dofs, behind().surface.nodes)) {}
+      front(spring_front(
+          std::get<MassSpringModel>(model->bodies[static_cast<std::size_t>(layout.front)]), layout,
+          push_point(scene, layout))),
+      behind_surface(
+          make_surface_adjacency(behind().surface.triangles, behind().mesh.node_count())),
+      behind_columns(std::make_unique<ComplianceColumns>(behind().free_factor, behind().dofs,
+                                                         behind().surface.nodes)) {}
 
 const ElasticBody& PushRig::behind() const { return elastic_body(*model, layout.behind); }
 
@@ -129,10 +150,12 @@ std::vector<double> paper_push_depths() {
   return depths;
 }
 
-std::vector<double> push_forces(PushRig& rig, BackCondition condition, const std::vector<double>& depths) {
+std::vector<double> push_forces(PushRig& rig, BackCondition condition,
+                                const std::vector<double>& depths) {
   BehindBody behind = rig.behind_body();
   std::vector<double> forces;
-  for (const PushSample& sample : push_front(rig.front, condition, &behind, depths)) forces.push_back(sample.force);
+  for (const PushSample& sample : push_front(rig.front, condition, &behind, depths))
+    forces.push_back(sample.force);
   return forces;
 }
 
@@ -142,10 +165,11 @@ struct Curve {
   std::string figure;  // conditions, youngs, poisson
   std::string label;
   PushVariation variation;
-  std::vector<double> forces;                // quasi-static, at the depths
-  std::vector<PushInTimeSample> in_time;     // every server step (--in-time)
-  std::vector<double> in_time_forces;        // at the depths (--in-time)
-  std::vector<double> nonlinear_forces;      // A's nonlinear equilibrium at the depths (--in-time; not on B)
+  std::vector<double> forces;             // quasi-static, at the depths
+  std::vector<PushInTimeSample> in_time;  // every server step (--in-time)
+  std::vector<double> in_time_forces;     // at the depths (--in-time)
+  std::vector<double>
+      nonlinear_forces;  // A's nonlinear equilibrium at the depths (--in-time; not on B)
 };
 
 void write_push_figures(const std::filesystem::path& out, const std::vector<Curve>& curves,
@@ -175,27 +199,35 @@ void write_push_figures(const std::filesystem::path& out, const std::vector<Curv
 // In time beside quasi-static at 5, 10 and 15 mm, and every server step of every curve.
 void write_in_time_results(const std::filesystem::path& out, const std::vector<Curve>& curves) {
   AtomicFile csv(out / "objects_push_in_time.csv");
-  csv.write("figure,curve,condition,behind_youngs_modulus_pa,behind_poisson_ratio,time_s,depth_mm,force_n\n");
+  csv.write(
+      "figure,curve,condition,behind_youngs_modulus_pa,behind_poisson_ratio,time_s,depth_mm,force_"
+      "n\n");
   for (const Curve& c : curves)
     for (const PushInTimeSample& s : c.in_time)
-      csv.print("{},{},{},{:g},{:g},{:g},{:.6g},{:.9g}\n", c.figure, c.label, back_condition_name(c.variation.condition),
-                c.variation.behind_youngs_modulus, c.variation.behind_poisson_ratio, s.time, 1e3 * s.depth, s.force);
+      csv.print("{},{},{},{:g},{:g},{:g},{:.6g},{:.9g}\n", c.figure, c.label,
+                back_condition_name(c.variation.condition), c.variation.behind_youngs_modulus,
+                c.variation.behind_poisson_ratio, s.time, 1e3 * s.depth, s.force);
   csv.commit();
   std::string table =
-      "| figure | curve | depth [mm] | in time [N] | nonlinear static [N] | linear quasi-static [N] |\n"
+      "| figure | curve | depth [mm] | in time [N] | nonlinear static [N] | linear quasi-static "
+      "[N] |\n"
       "|---|---|---|---|---|---|\n";
   for (const Curve& c : curves)
     for (std::size_t i : {std::size_t{0}, std::size_t{4}, std::size_t{9}, std::size_t{14}}) {
       const std::string nonlinear =
-          c.nonlinear_forces.empty() ? "-"
-                                     : fmt::format("{:.5f} ({:+.2f} %)", c.nonlinear_forces[i],
-                                                   100 * (c.in_time_forces[i] / c.nonlinear_forces[i] - 1));
-      table += fmt::format("| {} | {} | {} | {:.5f} | {} | {:.5f} ({:+.2f} %) |\n", c.figure, c.label, i + 1,
-                           c.in_time_forces[i], nonlinear, c.forces[i], 100 * (c.in_time_forces[i] / c.forces[i] - 1));
+          c.nonlinear_forces.empty()
+              ? "-"
+              : fmt::format("{:.5f} ({:+.2f} %)", c.nonlinear_forces[i],
+                            100 * (c.in_time_forces[i] / c.nonlinear_forces[i] - 1));
+      table += fmt::format("| {} | {} | {} | {:.5f} | {} | {:.5f} ({:+.2f} %) |\n", c.figure,
+                           c.label, i + 1, c.in_time_forces[i], nonlinear, c.forces[i],
+                           100 * (c.in_time_forces[i] / c.forces[i] - 1));
     }
   AtomicFile md(out / "objects_push_in_time.md");
-  md.print("# The several-objects pushing test in time (5 mm/s) beside the static solves\n\n"
-           "In brackets: the in-time force's difference from each.\n\n{}", table);
+  md.print(
+      "# The several-objects pushing test in time (5 mm/s) beside the static solves\n\n"
+      "In brackets: the in-time force's difference from each.\n\n{}",
+      table);
   md.commit();
   std::fputs(table.c_str(), stdout);
 }
@@ -208,15 +240,22 @@ int run_objects_push(const ObjectsPushOptions& options) {
   std::vector<Curve> curves;
   const auto run = [&](std::string figure, std::string label, PushVariation variation) {
     PushRig rig(scene, variation);
-    Curve curve{std::move(figure), std::move(label), variation, push_forces(rig, variation.condition, depths), {}, {}, {}};
+    Curve curve{std::move(figure),
+                std::move(label),
+                variation,
+                push_forces(rig, variation.condition, depths),
+                {},
+                {},
+                {}};
     if (options.in_time) {
       curve.in_time = push_in_time(scene, variation);
       curve.in_time_forces = forces_at_depths(curve.in_time, depths);
       if (variation.condition != BackCondition::on_behind)
         curve.nonlinear_forces = network_static_forces(scene, variation, depths);
     }
-    spdlog::info("objects-push: {} {}: {:.4f} N at 15 mm{}", curve.figure, curve.label, curve.forces.back(),
-                 options.in_time ? fmt::format(", {:.4f} N in time", curve.in_time_forces.back()) : "");
+    spdlog::info(
+        "objects-push: {} {}: {:.4f} N at 15 mm{}", curve.figure, curve.label, curve.forces.back(),
+        options.in_time ? fmt::format(", {:.4f} N in time", curve.in_time_forces.back()) : "");
     curves.push_back(std::move(curve));
   };
   run("conditions", "1: back free", {BackCondition::free, 1.0e6, 0.216});
@@ -229,18 +268,21 @@ int run_objects_push(const ObjectsPushOptions& options) {
 
   std::filesystem::create_directories(options.out);
   AtomicFile csv(options.out / "objects_push.csv");
-  csv.write("figure,curve,condition,behind_youngs_modulus_pa,behind_poisson_ratio,depth_mm,force_n\n");
+  csv.write(
+      "figure,curve,condition,behind_youngs_modulus_pa,behind_poisson_ratio,depth_mm,force_n\n");
   for (const Curve& c : curves)
     for (std::size_t i = 0; i < depths.size(); ++i)
-      csv.print("{},{},{},{:g},{:g},{:g},{:.9g}\n", c.figure, c.label, back_condition_name(c.variation.condition),
-                c.variation.behind_youngs_modulus, c.variation.behind_poisson_ratio, 1e3 * depths[i], c.forces[i]);
+      csv.print("{},{},{},{:g},{:g},{:g},{:.9g}\n", c.figure, c.label,
+                back_condition_name(c.variation.condition), c.variation.behind_youngs_modulus,
+                c.variation.behind_poisson_ratio, 1e3 * depths[i], c.forces[i]);
   csv.commit();
 
   std::string table =
-      "| figure | curve | F at 5 mm [N] | F at 10 mm [N] | F at 15 mm [N] |\n|---|---|---|---|---|\n";
+      "| figure | curve | F at 5 mm [N] | F at 10 mm [N] | F at 15 mm [N] "
+      "|\n|---|---|---|---|---|\n";
   for (const Curve& c : curves)
-    table += fmt::format("| {} | {} | {:.5f} | {:.5f} | {:.5f} |\n", c.figure, c.label, c.forces[4], c.forces[9],
-                         c.forces[14]);
+    table += fmt::format("| {} | {} | {:.5f} | {:.5f} | {:.5f} |\n", c.figure, c.label, c.forces[4],
+                         c.forces[9], c.forces[14]);
   AtomicFile md(options.out / "objects_push.md");
   md.print("# The several-objects pushing test (quasi-static)\n\n{}", table);
   md.commit();
@@ -257,15 +299,19 @@ int run_objects_push(const ObjectsPushOptions& options) {
 
 LabCommand add_objects_push_command(CLI::App& lab) {
   auto options = std::make_shared<ObjectsPushOptions>();
-  CLI::App* command = lab.add_subcommand(
-      "objects-push",
-      "The several-objects paper's pushing test: the front box pushed 1-15 mm with its back free, fixed or on the "
-      "elastic box behind it, and on B with three Young's moduli and Poisson ratios: objects_push.csv, "
-      "objects_push.md, objects_push_{conditions,youngs,poisson}.svg in --out");
-  command->add_option("--scene", options->scene, "The test's scene (condition 3)")->capture_default_str();
+  CLI::App* command =
+      lab.add_subcommand("objects-push",
+                         "The several-objects paper's pushing test: the front box pushed 1-15 mm "
+                         "with its back free, fixed or on the "
+                         "elastic box behind it, and on B with three Young's moduli and Poisson "
+                         "ratios: objects_push.csv, "
+                         "objects_push.md, objects_push_{conditions,youngs,poisson}.svg in --out");
+  command->add_option("--scene", options->scene, "The test's scene (condition 3)")
+      ->capture_default_str();
   command->add_option("--out", options->out, "Output directory")->required();
   command->add_flag("--in-time", options->in_time,
-                    "Also push 15 mm at 5 mm/s through the server's simulation: objects_push_in_time.{csv,md} and "
+                    "Also push 15 mm at 5 mm/s through the server's simulation: "
+                    "objects_push_in_time.{csv,md} and "
                     "objects_push_in_time_{conditions,youngs,poisson}.svg");
   return {command, [options] { return run_objects_push(*options); }};
 }

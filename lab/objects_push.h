@@ -82,7 +82,8 @@ std::vector<double> paper_push_depths();
 Eigen::Vector3d push_point(const Scene& scene, const PushLayout& layout);
 
 /// The tool's force at each of `depths` [N], quasi-statically.
-std::vector<double> push_forces(PushRig& rig, BackCondition condition, const std::vector<double>& depths);
+std::vector<double> push_forces(PushRig& rig, BackCondition condition,
+                                const std::vector<double>& depths);
 
 struct ObjectsPushOptions {
   std::filesystem::path scene = "scenes/objects/push.yaml";

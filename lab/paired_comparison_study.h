@@ -35,12 +35,12 @@ struct PairedComparisonDesign {
   std::vector<std::string> labels;  ///< 2 grades + 1 labels, from +grades down to -grades
   int subjects = 10;                ///< at least 2
   RaterKind rater_kind = RaterKind::simulated;
-  SimulatedRaterSettings rater;     ///< the simulated rater's
+  SimulatedRaterSettings rater;  ///< the simulated rater's
   // A person's session (lab/person_pairs.h):
-  int practice_pairs = 1;           ///< pairs felt before the rated ones, not rated
+  int practice_pairs = 1;                ///< pairs felt before the rated ones, not rated
   std::string show_object = "practice";  ///< the live view served: practice, always or never
-  double pair_duration_s = 60;      ///< the longest a pair is felt (then it is rated, not switched)
-  int switch_button = -1;           ///< a device button that switches too (person rater); -1: none
+  double pair_duration_s = 60;  ///< the longest a pair is felt (then it is rated, not switched)
+  int switch_button = -1;       ///< a device button that switches too (person rater); -1: none
 };
 
 /// Parses a `paired_comparison` block (errors name the file, line and key).
@@ -61,21 +61,22 @@ std::vector<PresentedPair> presentation_plan(int conditions, int subjects);
 
 /// A condition's factor levels, for the factors' main effects (a full factorial).
 struct StudyFactors {
-  std::vector<std::string> names;        ///< the factors that vary
+  std::vector<std::string> names;  ///< the factors that vary
   std::vector<int> level_count;
   std::vector<std::vector<int>> level_of;  ///< [condition][factor]
 };
 
 /// Writes `file` (pair_plan.csv: subject, position, first, second; 1-based) from
 /// presentation_plan(): the order each subject meets the pairs in, as run.
-void write_pair_plan(const std::filesystem::path& file, const std::vector<std::string>& condition_names, int subjects);
+void write_pair_plan(const std::filesystem::path& file,
+                     const std::vector<std::string>& condition_names, int subjects);
 
 /// One row of ratings.csv: a pair as presented, and its rating (positive: the first felt more).
 struct PairRatingRow {
   int subject = 0, position = 0;  ///< 1-based
   std::string first, second;      ///< the conditions' names, in presentation order
   int rating = 0;
-  std::string rated_by;           ///< "simulated" or "person"
+  std::string rated_by;  ///< "simulated" or "person"
 };
 
 /// ratings.csv's rows (none if the file does not exist); throws Error naming the file and
@@ -86,9 +87,9 @@ void write_ratings(const std::filesystem::path& file, const std::vector<PairRati
 
 /// The simulated rater's ratings of the whole plan. `measures[r][c]`: condition c's
 /// measures in repetition r + 1.
-std::vector<PairRatingRow> simulated_ratings(const PairedComparisonDesign& design,
-                                             const std::vector<std::string>& condition_names,
-                                             const std::vector<std::vector<TrialMeasures>>& measures);
+std::vector<PairRatingRow> simulated_ratings(
+    const PairedComparisonDesign& design, const std::vector<std::string>& condition_names,
+    const std::vector<std::vector<TrialMeasures>>& measures);
 
 /// Scheffe's analysis of `rows` (every subject's every pair, each once: else Error naming
 /// what is missing) into `out`/analysis and `out`/figures/scale.svg; prints the table.

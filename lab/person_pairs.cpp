@@ -34,14 +34,19 @@ struct SwitchRow {
 };
 
 // The switches in a pair's server report (its switch log), the pair labelled `pair`.
-std::vector<SwitchRow> reported_switches(const std::filesystem::path& report, int subject, const std::string& pair) {
+std::vector<SwitchRow> reported_switches(const std::filesystem::path& report, int subject,
+                                         const std::string& pair) {
   std::ifstream in(report);
   const nlohmann::json parsed = nlohmann::json::parse(in, nullptr, false);
-  if (parsed.is_discarded() || !parsed.contains("server") || !parsed["server"].contains("switch_log"))
-    throw Error(fmt::format("{}: the pair's server left no report with its switches (its log is beside it)", report.string()));
+  if (parsed.is_discarded() || !parsed.contains("server") ||
+      !parsed["server"].contains("switch_log"))
+    throw Error(
+        fmt::format("{}: the pair's server left no report with its switches (its log is beside it)",
+                    report.string()));
   std::vector<SwitchRow> rows;
   for (const nlohmann::json& made : parsed["server"]["switch_log"])
-    rows.push_back({subject, pair, made.at("time_s").get<double>(), made.at("served").get<std::string>()});
+    rows.push_back(
+        {subject, pair, made.at("time_s").get<double>(), made.at("served").get<std::string>()});
   return rows;
 }
 
@@ -53,7 +58,9 @@ void append_switches(const std::filesystem::path& file, const std::vector<Switch
   } else {
     text = "subject,pair,time_s,serving\n";
   }
-  for (const SwitchRow& row : rows) text += fmt::format("{},{},{:.6f},{}\n", row.subject, csv_field(row.pair), row.time_s, row.serving);
+  for (const SwitchRow& row : rows)
+    text +=
+        fmt::format("{},{},{:.6f},{}\n", row.subject, csv_field(row.pair), row.time_s, row.serving);
   AtomicFile out(file);
   out.write(text);
   out.commit();
@@ -91,28 +98,36 @@ class PairServing {
     std::filesystem::create_directories(dir);
     const double duration = setup.design.pair_duration_s;
     std::vector<std::string> server_arguments = {
-        "--scene", setup.scene.string(), "--listen", "127.0.0.1:0", "--condensation", setup.condensation,
-        "--condition", "first:" + setup.condition_settings[static_cast<std::size_t>(first)],
-        "--condition", "second:" + setup.condition_settings[static_cast<std::size_t>(second)],
-        "--control", (dir / "control").string(), "--duration", fmt::format("{:g}", duration + kServerBeyondPair_s),
-        "--record", (dir / "server.mcap").string(), "--report", (dir / "server.json").string()};
+        "--scene",        setup.scene.string(),
+        "--listen",       "127.0.0.1:0",
+        "--condensation", setup.condensation,
+        "--condition",    "first:" + setup.condition_settings[static_cast<std::size_t>(first)],
+        "--condition",    "second:" + setup.condition_settings[static_cast<std::size_t>(second)],
+        "--control",      (dir / "control").string(),
+        "--duration",     fmt::format("{:g}", duration + kServerBeyondPair_s),
+        "--record",       (dir / "server.mcap").string(),
+        "--report",       (dir / "server.json").string()};
     if (setup.design.switch_button >= 0)
-      server_arguments.insert(server_arguments.end(), {"--switch-button", std::to_string(setup.design.switch_button)});
+      server_arguments.insert(server_arguments.end(),
+                              {"--switch-button", std::to_string(setup.design.switch_button)});
     if (show_object) server_arguments.insert(server_arguments.end(), {"--view", "127.0.0.1:0"});
     server_.emplace(setup.server_program, server_arguments, dir / "server.log");
     if (!server_->wait_for_log("listening on", 120s))
       throw Error(fmt::format("the server did not start (see {})", (dir / "server.log").string()));
     const int port = listening_port(server_->log_text());
     client_.emplace(setup.client_program,
-                    std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user",
-                                             fmt::format("subject-{}", setup.subject), "--slot", "0", "--device",
-                                             setup.device, "--duration", fmt::format("{:g}", duration), "--record",
-                                             (dir / "subject.mcap").string(), "--report", (dir / "subject.json").string()},
+                    std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port),
+                                             "--user", fmt::format("subject-{}", setup.subject),
+                                             "--slot", "0", "--device", setup.device, "--duration",
+                                             fmt::format("{:g}", duration), "--record",
+                                             (dir / "subject.mcap").string(), "--report",
+                                             (dir / "subject.json").string()},
                     dir / "subject.log");
     if (!client_->wait_for_log("haptic thread", 60s))
       throw Error(fmt::format("the client did not start (see {})", (dir / "subject.log").string()));
     ends_ = std::chrono::steady_clock::now() +
-            std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(duration));
+            std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                std::chrono::duration<double>(duration));
     control_.emplace(dir / "control");
     if (show_object) {
       static const std::regex kView(R"(live view at (\S+))");
@@ -184,7 +199,8 @@ class SubjectInput {
 };
 
 // The rating page's screen between pairs: no condition served.
-view::RatingScreen idle_screen(const PersonSessionSetup& setup, const std::string& note, int rated, int pairs) {
+view::RatingScreen idle_screen(const PersonSessionSetup& setup, const std::string& note, int rated,
+                               int pairs) {
   view::RatingScreen screen;
   screen.set_study(setup.study_name);
   screen.set_question(setup.design.question);
@@ -196,14 +212,17 @@ view::RatingScreen idle_screen(const PersonSessionSetup& setup, const std::strin
 
 // One pair: the subject switches, and (unless practice) rates; `rating` is set when rated.
 // `screen` comes with the session's fields set.
-PairEnd present_pair(const PersonSessionSetup& setup, PairServing& serving, view::RatingScreen screen, SubjectInput& input,
-                     std::ostream& out, int& rating) {
+PairEnd present_pair(const PersonSessionSetup& setup, PairServing& serving,
+                     view::RatingScreen screen, SubjectInput& input, std::ostream& out,
+                     int& rating) {
   const PairedComparisonDesign& design = setup.design;
   const bool practice = screen.practice();
   out << fmt::format("\n{}: {}\n", screen.title(), design.question);
-  if (!serving.view_url().empty()) out << fmt::format("  the object: open {} in a browser\n", serving.view_url());
-  out << fmt::format("  s: switch between FIRST and SECOND, as often as you like; {}; q: stop (continue later)\n",
-                     practice ? "n: on to the next pair" : "a grade to rate");
+  if (!serving.view_url().empty())
+    out << fmt::format("  the object: open {} in a browser\n", serving.view_url());
+  out << fmt::format(
+      "  s: switch between FIRST and SECOND, as often as you like; {}; q: stop (continue later)\n",
+      practice ? "n: on to the next pair" : "a grade to rate");
   for (int grade = design.grades, i = 0; grade >= -design.grades; --grade, ++i) {
     const std::string& label = design.labels[static_cast<std::size_t>(i)];
     if (!practice) out << fmt::format("    {:>2}  {}\n", grade_text(grade), label);
@@ -214,13 +233,15 @@ PairEnd present_pair(const PersonSessionSetup& setup, PairServing& serving, view
   screen.set_serving(true);
   screen.set_object_url(serving.view_url());
   screen.set_feeling("first");
-  screen.set_note(practice ? "Feel both, switching as often as you like, then go on to the next pair"
-                           : "Feel both, switching as often as you like, then choose a grade and confirm it");
+  screen.set_note(
+      practice ? "Feel both, switching as often as you like, then go on to the next pair"
+               : "Feel both, switching as often as you like, then choose a grade and confirm it");
   out << "  You are feeling: FIRST\n> " << std::flush;
   input.show(screen);
   const auto feeling = [&](const std::string& served, const char* how) {
     screen.set_feeling(served);
-    out << fmt::format("  {}You are feeling: {}\n> ", how, served == "first" ? "FIRST" : "SECOND") << std::flush;
+    out << fmt::format("  {}You are feeling: {}\n> ", how, served == "first" ? "FIRST" : "SECOND")
+        << std::flush;
   };
   // The device's button switches without us: follow it before each command, and while the
   // page waits for one.
@@ -235,7 +256,8 @@ PairEnd present_pair(const PersonSessionSetup& setup, PairServing& serving, view
   while (const std::optional<std::string> line = input.next(out, follow_button)) {
     follow_button();
     if (*line == "s" && serving.time_up()) {
-      screen.set_note(practice ? "The pair's time is up: go on to the next pair" : "The pair's time is up: rate it");
+      screen.set_note(practice ? "The pair's time is up: go on to the next pair"
+                               : "The pair's time is up: rate it");
       out << fmt::format("  {}\n> ", screen.note()) << std::flush;
     } else if (*line == "s") {
       feeling(serving.switch_over(), "");
@@ -243,19 +265,24 @@ PairEnd present_pair(const PersonSessionSetup& setup, PairServing& serving, view
       return PairEnd::stopped;
     } else if (practice && *line == "n") {
       return PairEnd::next;
-    } else if (const std::optional<int> grade = practice ? std::nullopt : grade_of(*line, design.grades)) {
+    } else if (const std::optional<int> grade =
+                   practice ? std::nullopt : grade_of(*line, design.grades)) {
       chosen = grade;
       screen.set_chosen(true);
       screen.set_chosen_grade(*grade);
       const std::string& label = design.labels[static_cast<std::size_t>(design.grades - *grade)];
-      screen.set_note(fmt::format("{}: {}. Confirm, or choose another grade", grade_text(*grade), label));
-      out << fmt::format("  {}: {}. Enter (or y) to confirm, another grade to change\n> ", grade_text(*grade), label)
+      screen.set_note(
+          fmt::format("{}: {}. Confirm, or choose another grade", grade_text(*grade), label));
+      out << fmt::format("  {}: {}. Enter (or y) to confirm, another grade to change\n> ",
+                         grade_text(*grade), label)
           << std::flush;
     } else if (chosen && (line->empty() || *line == "y")) {
       rating = *chosen;
       return PairEnd::rated;
     } else {
-      out << (practice ? "  s, n or q\n> " : fmt::format("  s, a grade from {:+d} to {:+d}, or q\n> ", design.grades, -design.grades))
+      out << (practice ? "  s, n or q\n> "
+                       : fmt::format("  s, a grade from {:+d} to {:+d}, or q\n> ", design.grades,
+                                     -design.grades))
           << std::flush;
       continue;
     }
@@ -266,26 +293,32 @@ PairEnd present_pair(const PersonSessionSetup& setup, PairServing& serving, view
 
 }  // namespace
 
-bool run_person_pairs(const PersonSessionSetup& setup, std::istream& in, std::ostream& out, RatingPage* page) {
+bool run_person_pairs(const PersonSessionSetup& setup, std::istream& in, std::ostream& out,
+                      RatingPage* page) {
   const PairedComparisonDesign& design = setup.design;
   if (setup.subject < 1 || setup.subject > design.subjects)
-    throw Error(fmt::format("--subject {}: the study has subjects 1 to {}", setup.subject, design.subjects));
+    throw Error(fmt::format("--subject {}: the study has subjects 1 to {}", setup.subject,
+                            design.subjects));
   const int conditions = static_cast<int>(setup.condition_names.size());
   std::vector<PresentedPair> plan;
   for (const PresentedPair& pair : presentation_plan(conditions, design.subjects))
     if (pair.subject == setup.subject - 1) plan.push_back(pair);
-  const std::filesystem::path ratings_file = setup.out / "ratings.csv", switches_file = setup.out / "switches.csv";
+  const std::filesystem::path ratings_file = setup.out / "ratings.csv",
+                              switches_file = setup.out / "switches.csv";
   std::vector<PairRatingRow> ratings = read_ratings(ratings_file);
   const auto rated = [&](int position) {
-    return std::any_of(ratings.begin(), ratings.end(),
-                       [&](const PairRatingRow& r) { return r.subject == setup.subject && r.position == position; });
+    return std::any_of(ratings.begin(), ratings.end(), [&](const PairRatingRow& r) {
+      return r.subject == setup.subject && r.position == position;
+    });
   };
-  const std::size_t done = static_cast<std::size_t>(std::count_if(
-      plan.begin(), plan.end(), [&](const PresentedPair& pair) { return rated(pair.position + 1); }));
-  out << fmt::format("study '{}', subject {} of {}: {} pairs, {} rated{}\n", setup.study_name, setup.subject,
-                     design.subjects, plan.size(), done, done == 0 && design.practice_pairs > 0
-                                                              ? fmt::format("; {} practice pair(s) first", design.practice_pairs)
-                                                              : "");
+  const std::size_t done = static_cast<std::size_t>(
+      std::count_if(plan.begin(), plan.end(),
+                    [&](const PresentedPair& pair) { return rated(pair.position + 1); }));
+  out << fmt::format("study '{}', subject {} of {}: {} pairs, {} rated{}\n", setup.study_name,
+                     setup.subject, design.subjects, plan.size(), done,
+                     done == 0 && design.practice_pairs > 0
+                         ? fmt::format("; {} practice pair(s) first", design.practice_pairs)
+                         : "");
   const auto pair_dir = [&](const std::string& label) {
     return setup.out / "pairs" / fmt::format("s{:02d}-{}", setup.subject, label);
   };
@@ -298,23 +331,30 @@ bool run_person_pairs(const PersonSessionSetup& setup, std::istream& in, std::os
     screen.set_practice(practice);
     return screen;
   };
-  const auto setting_up = [&](const std::string& title) { input.show(idle_screen(setup, title + ": starting…", rated_now, pairs)); };
+  const auto setting_up = [&](const std::string& title) {
+    input.show(idle_screen(setup, title + ": starting…", rated_now, pairs));
+  };
   const auto stop = [&] {
-    input.show(idle_screen(setup, "Stopped: the experimenter runs the same command again to continue", rated_now, pairs));
+    input.show(idle_screen(setup,
+                           "Stopped: the experimenter runs the same command again to continue",
+                           rated_now, pairs));
     return false;
   };
   // Practice: felt, not rated, before the first rated pair only; the last pairs of the plan.
-  for (int k = 0; done == 0 && k < design.practice_pairs && k < static_cast<int>(plan.size()); ++k) {
+  for (int k = 0; done == 0 && k < design.practice_pairs && k < static_cast<int>(plan.size());
+       ++k) {
     const PresentedPair& pair = plan[plan.size() - 1 - static_cast<std::size_t>(k)];
     const std::string label = fmt::format("practice-{}", k + 1);
-    const std::string title = fmt::format("Practice pair {} of {} (not rated)", k + 1, design.practice_pairs);
+    const std::string title =
+        fmt::format("Practice pair {} of {} (not rated)", k + 1, design.practice_pairs);
     setting_up(title);
     std::optional<PairServing> serving;
     serving.emplace(setup, pair.first, pair.second, design.show_object != "never", pair_dir(label));
     int unused = 0;
     const PairEnd end = present_pair(setup, *serving, screen_of(title, true), input, out, unused);
     serving.reset();
-    append_switches(switches_file, reported_switches(pair_dir(label) / "server.json", setup.subject, label));
+    append_switches(switches_file,
+                    reported_switches(pair_dir(label) / "server.json", setup.subject, label));
     if (end == PairEnd::stopped) return stop();
   }
   for (const PresentedPair& pair : plan) {
@@ -324,17 +364,20 @@ bool run_person_pairs(const PersonSessionSetup& setup, std::istream& in, std::os
     const std::string title = fmt::format("Pair {} of {}", position, plan.size());
     setting_up(title);
     std::optional<PairServing> serving;
-    serving.emplace(setup, pair.first, pair.second, design.show_object == "always", pair_dir(label));
+    serving.emplace(setup, pair.first, pair.second, design.show_object == "always",
+                    pair_dir(label));
     int rating = 0;
     const PairEnd end = present_pair(setup, *serving, screen_of(title, false), input, out, rating);
     if (end == PairEnd::rated) {
-      ratings.push_back({setup.subject, position, setup.condition_names[static_cast<std::size_t>(pair.first)],
-                         setup.condition_names[static_cast<std::size_t>(pair.second)], rating, "person"});
+      ratings.push_back(
+          {setup.subject, position, setup.condition_names[static_cast<std::size_t>(pair.first)],
+           setup.condition_names[static_cast<std::size_t>(pair.second)], rating, "person"});
       write_ratings(ratings_file, ratings);  // at once: an interruption loses no rating
       ++rated_now;
     }
     serving.reset();
-    append_switches(switches_file, reported_switches(pair_dir(label) / "server.json", setup.subject, std::to_string(position)));
+    append_switches(switches_file, reported_switches(pair_dir(label) / "server.json", setup.subject,
+                                                     std::to_string(position)));
     if (end != PairEnd::rated) return stop();
   }
   out << fmt::format("subject {} has rated every pair\n", setup.subject);

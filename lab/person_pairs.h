@@ -38,7 +38,8 @@ struct PersonSessionSetup {
   std::filesystem::path scene;
   std::string condensation;                  ///< the server's --condensation
   std::vector<std::string> condition_names;  ///< the study's
-  /// Per condition, the settings of a --condition (after "NAME:"), e.g. "protocol=P0,step_nodes=150".
+  /// Per condition, the settings of a --condition (after "NAME:"), e.g.
+  /// "protocol=P0,step_nodes=150".
   std::vector<std::string> condition_settings;
   PairedComparisonDesign design;
   std::filesystem::path out;
@@ -50,6 +51,7 @@ struct PersonSessionSetup {
 /// Runs the subject's unrated pairs, taking commands from `page` when given, else from `in`.
 /// Returns true when the subject has rated every pair, false when stopped first. Throws Error
 /// when a program cannot start.
-bool run_person_pairs(const PersonSessionSetup& setup, std::istream& in, std::ostream& out, RatingPage* page = nullptr);
+bool run_person_pairs(const PersonSessionSetup& setup, std::istream& in, std::ostream& out,
+                      RatingPage* page = nullptr);
 
 }  // namespace cohaptic

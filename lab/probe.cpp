@@ -49,8 +49,8 @@ constexpr int kMaxSettlingSteps = 50;
 std::string parse_point(const std::string& text, Eigen::Vector3d& point) {
   double v[3];
   char tail = 0;
-  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 || !std::isfinite(v[0]) ||
-      !std::isfinite(v[1]) || !std::isfinite(v[2]))
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 ||
+      !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
     return "expected x,y,z (three numbers separated by commas), got '" + text + "'";
   point = {v[0], v[1], v[2]};
   return {};
@@ -75,8 +75,9 @@ bool reference_alone(const ProbeOptions& options, ContactModel contact_model) {
 
 // Presses `tools` at once (every other scene tool absent) and fills in their answers;
 // `columns` is null when reference_alone().
-void press(const Model& model, ComplianceColumns* columns, const ProbeOptions& options, ContactModel contact_model,
-           std::vector<ProbedTool>& tools, const std::vector<int>& users, ProbeTimings& timings) {
+void press(const Model& model, ComplianceColumns* columns, const ProbeOptions& options,
+           ContactModel contact_model, std::vector<ProbedTool>& tools,
+           const std::vector<int>& users, ProbeTimings& timings) {
   const ElasticBody& body = single_elastic_body(model);
   std::vector<PressedTool> pressed;
   for (int u : users) pressed.push_back(tools[u].tool);
@@ -92,9 +93,11 @@ void press(const Model& model, ComplianceColumns* columns, const ProbeOptions& o
     sim_options.ir.patch_rings = options.patch_rings.value_or(model.scene.haptic.patch_rings);
     sim_options.ir.precision = options.precision;
     sim_options.ir.contact_model = contact_model;
-    sim_options.ir.force_limit = std::numeric_limits<double>::infinity();  // the probe reports physics
+    sim_options.ir.force_limit =
+        std::numeric_limits<double>::infinity();  // the probe reports physics
     sim_options.step_delay_nodes = options.boundary_nodes;
-    simulation = std::make_unique<Simulation>(body, model.obstacles, *columns, model.scene.tools, sim_options);
+    simulation = std::make_unique<Simulation>(body, model.obstacles, *columns, model.scene.tools,
+                                              sim_options);
     // Each tool goes in a straight line from where its contact point touches the rest
     // surface (its position less the contact's displacement) to its position.
     StepReport report;
@@ -103,7 +106,8 @@ void press(const Model& model, ComplianceColumns* columns, const ProbeOptions& o
       const double fraction = static_cast<double>(k) / options.approach_steps;
       for (std::size_t i = 0; i < users.size(); ++i) {
         const Eigen::Vector3d& position = pressed[i].position;
-        const Eigen::Vector3d travel = contacts[i].contact ? contacts[i].contact->displacement : Eigen::Vector3d::Zero();
+        const Eigen::Vector3d travel =
+            contacts[i].contact ? contacts[i].contact->displacement : Eigen::Vector3d::Zero();
         simulation->set_tool(users[i], position - (1 - fraction) * travel);
       }
       report = simulation->step(steps * 1e-3);
@@ -112,7 +116,8 @@ void press(const Model& model, ComplianceColumns* columns, const ProbeOptions& o
       for (int settling = 0; report.rebuilt && settling < kMaxSettlingSteps; ++settling, ++steps)
         report = simulation->step(steps * 1e-3);
     if (report.rebuilt && options.approach_steps > 1)
-      spdlog::warn("probe: the sets still changed after {} steps at the final positions", kMaxSettlingSteps);
+      spdlog::warn("probe: the sets still changed after {} steps at the final positions",
+                   kMaxSettlingSteps);
     timings.ir_build_ms += watch.lap_ms();
     for (int u : users) {
       tools[u].boundary_nodes = report.boundary_nodes;
@@ -127,11 +132,13 @@ void press(const Model& model, ComplianceColumns* columns, const ProbeOptions& o
   if (options.reference) {
     std::vector<Eigen::Vector3d> reactions;
     if (contact_model == ContactModel::sphere) {
-      reactions = SphereContactReference(body, obstacle_constraints(body.mesh, body.surface, body.dofs, model.obstacles))
+      reactions = SphereContactReference(body, obstacle_constraints(body.mesh, body.surface,
+                                                                    body.dofs, model.obstacles))
                       .solve(pressed, held)
                       .reactions;
     } else {
-      for (const ToolReaction& reaction : contact_reactions_reference(body, contacts, held, contact_model))
+      for (const ToolReaction& reaction :
+           contact_reactions_reference(body, contacts, held, contact_model))
         reactions.push_back(reaction.reaction);
     }
     for (std::size_t i = 0; i < users.size(); ++i) tools[users[i]].force = reactions[i];
@@ -143,8 +150,9 @@ void press(const Model& model, ComplianceColumns* columns, const ProbeOptions& o
 
 nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-nlohmann::json probe_json(const Model& model, const ProbeOptions& options, ContactModel contact_model,
-                          const std::vector<ProbedTool>& tools, const ProbeTimings& timings) {
+nlohmann::json probe_json(const Model& model, const ProbeOptions& options,
+                          ContactModel contact_model, const std::vector<ProbedTool>& tools,
+                          const ProbeTimings& timings) {
   const ElasticBody& body = single_elastic_body(model);
   const double unit = model.scene.metres_per_unit;
   nlohmann::json out;
@@ -172,11 +180,13 @@ nlohmann::json probe_json(const Model& model, const ProbeOptions& options, Conta
       const ToolContact& c = *probed.query.contact;
       const Triangle& tri = body.surface.triangles[c.triangle];
       nlohmann::json contact;
-      contact["triangle"] = {body.mesh.node_tags[tri[0]], body.mesh.node_tags[tri[1]], body.mesh.node_tags[tri[2]]};
+      contact["triangle"] = {body.mesh.node_tags[tri[0]], body.mesh.node_tags[tri[1]],
+                             body.mesh.node_tags[tri[2]]};
       contact["foot"] = vector_json(c.foot / unit);
       contact["weights"] = vector_json(c.weights);
       contact["depth"] = c.depth / unit;
-      contact["displacement"] = {vector_json(c.displacement / unit), vector_json(c.displacement / unit),
+      contact["displacement"] = {vector_json(c.displacement / unit),
+                                 vector_json(c.displacement / unit),
                                  vector_json(c.displacement / unit)};
       tool["contact"] = contact;
     } else {
@@ -197,59 +207,74 @@ nlohmann::json probe_json(const Model& model, const ProbeOptions& options, Conta
 }
 
 std::string vec(const Eigen::Vector3d& v, int precision) {
-  return fmt::format("({:.{}f}, {:.{}f}, {:.{}f})", v.x(), precision, v.y(), precision, v.z(), precision);
+  return fmt::format("({:.{}f}, {:.{}f}, {:.{}f})", v.x(), precision, v.y(), precision, v.z(),
+                     precision);
 }
 
 void print_table(const Model& model, const ProbeOptions& options, ContactModel contact_model,
-                 const std::vector<ProbedTool>& tools, const ProbeTimings& timings, const std::string& compliance_note) {
+                 const std::vector<ProbedTool>& tools, const ProbeTimings& timings,
+                 const std::string& compliance_note) {
   const ElasticBody& body = single_elastic_body(model);
   const double unit = model.scene.metres_per_unit;
   const std::string& u = model.scene.units;
   const LinearElasticMaterial& material = body.spec.material;
   fmt::print("scene     {} ({})\n", model.scene.name, model.scene.file.string());
-  fmt::print("mesh      {} nodes, {} tetrahedra, {} surface triangles; {} fixed nodes; {} touchable nodes\n",
-             body.mesh.node_count(), body.mesh.tet_count(), body.surface.triangle_count(),
-             fixed_node_tags(body).size(), body.touchable_nodes.size());
-  fmt::print("material  E = {:g} Pa, nu = {:g}, {}\n", material.youngs_modulus, material.poisson_ratio,
-             formulation_name(material.formulation));
-  fmt::print("method    {}; contact model {}; tools pressed {}; {} boundary nodes held after {} step{}\n",
-             options.reference ? "full sparse solve (--reference)"
-                               : fmt::format("IR ({}, patch rings {})", options.precision == IrPrecision::f32 ? "f32" : "f64",
-                                             options.patch_rings.value_or(model.scene.haptic.patch_rings)),
-             contact_model_name(contact_model), options.separately ? "one at a time" : "together",
-             tools.empty() ? 0 : tools.front().boundary_nodes, tools.empty() ? 0 : tools.front().steps,
-             !tools.empty() && tools.front().steps == 1 ? "" : "s");
-  fmt::print("\n{:<4} {:<28} {:>10} {:<20} {:<28} {:<30} {:>9} {:>9}\n", "tool", fmt::format("position ({})", u),
-             fmt::format("depth ({})", u), "triangle (node ids)", fmt::format("node displacement ({})", u),
-             "reaction force on tool (N)", "|F| (N)", "IR bytes");
+  fmt::print(
+      "mesh      {} nodes, {} tetrahedra, {} surface triangles; {} fixed nodes; {} touchable "
+      "nodes\n",
+      body.mesh.node_count(), body.mesh.tet_count(), body.surface.triangle_count(),
+      fixed_node_tags(body).size(), body.touchable_nodes.size());
+  fmt::print("material  E = {:g} Pa, nu = {:g}, {}\n", material.youngs_modulus,
+             material.poisson_ratio, formulation_name(material.formulation));
+  fmt::print(
+      "method    {}; contact model {}; tools pressed {}; {} boundary nodes held after {} step{}\n",
+      options.reference ? "full sparse solve (--reference)"
+                        : fmt::format("IR ({}, patch rings {})",
+                                      options.precision == IrPrecision::f32 ? "f32" : "f64",
+                                      options.patch_rings.value_or(model.scene.haptic.patch_rings)),
+      contact_model_name(contact_model), options.separately ? "one at a time" : "together",
+      tools.empty() ? 0 : tools.front().boundary_nodes, tools.empty() ? 0 : tools.front().steps,
+      !tools.empty() && tools.front().steps == 1 ? "" : "s");
+  fmt::print("\n{:<4} {:<28} {:>10} {:<20} {:<28} {:<30} {:>9} {:>9}\n", "tool",
+             fmt::format("position ({})", u), fmt::format("depth ({})", u), "triangle (node ids)",
+             fmt::format("node displacement ({})", u), "reaction force on tool (N)", "|F| (N)",
+             "IR bytes");
   const double limit = model.scene.haptic.force_limit_n;
   bool over_limit = false;
   for (std::size_t t = 0; t < tools.size(); ++t) {
     const ProbedTool& probed = tools[t];
     if (!probed.query.contact) {
-      fmt::print("{:<4} {:<28} {:>10} no contact ({} {:.3f} {} from the surface)\n", t + 1,
-                 vec(probed.tool.position / unit, 3), "-",
-                 probed.query.signed_distance < 0 ? "inside, but no touchable triangle;" : "outside,",
-                 std::abs(probed.query.signed_distance) / unit, u);
+      fmt::print(
+          "{:<4} {:<28} {:>10} no contact ({} {:.3f} {} from the surface)\n", t + 1,
+          vec(probed.tool.position / unit, 3), "-",
+          probed.query.signed_distance < 0 ? "inside, but no touchable triangle;" : "outside,",
+          std::abs(probed.query.signed_distance) / unit, u);
       continue;
     }
     const ToolContact& c = *probed.query.contact;
     const Triangle& tri = body.surface.triangles[c.triangle];
     const bool over = probed.force.norm() > limit;
     over_limit |= over;
-    fmt::print("{:<4} {:<28} {:>10.3f} {:<20} {:<28} {:<30} {:>8.4f}{} {:>9}\n", t + 1, vec(probed.tool.position / unit, 3),
-               c.depth / unit,
-               fmt::format("{} {} {}", body.mesh.node_tags[tri[0]], body.mesh.node_tags[tri[1]], body.mesh.node_tags[tri[2]]),
-               vec(c.displacement / unit, 3), vec(probed.force, 4), probed.force.norm(), over ? "*" : " ", probed.ir_bytes);
+    fmt::print("{:<4} {:<28} {:>10.3f} {:<20} {:<28} {:<30} {:>8.4f}{} {:>9}\n", t + 1,
+               vec(probed.tool.position / unit, 3), c.depth / unit,
+               fmt::format("{} {} {}", body.mesh.node_tags[tri[0]], body.mesh.node_tags[tri[1]],
+                           body.mesh.node_tags[tri[2]]),
+               vec(c.displacement / unit, 3), vec(probed.force, 4), probed.force.norm(),
+               over ? "*" : " ", probed.ir_bytes);
   }
-  if (over_limit) fmt::print("* above the scene's haptic force limit of {:g} N (a haptic client would clamp it)\n", limit);
-  fmt::print("\ntimings (ms): load {:.1f}, precompute {:.1f} (assemble {:.1f}, compliance {:.1f}), "
-             "IR build {:.3f}, {} {:.3f}; K_ff {}\n",
-             timings.load_ms, timings.precompute_ms, body.timings.assemble_ms,
-             timings.precompute_ms - body.timings.assemble_ms, timings.ir_build_ms,
-             options.reference ? "full solve" : "force evaluation", timings.solve_ms,
-             body.free_factor.factored() ? fmt::format("factored in {:.1f} (within the above)", body.free_factor.factor_ms())
-                                         : std::string("not factored (not needed)"));
+  if (over_limit)
+    fmt::print(
+        "* above the scene's haptic force limit of {:g} N (a haptic client would clamp it)\n",
+        limit);
+  fmt::print(
+      "\ntimings (ms): load {:.1f}, precompute {:.1f} (assemble {:.1f}, compliance {:.1f}), "
+      "IR build {:.3f}, {} {:.3f}; K_ff {}\n",
+      timings.load_ms, timings.precompute_ms, body.timings.assemble_ms,
+      timings.precompute_ms - body.timings.assemble_ms, timings.ir_build_ms,
+      options.reference ? "full solve" : "force evaluation", timings.solve_ms,
+      body.free_factor.factored()
+          ? fmt::format("factored in {:.1f} (within the above)", body.free_factor.factor_ms())
+          : std::string("not factored (not needed)"));
   if (!compliance_note.empty()) fmt::print("compliance cache: {}\n", compliance_note);
 }
 
@@ -275,7 +300,8 @@ int run_probe(const ProbeOptions& options) {
   std::string compliance_note = "no compliance columns: the full solve alone";
   if (!reference_alone(options, contact_model)) {
     columns = std::make_unique<ComplianceColumns>(
-        body.free_factor, body.dofs, compliance_row_nodes(body, options.boundary_nodes > 0 || !model.obstacles.empty()));
+        body.free_factor, body.dofs,
+        compliance_row_nodes(body, options.boundary_nodes > 0 || !model.obstacles.empty()));
     compliance_note = prepare_compliance(body, *columns, options.cache_directory).note;
   }
   timings.precompute_ms += watch.lap_ms();
@@ -287,7 +313,8 @@ int run_probe(const ProbeOptions& options) {
     tools.push_back(probed);
   }
   if (options.separately) {
-    for (int u = 0; u < static_cast<int>(tools.size()); ++u) press(model, columns.get(), options, contact_model, tools, {u}, timings);
+    for (int u = 0; u < static_cast<int>(tools.size()); ++u)
+      press(model, columns.get(), options, contact_model, tools, {u}, timings);
   } else {
     std::vector<int> all(tools.size());
     for (std::size_t u = 0; u < all.size(); ++u) all[u] = static_cast<int>(u);
@@ -308,14 +335,17 @@ int run_probe(const ProbeOptions& options) {
       for (const ProbedTool& probed : tools) pressed.push_back(probed.tool);
       Eigen::VectorXd u;
       if (contact_model == ContactModel::sphere)
-        SphereContactReference(body, obstacle_constraints(body.mesh, body.surface, body.dofs, model.obstacles))
+        SphereContactReference(
+            body, obstacle_constraints(body.mesh, body.surface, body.dofs, model.obstacles))
             .solve(pressed, {}, &u);
       else
         contact_reactions_reference(body, find_tool_contacts(body, pressed), {}, contact_model, &u);
       u /= scene.metres_per_unit;
       write_vtu(options.export_vtu, in_scene_units,
-                {{"displacement", Eigen::Map<const Eigen::Matrix3Xd>(u.data(), 3, body.mesh.node_count())}});
-      spdlog::info("wrote {} (displacement in {}, without held boundary nodes)", options.export_vtu.string(), scene.units);
+                {{"displacement",
+                  Eigen::Map<const Eigen::Matrix3Xd>(u.data(), 3, body.mesh.node_count())}});
+      spdlog::info("wrote {} (displacement in {}, without held boundary nodes)",
+                   options.export_vtu.string(), scene.units);
     }
   }
 
@@ -329,47 +359,70 @@ int run_probe(const ProbeOptions& options) {
 LabCommand add_probe_command(CLI::App& lab) {
   auto line = std::make_shared<ProbeCommandLine>();
   ProbeOptions& probe = line->options;
-  CLI::App* command = lab.add_subcommand(
-      "probe",
-      "Static reaction force at tool positions pressed into the scene's object, through the intermediate "
-      "representation (condensed M~) and the haptic force evaluator, or the full FEM solve. Prints a table, "
-      "or JSON with --json.");
-  command->add_option("--scene", probe.scene, "Scene file (YAML)")->required()->check(CLI::ExistingFile);
+  CLI::App* command = lab.add_subcommand("probe",
+                                         "Static reaction force at tool positions pressed into the "
+                                         "scene's object, through the intermediate "
+                                         "representation (condensed M~) and the haptic force "
+                                         "evaluator, or the full FEM solve. Prints a table, "
+                                         "or JSON with --json.");
+  command->add_option("--scene", probe.scene, "Scene file (YAML)")
+      ->required()
+      ->check(CLI::ExistingFile);
   command
-      ->add_option("--tool", line->tools,
-                   "Tool position x,y,z in the scene's units; repeat for several tools pressing at once. "
-                   "Tool k takes the shape of the scene's k-th tool (the last one if there are fewer)")
+      ->add_option(
+          "--tool", line->tools,
+          "Tool position x,y,z in the scene's units; repeat for several tools pressing at once. "
+          "Tool k takes the shape of the scene's k-th tool (the last one if there are fewer)")
       ->required();
-  command->add_flag("--separately", probe.separately, "Press each tool alone (one solve per tool) instead of all tools at once");
-  command->add_option("--approach-steps", probe.approach_steps,
-                      "Simulation steps that bring each tool from touching the rest surface to its position; with "
-                      "more than 1 the last position is stepped again until no set changes (under the translation and "
-                      "point models obstacles hold the nodes where they reach them, so a one-step press from rest can "
-                      "hold more)")
+  command->add_flag("--separately", probe.separately,
+                    "Press each tool alone (one solve per tool) instead of all tools at once");
+  command
+      ->add_option("--approach-steps", probe.approach_steps,
+                   "Simulation steps that bring each tool from touching the rest surface to its "
+                   "position; with "
+                   "more than 1 the last position is stepped again until no set changes (under the "
+                   "translation and "
+                   "point models obstacles hold the nodes where they reach them, so a one-step "
+                   "press from rest can "
+                   "hold more)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  command->add_option("--boundary-nodes", probe.boundary_nodes,
-                      "Hold the N surface nodes nearest the tools at rest (the paper's step-delay T150/T300 sets)")
+  command
+      ->add_option("--boundary-nodes", probe.boundary_nodes,
+                   "Hold the N surface nodes nearest the tools at rest (the paper's step-delay "
+                   "T150/T300 sets)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  command->add_option("--contact-model", line->contact_model,
-                      "translation (the paper's: the triangle's nodes follow the tool), point (the contact point "
-                      "follows it with least energy) or sphere (the surface nodes a sphere tool pushes are held on its "
-                      "surface, frictionless and unilateral); default: the scene's")
+  command
+      ->add_option("--contact-model", line->contact_model,
+                   "translation (the paper's: the triangle's nodes follow the tool), point (the "
+                   "contact point "
+                   "follows it with least energy) or sphere (the surface nodes a sphere tool "
+                   "pushes are held on its "
+                   "surface, frictionless and unilateral); default: the scene's")
       ->check(CLI::IsMember({"translation", "point", "sphere"}));
-  command->add_option("--ir-precision", line->precision, "Storage of M~ and u_B in the IR: f64 or f32 (inversion is always double)")
+  command
+      ->add_option("--ir-precision", line->precision,
+                   "Storage of M~ and u_B in the IR: f64 or f32 (inversion is always double)")
       ->check(CLI::IsMember({"f64", "f32"}))
       ->capture_default_str();
-  command->add_option("--patch-rings", probe.patch_rings,
-                      "Rings of neighbouring triangles in each IR's contact patch (0-4); default: the scene's")
+  command
+      ->add_option(
+          "--patch-rings", probe.patch_rings,
+          "Rings of neighbouring triangles in each IR's contact patch (0-4); default: the scene's")
       ->check(CLI::Range(0, 4));
   command->add_flag("--reference", probe.reference,
-                    "Full sparse FEM solve instead of the condensed IR (slow; the answer the IR is checked against)");
+                    "Full sparse FEM solve instead of the condensed IR (slow; the answer the IR is "
+                    "checked against)");
   command->add_flag("--json", probe.json, "Print one JSON object on stdout instead of the table");
-  command->add_option("--export-vtu", probe.export_vtu, "Write the mesh with the displacement field (.vtu, for ParaView)");
-  command->add_option("--export-msh", probe.export_msh, "Write the mesh as Gmsh 4.1 ASCII (its node ids are the ones reported)");
-  command->add_option("--cache-dir", line->cache_dir, "Directory of the on-disk compliance cache")->capture_default_str();
-  command->add_flag("--no-disk-cache", line->no_disk_cache, "Neither read nor write the on-disk compliance cache");
+  command->add_option("--export-vtu", probe.export_vtu,
+                      "Write the mesh with the displacement field (.vtu, for ParaView)");
+  command->add_option("--export-msh", probe.export_msh,
+                      "Write the mesh as Gmsh 4.1 ASCII (its node ids are the ones reported)");
+  command->add_option("--cache-dir", line->cache_dir, "Directory of the on-disk compliance cache")
+      ->capture_default_str();
+  command->add_flag("--no-disk-cache", line->no_disk_cache,
+                    "Neither read nor write the on-disk compliance cache");
 
   return {command, [line] {
             ProbeOptions options = line->options;
@@ -383,9 +436,10 @@ LabCommand add_probe_command(CLI::App& lab) {
             }
             if (!line->no_disk_cache) options.cache_directory = line->cache_dir;
             if (!line->contact_model.empty())
-              options.contact_model = line->contact_model == "translation" ? ContactModel::node_translation
-                                      : line->contact_model == "point"     ? ContactModel::point_constraint
-                                                                           : ContactModel::sphere;
+              options.contact_model =
+                  line->contact_model == "translation" ? ContactModel::node_translation
+                  : line->contact_model == "point"     ? ContactModel::point_constraint
+                                                       : ContactModel::sphere;
             options.precision = line->precision == "f32" ? IrPrecision::f32 : IrPrecision::f64;
             return run_probe(options);
           }};

@@ -21,16 +21,16 @@ struct ProbeOptions {
   std::vector<Eigen::Vector3d> tools;  ///< in the scene's units
   bool separately = false;             ///< press each tool alone instead of all at once
   bool json = false;
-  bool reference = false;              ///< full sparse solve instead of the IR
-  int boundary_nodes = 0;              ///< step-delay boundary nodes held at rest
+  bool reference = false;  ///< full sparse solve instead of the IR
+  int boundary_nodes = 0;  ///< step-delay boundary nodes held at rest
   /// Simulation steps that bring each tool from touching to its position (1: one step from
   /// rest). Obstacles hold the nodes where they reach them, so their set depends on the path;
   /// with more than one, the last position is stepped again until no set changes.
   int approach_steps = 1;
-  std::optional<int> patch_rings;      ///< default: the scene's
+  std::optional<int> patch_rings;             ///< default: the scene's
   std::optional<ContactModel> contact_model;  ///< default: the scene's
   IrPrecision precision = IrPrecision::f64;
-  std::filesystem::path export_vtu;    ///< empty: no export
+  std::filesystem::path export_vtu;  ///< empty: no export
   std::filesystem::path export_msh;
   std::optional<std::filesystem::path> cache_directory;  ///< empty: no disk cache
 };

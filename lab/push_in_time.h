@@ -43,6 +43,7 @@ std::vector<double> network_static_forces(const Scene& scene, const PushVariatio
                                           const std::vector<double>& depths);
 
 /// The force at each of `depths` [m], linearly interpolated between the samples around it.
-std::vector<double> forces_at_depths(const std::vector<PushInTimeSample>& samples, const std::vector<double>& depths);
+std::vector<double> forces_at_depths(const std::vector<PushInTimeSample>& samples,
+                                     const std::vector<double>& depths);
 
 }  // namespace cohaptic

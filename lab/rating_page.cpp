@@ -9,12 +9,18 @@ namespace cohaptic {
 
 std::optional<std::string> command_of(const view::RatingAction& action) {
   switch (action.action_case()) {
-    case view::RatingAction::kSwitchCondition: return "s";
-    case view::RatingAction::kChoose: return fmt::format("{:+d}", action.choose());
-    case view::RatingAction::kConfirm: return "y";
-    case view::RatingAction::kNext: return "n";
-    case view::RatingAction::kStop: return "q";
-    case view::RatingAction::ACTION_NOT_SET: break;
+    case view::RatingAction::kSwitchCondition:
+      return "s";
+    case view::RatingAction::kChoose:
+      return fmt::format("{:+d}", action.choose());
+    case view::RatingAction::kConfirm:
+      return "y";
+    case view::RatingAction::kNext:
+      return "n";
+    case view::RatingAction::kStop:
+      return "q";
+    case view::RatingAction::ACTION_NOT_SET:
+      break;
   }
   return std::nullopt;
 }
@@ -27,7 +33,8 @@ RatingPage::RatingPage(const std::string& host, std::uint16_t port) {
   options.assets = COHAPTIC_VIEW_WEB_DIR;
   options.proto = COHAPTIC_PROTO_DIR;
   options.page = view::ViewPage::rating;
-  server_ = std::make_unique<view::ViewServer>(options, [this](const view::Command& command) { received(command); });
+  server_ = std::make_unique<view::ViewServer>(
+      options, [this](const view::Command& command) { received(command); });
   server_->start();
 }
 

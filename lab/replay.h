@@ -44,7 +44,7 @@ int run_replay(const ReplayOptions& options);
 /// The outcome of verifying one recording.
 struct VerifyResult {
   bool ok = true;
-  std::size_t checked = 0;     ///< forces (and IRs) compared
+  std::size_t checked = 0;  ///< forces (and IRs) compared
   std::string first_difference;
 };
 
@@ -53,7 +53,8 @@ struct VerifyResult {
 /// gmsh script: a recording may come from anyone (the command line without --scene-dir).
 /// Throws cohaptic::Error naming the file if it cannot be read as a recording (a chunk
 /// whose CRC does not match, for one) or not re-run.
-VerifyResult verify_recording(const std::filesystem::path& file, const SceneFileAccess& scene_files);
+VerifyResult verify_recording(const std::filesystem::path& file,
+                              const SceneFileAccess& scene_files);
 VerifyResult verify_recording(const std::filesystem::path& file);
 
 /// `cohaptic-lab replay FILE [--summary|--verify|--export-csv DIR]`.

@@ -43,10 +43,12 @@ int serve_replay(const record::Recording& recording, const ReplayViewOptions& op
   });
   server.publish(view::Channel::scene, view::server_message(player.scene()));
   server.start();
-  spdlog::info("replay of {} ({} frames, {:.1f} s) in the live view at {}{}", recording.file.string(),
-               recording.view_frames.size(), player.timeline().end() - player.timeline().start(),
-               server.url(!options.token_file),  // a token from a file stays out of the log
-               options.token_file ? " (add ?token= and the token in " + options.token_file->string() + ")" : "");
+  spdlog::info(
+      "replay of {} ({} frames, {:.1f} s) in the live view at {}{}", recording.file.string(),
+      recording.view_frames.size(), player.timeline().end() - player.timeline().start(),
+      server.url(!options.token_file),  // a token from a file stays out of the log
+      options.token_file ? " (add ?token= and the token in " + options.token_file->string() + ")"
+                         : "");
 
   std::size_t shown = static_cast<std::size_t>(-1);
   std::uint64_t handled = 0, shown_timeline = 0;

@@ -20,15 +20,16 @@ struct SeparationPullOptions {
   std::filesystem::path scene = "scenes/separation/two_layers.yaml";
   std::vector<double> at_mm{0, 20};  ///< the held node: the interface node nearest (x, y, 0) [mm]
   double speed_mm_s = 10;
-  double tilt_deg = 0;           ///< from the normal towards +x
-  std::filesystem::path out;     ///< empty: the summary only
-  bool disk_cache = true;        ///< the fields from (and into) the default cache directory
+  double tilt_deg = 0;        ///< from the normal towards +x
+  std::filesystem::path out;  ///< empty: the summary only
+  bool disk_cache = true;     ///< the fields from (and into) the default cache directory
 };
 
 /// Runs the loop, prints the summary, writes the files. Returns the exit code.
 int run_separation_pull(const SeparationPullOptions& options);
 
-/// `cohaptic-lab separation-pull [--scene FILE] [--at X Y] [--speed MM/S] [--tilt DEG] [--out DIR] [--no-disk-cache]`.
+/// `cohaptic-lab separation-pull [--scene FILE] [--at X Y] [--speed MM/S] [--tilt DEG] [--out DIR]
+/// [--no-disk-cache]`.
 LabCommand add_separation_pull_command(CLI::App& lab);
 
 }  // namespace cohaptic

@@ -34,13 +34,14 @@ struct HealthCriterion {
 };
 
 struct SessionVerdict {
-  nlohmann::json report;              ///< {"server", "clients", "healthy", "problems", "notes", "criteria"}
+  nlohmann::json report;  ///< {"server", "clients", "healthy", "problems", "notes", "criteria"}
   std::vector<HealthCriterion> criteria;
   std::vector<std::string> problems;  ///< empty when healthy
   std::vector<std::string> notes;     ///< worth knowing, not failures
 };
 
-SessionVerdict summarize_session(const nlohmann::json& server, const std::vector<nlohmann::json>& clients);
+SessionVerdict summarize_session(const nlohmann::json& server,
+                                 const std::vector<nlohmann::json>& clients);
 
 /// Whether a client's report shows missed deadlines of its own haptic loop: more than 0.1 % of
 /// its ticks beyond those the bare timer floor beside it missed (a stall of the whole machine,
@@ -48,7 +49,8 @@ SessionVerdict summarize_session(const nlohmann::json& server, const std::vector
 bool misses_deadlines_of_its_own(const nlohmann::json& client_report);
 
 /// Reads the reports, prints the table, writes `out` (if not empty); exit code 0 if healthy.
-int run_summarize(const std::filesystem::path& server_report, const std::vector<std::filesystem::path>& client_reports,
+int run_summarize(const std::filesystem::path& server_report,
+                  const std::vector<std::filesystem::path>& client_reports,
                   const std::filesystem::path& out);
 
 /// `cohaptic-lab summarize --server-report FILE --client-report FILE... [--out FILE]`.

@@ -22,8 +22,8 @@ constexpr double kApproachS = 1.5, kHoldS = 1.5;
 
 Trajectory wall_press() {
   const Eigen::Vector3d above(0, 0, 0.005), deep(0, 0, -0.010);
-  return Trajectory({0.0, kApproachS, kApproachS + kHoldS, 2 * kApproachS + kHoldS}, {above, deep, deep, above},
-                    "wall press");
+  return Trajectory({0.0, kApproachS, kApproachS + kHoldS, 2 * kApproachS + kHoldS},
+                    {above, deep, deep, above}, "wall press");
 }
 
 Eigen::Vector3d wall_force(double stiffness, const Eigen::Vector3d& position) {
@@ -33,8 +33,8 @@ Eigen::Vector3d wall_force(double stiffness, const Eigen::Vector3d& position) {
 }  // namespace
 
 WallLoopResult run_wall_loop(const WallLoopSettings& settings) {
-  if (!(settings.stiffness_n_per_m > 0) || !(settings.haptic_rate_hz > 0) || !(settings.shift_delay_s >= 0) ||
-      !(settings.step_period_s >= 0))
+  if (!(settings.stiffness_n_per_m > 0) || !(settings.haptic_rate_hz > 0) ||
+      !(settings.shift_delay_s >= 0) || !(settings.step_period_s >= 0))
     throw Error("run_wall_loop: stiffness and haptic rate must be positive, delays non-negative");
   const Trajectory motion = wall_press();
   HandModelDevice hand(motion, settings.hand, settings.force_limit_n);
@@ -52,7 +52,8 @@ WallLoopResult run_wall_loop(const WallLoopSettings& settings) {
     // The moment whose position the environment's current answer was computed from.
     double seen = t - settings.shift_delay_s;
     if (settings.step_period_s > 0)
-      seen = std::floor(seen / settings.step_period_s + 1e-9) * settings.step_period_s - settings.step_period_s;
+      seen = std::floor(seen / settings.step_period_s + 1e-9) * settings.step_period_s -
+             settings.step_period_s;
     Eigen::Vector3d force = Eigen::Vector3d::Zero();
     if (seen >= 0) {
       const auto index = std::min(k, static_cast<std::size_t>(std::floor(seen / period + 1e-9)));
@@ -97,7 +98,9 @@ double rms_difference(const ForceTrace& a, const ForceTrace& b, double peak) {
   return n && peak > 0 ? std::sqrt(sum / static_cast<double>(n)) / peak : 0;
 }
 
-const char* verdict(const WallLoopResult& r) { return r.stable() ? "stable" : r.passive() ? "oscillating" : "active"; }
+const char* verdict(const WallLoopResult& r) {
+  return r.stable() ? "stable" : r.passive() ? "oscillating" : "active";
+}
 
 // The largest stiffness in `rows` (same delays and rate) below which every run is stable.
 double stable_limit(const std::vector<const MapRow*>& rows, bool controlled) {
@@ -117,8 +120,8 @@ int run_stability(const StabilityOptions& options) {
   const std::vector<double> stiffnesses = {500, 1000, 2000, 4000, 8000, 16000, 32000, 64000};
   const std::vector<double> rates = {500, 1000, 2000, 5000};
   // (shift delay, step period) pairs: shift delay alone, then step delay alone.
-  const std::vector<std::pair<double, double>> delays = {{0, 0},     {0.002, 0}, {0.005, 0}, {0.010, 0},
-                                                         {0.020, 0}, {0, 0.010}, {0, 0.040}};
+  const std::vector<std::pair<double, double>> delays = {
+      {0, 0}, {0.002, 0}, {0.005, 0}, {0.010, 0}, {0.020, 0}, {0, 0.010}, {0, 0.040}};
   std::vector<MapRow> rows;
   for (const auto& [shift, step] : delays)
     for (double rate : rates)
@@ -133,49 +136,62 @@ int run_stability(const StabilityOptions& options) {
         WallLoopSettings controlled = row.settings;
         controlled.passivity_control = true;
         row.controlled = run_wall_loop(controlled);
-        row.transparency_cost = rms_difference(row.controlled.trace, row.plain.trace, row.plain.peak_force_n);
+        row.transparency_cost =
+            rms_difference(row.controlled.trace, row.plain.trace, row.plain.peak_force_n);
         rows.push_back(std::move(row));
       }
-  spdlog::info("stability: {} configurations, each with and without the passivity controller", rows.size());
+  spdlog::info("stability: {} configurations, each with and without the passivity controller",
+               rows.size());
 
   AtomicFile csv(options.out / "stability.csv");
   csv.write(
-      "stiffness_n_per_m,haptic_rate_hz,shift_delay_ms,step_period_ms,passivity_bound_n_per_m,energy_given_j,"
-      "oscillating,verdict,controlled_energy_given_j,controlled_oscillating,controlled_verdict,controller_ticks,"
+      "stiffness_n_per_m,haptic_rate_hz,shift_delay_ms,step_period_ms,passivity_bound_n_per_m,"
+      "energy_given_j,"
+      "oscillating,verdict,controlled_energy_given_j,controlled_oscillating,controlled_verdict,"
+      "controller_ticks,"
       "dissipated_j,transparency_cost\n");
   for (const MapRow& r : rows)
-    csv.print("{:g},{:g},{:g},{:g},{:.6g},{:.6g},{},{},{:.6g},{},{},{},{:.6g},{:.6g}\n", r.settings.stiffness_n_per_m,
-              r.settings.haptic_rate_hz, 1000 * r.settings.shift_delay_s, 1000 * r.settings.step_period_s,
-              passivity_bound(r.settings), r.plain.energy_given_to_hand_j, r.plain.oscillating ? 1 : 0,
-              verdict(r.plain), r.controlled.energy_given_to_hand_j, r.controlled.oscillating ? 1 : 0,
-              verdict(r.controlled), r.controlled.controller_ticks, r.controlled.dissipated_j, r.transparency_cost);
+    csv.print("{:g},{:g},{:g},{:g},{:.6g},{:.6g},{},{},{:.6g},{},{},{},{:.6g},{:.6g}\n",
+              r.settings.stiffness_n_per_m, r.settings.haptic_rate_hz,
+              1000 * r.settings.shift_delay_s, 1000 * r.settings.step_period_s,
+              passivity_bound(r.settings), r.plain.energy_given_to_hand_j,
+              r.plain.oscillating ? 1 : 0, verdict(r.plain), r.controlled.energy_given_to_hand_j,
+              r.controlled.oscillating ? 1 : 0, verdict(r.controlled),
+              r.controlled.controller_ticks, r.controlled.dissipated_j, r.transparency_cost);
   csv.commit();
 
   AtomicFile md(options.out / "stability.md");
   md.print(
       "# Stability of a virtual wall under the hand model (m {} kg, k {} N/m, c {} N s/m)\n\n"
-      "Each cell: the verdict without / with the passivity controller: S stable, o passive but oscillating, "
-      "a active (the wall gave the hand more than 1 mJ). *bound* is the first-order passivity bound "
-      "c / (T_hold/2 + latency) [N/m]; *stable up to* the largest K with every smaller K stable (without / with the "
+      "Each cell: the verdict without / with the passivity controller: S stable, o passive but "
+      "oscillating, "
+      "a active (the wall gave the hand more than 1 mJ). *bound* is the first-order passivity "
+      "bound "
+      "c / (T_hold/2 + latency) [N/m]; *stable up to* the largest K with every smaller K stable "
+      "(without / with the "
       "controller).\n\n| delay | rate Hz | bound |",
       options.hand.mass_kg, options.hand.stiffness_n_per_m, options.hand.damping_ns_per_m);
   for (double k : stiffnesses) md.print(" {:g} |", k);
   md.write(" stable up to |\n|---|---|---|");
   for (std::size_t i = 0; i <= stiffnesses.size(); ++i) md.write("---|");
   md.write("\n");
-  const auto letter = [](const WallLoopResult& r) { return r.stable() ? "S" : r.passive() ? "o" : "a"; };
+  const auto letter = [](const WallLoopResult& r) {
+    return r.stable() ? "S" : r.passive() ? "o" : "a";
+  };
   LinePlot plot;
   plot.title = "Largest stable wall stiffness (measured, with markers) and the passivity bound";
   plot.x_label = "haptic rate, Hz";
   plot.y_label = "stiffness, kN/m";
   for (const auto& [shift, step] : delays) {
-    const std::string label = step > 0 ? fmt::format("step {:g} ms", 1000 * step) : fmt::format("shift {:g} ms", 1000 * shift);
+    const std::string label = step > 0 ? fmt::format("step {:g} ms", 1000 * step)
+                                       : fmt::format("shift {:g} ms", 1000 * shift);
     Series measured{label, {}, {}, "", true};
     Series bound_line{label + " bound", {}, {}, "", false};
     for (double rate : rates) {
       std::vector<const MapRow*> same;
       for (const MapRow& r : rows)
-        if (r.settings.shift_delay_s == shift && r.settings.step_period_s == step && r.settings.haptic_rate_hz == rate)
+        if (r.settings.shift_delay_s == shift && r.settings.step_period_s == step &&
+            r.settings.haptic_rate_hz == rate)
           same.push_back(&r);
       const double limit = stable_limit(same, false), controlled_limit = stable_limit(same, true);
       const double bound = passivity_bound(same.front()->settings);
@@ -202,15 +218,21 @@ int run_stability(const StabilityOptions& options) {
       made_passive += !r.plain.passive() && r.controlled.passive();
     }
   md.print(
-      "\nThe passivity controller makes {} of the {} unstable configurations stable, and {} active ones passive. "
-      "Where the loop was already stable ({} configurations) it changes the force by {:.2f} % of the peak (RMS, "
-      "median; largest {:.2f} %): it acts only once the wall has given out more than its tolerance (0.1 mJ).\n",
-      rescued, unstable, made_passive, costs.size(), costs.empty() ? 0.0 : 100 * costs[costs.size() / 2],
+      "\nThe passivity controller makes {} of the {} unstable configurations stable, and {} active "
+      "ones passive. "
+      "Where the loop was already stable ({} configurations) it changes the force by {:.2f} % of "
+      "the peak (RMS, "
+      "median; largest {:.2f} %): it acts only once the wall has given out more than its tolerance "
+      "(0.1 mJ).\n",
+      rescued, unstable, made_passive, costs.size(),
+      costs.empty() ? 0.0 : 100 * costs[costs.size() / 2],
       costs.empty() ? 0.0 : 100 * costs.back());
   md.commit();
   write_svg(options.out / "stability.svg", plot);
-  spdlog::info("passivity controller: {} of {} unstable configurations made stable; cost where stable: median {:.2f} %",
-               rescued, unstable, costs.empty() ? 0.0 : 100 * costs[costs.size() / 2]);
+  spdlog::info(
+      "passivity controller: {} of {} unstable configurations made stable; cost where stable: "
+      "median {:.2f} %",
+      rescued, unstable, costs.empty() ? 0.0 : 100 * costs[costs.size() / 2]);
   spdlog::info("wrote {}/stability.csv, stability.md, stability.svg", options.out.string());
   return 0;
 }
@@ -218,12 +240,20 @@ int run_stability(const StabilityOptions& options) {
 LabCommand add_stability_command(CLI::App& lab) {
   auto options = std::make_shared<StabilityOptions>();
   CLI::App* command = lab.add_subcommand(
-      "stability", "Map where a virtual wall stays stable under the hand model (stiffness x haptic rate x delay), with "
-                   "and without the passivity controller: stability.csv, stability.md, stability.svg in --out");
+      "stability",
+      "Map where a virtual wall stays stable under the hand model (stiffness x haptic rate x "
+      "delay), with "
+      "and without the passivity controller: stability.csv, stability.md, stability.svg in --out");
   command->add_option("--out", options->out, "Output directory")->required();
-  command->add_option("--hand-mass", options->hand.mass_kg, "Hand model mass [kg]")->capture_default_str();
-  command->add_option("--hand-stiffness", options->hand.stiffness_n_per_m, "Hand model stiffness [N/m]")->capture_default_str();
-  command->add_option("--hand-damping", options->hand.damping_ns_per_m, "Hand model damping [N s/m]")->capture_default_str();
+  command->add_option("--hand-mass", options->hand.mass_kg, "Hand model mass [kg]")
+      ->capture_default_str();
+  command
+      ->add_option("--hand-stiffness", options->hand.stiffness_n_per_m,
+                   "Hand model stiffness [N/m]")
+      ->capture_default_str();
+  command
+      ->add_option("--hand-damping", options->hand.damping_ns_per_m, "Hand model damping [N s/m]")
+      ->capture_default_str();
   return {command, [options] { return run_stability(*options); }};
 }
 

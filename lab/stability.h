@@ -47,10 +47,10 @@ struct WallLoopSettings {
 struct WallLoopResult {
   ForceTrace trace;
   double energy_given_to_hand_j = 0;
-  bool oscillating = false;     ///< an oscillation episode in the last 0.5 s of the hold
+  bool oscillating = false;  ///< an oscillation episode in the last 0.5 s of the hold
   double peak_force_n = 0;
-  long controller_ticks = 0;    ///< ticks on which the passivity controller acted
-  double dissipated_j = 0;      ///< energy its damping took out
+  long controller_ticks = 0;  ///< ticks on which the passivity controller acted
+  double dissipated_j = 0;    ///< energy its damping took out
 
   bool passive() const { return energy_given_to_hand_j <= 1e-3; }
   bool stable() const { return passive() && !oscillating; }

@@ -32,7 +32,7 @@ struct StudyParticipant {
   std::string name;
   std::string device;  ///< "script" or "hand"
   std::filesystem::path trajectory;
-  int slot = 0;        ///< the scene tool it holds (its position in the list)
+  int slot = 0;  ///< the scene tool it holds (its position in the list)
 };
 
 /// One combination of factor levels.
@@ -44,7 +44,7 @@ struct StudyCondition {
 };
 
 struct StudyTrial {
-  int index = 0;        ///< 1-based, in run order
+  int index = 0;  ///< 1-based, in run order
   int repetition = 1;
   StudyCondition condition;
 };
@@ -79,9 +79,10 @@ struct StudyRunOptions {
   std::string server_program;  ///< empty: cohaptic-server beside this program's build
   std::string client_program;  ///< empty: cohaptic-client beside this program's build
   // A study rated by people (lab/person_pairs.h) runs one subject at a time:
-  int subject = 0;             ///< 1-based
-  std::string device;          ///< that subject's cohaptic-client --device
-  std::string rating_page;     ///< HOST:PORT: commands from a rating page served there, not the terminal
+  int subject = 0;     ///< 1-based
+  std::string device;  ///< that subject's cohaptic-client --device
+  std::string
+      rating_page;  ///< HOST:PORT: commands from a rating page served there, not the terminal
   std::istream* input = nullptr;   ///< the subject's commands; null: standard input
   std::ostream* output = nullptr;  ///< what the subject reads; null: standard output
 };

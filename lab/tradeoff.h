@@ -16,9 +16,9 @@
 // divisions (box scenes), element formulation, contact model, patch rings, IR precision,
 // B truncation (scenes with obstacles, the only ones with held nodes here), IR update
 // policy (every set change, or at most R per second), haptic rate. With obstacles the
-// references hold the nodes that the simulation's active set puts on them. Costs per setting: precompute time, M~ build time (p50/p99 of
-// the steps that rebuilt IRs), evaluation time per tick, IR bytes per second as the wire
-// carries them (compliance rows, lab/tradeoff_wire_bytes.h), memory
+// references hold the nodes that the simulation's active set puts on them. Costs per setting:
+// precompute time, M~ build time (p50/p99 of the steps that rebuilt IRs), evaluation time per tick,
+// IR bytes per second as the wire carries them (compliance rows, lab/tradeoff_wire_bytes.h), memory
 // (K, its factor, compliance columns) and CPU per second of session (simulation steps +
 // evaluations). Units as the column names say.
 #pragma once
@@ -45,7 +45,7 @@ struct TradeoffSetting {
   int patch_rings = 1;
   IrPrecision precision = IrPrecision::f64;
   double boundary_truncation = 0;
-  double ir_rate_hz = 0;          ///< 0: a new IR on every set change; else at most this many per second
+  double ir_rate_hz = 0;  ///< 0: a new IR on every set change; else at most this many per second
   double haptic_rate_hz = 1000;
 
   std::string name() const { return knob == "baseline" ? knob : knob + " " + value; }
@@ -74,28 +74,29 @@ struct ReferenceTrace {
   double peak_force = 0;                                ///< max |force| [N]
   int nodes = 0, tets = 0;
   std::size_t factorisations = 0;
-  double seconds = 0;                                   ///< to build the model and solve
+  double seconds = 0;  ///< to build the model and solve
 };
 
 /// Samples `motions` (one per scene tool) every 1 / sample_rate_hz s and solves the
 /// `reference` scene in full at each sample.
-ReferenceTrace reference_trace(const Scene& reference, const std::vector<Trajectory>& motions, double sample_rate_hz);
+ReferenceTrace reference_trace(const Scene& reference, const std::vector<Trajectory>& motions,
+                               double sample_rate_hz);
 
 struct TradeoffRow {
   TradeoffSetting setting;
   int nodes = 0, tets = 0;
-  double error_rms = 0;           ///< RMS over samples and tools of |F - F_ref|, over the reference's peak
-  double error_max = 0;           ///< max of the same, over the peak
-  /// The same against the full solve (the sphere model's, or node translation) on the setting's own mesh, over the
-  /// same (the reference's) peak, so that both columns share a scale: what the
-  /// IR pipeline itself costs in accuracy (patch, update policy, precision, haptic rate,
-  /// truncation, contact model), without the discretisation.
+  double error_rms = 0;  ///< RMS over samples and tools of |F - F_ref|, over the reference's peak
+  double error_max = 0;  ///< max of the same, over the peak
+  /// The same against the full solve (the sphere model's, or node translation) on the setting's own
+  /// mesh, over the same (the reference's) peak, so that both columns share a scale: what the IR
+  /// pipeline itself costs in accuracy (patch, update policy, precision, haptic rate, truncation,
+  /// contact model), without the discretisation.
   double own_mesh_error_rms = 0, own_mesh_error_max = 0;
-  double precompute_s = 0;        ///< model build (assembly, factorisation) + compliance precompute
+  double precompute_s = 0;  ///< model build (assembly, factorisation) + compliance precompute
   double mtilde_ms_p50 = 0, mtilde_ms_p99 = 0;  ///< per step that rebuilt the IRs (all users)
-  double evaluation_us = 0;       ///< per haptic tick and user (median)
-  double ir_bytes_per_s = 0;      ///< IRs sent to all users, per second of workload
-  double memory_mb = 0;           ///< K + factor of K_ff + compliance columns
+  double evaluation_us = 0;                     ///< per haptic tick and user (median)
+  double ir_bytes_per_s = 0;                    ///< IRs sent to all users, per second of workload
+  double memory_mb = 0;                         ///< K + factor of K_ff + compliance columns
   /// Simulation steps + evaluations per second of workload: steps that rebuilt IRs as timed,
   /// the others and the evaluations at their median time (robust to scheduler hiccups).
   double cpu_ms_per_s = 0;
@@ -103,8 +104,8 @@ struct TradeoffRow {
 };
 
 /// Runs the workload with `setting` against `reference` (sampled from the same motions).
-TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting, const std::vector<Trajectory>& motions,
-                        const ReferenceTrace& reference);
+TradeoffRow run_setting(const Scene& scene, const TradeoffSetting& setting,
+                        const std::vector<Trajectory>& motions, const ReferenceTrace& reference);
 
 /// Whether each point is on the Pareto front of (error, cost), both to be small: no other
 /// point is at least as good in both and better in one.

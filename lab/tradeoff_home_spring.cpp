@@ -19,7 +19,8 @@ namespace {
 double tissue_memory_mb(const HomeSpringBody& body) {
   const double vertices = static_cast<double>(body.surface.vertex_count()) * 3 * sizeof(double);
   const double triangles = static_cast<double>(body.surface.triangle_count()) * 3 * sizeof(int);
-  const double rings = static_cast<double>(body.rings.offsets.size() + body.rings.vertices.size()) * sizeof(int);
+  const double rings =
+      static_cast<double>(body.rings.offsets.size() + body.rings.vertices.size()) * sizeof(int);
   return (vertices + triangles + rings) / 1e6;
 }
 
@@ -27,10 +28,13 @@ double tissue_memory_mb(const HomeSpringBody& body) {
 
 TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajectory>& motions,
                                     const ReferenceTrace& reference, int per_step, int per_tick) {
-  if (scene.objects.size() != 1 || !std::holds_alternative<HomeSpringObjectSpec>(scene.objects.front().body))
-    throw Error(fmt::format("{}: the home-spring trade-off needs a scene of one home_spring object", scene.file.string()));
+  if (scene.objects.size() != 1 ||
+      !std::holds_alternative<HomeSpringObjectSpec>(scene.objects.front().body))
+    throw Error(fmt::format("{}: the home-spring trade-off needs a scene of one home_spring object",
+                            scene.file.string()));
   const std::size_t users = scene.tools.size();
-  if (motions.size() != users || reference.positions.empty() || reference.positions.front().size() != users)
+  if (motions.size() != users || reference.positions.empty() ||
+      reference.positions.front().size() != users)
     throw Error("tradeoff: the reference, the motions and the scene's tools do not match");
   TradeoffRow row;
   row.setting.knob = "model";
@@ -44,7 +48,8 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
   row.nodes = body.surface.vertex_count();
   row.memory_mb = tissue_memory_mb(body);
 
-  constexpr double kUnlimited = std::numeric_limits<double>::infinity();  // compare the physics, not the limiter
+  constexpr double kUnlimited =
+      std::numeric_limits<double>::infinity();  // compare the physics, not the limiter
   HomeSpringSimulation server(body, 0, scene.tools, kUnlimited);
   HomeSpringSimulation every_sample(body, 0, scene.tools, kUnlimited);
   std::vector<std::shared_ptr<const PreparedIR>> published(users);
@@ -73,7 +78,8 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
         held[u] = evaluate_force(*published[u], stateless, positions[u], {}, 0).force;
         tally.evaluation(1000 * evaluation.elapsed_ms());
       }
-    for (std::size_t u = 0; u < users; ++u) every_sample.set_tool(static_cast<int>(u), positions[u]);
+    for (std::size_t u = 0; u < users; ++u)
+      every_sample.set_tool(static_cast<int>(u), positions[u]);
     every_sample.step(t);
     for (std::size_t u = 0; u < users; ++u)
       tally.sample(held[u], reference.forces[j][u], every_sample.force(static_cast<int>(u)).force);

@@ -22,10 +22,12 @@ namespace {
 
 MassSpringObjectSpec& only_mass_spring_object(Scene& scene) {
   MassSpringObjectSpec* object =
-      scene.objects.size() == 1 ? std::get_if<MassSpringObjectSpec>(&scene.objects.front().body) : nullptr;
+      scene.objects.size() == 1 ? std::get_if<MassSpringObjectSpec>(&scene.objects.front().body)
+                                : nullptr;
   if (!object)
-    throw Error(fmt::format("{}: the mass-spring trade-off needs a scene whose only object is mass_spring",
-                            scene.file.string()));
+    throw Error(
+        fmt::format("{}: the mass-spring trade-off needs a scene whose only object is mass_spring",
+                    scene.file.string()));
   return *object;
 }
 
@@ -45,13 +47,15 @@ std::vector<MassSpringTradeoffSetting> mass_spring_tradeoff_grid(const Scene& sc
   return grid;
 }
 
-MassSpringTradeoffRow run_mass_spring_setting(const Scene& scene, const MassSpringTradeoffSetting& setting,
+MassSpringTradeoffRow run_mass_spring_setting(const Scene& scene,
+                                              const MassSpringTradeoffSetting& setting,
                                               const std::vector<Trajectory>& motions) {
   Scene varied = scene;
   MassSpringObjectSpec& object = only_mass_spring_object(varied);
   if (motions.size() != varied.tools.size())
-    throw Error(fmt::format("tradeoff: {} motions for the scene's {} tools (give one --motion per tool)", motions.size(),
-                            varied.tools.size()));
+    throw Error(
+        fmt::format("tradeoff: {} motions for the scene's {} tools (give one --motion per tool)",
+                    motions.size(), varied.tools.size()));
   object.ir.rate_hz = setting.ir_rate_hz;
   const Model model = build_model(varied);
   const MassSpringModel& built = std::get<MassSpringModel>(model.bodies.front());
@@ -62,7 +66,8 @@ MassSpringTradeoffRow run_mass_spring_setting(const Scene& scene, const MassSpri
   row.whole = 2 * body.spec.ir.sections + 1 >= body.section_count;
 
   // No force limit: the physics is compared, not the limiter.
-  MassSpringSimulation server(body, 0, varied.tools, std::numeric_limits<double>::infinity(), 1 / varied.haptic.rate_hz);
+  MassSpringSimulation server(body, 0, varied.tools, std::numeric_limits<double>::infinity(),
+                              1 / varied.haptic.rate_hz);
   const std::size_t users = varied.tools.size();
   std::vector<std::shared_ptr<const PreparedIR>> client_ir(users);
   std::vector<EvaluationState> client_state(users);
@@ -86,16 +91,19 @@ MassSpringTradeoffRow run_mass_spring_setting(const Scene& scene, const MassSpri
       if (client_ir[u]) {
         const auto& network = std::get<MassSpringIr>(client_ir[u]->ir.body);
         const std::size_t count = network.remote_users.size();
-        for (std::size_t r = 0; r < count; ++r) remotes[r] = positions[static_cast<std::size_t>(network.remote_users[r])];
+        for (std::size_t r = 0; r < count; ++r)
+          remotes[r] = positions[static_cast<std::size_t>(network.remote_users[r])];
         const Stopwatch evaluation;
-        client = evaluate_force(*client_ir[u], client_state[u], positions[u], std::span(remotes.data(), count), dt);
+        client = evaluate_force(*client_ir[u], client_state[u], positions[u],
+                                std::span(remotes.data(), count), dt);
         evaluation_us.push_back(1000 * evaluation.elapsed_ms());
       }
       const NetworkToolReaction& reference = server.reaction(static_cast<int>(u));
       const double error = (client.force - reference.force).norm();
       sum_squared += error * error;
       worst = std::max(worst, error);
-      if (((client.flags & kInContact) != 0) == reference.colliding) worst_agreeing = std::max(worst_agreeing, error);
+      if (((client.flags & kInContact) != 0) == reference.colliding)
+        worst_agreeing = std::max(worst_agreeing, error);
       row.peak_force = std::max(row.peak_force, reference.force.norm());
     }
     // The IRs cut in this step reach the clients for the next tick.
@@ -110,7 +118,8 @@ MassSpringTradeoffRow run_mass_spring_setting(const Scene& scene, const MassSpri
     }
   }
   const double peak = std::max(row.peak_force, 1e-300);
-  row.error_rms = std::sqrt(sum_squared / static_cast<double>(static_cast<std::size_t>(ticks) * users)) / peak;
+  row.error_rms =
+      std::sqrt(sum_squared / static_cast<double>(static_cast<std::size_t>(ticks) * users)) / peak;
   row.error_max = worst / peak;
   row.error_max_same_contact = worst_agreeing / peak;
   row.ir_nodes = row.irs_sent > 0 ? ir_nodes / row.irs_sent : 0;
@@ -122,17 +131,21 @@ MassSpringTradeoffRow run_mass_spring_setting(const Scene& scene, const MassSpri
   return row;
 }
 
-int run_mass_spring_tradeoff(const Scene& scene, const std::vector<Trajectory>& motions, const TradeoffOptions& options) {
+int run_mass_spring_tradeoff(const Scene& scene, const std::vector<Trajectory>& motions,
+                             const TradeoffOptions& options) {
   const std::vector<MassSpringTradeoffSetting> grid = mass_spring_tradeoff_grid(scene);
   std::vector<MassSpringTradeoffRow> rows;
   for (std::size_t i = 0; i < grid.size(); ++i) {
     const Stopwatch watch;
     rows.push_back(run_mass_spring_setting(scene, grid[i], motions));
     const MassSpringTradeoffRow& r = rows.back();
-    spdlog::info("[{}/{}] sections {}, IR {:g} Hz: error RMS {:.3f} % (max {:.3f} %), {:.0f} nodes per IR, {:.1f} kB/s, "
-                 "client {:.2f} µs per tick ({:.1f} s)",
-                 i + 1, grid.size(), sections_name(r), r.setting.ir_rate_hz, 100 * r.error_rms, 100 * r.error_max,
-                 r.ir_nodes, r.ir_bytes_per_s / 1000, r.evaluation_us, watch.elapsed_ms() / 1000);
+    spdlog::info(
+        "[{}/{}] sections {}, IR {:g} Hz: error RMS {:.3f} % (max {:.3f} %), {:.0f} nodes per IR, "
+        "{:.1f} kB/s, "
+        "client {:.2f} µs per tick ({:.1f} s)",
+        i + 1, grid.size(), sections_name(r), r.setting.ir_rate_hz, 100 * r.error_rms,
+        100 * r.error_max, r.ir_nodes, r.ir_bytes_per_s / 1000, r.evaluation_us,
+        watch.elapsed_ms() / 1000);
   }
   std::vector<double> error, bytes, cpu;
   for (const MassSpringTradeoffRow& r : rows) {
@@ -140,33 +153,41 @@ int run_mass_spring_tradeoff(const Scene& scene, const std::vector<Trajectory>& 
     bytes.push_back(r.ir_bytes_per_s);
     cpu.push_back(r.evaluation_us);
   }
-  const std::vector<bool> bytes_front = pareto_front(error, bytes), cpu_front = pareto_front(error, cpu);
+  const std::vector<bool> bytes_front = pareto_front(error, bytes),
+                          cpu_front = pareto_front(error, cpu);
 
   AtomicFile csv(options.out / "tradeoff.csv");
-  csv.write("sections,ir_rate_hz,ir_nodes,error_rms_pct,error_max_pct,error_max_same_contact_pct,peak_force_n,evaluation_us_p50,evaluation_us_p99,"
-            "ir_bytes_per_s,irs_sent,front_cpu,front_bytes\n");
+  csv.write(
+      "sections,ir_rate_hz,ir_nodes,error_rms_pct,error_max_pct,error_max_same_contact_pct,peak_"
+      "force_n,evaluation_us_p50,evaluation_us_p99,"
+      "ir_bytes_per_s,irs_sent,front_cpu,front_bytes\n");
   AtomicFile md(options.out / "tradeoff.md");
-  md.print("# Speed against accuracy: {} (mass-spring)\n\nReference: the server's whole network ({} nodes) run with "
-           "every tool at the haptic rate ({:g} Hz); peak force {:.4f} N. Workload: {}.\n\n"
-           "| sections | IR Hz | nodes per IR | error RMS % | error max % | max % where both agree on contact | client µs "
-           "p50 / p99 | IR kB/s | front |\n|---|---|---|---|---|---|---|---|---|\n",
-           scene.name, std::get<MassSpringModel>(build_model(scene).bodies.front()).network.node_count(),
-           scene.haptic.rate_hz, rows.empty() ? 0.0 : rows.front().peak_force, [&] {
-             std::string names;
-             for (const auto& file : options.motions) names += (names.empty() ? "" : ", ") + file.filename().string();
-             return names;
-           }());
+  md.print(
+      "# Speed against accuracy: {} (mass-spring)\n\nReference: the server's whole network ({} "
+      "nodes) run with "
+      "every tool at the haptic rate ({:g} Hz); peak force {:.4f} N. Workload: {}.\n\n"
+      "| sections | IR Hz | nodes per IR | error RMS % | error max % | max % where both agree on "
+      "contact | client µs "
+      "p50 / p99 | IR kB/s | front |\n|---|---|---|---|---|---|---|---|---|\n",
+      scene.name, std::get<MassSpringModel>(build_model(scene).bodies.front()).network.node_count(),
+      scene.haptic.rate_hz, rows.empty() ? 0.0 : rows.front().peak_force, [&] {
+        std::string names;
+        for (const auto& file : options.motions)
+          names += (names.empty() ? "" : ", ") + file.filename().string();
+        return names;
+      }());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const MassSpringTradeoffRow& r = rows[i];
     std::string front = cpu_front[i] ? "CPU" : "";
     if (bytes_front[i]) front += front.empty() ? "bytes" : ", bytes";
-    csv.print("{},{:g},{:.1f},{:.4g},{:.4g},{:.4g},{:.6g},{:.4g},{:.4g},{:.6g},{},{},{}\n", sections_name(r),
-              r.setting.ir_rate_hz, r.ir_nodes, 100 * r.error_rms, 100 * r.error_max, 100 * r.error_max_same_contact,
-              r.peak_force, r.evaluation_us, r.evaluation_us_p99,
-              r.ir_bytes_per_s, r.irs_sent, cpu_front[i] ? 1 : 0, bytes_front[i] ? 1 : 0);
-    md.print("| {} | {:g} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | {:.2f} / {:.2f} | {:.1f} | {} |\n", sections_name(r),
-             r.setting.ir_rate_hz, r.ir_nodes, 100 * r.error_rms, 100 * r.error_max, 100 * r.error_max_same_contact,
-             r.evaluation_us,
+    csv.print("{},{:g},{:.1f},{:.4g},{:.4g},{:.4g},{:.6g},{:.4g},{:.4g},{:.6g},{},{},{}\n",
+              sections_name(r), r.setting.ir_rate_hz, r.ir_nodes, 100 * r.error_rms,
+              100 * r.error_max, 100 * r.error_max_same_contact, r.peak_force, r.evaluation_us,
+              r.evaluation_us_p99, r.ir_bytes_per_s, r.irs_sent, cpu_front[i] ? 1 : 0,
+              bytes_front[i] ? 1 : 0);
+    md.print("| {} | {:g} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | {:.2f} / {:.2f} | {:.1f} | {} |\n",
+             sections_name(r), r.setting.ir_rate_hz, r.ir_nodes, 100 * r.error_rms,
+             100 * r.error_max, 100 * r.error_max_same_contact, r.evaluation_us,
              r.evaluation_us_p99, r.ir_bytes_per_s / 1000, front);
   }
   csv.commit();

@@ -21,7 +21,8 @@ void TradeoffTally::published(std::size_t bytes) {
   ++irs_;
 }
 
-void TradeoffTally::sample(const Eigen::Vector3d& held, const Eigen::Vector3d& reference, const Eigen::Vector3d& own) {
+void TradeoffTally::sample(const Eigen::Vector3d& held, const Eigen::Vector3d& reference,
+                           const Eigen::Vector3d& own) {
   const double error = (held - reference).norm();
   sum_squared_ += error * error;
   worst_ = std::max(worst_, error);
@@ -30,7 +31,8 @@ void TradeoffTally::sample(const Eigen::Vector3d& held, const Eigen::Vector3d& r
   own_worst_ = std::max(own_worst_, own_error);
 }
 
-void TradeoffTally::finish(TradeoffRow& row, const ReferenceTrace& reference, std::size_t users) const {
+void TradeoffTally::finish(TradeoffRow& row, const ReferenceTrace& reference,
+                           std::size_t users) const {
   const std::size_t samples = reference.positions.size();
   const double duration = static_cast<double>(samples) / reference.sample_rate_hz;
   const double peak = std::max(reference.peak_force, 1e-300);
@@ -47,8 +49,11 @@ void TradeoffTally::finish(TradeoffRow& row, const ReferenceTrace& reference, st
   row.ir_bytes_per_s = bytes_ / duration;
   row.irs_sent = irs_;
   const double plain_steps_ms =
-      plain_step_ms_.empty() ? 0 : percentile(plain_step_ms_, 0.5) * static_cast<double>(plain_step_ms_.size());
-  const double evaluations_ms = row.evaluation_us * static_cast<double>(evaluation_us_.size()) / 1000;
+      plain_step_ms_.empty()
+          ? 0
+          : percentile(plain_step_ms_, 0.5) * static_cast<double>(plain_step_ms_.size());
+  const double evaluations_ms =
+      row.evaluation_us * static_cast<double>(evaluation_us_.size()) / 1000;
   row.cpu_ms_per_s = (rebuild_step_ms_ + plain_steps_ms + evaluations_ms) / duration;
 }
 

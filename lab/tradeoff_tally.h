@@ -25,7 +25,8 @@ class TradeoffTally {
   void evaluation(double us) { evaluation_us_.push_back(us); }
   /// One user's force at one sample: `held` (what the client outputs) against the
   /// reference's and against the setting's own full solve [N].
-  void sample(const Eigen::Vector3d& held, const Eigen::Vector3d& reference, const Eigen::Vector3d& own);
+  void sample(const Eigen::Vector3d& held, const Eigen::Vector3d& reference,
+              const Eigen::Vector3d& own);
 
   /// Fills row's errors, M~ times, evaluation time, IR bytes per second, CPU per second and
   /// IRs sent, for a workload of `samples` samples of `users` users.

@@ -5,7 +5,8 @@
 
 namespace cohaptic {
 
-TradeoffWireBytes::TradeoffWireBytes(const ElasticBody& body, ComplianceSource& columns, std::size_t users)
+TradeoffWireBytes::TradeoffWireBytes(const ElasticBody& body, ComplianceSource& columns,
+                                     std::size_t users)
     : body_(body),
       columns_(columns),
       senders_(users),
@@ -26,7 +27,9 @@ std::size_t TradeoffWireBytes::published(const IntermediateRepresentation& ir, s
   std::vector<int> mesh_nodes;
   for (const std::int64_t tag : fem->held_node_ids()) mesh_nodes.push_back(node_of_tag_.at(tag));
   senders_.at(user).convert(sent_fem, mesh_nodes, columns_, body_.dofs);
-  return streams_.at(user).compress(wire::to_wire(sent), sent_fem.compliance_rows->generation == 1).ByteSizeLong();
+  return streams_.at(user)
+      .compress(wire::to_wire(sent), sent_fem.compliance_rows->generation == 1)
+      .ByteSizeLong();
 }
 
 }  // namespace cohaptic

@@ -7,7 +7,8 @@
 namespace cohaptic::net {
 
 BoundedWriteQueue::BoundedWriteQueue(std::size_t max_waiting) : max_waiting_(max_waiting) {
-  if (max_waiting == 0) throw Error("BoundedWriteQueue: at least one frame must be allowed to wait");
+  if (max_waiting == 0)
+    throw Error("BoundedWriteQueue: at least one frame must be allowed to wait");
 }
 
 BoundedWriteQueue::Push BoundedWriteQueue::push(std::vector<std::uint8_t> frame, FrameKind kind) {
@@ -15,7 +16,9 @@ BoundedWriteQueue::Push BoundedWriteQueue::push(std::vector<std::uint8_t> frame,
     waiting_.push_back({std::move(frame), kind});
     return Push::queued;
   }
-  const auto is_newest_wins = [](const Entry& entry) { return entry.kind == FrameKind::newest_wins; };
+  const auto is_newest_wins = [](const Entry& entry) {
+    return entry.kind == FrameKind::newest_wins;
+  };
   const auto superseding = std::count_if(waiting_.begin(), waiting_.end(), is_newest_wins) +
                            (kind == FrameKind::newest_wins ? 1 : 0);
   if (superseding < 2) return Push::refused;  // nothing waiting is superseded by a newer frame

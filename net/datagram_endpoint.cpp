@@ -15,7 +15,8 @@ namespace cohaptic::net {
 using asio::ip::udp;
 
 DatagramEndpoint::DatagramEndpoint(asio::io_context& io, const udp::endpoint& local,
-                                   std::unique_ptr<wire::DatagramInspector> inspector, RateLimit limit)
+                                   std::unique_ptr<wire::DatagramInspector> inspector,
+                                   RateLimit limit)
     : socket_(io), inspector_(std::move(inspector)), limiter_(limit) {
   socket_.open(local.protocol());
   socket_.bind(local);
@@ -75,7 +76,8 @@ void DatagramEndpoint::take(std::size_t bytes) {
     inspector_->count_unread(wire::Rejection::rate_limited);
     return;
   }
-  if (std::optional<wire::Datagram> datagram = inspector_->inspect(std::span(buffer_.data(), bytes))) {
+  if (std::optional<wire::Datagram> datagram =
+          inspector_->inspect(std::span(buffer_.data(), bytes))) {
     if (!admitted) limiter_.prove(from_.address(), arrival);
     on_datagram_(std::move(*datagram), from_, arrival);
   } else if (!admitted) {
@@ -96,9 +98,10 @@ void DatagramEndpoint::distrust(const udp::endpoint& peer) { std::erase(trusted_
 
 void DatagramEndpoint::send(std::vector<std::uint8_t> datagram, const udp::endpoint& to) {
   auto bytes = std::make_shared<std::vector<std::uint8_t>>(std::move(datagram));
-  socket_.async_send_to(asio::buffer(*bytes), to, [bytes, sent = sent_](std::error_code error, std::size_t) {
-    if (!error) sent->fetch_add(1, std::memory_order_relaxed);
-  });
+  socket_.async_send_to(asio::buffer(*bytes), to,
+                        [bytes, sent = sent_](std::error_code error, std::size_t) {
+                          if (!error) sent->fetch_add(1, std::memory_order_relaxed);
+                        });
 }
 
 void DatagramEndpoint::close() {

@@ -33,7 +33,8 @@
 
 namespace cohaptic::net {
 
-/// The receive buffer: every valid datagram (at most wire::kMaxDatagramBytes) fits with room to spare.
+/// The receive buffer: every valid datagram (at most wire::kMaxDatagramBytes) fits with room to
+/// spare.
 inline constexpr std::size_t kDatagramBufferBytes = 2048;
 static_assert(kDatagramBufferBytes > wire::kMaxDatagramBytes);
 /// The socket's kernel receive queue asked for (the kernel caps it at net.core.rmem_max).
@@ -43,8 +44,8 @@ inline constexpr int kReadsPerWakeUp = 64;
 
 class DatagramEndpoint {
  public:
-  using Handler =
-      std::function<void(wire::Datagram&& datagram, const asio::ip::udp::endpoint& from, std::int64_t arrival_ns)>;
+  using Handler = std::function<void(wire::Datagram&& datagram, const asio::ip::udp::endpoint& from,
+                                     std::int64_t arrival_ns)>;
 
   /// Opens and binds the socket (port 0: any free port). Throws std::system_error if it cannot.
   DatagramEndpoint(asio::io_context& io, const asio::ip::udp::endpoint& local,
@@ -87,7 +88,8 @@ class DatagramEndpoint {
   asio::ip::udp::endpoint from_;
   std::uint16_t port_ = 0;
   // Shared with pending sends' handlers, which may run after this endpoint is gone.
-  std::shared_ptr<std::atomic<std::uint64_t>> sent_ = std::make_shared<std::atomic<std::uint64_t>>(0);
+  std::shared_ptr<std::atomic<std::uint64_t>> sent_ =
+      std::make_shared<std::atomic<std::uint64_t>>(0);
   std::atomic<std::uint64_t> kernel_dropped_{0};
 };
 

@@ -17,15 +17,16 @@ namespace {
 std::optional<std::uint64_t> kernel_unacknowledged_bytes(tcp::socket& socket) {
 #ifdef TIOCOUTQ
   int bytes = 0;
-  if (::ioctl(socket.native_handle(), TIOCOUTQ, &bytes) == 0 && bytes >= 0) return static_cast<std::uint64_t>(bytes);
+  if (::ioctl(socket.native_handle(), TIOCOUTQ, &bytes) == 0 && bytes >= 0)
+    return static_cast<std::uint64_t>(bytes);
 #endif
   return std::nullopt;
 }
 
 }  // namespace
 
-FramedConnection::FramedConnection(Passkey, tcp::socket socket, wire::FrameReader reader, Handlers handlers,
-                                   std::chrono::milliseconds write_timeout)
+FramedConnection::FramedConnection(Passkey, tcp::socket socket, wire::FrameReader reader,
+                                   Handlers handlers, std::chrono::milliseconds write_timeout)
     : socket_(std::move(socket)),
       reader_(std::move(reader)),
       handlers_(std::make_shared<const Handlers>(std::move(handlers))),
@@ -38,36 +39,42 @@ FramedConnection::FramedConnection(Passkey, tcp::socket socket, wire::FrameReade
   if (!error) peer_address_ = remote.address();
 }
 
-std::shared_ptr<FramedConnection> FramedConnection::start(tcp::socket socket, wire::FrameReader reader,
-                                                          Handlers handlers, std::chrono::milliseconds write_timeout) {
-  auto connection = std::make_shared<FramedConnection>(Passkey{}, std::move(socket), std::move(reader), std::move(handlers),
-                                                       write_timeout);
+std::shared_ptr<FramedConnection> FramedConnection::start(tcp::socket socket,
+                                                          wire::FrameReader reader,
+                                                          Handlers handlers,
+                                                          std::chrono::milliseconds write_timeout) {
+  auto connection = std::make_shared<FramedConnection>(
+      Passkey{}, std::move(socket), std::move(reader), std::move(handlers), write_timeout);
   connection->read_next();
   return connection;
 }
 
 void FramedConnection::read_next() {
-  socket_.async_read_some(asio::buffer(buffer_), [self = shared_from_this()](std::error_code error, std::size_t n) {
-    if (self->closed_) return;
-    if (error) {
-      if (error == asio::error::eof) self->fail(CloseCause::peer_closed, "closed by the peer");
-      else self->fail(CloseCause::io_error, error.message());
-      return;
-    }
-    try {
-      self->reader_.feed(std::span(self->buffer_.data(), n));
-      const std::shared_ptr<const Handlers> handlers = self->handlers_;
-      while (auto control = self->reader_.next()) {
-        handlers->on_control(*control);
-        if (self->closed_) return;  // the owner closed it while handling the frame
-      }
-    } catch (const wire::FrameError& e) {
-      self->rejection_ = e.reason();
-      self->fail(CloseCause::rejected_frame, e.what());
-      return;
-    }
-    self->read_next();
-  });
+  socket_.async_read_some(asio::buffer(buffer_),
+                          [self = shared_from_this()](std::error_code error, std::size_t n) {
+                            if (self->closed_) return;
+                            if (error) {
+                              if (error == asio::error::eof)
+                                self->fail(CloseCause::peer_closed, "closed by the peer");
+                              else
+                                self->fail(CloseCause::io_error, error.message());
+                              return;
+                            }
+                            try {
+                              self->reader_.feed(std::span(self->buffer_.data(), n));
+                              const std::shared_ptr<const Handlers> handlers = self->handlers_;
+                              while (auto control = self->reader_.next()) {
+                                handlers->on_control(*control);
+                                if (self->closed_)
+                                  return;  // the owner closed it while handling the frame
+                              }
+                            } catch (const wire::FrameError& e) {
+                              self->rejection_ = e.reason();
+                              self->fail(CloseCause::rejected_frame, e.what());
+                              return;
+                            }
+                            self->read_next();
+                          });
 }
 
 FramedConnection::Sent FramedConnection::send(std::vector<std::uint8_t> frame, FrameKind kind) {
@@ -75,7 +82,8 @@ FramedConnection::Sent FramedConnection::send(std::vector<std::uint8_t> frame, F
   const BoundedWriteQueue::Push pushed = queue_.push(std::move(frame), kind);
   if (pushed == BoundedWriteQueue::Push::refused) {
     fail(CloseCause::write_queue_full,
-         fmt::format("the peer stopped reading: {} frames that must arrive are waiting", queue_.waiting()));
+         fmt::format("the peer stopped reading: {} frames that must arrive are waiting",
+                     queue_.waiting()));
     return Sent::closed;
   }
   write_next();
@@ -94,26 +102,30 @@ void FramedConnection::write_next() {
   write_timer_.async_wait([self = shared_from_this(), write](std::error_code error) {
     if (error || self->closed_ || self->writes_started_ != write || !self->queue_.writing()) return;
     self->fail(CloseCause::write_stalled,
-               fmt::format("the peer stopped reading: a frame has waited {:.1f} s to be written, {} more behind it",
-                           std::chrono::duration<double>(self->write_timeout_).count(), self->queue_.waiting()));
+               fmt::format("the peer stopped reading: a frame has waited {:.1f} s to be written, "
+                           "{} more behind it",
+                           std::chrono::duration<double>(self->write_timeout_).count(),
+                           self->queue_.waiting()));
   });
-  asio::async_write(socket_, asio::buffer(*frame), [self = shared_from_this()](std::error_code error, std::size_t written) {
-    self->queue_.end_write();
-    if (self->closed_) return;
-    if (error) {
-      self->fail(CloseCause::io_error, error.message());
-      return;
-    }
-    self->bytes_written_ += written;
-    self->watch_delivery();
-    self->write_next();
-  });
+  asio::async_write(socket_, asio::buffer(*frame),
+                    [self = shared_from_this()](std::error_code error, std::size_t written) {
+                      self->queue_.end_write();
+                      if (self->closed_) return;
+                      if (error) {
+                        self->fail(CloseCause::io_error, error.message());
+                        return;
+                      }
+                      self->bytes_written_ += written;
+                      self->watch_delivery();
+                      self->write_next();
+                    });
 }
 
 void FramedConnection::watch_delivery() {
   if (watching_delivery_) return;
   watching_delivery_ = true;
-  acknowledged_at_ = std::chrono::steady_clock::now();  // all was acknowledged when the watch last ended
+  acknowledged_at_ =
+      std::chrono::steady_clock::now();  // all was acknowledged when the watch last ended
   check_delivery();
 }
 
@@ -124,13 +136,15 @@ void FramedConnection::check_delivery() {
     return;
   }
   const auto now = std::chrono::steady_clock::now();
-  if (const std::uint64_t acknowledged = bytes_written_ - *waiting; acknowledged > bytes_acknowledged_) {
+  if (const std::uint64_t acknowledged = bytes_written_ - *waiting;
+      acknowledged > bytes_acknowledged_) {
     bytes_acknowledged_ = acknowledged;
     acknowledged_at_ = now;
   } else if (now - acknowledged_at_ >= 2 * write_timeout_) {
     fail(CloseCause::write_stalled,
-         fmt::format("the peer stopped reading: {} bytes sent have waited {:.1f} s for it to take any", *waiting,
-                     std::chrono::duration<double>(now - acknowledged_at_).count()));
+         fmt::format(
+             "the peer stopped reading: {} bytes sent have waited {:.1f} s for it to take any",
+             *waiting, std::chrono::duration<double>(now - acknowledged_at_).count()));
     return;
   }
   delivery_timer_.expires_after(write_timeout_ / 5);
@@ -154,8 +168,8 @@ void FramedConnection::fail(CloseCause cause, std::string why) {
   if (closed_) return;
   std::shared_ptr<const Handlers> handlers = handlers_;
   close();
-  asio::post(socket_.get_executor(), [self = shared_from_this(), handlers = std::move(handlers), cause,
-                                      why = std::move(why)] {
+  asio::post(socket_.get_executor(), [self = shared_from_this(), handlers = std::move(handlers),
+                                      cause, why = std::move(why)] {
     if (handlers->on_close) handlers->on_close(cause, why);
   });
 }

@@ -45,7 +45,13 @@ inline constexpr std::size_t kReadBufferBytes = 64 * 1024;
 /// A frame not taken by the kernel within this time means the peer has stopped reading.
 inline constexpr std::chrono::milliseconds kWriteTimeout{5000};
 
-enum class CloseCause : std::uint8_t { peer_closed, io_error, rejected_frame, write_queue_full, write_stalled };
+enum class CloseCause : std::uint8_t {
+  peer_closed,
+  io_error,
+  rejected_frame,
+  write_queue_full,
+  write_stalled
+};
 
 class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
  public:
@@ -56,11 +62,12 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
   enum class Sent : std::uint8_t { queued, queued_after_drop, closed };
 
   /// Takes over a connected socket and starts reading. Call on the I/O thread (or before it runs).
-  static std::shared_ptr<FramedConnection> start(asio::ip::tcp::socket socket, wire::FrameReader reader,
-                                                 Handlers handlers,
-                                                 std::chrono::milliseconds write_timeout = kWriteTimeout);
+  static std::shared_ptr<FramedConnection> start(
+      asio::ip::tcp::socket socket, wire::FrameReader reader, Handlers handlers,
+      std::chrono::milliseconds write_timeout = kWriteTimeout);
 
-  /// Queues a sealed frame; `closed` if the connection is (or, its queue overflowing, becomes) closed.
+  /// Queues a sealed frame; `closed` if the connection is (or, its queue overflowing, becomes)
+  /// closed.
   Sent send(std::vector<std::uint8_t> frame, FrameKind kind);
   /// Closes the socket; pending operations end, no handler is called any more.
   void close();
@@ -83,8 +90,8 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
     friend class FramedConnection;
     Passkey() = default;
   };
-  FramedConnection(Passkey, asio::ip::tcp::socket socket, wire::FrameReader reader, Handlers handlers,
-                   std::chrono::milliseconds write_timeout);
+  FramedConnection(Passkey, asio::ip::tcp::socket socket, wire::FrameReader reader,
+                   Handlers handlers, std::chrono::milliseconds write_timeout);
 
  private:
   void read_next();
@@ -97,14 +104,16 @@ class FramedConnection : public std::enable_shared_from_this<FramedConnection> {
 
   asio::ip::tcp::socket socket_;
   wire::FrameReader reader_;
-  std::shared_ptr<const Handlers> handlers_;  // a handler running keeps them alive if it closes the connection
+  std::shared_ptr<const Handlers>
+      handlers_;  // a handler running keeps them alive if it closes the connection
   BoundedWriteQueue queue_;
   asio::steady_timer write_timer_;  ///< runs while a write is in flight
   std::chrono::milliseconds write_timeout_;
   std::uint64_t writes_started_ = 0;
-  asio::steady_timer delivery_timer_;  ///< runs while written bytes wait for the peer's acknowledgement
-  std::uint64_t bytes_written_ = 0;       ///< taken by the kernel, since the start
-  std::uint64_t bytes_acknowledged_ = 0;  ///< by the peer's TCP, as last polled
+  asio::steady_timer
+      delivery_timer_;  ///< runs while written bytes wait for the peer's acknowledgement
+  std::uint64_t bytes_written_ = 0;                        ///< taken by the kernel, since the start
+  std::uint64_t bytes_acknowledged_ = 0;                   ///< by the peer's TCP, as last polled
   std::chrono::steady_clock::time_point acknowledged_at_;  ///< when that count last grew
   bool watching_delivery_ = false;
   std::optional<wire::Rejection> rejection_;

@@ -8,12 +8,15 @@ namespace cohaptic::net {
 
 SourceRateLimiter::SourceRateLimiter(RateLimit limit)
     : limit_(limit),
-      all_sources_{limit.all_sources_burst, limit.all_sources_refill_per_s, limit.all_sources_burst, 0} {
+      all_sources_{limit.all_sources_burst, limit.all_sources_refill_per_s, limit.all_sources_burst,
+                   0} {
   if (!(limit.burst >= 1) || !(limit.first_burst >= 1) || limit.first_burst > limit.burst ||
-      !(limit.refill_per_s > 0) || !(limit.all_sources_burst >= 1) || !(limit.all_sources_refill_per_s > 0) ||
-      limit.max_sources == 0 || limit.max_proven == 0)
-    throw Error("SourceRateLimiter: the bursts must be at least 1 (the first at most the burst), the refills "
-                "positive, and one source tracked");
+      !(limit.refill_per_s > 0) || !(limit.all_sources_burst >= 1) ||
+      !(limit.all_sources_refill_per_s > 0) || limit.max_sources == 0 || limit.max_proven == 0)
+    throw Error(
+        "SourceRateLimiter: the bursts must be at least 1 (the first at most the burst), the "
+        "refills "
+        "positive, and one source tracked");
 }
 
 SourceRateLimiter::Bucket* SourceRateLimiter::find(const asio::ip::address& source) {
@@ -23,7 +26,8 @@ SourceRateLimiter::Bucket* SourceRateLimiter::find(const asio::ip::address& sour
 }
 
 bool SourceRateLimiter::proven(const asio::ip::address& source) const {
-  return std::any_of(proven_.begin(), proven_.end(), [&](const Proven& p) { return p.source == source; });
+  return std::any_of(proven_.begin(), proven_.end(),
+                     [&](const Proven& p) { return p.source == source; });
 }
 
 bool SourceRateLimiter::limited(const asio::ip::address& source, std::int64_t now_ns) {
@@ -39,9 +43,10 @@ void SourceRateLimiter::charge(const asio::ip::address& source, std::int64_t now
     if (buckets_.size() < limit_.max_sources) {
       bucket = &buckets_.emplace_back();
     } else {
-      bucket = &*std::min_element(buckets_.begin(), buckets_.end(), [](const Bucket& a, const Bucket& b) {
-        return a.tokens.updated_ns < b.tokens.updated_ns;
-      });
+      bucket = &*std::min_element(buckets_.begin(), buckets_.end(),
+                                  [](const Bucket& a, const Bucket& b) {
+                                    return a.tokens.updated_ns < b.tokens.updated_ns;
+                                  });
     }
     const double tokens = proven(source) ? limit_.burst : limit_.first_burst;
     *bucket = Bucket{source, TokenBucket{limit_.burst, limit_.refill_per_s, tokens, now_ns}};
@@ -59,8 +64,9 @@ void SourceRateLimiter::prove(const asio::ip::address& source, std::int64_t now_
     proven_.push_back({source, now_ns});
     return;
   }
-  *std::min_element(proven_.begin(), proven_.end(),
-                    [](const Proven& a, const Proven& b) { return a.heard_ns < b.heard_ns; }) = {source, now_ns};
+  *std::min_element(proven_.begin(), proven_.end(), [](const Proven& a, const Proven& b) {
+    return a.heard_ns < b.heard_ns;
+  }) = {source, now_ns};
 }
 
 }  // namespace cohaptic::net

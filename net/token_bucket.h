@@ -17,7 +17,8 @@ struct TokenBucket {
 
   void refill(std::int64_t now_ns) {
     if (now_ns <= updated_ns) return;
-    tokens = std::min(capacity, tokens + static_cast<double>(now_ns - updated_ns) * 1e-9 * refill_per_s);
+    tokens =
+        std::min(capacity, tokens + static_cast<double>(now_ns - updated_ns) * 1e-9 * refill_per_s);
     updated_ns = now_ns;
   }
   /// Whether no event is allowed now.

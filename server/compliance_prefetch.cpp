@@ -9,7 +9,9 @@ namespace cohaptic {
 CompliancePrefetch::CompliancePrefetch(const ElasticBody& body, const std::vector<int>& row_nodes)
     : solver_(body.free_factor, body.dofs, row_nodes),
       row_positions_(body.mesh.nodes(Eigen::all, row_nodes)),
-      taken_(static_cast<std::size_t>(ComplianceColumns::group_of(static_cast<int>(row_nodes.size()) - 1) + 1), 0),
+      taken_(static_cast<std::size_t>(
+                 ComplianceColumns::group_of(static_cast<int>(row_nodes.size()) - 1) + 1),
+             0),
       distance_(taken_.size(), kNotQueued),
       worker_([this] { work(); }) {}
 
@@ -38,13 +40,15 @@ void CompliancePrefetch::request(std::span<const NodeDistance> nodes) {
   if (queued) wake_.notify_one();
 }
 
-void CompliancePrefetch::request_near(const Eigen::Vector3d& tool, const ComplianceColumns& columns) {
+void CompliancePrefetch::request_near(const Eigen::Vector3d& tool,
+                                      const ComplianceColumns& columns) {
   near_.clear();
   const std::vector<int>& rows = solver_.row_nodes();
   for (Eigen::Index r = 0; r < row_positions_.cols(); ++r) {
     const double distance = (row_positions_.col(r) - tool).norm();
     const int node = rows[static_cast<std::size_t>(r)];
-    if (distance < kToolReach && !columns.has_column(node)) near_.push_back({node, distance - kPatchRadius});
+    if (distance < kToolReach && !columns.has_column(node))
+      near_.push_back({node, distance - kPatchRadius});
   }
   request(near_);
 }
@@ -74,7 +78,8 @@ void CompliancePrefetch::work() {
       std::unique_lock lock(mutex_);
       // The nearest group queued (ties: the lowest index), the worker's from now on.
       const auto nearest = [this] {
-        return static_cast<std::size_t>(std::min_element(distance_.begin(), distance_.end()) - distance_.begin());
+        return static_cast<std::size_t>(std::min_element(distance_.begin(), distance_.end()) -
+                                        distance_.begin());
       };
       wake_.wait(lock, [&] { return stopping_ || distance_[nearest()] < kNotQueued; });
       if (stopping_) return;
@@ -84,7 +89,8 @@ void CompliancePrefetch::work() {
     }
     const std::size_t first = group * ComplianceColumns::kGroupSize;
     const std::size_t end = std::min(rows.size(), first + ComplianceColumns::kGroupSize);
-    group_nodes.assign(rows.begin() + static_cast<std::ptrdiff_t>(first), rows.begin() + static_cast<std::ptrdiff_t>(end));
+    group_nodes.assign(rows.begin() + static_cast<std::ptrdiff_t>(first),
+                       rows.begin() + static_cast<std::ptrdiff_t>(end));
     try {
       solver_.compute_columns(group_nodes);
     } catch (const std::exception& e) {

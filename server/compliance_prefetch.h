@@ -65,7 +65,7 @@ class CompliancePrefetch {
   static constexpr double kNotQueued = std::numeric_limits<double>::infinity();
   void work();
 
-  ComplianceColumns solver_;    // the worker's own: its CHOLMOD workspace, and the row layout
+  ComplianceColumns solver_;        // the worker's own: its CHOLMOD workspace, and the row layout
   Eigen::Matrix3Xd row_positions_;  // of the row nodes, in their order
   std::vector<NodeDistance> near_;  // request_near's scratch (the simulation thread's)
   std::mutex mutex_;

@@ -25,8 +25,9 @@ using asio::ip::udp;
 struct ConnectionHandler::Participant {
   std::shared_ptr<net::FramedConnection> connection;
   wire::Challenge challenge = wire::random_challenge();  // in the greeting; the Join must carry it
-  wire::FrameSealer sealer;                             // this connection's frames; keyed at the join
-  std::optional<wire::DatagramSealer> datagram_sealer;  // the datagrams to this user, from the join on
+  wire::FrameSealer sealer;  // this connection's frames; keyed at the join
+  std::optional<wire::DatagramSealer>
+      datagram_sealer;  // the datagrams to this user, from the join on
   int slot = -1;
   std::string user_name;
   udp::endpoint udp_endpoint;
@@ -34,7 +35,8 @@ struct ConnectionHandler::Participant {
   asio::steady_timer join_timer;
   net::TokenBucket datagram_budget;  // set at the join, from the user's haptic rate
   bool gone = false;
-  Participant(asio::io_context& io, std::uint64_t session, const LinkDelaySettings& shift, bool encrypt)
+  Participant(asio::io_context& io, std::uint64_t session, const LinkDelaySettings& shift,
+              bool encrypt)
       : sealer(session, wire::kServerSender, encrypt),
         to_client_udp(shift, false),
         to_client_tcp(shift, true),
@@ -46,15 +48,17 @@ namespace {
 
 std::vector<wire::TrafficKey> every_slot_key(const wire::SessionKey& key, std::size_t slots) {
   std::vector<wire::TrafficKey> keys;
-  for (std::size_t slot = 0; slot < slots; ++slot) keys.push_back(wire::participant_key(key, static_cast<std::uint32_t>(slot)));
+  for (std::size_t slot = 0; slot < slots; ++slot)
+    keys.push_back(wire::participant_key(key, static_cast<std::uint32_t>(slot)));
   return keys;
 }
 
 }  // namespace
 
-ConnectionHandler::ConnectionHandler(asio::io_context& io, const ServeOptions& options, wire::Welcome welcome,
-                                     const wire::SessionKey& key, std::uint64_t session, int max_participants,
-                                     ToolInputs& tools, record::SessionRecorder* recorder)
+ConnectionHandler::ConnectionHandler(asio::io_context& io, const ServeOptions& options,
+                                     wire::Welcome welcome, const wire::SessionKey& key,
+                                     std::uint64_t session, int max_participants, ToolInputs& tools,
+                                     record::SessionRecorder* recorder)
     : io_(io),
       options_(options),
       welcome_(std::move(welcome)),
@@ -110,8 +114,10 @@ void ConnectionHandler::warn_throttled(const std::string& message) {
     ++warnings_held_;
     return;
   }
-  if (warnings_held_ > 0) spdlog::warn("{} (and {} more such since the last one logged)", message, warnings_held_);
-  else spdlog::warn("{}", message);
+  if (warnings_held_ > 0)
+    spdlog::warn("{} (and {} more such since the last one logged)", message, warnings_held_);
+  else
+    spdlog::warn("{}", message);
   last_warning_ns_ = now;
   warnings_held_ = 0;
 }
@@ -123,7 +129,8 @@ void ConnectionHandler::accept() {
     if (error == asio::error::operation_aborted || !acceptor_.is_open()) return;  // closing
     if (error) {
       ++counters_.accept_errors;
-      warn_throttled(fmt::format("accept failed: {}; accepting again in {} ms", error.message(), kAcceptRetry.count()));
+      warn_throttled(fmt::format("accept failed: {}; accepting again in {} ms", error.message(),
+                                 kAcceptRetry.count()));
       accept_retry_.expires_after(kAcceptRetry);
       accept_retry_.async_wait([this](std::error_code timer_error) {
         if (!timer_error) accept();
@@ -150,16 +157,21 @@ void ConnectionHandler::accept() {
           const ParticipantPtr p = weak.lock();
           return p ? key_for(*p, sender) : nullptr;
         },
-        {.expect_greeting = false, .allow_cleartext = !options_.encrypt, .max_body_bytes = kMaxJoinFrameBytes});
-    participant->connection = net::FramedConnection::start(std::move(socket), std::move(reader), std::move(handlers));
+        {.expect_greeting = false,
+         .allow_cleartext = !options_.encrypt,
+         .max_body_bytes = kMaxJoinFrameBytes});
+    participant->connection =
+        net::FramedConnection::start(std::move(socket), std::move(reader), std::move(handlers));
     participants_.push_back(participant);
-    send_bytes(participant, wire::encode_greeting(participant->challenge), net::FrameKind::must_arrive, false);
+    send_bytes(participant, wire::encode_greeting(participant->challenge),
+               net::FrameKind::must_arrive, false);
     participant->join_timer.expires_after(kJoinTimeout);
     participant->join_timer.async_wait([this, weak](std::error_code timer_error) {
       const ParticipantPtr p = weak.lock();
       if (timer_error || !p || p->gone || p->slot >= 0) return;
       ++counters_.join_timeouts;
-      warn_throttled(fmt::format("connection from {} closed: no join within {} s", p->connection->peer(), kJoinTimeout.count()));
+      warn_throttled(fmt::format("connection from {} closed: no join within {} s",
+                                 p->connection->peer(), kJoinTimeout.count()));
       leave(p, "no join in time");
     });
     accept();
@@ -187,17 +199,22 @@ void ConnectionHandler::make_room_for_unjoined(const asio::ip::address& source) 
                                                                       : nullptr;
   if (!evicted) return;
   ++counters_.unjoined_evicted;
-  warn_throttled(fmt::format("connection from {} closed before its join to make room: {} not joined from {}, {} in all",
-                             evicted->connection->peer(), from_source, source.to_string(), in_all));
+  warn_throttled(fmt::format(
+      "connection from {} closed before its join to make room: {} not joined from {}, {} in all",
+      evicted->connection->peer(), from_source, source.to_string(), in_all));
   leave(evicted, "closed to make room for a newer connection");
 }
 
-void ConnectionHandler::closed(const ParticipantPtr& participant, net::CloseCause cause, const std::string& why) {
+void ConnectionHandler::closed(const ParticipantPtr& participant, net::CloseCause cause,
+                               const std::string& why) {
   const std::string& peer = participant->connection->peer();
   switch (cause) {
-    case net::CloseCause::peer_closed: leave(participant, "disconnected"); return;
+    case net::CloseCause::peer_closed:
+      leave(participant, "disconnected");
+      return;
     case net::CloseCause::rejected_frame:
-      reject_frame(participant, participant->connection->rejection().value_or(wire::Rejection::truncated), why);
+      reject_frame(participant,
+                   participant->connection->rejection().value_or(wire::Rejection::truncated), why);
       return;
     case net::CloseCause::write_queue_full:
       ++counters_.queue_overflows;
@@ -207,42 +224,53 @@ void ConnectionHandler::closed(const ParticipantPtr& participant, net::CloseCaus
       ++counters_.write_stalls;
       spdlog::warn("control connection to {}: {}", peer, why);
       break;
-    case net::CloseCause::io_error: break;
+    case net::CloseCause::io_error:
+      break;
   }
   leave(participant, why);
 }
 
-void ConnectionHandler::reject_frame(const ParticipantPtr& participant, wire::Rejection reason, const std::string& why) {
+void ConnectionHandler::reject_frame(const ParticipantPtr& participant, wire::Rejection reason,
+                                     const std::string& why) {
   ++counters_.frames_rejected;
   ++counters_.frames_rejected_by_reason[static_cast<std::size_t>(reason)];
-  warn_throttled(fmt::format("control connection from {} closed ({}): {}", participant->connection->peer(),
-                             wire::to_string(reason), why));
+  warn_throttled(fmt::format("control connection from {} closed ({}): {}",
+                             participant->connection->peer(), wire::to_string(reason), why));
   leave(participant, "protocol error");
 }
 
-const wire::TrafficKey* ConnectionHandler::key_for(const Participant& participant, std::uint32_t sender) const {
+const wire::TrafficKey* ConnectionHandler::key_for(const Participant& participant,
+                                                   std::uint32_t sender) const {
   if (participant.slot >= 0)  // joined: its own slot's key only
     return sender == wire::sender_of_slot(static_cast<std::uint32_t>(participant.slot))
                ? &slot_keys_[static_cast<std::size_t>(participant.slot)]
                : nullptr;
   if (sender == wire::kJoiningSender) return &joining_key_;
-  if (sender != wire::kServerSender && sender - 1 < slot_keys_.size()) return &slot_keys_[sender - 1];
+  if (sender != wire::kServerSender && sender - 1 < slot_keys_.size())
+    return &slot_keys_[sender - 1];
   return nullptr;
 }
 
-void ConnectionHandler::handle_control(const ParticipantPtr& participant, const wire::Control& control) {
-  if (control.has_join()) join(participant, control);
-  else if (control.has_bye()) leave(participant, "left: " + control.bye().reason());
-  else if (control.has_status() && participant->slot >= 0) client_status(*participant, control.status());
+void ConnectionHandler::handle_control(const ParticipantPtr& participant,
+                                       const wire::Control& control) {
+  if (control.has_join())
+    join(participant, control);
+  else if (control.has_bye())
+    leave(participant, "left: " + control.bye().reason());
+  else if (control.has_status() && participant->slot >= 0)
+    client_status(*participant, control.status());
 }
 
-void ConnectionHandler::client_status(const Participant& participant, const wire::ClientStatus& status) {
+void ConnectionHandler::client_status(const Participant& participant,
+                                      const wire::ClientStatus& status) {
   const auto& s = status;
-  for (double value : {s.haptic_rate_hz(), s.period_p99_us(), s.ir_age_p99_ms(), s.one_way_delay_p99_ms(),
-                       s.timer_floor_p99_us(), s.peak_force(), s.elapsed_s()})
+  for (double value :
+       {s.haptic_rate_hz(), s.period_p99_us(), s.ir_age_p99_ms(), s.one_way_delay_p99_ms(),
+        s.timer_floor_p99_us(), s.peak_force(), s.elapsed_s()})
     if (!std::isfinite(value)) {
       ++counters_.frames_rejected;
-      spdlog::warn("status of '{}' (slot {}) ignored: a value is not finite", participant.user_name, participant.slot);
+      spdlog::warn("status of '{}' (slot {}) ignored: a value is not finite", participant.user_name,
+                   participant.slot);
       return;
     }
   if (recorder_) {
@@ -257,31 +285,38 @@ void ConnectionHandler::client_status(const Participant& participant, const wire
 }
 
 // The slot `request` may take (-1 after a refusal, sent). `sender`: whose key sealed it.
-int ConnectionHandler::take_slot(const ParticipantPtr& participant, const wire::Join& request, std::uint32_t sender) {
+int ConnectionHandler::take_slot(const ParticipantPtr& participant, const wire::Join& request,
+                                 std::uint32_t sender) {
   const auto refuse = [&](const std::string& code, const std::string& text) {
     ++counters_.joins_refused;
     send_error(participant, code, text);
-    spdlog::warn("{} ('{}') refused: {}", participant->connection->peer(), printable(request.user_name()), text);
+    spdlog::warn("{} ('{}') refused: {}", participant->connection->peer(),
+                 printable(request.user_name()), text);
     return -1;
   };
   if (const std::string problem = wire::user_name_problem(request.user_name()); !problem.empty())
     return refuse("bad_user_name", problem);
   const double rate = request.haptic_rate_hz();
   if (!(rate >= 0 && rate <= kMaxClientHapticRateHz))
-    return refuse("bad_rate", fmt::format("a haptic rate of {} Hz: it must be at most {:.0f} Hz", rate, kMaxClientHapticRateHz));
+    return refuse("bad_rate", fmt::format("a haptic rate of {} Hz: it must be at most {:.0f} Hz",
+                                          rate, kMaxClientHapticRateHz));
   int wanted = request.requested_slot() > 0 ? static_cast<int>(request.requested_slot() - 1) : -1;
   if (sender != wire::kJoiningSender) {  // a participant key: its slot, and no other
     const int own = static_cast<int>(sender - 1);
     if (wanted >= 0 && wanted != own)
-      return refuse("wrong_slot", fmt::format("the key given is slot {}'s, and slot {} was asked for", own, wanted));
+      return refuse(
+          "wrong_slot",
+          fmt::format("the key given is slot {}'s, and slot {} was asked for", own, wanted));
     wanted = own;
   }
   if (users() >= max_participants_)
-    return refuse("session_full", fmt::format("the session is full: the scene allows {} participant{} at once "
-                                              "(network.max_participants)",
-                                              max_participants_, max_participants_ == 1 ? "" : "s"));
+    return refuse("session_full",
+                  fmt::format("the session is full: the scene allows {} participant{} at once "
+                              "(network.max_participants)",
+                              max_participants_, max_participants_ == 1 ? "" : "s"));
   if (wanted >= slots())
-    return refuse("session_full", fmt::format("slot {} does not exist: the scene has {} tools", wanted, slots()));
+    return refuse("session_full",
+                  fmt::format("slot {} does not exist: the scene has {} tools", wanted, slots()));
   if (wanted >= 0) {
     if (slots_[static_cast<std::size_t>(wanted)])
       return refuse("session_full", fmt::format("slot {} is taken", wanted));
@@ -295,27 +330,31 @@ int ConnectionHandler::take_slot(const ParticipantPtr& participant, const wire::
 void ConnectionHandler::join(const ParticipantPtr& participant, const wire::Control& control) {
   if (participant->slot >= 0) return;
   const wire::Join& request = control.join();
-  const std::uint32_t sender = control.header().sender();  // the envelope's: its key opened the frame
+  const std::uint32_t sender =
+      control.header().sender();  // the envelope's: its key opened the frame
   if (!wire::is_challenge(request.challenge(), participant->challenge)) {
-    reject_frame(participant, wire::Rejection::replayed, "a join without this connection's challenge (replayed?)");
+    reject_frame(participant, wire::Rejection::replayed,
+                 "a join without this connection's challenge (replayed?)");
     return;
   }
   // The reply goes under the key the join came with; what follows under the slot's.
-  participant->sealer.set_key(sender == wire::kJoiningSender ? joining_key_ : slot_keys_[sender - 1]);
+  participant->sealer.set_key(sender == wire::kJoiningSender ? joining_key_
+                                                             : slot_keys_[sender - 1]);
   const int slot = take_slot(participant, request, sender);
   if (slot < 0) return;
   const wire::TrafficKey& key = slot_keys_[static_cast<std::size_t>(slot)];
   participant->slot = slot;
   participant->connection->set_max_frame_bytes(kMaxClientFrameBytes);
   participant->user_name = request.user_name();
-  participant->udp_endpoint =
-      udp::endpoint(participant->connection->peer_address(), static_cast<std::uint16_t>(request.udp_port()));
+  participant->udp_endpoint = udp::endpoint(participant->connection->peer_address(),
+                                            static_cast<std::uint16_t>(request.udp_port()));
   participant->datagram_sealer.emplace(key, session_, wire::kServerSender, options_.encrypt);
-  const double rate = request.haptic_rate_hz() > 0 ? request.haptic_rate_hz() : welcome_.haptic_rate_hz();
+  const double rate =
+      request.haptic_rate_hz() > 0 ? request.haptic_rate_hz() : welcome_.haptic_rate_hz();
   participant->datagram_budget = {rate, kUserDatagramsPerTick * rate, rate, monotonic_now_ns()};
   slots_[static_cast<std::size_t>(slot)] = participant;
-  udp_.inspector().allow_sender(wire::sender_of_slot(static_cast<std::uint32_t>(slot)), key, request.datagram_salt(),
-                                request.datagram_sequence());
+  udp_.inspector().allow_sender(wire::sender_of_slot(static_cast<std::uint32_t>(slot)), key,
+                                request.datagram_salt(), request.datagram_sequence());
   udp_.trust(participant->udp_endpoint);
   tools_.join(slot);
   ++counters_.joins;
@@ -327,12 +366,13 @@ void ConnectionHandler::join(const ParticipantPtr& participant, const wire::Cont
   welcome->set_client_challenge(request.client_challenge());
   welcome->set_datagram_salt(participant->datagram_sealer->salt());
   for (int s = 0; s < slots(); ++s)
-    if (const ParticipantPtr& user = slots_[static_cast<std::size_t>(s)]) welcome->mutable_users(s)->set_user_name(user->user_name);
+    if (const ParticipantPtr& user = slots_[static_cast<std::size_t>(s)])
+      welcome->mutable_users(s)->set_user_name(user->user_name);
   send_control(participant, reply);
   participant->sealer.set_key(key);
   const std::string& tool = welcome_.users(slot).tool_name();
-  spdlog::info("user '{}' joined from {} as slot {} (tool {})", participant->user_name, participant->connection->peer(),
-               slot, tool);
+  spdlog::info("user '{}' joined from {} as slot {} (tool {})", participant->user_name,
+               participant->connection->peer(), slot, tool);
   broadcast_event("user_joined", fmt::format("{} took tool {}", participant->user_name, tool),
                   record::EventUser{participant->user_name, static_cast<std::uint32_t>(slot)});
 }
@@ -347,17 +387,21 @@ void ConnectionHandler::leave(const ParticipantPtr& participant, const std::stri
   if (slot < 0 || slots_[static_cast<std::size_t>(slot)] != participant) return;
   slots_[static_cast<std::size_t>(slot)].reset();
   udp_.distrust(participant->udp_endpoint);
-  auto timer = std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(kLeftSenderGrace_ms));
+  auto timer =
+      std::make_shared<asio::steady_timer>(io_, std::chrono::milliseconds(kLeftSenderGrace_ms));
   timer->async_wait([this, timer, slot](std::error_code) {
-    if (!slots_[static_cast<std::size_t>(slot)]) udp_.inspector().forget_sender(wire::sender_of_slot(static_cast<std::uint32_t>(slot)));
+    if (!slots_[static_cast<std::size_t>(slot)])
+      udp_.inspector().forget_sender(wire::sender_of_slot(static_cast<std::uint32_t>(slot)));
   });
   tools_.release(slot);
-  spdlog::info("user '{}' (slot {}) left: {}; its tool is released", participant->user_name, slot, why);
+  spdlog::info("user '{}' (slot {}) left: {}; its tool is released", participant->user_name, slot,
+               why);
   broadcast_event("user_left", fmt::format("{} left ({})", participant->user_name, why),
                   record::EventUser{participant->user_name, static_cast<std::uint32_t>(slot)});
 }
 
-void ConnectionHandler::broadcast_event(const std::string& kind, const std::string& text, const record::EventUser& user) {
+void ConnectionHandler::broadcast_event(const std::string& kind, const std::string& text,
+                                        const record::EventUser& user) {
   if (recorder_) recorder_->event(monotonic_now_ns(), kind, text, user);
   for (const ParticipantPtr& participant : slots_) {
     if (!participant) continue;
@@ -368,27 +412,32 @@ void ConnectionHandler::broadcast_event(const std::string& kind, const std::stri
   }
 }
 
-void ConnectionHandler::send_error(const ParticipantPtr& participant, const std::string& code, const std::string& text) {
+void ConnectionHandler::send_error(const ParticipantPtr& participant, const std::string& code,
+                                   const std::string& text) {
   wire::Control control;
   control.mutable_error()->set_code(code);
   control.mutable_error()->set_text(text);
   send_control(participant, control);
 }
 
-void ConnectionHandler::send_bytes(const ParticipantPtr& participant, std::vector<std::uint8_t> bytes, net::FrameKind kind,
+void ConnectionHandler::send_bytes(const ParticipantPtr& participant,
+                                   std::vector<std::uint8_t> bytes, net::FrameKind kind,
                                    bool frame) {
   if (participant->gone) return;
   // The TCP link keeps order and loses nothing: every frame is delivered, perhaps later.
-  net::deliver_over(participant->to_client_tcp, io_, monotonic_now_ns(),
-                    [this, participant, kind, frame, bytes = std::move(bytes)](std::int64_t) mutable {
-                      if (participant->gone) return;
-                      counters_.frames_sent += frame;
-                      if (participant->connection->send(std::move(bytes), kind) == net::FramedConnection::Sent::queued_after_drop)
-                        ++counters_.frames_dropped;
-                    });
+  net::deliver_over(
+      participant->to_client_tcp, io_, monotonic_now_ns(),
+      [this, participant, kind, frame, bytes = std::move(bytes)](std::int64_t) mutable {
+        if (participant->gone) return;
+        counters_.frames_sent += frame;
+        if (participant->connection->send(std::move(bytes), kind) ==
+            net::FramedConnection::Sent::queued_after_drop)
+          ++counters_.frames_dropped;
+      });
 }
 
-void ConnectionHandler::send_control(const ParticipantPtr& participant, wire::Control& control, bool newest_wins) {
+void ConnectionHandler::send_control(const ParticipantPtr& participant, wire::Control& control,
+                                     bool newest_wins) {
   if (participant->gone) return;
   send_bytes(participant, participant->sealer.seal(control),
              newest_wins ? net::FrameKind::newest_wins : net::FrameKind::must_arrive, true);
@@ -415,7 +464,8 @@ void ConnectionHandler::set_link_delay(const LinkDelaySettings& settings) {
   validate(settings);
   link_delay_ = settings;
   for (const ParticipantPtr& participant : participants_)
-    for (LinkDelay* link : {&participant->to_client_udp, &participant->to_client_tcp, &participant->from_client_udp})
+    for (LinkDelay* link :
+         {&participant->to_client_udp, &participant->to_client_tcp, &participant->from_client_udp})
       link->set_settings(settings);
 }
 
@@ -434,17 +484,18 @@ void ConnectionHandler::send(Outbox outbox) {
     if (const ParticipantPtr& participant = slots_[static_cast<std::size_t>(ir.slot)])
       send_control(participant, ir.message, !ir.must_arrive);
   for (ToSlot<wire::Datagram>& datagram : outbox.datagrams)
-    if (const ParticipantPtr& participant = slots_[static_cast<std::size_t>(datagram.slot)]) send_datagram(*participant, datagram.message);
+    if (const ParticipantPtr& participant = slots_[static_cast<std::size_t>(datagram.slot)])
+      send_datagram(*participant, datagram.message);
 }
 
 // ---- datagrams ----
 
 void ConnectionHandler::send_datagram(Participant& participant, wire::Datagram& datagram) {
   const udp::endpoint to = participant.udp_endpoint;
-  const bool delivered = net::deliver_over(participant.to_client_udp, io_, monotonic_now_ns(),
-                                           [this, to, bytes = participant.datagram_sealer->seal(datagram)](std::int64_t) mutable {
-                                             udp_.send(std::move(bytes), to);
-                                           });
+  const bool delivered =
+      net::deliver_over(participant.to_client_udp, io_, monotonic_now_ns(),
+                        [this, to, bytes = participant.datagram_sealer->seal(datagram)](
+                            std::int64_t) mutable { udp_.send(std::move(bytes), to); });
   if (!delivered) ++counters_.dropped_to_clients;
 }
 
@@ -455,24 +506,27 @@ void ConnectionHandler::receive_datagram(wire::Datagram&& datagram, std::int64_t
   Participant& user = *slots_[static_cast<std::size_t>(slot)];
   if (!user.datagram_budget.try_take(arrival_ns)) {
     ++counters_.datagrams_over_budget;
-    warn_throttled(fmt::format("datagrams of '{}' (slot {}) dropped: more than {:.0f} a second", user.user_name,
-                               slot, user.datagram_budget.refill_per_s));
+    warn_throttled(fmt::format("datagrams of '{}' (slot {}) dropped: more than {:.0f} a second",
+                               user.user_name, slot, user.datagram_budget.refill_per_s));
     return;
   }
-  const bool delivered = net::deliver_over(
-      user.from_client_udp, io_, arrival_ns,
-      [this, slot, datagram = std::move(datagram)](std::int64_t delivered_ns) { handle_datagram(datagram, slot, delivered_ns); });
+  const bool delivered =
+      net::deliver_over(user.from_client_udp, io_, arrival_ns,
+                        [this, slot, datagram = std::move(datagram)](std::int64_t delivered_ns) {
+                          handle_datagram(datagram, slot, delivered_ns);
+                        });
   if (!delivered) ++counters_.dropped_from_clients;
 }
 
-void ConnectionHandler::handle_datagram(const wire::Datagram& datagram, int slot, std::int64_t arrival_ns) {
+void ConnectionHandler::handle_datagram(const wire::Datagram& datagram, int slot,
+                                        std::int64_t arrival_ns) {
   if (!slots_[static_cast<std::size_t>(slot)]) return;  // left while the datagram was delayed
   if (recorder_) recorder_->datagram_in(arrival_ns, datagram);
   if (datagram.has_tool()) {
     const wire::ToolSample& sample = datagram.tool();
     if (static_cast<int>(sample.user()) != slot) return;  // a user speaks for its own tool only
-    if (!tools_.update(slot, sample.valid(), wire::from_wire(sample.position()), sample.buttons(), sample.sample_time_ns(),
-                       arrival_ns))
+    if (!tools_.update(slot, sample.valid(), wire::from_wire(sample.position()), sample.buttons(),
+                       sample.sample_time_ns(), arrival_ns))
       return;  // older than the sample held
     // Relay to the other users, who play it out against their own clocks.
     for (int other = 0; other < slots(); ++other) {

@@ -16,8 +16,8 @@
 //     at most kUserDatagramsPerTick datagrams a tick of its haptic loop; at most
 //     kMaxUnjoinedPerSource connections that have not joined from one address and
 //     kMaxUnjoinedConnections in all (a new one past either closes the oldest), each closed
-//     if it has not joined within kJoinTimeout; a user that stops reading is dropped by its connection
-//     (newest-wins IRs, then net::kWriteTimeout);
+//     if it has not joined within kJoinTimeout; a user that stops reading is dropped by its
+//     connection (newest-wins IRs, then net::kWriteTimeout);
 //   - its counters, for the status line and the report.
 // It decides slots and what to relay; sealing is the codec's (wire::FrameSealer,
 // wire::DatagramSealer), the sockets are net/'s. With --record it records the datagrams
@@ -87,14 +87,16 @@ struct ConnectionCounters {
   std::uint64_t frames_sent = 0, frames_rejected = 0, frames_dropped = 0;
   std::array<std::uint64_t, wire::kRejectionCount> frames_rejected_by_reason{};
   std::uint64_t dropped_to_clients = 0, dropped_from_clients = 0;  ///< by the injected loss
-  std::uint64_t connections = 0;       ///< accepted
-  std::uint64_t joins = 0;             ///< welcomed
-  std::uint64_t joins_refused = 0;     ///< session full, slot taken, or a key for another slot
-  std::uint64_t unjoined_evicted = 0;  ///< closed before joining: a newer connection needed the room
-  std::uint64_t join_timeouts = 0;     ///< closed: not joined within kJoinTimeout
-  std::uint64_t accept_errors = 0;     ///< accept() failed (e.g. out of file descriptors): tried again after kAcceptRetry
-  std::uint64_t write_stalls = 0;      ///< closed: the user stopped reading (write timeout)
-  std::uint64_t queue_overflows = 0;   ///< closed: frames that must arrive piled up unread
+  std::uint64_t connections = 0;                                   ///< accepted
+  std::uint64_t joins = 0;                                         ///< welcomed
+  std::uint64_t joins_refused = 0;  ///< session full, slot taken, or a key for another slot
+  std::uint64_t unjoined_evicted =
+      0;                            ///< closed before joining: a newer connection needed the room
+  std::uint64_t join_timeouts = 0;  ///< closed: not joined within kJoinTimeout
+  std::uint64_t accept_errors =
+      0;  ///< accept() failed (e.g. out of file descriptors): tried again after kAcceptRetry
+  std::uint64_t write_stalls = 0;     ///< closed: the user stopped reading (write timeout)
+  std::uint64_t queue_overflows = 0;  ///< closed: frames that must arrive piled up unread
 };
 
 class ConnectionHandler {
@@ -105,13 +107,14 @@ class ConnectionHandler {
   /// most (0: one per slot). `recorder` may be null. Throws std::system_error if a socket
   /// cannot be bound.
   ConnectionHandler(asio::io_context& io, const ServeOptions& options, wire::Welcome welcome,
-                    const wire::SessionKey& key, std::uint64_t session, int max_participants, ToolInputs& tools,
-                    record::SessionRecorder* recorder);
+                    const wire::SessionKey& key, std::uint64_t session, int max_participants,
+                    ToolInputs& tools, record::SessionRecorder* recorder);
   ~ConnectionHandler();
   ConnectionHandler(const ConnectionHandler&) = delete;
   ConnectionHandler& operator=(const ConnectionHandler&) = delete;
 
-  using StatusHandler = std::function<void(int slot, const std::string& user, const wire::ClientStatus& status)>;
+  using StatusHandler =
+      std::function<void(int slot, const std::string& user, const wire::ClientStatus& status)>;
   /// Where the users' status reports go (on the I/O thread); set before start().
   void on_client_status(StatusHandler handler) { on_status_ = std::move(handler); }
 
@@ -146,15 +149,21 @@ class ConnectionHandler {
   int take_slot(const ParticipantPtr& participant, const wire::Join& request, std::uint32_t sender);
   void client_status(const Participant& participant, const wire::ClientStatus& status);
   void leave(const ParticipantPtr& participant, const std::string& why);
-  void reject_frame(const ParticipantPtr& participant, wire::Rejection reason, const std::string& why);
-  void broadcast_event(const std::string& kind, const std::string& text, const record::EventUser& user);
-  void send_bytes(const ParticipantPtr& participant, std::vector<std::uint8_t> bytes, net::FrameKind kind, bool frame);
-  void send_control(const ParticipantPtr& participant, wire::Control& control, bool newest_wins = false);
-  void send_error(const ParticipantPtr& participant, const std::string& code, const std::string& text);
+  void reject_frame(const ParticipantPtr& participant, wire::Rejection reason,
+                    const std::string& why);
+  void broadcast_event(const std::string& kind, const std::string& text,
+                       const record::EventUser& user);
+  void send_bytes(const ParticipantPtr& participant, std::vector<std::uint8_t> bytes,
+                  net::FrameKind kind, bool frame);
+  void send_control(const ParticipantPtr& participant, wire::Control& control,
+                    bool newest_wins = false);
+  void send_error(const ParticipantPtr& participant, const std::string& code,
+                  const std::string& text);
   void send_datagram(Participant& participant, wire::Datagram& datagram);
   void receive_datagram(wire::Datagram&& datagram, std::int64_t arrival_ns);
   void handle_datagram(const wire::Datagram& datagram, int slot, std::int64_t arrival_ns);
-  /// Logs a warning about hostile or broken input at most once a second (the counters keep the rest).
+  /// Logs a warning about hostile or broken input at most once a second (the counters keep the
+  /// rest).
   void warn_throttled(const std::string& message);
   /// The injected shift delay on every link from now on, and for users who join later (a
   /// switched condition, from an outbox).

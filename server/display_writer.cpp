@@ -10,7 +10,8 @@
 
 namespace cohaptic {
 
-DisplayWriter::DisplayWriter(const Model& model, const ComplianceColumns& columns, std::filesystem::path directory)
+DisplayWriter::DisplayWriter(const Model& model, const ComplianceColumns& columns,
+                             std::filesystem::path directory)
     : model_(model), directory_(std::move(directory)) {
   const ElasticBody& body = single_elastic_body(model);
   ShownSurface shown = shown_surface(body, columns.row_nodes());
@@ -18,14 +19,18 @@ DisplayWriter::DisplayWriter(const Model& model, const ComplianceColumns& column
   triangles_ = std::move(shown.triangles);
   rest_.resize(3, static_cast<Eigen::Index>(nodes_.size()));
   for (std::size_t i = 0; i < nodes_.size(); ++i) {
-    rest_.col(static_cast<Eigen::Index>(i)) = body.mesh.nodes.col(nodes_[i]) / model.scene.metres_per_unit;
+    rest_.col(static_cast<Eigen::Index>(i)) =
+        body.mesh.nodes.col(nodes_[i]) / model.scene.metres_per_unit;
     tags_.push_back(body.mesh.node_tags[static_cast<std::size_t>(nodes_[i])]);
   }
   std::filesystem::create_directories(directory_);
 }
 
-DisplayWriter::DisplayWriter(const Model& model, const HomeSpringBody& tissue, std::filesystem::path directory)
-    : model_(model), directory_(std::move(directory)), triangles_(tissue.surface.triangles),
+DisplayWriter::DisplayWriter(const Model& model, const HomeSpringBody& tissue,
+                             std::filesystem::path directory)
+    : model_(model),
+      directory_(std::move(directory)),
+      triangles_(tissue.surface.triangles),
       rest_(tissue.surface.vertices / model.scene.metres_per_unit) {
   for (int v = 0; v < tissue.surface.vertex_count(); ++v) {
     nodes_.push_back(v);
@@ -36,7 +41,9 @@ DisplayWriter::DisplayWriter(const Model& model, const HomeSpringBody& tissue, s
 
 DisplayWriter::~DisplayWriter() { stop(); }
 
-void DisplayWriter::start() { thread_ = std::thread([this] { write_frames(); }); }
+void DisplayWriter::start() {
+  thread_ = std::thread([this] { write_frames(); });
+}
 
 bool DisplayWriter::offer(double time, Eigen::Matrix3Xd displacement) {
   std::lock_guard lock(mutex_);
@@ -82,12 +89,14 @@ void DisplayWriter::write_frames() {
 void DisplayWriter::write_index() const {
   try {
     AtomicFile index(directory_ / "surface.pvd");
-    index.write("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
-    for (const auto& [time, name] : written_) index.print("    <DataSet timestep=\"{:.6f}\" file=\"{}\"/>\n", time, name);
+    index.write(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n");
+    for (const auto& [time, name] : written_)
+      index.print("    <DataSet timestep=\"{:.6f}\" file=\"{}\"/>\n", time, name);
     index.write("  </Collection>\n</VTKFile>\n");
     index.commit();
-    spdlog::info("{} display frames in {} (open surface.pvd in ParaView; lengths in {})", written_.size(),
-                 directory_.string(), model_.scene.units);
+    spdlog::info("{} display frames in {} (open surface.pvd in ParaView; lengths in {})",
+                 written_.size(), directory_.string(), model_.scene.units);
   } catch (const Error& e) {
     spdlog::warn("display index not written: {}", e.what());
   }

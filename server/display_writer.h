@@ -4,8 +4,8 @@
 // collection of them all) when it stops. Shown, for a linear elastic object: the surface
 // triangles whose nodes all have compliance rows (common/model/shown_surface.h); for a
 // home-spring tissue: its whole surface, vertex i its node i, dented by its display
-// deformation (HomeSpringSimulation::displayed). Its queue holds at most kMaxQueuedDisplayFrames: a frame offered
-// while the writer is that far behind is dropped, so the simulation is never held up.
+// deformation (HomeSpringSimulation::displayed). Its queue holds at most kMaxQueuedDisplayFrames: a
+// frame offered while the writer is that far behind is dropped, so the simulation is never held up.
 // Units: offered in m and s; written in the scene's units.
 #pragma once
 
@@ -33,7 +33,8 @@ class DisplayWriter {
  public:
   /// Chooses the shown nodes and triangles of the scene's only object, linear elastic, and
   /// creates `directory`. `model` must outlive it.
-  DisplayWriter(const Model& model, const ComplianceColumns& columns, std::filesystem::path directory);
+  DisplayWriter(const Model& model, const ComplianceColumns& columns,
+                std::filesystem::path directory);
   /// The same for a scene whose only object is a home-spring tissue: its whole surface.
   DisplayWriter(const Model& model, const HomeSpringBody& tissue, std::filesystem::path directory);
   ~DisplayWriter();  ///< stop()
@@ -61,16 +62,17 @@ class DisplayWriter {
 
   const Model& model_;
   std::filesystem::path directory_;
-  std::vector<int> nodes_;            // nodes shown: FEM row nodes, or every tissue vertex
-  std::vector<Triangle> triangles_;   // in nodes_ numbering
-  Eigen::Matrix3Xd rest_;             // of nodes_, in the scene's units
-  std::vector<std::int64_t> tags_;    // of nodes_: the mesh's node ids, or the vertex indices
+  std::vector<int> nodes_;           // nodes shown: FEM row nodes, or every tissue vertex
+  std::vector<Triangle> triangles_;  // in nodes_ numbering
+  Eigen::Matrix3Xd rest_;            // of nodes_, in the scene's units
+  std::vector<std::int64_t> tags_;   // of nodes_: the mesh's node ids, or the vertex indices
   std::mutex mutex_;
   std::condition_variable ready_;
   std::deque<Frame> queue_;
   bool stopping_ = false;
   std::thread thread_;
-  std::vector<std::pair<double, std::string>> written_;  // (time, file) for the index; writer thread
+  std::vector<std::pair<double, std::string>>
+      written_;  // (time, file) for the index; writer thread
 };
 
 }  // namespace cohaptic

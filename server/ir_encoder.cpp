@@ -41,8 +41,10 @@ void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
   std::map<int, bool> carried_fresh;
   for (std::size_t i = 0; i < irs.size(); ++i) {
     bool& carried = carried_fresh[irs[i].user];
-    if (superseded[i]) carried = carried || irs[i].fresh;
-    else irs[i].fresh = std::exchange(carried, false) || irs[i].fresh;
+    if (superseded[i])
+      carried = carried || irs[i].fresh;
+    else
+      irs[i].fresh = std::exchange(carried, false) || irs[i].fresh;
   }
   std::uint64_t sent = 0, bytes = 0, skipped = 0;
   if (std::any_of(irs.begin(), irs.end(), [](const BuiltIr& built) { return built.announces_p1; }))
@@ -63,8 +65,8 @@ void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
       else
         *control.mutable_ir() = built.as_sent ? wire::to_wire(*built.as_sent) : whole;
     } catch (const std::exception& e) {
-      spdlog::error("user {}'s IR (epoch {}) not sent: {}; the next starts its stream afresh", built.user,
-                    built.built->ir.epoch, e.what());
+      spdlog::error("user {}'s IR (epoch {}) not sent: {}; the next starts its stream afresh",
+                    built.user, built.built->ir.epoch, e.what());
       if (recorder_) recorder_->ir(built.time_ns, whole, built.repeat);
       std::lock_guard lock(mutex_);
       restarts_.push_back(built.user);
@@ -75,7 +77,8 @@ void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
     // client's do), else the IR.
     if (recorder_) {
       if (built.streamed && !built.as_sent)
-        recorder_->ir_block(built.time_ns, static_cast<std::uint32_t>(built.user), control.compressed_ir(), built.repeat);
+        recorder_->ir_block(built.time_ns, static_cast<std::uint32_t>(built.user),
+                            control.compressed_ir(), built.repeat);
       else
         recorder_->ir(built.time_ns, whole, built.repeat);
     }
@@ -123,7 +126,8 @@ void IrEncoder::run() {
       changed_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
       if (queue_.empty()) return;  // stopping, and nothing left
       // Every step waiting, at once: a user's IR that a newer one replaces is not sent.
-      for (std::vector<BuiltIr>& step : queue_) std::move(step.begin(), step.end(), std::back_inserter(irs));
+      for (std::vector<BuiltIr>& step : queue_)
+        std::move(step.begin(), step.end(), std::back_inserter(irs));
       queue_.clear();
     }
     changed_.notify_all();  // room for post()

@@ -6,9 +6,11 @@ namespace cohaptic {
 
 void LoopStatistics::record_step(const StepFigures& step, double elapsed_s) {
   std::lock_guard lock(mutex_);
-  if (totals_.steps == 0) totals_.first_step_s = elapsed_s - static_cast<double>(step.duration_ns) * 1e-9;
+  if (totals_.steps == 0)
+    totals_.first_step_s = elapsed_s - static_cast<double>(step.duration_ns) * 1e-9;
   step_ns_.record(step.duration_ns);
-  if (step.report.recomputed) ir_build_ns_.record(static_cast<std::int64_t>(step.report.rebuild_ms * 1e6));
+  if (step.report.recomputed)
+    ir_build_ns_.record(static_cast<std::int64_t>(step.report.rebuild_ms * 1e6));
   if (step.report.rebuilt) {
     ++totals_.rebuilds;
     totals_.ir_bytes += step.report.ir_bytes;
@@ -17,12 +19,13 @@ void LoopStatistics::record_step(const StepFigures& step, double elapsed_s) {
   totals_.forces_sent += step.forces_sent;
   totals_.max_boundary_nodes = std::max(totals_.max_boundary_nodes, step.report.boundary_nodes);
   totals_.max_obstacle_nodes = std::max(totals_.max_obstacle_nodes, step.report.obstacle_nodes);
-  totals_.sphere_nodes_outside_patches += static_cast<std::uint64_t>(step.report.sphere_nodes_outside_patches);
+  totals_.sphere_nodes_outside_patches +=
+      static_cast<std::uint64_t>(step.report.sphere_nodes_outside_patches);
   totals_.elapsed_s = elapsed_s;
 }
 
-void LoopStatistics::record_irs_encoded(std::int64_t encode_ns, std::uint64_t irs_sent, std::uint64_t bytes_sent,
-                                        std::uint64_t superseded) {
+void LoopStatistics::record_irs_encoded(std::int64_t encode_ns, std::uint64_t irs_sent,
+                                        std::uint64_t bytes_sent, std::uint64_t superseded) {
   std::lock_guard lock(mutex_);
   totals_.irs_superseded += superseded;
   ir_encode_ns_.record(encode_ns);
@@ -40,7 +43,8 @@ void LoopStatistics::record_failure(int consecutive, const std::string& what, do
 
 void LoopStatistics::record_display_frame(double max_displacement_m) {
   std::lock_guard lock(mutex_);
-  totals_.max_surface_displacement_m = std::max(totals_.max_surface_displacement_m, max_displacement_m);
+  totals_.max_surface_displacement_m =
+      std::max(totals_.max_surface_displacement_m, max_displacement_m);
 }
 
 LoopSummary LoopStatistics::summary() const {

@@ -27,7 +27,8 @@ struct Outbox {
   std::optional<wire::Protocol> protocol_switch;
   /// The injected shift delay on every link from now on (a switched condition); unset: unchanged.
   std::optional<LinkDelaySettings> link_delay;
-  std::vector<ToSlot<wire::Control>> irs;         ///< P1: new IRs, over TCP (newest wins unless must_arrive)
+  std::vector<ToSlot<wire::Control>>
+      irs;  ///< P1: new IRs, over TCP (newest wins unless must_arrive)
   std::vector<ToSlot<wire::Datagram>> datagrams;  ///< P1: IR keep-alives; P0: forces (UDP)
 
   bool empty() const { return !protocol_switch && !link_delay && irs.empty() && datagrams.empty(); }

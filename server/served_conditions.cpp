@@ -30,9 +30,10 @@ std::string ServedCondition::describe() const {
 
 ServedCondition parse_served_condition(const std::string& text) {
   const auto fail = [&](const std::string& why) {
-    throw Error(fmt::format("--condition '{}': {} (expected NAME:key=value,... with keys protocol, shift_ms, "
-                            "jitter_ms, loss, step_nodes, sim_rate_hz)",
-                            text, why));
+    throw Error(fmt::format(
+        "--condition '{}': {} (expected NAME:key=value,... with keys protocol, shift_ms, "
+        "jitter_ms, loss, step_nodes, sim_rate_hz)",
+        text, why));
   };
   const std::size_t colon = text.find(':');
   ServedCondition condition;
@@ -62,7 +63,8 @@ ServedCondition parse_served_condition(const std::string& text) {
       return parsed;
     };
     if (key == "protocol") {
-      if (value != "P0" && value != "P1") fail(fmt::format("protocol={} is neither P0 nor P1", value));
+      if (value != "P0" && value != "P1")
+        fail(fmt::format("protocol={} is neither P0 nor P1", value));
       condition.protocol = value == "P0" ? ServeProtocol::p0 : ServeProtocol::p1;
     } else if (key == "shift_ms") {
       condition.shift_delay_ms = number(0, 60'000, "a delay from 0 to 60000 ms");
@@ -72,7 +74,8 @@ ServedCondition parse_served_condition(const std::string& text) {
       condition.loss = number(0, 0.999, "a probability in [0, 1)");
     } else if (key == "step_nodes") {
       const double nodes = number(0, 100'000, "a node count from 0 to 100000");
-      if (nodes != static_cast<int>(nodes)) fail(fmt::format("step_nodes={} is not a whole number", value));
+      if (nodes != static_cast<int>(nodes))
+        fail(fmt::format("step_nodes={} is not a whole number", value));
       condition.step_nodes = static_cast<int>(nodes);
     } else if (key == "sim_rate_hz") {
       condition.sim_rate_hz = number(0, 1'000'000, "a rate >= 0 Hz");
@@ -83,11 +86,13 @@ ServedCondition parse_served_condition(const std::string& text) {
   return condition;
 }
 
-ConditionSwitch::ConditionSwitch(std::vector<ServedCondition> conditions) : conditions_(std::move(conditions)) {
+ConditionSwitch::ConditionSwitch(std::vector<ServedCondition> conditions)
+    : conditions_(std::move(conditions)) {
   if (conditions_.empty()) throw Error("a session serves at least one condition");
   std::set<std::string> names;
   for (const ServedCondition& condition : conditions_)
-    if (!names.insert(condition.name).second) throw Error(fmt::format("two conditions are named '{}'", condition.name));
+    if (!names.insert(condition.name).second)
+      throw Error(fmt::format("two conditions are named '{}'", condition.name));
 }
 
 int ConditionSwitch::serve(const std::string& name) {
@@ -98,7 +103,8 @@ int ConditionSwitch::serve(const std::string& name) {
     }
   std::vector<std::string> known;
   for (const ServedCondition& condition : conditions_) known.push_back(condition.name);
-  throw Error(fmt::format("no condition named '{}' (this session serves {})", name, fmt::join(known, ", ")));
+  throw Error(fmt::format("no condition named '{}' (this session serves {})", name,
+                          fmt::join(known, ", ")));
 }
 
 int ConditionSwitch::serve_next() {

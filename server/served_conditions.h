@@ -6,8 +6,9 @@
 // first condition is served from the start; a switch (ConditionSwitch::serve from the
 // control socket, control_socket.h, or serve_next from a device button) takes effect at the
 // simulation's next step, where it is recorded: protocol, held nodes and rate there, the
-// links' delays with that step's outbox. Nothing a client is told names a condition: the clients learn only the
-// protocol (wire::ProtocolSwitch), so a subject cannot tell which condition is which.
+// links' delays with that step's outbox. Nothing a client is told names a condition: the clients
+// learn only the protocol (wire::ProtocolSwitch), so a subject cannot tell which condition is
+// which.
 #pragma once
 
 #include <atomic>

@@ -42,9 +42,11 @@ record::SessionConfig server_session_config(const ServeOptions& options, const M
 }
 
 record::SimulationStep simulation_step_record(std::int64_t time_ns, double simulation_time,
-                                              const std::vector<ToolInput>& tools, const std::vector<bool>& used,
-                                              const SceneSimulation& simulation, const StepReport& report,
-                                              bool display_frame, const std::vector<record::ServerForce>& forces) {
+                                              const std::vector<ToolInput>& tools,
+                                              const std::vector<bool>& used,
+                                              const SceneSimulation& simulation,
+                                              const StepReport& report, bool display_frame,
+                                              const std::vector<record::ServerForce>& forces) {
   record::SimulationStep step;
   step.set_time_ns(time_ns);
   step.set_simulation_time(simulation_time);

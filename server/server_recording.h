@@ -31,8 +31,10 @@ record::SessionConfig server_session_config(const ServeOptions& options, const M
 /// rebuilt the IRs, who pressed, |B|, whether a display frame was solved after it, and the
 /// P0 forces it sent.
 record::SimulationStep simulation_step_record(std::int64_t time_ns, double simulation_time,
-                                              const std::vector<ToolInput>& tools, const std::vector<bool>& used,
-                                              const SceneSimulation& simulation, const StepReport& report,
-                                              bool display_frame, const std::vector<record::ServerForce>& forces);
+                                              const std::vector<ToolInput>& tools,
+                                              const std::vector<bool>& used,
+                                              const SceneSimulation& simulation,
+                                              const StepReport& report, bool display_frame,
+                                              const std::vector<record::ServerForce>& forces);
 
 }  // namespace cohaptic

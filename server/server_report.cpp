@@ -20,7 +20,8 @@ nlohmann::json server_report(const ServerFigures& figures) {
     server["conditions"] = names;
     server["condition_switches"] = figures.condition_switches;
     nlohmann::json log = nlohmann::json::array();
-    for (const auto& [time_s, served] : figures.switch_log) log.push_back({{"time_s", time_s}, {"served", served}});
+    for (const auto& [time_s, served] : figures.switch_log)
+      log.push_back({{"time_s", time_s}, {"served", served}});
     server["switch_log"] = log;
   }
   server["sim_rate_hz"] = loop.rate_hz();
@@ -28,14 +29,17 @@ nlohmann::json server_report(const ServerFigures& figures) {
   server["target_sim_rate_hz"] = figures.min_sim_rate_hz;
   server["ir_max_age_ms"] = options.ir_max_age_s * 1e3;
   server["steps"] = loop.steps;
-  server["step_ms"] = {{"p50", loop.step_p50_ms}, {"p99", loop.step_p99_ms}, {"max", loop.step_max_ms}};
-  server["ir_build_ms"] = {{"p50", loop.ir_build_p50_ms}, {"p99", loop.ir_build_p99_ms}, {"count", loop.ir_builds}};
+  server["step_ms"] = {
+      {"p50", loop.step_p50_ms}, {"p99", loop.step_p99_ms}, {"max", loop.step_max_ms}};
+  server["ir_build_ms"] = {
+      {"p50", loop.ir_build_p50_ms}, {"p99", loop.ir_build_p99_ms}, {"count", loop.ir_builds}};
   server["ir_encode_ms"] = {{"p50", loop.ir_encode_p50_ms}, {"p99", loop.ir_encode_p99_ms}};
   server["irs_sent"] = loop.irs_sent;
   server["irs_superseded"] = loop.irs_superseded;
   server["ir_bytes_sent"] = loop.ir_bytes_sent;
   server["ir_bytes_built"] = loop.ir_bytes;
-  server["boundary_nodes"] = {{"max", loop.max_boundary_nodes}, {"obstacle_max", loop.max_obstacle_nodes}};
+  server["boundary_nodes"] = {{"max", loop.max_boundary_nodes},
+                              {"obstacle_max", loop.max_obstacle_nodes}};
   server["sphere_nodes_outside_patches"] = loop.sphere_nodes_outside_patches;
   server["forces_sent"] = loop.forces_sent;
   server["max_surface_displacement_mm"] = loop.max_surface_displacement_m * 1e3;
@@ -52,8 +56,9 @@ nlohmann::json server_report(const ServerFigures& figures) {
                          {"relayed", connections.datagrams_relayed}};
   std::map<std::string, std::uint64_t> frame_rejections;
   for (wire::Rejection reason : wire::kAllRejections)
-    frame_rejections.emplace(std::string(wire::to_string(reason)),
-                             connections.frames_rejected_by_reason[static_cast<std::size_t>(reason)]);
+    frame_rejections.emplace(
+        std::string(wire::to_string(reason)),
+        connections.frames_rejected_by_reason[static_cast<std::size_t>(reason)]);
   server["control_frames"] = {{"sent", connections.frames_sent},
                               {"rejected", connections.frames_rejected},
                               {"rejected_by_reason", frame_rejections},
@@ -84,10 +89,12 @@ nlohmann::json server_report(const ServerFigures& figures) {
 std::string status_line(const ServerFigures& figures, int users, int slots) {
   const LoopSummary& loop = figures.loop;
   std::string line = fmt::format(
-      "t {:.0f} s | users {}/{} | sim {:.0f} Hz, step p99 {:.2f} ms | |B| max {} | IRs {} | datagrams in {} (rejected {}), "
+      "t {:.0f} s | users {}/{} | sim {:.0f} Hz, step p99 {:.2f} ms | |B| max {} | IRs {} | "
+      "datagrams in {} (rejected {}), "
       "out {}",
-      loop.elapsed_s, users, slots, loop.rate_hz(), loop.step_p99_ms, loop.max_boundary_nodes, loop.rebuilds,
-      figures.datagrams.accepted(), figures.datagrams.rejected(), figures.connections.datagrams_sent);
+      loop.elapsed_s, users, slots, loop.rate_hz(), loop.step_p99_ms, loop.max_boundary_nodes,
+      loop.rebuilds, figures.datagrams.accepted(), figures.datagrams.rejected(),
+      figures.connections.datagrams_sent);
   if (loop.failed_steps > 0) line += fmt::format(" | failed steps {}", loop.failed_steps);
   return line;
 }

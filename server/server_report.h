@@ -23,7 +23,8 @@ struct ServerFigures {
   LoopSummary loop;
   ConnectionCounters connections;
   const wire::RejectionCounters& datagrams;
-  std::uint64_t condition_switches = 0;  ///< switches of the served condition (--condition, --control)
+  std::uint64_t condition_switches =
+      0;  ///< switches of the served condition (--condition, --control)
   /// Each switch: the server's session time [s] and the condition it served.
   std::vector<std::pair<double, std::string>> switch_log = {};
 };

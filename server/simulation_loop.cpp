@@ -30,10 +30,10 @@ SimulationOptions simulation_options(const Model& model, const ServeOptions& opt
 }  // namespace
 
 SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns,
-                               const ServeOptions& options, ToolInputs& tools, LoopStatistics& statistics,
-                               DisplayWriter* display,
-                               view::LiveView* view, record::SessionRecorder* recorder, std::int64_t start_ns,
-                               ConditionSwitch* conditions)
+                               const ServeOptions& options, ToolInputs& tools,
+                               LoopStatistics& statistics, DisplayWriter* display,
+                               view::LiveView* view, record::SessionRecorder* recorder,
+                               std::int64_t start_ns, ConditionSwitch* conditions)
     : options_(options),
       conditions_(conditions),
       protocol_(options.protocol),
@@ -58,10 +58,12 @@ SimulationLoop::SimulationLoop(const Model& model, std::span<ComplianceColumns* 
       node_of_tag_(model.bodies.size()),
       encoder_(simulation_.user_count(), recorder, statistics) {
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
-    if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i])) node_of_tag_[i] = node_indices_by_tag(body->mesh);
+    if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i]))
+      node_of_tag_[i] = node_indices_by_tag(body->mesh);
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
     if (const auto* body = std::get_if<ElasticBody>(&model.bodies[i]); body && columns[i])
-      prefetch_.push_back({columns[i], static_cast<int>(i), std::make_unique<CompliancePrefetch>(*body, columns[i]->row_nodes())});
+      prefetch_.push_back({columns[i], static_cast<int>(i),
+                           std::make_unique<CompliancePrefetch>(*body, columns[i]->row_nodes())});
 }
 
 void SimulationLoop::deliver_prefetched() {
@@ -79,7 +81,8 @@ std::optional<record::ConditionSwitch> SimulationLoop::apply_condition_switch(Ou
   const ConditionSwitch::Served served = conditions_->served();
   if (served.switches == switches_applied_) return std::nullopt;
   switches_applied_ = served.switches;
-  const ServedCondition& condition = conditions_->conditions()[static_cast<std::size_t>(served.index)];
+  const ServedCondition& condition =
+      conditions_->conditions()[static_cast<std::size_t>(served.index)];
   simulation_.set_step_delay_nodes(condition.step_nodes);
   outbox.link_delay = condition.link_delay(options_.shift);
   rate_hz_ = condition.sim_rate_hz > 0 ? condition.sim_rate_hz : kDefaultSimulationRate_hz;
@@ -113,8 +116,10 @@ SimulationLoop::StepOutput SimulationLoop::advance(std::int64_t now_ns) {
   const bool to_p1 = resend_irs_;
   if (report.rebuilt || resend_irs_) output.irs = new_irs(now_ns);
   if (to_p1) {  // told before the IRs on the same connection, or at once if there are none yet
-    if (output.irs.empty()) outbox.protocol_switch = wire::P1;
-    else output.irs.front().announces_p1 = true;
+    if (output.irs.empty())
+      outbox.protocol_switch = wire::P1;
+    else
+      output.irs.front().announces_p1 = true;
   }
   if (protocol_ == ServeProtocol::p1 && now_ns - last_keep_alive_ns_ >= kKeepAlivePeriod_ns) {
     last_keep_alive_ns_ = now_ns;
@@ -124,8 +129,9 @@ SimulationLoop::StepOutput SimulationLoop::advance(std::int64_t now_ns) {
       protocol_ == ServeProtocol::p0 ? add_forces(outbox) : std::vector<record::ServerForce>{};
   const bool display_frame = solve_display_frame(now_ns);
   if (recorder_) {
-    record::SimulationStep step = simulation_step_record(now_ns, seconds_since_start(now_ns), latest_, used_, simulation_,
-                                                         report, display_frame, forces);
+    record::SimulationStep step =
+        simulation_step_record(now_ns, seconds_since_start(now_ns), latest_, used_, simulation_,
+                               report, display_frame, forces);
     if (switched) *step.mutable_condition_switch() = *switched;
     recorder_->step(step);
     recorder_->flush_if_due();
@@ -149,17 +155,20 @@ void SimulationLoop::take_tools(std::int64_t now_ns) {
       restart_rows(static_cast<int>(slot));
     }
     used_[slot] = tool.joined && tool.valid && now_ns - tool.received_ns < timeout;
-    if (conditions_ && options_.switch_button >= 0 && used_[slot] && (tool.pressed & (1u << options_.switch_button)))
+    if (conditions_ && options_.switch_button >= 0 && used_[slot] &&
+        (tool.pressed & (1u << options_.switch_button)))
       conditions_->serve_next();
     if (used_[slot]) {
       simulation_.set_tool(static_cast<int>(slot), tool.position, tool.buttons);
-      for (BodyPrefetch& prefetch : prefetch_) prefetch.worker->request_near(tool.position, *prefetch.columns);
+      for (BodyPrefetch& prefetch : prefetch_)
+        prefetch.worker->request_near(tool.position, *prefetch.columns);
     } else {
       simulation_.clear_tool(static_cast<int>(slot));
     }
   }
   for (BodyPrefetch& prefetch : prefetch_)  // as of the previous step
-    prefetch.worker->request(std::get<Simulation>(simulation_.body(prefetch.body)).nodes_near_obstacles());
+    prefetch.worker->request(
+        std::get<Simulation>(simulation_.body(prefetch.body)).nodes_near_obstacles());
 }
 
 // The new IRs, to be recorded (either protocol) and sent to their users (P1).
@@ -191,7 +200,8 @@ std::vector<BuiltIr> SimulationLoop::new_irs(std::int64_t now_ns) {
       built.streamed = rows || sphere;
       if (built.streamed) {  // the user's stream starts afresh with the rows or its first IR
         const auto u = static_cast<std::size_t>(user);
-        built.fresh = rows ? condensed_fem(*built.as_sent).compliance_rows->generation == 1 : !stream_started_[u];
+        built.fresh = rows ? condensed_fem(*built.as_sent).compliance_rows->generation == 1
+                           : !stream_started_[u];
         stream_started_[u] = 1;
       }
     }
@@ -216,7 +226,8 @@ bool SimulationLoop::to_compliance_rows(IntermediateRepresentation& ir, int user
     restart_rows(user);
   }
   std::vector<int> mesh_nodes;
-  for (const std::int64_t tag : fem->held_node_ids()) mesh_nodes.push_back(node_of_tag_[object].at(tag));
+  for (const std::int64_t tag : fem->held_node_ids())
+    mesh_nodes.push_back(node_of_tag_[object].at(tag));
   sender.convert(*fem, mesh_nodes, *columns_[object], body.dofs);
   return true;
 }
@@ -267,17 +278,20 @@ std::vector<record::ServerForce> SimulationLoop::add_forces(Outbox& outbox) {
 
 bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
   const bool display_due =
-      display_ && now_ns - last_display_ns_ >= static_cast<std::int64_t>(1e9 / options_.display_rate_hz);
+      display_ &&
+      now_ns - last_display_ns_ >= static_cast<std::int64_t>(1e9 / options_.display_rate_hz);
   const bool view_due = view_ && view_->frame_due(now_ns);
   if (!display_due && !view_due) return false;
   // One state solve per linear elastic body serves both (the replay solves them too).
   const std::vector<std::optional<StateSolution>> states = solve_elastic_states(simulation_);
   if (view_due) {
     view_tools_.resize(latest_.size());
-    for (std::size_t slot = 0; slot < latest_.size(); ++slot) view_tools_[slot] = {used_[slot], latest_[slot].position};
+    for (std::size_t slot = 0; slot < latest_.size(); ++slot)
+      view_tools_[slot] = {used_[slot], latest_[slot].position};
     // The displacement and the encoding are the view's thread's work.
-    view_->publish_frame(now_ns, seconds_since_start(now_ns),
-                         view::frame_state(simulation_, columns_, states, view_tools_, view_forces()), steps_);
+    view_->publish_frame(
+        now_ns, seconds_since_start(now_ns),
+        view::frame_state(simulation_, columns_, states, view_tools_, view_forces()), steps_);
   }
   if (!display_due) return true;
   if (const auto* tissue = std::get_if<HomeSpringSimulation>(&simulation_.body(0))) {
@@ -287,29 +301,32 @@ bool SimulationLoop::solve_display_frame(std::int64_t now_ns) {
   }
   // Otherwise the display shows the row nodes' surface of a scene of one linear elastic
   // object (the server refuses it on another scene).
-  offer_display_frame(now_ns, displacement_of_nodes(*columns_.front(), states.front().value(), display_->nodes()));
+  offer_display_frame(
+      now_ns, displacement_of_nodes(*columns_.front(), states.front().value(), display_->nodes()));
   return true;
 }
 
 const std::vector<Eigen::Vector3d>& SimulationLoop::view_forces() {
   if (protocol_ == ServeProtocol::p1)
     for (int user = 0; user < simulation_.user_count(); ++user)
-      view_forces_[static_cast<std::size_t>(user)] =
-          used_[static_cast<std::size_t>(user)] ? simulation_.force(user).force : Eigen::Vector3d::Zero();
+      view_forces_[static_cast<std::size_t>(user)] = used_[static_cast<std::size_t>(user)]
+                                                         ? simulation_.force(user).force
+                                                         : Eigen::Vector3d::Zero();
   return view_forces_;
 }
 
 void SimulationLoop::offer_display_frame(std::int64_t now_ns, Eigen::Matrix3Xd displacement) {
   statistics_.record_display_frame(displacement.colwise().norm().maxCoeff());
   last_display_ns_ = now_ns;
-  display_->offer(seconds_since_start(now_ns), std::move(displacement));  // dropped if the writer is behind
+  display_->offer(seconds_since_start(now_ns),
+                  std::move(displacement));  // dropped if the writer is behind
 }
 
 std::optional<std::string> SimulationLoop::run(const std::atomic<bool>& running,
                                                const std::function<void(Outbox&&)>& send) {
   encoder_.start(send);
   const std::optional<std::string> failure = step_until(running, send);
-  encoder_.stop();        // every IR built is recorded and handed over
+  encoder_.stop();       // every IR built is recorded and handed over
   deliver_prefetched();  // so that the disk cache keeps them too
   return failure;
 }
@@ -328,10 +345,11 @@ std::optional<std::string> SimulationLoop::step_until(const std::atomic<bool>& r
       for (int user = 0; user < simulation_.user_count(); ++user) simulation_.clear_tool(user);
       const std::optional<std::string> line = failures_.failed(step_start, e.what());
       if (line) spdlog::error("{}", *line);
-      statistics_.record_failure(failures_.consecutive(), e.what(), seconds_since_start(monotonic_now_ns()));
+      statistics_.record_failure(failures_.consecutive(), e.what(),
+                                 seconds_since_start(monotonic_now_ns()));
       if (failures_.limit_reached())
-        return fmt::format("the simulation failed {} steps in a row, the last with: {}", failures_.consecutive(),
-                           e.what());
+        return fmt::format("the simulation failed {} steps in a row, the last with: {}",
+                           failures_.consecutive(), e.what());
     }
     next += static_cast<std::int64_t>(1e9 / rate_hz_);  // a switched condition may change the rate
     const std::int64_t step_end = monotonic_now_ns();

@@ -76,10 +76,10 @@ class SimulationLoop {
   /// columns[i]: body i's compliance columns (null unless it is linear elastic).
   /// `conditions` (may be null: the options' condition throughout): the condition served
   /// now, whose first is what `options` give.
-  SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns, const ServeOptions& options,
-                 ToolInputs& tools,
-                 LoopStatistics& statistics, DisplayWriter* display, view::LiveView* view,
-                 record::SessionRecorder* recorder, std::int64_t start_ns, ConditionSwitch* conditions = nullptr);
+  SimulationLoop(const Model& model, std::span<ComplianceColumns* const> columns,
+                 const ServeOptions& options, ToolInputs& tools, LoopStatistics& statistics,
+                 DisplayWriter* display, view::LiveView* view, record::SessionRecorder* recorder,
+                 std::int64_t start_ns, ConditionSwitch* conditions = nullptr);
 
   /// One step at `now_ns`: returns what to send, its new IRs encoded on the calling thread.
   /// Throws whatever the simulation's step throws. Not while run() runs.
@@ -90,7 +90,8 @@ class SimulationLoop {
   /// block). Returns once every IR built is encoded and handed over: why it stopped early,
   /// the last error after kMaxConsecutiveStepFailures failed steps in a row; nullopt when
   /// `running` ended it.
-  std::optional<std::string> run(const std::atomic<bool>& running, const std::function<void(Outbox&&)>& send);
+  std::optional<std::string> run(const std::atomic<bool>& running,
+                                 const std::function<void(Outbox&&)>& send);
 
   const StepFailures& failures() const { return failures_; }
 
@@ -104,7 +105,8 @@ class SimulationLoop {
   /// Applies a switch of the served condition made since the last step, if any: what the
   /// step records of it.
   std::optional<record::ConditionSwitch> apply_condition_switch(Outbox& outbox);
-  std::optional<std::string> step_until(const std::atomic<bool>& running, const std::function<void(Outbox&&)>& send);
+  std::optional<std::string> step_until(const std::atomic<bool>& running,
+                                        const std::function<void(Outbox&&)>& send);
   void take_tools(std::int64_t now_ns);
   /// The IRs that changed this step, as the encoder takes them.
   std::vector<BuiltIr> new_irs(std::int64_t now_ns);
@@ -119,7 +121,9 @@ class SimulationLoop {
   // The forces a view frame shows: P0's, as sent this step; under P1, evaluated for the view
   // alone (the server-held evaluations serve nothing else then).
   const std::vector<Eigen::Vector3d>& view_forces();
-  double seconds_since_start(std::int64_t ns) const { return static_cast<double>(ns - start_ns_) * 1e-9; }
+  double seconds_since_start(std::int64_t ns) const {
+    return static_cast<double>(ns - start_ns_) * 1e-9;
+  }
 
   // One compliance prefetch per FEM body, with the columns it fills.
   struct BodyPrefetch {
@@ -132,10 +136,10 @@ class SimulationLoop {
   const ServeOptions& options_;
   ConditionSwitch* conditions_;  // switched from here too: a device button
   std::uint64_t switches_applied_ = 0;
-  ServeProtocol protocol_;  // served now
-  double rate_hz_;          // the loop's rate now
-  bool resend_irs_ = false; // the next new_irs() sends every user's IR, changed or not
-  ToolInputs& tools_;  // taken each step (which restarts its press counts)
+  ServeProtocol protocol_;   // served now
+  double rate_hz_;           // the loop's rate now
+  bool resend_irs_ = false;  // the next new_irs() sends every user's IR, changed or not
+  ToolInputs& tools_;        // taken each step (which restarts its press counts)
   LoopStatistics& statistics_;
   DisplayWriter* display_;
   view::LiveView* view_;
@@ -148,9 +152,9 @@ class SimulationLoop {
   std::vector<bool> used_;         // per slot: fresh, given to the simulation
   std::vector<BodyPrefetch> prefetch_;
   std::int64_t last_keep_alive_ns_ = 0, last_display_ns_ = 0;
-  std::uint64_t steps_ = 0;                      // successful steps so far
-  std::vector<view::ToolState> view_tools_;      // this step's tools, for the view
-  std::vector<Eigen::Vector3d> view_forces_;     // per user, for the view [N]
+  std::uint64_t steps_ = 0;                   // successful steps so far
+  std::vector<view::ToolState> view_tools_;   // this step's tools, for the view
+  std::vector<Eigen::Vector3d> view_forces_;  // per user, for the view [N]
   // Compliance rows: what each user's client holds (restarted when a new user takes the
   // slot), whether its zstd stream (the encoder's) has begun, and per body the mesh node
   // of each node tag.
@@ -158,7 +162,8 @@ class SimulationLoop {
   bool compliance_rows_;
   std::vector<ComplianceRowsSender> rows_senders_;
   std::vector<int> rows_objects_;  // per user: the body its held rows are of
-  std::vector<std::uint8_t> stream_started_;  // per user: its IR stream has a block the client holds
+  std::vector<std::uint8_t>
+      stream_started_;  // per user: its IR stream has a block the client holds
   std::vector<std::uint64_t> joins_seen_;
   std::vector<std::unordered_map<std::int64_t, int>> node_of_tag_;
   IrEncoder encoder_;

@@ -44,11 +44,13 @@ std::uint64_t random_session_id() {
 }
 
 // Everything a joining user is told but its slot and the other users' names.
-wire::Welcome welcome_template(const ServeOptions& options, const Model& model, const std::string& scene_yaml) {
+wire::Welcome welcome_template(const ServeOptions& options, const Model& model,
+                               const std::string& scene_yaml) {
   wire::Welcome welcome;
   welcome.set_scene_name(model.scene.name);
   welcome.set_scene_yaml(scene_yaml);
-  *welcome.mutable_surface() = wire::surface_mesh_message(model.bodies.front());  // the first object's
+  *welcome.mutable_surface() =
+      wire::surface_mesh_message(model.bodies.front());  // the first object's
   welcome.set_protocol(wire_protocol(options));
   welcome.set_force_limit(model.scene.haptic.force_limit_n);
   welcome.set_haptic_rate_hz(model.scene.haptic.rate_hz);
@@ -100,7 +102,8 @@ struct SimulationServer::Impl {
   asio::steady_timer status_timer{io}, duration_timer{io};
   std::atomic<bool> running{true};
   std::thread sim_thread;
-  std::optional<std::string> failure;  // why the simulation loop ended the session; read after it joined
+  std::optional<std::string>
+      failure;  // why the simulation loop ended the session; read after it joined
 
   explicit Impl(ServeOptions o) : options(std::move(o)), conditions(served_conditions(options)) {}
 
@@ -114,24 +117,32 @@ struct SimulationServer::Impl {
     }
     model = std::make_unique<Model>(build_model(scene));
     bool holds_nodes = false;  // under any condition served
-    for (const ServedCondition& condition : conditions.conditions()) holds_nodes = holds_nodes || condition.step_nodes > 0;
-    const bool whole_surface = holds_nodes || !model->obstacles.empty() || !model->scene.interactions.empty();
+    for (const ServedCondition& condition : conditions.conditions())
+      holds_nodes = holds_nodes || condition.step_nodes > 0;
+    const bool whole_surface =
+        holds_nodes || !model->obstacles.empty() || !model->scene.interactions.empty();
     compliance = prepare_scene_compliance(*model, whole_surface, options.cache_directory);
     // The display shows one linear elastic object (single_elastic_body says why it refuses
     // another scene) or one home-spring tissue; the live view shows every body.
-    const auto* tissue = model->bodies.size() == 1 ? std::get_if<HomeSpringBody>(&model->bodies.front()) : nullptr;
-    if (!options.display.empty() && !tissue) single_elastic_body(*model);  // refuses another scene, naming it
+    const auto* tissue =
+        model->bodies.size() == 1 ? std::get_if<HomeSpringBody>(&model->bodies.front()) : nullptr;
+    if (!options.display.empty() && !tissue)
+      single_elastic_body(*model);  // refuses another scene, naming it
     if (!options.display.empty())
       display = tissue ? std::make_unique<DisplayWriter>(*model, *tissue, options.display)
-                       : std::make_unique<DisplayWriter>(*model, *compliance.per_body.front(), options.display);
+                       : std::make_unique<DisplayWriter>(*model, *compliance.per_body.front(),
+                                                         options.display);
     tools = std::make_unique<ToolInputs>(model->scene.tools.size());
-    spdlog::info("scene '{}' ready in {:.0f} ms: {} user slots", scene.name, watch.elapsed_ms(), tools->size());
+    spdlog::info("scene '{}' ready in {:.0f} ms: {} user slots", scene.name, watch.elapsed_ms(),
+                 tools->size());
 
     if (options.key_file) {
       key = wire::load_session_key(*options.key_file);
     } else {
       key = wire::development_key();
-      spdlog::warn("no --key-file: using the public development key; anyone who knows it can join this session");
+      spdlog::warn(
+          "no --key-file: using the public development key; anyone who knows it can join this "
+          "session");
     }
     if (!options.record.empty()) {
       recorder = std::make_unique<record::SessionRecorder>(options.record);
@@ -152,32 +163,43 @@ struct SimulationServer::Impl {
         spdlog::warn("live view off: {}; the session goes on without it", e.what());
       }
     }
-    loop = std::make_unique<SimulationLoop>(*model, compliance.per_body, options, *tools, statistics, display.get(),
-                                            view.get(), recorder.get(), start_ns, &conditions);
+    loop = std::make_unique<SimulationLoop>(*model, compliance.per_body, options, *tools,
+                                            statistics, display.get(), view.get(), recorder.get(),
+                                            start_ns, &conditions);
   }
 
   void bind() {
-    connections = std::make_unique<ConnectionHandler>(io, options, welcome_template(options, *model, scene_yaml), key,
-                                                      session_id, model->scene.network.max_participants, *tools,
-                                                      recorder.get());
-    spdlog::info("listening on {}:{} (TCP control, UDP samples), protocol {}, session {:016x}", options.host,
-                 connections->tcp_port(), options.protocol == ServeProtocol::p1 ? "P1" : "P0", session_id);
-    if (options.shift.active()) spdlog::info("injected shift delay on every link, each direction: {}", options.shift.describe());
-    if (!options.encrypt) spdlog::warn("--no-encryption: frames and datagrams travel in clear (authenticated, readable by anyone on the path)");
+    connections = std::make_unique<ConnectionHandler>(
+        io, options, welcome_template(options, *model, scene_yaml), key, session_id,
+        model->scene.network.max_participants, *tools, recorder.get());
+    spdlog::info("listening on {}:{} (TCP control, UDP samples), protocol {}, session {:016x}",
+                 options.host, connections->tcp_port(),
+                 options.protocol == ServeProtocol::p1 ? "P1" : "P0", session_id);
+    if (options.shift.active())
+      spdlog::info("injected shift delay on every link, each direction: {}",
+                   options.shift.describe());
+    if (!options.encrypt)
+      spdlog::warn(
+          "--no-encryption: frames and datagrams travel in clear (authenticated, readable by "
+          "anyone on the path)");
     if (options.conditions.size() > 1)
-      spdlog::info("conditions served: {} (starting with '{}')", condition_list(), options.conditions.front().name);
+      spdlog::info("conditions served: {} (starting with '{}')", condition_list(),
+                   options.conditions.front().name);
     if (options.control) {
-      control = std::make_unique<ControlSocket>(io, *options.control,
-                                                [this](const nlohmann::json& command) { return control_command(command); });
+      control = std::make_unique<ControlSocket>(
+          io, *options.control,
+          [this](const nlohmann::json& command) { return control_command(command); });
       spdlog::info("control socket at {}", options.control->string());
     }
     if (view) {
-      connections->on_client_status([this](int slot, const std::string& user, const wire::ClientStatus& status) {
-        view->publish_status(slot, user, status, static_cast<double>(monotonic_now_ns() - start_ns) * 1e-9);
-      });
+      connections->on_client_status(
+          [this](int slot, const std::string& user, const wire::ClientStatus& status) {
+            view->publish_status(slot, user, status,
+                                 static_cast<double>(monotonic_now_ns() - start_ns) * 1e-9);
+          });
       if (options.view_token_file)  // the operator has the token: it stays out of the log
-        spdlog::info("live view at {} (open it in a browser, adding ?token= and the token in {})", view->url(false),
-                     options.view_token_file->string());
+        spdlog::info("live view at {} (open it in a browser, adding ?token= and the token in {})",
+                     view->url(false), options.view_token_file->string());
       else
         spdlog::info("live view at {} (open it in a browser)", view->url());
     }
@@ -215,9 +237,10 @@ struct SimulationServer::Impl {
     } else if (command.contains("serve_next")) {
       conditions.serve_next();  // the one after the one served now, whoever switched last
     } else if (!command.contains("status")) {
-      throw Error(fmt::format(
-          "unknown command {} (the commands: {{\"serve\": NAME}}, {{\"serve_next\": true}}, {{\"status\": true}})",
-          command.dump()));
+      throw Error(
+          fmt::format("unknown command {} (the commands: {{\"serve\": NAME}}, {{\"serve_next\": "
+                      "true}}, {{\"status\": true}})",
+                      command.dump()));
     }
     const ConditionSwitch::Served served = conditions.served();
     return {{"served", conditions.conditions()[static_cast<std::size_t>(served.index)].name},
@@ -226,7 +249,8 @@ struct SimulationServer::Impl {
   }
 
   void print_status() {
-    status_timer.expires_after(std::chrono::milliseconds(static_cast<int>(options.status_interval_s * 1000)));
+    status_timer.expires_after(
+        std::chrono::milliseconds(static_cast<int>(options.status_interval_s * 1000)));
     status_timer.async_wait([this](std::error_code error) {
       if (error) return;
       spdlog::info("{}", status_line(figures(), connections->users(), connections->slots()));
@@ -237,7 +261,9 @@ struct SimulationServer::Impl {
   // The simulation thread: the loop, its outboxes posted to the I/O thread.
   void simulate() {
     failure = loop->run(running, [this](Outbox&& outbox) {
-      asio::post(io, [this, outbox = std::move(outbox)]() mutable { connections->send(std::move(outbox)); });
+      asio::post(io, [this, outbox = std::move(outbox)]() mutable {
+        connections->send(std::move(outbox));
+      });
     });
     if (failure) asio::post(io, [this] { shutdown("the server's simulation failed"); });
   }
@@ -262,7 +288,8 @@ struct SimulationServer::Impl {
     nlohmann::json report;
     report["server"] = server_report(figures());
     try {
-      if (options.report.has_parent_path()) std::filesystem::create_directories(options.report.parent_path());
+      if (options.report.has_parent_path())
+        std::filesystem::create_directories(options.report.parent_path());
       AtomicFile out(options.report);
       out.write(report.dump(2));
       out.commit();
@@ -273,7 +300,8 @@ struct SimulationServer::Impl {
   }
 };
 
-SimulationServer::SimulationServer(ServeOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {
+SimulationServer::SimulationServer(ServeOptions options)
+    : impl_(std::make_unique<Impl>(std::move(options))) {
   validate(impl_->options.shift);
   impl_->load();
   impl_->bind();
@@ -302,7 +330,8 @@ void SimulationServer::run() {
     s.shutdown("server shutting down");
   });
   if (s.options.duration_s > 0) {
-    s.duration_timer.expires_after(std::chrono::milliseconds(static_cast<long>(s.options.duration_s * 1000)));
+    s.duration_timer.expires_after(
+        std::chrono::milliseconds(static_cast<long>(s.options.duration_s * 1000)));
     s.duration_timer.async_wait([&s](std::error_code error) {
       if (!error) s.shutdown("server shutting down");
     });
@@ -318,7 +347,8 @@ void SimulationServer::run() {
   if (s.view) s.view->stop();
   if (s.recorder) s.recorder->close();
   // Compliance columns computed on demand during the session serve the next one.
-  if (s.options.cache_directory) save_scene_compliance(*s.model, s.compliance, *s.options.cache_directory);
+  if (s.options.cache_directory)
+    save_scene_compliance(*s.model, s.compliance, *s.options.cache_directory);
   if (!s.options.report.empty()) s.write_report();
   if (s.failure) throw Error(*s.failure + "; the session ended");
 }

@@ -11,10 +11,12 @@ void ToolInputs::join(int slot) {
 void ToolInputs::release(int slot) {
   std::lock_guard lock(mutex_);
   ToolInput& tool = tools_[static_cast<std::size_t>(slot)];
-  tool = ToolInput{.joins = tool.joins};  // still counted: a leave and a join between two steps is a new user
+  tool = ToolInput{
+      .joins = tool.joins};  // still counted: a leave and a join between two steps is a new user
 }
 
-bool ToolInputs::update(int slot, bool valid, const Eigen::Vector3d& position, std::uint32_t buttons, std::int64_t sample_time_ns,
+bool ToolInputs::update(int slot, bool valid, const Eigen::Vector3d& position,
+                        std::uint32_t buttons, std::int64_t sample_time_ns,
                         std::int64_t received_ns) {
   std::lock_guard lock(mutex_);
   ToolInput& tool = tools_[static_cast<std::size_t>(slot)];

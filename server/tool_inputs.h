@@ -17,11 +17,12 @@ namespace cohaptic {
 
 struct ToolInput {
   bool joined = false;  ///< a user holds the slot
-  std::uint64_t joins = 0;  ///< users that have taken the slot so far (a new one holds nothing of the last's)
-  bool valid = false;   ///< the device reported a position
+  std::uint64_t joins =
+      0;  ///< users that have taken the slot so far (a new one holds nothing of the last's)
+  bool valid = false;  ///< the device reported a position
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  std::uint32_t buttons = 0;        ///< the device's buttons (bit i = button i)
-  std::uint32_t pressed = 0;        ///< buttons that went down in a sample since the previous take()
+  std::uint32_t buttons = 0;  ///< the device's buttons (bit i = button i)
+  std::uint32_t pressed = 0;  ///< buttons that went down in a sample since the previous take()
   std::int64_t sample_time_ns = 0;  ///< the server's clock, as stamped by the client
   std::int64_t received_ns = 0;     ///< when the server took it in
 };
@@ -36,8 +37,8 @@ class ToolInputs {
   void release(int slot);
   /// Takes a sample of `slot`'s tool; false (and nothing changes) if it is not newer than
   /// the one held, as a reordered datagram would be.
-  bool update(int slot, bool valid, const Eigen::Vector3d& position, std::uint32_t buttons, std::int64_t sample_time_ns,
-              std::int64_t received_ns);
+  bool update(int slot, bool valid, const Eigen::Vector3d& position, std::uint32_t buttons,
+              std::int64_t sample_time_ns, std::int64_t received_ns);
   /// Copies every slot into `out` (resized to the number of slots) and starts counting
   /// presses afresh.
   void take(std::vector<ToolInput>& out);

@@ -34,7 +34,8 @@ const Model& brain_model(int mesh) {
   return *slot;
 }
 
-// The kernel's resident high-water mark, reset (Linux: /proc/self/clear_refs "5"), and read [bytes].
+// The kernel's resident high-water mark, reset (Linux: /proc/self/clear_refs "5"), and read
+// [bytes].
 void reset_peak_memory() { std::ofstream("/proc/self/clear_refs") << "5"; }
 double peak_memory_bytes() {
   std::ifstream status("/proc/self/status");
@@ -62,8 +63,8 @@ void BM_BrainRowCompliance(benchmark::State& state) {
   state.SetLabel(kMeshes[state.range(1)]);
   state.counters["nodes"] = brain.mesh.node_count();
   state.counters["row_nodes"] = static_cast<double>(rows.size());
-  state.counters["row_nodes_per_s"] =
-      benchmark::Counter(static_cast<double>(rows.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["row_nodes_per_s"] = benchmark::Counter(
+      static_cast<double>(rows.size()), benchmark::Counter::kIsIterationInvariantRate);
   state.counters["columns_MB"] = 8 * m * m / 1e6;
   state.counters["peak_MB"] = peak_memory_bytes() / 1e6;
 }

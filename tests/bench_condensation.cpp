@@ -38,12 +38,13 @@ struct Fixture {
   std::unique_ptr<Model> model;
   std::unique_ptr<ComplianceColumns> columns;
   const ElasticBody& body() const { return single_elastic_body(*model); }
-  std::vector<int> contact;         // C: patch + remote triangle
-  std::vector<int> boundary;        // B: |B| nodes nearest the contact
-  std::vector<int> spare;           // nodes that join and leave B
+  std::vector<int> contact;                      // C: patch + remote triangle
+  std::vector<int> boundary;                     // B: |B| nodes nearest the contact
+  std::vector<int> spare;                        // nodes that join and leave B
   std::vector<std::vector<int>> other_contacts;  // C after a triangle change, cycling
   std::shared_ptr<const PreparedIR> ir_f64, ir_f32;
-  Eigen::Vector3d own = Eigen::Vector3d(0.001, 0.002, -0.003), remote = Eigen::Vector3d(0.025, -0.005, -0.003);
+  Eigen::Vector3d own = Eigen::Vector3d(0.001, 0.002, -0.003),
+                  remote = Eigen::Vector3d(0.025, -0.005, -0.003);
 };
 
 Fixture& fixture(int boundary_nodes) {
@@ -54,8 +55,10 @@ Fixture& fixture(int boundary_nodes) {
   Fixture& f = *slot;
   testing::CubeSceneOptions scene;
   scene.divisions = boundary_nodes > 500 ? 16 : 11;
-  f.model = std::make_unique<Model>(build_model(parse_scene(testing::cube_scene_yaml(scene), "bench-cube.yaml")));
-  f.columns = std::make_unique<ComplianceColumns>(f.body().free_factor, f.body().dofs, f.body().surface.nodes);
+  f.model = std::make_unique<Model>(
+      build_model(parse_scene(testing::cube_scene_yaml(scene), "bench-cube.yaml")));
+  f.columns = std::make_unique<ComplianceColumns>(f.body().free_factor, f.body().dofs,
+                                                  f.body().surface.nodes);
   const Model& model = *f.model;
   const ElasticBody& body = single_elastic_body(model);
 
@@ -64,7 +67,9 @@ Fixture& fixture(int boundary_nodes) {
   std::vector<std::pair<double, int>> by_distance;
   for (int t : body.touchable_triangles) {
     const Triangle& tri = body.surface.triangles[t];
-    const Eigen::Vector3d centre = (body.mesh.nodes.col(tri[0]) + body.mesh.nodes.col(tri[1]) + body.mesh.nodes.col(tri[2])) / 3;
+    const Eigen::Vector3d centre =
+        (body.mesh.nodes.col(tri[0]) + body.mesh.nodes.col(tri[1]) + body.mesh.nodes.col(tri[2])) /
+        3;
     by_distance.emplace_back((centre - f.own).norm(), t);
   }
   std::sort(by_distance.begin(), by_distance.end());
@@ -79,9 +84,11 @@ Fixture& fixture(int boundary_nodes) {
       {1, f.remote, 0, nearest_touchable_triangle(body, f.remote), {}}};
   for (const UserTool& tool : tools)
     for (int node : body.surface.triangles[tool.nearest_triangle]) reserved[node] = true;
-  f.boundary = nearest_surface_nodes(body.mesh, body.surface, body.dofs, std::vector<Eigen::Vector3d>{f.own}, boundary_nodes, reserved);
+  f.boundary = nearest_surface_nodes(body.mesh, body.surface, body.dofs,
+                                     std::vector<Eigen::Vector3d>{f.own}, boundary_nodes, reserved);
   for (int node : f.boundary) reserved[node] = true;
-  f.spare = nearest_surface_nodes(body.mesh, body.surface, body.dofs, std::vector<Eigen::Vector3d>{f.own}, 8, reserved);
+  f.spare = nearest_surface_nodes(body.mesh, body.surface, body.dofs,
+                                  std::vector<Eigen::Vector3d>{f.own}, 8, reserved);
 
   IncrementalCondensation condensation(*f.columns, body.dofs);
   condensation.set_boundary_nodes(f.boundary);
@@ -89,11 +96,13 @@ Fixture& fixture(int boundary_nodes) {
   for (IrPrecision precision : {IrPrecision::f64, IrPrecision::f32}) {
     IrBuildOptions options;
     options.precision = precision;
-    auto prepared = std::make_shared<const PreparedIR>(prepare_ir(build_ir(body, condensation, tools, 0, held, options, 1, 0)));
+    auto prepared = std::make_shared<const PreparedIR>(
+        prepare_ir(build_ir(body, condensation, tools, 0, held, options, 1, 0)));
     (precision == IrPrecision::f64 ? f.ir_f64 : f.ir_f32) = prepared;
   }
   const CondensedFemIr& ir = condensed_fem(f.ir_f64->ir);
-  for (int i = 0; i < ir.row_node_count; ++i) f.contact.push_back(node_index_from_tag(body.mesh, ir.node_ids[i]));
+  for (int i = 0; i < ir.row_node_count; ++i)
+    f.contact.push_back(node_index_from_tag(body.mesh, ir.node_ids[i]));
   return f;
 }
 
@@ -102,9 +111,13 @@ void BM_MtildeUpdate_naive(benchmark::State& state) {
   std::vector<int> boundary = f.boundary;
   bool joined = false;
   for (auto _ : state) {
-    if (joined) boundary.pop_back(); else boundary.push_back(f.spare[0]);
+    if (joined)
+      boundary.pop_back();
+    else
+      boundary.push_back(f.spare[0]);
     joined = !joined;
-    benchmark::DoNotOptimize(naive_condensation(*f.columns, f.body().dofs, f.contact, boundary).m_cb.data());
+    benchmark::DoNotOptimize(
+        naive_condensation(*f.columns, f.body().dofs, f.contact, boundary).m_cb.data());
   }
   state.counters["contact_dofs"] = static_cast<double>(condensed_fem(f.ir_f64->ir).m_tilde.rows());
 }
@@ -113,12 +126,15 @@ void BM_MtildeUpdate_naive(benchmark::State& state) {
 // drift monitor refactored.
 void report_phases(benchmark::State& state, const IncrementalCondensation::Statistics& before,
                    const IncrementalCondensation::Statistics& after) {
-  const auto per_iteration = [](double ms) { return benchmark::Counter(ms, benchmark::Counter::kAvgIterations); };
+  const auto per_iteration = [](double ms) {
+    return benchmark::Counter(ms, benchmark::Counter::kAvgIterations);
+  };
   state.counters["factor_ms"] = per_iteration(after.factor_ms - before.factor_ms);
   state.counters["z_ms"] = per_iteration(after.z_ms - before.z_ms);
   state.counters["schur_ms"] = per_iteration(after.schur_ms - before.schur_ms);
   state.counters["m_cb_ms"] = per_iteration(after.m_cb_ms - before.m_cb_ms);
-  state.counters["refactorizations"] = static_cast<double>(after.refactorizations - before.refactorizations);
+  state.counters["refactorizations"] =
+      static_cast<double>(after.refactorizations - before.refactorizations);
 }
 
 // Odd iterations: `spare` joins B (last). Even ones: the newest node (the spare) leaves,
@@ -145,15 +161,20 @@ void mtilde_update_incremental(benchmark::State& state, bool oldest) {
   state.counters["contact_dofs"] = static_cast<double>(condensed_fem(f.ir_f64->ir).m_tilde.rows());
 }
 
-void BM_MtildeUpdate_incremental(benchmark::State& state) { mtilde_update_incremental(state, false); }
-void BM_MtildeUpdate_incremental_oldest(benchmark::State& state) { mtilde_update_incremental(state, true); }
+void BM_MtildeUpdate_incremental(benchmark::State& state) {
+  mtilde_update_incremental(state, false);
+}
+void BM_MtildeUpdate_incremental_oldest(benchmark::State& state) {
+  mtilde_update_incremental(state, true);
+}
 
 void BM_TriangleChange_naive(benchmark::State& state) {
   Fixture& f = fixture(static_cast<int>(state.range(0)));
   std::size_t next = 0;
   for (auto _ : state) {
     const std::vector<int>& contact = f.other_contacts[next++ % f.other_contacts.size()];
-    benchmark::DoNotOptimize(naive_condensation(*f.columns, f.body().dofs, contact, f.boundary).m_cb.data());
+    benchmark::DoNotOptimize(
+        naive_condensation(*f.columns, f.body().dofs, contact, f.boundary).m_cb.data());
   }
 }
 
@@ -178,7 +199,8 @@ void BM_Evaluate(benchmark::State& state) {
   Eigen::Vector3d tool = f.own;
   for (auto _ : state) {
     tool.z() = -0.003 - 1e-9 * static_cast<double>(state.iterations() % 1000);
-    benchmark::DoNotOptimize(testing::evaluate_static(prepared, tool, std::span(&f.remote, 1)).force.data());
+    benchmark::DoNotOptimize(
+        testing::evaluate_static(prepared, tool, std::span(&f.remote, 1)).force.data());
   }
   state.counters["ir_bytes_f64"] = static_cast<double>(f.ir_f64->ir.size_bytes());
   state.counters["ir_bytes_f32"] = static_cast<double>(f.ir_f32->ir.size_bytes());
@@ -186,7 +208,9 @@ void BM_Evaluate(benchmark::State& state) {
 
 void BM_PrepareIr(benchmark::State& state) {
   Fixture& f = fixture(static_cast<int>(state.range(0)));
-  for (auto _ : state) benchmark::DoNotOptimize(std::get<PreparedFem>(prepare_ir(f.ir_f64->ir).body).compliance.data());
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        std::get<PreparedFem>(prepare_ir(f.ir_f64->ir).body).compliance.data());
 }
 
 const std::vector<std::int64_t> kBoundarySizes = {0, 150, 300, 1000};
@@ -200,7 +224,8 @@ void register_condensation_benchmarks() {
   };
   add("BM_MtildeUpdate/naive", BM_MtildeUpdate_naive, benchmark::kMillisecond);
   add("BM_MtildeUpdate/incremental", BM_MtildeUpdate_incremental, benchmark::kMillisecond);
-  add("BM_MtildeUpdate/incremental_oldest", BM_MtildeUpdate_incremental_oldest, benchmark::kMillisecond);
+  add("BM_MtildeUpdate/incremental_oldest", BM_MtildeUpdate_incremental_oldest,
+      benchmark::kMillisecond);
   add("BM_TriangleChange/naive", BM_TriangleChange_naive, benchmark::kMillisecond);
   add("BM_TriangleChange/incremental", BM_TriangleChange_incremental, benchmark::kMillisecond);
   add("BM_Evaluate", BM_Evaluate, benchmark::kMicrosecond);

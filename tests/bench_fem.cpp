@@ -104,7 +104,8 @@ void BM_ComplianceSurfaceBlock_per_node(benchmark::State& state) {
 
 // A solve group's cost against its size: what ComplianceColumns::kGroupSize trades.
 void BM_ComplianceGroupSolve(benchmark::State& state) {
-  static const Model model = build_model(load_scene(std::string(COHAPTIC_SOURCE_DIR) + "/scenes/brain.yaml"));
+  static const Model model =
+      build_model(load_scene(std::string(COHAPTIC_SOURCE_DIR) + "/scenes/brain.yaml"));
   const ElasticBody& brain = single_elastic_body(model);
   const std::vector<int> rows = compliance_row_nodes(brain, true);
   const std::vector<int> group(rows.begin(), rows.begin() + state.range(0));
@@ -113,8 +114,9 @@ void BM_ComplianceGroupSolve(benchmark::State& state) {
     columns.compute_columns(group);  // one solve: the group is the whole row set
     benchmark::DoNotOptimize(columns.column_count());
   }
-  state.counters["cpu_s_per_node"] = benchmark::Counter(static_cast<double>(state.range(0)),
-                                                     benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["cpu_s_per_node"] = benchmark::Counter(
+      static_cast<double>(state.range(0)),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 BENCHMARK(BM_Assemble)->Arg(11)->Arg(22)->Unit(benchmark::kMillisecond);

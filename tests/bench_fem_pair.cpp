@@ -38,8 +38,8 @@ void BM_FemPairContact(benchmark::State& state) {
   FemPairBench bench;
   testing::CoupledPush& push = bench.push;
   for (auto _ : state) {
-    const FemPairContact contact =
-        solve_fem_pair_contact(push.collisions, *push.front_columns, push.free.tool_dofs, *push.rig.behind_columns);
+    const FemPairContact contact = solve_fem_pair_contact(
+        push.collisions, *push.front_columns, push.free.tool_dofs, *push.rig.behind_columns);
     benchmark::DoNotOptimize(contact.pushes.data());
   }
   state.counters["candidates"] = static_cast<double>(push.collisions.size());
@@ -50,8 +50,8 @@ void BM_FemPairSupportChange_folded(benchmark::State& state) {
   FemPairBench bench;
   const ElasticBody& a = bench.push.rig.front;
   for (auto _ : state) {
-    SupportedCompliance supported(*bench.push.front_columns, a.dofs, bench.support.nodes, bench.support.normals,
-                                  bench.support.compliance);
+    SupportedCompliance supported(*bench.push.front_columns, a.dofs, bench.support.nodes,
+                                  bench.support.normals, bench.support.compliance);
     const CondensedOperator m = naive_condensation(supported, a.dofs, bench.contact, {});
     benchmark::DoNotOptimize(m.m_cc.data());
   }
@@ -63,7 +63,8 @@ void BM_FemPairSupportChange_refactor(benchmark::State& state) {
   FemPairBench bench;
   const ElasticBody& a = bench.push.rig.front;
   for (auto _ : state) {
-    const SparseCholesky factor(testing::stiffness_with_support(a, bench.support.nodes, bench.support.normals, bench.support.compliance));
+    const SparseCholesky factor(testing::stiffness_with_support(
+        a, bench.support.nodes, bench.support.normals, bench.support.compliance));
     ComplianceColumns columns(factor, a.dofs, a.surface.nodes);
     const CondensedOperator m = naive_condensation(columns, a.dofs, bench.contact, {});
     benchmark::DoNotOptimize(m.m_cc.data());
@@ -73,8 +74,12 @@ void BM_FemPairSupportChange_refactor(benchmark::State& state) {
 }
 
 BENCHMARK(BM_FemPairContact)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_FemPairSupportChange_folded)->Name("BM_FemPairSupportChange/folded")->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_FemPairSupportChange_refactor)->Name("BM_FemPairSupportChange/refactor")->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FemPairSupportChange_folded)
+    ->Name("BM_FemPairSupportChange/folded")
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_FemPairSupportChange_refactor)
+    ->Name("BM_FemPairSupportChange/refactor")
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace cohaptic

@@ -52,7 +52,8 @@ InteractionFixture& interaction_fixture() {
     for (int node : behind.surface.nodes)
       if (behind.mesh.nodes(0, node) < 1e-9) made.face.push_back(node);
     std::sort(made.face.begin(), made.face.end(), [&](int a, int b) {
-      return (behind.mesh.nodes.col(a) - centre).norm() < (behind.mesh.nodes.col(b) - centre).norm();
+      return (behind.mesh.nodes.col(a) - centre).norm() <
+             (behind.mesh.nodes.col(b) - centre).norm();
     });
     made.rig->behind_columns->compute_columns(made.face);
     return made;
@@ -65,7 +66,8 @@ struct Displaced {
   std::vector<int> nodes;
   Eigen::VectorXd displacement;
   explicit Displaced(std::size_t n)
-      : nodes(interaction_fixture().face.begin(), interaction_fixture().face.begin() + static_cast<std::ptrdiff_t>(n)) {
+      : nodes(interaction_fixture().face.begin(),
+              interaction_fixture().face.begin() + static_cast<std::ptrdiff_t>(n)) {
     std::sort(nodes.begin(), nodes.end());
     displacement = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(n));
     for (std::size_t j = 0; j < n; ++j) displacement[3 * static_cast<Eigen::Index>(j)] = 0.001;
@@ -78,8 +80,8 @@ void BM_BehindReaction(benchmark::State& state) {
   Eigen::VectorXd forces(displaced.displacement.size());
   CondensedResponseWorkspace workspace;
   for (auto _ : state) {
-    condensed_reaction(*f.rig->behind_columns, f.rig->behind.dofs, displaced.nodes, displaced.displacement, forces,
-                       workspace);
+    condensed_reaction(*f.rig->behind_columns, f.rig->behind.dofs, displaced.nodes,
+                       displaced.displacement, forces, workspace);
     benchmark::DoNotOptimize(forces.data());
   }
 }
@@ -90,9 +92,10 @@ void BM_BehindDeformation(benchmark::State& state) {
   const Displaced displaced(static_cast<std::size_t>(state.range(0)));
   Eigen::VectorXd forces(displaced.displacement.size());
   CondensedResponseWorkspace workspace;
-  condensed_reaction(*f.rig->behind_columns, f.rig->behind.dofs, displaced.nodes, displaced.displacement, forces,
-                     workspace);
-  Eigen::VectorXd deformation(3 * static_cast<Eigen::Index>(f.rig->behind_columns->row_nodes().size()));
+  condensed_reaction(*f.rig->behind_columns, f.rig->behind.dofs, displaced.nodes,
+                     displaced.displacement, forces, workspace);
+  Eigen::VectorXd deformation(3 *
+                              static_cast<Eigen::Index>(f.rig->behind_columns->row_nodes().size()));
   for (auto _ : state) {
     condensed_deformation(*f.rig->behind_columns, displaced.nodes, forces, deformation);
     benchmark::DoNotOptimize(deformation.data());
@@ -122,7 +125,8 @@ struct PairsScenario {
   Eigen::Matrix3Xd active;
   SurfaceAdjacency active_surface;
   NodePairList list;
-  explicit PairsScenario(int pairs) : active(3, pairs), active_surface(make_surface_adjacency({}, pairs)) {
+  explicit PairsScenario(int pairs)
+      : active(3, pairs), active_surface(make_surface_adjacency({}, pairs)) {
     const InteractionFixture& f = interaction_fixture();
     list.paired.assign(static_cast<std::size_t>(pairs), 1);
     for (int k = 0; k < pairs; ++k) {
@@ -144,12 +148,14 @@ struct PairsScenario {
 };
 
 void BM_InteractionStep(benchmark::State& state) {
-  const auto workflow = state.range(0) == 0 ? InteractionWorkflow::naive : InteractionWorkflow::improved;
+  const auto workflow =
+      state.range(0) == 0 ? InteractionWorkflow::naive : InteractionWorkflow::improved;
   PairsScenario scenario(static_cast<int>(state.range(1)));
   CondensedResponseWorkspace workspace;
   std::size_t collisions = 0, displaced = 0;
   for (auto _ : state) {
-    const InteractionStep step = interaction_step(scenario.list, scenario.bodies(), workflow, workspace);
+    const InteractionStep step =
+        interaction_step(scenario.list, scenario.bodies(), workflow, workspace);
     collisions = step.collisions.size();
     displaced = step.displacement.nodes.size();
     benchmark::DoNotOptimize(step.active_forces.data());
@@ -166,8 +172,8 @@ void BM_UpdatePairs(benchmark::State& state) {
   PairsScenario scenario(static_cast<int>(state.range(0)));
   const InteractingBodies bodies = scenario.bodies();
   for (auto _ : state)
-    benchmark::DoNotOptimize(
-        update_node_pairs(scenario.list, bodies.active_positions, bodies.passive_positions, bodies.passive_surface));
+    benchmark::DoNotOptimize(update_node_pairs(scenario.list, bodies.active_positions,
+                                               bodies.passive_positions, bodies.passive_surface));
 }
 BENCHMARK(BM_UpdatePairs)->Arg(1)->Arg(16)->Unit(benchmark::kMicrosecond);
 
@@ -177,7 +183,8 @@ void BM_InstantCollision(benchmark::State& state) {
   const Eigen::Vector3d active = scenario.active.col(0);
   const int passive = scenario.list.pairs[0].passive;
   for (auto _ : state)
-    benchmark::DoNotOptimize(instant_collision_test(active, passive, bodies.passive_positions, bodies.passive_surface));
+    benchmark::DoNotOptimize(
+        instant_collision_test(active, passive, bodies.passive_positions, bodies.passive_surface));
 }
 BENCHMARK(BM_InstantCollision)->Unit(benchmark::kMicrosecond);
 
@@ -197,7 +204,8 @@ void BM_ForcibleDisplacement(benchmark::State& state) {
   const InteractingBodies bodies = scenario.bodies();
   const std::vector<PolygonCollision> collisions = find_polygon_collisions(scenario.list, bodies);
   for (auto _ : state)
-    benchmark::DoNotOptimize(forcible_displacement(collisions, bodies.passive_dofs.fixed_axes).displacement.data());
+    benchmark::DoNotOptimize(
+        forcible_displacement(collisions, bodies.passive_dofs.fixed_axes).displacement.data());
 }
 BENCHMARK(BM_ForcibleDisplacement)->Arg(1)->Arg(16)->Unit(benchmark::kMicrosecond);
 
@@ -206,7 +214,8 @@ void BM_Conveyance(benchmark::State& state) {
   CondensedResponseWorkspace workspace;
   const InteractionStep step =
       interaction_step(scenario.list, scenario.bodies(), InteractionWorkflow::improved, workspace);
-  for (auto _ : state) benchmark::DoNotOptimize(convey_reaction(step.displacement, step.passive_forces).data());
+  for (auto _ : state)
+    benchmark::DoNotOptimize(convey_reaction(step.displacement, step.passive_forces).data());
 }
 BENCHMARK(BM_Conveyance)->Arg(1)->Arg(16)->Unit(benchmark::kMicrosecond);
 
@@ -216,14 +225,15 @@ void BM_AddPairs(benchmark::State& state) {
   InteractionFixture& f = interaction_fixture();
   const testing::PairedBoxesRig& rig = *f.rig;
   const int centre = rig.front_face[rig.front_face.size() / 2];
-  NodePairList list =
-      make_node_pairs(std::span(&centre, 1), rig.front.mesh.nodes, rig.behind.surface.nodes, rig.behind.mesh.nodes);
+  NodePairList list = make_node_pairs(std::span(&centre, 1), rig.front.mesh.nodes,
+                                      rig.behind.surface.nodes, rig.behind.mesh.nodes);
   const std::vector<int> colliding{0};
   int added = 0;
   for (auto _ : state) {
-    added = add_neighbour_pairs(list, colliding, rig.front.mesh.nodes, rig.front_surface, rig.behind.mesh.nodes,
-                                rig.behind_surface);
-    for (std::size_t k = 1; k < list.pairs.size(); ++k) list.paired[static_cast<std::size_t>(list.pairs[k].active)] = 0;
+    added = add_neighbour_pairs(list, colliding, rig.front.mesh.nodes, rig.front_surface,
+                                rig.behind.mesh.nodes, rig.behind_surface);
+    for (std::size_t k = 1; k < list.pairs.size(); ++k)
+      list.paired[static_cast<std::size_t>(list.pairs[k].active)] = 0;
     list.pairs.resize(1);
   }
   state.counters["added"] = added;

@@ -36,15 +36,17 @@ const Vector3d kPivot(0.01, 0.02, 0.15);
 const TriangleSurface& sheet(int columns) {
   static std::map<int, std::unique_ptr<TriangleSurface>> sheets;
   auto& slot = sheets[columns];
-  if (!slot) slot = std::make_unique<TriangleSurface>(testing::equilateral_sheet(columns, columns, kSpacing));
+  if (!slot)
+    slot =
+        std::make_unique<TriangleSurface>(testing::equilateral_sheet(columns, columns, kSpacing));
   return *slot;
 }
 
 PreparedHomeSpringPatch patch_of_radius(double radius) {
   const TriangleSurface& surface = sheet(80);  // 16 cm square
   const VertexRings rings = vertex_rings(surface.triangles, surface.vertex_count());
-  return prepare_home_spring_patch(extract_home_spring_patch({surface.vertices, surface.triangles, rings},
-                                                             Vector3d::Zero(), radius, {300, 100}, kPivot));
+  return prepare_home_spring_patch(extract_home_spring_patch(
+      {surface.vertices, surface.triangles, rings}, Vector3d::Zero(), radius, {300, 100}, kPivot));
 }
 
 /// The tool circling 3 mm below the sheet's centre, a new point every tick.
@@ -59,9 +61,11 @@ void set_patch_counters(benchmark::State& state, const HomeSpringPatch& patch) {
 }
 
 void BM_HomeSpringTick(benchmark::State& state) {
-  const PreparedHomeSpringPatch prepared = patch_of_radius(1e-3 * static_cast<double>(state.range(0)));
+  const PreparedHomeSpringPatch prepared =
+      patch_of_radius(1e-3 * static_cast<double>(state.range(0)));
   int tick = 0;
-  for (auto _ : state) benchmark::DoNotOptimize(evaluate_home_spring(prepared, circling_tool(tick++)));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(evaluate_home_spring(prepared, circling_tool(tick++)));
   set_patch_counters(state, prepared.patch);
 }
 BENCHMARK(BM_HomeSpringTick)->Arg(5)->Arg(10)->Arg(20)->Arg(40)->Unit(benchmark::kMicrosecond);
@@ -75,7 +79,8 @@ void BM_HomeSpringIrTick(benchmark::State& state) {
   EvaluationState evaluation = make_evaluation_state(prepared);
   int tick = 0;
   for (auto _ : state)
-    benchmark::DoNotOptimize(evaluate_force(prepared, evaluation, circling_tool(tick++), {}, 1.0 / 2000));
+    benchmark::DoNotOptimize(
+        evaluate_force(prepared, evaluation, circling_tool(tick++), {}, 1.0 / 2000));
   set_patch_counters(state, std::get<HomeSpringPatch>(prepared.ir.body));
 }
 BENCHMARK(BM_HomeSpringIrTick)->Arg(5)->Arg(40)->Unit(benchmark::kMicrosecond);
@@ -85,8 +90,9 @@ HomeSpringContact scan_tick(const HomeSpringPatch& patch, const Vector3d& tool) 
   HomeSpringContact contact;
   double best = 2;
   for (const Triangle& tri : patch.triangles) {
-    const auto crossing = segment_triangle_crossing(patch.trocar_pivot, tool, patch.rest_positions.col(tri[0]),
-                                                    patch.rest_positions.col(tri[1]), patch.rest_positions.col(tri[2]));
+    const auto crossing = segment_triangle_crossing(
+        patch.trocar_pivot, tool, patch.rest_positions.col(tri[0]),
+        patch.rest_positions.col(tri[1]), patch.rest_positions.col(tri[2]));
     if (!crossing || crossing->t >= best) continue;
     best = crossing->t;
     contact.contact_point = patch.trocar_pivot + crossing->t * (tool - patch.trocar_pivot);
@@ -104,7 +110,8 @@ HomeSpringContact scan_tick(const HomeSpringPatch& patch, const Vector3d& tool) 
 }
 
 void BM_HomeSpringTick_scan(benchmark::State& state) {
-  const PreparedHomeSpringPatch prepared = patch_of_radius(1e-3 * static_cast<double>(state.range(0)));
+  const PreparedHomeSpringPatch prepared =
+      patch_of_radius(1e-3 * static_cast<double>(state.range(0)));
   int tick = 0;
   for (auto _ : state) benchmark::DoNotOptimize(scan_tick(prepared.patch, circling_tool(tick++)));
   set_patch_counters(state, prepared.patch);
@@ -116,7 +123,8 @@ void BM_HomeSpringLoad(benchmark::State& state) {
   const int vertex = nearest_touchable_vertex(prepared.patch, Vector3d::Zero());
   int tick = 0;
   for (auto _ : state)
-    benchmark::DoNotOptimize(home_spring_load(prepared.patch, vertex, circling_tool(tick++) - Vector3d(0, 0, 0.001)));
+    benchmark::DoNotOptimize(
+        home_spring_load(prepared.patch, vertex, circling_tool(tick++) - Vector3d(0, 0, 0.001)));
 }
 BENCHMARK(BM_HomeSpringLoad)->Unit(benchmark::kMicrosecond);
 
@@ -144,7 +152,8 @@ BernsteinLattice sheet_lattice(const Eigen::Matrix3Xd& rest) {
 
 /// A grasp at the centre pulled 1 cm up, by Eq. 7.
 LatticeControl pulled_control(const BernsteinLattice& lattice) {
-  return lattice.control + single_point_manipulation(lattice_basis(lattice, Vector3d::Zero()), Vector3d(0, 0, 0.01));
+  return lattice.control +
+         single_point_manipulation(lattice_basis(lattice, Vector3d::Zero()), Vector3d(0, 0, 0.01));
 }
 
 void BM_FfdDeformation(benchmark::State& state) {
@@ -175,9 +184,9 @@ void BM_FfdDeformation_naive(benchmark::State& state) {
       for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j)
           for (int k = 0; k < 4; ++k) {
-            const double b = binomial3(i) * std::pow(uvw[0], i) * std::pow(1 - uvw[0], 3 - i) * binomial3(j) *
-                             std::pow(uvw[1], j) * std::pow(1 - uvw[1], 3 - j) * binomial3(k) * std::pow(uvw[2], k) *
-                             std::pow(1 - uvw[2], 3 - k);
+            const double b = binomial3(i) * std::pow(uvw[0], i) * std::pow(1 - uvw[0], 3 - i) *
+                             binomial3(j) * std::pow(uvw[1], j) * std::pow(1 - uvw[1], 3 - j) *
+                             binomial3(k) * std::pow(uvw[2], k) * std::pow(1 - uvw[2], 3 - k);
             q += b * control.col(i + 4 * j + 16 * k);
           }
       deformed.col(v) = q;
@@ -191,7 +200,8 @@ BENCHMARK(BM_FfdDeformation_naive)->Arg(31)->Arg(100)->Arg(316)->Unit(benchmark:
 void BM_DirectManipulation_eq7(benchmark::State& state) {
   const BernsteinLattice lattice = sheet_lattice(sheet(31).vertices);
   const LatticeBasis basis = lattice_basis(lattice, Vector3d(0.001, 0.002, 0));
-  for (auto _ : state) benchmark::DoNotOptimize(single_point_manipulation(basis, Vector3d(0, 0, 0.01)));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(single_point_manipulation(basis, Vector3d(0, 0, 0.01)));
 }
 BENCHMARK(BM_DirectManipulation_eq7)->Unit(benchmark::kMicrosecond);
 
@@ -202,7 +212,8 @@ void BM_DirectManipulation_eq6(benchmark::State& state) {
   Eigen::Matrix<double, kLatticeControlPoints, Eigen::Dynamic> bases(kLatticeControlPoints, m);
   Eigen::Matrix3Xd displacements = Eigen::Matrix3Xd::Zero(3, m);
   displacements(2, 0) = 0.01;  // the grasp pulled up, the others pinned
-  for (Eigen::Index i = 0; i < m; ++i) bases.col(i) = lattice_basis(lattice, rest.col((i * 97) % rest.cols()));
+  for (Eigen::Index i = 0; i < m; ++i)
+    bases.col(i) = lattice_basis(lattice, rest.col((i * 97) % rest.cols()));
   for (auto _ : state) benchmark::DoNotOptimize(least_squares_manipulation(bases, displacements));
 }
 BENCHMARK(BM_DirectManipulation_eq6)->Arg(1)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);

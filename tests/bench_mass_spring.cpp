@@ -31,8 +31,10 @@ namespace {
 
 MassSpringObjectSpec paper_tube(int sections, double density) {
   MassSpringObjectSpec spec;
-  const double radius = 0.005, spacing = 0.0022245, lift = radius * std::cos(std::numbers::pi / kRingNodes);
-  spec.tube.centre_line = {Eigen::Vector3d(0, 0, lift), Eigen::Vector3d(spacing * (sections - 1), 0, lift)};
+  const double radius = 0.005, spacing = 0.0022245,
+               lift = radius * std::cos(std::numbers::pi / kRingNodes);
+  spec.tube.centre_line = {Eigen::Vector3d(0, 0, lift),
+                           Eigen::Vector3d(spacing * (sections - 1), 0, lift)};
   spec.tube.radius = radius;
   spec.tube.sections = sections;
   spec.material = {737.4, density, 1e-6};
@@ -53,7 +55,12 @@ void BM_MassSpringDeformation(benchmark::State& state) {
   }
   state.counters["step_ms"] = body.network.parameters.time_step * 1e3;
 }
-BENCHMARK(BM_MassSpringDeformation)->Arg(180)->Arg(360)->Arg(540)->Arg(720)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_MassSpringDeformation)
+    ->Arg(180)
+    ->Arg(360)
+    ->Arg(540)
+    ->Arg(720)
+    ->Unit(benchmark::kMicrosecond);
 
 // A tool above the middle of the tube's top, 0.5 mm into it.
 Eigen::Vector3d tool_over_middle(const MassSpringModel& body) {
@@ -69,9 +76,16 @@ Eigen::Vector3d tool_over_middle(const MassSpringModel& body) {
 void BM_MassSpringCollisionFaces(benchmark::State& state) {
   const MassSpringModel body = paper_body(static_cast<int>(state.range(0)) / kSectionNodes);
   const Eigen::Vector3d tool = tool_over_middle(body);
-  for (auto _ : state) benchmark::DoNotOptimize(find_surface_contact(body.network, body.network.rest_positions, tool, 0.002));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        find_surface_contact(body.network, body.network.rest_positions, tool, 0.002));
 }
-BENCHMARK(BM_MassSpringCollisionFaces)->Name("BM_MassSpringCollision/faces")->Arg(180)->Arg(360)->Arg(540)->Arg(720);
+BENCHMARK(BM_MassSpringCollisionFaces)
+    ->Name("BM_MassSpringCollision/faces")
+    ->Arg(180)
+    ->Arg(360)
+    ->Arg(540)
+    ->Arg(720);
 
 void BM_MassSpringCollisionAllTriangles(benchmark::State& state) {
   const MassSpringModel body = paper_body(static_cast<int>(state.range(0)) / kSectionNodes);
@@ -80,11 +94,19 @@ void BM_MassSpringCollisionAllTriangles(benchmark::State& state) {
   for (auto _ : state) {
     double nearest = std::numeric_limits<double>::infinity();
     for (const auto& t : body.network.triangles)
-      nearest = std::min(nearest, (closest_point_on_triangle(tool, x.col(t[0]), x.col(t[1]), x.col(t[2])).point - tool).squaredNorm());
+      nearest = std::min(
+          nearest,
+          (closest_point_on_triangle(tool, x.col(t[0]), x.col(t[1]), x.col(t[2])).point - tool)
+              .squaredNorm());
     benchmark::DoNotOptimize(nearest);
   }
 }
-BENCHMARK(BM_MassSpringCollisionAllTriangles)->Name("BM_MassSpringCollision/all_triangles")->Arg(180)->Arg(360)->Arg(540)->Arg(720);
+BENCHMARK(BM_MassSpringCollisionAllTriangles)
+    ->Name("BM_MassSpringCollision/all_triangles")
+    ->Arg(180)
+    ->Arg(360)
+    ->Arg(540)
+    ->Arg(720);
 
 void BM_MassSpringCriticalStep(benchmark::State& state) {
   const MassSpringModel body = paper_body(40, static_cast<double>(state.range(0)));
@@ -101,15 +123,17 @@ void BM_MassSpringClientTick(benchmark::State& state) {
   IntermediateRepresentation ir;
   ir.tool_radius = 0.002;
   ir.force_limit = 3.3;
-  MassSpringIr sub = build_mass_spring_ir(body, server, find_surface_contact(body.network, server.positions, tool, 0.002).nearest_node,
-                                          static_cast<int>(state.range(0)));
+  MassSpringIr sub = build_mass_spring_ir(
+      body, server, find_surface_contact(body.network, server.positions, tool, 0.002).nearest_node,
+      static_cast<int>(state.range(0)));
   sub.presses.resize(1);
   const int nodes = sub.node_count();
   const std::size_t bytes = sub.size_bytes();
   ir.body = std::move(sub);
   const PreparedIR prepared = prepare_ir(std::move(ir));
   EvaluationState evaluation = make_evaluation_state(prepared);
-  for (auto _ : state) benchmark::DoNotOptimize(evaluate_force(prepared, evaluation, tool, {}, 0.001).force.data());
+  for (auto _ : state)
+    benchmark::DoNotOptimize(evaluate_force(prepared, evaluation, tool, {}, 0.001).force.data());
   state.counters["nodes"] = nodes;
   state.counters["ir_bytes"] = static_cast<double>(bytes);
 }

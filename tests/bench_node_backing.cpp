@@ -24,7 +24,8 @@ namespace {
 struct BackedRow {
   NodeBacking backing;
   Eigen::Matrix3Xd positions, velocities;
-  explicit BackedRow(int count) : positions(3, count), velocities(Eigen::Matrix3Xd::Zero(3, count)) {
+  explicit BackedRow(int count)
+      : positions(3, count), velocities(Eigen::Matrix3Xd::Zero(3, count)) {
     backing.compliance.resize(count, count);
     for (int i = 0; i < count; ++i)
       for (int j = 0; j < count; ++j) backing.compliance(i, j) = 1e-4 / (1 + std::abs(i - j));
@@ -68,20 +69,29 @@ void BM_NodeBackingSubstep_lumped(benchmark::State& state) {
       const Eigen::Vector3d normal = backing.normals.segment<3>(3 * i);
       const double gap = (row.positions.col(node) - backing.targets.segment<3>(3 * i)).dot(normal);
       if (!(gap < 0)) continue;
-      const double push = -stiffness[i] * gap - backing.damping[i] * row.velocities.col(node).dot(normal);
+      const double push =
+          -stiffness[i] * gap - backing.damping[i] * row.velocities.col(node).dot(normal);
       if (push > 0) forces.col(node) += push * normal;
     }
     benchmark::DoNotOptimize(forces.data());
   }
 }
 
-BENCHMARK_CAPTURE(BM_NodeBackingSubstep_dense, dense, true)->Name("BM_NodeBackingSubstep/dense")->Arg(8)->Arg(16)->Arg(32);
+BENCHMARK_CAPTURE(BM_NodeBackingSubstep_dense, dense, true)
+    ->Name("BM_NodeBackingSubstep/dense")
+    ->Arg(8)
+    ->Arg(16)
+    ->Arg(32);
 BENCHMARK_CAPTURE(BM_NodeBackingSubstep_dense, dense_cold, false)
     ->Name("BM_NodeBackingSubstep/dense_cold")
     ->Arg(8)
     ->Arg(16)
     ->Arg(32);
-BENCHMARK(BM_NodeBackingSubstep_lumped)->Name("BM_NodeBackingSubstep/lumped")->Arg(8)->Arg(16)->Arg(32);
+BENCHMARK(BM_NodeBackingSubstep_lumped)
+    ->Name("BM_NodeBackingSubstep/lumped")
+    ->Arg(8)
+    ->Arg(16)
+    ->Arg(32);
 
 }  // namespace
 }  // namespace cohaptic

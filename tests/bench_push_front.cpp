@@ -27,8 +27,7 @@ struct PaperFront {
   PushLayout layout;
   int node = -1;  // the pushed node
   Eigen::Vector3d target, normal;
-  explicit PaperFront(const Scene& scene)
-      : model(build_model(scene)), layout(push_layout(scene)) {
+  explicit PaperFront(const Scene& scene) : model(build_model(scene)), layout(push_layout(scene)) {
     const Eigen::Vector3d point = push_point(scene, layout);
     const MassSpringNetwork& network = body().network;
     for (int n = 0; n < network.node_count(); ++n)
@@ -36,11 +35,14 @@ struct PaperFront {
     normal = -Eigen::Vector3d::Unit(layout.axis);
     target = point - 1e-3 * normal;
   }
-  const MassSpringModel& body() const { return std::get<MassSpringModel>(model.bodies[static_cast<std::size_t>(layout.front)]); }
+  const MassSpringModel& body() const {
+    return std::get<MassSpringModel>(model.bodies[static_cast<std::size_t>(layout.front)]);
+  }
 };
 
 const Scene& push_scene_file() {
-  static const Scene scene = load_scene(std::string(COHAPTIC_SOURCE_DIR) + "/scenes/objects/push.yaml");
+  static const Scene scene =
+      load_scene(std::string(COHAPTIC_SOURCE_DIR) + "/scenes/objects/push.yaml");
   return scene;
 }
 
@@ -52,9 +54,9 @@ void BM_FrontReaction(benchmark::State& state) {
   const double h = network.parameters.time_step;
   for (auto _ : state) {
     internal_forces(network, s.positions, s.velocities, s.forces);
-    const HapticNodeForce reaction = haptic_node_force(network.mass[front.node], s.positions.col(front.node),
-                                                       s.velocities.col(front.node), s.forces.col(front.node),
-                                                       front.target, front.normal, network.parameters.tool_friction, h);
+    const HapticNodeForce reaction = haptic_node_force(
+        network.mass[front.node], s.positions.col(front.node), s.velocities.col(front.node),
+        s.forces.col(front.node), front.target, front.normal, network.parameters.tool_friction, h);
     benchmark::DoNotOptimize(reaction.force.data());
   }
   state.counters["nodes"] = network.node_count();
@@ -74,7 +76,8 @@ void BM_FrontDeformation(benchmark::State& state) {
     s.positions = rest.positions;  // each step from the same state: the node 1 mm from its target
     s.velocities.setZero();
     state.ResumeTiming();
-    step_network(network, s, std::span(&drive, 1), std::span(&applied, 1), network.parameters.time_step);
+    step_network(network, s, std::span(&drive, 1), std::span(&applied, 1),
+                 network.parameters.time_step);
     benchmark::DoNotOptimize(s.positions.data());
   }
   state.counters["nodes"] = network.node_count();
@@ -85,11 +88,14 @@ void BM_FrontPeriod(benchmark::State& state) {
   const PaperFront front(push_scene_file());
   const MassSpringModel& body = front.body();
   const SceneCompliance compliance = prepare_scene_compliance(front.model, true, std::nullopt);
-  const auto& behind = std::get<ElasticBody>(front.model.bodies[static_cast<std::size_t>(front.layout.behind)]);
-  BodyInteraction interaction = make_body_interaction(front.layout.front, body, front.layout.behind, behind);
+  const auto& behind =
+      std::get<ElasticBody>(front.model.bodies[static_cast<std::size_t>(front.layout.behind)]);
+  BodyInteraction interaction =
+      make_body_interaction(front.layout.front, body, front.layout.behind, behind);
   MassSpringState s = make_state(body.network);
-  const NodeBacking backing = step_body_interaction(interaction, s.positions, body, behind,
-                                                    *compliance.per_body[static_cast<std::size_t>(front.layout.behind)]);
+  const NodeBacking backing =
+      step_body_interaction(interaction, s.positions, body, behind,
+                            *compliance.per_body[static_cast<std::size_t>(front.layout.behind)]);
   const ToolOnNetwork tool{front.target, 0};
   ToolPress press;
   NetworkToolReaction reaction;
@@ -99,8 +105,8 @@ void BM_FrontPeriod(benchmark::State& state) {
     s = rest;
     press = {};
     state.ResumeTiming();
-    advance_with_tools(body.network, s, std::span(&tool, 1), std::span(&press, 1), std::span(&reaction, 1), 1e-3,
-                       backing.empty() ? nullptr : &backing);
+    advance_with_tools(body.network, s, std::span(&tool, 1), std::span(&press, 1),
+                       std::span(&reaction, 1), 1e-3, backing.empty() ? nullptr : &backing);
     benchmark::DoNotOptimize(reaction.force.data());
   }
   state.counters["substeps"] = substeps_for(body.network, 1e-3);

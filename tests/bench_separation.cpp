@@ -27,7 +27,8 @@ const TwoLayerSetup& layers(int divisions) {
   static std::map<int, std::unique_ptr<TwoLayerSetup>> setups;
   auto& slot = setups[divisions];
   if (!slot)
-    slot = std::make_unique<TwoLayerSetup>(make_two_layer_setup(boxes(divisions), FieldSettings{}, SeparationSettings{}));
+    slot = std::make_unique<TwoLayerSetup>(
+        make_two_layer_setup(boxes(divisions), FieldSettings{}, SeparationSettings{}));
   return *slot;
 }
 
@@ -43,7 +44,8 @@ void BM_SeparationTick_elastic(benchmark::State& state) {
   SeparationState separation = make_separation_state(patch);
   const int node = nearest_patch_node(patch, Eigen::Vector3d(0.0203, 0.0197, 0));
   const Eigen::Vector3d start = patch.positions.col(node);
-  SeparationContact contact = begin_contact(patch, ContactMode::grasp, contact_at_node(patch, node), start);
+  SeparationContact contact =
+      begin_contact(patch, ContactMode::grasp, contact_at_node(patch, node), start);
   int i = 0;
   for (auto _ : state) {
     const double t = 1e-3 * (i++ % 6283);
@@ -61,7 +63,8 @@ void BM_SeparationTick_tearing(benchmark::State& state) {
   PullLoopSettings settings;
   settings.node = node;
   const PullLoop loop = run_pull_loop(patch, make_separation_state(patch), settings);
-  const Eigen::Vector3d start = patch.positions.col(node), n = patch.normals[patch.regions.of(node).front()];
+  const Eigen::Vector3d start = patch.positions.col(node),
+                        n = patch.normals[patch.regions.of(node).front()];
   double b = 0, c = loop.turn_travel;
   for (const PullLoopSample& s : loop.samples)
     if (s.phase == PullPhase::loading) b = s.travel;
@@ -80,11 +83,13 @@ void BM_SeparationTick_tearing(benchmark::State& state) {
     travel += 1e-5;
     const auto begin = std::chrono::steady_clock::now();
     const SeparationSample s = step_contact(patch, separation, contact, start + travel * n);
-    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
     tears += s.separated > 0;
   }
   set_counters(state, patch);
-  state.counters["tearing_share"] = static_cast<double>(tears) / static_cast<double>(state.iterations());
+  state.counters["tearing_share"] =
+      static_cast<double>(tears) / static_cast<double>(state.iterations());
 }
 
 // A tool under an opened flap (the strip x < 10 mm separated) pressing it up and dragged to
@@ -98,7 +103,8 @@ void BM_SeparationTick_sliding(benchmark::State& state) {
   separate_triangles(patch, separation, strip);
   const int node = nearest_patch_node(patch, Eigen::Vector3d(0.006, 0.02, 0));
   const Eigen::Vector3d start = patch.positions.col(node);
-  SeparationContact contact = begin_contact(patch, ContactMode::push, contact_at_node(patch, node), start);
+  SeparationContact contact =
+      begin_contact(patch, ContactMode::push, contact_at_node(patch, node), start);
   int i = 0;
   long slides = 0;
   for (auto _ : state) {
@@ -107,7 +113,8 @@ void BM_SeparationTick_sliding(benchmark::State& state) {
     slides += (step_contact(patch, separation, contact, tool).flags & kSeparationSliding) != 0;
   }
   set_counters(state, patch);
-  state.counters["sliding_share"] = static_cast<double>(slides) / static_cast<double>(state.iterations());
+  state.counters["sliding_share"] =
+      static_cast<double>(slides) / static_cast<double>(state.iterations());
 }
 
 // A laser sweep at half the vaporisation speed across the interface.
@@ -119,7 +126,8 @@ void BM_SeparationTick_laser(benchmark::State& state) {
   int i = 0;
   for (auto _ : state) {
     const double y = 0.001 + step * (i++ % static_cast<int>(0.038 / step));
-    benchmark::DoNotOptimize(step_laser(patch, separation, fibre, Eigen::Vector3d(0.0203, y, 0), true, 1e-3).vaporised);
+    benchmark::DoNotOptimize(
+        step_laser(patch, separation, fibre, Eigen::Vector3d(0.0203, y, 0), true, 1e-3).vaporised);
   }
   set_counters(state, patch);
 }
@@ -149,7 +157,8 @@ void BM_SeparationPrecompute(benchmark::State& state) {
   const SeparationInterface interface = find_interface(bodies, 1e-9);
   FieldPrecomputeReport report;
   for (auto _ : state)
-    benchmark::DoNotOptimize(precompute_separation_fields(bodies, interface, FieldSettings{}, &report).values.data());
+    benchmark::DoNotOptimize(
+        precompute_separation_fields(bodies, interface, FieldSettings{}, &report).values.data());
   state.counters["patch_nodes"] = interface.node_count();
   state.counters["fields"] = report.field_count;
   state.counters["compliance_ms"] = 1e3 * report.compliance_seconds;
@@ -160,11 +169,21 @@ void BM_SeparationPrecompute(benchmark::State& state) {
 }
 
 BENCHMARK(BM_SeparationTick_elastic)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_SeparationTick_tearing)->Arg(10)->Arg(20)->Arg(30)->UseManualTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SeparationTick_tearing)
+    ->Arg(10)
+    ->Arg(20)
+    ->Arg(30)
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeparationTick_sliding)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeparationTick_laser)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeparationTick_naive_full_solve)->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_SeparationPrecompute)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_SeparationPrecompute)
+    ->Arg(10)
+    ->Arg(20)
+    ->Arg(30)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 }  // namespace
 }  // namespace cohaptic

@@ -71,7 +71,7 @@ namespace cohaptic {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-constexpr double kRadius = 0.02;  // the sphere [m]
+constexpr double kRadius = 0.02;     // the sphere [m]
 constexpr double kAgreement = 1e-9;  // relative force difference allowed between the methods
 
 // The block of scenes/block/two_spheres.yaml, graded to 0.4 mm at (-25, 0, 0), touchable
@@ -98,12 +98,13 @@ struct SphereCase {
   int contacts;
   double depth;
 };
-constexpr std::array kCases{SphereCase{50, 0.104e-3}, SphereCase{200, 0.42e-3}, SphereCase{400, 0.86e-3},
-                            SphereCase{700, 1.75e-3}};
+constexpr std::array kCases{SphereCase{50, 0.104e-3}, SphereCase{200, 0.42e-3},
+                            SphereCase{400, 0.86e-3}, SphereCase{700, 1.75e-3}};
 constexpr int kStepContacts = 400;
 
 const SphereCase& case_of(int contacts) {
-  return *std::find_if(kCases.begin(), kCases.end(), [&](const SphereCase& c) { return c.contacts == contacts; });
+  return *std::find_if(kCases.begin(), kCases.end(),
+                       [&](const SphereCase& c) { return c.contacts == contacts; });
 }
 
 Eigen::Vector3d start_of(const SphereCase& c) { return {-0.025, 0, kRadius - c.depth}; }
@@ -131,12 +132,16 @@ class IterationTimes {
   void time(Work&& work) {
     const auto start = std::chrono::steady_clock::now();
     work();
-    times_.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
+    times_.push_back(
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start)
+            .count());
   }
   double p99_us() {
     if (times_.empty()) return 0;
-    const auto rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(times_.size()))) - 1;
-    std::nth_element(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(rank), times_.end());
+    const auto rank =
+        static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(times_.size()))) - 1;
+    std::nth_element(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(rank),
+                     times_.end());
     return times_[rank];
   }
 
@@ -152,10 +157,11 @@ struct BlockRig {
   std::vector<int> touchable;  // the touchable triangles' nodes: the condensed solve's candidates
 
   BlockRig()
-      : model(std::make_unique<Model>(
-            build_model(parse_scene(kSceneYaml, COHAPTIC_SOURCE_DIR "/scenes/block/bench_sphere_contact.yaml")))),
+      : model(std::make_unique<Model>(build_model(parse_scene(
+            kSceneYaml, COHAPTIC_SOURCE_DIR "/scenes/block/bench_sphere_contact.yaml")))),
         body(single_elastic_body(*model)),
-        columns(std::make_unique<ComplianceColumns>(body.free_factor, body.dofs, compliance_row_nodes(body, false))),
+        columns(std::make_unique<ComplianceColumns>(body.free_factor, body.dofs,
+                                                    compliance_row_nodes(body, false))),
         touchable(triangle_nodes(body.surface, body.touchable_triangles)) {
     prepare_compliance(body, *columns, default_cache_directory());
     for (int node = 0; node < body.mesh.node_count(); ++node)
@@ -181,11 +187,12 @@ std::unique_ptr<Simulation> simulation_at(const Eigen::Vector3d& start) {
   options.ir.contact_model = ContactModel::sphere;
   options.ir.patch_rings = 1;
   options.ir.force_limit = kInfinity;
-  auto simulation =
-      std::make_unique<Simulation>(rig.body, rig.model->obstacles, *rig.columns, rig.model->scene.tools, options);
+  auto simulation = std::make_unique<Simulation>(rig.body, rig.model->obstacles, *rig.columns,
+                                                 rig.model->scene.tools, options);
   simulation->set_tool(0, start);
   simulation->step(0);
-  if (!simulation->condensation().boundary_nodes().empty()) throw Error("the block holds boundary nodes: L~ is not L");
+  if (!simulation->condensation().boundary_nodes().empty())
+    throw Error("the block holds boundary nodes: L~ is not L");
   return simulation;
 }
 
@@ -226,11 +233,13 @@ class DenseTick {
     }
     const auto entry = [&](int a, int b) {
       const int i = node_[static_cast<std::size_t>(a)], j = node_[static_cast<std::size_t>(b)];
-      return sphere.normals.col(i).dot(compliance_.block<3, 3>(3 * i, 3 * j) * sphere.normals.col(j));
+      return sphere.normals.col(i).dot(compliance_.block<3, 3>(3 * i, 3 * j) *
+                                       sphere.normals.col(j));
     };
     const std::span<std::uint8_t> active(active_.data(), static_cast<std::size_t>(m));
     const WorkingSetSolveResult solved = solve_unilateral_over_candidates(
-        q_.head(m), entry, [](std::span<const int>) {}, m, active, lambda_.head(m), scratch_, kInfinity);
+        q_.head(m), entry, [](std::span<const int>) {}, m, active, lambda_.head(m), scratch_,
+        kInfinity);
     if (!solved.inner.solved) return std::nullopt;
     std::fill(warm_.begin(), warm_.end(), 0);
     Eigen::Vector3d contact_force = Eigen::Vector3d::Zero();
@@ -284,8 +293,9 @@ std::string compare_ticks(const TickRig& rig, int& contacts, double& difference)
       return fmt::format("tick {}: a solve failed", tick);
     difference = std::max(difference, relative_difference(sample.force, *expected));
     if (difference > kAgreement)
-      return fmt::format("tick {}: the incremental force differs from the dense one by {:.1e} relative", tick,
-                         difference);
+      return fmt::format(
+          "tick {}: the incremental force differs from the dense one by {:.1e} relative", tick,
+          difference);
   }
   return {};
 }
@@ -296,7 +306,8 @@ const TickRig& tick_rig(int contacts) {
   TickRig rig;
   rig.start = start_of(case_of(contacts));
   rig.prepared = simulation_at(rig.start)->ir(0);
-  rig.compliance = block_rig().columns->gather(block_rig().row_nodes(condensed_fem(rig.prepared->ir)));
+  rig.compliance =
+      block_rig().columns->gather(block_rig().row_nodes(condensed_fem(rig.prepared->ir)));
   rig.disagreement = compare_ticks(rig, rig.contacts, rig.difference);
   return built.emplace(contacts, std::move(rig)).first->second;
 }
@@ -372,14 +383,17 @@ void BM_PrepareSphereIr(benchmark::State& state, int contacts) {
 // inverted back to L~ (LLT), A = N^T L~ N and q = g + N^T u0 formed, and the unilateral
 // problem solved afresh; every other candidate that the solved state carries into its
 // sphere joins K, and K is solved again, until none does.
-StateSolution condensed_state_solve(ComplianceColumns& columns, IncrementalCondensation& condensation,
-                                    const ElasticBody& body, std::span<const int> candidates,
-                                    std::span<const SphereTool> spheres, const Eigen::VectorXd& boundary_displacement) {
+StateSolution condensed_state_solve(ComplianceColumns& columns,
+                                    IncrementalCondensation& condensation, const ElasticBody& body,
+                                    std::span<const int> candidates,
+                                    std::span<const SphereTool> spheres,
+                                    const Eigen::VectorXd& boundary_displacement) {
   const DofMap& dofs = body.dofs;
   std::vector<int> free_candidates;
   for (int node : candidates)
     if (!condensation.in_boundary(node)) free_candidates.push_back(node);
-  const SphereCandidates all = sphere_candidates(body.mesh, dofs, body.contact_normals, free_candidates, spheres);
+  const SphereCandidates all =
+      sphere_candidates(body.mesh, dofs, body.contact_normals, free_candidates, spheres);
 
   std::vector<bool> in_set(all.nodes.size());
   for (std::size_t i = 0; i < all.nodes.size(); ++i) in_set[i] = all.constraints[i].gap < 0;
@@ -398,14 +412,18 @@ StateSolution condensed_state_solve(ComplianceColumns& columns, IncrementalConde
     state.tool_forces.assign(spheres.size(), Eigen::Vector3d::Zero());
     const auto m = static_cast<Eigen::Index>(set.nodes.size());
     state.contact_dofs = free_dofs_of_nodes(dofs, set.nodes);
-    state.contact_forces = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(state.contact_dofs.size()));
+    state.contact_forces =
+        Eigen::VectorXd::Zero(static_cast<Eigen::Index>(state.contact_dofs.size()));
     if (m > 0) {
       const CondensedOperator op = condensation.condense(set.nodes);
       const Eigen::LLT<Eigen::MatrixXd> llt(op.m_cc);
-      if (llt.info() != Eigen::Success) throw NumericalError("the sphere contact's M_CC is not positive definite");
-      const Eigen::MatrixXd compliance = llt.solve(Eigen::MatrixXd::Identity(op.m_cc.rows(), op.m_cc.cols()));
+      if (llt.info() != Eigen::Success)
+        throw NumericalError("the sphere contact's M_CC is not positive definite");
+      const Eigen::MatrixXd compliance =
+          llt.solve(Eigen::MatrixXd::Identity(op.m_cc.rows(), op.m_cc.cols()));
       const Eigen::VectorXd free_displacement = -compliance * (op.m_cb * boundary_displacement);
-      Eigen::MatrixXd normals = Eigen::MatrixXd::Zero(compliance.rows(), m);  // N over the condensed rows
+      Eigen::MatrixXd normals =
+          Eigen::MatrixXd::Zero(compliance.rows(), m);  // N over the condensed rows
       for (Eigen::Index i = 0, row = 0; i < m; ++i)
         for (int axis = 0; axis < 3; ++axis)
           if (!dofs.is_fixed(set.nodes[static_cast<std::size_t>(i)], axis))
@@ -437,7 +455,8 @@ StateSolution condensed_state_solve(ComplianceColumns& columns, IncrementalConde
     bool joined = false;
     for (std::size_t k = 0; k < others.size(); ++k) {
       const SphereConstraint& c = all.constraints[others[k]];
-      if (c.gap + c.normal.dot(u.col(static_cast<Eigen::Index>(k))) < 0) in_set[others[k]] = joined = true;
+      if (c.gap + c.normal.dot(u.col(static_cast<Eigen::Index>(k))) < 0)
+        in_set[others[k]] = joined = true;
     }
     if (!joined) return state;
   }
@@ -467,7 +486,8 @@ struct StepRig {
 int pushed_nodes(const StateSolution& state) {
   std::vector<int> nodes;
   for (std::size_t i = 0; i < state.contact_dofs.size(); ++i)
-    if (state.contact_forces[static_cast<Eigen::Index>(i)] != 0) nodes.push_back(state.contact_dofs[i] / 3);
+    if (state.contact_forces[static_cast<Eigen::Index>(i)] != 0)
+      nodes.push_back(state.contact_dofs[i] / 3);
   return static_cast<int>(std::unique(nodes.begin(), nodes.end()) - nodes.begin());
 }
 
@@ -475,15 +495,19 @@ std::string compare_steps(StepRig& rig) {
   BlockRig& block = block_rig();
   for (std::size_t step = 0; step <= 100; step += 50) {
     const SphereTool sphere{along_path(rig.start, step), kRadius};
-    const StateSolution fresh =
-        rig.incremental->solve(*rig.condensation, rig.patch, std::span(&sphere, 1), rig.boundary_displacement);
-    const StateSolution condensed = condensed_state_solve(*block.columns, *rig.condensation, block.body, block.touchable,
-                                                      std::span(&sphere, 1), rig.boundary_displacement);
+    const StateSolution fresh = rig.incremental->solve(
+        *rig.condensation, rig.patch, std::span(&sphere, 1), rig.boundary_displacement);
+    const StateSolution condensed =
+        condensed_state_solve(*block.columns, *rig.condensation, block.body, block.touchable,
+                              std::span(&sphere, 1), rig.boundary_displacement);
     if (step == 0) rig.contacts = pushed_nodes(condensed);
-    rig.difference = std::max(rig.difference, relative_difference(fresh.tool_forces[0], condensed.tool_forces[0]));
+    rig.difference = std::max(rig.difference,
+                              relative_difference(fresh.tool_forces[0], condensed.tool_forces[0]));
     if (rig.difference > kAgreement)
-      return fmt::format("step {}: the incremental state's force differs from the condensed one's by {:.1e} relative",
-                         step, rig.difference);
+      return fmt::format(
+          "step {}: the incremental state's force differs from the condensed one's by {:.1e} "
+          "relative",
+          step, rig.difference);
   }
   rig.next_step[static_cast<std::size_t>(StepKind::incremental)] = 101;
   return {};
@@ -527,14 +551,15 @@ void BM_SphereStep(benchmark::State& state, StepKind kind) {
     times.time([&] {
       switch (kind) {
         case StepKind::incremental: {
-          StateSolution solved = rig->incremental->solve(*rig->condensation, rig->patch, std::span(&sphere, 1),
-                                                         rig->boundary_displacement);
+          StateSolution solved = rig->incremental->solve(
+              *rig->condensation, rig->patch, std::span(&sphere, 1), rig->boundary_displacement);
           benchmark::DoNotOptimize(solved.tool_forces[0].data());
           break;
         }
         case StepKind::condensed: {
-          StateSolution solved = condensed_state_solve(*block.columns, *rig->condensation, block.body, block.touchable,
-                                                       std::span(&sphere, 1), rig->boundary_displacement);
+          StateSolution solved =
+              condensed_state_solve(*block.columns, *rig->condensation, block.body, block.touchable,
+                                    std::span(&sphere, 1), rig->boundary_displacement);
           benchmark::DoNotOptimize(solved.tool_forces[0].data());
           break;
         }
@@ -546,32 +571,38 @@ void BM_SphereStep(benchmark::State& state, StepKind kind) {
     });
   }
   state.counters["contacts"] = rig->contacts;
-  state.counters["candidates"] = kind == StepKind::condensed ? static_cast<double>(block.touchable.size())
-                                                              : static_cast<double>(rig->patch.size());
+  state.counters["candidates"] = kind == StepKind::condensed
+                                     ? static_cast<double>(block.touchable.size())
+                                     : static_cast<double>(rig->patch.size());
   state.counters["p99_us"] = times.p99_us();
   if (kind == StepKind::condensed) state.counters["difference"] = rig->difference;
   if (kind == StepKind::simulation)
-    state.counters["rebuilt"] = static_cast<double>(rebuilt) / static_cast<double>(state.iterations());
+    state.counters["rebuilt"] =
+        static_cast<double>(rebuilt) / static_cast<double>(state.iterations());
 }
 
 void register_sphere_contact_benchmarks() {
   use_single_blas_thread();
   for (const SphereCase& c : kCases) {
     const std::string size = std::to_string(c.contacts);
-    benchmark::RegisterBenchmark((std::string("BM_SphereTick/incremental/") + size).c_str(), BM_SphereTickIncremental,
-                                 c.contacts)
+    benchmark::RegisterBenchmark((std::string("BM_SphereTick/incremental/") + size).c_str(),
+                                 BM_SphereTickIncremental, c.contacts)
         ->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark((std::string("BM_SphereTick/dense/") + size).c_str(), BM_SphereTickDense, c.contacts)
+    benchmark::RegisterBenchmark((std::string("BM_SphereTick/dense/") + size).c_str(),
+                                 BM_SphereTickDense, c.contacts)
         ->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark((std::string("BM_PrepareIr/sphere/") + size).c_str(), BM_PrepareSphereIr, c.contacts)
+    benchmark::RegisterBenchmark((std::string("BM_PrepareIr/sphere/") + size).c_str(),
+                                 BM_PrepareSphereIr, c.contacts)
         ->Unit(benchmark::kMicrosecond);
   }
   for (const auto& [name, kind] : {std::pair{"incremental", StepKind::incremental},
                                    std::pair{"condensed", StepKind::condensed},
                                    std::pair{"simulation", StepKind::simulation}}) {
-    const std::string full_name = std::string("BM_SphereStep/") + name + "/" + std::to_string(kStepContacts);
+    const std::string full_name =
+        std::string("BM_SphereStep/") + name + "/" + std::to_string(kStepContacts);
     benchmark::internal::Benchmark* step =
-        benchmark::RegisterBenchmark(full_name.c_str(), BM_SphereStep, kind)->Unit(benchmark::kMillisecond);
+        benchmark::RegisterBenchmark(full_name.c_str(), BM_SphereStep, kind)
+            ->Unit(benchmark::kMillisecond);
     // The condensed solve takes seconds at this size: a few calls give its spread.
     if (kind == StepKind::condensed) step->Iterations(3);
   }

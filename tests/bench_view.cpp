@@ -79,10 +79,11 @@ struct BrainRig {
     use_single_blas_thread();
     model = std::make_unique<Model>(build_model(load_scene(kBrain / "brain.yaml")));
     const ElasticBody& body = single_elastic_body(*model);
-    columns = std::make_unique<ComplianceColumns>(body.free_factor, body.dofs,
-                                                  compliance_row_nodes(body, !model->obstacles.empty()));
+    columns = std::make_unique<ComplianceColumns>(
+        body.free_factor, body.dofs, compliance_row_nodes(body, !model->obstacles.empty()));
     prepare_compliance(body, *columns, default_cache_directory());
-    for (const char* user : {"surgeon_a.yaml", "surgeon_b.yaml"}) motions.push_back(load_trajectory(kBrain / "brain" / user));
+    for (const char* user : {"surgeon_a.yaml", "surgeon_b.yaml"})
+      motions.push_back(load_trajectory(kBrain / "brain" / user));
   }
   static BrainRig& get() {
     static BrainRig rig;
@@ -112,7 +113,8 @@ class PinnedThread {
  public:
   static bool possible() {
     cpu_set_t allowed;
-    return sched_getaffinity(0, sizeof allowed, &allowed) == 0 && CPU_ISSET(0, &allowed) && CPU_ISSET(1, &allowed);
+    return sched_getaffinity(0, sizeof allowed, &allowed) == 0 && CPU_ISSET(0, &allowed) &&
+           CPU_ISSET(1, &allowed);
   }
   explicit PinnedThread(int cpu) {
     pthread_getaffinity_np(pthread_self(), sizeof before_, &before_);
@@ -134,7 +136,9 @@ class PinnedThread {
 double cpu_seconds(int who) {
   rusage usage{};
   getrusage(who, &usage);
-  const auto seconds = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  const auto seconds = [](const timeval& t) {
+    return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  };
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
@@ -150,10 +154,12 @@ class CpuBurner {
           const auto busy = kSlice * per_mille / 1000;
           std::vector<std::uint64_t> memory(std::size_t{4} << 20 >> 3);
           std::size_t next = 0;
-          for (auto slice = std::chrono::steady_clock::now(); !stop_.load(std::memory_order_relaxed); slice += kSlice) {
+          for (auto slice = std::chrono::steady_clock::now();
+               !stop_.load(std::memory_order_relaxed); slice += kSlice) {
             const auto woke = std::chrono::steady_clock::now();  // late by the timer's slack
             while (std::chrono::steady_clock::now() < woke + busy)
-              for (int k = 0; k < 256; ++k, next = (next + 8) % memory.size()) ++memory[next];  // one cache line each
+              for (int k = 0; k < 256; ++k, next = (next + 8) % memory.size())
+                ++memory[next];  // one cache line each
             std::this_thread::sleep_until(slice + kSlice);
           }
           benchmark::DoNotOptimize(memory.data());
@@ -183,15 +189,19 @@ struct Beside {
 // to be pinned to CPU 0 by whoever steps it.
 class LoopBeside {
  public:
-  LoopBeside(benchmark::State& state, Beside beside) : rig_(BrainRig::get()), tools_(rig_.motions.size()) {
+  LoopBeside(benchmark::State& state, Beside beside)
+      : rig_(BrainRig::get()), tools_(rig_.motions.size()) {
     if (!pin_) state.SetLabel("not pinned: CPUs 0 and 1 are not both available");
     options_.client_timeout_s = 3600;
-    for (std::size_t slot = 0; slot < rig_.motions.size(); ++slot) tools_.join(static_cast<int>(slot));
+    for (std::size_t slot = 0; slot < rig_.motions.size(); ++slot)
+      tools_.join(static_cast<int>(slot));
     if (beside.view)
-      live_ = std::make_unique<view::LiveView>(*rig_.model, std::array{rig_.columns.get()}, wire_protocol(options_),
-                                               injected_delays(options_), view::LiveViewOptions{}, nullptr);
-    loop_ = std::make_unique<SimulationLoop>(*rig_.model, std::array{rig_.columns.get()}, options_, tools_, statistics_,
-                                             nullptr, live_.get(), nullptr, monotonic_now_ns());
+      live_ = std::make_unique<view::LiveView>(*rig_.model, std::array{rig_.columns.get()},
+                                               wire_protocol(options_), injected_delays(options_),
+                                               view::LiveViewOptions{}, nullptr);
+    loop_ = std::make_unique<SimulationLoop>(*rig_.model, std::array{rig_.columns.get()}, options_,
+                                             tools_, statistics_, nullptr, live_.get(), nullptr,
+                                             monotonic_now_ns());
     // Once along the whole motion first: every compliance column it needs is computed (or
     // loaded) before the clock runs.
     for (double t = 0; t < rig_.motions[0].duration(); t += 0.005) {
@@ -205,7 +215,8 @@ class LoopBeside {
       const std::string url = "ws://127.0.0.1:" + std::to_string(live_->port()) + "/ws";
       for (int k = 0; k < beside.browsers; ++k) {
         clients_.push_back(std::make_unique<testing::WebSocketClient>(url));
-        if (!clients_.back()->wait_open(std::chrono::seconds(10))) state.SkipWithError("a browser could not connect");
+        if (!clients_.back()->wait_open(std::chrono::seconds(10)))
+          state.SkipWithError("a browser could not connect");
         clients_.back()->count_only();
       }
     }
@@ -236,15 +247,19 @@ class LoopBeside {
   }
   /// The view's frames and each browser's frames and kB per second over the window.
   void report_browsers(benchmark::State& state, double elapsed_s) const {
-    if (live_) state.counters["frames_built_per_s"] = static_cast<double>(live_->frames_built() - built_before_) / elapsed_s;
+    if (live_)
+      state.counters["frames_built_per_s"] =
+          static_cast<double>(live_->frames_built() - built_before_) / elapsed_s;
     if (clients_.empty()) return;
     double frames = 0, bytes = 0;
     for (std::size_t k = 0; k < clients_.size(); ++k) {
       frames += static_cast<double>(clients_[k]->message_count() - frames_before_[k]);
       bytes += static_cast<double>(clients_[k]->bytes_received() - bytes_before_[k]);
     }
-    state.counters["frames_per_s_per_browser"] = frames / static_cast<double>(clients_.size()) / elapsed_s;
-    state.counters["kB_per_s_per_browser"] = bytes / static_cast<double>(clients_.size()) / elapsed_s / 1e3;
+    state.counters["frames_per_s_per_browser"] =
+        frames / static_cast<double>(clients_.size()) / elapsed_s;
+    state.counters["kB_per_s_per_browser"] =
+        bytes / static_cast<double>(clients_.size()) / elapsed_s / 1e3;
     state.counters["dropped"] = static_cast<double>(live_->counters().dropped);
   }
 
@@ -273,7 +288,8 @@ void run_steps(benchmark::State& state, Beside beside) {
   std::optional<PinnedThread> on_cpu0;
   session.pin_simulation(on_cpu0);
   session.start_window();
-  const double process_cpu_before = cpu_seconds(RUSAGE_SELF), thread_cpu_before = cpu_seconds(RUSAGE_THREAD);
+  const double process_cpu_before = cpu_seconds(RUSAGE_SELF),
+               thread_cpu_before = cpu_seconds(RUSAGE_THREAD);
   const auto start = std::chrono::steady_clock::now();
   double t = kWindowStart_s;
   for (auto _ : state) {
@@ -281,11 +297,13 @@ void run_steps(benchmark::State& state, Beside beside) {
     benchmark::DoNotOptimize(session.loop().step(monotonic_now_ns()));
     t += kWindowStride_s;  // the motion at a fixed stride, whatever the steps cost
   }
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double others_cpu = (cpu_seconds(RUSAGE_SELF) - process_cpu_before) -
                             (cpu_seconds(RUSAGE_THREAD) - thread_cpu_before);
   state.SetItemsProcessed(state.iterations());
-  state.counters["others_cpu_us_per_step"] = 1e6 * others_cpu / static_cast<double>(state.iterations());
+  state.counters["others_cpu_us_per_step"] =
+      1e6 * others_cpu / static_cast<double>(state.iterations());
   session.report_browsers(state, elapsed);
 }
 
@@ -309,8 +327,9 @@ void run_paced(benchmark::State& state, Beside beside) {
     });
     const auto start = std::chrono::steady_clock::now();
     for (auto now = start; now - start < kPacedWindow; now = std::chrono::steady_clock::now()) {
-      const double t = kWindowStart_s + std::fmod(std::chrono::duration<double>(now - start).count(),
-                                                  static_cast<double>(kWindowSteps) * kWindowStride_s);
+      const double t =
+          kWindowStart_s + std::fmod(std::chrono::duration<double>(now - start).count(),
+                                     static_cast<double>(kWindowSteps) * kWindowStride_s);
       set_tools(session.tools(), session.rig(), t);
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
@@ -346,7 +365,8 @@ struct PressedBrain {
         simulation(scene.single_elastic()),
         shown(view::shown_scene(*rig.model, columns)) {
     for (double t = 0; t < 3.0; t += 0.005) {
-      for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) scene.set_tool(static_cast<int>(slot), rig.motions[slot].position(t));
+      for (std::size_t slot = 0; slot < rig.motions.size(); ++slot)
+        scene.set_tool(static_cast<int>(slot), rig.motions[slot].position(t));
       scene.step(t);
     }
     for (std::size_t slot = 0; slot < rig.motions.size(); ++slot) {
@@ -358,10 +378,13 @@ struct PressedBrain {
     static PressedBrain brain;
     return brain;
   }
-  view::FrameState frame_state() { return view::frame_state(scene, columns, solve_elastic_states(scene), tools, forces); }
+  view::FrameState frame_state() {
+    return view::frame_state(scene, columns, solve_elastic_states(scene), tools, forces);
+  }
   void describe(benchmark::State& state) {
     state.counters["pressing"] = simulation.pressing(0) + simulation.pressing(1);
-    state.counters["boundary_nodes"] = static_cast<double>(simulation.condensation().boundary_nodes().size());
+    state.counters["boundary_nodes"] =
+        static_cast<double>(simulation.condensation().boundary_nodes().size());
     state.counters["shown_nodes"] = static_cast<double>(shown.node_count());
   }
 };
@@ -377,7 +400,8 @@ void BM_ViewFrame_view_thread(benchmark::State& state) {
   const view::FrameState frame = brain.frame_state();
   std::size_t bytes = 0;
   for (auto _ : state) {
-    const std::string message = view::server_message(view::view_frame(frame, brain.shown, 1, 3.0, 400));
+    const std::string message =
+        view::server_message(view::view_frame(frame, brain.shown, 1, 3.0, 400));
     bytes = message.size();
     benchmark::DoNotOptimize(message.data());
   }
@@ -387,13 +411,16 @@ void BM_ViewFrame_view_thread(benchmark::State& state) {
 void BM_ViewFrame_displacement_from_loads(benchmark::State& state) {
   PressedBrain& brain = PressedBrain::get();
   const view::FrameState frame = brain.frame_state();
-  for (auto _ : state) benchmark::DoNotOptimize(
-      displacement_of_rows(std::get<view::ElasticFrameState>(frame.bodies.front()).loads, brain.shown.parts.front().row_positions));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        displacement_of_rows(std::get<view::ElasticFrameState>(frame.bodies.front()).loads,
+                             brain.shown.parts.front().row_positions));
 }
 
 void BM_ViewFrame_displacement_gathered(benchmark::State& state) {
   PressedBrain& brain = PressedBrain::get();
-  for (auto _ : state) benchmark::DoNotOptimize(brain.simulation.displacement_of(brain.shown.parts.front().nodes));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(brain.simulation.displacement_of(brain.shown.parts.front().nodes));
 }
 
 BENCHMARK(BM_ViewFrame_simulation_thread)->Unit(benchmark::kMicrosecond);
@@ -414,7 +441,10 @@ void BM_SimulationRate_paced_view_browsers(benchmark::State& state) {
   run_paced(state, {.view = true, .browsers = static_cast<int>(state.range(0))});
 }
 
-BENCHMARK(BM_SimulationSteps_no_view)->Iterations(kWindowSteps)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_SimulationSteps_no_view)
+    ->Iterations(kWindowSteps)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 BENCHMARK(BM_SimulationSteps_view_browsers)
     ->Arg(0)
     ->Arg(1)
@@ -430,7 +460,10 @@ BENCHMARK(BM_SimulationSteps_no_view_with_load)
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
 
-BENCHMARK(BM_SimulationRate_paced_no_view)->Iterations(1)->UseManualTime()->Unit(benchmark::kSecond);
+BENCHMARK(BM_SimulationRate_paced_no_view)
+    ->Iterations(1)
+    ->UseManualTime()
+    ->Unit(benchmark::kSecond);
 BENCHMARK(BM_SimulationRate_paced_view_browsers)
     ->Arg(0)
     ->Arg(1)

@@ -57,7 +57,8 @@ void BM_Datagram(benchmark::State& state, Mode mode) {
       bytes.resize(d.ByteSizeLong());
       d.SerializeWithCachedSizesToArray(bytes.data());
       wire::Datagram parsed;
-      if (!parsed.ParseFromArray(bytes.data(), static_cast<int>(bytes.size()))) state.SkipWithError("parse");
+      if (!parsed.ParseFromArray(bytes.data(), static_cast<int>(bytes.size())))
+        state.SkipWithError("parse");
       benchmark::DoNotOptimize(parsed.tool().position().x());
     } else {
       bytes = sealer.seal(d);
@@ -77,7 +78,8 @@ const wire::Control& ir_control(int held) {
   static const testing::CubeRig rig;
   SimulationOptions options;
   options.step_delay_nodes = held;
-  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), options);
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
+                        options);
   simulation.set_tool(0, {0, 0, -0.002});
   simulation.set_tool(1, {0.03, 0, -0.002});
   simulation.step(0);
@@ -90,7 +92,8 @@ void BM_IrFrame(benchmark::State& state, Mode mode) {
   use_single_blas_thread();
   const wire::Control& ir = ir_control(static_cast<int>(state.range(0)));
   wire::FrameSealer sealer(key(), 42, wire::kServerSender, mode == encrypted);
-  wire::FrameReader reader([](std::uint32_t) { return &key(); }, {.allow_cleartext = mode == clear});
+  wire::FrameReader reader([](std::uint32_t) { return &key(); },
+                           {.allow_cleartext = mode == clear});
   std::vector<std::uint8_t> bytes, received;
   std::size_t size = 0;
   wire::Control control = ir;  // stamped anew each time, as the server does
@@ -101,7 +104,8 @@ void BM_IrFrame(benchmark::State& state, Mode mode) {
       control.SerializeWithCachedSizesToArray(bytes.data());
       received.assign(bytes.begin(), bytes.end());
       wire::Control parsed;
-      if (!parsed.ParseFromArray(received.data(), static_cast<int>(received.size()))) state.SkipWithError("parse");
+      if (!parsed.ParseFromArray(received.data(), static_cast<int>(received.size())))
+        state.SkipWithError("parse");
       benchmark::DoNotOptimize(parsed.ir().fem().m_rows());
     } else {
       bytes = sealer.seal(control);
@@ -113,7 +117,8 @@ void BM_IrFrame(benchmark::State& state, Mode mode) {
     size = bytes.size();
   }
   state.counters["bytes"] = static_cast<double>(size);
-  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(size));
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) *
+                          static_cast<std::int64_t>(size));
 }
 
 void register_wire_benchmarks() {

@@ -33,12 +33,13 @@ struct Scan {
 };
 
 /// The reference: first triangle at the smallest distance, by a linear scan.
-Scan linear_scan(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& triangles, const Vector3d& p) {
+Scan linear_scan(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& triangles,
+                 const Vector3d& p) {
   Scan best;
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
     const Triangle& tri = triangles[t];
-    const TriangleClosestPoint q =
-        closest_point_on_triangle(p, vertices.col(tri[0]), vertices.col(tri[1]), vertices.col(tri[2]));
+    const TriangleClosestPoint q = closest_point_on_triangle(
+        p, vertices.col(tri[0]), vertices.col(tri[1]), vertices.col(tri[2]));
     const double d2 = (p - q.point).squaredNorm();
     if (d2 < best.distance2) best = {t, d2};
   }
@@ -46,7 +47,9 @@ Scan linear_scan(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& 
 }
 
 double distance_to(const Eigen::Matrix3Xd& vertices, const Triangle& tri, const Vector3d& p) {
-  return (p - closest_point_on_triangle(p, vertices.col(tri[0]), vertices.col(tri[1]), vertices.col(tri[2])).point)
+  return (p - closest_point_on_triangle(p, vertices.col(tri[0]), vertices.col(tri[1]),
+                                        vertices.col(tri[2]))
+                  .point)
       .norm();
 }
 
@@ -54,7 +57,8 @@ double distance_to(const Eigen::Matrix3Xd& vertices, const Triangle& tri, const 
 /// same triangle unless the tree's triangle is (to 1e-14) just as close. Returns how many
 /// triangles differed (ties).
 int expect_matches_linear_scan(const AabbTree& tree, const Eigen::Matrix3Xd& vertices,
-                               const std::vector<Triangle>& triangles, const std::vector<Vector3d>& points) {
+                               const std::vector<Triangle>& triangles,
+                               const std::vector<Vector3d>& points) {
   int ties = 0;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Vector3d& p = points[i];
@@ -68,14 +72,14 @@ int expect_matches_linear_scan(const AabbTree& tree, const Eigen::Matrix3Xd& ver
     EXPECT_NEAR(std::sqrt(hit.distance2), expected, tolerance);
     // The point returned belongs to the triangle reported (index mapping back to the input).
     const Triangle& tri = triangles[hit.triangle];
-    const TriangleClosestPoint q =
-        closest_point_on_triangle(p, vertices.col(tri[0]), vertices.col(tri[1]), vertices.col(tri[2]));
+    const TriangleClosestPoint q = closest_point_on_triangle(
+        p, vertices.col(tri[0]), vertices.col(tri[1]), vertices.col(tri[2]));
     EXPECT_EQ(hit.closest.point, q.point);
     EXPECT_EQ(hit.closest.weights, q.weights);
     if (hit.triangle != reference.triangle) {
       ++ties;
-      EXPECT_NEAR(distance_to(vertices, tri, p), expected, tolerance) << "tree " << hit.triangle << " scan "
-                                                                      << reference.triangle;
+      EXPECT_NEAR(distance_to(vertices, tri, p), expected, tolerance)
+          << "tree " << hit.triangle << " scan " << reference.triangle;
     }
   }
   return ties;
@@ -95,18 +99,21 @@ TEST(AabbTree, MatchesLinearScanOnPerturbedIcosphere) {
   for (int i = 0; i < 1000; ++i) points.push_back(shell(rng) * testing::random_direction(rng));
   for (int i = 0; i < 300; ++i) points.push_back(far(rng) * testing::random_direction(rng));
   // Exactly at vertices and edge midpoints, where several triangles tie.
-  for (Eigen::Index v = 0; v < surface.vertices.cols(); v += 7) points.push_back(surface.vertices.col(v));
+  for (Eigen::Index v = 0; v < surface.vertices.cols(); v += 7)
+    points.push_back(surface.vertices.col(v));
   for (int t = 0; t < surface.triangle_count(); t += 11) {
     const Triangle& tri = surface.triangles[t];
     points.push_back(1.01 * (surface.vertices.col(tri[0]) + surface.vertices.col(tri[1])) / 2);
   }
   const int ties = expect_matches_linear_scan(tree, surface.vertices, surface.triangles, points);
-  std::printf("[ perturbed icosphere ] %zu points, %d resolved to another triangle at the same distance\n",
-              points.size(), ties);
+  std::printf(
+      "[ perturbed icosphere ] %zu points, %d resolved to another triangle at the same distance\n",
+      points.size(), ties);
 }
 
 TEST(AabbTree, MatchesLinearScanOnBoxSurface) {
-  const TetMesh mesh = make_box_mesh(Vector3d(-0.2, 0.1, 0.3), Vector3d(1.0, 2.0, 0.5), Eigen::Vector3i(4, 6, 3));
+  const TetMesh mesh =
+      make_box_mesh(Vector3d(-0.2, 0.1, 0.3), Vector3d(1.0, 2.0, 0.5), Eigen::Vector3i(4, 6, 3));
   const BoundarySurface boundary = extract_boundary_surface(mesh);
   // Over the volume nodes directly: interior nodes are simply unused.
   const AabbTree tree(mesh.nodes, boundary.triangles);
@@ -118,10 +125,13 @@ TEST(AabbTree, MatchesLinearScanOnBoxSurface) {
   std::vector<Vector3d> points;
   for (int i = 0; i < 2000; ++i) points.emplace_back(x(rng), y(rng), z(rng));
   // On a lattice aligned with the box faces and nodes: many exact ties.
-  for (int i = 0; i < 500; ++i) points.emplace_back(0.125 * grid(rng), 0.25 * grid(rng), 0.125 * grid(rng));
+  for (int i = 0; i < 500; ++i)
+    points.emplace_back(0.125 * grid(rng), 0.25 * grid(rng), 0.125 * grid(rng));
   const int ties = expect_matches_linear_scan(tree, mesh.nodes, boundary.triangles, points);
-  std::printf("[ box surface ] %d triangles, %zu points, %d resolved to another triangle at the same distance\n",
-              boundary.triangle_count(), points.size(), ties);
+  std::printf(
+      "[ box surface ] %d triangles, %zu points, %d resolved to another triangle at the same "
+      "distance\n",
+      boundary.triangle_count(), points.size(), ties);
 }
 
 TEST(AabbTree, MatchesLinearScanOnTriangleSoupWithDegenerateTriangles) {
@@ -135,7 +145,7 @@ TEST(AabbTree, MatchesLinearScanOnTriangleSoupWithDegenerateTriangles) {
     const Vector3d b = a + Vector3d(small(rng), small(rng), small(rng));
     Vector3d c = a + Vector3d(small(rng), small(rng), small(rng));
     if (t % 10 == 0) c = a + 0.3 * (b - a);  // collinear
-    if (t % 10 == 1) c = b;                   // two equal corners
+    if (t % 10 == 1) c = b;                  // two equal corners
     vertices.col(3 * t) = a;
     vertices.col(3 * t + 1) = b;
     vertices.col(3 * t + 2) = c;
@@ -201,7 +211,8 @@ TEST(AabbTree, DepthIsLogarithmic) {
     int expected = 1;
     for (int size = n; size > AabbTree::kLeafSize; size = (size + 1) / 2) ++expected;
     EXPECT_EQ(tree.depth(), expected) << n << " triangles";
-    EXPECT_LE(tree.node_count(), 2 * ((n + AabbTree::kLeafSize - 1) / AabbTree::kLeafSize) * 2) << n;
+    EXPECT_LE(tree.node_count(), 2 * ((n + AabbTree::kLeafSize - 1) / AabbTree::kLeafSize) * 2)
+        << n;
   }
 }
 

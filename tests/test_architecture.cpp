@@ -2,9 +2,9 @@
 // `#include "..."` of common/, proto/, net/, view/, server/, client/ and lab/ is resolved to
 // the directory (the floor) it comes from, and each floor may include only the floors listed
 // for it: server/ and client/ never include each other or lab/, net/ and view/ no program's
-// directory (the server and the lab both use the view), common/ nothing outside common/. The subdirectories of common/ (common/X
-// includes common/Y) must not include each other in a circle; a failure prints the cycle
-// with a file and line for each step. The link-level twin of this test is
+// directory (the server and the lab both use the view), common/ nothing outside common/. The
+// subdirectories of common/ (common/X includes common/Y) must not include each other in a circle; a
+// failure prints the cycle with a file and line for each step. The link-level twin of this test is
 // cmake/check_links.cmake.
 #include <gtest/gtest.h>
 
@@ -49,25 +49,33 @@ const std::map<std::string, std::set<std::string>> kCommonMayInclude = {
     {"fem", {"mesh", "util"}},
     {"haptics", {"util"}},
     {"interaction", {"fem", "mass_spring", "mesh", "model", "util"}},
-    {"ir", {"condense", "contact", "fem", "kinds", "laparoscopy", "mass_spring", "mesh", "model", "separation", "util"}},
+    {"ir",
+     {"condense", "contact", "fem", "kinds", "laparoscopy", "mass_spring", "mesh", "model",
+      "separation", "util"}},
     {"kinds", {}},
     {"laparoscopy", {"contact", "mesh", "util"}},
     {"mass_spring", {"contact", "fem", "mesh", "util"}},
     {"mesh", {"util"}},
-    {"model", {"contact", "fem", "kinds", "laparoscopy", "mass_spring", "mesh", "scene", "separation", "util"}},
+    {"model",
+     {"contact", "fem", "kinds", "laparoscopy", "mass_spring", "mesh", "scene", "separation",
+      "util"}},
     {"scene", {"fem", "kinds", "laparoscopy", "mass_spring", "mesh", "separation", "util"}},
     {"separation", {"contact", "fem", "mesh", "study", "util"}},
-    {"sim", {"condense", "contact", "fem", "interaction", "ir", "kinds", "laparoscopy", "mass_spring", "model", "scene", "util"}},
+    {"sim",
+     {"condense", "contact", "fem", "interaction", "ir", "kinds", "laparoscopy", "mass_spring",
+      "model", "scene", "util"}},
     {"study", {"util"}},
     {"sync", {"util"}},
     {"util", {}},
 };
 
 struct Include {
-  fs::path file;       ///< relative to the source directory
+  fs::path file;  ///< relative to the source directory
   int line = 0;
-  fs::path included;   ///< relative to the source directory, as resolved
-  std::string where() const { return file.string() + ":" + std::to_string(line) + " includes " + included.string(); }
+  fs::path included;  ///< relative to the source directory, as resolved
+  std::string where() const {
+    return file.string() + ":" + std::to_string(line) + " includes " + included.string();
+  }
 };
 
 // An include of ours resolved to a path from the source directory: relative to the
@@ -75,12 +83,15 @@ struct Include {
 // directory. protoc's headers ("cohaptic/messages.pb.h") come from proto/cohaptic/.
 fs::path resolve(const fs::path& file, const std::string& text) {
   const fs::path beside = (kSourceDir / file).parent_path() / text;
-  if (fs::exists(beside)) return fs::relative(fs::weakly_canonical(beside), fs::weakly_canonical(kSourceDir));
+  if (fs::exists(beside))
+    return fs::relative(fs::weakly_canonical(beside), fs::weakly_canonical(kSourceDir));
   if (text.rfind("cohaptic/", 0) == 0) return fs::path("proto") / text;
   return fs::path(text).lexically_normal();
 }
 
-std::string floor_of(const fs::path& path) { return path.begin() == path.end() ? "" : path.begin()->string(); }
+std::string floor_of(const fs::path& path) {
+  return path.begin() == path.end() ? "" : path.begin()->string();
+}
 
 // The quoted includes of every C++ source and header under the floor `floor`.
 std::vector<Include> quoted_includes(const std::string& floor) {
@@ -88,13 +99,16 @@ std::vector<Include> quoted_includes(const std::string& floor) {
   std::vector<Include> includes;
   for (const fs::directory_entry& entry : fs::recursive_directory_iterator(kSourceDir / floor)) {
     const std::string extension = entry.path().extension().string();
-    if (!entry.is_regular_file() || (extension != ".h" && extension != ".cpp" && extension != ".hpp")) continue;
+    if (!entry.is_regular_file() ||
+        (extension != ".h" && extension != ".cpp" && extension != ".hpp"))
+      continue;
     const fs::path file = fs::relative(entry.path(), kSourceDir);
     std::ifstream in(entry.path());
     std::string text;
     std::smatch match;
     for (int line = 1; std::getline(in, text); ++line)
-      if (std::regex_search(text, match, include_line)) includes.push_back({file, line, resolve(file, match[1].str())});
+      if (std::regex_search(text, match, include_line))
+        includes.push_back({file, line, resolve(file, match[1].str())});
   }
   return includes;
 }
@@ -132,7 +146,8 @@ std::optional<std::vector<std::string>> find_cycle(const IncludeGraph& graph) {
 std::string describe_cycle(const IncludeGraph& graph, const std::vector<std::string>& cycle) {
   std::string text;
   for (std::size_t i = 0; i < cycle.size(); ++i) text += (i ? " -> " : "") + cycle[i];
-  for (std::size_t i = 0; i + 1 < cycle.size(); ++i) text += "\n  " + graph.at(cycle[i]).at(cycle[i + 1]).where();
+  for (std::size_t i = 0; i + 1 < cycle.size(); ++i)
+    text += "\n  " + graph.at(cycle[i]).at(cycle[i + 1]).where();
   return text;
 }
 
@@ -152,7 +167,8 @@ TEST(Architecture, TheCycleFinderFindsACycleAndOnlyACycle) {
   ASSERT_GE(cycle->size(), 3u);
   EXPECT_EQ(cycle->front(), cycle->back());
   for (std::size_t i = 0; i + 1 < cycle->size(); ++i)
-    EXPECT_TRUE(graph.count((*cycle)[i]) && graph.at((*cycle)[i]).count((*cycle)[i + 1])) << "not an edge";
+    EXPECT_TRUE(graph.count((*cycle)[i]) && graph.at((*cycle)[i]).count((*cycle)[i + 1]))
+        << "not an edge";
   EXPECT_NE(describe_cycle(graph, *cycle).find("x.h:1 includes"), std::string::npos);
 }
 
@@ -164,7 +180,8 @@ TEST(Architecture, EachFloorIncludesOnlyTheFloorsItMayUse) {
       const std::string target = floor_of(include.included);
       if (!kMayInclude.count(target)) continue;  // not ours (a quoted third-party header)
       ++checked;
-      if (!allowed.count(target)) ADD_FAILURE() << include.where() << ": " << floor << "/ may not include " << target << "/";
+      if (!allowed.count(target))
+        ADD_FAILURE() << include.where() << ": " << floor << "/ may not include " << target << "/";
     }
   }
   EXPECT_GT(checked, 500u) << "the walk found too few includes to be reading the sources";
@@ -190,19 +207,23 @@ IncludeGraph common_include_graph() {
 TEST(Architecture, CommonsSubdirectoriesIncludeEachOtherWithoutACycle) {
   const IncludeGraph graph = common_include_graph();
   EXPECT_GE(graph.size(), 10u) << "the walk found too few subdirectories of common/";
-  if (const auto cycle = find_cycle(graph)) ADD_FAILURE() << "common/ includes itself in a circle: " << describe_cycle(graph, *cycle);
+  if (const auto cycle = find_cycle(graph))
+    ADD_FAILURE() << "common/ includes itself in a circle: " << describe_cycle(graph, *cycle);
 }
 
 TEST(Architecture, CommonsSubdirectoriesIncludeOnlyWhatTheirListAllows) {
   IncludeGraph allowed;
   for (const auto& [from, targets] : kCommonMayInclude)
-    for (const std::string& to : targets) allowed[from][to] = Include{fs::path("common") / from, 0, fs::path("common") / to};
-  if (const auto cycle = find_cycle(allowed)) ADD_FAILURE() << "the allowed list itself has a cycle: " << describe_cycle(allowed, *cycle);
+    for (const std::string& to : targets)
+      allowed[from][to] = Include{fs::path("common") / from, 0, fs::path("common") / to};
+  if (const auto cycle = find_cycle(allowed))
+    ADD_FAILURE() << "the allowed list itself has a cycle: " << describe_cycle(allowed, *cycle);
 
   for (const fs::directory_entry& entry : fs::directory_iterator(kSourceDir / "common")) {
     const std::string name = entry.path().filename().string();
     if (entry.is_directory() && !kCommonMayInclude.count(name))
-      ADD_FAILURE() << "common/" << name << "/ is not in kCommonMayInclude: say what it may include";
+      ADD_FAILURE() << "common/" << name
+                    << "/ is not in kCommonMayInclude: say what it may include";
   }
   std::size_t edges = 0;
   for (const auto& [from, targets] : common_include_graph())
@@ -210,7 +231,8 @@ TEST(Architecture, CommonsSubdirectoriesIncludeOnlyWhatTheirListAllows) {
       ++edges;
       const auto listed = kCommonMayInclude.find(from);
       if (listed == kCommonMayInclude.end() || !listed->second.count(to))
-        ADD_FAILURE() << evidence.where() << ": common/" << from << "/ may not include common/" << to << "/";
+        ADD_FAILURE() << evidence.where() << ": common/" << from << "/ may not include common/"
+                      << to << "/";
     }
   EXPECT_GE(edges, 30u) << "the walk found too few includes between common/'s subdirectories";
 }
@@ -220,7 +242,8 @@ TEST(Architecture, NoFileCitesAPlanOutsideTheRepository) {
   // clone does not have is a dead end for its reader.
   const std::string outside = std::string("DESIGN") + ".md";
   std::vector<std::string> citations;
-  for (const char* floor : {"common", "proto", "net", "server", "client", "lab", "tests", "docs", "scenes", "deploy", "cmake"}) {
+  for (const char* floor : {"common", "proto", "net", "server", "client", "lab", "tests", "docs",
+                            "scenes", "deploy", "cmake"}) {
     if (!fs::exists(kSourceDir / floor)) continue;
     for (const fs::directory_entry& entry : fs::recursive_directory_iterator(kSourceDir / floor)) {
       if (!entry.is_regular_file() || entry.file_size() > 1'000'000) continue;
@@ -228,16 +251,19 @@ TEST(Architecture, NoFileCitesAPlanOutsideTheRepository) {
       std::string text;
       for (int line = 1; std::getline(in, text); ++line)
         if (text.find(outside) != std::string::npos)
-          citations.push_back(fs::relative(entry.path(), kSourceDir).string() + ":" + std::to_string(line));
+          citations.push_back(fs::relative(entry.path(), kSourceDir).string() + ":" +
+                              std::to_string(line));
     }
   }
   for (const char* file : {"README.md", "CMakeLists.txt", "Makefile"}) {
     std::ifstream in(kSourceDir / file);
     std::string text;
     for (int line = 1; std::getline(in, text); ++line)
-      if (text.find(outside) != std::string::npos) citations.push_back(std::string(file) + ":" + std::to_string(line));
+      if (text.find(outside) != std::string::npos)
+        citations.push_back(std::string(file) + ":" + std::to_string(line));
   }
-  EXPECT_TRUE(citations.empty()) << "cite docs/architecture.md instead at: " << ::testing::PrintToString(citations);
+  EXPECT_TRUE(citations.empty()) << "cite docs/architecture.md instead at: "
+                                 << ::testing::PrintToString(citations);
 }
 
 }  // namespace

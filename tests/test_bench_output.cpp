@@ -14,22 +14,26 @@ namespace cohaptic {
 namespace {
 
 TEST(BenchOutput, JsonOnStdoutParsesAndPairsNaiveWithIncremental) {
-  const testing::ProgramRun run = testing::run_program(
-      COHAPTIC_BENCH_EXE, "--benchmark_format=json --benchmark_filter='(naive|incremental)/0$' --benchmark_min_time=0.01");
+  const testing::ProgramRun run =
+      testing::run_program(COHAPTIC_BENCH_EXE,
+                           "--benchmark_format=json --benchmark_filter='(naive|incremental)/0$' "
+                           "--benchmark_min_time=0.01");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   nlohmann::json json;
-  ASSERT_NO_THROW(json = nlohmann::json::parse(run.out)) << "stdout is not JSON:\n" << run.out.substr(0, 2000);
+  ASSERT_NO_THROW(json = nlohmann::json::parse(run.out)) << "stdout is not JSON:\n"
+                                                         << run.out.substr(0, 2000);
   ASSERT_TRUE(json.contains("benchmarks")) << run.out.substr(0, 2000);
   std::set<std::string> names;
   for (const nlohmann::json& benchmark : json["benchmarks"]) {
     names.insert(benchmark.at("name").get<std::string>());
     EXPECT_GT(benchmark.at("real_time").get<double>(), 0) << benchmark.dump();
   }
-  for (const char* name : {"BM_MtildeUpdate/naive/0", "BM_MtildeUpdate/incremental/0", "BM_TriangleChange/naive/0",
-                           "BM_TriangleChange/incremental/0"})
+  for (const char* name : {"BM_MtildeUpdate/naive/0", "BM_MtildeUpdate/incremental/0",
+                           "BM_TriangleChange/naive/0", "BM_TriangleChange/incremental/0"})
     EXPECT_TRUE(names.count(name)) << name << " missing from the JSON";
   for (const std::string& name : names)
-    EXPECT_TRUE(name.find("naive") != std::string::npos || name.find("incremental") != std::string::npos)
+    EXPECT_TRUE(name.find("naive") != std::string::npos ||
+                name.find("incremental") != std::string::npos)
         << name << " passed a filter it should not have";
 }
 

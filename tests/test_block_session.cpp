@@ -48,17 +48,20 @@ TEST(BlockSession, TwoUsersPushHundredsOfNodesHealthyAndTheirRecordingsVerify) {
   const fs::path dir = testing::scratch_directory("block-session");
   write_block_press(dir / "a.yaml", -25);
   write_block_press(dir / "b.yaml", 25);
-  testing::run_scripted_session(dir, fs::path(COHAPTIC_SOURCE_DIR) / "scenes/block/two_spheres.yaml", {"--duration", "400"},
-                                {{"a", dir / "a.yaml"}, {"b", dir / "b.yaml"}}, kColdLoad);
+  testing::run_scripted_session(
+      dir, fs::path(COHAPTIC_SOURCE_DIR) / "scenes/block/two_spheres.yaml", {"--duration", "400"},
+      {{"a", dir / "a.yaml"}, {"b", dir / "b.yaml"}}, kColdLoad);
   if (HasFatalFailure()) return;
 
   const nlohmann::json server_report = nlohmann::json::parse(std::ifstream(dir / "server.json"));
   std::vector<nlohmann::json> client_reports;
   for (const char* user : {"a", "b"}) {
     SCOPED_TRACE(user);
-    const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / (std::string(user) + ".json")));
+    const nlohmann::json report =
+        nlohmann::json::parse(std::ifstream(dir / (std::string(user) + ".json")));
     EXPECT_EQ(report["ir"]["rejected"], 0);
-    EXPECT_EQ(report["contact_unresolved_ticks"], 0) << "every tick's contact solve finished in its budget";
+    EXPECT_EQ(report["contact_unresolved_ticks"], 0)
+        << "every tick's contact solve finished in its budget";
     // Hertz gives 0.46 N at 1 mm; the block is finite and the other sphere presses too.
     EXPECT_NEAR(report["force_n"]["peak"].get<double>(), 0.47, 0.03);
     client_reports.push_back(report);
@@ -73,14 +76,16 @@ TEST(BlockSession, TwoUsersPushHundredsOfNodesHealthyAndTheirRecordingsVerify) {
       most_rows = std::max(most_rows, static_cast<std::size_t>(fem.row_node_count));
       most_contacts = std::max(most_contacts, fem.sphere->contacts.size());
     }
-    std::printf("  %s: %zu IRs, up to %zu row nodes and %zu nodes pushed; peak force %.4f N\n", user, recording.irs.size(),
-                most_rows, most_contacts, report["force_n"]["peak"].get<double>());
+    std::printf("  %s: %zu IRs, up to %zu row nodes and %zu nodes pushed; peak force %.4f N\n",
+                user, recording.irs.size(), most_rows, most_contacts,
+                report["force_n"]["peak"].get<double>());
     EXPECT_GT(most_rows, 200u);
     EXPECT_GT(most_contacts, 100u);
   }
   const SessionVerdict verdict = summarize_session(server_report, client_reports);
   EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
-  for (const auto& [file, least] : {std::pair{"server.mcap", 3u}, {"a.mcap", 1000u}, {"b.mcap", 1000u}}) {
+  for (const auto& [file, least] :
+       {std::pair{"server.mcap", 3u}, {"a.mcap", 1000u}, {"b.mcap", 1000u}}) {
     const VerifyResult result = verify_recording(dir / file, SceneFileAccess{});
     EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
     EXPECT_GT(result.checked, least) << file;

@@ -20,7 +20,8 @@ using testing::ScratchDirectory;
 
 namespace fs = std::filesystem;
 
-std::string small_cube_yaml(double youngs_modulus = 1e6, int divisions = 4, const char* precompute = "touchable") {
+std::string small_cube_yaml(double youngs_modulus = 1e6, int divisions = 4,
+                            const char* precompute = "touchable") {
   return fmt::format(R"(
 units: mm
 objects:
@@ -40,22 +41,26 @@ TEST(Compliance, ColumnsEqualTheDenseInverseAndAreSymmetric) {
   const ElasticBody& body = single_elastic_body(model);
   ComplianceColumns columns(body.free_factor, body.dofs, body.touchable_nodes);
   const Eigen::MatrixXd k_ff(restrict_to_dofs(body.stiffness, body.dofs.free_dofs));
-  const Eigen::MatrixXd inverse = k_ff.ldlt().solve(Eigen::MatrixXd::Identity(k_ff.rows(), k_ff.cols()));
+  const Eigen::MatrixXd inverse =
+      k_ff.ldlt().solve(Eigen::MatrixXd::Identity(k_ff.rows(), k_ff.cols()));
   for (int i : {0, 7, 24})
     for (int j : {0, 3, 24}) {
       const int a = body.touchable_nodes[i], b = body.touchable_nodes[j];
       Eigen::Matrix3d expected;
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c)
-          expected(r, c) = inverse(body.dofs.free_index[3 * a + r], body.dofs.free_index[3 * b + c]);
+          expected(r, c) =
+              inverse(body.dofs.free_index[3 * a + r], body.dofs.free_index[3 * b + c]);
       EXPECT_LE((columns.block(a, b) - expected).norm(), 1e-10 * expected.norm());
-      EXPECT_LE((columns.block(a, b) - columns.block(b, a).transpose()).norm(), 1e-12 * expected.norm());
+      EXPECT_LE((columns.block(a, b) - columns.block(b, a).transpose()).norm(),
+                1e-12 * expected.norm());
     }
   // One at a time or all at once: the same numbers.
   ComplianceColumns batch(body.free_factor, body.dofs, body.touchable_nodes);
   batch.compute_columns(body.touchable_nodes);
   for (int node : body.touchable_nodes)
-    EXPECT_LE((batch.column(node) - columns.column(node)).norm(), 1e-13 * batch.column(node).norm());
+    EXPECT_LE((batch.column(node) - columns.column(node)).norm(),
+              1e-13 * batch.column(node).norm());
 }
 
 TEST(Compliance, AColumnsBitsDoNotDependOnWhatElseWasAskedFor) {
@@ -70,15 +75,19 @@ TEST(Compliance, AColumnsBitsDoNotDependOnWhatElseWasAskedFor) {
     const int node = body.surface.nodes[i];
     const ComplianceColumn& a = one_by_one.column(node);
     const ComplianceColumn& b = all_at_once.column(node);
-    ASSERT_EQ(std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())), 0) << "node " << node;
+    ASSERT_EQ(std::memcmp(a.data(), b.data(), sizeof(double) * static_cast<std::size_t>(a.size())),
+              0)
+        << "node " << node;
   }
 }
 
 TEST(ComplianceCache, KeyChangesWithMeshMaterialBoundaryConditionsRowsAndRoute) {
   const Model model = build_model(parse_scene(small_cube_yaml(), "cube.yaml"));
   const ElasticBody& body = single_elastic_body(model);
-  const auto key = [&](const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
-                       const std::vector<int>& rows) { return compliance_cache_key(mesh, material, dofs, rows, ComplianceRoute::solves); };
+  const auto key = [&](const TetMesh& mesh, const LinearElasticMaterial& material,
+                       const DofMap& dofs, const std::vector<int>& rows) {
+    return compliance_cache_key(mesh, material, dofs, rows, ComplianceRoute::solves);
+  };
   const LinearElasticMaterial material = body.spec.material;
   const Digest base = key(body.mesh, material, body.dofs, body.touchable_nodes);
   EXPECT_EQ(base, key(body.mesh, material, body.dofs, body.touchable_nodes));
@@ -89,14 +98,16 @@ TEST(ComplianceCache, KeyChangesWithMeshMaterialBoundaryConditionsRowsAndRoute) 
   TetMesh renumbered = body.mesh;
   std::swap(renumbered.tets[0][1], renumbered.tets[0][2]);
   EXPECT_NE(base, key(renumbered, material, body.dofs, body.touchable_nodes));
-  EXPECT_NE(base, key(body.mesh, {material.youngs_modulus * 1.000001, material.poisson_ratio}, body.dofs, body.touchable_nodes));
+  EXPECT_NE(base, key(body.mesh, {material.youngs_modulus * 1.000001, material.poisson_ratio},
+                      body.dofs, body.touchable_nodes));
   EXPECT_NE(base, key(body.mesh, {material.youngs_modulus, 0.3}, body.dofs, body.touchable_nodes));
   std::vector<AxisMask> fixed = body.dofs.fixed_axes;
   fixed[body.touchable_nodes[0]] = 0b100;  // one more node sliding
   EXPECT_NE(base, key(body.mesh, material, make_dof_map(fixed), body.touchable_nodes));
   std::vector<int> fewer_rows(body.touchable_nodes.begin() + 1, body.touchable_nodes.end());
   EXPECT_NE(base, key(body.mesh, material, body.dofs, fewer_rows));
-  EXPECT_NE(base, compliance_cache_key(body.mesh, material, body.dofs, body.touchable_nodes, ComplianceRoute::schur));
+  EXPECT_NE(base, compliance_cache_key(body.mesh, material, body.dofs, body.touchable_nodes,
+                                       ComplianceRoute::schur));
 }
 
 TEST(ComplianceCache, RoundTripsBitExactlyAndIsUsedOnTheSecondRun) {
@@ -113,7 +124,9 @@ TEST(ComplianceCache, RoundTripsBitExactlyAndIsUsedOnTheSecondRun) {
   EXPECT_TRUE(loaded.from_disk);
   ASSERT_EQ(second.column_count(), first.column_count());
   for (const auto& [node, column] : first.columns())
-    EXPECT_EQ(std::memcmp(column.data(), second.columns().at(node).data(), sizeof(double) * column.size()), 0);
+    EXPECT_EQ(std::memcmp(column.data(), second.columns().at(node).data(),
+                          sizeof(double) * column.size()),
+              0);
 }
 
 TEST(ComplianceCache, KffIsFactoredAtLoadOnlyWhenARowsColumnIsLeftToSolve) {
@@ -150,12 +163,15 @@ TEST(ComplianceCache, KffIsFactoredAtLoadOnlyWhenARowsColumnIsLeftToSolve) {
   const ComplianceColumn& column = columns.column(interior);
   EXPECT_TRUE(body.free_factor.factored());
   const Eigen::MatrixXd k_ff(restrict_to_dofs(body.stiffness, body.dofs.free_dofs));
-  const Eigen::MatrixXd inverse = k_ff.ldlt().solve(Eigen::MatrixXd::Identity(k_ff.rows(), k_ff.cols()));
+  const Eigen::MatrixXd inverse =
+      k_ff.ldlt().solve(Eigen::MatrixXd::Identity(k_ff.rows(), k_ff.cols()));
   const int row_node = columns.row_nodes().front();
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c)
-      EXPECT_NEAR(column(r, c), inverse(body.dofs.free_index[3 * row_node + r], body.dofs.free_index[3 * interior + c]),
-                  1e-10 * inverse.norm());
+      EXPECT_NEAR(
+          column(r, c),
+          inverse(body.dofs.free_index[3 * row_node + r], body.dofs.free_index[3 * interior + c]),
+          1e-10 * inverse.norm());
 }
 
 TEST(ComplianceCache, TruncatedOrCorruptedFilesAreDetectedAndRebuilt) {
@@ -165,7 +181,8 @@ TEST(ComplianceCache, TruncatedOrCorruptedFilesAreDetectedAndRebuilt) {
   ComplianceColumns reference(body.free_factor, body.dofs, compliance_row_nodes(body, false));
   const fs::path file = prepare_compliance(body, reference, dir.path).cache_file;
   const auto size = fs::file_size(file);
-  const Digest key = compliance_cache_key(body.mesh, body.spec.material, body.dofs, reference.row_nodes(), ComplianceRoute::schur);
+  const Digest key = compliance_cache_key(body.mesh, body.spec.material, body.dofs,
+                                          reference.row_nodes(), ComplianceRoute::schur);
 
   const auto expect_rebuilt = [&](const std::string& what) {
     ComplianceColumns probe(body.free_factor, body.dofs, compliance_row_nodes(body, false));
@@ -207,15 +224,20 @@ TEST(ComplianceCache, AFileForAnotherMaterialIsNotUsed) {
   ComplianceColumns soft_columns(soft.free_factor, soft.dofs, compliance_row_nodes(soft, false));
   const fs::path soft_file = prepare_compliance(soft, soft_columns, dir.path).cache_file;
   // Put the soft cache where the stiff one would be: its embedded key still tells them apart.
-  ComplianceColumns stiff_columns(stiff.free_factor, stiff.dofs, compliance_row_nodes(stiff, false));
-  const Digest stiff_key = compliance_cache_key(stiff.mesh, stiff.spec.material, stiff.dofs, stiff_columns.row_nodes(), ComplianceRoute::schur);
+  ComplianceColumns stiff_columns(stiff.free_factor, stiff.dofs,
+                                  compliance_row_nodes(stiff, false));
+  const Digest stiff_key = compliance_cache_key(stiff.mesh, stiff.spec.material, stiff.dofs,
+                                                stiff_columns.row_nodes(), ComplianceRoute::schur);
   fs::copy_file(soft_file, compliance_cache_file(dir.path, stiff_key));
-  const ComplianceCacheLoad load = load_compliance_cache(compliance_cache_file(dir.path, stiff_key), stiff_key, stiff_columns);
+  const ComplianceCacheLoad load =
+      load_compliance_cache(compliance_cache_file(dir.path, stiff_key), stiff_key, stiff_columns);
   EXPECT_FALSE(load.loaded);
-  EXPECT_NE(load.problem.find("different mesh, material or boundary conditions"), std::string::npos) << load.problem;
+  EXPECT_NE(load.problem.find("different mesh, material or boundary conditions"), std::string::npos)
+      << load.problem;
   // And the stiff object's compliance is half the soft one's (linear in 1/E).
   const int node = soft.touchable_nodes[5];
-  EXPECT_LE((stiff_columns.column(node) * 2 - soft_columns.column(node)).norm(), 1e-9 * soft_columns.column(node).norm());
+  EXPECT_LE((stiff_columns.column(node) * 2 - soft_columns.column(node)).norm(),
+            1e-9 * soft_columns.column(node).norm());
 }
 
 TEST(ComplianceCache, AnUnwritableCacheDirectoryIsNotFatal) {
@@ -245,7 +267,8 @@ TEST(ComplianceCache, OnDemandModeComputesNothingUpFrontAndSavesWhatItComputed) 
   ComplianceColumns again(body.free_factor, body.dofs, compliance_row_nodes(body, false));
   const ComplianceSetup setup = prepare_compliance(body, again, dir.path);
   EXPECT_TRUE(setup.from_disk);
-  EXPECT_EQ(again.column_count(), static_cast<std::size_t>(ComplianceColumns::kGroupSize));  // that group's columns
+  EXPECT_EQ(again.column_count(),
+            static_cast<std::size_t>(ComplianceColumns::kGroupSize));  // that group's columns
   EXPECT_LT(again.column_count(), body.touchable_nodes.size());
   EXPECT_TRUE(again.has_column(columns.row_nodes()[2]));
 }

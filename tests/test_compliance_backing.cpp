@@ -19,7 +19,7 @@
 namespace cohaptic {
 namespace {
 
-constexpr double kTimeStep = 1e-4;  // the front body's substep [s]
+constexpr double kTimeStep = 1e-4;    // the front body's substep [s]
 constexpr double kNodeMass = 3.7e-3;  // [kg]
 
 // A front node at (depth behind B's near face x = 0, y, z) [m], B occupying x > 0.
@@ -31,14 +31,16 @@ struct Pressed {
   testing::PairedBoxesRig rig;
   std::vector<PolygonCollision> collisions;
   Eigen::Matrix3Xd positions;
-  explicit Pressed(const std::vector<Press>& presses) : positions(3, static_cast<Eigen::Index>(presses.size())) {
+  explicit Pressed(const std::vector<Press>& presses)
+      : positions(3, static_cast<Eigen::Index>(presses.size())) {
     const ElasticBody& behind = rig.behind;
     for (std::size_t k = 0; k < presses.size(); ++k) {
       const Eigen::Vector3d point(presses[k].depth, presses[k].y, presses[k].z);
       positions.col(static_cast<Eigen::Index>(k)) = point;
       int nearest = -1;
       for (int node : behind.surface.nodes)
-        if (nearest < 0 || (behind.mesh.nodes.col(node) - point).norm() < (behind.mesh.nodes.col(nearest) - point).norm())
+        if (nearest < 0 || (behind.mesh.nodes.col(node) - point).norm() <
+                               (behind.mesh.nodes.col(nearest) - point).norm())
           nearest = node;
       const std::optional<PolygonTarget> target =
           node_polygon_collision(point, nearest, behind.mesh.nodes, rig.behind_surface);
@@ -59,14 +61,16 @@ struct Pressed {
 
 // B's normal compliance at the targets from full sparse solves of its whole stiffness, plus
 // each node's contact compliance h^2 / m.
-Eigen::MatrixXd full_solve_compliance(const ElasticBody& body, const std::vector<PolygonCollision>& collisions) {
+Eigen::MatrixXd full_solve_compliance(const ElasticBody& body,
+                                      const std::vector<PolygonCollision>& collisions) {
   const ConstrainedStaticSolver solver(body.stiffness, body.dofs, {});
   const auto count = static_cast<Eigen::Index>(collisions.size());
   Eigen::MatrixXd compliance(count, count);
   for (Eigen::Index j = 0; j < count; ++j) {
     const PolygonCollision& cj = collisions[static_cast<std::size_t>(j)];
     Eigen::VectorXd load = Eigen::VectorXd::Zero(3 * body.mesh.node_count());
-    for (int b = 0; b < 3; ++b) load.segment<3>(3 * cj.polygon[b]) -= cj.weights[b] * cj.normal;  // a unit push into B
+    for (int b = 0; b < 3; ++b)
+      load.segment<3>(3 * cj.polygon[b]) -= cj.weights[b] * cj.normal;  // a unit push into B
     const Eigen::VectorXd u = solver.solve(Eigen::VectorXd(0), load).displacement;
     for (Eigen::Index i = 0; i < count; ++i) {
       const PolygonCollision& ci = collisions[static_cast<std::size_t>(i)];
@@ -95,7 +99,8 @@ Eigen::VectorXd every_set_solution(const Eigen::MatrixXd& compliance, const Eige
     Eigen::VectorXd right(k);
     for (Eigen::Index a = 0; a < k; ++a) {
       right[a] = -gaps[in[static_cast<std::size_t>(a)]];
-      for (Eigen::Index b = 0; b < k; ++b) block(a, b) = compliance(in[static_cast<std::size_t>(a)], in[static_cast<std::size_t>(b)]);
+      for (Eigen::Index b = 0; b < k; ++b)
+        block(a, b) = compliance(in[static_cast<std::size_t>(a)], in[static_cast<std::size_t>(b)]);
     }
     Eigen::VectorXd pushes = Eigen::VectorXd::Zero(count);
     if (k > 0) {
@@ -105,7 +110,8 @@ Eigen::VectorXd every_set_solution(const Eigen::MatrixXd& compliance, const Eige
     const Eigen::VectorXd clearance = compliance * pushes + gaps;
     bool valid = true;
     for (Eigen::Index i = 0; i < count; ++i)
-      valid = valid && ((set & (1 << i)) ? pushes[i] >= -1e-12 * push_scale : clearance[i] >= -1e-15);
+      valid =
+          valid && ((set & (1 << i)) ? pushes[i] >= -1e-12 * push_scale : clearance[i] >= -1e-15);
     if (valid) {
       found = pushes;
       ++solutions;
@@ -120,15 +126,17 @@ Eigen::VectorXd check_against_full_solve(const std::vector<Press>& presses) {
   Pressed pressed(presses);
   const auto count = static_cast<Eigen::Index>(pressed.collisions.size());
   EXPECT_EQ(count, static_cast<Eigen::Index>(presses.size()));
-  const NodeBacking backing = compliance_backing(pressed.collisions, *pressed.rig.behind_columns,
-                                                 Eigen::VectorXd::Constant(count, kNodeMass), kTimeStep, 1.0);
+  const NodeBacking backing =
+      compliance_backing(pressed.collisions, *pressed.rig.behind_columns,
+                         Eigen::VectorXd::Constant(count, kNodeMass), kTimeStep, 1.0);
   const Eigen::MatrixXd full = full_solve_compliance(pressed.rig.behind, pressed.collisions);
   EXPECT_LE((backing.compliance - full).norm(), 1e-9 * full.norm());
 
   NodeBackingSolve solve;
   prepare_backing_solve(solve, backing);
   Eigen::Matrix3Xd forces = Eigen::Matrix3Xd::Zero(3, count);
-  add_node_backing_forces(backing, solve, pressed.positions, Eigen::Matrix3Xd::Zero(3, count), forces);
+  add_node_backing_forces(backing, solve, pressed.positions, Eigen::Matrix3Xd::Zero(3, count),
+                          forces);
   EXPECT_EQ(solve.failures, 0u);
   Eigen::VectorXd gaps(count);
   for (Eigen::Index i = 0; i < count; ++i) {
@@ -138,21 +146,23 @@ Eigen::VectorXd check_against_full_solve(const std::vector<Press>& presses) {
   const Eigen::VectorXd expected = every_set_solution(full, gaps);
   EXPECT_LE((solve.pushes - expected).cwiseAbs().maxCoeff(), 1e-9 * expected.cwiseAbs().maxCoeff());
   for (Eigen::Index i = 0; i < count; ++i)
-    EXPECT_LE((forces.col(i) - expected[i] * pressed.collisions[static_cast<std::size_t>(i)].normal).norm(),
+    EXPECT_LE((forces.col(i) - expected[i] * pressed.collisions[static_cast<std::size_t>(i)].normal)
+                  .norm(),
               1e-9 * expected.cwiseAbs().maxCoeff());
   return expected;
 }
 
 TEST(ComplianceBacking, ThreeNeighboursPressingTogetherGetTheFullSolvesPushes) {
-  const Eigen::VectorXd pushes =
-      check_against_full_solve({{0.5e-3, 0.060, 0.050}, {0.45e-3, 0.070, 0.055}, {0.5e-3, 0.065, 0.045}});
+  const Eigen::VectorXd pushes = check_against_full_solve(
+      {{0.5e-3, 0.060, 0.050}, {0.45e-3, 0.070, 0.055}, {0.5e-3, 0.065, 0.045}});
   EXPECT_GE((pushes.array() > 0).count(), 2);
 }
 
 TEST(ComplianceBacking, AShallowNodeBesideADeepOneIsReleasedAsInTheFullSolve) {
   // The shallow node penetrates B's rest surface, but the deep one's push lowers B's surface
   // under it further than that: B would have to pull it.
-  const Eigen::VectorXd pushes = check_against_full_solve({{1.0e-3, 0.065, 0.054}, {0.05e-3, 0.075, 0.054}});
+  const Eigen::VectorXd pushes =
+      check_against_full_solve({{1.0e-3, 0.065, 0.054}, {0.05e-3, 0.075, 0.054}});
   EXPECT_GT(pushes[0], 0);
   EXPECT_EQ(pushes[1], 0);
 }

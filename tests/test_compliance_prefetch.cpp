@@ -25,8 +25,8 @@ void deliver_until(CompliancePrefetch& prefetch, ComplianceColumns& columns, std
 }
 
 // The row nodes whose groups hold a row node within `reach` of `point`.
-std::set<int> nodes_of_groups_near(const ElasticBody& body, const ComplianceColumns& columns, const Eigen::Vector3d& point,
-                                   double reach) {
+std::set<int> nodes_of_groups_near(const ElasticBody& body, const ComplianceColumns& columns,
+                                   const Eigen::Vector3d& point, double reach) {
   std::set<int> groups, nodes;
   const std::vector<int>& rows = columns.row_nodes();
   for (std::size_t r = 0; r < rows.size(); ++r)
@@ -43,7 +43,8 @@ TEST(CompliancePrefetch, SolvesTheGroupsNearAToolBitForBitAsTheSimulationWould) 
   ComplianceColumns columns(body.free_factor, body.dofs, rig.columns->row_nodes());
   CompliancePrefetch prefetch(body, columns.row_nodes());
   const Eigen::Vector3d tool(0.01, -0.02, 0.004);  // 4 mm above the front face
-  const std::set<int> expected = nodes_of_groups_near(body, columns, tool, CompliancePrefetch::kToolReach);
+  const std::set<int> expected =
+      nodes_of_groups_near(body, columns, tool, CompliancePrefetch::kToolReach);
   ASSERT_GT(expected.size(), 8u);
   ASSERT_LT(expected.size(), columns.row_nodes().size() / 4);
 
@@ -69,7 +70,8 @@ TEST(CompliancePrefetch, NeverReplacesAColumnTheCallerHasAndSkipsWhatItHas) {
   ComplianceColumns columns(body.free_factor, body.dofs, rig.columns->row_nodes());
   CompliancePrefetch prefetch(body, columns.row_nodes());
   const int first = columns.row_nodes()[0];
-  const ComplianceColumn* held = &columns.column(first);  // the caller solved the first group itself
+  const ComplianceColumn* held =
+      &columns.column(first);  // the caller solved the first group itself
   const std::size_t group = columns.column_count();
   // Asked for explicitly (request() does not know the caller has it): solved again, not moved in.
   std::vector<NodeDistance> asked;

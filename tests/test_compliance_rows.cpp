@@ -34,13 +34,15 @@ using testing::mm;
 // held set of surface nodes away from both tools that changes every few steps.
 class GeneratedSession {
  public:
-  GeneratedSession(const testing::CubeRig& rig, ContactModel model, double radius, double truncation = 0)
+  GeneratedSession(const testing::CubeRig& rig, ContactModel model, double radius,
+                   double truncation = 0)
       : rig_(rig), condensation_(*rig.columns, rig.body.dofs) {
     options_.contact_model = model;
     options_.force_limit = 1000;  // compare forces, not the limit
     options_.boundary_truncation = truncation;
     radius_ = radius;
-    for (std::size_t i = 0; i < rig.body.mesh.node_tags.size(); ++i) mesh_of_tag_.emplace(rig.body.mesh.node_tags[i], static_cast<int>(i));
+    for (std::size_t i = 0; i < rig.body.mesh.node_tags.size(); ++i)
+      mesh_of_tag_.emplace(rig.body.mesh.node_tags[i], static_cast<int>(i));
   }
 
   /// The IRs of both users at step `step` (full M~, as the server builds them).
@@ -49,10 +51,12 @@ class GeneratedSession {
     const double angle = 0.31 * step;
     // Centres: a point tool 1 mm deep, a sphere's 2 mm deep.
     const Eigen::Vector3d lift(0, 0, radius_ > 0 ? radius_ - 2e-3 : 0);
-    const std::array<Eigen::Vector3d, 2> tools = {mm(25 * std::cos(angle), 25 * std::sin(angle), -1) + lift,
-                                                  mm(-20 + 12 * std::sin(0.7 * angle), 18 * std::cos(angle), -0.5) + lift};
+    const std::array<Eigen::Vector3d, 2> tools = {
+        mm(25 * std::cos(angle), 25 * std::sin(angle), -1) + lift,
+        mm(-20 + 12 * std::sin(0.7 * angle), 18 * std::cos(angle), -0.5) + lift};
     std::vector<UserTool> users;
-    for (int u = 0; u < 2; ++u) users.push_back({u, tools[u], radius_, nearest_touchable_triangle(body, tools[u]), {}});
+    for (int u = 0; u < 2; ++u)
+      users.push_back({u, tools[u], radius_, nearest_touchable_triangle(body, tools[u]), {}});
     if (step % 4 == 0) {
       // Surface nodes at least 45 mm from both tools (none of them in a patch), a random
       // part of them: B both gains and loses nodes.
@@ -64,7 +68,8 @@ class GeneratedSession {
           far.push_back(node);
       }
       std::shuffle(far.begin(), far.end(), rng_);
-      far.resize(std::min<std::size_t>(far.size(), std::uniform_int_distribution<std::size_t>(0, 30)(rng_)));
+      far.resize(std::min<std::size_t>(far.size(),
+                                       std::uniform_int_distribution<std::size_t>(0, 30)(rng_)));
       condensation_.set_boundary_nodes(far);
     }
     std::vector<Eigen::Vector3d> held;
@@ -94,8 +99,9 @@ class GeneratedSession {
 };
 
 // `full` in the rows form, through the wire, as a client receives it.
-IntermediateRepresentation as_rows(const IntermediateRepresentation& full, const std::vector<int>& mesh_nodes,
-                                   ComplianceRowsSender& sender, const testing::CubeRig& rig) {
+IntermediateRepresentation as_rows(const IntermediateRepresentation& full,
+                                   const std::vector<int>& mesh_nodes, ComplianceRowsSender& sender,
+                                   const testing::CubeRig& rig) {
   IntermediateRepresentation rows = full;
   sender.convert(condensed_fem(rows), mesh_nodes, *rig.columns, rig.body.dofs);
   return wire::from_wire(wire::to_wire(rows));
@@ -107,8 +113,10 @@ double largest_entry_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd&
 
 // The client's force equals the full IR's at the tool and around it (pressing deeper and
 // sliding), to 1e-9 relative.
-void expect_same_forces(const IntermediateRepresentation& full, const IntermediateRepresentation& completed,
-                        const std::array<Eigen::Vector3d, 2>& tools, int user, const std::string& when) {
+void expect_same_forces(const IntermediateRepresentation& full,
+                        const IntermediateRepresentation& completed,
+                        const std::array<Eigen::Vector3d, 2>& tools, int user,
+                        const std::string& when) {
   const PreparedIR a = prepare_ir(full);
   const PreparedIR b = prepare_ir(completed);
   EvaluationState state_a = make_evaluation_state(a), state_b = make_evaluation_state(b);
@@ -119,8 +127,8 @@ void expect_same_forces(const IntermediateRepresentation& full, const Intermedia
     const ForceSample fa = evaluate_force(a, state_a, tool, remote, 1e-3);
     const ForceSample fb = evaluate_force(b, state_b, tool, remote, 1e-3);
     EXPECT_EQ(fa.flags, fb.flags) << when;
-    EXPECT_LE((fa.force - fb.force).norm(), 1e-9 * fa.force.norm() + 1e-15) << when << ": " << fa.force.transpose()
-                                                                              << " vs " << fb.force.transpose();
+    EXPECT_LE((fa.force - fb.force).norm(), 1e-9 * fa.force.norm() + 1e-15)
+        << when << ": " << fa.force.transpose() << " vs " << fb.force.transpose();
     pressing += fa.force.norm() > 0;
   }
   EXPECT_GT(pressing, 0) << when << ": no force to compare";
@@ -132,14 +140,14 @@ void run_session(ContactModel model, double radius, double truncation = 0) {
   const testing::CubeRig rig(cube);
   GeneratedSession session(rig, model, radius, truncation);
   std::array<ComplianceRowsSender, 2> senders;
-  std::array<std::unique_ptr<ClientCondensation>, 2> clients = {std::make_unique<ClientCondensation>(),
-                                                                std::make_unique<ClientCondensation>()};
-  int joined = 0, left = 0;  // IRs that added nodes to a held set, or dropped some
+  std::array<std::unique_ptr<ClientCondensation>, 2> clients = {
+      std::make_unique<ClientCondensation>(), std::make_unique<ClientCondensation>()};
+  int joined = 0, left = 0;             // IRs that added nodes to a held set, or dropped some
   std::size_t kept = 0, truncated = 0;  // held nodes in the IRs and left out of them
   std::array<std::vector<std::int64_t>, 2> previous;
   for (int step = 0; step < 60; ++step) {
     if (step == 25) senders[0].restart();  // user A reconnects: the same client starts afresh
-    if (step == 40) {                      // user B joins late: a new client, the server from nothing
+    if (step == 40) {  // user B joins late: a new client, the server from nothing
       senders[1].restart();
       clients[1] = std::make_unique<ClientCondensation>();
     }
@@ -147,11 +155,14 @@ void run_session(ContactModel model, double radius, double truncation = 0) {
     for (int user = 0; user < 2; ++user) {
       const std::string when = fmt::format("step {}, user {}", step, user);
       const CondensedFemIr& full = condensed_fem(irs[user]);
-      IntermediateRepresentation received = as_rows(irs[user], session.mesh_nodes(full), senders[user], rig);
+      IntermediateRepresentation received =
+          as_rows(irs[user], session.mesh_nodes(full), senders[user], rig);
       const ComplianceRows& rows = *condensed_fem(received).compliance_rows;
       joined += rows.generation > 1 && rows.rows.rows() > 0;
-      left += rows.generation > 1 && std::any_of(previous[user].begin(), previous[user].end(), [&](std::int64_t tag) {
-                return std::find(full.node_ids.begin(), full.node_ids.end(), tag) == full.node_ids.end();
+      left += rows.generation > 1 &&
+              std::any_of(previous[user].begin(), previous[user].end(), [&](std::int64_t tag) {
+                return std::find(full.node_ids.begin(), full.node_ids.end(), tag) ==
+                       full.node_ids.end();
               });
       previous[user] = full.node_ids;
       kept += full.node_ids.size() - static_cast<std::size_t>(full.row_node_count);
@@ -162,7 +173,8 @@ void run_session(ContactModel model, double radius, double truncation = 0) {
       EXPECT_TRUE(condensed_fem(received).truncated_node_ids.empty()) << when;
       ASSERT_EQ(condensed_fem(received).m_tilde.rows(), full.m_tilde.rows()) << when;
       ASSERT_EQ(condensed_fem(received).m_tilde.cols(), full.m_tilde.cols()) << when;
-      EXPECT_LE(largest_entry_difference(condensed_fem(received).m_tilde, full.m_tilde), 1e-12) << when;
+      EXPECT_LE(largest_entry_difference(condensed_fem(received).m_tilde, full.m_tilde), 1e-12)
+          << when;
       expect_same_forces(irs[user], received, session.tools(), user, when);
     }
   }
@@ -189,7 +201,8 @@ TEST(ComplianceRows, ClientMTildeAndForcesEqualTheTruncatedIrWithThePointConstra
 
 // `all` (every held node kept) with only the held nodes `keep` says kept, as the server
 // would send it had its truncation chosen so: the others' columns of M~ and u_B left out.
-IntermediateRepresentation keeping(const IntermediateRepresentation& all, const std::vector<bool>& keep) {
+IntermediateRepresentation keeping(const IntermediateRepresentation& all,
+                                   const std::vector<bool>& keep) {
   IntermediateRepresentation out = all;
   const CondensedFemIr& from = condensed_fem(all);
   CondensedFemIr& to = condensed_fem(out);
@@ -217,7 +230,8 @@ IntermediateRepresentation keeping(const IntermediateRepresentation& all, const 
     column += dofs;
   }
   to.m_tilde = from.m_tilde(Eigen::all, columns);
-  to.boundary_displacement = Eigen::Map<const Eigen::VectorXd>(displacement.data(), static_cast<Eigen::Index>(displacement.size()));
+  to.boundary_displacement = Eigen::Map<const Eigen::VectorXd>(
+      displacement.data(), static_cast<Eigen::Index>(displacement.size()));
   return out;
 }
 
@@ -241,7 +255,8 @@ TEST(ComplianceRows, TheClientKeepsTheServersChoiceAndCondensesOverEveryHeldNode
   ASSERT_GT(fem.node_count(), fem.row_node_count);
   const auto completed = [&](const IntermediateRepresentation& server) {
     ComplianceRowsSender sender;
-    IntermediateRepresentation ir = as_rows(server, truncating.mesh_nodes(condensed_fem(server)), sender, rig);
+    IntermediateRepresentation ir =
+        as_rows(server, truncating.mesh_nodes(condensed_fem(server)), sender, rig);
     ClientCondensation client;
     client.complete(condensed_fem(ir));
     return condensed_fem(ir).m_tilde;
@@ -251,8 +266,10 @@ TEST(ComplianceRows, TheClientKeepsTheServersChoiceAndCondensesOverEveryHeldNode
   // then its complement.
   std::vector<bool> keep;
   const CondensedFemIr& whole = condensed_fem(all);
-  for (std::size_t i = static_cast<std::size_t>(whole.row_node_count); i < whole.node_ids.size(); ++i)
-    keep.push_back(std::find(fem.node_ids.begin(), fem.node_ids.end(), whole.node_ids[i]) != fem.node_ids.end());
+  for (std::size_t i = static_cast<std::size_t>(whole.row_node_count); i < whole.node_ids.size();
+       ++i)
+    keep.push_back(std::find(fem.node_ids.begin(), fem.node_ids.end(), whole.node_ids[i]) !=
+                   fem.node_ids.end());
   const IntermediateRepresentation same = keeping(all, keep);
   ASSERT_EQ(condensed_fem(same).node_ids, fem.node_ids);
   EXPECT_EQ(condensed_fem(same).m_tilde, fem.m_tilde);
@@ -267,7 +284,8 @@ TEST(ComplianceRows, TheClientKeepsTheServersChoiceAndCondensesOverEveryHeldNode
   condensed_fem(kept_only).truncated_node_ids.clear();
   condensed_fem(kept_only).truncated_fixed_axes.clear();
   const Eigen::Index c = fem.m_tilde.rows();
-  EXPECT_GT(largest_entry_difference(completed(kept_only).leftCols(c), fem.m_tilde.leftCols(c)), 1e-9);
+  EXPECT_GT(largest_entry_difference(completed(kept_only).leftCols(c), fem.m_tilde.leftCols(c)),
+            1e-9);
 }
 
 TEST(ComplianceRows, RefusesStaleAndHostileRowsAndLosesNothing) {
@@ -279,7 +297,8 @@ TEST(ComplianceRows, RefusesStaleAndHostileRowsAndLosesNothing) {
   std::vector<IntermediateRepresentation> full, sent;
   for (int step = 0; step < 6; ++step) {
     full.push_back(session.step(step)[0]);
-    sent.push_back(as_rows(full.back(), session.mesh_nodes(condensed_fem(full.back())), sender, rig));
+    sent.push_back(
+        as_rows(full.back(), session.mesh_nodes(condensed_fem(full.back())), sender, rig));
   }
   ClientCondensation client;
   const auto expect_refused = [&](IntermediateRepresentation ir, const std::string& reason) {
@@ -293,7 +312,9 @@ TEST(ComplianceRows, RefusesStaleAndHostileRowsAndLosesNothing) {
   const auto expect_exact = [&](int i) {
     IntermediateRepresentation ir = sent[static_cast<std::size_t>(i)];
     client.complete(condensed_fem(ir));
-    EXPECT_LE(largest_entry_difference(condensed_fem(ir).m_tilde, condensed_fem(full[static_cast<std::size_t>(i)]).m_tilde), 1e-12);
+    EXPECT_LE(largest_entry_difference(condensed_fem(ir).m_tilde,
+                                       condensed_fem(full[static_cast<std::size_t>(i)]).m_tilde),
+              1e-12);
   };
   expect_exact(0);
   expect_refused(sent[2], "this client holds generation 1");  // IR 1 skipped
@@ -325,9 +346,9 @@ TEST(ComplianceRows, RefusesStaleAndHostileRowsAndLosesNothing) {
   condensed_fem(tampered).truncated_node_ids.push_back(std::int64_t{1} << 40);
   expect_refused(tampered, "fixed axes for 1 truncated held nodes");
   EXPECT_EQ(client.generation(), 1u);
-  for (int i = 1; i < 6; ++i) expect_exact(i);  // nothing was lost
+  for (int i = 1; i < 6; ++i) expect_exact(i);                // nothing was lost
   expect_refused(sent[3], "this client holds generation 6");  // a stale one
-  expect_exact(0);  // generation 1 starts afresh
+  expect_exact(0);                                            // generation 1 starts afresh
   EXPECT_THROW(prepare_ir(sent[2]), Error);  // rows never reach the evaluator uncondensed
 }
 
@@ -338,7 +359,8 @@ TEST(ComplianceRows, TheWireRefusesRowsThatDoNotMatchTheirCount) {
   GeneratedSession session(rig, ContactModel::node_translation, 0);
   ComplianceRowsSender sender;
   IntermediateRepresentation ir = session.step(0)[0];
-  sender.convert(condensed_fem(ir), session.mesh_nodes(condensed_fem(ir)), *rig.columns, rig.body.dofs);
+  sender.convert(condensed_fem(ir), session.mesh_nodes(condensed_fem(ir)), *rig.columns,
+                 rig.body.dofs);
   wire::IntermediateRepresentation w = wire::to_wire(ir);
   ASSERT_GT(w.fem().compliance_rows_size(), 0);
   EXPECT_EQ(w.fem().m_tilde_f64_size(), 0);
@@ -366,19 +388,22 @@ TEST(ComplianceRows, TheWireCarriesTruncatedNodesWithRowsOnly) {
   const testing::CubeRig rig(cube);
   GeneratedSession session(rig, ContactModel::point_constraint, 0, 0.2);
   IntermediateRepresentation full;  // the first step whose IR leaves held nodes out
-  for (int step = 0; step < 40 && condensed_fem(full).truncated_node_ids.empty(); ++step) full = session.step(step)[0];
+  for (int step = 0; step < 40 && condensed_fem(full).truncated_node_ids.empty(); ++step)
+    full = session.step(step)[0];
   ASSERT_FALSE(condensed_fem(full).truncated_node_ids.empty());
   // M~ whole: complete without them, so they are not sent.
   EXPECT_EQ(wire::to_wire(full).fem().truncated_node_ids_size(), 0);
   ComplianceRowsSender sender;
   IntermediateRepresentation rows = full;
-  sender.convert(condensed_fem(rows), session.mesh_nodes(condensed_fem(full)), *rig.columns, rig.body.dofs);
+  sender.convert(condensed_fem(rows), session.mesh_nodes(condensed_fem(full)), *rig.columns,
+                 rig.body.dofs);
   const wire::IntermediateRepresentation w = wire::to_wire(rows);
   const IntermediateRepresentation back = wire::from_wire(w);
   EXPECT_EQ(condensed_fem(back).truncated_node_ids, condensed_fem(full).truncated_node_ids);
   EXPECT_EQ(condensed_fem(back).truncated_fixed_axes, condensed_fem(full).truncated_fixed_axes);
   EXPECT_EQ(condensed_fem(back).compliance_rows->rows, condensed_fem(rows).compliance_rows->rows);
-  const auto expect_refused = [](const wire::IntermediateRepresentation& bad, const std::string& reason) {
+  const auto expect_refused = [](const wire::IntermediateRepresentation& bad,
+                                 const std::string& reason) {
     try {
       wire::from_wire(bad);
       ADD_FAILURE() << "accepted: " << reason;
@@ -415,7 +440,9 @@ TEST(ComplianceRows, TheFuzzSeedsCompleteAndPrepare) {
     EXPECT_FALSE(fem.compliance_rows) << seed;
     EXPECT_TRUE(fem.truncated_node_ids.empty()) << seed;
     EXPECT_GT(fem.m_tilde.rows(), 0) << seed;
-    EXPECT_EQ(fem.m_tilde.cols(), static_cast<Eigen::Index>(ir_dofs(fem, 0, fem.node_count()).size())) << seed;
+    EXPECT_EQ(fem.m_tilde.cols(),
+              static_cast<Eigen::Index>(ir_dofs(fem, 0, fem.node_count()).size()))
+        << seed;
   }
 }
 

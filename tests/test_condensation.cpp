@@ -25,7 +25,9 @@ namespace {
 // The cube fixed at its rear face; with `sliding_side`, its x = -65 face also slides in
 // its plane (x fixed), so that some surface nodes have two free dofs, not three.
 Model cube_model(int divisions, double nu, bool sliding_side = false) {
-  return build_model(parse_scene(fmt::format(R"(
+  return build_model(parse_scene(
+      fmt::format(
+          R"(
 units: mm
 objects:
   - name: cube
@@ -34,9 +36,9 @@ objects:
     fixed: [{{plane: {{point: [0, 0, -130], normal: [0, 0, 1]}}}}{2}]
 tools: [{{name: A}}]
 )",
-                                                 divisions, nu,
-                                                 sliding_side ? ", {plane: {point: [-65, 0, 0], normal: [1, 0, 0]}, axes: x}" : ""),
-                                     "cube.yaml"));
+          divisions, nu,
+          sliding_side ? ", {plane: {point: [-65, 0, 0], normal: [1, 0, 0]}, axes: x}" : ""),
+      "cube.yaml"));
 }
 
 // Surface nodes that can move (not on the fixed rear face).
@@ -54,13 +56,16 @@ double relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
 
 // The incremental M~ for `contact` equals the naive one to 1e-12; returns the larger
 // relative difference of M_CC and M_CB.
-double expect_equals_naive(IncrementalCondensation& incremental, ComplianceColumns& columns, const DofMap& dofs,
-                           const std::vector<int>& contact, const std::string& when) {
+double expect_equals_naive(IncrementalCondensation& incremental, ComplianceColumns& columns,
+                           const DofMap& dofs, const std::vector<int>& contact,
+                           const std::string& when) {
   const CondensedOperator fast = incremental.condense(contact);
-  const CondensedOperator naive = naive_condensation(columns, dofs, contact, incremental.boundary_nodes());
+  const CondensedOperator naive =
+      naive_condensation(columns, dofs, contact, incremental.boundary_nodes());
   EXPECT_EQ(fast.contact_dofs, naive.contact_dofs) << when;
   EXPECT_EQ(fast.boundary_dofs, naive.boundary_dofs) << when;
-  const double difference = std::max(relative_difference(fast.m_cc, naive.m_cc), relative_difference(fast.m_cb, naive.m_cb));
+  const double difference = std::max(relative_difference(fast.m_cc, naive.m_cc),
+                                     relative_difference(fast.m_cb, naive.m_cb));
   EXPECT_LE(difference, 1e-12) << when << ", |B| " << incremental.boundary_nodes().size();
   return difference;
 }
@@ -84,14 +89,17 @@ TEST(Condensation, ForcesEqualTheFullSparseSolveForRandomActiveSets) {
     Eigen::VectorXd u_c(static_cast<Eigen::Index>(op.contact_dofs.size()));
     Eigen::VectorXd u_b(static_cast<Eigen::Index>(op.boundary_dofs.size()));
     std::vector<PrescribedDisplacement> prescribed;
-    for (Eigen::Index i = 0; i < u_c.size(); ++i) prescribed.push_back({op.contact_dofs[i], u_c[i] = displacement(rng)});
-    for (Eigen::Index i = 0; i < u_b.size(); ++i) prescribed.push_back({op.boundary_dofs[i], u_b[i] = displacement(rng)});
+    for (Eigen::Index i = 0; i < u_c.size(); ++i)
+      prescribed.push_back({op.contact_dofs[i], u_c[i] = displacement(rng)});
+    for (Eigen::Index i = 0; i < u_b.size(); ++i)
+      prescribed.push_back({op.boundary_dofs[i], u_b[i] = displacement(rng)});
     const StaticSolution full = solve_static(body.stiffness, body.dofs, prescribed);
 
     const Eigen::VectorXd f_c = op.m_cc * u_c + op.m_cb * u_b;
     Eigen::VectorXd expected(f_c.size());
     for (Eigen::Index i = 0; i < f_c.size(); ++i) expected[i] = full.reaction[op.contact_dofs[i]];
-    EXPECT_LE((f_c - expected).norm(), 1e-9 * expected.norm()) << "trial " << trial << ", |B| " << boundary.size();
+    EXPECT_LE((f_c - expected).norm(), 1e-9 * expected.norm())
+        << "trial " << trial << ", |B| " << boundary.size();
   }
 }
 
@@ -108,10 +116,13 @@ void incremental_matches_naive_after_random_updates(double nu) {
   const int operations = 10000;
   for (int op = 1; op <= operations; ++op) {
     // Drift around 40 nodes: join more often when small, leave more often when large.
-    const bool join = boundary.empty() || std::uniform_int_distribution<int>(0, 79)(rng) >= static_cast<int>(boundary.size());
+    const bool join = boundary.empty() || std::uniform_int_distribution<int>(0, 79)(rng) >=
+                                              static_cast<int>(boundary.size());
     if (join) {
       int node;
-      do node = candidates[std::uniform_int_distribution<std::size_t>(0, candidates.size() - 1)(rng)];
+      do
+        node =
+            candidates[std::uniform_int_distribution<std::size_t>(0, candidates.size() - 1)(rng)];
       while (std::find(boundary.begin(), boundary.end(), node) != boundary.end());
       incremental.add_boundary_node(node);
       boundary.push_back(node);
@@ -130,7 +141,8 @@ void incremental_matches_naive_after_random_updates(double nu) {
             contact.push_back(node);
       }
       for (auto it = contact.begin(); it != contact.end();)
-        it = std::find(boundary.begin(), boundary.end(), *it) != boundary.end() ? contact.erase(it) : it + 1;
+        it = std::find(boundary.begin(), boundary.end(), *it) != boundary.end() ? contact.erase(it)
+                                                                                : it + 1;
       if (contact.empty()) continue;
       worst = std::max(worst, expect_equals_naive(incremental, columns, body.dofs, contact,
                                                   fmt::format("after {} updates", op)));
@@ -138,8 +150,10 @@ void incremental_matches_naive_after_random_updates(double nu) {
     }
   }
   const auto& stats = incremental.statistics();
-  std::printf("  nu = %g: %ld joins, %ld leaves, %ld residual checks, %ld refactorisations, worst |dM|/|M| = %.2e\n",
-              nu, stats.joins, stats.leaves, stats.residual_checks, stats.refactorizations, worst);
+  std::printf(
+      "  nu = %g: %ld joins, %ld leaves, %ld residual checks, %ld refactorisations, worst |dM|/|M| "
+      "= %.2e\n",
+      nu, stats.joins, stats.leaves, stats.residual_checks, stats.refactorizations, worst);
   EXPECT_EQ(stats.joins + stats.leaves, operations);
 }
 
@@ -147,7 +161,9 @@ TEST(Condensation, IncrementalEqualsNaiveAfterTenThousandJoinsAndLeaves) {
   incremental_matches_naive_after_random_updates(0.3);
 }
 
-TEST(Condensation, IncrementalEqualsNaiveNearIncompressibility) { incremental_matches_naive_after_random_updates(0.499); }
+TEST(Condensation, IncrementalEqualsNaiveNearIncompressibility) {
+  incremental_matches_naive_after_random_updates(0.499);
+}
 
 // A node leaves B from its first, a middle and its last position, and joins again (at the
 // end); with the Z of the contact nodes cached before (corrected at each change) and not
@@ -170,7 +186,8 @@ TEST(Condensation, JoinsAndLeavesAtTheFirstMiddleAndLastPositionEqualNaive) {
       const std::size_t size = incremental.boundary_nodes().size();
       for (std::size_t position : {std::size_t{0}, size / 2, size - 1}) {
         const int node = incremental.boundary_nodes()[position];
-        const std::string where = fmt::format("nu {}, cached {}, position {}", nu, cached, position);
+        const std::string where =
+            fmt::format("nu {}, cached {}, position {}", nu, cached, position);
         incremental.remove_boundary_node(node);
         if (cached) expect_equals_naive(incremental, columns, body.dofs, contact, where + " left");
 
@@ -217,10 +234,10 @@ TEST(Condensation, ContactSetChangesEqualNaive) {
         std::find(sliding.begin(), sliding.end(), node) == sliding.end())
       pool.push_back(node);
   const std::vector<std::vector<int>> contacts = {
-      {pool[0], pool[1], pool[4]},                                // all new
-      {pool[1], pool[4], pool[5]},                                // two hits, one new
-      {pool[2], pool[3], pool[6], pool[7], pool[8], pool[9]},     // more than the cache keeps
-      {pool[0], pool[1], pool[4]},                                // evicted before: recomputed
+      {pool[0], pool[1], pool[4]},                             // all new
+      {pool[1], pool[4], pool[5]},                             // two hits, one new
+      {pool[2], pool[3], pool[6], pool[7], pool[8], pool[9]},  // more than the cache keeps
+      {pool[0], pool[1], pool[4]},                             // evicted before: recomputed
       {pool[10], pool[11], pool[0]}};
   // Spare nodes that join and leave B between contact changes.
   std::vector<int> spare;
@@ -231,13 +248,19 @@ TEST(Condensation, ContactSetChangesEqualNaive) {
   spare.push_back(sliding[6]);
   for (int round = 0; round < 3; ++round)
     for (std::size_t i = 0; i < contacts.size(); ++i) {
-      expect_equals_naive(incremental, columns, body.dofs, contacts[i], fmt::format("round {}, contact set {}", round, i));
+      expect_equals_naive(incremental, columns, body.dofs, contacts[i],
+                          fmt::format("round {}, contact set {}", round, i));
       // One join and one leave from a random position before the next contact set.
       const int joining = spare[(round * contacts.size() + i) % spare.size()];
-      if (incremental.in_boundary(joining)) incremental.remove_boundary_node(joining); else incremental.add_boundary_node(joining);
+      if (incremental.in_boundary(joining))
+        incremental.remove_boundary_node(joining);
+      else
+        incremental.add_boundary_node(joining);
       const auto& b = incremental.boundary_nodes();
-      incremental.remove_boundary_node(b[std::uniform_int_distribution<std::size_t>(0, b.size() - 2)(rng)]);
-      expect_equals_naive(incremental, columns, body.dofs, contacts[i], fmt::format("round {}, after B changed", round));
+      incremental.remove_boundary_node(
+          b[std::uniform_int_distribution<std::size_t>(0, b.size() - 2)(rng)]);
+      expect_equals_naive(incremental, columns, body.dofs, contacts[i],
+                          fmt::format("round {}, after B changed", round));
     }
 }
 
@@ -256,15 +279,22 @@ TEST(Condensation, RefactoringKeepsTheCondensationExact) {
   const std::vector<int> contact = {candidates[0], candidates[1], candidates[2]};
   std::mt19937 rng(7);
   for (int op = 0; op < 60; ++op) {
-    const int node = candidates[std::uniform_int_distribution<std::size_t>(3, candidates.size() - 1)(rng)];
-    if (incremental.in_boundary(node)) incremental.remove_boundary_node(node); else incremental.add_boundary_node(node);
-    if (op % 4 == 0) expect_equals_naive(incremental, columns, body.dofs, contact, fmt::format("after {} updates", op));
+    const int node =
+        candidates[std::uniform_int_distribution<std::size_t>(3, candidates.size() - 1)(rng)];
+    if (incremental.in_boundary(node))
+      incremental.remove_boundary_node(node);
+    else
+      incremental.add_boundary_node(node);
+    if (op % 4 == 0)
+      expect_equals_naive(incremental, columns, body.dofs, contact,
+                          fmt::format("after {} updates", op));
   }
   EXPECT_EQ(incremental.statistics().refactorizations, incremental.statistics().residual_checks);
   EXPECT_GE(incremental.statistics().refactorizations, 15);
 
   std::vector<int> more = incremental.boundary_nodes();
-  for (std::size_t i = 3; i < candidates.size() && more.size() < incremental.boundary_nodes().size() + 20; ++i)
+  for (std::size_t i = 3;
+       i < candidates.size() && more.size() < incremental.boundary_nodes().size() + 20; ++i)
     if (!incremental.in_boundary(candidates[i])) more.push_back(candidates[i]);
   incremental.set_boundary_nodes(more);
   expect_equals_naive(incremental, columns, body.dofs, contact, "after a bulk join");
@@ -281,7 +311,8 @@ TEST(Condensation, ANodeInBothSetsOrTwiceInBIsAClearError) {
   EXPECT_THROW(incremental.remove_boundary_node(nodes[1]), Error);
   const std::vector<int> contact = {nodes[0], nodes[2]};
   EXPECT_THROW(incremental.condense(contact), Error);
-  EXPECT_THROW(naive_condensation(columns, body.dofs, contact, incremental.boundary_nodes()), NumericalError);
+  EXPECT_THROW(naive_condensation(columns, body.dofs, contact, incremental.boundary_nodes()),
+               NumericalError);
 }
 
 }  // namespace

@@ -22,7 +22,8 @@ namespace {
 Eigen::MatrixXd factor_in_buffer(Eigen::Index n, unsigned seed) {
   std::srand(seed);
   const Eigen::MatrixXd m = Eigen::MatrixXd::Random(n, n);
-  const Eigen::MatrixXd spd = m * m.transpose() + static_cast<double>(n) * Eigen::MatrixXd::Identity(n, n);
+  const Eigen::MatrixXd spd =
+      m * m.transpose() + static_cast<double>(n) * Eigen::MatrixXd::Identity(n, n);
   Eigen::MatrixXd buffer = Eigen::MatrixXd::Constant(n + 7, n + 5, kNaN);
   buffer.block(2, 3, n, n).triangularView<Eigen::Lower>() = Eigen::MatrixXd(spd.llt().matrixL());
   return buffer;
@@ -48,7 +49,8 @@ TEST(CondensationKernels, TriangularSolvesEqualEigens) {
       EXPECT_LE((x_buffer.block(1, 1, n, columns) - backward).norm(), 1e-13 * backward.norm())
           << "backward, n " << n << ", " << columns << " right-hand sides";
       x_buffer.block(1, 1, n, columns).setZero();
-      EXPECT_TRUE(x_buffer.array().isNaN().count() == x_buffer.size() - n * columns) << "wrote outside x, n " << n;
+      EXPECT_TRUE(x_buffer.array().isNaN().count() == x_buffer.size() - n * columns)
+          << "wrote outside x, n " << n;
     }
 }
 
@@ -63,8 +65,10 @@ TEST(CondensationKernels, ProductsEqualEigensInEveryTransposition) {
     const Eigen::MatrixXd& b;
     Transposed tb;
   };
-  for (const Case& product : {Case{a, Transposed::no, b, Transposed::no}, Case{at, Transposed::yes, b, Transposed::no},
-                              Case{a, Transposed::no, bt, Transposed::yes}, Case{at, Transposed::yes, bt, Transposed::yes}}) {
+  for (const Case& product :
+       {Case{a, Transposed::no, b, Transposed::no}, Case{at, Transposed::yes, b, Transposed::no},
+        Case{a, Transposed::no, bt, Transposed::yes},
+        Case{at, Transposed::yes, bt, Transposed::yes}}) {
     Eigen::MatrixXd c = c0;
     multiply(-2.0, product.a, product.ta, product.b, product.tb, 0.5, c);
     EXPECT_LE((c - expected).norm(), 1e-14 * expected.norm());
@@ -74,7 +78,8 @@ TEST(CondensationKernels, ProductsEqualEigensInEveryTransposition) {
   multiply(1.0, a, Transposed::no, b, Transposed::no, 0.0, c);
   EXPECT_LE((c - a * b).norm(), 1e-14 * (a * b).norm());
   c.setConstant(kNaN);
-  multiply(1.0, Eigen::MatrixXd(7, 0), Transposed::no, Eigen::MatrixXd(0, 6), Transposed::no, 0.0, c);
+  multiply(1.0, Eigen::MatrixXd(7, 0), Transposed::no, Eigen::MatrixXd(0, 6), Transposed::no, 0.0,
+           c);
   EXPECT_TRUE(c.isZero());
   EXPECT_THROW(multiply(1.0, a, Transposed::yes, b, Transposed::no, 0.0, c), Error);
   Eigen::MatrixXd four_rows(4, 1);
@@ -91,7 +96,8 @@ TEST(CondensationKernels, RankUpdateGivesTheFactorOfTheUpdatedMatrix) {
       Eigen::MatrixXd scratch = w;
       cholesky_rank_update(buffer.block(2, 3, n, n), scratch, buffer.block(2, 3, n, n));
       const Eigen::MatrixXd lower = buffer.block(2, 3, n, n).triangularView<Eigen::Lower>();
-      EXPECT_LE((lower * lower.transpose() - expected).norm(), 1e-14 * expected.norm()) << "n " << n << ", k " << k;
+      EXPECT_LE((lower * lower.transpose() - expected).norm(), 1e-14 * expected.norm())
+          << "n " << n << ", k " << k;
       EXPECT_GT(lower.diagonal().minCoeff(), 0) << "n " << n;
       // Nothing outside the lower triangle was touched: it is all still NaN.
       EXPECT_EQ(buffer.array().isNaN().count(), buffer.size() - n * (n + 1) / 2) << "n " << n;
@@ -111,7 +117,8 @@ TEST(CondensationKernels, RankUpdateIntoTheRemovedRowsPlaceGivesTheReducedFactor
   const Eigen::MatrixXd reduced = l(kept, kept);
   auto factor = buffer.block(2, 3, n, n);
   Eigen::MatrixXd dropped = factor.block(first + k, first, below, k);
-  cholesky_rank_update(factor.block(first + k, first + k, below, below), dropped, factor.block(first, first, below, below));
+  cholesky_rank_update(factor.block(first + k, first + k, below, below), dropped,
+                       factor.block(first, first, below, below));
   // Rows below the node in the columns before it move up by k, as the condensation does.
   for (Eigen::Index col = 0; col < first; ++col)
     factor.col(col).segment(first, below) = factor.col(col).segment(first + k, below).eval();

@@ -36,7 +36,8 @@ constexpr int kHeldNodes = 60;
 
 double median(std::vector<double> values) {
   if (values.empty()) return std::nan("");
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2),
+                   values.end());
   return values[values.size() / 2];
 }
 
@@ -46,25 +47,33 @@ struct SwitchingSession {
   fs::path dir;
   std::unique_ptr<testing::ChildProcess> server, client;
 
-  SwitchingSession(const std::string& name, const std::string& trajectory, const std::vector<std::string>& server_extra,
-                   double client_s)
+  SwitchingSession(const std::string& name, const std::string& trajectory,
+                   const std::vector<std::string>& server_extra, double client_s)
       : dir(testing::scratch_directory(name)) {
     std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(testing::pressed_cube_options());
     std::ofstream(dir / "press.yaml") << trajectory;
     std::vector<std::string> arguments = {
-        "--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--condensation", "naive", "--condition",
-        fmt::format("A:protocol=P0,step_nodes={}", kHeldNodes), "--condition", fmt::format("B:protocol=P1,shift_ms={}", kShiftMs),
-        "--control", (dir / "control").string(), "--duration", "60", "--record", (dir / "server.mcap").string(), "--report",
-        (dir / "server.json").string()};
+        "--scene",        (dir / "cube.yaml").string(),
+        "--listen",       "127.0.0.1:0",
+        "--condensation", "naive",
+        "--condition",    fmt::format("A:protocol=P0,step_nodes={}", kHeldNodes),
+        "--condition",    fmt::format("B:protocol=P1,shift_ms={}", kShiftMs),
+        "--control",      (dir / "control").string(),
+        "--duration",     "60",
+        "--record",       (dir / "server.mcap").string(),
+        "--report",       (dir / "server.json").string()};
     arguments.insert(arguments.end(), server_extra.begin(), server_extra.end());
-    server = std::make_unique<testing::ChildProcess>(testing::server_program(), arguments, dir / "server.log");
+    server = std::make_unique<testing::ChildProcess>(testing::server_program(), arguments,
+                                                     dir / "server.log");
     EXPECT_TRUE(testing::wait_for_output(*server, "listening on")) << server->log_text();
     const int port = testing::listening_port(server->log_text());
     client = std::make_unique<testing::ChildProcess>(
         testing::client_program(),
-        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", "subject", "--slot", "0", "--device",
-                                 "script:" + (dir / "press.yaml").string(), "--duration", fmt::format("{:g}", client_s),
-                                 "--record", (dir / "subject.mcap").string(), "--report", (dir / "subject.json").string()},
+        std::vector<std::string>{
+            "--server", fmt::format("127.0.0.1:{}", port), "--user", "subject", "--slot", "0",
+            "--device", "script:" + (dir / "press.yaml").string(), "--duration",
+            fmt::format("{:g}", client_s), "--record", (dir / "subject.mcap").string(), "--report",
+            (dir / "subject.json").string()},
         dir / "subject.log");
     EXPECT_TRUE(testing::wait_for_output(*client, "haptic thread")) << client->log_text();
   }
@@ -102,12 +111,14 @@ segments:
   std::this_thread::sleep_for(1500ms);  // pressing by now
   const std::vector<std::string> switches = {"B", "A", "B", "A", "B"};
   for (std::size_t i = 0; i < switches.size(); ++i) {
-    const nlohmann::json reply = i + 1 < switches.size() ? control.serve(switches[i]) : control.serve_next();
+    const nlohmann::json reply =
+        i + 1 < switches.size() ? control.serve(switches[i]) : control.serve_next();
     EXPECT_EQ(reply.value("served", ""), switches[i]) << reply;
     EXPECT_EQ(reply.value("switches", 0u), i + 1) << reply;
     std::this_thread::sleep_for(700ms);
   }
-  EXPECT_NE(control.ask({{"serve", "C"}}).value("error", "").find("no condition named 'C'"), std::string::npos);
+  EXPECT_NE(control.ask({{"serve", "C"}}).value("error", "").find("no condition named 'C'"),
+            std::string::npos);
   session.finish();
   ASSERT_FALSE(::testing::Test::HasFailure());
 
@@ -125,21 +136,27 @@ segments:
       condition = s.name();
       EXPECT_EQ(s.protocol(), condition == "A" ? wire::P0 : wire::P1);
       EXPECT_EQ(s.injected().shift_delay_ms(), condition == "A" ? 0 : kShiftMs);
-      EXPECT_EQ(s.injected().step_nodes(), condition == "A" ? static_cast<unsigned>(kHeldNodes) : 0u);
+      EXPECT_EQ(s.injected().step_nodes(),
+                condition == "A" ? static_cast<unsigned>(kHeldNodes) : 0u);
       continue;  // the step a switch took effect mixes both
     }
     if (step.pressing_slots_size() == 0) continue;
     held[condition].insert(step.boundary_nodes());
     for (const record::ToolInput& tool : step.tools())
-      if (tool.known()) sample_age_ms[condition].push_back(static_cast<double>(step.time_ns() - tool.sample_time_ns()) * 1e-6);
+      if (tool.known())
+        sample_age_ms[condition].push_back(
+            static_cast<double>(step.time_ns() - tool.sample_time_ns()) * 1e-6);
   }
   EXPECT_EQ(recorded, switches);
   EXPECT_EQ(session.recorded_switches(), switches);
-  EXPECT_EQ(held["A"], (std::set<std::uint32_t>{kHeldNodes})) << "A holds its nodes whenever the tool presses";
+  EXPECT_EQ(held["A"], (std::set<std::uint32_t>{kHeldNodes}))
+      << "A holds its nodes whenever the tool presses";
   EXPECT_EQ(held["B"], (std::set<std::uint32_t>{0})) << "B holds none";
   const double age_a = median(sample_age_ms["A"]), age_b = median(sample_age_ms["B"]);
-  std::printf("  tool samples' age at the server (median): A %.1f ms, B %.1f ms (B's links delayed %g ms)\n", age_a, age_b,
-              kShiftMs);
+  std::printf(
+      "  tool samples' age at the server (median): A %.1f ms, B %.1f ms (B's links delayed %g "
+      "ms)\n",
+      age_a, age_b, kShiftMs);
   EXPECT_GE(age_b, kShiftMs);
   EXPECT_LT(age_a, kShiftMs / 2);
   const nlohmann::json server_report = nlohmann::json::parse(std::ifstream(dir / "server.json"));
@@ -159,7 +176,8 @@ segments:
   EXPECT_EQ(client_report["fades"]["count"], 0) << "the force never lapsed";
   const record::Recording felt = record::read_recording(dir / "subject.mcap");
   std::size_t changes = 0;
-  for (std::size_t i = 1; i < felt.ticks.size(); ++i) changes += felt.ticks[i].protocol() != felt.ticks[i - 1].protocol();
+  for (std::size_t i = 1; i < felt.ticks.size(); ++i)
+    changes += felt.ticks[i].protocol() != felt.ticks[i - 1].protocol();
   EXPECT_EQ(changes, switches.size());
 
   for (const char* file : {"server.mcap", "subject.mcap"}) {
@@ -199,11 +217,14 @@ segments:
   }
   std::vector<double> pressed_s, switched_s;
   std::string before = "0";
-  for (const testing::CsvRow& sample : testing::read_csv_table(session.dir / "server.mcap-csv" / "tool_samples.csv")) {
-    if (sample.at("buttons") == "1" && before == "0") pressed_s.push_back(std::stod(sample.at("receive_time_s")));
+  for (const testing::CsvRow& sample :
+       testing::read_csv_table(session.dir / "server.mcap-csv" / "tool_samples.csv")) {
+    if (sample.at("buttons") == "1" && before == "0")
+      pressed_s.push_back(std::stod(sample.at("receive_time_s")));
     before = sample.at("buttons");
   }
-  for (const testing::CsvRow& step : testing::read_csv_table(session.dir / "server.mcap-csv" / "steps.csv"))
+  for (const testing::CsvRow& step :
+       testing::read_csv_table(session.dir / "server.mcap-csv" / "steps.csv"))
     if (!step.at("condition_switch").empty()) switched_s.push_back(std::stod(step.at("time_s")));
   ASSERT_EQ(pressed_s.size(), 2u);
   ASSERT_EQ(switched_s.size(), 2u);
@@ -212,10 +233,12 @@ segments:
     EXPECT_LT(switched_s[k], pressed_s[k] + 0.05);
   }
   int ticks_pressed = 0;
-  for (const testing::CsvRow& tick : testing::read_csv_table(session.dir / "subject.mcap-csv" / "haptic.csv"))
+  for (const testing::CsvRow& tick :
+       testing::read_csv_table(session.dir / "subject.mcap-csv" / "haptic.csv"))
     ticks_pressed += tick.at("buttons") == "1";
   EXPECT_NEAR(ticks_pressed, 2 * 200, 10) << "two presses of 0.2 s at 1 kHz";
-  const nlohmann::json client_report = nlohmann::json::parse(std::ifstream(session.dir / "subject.json"));
+  const nlohmann::json client_report =
+      nlohmann::json::parse(std::ifstream(session.dir / "subject.json"));
   EXPECT_EQ(client_report["protocol_switches"], 2);
   EXPECT_EQ(client_report["fades"]["count"], 0);
   for (const char* file : {"server.mcap", "subject.mcap"}) {

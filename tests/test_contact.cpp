@@ -34,10 +34,12 @@ double exact_distance(const Vector3d& p, const Vector3d& a, const Vector3d& b, c
   const Vector3d n = (b - a).cross(c - a);
   if (n.squaredNorm() > 0) {
     const Vector3d q = p - (p - a).dot(n) / n.squaredNorm() * n;
-    if ((b - a).cross(q - a).dot(n) >= 0 && (c - b).cross(q - b).dot(n) >= 0 && (a - c).cross(q - c).dot(n) >= 0)
+    if ((b - a).cross(q - a).dot(n) >= 0 && (c - b).cross(q - b).dot(n) >= 0 &&
+        (a - c).cross(q - c).dot(n) >= 0)
       return (p - q).norm();
   }
-  return std::min({(p - closest_on_segment(p, a, b)).norm(), (p - closest_on_segment(p, b, c)).norm(),
+  return std::min({(p - closest_on_segment(p, a, b)).norm(),
+                   (p - closest_on_segment(p, b, c)).norm(),
                    (p - closest_on_segment(p, c, a)).norm()});
 }
 
@@ -47,16 +49,19 @@ struct BruteForce {
   double distance;
   double resolution;
 };
-BruteForce brute_force_distance(const Vector3d& p, const Vector3d& a, const Vector3d& b, const Vector3d& c, int n) {
+BruteForce brute_force_distance(const Vector3d& p, const Vector3d& a, const Vector3d& b,
+                                const Vector3d& c, int n) {
   double best2 = std::numeric_limits<double>::infinity();
   const Vector3d ab = (b - a) / n, ac = (c - a) / n;
   for (int i = 0; i <= n; ++i)
-    for (int j = 0; i + j <= n; ++j) best2 = std::min(best2, (a + i * ab + j * ac - p).squaredNorm());
+    for (int j = 0; i + j <= n; ++j)
+      best2 = std::min(best2, (a + i * ab + j * ac - p).squaredNorm());
   const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
   return {std::sqrt(best2), longest / n};
 }
 
-void expect_valid_weights(const TriangleClosestPoint& q, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+void expect_valid_weights(const TriangleClosestPoint& q, const Vector3d& a, const Vector3d& b,
+                          const Vector3d& c) {
   EXPECT_GE(q.weights.minCoeff(), 0.0) << q.weights.transpose();
   EXPECT_NEAR(q.weights.sum(), 1.0, 1e-12);
   const Vector3d rebuilt = q.weights[0] * a + q.weights[1] * b + q.weights[2] * c;
@@ -75,7 +80,8 @@ TEST(ClosestPointOnTriangle, MatchesBruteForceAndExactReferenceOnRandomTriangles
     Vector3d p(point(rng), point(rng), point(rng));
     if (trial % 2 == 0) {
       const Vector3d n = (b - a).cross(c - a).normalized();
-      p = (a + b + c) / 3 + (p - (a + b + c) / 3).dot(n) * 0.1 * n + 0.8 * (p - (p - a).dot(n) * n - a);
+      p = (a + b + c) / 3 + (p - (a + b + c) / 3).dot(n) * 0.1 * n +
+          0.8 * (p - (p - a).dot(n) * n - a);
     }
     SCOPED_TRACE(::testing::Message() << "trial " << trial);
     const TriangleClosestPoint q = closest_point_on_triangle(p, a, b, c);
@@ -96,14 +102,14 @@ TEST(ClosestPointOnTriangle, ZeroWeightPatternNamesTheFeature) {
     Vector3d expected_weights;
   };
   const Case cases[] = {
-      {{-1, -1, 0.5}, a, {1, 0, 0}},                        // vertex a
-      {{2, -0.5, 1}, b, {0, 1, 0}},                         // vertex b
-      {{-0.3, 2, -1}, c, {0, 0, 1}},                        // vertex c
-      {{0.3, -1, 2}, {0.3, 0, 0}, {0.7, 0.3, 0}},           // edge ab
-      {{-1, 0.6, 0}, {0, 0.6, 0}, {0.4, 0, 0.6}},           // edge ca
-      {{1, 1, 0.7}, {0.5, 0.5, 0}, {0, 0.5, 0.5}},          // edge bc
-      {{0.2, 0.3, 5}, {0.2, 0.3, 0}, {0.5, 0.2, 0.3}},      // face
-      {{0.2, 0.3, -5}, {0.2, 0.3, 0}, {0.5, 0.2, 0.3}},     // face, other side
+      {{-1, -1, 0.5}, a, {1, 0, 0}},                     // vertex a
+      {{2, -0.5, 1}, b, {0, 1, 0}},                      // vertex b
+      {{-0.3, 2, -1}, c, {0, 0, 1}},                     // vertex c
+      {{0.3, -1, 2}, {0.3, 0, 0}, {0.7, 0.3, 0}},        // edge ab
+      {{-1, 0.6, 0}, {0, 0.6, 0}, {0.4, 0, 0.6}},        // edge ca
+      {{1, 1, 0.7}, {0.5, 0.5, 0}, {0, 0.5, 0.5}},       // edge bc
+      {{0.2, 0.3, 5}, {0.2, 0.3, 0}, {0.5, 0.2, 0.3}},   // face
+      {{0.2, 0.3, -5}, {0.2, 0.3, 0}, {0.5, 0.2, 0.3}},  // face, other side
   };
   for (const Case& k : cases) {
     SCOPED_TRACE(::testing::Message() << "p = " << k.p.transpose());
@@ -111,7 +117,8 @@ TEST(ClosestPointOnTriangle, ZeroWeightPatternNamesTheFeature) {
     EXPECT_LT((q.point - k.expected_point).norm(), 1e-15);
     for (int i = 0; i < 3; ++i) {
       if (k.expected_weights[i] == 0)
-        EXPECT_EQ(q.weights[i], 0.0) << "weight " << i << " must be exactly zero: " << q.weights.transpose();
+        EXPECT_EQ(q.weights[i], 0.0)
+            << "weight " << i << " must be exactly zero: " << q.weights.transpose();
       else
         EXPECT_NEAR(q.weights[i], k.expected_weights[i], 1e-15) << "weight " << i;
     }
@@ -136,7 +143,8 @@ TEST(ClosestPointOnTriangle, DegenerateTrianglesGiveAPointOnTheirSegment) {
       ASSERT_TRUE(q.point.allFinite() && q.weights.allFinite());
       expect_valid_weights(q, tri[0], tri[1], tri[2]);
       const Vector3d expected = closest_on_segment(p, s, e);
-      EXPECT_LT((q.point - expected).norm(), 1e-12) << "p " << p.transpose() << " got " << q.point.transpose();
+      EXPECT_LT((q.point - expected).norm(), 1e-12)
+          << "p " << p.transpose() << " got " << q.point.transpose();
     }
   }
   // All three vertices coincident.
@@ -148,15 +156,18 @@ TEST(ClosestPointOnTriangle, DegenerateTrianglesGiveAPointOnTheirSegment) {
 // An exactly collinear triangle whose area terms come out as rounding noise (~1e-16, not
 // 0): the closest point must still be the one on its edges, with a zero weight.
 TEST(ClosestPointOnTriangle, ExactlyCollinearTriangleWithRoundingNoiseInItsAreaTerms) {
-  const Vector3d a(0.5, 0.25, -0.25), b(0, 0, 0), c(3, 1.5, -1.5);  // 0.25 d, 0, 1.5 d with d = (2, 1, -1)
-  ASSERT_EQ((b - a).cross(c - a), Vector3d::Zero());                // exactly zero area
+  const Vector3d a(0.5, 0.25, -0.25), b(0, 0, 0),
+      c(3, 1.5, -1.5);                                // 0.25 d, 0, 1.5 d with d = (2, 1, -1)
+  ASSERT_EQ((b - a).cross(c - a), Vector3d::Zero());  // exactly zero area
   const Vector3d p(1.6307384325554901, -1.2571786693070988, 0.58082513594345864);
-  const Vector3d expected = closest_on_segment(p, b, c);             // (0.4745, 0.2372, -0.2372)
+  const Vector3d expected = closest_on_segment(p, b, c);  // (0.4745, 0.2372, -0.2372)
   const TriangleClosestPoint q = closest_point_on_triangle(p, a, b, c);
   ASSERT_TRUE(q.point.allFinite());
-  EXPECT_LT((q.point - expected).norm(), 1e-12) << "got " << q.point.transpose() << ", expected "
-                                                << expected.transpose() << ", weights " << q.weights.transpose();
-  EXPECT_TRUE(q.weights.minCoeff() == 0) << "a point on a segment has a zero weight: " << q.weights.transpose();
+  EXPECT_LT((q.point - expected).norm(), 1e-12)
+      << "got " << q.point.transpose() << ", expected " << expected.transpose() << ", weights "
+      << q.weights.transpose();
+  EXPECT_TRUE(q.weights.minCoeff() == 0)
+      << "a point on a segment has a zero weight: " << q.weights.transpose();
 }
 
 // The unit box [0,1]^3 meshed with 3 divisions, its surface and pseudo-normals.
@@ -182,7 +193,8 @@ TEST(ContactSignedDistance, MatchesAnalyticBoxDistance) {
   const BoxFixture box;
   std::vector<Vector3d> points;
   std::mt19937 rng(99);
-  std::uniform_real_distribution<double> anywhere(-0.5, 1.5), inside(0.001, 0.999), small(0.001, 0.2);
+  std::uniform_real_distribution<double> anywhere(-0.5, 1.5), inside(0.001, 0.999),
+      small(0.001, 0.2);
   for (int i = 0; i < 300; ++i) points.emplace_back(anywhere(rng), anywhere(rng), anywhere(rng));
   for (int i = 0; i < 100; ++i) points.emplace_back(inside(rng), inside(rng), inside(rng));
   // Outside near edges (closest point on a box edge) and corners (closest point a corner),
@@ -242,21 +254,23 @@ TEST(ContactFind, PointBelowTheTouchableFace) {
     EXPECT_NEAR(contact.depth, 0.1, 1e-12);
     // The triangle contains the foot: its area coordinates rebuild it and are >= 0.
     const Triangle& tri = box.surface.triangles[contact.triangle];
-    expect_valid_weights({contact.foot, contact.weights}, box.mesh.nodes.col(tri[0]), box.mesh.nodes.col(tri[1]),
-                         box.mesh.nodes.col(tri[2]));
+    expect_valid_weights({contact.foot, contact.weights}, box.mesh.nodes.col(tri[0]),
+                         box.mesh.nodes.col(tri[1]), box.mesh.nodes.col(tri[2]));
   }
 }
 
 TEST(ContactFind, PointOutsideIsNoContact) {
   const BoxFixture box;
-  for (const Vector3d& p : {Vector3d(0.5, 0.5, 1.1), Vector3d(0.3, 0.7, 1 + 1e-9), Vector3d(-0.1, 0.5, 0.5),
-                            Vector3d(0.5, 0.5, -0.01), Vector3d(1.05, 1.05, 1.05)}) {
+  for (const Vector3d& p :
+       {Vector3d(0.5, 0.5, 1.1), Vector3d(0.3, 0.7, 1 + 1e-9), Vector3d(-0.1, 0.5, 0.5),
+        Vector3d(0.5, 0.5, -0.01), Vector3d(1.05, 1.05, 1.05)}) {
     const ContactQuery query = find_contact(box.mesh, box.surface, box.normals, box.top, p, 0);
     EXPECT_FALSE(query.contact.has_value()) << "p = " << p.transpose();
     EXPECT_NEAR(query.signed_distance, box_signed_distance(p), 1e-12) << "p = " << p.transpose();
   }
   // Inside, but nothing touchable.
-  const ContactQuery none = find_contact(box.mesh, box.surface, box.normals, {}, Vector3d(0.5, 0.5, 0.9), 0);
+  const ContactQuery none =
+      find_contact(box.mesh, box.surface, box.normals, {}, Vector3d(0.5, 0.5, 0.9), 0);
   EXPECT_FALSE(none.contact.has_value());
   EXPECT_NEAR(none.signed_distance, -0.1, 1e-12);
 }
@@ -280,20 +294,25 @@ TEST(ContactFind, DeepUnderANonTouchableFaceStillPressesTheClosestTouchableTrian
 
 TEST(ContactFind, BelowASharedEdgeEitherTriangleDeterministically) {
   const BoxFixture box;
-  const auto is_top = [&](int t) { return std::find(box.top.begin(), box.top.end(), t) != box.top.end(); };
+  const auto is_top = [&](int t) {
+    return std::find(box.top.begin(), box.top.end(), t) != box.top.end();
+  };
   int shared_edges = 0;
   for (int t : box.top)
     for (int k = 0; k < 3; ++k) {
       const int neighbour = box.surface.triangle_neighbours[t][k];
-      if (neighbour < 0 || !is_top(neighbour) || neighbour < t) continue;  // each interior edge once
+      if (neighbour < 0 || !is_top(neighbour) || neighbour < t)
+        continue;  // each interior edge once
       ++shared_edges;
       const Triangle& tri = box.surface.triangles[t];
-      const Vector3d midpoint = 0.5 * (box.mesh.nodes.col(tri[k]) + box.mesh.nodes.col(tri[(k + 1) % 3]));
+      const Vector3d midpoint =
+          0.5 * (box.mesh.nodes.col(tri[k]) + box.mesh.nodes.col(tri[(k + 1) % 3]));
       const Vector3d p = midpoint - Vector3d(0, 0, 0.1);
       SCOPED_TRACE(::testing::Message() << "edge midpoint " << midpoint.transpose());
       const ContactQuery first = find_contact(box.mesh, box.surface, box.normals, box.top, p, 0);
       ASSERT_TRUE(first.contact.has_value());
-      EXPECT_TRUE(first.contact->triangle == t || first.contact->triangle == neighbour) << first.contact->triangle;
+      EXPECT_TRUE(first.contact->triangle == t || first.contact->triangle == neighbour)
+          << first.contact->triangle;
       EXPECT_LT((first.contact->foot - midpoint).norm(), 1e-12);
       EXPECT_LT((first.contact->displacement - Vector3d(0, 0, -0.1)).norm(), 1e-12);
       EXPECT_NEAR(first.contact->depth, 0.1, 1e-12);

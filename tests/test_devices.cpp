@@ -40,12 +40,14 @@ std::atomic<long> g_new_calls{0};
 
 #ifndef COHAPTIC_SANITIZER_OWNS_MALLOC
 __attribute__((weak)) void* operator new(std::size_t size) {
-  if (g_count_new.load(std::memory_order_relaxed)) g_new_calls.fetch_add(1, std::memory_order_relaxed);
+  if (g_count_new.load(std::memory_order_relaxed))
+    g_new_calls.fetch_add(1, std::memory_order_relaxed);
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
 __attribute__((weak)) void* operator new[](std::size_t size) {
-  if (g_count_new.load(std::memory_order_relaxed)) g_new_calls.fetch_add(1, std::memory_order_relaxed);
+  if (g_count_new.load(std::memory_order_relaxed))
+    g_new_calls.fetch_add(1, std::memory_order_relaxed);
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
   throw std::bad_alloc();
 }
@@ -62,7 +64,10 @@ constexpr double kMm = 1e-3;
 long count_allocations(const std::function<void()>& body) {
   g_new_calls = 0;
   g_count_new = true;
-  { volatile auto* probe = new std::vector<int>(10); delete probe; }
+  {
+    volatile auto* probe = new std::vector<int>(10);
+    delete probe;
+  }
   g_count_new = false;
   if (g_new_calls.load() == 0) return -1;
   g_new_calls = 0;
@@ -72,9 +77,11 @@ long count_allocations(const std::function<void()>& body) {
   return g_new_calls.load();
 }
 
-void expect_near(const Eigen::Vector3d& actual, const Eigen::Vector3d& expected, double tolerance, const std::string& what) {
-  EXPECT_LE((actual - expected).norm(), tolerance) << what << ": actual [" << actual.transpose() << "], expected ["
-                                                   << expected.transpose() << "]";
+void expect_near(const Eigen::Vector3d& actual, const Eigen::Vector3d& expected, double tolerance,
+                 const std::string& what) {
+  EXPECT_LE((actual - expected).norm(), tolerance)
+      << what << ": actual [" << actual.transpose() << "], expected [" << expected.transpose()
+      << "]";
 }
 
 // ---------------------------------------------------------------------------------------
@@ -105,27 +112,29 @@ TEST(Trajectory, ExamplePositionsAndVelocitiesByHand) {
     Eigen::Vector3d p_mm, v_mm_s;
   };
   const std::vector<Expect> expected{
-      {-1.0, {0, 0, 20}, {0, 0, 0}},        // before the start
-      {0.0, {0, 0, 20}, {0, 0, -20}},       // t = 0: start, moving
-      {0.45, {0, 0, 11}, {0, 0, -20}},      // half way down the approach
-      {2.4, {0, 0, -5.5}, {0, 0, -5}},      // 1.5 s into the press: 7.5 mm below 2
-      {4.0, {0, 0, -13}, {0, 0, 0}},        // holding at the bottom
-      {6.4, {0, 0, -5.5}, {0, 0, 5}},       // releasing: back up along +z
-      {8.4, {5, 0, 2}, {10, 0, 0}},         // move_by half way
-      {9.15, {5, 0, 2}, {-20, 0, 0}},       // repetition 2 starts where 1 ended: move_to back
-      {11.4, {0, 0, -8}, {0, 0, -5}},       // repetition 2, 2 s into the press
-      {25.4, {5, 0, 2}, {10, 0, 0}},        // repetition 3, last move_by
-      {25.9, {10, 0, 2}, {0, 0, 0}},        // the end
-      {1e6, {10, 0, 2}, {0, 0, 0}},         // long after
+      {-1.0, {0, 0, 20}, {0, 0, 0}},    // before the start
+      {0.0, {0, 0, 20}, {0, 0, -20}},   // t = 0: start, moving
+      {0.45, {0, 0, 11}, {0, 0, -20}},  // half way down the approach
+      {2.4, {0, 0, -5.5}, {0, 0, -5}},  // 1.5 s into the press: 7.5 mm below 2
+      {4.0, {0, 0, -13}, {0, 0, 0}},    // holding at the bottom
+      {6.4, {0, 0, -5.5}, {0, 0, 5}},   // releasing: back up along +z
+      {8.4, {5, 0, 2}, {10, 0, 0}},     // move_by half way
+      {9.15, {5, 0, 2}, {-20, 0, 0}},   // repetition 2 starts where 1 ended: move_to back
+      {11.4, {0, 0, -8}, {0, 0, -5}},   // repetition 2, 2 s into the press
+      {25.4, {5, 0, 2}, {10, 0, 0}},    // repetition 3, last move_by
+      {25.9, {10, 0, 2}, {0, 0, 0}},    // the end
+      {1e6, {10, 0, 2}, {0, 0, 0}},     // long after
   };
   for (const auto& e : expected) {
     expect_near(tr.position(e.t), e.p_mm * kMm, tol, "position at t = " + std::to_string(e.t));
     expect_near(tr.velocity(e.t), e.v_mm_s * kMm, tol, "velocity at t = " + std::to_string(e.t));
   }
   // Knot times, all of them.
-  const std::vector<double> times{0, 0.9, 3.9, 4.9, 7.9, 8.9, 9.4, 12.4, 13.4, 16.4, 17.4, 17.9, 20.9, 21.9, 24.9, 25.9};
+  const std::vector<double> times{0,    0.9,  3.9,  4.9,  7.9,  8.9,  9.4,  12.4,
+                                  13.4, 16.4, 17.4, 17.9, 20.9, 21.9, 24.9, 25.9};
   ASSERT_EQ(tr.knot_times().size(), times.size());
-  for (std::size_t i = 0; i < times.size(); ++i) EXPECT_NEAR(tr.knot_times()[i], times[i], 1e-12) << "knot " << i;
+  for (std::size_t i = 0; i < times.size(); ++i)
+    EXPECT_NEAR(tr.knot_times()[i], times[i], 1e-12) << "knot " << i;
   EXPECT_TRUE(std::isfinite(tr.position(std::numeric_limits<double>::quiet_NaN()).norm()));
 }
 
@@ -147,9 +156,11 @@ segments:
   expect_near(tr.position(2.4), start + 0.008 * dir, 1e-15, "half released");
   expect_near(tr.velocity(2.4), -0.005 * dir, 1e-15, "release velocity");
   expect_near(tr.position(2.8), start + 0.006 * dir, 1e-15, "released");
-  expect_near(tr.position(4.8), start + 0.008 * dir, 1e-15, "pressed again along the same direction");
+  expect_near(tr.position(4.8), start + 0.008 * dir, 1e-15,
+              "pressed again along the same direction");
   // Without any direction a press goes along -z.
-  const Trajectory down = parse_trajectory("start: [0, 0, 0]\nsegments: [{press: 0.01, speed: 0.01}]\n", "down.yaml");
+  const Trajectory down =
+      parse_trajectory("start: [0, 0, 0]\nsegments: [{press: 0.01, speed: 0.01}]\n", "down.yaml");
   expect_near(down.position(1.0), Eigen::Vector3d(0, 0, -0.01), 1e-15, "default press direction");
 }
 
@@ -158,7 +169,8 @@ TEST(Trajectory, UnitsConvertToMetres) {
   const Trajectory mm = parse_trajectory("units: mm\n" + body, "mm.yaml");
   const Trajectory cm = parse_trajectory("units: cm\n" + body, "cm.yaml");
   const Trajectory m = parse_trajectory(body, "m.yaml");  // default: m
-  for (const Trajectory* tr : {&mm, &cm, &m}) EXPECT_NEAR(tr->duration(), 5.0, 1e-12);  // 50 units at 10 units/s
+  for (const Trajectory* tr : {&mm, &cm, &m})
+    EXPECT_NEAR(tr->duration(), 5.0, 1e-12);  // 50 units at 10 units/s
   expect_near(mm.position(5.0), Eigen::Vector3d(0, 0.030, 0.060), 1e-15, "mm");
   expect_near(cm.position(5.0), Eigen::Vector3d(0, 0.30, 0.60), 1e-15, "cm");
   expect_near(m.position(5.0), Eigen::Vector3d(0, 30, 60), 1e-12, "m");
@@ -166,8 +178,9 @@ TEST(Trajectory, UnitsConvertToMetres) {
 }
 
 TEST(Trajectory, MoveToWhereTheToolIsTakesNoTime) {
-  const Trajectory tr = parse_trajectory("start: [1, 0, 0]\nsegments:\n  - {move_to: [1, 0, 0], speed: 1}\n  - {hold: 2}\n",
-                                         "still.yaml");
+  const Trajectory tr = parse_trajectory(
+      "start: [1, 0, 0]\nsegments:\n  - {move_to: [1, 0, 0], speed: 1}\n  - {hold: 2}\n",
+      "still.yaml");
   EXPECT_EQ(tr.knot_times().size(), 2u);
   EXPECT_NEAR(tr.duration(), 2.0, 1e-15);
 }
@@ -178,19 +191,25 @@ TEST(Trajectory, ButtonsAreHeldForTheirSegmentAndFromTheEndOn) {
   // buttons 0 and 2 (3-5 s), hold 1 s with none (5-6 s); then again with repeat, and the
   // last segment's buttons (none) from the end on.
   const Trajectory tr = parse_trajectory(
-      "units: mm\nstart: [0, 0, 10]\nsegments:\n  - {move_to: [0, 0, 0], speed: 10}\n  - {hold: 2, buttons: 1}\n"
-      "  - {move_to: [0, 0, 0], speed: 10, buttons: 2}\n  - {move_by: [0, 0, 20], speed: 10, buttons: 5}\n  - {hold: 1}\n",
+      "units: mm\nstart: [0, 0, 10]\nsegments:\n  - {move_to: [0, 0, 0], speed: 10}\n  - {hold: 2, "
+      "buttons: 1}\n"
+      "  - {move_to: [0, 0, 0], speed: 10, buttons: 2}\n  - {move_by: [0, 0, 20], speed: 10, "
+      "buttons: 5}\n  - {hold: 1}\n",
       "grasp.yaml");
   ASSERT_NEAR(tr.duration(), 6.0, 1e-12);
-  const std::vector<std::pair<double, std::uint32_t>> expected{{-1, 0},  {0, 0},   {0.99, 0}, {1.0, 1}, {2.99, 1},
-                                                               {3.0, 5}, {4.5, 5}, {5.0, 0},  {5.5, 0}, {9, 0}};
+  const std::vector<std::pair<double, std::uint32_t>> expected{
+      {-1, 0},  {0, 0},   {0.99, 0}, {1.0, 1}, {2.99, 1},
+      {3.0, 5}, {4.5, 5}, {5.0, 0},  {5.5, 0}, {9, 0}};
   for (const auto& [t, buttons] : expected) EXPECT_EQ(tr.buttons(t), buttons) << "t = " << t;
   EXPECT_NEAR(tr.position(4.0).z(), 0.010, 1e-15);  // buttons do not move the tool
 
-  const Trajectory holding = parse_trajectory("start: [0, 0, 0]\nsegments:\n  - {hold: 1, buttons: 1}\n", "hold.yaml");
+  const Trajectory holding =
+      parse_trajectory("start: [0, 0, 0]\nsegments:\n  - {hold: 1, buttons: 1}\n", "hold.yaml");
   EXPECT_EQ(holding.buttons(0.5), 1u);
   EXPECT_EQ(holding.buttons(7.0), 1u) << "a script that ends holding a button keeps holding it";
-  EXPECT_EQ(parse_trajectory("start: [0, 0, 0]\nsegments:\n  - {hold: 1}\n", "none.yaml").buttons(0.5), 0u);
+  EXPECT_EQ(
+      parse_trajectory("start: [0, 0, 0]\nsegments:\n  - {hold: 1}\n", "none.yaml").buttons(0.5),
+      0u);
 
   ScriptedDevice device(tr, 3.3);
   EXPECT_EQ(device.read(1.5).buttons, 1u);
@@ -201,9 +220,13 @@ TEST(Trajectory, KnotsAreValidated) {
   EXPECT_NO_THROW(Trajectory({0.0}, {Eigen::Vector3d::Zero()}, "point"));
   EXPECT_THROW(Trajectory({}, {}, "empty"), Error);
   EXPECT_THROW(Trajectory({0.5}, {Eigen::Vector3d::Zero()}, "late start"), Error);
-  EXPECT_THROW(Trajectory({0.0, 1.0, 1.0}, std::vector<Eigen::Vector3d>(3, Eigen::Vector3d::Zero()), "repeated time"), Error);
+  EXPECT_THROW(Trajectory({0.0, 1.0, 1.0}, std::vector<Eigen::Vector3d>(3, Eigen::Vector3d::Zero()),
+                          "repeated time"),
+               Error);
   EXPECT_THROW(Trajectory({0.0, 1.0}, {Eigen::Vector3d::Zero()}, "mismatch"), Error);
-  EXPECT_THROW(Trajectory({0.0, 1.0}, std::vector<Eigen::Vector3d>(2, Eigen::Vector3d::Zero()), "buttons", {1u}), Error);
+  EXPECT_THROW(Trajectory({0.0, 1.0}, std::vector<Eigen::Vector3d>(2, Eigen::Vector3d::Zero()),
+                          "buttons", {1u}),
+               Error);
 }
 
 TEST(Trajectory, DemoFilesMatchHandComputation) {
@@ -212,16 +235,20 @@ TEST(Trajectory, DemoFilesMatchHandComputation) {
   const Trajectory press = load_trajectory(kDataDir + "press.yaml");
   EXPECT_NEAR(press.duration(), 21.9, 1e-12);
   expect_near(press.position(0.0), Eigen::Vector3d(20, -20, 90) * kMm, 1e-15, "press start");
-  expect_near(press.position(4.4), Eigen::Vector3d(20, -20, 57) * kMm, 1e-15, "press bottom, stroke 1");
-  expect_near(press.position(9.4), Eigen::Vector3d(20, -20, 64.5) * kMm, 1e-15, "half way down, stroke 2");
-  expect_near(press.position(21.9), Eigen::Vector3d(20, -20, 72) * kMm, 1e-15, "released after stroke 3");
+  expect_near(press.position(4.4), Eigen::Vector3d(20, -20, 57) * kMm, 1e-15,
+              "press bottom, stroke 1");
+  expect_near(press.position(9.4), Eigen::Vector3d(20, -20, 64.5) * kMm, 1e-15,
+              "half way down, stroke 2");
+  expect_near(press.position(21.9), Eigen::Vector3d(20, -20, 72) * kMm, 1e-15,
+              "released after stroke 3");
   // lift.yaml (mm): approach 20 mm at 20 -> 1.0; press 10 up at 4 -> 3.5; slide +5 y at 2.5
   // -> 5.5; hold 1.5 -> 7.0; slide back -> 9.0; release -> 11.5; repetition 2 -> 22.0.
   const Trajectory lift = load_trajectory(kDataDir + "lift.yaml");
   EXPECT_NEAR(lift.duration(), 22.0, 1e-12);
   expect_near(lift.position(6.0), Eigen::Vector3d(25, -50, -69) * kMm, 1e-15, "lifted and slid");
   expect_near(lift.velocity(4.5), Eigen::Vector3d(0, 2.5, 0) * kMm, 1e-15, "sliding");
-  expect_near(lift.position(12.75), Eigen::Vector3d(25, -55, -74) * kMm, 1e-15, "half way up, stroke 2");
+  expect_near(lift.position(12.75), Eigen::Vector3d(25, -55, -74) * kMm, 1e-15,
+              "half way up, stroke 2");
   const auto hand = load_hand_parameters(kDataDir + "lift.yaml");
   ASSERT_TRUE(hand.has_value());
   EXPECT_EQ(hand->mass_kg, 0.25);
@@ -289,7 +316,8 @@ TEST(Trajectory, ErrorsNameFileLineAndKey) {
       {"zero speed", 5, "    speed: 0", "segments[0].speed", "positive speed"},
       {"negative speed", 7, "    speed: -5", "segments[1].speed", "positive speed"},
       {"infinite speed", 7, "    speed: .inf", "segments[1].speed", "finite number"},
-      {"zero direction", 8, "    direction: [0, 0, 0]", "segments[1].direction", "non-zero direction"},
+      {"zero direction", 8, "    direction: [0, 0, 0]", "segments[1].direction",
+       "non-zero direction"},
       {"zero depth", 6, "  - press: 0", "segments[1].press", "positive depth"},
       {"negative hold", 9, "  - hold: -1", "segments[2].hold", "positive duration"},
       {"zero hold", 9, "  - hold: 0", "segments[2].hold", "positive duration"},
@@ -298,7 +326,8 @@ TEST(Trajectory, ErrorsNameFileLineAndKey) {
       {"repeat fraction", 12, "repeat: 1.5", "repeat", "an integer"},
       {"unknown top key", 12, "repaet: 3", "repaet", "unknown key"},
       {"unknown segment key", 8, "    dirction: [0, 0, -1]", "segments[1].dirction", "unknown key"},
-      {"segment with no kind", 9, "  - wait: 1.0", "segments[2]", "one of move_to, move_by, press, release or hold"},
+      {"segment with no kind", 9, "  - wait: 1.0", "segments[2]",
+       "one of move_to, move_by, press, release or hold"},
       {"two kinds", 8, "    hold: 1", "segments[1].hold", "exactly one of"},
       {"missing speed", 5, "    spede: 20", "segments[0].spede", "unknown key"},
       {"negative buttons", 11, "    buttons: -1", "segments[3].buttons", "a button mask"},
@@ -312,9 +341,11 @@ TEST(Trajectory, ErrorsNameFileLineAndKey) {
       const std::string message = e.what();
       EXPECT_EQ(e.file(), "cases/bad.yaml") << c.what;
       EXPECT_EQ(e.line(), c.line) << c.what << ": " << message;
-      EXPECT_NE(message.find(std::string("cases/bad.yaml:") + std::to_string(c.line) + ":"), std::string::npos)
+      EXPECT_NE(message.find(std::string("cases/bad.yaml:") + std::to_string(c.line) + ":"),
+                std::string::npos)
           << c.what << ": " << message;
-      EXPECT_NE(message.find(std::string(" ") + c.key + ":"), std::string::npos) << c.what << ": " << message;
+      EXPECT_NE(message.find(std::string(" ") + c.key + ":"), std::string::npos)
+          << c.what << ": " << message;
       EXPECT_NE(message.find(c.expects), std::string::npos) << c.what << ": " << message;
     }
   }
@@ -328,12 +359,16 @@ TEST(Trajectory, StructuralErrorsNameFileLineAndKey) {
     const char* expects;
   };
   const std::vector<Case> cases{
-      {"no segments", "start: [0, 0, 0]\nsegments: []\n", 2, "segments: expected at least one segment"},
-      {"segments not a list", "start: [0, 0, 0]\nsegments: 3\n", 2, "segments: expected a list, found '3'"},
-      {"missing start", "units: mm\nsegments:\n  - {hold: 1}\n", 1, "(top level): missing required key 'start'"},
+      {"no segments", "start: [0, 0, 0]\nsegments: []\n", 2,
+       "segments: expected at least one segment"},
+      {"segments not a list", "start: [0, 0, 0]\nsegments: 3\n", 2,
+       "segments: expected a list, found '3'"},
+      {"missing start", "units: mm\nsegments:\n  - {hold: 1}\n", 1,
+       "(top level): missing required key 'start'"},
       {"missing speed", "start: [0, 0, 0]\nsegments:\n  - {hold: 1}\n  - {move_by: [1, 0, 0]}\n", 4,
        "segments[1]: missing required key 'speed'"},
-      {"release before press", "start: [0, 0, 0]\nsegments:\n  - {hold: 1}\n  - {release: 1, speed: 1}\n", 4,
+      {"release before press",
+       "start: [0, 0, 0]\nsegments:\n  - {hold: 1}\n  - {release: 1, speed: 1}\n", 4,
        "segments[1]: release before any press"},
       {"not a map", "- 1\n- 2\n", 1, "expected a map with start and segments"},
       {"YAML syntax", "start: [0, 0, 0]\nsegments:\n  - {hold: 1\n", 4, "YAML syntax error"},
@@ -344,7 +379,8 @@ TEST(Trajectory, StructuralErrorsNameFileLineAndKey) {
       ADD_FAILURE() << c.what << ": no error";
     } catch (const ParseError& e) {
       EXPECT_EQ(e.line(), c.line) << c.what << ": " << e.what();
-      EXPECT_NE(std::string(e.what()).find(c.expects), std::string::npos) << c.what << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.expects), std::string::npos)
+          << c.what << ": " << e.what();
       EXPECT_EQ(std::string(e.what()).rfind("s.yaml:", 0), 0u) << c.what << ": " << e.what();
     }
   }
@@ -357,7 +393,9 @@ TEST(Trajectory, StructuralErrorsNameFileLineAndKey) {
 }
 
 TEST(Trajectory, HandMapErrorsNameFileLineAndKey) {
-  const std::string base = "start: [0, 0, 0]\nsegments: [{hold: 1}]\nhand:\n  mass: 0.2\n  stiffness: 300\n  damping: 8\n";
+  const std::string base =
+      "start: [0, 0, 0]\nsegments: [{hold: 1}]\nhand:\n  mass: 0.2\n  stiffness: 300\n  damping: "
+      "8\n";
   EXPECT_NO_THROW(parse_trajectory(base, "h.yaml"));
   const auto ok = parse_hand_parameters(base, "h.yaml");
   ASSERT_TRUE(ok.has_value());
@@ -374,7 +412,8 @@ TEST(Trajectory, HandMapErrorsNameFileLineAndKey) {
       ADD_FAILURE() << c.what << ": no error";
     } catch (const ParseError& e) {
       EXPECT_EQ(e.line(), c.line) << c.what << ": " << e.what();
-      EXPECT_NE(std::string(e.what()).find(std::string(" ") + c.key + ":"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(std::string(" ") + c.key + ":"), std::string::npos)
+          << e.what();
       EXPECT_NE(std::string(e.what()).find(c.expects), std::string::npos) << e.what();
     }
   }
@@ -427,16 +466,19 @@ TEST(Device, MakeDeviceFromSpecs) {
   EXPECT_EQ(hand_model->parameters().stiffness_n_per_m, 400.0);  // from the file's hand: map
   const auto hand_defaults = make_device("hand:" + kDataDir + "press.yaml", 2.0);
   ASSERT_NE(dynamic_cast<HandModelDevice*>(hand_defaults.get()), nullptr);
-  EXPECT_EQ(dynamic_cast<HandModelDevice*>(hand_defaults.get())->parameters().stiffness_n_per_m, 300.0);
+  EXPECT_EQ(dynamic_cast<HandModelDevice*>(hand_defaults.get())->parameters().stiffness_n_per_m,
+            300.0);
 
   const auto bridge = make_device("bridge:17493", 3.3);
   ASSERT_NE(dynamic_cast<BridgeDevice*>(bridge.get()), nullptr);
-  EXPECT_NE(bridge->describe().find("bridge:127.0.0.1:17493"), std::string::npos) << bridge->describe();
+  EXPECT_NE(bridge->describe().find("bridge:127.0.0.1:17493"), std::string::npos)
+      << bridge->describe();
   const auto bridge_host = make_device("bridge:0.0.0.0:17494", 3.3);
-  EXPECT_NE(bridge_host->describe().find("bridge:0.0.0.0:17494"), std::string::npos) << bridge_host->describe();
+  EXPECT_NE(bridge_host->describe().find("bridge:0.0.0.0:17494"), std::string::npos)
+      << bridge_host->describe();
 
-  for (const char* bad : {"", "script", "script:", "mouse:1", "bridge:", "bridge:abc", "bridge:70000", "bridge:0",
-                                "bridge:host:", "Script:x.yaml"}) {
+  for (const char* bad : {"", "script", "script:", "mouse:1", "bridge:", "bridge:abc",
+                          "bridge:70000", "bridge:0", "bridge:host:", "Script:x.yaml"}) {
     try {
       make_device(bad, 3.0);
       ADD_FAILURE() << "no error for '" << bad << "'";
@@ -444,7 +486,8 @@ TEST(Device, MakeDeviceFromSpecs) {
       const std::string message = e.what();
       EXPECT_NE(message.find(std::string("'") + bad + "'"), std::string::npos) << message;
       if (message.find("unknown device") != std::string::npos) {
-        for (const char* form : {"script:FILE", "hand:FILE", "bridge:[HOST:]PORT", "replay:FILE[:USER]"})
+        for (const char* form :
+             {"script:FILE", "hand:FILE", "bridge:[HOST:]PORT", "replay:FILE[:USER]"})
           EXPECT_NE(message.find(form), std::string::npos) << "'" << bad << "': " << message;
       }
     }
@@ -464,7 +507,8 @@ const double kOmegaD = std::sqrt(1100.0);
 Trajectory still_at(const Eigen::Vector3d& p) { return Trajectory({0.0}, {p}, "still"); }
 
 // Runs a device at 1 kHz for `seconds`, with force(state) fed back; calls `each(t, state)`.
-void run_loop(HapticDevice& device, double seconds, const std::function<Eigen::Vector3d(const DeviceState&)>& force,
+void run_loop(HapticDevice& device, double seconds,
+              const std::function<Eigen::Vector3d(const DeviceState&)>& force,
               const std::function<void(double, const DeviceState&)>& each) {
   const int ticks = static_cast<int>(std::lround(seconds * 1000.0));
   for (int i = 0; i <= ticks; ++i) {
@@ -489,7 +533,8 @@ double step_error(double h, double e0) {
   run_loop(
       hand, 1.5, [](const DeviceState&) { return Eigen::Vector3d::Zero(); },
       [&](double t, const DeviceState& s) {
-        const double exact = e0 * std::exp(-kSigma * t) * (std::cos(kOmegaD * t) + kSigma / kOmegaD * std::sin(kOmegaD * t));
+        const double exact = e0 * std::exp(-kSigma * t) *
+                             (std::cos(kOmegaD * t) + kSigma / kOmegaD * std::sin(kOmegaD * t));
         worst = std::max(worst, std::abs(s.position.z() - exact));
         EXPECT_EQ(s.position.x(), 0.0);
       });
@@ -504,8 +549,10 @@ TEST(HandModel, StepResponseMatchesTheDampedOscillator) {
   const double bound = e0 * kOmega0 * h;
   RecordProperty("step_max_error_m", std::to_string(error));
   RecordProperty("step_bound_m", std::to_string(bound));
-  std::printf("hand model step, e0 = 10 mm: max error %.3g m at h = 0.1 ms, %.3g m at 0.05 ms (bound %.3g m)\n", error,
-              error_half, bound);
+  std::printf(
+      "hand model step, e0 = 10 mm: max error %.3g m at h = 0.1 ms, %.3g m at 0.05 ms (bound %.3g "
+      "m)\n",
+      error, error_half, bound);
   EXPECT_LT(error, bound);
   EXPECT_NEAR(error / error_half, 2.0, 0.2) << "semi-implicit Euler should be first order";
 }
@@ -531,7 +578,8 @@ TEST(HandModel, RampResponseMatchesTheDampedOscillator) {
   EXPECT_LT(worst, bound);
   // After the reference stops, the arm comes to rest on it.
   for (int i = 1000; i <= 4000; ++i) hand.read(i * 1e-3);
-  expect_near(hand.state().position, Eigen::Vector3d(u, 0, 0), 1e-9, "at rest on the end of the ramp");
+  expect_near(hand.state().position, Eigen::Vector3d(u, 0, 0), 1e-9,
+              "at rest on the end of the ramp");
 }
 
 TEST(HandModel, ConstantForceSettlesAtReferencePlusForceOverStiffness) {
@@ -563,8 +611,12 @@ TEST(HandModel, UndampedEnergyStaysWithinTheSymplecticBound) {
   hand.set_state({0.0, Eigen::Vector3d(x0, 0, 0), Eigen::Vector3d::Zero()});
   const double h = hand.max_substep();
   const double k = p.stiffness_n_per_m, m = p.mass_kg;
-  const auto energy = [&](const HandState& st) { return 0.5 * m * st.velocity.squaredNorm() + 0.5 * k * st.position.squaredNorm(); };
-  const auto modified = [&](const HandState& st) { return energy(st) - 0.5 * h * k * st.position.dot(st.velocity); };
+  const auto energy = [&](const HandState& st) {
+    return 0.5 * m * st.velocity.squaredNorm() + 0.5 * k * st.position.squaredNorm();
+  };
+  const auto modified = [&](const HandState& st) {
+    return energy(st) - 0.5 * h * k * st.position.dot(st.velocity);
+  };
   const double e0 = energy(hand.state());
   const double q0 = modified(hand.state());
   double worst = 0, worst_modified = 0;
@@ -575,11 +627,13 @@ TEST(HandModel, UndampedEnergyStaysWithinTheSymplecticBound) {
         worst = std::max(worst, std::abs(energy(hand.state()) / e0 - 1.0));
         worst_modified = std::max(worst_modified, std::abs(modified(hand.state()) / q0 - 1.0));
       });
-  std::printf("hand model, c = 0 for 100 s (%.0f periods): max |E/E0 - 1| = %.3g (bound omega0 h = %.3g); "
-              "max |E~/E~0 - 1| = %.3g\n",
-              seconds * kOmega0 / (2 * std::numbers::pi), worst, kOmega0 * h, worst_modified);
+  std::printf(
+      "hand model, c = 0 for 100 s (%.0f periods): max |E/E0 - 1| = %.3g (bound omega0 h = %.3g); "
+      "max |E~/E~0 - 1| = %.3g\n",
+      seconds * kOmega0 / (2 * std::numbers::pi), worst, kOmega0 * h, worst_modified);
   EXPECT_LT(worst, kOmega0 * h);
-  EXPECT_GT(worst, 0.25 * kOmega0 * h) << "E should oscillate by about omega0 h / 2 (is the integrator symplectic Euler?)";
+  EXPECT_GT(worst, 0.25 * kOmega0 * h)
+      << "E should oscillate by about omega0 h / 2 (is the integrator symplectic Euler?)";
   EXPECT_LT(worst_modified, 1e-10);
   EXPECT_EQ(hand.substep_count(), static_cast<std::uint64_t>(std::lround(seconds / h)));
 }
@@ -593,14 +647,22 @@ TEST(HandModel, SubstepsAtMostATenthOfAMillisecond) {
   hand.read(1e-3);  // time going backwards is ignored
   EXPECT_EQ(hand.substep_count(), 43u);
   hand.read(10.0);  // a stall longer than 0.5 s: the rest is skipped, and counted
-  EXPECT_EQ(hand.substep_count(), 43u + static_cast<std::uint64_t>(HandModelDevice::kMaxSubstepsPerRead));
+  EXPECT_EQ(hand.substep_count(),
+            43u + static_cast<std::uint64_t>(HandModelDevice::kMaxSubstepsPerRead));
   EXPECT_NEAR(hand.skipped_time_s(), 10.0 - 4.3e-3 - 0.5, 1e-9);
   EXPECT_EQ(hand.state().time_s, 10.0);
   // Parameters the sub-step cannot resolve are refused.
-  EXPECT_THROW(HandModelDevice(still_at(Eigen::Vector3d::Zero()), HandParameters{0.001, 1e5, 0}, 3.0), Error);
-  EXPECT_THROW(HandModelDevice(still_at(Eigen::Vector3d::Zero()), HandParameters{0.01, 300, 100}, 3.0), Error);
-  EXPECT_THROW(HandModelDevice(still_at(Eigen::Vector3d::Zero()), HandParameters{0.2, 300, 8}, 3.0, 2e-4), Error);
-  EXPECT_THROW(HandModelDevice(still_at(Eigen::Vector3d::Zero()), HandParameters{-1, 300, 8}, 3.0), Error);
+  EXPECT_THROW(
+      HandModelDevice(still_at(Eigen::Vector3d::Zero()), HandParameters{0.001, 1e5, 0}, 3.0),
+      Error);
+  EXPECT_THROW(
+      HandModelDevice(still_at(Eigen::Vector3d::Zero()), HandParameters{0.01, 300, 100}, 3.0),
+      Error);
+  EXPECT_THROW(
+      HandModelDevice(still_at(Eigen::Vector3d::Zero()), HandParameters{0.2, 300, 8}, 3.0, 2e-4),
+      Error);
+  EXPECT_THROW(HandModelDevice(still_at(Eigen::Vector3d::Zero()), HandParameters{-1, 300, 8}, 3.0),
+               Error);
 }
 
 // Closed loop against a unilateral virtual wall z >= 0 of stiffness K, rendered at 1 kHz
@@ -619,7 +681,10 @@ WallRun run_wall(double wall_k) {
   hand.set_state({0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
   double lo = INFINITY, hi = -INFINITY;
   run_loop(
-      hand, 3.0, [&](const DeviceState& s) { return Eigen::Vector3d(0, 0, wall_k * std::max(-s.position.z(), 0.0)); },
+      hand, 3.0,
+      [&](const DeviceState& s) {
+        return Eigen::Vector3d(0, 0, wall_k * std::max(-s.position.z(), 0.0));
+      },
       [&](double t, const DeviceState& s) {
         if (t >= 2.5) {
           lo = std::min(lo, s.position.z());
@@ -638,15 +703,21 @@ TEST(HandModel, SettlesAgainstAVirtualWallWhenPassive) {
 
 TEST(HandModel, ChattersAgainstAStiffWallBeyondThePassivityBound) {
   const WallRun run = run_wall(1e5);
-  std::printf("hand model against a 1e5 N/m wall at 1 kHz: peak-to-peak %.3g m over the last 0.5 s\n", run.late_peak_to_peak);
-  EXPECT_GT(run.late_peak_to_peak, 1e-4) << "the closed loop should show the sampled-wall instability";
+  std::printf(
+      "hand model against a 1e5 N/m wall at 1 kHz: peak-to-peak %.3g m over the last 0.5 s\n",
+      run.late_peak_to_peak);
+  EXPECT_GT(run.late_peak_to_peak, 1e-4)
+      << "the closed loop should show the sampled-wall instability";
 }
 
 TEST(HandModel, ReadAndWriteAllocateNothing) {
   HandModelDevice hand(load_trajectory(kDataDir + "press.yaml"), HandParameters{}, 3.0);
   const long calls = count_allocations([&] {
     run_loop(
-        hand, 5.0, [](const DeviceState& s) { return Eigen::Vector3d(0, 0, 100.0 * std::max(0.07 - s.position.z(), 0.0)); },
+        hand, 5.0,
+        [](const DeviceState& s) {
+          return Eigen::Vector3d(0, 0, 100.0 * std::max(0.07 - s.position.z(), 0.0));
+        },
         [](double, const DeviceState&) {});
   });
   if (calls < 0) GTEST_SKIP() << "operator new is not counted in this program";
@@ -668,8 +739,9 @@ TEST(HandModel, ReadAndWriteAllocateNothing) {
 
 /// Waits until a force packet from the device has reached `peer`.
 ::testing::AssertionResult force_arrives(BridgePeer& peer) {
-  return testing::wait_until([&] { return peer.poll_forces() > 0 || peer.newest_force().has_value(); },
-                             "a force packet at the bridge peer");
+  return testing::wait_until(
+      [&] { return peer.poll_forces() > 0 || peer.newest_force().has_value(); },
+      "a force packet at the bridge peer");
 }
 
 TEST(Bridge, PacketLayoutIsLittleEndianAndFixed) {
@@ -683,11 +755,11 @@ TEST(Bridge, PacketLayoutIsLittleEndianAndFixed) {
   bridge::encode(pose, bytes);
   const std::vector<std::uint8_t> expected{
       'C', 'H', 'B', '1', 0x04, 0x03, 0x02, 0x01,  // magic, sequence
-      0, 0, 0, 0, 0, 0, 0x00, 0x40,                // device_time_s = 2
-      0, 0, 0, 0, 0, 0, 0xF0, 0x3F,                // x = 1
-      0, 0, 0, 0, 0, 0, 0x00, 0xC0,                // y = -2
-      0, 0, 0, 0, 0, 0, 0xE0, 0x3F,                // z = 0.5
-      5, 0, 0, 0, 1, 0, 0, 0};                     // buttons, flags
+      0,   0,   0,   0,   0,    0,    0x00, 0x40,  // device_time_s = 2
+      0,   0,   0,   0,   0,    0,    0xF0, 0x3F,  // x = 1
+      0,   0,   0,   0,   0,    0,    0x00, 0xC0,  // y = -2
+      0,   0,   0,   0,   0,    0,    0xE0, 0x3F,  // z = 0.5
+      5,   0,   0,   0,   1,    0,    0,    0};    // buttons, flags
   ASSERT_EQ(bytes.size(), 48u);
   EXPECT_TRUE(std::equal(bytes.begin(), bytes.end(), expected.begin()));
   bridge::PosePacket back;
@@ -705,25 +777,27 @@ TEST(Bridge, PacketLayoutIsLittleEndianAndFixed) {
   bridge::ForceBytes fbytes;
   bridge::encode(force, fbytes);
   const std::vector<std::uint8_t> fexpected{
-      'C', 'H', 'F', '1', 7, 0, 0, 0,  //
-      0, 0, 0, 0, 0, 0, 0x00, 0xC0,    // device_time_s = -2
-      0, 0, 0, 0, 0, 0, 0xE0, 0x3F,    // fx = 0.5
-      0, 0, 0, 0, 0, 0, 0xF0, 0x3F,    // fy = 1
-      0, 0, 0, 0, 0, 0, 0x00, 0xC0,    // fz = -2
-      0, 0, 0, 0, 0, 0, 0x00, 0x40,    // force_limit = 2
-      1, 0, 0, 0, 0, 0, 0, 0};         // flags, reserved
+      'C', 'H', 'F', '1', 7, 0, 0,    0,     //
+      0,   0,   0,   0,   0, 0, 0x00, 0xC0,  // device_time_s = -2
+      0,   0,   0,   0,   0, 0, 0xE0, 0x3F,  // fx = 0.5
+      0,   0,   0,   0,   0, 0, 0xF0, 0x3F,  // fy = 1
+      0,   0,   0,   0,   0, 0, 0x00, 0xC0,  // fz = -2
+      0,   0,   0,   0,   0, 0, 0x00, 0x40,  // force_limit = 2
+      1,   0,   0,   0,   0, 0, 0,    0};    // flags, reserved
   ASSERT_EQ(fbytes.size(), 56u);
   EXPECT_TRUE(std::equal(fbytes.begin(), fbytes.end(), fexpected.begin()));
 
   // Rejections.
-  EXPECT_EQ(bridge::decode(std::span<const std::uint8_t>(bytes.data(), 47), back), bridge::PacketStatus::bad_size);
+  EXPECT_EQ(bridge::decode(std::span<const std::uint8_t>(bytes.data(), 47), back),
+            bridge::PacketStatus::bad_size);
   bridge::PoseBytes wrong = bytes;
   wrong[3] = '2';
   EXPECT_EQ(bridge::decode(wrong, back), bridge::PacketStatus::bad_magic);
   pose.position.y() = std::numeric_limits<double>::infinity();
   bridge::encode(pose, wrong);
   EXPECT_EQ(bridge::decode(wrong, back), bridge::PacketStatus::non_finite);
-  EXPECT_EQ(bridge::decode(fbytes, back), bridge::PacketStatus::bad_size);  // a force packet is not a pose
+  EXPECT_EQ(bridge::decode(fbytes, back),
+            bridge::PacketStatus::bad_size);  // a force packet is not a pose
   // Sequence order wraps.
   EXPECT_TRUE(bridge::sequence_after(1, 0));
   EXPECT_TRUE(bridge::sequence_after(0, 0xFFFFFFFFu));
@@ -815,19 +889,19 @@ TEST(Bridge, BadPacketsAreDroppedAndCounted) {
   p.sequence = 100;
   p.position = {0.5, 0.5, 0.5};
   bridge::encode(p, good);
-  intruder.send_pose(p);                                                        // foreign source (well formed)
-  peer.send_bytes(std::span<const std::uint8_t>(good.data(), 40));              // short
+  intruder.send_pose(p);                                            // foreign source (well formed)
+  peer.send_bytes(std::span<const std::uint8_t>(good.data(), 40));  // short
   std::vector<std::uint8_t> longer(good.begin(), good.end());
   longer.resize(64, 0);
-  peer.send_bytes(longer);                                                      // long
+  peer.send_bytes(longer);  // long
   bridge::PoseBytes bad_magic = good;
   bad_magic[0] = 'X';
-  peer.send_bytes(bad_magic);                                                   // magic
+  peer.send_bytes(bad_magic);  // magic
   p.position.z() = std::numeric_limits<double>::quiet_NaN();
-  peer.send_pose(p);                                                            // NaN
+  peer.send_pose(p);  // NaN
   p.position.z() = 0.5;
   p.device_time_s = std::numeric_limits<double>::infinity();
-  peer.send_pose(p);                                                            // infinite time
+  peer.send_pose(p);  // infinite time
   ASSERT_TRUE(read_until(device, 8, 1.001));
 
   const BridgeCounters c = device.counters();
@@ -840,7 +914,8 @@ TEST(Bridge, BadPacketsAreDroppedAndCounted) {
   EXPECT_EQ(c.dropped(), 7u);
   const DeviceState s = device.read(1.002);
   EXPECT_TRUE(s.valid);
-  EXPECT_EQ(s.position, Eigen::Vector3d(0.001, 0.002, 0.003)) << "none of the bad packets got through";
+  EXPECT_EQ(s.position, Eigen::Vector3d(0.001, 0.002, 0.003))
+      << "none of the bad packets got through";
   device.stop();
 }
 

@@ -31,8 +31,8 @@ const fs::path kTreeRoot = COHAPTIC_SOURCE_DIR;
 bool skipped_directory(const fs::path& relative) {
   static const std::set<std::string> kSkippedPaths = {"out", "view/web/lib", "tests/fuzz/corpus"};
   const std::string name = relative.filename().string();
-  return kSkippedPaths.count(relative.generic_string()) > 0 || name == ".git" || name == "node_modules" ||
-         name.rfind("build", 0) == 0;
+  return kSkippedPaths.count(relative.generic_string()) > 0 || name == ".git" ||
+         name == "node_modules" || name.rfind("build", 0) == 0;
 }
 
 struct TextFile {
@@ -42,7 +42,8 @@ struct TextFile {
 
 std::vector<TextFile> project_text_files() {
   std::vector<TextFile> files;
-  for (auto it = fs::recursive_directory_iterator(kTreeRoot); it != fs::recursive_directory_iterator(); ++it) {
+  for (auto it = fs::recursive_directory_iterator(kTreeRoot);
+       it != fs::recursive_directory_iterator(); ++it) {
     const fs::path relative = fs::relative(it->path(), kTreeRoot);
     if (it->is_directory()) {
       if (skipped_directory(relative)) it.disable_recursion_pending();
@@ -70,18 +71,23 @@ std::string anchor_of(const std::string& heading) {
   for (std::size_t i = 0; i < heading.size();) {
     const auto byte = static_cast<unsigned char>(heading[i]);
     if (byte < 0x80) {
-      if (std::isalnum(byte) || byte == '-' || byte == '_') anchor += static_cast<char>(std::tolower(byte));
-      else if (byte == ' ') anchor += '-';
+      if (std::isalnum(byte) || byte == '-' || byte == '_')
+        anchor += static_cast<char>(std::tolower(byte));
+      else if (byte == ' ')
+        anchor += '-';
       ++i;
       continue;
     }
     const std::size_t length = byte >= 0xF0 ? 4 : byte >= 0xE0 ? 3 : 2;
     const std::string sequence = heading.substr(i, length);
     char32_t code = length == 2 ? (byte & 0x1Fu) : length == 3 ? (byte & 0x0Fu) : (byte & 0x07u);
-    for (std::size_t k = 1; k < sequence.size(); ++k) code = (code << 6) | (static_cast<unsigned char>(sequence[k]) & 0x3Fu);
-    const bool latin_symbol = code >= 0xA1 && code <= 0xBF && code != 0xB2 && code != 0xB3 && code != 0xB5 && code != 0xB9;
-    const bool punctuation = (code >= 0x2000 && code <= 0x206F) || (code >= 0x2190 && code <= 0x22FF) || code == 0xD7 ||
-                             code == 0xF7 || latin_symbol;
+    for (std::size_t k = 1; k < sequence.size(); ++k)
+      code = (code << 6) | (static_cast<unsigned char>(sequence[k]) & 0x3Fu);
+    const bool latin_symbol = code >= 0xA1 && code <= 0xBF && code != 0xB2 && code != 0xB3 &&
+                              code != 0xB5 && code != 0xB9;
+    const bool punctuation = (code >= 0x2000 && code <= 0x206F) ||
+                             (code >= 0x2190 && code <= 0x22FF) || code == 0xD7 || code == 0xF7 ||
+                             latin_symbol;
     if (!punctuation) anchor += sequence;
     i += length;
   }
@@ -125,15 +131,20 @@ TEST(Docs, AnchorsAreGitHubsForHeadingsWithCodePunctuationAndDashes) {
 }
 
 TEST(Docs, EveryCitedPageHeadingAndLinkExists) {
-  static const std::regex kPageCitation(R"re((?:^|[^\w/.-])(docs/[\w/.-]+?\.md)(?:,? "([^"]+)"|#([\w-]+))?)re");
-  static const std::regex kReadmeCitation(R"re((?:^|[^\w/.-])README(?:\.md)?(?:'s)?,? "([^"]+)")re");
+  static const std::regex kPageCitation(
+      R"re((?:^|[^\w/.-])(docs/[\w/.-]+?\.md)(?:,? "([^"]+)"|#([\w-]+))?)re");
+  static const std::regex kReadmeCitation(
+      R"re((?:^|[^\w/.-])README(?:\.md)?(?:'s)?,? "([^"]+)")re");
   static const std::regex kMarkdownLink(R"(\]\(([^)\s]+)\))");
   std::size_t citations = 0;
   std::vector<std::string> broken;
-  const auto check_heading = [&](const fs::path& page, const std::string& text, const std::string& anchor, const std::string& at) {
+  const auto check_heading = [&](const fs::path& page, const std::string& text,
+                                 const std::string& anchor, const std::string& at) {
     const Headings& headings = headings_of(page);
-    if (!text.empty() && !headings.texts.count(text)) broken.push_back(at + ": no heading \"" + text + "\" on " + page.filename().string());
-    if (!anchor.empty() && !headings.anchors.count(anchor)) broken.push_back(at + ": no heading #" + anchor + " on " + page.filename().string());
+    if (!text.empty() && !headings.texts.count(text))
+      broken.push_back(at + ": no heading \"" + text + "\" on " + page.filename().string());
+    if (!anchor.empty() && !headings.anchors.count(anchor))
+      broken.push_back(at + ": no heading #" + anchor + " on " + page.filename().string());
   };
   for (const TextFile& file : project_text_files()) {
     const bool markdown = file.relative.extension() == ".md";
@@ -143,12 +154,15 @@ TEST(Docs, EveryCitedPageHeadingAndLinkExists) {
         for (std::sregex_iterator m(line.begin(), line.end(), kPageCitation), end; m != end; ++m) {
           ++citations;
           const fs::path page = kTreeRoot / (*m)[1].str();
-          if (!fs::exists(page)) broken.push_back(line_at(file, i) + ": no page " + (*m)[1].str());
-          else check_heading(page, (*m)[2], (*m)[3], line_at(file, i));
+          if (!fs::exists(page))
+            broken.push_back(line_at(file, i) + ": no page " + (*m)[1].str());
+          else
+            check_heading(page, (*m)[2], (*m)[3], line_at(file, i));
         }
       }
       if (line.find("README") != std::string::npos) {
-        for (std::sregex_iterator m(line.begin(), line.end(), kReadmeCitation), end; m != end; ++m) {
+        for (std::sregex_iterator m(line.begin(), line.end(), kReadmeCitation), end; m != end;
+             ++m) {
           ++citations;
           check_heading(kTreeRoot / "README.md", (*m)[1], "", line_at(file, i));
         }
@@ -159,10 +173,14 @@ TEST(Docs, EveryCitedPageHeadingAndLinkExists) {
         if (std::regex_search(target, std::regex("^[a-z]+:"))) continue;  // https:, mailto:
         ++citations;
         const std::size_t hash = target.find('#');
-        const std::string path = target.substr(0, hash), anchor = hash == std::string::npos ? "" : target.substr(hash + 1);
-        const fs::path linked = path.empty() ? kTreeRoot / file.relative : (kTreeRoot / file.relative).parent_path() / path;
-        if (!fs::exists(linked)) broken.push_back(line_at(file, i) + ": link to a missing " + target);
-        else if (!anchor.empty()) check_heading(linked, "", anchor, line_at(file, i));
+        const std::string path = target.substr(0, hash),
+                          anchor = hash == std::string::npos ? "" : target.substr(hash + 1);
+        const fs::path linked = path.empty() ? kTreeRoot / file.relative
+                                             : (kTreeRoot / file.relative).parent_path() / path;
+        if (!fs::exists(linked))
+          broken.push_back(line_at(file, i) + ": link to a missing " + target);
+        else if (!anchor.empty())
+          check_heading(linked, "", anchor, line_at(file, i));
       }
     }
   }
@@ -172,8 +190,10 @@ TEST(Docs, EveryCitedPageHeadingAndLinkExists) {
 
 TEST(Docs, NoLineDatesItselfByTheProjectsDevelopment) {
   const std::string stage = "stage", change = "this change", engineer = "engineer";
-  const std::regex dated("\\b(development |project )?" + stage + "s? [0-9]+\\b|\\b(before|after|since|until) " + change +
-                             "\\b|\\b" + engineer + "'?s build|\\b(another|other|a second) " + engineer + "s?\\b",
+  const std::regex dated("\\b(development |project )?" + stage +
+                             "s? [0-9]+\\b|\\b(before|after|since|until) " + change + "\\b|\\b" +
+                             engineer + "'?s build|\\b(another|other|a second) " + engineer +
+                             "s?\\b",
                          std::regex::icase);
   std::size_t lines = 0;
   std::vector<std::string> dated_lines;
@@ -182,10 +202,14 @@ TEST(Docs, NoLineDatesItselfByTheProjectsDevelopment) {
     for (std::size_t i = 0; i < file.lines.size(); ++i) {
       ++lines;
       std::string lower = file.lines[i];
-      std::transform(lower.begin(), lower.end(), lower.begin(), [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); });
-      const bool may_match = lower.find(stage) != std::string::npos || lower.find(change) != std::string::npos ||
+      std::transform(lower.begin(), lower.end(), lower.begin(), [](char c) {
+        return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      });
+      const bool may_match = lower.find(stage) != std::string::npos ||
+                             lower.find(change) != std::string::npos ||
                              lower.find(engineer) != std::string::npos;
-      if (may_match && std::regex_search(file.lines[i], dated)) dated_lines.push_back(line_at(file, i) + ": " + file.lines[i]);
+      if (may_match && std::regex_search(file.lines[i], dated))
+        dated_lines.push_back(line_at(file, i) + ": " + file.lines[i]);
     }
   }
   EXPECT_GT(lines, 50'000u) << "the walk found too few lines to be reading the tree";

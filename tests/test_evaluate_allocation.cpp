@@ -38,7 +38,8 @@ std::atomic<long> allocations{0};
 }  // namespace
 
 #ifdef COHAPTIC_SANITIZER_OWNS_MALLOC
-#define REQUIRE_COUNTED_MALLOC() GTEST_SKIP() << "a sanitizer owns malloc in this build: the plain build counts"
+#define REQUIRE_COUNTED_MALLOC() \
+  GTEST_SKIP() << "a sanitizer owns malloc in this build: the plain build counts"
 #else
 extern "C" void* __libc_malloc(std::size_t size);  // glibc's own, behind the interposed one
 
@@ -48,7 +49,8 @@ extern "C" void* malloc(std::size_t size) {
   return __libc_malloc(size);
 }
 
-#define REQUIRE_COUNTED_MALLOC() ASSERT_TRUE(cohaptic::interposition_counts()) << "malloc interposition is not active"
+#define REQUIRE_COUNTED_MALLOC() \
+  ASSERT_TRUE(cohaptic::interposition_counts()) << "malloc interposition is not active"
 #endif
 
 namespace cohaptic {
@@ -58,7 +60,10 @@ namespace {
 [[maybe_unused]] bool interposition_counts() {
   allocations = 0;
   counting = true;
-  { volatile auto* probe = new std::vector<int>(100); delete probe; }
+  {
+    volatile auto* probe = new std::vector<int>(100);
+    delete probe;
+  }
   counting = false;
   const bool seen = allocations.load() > 0;
   allocations = 0;
@@ -71,7 +76,8 @@ TEST(ForceEvaluator, AllocatesNothing) {
   const Model model = build_model(parse_scene(testing::cube_scene_yaml(), "cube.yaml"));
   const ElasticBody& body = single_elastic_body(model);
   ComplianceColumns columns(body.free_factor, body.dofs, body.surface.nodes);
-  for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
+  for (ContactModel contact_model :
+       {ContactModel::node_translation, ContactModel::point_constraint}) {
     SimulationOptions options;
     options.ir.contact_model = contact_model;
     options.ir.patch_rings = 2;
@@ -100,9 +106,11 @@ TEST(ForceEvaluator, AllocatesNothing) {
 TEST(ForceEvaluator, MassSpringSubNetworkAllocatesNothing) {
   const Model model = build_model(load_scene(testing::source_path("scenes/thin/noodle.yaml")));
   const MassSpringModel& body = std::get<MassSpringModel>(model.bodies.front());
-  MassSpringSimulation simulation(body, 0, model.scene.tools, model.scene.haptic.force_limit_n, 0.001);
+  MassSpringSimulation simulation(body, 0, model.scene.tools, model.scene.haptic.force_limit_n,
+                                  0.001);
   const Eigen::Vector3d middle(0.0434, 0, 0.0092);
-  const Eigen::Vector3d own = middle + Eigen::Vector3d(0, 0, 0.0015), other = own + Eigen::Vector3d(0.004, 0, 0);
+  const Eigen::Vector3d own = middle + Eigen::Vector3d(0, 0, 0.0015),
+                        other = own + Eigen::Vector3d(0.004, 0, 0);
   for (int i = 0; i < 20 && !simulation.ir(0); ++i) {
     simulation.set_tool(0, own);
     simulation.set_tool(1, other);
@@ -157,12 +165,14 @@ class PathDevice final : public HapticDevice {
 TEST(HapticLoop, TicksAllocateNothingWhileMassSpringIrsOfGrowingSubNetworksArrive) {
   const Model model = build_model(load_scene(testing::source_path("scenes/thin/noodle.yaml")));
   const MassSpringModel& body = std::get<MassSpringModel>(model.bodies.front());
-  MassSpringSimulation simulation(body, 0, model.scene.tools, model.scene.haptic.force_limit_n, 0.001);
+  MassSpringSimulation simulation(body, 0, model.scene.tools, model.scene.haptic.force_limit_n,
+                                  0.001);
   std::vector<Eigen::Vector3d> path;
   std::vector<IrSlot> slots;  // one every 10 ticks
   std::vector<int> node_counts;
   for (int i = 0; i < 600; ++i) {  // 0.6 s: from 2 mm to 26 mm along the tube, 1.5 mm into its top
-    const Eigen::Vector3d tool(0.002 + 0.04 * i * 1e-3, 0, 0.0092 - 0.0015 * std::min(1.0, i / 100.0));
+    const Eigen::Vector3d tool(0.002 + 0.04 * i * 1e-3, 0,
+                               0.0092 - 0.0015 * std::min(1.0, i / 100.0));
     path.push_back(tool);
     simulation.set_tool(0, tool);
     simulation.step(1e-3 * i);
@@ -220,17 +230,20 @@ TEST(HapticLoop, TicksAllocateNothingWhileMassSpringIrsOfGrowingSubNetworksArriv
   EXPECT_GE(loop.metrics().ir_switches, slots.size() - 1);
   EXPECT_EQ(loop.metrics().non_finite, 0u);
   EXPECT_GT(loop.metrics().peak_force, 0) << "the tool pressed";
-  std::cout << "sub-network nodes from " << node_counts.front() << " to " << node_counts.back() << ", " << slots.size()
-            << " IRs, " << loop.metrics().ir_switches << " switches, peak force " << loop.metrics().peak_force << " N\n";
+  std::cout << "sub-network nodes from " << node_counts.front() << " to " << node_counts.back()
+            << ", " << slots.size() << " IRs, " << loop.metrics().ir_switches
+            << " switches, peak force " << loop.metrics().peak_force << " N\n";
 }
 
 // The paired boxes (scenes/objects/paired_boxes.yaml): A's IR carries B's backing, which
 // the client's evaluation integrates every substep.
 TEST(ForceEvaluator, BackedMassSpringSubNetworkAllocatesNothing) {
-  const Model model = build_model(load_scene(testing::source_path("scenes/objects/paired_boxes.yaml")));
+  const Model model =
+      build_model(load_scene(testing::source_path("scenes/objects/paired_boxes.yaml")));
   const SceneCompliance compliance = prepare_scene_compliance(model, true, std::nullopt);
   SceneSimulation simulation(model, compliance.per_body, model.scene.tools, SimulationOptions{});
-  const Eigen::Vector3d tool(0, 0, 0.0535);  // its 2 mm radius about 2 mm into A's top (53.3 mm less its sag)
+  const Eigen::Vector3d tool(
+      0, 0, 0.0535);  // its 2 mm radius about 2 mm into A's top (53.3 mm less its sag)
   for (int i = 0; i < 500; ++i) {
     simulation.set_tool(0, tool);
     simulation.step(0.001 * i);
@@ -244,7 +257,8 @@ TEST(ForceEvaluator, BackedMassSpringSubNetworkAllocatesNothing) {
   bool finite = true;
   counting = true;
   for (int i = 0; i < 2000; ++i) {
-    const ForceSample sample = evaluate_force(prepared, state, tool - Eigen::Vector3d(0, 0, 2e-6 * (i % 1000)), {}, 0.001);
+    const ForceSample sample =
+        evaluate_force(prepared, state, tool - Eigen::Vector3d(0, 0, 2e-6 * (i % 1000)), {}, 0.001);
     finite = finite && sample.force.allFinite();
     largest = std::max(largest, sample.force.norm());
   }
@@ -269,14 +283,17 @@ TEST(LaparoscopyHapticPath, AllocatesNothing) {
   const AabbTree sheet_tree(sheet.vertices, sheet.triangles);
   const ForcepsGeometry geometry{0.01, 0.5, 0.01};
   ForcepsJaws jaws = open_forceps(geometry);
-  const TissueDisplay polynomial = make_tissue_display(sheet.vertices, 0.01, DisplayDeformation::polynomial);
-  const TissueDisplay lattice = make_tissue_display(sheet.vertices, 0.01, DisplayDeformation::ffd_one_point);
+  const TissueDisplay polynomial =
+      make_tissue_display(sheet.vertices, 0.01, DisplayDeformation::polynomial);
+  const TissueDisplay lattice =
+      make_tissue_display(sheet.vertices, 0.01, DisplayDeformation::ffd_one_point);
   Eigen::Matrix3Xd deformed(3, sheet.vertices.cols());
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int touching = 0;
   counting = true;
   for (int i = 0; i < 2000; ++i) {
-    const Eigen::Vector3d tool(0.008 * std::cos(1e-2 * i), 0.008 * std::sin(1e-2 * i), 0.003 - 6e-6 * i);
+    const Eigen::Vector3d tool(0.008 * std::cos(1e-2 * i), 0.008 * std::sin(1e-2 * i),
+                               0.003 - 6e-6 * i);
     const HomeSpringContact contact = evaluate_home_spring(prepared, tool);
     sum += contact.force + evaluate_force(client, client_state, tool, {}, 1.0 / 2000).force;
     touching += contact.touching ? 1 : 0;
@@ -305,17 +322,21 @@ TEST(ForceEvaluator, SeparationBodyAllocatesNothing) {
   ir.body = std::move(body);
   const PreparedIR client = prepare_ir(std::move(ir));
   EvaluationState state = make_evaluation_state(client);
-  const Eigen::Vector3d from(0.0205, 0.012, 0.0002), to(0.0205, 0.028, 0.0002), rim(0, 0.02, 0.0002);
+  const Eigen::Vector3d from(0.0205, 0.012, 0.0002), to(0.0205, 0.028, 0.0002),
+      rim(0, 0.02, 0.0002);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   counting = true;
   for (int i = 0; i <= 800; ++i)  // the groove at 20 mm/s, firing
-    sum += evaluate_force(client, state, from + (to - from) * (i / 800.0), {}, 1e-3, kLaserFireButton).force;
+    sum +=
+        evaluate_force(client, state, from + (to - from) * (i / 800.0), {}, 1e-3, kLaserFireButton)
+            .force;
   for (int i = 0; i <= 1000; ++i)  // jaws closed on the rim, pulled up 5 mm: it tears
     sum += evaluate_force(client, state, rim + Eigen::Vector3d(0, 0, 5e-6 * i), {}, 1e-3, 2).force;
   counting = false;
   EXPECT_EQ(allocations.load(), 0) << "the separation body's haptic path allocated";
   EXPECT_TRUE(sum.allFinite());
-  EXPECT_GT(std::get<SeparationEvaluation>(state.body).state.separated_area, patch.spot_diameter * 0.016)
+  EXPECT_GT(std::get<SeparationEvaluation>(state.body).state.separated_area,
+            patch.spot_diameter * 0.016)
       << "the groove and the tear happened";
 }
 

@@ -66,9 +66,10 @@ Comparison compare(Rig& rig, const Eigen::Vector3d& tool, const SimulationOption
   c.ir = simulation.force(0).force;
   c.condition = simulation.ir(0)->condition_estimate;
   c.boundary_nodes = report.boundary_nodes;
-  const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
-  c.reference = contact_reactions_reference(rig.body, find_tool_contacts(rig.body, {{tool, 0}}), held,
-                                            o.ir.contact_model)[0]
+  const HeldNodes held{simulation.condensation().boundary_nodes(),
+                       simulation.boundary_displacement()};
+  c.reference = contact_reactions_reference(rig.body, find_tool_contacts(rig.body, {{tool, 0}}),
+                                            held, o.ir.contact_model)[0]
                     .reaction;
   c.relative_error = (c.ir - c.reference).norm() / c.reference.norm();
   return c;
@@ -85,7 +86,8 @@ TEST(Extremes, PoissonRatioFromZeroToNearlyIncompressible) {
     Rig rig(scene);
     for (ContactModel model : {ContactModel::node_translation, ContactModel::point_constraint}) {
       const Comparison c = compare(rig, mm(3, -4, -4), options(kUnlimited, 100, model));
-      std::printf("  %-6g  %8.3f  %14.3g   %.2e (%s)\n", nu, c.ir.norm(), c.condition, c.relative_error,
+      std::printf("  %-6g  %8.3f  %14.3g   %.2e (%s)\n", nu, c.ir.norm(), c.condition,
+                  c.relative_error,
                   model == ContactModel::node_translation ? "translation" : "point");
       ASSERT_TRUE(c.ir.allFinite());
       // Stated tolerance: round-off amplified by the conditioning, never worse than 1e-9.
@@ -103,9 +105,11 @@ TEST(Extremes, VerySoftAndVeryStiffTissueScaleExactlyAndRespectTheLimit) {
     scene.youngs_modulus = modulus;
     Rig rig(scene);
     const Eigen::Vector3d force = compare(rig, mm(2, 3, -5), options(kUnlimited)).ir;
-    EXPECT_LE((force / modulus - reference / 1e6).norm(), 1e-9 * (reference / 1e6).norm()) << "E = " << modulus;
+    EXPECT_LE((force / modulus - reference / 1e6).norm(), 1e-9 * (reference / 1e6).norm())
+        << "E = " << modulus;
     // With the haptic limit the magnitude never exceeds it, whatever E.
-    Simulation limited(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), options(3.3));
+    Simulation limited(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1),
+                       options(3.3));
     limited.set_tool(0, mm(2, 3, -5));
     limited.step(0);
     const ForceSample sample = limited.force(0);
@@ -123,12 +127,14 @@ TEST(Extremes, ASliverAndANearlyDegenerateContactTriangleAtTheSurface) {
   TetMesh mesh = make_box_mesh(box.min_corner, box.size, box.divisions);
   const int moved = 2 + 5 * (2 + 5 * 4);  // node (2, 2, 4): centre of the front face z = 0
   const Eigen::Vector3d target = mesh.nodes.col(3 + 5 * (3 + 5 * 4));  // node (3, 3, 4)
-  mesh.nodes.col(moved) += 0.9995 * (target - mesh.nodes.col(moved)).cwiseProduct(Eigen::Vector3d(1, 0, 0));
+  mesh.nodes.col(moved) +=
+      0.9995 * (target - mesh.nodes.col(moved)).cwiseProduct(Eigen::Vector3d(1, 0, 0));
   const MeshCheckReport report = check_tet_mesh(mesh);
   std::string warnings;
   for (const std::string& w : report.warnings) warnings += w;
   EXPECT_NE(warnings.find("sliver"), std::string::npos) << warnings;
-  std::printf("  smallest dihedral angle %.3g deg: %s\n", report.min_dihedral_deg, warnings.c_str());
+  std::printf("  smallest dihedral angle %.3g deg: %s\n", report.min_dihedral_deg,
+              warnings.c_str());
   EXPECT_LT(report.min_dihedral_deg, 1.0);
 
   // Build a model from the distorted mesh through a .msh file, as a user would.
@@ -139,14 +145,17 @@ TEST(Extremes, ASliverAndANearlyDegenerateContactTriangleAtTheSurface) {
     write_gmsh41(path, in_mm);
   }
   const std::size_t mesh_line = yaml.find("mesh: {box:");
-  const std::string file_yaml =
-      yaml.substr(0, mesh_line) + "mesh: {file: " + path + "}" + yaml.substr(yaml.find('\n', mesh_line));
+  const std::string file_yaml = yaml.substr(0, mesh_line) + "mesh: {file: " + path + "}" +
+                                yaml.substr(yaml.find('\n', mesh_line));
   Rig rig(file_yaml);
   // Press on the needle triangle and around it.
-  const Eigen::Vector3d needle_point = (mesh.nodes.col(moved) + target.cwiseProduct(Eigen::Vector3d(1, 0, 0)) +
-                                        Eigen::Vector3d(0, target.y(), 0)) / 2;
-  for (const Eigen::Vector3d& at : {Eigen::Vector3d(needle_point.x(), mesh.nodes(1, moved) + 1e-5, -2e-3),
-                                    Eigen::Vector3d(mesh.nodes(0, moved) - 1e-6, mesh.nodes(1, moved) + 1e-6, -2e-3)}) {
+  const Eigen::Vector3d needle_point =
+      (mesh.nodes.col(moved) + target.cwiseProduct(Eigen::Vector3d(1, 0, 0)) +
+       Eigen::Vector3d(0, target.y(), 0)) /
+      2;
+  for (const Eigen::Vector3d& at :
+       {Eigen::Vector3d(needle_point.x(), mesh.nodes(1, moved) + 1e-5, -2e-3),
+        Eigen::Vector3d(mesh.nodes(0, moved) - 1e-6, mesh.nodes(1, moved) + 1e-6, -2e-3)}) {
     for (ContactModel model : {ContactModel::node_translation, ContactModel::point_constraint}) {
       const Comparison c = compare(rig, at, options(kUnlimited, 0, model));
       ASSERT_TRUE(c.ir.allFinite());
@@ -166,7 +175,8 @@ TEST(Extremes, FromNoHeldNodesToTheWholeSurface) {
     SimulationOptions o = options(kUnlimited, held);
     o.ir.patch_rings = 0;  // the patch is the contact triangle alone: every other node may be held
     const Comparison c = compare(rig, mm(1, 2, -2), o);
-    std::printf("  %-6d %8.3f   %.2e           %.3g\n", c.boundary_nodes, c.ir.norm(), c.relative_error, c.condition);
+    std::printf("  %-6d %8.3f   %.2e           %.3g\n", c.boundary_nodes, c.ir.norm(),
+                c.relative_error, c.condition);
     EXPECT_EQ(c.boundary_nodes, held);
     EXPECT_LE(c.relative_error, 1e-9);
     EXPECT_GT(c.ir.norm(), previous) << "holding more nodes stiffens the object";
@@ -175,8 +185,8 @@ TEST(Extremes, FromNoHeldNodesToTheWholeSurface) {
   // 1,000 held nodes need a finer cube: the paper's has 584 movable surface nodes.
   Rig fine(cube(16));
   const Comparison c = compare(fine, mm(1, 2, -2), options(kUnlimited, 1000));
-  std::printf("  %-6d %8.3f   %.2e           %.3g   (16-division cube)\n", c.boundary_nodes, c.ir.norm(),
-              c.relative_error, c.condition);
+  std::printf("  %-6d %8.3f   %.2e           %.3g   (16-division cube)\n", c.boundary_nodes,
+              c.ir.norm(), c.relative_error, c.condition);
   EXPECT_EQ(c.boundary_nodes, 1000);
   EXPECT_LE(c.relative_error, 1e-9);
 }
@@ -185,7 +195,8 @@ TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
   Rig rig(testing::CubeSceneOptions{});
   const Model& model = *rig.model;
   const ElasticBody& body = single_elastic_body(model);
-  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), options(3.3));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns,
+                        std::vector<ToolSpec>(1), options(3.3));
   simulation.set_tool(0, mm(1, 2, -1));
   simulation.step(0);
   const PreparedIR& prepared = *simulation.ir(0);
@@ -200,7 +211,8 @@ TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
   // same triangle as the server picks (ties go to the lower surface index on both sides).
   const IrTriangle& tri = condensed_fem(prepared.ir).patch[0];
   const Eigen::Vector3d vertex = condensed_fem(prepared.ir).rest_positions.col(tri.nodes[0]);
-  const Eigen::Vector3d edge = (vertex + condensed_fem(prepared.ir).rest_positions.col(tri.nodes[1])) / 2;
+  const Eigen::Vector3d edge =
+      (vertex + condensed_fem(prepared.ir).rest_positions.col(tri.nodes[1])) / 2;
   for (const Eigen::Vector3d& on : {vertex, edge}) {
     const Eigen::Vector3d tool = on - 2e-3 * tri.normal;
     const ForceSample a = testing::evaluate_static(prepared, tool, {});
@@ -209,7 +221,8 @@ TEST(Extremes, ToolsDeeperThanTheObjectOnEdgesAndOnVertices) {
     EXPECT_EQ(a.force, b.force);
     EXPECT_EQ(a.triangle, b.triangle);
     const int server_triangle =
-        nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, tool).triangle;
+        nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, tool)
+            .triangle;
     EXPECT_EQ(condensed_fem(prepared.ir).patch[a.triangle].surface_index, server_triangle);
   }
 }
@@ -225,17 +238,22 @@ TEST(Extremes, ARigidWallCatchesTheBulge) {
   const ElasticBody& body = single_elastic_body(model);
   Rig free_rig(cube(8));
   const Eigen::Vector3d tool = mm(40, 0, -8);
-  for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
-    Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), options(kUnlimited, 0, contact_model));
+  for (ContactModel contact_model :
+       {ContactModel::node_translation, ContactModel::point_constraint}) {
+    Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns,
+                          std::vector<ToolSpec>(1), options(kUnlimited, 0, contact_model));
     simulation.set_tool(0, tool);
     StepReport report;
     for (int step = 0; step < 6; ++step) report = simulation.step(0.001 * step);
     ASSERT_GT(report.obstacle_nodes, 0) << "the bulge should reach the wall";
     const Eigen::Vector3d ir_force = simulation.force(0).force;
-    const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
+    const HeldNodes held{simulation.condensation().boundary_nodes(),
+                         simulation.boundary_displacement()};
     Eigen::VectorXd u;
     const Eigen::Vector3d reference =
-        contact_reactions_reference(body, find_tool_contacts(body, {{tool, 0}}), held, contact_model, &u)[0].reaction;
+        contact_reactions_reference(body, find_tool_contacts(body, {{tool, 0}}), held,
+                                    contact_model, &u)[0]
+            .reaction;
     EXPECT_LE((ir_force - reference).norm(), 1e-9 * reference.norm());
     // Free surface nodes stay on the allowed side; held nodes sit on the wall and are pushed.
     const StateSolution state = simulation.solve();
@@ -246,17 +264,19 @@ TEST(Extremes, ARigidWallCatchesTheBulge) {
       EXPECT_NEAR(body.mesh.nodes(0, node) + held.displacement[b].x(), 65.005e-3, 1e-12);
       Eigen::Vector3d force = Eigen::Vector3d::Zero();
       for (int axis = 0; axis < 3; ++axis)
-        if (!body.dofs.is_fixed(node, axis)) force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
+        if (!body.dofs.is_fixed(node, axis))
+          force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
       EXPECT_LE(force.x(), 1e-12) << "the wall pushes (towards -x), it never pulls";
     }
     // The wall stiffens the object.
-    Simulation free(free_rig.body, free_rig.model->obstacles, *free_rig.columns, std::vector<ToolSpec>(1), options(kUnlimited, 0, contact_model));
+    Simulation free(free_rig.body, free_rig.model->obstacles, *free_rig.columns,
+                    std::vector<ToolSpec>(1), options(kUnlimited, 0, contact_model));
     free.set_tool(0, tool);
     free.step(0);
     EXPECT_GT(ir_force.norm(), free.force(0).force.norm());
     std::printf("  %s: %d nodes held by the wall, |F| %.4f N (free %.4f N)\n",
-                contact_model == ContactModel::node_translation ? "translation" : "point", report.obstacle_nodes,
-                ir_force.norm(), free.force(0).force.norm());
+                contact_model == ContactModel::node_translation ? "translation" : "point",
+                report.obstacle_nodes, ir_force.norm(), free.force(0).force.norm());
   }
 }
 
@@ -272,7 +292,8 @@ TEST(Extremes, TheNodesAboutToReachAWallAreNamedForPrefetching) {
   SimulationOptions o = options(kUnlimited);
   ASSERT_EQ(o.near_obstacle_distance, 1e-3);
   Simulation simulation(body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), o);
-  simulation.set_tool(0, mm(30, 0, -4));  // the side bulges towards the wall by a few tenths of a millimetre
+  simulation.set_tool(
+      0, mm(30, 0, -4));  // the side bulges towards the wall by a few tenths of a millimetre
   const StepReport report = simulation.step(0);
   EXPECT_GT(report.obstacle_nodes, 0) << "the bulge should reach the wall";
   std::vector<int> named;
@@ -280,10 +301,11 @@ TEST(Extremes, TheNodesAboutToReachAWallAreNamedForPrefetching) {
   const Eigen::Matrix3Xd u = simulation.displacement_of(named);
   for (std::size_t k = 0; k < named.size(); ++k) {
     const int node = named[k];
-    EXPECT_EQ(body.mesh.nodes(0, node), 65e-3) << "node " << node << " is not on the side by the wall";
+    EXPECT_EQ(body.mesh.nodes(0, node), 65e-3)
+        << "node " << node << " is not on the side by the wall";
     // A plane's estimate is exact: the gap left by the bulge.
-    EXPECT_NEAR(simulation.nodes_near_obstacles()[k].distance, 65.5e-3 - (65e-3 + u(0, static_cast<Eigen::Index>(k))),
-                1e-12)
+    EXPECT_NEAR(simulation.nodes_near_obstacles()[k].distance,
+                65.5e-3 - (65e-3 + u(0, static_cast<Eigen::Index>(k))), 1e-12)
         << "node " << node;
   }
   // Every free node of that side without columns is named, once.

@@ -36,7 +36,8 @@ TEST(TetStiffness, EqualsTheLameFormOnRandomElements) {
     tet_shape_gradients(corners, volume);
     if (volume < 0) corners.col(2).swap(corners.col(3));
     const TetStiffness k = tet_stiffness(corners, elasticity_matrix(kSoft));
-    const auto expected = testing::independent_tet_stiffness(corners, kSoft.youngs_modulus, kSoft.poisson_ratio);
+    const auto expected =
+        testing::independent_tet_stiffness(corners, kSoft.youngs_modulus, kSoft.poisson_ratio);
     EXPECT_LE((k - expected).norm(), 1e-12 * expected.norm()) << "trial " << trial;
   }
 }
@@ -58,7 +59,8 @@ TEST(Stiffness, SymmetricWithTheSixRigidBodyModesInItsNullSpace) {
     }
   }
   for (int m = 0; m < 6; ++m)
-    EXPECT_LE((dense * modes.col(m)).norm(), 1e-12 * dense.norm() * modes.col(m).norm()) << "mode " << m;
+    EXPECT_LE((dense * modes.col(m)).norm(), 1e-12 * dense.norm() * modes.col(m).norm())
+        << "mode " << m;
 
   // Exactly six zero eigenvalues: rank 3N - 6.
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(dense);
@@ -96,7 +98,8 @@ TEST(Stiffness, PositiveDefiniteOnceFixedAndCholmodAgreesWithADenseSolve) {
   for (std::size_t t = 0; t < answers.size(); ++t)
     threads.emplace_back([&, t] {
       CholeskyWorkspace workspace;
-      for (int repeat = 0; repeat < 50; ++repeat) answers[t] = factor.solve(rhs * double(t + 1), workspace);
+      for (int repeat = 0; repeat < 50; ++repeat)
+        answers[t] = factor.solve(rhs * double(t + 1), workspace);
     });
   for (std::thread& thread : threads) thread.join();
   for (std::size_t t = 0; t < answers.size(); ++t)
@@ -104,7 +107,8 @@ TEST(Stiffness, PositiveDefiniteOnceFixedAndCholmodAgreesWithADenseSolve) {
 }
 
 TEST(SparseCholesky, AnIndefiniteMatrixIsATypedErrorNamingTheRow) {
-  const TetMesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1), Eigen::Vector3i::Constant(2));
+  const TetMesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1),
+                                     Eigen::Vector3i::Constant(2));
   const SparseMatrix k = -assemble_stiffness(mesh, kSoft);  // negative definite once fixed
   std::vector<AxisMask> fixed(static_cast<std::size_t>(mesh.node_count()), 0);
   fixed[0] = fixed[1] = fixed[3] = kAllAxes;
@@ -125,7 +129,8 @@ TEST(DeferredCholesky, FactorsOnceOnFirstUseSharedByCopiesAndThreadsAndEqualsThe
   std::vector<AxisMask> fixed(static_cast<std::size_t>(mesh.node_count()), 0);
   for (int i = 0; i < mesh.node_count(); ++i)
     if (mesh.nodes(2, i) < 1e-12) fixed[i] = kAllAxes;
-  const SparseMatrix k_ff = restrict_to_dofs(assemble_stiffness(mesh, kSoft), make_dof_map(fixed).free_dofs);
+  const SparseMatrix k_ff =
+      restrict_to_dofs(assemble_stiffness(mesh, kSoft), make_dof_map(fixed).free_dofs);
   const DeferredCholesky deferred(k_ff, {});
   const DeferredCholesky copy = deferred;
   EXPECT_FALSE(deferred.factored());
@@ -134,7 +139,8 @@ TEST(DeferredCholesky, FactorsOnceOnFirstUseSharedByCopiesAndThreadsAndEqualsThe
   // Threads asking at once all get the one factor the first of them made.
   std::vector<const SparseCholesky*> seen(4, nullptr);
   std::vector<std::thread> threads;
-  for (std::size_t t = 0; t < seen.size(); ++t) threads.emplace_back([&, t] { seen[t] = &(t % 2 ? copy : deferred).factor(); });
+  for (std::size_t t = 0; t < seen.size(); ++t)
+    threads.emplace_back([&, t] { seen[t] = &(t % 2 ? copy : deferred).factor(); });
   for (std::thread& thread : threads) thread.join();
   for (const SparseCholesky* factor : seen) EXPECT_EQ(factor, seen.front());
   EXPECT_TRUE(copy.factored());
@@ -147,18 +153,21 @@ TEST(DeferredCholesky, FactorsOnceOnFirstUseSharedByCopiesAndThreadsAndEqualsThe
 }
 
 TEST(DeferredCholesky, AMatrixThatIsNotPositiveDefiniteFailsAtEveryUseNamingTheRow) {
-  const TetMesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1), Eigen::Vector3i::Constant(2));
+  const TetMesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1),
+                                     Eigen::Vector3i::Constant(2));
   std::vector<AxisMask> fixed(static_cast<std::size_t>(mesh.node_count()), 0);
   fixed[0] = fixed[1] = fixed[3] = kAllAxes;
   const DofMap dofs = make_dof_map(fixed);
-  const DeferredCholesky deferred(restrict_to_dofs(-assemble_stiffness(mesh, kSoft), dofs.free_dofs),  // negative definite
-                                  [&](int row) { return "node " + std::to_string(mesh.node_tags[dofs.free_dofs[row] / 3]); });
+  const DeferredCholesky deferred(
+      restrict_to_dofs(-assemble_stiffness(mesh, kSoft), dofs.free_dofs),  // negative definite
+      [&](int row) { return "node " + std::to_string(mesh.node_tags[dofs.free_dofs[row] / 3]); });
   for (int attempt = 0; attempt < 2; ++attempt) {
     try {
       deferred.factor();
       FAIL() << "no error";
     } catch (const NumericalError& e) {
-      EXPECT_NE(std::string(e.what()).find("first failure at node "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("first failure at node "), std::string::npos)
+          << e.what();
     }
     EXPECT_FALSE(deferred.factored());
   }
@@ -172,13 +181,17 @@ TEST(PatchTest, ALinearFieldOnTheBoundaryIsReproducedInsideADistortedMesh) {
   Eigen::Matrix3d gradient;
   gradient << 0.010, -0.004, 0.002, 0.003, -0.007, 0.001, -0.002, 0.005, 0.006;
   const Eigen::Vector3d offset(0.001, -0.002, 0.0005);
-  const auto exact = [&](int node) -> Eigen::Vector3d { return offset + gradient * mesh.nodes.col(node); };
+  const auto exact = [&](int node) -> Eigen::Vector3d {
+    return offset + gradient * mesh.nodes.col(node);
+  };
 
-  const DofMap dofs = make_dof_map(std::vector<AxisMask>(static_cast<std::size_t>(mesh.node_count()), 0));
+  const DofMap dofs =
+      make_dof_map(std::vector<AxisMask>(static_cast<std::size_t>(mesh.node_count()), 0));
   std::vector<PrescribedDisplacement> prescribed;
   for (int node : surface.nodes)
     for (int a = 0; a < 3; ++a) prescribed.push_back({3 * node + a, exact(node)[a]});
-  const StaticSolution solution = solve_static(assemble_stiffness(mesh, {2.0e4, 0.35}), dofs, prescribed);
+  const StaticSolution solution =
+      solve_static(assemble_stiffness(mesh, {2.0e4, 0.35}), dofs, prescribed);
 
   double worst = 0, scale = 0;
   std::vector<bool> on_surface(static_cast<std::size_t>(mesh.node_count()), false);
@@ -229,7 +242,8 @@ tools: [{name: A}]
   for (int node = 0; node < body.mesh.node_count(); ++node) {
     const Eigen::Vector3d x = body.mesh.nodes.col(node);
     const Eigen::Vector3d expected(nu * strain * x.x(), nu * strain * x.y(), -strain * x.z());
-    EXPECT_LE((solution.displacement.segment<3>(3 * node) - expected).norm(), 1e-10 * strain * height);
+    EXPECT_LE((solution.displacement.segment<3>(3 * node) - expected).norm(),
+              1e-10 * strain * height);
   }
 }
 
@@ -249,13 +263,15 @@ double cantilever_tip_deflection(int along, double nu,
   const BoundarySurface surface = extract_boundary_surface(mesh);
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * mesh.node_count());
   for (const Triangle& tri : surface.triangles) {
-    const Eigen::Vector3d a = mesh.nodes.col(tri[0]), b = mesh.nodes.col(tri[1]), c = mesh.nodes.col(tri[2]);
-    if (std::abs(a.x() - length) + std::abs(b.x() - length) + std::abs(c.x() - length) > 1e-12) continue;
+    const Eigen::Vector3d a = mesh.nodes.col(tri[0]), b = mesh.nodes.col(tri[1]),
+                          c = mesh.nodes.col(tri[2]);
+    if (std::abs(a.x() - length) + std::abs(b.x() - length) + std::abs(c.x() - length) > 1e-12)
+      continue;
     const double share = load * 0.5 * (b - a).cross(c - a).norm() / (side * side);
     for (int v : tri) loads[3 * v + 2] -= share / 3;
   }
-  const StaticSolution solution =
-      solve_static(assemble_stiffness(mesh, {modulus, nu, formulation}), make_dof_map(fixed), {}, loads);
+  const StaticSolution solution = solve_static(assemble_stiffness(mesh, {modulus, nu, formulation}),
+                                               make_dof_map(fixed), {}, loads);
   // The load-weighted deflection: P delta = work of the load = 2 x strain energy.
   return loads.dot(solution.displacement) / load;
 }
@@ -279,7 +295,8 @@ TEST(Cantilever, TipDeflectionApproachesBeamTheoryAsTheMeshIsRefined) {
   for (int along : refinements) {
     std::printf("  %3d x %2d x %2d  ", along, std::max(1, along / 10), std::max(1, along / 10));
     for (std::size_t r = 0; r < ratios.size(); ++r) {
-      const double ratio = cantilever_tip_deflection(along, ratios[r]) / timoshenko_tip_deflection(ratios[r]);
+      const double ratio =
+          cantilever_tip_deflection(along, ratios[r]) / timoshenko_tip_deflection(ratios[r]);
       error[r].push_back(std::abs(1 - ratio));
       std::printf("  %-12.4f", ratio);
     }
@@ -287,7 +304,8 @@ TEST(Cantilever, TipDeflectionApproachesBeamTheoryAsTheMeshIsRefined) {
   }
   for (std::size_t r = 0; r < ratios.size(); ++r)
     for (std::size_t i = 1; i < refinements.size(); ++i)
-      EXPECT_LT(error[r][i], error[r][i - 1]) << "nu " << ratios[r] << " refinement " << refinements[i];
+      EXPECT_LT(error[r][i], error[r][i - 1])
+          << "nu " << ratios[r] << " refinement " << refinements[i];
   EXPECT_LT(error[0].back(), 0.10);  // nu = 0.3, finest mesh: within 10 % of beam theory
   // Volumetric locking: near incompressibility the same mesh is much too stiff.
   EXPECT_GT(error[2].back(), 2 * error[0].back());
@@ -299,10 +317,13 @@ TEST(NodalPressureTet, CantileverReachesBeamTheoryNearIncompressibilityWherePlai
   const double nu = 0.49;
   const double beam = timoshenko_tip_deflection(nu);
   const double plain = cantilever_tip_deflection(80, nu) / beam;
-  const double nodal = cantilever_tip_deflection(80, nu, ElementFormulation::nodal_pressure_tet) / beam;
-  const double nodal_coarse = cantilever_tip_deflection(40, nu, ElementFormulation::nodal_pressure_tet) / beam;
-  std::printf("  nu = 0.49, FE / Timoshenko: plain 80x8x8 %.4f, nodal pressure 40x4x4 %.4f, 80x8x8 %.4f\n", plain,
-              nodal_coarse, nodal);
+  const double nodal =
+      cantilever_tip_deflection(80, nu, ElementFormulation::nodal_pressure_tet) / beam;
+  const double nodal_coarse =
+      cantilever_tip_deflection(40, nu, ElementFormulation::nodal_pressure_tet) / beam;
+  std::printf(
+      "  nu = 0.49, FE / Timoshenko: plain 80x8x8 %.4f, nodal pressure 40x4x4 %.4f, 80x8x8 %.4f\n",
+      plain, nodal_coarse, nodal);
   EXPECT_LT(plain, 0.7);
   EXPECT_GE(nodal, 0.90);
   EXPECT_LT(nodal, 1.05);
@@ -327,17 +348,21 @@ TEST(NodalPressureTet, PassesThePatchTest) {
       const Eigen::Vector3d u = gradient * mesh.nodes.col(i) + offset;
       for (int a = 0; a < 3; ++a) prescribed.push_back({3 * i + a, u[a]});
     }
-  const DofMap dofs = make_dof_map(std::vector<AxisMask>(static_cast<std::size_t>(mesh.node_count()), 0));
-  for (const auto formulation : {ElementFormulation::linear_tet, ElementFormulation::nodal_pressure_tet})
+  const DofMap dofs =
+      make_dof_map(std::vector<AxisMask>(static_cast<std::size_t>(mesh.node_count()), 0));
+  for (const auto formulation :
+       {ElementFormulation::linear_tet, ElementFormulation::nodal_pressure_tet})
     for (const double nu : {0.3, 0.499}) {
-      const StaticSolution solution = solve_static(assemble_stiffness(mesh, {1e5, nu, formulation}), dofs, prescribed);
+      const StaticSolution solution =
+          solve_static(assemble_stiffness(mesh, {1e5, nu, formulation}), dofs, prescribed);
       double worst = 0;
       int interior = 0;
       for (int i = 0; i < mesh.node_count(); ++i) {
         if (on_boundary[i]) continue;
         ++interior;
         const Eigen::Vector3d exact = gradient * mesh.nodes.col(i) + offset;
-        worst = std::max(worst, (solution.displacement.segment<3>(3 * i) - exact).norm() / exact.norm());
+        worst = std::max(worst,
+                         (solution.displacement.segment<3>(3 * i) - exact).norm() / exact.norm());
       }
       EXPECT_GT(interior, 20);
       EXPECT_LT(worst, 1e-9) << formulation_name(formulation) << " nu " << nu;
@@ -355,7 +380,8 @@ TEST(NodalPressureTet, StiffnessGivesTheNodalPressureEnergy) {
 
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> uniform(-1e-3, 1e-3);
-  const Eigen::VectorXd u = Eigen::VectorXd::NullaryExpr(3 * mesh.node_count(), [&] { return uniform(rng); });
+  const Eigen::VectorXd u =
+      Eigen::VectorXd::NullaryExpr(3 * mesh.node_count(), [&] { return uniform(rng); });
   const Eigen::Matrix<double, 6, 6> deviatoric = deviatoric_elasticity_matrix(material);
   std::vector<double> nodal_volume(static_cast<std::size_t>(mesh.node_count()), 0.0);
   std::vector<double> nodal_dilatation_volume(static_cast<std::size_t>(mesh.node_count()), 0.0);
@@ -368,7 +394,8 @@ TEST(NodalPressureTet, StiffnessGivesTheNodalPressureEnergy) {
       ue.segment<3>(3 * i) = u.segment<3>(3 * tet[i]);
     }
     double volume = 0;
-    const Eigen::Matrix<double, 6, 1> strain = tet_strain_matrix(tet_shape_gradients(corners, volume)) * ue;
+    const Eigen::Matrix<double, 6, 1> strain =
+        tet_strain_matrix(tet_shape_gradients(corners, volume)) * ue;
     energy += 0.5 * volume * strain.dot(deviatoric * strain);
     for (int i = 0; i < 4; ++i) {
       nodal_volume[tet[i]] += volume / 4;
@@ -376,7 +403,8 @@ TEST(NodalPressureTet, StiffnessGivesTheNodalPressureEnergy) {
     }
   }
   for (int a = 0; a < mesh.node_count(); ++a)
-    energy += 0.5 * material.bulk_modulus() * nodal_dilatation_volume[a] * nodal_dilatation_volume[a] / nodal_volume[a];
+    energy += 0.5 * material.bulk_modulus() * nodal_dilatation_volume[a] *
+              nodal_dilatation_volume[a] / nodal_volume[a];
   EXPECT_NEAR(0.5 * u.dot(k * u), energy, 1e-12 * energy);
 
   // Translations and infinitesimal rotations cost nothing.
@@ -416,20 +444,23 @@ TEST(StaticSolve, AgreesWithTheIndependentFemUnderLoadsAndPrescribedDisplacement
     }
   }
   ASSERT_FALSE(prescribed.empty());
-  const StaticSolution solution =
-      solve_static(assemble_stiffness(mesh, {modulus, nu}), make_dof_map(fixed_axes), prescribed, loads);
+  const StaticSolution solution = solve_static(assemble_stiffness(mesh, {modulus, nu}),
+                                               make_dof_map(fixed_axes), prescribed, loads);
   const testing::IndependentSolution expected =
       testing::independent_static_solve(mesh, modulus, nu, fixed, prescribed_map, loads);
-  EXPECT_LE((solution.displacement - expected.displacement).norm(), 1e-9 * expected.displacement.norm());
+  EXPECT_LE((solution.displacement - expected.displacement).norm(),
+            1e-9 * expected.displacement.norm());
   EXPECT_LE((solution.reaction - expected.reaction).norm(), 1e-8 * expected.reaction.norm());
   // Equilibrium: all reactions together balance the applied loads.
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
-  for (int i = 0; i < mesh.node_count(); ++i) total += solution.reaction.segment<3>(3 * i) + loads.segment<3>(3 * i);
+  for (int i = 0; i < mesh.node_count(); ++i)
+    total += solution.reaction.segment<3>(3 * i) + loads.segment<3>(3 * i);
   EXPECT_LE(total.norm(), 1e-9 * loads.norm());
 }
 
 TEST(StaticSolve, RejectsPrescribingAFixedOrRepeatedDof) {
-  const TetMesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1), Eigen::Vector3i::Constant(1));
+  const TetMesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(1),
+                                     Eigen::Vector3i::Constant(1));
   std::vector<AxisMask> fixed(static_cast<std::size_t>(mesh.node_count()), 0);
   fixed[0] = kAllAxes;
   const DofMap dofs = make_dof_map(fixed);

@@ -46,9 +46,12 @@ struct JointPush {
 
 JointPush joint_contact_solve(const testing::PairedBoxesRig& rig, const testing::FreePush& push,
                               const std::vector<PolygonCollision>& collisions) {
-  JointPush joint{testing::joint_pair_solve(rig.front, rig.behind, push.tool_dofs, push.tool_values, collisions), {}};
+  JointPush joint{testing::joint_pair_solve(rig.front, rig.behind, push.tool_dofs, push.tool_values,
+                                            collisions),
+                  {}};
   for (int axis = 0; axis < 3; ++axis)
-    joint.tool_force[axis] = joint.solution.front_reaction[push.tool_dofs[static_cast<std::size_t>(axis)]];
+    joint.tool_force[axis] =
+        joint.solution.front_reaction[push.tool_dofs[static_cast<std::size_t>(axis)]];
   return joint;
 }
 
@@ -63,15 +66,19 @@ void expect_joint_solve(const testing::CoupledPush& push) {
   EXPECT_GE(joint.gaps.minCoeff(), -1e-12);
   EXPECT_LE(joint.pushes.cwiseProduct(joint.gaps).cwiseAbs().maxCoeff(), 1e-9 * push_scale * 1e-3);
   EXPECT_LE((push.contact.pushes - joint.pushes).cwiseAbs().maxCoeff(), 1e-9 * push_scale);
-  EXPECT_LE((push.contact.gaps - joint.gaps).cwiseAbs().maxCoeff(), 1e-9 * joint.gaps.cwiseAbs().maxCoeff() + 1e-15);
-  EXPECT_LE((push.tool_force() - joint_push.tool_force).norm(), 1e-9 * joint_push.tool_force.norm());
-  const Eigen::VectorXd behind = behind_pair_displacement(push.collisions, push.contact.pushes, *push.rig.behind_columns);
+  EXPECT_LE((push.contact.gaps - joint.gaps).cwiseAbs().maxCoeff(),
+            1e-9 * joint.gaps.cwiseAbs().maxCoeff() + 1e-15);
+  EXPECT_LE((push.tool_force() - joint_push.tool_force).norm(),
+            1e-9 * joint_push.tool_force.norm());
+  const Eigen::VectorXd behind =
+      behind_pair_displacement(push.collisions, push.contact.pushes, *push.rig.behind_columns);
   double largest = 0, error = 0;
   const std::vector<int>& rows = push.rig.behind_columns->row_nodes();
   for (std::size_t r = 0; r < rows.size(); ++r) {
     const Eigen::Vector3d expected = joint.behind.segment<3>(3 * rows[r]);
     largest = std::max(largest, expected.norm());
-    error = std::max(error, (behind.segment<3>(3 * static_cast<Eigen::Index>(r)) - expected).norm());
+    error =
+        std::max(error, (behind.segment<3>(3 * static_cast<Eigen::Index>(r)) - expected).norm());
   }
   EXPECT_GT(largest, 0);
   EXPECT_LE(error, 1e-9 * largest);
@@ -88,7 +95,8 @@ TEST(FemPairCoupling, ThroughAGapOnlyTheNodesThatReachBPushAsInTheJointSolve) {
   expect_joint_solve(push);
   const auto pushing = (push.contact.pushes.array() > 0).count();
   EXPECT_GE(pushing, 1);
-  EXPECT_LT(pushing, static_cast<Eigen::Index>(push.collisions.size()));  // some candidates stay clear or are released
+  EXPECT_LT(pushing, static_cast<Eigen::Index>(
+                         push.collisions.size()));  // some candidates stay clear or are released
 }
 
 // A pushed 5 mm into B (touching at rest), B folded into A's compliance on the pushing set;
@@ -103,8 +111,8 @@ struct FoldedFront {
     EXPECT_TRUE(push.contact.solved);
     EXPECT_GE(support.nodes.size(), 2u);
     const ElasticBody& a = push.rig.front;
-    supported = std::make_unique<SupportedCompliance>(*push.front_columns, a.dofs, support.nodes, support.normals,
-                                                      support.compliance);
+    supported = std::make_unique<SupportedCompliance>(*push.front_columns, a.dofs, support.nodes,
+                                                      support.normals, support.compliance);
     factor = std::make_unique<SparseCholesky>(
         testing::stiffness_with_support(a, support.nodes, support.normals, support.compliance));
     reference = std::make_unique<ComplianceColumns>(*factor, a.dofs, a.surface.nodes);
@@ -124,13 +132,16 @@ TEST(FemPairCoupling, AsMTildeWithBFoldedInEqualsCholmodOnKAWithTheSupportSpring
   for (int node : back)
     if (a.mesh.nodes(2, node) > a.mesh.nodes(2, top) + 1e-9) top = node;
   const std::vector<int> boundary{top};
-  const CondensedOperator folded = naive_condensation(*folded_front.supported, a.dofs, contact, boundary);
-  const CondensedOperator expected = naive_condensation(*folded_front.reference, a.dofs, contact, boundary);
+  const CondensedOperator folded =
+      naive_condensation(*folded_front.supported, a.dofs, contact, boundary);
+  const CondensedOperator expected =
+      naive_condensation(*folded_front.reference, a.dofs, contact, boundary);
   EXPECT_LE((folded.m_cc - expected.m_cc).norm(), 1e-9 * expected.m_cc.norm());
   EXPECT_GT(expected.m_cb.norm(), 0);
   EXPECT_LE((folded.m_cb - expected.m_cb).norm(), 1e-9 * expected.m_cb.norm());
   // B stiffens A where A presses on it: the tool's condensed stiffness along x grows.
-  const CondensedOperator alone = naive_condensation(*folded_front.push.front_columns, a.dofs, contact, boundary);
+  const CondensedOperator alone =
+      naive_condensation(*folded_front.push.front_columns, a.dofs, contact, boundary);
   EXPECT_GT(folded.m_cc(0, 0), alone.m_cc(0, 0));
 }
 
@@ -149,16 +160,20 @@ IntermediateRepresentation front_ir(const FoldedFront& folded_front, ComplianceS
 TEST(FemPairCoupling, TheClientFeelsBThroughAExactlyWhenTheRowsAreOfTheSupportedCompliance) {
   FoldedFront folded_front;
   const ElasticBody& a = folded_front.push.rig.front;
-  const Eigen::Vector3d tool = a.mesh.nodes.col(folded_front.tool_node()) + Eigen::Vector3d(1e-3, 0.7e-3, -0.4e-3);
+  const Eigen::Vector3d tool =
+      a.mesh.nodes.col(folded_front.tool_node()) + Eigen::Vector3d(1e-3, 0.7e-3, -0.4e-3);
   const IntermediateRepresentation server = front_ir(folded_front, *folded_front.supported, tool);
-  const IntermediateRepresentation reference = front_ir(folded_front, *folded_front.reference, tool);
+  const IntermediateRepresentation reference =
+      front_ir(folded_front, *folded_front.reference, tool);
   const Eigen::MatrixXd& m_tilde = condensed_fem(server).m_tilde;
   EXPECT_LE((m_tilde - condensed_fem(reference).m_tilde).norm(), 1e-9 * m_tilde.norm());
 
   std::unordered_map<std::int64_t, int> mesh_of_tag;
-  for (std::size_t i = 0; i < a.mesh.node_tags.size(); ++i) mesh_of_tag.emplace(a.mesh.node_tags[i], static_cast<int>(i));
+  for (std::size_t i = 0; i < a.mesh.node_tags.size(); ++i)
+    mesh_of_tag.emplace(a.mesh.node_tags[i], static_cast<int>(i));
   std::vector<int> mesh_nodes;
-  for (const std::int64_t tag : condensed_fem(server).node_ids) mesh_nodes.push_back(mesh_of_tag.at(tag));
+  for (const std::int64_t tag : condensed_fem(server).node_ids)
+    mesh_nodes.push_back(mesh_of_tag.at(tag));
   // The rows form, through the wire, completed by a client: rows of the supported
   // compliance give the server's M~; rows of A's own L (what the server's sender reads
   // today) would give A without B.
@@ -172,14 +187,18 @@ TEST(FemPairCoupling, TheClientFeelsBThroughAExactlyWhenTheRowsAreOfTheSupported
     return received;
   };
   const IntermediateRepresentation client = completed(*folded_front.supported);
-  EXPECT_LE((condensed_fem(client).m_tilde - m_tilde).cwiseAbs().maxCoeff(), 1e-9 * m_tilde.cwiseAbs().maxCoeff());
+  EXPECT_LE((condensed_fem(client).m_tilde - m_tilde).cwiseAbs().maxCoeff(),
+            1e-9 * m_tilde.cwiseAbs().maxCoeff());
   const IntermediateRepresentation without_b = completed(*folded_front.push.front_columns);
-  EXPECT_GT((condensed_fem(without_b).m_tilde - m_tilde).cwiseAbs().maxCoeff(), 1e-3 * m_tilde.cwiseAbs().maxCoeff());
+  EXPECT_GT((condensed_fem(without_b).m_tilde - m_tilde).cwiseAbs().maxCoeff(),
+            1e-3 * m_tilde.cwiseAbs().maxCoeff());
 
   const PreparedIR on_server = prepare_ir(server);
   const PreparedIR on_client = prepare_ir(client);
-  EvaluationState server_state = make_evaluation_state(on_server), client_state = make_evaluation_state(on_client);
-  for (const Eigen::Vector3d& offset : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.5e-3, -0.3e-3, 0.2e-3)}) {
+  EvaluationState server_state = make_evaluation_state(on_server),
+                  client_state = make_evaluation_state(on_client);
+  for (const Eigen::Vector3d& offset :
+       {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.5e-3, -0.3e-3, 0.2e-3)}) {
     const ForceSample expected = evaluate_force(on_server, server_state, tool + offset, {}, 1e-3);
     const ForceSample felt = evaluate_force(on_client, client_state, tool + offset, {}, 1e-3);
     EXPECT_GT(expected.force.norm(), 0);
@@ -194,17 +213,21 @@ TEST(FemPairCoupling, AToolPushingAOnBFeelsMoreThanFreeAndLessThanFixed) {
     std::vector<int> back_dofs;
     for (int node : push.rig.front_face)
       for (int dof : testing::node_dofs(node))
-        if (push.rig.front.dofs.free_index[static_cast<std::size_t>(dof)] >= 0) back_dofs.push_back(dof);
-    const double fixed = testing::push_without_behind(push.rig.front, depth, back_dofs).tool_force.x();
+        if (push.rig.front.dofs.free_index[static_cast<std::size_t>(dof)] >= 0)
+          back_dofs.push_back(dof);
+    const double fixed =
+        testing::push_without_behind(push.rig.front, depth, back_dofs).tool_force.x();
     const double free = push.free.tool_force.x();
     const double on_behind = push.tool_force().x();
     EXPECT_LT(free, on_behind) << depth;
     EXPECT_LT(on_behind, fixed) << depth;
     // The forces [N] as test properties (--gtest_output=xml:...).
     const auto mm = static_cast<int>(std::lround(depth * 1e3));
-    RecordProperty(fmt::format("force_{}mm_free_on_b_fixed", mm), fmt::format("{:.6f} {:.6f} {:.6f}", free, on_behind, fixed));
-    RecordProperty(fmt::format("pushing_nodes_{}mm", mm),
-                   fmt::format("{} of {}", (push.contact.pushes.array() > 0).count(), push.collisions.size()));
+    RecordProperty(fmt::format("force_{}mm_free_on_b_fixed", mm),
+                   fmt::format("{:.6f} {:.6f} {:.6f}", free, on_behind, fixed));
+    RecordProperty(
+        fmt::format("pushing_nodes_{}mm", mm),
+        fmt::format("{} of {}", (push.contact.pushes.array() > 0).count(), push.collisions.size()));
   }
 }
 

@@ -51,7 +51,8 @@ testing::PairedBoxesOptions fem_pair_scene_options(double gap_mm) {
 
 // The paired boxes with `extra` YAML appended (the interaction, a contact model).
 Scene fem_pair_scene(double gap_mm, const std::string& extra) {
-  return parse_scene(testing::paired_boxes_scene_yaml(fem_pair_scene_options(gap_mm)) + extra, "fem-pair.yaml");
+  return parse_scene(testing::paired_boxes_scene_yaml(fem_pair_scene_options(gap_mm)) + extra,
+                     "fem-pair.yaml");
 }
 
 // `scene` with A's back face (x = -gap, towards B) fixed: the fixed condition.
@@ -93,7 +94,8 @@ struct FemPairRun {
 // The tool `depth` [m] into A's front face near its centre, a quarter and a half into a cell
 // of the face: inside a triangle, away from its edges, whichever way the cell is split.
 Eigen::Vector3d fem_pair_tool(double gap_mm, double depth) {
-  return Eigen::Vector3d((-57.5 - gap_mm) * 1e-3 + depth, (15.95 + 2.25 * 98.9 / 5) * 1e-3, (1.5 * 57.5 / 3) * 1e-3);
+  return Eigen::Vector3d((-57.5 - gap_mm) * 1e-3 + depth, (15.95 + 2.25 * 98.9 / 5) * 1e-3,
+                         (1.5 * 57.5 / 3) * 1e-3);
 }
 
 // The joint solve for a tool at `tool` under the translation model: the nearest triangle's
@@ -101,12 +103,14 @@ Eigen::Vector3d fem_pair_tool(double gap_mm, double depth) {
 struct ExpectedPress {
   std::vector<PolygonCollision> candidates;  // A's back face at A's state alone, against B
   testing::JointPairSolution joint;
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();  // on the tool, as ForceSample gives it: -sum_i w_i f_i [N]
+  Eigen::Vector3d force =
+      Eigen::Vector3d::Zero();  // on the tool, as ForceSample gives it: -sum_i w_i f_i [N]
 };
 
 ExpectedPress expected_press(const testing::PairedBoxesRig& rig, const Eigen::Vector3d& tool) {
   const ElasticBody& a = rig.front;
-  const Triangle& triangle = a.surface.triangles[static_cast<std::size_t>(nearest_touchable_triangle(a, tool))];
+  const Triangle& triangle =
+      a.surface.triangles[static_cast<std::size_t>(nearest_touchable_triangle(a, tool))];
   const Eigen::Vector3d p0 = a.mesh.nodes.col(triangle[0]), p1 = a.mesh.nodes.col(triangle[1]),
                         p2 = a.mesh.nodes.col(triangle[2]);
   const Eigen::Vector3d cross = (p1 - p0).cross(p2 - p0);
@@ -125,15 +129,19 @@ ExpectedPress expected_press(const testing::PairedBoxesRig& rig, const Eigen::Ve
         held.push_back(3 * node + axis);
         values.push_back(d[axis]);
       }
-  const Eigen::VectorXd held_values = Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
-  const StaticSolution alone = ConstrainedStaticSolver(a.stiffness, a.dofs, held).solve(held_values);
+  const Eigen::VectorXd held_values =
+      Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  const StaticSolution alone =
+      ConstrainedStaticSolver(a.stiffness, a.dofs, held).solve(held_values);
   ExpectedPress expected;
   expected.candidates = testing::back_face_candidates(rig, alone.displacement);
   expected.joint = testing::joint_pair_solve(a, rig.behind, held, held_values, expected.candidates);
   for (int k = 0; k < 3; ++k)
     for (int axis = 0; axis < 3; ++axis)
       if (!a.dofs.is_fixed(triangle[static_cast<std::size_t>(k)], axis))
-        expected.force[axis] -= weights[k] * expected.joint.front_reaction[3 * triangle[static_cast<std::size_t>(k)] + axis];
+        expected.force[axis] -=
+            weights[k] *
+            expected.joint.front_reaction[3 * triangle[static_cast<std::size_t>(k)] + axis];
   return expected;
 }
 
@@ -166,8 +174,10 @@ TEST(FemPairScene, AppliedLoadsBesideAToolAndHeldNodesAreTheFullSolves) {
   const std::vector<int> held{free_back[1], free_back[4]};
   for (int node : held) condensation.add_boundary_node(node);
   const Eigen::Vector3d tool = fem_pair_tool(0.0, 3e-3);
-  const Triangle& triangle = a.surface.triangles[static_cast<std::size_t>(nearest_touchable_triangle(a, tool))];
-  const PressingContact contact{{triangle[0], triangle[1], triangle[2]}, Eigen::Vector3d(0.2, 0.3, 0.5),
+  const Triangle& triangle =
+      a.surface.triangles[static_cast<std::size_t>(nearest_touchable_triangle(a, tool))];
+  const PressingContact contact{{triangle[0], triangle[1], triangle[2]},
+                                Eigen::Vector3d(0.2, 0.3, 0.5),
                                 Eigen::Vector3d(3e-3, 0.4e-3, -0.2e-3)};
   AppliedLoads applied;  // on three back-face nodes, none held
   std::vector<double> forces;
@@ -177,7 +187,8 @@ TEST(FemPairScene, AppliedLoadsBesideAToolAndHeldNodesAreTheFullSolves) {
         applied.dofs.push_back(3 * node + axis);
         forces.push_back(0.3 * (axis + 1) - 0.1 * (node % 5));
       }
-  applied.forces = Eigen::Map<const Eigen::VectorXd>(forces.data(), static_cast<Eigen::Index>(forces.size()));
+  applied.forces =
+      Eigen::Map<const Eigen::VectorXd>(forces.data(), static_cast<Eigen::Index>(forces.size()));
   std::vector<int> prescribed;
   std::vector<double> values;
   Eigen::VectorXd held_displacement(0);
@@ -189,7 +200,8 @@ TEST(FemPairScene, AppliedLoadsBesideAToolAndHeldNodesAreTheFullSolves) {
         values.push_back((k == 0 ? 1e-4 : -2e-4) * (axis + 1));
         held_values.push_back(values.back());
       }
-  held_displacement = Eigen::Map<const Eigen::VectorXd>(held_values.data(), static_cast<Eigen::Index>(held_values.size()));
+  held_displacement = Eigen::Map<const Eigen::VectorXd>(
+      held_values.data(), static_cast<Eigen::Index>(held_values.size()));
   for (int node : triangle)
     for (int axis = 0; axis < 3; ++axis)
       if (!a.dofs.is_fixed(node, axis)) {
@@ -198,13 +210,17 @@ TEST(FemPairScene, AppliedLoadsBesideAToolAndHeldNodesAreTheFullSolves) {
       }
   ASSERT_EQ(applied.dofs.size(), 9u);
   ASSERT_EQ(held_values.size(), 6u);
-  const StateSolution state = solve_state(columns, condensation, a.dofs, std::span(&contact, 1), held_displacement,
-                                          ContactModel::node_translation, applied);
+  const StateSolution state =
+      solve_state(columns, condensation, a.dofs, std::span(&contact, 1), held_displacement,
+                  ContactModel::node_translation, applied);
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(a.stiffness.rows());
-  for (std::size_t k = 0; k < applied.dofs.size(); ++k) loads[applied.dofs[k]] = applied.forces[static_cast<Eigen::Index>(k)];
+  for (std::size_t k = 0; k < applied.dofs.size(); ++k)
+    loads[applied.dofs[k]] = applied.forces[static_cast<Eigen::Index>(k)];
   const StaticSolution full =
       ConstrainedStaticSolver(a.stiffness, a.dofs, prescribed)
-          .solve(Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())), loads);
+          .solve(Eigen::Map<const Eigen::VectorXd>(values.data(),
+                                                   static_cast<Eigen::Index>(values.size())),
+                 loads);
 
   const Eigen::Matrix3Xd u = displacement_of_nodes(columns, state, a.surface.nodes);
   double error = 0, largest = 0;
@@ -216,13 +232,14 @@ TEST(FemPairScene, AppliedLoadsBesideAToolAndHeldNodesAreTheFullSolves) {
   EXPECT_LE(error, 1e-9 * largest);
   ASSERT_EQ(state.boundary_dofs.size(), held_values.size());
   for (std::size_t k = 0; k < state.boundary_dofs.size(); ++k)
-    EXPECT_NEAR(state.boundary_forces[static_cast<Eigen::Index>(k)], full.reaction[state.boundary_dofs[k]],
-                1e-9 * full.reaction.cwiseAbs().maxCoeff());
+    EXPECT_NEAR(state.boundary_forces[static_cast<Eigen::Index>(k)],
+                full.reaction[state.boundary_dofs[k]], 1e-9 * full.reaction.cwiseAbs().maxCoeff());
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();
   for (int k = 0; k < 3; ++k)
     for (int axis = 0; axis < 3; ++axis)
       if (!a.dofs.is_fixed(triangle[static_cast<std::size_t>(k)], axis))
-        tool_force[axis] += contact.weights[k] * full.reaction[3 * triangle[static_cast<std::size_t>(k)] + axis];
+        tool_force[axis] +=
+            contact.weights[k] * full.reaction[3 * triangle[static_cast<std::size_t>(k)] + axis];
   EXPECT_LE((state.tool_forces.at(0) - tool_force).norm(), 1e-9 * tool_force.norm());
 }
 
@@ -265,12 +282,15 @@ TEST(FemPairScene, TheServersForceAndBothBodiesShapesAreTheJointSparseSolves) {
     EXPECT_LE((felt.force - expected.force).norm(), 1e-9 * expected.force.norm())
         << felt.force.transpose() << " vs " << expected.force.transpose();
     EXPECT_EQ(condensed_fem(run.simulation.ir(0)->ir).rest_forces.size() == 0, gap_mm == 0);
-    RecordProperty(fmt::format("ir_force_relative_error_gap_{}mm", gap_mm),
-                   fmt::format("{:.2e}", (felt.force - expected.force).norm() / expected.force.norm()));
+    RecordProperty(
+        fmt::format("ir_force_relative_error_gap_{}mm", gap_mm),
+        fmt::format("{:.2e}", (felt.force - expected.force).norm() / expected.force.norm()));
     // A shows B's support and B shows A's pushes.
-    const auto [front_error, front_largest] = surface_difference(run.fem(0), rig.front, expected.joint.front);
+    const auto [front_error, front_largest] =
+        surface_difference(run.fem(0), rig.front, expected.joint.front);
     EXPECT_LE(front_error, 1e-9 * front_largest);
-    const auto [behind_error, behind_largest] = surface_difference(run.fem(1), rig.behind, expected.joint.behind);
+    const auto [behind_error, behind_largest] =
+        surface_difference(run.fem(1), rig.behind, expected.joint.behind);
     EXPECT_GT(behind_largest, 0);
     EXPECT_LE(behind_error, 1e-9 * behind_largest);
   }
@@ -324,8 +344,10 @@ TEST(FemPairScene, APushOnBFeelsMoreThanFreeAndLessThanFixed) {
 // gives way under A, and each feels more than on A alone (the scene without its interaction).
 TEST(FemPairScene, TheShippedScenesSurgeonsFeelBThroughA) {
   const std::filesystem::path file = testing::source_path("scenes/objects/fem_pair.yaml");
-  const Trajectory surgeon_a = load_trajectory(testing::source_path("scenes/objects/fem_pair/surgeon_a.yaml"));
-  const Trajectory surgeon_b = load_trajectory(testing::source_path("scenes/objects/fem_pair/surgeon_b.yaml"));
+  const Trajectory surgeon_a =
+      load_trajectory(testing::source_path("scenes/objects/fem_pair/surgeon_a.yaml"));
+  const Trajectory surgeon_b =
+      load_trajectory(testing::source_path("scenes/objects/fem_pair/surgeon_b.yaml"));
   Scene alone_scene = load_scene(file);
   alone_scene.interactions.clear();
   FemPairRun on_behind(load_scene(file));
@@ -345,7 +367,8 @@ TEST(FemPairScene, TheShippedScenesSurgeonsFeelBThroughA) {
     const double without_b = alone.simulation.force(user).force.z();
     EXPECT_GT(without_b, 0);
     EXPECT_GT(felt, without_b);
-    RecordProperty(fmt::format("user_{}_force_on_b_alone_n", user), fmt::format("{:.4f} {:.4f}", felt, without_b));
+    RecordProperty(fmt::format("user_{}_force_on_b_alone_n", user),
+                   fmt::format("{:.4f} {:.4f}", felt, without_b));
   }
   EXPECT_TRUE(on_behind.simulation.condenses_over_support(0));
   const FemPairInteraction& pair = on_behind.simulation.fem_pair(0);

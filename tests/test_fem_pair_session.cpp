@@ -40,17 +40,20 @@ TEST(FemPairSession, TwoUsersFeelBThroughAAndTheirRecordingsVerify) {
   write_fem_pair_press(dir / "a.yaml", -5, -6, 0);
   write_fem_pair_press(dir / "b.yaml", 14, 16, -6);
   testing::run_scripted_session(dir, fs::path(COHAPTIC_SOURCE_DIR) / "scenes/objects/fem_pair.yaml",
-                                {"--duration", "60", "--no-disk-cache"}, {{"a", dir / "a.yaml"}, {"b", dir / "b.yaml"}});
+                                {"--duration", "60", "--no-disk-cache"},
+                                {{"a", dir / "a.yaml"}, {"b", dir / "b.yaml"}});
   if (HasFatalFailure()) return;
 
   const nlohmann::json server_report = nlohmann::json::parse(std::ifstream(dir / "server.json"));
   EXPECT_EQ(server_report["server"]["failed_steps"]["count"], 0);
   for (const char* user : {"a", "b"}) {
     SCOPED_TRACE(user);
-    const nlohmann::json report = nlohmann::json::parse(std::ifstream(dir / (std::string(user) + ".json")));
+    const nlohmann::json report =
+        nlohmann::json::parse(std::ifstream(dir / (std::string(user) + ".json")));
     EXPECT_EQ(report["non_finite_ticks"], 0);
     EXPECT_EQ(report["fades"]["count"], 0) << "the force faded while the user pushed";
-    EXPECT_GT(report["force_n"]["peak"].get<double>(), 0.2);  // B felt: on A alone a 4 mm press gives 0.10 N
+    EXPECT_GT(report["force_n"]["peak"].get<double>(),
+              0.2);  // B felt: on A alone a 4 mm press gives 0.10 N
     const int received = report["ir"]["received"], as_rows = report["ir"]["condensed"];
     EXPECT_EQ(report["ir"]["rejected"], 0);
     EXPECT_GT(received - as_rows, 0);  // M~ whole while A pushes B

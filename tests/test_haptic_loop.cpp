@@ -31,7 +31,8 @@ class NanDevice final : public HapticDevice {
   std::string describe() const override { return "nan"; }
   DeviceState read(double t) override {
     DeviceState s;
-    s.position = t < nan_after_s_ ? Eigen::Vector3d(0.001, 0.002, -0.002) : Eigen::Vector3d::Constant(NAN);
+    s.position =
+        t < nan_after_s_ ? Eigen::Vector3d(0.001, 0.002, -0.002) : Eigen::Vector3d::Constant(NAN);
     return s;
   }
   void write_force(const Eigen::Vector3d& f, double) override { last = f; }
@@ -52,7 +53,8 @@ struct Fixture {
   std::shared_ptr<const PreparedIR> ir_for(const Eigen::Vector3d& tool) {
     SimulationOptions options;
     options.ir.force_limit = std::numeric_limits<double>::infinity();
-    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), options);
+    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1),
+                          options);
     simulation.set_tool(0, tool);
     simulation.step(0);
     return simulation.ir(0);
@@ -71,7 +73,10 @@ struct Fixture {
   }
   /// A scripted device holding the tool where it is pressed.
   static ScriptedDevice holding_device() {
-    return ScriptedDevice(parse_trajectory("units: m\nstart: [0.001, 0.002, -0.002]\nsegments: [{hold: 10}]\n", "hold"), 10);
+    return ScriptedDevice(
+        parse_trajectory("units: m\nstart: [0.001, 0.002, -0.002]\nsegments: [{hold: 10}]\n",
+                         "hold"),
+        10);
   }
 };
 
@@ -139,18 +144,22 @@ TEST(HapticLoop, FadesTheForceLinearlyFromMaxAgeToZeroOnADrivenClock) {
     const std::int64_t ms = (t.time_ns - start) / kMs;
     ASSERT_EQ(t.time_ns, start + ms * kMs) << "on the 1 ms grid";
     const std::int64_t age_ms = ms - std::min<std::int64_t>(ms / 10 * 10, 200);
-    const double fade = age_ms <= 100 ? 1.0 : std::max(0.0, static_cast<double>(150 - age_ms) / 50.0);
+    const double fade =
+        age_ms <= 100 ? 1.0 : std::max(0.0, static_cast<double>(150 - age_ms) / 50.0);
     EXPECT_EQ(t.evaluated, expected) << "at " << ms << " ms";
-    EXPECT_FLOAT_EQ(t.fade, static_cast<float>(fade)) << "at " << ms << " ms, " << age_ms << " ms after the last confirmation";
+    EXPECT_FLOAT_EQ(t.fade, static_cast<float>(fade))
+        << "at " << ms << " ms, " << age_ms << " ms after the last confirmation";
     EXPECT_EQ(t.force, expected * static_cast<double>(t.fade)) << "at " << ms << " ms";
     if (fade > 0 && fade < 1) ++fading;
   }
   EXPECT_EQ(fading, 49) << "ages 101 to 149 ms";
   // By hand: the last confirmation came at 200 ms; the fade is 0.8, 0.5 and 0.2 at 10, 25
   // and 40 ms into its 50 ms.
-  for (const auto& [ms, fade] : {std::pair{300, 1.0f}, {310, 0.8f}, {325, 0.5f}, {340, 0.2f}, {350, 0.0f}})
+  for (const auto& [ms, fade] :
+       {std::pair{300, 1.0f}, {310, 0.8f}, {325, 0.5f}, {340, 0.2f}, {350, 0.0f}})
     EXPECT_FLOAT_EQ(ticks[static_cast<std::size_t>(ms - 1)].fade, fade) << ms << " ms";
-  EXPECT_EQ(device.last_force(), Eigen::Vector3d::Zero()) << "the loop leaves the device at zero force";
+  EXPECT_EQ(device.last_force(), Eigen::Vector3d::Zero())
+      << "the loop leaves the device at zero force";
   // The user felt one fade, from 301 ms to the end (499 ms), the faded-out ticks included.
   EXPECT_EQ(loop.metrics().fades.count, 1u);
   EXPECT_NEAR(loop.metrics().fades.total_s, 0.199, 1e-9);
@@ -167,7 +176,8 @@ TEST(HapticLoop, WhileANewerIrIsOnItsWayTheOneInUseAgesFromItsLastConfirmation) 
   const std::unique_ptr<HapticChannels> channels = fixture.channels_with_ir(start);
   clock.at = [&](std::int64_t now) {
     if ((now - start) % (10 * kMs) != 0 || now - start > 400 * kMs) return;
-    channels->confirmation.back() = {fixture.ir->ir.epoch + (now - start <= 200 * kMs ? 0 : 1), now};
+    channels->confirmation.back() = {fixture.ir->ir.epoch + (now - start <= 200 * kMs ? 0 : 1),
+                                     now};
     channels->confirmation.publish();
   };
   ScriptedDevice device = Fixture::holding_device();
@@ -180,7 +190,8 @@ TEST(HapticLoop, WhileANewerIrIsOnItsWayTheOneInUseAgesFromItsLastConfirmation) 
   HapticLoop loop(device, *channels, settings, clock.haptic());
   const std::vector<TickRecord> ticks = run_to_end(loop, *channels);
   ASSERT_EQ(ticks.size(), 399u);
-  for (const auto& [ms, fade] : {std::pair{150, 1.0f}, {250, 1.0f}, {300, 1.0f}, {310, 0.8f}, {325, 0.5f}, {350, 0.0f}})
+  for (const auto& [ms, fade] :
+       {std::pair{150, 1.0f}, {250, 1.0f}, {300, 1.0f}, {310, 0.8f}, {325, 0.5f}, {350, 0.0f}})
     EXPECT_FLOAT_EQ(ticks[static_cast<std::size_t>(ms - 1)].fade, fade) << ms << " ms";
 }
 
@@ -198,7 +209,8 @@ TEST(HapticLoop, OutputsTheEvaluatorsForceLimitedAndFadedWhenConfirmationsStop) 
   settings.force_limit = 0.2;  // below the evaluated force: clamped
   settings.max_age_s = 0.1;
   settings.fade_s = 0.05;
-  settings.duration_s = 1.0;  // long after the confirmations stop, however late a loaded machine sends them
+  settings.duration_s =
+      1.0;  // long after the confirmations stop, however late a loaded machine sends them
   settings.realtime = false;
   HapticLoop loop(device, *channels, settings);
   // Confirm the IR 20 times, every 10 ms, then go silent (as a dead server would): the
@@ -229,24 +241,29 @@ TEST(HapticLoop, OutputsTheEvaluatorsForceLimitedAndFadedWhenConfirmationsStop) 
     const auto seen = std::find_if(confirmed.rbegin(), confirmed.rend(),
                                    [&](const Confirmed& c) { return c.published_ns <= t.time_ns; });
     if (seen != confirmed.rend() && t.time_ns - seen->stamp_ns <= max_age_ns) {
-      EXPECT_EQ(t.fade, 1.0f) << static_cast<double>(t.time_ns - seen->stamp_ns) * 1e-6 << " ms after a confirmation it saw";
+      EXPECT_EQ(t.fade, 1.0f) << static_cast<double>(t.time_ns - seen->stamp_ns) * 1e-6
+                              << " ms after a confirmation it saw";
       ++full;
     }
     if (t.time_ns - confirmed.back().stamp_ns > faded_out_ns) {
-      EXPECT_EQ(t.force.norm(), 0.0) << static_cast<double>(t.time_ns - confirmed.back().stamp_ns) * 1e-6
-                                     << " ms after the last confirmation";
+      EXPECT_EQ(t.force.norm(), 0.0)
+          << static_cast<double>(t.time_ns - confirmed.back().stamp_ns) * 1e-6
+          << " ms after the last confirmation";
       ++zero;
     }
   }
-  std::printf("  %zu ticks: %d at full force after a confirmation, %d at zero after the fade\n", ticks.size(), full, zero);
+  std::printf("  %zu ticks: %d at full force after a confirmation, %d at zero after the fade\n",
+              ticks.size(), full, zero);
   EXPECT_GT(full, 100);
   EXPECT_GT(zero, 100);
   EXPECT_NEAR(ticks.front().force.norm(), 0.2, 1e-12);
   EXPECT_GT(loop.metrics().clamped, 0u);
   // Every 1 ms period of the 1 s run is either a tick or a skipped deadline (a loaded
   // machine skips some), so together they account for the duration.
-  EXPECT_NEAR(static_cast<double>(loop.metrics().ticks + loop.metrics().missed_deadlines), 1000, 25);
-  EXPECT_EQ(device.last_force(), Eigen::Vector3d::Zero()) << "the loop leaves the device at zero force";
+  EXPECT_NEAR(static_cast<double>(loop.metrics().ticks + loop.metrics().missed_deadlines), 1000,
+              25);
+  EXPECT_EQ(device.last_force(), Eigen::Vector3d::Zero())
+      << "the loop leaves the device at zero force";
 }
 
 TEST(HapticLoop, NonFiniteInputGivesZeroForceAndAnEvent) {
@@ -286,8 +303,10 @@ TEST(HapticLoop, ASphereSolvePastItsBudgetHoldsTheLastResolvedForceAndCatchesUp)
   options.ir.contact_model = ContactModel::sphere;
   options.ir.patch_rings = 3;  // the deeper press stays within the IR's rows
   options.ir.force_limit = 1000;
-  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, rig.model->scene.tools, options);
-  const Eigen::Vector3d shallow(0.001, 0.002, 0.0295), deep(0.001, 0.002, 0.026);  // 0.5 and 4 mm deep
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, rig.model->scene.tools,
+                        options);
+  const Eigen::Vector3d shallow(0.001, 0.002, 0.0295),
+      deep(0.001, 0.002, 0.026);  // 0.5 and 4 mm deep
   simulation.set_tool(0, shallow);
   simulation.step(0);
   const std::shared_ptr<const PreparedIR> ir = simulation.ir(0);
@@ -301,10 +320,12 @@ TEST(HapticLoop, ASphereSolvePastItsBudgetHoldsTheLastResolvedForceAndCatchesUp)
   channels->ir.back() = make_ir_slot(std::make_unique<const PreparedIR>(*ir), clock.now);
   std::get<SphereContactState>(channels->ir.back().state->body).work_budget = 200;
   channels->ir.publish();
-  ScriptedDevice device(parse_trajectory("units: mm\nstart: [1, 2, 29.5]\nsegments: [{hold: 0.05}, {move_to: [1, 2, 26], "
-                                         "speed: 1e6}, {hold: 0.15}]\n",
-                                         "jump"),
-                        1000);
+  ScriptedDevice device(
+      parse_trajectory(
+          "units: mm\nstart: [1, 2, 29.5]\nsegments: [{hold: 0.05}, {move_to: [1, 2, 26], "
+          "speed: 1e6}, {hold: 0.15}]\n",
+          "jump"),
+      1000);
   HapticLoopSettings settings;
   settings.duration_s = 0.2;
   settings.realtime = false;
@@ -321,17 +342,19 @@ TEST(HapticLoop, ASphereSolvePastItsBudgetHoldsTheLastResolvedForceAndCatchesUp)
     if (t.flags & kContactUnresolved) {
       ++unresolved;
       ASSERT_GT(i, 0u);
-      EXPECT_EQ(t.evaluated, ticks[i - 1].evaluated) << "tick " << i << ": the last resolved force is held";
+      EXPECT_EQ(t.evaluated, ticks[i - 1].evaluated)
+          << "tick " << i << ": the last resolved force is held";
     } else if ((t.own - deep).norm() < 1e-12 && first_resolved_deep < 0) {
       first_resolved_deep = static_cast<int>(i);
     }
   }
-  std::printf("  %d ticks unresolved after the jump; resolved again %d ticks after it\n", unresolved,
-              first_resolved_deep - 50);
+  std::printf("  %d ticks unresolved after the jump; resolved again %d ticks after it\n",
+              unresolved, first_resolved_deep - 50);
   EXPECT_GT(unresolved, 2) << "the budget was never short";
   EXPECT_EQ(loop.metrics().contact_unresolved, static_cast<std::uint64_t>(unresolved));
   ASSERT_GE(first_resolved_deep, 0) << "the solve never caught up";
-  EXPECT_LE((ticks.back().evaluated - deep_force).norm(), 1e-9 * deep_force.norm()) << "the exact force returned";
+  EXPECT_LE((ticks.back().evaluated - deep_force).norm(), 1e-9 * deep_force.norm())
+      << "the exact force returned";
   EXPECT_LE((ticks[40].evaluated - shallow_force).norm(), 1e-9 * shallow_force.norm());
 }
 
@@ -377,13 +400,16 @@ TEST(HapticLoop, ALateTickSkipsTheMissedDeadlinesAndKeepsThePhase) {
       if (offset > 500'000) offset -= 1'000'000;  // in (-0.5, 0.5] ms
       offsets.push_back(offset);
     }
-    std::nth_element(offsets.begin(), offsets.begin() + static_cast<std::ptrdiff_t>(offsets.size() / 2), offsets.end());
+    std::nth_element(offsets.begin(),
+                     offsets.begin() + static_cast<std::ptrdiff_t>(offsets.size() / 2),
+                     offsets.end());
     return offsets[offsets.size() / 2];
   };
   // The stall comes at 50 ms: before it, 0-45 ms; after it, from 70 ms.
-  const std::int64_t before = median_offset(0, 45'000'000), after = median_offset(70'000'000, 200'000'000);
-  EXPECT_LT(std::abs(after - before), 300'000) << "median offset from the 1 ms grid: " << before << " ns before the stall, "
-                                               << after << " ns after";
+  const std::int64_t before = median_offset(0, 45'000'000),
+                     after = median_offset(70'000'000, 200'000'000);
+  EXPECT_LT(std::abs(after - before), 300'000) << "median offset from the 1 ms grid: " << before
+                                               << " ns before the stall, " << after << " ns after";
   EXPECT_LT(ticks.size(), 200u - 3u) << "missed ticks are skipped, not caught up";
 }
 
@@ -409,7 +435,8 @@ TEST(HapticLoop, ALateTickSkipsExactlyTheMissedDeadlinesOnADrivenClock) {
   std::vector<std::int64_t> times;
   for (const TickRecord& t : ticks) times.push_back(t.time_ns - start);
   EXPECT_EQ(times, expected);
-  EXPECT_EQ(loop.metrics().ticks + loop.metrics().missed_deadlines, 199u) << "every period a tick or a skipped deadline";
+  EXPECT_EQ(loop.metrics().ticks + loop.metrics().missed_deadlines, 199u)
+      << "every period a tick or a skipped deadline";
 }
 
 }  // namespace

@@ -35,12 +35,15 @@ Problem surface_like(std::mt19937& random, int m) {
   std::uniform_real_distribution<double> coordinate(-10e-3, 10e-3);
   Problem problem;
   problem.points.resize(2, m);
-  for (int i = 0; i < m; ++i) problem.points.col(i) = Eigen::Vector2d(coordinate(random), coordinate(random));
+  for (int i = 0; i < m; ++i)
+    problem.points.col(i) = Eigen::Vector2d(coordinate(random), coordinate(random));
   problem.w.resize(m, m);
   for (int i = 0; i < m; ++i)
     for (int j = 0; j < m; ++j)
-      problem.w(i, j) = 1e-4 * std::exp(-(problem.points.col(i) - problem.points.col(j)).squaredNorm() / (2e-3 * 2e-3)) +
-                        (i == j ? 2e-4 : 0.0);
+      problem.w(i, j) =
+          1e-4 * std::exp(-(problem.points.col(i) - problem.points.col(j)).squaredNorm() /
+                          (2e-3 * 2e-3)) +
+          (i == j ? 2e-4 : 0.0);
   problem.nonnegative.assign(static_cast<std::size_t>(m), 1);
   return problem;
 }
@@ -49,7 +52,8 @@ Problem surface_like(std::mt19937& random, int m) {
 // `depth` deep [m].
 Eigen::VectorXd clearances(const Problem& problem, const Eigen::Vector2d& centre, double depth) {
   Eigen::VectorXd q(problem.points.cols());
-  for (Eigen::Index i = 0; i < q.size(); ++i) q[i] = (problem.points.col(i) - centre).squaredNorm() / (2 * 20e-3) - depth;
+  for (Eigen::Index i = 0; i < q.size(); ++i)
+    q[i] = (problem.points.col(i) - centre).squaredNorm() / (2 * 20e-3) - depth;
   return q;
 }
 
@@ -69,7 +73,8 @@ Dense dense_solve(const Eigen::MatrixXd& w, const Eigen::VectorXd& q) {
   Eigen::VectorXd b(n);
   for (Eigen::Index i = 0; i < n; ++i) {
     b[i] = q[kept[static_cast<std::size_t>(i)]];
-    for (Eigen::Index j = 0; j < n; ++j) a(i, j) = w(kept[static_cast<std::size_t>(i)], kept[static_cast<std::size_t>(j)]);
+    for (Eigen::Index j = 0; j < n; ++j)
+      a(i, j) = w(kept[static_cast<std::size_t>(i)], kept[static_cast<std::size_t>(j)]);
   }
   std::vector<std::uint8_t> active(static_cast<std::size_t>(n), 0);
   Eigen::VectorXd lambda(n);
@@ -79,7 +84,8 @@ Dense dense_solve(const Eigen::MatrixXd& w, const Eigen::VectorXd& q) {
   Dense dense{Eigen::VectorXd::Zero(m), std::vector<std::uint8_t>(static_cast<std::size_t>(m), 0)};
   for (Eigen::Index i = 0; i < n; ++i) {
     dense.lambda[kept[static_cast<std::size_t>(i)]] = lambda[i];
-    dense.active[static_cast<std::size_t>(kept[static_cast<std::size_t>(i)])] = active[static_cast<std::size_t>(i)];
+    dense.active[static_cast<std::size_t>(kept[static_cast<std::size_t>(i)])] =
+        active[static_cast<std::size_t>(i)];
   }
   return dense;
 }
@@ -104,7 +110,8 @@ TEST(IncrementalContactSolve, FromAnyKeptSetEqualsTheDenseSolve) {
     const int m = 20 + 7 * trial;
     const Problem problem = surface_like(random, m);
     std::uniform_real_distribution<double> offset(-3e-3, 3e-3), depth(0.2e-3, 2e-3);
-    const Eigen::VectorXd q = clearances(problem, Eigen::Vector2d(offset(random), offset(random)), depth(random));
+    const Eigen::VectorXd q =
+        clearances(problem, Eigen::Vector2d(offset(random), offset(random)), depth(random));
     const Dense dense = dense_solve(problem.w, q);
     for (int start = 0; start < 3; ++start) {
       IncrementalContactSolve solve(m);
@@ -112,14 +119,17 @@ TEST(IncrementalContactSolve, FromAnyKeptSetEqualsTheDenseSolve) {
       for (int i = 0; i < m; ++i)
         if (start == 1 || (start == 2 && random() % 2)) set.push_back(i);
       ASSERT_TRUE(solve.start_from(problem.w, set));
-      const UnilateralSolveResult result = solve.solve(problem.w, q, problem.nonnegative, kUnlimited);
+      const UnilateralSolveResult result =
+          solve.solve(problem.w, q, problem.nonnegative, kUnlimited);
       ASSERT_TRUE(result.solved);
       worst = std::max(worst, compare(solve, dense));
       ++solves;
     }
   }
-  std::printf("  %d solves of 20 to 433 candidates from three kinds of kept set: largest relative difference %.2e\n",
-              solves, worst);
+  std::printf(
+      "  %d solves of 20 to 433 candidates from three kinds of kept set: largest relative "
+      "difference %.2e\n",
+      solves, worst);
   EXPECT_LT(worst, 1e-9);
 }
 
@@ -139,7 +149,8 @@ TEST(IncrementalContactSolve, AlongAMovingToolEveryAnswerIsTheDenseSolvesAndTheF
     problem.w(i, j) -= kLift;
     problem.w(j, i) -= kLift;
     ASSERT_LT(problem.w(i, j), 0);
-    problem.nonnegative[static_cast<std::size_t>(i)] = problem.nonnegative[static_cast<std::size_t>(j)] = 0;
+    problem.nonnegative[static_cast<std::size_t>(i)] =
+        problem.nonnegative[static_cast<std::size_t>(j)] = 0;
   }
   IncrementalContactSolve solve(m);
   double worst = 0, most_work = 0;
@@ -149,9 +160,11 @@ TEST(IncrementalContactSolve, AlongAMovingToolEveryAnswerIsTheDenseSolvesAndTheF
     // Down 2 mm, then round a 4 mm circle twice at that depth, then up.
     const double t = tick / 2000.0;
     const double depth = 2e-3 * std::min({1.0, 4 * t, 4 * (1 - t)}) - 0.3e-3;
-    const Eigen::Vector2d centre = 4e-3 * Eigen::Vector2d(std::cos(4 * M_PI * t), std::sin(4 * M_PI * t));
+    const Eigen::Vector2d centre =
+        4e-3 * Eigen::Vector2d(std::cos(4 * M_PI * t), std::sin(4 * M_PI * t));
     Eigen::VectorXd q = clearances(problem, centre, depth);
-    if (tick % 7 == 0) q[tick % m] = std::numeric_limits<double>::infinity();  // a node no tool reaches now
+    if (tick % 7 == 0)
+      q[tick % m] = std::numeric_limits<double>::infinity();  // a node no tool reaches now
     const UnilateralSolveResult result = solve.solve(problem.w, q, problem.nonnegative, kUnlimited);
     ASSERT_TRUE(result.solved) << "tick " << tick;
     most_work = std::max(most_work, result.work);
@@ -159,7 +172,8 @@ TEST(IncrementalContactSolve, AlongAMovingToolEveryAnswerIsTheDenseSolvesAndTheF
     std::vector<int> set(solve.members().begin(), solve.members().end());
     std::sort(set.begin(), set.end());
     std::vector<int> changed;
-    std::set_symmetric_difference(set.begin(), set.end(), previous.begin(), previous.end(), std::back_inserter(changed));
+    std::set_symmetric_difference(set.begin(), set.end(), previous.begin(), previous.end(),
+                                  std::back_inserter(changed));
     changes += static_cast<int>(changed.size());
     previous = set;
     largest_set = std::max(largest_set, static_cast<int>(set.size()));
@@ -176,9 +190,11 @@ TEST(IncrementalContactSolve, AlongAMovingToolEveryAnswerIsTheDenseSolvesAndTheF
     drift = std::max(drift, std::abs(solve.push(i) - fresh.push(i)));
     scale = std::max(scale, std::abs(fresh.push(i)));
   }
-  std::printf("  2001 ticks over %d candidates: up to %d in contact, %d joins and leaves, at most %.3g multiply-adds a "
-              "tick; largest difference from the dense solve %.2e, from a fresh factor %.2e\n",
-              m, largest_set, changes, most_work, worst, drift / scale);
+  std::printf(
+      "  2001 ticks over %d candidates: up to %d in contact, %d joins and leaves, at most %.3g "
+      "multiply-adds a "
+      "tick; largest difference from the dense solve %.2e, from a fresh factor %.2e\n",
+      m, largest_set, changes, most_work, worst, drift / scale);
   EXPECT_GT(largest_set, 150) << "the tool pressed too little to test anything";
   EXPECT_GT(changes, 500);
   EXPECT_LT(worst, 1e-9);
@@ -196,7 +212,8 @@ TEST(IncrementalContactSolve, PastItsBudgetItStopsAndGoesOnFromThereNextTime) {
   for (; calls < 1000; ++calls) {
     const UnilateralSolveResult result = solve.solve(problem.w, q, problem.nonnegative, 2e4);
     const double k = static_cast<double>(solve.members().size()) + 1;
-    EXPECT_LE(result.work, 2e4 + 3 * k * k + m * k) << "a call overran its budget by more than a pass and a change";
+    EXPECT_LE(result.work, 2e4 + 3 * k * k + m * k)
+        << "a call overran its budget by more than a pass and a change";
     if (result.solved) break;
   }
   std::printf("  %d in contact from nothing, 2e4 multiply-adds a call: solved at call %d\n",

@@ -36,7 +36,8 @@ Fan random_fan(std::mt19937& rng) {
     const double angle = 2 * M_PI * (i + 0.8 * unit(rng)) / ring;
     const double radius = 0.3 + unit(rng);
     fan.positions.col(i + 1) =
-        fan.positions.col(0) + Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), height(rng));
+        fan.positions.col(0) +
+        Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), height(rng));
     triangles.push_back({0, i + 1, (i + 1) % ring + 1});
   }
   fan.surface = make_surface_adjacency(triangles, ring + 1);
@@ -55,7 +56,8 @@ BruteForceCollisions brute_force(const Fan& fan, const Eigen::Vector3d& active) 
   double nearest = INFINITY;
   for (int t = 0; t < static_cast<int>(fan.surface.triangles.size()); ++t) {
     const Triangle& tri = fan.surface.triangles[static_cast<std::size_t>(t)];
-    const Eigen::Vector3d a = fan.positions.col(tri[0]), b = fan.positions.col(tri[1]), c = fan.positions.col(tri[2]);
+    const Eigen::Vector3d a = fan.positions.col(tri[0]), b = fan.positions.col(tri[1]),
+                          c = fan.positions.col(tri[2]);
     // Orientation of the tetrahedron (a, b, c, active): positive when active is in front.
     const double orientation =
         Eigen::Matrix3d((Eigen::Matrix3d() << b - a, c - a, active - a).finished()).determinant();
@@ -78,7 +80,8 @@ TEST(InteractionCollision, AgreesWithBruteForceClosestPointsOnRandomFans) {
   int collisions = 0, behind_without_foot = 0, in_front = 0;
   for (int trial = 0; trial < 10000; ++trial) {
     const Fan fan = random_fan(rng);
-    const Eigen::Vector3d active = fan.positions.col(0) + Eigen::Vector3d(offset(rng), offset(rng), offset(rng));
+    const Eigen::Vector3d active =
+        fan.positions.col(0) + Eigen::Vector3d(offset(rng), offset(rng), offset(rng));
     const BruteForceCollisions expected = brute_force(fan, active);
     const bool instant = instant_collision_test(active, 0, fan.positions, fan.surface);
     const auto target = node_polygon_collision(active, 0, fan.positions, fan.surface);

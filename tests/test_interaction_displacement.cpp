@@ -34,22 +34,25 @@ struct Grid {
 };
 
 // A collision of an active node at `active` with triangle `t` at barycentric `weights`.
-PolygonCollision collision_at(const Grid& grid, int t, const Eigen::Vector3d& weights, const Eigen::Vector3d& active) {
+PolygonCollision collision_at(const Grid& grid, int t, const Eigen::Vector3d& weights,
+                              const Eigen::Vector3d& active) {
   PolygonCollision c;
   c.active = t;
   c.polygon = grid.triangles[static_cast<std::size_t>(t)];
   c.weights = weights;
-  for (int k = 0; k < 3; ++k) c.target += weights[k] * grid.positions.col(c.polygon[static_cast<std::size_t>(k)]);
+  for (int k = 0; k < 3; ++k)
+    c.target += weights[k] * grid.positions.col(c.polygon[static_cast<std::size_t>(k)]);
   c.gap = active - c.target;
   return c;
 }
 
-Eigen::Vector3d displaced_target(const Grid& grid, const PolygonCollision& c, const ForcibleDisplacement& d) {
+Eigen::Vector3d displaced_target(const Grid& grid, const PolygonCollision& c,
+                                 const ForcibleDisplacement& d) {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   for (std::size_t k = 0; k < 3; ++k) {
     const auto j = std::lower_bound(d.nodes.begin(), d.nodes.end(), c.polygon[k]) - d.nodes.begin();
-    point +=
-        c.weights[static_cast<Eigen::Index>(k)] * (grid.positions.col(c.polygon[k]) + d.displacement.segment<3>(3 * j));
+    point += c.weights[static_cast<Eigen::Index>(k)] *
+             (grid.positions.col(c.polygon[k]) + d.displacement.segment<3>(3 * j));
   }
   return point;
 }
@@ -69,13 +72,15 @@ TEST(InteractionDisplacement, OnePolygonFollowsTheBalanceRule) {
   ASSERT_EQ(d.nodes.size(), 3u);
   for (std::size_t k = 0; k < 3; ++k) {
     const auto j = std::lower_bound(d.nodes.begin(), d.nodes.end(), c.polygon[k]) - d.nodes.begin();
-    const Eigen::Vector3d expected = weights[static_cast<Eigen::Index>(k)] / weights.squaredNorm() * c.gap;
+    const Eigen::Vector3d expected =
+        weights[static_cast<Eigen::Index>(k)] / weights.squaredNorm() * c.gap;
     EXPECT_LT((d.displacement.segment<3>(3 * j) - expected).norm(), 1e-15);
   }
   EXPECT_LT((displaced_target(grid, c, d) - (c.target + c.gap)).norm(), 1e-12);
 }
 
-TEST(InteractionDisplacement, ManyPolygonsSharingNodesPutEveryActiveNodeOnItsPolygonWithTheLeastDisplacement) {
+TEST(InteractionDisplacement,
+     ManyPolygonsSharingNodesPutEveryActiveNodeOnItsPolygonWithTheLeastDisplacement) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> depth(-0.05, 0.01), slide(-0.02, 0.02);
   const Grid grid(6);
@@ -92,16 +97,17 @@ TEST(InteractionDisplacement, ManyPolygonsSharingNodesPutEveryActiveNodeOnItsPol
       const Eigen::Vector3d weights = random_weights(rng);
       Eigen::Vector3d target = Eigen::Vector3d::Zero();
       for (std::size_t c = 0; c < 3; ++c)
-        target +=
-            weights[static_cast<Eigen::Index>(c)] * grid.positions.col(grid.triangles[static_cast<std::size_t>(t)][c]);
-      collisions.push_back(
-          collision_at(grid, t, weights, target + Eigen::Vector3d(slide(rng), slide(rng), depth(rng))));
+        target += weights[static_cast<Eigen::Index>(c)] *
+                  grid.positions.col(grid.triangles[static_cast<std::size_t>(t)][c]);
+      collisions.push_back(collision_at(
+          grid, t, weights, target + Eigen::Vector3d(slide(rng), slide(rng), depth(rng))));
     }
     const ForcibleDisplacement d = forcible_displacement(collisions, fixed);
     const auto n = static_cast<Eigen::Index>(d.nodes.size());
     const auto p = static_cast<Eigen::Index>(collisions.size());
     for (const PolygonCollision& c : collisions)
-      EXPECT_LT((displaced_target(grid, c, d) - (c.target + c.gap)).norm(), 1e-9) << "trial " << trial;
+      EXPECT_LT((displaced_target(grid, c, d) - (c.target + c.gap)).norm(), 1e-9)
+          << "trial " << trial;
     // The least-norm displacement per axis from its KKT system [I W^T; W 0] [u; l] = [0; r]
     // over the nodes free along that axis.
     for (int axis = 0; axis < 3; ++axis) {
@@ -118,10 +124,12 @@ TEST(InteractionDisplacement, ManyPolygonsSharingNodesPutEveryActiveNodeOnItsPol
       kkt.topRightCorner(n, p) = w.transpose();
       kkt.bottomLeftCorner(p, n) = w;
       Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + p);
-      for (Eigen::Index k = 0; k < p; ++k) rhs[n + k] = collisions[static_cast<std::size_t>(k)].gap[axis];
+      for (Eigen::Index k = 0; k < p; ++k)
+        rhs[n + k] = collisions[static_cast<std::size_t>(k)].gap[axis];
       const Eigen::VectorXd solution = kkt.fullPivLu().solve(rhs);
       for (Eigen::Index j = 0; j < n; ++j)
-        EXPECT_NEAR(d.displacement[3 * j + axis], solution[j], 1e-12) << "trial " << trial << " axis " << axis;
+        EXPECT_NEAR(d.displacement[3 * j + axis], solution[j], 1e-12)
+            << "trial " << trial << " axis " << axis;
     }
     // The fixed axis stays.
     const auto sliding = std::lower_bound(d.nodes.begin(), d.nodes.end(), 14);
@@ -142,17 +150,22 @@ TEST(InteractionDisplacement, ContradictingConditionsAreMetInTheLeastSquaresSens
   second.gap = Eigen::Vector3d(0, 0, -0.03);
   const std::vector<PolygonCollision> collisions{first, second};
   const ForcibleDisplacement d = forcible_displacement(collisions, free_axes);
-  EXPECT_LT((displaced_target(grid, first, d) - (first.target + Eigen::Vector3d(0, 0, -0.02))).norm(), 1e-12);
+  EXPECT_LT(
+      (displaced_target(grid, first, d) - (first.target + Eigen::Vector3d(0, 0, -0.02))).norm(),
+      1e-12);
   EXPECT_TRUE(d.displacement.allFinite());
 }
 
 TEST(InteractionDisplacement, APolygonFixedAlongAnAxisDoesNotGiveWayAlongIt) {
   const Grid grid(3);
   std::vector<AxisMask> fixed(9, 0b100);  // z fixed everywhere: a rigid floor in z
-  const PolygonCollision c = collision_at(grid, 0, Eigen::Vector3d(0.2, 0.5, 0.3), Eigen::Vector3d(0.5, 0.4, -0.01));
+  const PolygonCollision c =
+      collision_at(grid, 0, Eigen::Vector3d(0.2, 0.5, 0.3), Eigen::Vector3d(0.5, 0.4, -0.01));
   const ForcibleDisplacement d = forcible_displacement(std::span(&c, 1), fixed);
   for (Eigen::Index j = 0; j < 3; ++j) EXPECT_EQ(d.displacement[3 * j + 2], 0.0);
-  EXPECT_LT((displaced_target(grid, c, d) - (c.target + Eigen::Vector3d(c.gap.x(), c.gap.y(), 0))).norm(), 1e-12);
+  EXPECT_LT(
+      (displaced_target(grid, c, d) - (c.target + Eigen::Vector3d(c.gap.x(), c.gap.y(), 0))).norm(),
+      1e-12);
 }
 
 }  // namespace

@@ -64,7 +64,8 @@ struct Pushed {
     int deepest = rig.front_face.front();
     for (int node : rig.front_face)
       if (front_positions(0, node) > front_positions(0, deepest)) deepest = node;
-    pairs = make_node_pairs(std::span(&deepest, 1), front_positions, rig.behind.surface.nodes, rig.behind.mesh.nodes);
+    pairs = make_node_pairs(std::span(&deepest, 1), front_positions, rig.behind.surface.nodes,
+                            rig.behind.mesh.nodes);
   }
 };
 
@@ -77,8 +78,8 @@ TEST(InteractionFem, PairsGrownFromOneReachEveryPenetratingNodeAndAreNearest) {
   const InteractionStep step = pushed.settle();
   std::vector<int> colliding, penetrating;
   for (const NodePair& pair : pushed.pairs.pairs)
-    if (node_polygon_collision(pushed.front_positions.col(pair.active), pair.passive, pushed.rig.behind.mesh.nodes,
-                               pushed.rig.behind_surface))
+    if (node_polygon_collision(pushed.front_positions.col(pair.active), pair.passive,
+                               pushed.rig.behind.mesh.nodes, pushed.rig.behind_surface))
       colliding.push_back(pair.active);
   EXPECT_EQ(colliding.size(), step.collisions.size() + static_cast<std::size_t>(step.released));
   for (int node : pushed.rig.front_face)
@@ -89,26 +90,34 @@ TEST(InteractionFem, PairsGrownFromOneReachEveryPenetratingNodeAndAreNearest) {
   for (const NodePair& pair : pushed.pairs.pairs) {
     double nearest = INFINITY;
     for (int node : pushed.rig.behind.surface.nodes)
-      nearest =
-          std::min(nearest, (pushed.rig.behind.mesh.nodes.col(node) - pushed.front_positions.col(pair.active)).norm());
-    EXPECT_NEAR((pushed.rig.behind.mesh.nodes.col(pair.passive) - pushed.front_positions.col(pair.active)).norm(),
-                nearest, 1e-15);
+      nearest = std::min(nearest, (pushed.rig.behind.mesh.nodes.col(node) -
+                                   pushed.front_positions.col(pair.active))
+                                      .norm());
+    EXPECT_NEAR(
+        (pushed.rig.behind.mesh.nodes.col(pair.passive) - pushed.front_positions.col(pair.active))
+            .norm(),
+        nearest, 1e-15);
   }
 }
 
-TEST(InteractionFem, ReactionAndDeformationEqualTheFullSparseSolveAndActiveNodesLieOnDisplacedPolygons) {
+TEST(InteractionFem,
+     ReactionAndDeformationEqualTheFullSparseSolveAndActiveNodesLieOnDisplacedPolygons) {
   Pushed pushed(0.006);
   const InteractionStep step = pushed.settle();
   ASSERT_FALSE(step.collisions.empty());
   const ElasticBody& behind = pushed.rig.behind;
-  const StaticSolution solution = prescribed_nodes_solve(behind, step.displacement.nodes, step.displacement.displacement);
-  EXPECT_LT(
-      relative_difference(step.passive_forces, free_reactions(behind, solution.reaction, step.displacement.nodes)),
-      1e-9);
-  EXPECT_LT(relative_difference(step.passive_deformation, nodal(solution.displacement, behind.surface.nodes)), 1e-9);
+  const StaticSolution solution =
+      prescribed_nodes_solve(behind, step.displacement.nodes, step.displacement.displacement);
+  EXPECT_LT(relative_difference(step.passive_forces,
+                                free_reactions(behind, solution.reaction, step.displacement.nodes)),
+            1e-9);
+  EXPECT_LT(relative_difference(step.passive_deformation,
+                                nodal(solution.displacement, behind.surface.nodes)),
+            1e-9);
   // B pushes A back, out of B (towards -x).
   double push_back = 0;
-  for (Eigen::Index k = 0; k < step.active_forces.size(); k += 3) push_back += step.active_forces[k];
+  for (Eigen::Index k = 0; k < step.active_forces.size(); k += 3)
+    push_back += step.active_forces[k];
   EXPECT_LT(push_back, 0);
 
   // Each active node on its polygon displaced as B's deformation says.
@@ -120,7 +129,8 @@ TEST(InteractionFem, ReactionAndDeformationEqualTheFullSparseSolveAndActiveNodes
       on_polygon += c.weights[static_cast<Eigen::Index>(k)] *
                     (behind.mesh.nodes.col(node) + step.passive_deformation.segment<3>(3 * row));
     }
-    EXPECT_LT((on_polygon - pushed.front_positions.col(c.active)).norm(), 1e-9) << "active node " << c.active;
+    EXPECT_LT((on_polygon - pushed.front_positions.col(c.active)).norm(), 1e-9)
+        << "active node " << c.active;
   }
 }
 
@@ -143,14 +153,15 @@ TEST(InteractionFem, LinearBackingEqualsTheFullSolveForOtherDisplacementsOfTheCo
   const ElasticBody& behind = pushed.rig.behind;
   const Eigen::MatrixXd stiffness =
       condensed_stiffness(*pushed.rig.behind_columns, behind.dofs, step.displacement.nodes);
-  const LinearBacking backing =
-      build_linear_backing(step.collisions, step.displacement, stiffness, pushed.rig.front.mesh.nodes);
+  const LinearBacking backing = build_linear_backing(step.collisions, step.displacement, stiffness,
+                                                     pushed.rig.front.mesh.nodes);
   const auto size = static_cast<Eigen::Index>(3 * backing.nodes.size());
   // At the step's own displacement: the conveyed reaction.
   Eigen::VectorXd displacement(size), force(size);
   for (std::size_t k = 0; k < backing.nodes.size(); ++k)
     displacement.segment<3>(3 * static_cast<Eigen::Index>(k)) =
-        pushed.front_positions.col(backing.nodes[k]) - pushed.rig.front.mesh.nodes.col(backing.nodes[k]);
+        pushed.front_positions.col(backing.nodes[k]) -
+        pushed.rig.front.mesh.nodes.col(backing.nodes[k]);
   evaluate_linear_backing(backing, displacement, force);
   EXPECT_LT(relative_difference(force, step.active_forces), 1e-9);
   // Elsewhere, pairs and polygons held: the full solve for the displaced nodes that map
@@ -163,13 +174,15 @@ TEST(InteractionFem, LinearBackingEqualsTheFullSolveForOtherDisplacementsOfTheCo
     Eigen::VectorXd gaps(size);
     for (std::size_t k = 0; k < backing.nodes.size(); ++k) {
       const auto at = 3 * static_cast<Eigen::Index>(k);
-      gaps.segment<3>(at) =
-          pushed.rig.front.mesh.nodes.col(backing.nodes[k]) + moved.segment<3>(at) - step.collisions[k].target;
+      gaps.segment<3>(at) = pushed.rig.front.mesh.nodes.col(backing.nodes[k]) +
+                            moved.segment<3>(at) - step.collisions[k].target;
     }
     const Eigen::VectorXd passive_displacement = step.displacement.map * gaps;
-    const StaticSolution solution = prescribed_nodes_solve(behind, step.displacement.nodes, passive_displacement);
+    const StaticSolution solution =
+        prescribed_nodes_solve(behind, step.displacement.nodes, passive_displacement);
     const Eigen::VectorXd expected =
-        -step.displacement.map.transpose() * free_reactions(behind, solution.reaction, step.displacement.nodes);
+        -step.displacement.map.transpose() *
+        free_reactions(behind, solution.reaction, step.displacement.nodes);
     evaluate_linear_backing(backing, moved, force);
     EXPECT_LT(relative_difference(force, expected), 1e-9) << "trial " << trial;
   }
@@ -183,7 +196,8 @@ TEST(InteractionFem, NoKeptCollisionPullsAndReleasedNodesLieOutsideTheDeformedBo
   const Eigen::Vector3d centre(0, 0.0654, 0.035);
   int deepest = shape.front_face.front();
   for (int node : shape.front_face)
-    if ((positions.col(node) - centre).tail<2>().norm() < (positions.col(deepest) - centre).tail<2>().norm())
+    if ((positions.col(node) - centre).tail<2>().norm() <
+        (positions.col(deepest) - centre).tail<2>().norm())
       deepest = node;
   for (int node : shape.front_surface.neighbours(deepest))
     if (positions(0, node) > -0.0011) positions(0, node) = 0.0001;
@@ -193,7 +207,9 @@ TEST(InteractionFem, NoKeptCollisionPullsAndReleasedNodesLieOutsideTheDeformedBo
   ASSERT_FALSE(step.collisions.empty());
   EXPECT_GT(step.released, 0);
   for (std::size_t k = 0; k < step.collisions.size(); ++k)
-    EXPECT_GE(step.active_forces.segment<3>(3 * static_cast<Eigen::Index>(k)).dot(step.collisions[k].normal), 0);
+    EXPECT_GE(step.active_forces.segment<3>(3 * static_cast<Eigen::Index>(k))
+                  .dot(step.collisions[k].normal),
+              0);
   // Each released node (penetrating at rest, not kept) is in front of the polygon it hit,
   // as B's deformation moved that polygon.
   std::vector<int> kept;
@@ -203,16 +219,19 @@ TEST(InteractionFem, NoKeptCollisionPullsAndReleasedNodesLieOutsideTheDeformedBo
   for (const NodePair& pair : pushed.pairs.pairs) {
     if (std::find(kept.begin(), kept.end(), pair.active) != kept.end()) continue;
     const Eigen::Vector3d active = pushed.front_positions.col(pair.active);
-    const auto target = node_polygon_collision(active, pair.passive, rig.behind.mesh.nodes, rig.behind_surface);
+    const auto target =
+        node_polygon_collision(active, pair.passive, rig.behind.mesh.nodes, rig.behind_surface);
     if (!target) continue;
     ++released;
-    const Triangle& polygon = rig.behind_surface.triangles[static_cast<std::size_t>(target->triangle)];
+    const Triangle& polygon =
+        rig.behind_surface.triangles[static_cast<std::size_t>(target->triangle)];
     Eigen::Matrix3d moved;
     for (std::size_t k = 0; k < 3; ++k)
       moved.col(static_cast<Eigen::Index>(k)) =
           rig.behind.mesh.nodes.col(polygon[k]) +
           step.passive_deformation.segment<3>(3 * rig.behind_columns->row_position(polygon[k]));
-    const Eigen::Vector3d normal = (moved.col(1) - moved.col(0)).cross(moved.col(2) - moved.col(0)).normalized();
+    const Eigen::Vector3d normal =
+        (moved.col(1) - moved.col(0)).cross(moved.col(2) - moved.col(0)).normalized();
     EXPECT_GT((active - moved.col(0)).dot(normal), -1e-9) << "released node " << pair.active;
   }
   EXPECT_EQ(released, step.released);

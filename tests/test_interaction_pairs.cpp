@@ -26,17 +26,21 @@ TEST(InteractionPairs, UpdateWalksToTheNearestNodeOfBruteForce) {
   std::uniform_int_distribution<int> any_node(0, sphere.vertex_count() - 1);
   std::uniform_real_distribution<double> radius(0.045, 0.06);
   Eigen::Matrix3Xd active(3, 200);
-  for (Eigen::Index i = 0; i < active.cols(); ++i) active.col(i) = radius(rng) * testing::random_direction(rng);
+  for (Eigen::Index i = 0; i < active.cols(); ++i)
+    active.col(i) = radius(rng) * testing::random_direction(rng);
   std::vector<int> active_nodes(200);
   std::iota(active_nodes.begin(), active_nodes.end(), 0);
   NodePairList list;
   list.paired.assign(200, 1);
-  for (int node : active_nodes) list.pairs.push_back({node, any_node(rng)});  // far from nearest, on purpose
+  for (int node : active_nodes)
+    list.pairs.push_back({node, any_node(rng)});  // far from nearest, on purpose
   for (int step = 0; step < 5; ++step) {
     update_node_pairs(list, active, sphere.vertices, surface);
     for (const NodePair& pair : list.pairs)
-      EXPECT_EQ(pair.passive, brute_force_nearest(active.col(pair.active), sphere.vertices)) << "step " << step;
-    for (Eigen::Index i = 0; i < active.cols(); ++i) active.col(i) += 0.004 * testing::random_direction(rng);
+      EXPECT_EQ(pair.passive, brute_force_nearest(active.col(pair.active), sphere.vertices))
+          << "step " << step;
+    for (Eigen::Index i = 0; i < active.cols(); ++i)
+      active.col(i) += 0.004 * testing::random_direction(rng);
   }
 }
 

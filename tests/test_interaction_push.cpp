@@ -63,8 +63,10 @@ TEST(InteractionPush, BehindShareScalesWithYoungsModulusAndTheForceIsMonotoneInE
   BehindBody behind = base.behind_body();
   const PushSample sample = push_front(base.front, BackCondition::on_behind, &behind, depth)[0];
   ASSERT_FALSE(sample.forcible.nodes.empty());
-  const Eigen::MatrixXd k1 = condensed_stiffness(*base.behind_columns, base.behind().dofs, sample.forcible.nodes);
-  const Eigen::MatrixXd k2 = condensed_stiffness(*doubled.behind_columns, doubled.behind().dofs, sample.forcible.nodes);
+  const Eigen::MatrixXd k1 =
+      condensed_stiffness(*base.behind_columns, base.behind().dofs, sample.forcible.nodes);
+  const Eigen::MatrixXd k2 =
+      condensed_stiffness(*doubled.behind_columns, doubled.behind().dofs, sample.forcible.nodes);
   EXPECT_LT((k2 - 2 * k1).norm(), 1e-9 * k2.norm());
 
   double previous = 0;
@@ -88,8 +90,10 @@ TEST(InteractionPush, BehindShareScalesWithYoungsModulusAndTheForceIsMonotoneInE
 Eigen::VectorXd spring_forces(const PushedFront& front, const Eigen::VectorXd& u) {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(u.size());
   for (const Spring& s : front.springs) {
-    const Eigen::Vector3d n = (front.rest_positions.col(s.b) - front.rest_positions.col(s.a)).normalized();
-    const Eigen::Vector3d on_a = s.stiffness * n * n.dot(u.segment<3>(3 * s.a) - u.segment<3>(3 * s.b));
+    const Eigen::Vector3d n =
+        (front.rest_positions.col(s.b) - front.rest_positions.col(s.a)).normalized();
+    const Eigen::Vector3d on_a =
+        s.stiffness * n * n.dot(u.segment<3>(3 * s.a) - u.segment<3>(3 * s.b));
     f.segment<3>(3 * s.a) += on_a;
     f.segment<3>(3 * s.b) -= on_a;
   }
@@ -109,24 +113,31 @@ TEST(InteractionPush, OnBehindBalancesAgainstTheFullSparseSolveOfB) {
     for (std::size_t k = 0; k < sample.collisions.size(); ++k) {
       const PolygonCollision& c = sample.collisions[k];
       gaps.segment<3>(3 * static_cast<Eigen::Index>(k)) =
-          rig.front.rest_positions.col(c.active) + sample.displacement.segment<3>(3 * c.active) - c.target;
+          rig.front.rest_positions.col(c.active) + sample.displacement.segment<3>(3 * c.active) -
+          c.target;
     }
     const ElasticBody& b = rig.behind();
-    const StaticSolution solution = testing::prescribed_nodes_solve(b, sample.forcible.nodes, sample.forcible.map * gaps);
+    const StaticSolution solution =
+        testing::prescribed_nodes_solve(b, sample.forcible.nodes, sample.forcible.map * gaps);
     const Eigen::VectorXd conveyed =
-        -sample.forcible.map.transpose() * testing::free_reactions(b, solution.reaction, sample.forcible.nodes);
+        -sample.forcible.map.transpose() *
+        testing::free_reactions(b, solution.reaction, sample.forcible.nodes);
 
     // A's balance: spring forces = B's conveyed reaction at every free dof but the tool's.
     Eigen::VectorXd residual = spring_forces(rig.front, sample.displacement);
     for (std::size_t k = 0; k < sample.collisions.size(); ++k) {
-      residual.segment<3>(3 * sample.collisions[k].active) -= conveyed.segment<3>(3 * static_cast<Eigen::Index>(k));
+      residual.segment<3>(3 * sample.collisions[k].active) -=
+          conveyed.segment<3>(3 * static_cast<Eigen::Index>(k));
       // No kept contact pulls A into B.
-      EXPECT_GE(conveyed.segment<3>(3 * static_cast<Eigen::Index>(k)).dot(sample.collisions[k].normal), 0);
+      EXPECT_GE(
+          conveyed.segment<3>(3 * static_cast<Eigen::Index>(k)).dot(sample.collisions[k].normal),
+          0);
     }
     const int tool_dof = 3 * rig.front.tool_node + rig.front.push_axis;
     EXPECT_NEAR(residual[tool_dof], sample.force, 1e-9 * sample.force);
     for (int dof = 0; dof < residual.size(); ++dof) {
-      const bool fixed = (rig.front.fixed_axes[static_cast<std::size_t>(dof / 3)] >> (dof % 3)) & 1u;
+      const bool fixed =
+          (rig.front.fixed_axes[static_cast<std::size_t>(dof / 3)] >> (dof % 3)) & 1u;
       if (dof / 3 != rig.front.tool_node && !fixed) {  // the tool holds its node on every axis
         EXPECT_NEAR(residual[dof], 0, 1e-9 * sample.force) << "dof " << dof;
       }
@@ -136,9 +147,12 @@ TEST(InteractionPush, OnBehindBalancesAgainstTheFullSparseSolveOfB) {
     for (const PolygonCollision& c : sample.collisions) {
       Eigen::Vector3d on_polygon = Eigen::Vector3d::Zero();
       for (std::size_t k = 0; k < 3; ++k)
-        on_polygon += c.weights[static_cast<Eigen::Index>(k)] *
-                      (b.mesh.nodes.col(c.polygon[k]) + solution.displacement.segment<3>(3 * c.polygon[k]));
-      EXPECT_LT((on_polygon - rig.front.rest_positions.col(c.active) - sample.displacement.segment<3>(3 * c.active)).norm(),
+        on_polygon +=
+            c.weights[static_cast<Eigen::Index>(k)] *
+            (b.mesh.nodes.col(c.polygon[k]) + solution.displacement.segment<3>(3 * c.polygon[k]));
+      EXPECT_LT((on_polygon - rig.front.rest_positions.col(c.active) -
+                 sample.displacement.segment<3>(3 * c.active))
+                    .norm(),
                 1e-9)
           << "back node " << c.active;
     }

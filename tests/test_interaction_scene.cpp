@@ -55,9 +55,12 @@ TEST(InteractionScene, ParsesThePairsAndRejectsWhatCannotPress) {
   EXPECT_EQ(scene.interactions[0].front, "A");
   EXPECT_EQ(scene.interactions[0].behind, "B");
   EXPECT_TRUE(parse_scene(with_interactions(""), "paired.yaml").interactions.empty());
-  expect_scene_error("interactions:\n  - {front: A, behind: C}\n", "no object named 'C' (the scene's objects: A, B)");
-  expect_scene_error("interactions:\n  - {front: A, behind: A}\n", "an object other than the front one");
-  expect_scene_error("interactions:\n  - {front: B, behind: A}\n", "object 'A' is not linear elastic");
+  expect_scene_error("interactions:\n  - {front: A, behind: C}\n",
+                     "no object named 'C' (the scene's objects: A, B)");
+  expect_scene_error("interactions:\n  - {front: A, behind: A}\n",
+                     "an object other than the front one");
+  expect_scene_error("interactions:\n  - {front: B, behind: A}\n",
+                     "object 'A' is not linear elastic");
   expect_scene_error("interactions:\n  - {front: A, behind: B}\n  - {front: A, behind: B}\n",
                      "object 'A' is the front of an earlier interaction already");
   expect_scene_error("interactions:\n  - {front: A, behind: B, friction: 1}\n", "friction");
@@ -70,12 +73,16 @@ struct PairedBoxes {
   SceneSimulation simulation;
   double time = 0;
   explicit PairedBoxes(const std::string& text)
-      : model(build_model(parse_scene(text, testing::source_path("scenes/objects/paired_boxes.yaml")))),
+      : model(build_model(
+            parse_scene(text, testing::source_path("scenes/objects/paired_boxes.yaml")))),
         compliance(prepare_scene_compliance(model, true, std::nullopt)),
         simulation(model, compliance.per_body, model.scene.tools, SimulationOptions{}) {}
-  const MassSpringSimulation& front() const { return std::get<MassSpringSimulation>(simulation.body(0)); }
+  const MassSpringSimulation& front() const {
+    return std::get<MassSpringSimulation>(simulation.body(0));
+  }
   void run(double seconds) {
-    for (int i = 0; i < static_cast<int>(std::lround(seconds / 0.001)); ++i, time += 0.001) simulation.step(time);
+    for (int i = 0; i < static_cast<int>(std::lround(seconds / 0.001)); ++i, time += 0.001)
+      simulation.step(time);
   }
   double weight() const { return front().body().network.mass.sum() * 9.81; }
   // The backing's force on A at its current positions, summed over A's nodes [N].
@@ -83,7 +90,8 @@ struct PairedBoxes {
     const MassSpringNetwork& network = front().body().network;
     Eigen::Matrix3Xd forces = Eigen::Matrix3Xd::Zero(3, network.node_count());
     NodeBackingSolve solve = front().state().backing;
-    add_node_backing_forces(front().backing(), solve, front().state().positions, front().state().velocities, forces);
+    add_node_backing_forces(front().backing(), solve, front().state().positions,
+                            front().state().velocities, forces);
     return forces.rowwise().sum();
   }
   // A's energy: kinetic, gravity, springs and B's elastic energy under the backing [J].
@@ -92,8 +100,8 @@ struct PairedBoxes {
     const MassSpringState& state = front().state();
     NodeBackingSolve solve = state.backing;
     Eigen::Matrix3Xd forces = Eigen::Matrix3Xd::Zero(3, network.node_count());
-    add_node_backing_forces(front().backing(), solve, state.positions, Eigen::Matrix3Xd::Zero(3, network.node_count()),
-                            forces);
+    add_node_backing_forces(front().backing(), solve, state.positions,
+                            Eigen::Matrix3Xd::Zero(3, network.node_count()), forces);
     return kinetic_energy(network, state.velocities) + potential_energy(network, state.positions) +
            backing_energy(front().backing(), solve.pushes);
   }
@@ -113,7 +121,9 @@ TEST(InteractionScene, BehindBoxCarriesTheFrontObjectsWeightAndATool) {
       if (tool) boxes.simulation.set_tool(0, *tool);
       boxes.simulation.step(boxes.time);
       sum += boxes.backing_force();
-      pushed += boxes.front().reaction(0).force.z();  // A pushes the tool up as hard as the tool pushes A down
+      pushed += boxes.front()
+                    .reaction(0)
+                    .force.z();  // A pushes the tool up as hard as the tool pushes A down
     }
     return std::pair(Eigen::Vector3d(sum / steps), pushed / steps);
   };
@@ -124,7 +134,7 @@ TEST(InteractionScene, BehindBoxCarriesTheFrontObjectsWeightAndATool) {
   EXPECT_NEAR(carried.z(), boxes.weight(), 0.02 * boxes.weight());
   EXPECT_NEAR(carried.head<2>().norm(), 0, 0.02 * boxes.weight());
   EXPECT_EQ(no_push, 0);
-  EXPECT_LT(boxes.lowest(), 0);  // A sank into B's rest surface as B gave way ...
+  EXPECT_LT(boxes.lowest(), 0);      // A sank into B's rest surface as B gave way ...
   EXPECT_GT(boxes.lowest(), -1e-3);  // ... by less than a millimetre
   EXPECT_FALSE(boxes.front().backing().empty());
   EXPECT_EQ(boxes.front().state().backing.failures, 0u);
@@ -154,16 +164,17 @@ TEST(InteractionScene, TheFrontObjectDroppedOnTheBoxNeverGainsEnergyAndSettles) 
     const double energy = boxes.energy();
     largest_rise = std::max(largest_rise, energy - lowest);  // above the lowest so far
     lowest = std::min(lowest, energy);
-    stored = std::max(stored, backing_energy(boxes.front().backing(), boxes.front().state().backing.pushes));
+    stored = std::max(
+        stored, backing_energy(boxes.front().backing(), boxes.front().state().backing.pushes));
   }
   const double drop = boxes.weight() * 0.2e-3;  // A's fall onto B's rest surface [J]
   EXPECT_GT(stored, 0);
-  EXPECT_LT(largest_rise, 0.01 * drop);  // never gained energy
+  EXPECT_LT(largest_rise, 0.01 * drop);                                     // never gained energy
   EXPECT_LT(boxes.front().state().velocities.cwiseAbs().maxCoeff(), 0.01);  // settled [m/s]
   EXPECT_GT(boxes.lowest(), -1e-3);
   EXPECT_EQ(boxes.front().state().backing.failures, 0u);
-  std::cout << "drop " << drop << " J, lost " << start - lowest << " J, largest rise " << largest_rise
-            << " J, B stored at most " << stored << " J\n";
+  std::cout << "drop " << drop << " J, lost " << start - lowest << " J, largest rise "
+            << largest_rise << " J, B stored at most " << stored << " J\n";
 }
 
 // The client feels B through A: the IR of a user pressing A carries B's backing on the
@@ -186,7 +197,8 @@ TEST(InteractionScene, ClientFeelsTheBehindBoxThroughTheWireAsTheServerDoes) {
     const double dt = t - previous;
     previous = t;
     if (boxes.simulation.ir_changed(0)) {
-      IntermediateRepresentation received = wire::from_wire(wire::to_wire(boxes.simulation.ir(0)->ir));
+      IntermediateRepresentation received =
+          wire::from_wire(wire::to_wire(boxes.simulation.ir(0)->ir));
       const auto& network = std::get<MassSpringIr>(received.body);
       ++irs;
       if (!network.backing.empty()) ++backed_irs;

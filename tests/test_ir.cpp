@@ -34,30 +34,37 @@ Rig& shared_cube() {
 
 // The full sparse solve with all `tools` pressing and the simulation's held nodes.
 std::vector<Eigen::Vector3d> reference_forces(const Model& model, const Simulation& simulation,
-                                              const std::vector<Eigen::Vector3d>& tools, ContactModel contact_model) {
+                                              const std::vector<Eigen::Vector3d>& tools,
+                                              ContactModel contact_model) {
   const ElasticBody& body = single_elastic_body(model);
   std::vector<PressedTool> pressed;
   for (const Eigen::Vector3d& p : tools) pressed.push_back({p, 0});
-  const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
+  const HeldNodes held{simulation.condensation().boundary_nodes(),
+                       simulation.boundary_displacement()};
   std::vector<Eigen::Vector3d> forces;
-  for (const ToolReaction& r : contact_reactions_reference(body, find_tool_contacts(body, pressed), held, contact_model))
+  for (const ToolReaction& r :
+       contact_reactions_reference(body, find_tool_contacts(body, pressed), held, contact_model))
     forces.push_back(r.reaction);
   return forces;
 }
 
 // Whether the IR of `user` holds the triangles the tools now press (own within the patch,
 // remote on its IR triangle): then the evaluator must be exact.
-bool ir_covers(const Model& model, const PreparedIR& prepared, const std::vector<Eigen::Vector3d>& tools, int user) {
+bool ir_covers(const Model& model, const PreparedIR& prepared,
+               const std::vector<Eigen::Vector3d>& tools, int user) {
   const ElasticBody& body = single_elastic_body(model);
   const auto surface_triangle = [&](const Eigen::Vector3d& p) {
-    return nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, p).triangle;
+    return nearest_triangle(body.mesh, body.surface, body.normals, body.touchable_triangles, p)
+        .triangle;
   };
   bool own = false;
-  for (const IrTriangle& tri : condensed_fem(prepared.ir).patch) own |= tri.surface_index == surface_triangle(tools[user]);
+  for (const IrTriangle& tri : condensed_fem(prepared.ir).patch)
+    own |= tri.surface_index == surface_triangle(tools[user]);
   for (const IrRemoteContact& remote : condensed_fem(prepared.ir).remotes) {
     const Triangle& t = body.surface.triangles[surface_triangle(tools[remote.user])];
     for (int k = 0; k < 3; ++k)
-      if (body.mesh.node_tags[t[k]] != condensed_fem(prepared.ir).node_ids[remote.nodes[k]]) return false;
+      if (body.mesh.node_tags[t[k]] != condensed_fem(prepared.ir).node_ids[remote.nodes[k]])
+        return false;
   }
   return own;
 }
@@ -65,7 +72,9 @@ bool ir_covers(const Model& model, const PreparedIR& prepared, const std::vector
 void two_users_match_the_full_solve(ContactModel contact_model, int step_delay_nodes) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(contact_model, step_delay_nodes));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns,
+                        std::vector<ToolSpec>(2),
+                        unlimited_options(contact_model, step_delay_nodes));
   const std::vector<Eigen::Vector3d> start = {mm(-20, 5, -4), mm(25, -5, -3)};
   simulation.set_tool(0, start[0]);
   simulation.set_tool(1, start[1]);
@@ -83,7 +92,9 @@ void two_users_match_the_full_solve(ContactModel contact_model, int step_delay_n
     pressed[0].z() = -depth(rng) * 1e-3;
     pressed[1].z() = -depth(rng) * 1e-3;
     // A tool moved onto a held node, or outside its IR's triangles: not this test's subject.
-    if (!ir_covers(model, *simulation.ir(0), pressed, 0) && !ir_covers(model, *simulation.ir(1), pressed, 1)) continue;
+    if (!ir_covers(model, *simulation.ir(0), pressed, 0) &&
+        !ir_covers(model, *simulation.ir(1), pressed, 1))
+      continue;
     std::vector<Eigen::Vector3d> expected;
     try {
       expected = reference_forces(model, simulation, pressed, contact_model);
@@ -94,15 +105,18 @@ void two_users_match_the_full_solve(ContactModel contact_model, int step_delay_n
       const PreparedIR& prepared = *simulation.ir(user);
       if (!ir_covers(model, prepared, pressed, user)) continue;
       const Eigen::Vector3d remote = pressed[1 - user];
-      const ForceSample sample = testing::evaluate_static(prepared, pressed[user], std::span(&remote, 1));
+      const ForceSample sample =
+          testing::evaluate_static(prepared, pressed[user], std::span(&remote, 1));
       ASSERT_TRUE(sample.flags & kInContact);
       worst = std::max(worst, relative_error(sample.force, expected[user]));
-      EXPECT_LE(relative_error(sample.force, expected[user]), 1e-9) << "trial " << trial << " user " << user;
+      EXPECT_LE(relative_error(sample.force, expected[user]), 1e-9)
+          << "trial " << trial << " user " << user;
       ++checked;
     }
   }
   std::printf("  %s, %d held nodes: %d evaluations checked, worst relative error %.2e\n",
-              contact_model == ContactModel::node_translation ? "translation" : "point", step_delay_nodes, checked, worst);
+              contact_model == ContactModel::node_translation ? "translation" : "point",
+              step_delay_nodes, checked, worst);
   EXPECT_GE(checked, 10);
 }
 
@@ -131,13 +145,15 @@ TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
   for (int v : body.surface.triangles[user.nearest_triangle]) under_tool[v] = true;
   IncrementalCondensation condensation(*rig.columns, body.dofs);
   const std::vector<Eigen::Vector3d> around = {tool};
-  std::vector<int> held = nearest_surface_nodes(body.mesh, body.surface, body.dofs, around, 200, under_tool);
+  std::vector<int> held =
+      nearest_surface_nodes(body.mesh, body.surface, body.dofs, around, 200, under_tool);
   held.erase(held.begin(), held.begin() + 20);  // leave the patch's neighbourhood free
   condensation.set_boundary_nodes(held);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> uniform(-1e-3, 1e-3);
   std::vector<Eigen::Vector3d> held_displacement;
-  for (std::size_t i = 0; i < held.size(); ++i) held_displacement.emplace_back(uniform(rng), uniform(rng), uniform(rng));
+  for (std::size_t i = 0; i < held.size(); ++i)
+    held_displacement.emplace_back(uniform(rng), uniform(rng), uniform(rng));
   const std::vector<UserTool> users = {user};
 
   const auto build = [&](double threshold) {
@@ -146,7 +162,8 @@ TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
     return build_ir(body, condensation, users, 0, held_displacement, options, 1, 0.0);
   };
   const IntermediateRepresentation full = build(0.0);
-  EXPECT_EQ(condensed_fem(full).node_count(), condensed_fem(full).row_node_count + static_cast<int>(held.size()));
+  EXPECT_EQ(condensed_fem(full).node_count(),
+            condensed_fem(full).row_node_count + static_cast<int>(held.size()));
   const IntermediateRepresentation zero = build(0.0);
   EXPECT_EQ(condensed_fem(zero).m_tilde, condensed_fem(full).m_tilde);
   EXPECT_EQ(condensed_fem(zero).node_ids, condensed_fem(full).node_ids);
@@ -157,44 +174,57 @@ TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
   ASSERT_GT(condensed_fem(cut).node_count(), condensed_fem(full).row_node_count);
   EXPECT_LT(cut.size_bytes(), full.size_bytes());
   const Eigen::Index contact = condensed_fem(full).m_tilde.rows();
-  EXPECT_EQ(condensed_fem(cut).m_tilde.leftCols(contact), condensed_fem(full).m_tilde.leftCols(contact));
+  EXPECT_EQ(condensed_fem(cut).m_tilde.leftCols(contact),
+            condensed_fem(full).m_tilde.leftCols(contact));
 
   // Each held node's coupling (norm of its three columns), kept or not.
   std::vector<double> coupling;
   for (std::size_t b = 0; b < held.size(); ++b)
-    coupling.push_back(condensed_fem(full).m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3).norm());
+    coupling.push_back(condensed_fem(full)
+                           .m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3)
+                           .norm());
   const double strongest = *std::max_element(coupling.begin(), coupling.end());
   const Eigen::VectorXd u_c = Eigen::VectorXd::NullaryExpr(contact, [&] { return uniform(rng); });
   Eigen::VectorXd dropped_force = Eigen::VectorXd::Zero(contact);
   std::size_t next_kept = static_cast<std::size_t>(condensed_fem(cut).row_node_count);
   for (std::size_t b = 0; b < held.size(); ++b) {
     const std::int64_t tag = body.mesh.node_tags[held[b]];
-    const bool kept = next_kept < condensed_fem(cut).node_ids.size() && condensed_fem(cut).node_ids[next_kept] == tag;
+    const bool kept = next_kept < condensed_fem(cut).node_ids.size() &&
+                      condensed_fem(cut).node_ids[next_kept] == tag;
     EXPECT_EQ(kept, coupling[b] >= threshold * strongest) << "node " << tag;
     if (kept) {
       ++next_kept;
     } else {
-      dropped_force += condensed_fem(full).m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3) *
-                       condensed_fem(full).boundary_displacement.segment<3>(3 * static_cast<Eigen::Index>(b));
+      dropped_force +=
+          condensed_fem(full).m_tilde.middleCols(contact + 3 * static_cast<Eigen::Index>(b), 3) *
+          condensed_fem(full).boundary_displacement.segment<3>(3 * static_cast<Eigen::Index>(b));
     }
   }
   EXPECT_EQ(next_kept, condensed_fem(cut).node_ids.size());
-  Eigen::VectorXd full_u(condensed_fem(full).m_tilde.cols()), cut_u(condensed_fem(cut).m_tilde.cols());
+  Eigen::VectorXd full_u(condensed_fem(full).m_tilde.cols()),
+      cut_u(condensed_fem(cut).m_tilde.cols());
   full_u << u_c, condensed_fem(full).boundary_displacement;
   cut_u << u_c, condensed_fem(cut).boundary_displacement;
-  const Eigen::VectorXd difference = condensed_fem(full).m_tilde * full_u - condensed_fem(cut).m_tilde * cut_u;
-  EXPECT_LE((difference - dropped_force).norm(), 1e-12 * (condensed_fem(full).m_tilde * full_u).norm());
+  const Eigen::VectorXd difference =
+      condensed_fem(full).m_tilde * full_u - condensed_fem(cut).m_tilde * cut_u;
+  EXPECT_LE((difference - dropped_force).norm(),
+            1e-12 * (condensed_fem(full).m_tilde * full_u).norm());
   EXPECT_GT(dropped_force.norm(), 0.0);
-  std::printf("  B truncation at %.2f keeps %d of %zu held nodes: %zu -> %zu bytes, dropped force %.3g of %.3g N\n",
-              threshold, condensed_fem(cut).node_count() - condensed_fem(cut).row_node_count, held.size(), full.size_bytes(), cut.size_bytes(),
-              dropped_force.norm(), (condensed_fem(full).m_tilde * full_u).norm());
+  std::printf(
+      "  B truncation at %.2f keeps %d of %zu held nodes: %zu -> %zu bytes, dropped force %.3g of "
+      "%.3g N\n",
+      threshold, condensed_fem(cut).node_count() - condensed_fem(cut).row_node_count, held.size(),
+      full.size_bytes(), cut.size_bytes(), dropped_force.norm(),
+      (condensed_fem(full).m_tilde * full_u).norm());
 }
 
 TEST(IntermediateRepresentation, EachUserFeelsTheOther) {
   Rig& rig = shared_cube();
   const auto force_alone_and_together = [&](int user) {
-    Simulation alone(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
-    Simulation together(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
+    Simulation alone(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
+                     unlimited_options(ContactModel::node_translation));
+    Simulation together(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
+                        unlimited_options(ContactModel::node_translation));
     alone.set_tool(user, user == 0 ? mm(-12, 0, -5) : mm(12, 0, -5));
     together.set_tool(0, mm(-12, 0, -5));
     together.set_tool(1, mm(12, 0, -5));
@@ -217,8 +247,10 @@ TEST(IntermediateRepresentation, EachUserFeelsTheOther) {
 // twice would make the condensed compliance singular and fail every step a browser watched.
 TEST(IntermediateRepresentation, TwoToolsOnOneTriangleSolveTheStateWithTheEarlierAsIfAlone) {
   Rig& rig = shared_cube();
-  Simulation alone(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
-  Simulation together(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
+  Simulation alone(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
+                   unlimited_options(ContactModel::node_translation));
+  Simulation together(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
+                      unlimited_options(ContactModel::node_translation));
   alone.set_tool(0, mm(1, 1, -2));
   together.set_tool(0, mm(1, 1, -2));
   together.set_tool(1, mm(1.5, 1.2, -2.5));
@@ -230,7 +262,8 @@ TEST(IntermediateRepresentation, TwoToolsOnOneTriangleSolveTheStateWithTheEarlie
   const StateSolution reference = alone.solve();
   ASSERT_EQ(state.tool_forces.size(), 1u) << "the later tool is left out";
   EXPECT_GT(reference.tool_forces[0].norm(), 0.0);
-  EXPECT_LE((state.tool_forces[0] - reference.tool_forces[0]).norm(), 1e-9 * reference.tool_forces[0].norm());
+  EXPECT_LE((state.tool_forces[0] - reference.tool_forces[0]).norm(),
+            1e-9 * reference.tool_forces[0].norm());
 }
 
 // Two remote tools on one triangle, away from the own tool: the client leaves out the later
@@ -238,7 +271,8 @@ TEST(IntermediateRepresentation, TwoToolsOnOneTriangleSolveTheStateWithTheEarlie
 // listed twice made it singular, and the own tool's force was zero (kNonFinite).
 TEST(IntermediateRepresentation, TwoRemotesOnOneTriangleLeaveTheOwnForceResolved) {
   Rig& rig = shared_cube();
-  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(3), unlimited_options(ContactModel::node_translation));
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(3),
+                        unlimited_options(ContactModel::node_translation));
   simulation.set_tool(0, mm(-20, 5, -3));
   simulation.set_tool(1, mm(20, 5, -3));
   simulation.set_tool(2, mm(20.5, 5.2, -3.5));
@@ -252,7 +286,9 @@ TEST(IntermediateRepresentation, TwoRemotesOnOneTriangleLeaveTheOwnForceResolved
 TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited_options(ContactModel::node_translation, 0, 2));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns,
+                        std::vector<ToolSpec>(1),
+                        unlimited_options(ContactModel::node_translation, 0, 2));
   simulation.set_tool(0, mm(1, 2, -3));
   simulation.step(0);
   const PreparedIR& prepared = *simulation.ir(0);
@@ -261,7 +297,9 @@ TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
     const std::vector<Eigen::Vector3d> tool = {mm(x, 2 + 0.3 * x, -3)};
     if (!ir_covers(model, prepared, tool, 0)) break;
     const ForceSample sample = testing::evaluate_static(prepared, tool[0], {});
-    EXPECT_LE(relative_error(sample.force, reference_forces(model, simulation, tool, ContactModel::node_translation)[0]), 1e-9)
+    EXPECT_LE(relative_error(sample.force, reference_forces(model, simulation, tool,
+                                                            ContactModel::node_translation)[0]),
+              1e-9)
         << "x = " << x;
     if (sample.triangle != previous) ++triangles_visited;
     previous = sample.triangle;
@@ -271,8 +309,10 @@ TEST(IntermediateRepresentation, SlidingWithinThePatchStaysExact) {
 
 TEST(IntermediateRepresentation, Float32StorageStaysCloseToFloat64) {
   Rig& rig = shared_cube();
-  for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
-    Simulation f64(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(contact_model, 300));
+  for (ContactModel contact_model :
+       {ContactModel::node_translation, ContactModel::point_constraint}) {
+    Simulation f64(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
+                   unlimited_options(contact_model, 300));
     Simulation f32(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
                    unlimited_options(contact_model, 300, 1, IrPrecision::f32));
     for (Simulation* s : {&f64, &f32}) {
@@ -280,7 +320,8 @@ TEST(IntermediateRepresentation, Float32StorageStaysCloseToFloat64) {
       s->set_tool(1, mm(25, -5, -3));
       s->step(0);
     }
-    EXPECT_LT(static_cast<double>(f32.ir(0)->ir.size_bytes()), 0.6 * static_cast<double>(f64.ir(0)->ir.size_bytes()));
+    EXPECT_LT(static_cast<double>(f32.ir(0)->ir.size_bytes()),
+              0.6 * static_cast<double>(f64.ir(0)->ir.size_bytes()));
     for (int user = 0; user < 2; ++user) {
       const double error = relative_error(f32.force(user).force, f64.force(user).force);
       std::printf("  f32 vs f64 (%s, |B| 300): relative force difference %.2e\n",
@@ -310,16 +351,22 @@ double largest_change_along_slide(const PreparedIR& prepared, double step, doubl
 TEST(IntermediateRepresentation, NodeTranslationJumpsAtEdgesThePointModelDoesNot) {
   // A continuous force's largest step-to-step change shrinks with the step; a jump does not.
   Rig& rig = shared_cube();
-  std::printf("  tool sliding 3 mm deep across several triangles (patch rings 2), largest change between samples:\n");
-  for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
-    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited_options(contact_model, 0, 2));
+  std::printf(
+      "  tool sliding 3 mm deep across several triangles (patch rings 2), largest change between "
+      "samples:\n");
+  for (ContactModel contact_model :
+       {ContactModel::node_translation, ContactModel::point_constraint}) {
+    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1),
+                          unlimited_options(contact_model, 0, 2));
     simulation.set_tool(0, mm(0.5, 0.4, -3));
     simulation.step(0);
     double peak = 0;
     const double coarse = largest_change_along_slide(*simulation.ir(0), 0.2, peak);
     const double fine = largest_change_along_slide(*simulation.ir(0), 0.02, peak);
-    std::printf("    %-11s %.3f N with 0.2 mm steps, %.3f N with 0.02 mm steps (peak force %.2f N)\n",
-                contact_model == ContactModel::node_translation ? "translation" : "point", coarse, fine, peak);
+    std::printf(
+        "    %-11s %.3f N with 0.2 mm steps, %.3f N with 0.02 mm steps (peak force %.2f N)\n",
+        contact_model == ContactModel::node_translation ? "translation" : "point", coarse, fine,
+        peak);
     if (contact_model == ContactModel::node_translation) {
       EXPECT_GT(fine, 0.5 * coarse) << "node translation switches nodes at an edge: a jump";
       EXPECT_LT(fine, 0.25 * peak) << "but the jump is bounded";
@@ -332,7 +379,9 @@ TEST(IntermediateRepresentation, NodeTranslationJumpsAtEdgesThePointModelDoesNot
 TEST(IntermediateRepresentation, PastThePatchTheForceIsHeldAndTheNextIrCatchesUp) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited_options(ContactModel::point_constraint, 0, 0));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns,
+                        std::vector<ToolSpec>(1),
+                        unlimited_options(ContactModel::point_constraint, 0, 0));
   simulation.set_tool(0, mm(1, 1, -3));
   simulation.step(0);
   const std::shared_ptr<const PreparedIR> old_ir = simulation.ir(0);
@@ -359,10 +408,14 @@ TEST(IntermediateRepresentation, PastThePatchTheForceIsHeldAndTheNextIrCatchesUp
   simulation.set_tool(0, p);
   simulation.step(0.01);
   const Eigen::Vector3d exact = simulation.force(0).force;
-  EXPECT_LE(relative_error(exact, reference_forces(model, simulation, {p}, ContactModel::point_constraint)[0]), 1e-9);
-  std::printf("  1 mm past a one-triangle patch: force held on the rim %.3f N, exact at the new triangle %.3f N "
-              "(jump %.3f N when the next IR arrives)\n",
-              previous.norm(), exact.norm(), (exact - previous).norm());
+  EXPECT_LE(relative_error(
+                exact, reference_forces(model, simulation, {p}, ContactModel::point_constraint)[0]),
+            1e-9);
+  std::printf(
+      "  1 mm past a one-triangle patch: force held on the rim %.3f N, exact at the new triangle "
+      "%.3f N "
+      "(jump %.3f N when the next IR arrives)\n",
+      previous.norm(), exact.norm(), (exact - previous).norm());
   EXPECT_LT((exact - previous).norm(), 0.25 * exact.norm());
 }
 
@@ -371,25 +424,30 @@ TEST(IntermediateRepresentation, SphereToolsEqualTheFullSolve) {
   const Model& model = *rig.model;
   const ElasticBody& body = single_elastic_body(model);
   const double radius = 4e-3;
-  for (ContactModel contact_model : {ContactModel::node_translation, ContactModel::point_constraint}) {
+  for (ContactModel contact_model :
+       {ContactModel::node_translation, ContactModel::point_constraint}) {
     std::vector<ToolSpec> tools(2);
     for (ToolSpec& tool : tools) {
       tool.shape = ToolShape::sphere;
       tool.radius = radius;
     }
-    Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, tools, unlimited_options(contact_model));
+    Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, tools,
+                          unlimited_options(contact_model));
     // Centres outside the surface (1 mm above it) and inside (2 mm below): both press.
     const std::vector<Eigen::Vector3d> centres = {mm(-20, 5, 1), mm(25, -5, -2)};
     simulation.set_tool(0, centres[0]);
     simulation.set_tool(1, centres[1]);
     simulation.step(0);
     std::vector<PressedTool> pressed = {{centres[0], radius}, {centres[1], radius}};
-    const HeldNodes held{simulation.condensation().boundary_nodes(), simulation.boundary_displacement()};
-    const auto reference = contact_reactions_reference(body, find_tool_contacts(body, pressed), held, contact_model);
+    const HeldNodes held{simulation.condensation().boundary_nodes(),
+                         simulation.boundary_displacement()};
+    const auto reference =
+        contact_reactions_reference(body, find_tool_contacts(body, pressed), held, contact_model);
     for (int user = 0; user < 2; ++user) {
       ASSERT_TRUE(reference[user].query.contact.has_value());
       EXPECT_NEAR(reference[user].query.contact->depth, user == 0 ? 3e-3 : 6e-3, 1e-12);
-      EXPECT_LE(relative_error(simulation.force(user).force, reference[user].reaction), 1e-9) << "user " << user;
+      EXPECT_LE(relative_error(simulation.force(user).force, reference[user].reaction), 1e-9)
+          << "user " << user;
     }
   }
 }
@@ -397,7 +455,9 @@ TEST(IntermediateRepresentation, SphereToolsEqualTheFullSolve) {
 TEST(IntermediateRepresentation, NonFiniteToolsGiveZeroOrAreIgnored) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;
-  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns, std::vector<ToolSpec>(2), unlimited_options(ContactModel::node_translation));
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns,
+                        std::vector<ToolSpec>(2),
+                        unlimited_options(ContactModel::node_translation));
   simulation.set_tool(0, mm(-20, 5, -4));
   simulation.set_tool(1, mm(25, -5, -3));
   simulation.step(0);
@@ -408,14 +468,17 @@ TEST(IntermediateRepresentation, NonFiniteToolsGiveZeroOrAreIgnored) {
   EXPECT_TRUE(own_nan.flags & kNonFinite);
   // An unknown remote leaves its nodes unloaded: the force of the own tool alone.
   const Eigen::Vector3d unknown(nan, nan, nan);
-  const ForceSample alone = testing::evaluate_static(prepared, mm(-20, 5, -4), std::span(&unknown, 1));
-  EXPECT_LE(relative_error(alone.force, reference_forces(model, simulation, {mm(-20, 5, -4)}, ContactModel::node_translation)[0]),
+  const ForceSample alone =
+      testing::evaluate_static(prepared, mm(-20, 5, -4), std::span(&unknown, 1));
+  EXPECT_LE(relative_error(alone.force, reference_forces(model, simulation, {mm(-20, 5, -4)},
+                                                         ContactModel::node_translation)[0]),
             1e-9);
 }
 
 TEST(IntermediateRepresentation, PrepareRejectsMalformedIrs) {
   Rig& rig = shared_cube();
-  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1), unlimited_options(ContactModel::node_translation));
+  Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(1),
+                        unlimited_options(ContactModel::node_translation));
   simulation.set_tool(0, mm(0, 0, -2));
   simulation.step(0);
   const IntermediateRepresentation good = simulation.ir(0)->ir;
@@ -423,10 +486,12 @@ TEST(IntermediateRepresentation, PrepareRejectsMalformedIrs) {
   condensed_fem(bad).m_tilde(0, 0) = std::numeric_limits<double>::infinity();
   EXPECT_THROW(prepare_ir(bad), Error);
   bad = good;
-  condensed_fem(bad).m_tilde.conservativeResize(condensed_fem(bad).m_tilde.rows() - 1, Eigen::NoChange);
+  condensed_fem(bad).m_tilde.conservativeResize(condensed_fem(bad).m_tilde.rows() - 1,
+                                                Eigen::NoChange);
   EXPECT_THROW(prepare_ir(bad), Error);
   bad = good;
-  condensed_fem(bad).m_tilde.leftCols(condensed_fem(bad).m_tilde.rows()) *= -1;  // not positive definite
+  condensed_fem(bad).m_tilde.leftCols(condensed_fem(bad).m_tilde.rows()) *=
+      -1;  // not positive definite
   EXPECT_THROW(prepare_ir(bad), Error);
   bad = good;
   condensed_fem(bad).patch[0].nodes[1] = condensed_fem(bad).node_count() + 5;

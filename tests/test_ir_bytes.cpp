@@ -33,14 +33,17 @@ TEST(IrBytes, CountsWhatEachOptionWouldSendOnARecording) {
   const std::vector<UserTool> users = {{0, tool, 0, nearest_touchable_triangle(body, tool), {}}};
   IncrementalCondensation condensation(*rig.columns, body.dofs);
   const auto build = [&](std::span<const Eigen::Vector3d> held, std::uint64_t epoch) {
-    return wire::to_wire(build_ir(body, condensation, users, 0, held, IrBuildOptions{}, epoch, 0.0));
+    return wire::to_wire(
+        build_ir(body, condensation, users, 0, held, IrBuildOptions{}, epoch, 0.0));
   };
   const wire::IntermediateRepresentation first = build({}, 1);
   const wire::IntermediateRepresentation again = build({}, 2);
   std::vector<bool> under_tool(static_cast<std::size_t>(body.mesh.node_count()), false);
-  for (int v : body.surface.triangles[users[0].nearest_triangle]) under_tool[static_cast<std::size_t>(v)] = true;
+  for (int v : body.surface.triangles[users[0].nearest_triangle])
+    under_tool[static_cast<std::size_t>(v)] = true;
   const std::vector<Eigen::Vector3d> around = {tool};
-  std::vector<int> held = nearest_surface_nodes(body.mesh, body.surface, body.dofs, around, 30, under_tool);
+  std::vector<int> held =
+      nearest_surface_nodes(body.mesh, body.surface, body.dofs, around, 30, under_tool);
   held.erase(held.begin(), held.begin() + 20);  // outside the patch: 10 held nodes
   condensation.set_boundary_nodes(held);
   const std::vector<Eigen::Vector3d> displacement(held.size(), Eigen::Vector3d(1e-4, 0, 0));
@@ -49,7 +52,8 @@ TEST(IrBytes, CountsWhatEachOptionWouldSendOnARecording) {
   const int k = static_cast<int>(held.size());
   ASSERT_EQ(more.fem().node_ids_size(), n + k);
 
-  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "ir_bytes_client.mcap";
+  const std::filesystem::path file =
+      std::filesystem::path(::testing::TempDir()) / "ir_bytes_client.mcap";
   {
     record::SessionRecorder recorder(file);
     record::SessionConfig config;
@@ -60,11 +64,13 @@ TEST(IrBytes, CountsWhatEachOptionWouldSendOnARecording) {
     recorder.ir(3'000'000'000, more);
     recorder.close();
   }
-  const std::filesystem::path frames = std::filesystem::path(::testing::TempDir()) / "ir_bytes_frames";
+  const std::filesystem::path frames =
+      std::filesystem::path(::testing::TempDir()) / "ir_bytes_frames";
   std::filesystem::remove_all(frames);
   const IrBytesRow row = measure_ir_bytes(file, body, *rig.columns, frames);
 
-  const double sizes[] = {static_cast<double>(first.ByteSizeLong()), static_cast<double>(again.ByteSizeLong()),
+  const double sizes[] = {static_cast<double>(first.ByteSizeLong()),
+                          static_cast<double>(again.ByteSizeLong()),
                           static_cast<double>(more.ByteSizeLong())};
   EXPECT_EQ(row.irs, 3u);
   EXPECT_DOUBLE_EQ(row.span_s, 2.0);
@@ -78,8 +84,10 @@ TEST(IrBytes, CountsWhatEachOptionWouldSendOnARecording) {
   // repeat, then the k new nodes' rows against all n + k nodes (each pair once), 8 bytes a value.
   const double whole = 9.0 * n * (n + 1) / 2;
   const double added = 9.0 * (k * (n + k) - k * (k - 1) / 2.0);
-  EXPECT_DOUBLE_EQ(row.rows_bytes, without_m_tilde(first) + 8 * whole + without_m_tilde(again) + without_m_tilde(more) + 8 * added);
-  EXPECT_DOUBLE_EQ(row.without_m_bytes, without_m_tilde(first) + without_m_tilde(again) + without_m_tilde(more));
+  EXPECT_DOUBLE_EQ(row.rows_bytes, without_m_tilde(first) + 8 * whole + without_m_tilde(again) +
+                                       without_m_tilde(more) + 8 * added);
+  EXPECT_DOUBLE_EQ(row.without_m_bytes,
+                   without_m_tilde(first) + without_m_tilde(again) + without_m_tilde(more));
   EXPECT_GT(row.rows_client_us_p50, 0);
   // The client's own condensation of L_AA gives the server's M~ (its incremental
   // condensation) to rounding: that way of sending changes no force.

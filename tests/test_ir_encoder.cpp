@@ -55,7 +55,8 @@ TEST(IrEncoder, SendsOnlyTheNewestOfAUsersWholeIrsAndRecordsEveryOne) {
     recorder.config(record::SessionConfig{});
     IrEncoder encoder(2, &recorder, statistics);
     // User 0's first IR, which starts its stream, is superseded by its second; user 1's stands.
-    std::vector<BuiltIr> irs{whole_in_stream(0, 1, true), whole_in_stream(1, 1, true), whole_in_stream(0, 2, false)};
+    std::vector<BuiltIr> irs{whole_in_stream(0, 1, true), whole_in_stream(1, 1, true),
+                             whole_in_stream(0, 2, false)};
     encoder.encode(irs, outbox);
     // User 0's stream goes on (block 2); then a new start (a new user of the slot, say)
     // superseded by the IR after it, which must begin the new stream in its place.
@@ -67,7 +68,8 @@ TEST(IrEncoder, SendsOnlyTheNewestOfAUsersWholeIrsAndRecordsEveryOne) {
   }
   ASSERT_EQ(later.irs.size(), 2u);
   EXPECT_EQ(later.irs[0].message.compressed_ir().index(), 2u);
-  EXPECT_EQ(later.irs[1].message.compressed_ir().index(), 1u) << "the superseded IR's fresh start passes on";
+  EXPECT_EQ(later.irs[1].message.compressed_ir().index(), 1u)
+      << "the superseded IR's fresh start passes on";
   {
     wire::IrStreamReader reader;
     EXPECT_EQ(reader.open(later.irs[1].message.compressed_ir()).epoch(), 5u);
@@ -75,7 +77,8 @@ TEST(IrEncoder, SendsOnlyTheNewestOfAUsersWholeIrsAndRecordsEveryOne) {
   ASSERT_EQ(outbox.irs.size(), 2u);
   EXPECT_EQ(outbox.irs[0].slot, 1);
   EXPECT_EQ(outbox.irs[1].slot, 0);
-  for (const auto& sent : outbox.irs) EXPECT_TRUE(sent.must_arrive) << "a stream's blocks must all arrive";
+  for (const auto& sent : outbox.irs)
+    EXPECT_TRUE(sent.must_arrive) << "a stream's blocks must all arrive";
   // Each opens a fresh stream: user 0's the one its superseded IR would have opened.
   for (const auto& [slot, epoch] : {std::pair{1, 1u}, std::pair{0, 2u}}) {
     const auto& sent = outbox.irs[slot == 1 ? 0 : 1].message.compressed_ir();
@@ -89,7 +92,8 @@ TEST(IrEncoder, SendsOnlyTheNewestOfAUsersWholeIrsAndRecordsEveryOne) {
 
   const record::Recording recording = record::read_recording(file);
   ASSERT_EQ(recording.irs.size(), 6u) << "every IR built is recorded, the superseded ones too";
-  const std::vector<std::pair<int, std::uint64_t>> recorded{{0, 1}, {1, 1}, {0, 2}, {0, 3}, {0, 4}, {0, 5}};
+  const std::vector<std::pair<int, std::uint64_t>> recorded{{0, 1}, {1, 1}, {0, 2},
+                                                            {0, 3}, {0, 4}, {0, 5}};
   for (std::size_t i = 0; i < recorded.size(); ++i) {
     EXPECT_FALSE(recording.irs[i].has_compressed_ir()) << "reading opened the block";
     EXPECT_EQ(recording.irs[i].ir().user(), static_cast<std::uint32_t>(recorded[i].first)) << i;
@@ -108,12 +112,14 @@ TEST(IrEncoder, ItsThreadSendsEveryRowsIrInOrder) {
     handed_over.push_back(std::move(outbox));
   });
   constexpr std::uint64_t kIrs = 40;
-  for (std::uint64_t epoch = 1; epoch <= kIrs; ++epoch) encoder.post({as_rows(0, epoch, epoch == 1)});
+  for (std::uint64_t epoch = 1; epoch <= kIrs; ++epoch)
+    encoder.post({as_rows(0, epoch, epoch == 1)});
   encoder.stop();
   wire::IrStreamReader reader;
   std::uint64_t expected = 1;
   for (const Outbox& outbox : handed_over)
-    for (const auto& sent : outbox.irs) EXPECT_EQ(reader.open(sent.message.compressed_ir()).epoch(), expected++);
+    for (const auto& sent : outbox.irs)
+      EXPECT_EQ(reader.open(sent.message.compressed_ir()).epoch(), expected++);
   EXPECT_EQ(expected, kIrs + 1) << "rows build on each other: none is superseded";
   EXPECT_EQ(statistics.summary().irs_superseded, 0u);
 }
@@ -126,7 +132,8 @@ TEST(Recording, LeavesOutABlockThatDoesNotFollowItsStream) {
     recorder.config(record::SessionConfig{});
     wire::IrStreamWriter writer;
     std::vector<wire::CompressedIr> blocks;
-    for (std::uint64_t epoch = 1; epoch <= 3; ++epoch) blocks.push_back(writer.compress(wire::to_wire(ir_of_epoch(0, epoch)->ir), epoch == 1));
+    for (std::uint64_t epoch = 1; epoch <= 3; ++epoch)
+      blocks.push_back(writer.compress(wire::to_wire(ir_of_epoch(0, epoch)->ir), epoch == 1));
     recorder.ir_block(1, 0, blocks[0]);
     recorder.ir_block(3, 0, blocks[2]);  // block 2 missing
     recorder.close();

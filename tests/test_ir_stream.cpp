@@ -17,8 +17,10 @@ namespace {
 // The IR fuzzer's seeds: real IRs of every body kind, recorded by tests/fuzz/make_seeds.sh.
 std::vector<wire::IntermediateRepresentation> seed_irs() {
   std::vector<wire::IntermediateRepresentation> irs;
-  for (const char* name : {"smallest", "sphere", "with_remote", "rows_first", "mass_spring", "home_spring", "separation"}) {
-    std::ifstream in(std::string(COHAPTIC_SOURCE_DIR) + "/tests/fuzz/corpus/ir/" + name, std::ios::binary);
+  for (const char* name : {"smallest", "sphere", "with_remote", "rows_first", "mass_spring",
+                           "home_spring", "separation"}) {
+    std::ifstream in(std::string(COHAPTIC_SOURCE_DIR) + "/tests/fuzz/corpus/ir/" + name,
+                     std::ios::binary);
     wire::IntermediateRepresentation ir;
     EXPECT_TRUE(ir.ParseFromIstream(&in)) << name;
     irs.push_back(std::move(ir));
@@ -35,12 +37,13 @@ TEST(IrStream, EveryIrComesOutBitForBitAndWhatRepeatsCostsLittle) {
     for (std::size_t i = 0; i < irs.size(); ++i) {
       const wire::CompressedIr block = writer.compress(irs[i], pass == 0 && i == 0);
       EXPECT_EQ(block.index(), static_cast<std::uint64_t>(pass * irs.size() + i + 1));
-      EXPECT_EQ(reader.open(block).SerializeAsString(), irs[i].SerializeAsString()) << "pass " << pass << ", IR " << i;
+      EXPECT_EQ(reader.open(block).SerializeAsString(), irs[i].SerializeAsString())
+          << "pass " << pass << ", IR " << i;
       (pass == 0 ? plain_first : plain_again) += irs[i].ByteSizeLong();
       (pass == 0 ? packed_first : packed_again) += block.zstd().size();
     }
-  std::printf("  %zu IRs: %zu -> %zu bytes the first time, %zu -> %zu again\n", irs.size(), plain_first, packed_first,
-              plain_again, packed_again);
+  std::printf("  %zu IRs: %zu -> %zu bytes the first time, %zu -> %zu again\n", irs.size(),
+              plain_first, packed_first, plain_again, packed_again);
   // The second time, every IR repeats one already in the window: a few bytes each.
   EXPECT_LT(packed_again, plain_again / 20);
   EXPECT_LT(packed_first, plain_first);
@@ -70,11 +73,15 @@ TEST(IrStream, RefusesBlocksOutOfTurnGarbageAndBombsUntilAFreshStart) {
     reader.open(third);
     ADD_FAILURE() << "a block out of turn was opened";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("block 3 of its stream, and this client opened block 1 last"), std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("block 3 of its stream, and this client opened block 1 last"),
+        std::string::npos)
         << e.what();
   }
-  EXPECT_THROW(reader.open(writer.compress(irs[3], false)), Error);  // nothing but a fresh start now
-  EXPECT_EQ(reader.open(writer.compress(irs[3], true)).SerializeAsString(), irs[3].SerializeAsString());
+  EXPECT_THROW(reader.open(writer.compress(irs[3], false)),
+               Error);  // nothing but a fresh start now
+  EXPECT_EQ(reader.open(writer.compress(irs[3], true)).SerializeAsString(),
+            irs[3].SerializeAsString());
 
   wire::CompressedIr garbage;
   garbage.set_index(1);
@@ -86,7 +93,8 @@ TEST(IrStream, RefusesBlocksOutOfTurnGarbageAndBombsUntilAFreshStart) {
   ZSTD_CCtx_setParameter(cctx, ZSTD_c_windowLog, wire::kIrStreamWindowLog);
   const std::string zeros(std::size_t{65} << 20, '\0');
   std::string bomb(std::size_t{1} << 20, '\0');
-  const std::size_t size = ZSTD_compress2(cctx, bomb.data(), bomb.size(), zeros.data(), zeros.size());
+  const std::size_t size =
+      ZSTD_compress2(cctx, bomb.data(), bomb.size(), zeros.data(), zeros.size());
   ZSTD_freeCCtx(cctx);
   ASSERT_FALSE(ZSTD_isError(size));
   bomb.resize(size);
@@ -97,7 +105,8 @@ TEST(IrStream, RefusesBlocksOutOfTurnGarbageAndBombsUntilAFreshStart) {
     reader.open(block);
     ADD_FAILURE() << "a bomb was opened";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("decompresses to more than"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("decompresses to more than"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -10,13 +10,15 @@
 namespace cohaptic {
 namespace {
 
-const char* const kLabTools[] = {"probe", "replay", "study", "tradeoff", "stability", "summarize", "keygen"};
+const char* const kLabTools[] = {"probe",     "replay",    "study", "tradeoff",
+                                 "stability", "summarize", "keygen"};
 
 TEST(LabProgram, EveryToolIsASubcommandWithItsOwnHelp) {
   const testing::ProgramRun help = testing::run_program(COHAPTIC_LAB_EXE, "--help");
   EXPECT_EQ(help.exit_code, 0);
   for (const std::string tool : kLabTools) {
-    EXPECT_NE(help.out.find("\n  " + tool + " "), std::string::npos) << tool << " missing from:\n" << help.out;
+    EXPECT_NE(help.out.find("\n  " + tool + " "), std::string::npos) << tool << " missing from:\n"
+                                                                     << help.out;
     const testing::ProgramRun own = testing::run_program(COHAPTIC_LAB_EXE, tool + " --help");
     EXPECT_EQ(own.exit_code, 0) << tool;
     EXPECT_NE(own.out.find("cohaptic-lab " + tool), std::string::npos) << own.out;
@@ -27,7 +29,8 @@ TEST(LabProgram, EveryToolIsASubcommandWithItsOwnHelp) {
 
 TEST(LabProgram, ALabToolNamedToTheServerFailsWithOneLineNamingTheLabCommand) {
   for (const std::string tool : kLabTools) {
-    for (const std::string& arguments : {tool + " --help", "--log-level warn " + tool + " --scene /no/such.yaml"}) {
+    for (const std::string& arguments :
+         {tool + " --help", "--log-level warn " + tool + " --scene /no/such.yaml"}) {
       const testing::ProgramRun run = testing::run_program(COHAPTIC_SERVER_EXE, arguments, true);
       EXPECT_EQ(run.exit_code, 2) << arguments << ": " << run.out;
       EXPECT_NE(run.out.find("run `cohaptic-lab " + tool + " ...`"), std::string::npos) << run.out;

@@ -39,9 +39,9 @@ TEST(PolynomialDeformation, MovesWithinTheRadiusAlongAP) {
   const PolynomialDent dent{Vector3d(0.01, 0.02, 0), Vector3d(0.012, 0.019, -0.006), radius};
   const Vector3d ap = dent.tool_point - dent.contact_point;
   Eigen::Matrix3Xd rest(3, 5);
-  rest.col(0) = dent.contact_point;                            // r = 0
-  rest.col(1) = dent.contact_point + Vector3d(radius / 2, 0, 0);  // r = R/2
-  rest.col(2) = dent.contact_point + Vector3d(0, radius, 0);      // r = R
+  rest.col(0) = dent.contact_point;                                                   // r = 0
+  rest.col(1) = dent.contact_point + Vector3d(radius / 2, 0, 0);                      // r = R/2
+  rest.col(2) = dent.contact_point + Vector3d(0, radius, 0);                          // r = R
   rest.col(3) = dent.contact_point + Vector3d(0, 0.6 * radius, 0.8 * radius * 1.01);  // beyond R
   rest.col(4) = dent.contact_point + Vector3d(0.3 * radius, 0.4 * radius, 0);         // r = R/2 too
   Eigen::Matrix3Xd deformed(3, 5);
@@ -53,14 +53,18 @@ TEST(PolynomialDeformation, MovesWithinTheRadiusAlongAP) {
   EXPECT_LT((deformed.col(4) - rest.col(4) - 0.75 * ap).norm(), 1e-17);
 }
 
-BernsteinLattice box_lattice() { return identity_lattice(Vector3d(-0.05, -0.04, -0.03), Vector3d(0.05, 0.06, 0.01)); }
+BernsteinLattice box_lattice() {
+  return identity_lattice(Vector3d(-0.05, -0.04, -0.03), Vector3d(0.05, 0.06, 0.01));
+}
 
 std::vector<Vector3d> random_points_in(const BernsteinLattice& lattice, int count, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0, 1);
   std::vector<Vector3d> points;
   for (int i = 0; i < count; ++i)
-    points.push_back(lattice.lo + Vector3d(unit(rng), unit(rng), unit(rng)).cwiseProduct(lattice.hi - lattice.lo));
+    points.push_back(
+        lattice.lo +
+        Vector3d(unit(rng), unit(rng), unit(rng)).cwiseProduct(lattice.hi - lattice.lo));
   return points;
 }
 
@@ -91,10 +95,12 @@ TEST(FreeFormDeformation, BindingEqualsTheTripleSum) {
   BernsteinLattice lattice = box_lattice();
   std::mt19937 rng(4);
   std::normal_distribution<double> jiggle(0, 0.01);
-  for (int c = 0; c < kLatticeControlPoints; ++c) lattice.control.col(c) += Vector3d(jiggle(rng), jiggle(rng), jiggle(rng));
+  for (int c = 0; c < kLatticeControlPoints; ++c)
+    lattice.control.col(c) += Vector3d(jiggle(rng), jiggle(rng), jiggle(rng));
   const std::vector<Vector3d> points = random_points_in(lattice, 200, 5);
   Eigen::Matrix3Xd rest(3, static_cast<Eigen::Index>(points.size()));
-  for (std::size_t i = 0; i < points.size(); ++i) rest.col(static_cast<Eigen::Index>(i)) = points[i];
+  for (std::size_t i = 0; i < points.size(); ++i)
+    rest.col(static_cast<Eigen::Index>(i)) = points[i];
   Eigen::Matrix3Xd deformed(3, rest.cols());
   deform_ffd(bind_to_lattice(lattice, rest), lattice.control, deformed);
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -104,8 +110,8 @@ TEST(FreeFormDeformation, BindingEqualsTheTripleSum) {
     for (int i3 = 0; i3 < 4; ++i3)
       for (int j3 = 0; j3 < 4; ++j3)
         for (int k3 = 0; k3 < 4; ++k3)
-          q += lattice.control.col(i3 + 4 * j3 + 16 * k3) * cubic_bernstein(uvw[0])[i3] * cubic_bernstein(uvw[1])[j3] *
-               cubic_bernstein(uvw[2])[k3];
+          q += lattice.control.col(i3 + 4 * j3 + 16 * k3) * cubic_bernstein(uvw[0])[i3] *
+               cubic_bernstein(uvw[1])[j3] * cubic_bernstein(uvw[2])[k3];
     EXPECT_LT((deformed.col(static_cast<Eigen::Index>(i)) - q).norm(), 1e-16);
   }
 }
@@ -134,7 +140,8 @@ TEST(DirectManipulation, Eq6EqualsTheSvdLeastSquaresSolution) {
   std::mt19937 rng(9);
   std::normal_distribution<double> shift(0, 0.003);
   for (const int m : {1, 2, 5, 20, 40, 100, 300}) {
-    const std::vector<Vector3d> points = random_points_in(lattice, m, static_cast<unsigned>(10 + m));
+    const std::vector<Vector3d> points =
+        random_points_in(lattice, m, static_cast<unsigned>(10 + m));
     Bases bases(kLatticeControlPoints, m);
     Eigen::Matrix3Xd displacements(3, m);
     for (int i = 0; i < m; ++i) {
@@ -193,11 +200,12 @@ TEST(DirectManipulation, DependentPointsAreRefused) {
 }
 
 /// Largest displacement of the sheet's vertices farther than `beyond` from `centre`.
-double far_motion(const Eigen::Matrix3Xd& rest, const Eigen::Matrix3Xd& deformed, const Vector3d& centre,
-                  double beyond) {
+double far_motion(const Eigen::Matrix3Xd& rest, const Eigen::Matrix3Xd& deformed,
+                  const Vector3d& centre, double beyond) {
   double largest = 0;
   for (Eigen::Index v = 0; v < rest.cols(); ++v)
-    if ((rest.col(v) - centre).norm() > beyond) largest = std::max(largest, (deformed.col(v) - rest.col(v)).norm());
+    if ((rest.col(v) - centre).norm() > beyond)
+      largest = std::max(largest, (deformed.col(v) - rest.col(v)).norm());
   return largest;
 }
 
@@ -210,7 +218,8 @@ TEST(TissueDisplay, BothMethodsLandPOnAThePolynomialLocallyEq7Globally) {
   const Vector3d p = sheet.vertices.col(centre);
   const Vector3d a = p + Vector3d(0.001, -0.0005, 0.006);  // the forceps pull up and aside
   std::map<DisplayDeformation, double> far;
-  for (const DisplayDeformation method : {DisplayDeformation::polynomial, DisplayDeformation::ffd_one_point}) {
+  for (const DisplayDeformation method :
+       {DisplayDeformation::polynomial, DisplayDeformation::ffd_one_point}) {
     const TissueDisplay display = make_tissue_display(sheet.vertices, radius, method);
     Eigen::Matrix3Xd deformed(3, sheet.vertices.cols());
     display_tissue(display, p, a, deformed);
@@ -221,30 +230,37 @@ TEST(TissueDisplay, BothMethodsLandPOnAThePolynomialLocallyEq7Globally) {
     EXPECT_EQ(at_rest, sheet.vertices);
   }
   EXPECT_EQ(far[DisplayDeformation::polynomial], 0.0);
-  EXPECT_GT(far[DisplayDeformation::ffd_one_point], 0.5 * (a - p).norm());  // Eq. 7 moves the whole tissue
+  EXPECT_GT(far[DisplayDeformation::ffd_one_point],
+            0.5 * (a - p).norm());  // Eq. 7 moves the whole tissue
 
   // Why the display offers no Eq. 6 with a pinned rim: holding eight points on a circle of
   // radius R about P (perpendicular to AP) still while P lands on A makes this coarse
   // lattice swing the far tissue more than Eq. 7 alone does.
-  const TissueDisplay display = make_tissue_display(sheet.vertices, radius, DisplayDeformation::ffd_one_point);
+  const TissueDisplay display =
+      make_tissue_display(sheet.vertices, radius, DisplayDeformation::ffd_one_point);
   constexpr int kRim = 8;
-  Eigen::Matrix<double, kLatticeControlPoints, Eigen::Dynamic> bases(kLatticeControlPoints, kRim + 1);
+  Eigen::Matrix<double, kLatticeControlPoints, Eigen::Dynamic> bases(kLatticeControlPoints,
+                                                                     kRim + 1);
   Eigen::Matrix3Xd wanted = Eigen::Matrix3Xd::Zero(3, kRim + 1);
   bases.col(0) = lattice_basis(display.lattice, p);
   wanted.col(0) = a - p;
   const Vector3d axis = (a - p).normalized(), e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
   for (int i = 0; i < kRim; ++i) {
     const double angle = 2 * std::numbers::pi * i / kRim;
-    bases.col(i + 1) = lattice_basis(display.lattice, p + radius * (std::cos(angle) * e1 + std::sin(angle) * e2));
+    bases.col(i + 1) =
+        lattice_basis(display.lattice, p + radius * (std::cos(angle) * e1 + std::sin(angle) * e2));
   }
   const LatticeControl pinned = display.lattice.control + least_squares_manipulation(bases, wanted);
-  EXPECT_LT((pinned * bases - (display.lattice.control * bases + wanted)).norm(), 1e-12);  // all nine land
+  EXPECT_LT((pinned * bases - (display.lattice.control * bases + wanted)).norm(),
+            1e-12);  // all nine land
   Eigen::Matrix3Xd deformed(3, sheet.vertices.cols());
   deform_ffd(display.binding, pinned, deformed);
-  EXPECT_GT(far_motion(sheet.vertices, deformed, p, 2 * radius), 2 * far[DisplayDeformation::ffd_one_point]);
+  EXPECT_GT(far_motion(sheet.vertices, deformed, p, 2 * radius),
+            2 * far[DisplayDeformation::ffd_one_point]);
 
   EXPECT_THROW(make_tissue_display(sheet.vertices, 0, DisplayDeformation::polynomial), Error);
-  EXPECT_THROW(make_tissue_display(Eigen::Matrix3Xd(3, 0), radius, DisplayDeformation::polynomial), Error);
+  EXPECT_THROW(make_tissue_display(Eigen::Matrix3Xd(3, 0), radius, DisplayDeformation::polynomial),
+               Error);
 }
 
 }  // namespace

@@ -34,8 +34,8 @@ HomeSpringPatch hexagon(double h, double jitter = 0, unsigned seed = 1) {
   patch.rest_positions.col(0).setZero();
   for (int j = 0; j < 6; ++j) {
     const double angle = j * std::numbers::pi / 3;
-    patch.rest_positions.col(j + 1) =
-        Vector3d(h * std::cos(angle), h * std::sin(angle), 0) + Vector3d(noise(rng), noise(rng), noise(rng));
+    patch.rest_positions.col(j + 1) = Vector3d(h * std::cos(angle), h * std::sin(angle), 0) +
+                                      Vector3d(noise(rng), noise(rng), noise(rng));
   }
   patch.contact_vertex_count = 1;
   patch.ring_offsets = {0, 6};
@@ -50,7 +50,8 @@ HomeSpringPatch hexagon(double h, double jitter = 0, unsigned seed = 1) {
 /// A patch that validates needs a triangle of touchable vertices: make the ring touchable.
 HomeSpringPatch touchable_hexagon(double h) {
   HomeSpringPatch patch = hexagon(h);
-  const VertexRings rings = vertex_rings(std::vector<Triangle>{{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}, {0, 5, 6}, {0, 6, 1}}, 7);
+  const VertexRings rings = vertex_rings(
+      std::vector<Triangle>{{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}, {0, 5, 6}, {0, 6, 1}}, 7);
   patch.contact_vertex_count = 7;
   patch.ring_offsets = rings.offsets;
   patch.ring_vertices = rings.vertices;
@@ -63,7 +64,8 @@ TEST(HomeSprings, FlatHexagonNormalForceClosedForm) {
   const HomeSpringPatch patch = hexagon(h);
   for (const double delta : {1e-5, 1e-4, 1e-3, 3e-3, 1e-2, -2e-3}) {
     const Vector3d load = home_spring_load(patch, 0, Vector3d(0, 0, -delta));
-    const double expected = kHome * delta + 6 * kNeighbour * delta * (1 - h / std::sqrt(h * h + delta * delta));
+    const double expected =
+        kHome * delta + 6 * kNeighbour * delta * (1 - h / std::sqrt(h * h + delta * delta));
     EXPECT_NEAR(-load.z(), expected, 1e-12 * std::abs(expected)) << "delta " << delta;
     EXPECT_NEAR(load.x(), 0, 1e-12 * std::abs(expected));
     EXPECT_NEAR(load.y(), 0, 1e-12 * std::abs(expected));
@@ -74,14 +76,14 @@ TEST(HomeSprings, IndentationStiffnessIsTheHomeSpring) {
   // The ring springs are perpendicular to a normal indentation: to first order only k1 acts.
   const HomeSpringPatch patch = hexagon(0.004);
   const double step = 1e-7;
-  const double stiffness =
-      (home_spring_load(patch, 0, Vector3d(0, 0, step)).z() - home_spring_load(patch, 0, Vector3d(0, 0, -step)).z()) /
-      (2 * step);
+  const double stiffness = (home_spring_load(patch, 0, Vector3d(0, 0, step)).z() -
+                            home_spring_load(patch, 0, Vector3d(0, 0, -step)).z()) /
+                           (2 * step);
   EXPECT_NEAR(stiffness, kHome, 1e-9 * kHome);
   // In the plane, each ring spring adds k2 cos^2 of its angle: 3 k2 in every direction.
-  const double shear =
-      (home_spring_load(patch, 0, Vector3d(step, 0, 0)).x() - home_spring_load(patch, 0, Vector3d(-step, 0, 0)).x()) /
-      (2 * step);
+  const double shear = (home_spring_load(patch, 0, Vector3d(step, 0, 0)).x() -
+                        home_spring_load(patch, 0, Vector3d(-step, 0, 0)).x()) /
+                       (2 * step);
   EXPECT_NEAR(shear, kHome + 3 * kNeighbour, 1e-6 * kHome);
 }
 
@@ -95,7 +97,8 @@ TEST(HomeSprings, LoadIsTheEnergyGradient) {
     Vector3d gradient;
     for (int axis = 0; axis < 3; ++axis) {
       const Vector3d e = step * Vector3d::Unit(axis);
-      gradient[axis] = (home_spring_energy(patch, 0, u + e) - home_spring_energy(patch, 0, u - e)) / (2 * step);
+      gradient[axis] =
+          (home_spring_energy(patch, 0, u + e) - home_spring_energy(patch, 0, u - e)) / (2 * step);
     }
     const Vector3d load = home_spring_load(patch, 0, u);
     EXPECT_LT((gradient - load).norm(), 1e-6 * load.norm()) << "u " << u.transpose();
@@ -136,7 +139,8 @@ TEST(HomeSprings, ClosedLoopsDoNoWork) {
     open += weight * home_spring_load(patch, 0, loop(i * h)).dot(tangent(i * h));
   }
   open *= h / 3;
-  const double difference = home_spring_energy(patch, 0, loop(std::numbers::pi)) - home_spring_energy(patch, 0, loop(0));
+  const double difference =
+      home_spring_energy(patch, 0, loop(std::numbers::pi)) - home_spring_energy(patch, 0, loop(0));
   EXPECT_NEAR(open, difference, 1e-9);
 }
 
@@ -149,7 +153,8 @@ TEST(HomeSprings, NeighbourOnTheVertexAddsNothingUndefined) {
 
 /// Eq. 8 written out from the paper, independently of the patch's rings: the neighbours of
 /// the sheet vertex nearest the contact are the vertices at one spacing from it.
-Vector3d independent_eq8(const TriangleSurface& sheet, double spacing, int vertex, const Vector3d& current) {
+Vector3d independent_eq8(const TriangleSurface& sheet, double spacing, int vertex,
+                         const Vector3d& current) {
   const Vector3d original = sheet.vertices.col(vertex);
   Vector3d total = kHome * (current - original);
   for (int j = 0; j < sheet.vertex_count(); ++j) {
@@ -166,8 +171,9 @@ TEST(HomeSprings, RandomPokesMatchEq8WrittenOut) {
   const TriangleSurface sheet = testing::equilateral_sheet(30, 30, spacing);
   const VertexRings rings = vertex_rings(sheet.triangles, sheet.vertex_count());
   const Vector3d pivot(0.01, -0.02, 0.12);
-  const PreparedHomeSpringPatch prepared = prepare_home_spring_patch(extract_home_spring_patch(
-      {sheet.vertices, sheet.triangles, rings}, Vector3d::Zero(), 0.02, {kHome, kNeighbour}, pivot));
+  const PreparedHomeSpringPatch prepared = prepare_home_spring_patch(
+      extract_home_spring_patch({sheet.vertices, sheet.triangles, rings}, Vector3d::Zero(), 0.02,
+                                {kHome, kNeighbour}, pivot));
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> across(-0.015, 0.015), depth(-0.008, 0.004);
   int touching = 0;
@@ -184,14 +190,17 @@ TEST(HomeSprings, RandomPokesMatchEq8WrittenOut) {
     if (p.head<2>().norm() > 0.0155) continue;  // near the patch's rim: coverage differs
     int nearest = 0;
     for (int v = 1; v < sheet.vertex_count(); ++v)
-      if ((sheet.vertices.col(v) - p).squaredNorm() < (sheet.vertices.col(nearest) - p).squaredNorm()) nearest = v;
+      if ((sheet.vertices.col(v) - p).squaredNorm() <
+          (sheet.vertices.col(nearest) - p).squaredNorm())
+        nearest = v;
     ASSERT_TRUE(contact.touching) << "tool " << tool.transpose();
     ++touching;
     EXPECT_EQ(prepared.patch.surface_vertex[static_cast<std::size_t>(contact.vertex)], nearest);
     EXPECT_LT((contact.contact_point - p).norm(), 1e-12);
     const Vector3d expected =
         -independent_eq8(sheet, spacing, nearest, sheet.vertices.col(nearest) + (tool - p));
-    EXPECT_LT((contact.force - expected).norm(), 1e-12 * (1 + expected.norm())) << "tool " << tool.transpose();
+    EXPECT_LT((contact.force - expected).norm(), 1e-12 * (1 + expected.norm()))
+        << "tool " << tool.transpose();
   }
   EXPECT_GT(touching, 500);
 }
@@ -203,17 +212,21 @@ TEST(HomeSprings, GraspedVertexFollowsTheTool) {
   const HomeSpringContact at_grasp = evaluate_home_spring(prepared, patch.grasp.tool_at_grasp);
   EXPECT_TRUE(at_grasp.touching);
   EXPECT_EQ(at_grasp.force, Vector3d::Zero());
-  const Vector3d pulled = patch.grasp.tool_at_grasp + Vector3d(0, 0, 0.005);  // well above the surface
+  const Vector3d pulled =
+      patch.grasp.tool_at_grasp + Vector3d(0, 0, 0.005);  // well above the surface
   const HomeSpringContact pull = evaluate_home_spring(prepared, pulled);
   EXPECT_EQ(pull.vertex, 0);
   const double h = 0.004, delta = 0.005;
-  EXPECT_NEAR(pull.force.z(), -(kHome * delta + 6 * kNeighbour * delta * (1 - h / std::sqrt(h * h + delta * delta))),
-              1e-12);
+  EXPECT_NEAR(
+      pull.force.z(),
+      -(kHome * delta + 6 * kNeighbour * delta * (1 - h / std::sqrt(h * h + delta * delta))),
+      1e-12);
 }
 
 TEST(HomeSprings, ToolThatIsNotFiniteTouchesNothing) {
   const PreparedHomeSpringPatch prepared = prepare_home_spring_patch(touchable_hexagon(0.004));
-  const HomeSpringContact contact = evaluate_home_spring(prepared, Vector3d(0, std::nan(""), -0.001));
+  const HomeSpringContact contact =
+      evaluate_home_spring(prepared, Vector3d(0, std::nan(""), -0.001));
   EXPECT_FALSE(contact.touching);
   EXPECT_EQ(contact.force, Vector3d::Zero());
   EXPECT_TRUE(evaluate_home_spring(prepared, Vector3d(0.0005, 0.0003, -0.001)).touching);
@@ -278,8 +291,9 @@ TEST(HomeSprings, ValidationNamesWhatIsWrong) {
 TEST(HomeSprings, ExtractedPatchHasFullRings) {
   const TriangleSurface sheet = testing::equilateral_sheet(20, 20, 0.003);
   const VertexRings rings = vertex_rings(sheet.triangles, sheet.vertex_count());
-  const HomeSpringPatch patch = extract_home_spring_patch({sheet.vertices, sheet.triangles, rings}, Vector3d::Zero(),
-                                                          0.01, {kHome, kNeighbour}, Vector3d(0, 0, 0.1));
+  const HomeSpringPatch patch =
+      extract_home_spring_patch({sheet.vertices, sheet.triangles, rings}, Vector3d::Zero(), 0.01,
+                                {kHome, kNeighbour}, Vector3d(0, 0, 0.1));
   EXPECT_GT(patch.contact_vertex_count, 30);
   for (int v = 0; v < patch.contact_vertex_count; ++v) {
     EXPECT_EQ(patch.ring(v).size(), 6u) << "vertex " << v;  // interior of the sheet: hexagons
@@ -287,9 +301,10 @@ TEST(HomeSprings, ExtractedPatchHasFullRings) {
       EXPECT_NEAR((patch.rest_positions.col(j) - patch.rest_positions.col(v)).norm(), 0.003, 1e-12);
   }
   EXPECT_GT(patch.vertex_count(), patch.contact_vertex_count);  // ring-only rim
-  EXPECT_THROW(extract_home_spring_patch({sheet.vertices, sheet.triangles, rings}, Vector3d(1, 1, 1), 0.01,
-                                         {kHome, kNeighbour}, Vector3d::Zero()),
-               Error);
+  EXPECT_THROW(
+      extract_home_spring_patch({sheet.vertices, sheet.triangles, rings}, Vector3d(1, 1, 1), 0.01,
+                                {kHome, kNeighbour}, Vector3d::Zero()),
+      Error);
 }
 
 }  // namespace

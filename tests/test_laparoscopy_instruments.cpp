@@ -45,8 +45,8 @@ struct Slab {
 };
 
 Slab make_slab(double centre, double thickness) {
-  Slab slab{make_box_mesh(Vector3d(centre - thickness / 2, -0.03, -0.03), Vector3d(thickness, 0.06, 0.03),
-                          Eigen::Vector3i(2, 12, 6)),
+  Slab slab{make_box_mesh(Vector3d(centre - thickness / 2, -0.03, -0.03),
+                          Vector3d(thickness, 0.06, 0.03), Eigen::Vector3i(2, 12, 6)),
             {}};
   slab.surface = extract_boundary_surface(slab.mesh);
   return slab;
@@ -66,7 +66,8 @@ TEST(Forceps, JawsStopWithinOneIncrementOfTheContactAngle) {
     const auto frame = shaft_frame(hinge + Vector3d(0, 0, 0.2), hinge, Vector3d::UnitX());
     ASSERT_TRUE(frame.has_value());
     ForcepsJaws jaws = open_forceps(geometry);
-    for (int step = 0; step < 400 && !jaws.grasping; ++step) step_forceps(geometry, *frame, true, tree, jaws);
+    for (int step = 0; step < 400 && !jaws.grasping; ++step)
+      step_forceps(geometry, *frame, true, tree, jaws);
     ASSERT_TRUE(jaws.grasping) << "offset " << offset;
     // Jaw k is first stopped by the slab's top corner at x = offset +- thickness/2, z = 0:
     // tan(angle) = |x_corner| / z_hinge.
@@ -111,10 +112,11 @@ TEST(Forceps, GraspHoldsUntilReleaseAndTheForceReturnsToZero) {
   const ForcepsJaws closed = jaws;
 
   // The server's side: the patch around the grasp point, the nearest vertex grasped.
-  const VertexRings rings = vertex_rings(slab.surface.triangles, static_cast<int>(slab.mesh.nodes.cols()));
+  const VertexRings rings =
+      vertex_rings(slab.surface.triangles, static_cast<int>(slab.mesh.nodes.cols()));
   const double k1 = 250, k2 = 80;
-  HomeSpringPatch patch = extract_home_spring_patch({slab.mesh.nodes, slab.surface.triangles, rings},
-                                                    jaws.grasp_point, 0.012, {k1, k2}, pivot);
+  HomeSpringPatch patch = extract_home_spring_patch(
+      {slab.mesh.nodes, slab.surface.triangles, rings}, jaws.grasp_point, 0.012, {k1, k2}, pivot);
   patch.grasp = {nearest_touchable_vertex(patch, jaws.grasp_point), jaws.tool_at_grasp};
   const PreparedHomeSpringPatch grasped = prepare_home_spring_patch(patch);
 

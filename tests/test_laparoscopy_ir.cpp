@@ -28,8 +28,9 @@ using testing::expect_refused;
 HomeSpringPatch sheet_patch() {
   const TriangleSurface sheet = testing::equilateral_sheet(24, 24, 0.003);
   const VertexRings rings = vertex_rings(sheet.triangles, sheet.vertex_count());
-  return extract_home_spring_patch({sheet.vertices, sheet.triangles, rings}, Vector3d(0.001, -0.002, 0), 0.015,
-                                   {300, 120}, Vector3d(0.01, -0.02, 0.12));
+  return extract_home_spring_patch({sheet.vertices, sheet.triangles, rings},
+                                   Vector3d(0.001, -0.002, 0), 0.015, {300, 120},
+                                   Vector3d(0.01, -0.02, 0.12));
 }
 
 IntermediateRepresentation envelope_of(HomeSpringPatch patch, double force_limit) {
@@ -64,7 +65,8 @@ void expect_same_patch(const HomeSpringPatch& a, const HomeSpringPatch& b) {
 TEST(LaparoscopyIr, WireRoundTripIsBitExact) {
   HomeSpringPatch patch = sheet_patch();
   expect_same_patch(received(envelope_of(patch, 5)), patch);
-  patch.grasp = {nearest_touchable_vertex(patch, Vector3d::Zero()), Vector3d(0.0004, 0.0002, -0.001)};
+  patch.grasp = {nearest_touchable_vertex(patch, Vector3d::Zero()),
+                 Vector3d(0.0004, 0.0002, -0.001)};
   expect_same_patch(received(envelope_of(patch, 5)), patch);
   const IntermediateRepresentation ir = envelope_of(patch, 5);
   EXPECT_GT(ir.size_bytes(), static_cast<std::size_t>(patch.vertex_count()) * 3 * sizeof(double));
@@ -108,14 +110,16 @@ void expect_client_equals_server(const HomeSpringPatch& patch, unsigned seed) {
 TEST(LaparoscopyIr, ClientEvaluatesWhatTheServerWould) {
   HomeSpringPatch patch = sheet_patch();
   expect_client_equals_server(patch, 3);
-  patch.grasp = {nearest_touchable_vertex(patch, Vector3d::Zero()), Vector3d(0.0004, 0.0002, -0.001)};
+  patch.grasp = {nearest_touchable_vertex(patch, Vector3d::Zero()),
+                 Vector3d(0.0004, 0.0002, -0.001)};
   expect_client_equals_server(patch, 4);
 }
 
 TEST(LaparoscopyIr, NonFiniteToolGivesZeroForce) {
   const PreparedIR client = prepare_ir(envelope_of(sheet_patch(), 5));
   EvaluationState state = make_evaluation_state(client);
-  const ForceSample sample = evaluate_force(client, state, Vector3d(0, std::nan(""), -0.001), {}, 1.0 / 2000);
+  const ForceSample sample =
+      evaluate_force(client, state, Vector3d(0, std::nan(""), -0.001), {}, 1.0 / 2000);
   EXPECT_EQ(sample.force, Vector3d::Zero());
   EXPECT_TRUE(sample.flags & kNonFinite);
 }
@@ -126,14 +130,16 @@ TEST(LaparoscopyIr, NonFiniteToolGivesZeroForce) {
 TEST(LaparoscopyIr, FuzzSeedsReachTheEvaluation) {
   const PreparedIR free = testing::prepared_ir_seed("home_spring");
   EvaluationState free_state = make_evaluation_state(free);
-  EXPECT_TRUE(evaluate_force(free, free_state, Vector3d(0.0005, 0.0003, -0.001), {}, 1e-3).flags & kInContact);
+  EXPECT_TRUE(evaluate_force(free, free_state, Vector3d(0.0005, 0.0003, -0.001), {}, 1e-3).flags &
+              kInContact);
   const PreparedIR grasped = testing::prepared_ir_seed("home_spring_grasped");
   const HomeSpringPatch& patch = std::get<HomeSpringPatch>(grasped.ir.body);
   EvaluationState state = make_evaluation_state(grasped);
   const double h = 0.004, delta = 0.005, k1 = 300, k2 = 120;
   const ForceSample pull =
       evaluate_force(grasped, state, patch.grasp.tool_at_grasp + Vector3d(0, 0, delta), {}, 1e-3);
-  EXPECT_NEAR(pull.force.z(), -(k1 * delta + 6 * k2 * delta * (1 - h / std::sqrt(h * h + delta * delta))), 1e-12);
+  EXPECT_NEAR(pull.force.z(),
+              -(k1 * delta + 6 * k2 * delta * (1 - h / std::sqrt(h * h + delta * delta))), 1e-12);
   EXPECT_NEAR(pull.force.head<2>().norm(), 0, 1e-12);
 }
 

@@ -45,8 +45,8 @@ struct LaparoscopyTick {
 std::vector<LaparoscopyTick> recorded_ticks(const record::Recording& recording) {
   std::vector<LaparoscopyTick> ticks;
   for (const record::HapticTick& t : recording.ticks)
-    ticks.push_back({wire::from_wire(t.own()), wire::from_wire(t.force()), wire::from_wire(t.evaluated()), t.ir_epoch(),
-                     static_cast<int>(t.flags())});
+    ticks.push_back({wire::from_wire(t.own()), wire::from_wire(t.force()),
+                     wire::from_wire(t.evaluated()), t.ir_epoch(), static_cast<int>(t.flags())});
   return ticks;
 }
 
@@ -58,18 +58,23 @@ nlohmann::json read_json(const fs::path& file) {
 TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
   const fs::path dir = testing::scratch_directory("e2e-laparoscopy");
   ChildProcess server(testing::server_program(),
-                      {"--scene", (kScenes / "tissue.yaml").string(), "--listen", "127.0.0.1:0", "--report",
-                       (dir / "server.json").string(), "--display", (dir / "display").string(), "--display-rate-hz", "20"},
+                      {"--scene", (kScenes / "tissue.yaml").string(), "--listen", "127.0.0.1:0",
+                       "--report", (dir / "server.json").string(), "--display",
+                       (dir / "display").string(), "--display-rate-hz", "20"},
                       dir / "server.log");
   ASSERT_TRUE(testing::wait_for_output(server, "listening on"));
   const int port = testing::listening_port(server.log_text());
-  const auto client = [&](const std::string& user, int slot, const std::string& script, std::vector<std::string> extra) {
-    std::vector<std::string> arguments = {"--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot",
-                                          std::to_string(slot), "--device", "script:" + (kScenes / script).string(),
-                                          "--report", (dir / (user + ".json")).string(), "--record",
-                                          (dir / (user + ".mcap")).string()};
+  const auto client = [&](const std::string& user, int slot, const std::string& script,
+                          std::vector<std::string> extra) {
+    std::vector<std::string> arguments = {"--server", fmt::format("127.0.0.1:{}", port),
+                                          "--user",   user,
+                                          "--slot",   std::to_string(slot),
+                                          "--device", "script:" + (kScenes / script).string(),
+                                          "--report", (dir / (user + ".json")).string(),
+                                          "--record", (dir / (user + ".mcap")).string()};
     arguments.insert(arguments.end(), extra.begin(), extra.end());
-    return std::make_unique<ChildProcess>(testing::client_program(), arguments, dir / (user + ".log"));
+    return std::make_unique<ChildProcess>(testing::client_program(), arguments,
+                                          dir / (user + ".log"));
   };
   const auto probe = client("prober", 0, "probe.yaml", {});
   const auto forceps = client("grasper", 1, "forceps.yaml", {"--rate-hz", "2000"});
@@ -82,10 +87,12 @@ TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
   // grasped vertex's while pulled 8.31 mm ((2, 1, 8) mm), (1 - r^2/R^2) of the pull for its
   // distance r to the grasp point (under 2.9 mm, a half cell's diagonal, so at least 97.9 %).
   const double pull_mm = std::sqrt(2.0 * 2 + 1 + 8 * 8);
-  const double displayed_mm = read_json(dir / "server.json")["server"]["max_surface_displacement_mm"].get<double>();
+  const double displayed_mm =
+      read_json(dir / "server.json")["server"]["max_surface_displacement_mm"].get<double>();
   EXPECT_LE(displayed_mm, pull_mm + 1e-9);
   EXPECT_GE(displayed_mm, 0.979 * pull_mm - 0.1) << "the 20 Hz frames catch the 1 s hold";
-  std::printf("  display: largest surface displacement %.3f mm (the pull: %.3f mm)\n", displayed_mm, pull_mm);
+  std::printf("  display: largest surface displacement %.3f mm (the pull: %.3f mm)\n", displayed_mm,
+              pull_mm);
   std::ifstream index(dir / "display" / "surface.pvd");
   const std::string pvd((std::istreambuf_iterator<char>(index)), std::istreambuf_iterator<char>());
   EXPECT_GT(std::count(pvd.begin(), pvd.end(), '\n'), 50) << "display frames listed in surface.pvd";
@@ -94,7 +101,8 @@ TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
     const record::Recording recording = record::read_recording(dir / (user + ".mcap"));
     std::map<std::uint64_t, std::unique_ptr<PreparedIR>> irs;
     for (const record::RecordedIr& recorded : recording.irs)
-      irs[recorded.ir().epoch()] = std::make_unique<PreparedIR>(prepare_ir(wire::from_wire(recorded.ir())));
+      irs[recorded.ir().epoch()] =
+          std::make_unique<PreparedIR>(prepare_ir(wire::from_wire(recorded.ir())));
     const std::vector<LaparoscopyTick> ticks = recorded_ticks(recording);
     ASSERT_GT(ticks.size(), 1000u) << user;
     int contact_ticks = 0, grasp_ticks = 0, pulled_back = 0;
@@ -112,7 +120,8 @@ TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
       ASSERT_TRUE(irs.count(t.epoch)) << user << ": IR " << t.epoch << " not recorded";
       const PreparedIR& ir = *irs.at(t.epoch);
       ASSERT_TRUE(std::holds_alternative<HomeSpringPatch>(ir.ir.body)) << user;
-      ASSERT_EQ(testing::evaluate_static(ir, t.own, {}).force, t.evaluated) << user << " tick " << i;
+      ASSERT_EQ(testing::evaluate_static(ir, t.own, {}).force, t.evaluated)
+          << user << " tick " << i;
       if (!(t.flags & kInContact)) continue;
       ++contact_ticks;
       peak = std::max(peak, t.evaluated.norm());
@@ -120,16 +129,19 @@ TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
       if (!grasp.active()) continue;
       ++grasp_ticks;
       const Eigen::Vector3d pull = t.own - grasp.tool_at_grasp;
-      if (pull.norm() > 0.002 && t.evaluated.dot(pull) < -0.5 * t.evaluated.norm() * pull.norm()) ++pulled_back;
+      if (pull.norm() > 0.002 && t.evaluated.dot(pull) < -0.5 * t.evaluated.norm() * pull.norm())
+        ++pulled_back;
     }
-    std::printf("  %s: %zu ticks, %d in contact, %d grasping (%d pulled back), peak %.3f N, %zu IRs\n", user.c_str(),
-                ticks.size(), contact_ticks, grasp_ticks, pulled_back, peak, irs.size());
+    std::printf(
+        "  %s: %zu ticks, %d in contact, %d grasping (%d pulled back), peak %.3f N, %zu IRs\n",
+        user.c_str(), ticks.size(), contact_ticks, grasp_ticks, pulled_back, peak, irs.size());
     EXPECT_GT(contact_ticks, 200) << user;
     EXPECT_GT(peak, 0.2) << user << " feels the tissue";
     // Each feels its own vertex's springs: the users do not couple, and the client says it
     // measured no coupling (the demo's health check then asks for none).
     EXPECT_FALSE(read_json(dir / (user + ".json"))["coupling_n"]["measured"].get<bool>()) << user;
-    EXPECT_EQ(read_json(dir / (user + ".json"))["fades"]["count"], 0) << user << ": the force faded while pushing";
+    EXPECT_EQ(read_json(dir / (user + ".json"))["fades"]["count"], 0)
+        << user << ": the force faded while pushing";
     if (user == "grasper") {
       EXPECT_GT(grasp_ticks, 500) << "the forceps grasped";
       EXPECT_GT(pulled_back, 200) << "the pull is pulled back";
@@ -141,9 +153,10 @@ TEST(LaparoscopySession, OneUserGraspsAndPullsTheOtherProbesAndEachFeelsItsIr) {
   // The rate is the machine's to keep (the figures go to the output, not into assertions).
   const nlohmann::json report = read_json(dir / "grasper.json");
   EXPECT_EQ(report["rate_setting_hz"].get<double>(), 2000);
-  std::printf("  grasper's haptic loop: set %.0f Hz, ran %.1f Hz, period p50 %.1f us, p99 %.1f us\n",
-              report["rate_setting_hz"].get<double>(), report["haptic_rate_hz"].get<double>(),
-              report["period_us"]["p50"].get<double>(), report["period_us"]["p99"].get<double>());
+  std::printf(
+      "  grasper's haptic loop: set %.0f Hz, ran %.1f Hz, period p50 %.1f us, p99 %.1f us\n",
+      report["rate_setting_hz"].get<double>(), report["haptic_rate_hz"].get<double>(),
+      report["period_us"]["p50"].get<double>(), report["period_us"]["p99"].get<double>());
 }
 
 }  // namespace

@@ -42,7 +42,9 @@ tools:
 haptic: {rate_hz: 1000, force_limit: 100}
 )";
 
-Scene tissue_scene(const std::string& text = kTissueScene) { return parse_scene(text, "tissue.yaml"); }
+Scene tissue_scene(const std::string& text = kTissueScene) {
+  return parse_scene(text, "tissue.yaml");
+}
 
 // Eq. 8 written out on the whole surface: the load holding `vertex` displaced by u, its
 // 1-ring taken from the triangles' edges here.
@@ -70,18 +72,21 @@ struct BruteCrossing {
 };
 
 // The first crossing of pivot -> tool over every triangle, and its triangle's nearest corner.
-BruteCrossing brute_force_crossing(const HomeSpringBody& body, const Vector3d& pivot, const Vector3d& tool) {
+BruteCrossing brute_force_crossing(const HomeSpringBody& body, const Vector3d& pivot,
+                                   const Vector3d& tool) {
   BruteCrossing best;
   double best_t = 2;
   for (const Triangle& tri : body.surface.triangles) {
-    const auto hit = segment_triangle_crossing(pivot, tool, body.surface.vertices.col(tri[0]), body.surface.vertices.col(tri[1]),
+    const auto hit = segment_triangle_crossing(pivot, tool, body.surface.vertices.col(tri[0]),
+                                               body.surface.vertices.col(tri[1]),
                                                body.surface.vertices.col(tri[2]));
     if (!hit || hit->t >= best_t) continue;
     best_t = hit->t;
     best.point = pivot + hit->t * (tool - pivot);
     best.vertex = tri[0];
     for (const int v : tri)
-      if ((body.surface.vertices.col(v) - best.point).norm() < (body.surface.vertices.col(best.vertex) - best.point).norm())
+      if ((body.surface.vertices.col(v) - best.point).norm() <
+          (body.surface.vertices.col(best.vertex) - best.point).norm())
         best.vertex = v;
   }
   return best;
@@ -129,7 +134,8 @@ TEST(LaparoscopyScene, LoadsTheTissueAndTheInstrumentsInSiUnits) {
 }
 
 TEST(LaparoscopyScene, TheShippedScenesLoad) {
-  const std::filesystem::path dir = std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes/laparoscopy";
+  const std::filesystem::path dir =
+      std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes/laparoscopy";
   const Model tissue = build_model(load_scene(dir / "tissue.yaml"));
   EXPECT_TRUE(std::holds_alternative<HomeSpringBody>(tissue.bodies[0]));
   const Model fem = build_model(load_scene(dir / "tissue_fem.yaml"));
@@ -144,48 +150,64 @@ TEST(LaparoscopyScene, TheShippedScenesLoad) {
 }
 
 TEST(LaparoscopyScene, ATissueFromAFreeSurferFileIsScaledToMetres) {
-  const std::filesystem::path data = std::filesystem::path(COHAPTIC_SOURCE_DIR) / "tests/data/mesh_io";
+  const std::filesystem::path data =
+      std::filesystem::path(COHAPTIC_SOURCE_DIR) / "tests/data/mesh_io";
   const Scene scene = parse_scene(
-      replaced(replaced(kTissueScene, "surface: {grid: {min: [-40, -40, 0], size: [80, 80], divisions: [20, 20]}}",
-                        "surface: {file: tet_surface.asc}"),
-               "patch_radius: 12", "patch_radius: 20"),
+      replaced(
+          replaced(kTissueScene,
+                   "surface: {grid: {min: [-40, -40, 0], size: [80, 80], divisions: [20, 20]}}",
+                   "surface: {file: tet_surface.asc}"),
+          "patch_radius: 12", "patch_radius: 20"),
       data / "tissue.yaml");
-  EXPECT_EQ(std::get<HomeSpringObjectSpec>(scene.objects[0].body).surface_file, data / "tet_surface.asc");
+  EXPECT_EQ(std::get<HomeSpringObjectSpec>(scene.objects[0].body).surface_file,
+            data / "tet_surface.asc");
   const Model model = build_model(scene);
   const auto& body = std::get<HomeSpringBody>(model.bodies[0]);
   ASSERT_EQ(body.surface.vertex_count(), 4);
   EXPECT_EQ(body.surface.vertices.col(1), Vector3d(0.0105, 0, 0));
   EXPECT_EQ(body.rings.ring(0).size(), 3u);
-  const std::string missing =
-      load_error(replaced(kTissueScene, "{grid: {min: [-40, -40, 0], size: [80, 80], divisions: [20, 20]}}", "{file: none.asc}"));
-  EXPECT_NE(missing.find("tissue.yaml:6: objects[0].surface.file: surface file"), std::string::npos) << missing;
+  const std::string missing = load_error(
+      replaced(kTissueScene, "{grid: {min: [-40, -40, 0], size: [80, 80], divisions: [20, 20]}}",
+               "{file: none.asc}"));
+  EXPECT_NE(missing.find("tissue.yaml:6: objects[0].surface.file: surface file"), std::string::npos)
+      << missing;
   EXPECT_NE(missing.find("none.asc"), std::string::npos) << missing;
 }
 
 TEST(LaparoscopyScene, MistakesAreNamedByFileLineAndKey) {
-  EXPECT_NE(load_error(replaced(kTissueScene, "{name: probe, shape: probe, trocar: [-60, 0, 120]}", "{name: probe, shape: probe}"))
+  EXPECT_NE(load_error(replaced(kTissueScene, "{name: probe, shape: probe, trocar: [-60, 0, 120]}",
+                                "{name: probe, shape: probe}"))
                 .find("tissue.yaml:11: tools[0]: missing required key 'trocar'"),
             std::string::npos)
-      << load_error(replaced(kTissueScene, "{name: probe, shape: probe, trocar: [-60, 0, 120]}", "{name: probe, shape: probe}"));
-  EXPECT_NE(load_error(replaced(kTissueScene, "trocar: [-60, 0, 120]}", "trocar: [-60, 0, 120], jaws: {length: 3}}"))
+      << load_error(replaced(kTissueScene, "{name: probe, shape: probe, trocar: [-60, 0, 120]}",
+                             "{name: probe, shape: probe}"));
+  EXPECT_NE(load_error(replaced(kTissueScene, "trocar: [-60, 0, 120]}",
+                                "trocar: [-60, 0, 120], jaws: {length: 3}}"))
                 .find("tissue.yaml:11: tools[0].jaws: a probe has no jaws"),
             std::string::npos);
-  EXPECT_NE(load_error(replaced(kTissueScene, "shape: probe, trocar", "shape: point, trocar")).find("tools[0].trocar: only an instrument"),
+  EXPECT_NE(load_error(replaced(kTissueScene, "shape: probe, trocar", "shape: point, trocar"))
+                .find("tools[0].trocar: only an instrument"),
             std::string::npos);
-  EXPECT_NE(load_error(replaced(kTissueScene, "open_angle_deg: 40", "open_angle_deg: 95")).find("tools[1].jaws.open_angle_deg"),
+  EXPECT_NE(load_error(replaced(kTissueScene, "open_angle_deg: 40", "open_angle_deg: 95"))
+                .find("tools[1].jaws.open_angle_deg"),
             std::string::npos);
-  EXPECT_NE(load_error(replaced(kTissueScene, "home: 100", "home: -1")).find("tissue.yaml:7: objects[0].stiffness.home"),
+  EXPECT_NE(load_error(replaced(kTissueScene, "home: 100", "home: -1"))
+                .find("tissue.yaml:7: objects[0].stiffness.home"),
             std::string::npos);
-  EXPECT_NE(load_error(replaced(kTissueScene, "surface: {grid:", "surface: {file: a.asc, grid:")).find("objects[0].surface: expected exactly one"),
+  EXPECT_NE(load_error(replaced(kTissueScene, "surface: {grid:", "surface: {file: a.asc, grid:"))
+                .find("objects[0].surface: expected exactly one"),
             std::string::npos);
-  EXPECT_NE(load_error(replaced(kTissueScene, "deformation: polynomial", "deformation: cubic")).find("objects[0].display.deformation"),
+  EXPECT_NE(load_error(replaced(kTissueScene, "deformation: polynomial", "deformation: cubic"))
+                .find("objects[0].display.deformation"),
             std::string::npos);
   // Caught when compiling: a patch smaller than a triangle.
   try {
     build_model(tissue_scene(replaced(kTissueScene, "patch_radius: 12", "patch_radius: 5")));
     ADD_FAILURE() << "a patch radius below the longest edge was accepted";
   } catch (const SceneError& e) {
-    EXPECT_NE(std::string(e.what()).find("tissue.yaml:4: objects[0].patch_radius"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("tissue.yaml:4: objects[0].patch_radius"),
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -216,7 +238,8 @@ TEST(HomeSpringSimulation, ProbeForceIsEq8AtTheVertexWhereTheShaftCrosses) {
     ASSERT_TRUE(simulation.pressing(0));
     const Vector3d expected = -eq8_load(body, crossing.vertex, tool - crossing.point);
     const Vector3d felt = simulation.force(0).force;
-    EXPECT_LT((felt - expected).norm(), 1e-12 * expected.norm()) << "poke " << poke << ": " << felt.transpose() << " against " << expected.transpose();
+    EXPECT_LT((felt - expected).norm(), 1e-12 * expected.norm())
+        << "poke " << poke << ": " << felt.transpose() << " against " << expected.transpose();
     EXPECT_GT(felt.z(), 0) << "pushed in, pushed back";
     const auto& patch = std::get<HomeSpringPatch>(simulation.ir(0)->ir.body);
     EXPECT_FALSE(patch.grasp.active());
@@ -318,33 +341,39 @@ TEST(HomeSpringSimulation, TheSceneChoosesTheDisplayDeformationLocalOrGlobal) {
   // the rim at rest; FFD (Eq. 7 on the lattice) moves the whole sheet, less far away.
   const Vector3d tool(0.001, 0.0005, -0.005);
   for (const std::string method : {"polynomial", "ffd"}) {
-    const Model model = build_model(tissue_scene(replaced(kTissueScene, "deformation: polynomial", "deformation: " + method)));
+    const Model model = build_model(
+        tissue_scene(replaced(kTissueScene, "deformation: polynomial", "deformation: " + method)));
     const auto& body = std::get<HomeSpringBody>(model.bodies[0]);
     HomeSpringSimulation simulation(body, 0, model.scene.tools, 100);
     simulation.set_tool(0, tool);
     simulation.step(0);
     ASSERT_TRUE(simulation.pressing(0));
-    const BruteCrossing crossing = brute_force_crossing(body, model.scene.tools[0].instrument->trocar, tool);
+    const BruteCrossing crossing =
+        brute_force_crossing(body, model.scene.tools[0].instrument->trocar, tool);
     const double pull = (tool - crossing.point).norm();
     const Eigen::VectorXd moved = (simulation.displayed() - body.surface.vertices).colwise().norm();
     const double corner = moved(0);  // vertex 0: the sheet's corner at (-40, -40) mm, 57 mm away
     EXPECT_LE(moved.maxCoeff(), pull * (1 + 1e-12)) << method;
     EXPECT_GT(moved(crossing.vertex), 0.5 * pull) << method;
-    if (method == "polynomial") EXPECT_EQ(corner, 0);
-    else EXPECT_GT(corner, 1e-6) << "FFD moves the whole tissue";
+    if (method == "polynomial")
+      EXPECT_EQ(corner, 0);
+    else
+      EXPECT_GT(corner, 1e-6) << "FFD moves the whole tissue";
   }
 }
 
 TEST(SceneSimulation, EachInstrumentGetsItsOwnPatchOnTheTissue) {
   const Model model = build_model(tissue_scene());
-  SceneSimulation simulation(model, std::vector<ComplianceColumns*>{nullptr}, model.scene.tools, SimulationOptions{});
+  SceneSimulation simulation(model, std::vector<ComplianceColumns*>{nullptr}, model.scene.tools,
+                             SimulationOptions{});
   simulation.set_tool(0, Vector3d(-0.01, 0.0, -0.003));
   simulation.set_tool(1, Vector3d(0.01, 0.0, -0.003));
   simulation.step(0);
   ASSERT_TRUE(simulation.ir_changed(0) && simulation.ir_changed(1));
   for (int user = 0; user < 2; ++user) {
     const auto& patch = std::get<HomeSpringPatch>(simulation.ir(user)->ir.body);
-    EXPECT_EQ(patch.trocar_pivot, model.scene.tools[static_cast<std::size_t>(user)].instrument->trocar);
+    EXPECT_EQ(patch.trocar_pivot,
+              model.scene.tools[static_cast<std::size_t>(user)].instrument->trocar);
     EXPECT_EQ(simulation.ir(user)->ir.user, user);
     EXPECT_TRUE(simulation.pressing(user));
     EXPECT_GT(simulation.force(user).force.z(), 0);
@@ -353,7 +382,8 @@ TEST(SceneSimulation, EachInstrumentGetsItsOwnPatchOnTheTissue) {
 
 TEST(SceneSimulation, ButtonZeroReachesTheForcepsAndClosesThem) {
   const Model model = build_model(tissue_scene());
-  SceneSimulation simulation(model, std::vector<ComplianceColumns*>{nullptr}, model.scene.tools, SimulationOptions{});
+  SceneSimulation simulation(model, std::vector<ComplianceColumns*>{nullptr}, model.scene.tools,
+                             SimulationOptions{});
   const Vector3d above(0.0012, -0.0007, 0.0085);
   const auto& tissue = std::get<HomeSpringSimulation>(simulation.body(0));
   double time = 0;

@@ -15,15 +15,18 @@ namespace {
 
 using testing::mm;
 
-const std::filesystem::path kLaparoscopy = std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes/laparoscopy";
+const std::filesystem::path kLaparoscopy =
+    std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes/laparoscopy";
 
 TEST(LaparoscopyTradeoff, HomeSpringRowIsMeasuredAgainstTheReferenceItIsGiven) {
   const Scene tissue = load_scene(kLaparoscopy / "tissue.yaml");
   const Scene fem = load_scene(kLaparoscopy / "tissue_fem.yaml");
   // Press, slide across a few vertices, release; the second tool pokes beside it.
   const std::vector<Trajectory> motions = {
-      Trajectory({0, 0.1, 0.3, 0.4}, {mm(-10, 5, 1), mm(-10, 5, -4), mm(-2, 5, -4), mm(-2, 5, 1)}, "probe"),
-      Trajectory({0, 0.1, 0.3, 0.4}, {mm(10, -5, 1), mm(10, -5, -3), mm(10, 1, -3), mm(10, 1, 1)}, "forceps")};
+      Trajectory({0, 0.1, 0.3, 0.4}, {mm(-10, 5, 1), mm(-10, 5, -4), mm(-2, 5, -4), mm(-2, 5, 1)},
+                 "probe"),
+      Trajectory({0, 0.1, 0.3, 0.4}, {mm(10, -5, 1), mm(10, -5, -3), mm(10, 1, -3), mm(10, 1, 1)},
+                 "forceps")};
   constexpr double kSampleRate = 10000;
   const ReferenceTrace twin = reference_trace(fem, motions, kSampleRate);
   const TradeoffRow row = run_home_spring_setting(tissue, motions, twin, 10, 10);
@@ -50,9 +53,12 @@ TEST(LaparoscopyTradeoff, HomeSpringRowIsMeasuredAgainstTheReferenceItIsGiven) {
   }
   const TradeoffRow self = run_home_spring_setting(tissue, motions, own, 10, 10);
   EXPECT_NEAR(self.error_rms, self.own_mesh_error_rms, 1e-12);
-  EXPECT_NEAR(self.own_mesh_error_rms * own.peak_force, row.own_mesh_error_rms * twin.peak_force, 1e-12);
-  std::printf("  home springs against the FEM twin: error %.1f %% (own model %.3f %%), peak %.3f N against %.3f N\n",
-              100 * row.error_rms, 100 * row.own_mesh_error_rms, own.peak_force, twin.peak_force);
+  EXPECT_NEAR(self.own_mesh_error_rms * own.peak_force, row.own_mesh_error_rms * twin.peak_force,
+              1e-12);
+  std::printf(
+      "  home springs against the FEM twin: error %.1f %% (own model %.3f %%), peak %.3f N against "
+      "%.3f N\n",
+      100 * row.error_rms, 100 * row.own_mesh_error_rms, own.peak_force, twin.peak_force);
 }
 
 }  // namespace

@@ -29,15 +29,17 @@
 namespace cohaptic {
 namespace {
 
-constexpr double kRadius = 0.005;            // the paper's geometry, as Table 1 implies (README)
+constexpr double kRadius = 0.005;  // the paper's geometry, as Table 1 implies (README)
 constexpr double kSpacing = 0.0022245;
-constexpr double kYoungsModulus = 737.4;     // [Pa]
+constexpr double kYoungsModulus = 737.4;  // [Pa]
 constexpr double kG = 9.81;
 
 TubeGeometry straight_tube(int sections, double radius = kRadius, double spacing = kSpacing) {
   TubeGeometry tube;
-  const double lift = radius * std::cos(std::numbers::pi / kRingNodes);  // resting on its flat bottom face
-  tube.centre_line = {Eigen::Vector3d(0, 0, lift), Eigen::Vector3d(spacing * (sections - 1), 0, lift)};
+  const double lift =
+      radius * std::cos(std::numbers::pi / kRingNodes);  // resting on its flat bottom face
+  tube.centre_line = {Eigen::Vector3d(0, 0, lift),
+                      Eigen::Vector3d(spacing * (sections - 1), 0, lift)};
   tube.radius = radius;
   tube.sections = sections;
   return tube;
@@ -63,7 +65,8 @@ TEST(MassSpringTube, NodeDegreesAreThoseOfFig7) {
   }
   auto count = [&](int node, bool centres) {
     int n = 0;
-    for (int other : neighbours[static_cast<std::size_t>(node)]) n += (other % kSectionNodes == 0) == centres;
+    for (int other : neighbours[static_cast<std::size_t>(node)])
+      n += (other % kSectionNodes == 0) == centres;
     return n;
   };
   for (int section = 1; section < 5; ++section) {
@@ -87,30 +90,38 @@ TEST(MassSpringTube, StiffnessIsGeldersFormulaByHand) {
   const double prism = 0.5 * r * r * std::sin(std::numbers::pi / 4) * h;
   const double chord = 2 * r * std::sin(std::numbers::pi / kRingNodes);
   const MassSpringNetwork network = tube_network(straight_tube(5), paper_material());
-  struct Case { int a, b; int prisms; double length; };
+  struct Case {
+    int a, b;
+    int prisms;
+    double length;
+  };
   const Case cases[] = {
-      {ring(2, 0), ring(2, 1), 2, chord},                          // ring edge: one prism each side
-      {ring(2, 0), ring(3, 0), 2, h},                              // longitudinal
-      {ring(2, 0), ring(3, 1), 1, std::hypot(chord, h)},           // diagonal
-      {centre(2), ring(2, 0), 4, r},                               // spoke
-      {centre(2), ring(3, 0), 2, std::hypot(r, h)},                // centre to the next ring
-      {centre(2), centre(3), 8, h},                                // centre to centre
-      {ring(0, 0), ring(0, 1), 1, chord},                          // ring edge at the end
+      {ring(2, 0), ring(2, 1), 2, chord},                 // ring edge: one prism each side
+      {ring(2, 0), ring(3, 0), 2, h},                     // longitudinal
+      {ring(2, 0), ring(3, 1), 1, std::hypot(chord, h)},  // diagonal
+      {centre(2), ring(2, 0), 4, r},                      // spoke
+      {centre(2), ring(3, 0), 2, std::hypot(r, h)},       // centre to the next ring
+      {centre(2), centre(3), 8, h},                       // centre to centre
+      {ring(0, 0), ring(0, 1), 1, chord},                 // ring edge at the end
   };
   for (const Case& c : cases) {
     const Spring& s = spring_between(network, c.a, c.b);
     EXPECT_NEAR(s.rest_length, c.length, 1e-12);
-    EXPECT_NEAR(s.stiffness, E * c.prisms * prism / (c.length * c.length), 1e-9 * s.stiffness) << c.a << "-" << c.b;
+    EXPECT_NEAR(s.stiffness, E * c.prisms * prism / (c.length * c.length), 1e-9 * s.stiffness)
+        << c.a << "-" << c.b;
     EXPECT_NEAR(s.damping, 1e-6 * s.stiffness, 1e-18);  // Eq. (2)
   }
   // Eq. (1) scales with E and, at a fixed shape, with size (volume / length^2).
   TubeMaterial stiffer = paper_material();
   stiffer.youngs_modulus *= 3;
   const MassSpringNetwork scaled_e = tube_network(straight_tube(5), stiffer);
-  const MassSpringNetwork doubled = tube_network(straight_tube(5, 2 * kRadius, 2 * kSpacing), paper_material());
+  const MassSpringNetwork doubled =
+      tube_network(straight_tube(5, 2 * kRadius, 2 * kSpacing), paper_material());
   for (std::size_t i = 0; i < network.springs.size(); ++i) {
-    EXPECT_NEAR(scaled_e.springs[i].stiffness, 3 * network.springs[i].stiffness, 1e-9 * network.springs[i].stiffness);
-    EXPECT_NEAR(doubled.springs[i].stiffness, 2 * network.springs[i].stiffness, 1e-9 * network.springs[i].stiffness);
+    EXPECT_NEAR(scaled_e.springs[i].stiffness, 3 * network.springs[i].stiffness,
+                1e-9 * network.springs[i].stiffness);
+    EXPECT_NEAR(doubled.springs[i].stiffness, 2 * network.springs[i].stiffness,
+                1e-9 * network.springs[i].stiffness);
   }
 }
 
@@ -130,7 +141,8 @@ TEST(MassSpringTube, ReproducesTable1AtThePapersGeometry) {
 
 TEST(MassSpringTube, MassIsDensityTimesVolumeAndTheSurfaceIsClosed) {
   const MassSpringNetwork network = tube_network(straight_tube(10), paper_material());
-  const double area = 0.5 * kRingNodes * kRadius * kRadius * std::sin(2 * std::numbers::pi / kRingNodes);  // octagon
+  const double area = 0.5 * kRingNodes * kRadius * kRadius *
+                      std::sin(2 * std::numbers::pi / kRingNodes);  // octagon
   const double volume = area * 9 * kSpacing;
   EXPECT_NEAR(network.mass.sum(), 9049 * volume, 1e-12);
   EXPECT_NEAR(enclosed_volume(network, network.rest_positions), volume, 1e-12 * volume);
@@ -161,7 +173,9 @@ TEST(MassSpringIntegrator, ConservesItsInvariantAndDoesNotDriftOnAHarmonicOscill
     const double x = state.positions(0, 1) - 1, v = state.velocities(0, 1);
     return v * v + omega * omega * x * x - h * omega * omega * x * v;
   };
-  auto energy = [&] { return kinetic_energy(network, state.velocities) + potential_energy(network, state.positions); };
+  auto energy = [&] {
+    return kinetic_energy(network, state.velocities) + potential_energy(network, state.positions);
+  };
   const double q0 = invariant();
   const int period_steps = static_cast<int>(std::round(2 * std::numbers::pi / (omega * h)));
   double first_period = 0, last_period = 0;
@@ -227,18 +241,22 @@ MassSpringNetwork hanging_chain(int count, double m, double k, double length) {
 
 double settle_and_sag(const MassSpringNetwork& network) {
   MassSpringState state = make_state(network);
-  for (int i = 0; i < 200000; ++i) step_network(network, state, {}, {}, network.parameters.time_step);
-  return network.rest_positions(2, network.node_count() - 1) - state.positions(2, network.node_count() - 1);
+  for (int i = 0; i < 200000; ++i)
+    step_network(network, state, {}, {}, network.parameters.time_step);
+  return network.rest_positions(2, network.node_count() - 1) -
+         state.positions(2, network.node_count() - 1);
 }
 
 TEST(MassSpringStatics, ChainSagsByTheClosedFormAndHeatingScalesItByTheInverseFactor) {
   const int count = 6;
   const double m = 0.001, k = 4;
   MassSpringNetwork chain = hanging_chain(count, m, k, 0.01);
-  const double expected = m * kG / k * count * (count + 1) / 2;  // spring i carries the weight below it
+  const double expected =
+      m * kG / k * count * (count + 1) / 2;  // spring i carries the weight below it
   EXPECT_NEAR(settle_and_sag(chain), expected, 1e-6 * expected);
 
-  HeatedRegion everywhere{Eigen::Vector3d::Constant(-1), Eigen::Vector3d::Constant(1), 40, 1.2e-4, 100};
+  HeatedRegion everywhere{Eigen::Vector3d::Constant(-1), Eigen::Vector3d::Constant(1), 40, 1.2e-4,
+                          100};
   const double factor = thermal_stiffness_factor(everywhere);
   ASSERT_NEAR(factor, 1 - 100 * 1.2e-4 * 40, 1e-15);
   MassSpringNetwork heated = chain;
@@ -258,7 +276,8 @@ TEST(MassSpringStatics, HeatingHalfATubeScalesExactlyTheSpringsInside) {
   const int heated = heat_springs(warm, half);
   int inside = 0;
   for (std::size_t s = 0; s < cold.springs.size(); ++s) {
-    const bool hot = cold.rest_positions(0, cold.springs[s].a) <= middle && cold.rest_positions(0, cold.springs[s].b) <= middle;
+    const bool hot = cold.rest_positions(0, cold.springs[s].a) <= middle &&
+                     cold.rest_positions(0, cold.springs[s].b) <= middle;
     inside += hot;
     EXPECT_DOUBLE_EQ(warm.springs[s].stiffness, (hot ? 0.7 : 1.0) * cold.springs[s].stiffness);
   }
@@ -270,7 +289,8 @@ MassSpringNetwork tube_on_plane(int sections, double density, const Eigen::Vecto
   MassSpringNetwork network = tube_network(straight_tube(sections), paper_material(density));
   network.parameters.gravity = gravity;
   network.parameters.node_damping = 0.007;
-  network.parameters.plane = SupportPlane{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.2};
+  network.parameters.plane =
+      SupportPlane{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.2};
   network.parameters.time_step = 0.5 * critical_time_step(network);
   return network;
 }
@@ -278,16 +298,19 @@ MassSpringNetwork tube_on_plane(int sections, double density, const Eigen::Vecto
 // The friction closed forms are a rigid block's without air drag: the tube 100 times stiffer
 // (its own wobble then negligible) and no nodal damping (-beta v acts like air drag).
 MassSpringNetwork rigid_tube_on_plane(int sections, const Eigen::Vector3d& gravity) {
-  MassSpringNetwork network = tube_network(straight_tube(sections), {100 * kYoungsModulus, 9049, 1e-3});
+  MassSpringNetwork network =
+      tube_network(straight_tube(sections), {100 * kYoungsModulus, 9049, 1e-3});
   network.parameters.gravity = gravity;
-  network.parameters.plane = SupportPlane{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.2};
+  network.parameters.plane =
+      SupportPlane{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.2};
   network.parameters.time_step = 0.5 * critical_time_step(network);
   return network;
 }
 
 void run(const MassSpringNetwork& network, MassSpringState& state, double seconds) {
   const int steps = static_cast<int>(std::round(seconds / network.parameters.time_step));
-  for (int i = 0; i < steps; ++i) step_network(network, state, {}, {}, network.parameters.time_step);
+  for (int i = 0; i < steps; ++i)
+    step_network(network, state, {}, {}, network.parameters.time_step);
 }
 
 Eigen::Vector3d centre_of_mass(const MassSpringNetwork& network, const MassSpringState& state) {
@@ -297,9 +320,9 @@ Eigen::Vector3d centre_of_mass(const MassSpringNetwork& network, const MassSprin
 // Gravity tilted by angle a from the plane's normal: tan a below mu_s holds, above slides
 // at g (sin a - mu_d cos a). The tilt grows over 0.3 s (quasi-statically: a sudden tilt
 // would load the elastic tube's contacts up to twice the static pull for a moment), then
-// the nodes on the plane must not move, or the centre of mass must move by v0 t + a t^2 / 2 over the next 0.2 s.
-// (Close below mu_s, at tan a = 0.45, the elastic tube creeps: its contact nodes do not
-// share the pull evenly, the most loaded slip and hand their load on.)
+// the nodes on the plane must not move, or the centre of mass must move by v0 t + a t^2 / 2 over
+// the next 0.2 s. (Close below mu_s, at tan a = 0.45, the elastic tube creeps: its contact nodes do
+// not share the pull evenly, the most loaded slip and hand their load on.)
 TEST(MassSpringFriction, StaysBelowTheStaticThresholdAndAcceleratesByTheDynamicLawAbove) {
   for (const double tilt : {0.3, 0.55, 0.8}) {  // tan of the tilt; mu_s = 0.5, mu_d = 0.2
     const double angle = std::atan(tilt);
@@ -327,7 +350,8 @@ TEST(MassSpringFriction, StaysBelowTheStaticThresholdAndAcceleratesByTheDynamicL
       double slid = 0;
       for (int n = 0; n < network.node_count(); ++n)
         if (settled.positions(2, n) <= kPlaneTouchTolerance)
-          slid = std::max(slid, (state.positions.col(n) - settled.positions.col(n)).head<2>().norm());
+          slid =
+              std::max(slid, (state.positions.col(n) - settled.positions.col(n)).head<2>().norm());
       EXPECT_LT(slid, 2e-6) << "tilt " << tilt;
       EXPECT_LT(std::abs(centre_of_mass(network, state).x() - rest.x()), 1e-4) << "tilt " << tilt;
     } else {
@@ -348,18 +372,23 @@ TEST(MassSpringFriction, ASlidingNodeFeelsTheDynamicLawUntilItCanStopAndANodeAtR
   bool sliding = false;
   // Sliding at a speed that mu_s F_n could stop within the step but mu_d F_n cannot.
   const double speed = 0.35 * load * h / m;
-  const Eigen::Vector3d slow = plane_reaction(plane, x, Eigen::Vector3d(speed, 0, 0), weight, m, h, sliding);
+  const Eigen::Vector3d slow =
+      plane_reaction(plane, x, Eigen::Vector3d(speed, 0, 0), weight, m, h, sliding);
   EXPECT_TRUE(sliding);
   EXPECT_NEAR(slow.x(), -0.2 * load, 1e-15);
   EXPECT_NEAR(slow.z(), load, 1e-15);
   // Slow enough for mu_d F_n to stop: stopped exactly.
-  const Eigen::Vector3d stopped = plane_reaction(plane, x, Eigen::Vector3d(0.1 * load * h / m, 0, 0), weight, m, h, sliding);
+  const Eigen::Vector3d stopped =
+      plane_reaction(plane, x, Eigen::Vector3d(0.1 * load * h / m, 0, 0), weight, m, h, sliding);
   EXPECT_FALSE(sliding);
   EXPECT_NEAR(stopped.x(), -0.1 * load, 1e-15);
   // At rest, pulled by 0.35 F_n: held; by 0.6 F_n: mu_s F_n against the pull.
-  const Eigen::Vector3d held = plane_reaction(plane, x, Eigen::Vector3d::Zero(), weight + Eigen::Vector3d(0.35 * load, 0, 0), m, h, sliding);
+  const Eigen::Vector3d held =
+      plane_reaction(plane, x, Eigen::Vector3d::Zero(), weight + Eigen::Vector3d(0.35 * load, 0, 0),
+                     m, h, sliding);
   EXPECT_NEAR(held.x(), -0.35 * load, 1e-15);
-  const Eigen::Vector3d broke = plane_reaction(plane, x, Eigen::Vector3d::Zero(), weight + Eigen::Vector3d(0.6 * load, 0, 0), m, h, sliding);
+  const Eigen::Vector3d broke = plane_reaction(
+      plane, x, Eigen::Vector3d::Zero(), weight + Eigen::Vector3d(0.6 * load, 0, 0), m, h, sliding);
   EXPECT_NEAR(broke.x(), -0.5 * load, 1e-15);
 }
 
@@ -388,9 +417,11 @@ TEST(MassSpringFriction, DroppedTubeFallsByHalfGTSquaredAndRestsOnThePlane) {
   state.positions.row(2).array() += 0.02;
   const double start = centre_of_mass(network, state).z();
   const int falling = static_cast<int>(std::round(0.05 / network.parameters.time_step));
-  for (int i = 0; i < falling; ++i) step_network(network, state, {}, {}, network.parameters.time_step);
+  for (int i = 0; i < falling; ++i)
+    step_network(network, state, {}, {}, network.parameters.time_step);
   const double t = falling * network.parameters.time_step;
-  EXPECT_NEAR(start - centre_of_mass(network, state).z(), 0.5 * kG * t * t, 0.01 * 0.5 * kG * t * t);
+  EXPECT_NEAR(start - centre_of_mass(network, state).z(), 0.5 * kG * t * t,
+              0.01 * 0.5 * kG * t * t);
   double lowest = 1;
   for (int i = 0; i < static_cast<int>(0.5 / network.parameters.time_step); ++i) {
     step_network(network, state, {}, {}, network.parameters.time_step);
@@ -407,7 +438,8 @@ TEST(MassSpringFriction, NoNodeGoesBelowThePlaneWhenDropped) {
   state.positions.row(2).array() += 0.02;
   // Tumbling: a spin about the tube's axis and a tilt, so that it lands unevenly.
   for (int n = 0; n < network.node_count(); ++n)
-    state.velocities.col(n) = Eigen::Vector3d(0, 0.3 * state.positions(2, n) / 0.02, -0.5 + 2 * state.positions(0, n));
+    state.velocities.col(n) =
+        Eigen::Vector3d(0, 0.3 * state.positions(2, n) / 0.02, -0.5 + 2 * state.positions(0, n));
   double lowest = 1;
   // Nodal damping -beta v holds this light tube's fall to about 4 cm/s: 1.5 s to land.
   const int steps = static_cast<int>(1.5 / network.parameters.time_step);
@@ -421,34 +453,40 @@ TEST(MassSpringFriction, NoNodeGoesBelowThePlaneWhenDropped) {
 
 TEST(MassSpringHaptic, Eq5PutsTheContactNodeOnItsCommandedPosition) {
   MassSpringNetwork network = tube_on_plane(6, 9049, Eigen::Vector3d(0, 0, -kG));
-  network.parameters.tool_friction = std::numeric_limits<double>::infinity();  // no slip: exactly on target
+  network.parameters.tool_friction =
+      std::numeric_limits<double>::infinity();  // no slip: exactly on target
   MassSpringState state = make_state(network);
   state.velocities.setRandom();
   state.velocities *= 0.01;
   const int node = ring(3, 1);  // on the upper side
-  NodeDrive drive{node, Eigen::Vector3d(state.positions.col(node)) + Eigen::Vector3d(0.0002, 0, -0.001),
+  NodeDrive drive{node,
+                  Eigen::Vector3d(state.positions.col(node)) + Eigen::Vector3d(0.0002, 0, -0.001),
                   Eigen::Vector3d(0, 0, 1)};
   Eigen::Vector3d applied;
-  step_network(network, state, std::span(&drive, 1), std::span(&applied, 1), network.parameters.time_step);
+  step_network(network, state, std::span(&drive, 1), std::span(&applied, 1),
+               network.parameters.time_step);
   EXPECT_LT((state.positions.col(node) - drive.target).norm(), 1e-15);
   EXPECT_LT(applied.z(), 0);  // pushed down
 
   // A mostly tangential command: the tangential force is capped at mu |normal force|.
   MassSpringState again = make_state(network);
-  const HapticNodeForce capped =
-      haptic_node_force(network.mass[node], again.positions.col(node), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
-                        Eigen::Vector3d(again.positions.col(node)) + Eigen::Vector3d(0.001, 0, -0.0001),
-                        Eigen::Vector3d::UnitZ(), 0.3, 1e-3);
+  const HapticNodeForce capped = haptic_node_force(
+      network.mass[node], again.positions.col(node), Eigen::Vector3d::Zero(),
+      Eigen::Vector3d::Zero(),
+      Eigen::Vector3d(again.positions.col(node)) + Eigen::Vector3d(0.001, 0, -0.0001),
+      Eigen::Vector3d::UnitZ(), 0.3, 1e-3);
   EXPECT_TRUE(capped.slipped);
-  EXPECT_NEAR(std::hypot(capped.force.x(), capped.force.y()), 0.3 * std::abs(capped.force.z()), 1e-15);
+  EXPECT_NEAR(std::hypot(capped.force.x(), capped.force.y()), 0.3 * std::abs(capped.force.z()),
+              1e-15);
 }
 
 TEST(MassSpringCollision, FaceSearchMatchesASecondClosestPointMethod) {
   std::mt19937 random(7);
   std::uniform_real_distribution<double> uniform(-1, 1);
   for (int i = 0; i < 2000; ++i) {
-    const Eigen::Vector3d a(uniform(random), uniform(random), uniform(random)), b(uniform(random), uniform(random), 0),
-        c(uniform(random), 0, uniform(random)), p(2 * uniform(random), 2 * uniform(random), 2 * uniform(random));
+    const Eigen::Vector3d a(uniform(random), uniform(random), uniform(random)),
+        b(uniform(random), uniform(random), 0), c(uniform(random), 0, uniform(random)),
+        p(2 * uniform(random), 2 * uniform(random), 2 * uniform(random));
     const Eigen::Vector3d ours = closest_point_on_face(p, a, b, c);
     const Eigen::Vector3d theirs = closest_point_on_triangle(p, a, b, c).point;
     EXPECT_NEAR((ours - p).norm(), (theirs - p).norm(), 1e-12);
@@ -460,20 +498,26 @@ TEST(MassSpringCollision, ConvexCornerOfFig8IsNoCollisionForTheFaceTest) {
   // The flat top face of section 2's octagon: ring nodes 7 and 0, at -22.5 and 22.5 degrees
   // from the vertical.
   const int a = ring(2, 7), b = ring(2, 0);
-  const Eigen::Vector3d midpoint = 0.5 * (network.rest_positions.col(a) + network.rest_positions.col(b));
+  const Eigen::Vector3d midpoint =
+      0.5 * (network.rest_positions.col(a) + network.rest_positions.col(b));
   const Eigen::Vector3d outward(0, 0, 1);
-  ASSERT_NEAR((network.rest_positions.col(a) - midpoint).dot(outward), 0, 1e-12);  // a flat top face
+  ASSERT_NEAR((network.rest_positions.col(a) - midpoint).dot(outward), 0,
+              1e-12);  // a flat top face
   // Just above the face, a little nearer node b than node a.
-  const Eigen::Vector3d tool = midpoint + 0.0002 * outward + 0.0003 * (network.rest_positions.col(b) - midpoint).normalized();
+  const Eigen::Vector3d tool = midpoint + 0.0002 * outward +
+                               0.0003 * (network.rest_positions.col(b) - midpoint).normalized();
   // The nearest-node test: (x_sn - x_h) . N_sn >= 0 with the node's radial normal.
-  const Eigen::Vector3d node_normal = (network.rest_positions.col(b) - network.rest_positions.col(centre(2))).normalized();
-  EXPECT_GE((network.rest_positions.col(b) - tool).dot(node_normal), 0) << "the nearest-node test collides";
+  const Eigen::Vector3d node_normal =
+      (network.rest_positions.col(b) - network.rest_positions.col(centre(2))).normalized();
+  EXPECT_GE((network.rest_positions.col(b) - tool).dot(node_normal), 0)
+      << "the nearest-node test collides";
   const SurfaceContact contact = find_surface_contact(network, network.rest_positions, tool, 0);
   EXPECT_EQ(contact.nearest_node, b);
   EXPECT_FALSE(contact.colliding);
   EXPECT_NEAR(contact.depth, -0.0002, 1e-12);
   // Pressed below the face, it collides.
-  EXPECT_TRUE(find_surface_contact(network, network.rest_positions, tool - 0.0004 * outward, 0).colliding);
+  EXPECT_TRUE(
+      find_surface_contact(network, network.rest_positions, tool - 0.0004 * outward, 0).colliding);
 }
 
 // The paper (Sec. 5) found the volume to change by at most 2 % without volume-conserving
@@ -502,7 +546,8 @@ TEST(MassSpringStatics, BentTubeKeepsItsVolumeWithinTwoPercent) {
   run(network, state, 1.2);
   for (int n : end_nodes(sections - 1)) state.velocities.col(n).setZero();
   run(network, state, 0.5);
-  const double middle = state.positions(1, centre(sections / 2)), left = state.positions(1, centre(0)),
+  const double middle = state.positions(1, centre(sections / 2)),
+               left = state.positions(1, centre(0)),
                right = state.positions(1, centre(sections - 1));
   EXPECT_NEAR(right - left, 0.012, 1e-5);
   // Friction on the plane holds the middle back: far off the straight chord's 6 mm.
@@ -524,10 +569,12 @@ TEST(MassSpringStatics, BentTubeKeepsItsVolumeWithinTwoPercent) {
 // 10.15 mm, ends 5.95 mm, volume ratio 0.9961, measured once).
 TEST(MassSpringStatics, TubeBentByAToolKeepsItsVolumeWithinTwoPercent) {
   const int sections = 20;
-  MassSpringNetwork network = tube_network(straight_tube(sections), {10 * kYoungsModulus, 9049, 1e-4});
+  MassSpringNetwork network =
+      tube_network(straight_tube(sections), {10 * kYoungsModulus, 9049, 1e-4});
   network.parameters.gravity = Eigen::Vector3d(0, 0, -kG);
   network.parameters.node_damping = 0.007;
-  network.parameters.plane = SupportPlane{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.2};
+  network.parameters.plane =
+      SupportPlane{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0.5, 0.2};
   network.parameters.tool_friction = 0.3;
   network.parameters.time_step = 0.5 * critical_time_step(network);
   MassSpringState state = make_state(network);
@@ -552,11 +599,14 @@ TEST(MassSpringStatics, TubeBentByAToolKeepsItsVolumeWithinTwoPercent) {
     in_contact += reaction[0].colliding;
   }
   const auto moved = [&](int node) { return state.positions(1, node) - start_y[node]; };
-  const double middle_moved = moved(middle), ends_moved = 0.5 * (moved(centre(0)) + moved(centre(sections - 1)));
+  const double middle_moved = moved(middle),
+               ends_moved = 0.5 * (moved(centre(0)) + moved(centre(sections - 1)));
   const double ratio = enclosed_volume(network, state.positions) / rest_volume;
-  std::printf("bent by a tool: middle moved %.2f mm, ends %.2f mm, largest force %.3f N, volume ratio %.4f, "
-              "%d periods in contact\n",
-              1e3 * middle_moved, 1e3 * ends_moved, largest, ratio, in_contact);
+  std::printf(
+      "bent by a tool: middle moved %.2f mm, ends %.2f mm, largest force %.3f N, volume ratio "
+      "%.4f, "
+      "%d periods in contact\n",
+      1e3 * middle_moved, 1e3 * ends_moved, largest, ratio, in_contact);
   EXPECT_GT(middle_moved, 0.009) << "the tool pushed the tube, it did not sink through it";
   EXPECT_LT(ends_moved, middle_moved - 0.001) << "the tube bent";
   EXPECT_GE(lowest, 0.0);

@@ -32,10 +32,13 @@
 namespace cohaptic {
 namespace {
 
-bool same_bits(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::memcmp(a.data(), b.data(), sizeof(double) * 3) == 0; }
+bool same_bits(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::memcmp(a.data(), b.data(), sizeof(double) * 3) == 0;
+}
 
 const Model& noodle_model() {
-  static const Model model = build_model(load_scene(testing::source_path("scenes/thin/noodle.yaml")));
+  static const Model model =
+      build_model(load_scene(testing::source_path("scenes/thin/noodle.yaml")));
   return model;
 }
 
@@ -45,7 +48,8 @@ const MassSpringModel& noodle() { return std::get<MassSpringModel>(noodle_model(
 int top_node(const MassSpringModel& body, int section) {
   int best = kSectionNodes * section + 1;
   for (int k = 1; k <= kRingNodes; ++k)
-    if (body.network.rest_positions(2, kSectionNodes * section + k) > body.network.rest_positions(2, best))
+    if (body.network.rest_positions(2, kSectionNodes * section + k) >
+        body.network.rest_positions(2, best))
       best = kSectionNodes * section + k;
   return best;
 }
@@ -58,7 +62,8 @@ TEST(MassSpringIr, CarriesTheSectionsAroundTheContactWithAHeldRim) {
   ASSERT_EQ(ir.node_count(), (2 * 4 + 1 + 2) * kSectionNodes);
   int held = 0;
   for (int i = 0; i < ir.node_count(); ++i) {
-    const int section = body.section_of_node[static_cast<std::size_t>(ir.node_ids[static_cast<std::size_t>(i)])];
+    const int section =
+        body.section_of_node[static_cast<std::size_t>(ir.node_ids[static_cast<std::size_t>(i)])];
     const bool rim = std::abs(section - middle) == 5;
     EXPECT_EQ(ir.held[static_cast<std::size_t>(i)] != 0, rim) << "local node " << i;
     held += ir.held[static_cast<std::size_t>(i)];
@@ -70,12 +75,14 @@ TEST(MassSpringIr, CarriesTheSectionsAroundTheContactWithAHeldRim) {
   for (const Spring& s : body.network.springs) body_springs[{s.a, s.b}] = &s;
   std::size_t inside = 0;
   for (const Spring& s : body.network.springs) {
-    const int a = body.section_of_node[static_cast<std::size_t>(s.a)], b = body.section_of_node[static_cast<std::size_t>(s.b)];
+    const int a = body.section_of_node[static_cast<std::size_t>(s.a)],
+              b = body.section_of_node[static_cast<std::size_t>(s.b)];
     inside += std::abs(a - middle) <= 5 && std::abs(b - middle) <= 5;
   }
   ASSERT_EQ(ir.springs.size(), inside);
   for (const Spring& s : ir.springs) {
-    const Spring* original = body_springs.at({ir.node_ids[static_cast<std::size_t>(s.a)], ir.node_ids[static_cast<std::size_t>(s.b)]});
+    const Spring* original = body_springs.at(
+        {ir.node_ids[static_cast<std::size_t>(s.a)], ir.node_ids[static_cast<std::size_t>(s.b)]});
     EXPECT_EQ(s.stiffness, original->stiffness);
     EXPECT_EQ(s.rest_length, original->rest_length);
     EXPECT_EQ(s.damping, original->damping);
@@ -84,7 +91,8 @@ TEST(MassSpringIr, CarriesTheSectionsAroundTheContactWithAHeldRim) {
   // At an end: no rim beyond it. Wider than the body: the whole network, nothing held.
   const MassSpringIr end = build_mass_spring_ir(body, state, top_node(body, 0), 4);
   EXPECT_EQ(end.node_count(), (4 + 1 + 1) * kSectionNodes);
-  const MassSpringIr whole = build_mass_spring_ir(body, state, top_node(body, middle), body.section_count);
+  const MassSpringIr whole =
+      build_mass_spring_ir(body, state, top_node(body, middle), body.section_count);
   EXPECT_EQ(whole.node_count(), body.network.node_count());
   EXPECT_EQ(whole.springs.size(), body.network.springs.size());
   EXPECT_EQ(whole.triangles.size(), body.network.triangles.size());
@@ -124,14 +132,16 @@ TEST(MassSpringIr, CrossesTheWireBitForBitAndABadSpringIsRefusedByName) {
     wire::from_wire(parsed);
     FAIL() << "a spring naming a node out of range was accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("spring 2 names node 100000"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("spring 2 names node 100000"), std::string::npos)
+        << e.what();
   }
 }
 
 // A tool of radius 2 mm over the top of the middle section, pressing down by `depth` [m]
 // over the first 0.1 s.
 Eigen::Vector3d pressing_tool(const MassSpringModel& body, double t, double depth) {
-  const Eigen::Vector3d top = body.network.rest_positions.col(top_node(body, body.section_count / 2));
+  const Eigen::Vector3d top =
+      body.network.rest_positions.col(top_node(body, body.section_count / 2));
   return top + Eigen::Vector3d(0, 0, 0.002 - depth * std::min(t / 0.1, 1.0));
 }
 
@@ -140,7 +150,8 @@ Eigen::Vector3d pressing_tool(const MassSpringModel& body, double t, double dept
 struct Lockstep {
   // The server advances by the test's tick, 1/1024 s: exact in binary, so its step times'
   // differences are exactly one tick.
-  explicit Lockstep(const MassSpringModel& body) : simulation(body, 0, {ToolSpec{"A", ToolShape::sphere, 0.002, {}}}, 3.3, 1.0 / 1024) {}
+  explicit Lockstep(const MassSpringModel& body)
+      : simulation(body, 0, {ToolSpec{"A", ToolShape::sphere, 0.002, {}}}, 3.3, 1.0 / 1024) {}
   MassSpringSimulation simulation;
   std::unique_ptr<PreparedIR> client;
   EvaluationState client_state;
@@ -158,7 +169,8 @@ struct Lockstep {
 
 TEST(MassSpringSimulation, ClientForceThroughTheWireIsTheServersP0ForceBitForBit) {
   Lockstep run(noodle());
-  const double dt = 1.0 / 1024;  // exact in binary: the server's periods t - t_previous are exactly dt
+  const double dt =
+      1.0 / 1024;  // exact in binary: the server's periods t - t_previous are exactly dt
   int compared = 0, in_contact = 0;
   double largest = 0;
   for (int tick = 0; tick < 400; ++tick) {
@@ -226,7 +238,8 @@ TEST(MassSpringSimulation, SubNetworkForceFollowsTheWholeNetwork) {
     }
     EXPECT_GT(largest, 1e-4) << "the tool pressed";
     EXPECT_LT(worst, 0.1 * largest) << sections << " sections";
-    std::printf("sections %d: largest force %.4g N, largest difference %.3g N\n", sections, largest, worst);
+    std::printf("sections %d: largest force %.4g N, largest difference %.3g N\n", sections, largest,
+                worst);
   }
 }
 
@@ -252,17 +265,22 @@ double rigid_slide(double v0, double friction_deceleration, double c, double h) 
 }
 
 struct DropAndSlide {
-  double fall = 0, expected_fall = 0, lowest = 0, landed_lowest = 0, landed_speed = 0, rest_offset = 0, slide = 0, expected_slide = 0, speed_after = 0;
+  double fall = 0, expected_fall = 0, lowest = 0, landed_lowest = 0, landed_speed = 0,
+         rest_offset = 0, slide = 0, expected_slide = 0, speed_after = 0;
 };
 
 // Dropped from 20 mm for 50 ms, then left 1 s to land; set on the plane at rest, pushed
 // along it at v0 = 0.2 m/s and left 1 s.
 DropAndSlide drop_and_slide(const MassSpringNetwork& network) {
   const double h = network.parameters.time_step, g = -network.parameters.gravity.z();
-  const double total_mass = network.mass.sum(), c = network.parameters.node_damping * network.node_count() / total_mass;
-  const auto centre_of_mass = [&](const MassSpringState& s) -> Eigen::Vector3d { return s.positions * network.mass / total_mass; };
+  const double total_mass = network.mass.sum(),
+               c = network.parameters.node_damping * network.node_count() / total_mass;
+  const auto centre_of_mass = [&](const MassSpringState& s) -> Eigen::Vector3d {
+    return s.positions * network.mass / total_mass;
+  };
   const auto run = [&](MassSpringState& s, double seconds) {
-    for (int i = 0; i < static_cast<int>(std::round(seconds / h)); ++i) step_network(network, s, {}, {}, h);
+    for (int i = 0; i < static_cast<int>(std::round(seconds / h)); ++i)
+      step_network(network, s, {}, {}, h);
   };
   DropAndSlide result;
   MassSpringState resting = make_state(network);
@@ -292,18 +310,21 @@ DropAndSlide drop_and_slide(const MassSpringNetwork& network) {
   result.slide = centre_of_mass(sliding).x() - x0;
   result.expected_slide = rigid_slide(v0, network.parameters.plane->dynamic_friction * g, c, h);
   result.speed_after = sliding.velocities.cwiseAbs().maxCoeff();
-  std::printf("fell %.4g mm in 50 ms (closed form %.4g); slid from %.2f m/s %.4g mm (closed form %.4g; without damping %.4g)\n",
-              result.fall * 1e3, result.expected_fall * 1e3, v0, result.slide * 1e3, result.expected_slide * 1e3,
-              v0 * v0 / (2 * network.parameters.plane->dynamic_friction * g) * 1e3);
+  std::printf(
+      "fell %.4g mm in 50 ms (closed form %.4g); slid from %.2f m/s %.4g mm (closed form %.4g; "
+      "without damping %.4g)\n",
+      result.fall * 1e3, result.expected_fall * 1e3, v0, result.slide * 1e3,
+      result.expected_slide * 1e3,
+      v0 * v0 / (2 * network.parameters.plane->dynamic_friction * g) * 1e3);
   return result;
 }
 
 // The scene's noodle falls as the rigid body does (its springs carry no load in free fall),
 // lands without a node below the plane and comes to rest on it (0.13 mm lower than the noodle
-// set down gently: the soft tube spreads on landing, and friction keeps its footprint). Sliding, the soft noodle
-// (E = 737 Pa: it sags to half its height under its own weight) goes 7 % further than a rigid
-// body, its upper part rolling on after its base stops; with its springs 100 times stiffer
-// (the step shortened to stay stable) it slides as the rigid body does.
+// set down gently: the soft tube spreads on landing, and friction keeps its footprint). Sliding,
+// the soft noodle (E = 737 Pa: it sags to half its height under its own weight) goes 7 % further
+// than a rigid body, its upper part rolling on after its base stops; with its springs 100 times
+// stiffer (the step shortened to stay stable) it slides as the rigid body does.
 TEST(MassSpringSimulation, NoodleSceneDroppedAndSlidFollowsTheRigidClosedForms) {
   const MassSpringNetwork& network = noodle().network;
   ASSERT_GT(network.parameters.node_damping, 0);
@@ -332,7 +353,8 @@ TEST(MassSpringSimulation, NoodleSceneDroppedAndSlidFollowsTheRigidClosedForms) 
 // A scripted tool driven through the server's simulation of `body` (the scene's tools, one
 // user): from `start` at `velocity` [m/s] for `seconds`, 1 ms periods. The whole network's
 // reaction on the tool each period.
-std::vector<Eigen::Vector3d> move_tool(MassSpringSimulation& simulation, double& time, const Eigen::Vector3d& start,
+std::vector<Eigen::Vector3d> move_tool(MassSpringSimulation& simulation, double& time,
+                                       const Eigen::Vector3d& start,
                                        const Eigen::Vector3d& velocity, double seconds) {
   std::vector<Eigen::Vector3d> forces;
   const int periods = static_cast<int>(std::round(seconds / 1e-3));
@@ -375,22 +397,26 @@ TEST(MassSpringSimulation, ToolPushingTheTubeAlongThePlaneFeelsItsSlidingFrictio
     const double radius = noodle_model().scene.tools[0].radius, speed = 0.02;
     const MassSpringNetwork& network = stiff.network;
     const double mass = network.mass.sum(), g = -network.parameters.gravity.z();
-    const double mu = network.parameters.plane->dynamic_friction, beta = network.parameters.node_damping;
+    const double mu = network.parameters.plane->dynamic_friction,
+                 beta = network.parameters.node_damping;
     const double axis = network.rest_positions(2, 0);  // section 0's centre node, on the end cap
     const Eigen::Vector3d start(-radius - 0.001, 0, axis), velocity(speed, 0, 0);
     const auto centre_x = [&] { return (simulation.state().positions * network.mass).x() / mass; };
     const std::vector<Eigen::Vector3d> starting = move_tool(simulation, time, start, velocity, 0.5);
     const double from = centre_x();
-    const std::vector<Eigen::Vector3d> forces = move_tool(simulation, time, start + 0.5 * velocity, velocity, 1.0);
+    const std::vector<Eigen::Vector3d> forces =
+        move_tool(simulation, time, start + 0.5 * velocity, velocity, 1.0);
     const double centre_speed = centre_x() - from;  // over 1 s
     for (const Eigen::Vector3d& f : starting) ASSERT_TRUE(f.allFinite());
     const Eigen::Vector3d mean = mean_of(forces);
     const double lift = -mean.z();
     const double expected = mu * (mass * g - lift) + beta * network.node_count() * speed;
-    std::printf("push along (alpha %g s): mean force on the tool %.4f %.4f %.4f N; mu_d (M g - L) + beta N v = %.4f N "
-                "(mu_d M g = %.4f, beta N v = %.4f, L = %.4f N); tube at %.2f mm/s\n",
-                alpha, mean.x(), mean.y(), mean.z(), expected, mu * mass * g, beta * network.node_count() * speed, lift,
-                1e3 * centre_speed);
+    std::printf(
+        "push along (alpha %g s): mean force on the tool %.4f %.4f %.4f N; mu_d (M g - L) + beta N "
+        "v = %.4f N "
+        "(mu_d M g = %.4f, beta N v = %.4f, L = %.4f N); tube at %.2f mm/s\n",
+        alpha, mean.x(), mean.y(), mean.z(), expected, mu * mass * g,
+        beta * network.node_count() * speed, lift, 1e3 * centre_speed);
     EXPECT_NEAR(-mean.x(), expected, 0.05 * expected);
     EXPECT_NEAR(centre_speed, speed, 0.01 * speed) << "the tube slides with the tool";
     EXPECT_LT(std::abs(mean.y()), 0.05 * expected);
@@ -430,14 +456,15 @@ TEST(MassSpringSimulation, TubeDraggedByItsEndFeelsItsSlidingFriction) {
     if (i < start) continue;
     internal_forces(network, state.positions, state.velocities, forces);
     for (int n = 0; n < kSectionNodes; ++n)  // the springs' pull on the held node, reversed
-      pull -= forces.col(n) - network.mass[n] * p.gravity + p.node_damping * state.velocities.col(n);
+      pull -=
+          forces.col(n) - network.mass[n] * p.gravity + p.node_damping * state.velocities.col(n);
   }
   pull /= steps - start;
   const double free_nodes = network.node_count() - kSectionNodes;
-  const double expected =
-      p.plane->dynamic_friction * (free_mass * -p.gravity.z() - pull.z()) + p.node_damping * free_nodes * speed;
-  std::printf("dragged by its end: pull %.4f %.4f %.4f N, mu_d (m g - L) + beta N v = %.4f N\n", pull.x(), pull.y(),
-              pull.z(), expected);
+  const double expected = p.plane->dynamic_friction * (free_mass * -p.gravity.z() - pull.z()) +
+                          p.node_damping * free_nodes * speed;
+  std::printf("dragged by its end: pull %.4f %.4f %.4f N, mu_d (m g - L) + beta N v = %.4f N\n",
+              pull.x(), pull.y(), pull.z(), expected);
   EXPECT_NEAR(pull.x(), expected, 0.05 * expected);
   EXPECT_LT(std::abs(pull.y()), 0.05 * expected);
 }
@@ -479,7 +506,8 @@ haptic: {rate_hz: 1000, force_limit: 3.3}
   };
   run_at(Eigen::Vector3d(0.02, 0.05, 0.03), 0.05);  // far above both
   EXPECT_EQ(simulation.ir(0), nullptr);
-  run_at(Eigen::Vector3d(0.02, 0.05, 0.0125), 0.05);  // just above the right one (its top at 9.2 mm)
+  run_at(Eigen::Vector3d(0.02, 0.05, 0.0125),
+         0.05);  // just above the right one (its top at 9.2 mm)
   EXPECT_EQ(simulation.body_of(0), 1);
   ASSERT_NE(simulation.ir(0), nullptr);
   run_at(Eigen::Vector3d(0.02, 0.05, 0.008), 0.05);  // pressing it

@@ -60,8 +60,8 @@ using testing::le32;
 using testing::le64;
 using testing::RawChunk;
 using testing::RawRecord;
-using testing::read_chunk;
 using testing::read_bytes;
+using testing::read_chunk;
 using testing::reference_crc;
 using testing::text;
 using testing::walk;
@@ -71,7 +71,10 @@ const std::string& kMagic = testing::kMcapMagicText;
 // Appends MCAP fields for hand-made files.
 struct Builder {
   Bytes out;
-  Builder& u8(std::uint8_t v) { out.push_back(v); return *this; }
+  Builder& u8(std::uint8_t v) {
+    out.push_back(v);
+    return *this;
+  }
   Builder& uint(std::uint64_t v, int width) {
     for (int i = 0; i < width; ++i) out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
     return *this;
@@ -167,15 +170,25 @@ McapMessage expected_message(const Channels& c, std::uint32_t i) {
   m.log_time_ns = kEpochNs + std::uint64_t{i} * 1'000'000;
   m.publish_time_ns = m.log_time_ns - 250'000;
   switch (i % 3) {
-    case 0: m.channel_id = c.tool; m.data = serialized(tool_sample(i)); break;
-    case 1: m.channel_id = c.datagram; m.data = serialized(datagram(i)); break;
-    default: m.channel_id = c.force; m.data = serialized(force_sample(i)); break;
+    case 0:
+      m.channel_id = c.tool;
+      m.data = serialized(tool_sample(i));
+      break;
+    case 1:
+      m.channel_id = c.datagram;
+      m.data = serialized(datagram(i));
+      break;
+    default:
+      m.channel_id = c.force;
+      m.data = serialized(force_sample(i));
+      break;
   }
   return m;
 }
 
 // Writes messages [first, first + count); ToolSample by the protobuf overload, the others as bytes.
-void write_messages(McapWriter& writer, const Channels& c, std::uint32_t first, std::uint32_t count) {
+void write_messages(McapWriter& writer, const Channels& c, std::uint32_t first,
+                    std::uint32_t count) {
   for (std::uint32_t i = first; i < first + count; ++i) {
     const McapMessage m = expected_message(c, i);
     if (i % 3 == 0) {
@@ -190,7 +203,8 @@ void write_messages(McapWriter& writer, const Channels& c, std::uint32_t first, 
 // depend on timing.
 const McapWriterOptions kSmallChunks{std::chrono::hours(1), 4096};
 
-Channels record_session(const fs::path& path, std::uint32_t count, McapWriterOptions options = kSmallChunks) {
+Channels record_session(const fs::path& path, std::uint32_t count,
+                        McapWriterOptions options = kSmallChunks) {
   McapWriter writer(path, options);
   const Channels c = open_channels(writer);
   write_messages(writer, c, 0, count);
@@ -211,7 +225,8 @@ void expect_error(F&& f, const std::vector<std::string>& parts) {
     f();
     ADD_FAILURE() << "no cohaptic::Error thrown";
   } catch (const Error& e) {
-    for (const auto& part : parts) EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    for (const auto& part : parts)
+      EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
   }
 }
 
@@ -219,7 +234,8 @@ void expect_error(F&& f, const std::vector<std::string>& parts) {
 
 TEST(McapCrc32, MatchesTheStandardCheckValueAndTheBitwiseDefinition) {
   const std::string check = "123456789";
-  EXPECT_EQ(crc32({reinterpret_cast<const std::uint8_t*>(check.data()), check.size()}), 0xCBF43926u);
+  EXPECT_EQ(crc32({reinterpret_cast<const std::uint8_t*>(check.data()), check.size()}),
+            0xCBF43926u);
   EXPECT_EQ(crc32({}), 0u);
   std::mt19937 rng(5);
   Bytes data(10007);
@@ -256,7 +272,8 @@ TEST(McapRoundTrip, SchemasChannelsAndThousandsOfMessages) {
       const auto tool = reader.parse<wire::ToolSample>(*m);
       ASSERT_TRUE(tool.has_value());
       EXPECT_EQ(tool->SerializeAsString(), tool_sample(i).SerializeAsString());
-      EXPECT_FALSE(reader.parse<wire::ForceSample>(*m).has_value()) << "a ToolSample channel parsed as ForceSample";
+      EXPECT_FALSE(reader.parse<wire::ForceSample>(*m).has_value())
+          << "a ToolSample channel parsed as ForceSample";
       ++tools;
     } else if (m->channel_id == c.datagram) {
       const auto d = reader.parse<wire::Datagram>(*m);
@@ -300,7 +317,8 @@ TEST(McapRoundTrip, SchemasChannelsAndThousandsOfMessages) {
   EXPECT_EQ(s.channel_count, 3u);
   const Bytes b = read_bytes(file);
   const std::vector<RawRecord> records = walk(b);
-  const auto chunks = std::count_if(records.begin(), records.end(), [](const RawRecord& r) { return r.opcode == 0x06; });
+  const auto chunks = std::count_if(records.begin(), records.end(),
+                                    [](const RawRecord& r) { return r.opcode == 0x06; });
   EXPECT_GT(chunks, 50) << "4 kB chunks";
   EXPECT_EQ(s.chunk_count, static_cast<std::uint32_t>(chunks));
   EXPECT_EQ(s.message_start_time_ns, kEpochNs);
@@ -312,7 +330,8 @@ TEST(McapRoundTrip, SchemasChannelsAndThousandsOfMessages) {
   const McapCrcCoverage& crc = reader.crc_coverage();
   EXPECT_EQ(crc.checked_messages, kCount);
   EXPECT_EQ(crc.unchecked_messages, 0u);
-  const auto data_end = std::find_if(records.begin(), records.end(), [](const RawRecord& r) { return r.opcode == 0x0F; });
+  const auto data_end = std::find_if(records.begin(), records.end(),
+                                     [](const RawRecord& r) { return r.opcode == 0x0F; });
   ASSERT_NE(data_end, records.end());
   EXPECT_EQ(crc.checked_through_offset, data_end->end());
   EXPECT_EQ(crc.checked_end_time_ns, s.message_end_time_ns);
@@ -358,14 +377,16 @@ TEST(McapLayout, ChunksIndexesSummaryAndFooterFollowTheSpec) {
   // End; summary: Schema, 2 Channels, Statistics, 2 Chunk Indexes; 4 Summary Offsets; Footer.
   std::vector<int> opcodes;
   for (const auto& record : r) opcodes.push_back(record.opcode);
-  EXPECT_EQ(opcodes, (std::vector<int>{0x01, 0x06, 0x07, 0x06, 0x07, 0x07, 0x0F, 0x03, 0x04, 0x04, 0x0B, 0x08, 0x08,
-                                       0x0E, 0x0E, 0x0E, 0x0E, 0x02}));
+  EXPECT_EQ(opcodes, (std::vector<int>{0x01, 0x06, 0x07, 0x06, 0x07, 0x07, 0x0F, 0x03, 0x04, 0x04,
+                                       0x0B, 0x08, 0x08, 0x0E, 0x0E, 0x0E, 0x0E, 0x02}));
   ASSERT_EQ(r.size(), 18u);
   EXPECT_EQ(r.back().end() + 8, b.size()) << "the Footer is followed by the magic and nothing else";
   const auto bytes_of = [&](std::size_t begin, std::size_t end) {
     return Bytes(b.begin() + static_cast<long>(begin), b.begin() + static_cast<long>(end));
   };
-  const auto record_bytes = [&](const RawRecord& record) { return bytes_of(record.offset, record.end()); };
+  const auto record_bytes = [&](const RawRecord& record) {
+    return bytes_of(record.offset, record.end());
+  };
 
   // Header: profile "", library "cohaptic"; outside any chunk, as the first record must be.
   EXPECT_EQ(r[0].offset, 8u);
@@ -384,7 +405,8 @@ TEST(McapLayout, ChunksIndexesSummaryAndFooterFollowTheSpec) {
   EXPECT_EQ(first.records_end, r[1].end()) << "the records fill the rest of the Chunk";
   EXPECT_EQ(first.uncompressed_size, first.records_end - first.records_begin);
   EXPECT_EQ(first.uncompressed_crc, reference_crc(b, first.records_begin, first.records_end));
-  const std::vector<RawRecord> in_first = testing::records_between(b, first.records_begin, first.records_end);
+  const std::vector<RawRecord> in_first =
+      testing::records_between(b, first.records_begin, first.records_end);
   ASSERT_EQ(in_first.size(), 4u);
   EXPECT_EQ(in_first.back().end(), first.records_end);
   EXPECT_EQ(in_first[0].opcode, 0x03);
@@ -434,17 +456,20 @@ TEST(McapLayout, ChunksIndexesSummaryAndFooterFollowTheSpec) {
 
   // Message Index: channel, then (log time, offset from the start of the chunk's records)
   // for each of its messages in the chunk.
-  const auto expect_index = [&](const RawRecord& index, std::uint16_t channel,
-                                const std::vector<std::pair<std::uint64_t, const RawRecord*>>& entries,
-                                const RawChunk& chunk) {
-    EXPECT_EQ(le16(b, index.content()), channel);
-    EXPECT_EQ(le32(b, index.content() + 2), entries.size() * 16);
-    EXPECT_EQ(index.length, 2 + 4 + entries.size() * 16);
-    for (std::size_t k = 0; k < entries.size(); ++k) {
-      EXPECT_EQ(le64(b, index.content() + 6 + 16 * k), entries[k].first) << "entry " << k;
-      EXPECT_EQ(le64(b, index.content() + 14 + 16 * k), entries[k].second->offset - chunk.records_begin) << "entry " << k;
-    }
-  };
+  const auto expect_index =
+      [&](const RawRecord& index, std::uint16_t channel,
+          const std::vector<std::pair<std::uint64_t, const RawRecord*>>& entries,
+          const RawChunk& chunk) {
+        EXPECT_EQ(le16(b, index.content()), channel);
+        EXPECT_EQ(le32(b, index.content() + 2), entries.size() * 16);
+        EXPECT_EQ(index.length, 2 + 4 + entries.size() * 16);
+        for (std::size_t k = 0; k < entries.size(); ++k) {
+          EXPECT_EQ(le64(b, index.content() + 6 + 16 * k), entries[k].first) << "entry " << k;
+          EXPECT_EQ(le64(b, index.content() + 14 + 16 * k),
+                    entries[k].second->offset - chunk.records_begin)
+              << "entry " << k;
+        }
+      };
   expect_index(r[2], 1, {{0x0102030405060708ull, &in_first[2]}, {2000, &in_first[3]}}, first);
 
   // The second Chunk: the channel added after the first flush, then its messages.
@@ -453,7 +478,8 @@ TEST(McapLayout, ChunksIndexesSummaryAndFooterFollowTheSpec) {
   EXPECT_EQ(second.message_start_time, 2500u);
   EXPECT_EQ(second.message_end_time, 3000u);
   EXPECT_EQ(second.uncompressed_crc, reference_crc(b, second.records_begin, second.records_end));
-  const std::vector<RawRecord> in_second = testing::records_between(b, second.records_begin, second.records_end);
+  const std::vector<RawRecord> in_second =
+      testing::records_between(b, second.records_begin, second.records_end);
   ASSERT_EQ(in_second.size(), 3u);
   EXPECT_EQ(in_second[0].opcode, 0x04);
   EXPECT_EQ(le16(b, in_second[0].content()), 2);
@@ -489,26 +515,29 @@ TEST(McapLayout, ChunksIndexesSummaryAndFooterFollowTheSpec) {
 
   // Chunk Index, one per chunk: its time range, where it is and how long, where each of its
   // Message Index records is and their length, compression and sizes.
-  const auto expect_chunk_index = [&](const RawRecord& index, const RawRecord& chunk_record, const RawChunk& chunk,
-                                      const std::vector<std::pair<std::uint16_t, const RawRecord*>>& indexes) {
-    at = index.content();
-    EXPECT_EQ(le64(b, at), chunk.message_start_time);
-    EXPECT_EQ(le64(b, at + 8), chunk.message_end_time);
-    EXPECT_EQ(le64(b, at + 16), chunk_record.offset) << "chunk_start_offset";
-    EXPECT_EQ(le64(b, at + 24), chunk_record.end() - chunk_record.offset) << "chunk_length, prefix included";
-    EXPECT_EQ(le32(b, at + 32), indexes.size() * 10) << "message_index_offsets byte length";
-    at += 36;
-    for (const auto& [channel, message_index] : indexes) {
-      EXPECT_EQ(le16(b, at), channel);
-      EXPECT_EQ(le64(b, at + 2), message_index->offset);
-      at += 10;
-    }
-    EXPECT_EQ(le64(b, at), indexes.back().second->end() - chunk_record.end()) << "message_index_length";
-    EXPECT_EQ(le32(b, at + 8), 0u) << "compression \"\"";
-    EXPECT_EQ(le64(b, at + 12), chunk.records_end - chunk.records_begin) << "compressed_size";
-    EXPECT_EQ(le64(b, at + 20), chunk.uncompressed_size) << "uncompressed_size";
-    EXPECT_EQ(at + 28, index.end());
-  };
+  const auto expect_chunk_index =
+      [&](const RawRecord& index, const RawRecord& chunk_record, const RawChunk& chunk,
+          const std::vector<std::pair<std::uint16_t, const RawRecord*>>& indexes) {
+        at = index.content();
+        EXPECT_EQ(le64(b, at), chunk.message_start_time);
+        EXPECT_EQ(le64(b, at + 8), chunk.message_end_time);
+        EXPECT_EQ(le64(b, at + 16), chunk_record.offset) << "chunk_start_offset";
+        EXPECT_EQ(le64(b, at + 24), chunk_record.end() - chunk_record.offset)
+            << "chunk_length, prefix included";
+        EXPECT_EQ(le32(b, at + 32), indexes.size() * 10) << "message_index_offsets byte length";
+        at += 36;
+        for (const auto& [channel, message_index] : indexes) {
+          EXPECT_EQ(le16(b, at), channel);
+          EXPECT_EQ(le64(b, at + 2), message_index->offset);
+          at += 10;
+        }
+        EXPECT_EQ(le64(b, at), indexes.back().second->end() - chunk_record.end())
+            << "message_index_length";
+        EXPECT_EQ(le32(b, at + 8), 0u) << "compression \"\"";
+        EXPECT_EQ(le64(b, at + 12), chunk.records_end - chunk.records_begin) << "compressed_size";
+        EXPECT_EQ(le64(b, at + 20), chunk.uncompressed_size) << "uncompressed_size";
+        EXPECT_EQ(at + 28, index.end());
+      };
   expect_chunk_index(r[11], r[1], first, {{1, &r[2]}});
   expect_chunk_index(r[12], r[3], second, {{1, &r[4]}, {2, &r[5]}});
 
@@ -567,21 +596,28 @@ TEST(McapSchema, TheDescriptorSetDecodesARecordedMessageWithoutTheGeneratedClass
   EXPECT_NE(type, wire::Datagram::descriptor()) << "not the generated class's descriptor";
   google::protobuf::DynamicMessageFactory factory(&pool);
   std::unique_ptr<google::protobuf::Message> message(factory.GetPrototype(type)->New());
-  ASSERT_TRUE(message->ParseFromArray(recorded->data.data(), static_cast<int>(recorded->data.size())));
+  ASSERT_TRUE(
+      message->ParseFromArray(recorded->data.data(), static_cast<int>(recorded->data.size())));
 
   const auto* reflection = message->GetReflection();
   const auto& header = reflection->GetMessage(*message, type->FindFieldByName("header"));
-  EXPECT_EQ(header.GetReflection()->GetUInt64(header, header.GetDescriptor()->FindFieldByName("sequence")), 10u);
-  EXPECT_EQ(header.GetReflection()->GetUInt64(header, header.GetDescriptor()->FindFieldByName("session")),
-            0x5e55'1000'0001u);
+  EXPECT_EQ(header.GetReflection()->GetUInt64(header,
+                                              header.GetDescriptor()->FindFieldByName("sequence")),
+            10u);
+  EXPECT_EQ(
+      header.GetReflection()->GetUInt64(header, header.GetDescriptor()->FindFieldByName("session")),
+      0x5e55'1000'0001u);
   const google::protobuf::FieldDescriptor* tool_field = type->FindFieldByName("tool");
   ASSERT_TRUE(reflection->HasField(*message, tool_field));
   const auto& tool = reflection->GetMessage(*message, tool_field);
-  const auto& position = tool.GetReflection()->GetMessage(tool, tool.GetDescriptor()->FindFieldByName("position"));
-  EXPECT_EQ(position.GetReflection()->GetDouble(position, position.GetDescriptor()->FindFieldByName("x")),
-            tool_sample(10).position().x());
-  EXPECT_EQ(position.GetReflection()->GetDouble(position, position.GetDescriptor()->FindFieldByName("z")),
-            tool_sample(10).position().z());
+  const auto& position =
+      tool.GetReflection()->GetMessage(tool, tool.GetDescriptor()->FindFieldByName("position"));
+  EXPECT_EQ(
+      position.GetReflection()->GetDouble(position, position.GetDescriptor()->FindFieldByName("x")),
+      tool_sample(10).position().x());
+  EXPECT_EQ(
+      position.GetReflection()->GetDouble(position, position.GetDescriptor()->FindFieldByName("z")),
+      tool_sample(10).position().z());
   EXPECT_EQ(message->SerializeAsString(), datagram(10).SerializeAsString());
 }
 
@@ -592,13 +628,16 @@ TEST(McapSchema, TheDescriptorSetHoldsEveryImportOnceBeforeItsImporters) {
   ASSERT_TRUE(set.ParseFromString(protobuf_schema_data(google::protobuf::Api::descriptor())));
   std::vector<std::string> names;
   for (const auto& f : set.file()) names.push_back(f.name());
-  EXPECT_EQ(std::set<std::string>(names.begin(), names.end()),
-            (std::set<std::string>{"google/protobuf/api.proto", "google/protobuf/type.proto",
-                                   "google/protobuf/source_context.proto", "google/protobuf/any.proto"}));
+  EXPECT_EQ(
+      std::set<std::string>(names.begin(), names.end()),
+      (std::set<std::string>{"google/protobuf/api.proto", "google/protobuf/type.proto",
+                             "google/protobuf/source_context.proto", "google/protobuf/any.proto"}));
   EXPECT_EQ(names.size(), 4u) << "each file once";
   EXPECT_EQ(names.back(), "google/protobuf/api.proto");
-  google::protobuf::DescriptorPool pool;  // BuildFile fails on a file whose imports are not built yet
-  for (const auto& f : set.file()) ASSERT_NE(pool.BuildFile(f), nullptr) << f.name() << " before its imports";
+  google::protobuf::DescriptorPool
+      pool;  // BuildFile fails on a file whose imports are not built yet
+  for (const auto& f : set.file())
+    ASSERT_NE(pool.BuildFile(f), nullptr) << f.name() << " before its imports";
   EXPECT_NE(pool.FindMessageTypeByName("google.protobuf.Api"), nullptr);
 }
 
@@ -609,11 +648,12 @@ TEST(McapSchema, TheDescriptorSetHoldsEveryImportOnceBeforeItsImporters) {
 // Chunk, or themselves outside chunks) is complete before it; the readable prefix ends with
 // the last complete record; and crc_coverage() counts them as checked when a Chunk's CRC
 // covers them (or Data End's, once the cut leaves it), as unchecked otherwise.
-void expect_every_cut_yields_the_messages_complete_before_it(const fs::path& dir, const Bytes& b,
-                                                             const std::vector<McapMessage>& expected) {
+void expect_every_cut_yields_the_messages_complete_before_it(
+    const fs::path& dir, const Bytes& b, const std::vector<McapMessage>& expected) {
   const std::vector<RawRecord> records = walk(b);
   std::vector<std::size_t> readable_from;
-  for (const testing::RawMessage& m : testing::messages_of(b)) readable_from.push_back(m.readable_from);
+  for (const testing::RawMessage& m : testing::messages_of(b))
+    readable_from.push_back(m.readable_from);
   ASSERT_EQ(readable_from.size(), expected.size());
   std::vector<std::size_t> record_ends = {8};
   std::vector<std::size_t> chunk_ends = {0};
@@ -624,7 +664,8 @@ void expect_every_cut_yields_the_messages_complete_before_it(const fs::path& dir
   record_ends.push_back(b.size());
   const bool chunked = chunk_ends.size() > 1;
   const auto first_of = [&](int opcode) {
-    return std::find_if(records.begin(), records.end(), [&](const RawRecord& r) { return r.opcode == opcode; });
+    return std::find_if(records.begin(), records.end(),
+                        [&](const RawRecord& r) { return r.opcode == opcode; });
   };
   ASSERT_NE(first_of(0x0F), records.end());
   const RawRecord data_end = *first_of(0x0F);
@@ -650,9 +691,10 @@ void expect_every_cut_yields_the_messages_complete_before_it(const fs::path& dir
     if (cut > b.size()) continue;
     fs::resize_file(cut_file, cut);
     SCOPED_TRACE("cut at byte " + std::to_string(cut) + " of " + std::to_string(b.size()));
-    const std::size_t complete_messages =
-        static_cast<std::size_t>(std::upper_bound(readable_from.begin(), readable_from.end(), cut) - readable_from.begin());
-    const std::size_t valid = cut < 8 ? 0 : *(std::upper_bound(record_ends.begin(), record_ends.end(), cut) - 1);
+    const std::size_t complete_messages = static_cast<std::size_t>(
+        std::upper_bound(readable_from.begin(), readable_from.end(), cut) - readable_from.begin());
+    const std::size_t valid =
+        cut < 8 ? 0 : *(std::upper_bound(record_ends.begin(), record_ends.end(), cut) - 1);
 
     McapReader reader(cut_file);
     std::vector<McapMessage> got = read_all(reader);
@@ -672,11 +714,13 @@ void expect_every_cut_yields_the_messages_complete_before_it(const fs::path& dir
       coverage.checked_through_offset = data_end.end();
     } else if (chunked) {
       coverage.checked_messages = complete_messages;
-      coverage.checked_through_offset = *(std::upper_bound(chunk_ends.begin(), chunk_ends.end(), cut) - 1);
+      coverage.checked_through_offset =
+          *(std::upper_bound(chunk_ends.begin(), chunk_ends.end(), cut) - 1);
     } else {
       coverage.unchecked_messages = complete_messages;
     }
-    if (coverage.checked_messages > 0) coverage.checked_end_time_ns = expected[coverage.checked_messages - 1].log_time_ns;
+    if (coverage.checked_messages > 0)
+      coverage.checked_end_time_ns = expected[coverage.checked_messages - 1].log_time_ns;
     ASSERT_EQ(reader.crc_coverage(), coverage);
     ++checked;
   }
@@ -701,16 +745,22 @@ TEST(McapTruncation, EveryCutOfAChunkedFileYieldsExactlyTheMessagesOfItsComplete
   // The descriptions say where the file ends: inside the fifth chunk, or right after it.
   const std::vector<RawRecord> records = walk(b);
   std::vector<RawRecord> chunks;
-  std::copy_if(records.begin(), records.end(), std::back_inserter(chunks), [](const RawRecord& r) { return r.opcode == 0x06; });
+  std::copy_if(records.begin(), records.end(), std::back_inserter(chunks),
+               [](const RawRecord& r) { return r.opcode == 0x06; });
   ASSERT_GT(chunks.size(), 10u);
   const fs::path cut_file = dir / "cut.mcap";
-  const auto cut_copy = [&](std::size_t n) { write_bytes(cut_file, Bytes(b.begin(), b.begin() + static_cast<long>(n))); };
-  const std::size_t in_first_four = testing::messages_of(Bytes(b.begin(), b.begin() + static_cast<long>(chunks[4].offset))).size();
+  const auto cut_copy = [&](std::size_t n) {
+    write_bytes(cut_file, Bytes(b.begin(), b.begin() + static_cast<long>(n)));
+  };
+  const std::size_t in_first_four =
+      testing::messages_of(Bytes(b.begin(), b.begin() + static_cast<long>(chunks[4].offset)))
+          .size();
   cut_copy(chunks[4].offset + 9 + 100);
   McapReader mid(cut_file);
   EXPECT_EQ(read_all(mid).size(), in_first_four);
-  EXPECT_EQ(mid.truncation(), "file ends 100 bytes into the content of a " + std::to_string(chunks[4].length) +
-                                  "-byte Chunk record at offset " + std::to_string(chunks[4].offset));
+  EXPECT_EQ(mid.truncation(),
+            "file ends 100 bytes into the content of a " + std::to_string(chunks[4].length) +
+                "-byte Chunk record at offset " + std::to_string(chunks[4].offset));
   cut_copy(chunks[4].end());
   McapReader boundary(cut_file);
   EXPECT_GT(read_all(boundary).size(), in_first_four);
@@ -726,28 +776,36 @@ TEST(McapTruncation, EveryCutOfAnUnchunkedFileYieldsExactlyTheMessagesCompleteBe
   const Channels c = record_session(dir / "chunked.mcap", kCount);
   const Bytes b = testing::unchunked(read_bytes(dir / "chunked.mcap"));
   const std::vector<RawRecord> records = walk(b);
-  ASSERT_TRUE(std::none_of(records.begin(), records.end(), [](const RawRecord& r) { return r.opcode == 0x06 || r.opcode == 0x07; }));
+  ASSERT_TRUE(std::none_of(records.begin(), records.end(), [](const RawRecord& r) {
+    return r.opcode == 0x06 || r.opcode == 0x07;
+  }));
   expect_every_cut_yields_the_messages_complete_before_it(dir, b, expected_messages(c, kCount));
 
   const std::vector<testing::RawMessage> messages = testing::messages_of(b);
   const fs::path cut_file = dir / "cut.mcap";
-  const auto cut_copy = [&](std::size_t n) { write_bytes(cut_file, Bytes(b.begin(), b.begin() + static_cast<long>(n))); };
+  const auto cut_copy = [&](std::size_t n) {
+    write_bytes(cut_file, Bytes(b.begin(), b.begin() + static_cast<long>(n)));
+  };
   cut_copy(messages[499].record.end() + 12);
   McapReader mid(cut_file);
   EXPECT_EQ(read_all(mid).size(), 500u);
-  EXPECT_EQ(mid.truncation(), "file ends 3 bytes into the content of a " + std::to_string(messages[500].record.length) +
-                                  "-byte Message record at offset " + std::to_string(messages[499].record.end()));
+  EXPECT_EQ(mid.truncation(), "file ends 3 bytes into the content of a " +
+                                  std::to_string(messages[500].record.length) +
+                                  "-byte Message record at offset " +
+                                  std::to_string(messages[499].record.end()));
   cut_copy(messages[499].record.end());
   McapReader boundary(cut_file);
   EXPECT_EQ(read_all(boundary).size(), 500u);
   EXPECT_EQ(boundary.truncation(), "file ends after the complete record ending at offset " +
-                                       std::to_string(messages[499].record.end()) + ", without a Footer");
+                                       std::to_string(messages[499].record.end()) +
+                                       ", without a Footer");
 }
 
 // ---- a writer that dies ----
 
 void expect_crash_leaves_flushed_messages(bool kill) {
-  const fs::path file = testing::scratch_directory(kill ? "mcap-killed" : "mcap-exited") / "crashed.mcap";
+  const fs::path file =
+      testing::scratch_directory(kill ? "mcap-killed" : "mcap-exited") / "crashed.mcap";
   constexpr std::uint32_t kFlushed = 500;
   const pid_t pid = ::fork();
   ASSERT_GE(pid, 0) << std::strerror(errno);
@@ -781,25 +839,33 @@ void expect_crash_leaves_flushed_messages(bool kill) {
   c.force = 3;
   const std::vector<McapMessage> got = read_all(reader);
   ASSERT_EQ(got.size(), kFlushed);
-  for (std::uint32_t i = 0; i < kFlushed; ++i) ASSERT_EQ(got[i], expected_message(c, i)) << "message " << i;
+  for (std::uint32_t i = 0; i < kFlushed; ++i)
+    ASSERT_EQ(got[i], expected_message(c, i)) << "message " << i;
   EXPECT_EQ(reader.channels().size(), 3u);
   EXPECT_EQ(reader.schemas().size(), 3u);
   EXPECT_TRUE(reader.truncated());
   EXPECT_FALSE(reader.complete());
   EXPECT_EQ(reader.valid_bytes(), fs::file_size(file)) << "flushed records are whole";
-  EXPECT_EQ(reader.crc_coverage().checked_messages, kFlushed) << "each flush left a chunk with its CRC";
+  EXPECT_EQ(reader.crc_coverage().checked_messages, kFlushed)
+      << "each flush left a chunk with its CRC";
   EXPECT_EQ(reader.crc_coverage().unchecked_messages, 0u);
 }
 
-TEST(McapCrash, AWriterKilledMidSessionLeavesEveryFlushedMessage) { expect_crash_leaves_flushed_messages(true); }
+TEST(McapCrash, AWriterKilledMidSessionLeavesEveryFlushedMessage) {
+  expect_crash_leaves_flushed_messages(true);
+}
 
-TEST(McapCrash, AWriterExitingWithoutClosingLeavesEveryFlushedMessage) { expect_crash_leaves_flushed_messages(false); }
+TEST(McapCrash, AWriterExitingWithoutClosingLeavesEveryFlushedMessage) {
+  expect_crash_leaves_flushed_messages(false);
+}
 
 // ---- flushing ----
 
 TEST(McapWriter, FlushesWhenTheBufferFillsWhenTimeIsUpAndOnRequest) {
   const fs::path dir = testing::scratch_directory("mcap-flush");
-  const auto on_disk = [](const fs::path& p) { return static_cast<std::uint64_t>(fs::file_size(p)); };
+  const auto on_disk = [](const fs::path& p) {
+    return static_cast<std::uint64_t>(fs::file_size(p));
+  };
   {
     const fs::path file = dir / "by-bytes.mcap";
     McapWriter writer(file, McapWriterOptions{std::chrono::hours(1), 1000});
@@ -851,7 +917,8 @@ TEST(McapWriter, FlushesWhenTheBufferFillsWhenTimeIsUpAndOnRequest) {
 TEST(McapWriter, AFullDeviceThrowsWithTheReason) {
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this machine";
   expect_error([] { McapWriter writer("/dev/full"); }, {"/dev/full", std::strerror(ENOSPC)});
-  expect_error([] { McapWriter writer("/nonexistent-dir/x.mcap"); }, {"/nonexistent-dir/x.mcap", std::strerror(ENOENT)});
+  expect_error([] { McapWriter writer("/nonexistent-dir/x.mcap"); },
+               {"/nonexistent-dir/x.mcap", std::strerror(ENOENT)});
 }
 
 TEST(McapWriter, AWriteErrorMidSessionThrowsAndTheFileStaysReadable) {
@@ -894,7 +961,8 @@ TEST(McapWriter, AWriteErrorMidSessionThrowsAndTheFileStaysReadable) {
   ::close(pipe_fds[1]);
   std::string report;
   char buffer[4096];
-  for (ssize_t n; (n = ::read(pipe_fds[0], buffer, sizeof buffer)) > 0;) report.append(buffer, static_cast<std::size_t>(n));
+  for (ssize_t n; (n = ::read(pipe_fds[0], buffer, sizeof buffer)) > 0;)
+    report.append(buffer, static_cast<std::size_t>(n));
   ::close(pipe_fds[0]);
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
@@ -919,7 +987,8 @@ TEST(McapWriter, AWriteErrorMidSessionThrowsAndTheFileStaysReadable) {
   c.tool = 1;
   c.datagram = 2;
   c.force = 3;
-  for (std::uint32_t i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], expected_message(c, i)) << "message " << i;
+  for (std::uint32_t i = 0; i < got.size(); ++i)
+    ASSERT_EQ(got[i], expected_message(c, i)) << "message " << i;
 }
 
 TEST(McapWriter, WrongIdsThrowWithoutSpoilingTheRecording) {
@@ -951,7 +1020,8 @@ TEST(McapReader, RejectsFilesThatAreNotMcap) {
   const fs::path v1 = dir / "v1.mcap";
   write_bytes(v1, Builder{}.u8(0x89).u8('M').u8('C').u8('A').u8('P').u8('1').u8('\r').u8('\n').out);
   expect_error([&] { McapReader reader(v1); }, {v1.string(), "unsupported MCAP major version '1'"});
-  expect_error([&] { McapReader reader(dir / "missing.mcap"); }, {(dir / "missing.mcap").string(), std::strerror(ENOENT)});
+  expect_error([&] { McapReader reader(dir / "missing.mcap"); },
+               {(dir / "missing.mcap").string(), std::strerror(ENOENT)});
   expect_error([&] { McapReader reader(dir); }, {dir.string()});
 
   // An empty file, or a cut inside the magic, is a truncated recording, not a foreign file.
@@ -963,7 +1033,9 @@ TEST(McapReader, RejectsFilesThatAreNotMcap) {
 }
 
 Bytes header_content() { return Builder{}.str("").str("hand-made").out; }
-Bytes schema_content(std::uint16_t id) { return Builder{}.uint(id, 2).str("raw").str("").str("").out; }
+Bytes schema_content(std::uint16_t id) {
+  return Builder{}.uint(id, 2).str("raw").str("").str("").out;
+}
 Bytes channel_content(std::uint16_t id, std::uint16_t schema) {
   return Builder{}.uint(id, 2).uint(schema, 2).str("/t").str("raw").uint(0, 4).out;
 }
@@ -978,10 +1050,13 @@ Bytes footer_content() { return Builder{}.uint(0, 8).uint(0, 8).uint(0, 4).out; 
 // A Chunk's content around `records`: uncompressed unless `compression` says otherwise,
 // with their CRC unless `crc` is given (0: none computed).
 Bytes chunk_content(const Bytes& records, std::optional<std::uint32_t> crc = std::nullopt,
-                    const std::string& compression = "", std::optional<std::uint64_t> uncompressed_size = std::nullopt) {
+                    const std::string& compression = "",
+                    std::optional<std::uint64_t> uncompressed_size = std::nullopt) {
   Builder chunk;
   chunk.uint(100, 8).uint(101, 8).uint(uncompressed_size.value_or(records.size()), 8);
-  chunk.uint(crc.value_or(reference_crc(records, 0, records.size())), 4).str(compression).uint(records.size(), 8);
+  chunk.uint(crc.value_or(reference_crc(records, 0, records.size())), 4)
+      .str(compression)
+      .uint(records.size(), 8);
   chunk.out.insert(chunk.out.end(), records.begin(), records.end());
   return chunk.out;
 }
@@ -992,10 +1067,13 @@ TEST(McapReader, ReadsChunksCheckingTheirCrcs) {
   b.magic().record(0x01, header_content());
   Builder first;
   first.record(0x03, schema_content(1)).record(0x04, channel_content(1, 1));
-  first.record(0x05, message_content(1, 1, "first")).record(0x80, Bytes{7, 7});  // a record of a later spec: skipped
+  first.record(0x05, message_content(1, 1, "first"))
+      .record(0x80, Bytes{7, 7});  // a record of a later spec: skipped
   first.record(0x05, message_content(1, 2, "second"));
   b.record(0x06, chunk_content(first.out));
-  b.record(0x07, Builder{}.uint(1, 2).uint(0, 4).out);  // a Message Index: of no use when reading in order
+  b.record(
+      0x07,
+      Builder{}.uint(1, 2).uint(0, 4).out);  // a Message Index: of no use when reading in order
   const std::size_t unchecked_chunk = b.out.size();
   b.record(0x06, chunk_content(Builder{}.record(0x05, message_content(1, 3, "third")).out, 0));
   b.record(0x05, message_content(1, 4, "fourth"));  // outside any chunk
@@ -1024,9 +1102,13 @@ TEST(McapReader, ReadsChunksCheckingTheirCrcs) {
 
 TEST(McapReader, RejectsDamagedAndMalformedChunksNamingThem) {
   const fs::path dir = testing::scratch_directory("mcap-bad-chunks");
-  const Bytes records = Builder{}.record(0x03, schema_content(1)).record(0x04, channel_content(1, 1))
-                            .record(0x05, message_content(1, 1, "x")).out;
-  const auto expect_rejected = [&](const std::string& name, const Bytes& content, const std::vector<std::string>& parts) {
+  const Bytes records = Builder{}
+                            .record(0x03, schema_content(1))
+                            .record(0x04, channel_content(1, 1))
+                            .record(0x05, message_content(1, 1, "x"))
+                            .out;
+  const auto expect_rejected = [&](const std::string& name, const Bytes& content,
+                                   const std::vector<std::string>& parts) {
     const fs::path file = dir / name;
     Builder b;
     b.magic().record(0x01, header_content()).record(0x06, content);
@@ -1045,16 +1127,21 @@ TEST(McapReader, RejectsDamagedAndMalformedChunksNamingThem) {
                    fmt::format("recorded as {:08x} but computes to {:08x}", crc ^ 0x10u, crc)});
   expect_rejected("zstd.mcap", chunk_content(records, std::nullopt, "zstd"),
                   {"Chunk record at offset 34", "compressed ('zstd')"});
-  expect_rejected("size.mcap", chunk_content(records, std::nullopt, "", records.size() + 1),
-                  {"Chunk record at offset 34", fmt::format("uncompressed_size is {}", records.size() + 1)});
+  expect_rejected(
+      "size.mcap", chunk_content(records, std::nullopt, "", records.size() + 1),
+      {"Chunk record at offset 34", fmt::format("uncompressed_size is {}", records.size() + 1)});
   Bytes overrun = records;
   overrun.resize(overrun.size() - 1);  // the message's content runs past the chunk's records
   expect_rejected("overrun.mcap", chunk_content(overrun),
-                  {"Message record at offset", "inside the Chunk at offset 34", "run past the end of the chunk's records"});
+                  {"Message record at offset", "inside the Chunk at offset 34",
+                   "run past the end of the chunk's records"});
   expect_rejected("header.mcap", chunk_content(Builder{}.record(0x01, header_content()).out),
-                  {"Header record at offset 83 inside the Chunk at offset 34", "only Schema, Channel and Message"});
-  expect_rejected("orphan.mcap", chunk_content(Builder{}.record(0x05, message_content(1, 1, "x")).out),
-                  {"Message record at offset 83 inside the Chunk at offset 34", "which no earlier Channel record defines"});
+                  {"Header record at offset 83 inside the Chunk at offset 34",
+                   "only Schema, Channel and Message"});
+  expect_rejected("orphan.mcap",
+                  chunk_content(Builder{}.record(0x05, message_content(1, 1, "x")).out),
+                  {"Message record at offset 83 inside the Chunk at offset 34",
+                   "which no earlier Channel record defines"});
 }
 
 TEST(McapReader, SkipsRecordTypesItDoesNotKnowAndFieldsAddedLater) {
@@ -1066,9 +1153,9 @@ TEST(McapReader, SkipsRecordTypesItDoesNotKnowAndFieldsAddedLater) {
   b.record(0x03, extended_schema).record(0x04, channel_content(1, 1));
   b.record(0x80, Bytes{1, 2, 3, 4, 5});  // an application extension
   b.record(0x05, message_content(1, 1, "first"));
-  b.record(0x09, Bytes(40, 0x11));       // an attachment: known, of no use here
+  b.record(0x09, Bytes(40, 0x11));                       // an attachment: known, of no use here
   b.record(0x0C, Builder{}.str("info").uint(0, 4).out);  // metadata
-  b.record(0x7E, Bytes{});               // a future MCAP record, empty
+  b.record(0x7E, Bytes{});                               // a future MCAP record, empty
   b.record(0x05, message_content(1, 2, "second"));
   b.record(0x0F, Builder{}.uint(0, 4).out).record(0x02, footer_content()).magic();
   write_bytes(file, b.out);
@@ -1087,7 +1174,8 @@ TEST(McapReader, SkipsRecordTypesItDoesNotKnowAndFieldsAddedLater) {
 
 TEST(McapReader, RejectsMalformedAndCorruptFiles) {
   const fs::path dir = testing::scratch_directory("mcap-malformed");
-  const auto expect_rejected = [&](const std::string& name, const Bytes& bytes, const std::string& part) {
+  const auto expect_rejected = [&](const std::string& name, const Bytes& bytes,
+                                   const std::string& part) {
     const fs::path file = dir / name;
     write_bytes(file, bytes);
     expect_error(
@@ -1098,11 +1186,15 @@ TEST(McapReader, RejectsMalformedAndCorruptFiles) {
         {file.string(), part});
   };
   Builder start;
-  start.magic().record(0x01, header_content()).record(0x03, schema_content(1)).record(0x04, channel_content(1, 1));
+  start.magic()
+      .record(0x01, header_content())
+      .record(0x03, schema_content(1))
+      .record(0x04, channel_content(1, 1));
 
   Builder orphan = start;
   orphan.record(0x05, message_content(2, 1, "x"));
-  expect_rejected("orphan.mcap", orphan.out, "message on channel 2, which no earlier Channel record defines");
+  expect_rejected("orphan.mcap", orphan.out,
+                  "message on channel 2, which no earlier Channel record defines");
 
   Builder short_record = start;
   short_record.record(0x05, Bytes{1, 0, 0});
@@ -1123,14 +1215,16 @@ TEST(McapReader, RejectsMalformedAndCorruptFiles) {
   const Bytes intact = read_bytes(good);
   const std::vector<RawRecord> records = walk(intact);
   const std::vector<testing::RawMessage> messages = testing::messages_of(intact);
-  const auto first_chunk = std::find_if(records.begin(), records.end(),
-                                        [&](const RawRecord& r) { return r.end() == messages.front().readable_from; });
+  const auto first_chunk = std::find_if(records.begin(), records.end(), [&](const RawRecord& r) {
+    return r.end() == messages.front().readable_from;
+  });
   ASSERT_NE(first_chunk, records.end());
   ASSERT_EQ(first_chunk->opcode, 0x06) << "the first message is in a chunk";
   Bytes corrupt = intact;
   corrupt[messages[5].record.content() + 23] ^= 0x04;
   ASSERT_EQ(messages[5].readable_from, first_chunk->end());
-  expect_rejected("corrupt.mcap", corrupt, "Chunk record at offset " + std::to_string(first_chunk->offset));
+  expect_rejected("corrupt.mcap", corrupt,
+                  "Chunk record at offset " + std::to_string(first_chunk->offset));
   {
     McapReader reader(dir / "corrupt.mcap");
     EXPECT_THROW(reader.next(), Error) << "the first message comes from the damaged chunk";
@@ -1142,7 +1236,8 @@ TEST(McapReader, RejectsMalformedAndCorruptFiles) {
   corrupt_index[index.content() + 10] ^= 0x01;
   expect_rejected("corrupt-index.mcap", corrupt_index, "data section CRC-32");
   Bytes corrupt_summary = intact;
-  corrupt_summary[corrupt_summary.size() - 8 - 29 - 40] ^= 0x01;  // a group_start in the Summary Offsets
+  corrupt_summary[corrupt_summary.size() - 8 - 29 - 40] ^=
+      0x01;  // a group_start in the Summary Offsets
   expect_rejected("corrupt-summary.mcap", corrupt_summary, "summary CRC-32");
 }
 
@@ -1155,13 +1250,14 @@ struct NodeRun {
 };
 
 NodeRun run_mcap_check(const fs::path& file, const fs::path& errors) {
-  const std::string command = "node '" + testing::source_path("tests/support/mcap_check.mjs") + "' '" +
-                              file.string() + "' 2>'" + errors.string() + "'";
+  const std::string command = "node '" + testing::source_path("tests/support/mcap_check.mjs") +
+                              "' '" + file.string() + "' 2>'" + errors.string() + "'";
   NodeRun run;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) return run;
   char buffer[4096];
-  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) run.output.append(buffer, n);
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;)
+    run.output.append(buffer, n);
   const int status = ::pclose(pipe);
   run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   std::ifstream in(errors);
@@ -1172,10 +1268,12 @@ NodeRun run_mcap_check(const fs::path& file, const fs::path& errors) {
 TEST(McapWriter, TheOfficialReaderReadsOurFiles) {
   if (std::system("node --version > /dev/null 2>&1") != 0) {
     GTEST_SKIP() << "node is not installed; this check needs node (v18 or later) and @mcap/core: "
-                    "install Debian's nodejs and npm, then npm ci --prefix deploy/node (deploy/install-deps.sh does both)";
+                    "install Debian's nodejs and npm, then npm ci --prefix deploy/node "
+                    "(deploy/install-deps.sh does both)";
   }
   if (!fs::exists(testing::source_path("deploy/node/node_modules/@mcap/core/package.json"))) {
-    GTEST_SKIP() << "@mcap/core is not installed; from the source tree run: npm ci --prefix deploy/node (deploy/install-deps.sh does)";
+    GTEST_SKIP() << "@mcap/core is not installed; from the source tree run: npm ci --prefix "
+                    "deploy/node (deploy/install-deps.sh does)";
   }
   const fs::path dir = testing::scratch_directory("mcap-official");
   constexpr std::uint32_t kCount = 2400;
@@ -1192,7 +1290,8 @@ TEST(McapWriter, TheOfficialReaderReadsOurFiles) {
     try {
       json = nlohmann::json::parse(run.output);
     } catch (const std::exception& e) {
-      ADD_FAILURE() << "mcap_check.mjs printed no JSON (" << e.what() << "): " << run.output << run.errors;
+      ADD_FAILURE() << "mcap_check.mjs printed no JSON (" << e.what() << "): " << run.output
+                    << run.errors;
     }
     return json;
   };
@@ -1210,10 +1309,12 @@ TEST(McapWriter, TheOfficialReaderReadsOurFiles) {
     EXPECT_EQ(indexed["channels"].get<std::vector<std::string>>(), topics);
     EXPECT_EQ(indexed["schemas"].get<std::vector<std::string>>(), schemas);
     const std::vector<RawRecord> records = walk(read_bytes(full));
-    const auto chunks = std::count_if(records.begin(), records.end(), [](const RawRecord& r) { return r.opcode == 0x06; });
+    const auto chunks = std::count_if(records.begin(), records.end(),
+                                      [](const RawRecord& r) { return r.opcode == 0x06; });
     EXPECT_GT(chunks, 10);
     EXPECT_EQ(indexed["chunkCount"], chunks);
-    EXPECT_EQ(indexed["summaryOffsetOpcodes"].get<std::vector<int>>(), (std::vector<int>{0x03, 0x04, 0x08, 0x0B}));
+    EXPECT_EQ(indexed["summaryOffsetOpcodes"].get<std::vector<int>>(),
+              (std::vector<int>{0x03, 0x04, 0x08, 0x0B}));
     EXPECT_EQ(indexed["statistics"]["messageCount"], kCount);
     EXPECT_EQ(indexed["statistics"]["channelCount"], 3);
     EXPECT_EQ(indexed["statistics"]["messageStartTime"], std::to_string(kEpochNs));
@@ -1240,14 +1341,16 @@ TEST(McapWriter, TheOfficialReaderReadsOurFiles) {
     nlohmann::json j = check(file);
     if (j.is_null()) return ours;
     EXPECT_EQ(j["complete"], false) << j.dump();
-    EXPECT_FALSE(j["indexError"].is_null()) << "the indexed reader should refuse a file without a footer";
+    EXPECT_FALSE(j["indexError"].is_null())
+        << "the indexed reader should refuse a file without a footer";
     EXPECT_EQ(j["messageCount"], ours) << j.dump();
     EXPECT_EQ(j["channels"].get<std::vector<std::string>>(), topics);
     return ours;
   };
   const auto readable_at = [&](std::size_t cut) {
-    return static_cast<std::size_t>(std::count_if(messages.begin(), messages.end(),
-                                                  [&](const testing::RawMessage& m) { return m.readable_from <= cut; }));
+    return static_cast<std::size_t>(
+        std::count_if(messages.begin(), messages.end(),
+                      [&](const testing::RawMessage& m) { return m.readable_from <= cut; }));
   };
   // Inside the 1501st message, so inside its chunk: that chunk is lost whole.
   const std::size_t inside = messages[1500].record.offset + 20;
@@ -1270,7 +1373,8 @@ TEST(McapWriter, TheOfficialReaderReadsOurFiles) {
     EXPECT_NE(run.output.find("Incorrect chunk CRC"), std::string::npos) << run.output;
   }
 
-  {  // an unchunked copy, as recordings written without chunks are: valid, every message read from the front
+  {  // an unchunked copy, as recordings written without chunks are: valid, every message read from
+     // the front
     const fs::path file = dir / "unchunked.mcap";
     write_bytes(file, testing::unchunked(b));
     nlohmann::json j = check(file);

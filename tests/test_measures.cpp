@@ -25,7 +25,8 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 // Samples k = 0..n-1 at t = k dt of a force magnitude along `axis` and a position.
-ForceTrace sample(std::size_t n, double dt, const std::function<Eigen::Vector3d(std::size_t, double)>& force,
+ForceTrace sample(std::size_t n, double dt,
+                  const std::function<Eigen::Vector3d(std::size_t, double)>& force,
                   const std::function<Eigen::Vector3d(std::size_t, double)>& position) {
   ForceTrace trace;
   for (std::size_t k = 0; k < n; ++k) {
@@ -37,7 +38,8 @@ ForceTrace sample(std::size_t n, double dt, const std::function<Eigen::Vector3d(
   return trace;
 }
 
-const Eigen::Vector3d kAxis = Eigen::Vector3d(1, 2, 2) / 3;  // a unit vector off the coordinate axes
+const Eigen::Vector3d kAxis =
+    Eigen::Vector3d(1, 2, 2) / 3;  // a unit vector off the coordinate axes
 Eigen::Vector3d still(std::size_t, double) { return Eigen::Vector3d::Zero(); }
 
 // 1 s at 1 kHz of 2 + 3 sin(pi t) N, recomputed every sample (smooth) or every 25 ms (steps).
@@ -118,7 +120,10 @@ TEST(MeasureTrace, AForceThatFadesToZeroBrieflyWithinAPressIsOneStroke) {
 TEST(MeasureLowpass, KeepsLinesAndConstantsAndFiltersAtTwentyHertz) {
   const auto signal = [](double hz) {
     return sample(
-        2001, 1e-3, [hz](std::size_t, double t) { return Eigen::Vector3d(std::sin(2 * kPi * hz * t), 3, 2 + 5 * t); },
+        2001, 1e-3,
+        [hz](std::size_t, double t) {
+          return Eigen::Vector3d(std::sin(2 * kPi * hz * t), 3, 2 + 5 * t);
+        },
         still);
   };
   for (double hz : {5.0, 20.0, 100.0}) {
@@ -127,7 +132,8 @@ TEST(MeasureLowpass, KeepsLinesAndConstantsAndFiltersAtTwentyHertz) {
     ASSERT_EQ(out.size(), trace.size());
     double amplitude = 0, line_error = 0;
     for (std::size_t k = 0; k < out.size(); ++k) {
-      line_error = std::max(line_error, (out[k].tail<2>() - trace.force[k].tail<2>()).cwiseAbs().maxCoeff());
+      line_error =
+          std::max(line_error, (out[k].tail<2>() - trace.force[k].tail<2>()).cwiseAbs().maxCoeff());
       if (k >= 500 && k <= 1500) amplitude = std::max(amplitude, std::abs(out[k].x()));
     }
     EXPECT_LT(line_error, 1e-6) << hz << " Hz";  // constant and straight line pass unchanged
@@ -224,14 +230,17 @@ TEST(MeasureHardness, EffectiveStiffnessOfASpringIsItsStiffnessOverTheLoadingPha
         const double s = s_of(t);
         return Eigen::Vector3d(-(t <= 0.5 ? k * s : k * s * s / depth) * d);
       },
-      [&](std::size_t, double t) { return Eigen::Vector3d(Eigen::Vector3d(0.1, 0.2, 0.3) + s_of(t) * d); });
+      [&](std::size_t, double t) {
+        return Eigen::Vector3d(Eigen::Vector3d(0.1, 0.2, 0.3) + s_of(t) * d);
+      });
   const std::vector<Stroke> strokes = find_strokes(trace);
   ASSERT_EQ(strokes.size(), 1u);
   EXPECT_NEAR(effective_stiffness(trace, strokes[0]), k, 1e-9 * k);
   EXPECT_NEAR(terminal_force_ratio(trace, strokes[0]), 1, 1e-12);
   // Loading work k depth^2 / 2 minus unloading work k depth^2 / 3 (the loop is lossy).
   // (1 %: the stroke misses the work below the 1 % contact threshold at both ends.)
-  EXPECT_NEAR(hysteresis_energy(trace, strokes[0]), k * depth * depth / 6, 1e-2 * k * depth * depth / 6);
+  EXPECT_NEAR(hysteresis_energy(trace, strokes[0]), k * depth * depth / 6,
+              1e-2 * k * depth * depth / 6);
 }
 
 // A closed loop of one period T = 0.5 s around a pressed state: s = 2A + A sin(w t) along -z,
@@ -241,7 +250,8 @@ ForceTrace loop(double c) {
   return sample(
       501, 1e-3,
       [=](std::size_t, double t) {
-        return Eigen::Vector3d(0, 0, k * (2 * a + a * std::sin(w * t)) + c * a * w * std::cos(w * t));
+        return Eigen::Vector3d(0, 0,
+                               k * (2 * a + a * std::sin(w * t)) + c * a * w * std::cos(w * t));
       },
       [=](std::size_t, double t) { return Eigen::Vector3d(0, 0, -(2 * a + a * std::sin(w * t))); });
 }
@@ -255,7 +265,8 @@ TEST(MeasureHardness, HysteresisEnergyOfADampedLoopIsTheEllipseArea) {
   const double area = kPi * c * w * a * a;
   EXPECT_NEAR(hysteresis_energy(damped, strokes[0]), area, 0.01 * area);
   const ForceTrace spring = loop(0);
-  EXPECT_NEAR(hysteresis_energy(spring, find_strokes(spring)[0]), 0, 1e-12);  // trapezoids telescope
+  EXPECT_NEAR(hysteresis_energy(spring, find_strokes(spring)[0]), 0,
+              1e-12);  // trapezoids telescope
 }
 
 TEST(MeasureStability, PassiveSpringLoopGivesOnlyTheZeroOrderHoldLeak) {
@@ -267,7 +278,8 @@ TEST(MeasureStability, PassiveSpringLoopGivesOnlyTheZeroOrderHoldLeak) {
   const double w = energy_given_to_hand(spring);
   EXPECT_GE(w, 0);
   EXPECT_NEAR(w, hold_leak, 1e-9 * hold_leak + 1e-15);
-  EXPECT_LT(w, 0.01 * 4 * 500 * 0.005 * 0.005);  // < 1 % of the work k (9 - 1) A^2 / 2 put in while loading
+  EXPECT_LT(w, 0.01 * 4 * 500 * 0.005 *
+                   0.005);  // < 1 % of the work k (9 - 1) A^2 / 2 put in while loading
   // A real damper takes energy from the hand.
   EXPECT_LT(energy_given_to_hand(loop(5)), -0.9 * kPi * 5 * 4 * kPi * 0.005 * 0.005);
 }
@@ -278,7 +290,8 @@ TEST(MeasureStability, NegativeDampingGivesTheHandItsWork) {
   const std::size_t n = 1001;  // one period of 1/3 s at 1/3 ms
   const double dt = (1.0 / 3) / static_cast<double>(n - 1);
   const ForceTrace trace = sample(
-      n, dt, [=](std::size_t, double t) { return Eigen::Vector3d(c * a * w * std::cos(w * t) * kAxis); },
+      n, dt,
+      [=](std::size_t, double t) { return Eigen::Vector3d(c * a * w * std::cos(w * t) * kAxis); },
       [=](std::size_t, double t) { return Eigen::Vector3d(a * std::sin(w * t) * kAxis); });
   const double expected = kPi * c * w * a * a;
   EXPECT_NEAR(energy_given_to_hand(trace), expected, 0.01 * expected);
@@ -325,10 +338,10 @@ TEST(MeasureTrial, HardnessIsTheMeanOverStrokesAndShortBlipsAreLeftOut) {
   EXPECT_NEAR(m.terminal_force_ratio, (std::cos(kOmega * 0.1) + 1) / 2, 1e-3);
   EXPECT_NEAR(m.peak_force_n, kK * kA, 1e-9);
   EXPECT_NEAR(m.duration_s, 1.999, 1e-12);
-  EXPECT_NEAR(
-      m.effective_stiffness_n_per_m,
-      effective_stiffness(trace, find_strokes(trace)[1]) / 2 + effective_stiffness(trace, find_strokes(trace)[0]) / 2,
-      1e-9);
+  EXPECT_NEAR(m.effective_stiffness_n_per_m,
+              effective_stiffness(trace, find_strokes(trace)[1]) / 2 +
+                  effective_stiffness(trace, find_strokes(trace)[0]) / 2,
+              1e-9);
   EXPECT_GT(m.force_update_rate_hz, 980);  // the blip holds one value for 10 ms
   EXPECT_LT(m.force_update_rate_hz, 1000);
   const std::vector<NamedMeasure> named = named_measures(m);
@@ -358,8 +371,9 @@ TEST(MeasureSummary, MeanSdAndNMatchAHandComputation) {
     measures.roughness = roughness;
     return condition_trial(condition, measures);
   };
-  std::vector<ConditionTrial> trials = {with_roughness("S30-T150-P0", 0.1), with_roughness("S0, \"fast\"", 0.5),
-                                        with_roughness("S30-T150-P0", 0.3), with_roughness("S30-T150-P0", kNaN)};
+  std::vector<ConditionTrial> trials = {
+      with_roughness("S30-T150-P0", 0.1), with_roughness("S0, \"fast\"", 0.5),
+      with_roughness("S30-T150-P0", 0.3), with_roughness("S30-T150-P0", kNaN)};
   trials[1].values.push_back({"server_rate_hz", 400});  // a value only some trials have
   const std::vector<ConditionSummary> summary = summarize(trials);
   ASSERT_EQ(summary.size(), 2 * (named_measures(TrialMeasures{}).size() + 1));
@@ -389,8 +403,10 @@ TEST(MeasureSummary, MeanSdAndNMatchAHandComputation) {
   std::stringstream text;
   text << in.rdbuf();
   EXPECT_EQ(text.str().substr(0, 28), "condition,measure,mean,sd,n\n");
-  EXPECT_NE(text.str().find("\nS30-T150-P0,roughness,0.2,0.141421356,2\n"), std::string::npos) << text.str();
-  EXPECT_NE(text.str().find("\n\"S0, \"\"fast\"\"\",roughness,0.5,nan,1\n"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("\nS30-T150-P0,roughness,0.2,0.141421356,2\n"), std::string::npos)
+      << text.str();
+  EXPECT_NE(text.str().find("\n\"S0, \"\"fast\"\"\",roughness,0.5,nan,1\n"), std::string::npos)
+      << text.str();
 }
 
 }  // namespace

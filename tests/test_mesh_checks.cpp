@@ -25,10 +25,13 @@ constexpr std::int64_t kTetTagBase = 100;   // tetrahedron i has tag 100 + i
 TetMesh make_mesh(const std::vector<Eigen::Vector3d>& points, const std::vector<Tet>& tets) {
   TetMesh mesh;
   mesh.nodes.resize(3, static_cast<Eigen::Index>(points.size()));
-  for (std::size_t i = 0; i < points.size(); ++i) mesh.nodes.col(static_cast<Eigen::Index>(i)) = points[i];
+  for (std::size_t i = 0; i < points.size(); ++i)
+    mesh.nodes.col(static_cast<Eigen::Index>(i)) = points[i];
   mesh.tets = tets;
-  for (std::size_t i = 0; i < points.size(); ++i) mesh.node_tags.push_back(kNodeTagBase + static_cast<std::int64_t>(i));
-  for (std::size_t i = 0; i < tets.size(); ++i) mesh.tet_tags.push_back(kTetTagBase + static_cast<std::int64_t>(i));
+  for (std::size_t i = 0; i < points.size(); ++i)
+    mesh.node_tags.push_back(kNodeTagBase + static_cast<std::int64_t>(i));
+  for (std::size_t i = 0; i < tets.size(); ++i)
+    mesh.tet_tags.push_back(kTetTagBase + static_cast<std::int64_t>(i));
   return mesh;
 }
 
@@ -40,13 +43,16 @@ void orient_positive(TetMesh& mesh) {
 
 /// Box mesh with tags 500 + i and 100 + i instead of the mesher's index + 1.
 TetMesh tagged_box(const Eigen::Vector3d& min_corner, double size, int divisions) {
-  TetMesh mesh = make_box_mesh(min_corner, Eigen::Vector3d::Constant(size), Eigen::Vector3i::Constant(divisions));
+  TetMesh mesh = make_box_mesh(min_corner, Eigen::Vector3d::Constant(size),
+                               Eigen::Vector3i::Constant(divisions));
   for (int n = 0; n < mesh.node_count(); ++n) mesh.node_tags[n] = kNodeTagBase + n;
   for (int t = 0; t < mesh.tet_count(); ++t) mesh.tet_tags[t] = kTetTagBase + t;
   return mesh;
 }
 
-bool contains(const std::string& text, const std::string& fragment) { return text.find(fragment) != std::string::npos; }
+bool contains(const std::string& text, const std::string& fragment) {
+  return text.find(fragment) != std::string::npos;
+}
 
 std::string joined(const std::vector<std::string>& lines) {
   std::string out;
@@ -91,7 +97,8 @@ TEST(MeshChecks, CleanBoxMeshHasNoFindings) {
   EXPECT_TRUE(report.notes.empty()) << joined(report.notes);
   EXPECT_EQ(report.parts, 1);
   const BoundarySurface surface = extract_boundary_surface(mesh);
-  EXPECT_TRUE(check_boundary_surface(mesh, surface).empty()) << joined(check_boundary_surface(mesh, surface));
+  EXPECT_TRUE(check_boundary_surface(mesh, surface).empty())
+      << joined(check_boundary_surface(mesh, surface));
 }
 
 TEST(MeshChecks, OneInvertedElementIsAnErrorNamingItsTag) {
@@ -152,8 +159,9 @@ TEST(MeshChecks, CoincidentNodesWithDifferentTagsAreNamed) {
   orient_positive(mesh);
   const MeshCheckReport report = check_tet_mesh(mesh);
   const std::string all = joined(report.warnings);
-  const auto coincident = std::find_if(report.warnings.begin(), report.warnings.end(),
-                                       [](const std::string& w) { return contains(w, "coincident"); });
+  const auto coincident =
+      std::find_if(report.warnings.begin(), report.warnings.end(),
+                   [](const std::string& w) { return contains(w, "coincident"); });
   ASSERT_NE(coincident, report.warnings.end()) << all;
   EXPECT_TRUE(contains(*coincident, "2 pair(s)")) << *coincident;
   EXPECT_TRUE(contains(*coincident, "501 and 504")) << *coincident;
@@ -208,7 +216,8 @@ TEST(MeshCheckSurface, TetrahedraTouchingAtOneVertexMakeANonManifoldVertex) {
 
 TEST(MeshCheckSurface, TetrahedraTouchingAlongOneEdgeMakeANonManifoldEdge) {
   // Shared edge 0-1 on the x axis; the two elements lie in opposite quadrants around it.
-  const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, -1, 0}, {0, 0, -1}};
+  const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0},  {0, 1, 0},
+                                            {0, 0, 1}, {0, -1, 0}, {0, 0, -1}};
   TetMesh mesh = make_mesh(points, {{0, 1, 2, 3}, {0, 1, 4, 5}});
   orient_positive(mesh);
   check_tet_mesh(mesh);
@@ -220,14 +229,17 @@ TEST(MeshCheckSurface, TetrahedraTouchingAlongOneEdgeMakeANonManifoldEdge) {
   EXPECT_TRUE(contains(all, "500-501")) << all;
   EXPECT_FALSE(contains(all, "500-501, 500-501")) << all;
   // Both end nodes are also where two parts of the surface touch.
-  EXPECT_TRUE(contains(all, "non-manifold surface vertex(es) (parts of the surface touch at a point): node 500, 501"))
+  EXPECT_TRUE(contains(
+      all,
+      "non-manifold surface vertex(es) (parts of the surface touch at a point): node 500, 501"))
       << all;
 }
 
 TEST(MeshChecks, SliverIsWarnedWithItsTag) {
   const double eps = 1e-3;
   // A unit square's corners with one lifted by eps: all four nearly coplanar.
-  const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, eps}, {0, 0, -2}};
+  const std::vector<Eigen::Vector3d> points{
+      {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, eps}, {0, 0, -2}};
   TetMesh mesh = make_mesh(points, {{0, 1, 2, 4}, {0, 1, 2, 3}});
   orient_positive(mesh);
   const Eigen::Vector3d x[4] = {mesh.nodes.col(mesh.tets[1][0]), mesh.nodes.col(mesh.tets[1][1]),
@@ -250,12 +262,14 @@ TEST(MeshChecks, DihedralAnglesOfRegularAndKuhnTetrahedra) {
   const std::vector<Eigen::Vector3d> regular{{1, 1, 1}, {1, -1, -1}, {-1, 1, -1}, {-1, -1, 1}};
   TetMesh mesh = make_mesh(regular, {{0, 1, 2, 3}});
   orient_positive(mesh);
-  EXPECT_NEAR(min_dihedral_angle_deg(mesh, 0), std::acos(1.0 / 3.0) * 180 / std::numbers::pi, 1e-10);
+  EXPECT_NEAR(min_dihedral_angle_deg(mesh, 0), std::acos(1.0 / 3.0) * 180 / std::numbers::pi,
+              1e-10);
   EXPECT_NEAR(min_dihedral_angle_deg(mesh, 0), 70.528779365509308, 1e-10);
 
   // Kuhn tetrahedra of a cube cell have dihedral angles 45, 60 and 90 degrees.
   TetMesh box = tagged_box(Eigen::Vector3d(-1, 0, 2), 0.3, 2);
-  for (int t = 0; t < box.tet_count(); ++t) EXPECT_NEAR(min_dihedral_angle_deg(box, t), 45.0, 1e-10) << "tet " << t;
+  for (int t = 0; t < box.tet_count(); ++t)
+    EXPECT_NEAR(min_dihedral_angle_deg(box, t), 45.0, 1e-10) << "tet " << t;
   EXPECT_NEAR(check_tet_mesh(box).min_dihedral_deg, 45.0, 1e-10);
 }
 
@@ -264,20 +278,24 @@ TEST(MeshChecks, MinDihedralAngleMatchesBruteForceOnRandomTetrahedra) {
   std::uniform_real_distribution<double> coordinate(-1, 1);
   for (int trial = 0; trial < 200; ++trial) {
     std::vector<Eigen::Vector3d> points;
-    for (int i = 0; i < 4; ++i) points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
+    for (int i = 0; i < 4; ++i)
+      points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
     TetMesh mesh = make_mesh(points, {{0, 1, 2, 3}});
     if (std::abs(signed_volume(mesh, 0)) < 1e-3) continue;
     const Eigen::Vector3d x[4] = {points[0], points[1], points[2], points[3]};
-    EXPECT_NEAR(min_dihedral_angle_deg(mesh, 0), brute_min_dihedral_deg(x), 1e-7) << "trial " << trial;
+    EXPECT_NEAR(min_dihedral_angle_deg(mesh, 0), brute_min_dihedral_deg(x), 1e-7)
+        << "trial " << trial;
     // Orientation does not matter for an angle.
     orient_positive(mesh);
-    EXPECT_NEAR(min_dihedral_angle_deg(mesh, 0), brute_min_dihedral_deg(x), 1e-7) << "trial " << trial;
+    EXPECT_NEAR(min_dihedral_angle_deg(mesh, 0), brute_min_dihedral_deg(x), 1e-7)
+        << "trial " << trial;
   }
 }
 
 TEST(MeshCheckSurface, FaceSharedByThreeTetrahedraIsAnError) {
   // Face (0, 1, 2) in the plane z = 0 with three apexes: one below, two above.
-  const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.2, 0.2, -1}, {0.2, 0.2, 1}, {0.3, 0.1, 2}};
+  const std::vector<Eigen::Vector3d> points{{0, 0, 0},      {1, 0, 0},     {0, 1, 0},
+                                            {0.2, 0.2, -1}, {0.2, 0.2, 1}, {0.3, 0.1, 2}};
   TetMesh mesh = make_mesh(points, {{0, 1, 2, 3}, {0, 1, 2, 4}, {0, 1, 2, 5}});
   orient_positive(mesh);
   try {
@@ -309,7 +327,8 @@ TEST(MeshCheckSurface, TriangleSurfaceOpenAndClosed) {
       0, 0, 1, 0,                 //
       0, 0, 0, 1;
   closed.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
-  EXPECT_TRUE(check_triangle_surface(closed, "tetrahedron").empty()) << joined(check_triangle_surface(closed, "t"));
+  EXPECT_TRUE(check_triangle_surface(closed, "tetrahedron").empty())
+      << joined(check_triangle_surface(closed, "t"));
 
   // A fin on the closed surface: edge 0-1 then has three triangles.
   TriangleSurface fin = closed;

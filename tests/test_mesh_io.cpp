@@ -31,7 +31,9 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-std::string data_file(const std::string& name) { return testing::source_path("tests/data/mesh_io/" + name); }
+std::string data_file(const std::string& name) {
+  return testing::source_path("tests/data/mesh_io/" + name);
+}
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -45,8 +47,8 @@ class ScratchDir {
  public:
   ScratchDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            ("cohaptic_mesh_io_" + std::to_string(::getpid()) + "_" + info->test_suite_name() + "_" + info->name());
+    path_ = fs::temp_directory_path() / ("cohaptic_mesh_io_" + std::to_string(::getpid()) + "_" +
+                                         info->test_suite_name() + "_" + info->name());
     fs::remove_all(path_);
     fs::create_directories(path_);
   }
@@ -117,7 +119,9 @@ TEST(ReadGmsh, WindowsLineEndingsAndSourceNameInMessages) {
     parse_gmsh(bad, "inline.msh");
     FAIL() << "no ParseError";
   } catch (const ParseError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("inline.msh:6: expected a node line 'tag x y z' (4 values), found 3 values"));
+    EXPECT_THAT(
+        e.what(),
+        HasSubstr("inline.msh:6: expected a node line 'tag x y z' (4 values), found 3 values"));
     EXPECT_EQ(e.file(), "inline.msh");
     EXPECT_EQ(e.line(), 6);
   }
@@ -178,28 +182,35 @@ TEST_P(MalformedMesh, ThrowsParseErrorAtTheLine) {
 INSTANTIATE_TEST_SUITE_P(
     Gmsh, MalformedMesh,
     ::testing::Values(
-        MalformedFile{"bad_binary.msh", 2, "binary .msh is not supported; save as ASCII, e.g. gmsh -save -format msh41 -bin 0"},
-        MalformedFile{"bad_version.msh", 2, "unsupported .msh version '4.0'; cohaptic reads ASCII versions 2.2 and 4.1"},
+        MalformedFile{
+            "bad_binary.msh", 2,
+            "binary .msh is not supported; save as ASCII, e.g. gmsh -save -format msh41 -bin 0"},
+        MalformedFile{"bad_version.msh", 2,
+                      "unsupported .msh version '4.0'; cohaptic reads ASCII versions 2.2 and 4.1"},
         MalformedFile{"bad_missing_format.msh", 1, "missing $MeshFormat"},
         MalformedFile{"bad_truncated.msh", 12, "the file ends inside the $Nodes section"},
-        MalformedFile{"bad_unterminated_section.msh", 6, "the file ends inside the $PhysicalNames section"},
+        MalformedFile{"bad_unterminated_section.msh", 6,
+                      "the file ends inside the $PhysicalNames section"},
         MalformedFile{"bad_node_tag.msh", 9, "expected node tag, found 'abc'"},
         MalformedFile{"bad_coordinate.msh", 8, "expected y coordinate, found '1.0x'"},
         MalformedFile{"bad_nan_coordinate.msh", 7, "non-finite x coordinate 'nan'"},
-        MalformedFile{"bad_element_nodes.msh", 14, "element 2 (Gmsh type 4, 4-node tetrahedron) has 3 nodes, expected 4"},
+        MalformedFile{"bad_element_nodes.msh", 14,
+                      "element 2 (Gmsh type 4, 4-node tetrahedron) has 3 nodes, expected 4"},
         MalformedFile{"bad_unknown_node.msh", 20, "element 2 refers to node tag 77"},
-        MalformedFile{"bad_duplicate_node.msh", 8, "duplicate node tag 3 (first defined on line 7)"},
+        MalformedFile{"bad_duplicate_node.msh", 8,
+                      "duplicate node tag 3 (first defined on line 7)"},
         MalformedFile{"bad_no_tets.msh", 14, "no 4-node tetrahedra (Gmsh type 4)"},
         MalformedFile{"bad_node_count.msh", 9, "expected $EndNodes after the 3 nodes"}));
 
 INSTANTIATE_TEST_SUITE_P(
     FreeSurfer, MalformedMesh,
-    ::testing::Values(MalformedFile{"bad_comment.asc", 1, "bad header"},
-                      MalformedFile{"bad_header.asc", 2, "bad header: expected '<vertices> <triangles>'"},
-                      MalformedFile{"bad_truncated.asc", 9, "the file ends after 3 of the 4 triangles"},
-                      MalformedFile{"bad_index.asc", 8, "vertex index 4, out of range"},
-                      MalformedFile{"bad_number.asc", 5, "expected z coordinate, found 'zero'"},
-                      MalformedFile{"bad_inf.asc", 6, "non-finite y coordinate 'inf'"}));
+    ::testing::Values(
+        MalformedFile{"bad_comment.asc", 1, "bad header"},
+        MalformedFile{"bad_header.asc", 2, "bad header: expected '<vertices> <triangles>'"},
+        MalformedFile{"bad_truncated.asc", 9, "the file ends after 3 of the 4 triangles"},
+        MalformedFile{"bad_index.asc", 8, "vertex index 4, out of range"},
+        MalformedFile{"bad_number.asc", 5, "expected z coordinate, found 'zero'"},
+        MalformedFile{"bad_inf.asc", 6, "non-finite y coordinate 'inf'"}));
 
 // Writers leave "<name>.<pid>.tmp" only while writing; none may survive a call.
 bool has_temporary_files(const fs::path& directory) {
@@ -211,11 +222,12 @@ bool has_temporary_files(const fs::path& directory) {
 
 TetMesh tagged_box_mesh() {
   // Coordinates such as 0.13 / 3 are not short decimals: only 17 digits round-trip them.
-  TetMesh mesh = make_box_mesh(Eigen::Vector3d(-0.065, -0.065, -0.13), Eigen::Vector3d::Constant(0.13),
-                               Eigen::Vector3i(3, 4, 5));
+  TetMesh mesh = make_box_mesh(Eigen::Vector3d(-0.065, -0.065, -0.13),
+                               Eigen::Vector3d::Constant(0.13), Eigen::Vector3i(3, 4, 5));
   mesh.nodes.col(7) = Eigen::Vector3d(1e-300, -0.0, 123456789.123456789);
   for (auto& tag : mesh.node_tags) tag = 7 * tag + 1000000000000;  // sparse, beyond 32 bits
-  for (std::size_t t = 0; t < mesh.tet_tags.size(); ++t) mesh.tet_tags[t] = static_cast<std::int64_t>(3 * (mesh.tet_tags.size() - t));
+  for (std::size_t t = 0; t < mesh.tet_tags.size(); ++t)
+    mesh.tet_tags[t] = static_cast<std::int64_t>(3 * (mesh.tet_tags.size() - t));
   return mesh;
 }
 
@@ -229,7 +241,9 @@ TEST(WriteGmsh, RoundTripsBitExactly) {
     EXPECT_EQ(read.unused_nodes_dropped, 0);
     EXPECT_TRUE(read.skipped_elements.empty());
     ASSERT_EQ(read.mesh.node_count(), mesh.node_count());
-    EXPECT_EQ(std::memcmp(read.mesh.nodes.data(), mesh.nodes.data(), sizeof(double) * mesh.nodes.size()), 0);
+    EXPECT_EQ(
+        std::memcmp(read.mesh.nodes.data(), mesh.nodes.data(), sizeof(double) * mesh.nodes.size()),
+        0);
     EXPECT_EQ(read.mesh.tets, mesh.tets);
     EXPECT_EQ(read.mesh.node_tags, mesh.node_tags);
     EXPECT_EQ(read.mesh.tet_tags, mesh.tet_tags);
@@ -299,7 +313,8 @@ std::string attribute(const std::string& xml, const std::string& element, const 
 }
 
 /// The opening tag and the whitespace-separated values of the DataArray named `name`.
-std::pair<std::string, std::vector<std::string>> data_array(const std::string& xml, const std::string& name) {
+std::pair<std::string, std::vector<std::string>> data_array(const std::string& xml,
+                                                            const std::string& name) {
   const std::regex pattern("(<DataArray\\b[^>]*\\bName=\"" + name + "\"[^>]*>)([^<]*)</DataArray>");
   std::smatch match;
   if (!std::regex_search(xml, match, pattern)) return {};
@@ -396,7 +411,8 @@ TEST(WriteVtu, FieldWithWrongNodeCountThrowsNamingIt) {
     EXPECT_THAT(e.what(), HasSubstr("'displacement'"));
     EXPECT_THAT(e.what(), HasSubstr(std::to_string(mesh.node_count() - 1) + " columns"));
   }
-  EXPECT_THROW(write_vtu(path, mesh, {{"node_tag", Eigen::MatrixXd::Zero(1, mesh.node_count())}}), Error);
+  EXPECT_THROW(write_vtu(path, mesh, {{"node_tag", Eigen::MatrixXd::Zero(1, mesh.node_count())}}),
+               Error);
   EXPECT_FALSE(fs::exists(path));
   EXPECT_TRUE(fs::is_empty(dir.path()));
 }
@@ -415,7 +431,8 @@ TEST(ReadFreeSurfer, AHeaderClaimingBillionsOfVerticesIsRefusedAndStorageFollows
     return std::string("no ParseError");
   };
   EXPECT_THAT(error_of("#!ascii\n1772764997 4\n0 0 0 0\n"),
-              HasSubstr("claims.asc:2: bad header: 1772764997 vertices and 4 triangles; a surface may have at most "
+              HasSubstr("claims.asc:2: bad header: 1772764997 vertices and 4 triangles; a surface "
+                        "may have at most "
                         "250000 vertices"));
   EXPECT_THAT(error_of("#!ascii\n250000 4\n0 0 0 0\n"),
               HasSubstr("claims.asc:3: the file ends after 1 of the 250000 vertices"));
@@ -433,7 +450,8 @@ TEST(ReadFreeSurfer, TetrahedronSurface) {
 
 TEST(ReadFreeSurfer, Colin27BrainSurface) {
   const std::string path = testing::source_path("../shared/data/colin27/brain_surface.asc");
-  if (!fs::exists(path)) GTEST_SKIP() << path << " is not present (shared/ is not beside this clone)";
+  if (!fs::exists(path))
+    GTEST_SKIP() << path << " is not present (shared/ is not beside this clone)";
   const TriangleSurface surface = read_freesurfer_ascii(path);
   ASSERT_EQ(surface.vertex_count(), 10242);
   ASSERT_EQ(surface.triangle_count(), 20480);

@@ -42,15 +42,18 @@ TEST(AabbTree, TrianglesNearAreExactlyThoseWhoseBoxesAreWithinReach) {
     std::vector<int> expected;
     for (int t = 0; t < sphere.triangle_count(); ++t) {
       const Triangle& tri = sphere.triangles[t];
-      const Vector3d a = sphere.vertices.col(tri[0]), b = sphere.vertices.col(tri[1]), c = sphere.vertices.col(tri[2]);
-      if (box_distance(p, a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)) <= r) expected.push_back(t);
+      const Vector3d a = sphere.vertices.col(tri[0]), b = sphere.vertices.col(tri[1]),
+                     c = sphere.vertices.col(tri[2]);
+      if (box_distance(p, a.cwiseMin(b).cwiseMin(c), a.cwiseMax(b).cwiseMax(c)) <= r)
+        expected.push_back(t);
     }
     ASSERT_EQ(found, expected) << "point " << p.transpose() << ", reach " << r;
   }
 }
 
 // The rules over the candidates give the very triangle, point and distance of the full scans.
-int expect_same_as_full_scans(const TetMesh& mesh, const BoundarySurface& surface, const std::vector<int>& touchable,
+int expect_same_as_full_scans(const TetMesh& mesh, const BoundarySurface& surface,
+                              const std::vector<int>& touchable,
                               const std::vector<Vector3d>& points) {
   const SurfacePseudoNormals normals = compute_pseudo_normals(mesh, surface);
   const NearestTriangleCandidates candidates(mesh, surface, touchable);
@@ -71,7 +74,8 @@ int expect_same_as_full_scans(const TetMesh& mesh, const BoundarySurface& surfac
     EXPECT_EQ(nearest_pruned.signed_distance, nearest.signed_distance);
     for (double radius : {0.0, 0.05}) {
       const ContactQuery contact = find_contact(mesh, surface, normals, touchable, p, radius);
-      const ContactQuery contact_pruned = find_contact(mesh, surface, normals, touchable_near, p, radius, all_near);
+      const ContactQuery contact_pruned =
+          find_contact(mesh, surface, normals, touchable_near, p, radius, all_near);
       EXPECT_EQ(contact_pruned.signed_distance, contact.signed_distance);
       EXPECT_EQ(contact_pruned.contact.has_value(), contact.contact.has_value());
       if (contact.contact && contact_pruned.contact) {
@@ -84,12 +88,15 @@ int expect_same_as_full_scans(const TetMesh& mesh, const BoundarySurface& surfac
 }
 
 TEST(NearestTriangleCandidates, GiveTheFullScansAnswersOnABoxWithATouchableFace) {
-  const TetMesh mesh = make_box_mesh(Vector3d::Zero(), Vector3d(1.0, 0.8, 0.6), Eigen::Vector3i(5, 4, 3));
+  const TetMesh mesh =
+      make_box_mesh(Vector3d::Zero(), Vector3d(1.0, 0.8, 0.6), Eigen::Vector3i(5, 4, 3));
   const BoundarySurface surface = extract_boundary_surface(mesh);
   std::vector<int> top;  // the face z = 0.6
   for (int t = 0; t < surface.triangle_count(); ++t) {
     const Triangle& tri = surface.triangles[t];
-    if (mesh.nodes(2, tri[0]) == 0.6 && mesh.nodes(2, tri[1]) == 0.6 && mesh.nodes(2, tri[2]) == 0.6) top.push_back(t);
+    if (mesh.nodes(2, tri[0]) == 0.6 && mesh.nodes(2, tri[1]) == 0.6 &&
+        mesh.nodes(2, tri[2]) == 0.6)
+      top.push_back(t);
   }
   ASSERT_GT(top.size(), 10u);
   std::mt19937 rng(9);
@@ -98,13 +105,16 @@ TEST(NearestTriangleCandidates, GiveTheFullScansAnswersOnABoxWithATouchableFace)
   std::vector<Vector3d> points;
   for (int i = 0; i < 1500; ++i) points.emplace_back(x(rng), y(rng), z(rng));
   // On the mesh's lattice and halfway between: exact ties at vertices, edges and faces.
-  for (int i = 0; i < 1500; ++i) points.emplace_back(0.1 * lattice(rng), 0.1 * lattice(rng), 0.1 * lattice(rng));
+  for (int i = 0; i < 1500; ++i)
+    points.emplace_back(0.1 * lattice(rng), 0.1 * lattice(rng), 0.1 * lattice(rng));
   const int most = expect_same_as_full_scans(mesh, surface, top, points);
-  std::printf("  box: %d surface triangles, at most %d candidates per point\n", surface.triangle_count(), most);
+  std::printf("  box: %d surface triangles, at most %d candidates per point\n",
+              surface.triangle_count(), most);
 }
 
 TEST(NearestTriangleCandidates, GiveTheFullScansAnswersOnTheBrain) {
-  const std::filesystem::path file = std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes/brain/brain.msh";
+  const std::filesystem::path file =
+      std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes/brain/brain.msh";
   TetMesh mesh = read_gmsh(file).mesh;
   check_tet_mesh(mesh);  // orients the tetrahedra, so that the surface faces outwards
   mesh.nodes *= 1e-3;
@@ -119,9 +129,11 @@ TEST(NearestTriangleCandidates, GiveTheFullScansAnswersOnTheBrain) {
     const Triangle& tri = surface.triangles[pick(rng)];
     points.push_back(mesh.nodes.col(tri[i % 3]) + Vector3d(offset(rng), offset(rng), offset(rng)));
   }
-  for (int i = 0; i < 200; ++i) points.push_back(mesh.nodes.col(surface.triangles[pick(rng)][0]));  // at vertices
+  for (int i = 0; i < 200; ++i)
+    points.push_back(mesh.nodes.col(surface.triangles[pick(rng)][0]));  // at vertices
   const int most = expect_same_as_full_scans(mesh, surface, every, points);
-  std::printf("  brain: %d surface triangles, at most %d candidates per point\n", surface.triangle_count(), most);
+  std::printf("  brain: %d surface triangles, at most %d candidates per point\n",
+              surface.triangle_count(), most);
 }
 
 }  // namespace

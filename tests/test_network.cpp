@@ -62,7 +62,8 @@ std::vector<Tick> read_ticks(const fs::path& file) {
     Tick tick;
     tick.time = static_cast<double>(t.time_ns()) * 1e-9;
     tick.own = wire::from_wire(t.own());
-    tick.remote = t.remotes_size() > 0 ? wire::from_wire(t.remotes(0)) : Eigen::Vector3d::Constant(NAN);
+    tick.remote =
+        t.remotes_size() > 0 ? wire::from_wire(t.remotes(0)) : Eigen::Vector3d::Constant(NAN);
     tick.force = wire::from_wire(t.force());
     tick.evaluated = wire::from_wire(t.evaluated());
     tick.epoch = t.ir_epoch();
@@ -87,7 +88,8 @@ std::map<std::uint64_t, std::unique_ptr<PreparedIR>> read_irs(const fs::path& fi
 }
 
 TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
-  Session session("e2e-forces", {"--duration", "30", "--display", "display", "--display-rate-hz", "20"});
+  Session session("e2e-forces",
+                  {"--duration", "30", "--display", "display", "--display-rate-hz", "20"});
   const auto a = session.client("alice", 0, write_press(session.dir, "a", -20, 2, 4, 0.6));
   const auto b = session.client("bob", 1, write_press(session.dir, "b", 20, -2, 4, 0.6));
   ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
@@ -109,7 +111,8 @@ TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
   for (const std::string user : {"alice", "bob"}) {
     const std::vector<Tick> ticks = read_ticks(session.dir / (user + ".mcap"));
     ASSERT_GT(ticks.size(), 1500u) << user;
-    const std::map<std::uint64_t, std::unique_ptr<PreparedIR>> irs = read_irs(session.dir / (user + ".mcap"));
+    const std::map<std::uint64_t, std::unique_ptr<PreparedIR>> irs =
+        read_irs(session.dir / (user + ".mcap"));
     int contact_ticks = 0, offline_checked = 0, reference_checked = 0;
     for (std::size_t i = 0; i < ticks.size(); ++i) {
       const Tick& t = ticks[i];
@@ -119,7 +122,8 @@ TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
       const auto& ir = irs.at(t.epoch);
       // The same IR and positions give the same force, bit for bit.
       const Eigen::Vector3d remote = t.remote;
-      const ForceSample offline = testing::evaluate_static(*ir, t.own, std::span(&remote, condensed_fem(ir->ir).remotes.empty() ? 0 : 1));
+      const ForceSample offline = testing::evaluate_static(
+          *ir, t.own, std::span(&remote, condensed_fem(ir->ir).remotes.empty() ? 0 : 1));
       ASSERT_EQ(offline.force, t.evaluated) << user << " tick " << i;
       ++offline_checked;
       // And the full FEM solve with both tools at those positions, where both sit on the
@@ -130,26 +134,35 @@ TEST(EndToEnd, ClientForcesEqualOfflineEvaluationAndTheFullSolve) {
       bool covered = contacts[0].contact.has_value();
       if (covered) {
         bool in_patch = false;
-        for (const IrTriangle& tri : condensed_fem(ir->ir).patch) in_patch |= tri.surface_index == contacts[0].contact->triangle;
-        covered = in_patch && (!contacts[1].contact || [&] {
-          const Triangle& tri = body.surface.triangles[contacts[1].contact->triangle];
-          for (int k = 0; k < 3; ++k)
-            if (condensed_fem(ir->ir).remotes.empty() || body.mesh.node_tags[tri[k]] != condensed_fem(ir->ir).node_ids[condensed_fem(ir->ir).remotes[0].nodes[k]]) return false;
-          return true;
-        }());
+        for (const IrTriangle& tri : condensed_fem(ir->ir).patch)
+          in_patch |= tri.surface_index == contacts[0].contact->triangle;
+        covered =
+            in_patch && (!contacts[1].contact || [&] {
+              const Triangle& tri = body.surface.triangles[contacts[1].contact->triangle];
+              for (int k = 0; k < 3; ++k)
+                if (condensed_fem(ir->ir).remotes.empty() ||
+                    body.mesh.node_tags[tri[k]] !=
+                        condensed_fem(ir->ir).node_ids[condensed_fem(ir->ir).remotes[0].nodes[k]])
+                  return false;
+              return true;
+            }());
       }
       if (!covered) continue;
       const Eigen::Vector3d expected =
-          contact_reactions_reference(body, contacts, {}, ContactModel::node_translation)[0].reaction;
+          contact_reactions_reference(body, contacts, {}, ContactModel::node_translation)[0]
+              .reaction;
       EXPECT_LE((t.evaluated - expected).norm(), 1e-9 * expected.norm()) << user << " tick " << i;
       ++reference_checked;
     }
-    std::printf("  %s: %zu ticks, %d in contact, %d re-evaluated offline, %d checked against the full solve\n",
-                user.c_str(), ticks.size(), contact_ticks, offline_checked, reference_checked);
+    std::printf(
+        "  %s: %zu ticks, %d in contact, %d re-evaluated offline, %d checked against the full "
+        "solve\n",
+        user.c_str(), ticks.size(), contact_ticks, offline_checked, reference_checked);
     EXPECT_GT(contact_ticks, 300);
     EXPECT_GE(reference_checked, 5);
     const nlohmann::json report = session.report(user);
-    EXPECT_GT(report["coupling_n"]["peak"].get<double>(), 0.1 * report["force_n"]["peak"].get<double>());
+    EXPECT_GT(report["coupling_n"]["peak"].get<double>(),
+              0.1 * report["force_n"]["peak"].get<double>());
   }
 }
 
@@ -169,12 +182,14 @@ double force_updates_per_second(const std::vector<Tick>& ticks) {
 TEST(EndToEnd, P0IsStepwiseAndP1SmoothAtACappedSimulationRate) {
   std::map<std::string, double> rate;
   for (const std::string protocol : {"P0", "P1"}) {
-    Session session("e2e-" + protocol, {"--protocol", protocol, "--sim-rate-hz", "40", "--duration", "30"});
+    Session session("e2e-" + protocol,
+                    {"--protocol", protocol, "--sim-rate-hz", "40", "--duration", "30"});
     const auto a = session.client("alice", 0, write_press(session.dir, "a", 3, 2, 5, 0.2));
     ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
     session.stop_server();
     rate[protocol] = force_updates_per_second(read_ticks(session.dir / "alice.mcap"));
-    std::printf("  %s at a 40 Hz simulation: %.0f distinct forces per second\n", protocol.c_str(), rate[protocol]);
+    std::printf("  %s at a 40 Hz simulation: %.0f distinct forces per second\n", protocol.c_str(),
+                rate[protocol]);
   }
   EXPECT_LE(rate["P0"], 45);   // one force per simulation step, held in between
   EXPECT_GE(rate["P1"], 500);  // a new force every haptic tick
@@ -188,7 +203,9 @@ TEST(EndToEnd, AnInjectedShiftDelayIsMeasuredBack) {
   const nlohmann::json client = session.report("alice");
   const double one_way = client["one_way_delay_ms"]["p50"].get<double>();
   const double round_trip = client["clock"]["round_trip_ms"].get<double>();
-  std::printf("  injected 20 ms each way: measured one-way %.2f ms (p50), clock round trip %.2f ms\n", one_way, round_trip);
+  std::printf(
+      "  injected 20 ms each way: measured one-way %.2f ms (p50), clock round trip %.2f ms\n",
+      one_way, round_trip);
   EXPECT_NEAR(one_way, 20.0, 1.0);
   EXPECT_NEAR(round_trip, 40.0, 2.0);
   EXPECT_EQ(session.report("server")["server"]["injected"]["shift_delay_ms"], 20.0);
@@ -206,7 +223,8 @@ TEST(EndToEnd, HostileDatagramsAreRejectedByReasonAndDoNotMoveTheHapticPeriod) {
 
   asio::io_context io;
   asio::ip::udp::socket socket(io, asio::ip::udp::endpoint(asio::ip::udp::v4(), 0));
-  const asio::ip::udp::endpoint server(asio::ip::make_address("127.0.0.1"), static_cast<std::uint16_t>(session.port));
+  const asio::ip::udp::endpoint server(asio::ip::make_address("127.0.0.1"),
+                                       static_cast<std::uint16_t>(session.port));
   const asio::ip::udp::endpoint client(asio::ip::make_address("127.0.0.1"), client_port);
   // The flood may know the public development key: it derives slot 0's key, and still has
   // neither the session id nor the sealer's salt.
@@ -225,11 +243,11 @@ TEST(EndToEnd, HostileDatagramsAreRejectedByReasonAndDoNotMoveTheHapticPeriod) {
   };
   // One of each kind to the server (its session id is unknown to us: wrong_session, except
   // where an earlier check fires first).
-  send({1, 2, 3}, server);                                          // truncated
-  send(std::vector<std::uint8_t>(2000, 7), server);                 // oversized
+  send({1, 2, 3}, server);                           // truncated
+  send(std::vector<std::uint8_t>(2000, 7), server);  // oversized
   std::vector<std::uint8_t> forged = datagram(wire::kProtocolVersion, 5, 0.0);
   forged.back() ^= 0x40;
-  send(forged, server);                                             // bad_tag
+  send(forged, server);                                        // bad_tag
   send(datagram(wire::kProtocolVersion - 1, 5, 0.0), server);  // bad_version: an older peer
   send(datagram(wire::kProtocolVersion, 5, 0.0), server);      // wrong_session
   // A flood at the client while its haptic loop runs: random bytes and forged datagrams.
@@ -237,13 +255,18 @@ TEST(EndToEnd, HostileDatagramsAreRejectedByReasonAndDoNotMoveTheHapticPeriod) {
   for (int i = 0; i < 20000; ++i) {
     std::vector<std::uint8_t> junk(16 + rng() % 200);
     for (auto& byte : junk) byte = static_cast<std::uint8_t>(rng());
-    send(i % 2 ? junk : datagram(wire::kProtocolVersion, 1000 + static_cast<std::uint64_t>(i), std::nan("")), client);
-    if (i % 1000 == 999) std::this_thread::sleep_for(5ms);  // stimulus: a flood in bursts the kernel can take
+    send(i % 2
+             ? junk
+             : datagram(wire::kProtocolVersion, 1000 + static_cast<std::uint64_t>(i), std::nan("")),
+         client);
+    if (i % 1000 == 999)
+      std::this_thread::sleep_for(5ms);  // stimulus: a flood in bursts the kernel can take
   }
   ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
   session.stop_server();
 
-  const nlohmann::json server_reasons = session.report("server")["server"]["datagrams"]["rejected_by_reason"];
+  const nlohmann::json server_reasons =
+      session.report("server")["server"]["datagrams"]["rejected_by_reason"];
   for (const char* reason : {"truncated", "oversized", "bad_tag", "bad_version", "wrong_session"})
     EXPECT_GE(server_reasons[reason].get<int>(), 1) << reason << ": " << server_reasons.dump();
   const nlohmann::json report = session.report("alice");
@@ -256,8 +279,10 @@ TEST(EndToEnd, HostileDatagramsAreRejectedByReasonAndDoNotMoveTheHapticPeriod) {
   EXPECT_LE(reasons["accepted"].get<int>(), report["datagrams"]["received"].get<int>() - 15000);
   const double p99 = report["period_us"]["p99"].get<double>();
   const double floor_p99 = report["timer_floor"]["period_us"]["p99"].get<double>();
-  std::printf("  under a flood of 20,000 hostile datagrams: haptic period p99 %.0f us, timer floor p99 %.0f us\n", p99,
-              floor_p99);
+  std::printf(
+      "  under a flood of 20,000 hostile datagrams: haptic period p99 %.0f us, timer floor p99 "
+      "%.0f us\n",
+      p99, floor_p99);
   // The floor is measured before the session, the flood's period during it: on an idle
   // machine they agree within ~50 us; on a loaded one (a 2 ms floor) both swing by a
   // tenth or more between the two measurements, so the margin grows with the floor. A flood
@@ -288,18 +313,24 @@ segments:
   const nlohmann::json client = session.report("alice");
   const auto sent = server["irs_sent"].get<std::uint64_t>();
   const auto received = client["ir"]["received"].get<std::uint64_t>();
-  const double mean_bytes = static_cast<double>(client["ir"]["bytes"].get<std::uint64_t>()) / static_cast<double>(received);
-  const double fragments = std::ceil(mean_bytes / static_cast<double>(wire::kMaxDatagramBytes - 100));
+  const double mean_bytes = static_cast<double>(client["ir"]["bytes"].get<std::uint64_t>()) /
+                            static_cast<double>(received);
+  const double fragments =
+      std::ceil(mean_bytes / static_cast<double>(wire::kMaxDatagramBytes - 100));
   const double udp_survival = std::pow(0.8, fragments);
   const double udp_chain = std::pow(udp_survival, static_cast<double>(received));
-  std::printf("  20 %% datagram loss: %lu of %lu IRs arrived over TCP; as UDP, an IR of %.0f bytes (%.0f fragments) "
-              "would arrive with probability %.2g, all %lu of them (each needs the ones before) %.2g\n",
-              static_cast<unsigned long>(received), static_cast<unsigned long>(sent), mean_bytes, fragments, udp_survival,
-              static_cast<unsigned long>(received), udp_chain);
+  std::printf(
+      "  20 %% datagram loss: %lu of %lu IRs arrived over TCP; as UDP, an IR of %.0f bytes (%.0f "
+      "fragments) "
+      "would arrive with probability %.2g, all %lu of them (each needs the ones before) %.2g\n",
+      static_cast<unsigned long>(received), static_cast<unsigned long>(sent), mean_bytes, fragments,
+      udp_survival, static_cast<unsigned long>(received), udp_chain);
   EXPECT_EQ(received, sent);
   EXPECT_GE(received, 5u);
-  EXPECT_GT(client["remote_samples_received"].get<int>() + client["datagrams"]["received"].get<int>(), 0);
-  EXPECT_EQ(client["ir"]["condensed"].get<std::uint64_t>(), received) << "every IR came as compliance rows";
+  EXPECT_GT(
+      client["remote_samples_received"].get<int>() + client["datagrams"]["received"].get<int>(), 0);
+  EXPECT_EQ(client["ir"]["condensed"].get<std::uint64_t>(), received)
+      << "every IR came as compliance rows";
   EXPECT_LT(udp_chain, 0.1);
   // The datagrams did suffer: about 20 % lost each way.
   const double to_lost = server["injected"]["datagrams_dropped_to_clients"].get<double>();
@@ -322,7 +353,8 @@ FadeTimeline fade_timeline(const std::vector<Tick>& ticks) {
     const double s = t.time - ticks.front().time;
     if (timeline.started < 0 && t.fade < 1 && t.evaluated.norm() > 0) timeline.started = s;
     if (timeline.started >= 0 && timeline.zero_at < 0 && t.fade == 0) timeline.zero_at = s;
-    if (timeline.zero_at >= 0 && timeline.back_at < 0 && t.fade == 1 && t.force.norm() > 0) timeline.back_at = s;
+    if (timeline.zero_at >= 0 && timeline.back_at < 0 && t.fade == 1 && t.force.norm() > 0)
+      timeline.back_at = s;
   }
   return timeline;
 }
@@ -338,7 +370,8 @@ std::vector<Tick> ticks_so_far(const fs::path& file) {
 }
 
 TEST(EndToEnd, AServerRestartFadesTheForceOutAndTheClientReconnects) {
-  auto session = std::make_unique<Session>("e2e-restart", std::vector<std::string>{"--duration", "120"});
+  auto session =
+      std::make_unique<Session>("e2e-restart", std::vector<std::string>{"--duration", "120"});
   const int port = session->port;
   // Press 3 mm from 0.5 mm above the face and hold far longer than any restart takes: the
   // test ends the client once its force is back.
@@ -347,22 +380,26 @@ TEST(EndToEnd, AServerRestartFadesTheForceOutAndTheClientReconnects) {
   ASSERT_TRUE(testing::wait_until(
       [&] {
         const std::vector<Tick> ticks = ticks_so_far(recording);
-        return std::any_of(ticks.begin(), ticks.end(), [](const Tick& t) { return t.own.z() < -2.4e-3 && t.force.norm() > 0; });
+        return std::any_of(ticks.begin(), ticks.end(),
+                           [](const Tick& t) { return t.own.z() < -2.4e-3 && t.force.norm() > 0; });
       },
       "alice's recording to show her holding the press (2.5 mm deep, with a force)"))
       << a->log_text();
   session->server->signal(SIGKILL);
   ASSERT_TRUE(session->server->wait(testing::kPatience).has_value());
-  ASSERT_TRUE(testing::wait_until([&] { return fade_timeline(ticks_so_far(recording)).zero_at >= 0; },
-                                  "alice's force to fade out to zero after the server was killed"))
+  ASSERT_TRUE(
+      testing::wait_until([&] { return fade_timeline(ticks_so_far(recording)).zero_at >= 0; },
+                          "alice's force to fade out to zero after the server was killed"))
       << a->log_text();
-  ChildProcess restarted(testing::server_program(),
-                         {"--scene", (session->dir / "cube.yaml").string(), "--listen", fmt::format("127.0.0.1:{}", port),
-                          "--duration", "120", "--no-disk-cache"},
-                         session->dir / "server2.log");
+  ChildProcess restarted(
+      testing::server_program(),
+      {"--scene", (session->dir / "cube.yaml").string(), "--listen",
+       fmt::format("127.0.0.1:{}", port), "--duration", "120", "--no-disk-cache"},
+      session->dir / "server2.log");
   ASSERT_TRUE(testing::wait_for_output(restarted, "listening on"));
-  ASSERT_TRUE(testing::wait_until([&] { return fade_timeline(ticks_so_far(recording)).back_at >= 0; },
-                                  "alice's force to come back after the server's restart"))
+  ASSERT_TRUE(
+      testing::wait_until([&] { return fade_timeline(ticks_so_far(recording)).back_at >= 0; },
+                          "alice's force to come back after the server's restart"))
       << a->log_text() << restarted.log_text();
   a->signal(SIGINT);
   ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
@@ -375,8 +412,8 @@ TEST(EndToEnd, AServerRestartFadesTheForceOutAndTheClientReconnects) {
   const std::vector<Tick> ticks = read_ticks(recording);
   ASSERT_FALSE(ticks.empty());
   const FadeTimeline timeline = fade_timeline(ticks);
-  std::printf("  force fading from %.3f s, zero at %.3f s, back at %.3f s\n", timeline.started, timeline.zero_at,
-              timeline.back_at);
+  std::printf("  force fading from %.3f s, zero at %.3f s, back at %.3f s\n", timeline.started,
+              timeline.zero_at, timeline.back_at);
   ASSERT_GT(timeline.started, 0) << "the force never faded";
   ASSERT_GT(timeline.zero_at, 0) << "the force never reached zero";
   EXPECT_LE(timeline.zero_at - timeline.started, 0.1 + 0.02);  // the fade time, plus a tick or two

@@ -46,12 +46,14 @@ NodeBacking one_node_backing(double stiffness, double damping) {
 Eigen::VectorXd pushes_at(const NodeBacking& backing, const Eigen::VectorXd& z) {
   const auto count = static_cast<Eigen::Index>(backing.nodes.size());
   Eigen::Matrix3Xd positions(3, count), forces = Eigen::Matrix3Xd::Zero(3, count);
-  for (Eigen::Index i = 0; i < count; ++i) positions.col(i) = backing.targets.segment<3>(3 * i) + Eigen::Vector3d(0, 0, z[i]);
+  for (Eigen::Index i = 0; i < count; ++i)
+    positions.col(i) = backing.targets.segment<3>(3 * i) + Eigen::Vector3d(0, 0, z[i]);
   NodeBackingSolve solve;
   prepare_backing_solve(solve, backing);
   add_node_backing_forces(backing, solve, positions, Eigen::Matrix3Xd::Zero(3, count), forces);
   EXPECT_EQ(solve.failures, 0u);
-  for (Eigen::Index i = 0; i < count; ++i) EXPECT_NEAR(forces(2, i), solve.pushes[i], 1e-12 * (1 + solve.pushes[i]));
+  for (Eigen::Index i = 0; i < count; ++i)
+    EXPECT_NEAR(forces(2, i), solve.pushes[i], 1e-12 * (1 + solve.pushes[i]));
   return forces.row(2).transpose();
 }
 
@@ -85,7 +87,8 @@ TEST(NodeBacking, ADroppedNodeRestsAtItsWeightTimesItsComplianceWithoutABounce) 
   node.run(one_node_backing(k, 2 * std::sqrt(k * m)), 0.5);
   EXPECT_NEAR(node.state.positions(2, 0), -m * g / k, 1e-9);  // statics: depth = A m g
   EXPECT_LT(node.state.velocities.norm(), 1e-9);
-  EXPECT_LE(node.highest_after_touching, 0);  // critically damped: it never leaves the surface again
+  EXPECT_LE(node.highest_after_touching,
+            0);  // critically damped: it never leaves the surface again
   EXPECT_NEAR(node.state.positions(0, 0), 0.0, 1e-12);  // a normal contact: no sideways force
 }
 
@@ -94,7 +97,7 @@ TEST(NodeBacking, AnUndampedContactGivesBackNoMoreEnergyThanItTook) {
   // O(h) error: the contact is the gradient of an energy, it cannot pump.
   DroppedNode node;
   node.run(one_node_backing(1.5e4, 0), 1.0);
-  EXPECT_GT(node.highest_after_touching, 0.9e-3);  // it bounces ...
+  EXPECT_GT(node.highest_after_touching, 0.9e-3);   // it bounces ...
   EXPECT_LT(node.highest_after_touching, 1.01e-3);  // ... but no higher than it fell from
 }
 
@@ -110,11 +113,12 @@ TEST(NodeBacking, AContactPushesOnlyWhileTheNodeIsBehindItAndNeverPulls) {
     add_node_backing_forces(backing, solve, positions, velocities, forces);
     return Eigen::Vector3d(forces.col(0));
   };
-  EXPECT_EQ(force(1e-4, -1.0), Eigen::Vector3d::Zero());        // in front of it: nothing, even approaching
-  EXPECT_NEAR(force(-1e-4, 0).z(), 1.0, 1e-12);                 // depth / A
-  EXPECT_NEAR(force(-1e-4, -0.01).z(), 1.0 + 0.2, 1e-12);       // sinking: the dashpot adds
-  EXPECT_NEAR(force(-1e-4, 0.02).z(), 1.0 - 0.4, 1e-12);        // leaving: it takes some off ...
-  EXPECT_EQ(force(-1e-4, 1.0), Eigen::Vector3d::Zero());        // ... but never pulls
+  EXPECT_EQ(force(1e-4, -1.0),
+            Eigen::Vector3d::Zero());            // in front of it: nothing, even approaching
+  EXPECT_NEAR(force(-1e-4, 0).z(), 1.0, 1e-12);  // depth / A
+  EXPECT_NEAR(force(-1e-4, -0.01).z(), 1.0 + 0.2, 1e-12);  // sinking: the dashpot adds
+  EXPECT_NEAR(force(-1e-4, 0.02).z(), 1.0 - 0.4, 1e-12);   // leaving: it takes some off ...
+  EXPECT_EQ(force(-1e-4, 1.0), Eigen::Vector3d::Zero());   // ... but never pulls
   EXPECT_EQ(force(-1e-4, 0).head<2>(), Eigen::Vector2d::Zero());
   EXPECT_EQ(solve.failures, 0u);
 }
@@ -129,10 +133,12 @@ TEST(NodeBacking, PressingOneNodeLowersTheSurfaceUnderItsNeighbour) {
   // by b deep / a = 0.4 mm, so it no longer touches and is released.
   const Eigen::VectorXd released = pushes_at(backing, Eigen::Vector2d(-deep, -0.2e-3));
   EXPECT_NEAR(released[0], deep / a, 1e-9 * deep / a);
-  EXPECT_EQ(released[1], 0);  // one spring per node (the lumped backing) would push it back by about 0.2 mm / a
+  EXPECT_EQ(released[1],
+            0);  // one spring per node (the lumped backing) would push it back by about 0.2 mm / a
   // A deeper neighbour, 0.6 mm in: both touch, A lambda = depths.
   const Eigen::Vector2d both = pushes_at(backing, Eigen::Vector2d(-deep, -0.6e-3));
-  const Eigen::Vector2d expected = (Eigen::Matrix2d() << a, b, b, a).finished().inverse() * Eigen::Vector2d(deep, 0.6e-3);
+  const Eigen::Vector2d expected =
+      (Eigen::Matrix2d() << a, b, b, a).finished().inverse() * Eigen::Vector2d(deep, 0.6e-3);
   EXPECT_NEAR((both - expected).norm(), 0, 1e-9 * expected.norm());
   EXPECT_GT(both.minCoeff(), 0);
   // The coupling is felt: the deep node is pushed less than on its own (depth / a), as the
@@ -149,7 +155,8 @@ TEST(NodeBacking, ANetworkDroppedOnACoupledBackingNeverGainsEnergy) {
   const int count = 5;
   MassSpringNetwork network;
   network.rest_positions = Eigen::Matrix3Xd::Zero(3, count);
-  for (int i = 0; i < count; ++i) network.rest_positions.col(i) = Eigen::Vector3d(0.01 * i, 0, 0.5e-3 + 0.2e-3 * i);
+  for (int i = 0; i < count; ++i)
+    network.rest_positions.col(i) = Eigen::Vector3d(0.01 * i, 0, 0.5e-3 + 0.2e-3 * i);
   network.mass = Eigen::VectorXd::Constant(count, 3.7e-3);
   network.held.assign(count, 0);
   for (int i = 0; i + 1 < count; ++i) network.springs.push_back({i, i + 1, 0.01, 200, 0});
@@ -158,7 +165,8 @@ TEST(NodeBacking, ANetworkDroppedOnACoupledBackingNeverGainsEnergy) {
   Eigen::MatrixXd compliance(count, count);
   for (int i = 0; i < count; ++i)
     for (int j = 0; j < count; ++j) compliance(i, j) = 1e-4 / (1 + std::abs(i - j));
-  compliance.diagonal().array() += 1e-8 / 3.7e-3;  // the contact's own compliance (compliance_backing.h)
+  compliance.diagonal().array() +=
+      1e-8 / 3.7e-3;  // the contact's own compliance (compliance_backing.h)
   const NodeBacking backing = plane_backing(compliance, 0);
   MassSpringState state = make_state(network);
   prepare_backing_solve(state.backing, backing);
@@ -183,12 +191,13 @@ TEST(NodeBacking, ANetworkDroppedOnACoupledBackingNeverGainsEnergy) {
     }
   }
   EXPECT_EQ(state.backing.failures, 0u);
-  const double fallen = network.mass.sum() * 9.81 * 0.9e-3;  // the scale of the energy exchanged [J]
-  EXPECT_GT(largest_stored, 0.3 * fallen);                    // the backing stored much of it ...
-  EXPECT_GT(free_samples, 100);                               // ... and the network bounced off
-  EXPECT_LT(highest_free - start, 1e-2 * fallen);             // no higher than it fell from, up to O(h)
-  std::cout << "drop energy " << fallen << " J, stored at most " << largest_stored << " J, free-flight energy gain "
-            << highest_free - start << " J\n";
+  const double fallen =
+      network.mass.sum() * 9.81 * 0.9e-3;          // the scale of the energy exchanged [J]
+  EXPECT_GT(largest_stored, 0.3 * fallen);         // the backing stored much of it ...
+  EXPECT_GT(free_samples, 100);                    // ... and the network bounced off
+  EXPECT_LT(highest_free - start, 1e-2 * fallen);  // no higher than it fell from, up to O(h)
+  std::cout << "drop energy " << fallen << " J, stored at most " << largest_stored
+            << " J, free-flight energy gain " << highest_free - start << " J\n";
 }
 
 // A client's sub-network holds the server's pushes on backed nodes outside it: with every
@@ -199,7 +208,8 @@ TEST(NodeBacking, ASubNetworksBackingWithTheOthersPushesHeldGivesTheWholesPushes
   const int count = 6;
   Eigen::MatrixXd root(count, count);
   for (Eigen::Index i = 0; i < root.size(); ++i) root.data()[i] = uniform(random);
-  const Eigen::MatrixXd compliance = 1e-5 * (root * root.transpose() + Eigen::MatrixXd::Identity(count, count));
+  const Eigen::MatrixXd compliance =
+      1e-5 * (root * root.transpose() + Eigen::MatrixXd::Identity(count, count));
   const NodeBacking whole = plane_backing(compliance, 0);
   Eigen::VectorXd z(count);
   for (int i = 0; i < count; ++i) z[i] = -1e-4 * (1 + uniform(random));
@@ -210,7 +220,8 @@ TEST(NodeBacking, ASubNetworksBackingWithTheOthersPushesHeldGivesTheWholesPushes
   const NodeBacking sub = sub_network_backing(whole, pushes, body_nodes);
   ASSERT_EQ(sub.nodes, (std::vector<int>{0, 1, 2}));
   const Eigen::VectorXd sub_pushes = pushes_at(sub, Eigen::Vector3d(z[1], z[3], z[4]));
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(sub_pushes[k], pushes[body_nodes[k]], 1e-9 * pushes.maxCoeff());
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(sub_pushes[k], pushes[body_nodes[k]], 1e-9 * pushes.maxCoeff());
 }
 
 }  // namespace

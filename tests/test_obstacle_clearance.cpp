@@ -21,7 +21,8 @@ using Eigen::Vector3d;
 
 double nearest_obstacle(const std::vector<ObstacleDistance>& obstacles, const Vector3d& p) {
   double nearest = std::numeric_limits<double>::infinity();
-  for (const ObstacleDistance& obstacle : obstacles) nearest = std::min(nearest, obstacle.signed_distance(p));
+  for (const ObstacleDistance& obstacle : obstacles)
+    nearest = std::min(nearest, obstacle.signed_distance(p));
   return nearest;
 }
 
@@ -30,12 +31,16 @@ TEST(ObstacleClearance, PointsItSkipsAreClearOfEveryObstacleAndItSkipsMost) {
   const int count = 300;
   Eigen::Matrix3Xd rest(3, count);
   for (int i = 0; i < count; ++i)
-    rest.col(i) = std::uniform_real_distribution<double>(0.2, 0.9)(rng) * testing::random_direction(rng);
+    rest.col(i) =
+        std::uniform_real_distribution<double>(0.2, 0.9)(rng) * testing::random_direction(rng);
   std::vector<ObstacleDistance> obstacles;
   obstacles.emplace_back(Obstacle{"ball", testing::make_icosphere(3, 1.0), std::nullopt}, rest);
-  obstacles.emplace_back(Obstacle{"floor", {}, std::pair{Vector3d(0, 0, -0.8), Vector3d(0, 0, 1)}}, rest);
+  obstacles.emplace_back(Obstacle{"floor", {}, std::pair{Vector3d(0, 0, -0.8), Vector3d(0, 0, 1)}},
+                         rest);
   ObstacleClearance clearance(obstacles, rest);
-  for (int i = 0; i < count; ++i) EXPECT_EQ(clearance.radius(static_cast<std::size_t>(i)), nearest_obstacle(obstacles, rest.col(i)));
+  for (int i = 0; i < count; ++i)
+    EXPECT_EQ(clearance.radius(static_cast<std::size_t>(i)),
+              nearest_obstacle(obstacles, rest.col(i)));
 
   // Each point walks in steps of up to 5 mm with a slight outward drift.
   Eigen::Matrix3Xd position = rest;
@@ -44,7 +49,9 @@ TEST(ObstacleClearance, PointsItSkipsAreClearOfEveryObstacleAndItSkipsMost) {
     for (int i = 0; i < count; ++i) {
       const auto slot = static_cast<std::size_t>(i);
       const Vector3d p = position.col(i);
-      Vector3d next = p + 0.005 * std::uniform_real_distribution<double>(0, 1)(rng) * testing::random_direction(rng) +
+      Vector3d next = p +
+                      0.005 * std::uniform_real_distribution<double>(0, 1)(rng) *
+                          testing::random_direction(rng) +
                       0.001 * p.normalized();
       if (next.norm() > 1.1) next = rest.col(i);  // far out: start again from rest
       position.col(i) = next;
@@ -59,16 +66,17 @@ TEST(ObstacleClearance, PointsItSkipsAreClearOfEveryObstacleAndItSkipsMost) {
       }
     }
   }
-  std::printf("  %ld point checks: %ld skipped, %ld queried (%ld penetrating)\n", skipped + queried, skipped, queried,
-              penetrating);
-  EXPECT_GT(penetrating, 1000);           // the walk does reach the obstacles
-  EXPECT_GT(skipped, 3 * queried);        // and the screen spares most queries
+  std::printf("  %ld point checks: %ld skipped, %ld queried (%ld penetrating)\n", skipped + queried,
+              skipped, queried, penetrating);
+  EXPECT_GT(penetrating, 1000);     // the walk does reach the obstacles
+  EXPECT_GT(skipped, 3 * queried);  // and the screen spares most queries
 }
 
 TEST(ObstacleClearance, APenetratingOrTouchingPointIsAlwaysQueried) {
   const Eigen::Matrix3Xd rest = Eigen::Vector3d(0, 0, 1).replicate(1, 1);
   std::vector<ObstacleDistance> obstacles;
-  obstacles.emplace_back(Obstacle{"floor", {}, std::pair{Vector3d::Zero(), Vector3d(0, 0, 1)}}, rest);
+  obstacles.emplace_back(Obstacle{"floor", {}, std::pair{Vector3d::Zero(), Vector3d(0, 0, 1)}},
+                         rest);
   ObstacleClearance clearance(obstacles, rest);
   EXPECT_TRUE(clearance.certainly_clear(0, Vector3d(0, 0, 0.5)));
   EXPECT_FALSE(clearance.certainly_clear(0, Vector3d(0, 0, 0)));  // moved by the whole radius
@@ -79,9 +87,11 @@ TEST(ObstacleClearance, APenetratingOrTouchingPointIsAlwaysQueried) {
 }
 
 TEST(ObstacleClearance, EstimatesThePlanesDistanceExactlyAndTheSpheresToSecondOrder) {
-  const Eigen::Matrix3Xd rest = (Eigen::Matrix3Xd(3, 2) << 0, 0, 0, 0, 0.5, 0.6).finished();  // (0, 0, 0.5), (0, 0, 0.6)
+  const Eigen::Matrix3Xd rest =
+      (Eigen::Matrix3Xd(3, 2) << 0, 0, 0, 0, 0.5, 0.6).finished();  // (0, 0, 0.5), (0, 0, 0.6)
   std::vector<ObstacleDistance> plane;
-  plane.emplace_back(Obstacle{"floor", {}, std::pair{Vector3d(0, 0, 0.2), Vector3d(0, 0, 1)}}, rest);
+  plane.emplace_back(Obstacle{"floor", {}, std::pair{Vector3d(0, 0, 0.2), Vector3d(0, 0, 1)}},
+                     rest);
   const ObstacleClearance flat(plane, rest);
   for (const Vector3d& p : {Vector3d(0.3, -0.1, 0.25), Vector3d(-1, 2, 0.9), Vector3d(0, 0, 0.1)})
     EXPECT_NEAR(flat.estimate(0, p), p.z() - 0.2, 1e-15);

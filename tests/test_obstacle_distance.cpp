@@ -60,7 +60,8 @@ Obstacle surface_obstacle(const std::string& name, TriangleSurface surface) {
 TEST(ObstacleDistance, PlaneGivesAnalyticSignedDistanceClosestPointAndNormal) {
   const Vector3d point(0.1, -0.2, 0.3);
   const Vector3d normal = Vector3d(2, -1, 2) / 3;
-  const ObstacleDistance plane(Obstacle{"table", {}, std::make_pair(point, normal)}, Eigen::Matrix3Xd());
+  const ObstacleDistance plane(Obstacle{"table", {}, std::make_pair(point, normal)},
+                               Eigen::Matrix3Xd());
   EXPECT_TRUE(plane.is_plane());
   EXPECT_EQ(plane.name(), "table");
   std::mt19937 rng(1);
@@ -78,8 +79,9 @@ TEST(ObstacleDistance, PlaneGivesAnalyticSignedDistanceClosestPointAndNormal) {
     EXPECT_EQ(c.triangle, -1);
   }
   // A normal that is not unit is normalised; the allowed side is still where it points.
-  const ObstacleDistance floor(Obstacle{"floor", {}, std::make_pair(Vector3d::Zero(), Vector3d(0, 0, 5))},
-                               Eigen::Matrix3Xd());
+  const ObstacleDistance floor(
+      Obstacle{"floor", {}, std::make_pair(Vector3d::Zero(), Vector3d(0, 0, 5))},
+      Eigen::Matrix3Xd());
   EXPECT_DOUBLE_EQ(floor.signed_distance(Vector3d(4, 5, 0.25)), 0.25);
   EXPECT_DOUBLE_EQ(floor.signed_distance(Vector3d(4, 5, -0.5)), -0.5);
 }
@@ -119,15 +121,18 @@ void expect_sphere_distances(const ObstacleDistance& sphere, double r_min, bool 
       worst_normal_cosine = std::min(worst_normal_cosine, cosine);
     }
   }
-  std::printf("[ icosphere ] faceting bound 1 - r_min = %.6f, largest |error| %.6f, smallest normal cosine %.6f\n",
-              facet_error, worst_error, worst_normal_cosine);
+  std::printf(
+      "[ icosphere ] faceting bound 1 - r_min = %.6f, largest |error| %.6f, smallest normal cosine "
+      "%.6f\n",
+      facet_error, worst_error, worst_normal_cosine);
 }
 
 TEST(ObstacleDistance, ClosedSurfaceWithObjectInsideAllowsInside) {
   const TriangleSurface sphere = testing::make_icosphere(3, 1.0);
   const double r_min = smallest_plane_distance(sphere);
   ASSERT_GT(r_min, 0.99);  // level 3: the faceting error is a few thousandths
-  const ObstacleDistance obstacle(surface_obstacle("ball", sphere), points_in_shell(200, 0.1, 0.9, 1));
+  const ObstacleDistance obstacle(surface_obstacle("ball", sphere),
+                                  points_in_shell(200, 0.1, 0.9, 1));
   EXPECT_TRUE(obstacle.is_closed());
   EXPECT_FALSE(obstacle.is_plane());
   EXPECT_TRUE(obstacle.allowed_inside());
@@ -138,7 +143,8 @@ TEST(ObstacleDistance, ClosedSurfaceWithObjectInsideAllowsInside) {
 TEST(ObstacleDistance, ClosedSurfaceWithObjectOutsideAllowsOutside) {
   const TriangleSurface sphere = testing::make_icosphere(3, 1.0);
   const double r_min = smallest_plane_distance(sphere);
-  const ObstacleDistance obstacle(surface_obstacle("ball", sphere), points_in_shell(200, 1.5, 3.0, 2));
+  const ObstacleDistance obstacle(surface_obstacle("ball", sphere),
+                                  points_in_shell(200, 1.5, 3.0, 2));
   EXPECT_FALSE(obstacle.allowed_inside());
   EXPECT_LT(obstacle.signed_distance(Vector3d::Zero()), -0.99);
   expect_sphere_distances(obstacle, r_min, false);
@@ -167,19 +173,24 @@ TEST(ObstacleDistance, ObjectOnBothSidesIsAnErrorNamingTheSplit) {
   reference.leftCols(62) = points_in_shell(62, 0.2, 0.8, 5);
   reference.rightCols(38) = points_in_shell(38, 1.5, 2.0, 6);
   try {
-    const ObstacleDistance obstacle(surface_obstacle("skull", testing::make_icosphere(2, 1.0)), reference);
+    const ObstacleDistance obstacle(surface_obstacle("skull", testing::make_icosphere(2, 1.0)),
+                                    reference);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "the object is not on one side of obstacle 'skull': 62 % inside, 38 % outside");
+    EXPECT_STREQ(e.what(),
+                 "the object is not on one side of obstacle 'skull': 62 % inside, 38 % outside");
   }
   // 90 % on one side is enough.
   reference.leftCols(90) = points_in_shell(90, 1.5, 2.0, 7);
   reference.rightCols(10) = points_in_shell(10, 0.2, 0.8, 8);
-  EXPECT_FALSE(ObstacleDistance(surface_obstacle("skull", testing::make_icosphere(2, 1.0)), reference).allowed_inside());
+  EXPECT_FALSE(
+      ObstacleDistance(surface_obstacle("skull", testing::make_icosphere(2, 1.0)), reference)
+          .allowed_inside());
 }
 
 TEST(ObstacleDistance, ConstructionErrorsNameTheObstacle) {
-  const auto message = [](const Obstacle& obstacle, const Eigen::Matrix3Xd& reference) -> std::string {
+  const auto message = [](const Obstacle& obstacle,
+                          const Eigen::Matrix3Xd& reference) -> std::string {
     try {
       ObstacleDistance distance(obstacle, reference);
     } catch (const Error& e) {
@@ -188,11 +199,14 @@ TEST(ObstacleDistance, ConstructionErrorsNameTheObstacle) {
     return "no error";
   };
   const Eigen::Matrix3Xd one = Eigen::Matrix3Xd::Zero(3, 1);
-  EXPECT_THAT(message(Obstacle{"nothing", {}, std::nullopt}, one), ::testing::HasSubstr("'nothing'"));
-  EXPECT_THAT(message(Obstacle{"flat", {}, std::make_pair(Vector3d::Zero(), Vector3d::Zero())}, one),
-              ::testing::HasSubstr("'flat'"));
-  EXPECT_THAT(message(surface_obstacle("ball", testing::make_icosphere(1, 1.0)), Eigen::Matrix3Xd()),
-              ::testing::HasSubstr("'ball': no reference points"));
+  EXPECT_THAT(message(Obstacle{"nothing", {}, std::nullopt}, one),
+              ::testing::HasSubstr("'nothing'"));
+  EXPECT_THAT(
+      message(Obstacle{"flat", {}, std::make_pair(Vector3d::Zero(), Vector3d::Zero())}, one),
+      ::testing::HasSubstr("'flat'"));
+  EXPECT_THAT(
+      message(surface_obstacle("ball", testing::make_icosphere(1, 1.0)), Eigen::Matrix3Xd()),
+      ::testing::HasSubstr("'ball': no reference points"));
 }
 
 TEST(ObstacleDistance, OpenSurfaceUsesFaceNormalsBeyondItsRim) {
@@ -209,7 +223,8 @@ TEST(ObstacleDistance, OpenSurfaceUsesFaceNormalsBeyondItsRim) {
   EXPECT_FALSE(sheet.allowed_inside());  // in front of the triangles
   EXPECT_DOUBLE_EQ(sheet.signed_distance(Vector3d(0.2, 0.3, 0.4)), 0.4);
   EXPECT_DOUBLE_EQ(sheet.signed_distance(Vector3d(0.2, 0.3, -0.4)), -0.4);
-  EXPECT_DOUBLE_EQ(sheet.signed_distance(Vector3d(0.1, 0.1, 0.3)), 0.3);  // above the shared diagonal
+  EXPECT_DOUBLE_EQ(sheet.signed_distance(Vector3d(0.1, 0.1, 0.3)),
+                   0.3);  // above the shared diagonal
   // Beyond the rim edge x = 1: distance to the edge, sign from the face normal.
   EXPECT_DOUBLE_EQ(sheet.signed_distance(Vector3d(2, 0, 0.5)), std::sqrt(1.25));
   EXPECT_DOUBLE_EQ(sheet.signed_distance(Vector3d(2, 0, -0.5)), -std::sqrt(1.25));
@@ -218,7 +233,8 @@ TEST(ObstacleDistance, OpenSurfaceUsesFaceNormalsBeyondItsRim) {
   EXPECT_DOUBLE_EQ(sheet.signed_distance(Vector3d(2, 3, -0.5)), -std::sqrt(1 + 4 + 0.25));
   const ObstaclePoint c = sheet.closest_point(Vector3d(2, 0, -0.5));
   EXPECT_LT((c.point - Vector3d(1, 0, 0)).norm(), 1e-15);
-  EXPECT_LT((c.normal - Vector3d(-1, 0, 0.5).normalized()).norm(), 1e-15);  // towards the allowed side
+  EXPECT_LT((c.normal - Vector3d(-1, 0, 0.5).normalized()).norm(),
+            1e-15);  // towards the allowed side
   // On the surface: the pseudo-normal.
   const ObstaclePoint on = sheet.closest_point(Vector3d(0.5, -0.25, 0));
   EXPECT_EQ(on.signed_distance, 0.0);
@@ -233,7 +249,8 @@ std::filesystem::path colin27(const std::string& name) {
 }
 
 TEST(ObstacleDistance, Colin27InnerSkullContainsTheBrain) {
-  const auto skull_file = colin27("inner_skull_surface.asc"), brain_file = colin27("brain_surface.asc");
+  const auto skull_file = colin27("inner_skull_surface.asc"),
+             brain_file = colin27("brain_surface.asc");
   if (!std::filesystem::exists(skull_file) || !std::filesystem::exists(brain_file))
     GTEST_SKIP() << "Colin27 surfaces not found at " << skull_file.parent_path();
   const TriangleSurface skull = read_freesurfer_ascii(skull_file);
@@ -255,10 +272,11 @@ TEST(ObstacleDistance, Colin27InnerSkullContainsTheBrain) {
   const int n = brain.vertex_count();
   EXPECT_GE(positive, static_cast<int>(std::ceil(0.99 * n)));
   std::printf(
-      "[ Colin27 ] skull %d triangles (%s), built in %.1f ms; brain %d vertices: %d on the allowed side, %d within "
+      "[ Colin27 ] skull %d triangles (%s), built in %.1f ms; brain %d vertices: %d on the allowed "
+      "side, %d within "
       "1 mm, %d within 3 mm, smallest signed distance %.3f mm\n",
-      skull.triangle_count(), obstacle.is_closed() ? "closed" : "open", build_ms, n, positive, within_1mm, within_3mm,
-      smallest);
+      skull.triangle_count(), obstacle.is_closed() ? "closed" : "open", build_ms, n, positive,
+      within_1mm, within_3mm, smallest);
 
   // Far outside the skull is forbidden; the brain's centre is allowed.
   const Vector3d centre = brain.vertices.rowwise().mean();
@@ -279,15 +297,17 @@ TEST(ObstacleDistance, Colin27InnerSkullContainsTheBrain) {
   for (int i = 0; i < scanned; ++i) {
     double best2 = std::numeric_limits<double>::infinity();
     for (const Triangle& tri : skull.triangles) {
-      const TriangleClosestPoint q = closest_point_on_triangle(points[i], skull.vertices.col(tri[0]),
-                                                               skull.vertices.col(tri[1]), skull.vertices.col(tri[2]));
+      const TriangleClosestPoint q =
+          closest_point_on_triangle(points[i], skull.vertices.col(tri[0]),
+                                    skull.vertices.col(tri[1]), skull.vertices.col(tri[2]));
       best2 = std::min(best2, (points[i] - q.point).squaredNorm());
     }
     scan_distance[i] = std::sqrt(best2);
   }
   const double scan_ms = scan_clock.elapsed_ms();
   for (int i = 0; i < scanned; ++i)
-    EXPECT_NEAR(std::abs(obstacle.signed_distance(points[i])), scan_distance[i], 1e-12 * scan_distance[i]);
+    EXPECT_NEAR(std::abs(obstacle.signed_distance(points[i])), scan_distance[i],
+                1e-12 * scan_distance[i]);
 
   double sink = 0;
   Stopwatch tree_clock;
@@ -297,9 +317,11 @@ TEST(ObstacleDistance, Colin27InnerSkullContainsTheBrain) {
   for (int v = 0; v < n; ++v) sink += obstacle.signed_distance(brain.vertices.col(v));
   const double near_ms = near_clock.elapsed_ms();
   std::printf(
-      "[ Colin27 ] signed distance: %.0f queries/s (random in the skull's box), %.0f queries/s (brain vertices); "
+      "[ Colin27 ] signed distance: %.0f queries/s (random in the skull's box), %.0f queries/s "
+      "(brain vertices); "
       "linear scan %.0f queries/s (checksum %.3g)\n",
-      1e3 * static_cast<double>(points.size()) / tree_ms, 1e3 * n / near_ms, 1e3 * scanned / scan_ms, sink);
+      1e3 * static_cast<double>(points.size()) / tree_ms, 1e3 * n / near_ms,
+      1e3 * scanned / scan_ms, sink);
 }
 
 }  // namespace

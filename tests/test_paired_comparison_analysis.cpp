@@ -70,7 +70,10 @@ PairedComparisonRatings random_ratings(int t, int n, unsigned seed) {
     for (int i = 0; i < t; ++i)
       for (int j = i + 1; j < t; ++j)
         subject[static_cast<std::size_t>(pair_index(i, j, t))] =
-            std::clamp(std::round(gain * (truth[static_cast<std::size_t>(i)] - truth[static_cast<std::size_t>(j)]) + normal(random)), -2.0, 2.0);
+            std::clamp(std::round(gain * (truth[static_cast<std::size_t>(i)] -
+                                          truth[static_cast<std::size_t>(j)]) +
+                                  normal(random)),
+                       -2.0, 2.0);
   }
   return ratings;
 }
@@ -80,12 +83,14 @@ PairedComparisonRatings random_ratings(int t, int n, unsigned seed) {
 // removes from the residual (main effect; its deviations per subject; a free mean per pair,
 // which holds the main effect and the combination effect).
 TEST(PairedComparisonAnalysis, EqualsALeastSquaresFitOfTheSameModel) {
-  for (const auto& [t, n, seed] : {std::tuple{3, 2, 1u}, std::tuple{5, 7, 2u}, std::tuple{6, 10, 3u}}) {
+  for (const auto& [t, n, seed] :
+       {std::tuple{3, 2, 1u}, std::tuple{5, 7, 2u}, std::tuple{6, 10, 3u}}) {
     SCOPED_TRACE(::testing::Message() << t << " conditions, " << n << " subjects");
     const PairedComparisonRatings ratings = random_ratings(t, n, seed);
     const int pairs = pair_count(t), rows = n * pairs;
     Eigen::VectorXd y(rows);
-    Eigen::MatrixXd main = Eigen::MatrixXd::Zero(rows, t), by_subject = Eigen::MatrixXd::Zero(rows, t * n),
+    Eigen::MatrixXd main = Eigen::MatrixXd::Zero(rows, t),
+                    by_subject = Eigen::MatrixXd::Zero(rows, t * n),
                     pair = Eigen::MatrixXd::Zero(rows, pairs);
     for (int l = 0; l < n; ++l)
       for (int i = 0; i < t; ++i)
@@ -102,7 +107,8 @@ TEST(PairedComparisonAnalysis, EqualsALeastSquaresFitOfTheSameModel) {
     with_subjects << main, by_subject;
     full << main, by_subject, pair;
     const double total = y.squaredNorm(), after_main = residual_squares(main, y),
-                 after_subjects = residual_squares(with_subjects, y), after_pairs = residual_squares(full, y);
+                 after_subjects = residual_squares(with_subjects, y),
+                 after_pairs = residual_squares(full, y);
 
     const PairedComparisonAnalysis a = analyse_paired_comparisons(ratings);
     const Eigen::VectorXd alpha = main.completeOrthogonalDecomposition().solve(y);
@@ -111,7 +117,8 @@ TEST(PairedComparisonAnalysis, EqualsALeastSquaresFitOfTheSameModel) {
     EXPECT_NEAR(a.main_by_subject.sum_of_squares, after_main - after_subjects, 1e-9);
     EXPECT_NEAR(a.combination.sum_of_squares, after_subjects - after_pairs, 1e-9);
     EXPECT_NEAR(a.error.sum_of_squares, after_pairs, 1e-9);
-    EXPECT_EQ(a.error.degrees_of_freedom, rows - (t - 1) - (t - 1) * (n - 1) - (t - 1) * (t - 2) / 2);
+    EXPECT_EQ(a.error.degrees_of_freedom,
+              rows - (t - 1) - (t - 1) * (n - 1) - (t - 1) * (t - 2) / 2);
   }
 }
 
@@ -125,10 +132,12 @@ TEST(PairedComparisonAnalysis, SplitsTheMainEffectIntoFactorsOfAFullFactorial) {
   std::vector<std::vector<int>> level_of;
   for (int protocol = 0; protocol < 2; ++protocol)
     for (int step = 0; step < 3; ++step) level_of.push_back({protocol, step});
-  const std::vector<FactorEffect> effects = factor_effects(a, {"protocol", "step_nodes"}, {2, 3}, level_of);
+  const std::vector<FactorEffect> effects =
+      factor_effects(a, {"protocol", "step_nodes"}, {2, 3}, level_of);
   ASSERT_EQ(effects.size(), 3u);
   EXPECT_EQ(effects[2].name, "interaction");
-  EXPECT_NEAR(effects[0].source.sum_of_squares + effects[1].source.sum_of_squares + effects[2].source.sum_of_squares,
+  EXPECT_NEAR(effects[0].source.sum_of_squares + effects[1].source.sum_of_squares +
+                  effects[2].source.sum_of_squares,
               a.main_effect.sum_of_squares, 1e-9);
   EXPECT_EQ(effects[2].source.degrees_of_freedom, 2);
 
@@ -141,21 +150,25 @@ TEST(PairedComparisonAnalysis, SplitsTheMainEffectIntoFactorsOfAFullFactorial) {
       for (int i = 0; i < t; ++i)
         for (int j = i + 1; j < t; ++j) {
           const int row = l * pairs + pair_index(i, j, t);
-          y(row) = ratings.ratings[static_cast<std::size_t>(l)][static_cast<std::size_t>(pair_index(i, j, t))];
+          y(row) = ratings.ratings[static_cast<std::size_t>(l)]
+                                  [static_cast<std::size_t>(pair_index(i, j, t))];
           x(row, level_of[static_cast<std::size_t>(i)][f]) += 1;
           x(row, level_of[static_cast<std::size_t>(j)][f]) -= 1;
         }
-    EXPECT_NEAR(effects[f].source.sum_of_squares, y.squaredNorm() - residual_squares(x, y), 1e-9) << effects[f].name;
+    EXPECT_NEAR(effects[f].source.sum_of_squares, y.squaredNorm() - residual_squares(x, y), 1e-9)
+        << effects[f].name;
     EXPECT_EQ(effects[f].level_scale.size(), static_cast<std::size_t>(levels));
   }
-  EXPECT_THROW(factor_effects(a, {"protocol"}, {2}, std::vector<std::vector<int>>(6, {0})), Error) << "not a full factorial";
+  EXPECT_THROW(factor_effects(a, {"protocol"}, {2}, std::vector<std::vector<int>>(6, {0})), Error)
+      << "not a full factorial";
 }
 
 TEST(PairedComparisonAnalysis, RatingsThatCannotBeAnalysedAreRefused) {
   EXPECT_THROW(analyse_paired_comparisons({2, {{1}, {-1}}}), Error) << "two conditions";
   EXPECT_THROW(analyse_paired_comparisons({3, {{1, 0, 2}}}), Error) << "one subject";
   EXPECT_THROW(analyse_paired_comparisons({3, {{1, 0, 2}, {1, 0}}}), Error) << "a rating missing";
-  EXPECT_THROW(analyse_paired_comparisons({3, {{1, 0, 2}, {1, std::nan(""), 0}}}), Error) << "not a number";
+  EXPECT_THROW(analyse_paired_comparisons({3, {{1, 0, 2}, {1, std::nan(""), 0}}}), Error)
+      << "not a number";
 }
 
 TEST(PairedComparisonAnalysis, PairsAreIndexedInOrder) {

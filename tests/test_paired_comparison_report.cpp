@@ -27,7 +27,8 @@ namespace {
 // The published worked example of test_paired_comparison_analysis.cpp: 3 conditions, 6
 // subjects; scale values -0.9444, 1.3333, -0.3889, Y(0.05) = 0.8323, Y(0.01) = 1.2617.
 PairedComparisonAnalysis worked_example() {
-  return analyse_paired_comparisons({3, {{-2, -1, 1}, {-2, -2, 2}, {-3, 0, 3}, {-3, 0, 2}, {-1, 1, 2}, {-3, -1, 0}}});
+  return analyse_paired_comparisons(
+      {3, {{-2, -1, 1}, {-2, -2, 2}, {-3, 0, 3}, {-3, 0, 2}, {-1, 1, 2}, {-3, -1, 0}}});
 }
 const std::vector<std::string> kWorkedExampleNames = {"no delay", "20 ms delay", "80 ms delay"};
 
@@ -38,29 +39,35 @@ PairedComparisonAnalysis two_by_two() {
       {4, {{2, 1, 2, -1, 1, 1}, {1, 1, 2, 0, 1, 2}, {2, 0, 1, -1, 0, 1}, {1, 2, 2, 0, 1, 1}}});
 }
 // Names that CSV must quote.
-const std::vector<std::string> kTwoByTwoNames = {"wave, 1 node", "wave, 4 nodes", "\"plain\" 1 node", "plain 4 nodes"};
+const std::vector<std::string> kTwoByTwoNames = {"wave, 1 node", "wave, 4 nodes",
+                                                 "\"plain\" 1 node", "plain 4 nodes"};
 std::vector<FactorEffect> two_by_two_factors(const PairedComparisonAnalysis& a) {
   return factor_effects(a, {"protocol", "step nodes"}, {2, 2}, {{0, 0}, {0, 1}, {1, 0}, {1, 1}});
 }
 
 // The elements <tag class="css_class" ...> of an SVG document, as their attributes (and, for
 // a <text>, its character data under the key "").
-std::vector<std::map<std::string, std::string>> svg_elements(const std::string& svg, const std::string& tag,
-                                                        const std::string& css_class) {
-  const std::regex element("<" + tag + " class=\"" + css_class + "\"([^>]*?)/?>" + (tag == "text" ? "([^<]*)</text>" : ""));
+std::vector<std::map<std::string, std::string>> svg_elements(const std::string& svg,
+                                                             const std::string& tag,
+                                                             const std::string& css_class) {
+  const std::regex element("<" + tag + " class=\"" + css_class + "\"([^>]*?)/?>" +
+                           (tag == "text" ? "([^<]*)</text>" : ""));
   static const std::regex attribute(R"re(([a-zA-Z][a-zA-Z0-9-]*)="([^"]*)")re");
   std::vector<std::map<std::string, std::string>> found;
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), element); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), element);
+       it != std::sregex_iterator(); ++it) {
     std::map<std::string, std::string>& attributes = found.emplace_back();
     const std::string inside = (*it)[1];
-    for (auto a = std::sregex_iterator(inside.begin(), inside.end(), attribute); a != std::sregex_iterator(); ++a)
+    for (auto a = std::sregex_iterator(inside.begin(), inside.end(), attribute);
+         a != std::sregex_iterator(); ++a)
       attributes[(*a)[1]] = (*a)[2];
     if (tag == "text") attributes[""] = (*it)[2];
   }
   return found;
 }
 
-double attribute_number(const std::map<std::string, std::string>& attributes, const std::string& key) {
+double attribute_number(const std::map<std::string, std::string>& attributes,
+                        const std::string& key) {
   return std::stod(attributes.at(key));
 }
 
@@ -74,8 +81,10 @@ AxisPixels axis_of(const std::string& svg) {
   const auto labels = svg_elements(svg, "text", "axis-label");
   EXPECT_GE(labels.size(), 3u);
   if (labels.size() < 2) return {};
-  const double first_value = std::stod(labels.front().at("")), last_value = std::stod(labels.back().at(""));
-  const double first_x = attribute_number(labels.front(), "x"), last_x = attribute_number(labels.back(), "x");
+  const double first_value = std::stod(labels.front().at("")),
+               last_value = std::stod(labels.back().at(""));
+  const double first_x = attribute_number(labels.front(), "x"),
+               last_x = attribute_number(labels.back(), "x");
   EXPECT_EQ(first_value, -last_value) << "an axis symmetric about 0";
   AxisPixels axis;
   axis.per_grade = (last_x - first_x) / (last_value - first_value);
@@ -89,11 +98,13 @@ constexpr double kPixel = 0.02;  // coordinates are written to 0.01 px
 
 ScaleLineFigure worked_example_figure() {
   const PairedComparisonAnalysis a = worked_example();
-  return {"Delay & \"feel\"", "which felt finer?  positive: felt more", kWorkedExampleNames, a.scale, a.yardstick_05,
-          a.yardstick_01};
+  return {"Delay & \"feel\"",  "which felt finer?  positive: felt more",
+          kWorkedExampleNames, a.scale,
+          a.yardstick_05,      a.yardstick_01};
 }
 
-TEST(PairedComparisonReport, FigureTicksSitAtTheirScaleValuesAndYardsticksAreAsLongAsTheyAreInGrades) {
+TEST(PairedComparisonReport,
+     FigureTicksSitAtTheirScaleValuesAndYardsticksAreAsLongAsTheyAreInGrades) {
   const ScaleLineFigure figure = worked_example_figure();
   const std::string svg = render_scale_line_svg(figure);
   EXPECT_NE(svg.find(">Delay &amp; &quot;feel&quot;</text>"), std::string::npos) << svg;
@@ -109,7 +120,8 @@ TEST(PairedComparisonReport, FigureTicksSitAtTheirScaleValuesAndYardsticksAreAsL
   for (std::size_t i = 0; i < ticks.size(); ++i) {
     SCOPED_TRACE(kWorkedExampleNames[i]);
     EXPECT_EQ(labels[i].at(""), kWorkedExampleNames[i]);
-    EXPECT_EQ(attribute_number(ticks[i], "x1"), attribute_number(ticks[i], "x2")) << "a vertical tick";
+    EXPECT_EQ(attribute_number(ticks[i], "x1"), attribute_number(ticks[i], "x2"))
+        << "a vertical tick";
     EXPECT_NEAR(attribute_number(ticks[i], "x1"), axis.x(figure.scale[i]), kPixel);
     EXPECT_GE(attribute_number(ticks[i], "x1"), axis.left);
     EXPECT_LE(attribute_number(ticks[i], "x1"), axis.right);
@@ -122,11 +134,16 @@ TEST(PairedComparisonReport, FigureTicksSitAtTheirScaleValuesAndYardsticksAreAsL
   ASSERT_EQ(yardsticks.size(), 2u);
   const double lengths[] = {figure.yardstick_05, figure.yardstick_01};
   for (std::size_t k = 0; k < 2; ++k) {
-    EXPECT_EQ(attribute_number(yardsticks[k], "y1"), attribute_number(yardsticks[k], "y2")) << "a horizontal bar";
-    EXPECT_GT(attribute_number(yardsticks[k], "y1"), attribute_number(ticks[0], "y2")) << "below the line";
-    EXPECT_NEAR(std::abs(attribute_number(yardsticks[k], "x2") - attribute_number(yardsticks[k], "x1")),
-                std::abs(axis.x(lengths[k]) - axis.x(0)), kPixel);
-    EXPECT_LE(std::max(attribute_number(yardsticks[k], "x1"), attribute_number(yardsticks[k], "x2")), axis.right + kPixel);
+    EXPECT_EQ(attribute_number(yardsticks[k], "y1"), attribute_number(yardsticks[k], "y2"))
+        << "a horizontal bar";
+    EXPECT_GT(attribute_number(yardsticks[k], "y1"), attribute_number(ticks[0], "y2"))
+        << "below the line";
+    EXPECT_NEAR(
+        std::abs(attribute_number(yardsticks[k], "x2") - attribute_number(yardsticks[k], "x1")),
+        std::abs(axis.x(lengths[k]) - axis.x(0)), kPixel);
+    EXPECT_LE(
+        std::max(attribute_number(yardsticks[k], "x1"), attribute_number(yardsticks[k], "x2")),
+        axis.right + kPixel);
   }
   const auto yardstick_labels = svg_elements(svg, "text", "yardstick-label");
   ASSERT_EQ(yardstick_labels.size(), 2u);
@@ -152,7 +169,8 @@ void expect_labels_apart(const ScaleLineFigure& figure) {
   std::vector<Box> boxes;
   for (const auto& label : labels) {
     EXPECT_EQ(label.at("text-anchor"), "middle");
-    const double x = attribute_number(label, "x"), y = attribute_number(label, "y"), w = scale_line_label_width(label.at(""));
+    const double x = attribute_number(label, "x"), y = attribute_number(label, "y"),
+                 w = scale_line_label_width(label.at(""));
     boxes.push_back({x - w / 2, x + w / 2, y - kScaleLineFontSize, y + kScaleLineFontSize / 4});
     EXPECT_GE(boxes.back().left, 0) << label.at("");
     EXPECT_LE(boxes.back().right, width) << label.at("");
@@ -167,7 +185,8 @@ void expect_labels_apart(const ScaleLineFigure& figure) {
     }
   // Nothing drawn below the document's bottom (it grows for many rows).
   static const std::regex y_coordinate(R"re(\by[12]?="([^"]*)")re");
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), y_coordinate); it != std::sregex_iterator(); ++it)
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), y_coordinate);
+       it != std::sregex_iterator(); ++it)
     EXPECT_LT(std::stod((*it)[1]), height);
 }
 
@@ -199,7 +218,8 @@ TEST(PairedComparisonReport, FigureLabelsNeverOverlap) {
   figure.names.clear();
   figure.scale.clear();
   for (int i = 0; i < 12; ++i) {
-    figure.names.push_back(std::string(static_cast<std::size_t>(3 + (i * 7) % 11), static_cast<char>('a' + i)));
+    figure.names.push_back(
+        std::string(static_cast<std::size_t>(3 + (i * 7) % 11), static_cast<char>('a' + i)));
     figure.scale.push_back(0.004 * (i / 2));
   }
   figure.names.push_back("a name long enough to stick out at the left end of the axis");
@@ -272,10 +292,14 @@ TEST(PairedComparisonReport, CsvFilesReadBackAsTheAnalysis) {
     SCOPED_TRACE(factorial ? "2 x 2 factorial" : "worked example");
     const PairedComparisonAnalysis a = factorial ? two_by_two() : worked_example();
     const std::vector<std::string>& names = factorial ? kTwoByTwoNames : kWorkedExampleNames;
-    const std::vector<FactorEffect> factors = factorial ? two_by_two_factors(a) : std::vector<FactorEffect>{};
-    const std::filesystem::path dir = root / (factorial ? "factorial" : "worked") / "tables";  // made by the writer
+    const std::vector<FactorEffect> factors =
+        factorial ? two_by_two_factors(a) : std::vector<FactorEffect>{};
+    const std::filesystem::path dir =
+        root / (factorial ? "factorial" : "worked") / "tables";  // made by the writer
     write_analysis_csv(dir, a, names, factors);
-    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()), 4)
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir),
+                            std::filesystem::directory_iterator()),
+              4)
         << "four files and no temporary left";
 
     const auto scale = read_csv_rows(dir / "scale.csv");
@@ -286,20 +310,25 @@ TEST(PairedComparisonReport, CsvFilesReadBackAsTheAnalysis) {
       ASSERT_EQ(row.size(), 3u);
       EXPECT_EQ(row[0], names[i]);
       expect_number(row[1], a.scale[i], names[i]);
-      EXPECT_EQ(std::stoi(row[2]), 1 + std::count_if(a.scale.begin(), a.scale.end(), [&](double s) { return s > a.scale[i]; }));
+      EXPECT_EQ(std::stoi(row[2]), 1 + std::count_if(a.scale.begin(), a.scale.end(),
+                                                     [&](double s) { return s > a.scale[i]; }));
     }
     if (!factorial) {
-      EXPECT_EQ((std::vector<std::string>{scale[1][2], scale[2][2], scale[3][2]}), (std::vector<std::string>{"3", "1", "2"}));
+      EXPECT_EQ((std::vector<std::string>{scale[1][2], scale[2][2], scale[3][2]}),
+                (std::vector<std::string>{"3", "1", "2"}));
     }
 
     const auto anova = read_csv_rows(dir / "anova.csv");
-    EXPECT_EQ(anova[0], (std::vector<std::string>{"source", "sum_of_squares", "degrees_of_freedom", "mean_square", "f", "p"}));
-    std::vector<std::pair<std::string, VarianceSource>> expected{{"main_effect", a.main_effect},
-                                                                 {"main_effect_x_subject", a.main_by_subject},
-                                                                 {"combination", a.combination},
-                                                                 {"error", a.error},
-                                                                 {"total", a.total}};
-    for (const FactorEffect& factor : factors) expected.emplace_back("factor:" + factor.name, factor.source);
+    EXPECT_EQ(anova[0], (std::vector<std::string>{"source", "sum_of_squares", "degrees_of_freedom",
+                                                  "mean_square", "f", "p"}));
+    std::vector<std::pair<std::string, VarianceSource>> expected{
+        {"main_effect", a.main_effect},
+        {"main_effect_x_subject", a.main_by_subject},
+        {"combination", a.combination},
+        {"error", a.error},
+        {"total", a.total}};
+    for (const FactorEffect& factor : factors)
+      expected.emplace_back("factor:" + factor.name, factor.source);
     ASSERT_EQ(anova.size(), expected.size() + 1);
     for (std::size_t k = 0; k < expected.size(); ++k) {
       const auto& row = anova[k + 1];
@@ -327,7 +356,8 @@ TEST(PairedComparisonReport, CsvFilesReadBackAsTheAnalysis) {
     expect_number(yardsticks[2][1], a.yardstick_01, "Y(0.01)");
 
     const auto differences = read_csv_rows(dir / "differences.csv");
-    EXPECT_EQ(differences[0], (std::vector<std::string>{"first", "second", "difference", "significant_05", "significant_01"}));
+    EXPECT_EQ(differences[0], (std::vector<std::string>{"first", "second", "difference",
+                                                        "significant_05", "significant_01"}));
     ASSERT_EQ(differences.size(), static_cast<std::size_t>(pair_count(a.conditions)) + 1);
     std::size_t row_index = 1;
     for (std::size_t i = 0; i < names.size(); ++i)
@@ -338,8 +368,10 @@ TEST(PairedComparisonReport, CsvFilesReadBackAsTheAnalysis) {
         EXPECT_EQ(row[1], names[j]);
         const double difference = a.scale[i] - a.scale[j];
         expect_number(row[2], difference, row[0] + " - " + row[1]);
-        EXPECT_EQ(row[3], std::abs(difference) > a.yardstick_05 ? "yes" : "no") << row[0] << " - " << row[1];
-        EXPECT_EQ(row[4], std::abs(difference) > a.yardstick_01 ? "yes" : "no") << row[0] << " - " << row[1];
+        EXPECT_EQ(row[3], std::abs(difference) > a.yardstick_05 ? "yes" : "no")
+            << row[0] << " - " << row[1];
+        EXPECT_EQ(row[4], std::abs(difference) > a.yardstick_01 ? "yes" : "no")
+            << row[0] << " - " << row[1];
         yes += (row[3] == "yes") + (row[4] == "yes");
         no += (row[3] == "no") + (row[4] == "no");
       }
@@ -351,8 +383,10 @@ TEST(PairedComparisonReport, CsvFilesReadBackAsTheAnalysis) {
 TEST(PairedComparisonReport, CsvWriterRefusesWhatItCannotWrite) {
   const std::filesystem::path dir = testing::scratch_directory("paired-comparison-csv-refused");
   const PairedComparisonAnalysis a = worked_example();
-  EXPECT_THROW(write_analysis_csv(dir / "tables", a, {"only", "two"}, {}), Error) << "a name missing";
-  EXPECT_THROW(write_analysis_csv(dir / "tables", a, {"one", "two", "three", "four"}, {}), Error) << "a name too many";
+  EXPECT_THROW(write_analysis_csv(dir / "tables", a, {"only", "two"}, {}), Error)
+      << "a name missing";
+  EXPECT_THROW(write_analysis_csv(dir / "tables", a, {"one", "two", "three", "four"}, {}), Error)
+      << "a name too many";
   EXPECT_FALSE(std::filesystem::exists(dir / "tables" / "scale.csv"));
   std::ofstream(dir / "a file") << "not a directory\n";
   EXPECT_THROW(write_analysis_csv(dir / "a file", a, kWorkedExampleNames, {}), Error);
@@ -364,7 +398,8 @@ std::string line_starting(const std::string& text, const std::string& start) {
   for (std::size_t begin = 0; begin < text.size();) {
     const std::size_t end = std::min(text.find('\n', begin), text.size());
     const std::string line = text.substr(begin, end - begin);
-    if (line.find_first_not_of(' ') != std::string::npos && line.substr(line.find_first_not_of(' ')).starts_with(start))
+    if (line.find_first_not_of(' ') != std::string::npos &&
+        line.substr(line.find_first_not_of(' ')).starts_with(start))
       return line;
     begin = end + 1;
   }
@@ -375,7 +410,8 @@ TEST(PairedComparisonReport, TextTableListsConditionsHighToLowTheAnovaAndTheYard
   const PairedComparisonAnalysis a = worked_example();
   const std::vector<FactorEffect> delay = factor_effects(a, {"delay"}, {3}, {{0}, {1}, {2}});
   const std::string table = format_analysis_table(a, kWorkedExampleNames, delay);
-  for (const std::string& name : kWorkedExampleNames) EXPECT_NE(table.find(name), std::string::npos) << name << "\n" << table;
+  for (const std::string& name : kWorkedExampleNames)
+    EXPECT_NE(table.find(name), std::string::npos) << name << "\n" << table;
   // 20 ms (1.333) above 80 ms (-0.389) above none (-0.944).
   EXPECT_LT(table.find("20 ms delay"), table.find("80 ms delay")) << table;
   EXPECT_LT(table.find("80 ms delay"), table.find("no delay")) << table;
@@ -396,7 +432,8 @@ TEST(PairedComparisonReport, TextTableListsConditionsHighToLowTheAnovaAndTheYard
   // p between 0.01 and 0.05: one star.
   PairedComparisonAnalysis one_star = a;
   one_star.combination.p = 0.03;
-  EXPECT_TRUE(line_starting(format_analysis_table(one_star, kWorkedExampleNames, {}), "combination").ends_with(" 0.0300  *"))
+  EXPECT_TRUE(line_starting(format_analysis_table(one_star, kWorkedExampleNames, {}), "combination")
+                  .ends_with(" 0.0300  *"))
       << format_analysis_table(one_star, kWorkedExampleNames, {});
 
   EXPECT_THROW(format_analysis_table(a, {"one"}, {}), Error);

@@ -32,20 +32,25 @@ class CubeProbe : public ::testing::Test {
   static void SetUpTestSuite() {
     model_ = new Model(build_model(load_scene(testing::source_path("scenes/cube.yaml"))));
     const ElasticBody& body = single_elastic_body(*model_);
-    columns_ = new ComplianceColumns(body.free_factor, body.dofs, compliance_row_nodes(body, false));
+    columns_ =
+        new ComplianceColumns(body.free_factor, body.dofs, compliance_row_nodes(body, false));
   }
   static void TearDownTestSuite() {
     delete columns_;
     delete model_;
   }
-  static Eigen::Vector3d mm(double x, double y, double z) { return Eigen::Vector3d(x, y, z) * 1e-3; }
+  static Eigen::Vector3d mm(double x, double y, double z) {
+    return Eigen::Vector3d(x, y, z) * 1e-3;
+  }
   // The IR path: one simulation step with these tools, each user's force from its IR.
   static std::vector<ToolReaction> condensed(const std::vector<PressedTool>& tools) {
     const std::vector<ContactQuery> contacts = find_tool_contacts(body(), tools);
     SimulationOptions options;
     options.ir.force_limit = std::numeric_limits<double>::infinity();
-    Simulation simulation(body(), model_->obstacles, *columns_, std::vector<ToolSpec>(tools.size()), options);
-    for (std::size_t t = 0; t < tools.size(); ++t) simulation.set_tool(static_cast<int>(t), tools[t].position);
+    Simulation simulation(body(), model_->obstacles, *columns_, std::vector<ToolSpec>(tools.size()),
+                          options);
+    for (std::size_t t = 0; t < tools.size(); ++t)
+      simulation.set_tool(static_cast<int>(t), tools[t].position);
     simulation.step(0);
     std::vector<ToolReaction> reactions(tools.size());
     for (std::size_t t = 0; t < tools.size(); ++t) {
@@ -65,7 +70,8 @@ ComplianceColumns* CubeProbe::columns_ = nullptr;
 std::vector<PressedTool> random_presses(std::mt19937& rng, int count, double max_depth_mm) {
   std::uniform_real_distribution<double> across(-60, 60), depth(0.2, max_depth_mm);
   std::vector<PressedTool> tools;
-  for (int i = 0; i < count; ++i) tools.push_back({Eigen::Vector3d(across(rng), across(rng), -depth(rng)) * 1e-3, 0});
+  for (int i = 0; i < count; ++i)
+    tools.push_back({Eigen::Vector3d(across(rng), across(rng), -depth(rng)) * 1e-3, 0});
   return tools;
 }
 
@@ -80,10 +86,12 @@ TEST_F(CubeProbe, CondensedForcesEqualTheFullSparseSolve) {
       continue;  // two random tools on neighbouring triangles: not this test's subject
     }
     const auto fast = condensed(tools);
-    const auto reference = contact_reactions_reference(body(), contacts, {}, ContactModel::node_translation);
+    const auto reference =
+        contact_reactions_reference(body(), contacts, {}, ContactModel::node_translation);
     for (std::size_t t = 0; t < tools.size(); ++t) {
       ASSERT_TRUE(fast[t].query.contact.has_value());
-      EXPECT_LE((fast[t].reaction - reference[t].reaction).norm(), 1e-9 * reference[t].reaction.norm());
+      EXPECT_LE((fast[t].reaction - reference[t].reaction).norm(),
+                1e-9 * reference[t].reaction.norm());
     }
   }
 }
@@ -95,15 +103,18 @@ TEST_F(CubeProbe, ForcesAgreeWithAnIndependentFemOfTheSameMesh) {
   const auto fast = condensed(tools);
 
   std::vector<bool> fixed(static_cast<std::size_t>(3 * body().mesh.node_count()));
-  for (int dof = 0; dof < 3 * body().mesh.node_count(); ++dof) fixed[dof] = body().dofs.free_index[dof] < 0;
+  for (int dof = 0; dof < 3 * body().mesh.node_count(); ++dof)
+    fixed[dof] = body().dofs.free_index[dof] < 0;
   std::map<int, double> prescribed;
   const ToolContact& contact = *contacts[0].contact;
   const Triangle& tri = body().surface.triangles[contact.triangle];
   for (int node : tri)
     for (int a = 0; a < 3; ++a) prescribed[3 * node + a] = contact.displacement[a];
-  const auto independent = testing::independent_static_solve(body().mesh, 1.0e6, 0.4, fixed, prescribed);
+  const auto independent =
+      testing::independent_static_solve(body().mesh, 1.0e6, 0.4, fixed, prescribed);
   Eigen::Vector3d expected = Eigen::Vector3d::Zero();
-  for (int i = 0; i < 3; ++i) expected -= contact.weights[i] * independent.reaction.segment<3>(3 * tri[i]);
+  for (int i = 0; i < 3; ++i)
+    expected -= contact.weights[i] * independent.reaction.segment<3>(3 * tri[i]);
   EXPECT_LE((fast[0].reaction - expected).norm(), 1e-8 * expected.norm())
       << "probe " << fast[0].reaction.transpose() << " independent " << expected.transpose();
 }
@@ -139,16 +150,20 @@ TEST_F(CubeProbe, AToolOutsideOrBesideTheTouchableFaceHasNoForce) {
 
 // --- the program ---
 
-testing::ProgramRun run(const std::string& arguments) { return testing::run_program(COHAPTIC_LAB_EXE, arguments); }
+testing::ProgramRun run(const std::string& arguments) {
+  return testing::run_program(COHAPTIC_LAB_EXE, arguments);
+}
 
 TEST_F(CubeProbe, TheProgramPrintsOneJsonObjectWithTheSameForces) {
   const fs::path dir = fs::temp_directory_path() / ("cohaptic-probe-" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  const testing::ProgramRun result = run("probe --scene " + testing::source_path("scenes/cube.yaml") +
-                                " --tool 5,-7,-4 --tool -30,40,-2 --tool 0,0,10 --json --no-disk-cache --export-msh " +
-                                (dir / "cube.msh").string() + " --export-vtu " + (dir / "cube.vtu").string());
+  const testing::ProgramRun result =
+      run("probe --scene " + testing::source_path("scenes/cube.yaml") +
+          " --tool 5,-7,-4 --tool -30,40,-2 --tool 0,0,10 --json --no-disk-cache --export-msh " +
+          (dir / "cube.msh").string() + " --export-vtu " + (dir / "cube.vtu").string());
   ASSERT_EQ(result.exit_code, 0) << result.out;
-  const nlohmann::json json = nlohmann::json::parse(result.out);  // throws if stdout holds anything else
+  const nlohmann::json json =
+      nlohmann::json::parse(result.out);  // throws if stdout holds anything else
   EXPECT_EQ(json["nodes"], 1728);
   EXPECT_EQ(json["tets"], 7986);
   EXPECT_EQ(json["fixed_nodes"].size(), 144u);
@@ -169,7 +184,8 @@ TEST_F(CubeProbe, TheProgramPrintsOneJsonObjectWithTheSameForces) {
       EXPECT_EQ(id, body().mesh.node_tags[tri[i]]);
       const int index = node_index_from_tag(exported.mesh, id);
       ASSERT_GE(index, 0);
-      EXPECT_LE((exported.mesh.nodes.col(index) * 1e-3 - body().mesh.nodes.col(tri[i])).norm(), 1e-15);
+      EXPECT_LE((exported.mesh.nodes.col(index) * 1e-3 - body().mesh.nodes.col(tri[i])).norm(),
+                1e-15);
       const double dz = tool["contact"]["displacement"][i][2];
       EXPECT_NEAR(dz, t == 0 ? -4.0 : -2.0, 1e-9);
     }
@@ -239,17 +255,19 @@ TEST(ProbeProgram, AnApproachInStepsEndsWhereOneStepDoesWhenNothingIsHeldOnTheWa
 // agrees to 5 % (0.5 mm deep its contact spans two of its cells, and it is 5.5 % stiffer).
 TEST(ProbeProgram, ASpherePressedIntoTheGradedBlockLandsWithinFivePercentOfHertzOnBothMeshes) {
   const auto force_at = [](const char* scene, double depth_mm) {
-    const nlohmann::json json = probe_json_of(fmt::format("probe --scene {} --tool=-25,0,{} --json",
-                                                          testing::source_path(scene), 10 - depth_mm));
+    const nlohmann::json json = probe_json_of(fmt::format(
+        "probe --scene {} --tool=-25,0,{} --json", testing::source_path(scene), 10 - depth_mm));
     EXPECT_EQ(json["contact_model"], "sphere");
     return json.is_null() ? 0.0 : probed_force(json, 0).z();
   };
   for (const double depth_mm : {0.5, 1.0}) {
-    const double depth = depth_mm * 1e-3, hertz = 4.0 / 3.0 * 1e5 / (1 - 0.3 * 0.3) * std::sqrt(0.01) * std::pow(depth, 1.5);
+    const double depth = depth_mm * 1e-3,
+                 hertz = 4.0 / 3.0 * 1e5 / (1 - 0.3 * 0.3) * std::sqrt(0.01) * std::pow(depth, 1.5);
     const double fine = force_at("scenes/block/two_spheres.yaml", depth_mm);
     const double coarse = force_at("scenes/block/two_spheres_coarse.yaml", depth_mm);
-    std::printf("  %.1f mm deep: 0.6 mm mesh %.4f N, 1.2 mm mesh %.4f N, Hertz %.4f N (%.3f, %.3f)\n", depth_mm, fine,
-                coarse, hertz, fine / hertz, coarse / hertz);
+    std::printf(
+        "  %.1f mm deep: 0.6 mm mesh %.4f N, 1.2 mm mesh %.4f N, Hertz %.4f N (%.3f, %.3f)\n",
+        depth_mm, fine, coarse, hertz, fine / hertz, coarse / hertz);
     EXPECT_NEAR(fine / hertz, 1, 0.05) << depth_mm << " mm";
     if (depth_mm == 1.0) {
       EXPECT_NEAR(coarse / fine, 1, 0.05);

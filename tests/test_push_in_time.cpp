@@ -44,7 +44,8 @@ const std::vector<double>& in_time_forces(BackCondition condition) {
   static std::map<BackCondition, std::vector<double>> runs;
   auto [it, inserted] = runs.try_emplace(condition);
   if (inserted)
-    it->second = forces_at_depths(push_in_time(in_time_scene(), {condition, 1.0e6, 0.216}), paper_push_depths());
+    it->second = forces_at_depths(push_in_time(in_time_scene(), {condition, 1.0e6, 0.216}),
+                                  paper_push_depths());
   return it->second;
 }
 
@@ -53,7 +54,8 @@ double start_transient_bound(BackCondition condition, double speed, double tau) 
   const Scene& scene = in_time_scene();
   const PushLayout layout = push_layout(scene);
   const Model model = build_model(push_scene(scene, {condition, 1.0e6, 0.216}));
-  const MassSpringNetwork& network = std::get<MassSpringModel>(model.bodies[static_cast<std::size_t>(layout.front)]).network;
+  const MassSpringNetwork& network =
+      std::get<MassSpringModel>(model.bodies[static_cast<std::size_t>(layout.front)]).network;
   const Eigen::Vector3d point = push_point(scene, layout);
   int node = 0;
   for (int n = 0; n < network.node_count(); ++n)
@@ -64,7 +66,8 @@ double start_transient_bound(BackCondition condition, double speed, double tau) 
   const SparseMatrix k = network_stiffness(network.rest_positions, network.springs);
   const int tool = 3 * node + layout.axis;
   std::vector<PrescribedDisplacement> unit;
-  for (int axis = 0; axis < 3; ++axis) unit.push_back({3 * node + axis, axis == layout.axis ? 1.0 : 0.0});
+  for (int axis = 0; axis < 3; ++axis)
+    unit.push_back({3 * node + axis, axis == layout.axis ? 1.0 : 0.0});
   const StaticSolution mode = solve_static(k, dofs, unit);  // U' and K_eff
   const double k_eff = mode.reaction[tool];
   double kinetic = 0, k_over_m = 0;  // U'_f^T M U'_f and k_tf^T M^-1 k_tf over the free dofs
@@ -75,7 +78,8 @@ double start_transient_bound(BackCondition condition, double speed, double tau) 
     k_over_m += k.coeff(d, tool) * k.coeff(d, tool) / m;
   }
   EXPECT_GT(k_eff, 0);
-  return speed * std::sqrt(kinetic) * (std::sqrt(k.coeff(tool, tool) - k_eff) + tau * std::sqrt(k_over_m));
+  return speed * std::sqrt(kinetic) *
+         (std::sqrt(k.coeff(tool, tool) - k_eff) + tau * std::sqrt(k_over_m));
 }
 
 TEST(PushInTime, ForceFollowsTheNonlinearStaticForceWithinTheDampersShareAndTheStartsTransient) {
@@ -84,7 +88,8 @@ TEST(PushInTime, ForceFollowsTheNonlinearStaticForceWithinTheDampersShareAndTheS
   for (BackCondition condition : {BackCondition::free, BackCondition::fixed}) {
     SCOPED_TRACE(back_condition_name(condition));
     const std::vector<double>& in_time = in_time_forces(condition);
-    const std::vector<double> slow = network_static_forces(in_time_scene(), {condition, 1.0e6, 0.216}, depths);
+    const std::vector<double> slow =
+        network_static_forces(in_time_scene(), {condition, 1.0e6, 0.216}, depths);
     double steepest = slow[0] / depths[0];
     for (std::size_t i = 1; i < depths.size(); ++i)
       steepest = std::max(steepest, (slow[i] - slow[i - 1]) / (depths[i] - depths[i - 1]));
@@ -92,7 +97,8 @@ TEST(PushInTime, ForceFollowsTheNonlinearStaticForceWithinTheDampersShareAndTheS
     const double tolerance = tau * speed * steepest + transient;
     EXPECT_LT(tolerance, 0.05 * slow.back());  // the bound says something at depth
     for (std::size_t i = 0; i < depths.size(); ++i)
-      EXPECT_NEAR(in_time[i], slow[i], tolerance) << "depth " << depths[i] << " m; transient bound " << transient << " N";
+      EXPECT_NEAR(in_time[i], slow[i], tolerance)
+          << "depth " << depths[i] << " m; transient bound " << transient << " N";
   }
 }
 
@@ -117,7 +123,8 @@ TEST(PushInTime, NonlinearStaticForceTendsToTheLinearOneAtSmallDepths) {
   for (BackCondition condition : {BackCondition::free, BackCondition::fixed}) {
     const std::vector<double> small{1e-5};
     const double linear_small = push_forces(rig, condition, small)[0];
-    EXPECT_NEAR(network_static_forces(scene, {condition, 1.0e6, 0.216}, small)[0], linear_small, 1e-3 * linear_small);
+    EXPECT_NEAR(network_static_forces(scene, {condition, 1.0e6, 0.216}, small)[0], linear_small,
+                1e-3 * linear_small);
   }
   const std::vector<double> deep{15e-3};
   EXPECT_LT(network_static_forces(scene, {BackCondition::fixed, 1.0e6, 0.216}, deep)[0],

@@ -75,7 +75,8 @@ CutRecording cut_in_last_chunk(const Bytes& whole) {
   EXPECT_GE(chunks.size(), 4u) << "schemas and channels, the configuration, ticks, ticks";
   CutRecording cut;
   const RawRecord& last = chunks.back();
-  cut.bytes.assign(whole.begin(), whole.begin() + static_cast<long>(last.offset + 9 + last.length / 2));
+  cut.bytes.assign(whole.begin(),
+                   whole.begin() + static_cast<long>(last.offset + 9 + last.length / 2));
   cut.last_complete = chunks[chunks.size() - 2];
   cut.last_complete_fields = testing::read_chunk(whole, cut.last_complete);
   cut.messages = testing::messages_of(cut.bytes).size();
@@ -86,14 +87,16 @@ CutRecording cut_in_last_chunk(const Bytes& whole) {
 // the last tick in bytes[begin, end).
 void flip_last_fade(Bytes& bytes, std::size_t begin, std::size_t end) {
   const Bytes fade = {0x45, 0x00, 0x00, 0x80, 0x3F};
-  const auto from = bytes.begin() + static_cast<long>(begin), to = bytes.begin() + static_cast<long>(end);
+  const auto from = bytes.begin() + static_cast<long>(begin),
+             to = bytes.begin() + static_cast<long>(end);
   const auto at = std::find_end(from, to, fade.begin(), fade.end());
   ASSERT_NE(at, to) << "no tick's fade in the range";
   at[1] ^= 0x01;
 }
 
 std::string lab_replay(const fs::path& file, const std::string& mode, int& exit_code) {
-  const testing::ProgramRun run = testing::run_program(COHAPTIC_LAB_EXE, "replay '" + file.string() + "' " + mode, true);
+  const testing::ProgramRun run =
+      testing::run_program(COHAPTIC_LAB_EXE, "replay '" + file.string() + "' " + mode, true);
   exit_code = run.exit_code;
   return run.out;
 }
@@ -115,12 +118,14 @@ TEST(RecordingCrc, ACutRecordingReadsItsCompleteChunksAndSaysHowFarTheirCrcsVouc
   EXPECT_EQ(rec.crc.unchecked_messages, 0u);
   EXPECT_EQ(rec.crc.checked_through_offset, cut.last_complete.end());
   EXPECT_EQ(rec.crc.checked_end_time_ns, cut.last_complete_fields.message_end_time);
-  EXPECT_EQ(static_cast<std::int64_t>(cut.last_complete_fields.message_end_time), rec.ticks.back().time_ns());
+  EXPECT_EQ(static_cast<std::int64_t>(cut.last_complete_fields.message_end_time),
+            rec.ticks.back().time_ns());
 
   const std::string line = fmt::format(
-      "cut short at byte {}: everything up to t = {:.3f} s is checked by its chunks' CRCs ({} messages, through byte {})",
-      cut.bytes.size(), static_cast<double>(rec.ticks.back().time_ns() - kStartNs) * 1e-9, cut.messages,
-      cut.last_complete.end());
+      "cut short at byte {}: everything up to t = {:.3f} s is checked by its chunks' CRCs ({} "
+      "messages, through byte {})",
+      cut.bytes.size(), static_cast<double>(rec.ticks.back().time_ns() - kStartNs) * 1e-9,
+      cut.messages, cut.last_complete.end());
   EXPECT_EQ(record::describe_cut(rec), line);
 
   const VerifyResult result = verify_recording(file);
@@ -146,7 +151,8 @@ TEST(RecordingCrc, AByteFlippedInTheLastCompleteChunkOfACutRecordingIsFoundAndNa
   const fs::path dir = testing::scratch_directory("recording-crc-flipped");
   record_ticks(dir / "whole.mcap");
   CutRecording cut = cut_in_last_chunk(testing::read_bytes(dir / "whole.mcap"));
-  flip_last_fade(cut.bytes, cut.last_complete_fields.records_begin, cut.last_complete_fields.records_end);
+  flip_last_fade(cut.bytes, cut.last_complete_fields.records_begin,
+                 cut.last_complete_fields.records_end);
   const fs::path file = dir / "flipped.mcap";
   testing::write_bytes(file, cut.bytes);
 
@@ -184,7 +190,8 @@ TEST(RecordingCrc, AnUnchunkedRecordingCutShortSaysNoCrcCoversIt) {
   const std::vector<testing::RawMessage> messages = testing::messages_of(unchunked);
   ASSERT_EQ(messages.size(), std::size_t{kBatches * kTicksPerBatch + 1});
   // Cut inside its 600th message, with the fade of the tick before flipped as above.
-  Bytes cut(unchunked.begin(), unchunked.begin() + static_cast<long>(messages[600].record.offset + 20));
+  Bytes cut(unchunked.begin(),
+            unchunked.begin() + static_cast<long>(messages[600].record.offset + 20));
   flip_last_fade(cut, messages[599].record.offset, messages[599].record.end());
   const fs::path file = dir / "cut.mcap";
   testing::write_bytes(file, cut);
@@ -196,7 +203,8 @@ TEST(RecordingCrc, AnUnchunkedRecordingCutShortSaysNoCrcCoversIt) {
   EXPECT_EQ(rec.crc.checked_messages, 0u);
   EXPECT_EQ(rec.crc.unchecked_messages, 600u);
   const std::string line = fmt::format(
-      "cut short at byte {}: its 600 messages are not covered by any CRC (they are not in chunks with a CRC, as in a "
+      "cut short at byte {}: its 600 messages are not covered by any CRC (they are not in chunks "
+      "with a CRC, as in a "
       "recording written unchunked): a damaged byte in them goes unnoticed",
       cut.size());
   EXPECT_EQ(record::describe_cut(rec), line);

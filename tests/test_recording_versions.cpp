@@ -14,7 +14,8 @@ namespace cohaptic {
 namespace {
 
 TEST(RecordingVersions, ReplayRefusesIrsOfAnotherFormatNamingBoth) {
-  const std::filesystem::path file = std::filesystem::path(::testing::TempDir()) / "format1_server.mcap";
+  const std::filesystem::path file =
+      std::filesystem::path(::testing::TempDir()) / "format1_server.mcap";
   {
     record::SessionRecorder recorder(file);
     record::SessionConfig config;
@@ -32,7 +33,9 @@ TEST(RecordingVersions, ReplayRefusesIrsOfAnotherFormatNamingBoth) {
   } catch (const Error& e) {
     const std::string message = e.what();
     EXPECT_NE(message.find("format version 1"), std::string::npos) << message;
-    EXPECT_NE(message.find(fmt::format("format version {}", IntermediateRepresentation::kFormatVersion)), std::string::npos)
+    EXPECT_NE(
+        message.find(fmt::format("format version {}", IntermediateRepresentation::kFormatVersion)),
+        std::string::npos)
         << message;
     EXPECT_NE(message.find(file.string()), std::string::npos) << message;
   }

@@ -36,7 +36,9 @@ void write_files(const fs::path& dir, double truncation) {
   soft.youngs_modulus = 2.0e4;
   soft.touchable = "{surface: true}";
   std::string scene = testing::cube_scene_yaml(soft);
-  if (truncation > 0) scene.replace(scene.find("haptic: {"), 9, fmt::format("haptic: {{boundary_truncation: {}, ", truncation));
+  if (truncation > 0)
+    scene.replace(scene.find("haptic: {"), 9,
+                  fmt::format("haptic: {{boundary_truncation: {}, ", truncation));
   std::ofstream(dir / "cube.yaml") << scene;
   for (const auto& [name, x] : {std::pair{"a", -20}, std::pair{"b", 20}})
     std::ofstream(dir / (std::string(name) + ".yaml")) << fmt::format(R"(
@@ -48,29 +50,36 @@ segments:
   - {{move_by: [8, 0, 0], speed: 8}}
   - {{release: 4, speed: 5}}
 )",
-                                                                    x);
+                                                                      x);
 }
 
 struct RecordedSession {
   fs::path dir;
-  explicit RecordedSession(const std::string& name, const std::vector<std::string>& server_extra = {},
-                           double truncation = 0)
+  explicit RecordedSession(const std::string& name,
+                           const std::vector<std::string>& server_extra = {}, double truncation = 0)
       : dir(testing::scratch_directory(name)) {
     write_files(dir, truncation);
-    std::vector<std::string> args = {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--duration", "30",
-                                     "--record", (dir / "server.mcap").string(), "--step-nodes", "40", "--no-disk-cache"};
+    std::vector<std::string> args = {"--scene",        (dir / "cube.yaml").string(),
+                                     "--listen",       "127.0.0.1:0",
+                                     "--duration",     "30",
+                                     "--record",       (dir / "server.mcap").string(),
+                                     "--step-nodes",   "40",
+                                     "--no-disk-cache"};
     args.insert(args.end(), server_extra.begin(), server_extra.end());
     server = std::make_unique<ChildProcess>(testing::server_program(), args, dir / "server.log");
     EXPECT_TRUE(testing::wait_for_output(*server, "listening on"));
     port = testing::listening_port(server->log_text());
   }
   // A client playing `device` (default: the user's script), recording to <user>.mcap.
-  std::unique_ptr<ChildProcess> client(const std::string& user, int slot, const std::string& device = "") const {
+  std::unique_ptr<ChildProcess> client(const std::string& user, int slot,
+                                       const std::string& device = "") const {
     return std::make_unique<ChildProcess>(
         testing::client_program(),
-        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot", std::to_string(slot),
-                                 "--device", device.empty() ? "script:" + (dir / (user + ".yaml")).string() : device,
-                                 "--record", (dir / (user + ".mcap")).string(), "--report", (dir / (user + ".json")).string()},
+        std::vector<std::string>{
+            "--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot",
+            std::to_string(slot), "--device",
+            device.empty() ? "script:" + (dir / (user + ".yaml")).string() : device, "--record",
+            (dir / (user + ".mcap")).string(), "--report", (dir / (user + ".json")).string()},
         dir / (user + ".log"));
   }
   void stop() {
@@ -103,25 +112,34 @@ TEST(Replay, ATwoUserSessionVerifiesBitForBit) {
   // Both users' forces were recorded with the other tool in them.
   const record::Recording a_recording = record::read_recording(session.dir / "a.mcap");
   bool saw_remote = false;
-  for (const auto& tick : a_recording.ticks) saw_remote |= tick.remotes_size() > 0 && std::isfinite(tick.remotes(0).x());
+  for (const auto& tick : a_recording.ticks)
+    saw_remote |= tick.remotes_size() > 0 && std::isfinite(tick.remotes(0).x());
   EXPECT_TRUE(saw_remote);
   EXPECT_FALSE(a_recording.truncated);
 
   // The summary of a client's recording shows its report's counters, recomputed from the ticks.
   for (const std::string user : {"a", "b"}) {
-    ChildProcess replay(COHAPTIC_LAB_EXE, {"replay", (session.dir / (user + ".mcap")).string(), "--summary"},
+    ChildProcess replay(COHAPTIC_LAB_EXE,
+                        {"replay", (session.dir / (user + ".mcap")).string(), "--summary"},
                         session.dir / ("summary-" + user + ".log"));
     ASSERT_EQ(replay.wait(testing::kPatience), 0) << replay.log_text();
     const std::string summary = replay.log_text();
-    const nlohmann::json report = nlohmann::json::parse(std::ifstream(session.dir / (user + ".json")));
+    const nlohmann::json report =
+        nlohmann::json::parse(std::ifstream(session.dir / (user + ".json")));
     std::smatch fades, ages;
-    ASSERT_TRUE(std::regex_search(summary, fades, std::regex(R"(fades +(\d+) while pushing)"))) << summary;
-    EXPECT_EQ(std::stoi(fades[1].str()), report["fades"]["count"].get<int>()) << summary;
-    ASSERT_TRUE(std::regex_search(summary, ages, std::regex(R"(IR age +p50 ([0-9.]+) ms, p99 ([0-9.]+) ms, max ([0-9.]+) ms)")))
+    ASSERT_TRUE(std::regex_search(summary, fades, std::regex(R"(fades +(\d+) while pushing)")))
         << summary;
-    EXPECT_NEAR(std::stod(ages[2].str()), report["ir_age_ms"]["p99"].get<double>(), 0.051) << summary;
-    EXPECT_NEAR(std::stod(ages[3].str()), report["ir_age_ms"]["max"].get<double>(), 0.051) << summary;
-    EXPECT_GT(report["ir_age_ms"]["max"].get<double>(), 0) << "an IR age the summary could match by accident";
+    EXPECT_EQ(std::stoi(fades[1].str()), report["fades"]["count"].get<int>()) << summary;
+    ASSERT_TRUE(std::regex_search(
+        summary, ages,
+        std::regex(R"(IR age +p50 ([0-9.]+) ms, p99 ([0-9.]+) ms, max ([0-9.]+) ms)")))
+        << summary;
+    EXPECT_NEAR(std::stod(ages[2].str()), report["ir_age_ms"]["p99"].get<double>(), 0.051)
+        << summary;
+    EXPECT_NEAR(std::stod(ages[3].str()), report["ir_age_ms"]["max"].get<double>(), 0.051)
+        << summary;
+    EXPECT_GT(report["ir_age_ms"]["max"].get<double>(), 0)
+        << "an IR age the summary could match by accident";
   }
 }
 
@@ -132,14 +150,15 @@ TEST(Replay, ASessionWithBTruncationVerifiesBitForBit) {
   session.run_one_user("a");
   const record::Recording a_recording = record::read_recording(session.dir / "a.mcap");
   std::size_t truncating = 0;
-  for (const record::RecordedIr& ir : a_recording.irs) truncating += ir.ir().fem().truncated_node_ids_size() > 0;
+  for (const record::RecordedIr& ir : a_recording.irs)
+    truncating += ir.ir().fem().truncated_node_ids_size() > 0;
   EXPECT_GT(truncating, 0u) << "no IR left a held node out";
   for (const char* file : {"server.mcap", "a.mcap"}) {
     const VerifyResult result = verify_recording(session.dir / file);
     EXPECT_TRUE(result.ok) << file << ": " << result.first_difference;
     EXPECT_GT(result.checked, 3u) << file;
-    std::printf("  %s: %zu values re-run, identical (%zu IRs with truncated held nodes)\n", file, result.checked,
-                truncating);
+    std::printf("  %s: %zu values re-run, identical (%zu IRs with truncated held nodes)\n", file,
+                result.checked, truncating);
   }
 }
 
@@ -166,8 +185,11 @@ TEST(Replay, AChangedForceIsFoundAndNamed) {
   ASSERT_GT(changed, 0u);
   const VerifyResult result = verify_recording(session.dir / "tampered.mcap");
   EXPECT_FALSE(result.ok);
-  EXPECT_NE(result.first_difference.find(fmt::format("haptic tick {} ", changed)), std::string::npos) << result.first_difference;
-  EXPECT_NE(result.first_difference.find("output force"), std::string::npos) << result.first_difference;
+  EXPECT_NE(result.first_difference.find(fmt::format("haptic tick {} ", changed)),
+            std::string::npos)
+      << result.first_difference;
+  EXPECT_NE(result.first_difference.find("output force"), std::string::npos)
+      << result.first_difference;
 }
 
 TEST(Replay, AClientKilledMidSessionLeavesARecordingThatReadsAndVerifies) {
@@ -200,24 +222,29 @@ segments:
   session.stop();
   const record::Recording recording = record::read_recording(session.dir / "a.mcap");
   EXPECT_TRUE(recording.truncated) << "a killed writer cannot have written the footer";
-  EXPECT_GE(recording.ticks.size(), on_disk_before_kill) << "every tick flushed before the kill is still readable";
+  EXPECT_GE(recording.ticks.size(), on_disk_before_kill)
+      << "every tick flushed before the kill is still readable";
   const VerifyResult result = verify_recording(session.dir / "a.mcap");
   EXPECT_TRUE(result.ok) << result.first_difference;
   // Every message read lies in a chunk whose CRC matched, and replay says so.
   EXPECT_GT(recording.crc.checked_messages, recording.ticks.size());
   EXPECT_EQ(recording.crc.unchecked_messages, 0u);
   ASSERT_TRUE(recording.crc.checked_end_time_ns.has_value());
-  EXPECT_GE(*recording.crc.checked_end_time_ns, static_cast<std::uint64_t>(recording.ticks.back().time_ns()));
-  const testing::ProgramRun replay =
-      testing::run_program(COHAPTIC_LAB_EXE, "replay '" + (session.dir / "a.mcap").string() + "' --verify");
+  EXPECT_GE(*recording.crc.checked_end_time_ns,
+            static_cast<std::uint64_t>(recording.ticks.back().time_ns()));
+  const testing::ProgramRun replay = testing::run_program(
+      COHAPTIC_LAB_EXE, "replay '" + (session.dir / "a.mcap").string() + "' --verify");
   EXPECT_EQ(replay.exit_code, 0) << replay.out;
   const std::string line = record::describe_cut(recording);
-  EXPECT_NE(line.find(fmt::format("cut short at byte {}: everything up to t = ", fs::file_size(session.dir / "a.mcap"))),
-            std::string::npos) << line;
+  EXPECT_NE(line.find(fmt::format("cut short at byte {}: everything up to t = ",
+                                  fs::file_size(session.dir / "a.mcap"))),
+            std::string::npos)
+      << line;
   EXPECT_NE(line.find(" s is checked by its chunks' CRCs"), std::string::npos) << line;
   EXPECT_NE(replay.out.find("verify: " + line + "\n"), std::string::npos) << replay.out;
-  std::printf("  killed with %zu ticks on disk: %zu ticks readable (%s), all verified; %s\n", on_disk_before_kill,
-              recording.ticks.size(), recording.truncation.c_str(), line.c_str());
+  std::printf("  killed with %zu ticks on disk: %zu ticks readable (%s), all verified; %s\n",
+              on_disk_before_kill, recording.ticks.size(), recording.truncation.c_str(),
+              line.c_str());
 }
 
 // The deepest point (smallest z) of the own tool and the peak force of a client recording.
@@ -264,7 +291,8 @@ TEST(Replay, ARecordedHandMotionDrivesANewSession) {
   // The device spec splits FILE from USER at the last ':'.
   const auto device = make_device("replay:" + (first.dir / "server.mcap").string() + ":a", 3.0);
   EXPECT_NE(device->describe().find("server.mcap"), std::string::npos) << device->describe();
-  EXPECT_THROW(make_device("replay:" + (first.dir / "server.mcap").string() + ":nobody", 3.0), Error);
+  EXPECT_THROW(make_device("replay:" + (first.dir / "server.mcap").string() + ":nobody", 3.0),
+               Error);
   EXPECT_THROW(recorded_motion(first.dir / "server.mcap", "1"), Error) << "slot 1 never had a tool";
 
   // A new session driven by the recorded motion (open loop) reaches the same depth and
@@ -274,9 +302,10 @@ TEST(Replay, ARecordedHandMotionDrivesANewSession) {
   ASSERT_EQ(replayed->wait(testing::kPatience), 0) << replayed->log_text();
   second.stop();
   const auto [source_depth, source_peak] = deepest_and_peak(source);
-  const auto [replay_depth, replay_peak] = deepest_and_peak(record::read_recording(second.dir / "r.mcap"));
-  std::printf("  deepest z %.4f mm vs %.4f mm; peak force %.4f N vs %.4f N\n", source_depth * 1e3, replay_depth * 1e3,
-              source_peak, replay_peak);
+  const auto [replay_depth, replay_peak] =
+      deepest_and_peak(record::read_recording(second.dir / "r.mcap"));
+  std::printf("  deepest z %.4f mm vs %.4f mm; peak force %.4f N vs %.4f N\n", source_depth * 1e3,
+              replay_depth * 1e3, source_peak, replay_peak);
   EXPECT_NEAR(replay_depth, source_depth, 2e-6);
   EXPECT_NEAR(replay_peak, source_peak, 0.02 * source_peak);
   EXPECT_GT(source_peak, 0.05);

@@ -41,7 +41,8 @@ std::string file_text(const fs::path& path) {
 }
 
 int line_at(const std::string& text, std::size_t offset) {
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(offset), '\n'));
+  return 1 + static_cast<int>(std::count(text.begin(),
+                                         text.begin() + static_cast<std::ptrdiff_t>(offset), '\n'));
 }
 
 // One only_keys({...}) call: where it is and the keys it accepts.
@@ -59,7 +60,8 @@ ParserKeys parser_keys() {
   ParserKeys parsed;
   std::vector<fs::path> sources;
   for (const auto& entry : fs::directory_iterator(kSourceRoot / "common/scene"))
-    if (entry.is_regular_file() && entry.path().extension() == ".cpp") sources.push_back(entry.path());
+    if (entry.is_regular_file() && entry.path().extension() == ".cpp")
+      sources.push_back(entry.path());
   std::sort(sources.begin(), sources.end());
 
   static const std::regex kLiteral("\"([^\"\\\\]*)\"");
@@ -68,7 +70,8 @@ ParserKeys parser_keys() {
   for (const fs::path& source : sources) {
     const std::string text = file_text(source);
     const std::string file = fs::relative(source, kSourceRoot).generic_string();
-    for (std::size_t at = text.find(call); at != std::string::npos; at = text.find(call, at + call.size())) {
+    for (std::size_t at = text.find(call); at != std::string::npos;
+         at = text.find(call, at + call.size())) {
       std::size_t open = at + call.size();
       while (open < text.size() && std::isspace(static_cast<unsigned char>(text[open]))) ++open;
       if (open >= text.size() || text[open] != '{') continue;  // the declaration, or a mention
@@ -209,8 +212,10 @@ TEST(SceneReference, EveryKeyTheParserAcceptsIsDocumented) {
       for (const std::string& file : files) where += (where.empty() ? "" : ", ") + file;
       missing += "\n  " + key + " (accepted in " + where + ")";
     }
-  EXPECT_EQ(count, 0) << count << " key(s) the scene parser accepts are not documented in a key table of "
-                      << kReferencePage.generic_string() << " (a row whose first cell is the key's path in backticks):" << missing;
+  EXPECT_EQ(count, 0) << count
+                      << " key(s) the scene parser accepts are not documented in a key table of "
+                      << kReferencePage.generic_string()
+                      << " (a row whose first cell is the key's path in backticks):" << missing;
 }
 
 TEST(SceneReference, EveryDocumentedKeyIsOneTheParserAccepts) {
@@ -222,15 +227,16 @@ TEST(SceneReference, EveryDocumentedKeyIsOneTheParserAccepts) {
     for (const Row& row : table.rows)
       if (!parser.files_of_key.count(row.key)) {
         ++count;
-        unknown += "\n  " + kReferencePage.generic_string() + ":" + std::to_string(row.line) + ": `" + row.path +
-                   "` (" + row.key + ")";
+        unknown += "\n  " + kReferencePage.generic_string() + ":" + std::to_string(row.line) +
+                   ": `" + row.path + "` (" + row.key + ")";
       }
-  EXPECT_EQ(count, 0) << count << " documented key(s) that the scene parser (common/scene/*.cpp) does not accept:"
-                      << unknown;
+  EXPECT_EQ(count, 0)
+      << count << " documented key(s) that the scene parser (common/scene/*.cpp) does not accept:"
+      << unknown;
   std::string malformed;
   for (const std::string& row : page.malformed) malformed += "\n  " + row;
-  EXPECT_TRUE(page.malformed.empty()) << "key-table rows whose first cell is not one backticked key path:"
-                                      << malformed;
+  EXPECT_TRUE(page.malformed.empty())
+      << "key-table rows whose first cell is not one backticked key path:" << malformed;
 }
 
 TEST(SceneReference, EveryCheckedMapHasATableOfExactlyItsKeys) {
@@ -239,30 +245,36 @@ TEST(SceneReference, EveryCheckedMapHasATableOfExactlyItsKeys) {
 
   std::string problems;
   for (const KeyList& list : parser.lists) {
-    const bool tabled = std::any_of(page.tables.begin(), page.tables.end(),
-                                    [&](const KeyTable& table) { return keys_of(table) == list.keys; });
-    if (!tabled) problems += "\n  " + list.where + ": no table has exactly the keys {" + joined(list.keys) + "}";
+    const bool tabled =
+        std::any_of(page.tables.begin(), page.tables.end(),
+                    [&](const KeyTable& table) { return keys_of(table) == list.keys; });
+    if (!tabled)
+      problems +=
+          "\n  " + list.where + ": no table has exactly the keys {" + joined(list.keys) + "}";
   }
 
   std::set<std::string> paths;
   for (const KeyTable& table : page.tables)
     for (const Row& row : table.rows) paths.insert(without_list_mark(row.path));
   for (const KeyTable& table : page.tables) {
-    const std::string where = kReferencePage.generic_string() + ":" + std::to_string(table.line) + " (" + table.heading + ")";
+    const std::string where = kReferencePage.generic_string() + ":" + std::to_string(table.line) +
+                              " (" + table.heading + ")";
     const std::set<std::string> keys = keys_of(table);
     const bool parsed = std::any_of(parser.lists.begin(), parser.lists.end(),
                                     [&](const KeyList& list) { return list.keys == keys; });
-    if (!parsed) problems += "\n  " + where + ": no only_keys call accepts exactly {" + joined(keys) + "}";
+    if (!parsed)
+      problems += "\n  " + where + ": no only_keys call accepts exactly {" + joined(keys) + "}";
     if (table.rows.empty()) continue;
     const std::string parent = parent_path(table.rows.front().path);
     for (const Row& row : table.rows)
       if (parent_path(row.path) != parent)
-        problems += "\n  " + kReferencePage.generic_string() + ":" + std::to_string(row.line) + ": `" + row.path +
-                    "` is not under `" + parent + "` like the table's first row";
+        problems += "\n  " + kReferencePage.generic_string() + ":" + std::to_string(row.line) +
+                    ": `" + row.path + "` is not under `" + parent + "` like the table's first row";
     if (!parent.empty() && !paths.count(without_list_mark(parent)))
       problems += "\n  " + where + ": its parent `" + parent + "` is documented in no table";
   }
-  EXPECT_TRUE(problems.empty()) << "the page's key tables and the parser's only_keys calls differ:" << problems;
+  EXPECT_TRUE(problems.empty()) << "the page's key tables and the parser's only_keys calls differ:"
+                                << problems;
 }
 
 }  // namespace scene_reference_test

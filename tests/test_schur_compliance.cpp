@@ -1,6 +1,7 @@
 // The Schur-complement route to the compliance among a set of dofs (schur_compliance.h)
-// against the dense inverse of K and against ComplianceColumns' solves, on the paper's cube: equal to round-off, exactly symmetric, the same bits run to run, and a
-// K that is not positive definite refused.
+// against the dense inverse of K and against ComplianceColumns' solves, on the paper's cube: equal
+// to round-off, exactly symmetric, the same bits run to run, and a K that is not positive definite
+// refused.
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -28,7 +29,8 @@ TEST(SchurCompliance, EqualsTheDenseInverseAmongAnySetOfDofsAndIsExactlySymmetri
   const ElasticBody& body = single_elastic_body(model);
   const SparseMatrix k_ff = restrict_to_dofs(body.stiffness, body.dofs.free_dofs);
   const Eigen::MatrixXd dense(k_ff);
-  const Eigen::MatrixXd inverse = dense.llt().solve(Eigen::MatrixXd::Identity(dense.rows(), dense.cols()));
+  const Eigen::MatrixXd inverse =
+      dense.llt().solve(Eigen::MatrixXd::Identity(dense.rows(), dense.cols()));
   const int n = static_cast<int>(k_ff.rows());
   // Scattered dofs out of order, a contiguous block, a single dof, and every dof (no interior).
   std::vector<std::vector<int>> sets = {{n - 1, 5, 17, 2, 60, 33, n / 2}, {}, {n / 3}, {}};
@@ -41,7 +43,8 @@ TEST(SchurCompliance, EqualsTheDenseInverseAmongAnySetOfDofsAndIsExactlySymmetri
     Eigen::MatrixXd expected(l.rows(), l.cols());
     for (std::size_t i = 0; i < rows.size(); ++i)
       for (std::size_t j = 0; j < rows.size(); ++j)
-        expected(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = inverse(rows[i], rows[j]);
+        expected(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
+            inverse(rows[i], rows[j]);
     EXPECT_LE((l - expected).norm(), 1e-10 * expected.norm());
     EXPECT_EQ(l, l.transpose());
     EXPECT_EQ(l, schur_compliance(k_ff, rows)) << "not the same bits a second time";
@@ -69,7 +72,8 @@ TEST(SchurCompliance, FillsTheRowNodesColumnsAsTheSolvesDoWithFixedAxesZero) {
   EXPECT_EQ(schur.column(rows[1]), solved.column(rows[1]));
   for (int node : rows) {
     const ComplianceColumn& expected = solved.column(node);
-    EXPECT_LE((schur.column(node) - expected).norm(), 1e-10 * expected.norm() + 1e-300) << "node " << node;
+    EXPECT_LE((schur.column(node) - expected).norm(), 1e-10 * expected.norm() + 1e-300)
+        << "node " << node;
     if (body.dofs.is_fixed(node, 0)) {
       EXPECT_TRUE(schur.column(node).isZero(0)) << "fixed node " << node;
     }

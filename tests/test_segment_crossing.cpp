@@ -21,26 +21,33 @@ using Eigen::Vector3d;
 TEST(SegmentCrossing, AgreesWithThePlaneCrossing) {
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> coordinate(-1, 1);
-  const auto random_point = [&] { return Vector3d(coordinate(rng), coordinate(rng), coordinate(rng)); };
+  const auto random_point = [&] {
+    return Vector3d(coordinate(rng), coordinate(rng), coordinate(rng));
+  };
   int crossings = 0;
   for (int trial = 0; trial < 20000; ++trial) {
-    const Vector3d a = random_point(), b = random_point(), c = random_point(), from = random_point(), to = random_point();
+    const Vector3d a = random_point(), b = random_point(), c = random_point(),
+                   from = random_point(), to = random_point();
     // Independently: the line meets the plane at t; the point is inside when its three
     // sub-triangle areas, signed along the normal, share the sign of the whole.
     const Vector3d normal = (b - a).cross(c - a);
     const double t = normal.dot(a - from) / normal.dot(to - from);
     const Vector3d x = from + t * (to - from);
-    const Vector3d w(normal.dot((b - x).cross(c - x)), normal.dot((c - x).cross(a - x)), normal.dot((a - x).cross(b - x)));
+    const Vector3d w(normal.dot((b - x).cross(c - x)), normal.dot((c - x).cross(a - x)),
+                     normal.dot((a - x).cross(b - x)));
     const bool inside = t >= 0 && t <= 1 && w.minCoeff() >= 0;
     const auto crossing = segment_triangle_crossing(from, to, a, b, c);
-    const double margin = std::min({std::abs(t), std::abs(1 - t), w.cwiseAbs().minCoeff() / normal.squaredNorm()});
+    const double margin =
+        std::min({std::abs(t), std::abs(1 - t), w.cwiseAbs().minCoeff() / normal.squaredNorm()});
     if (margin < 1e-9) continue;  // too near an edge or an end to call either way
     ASSERT_EQ(crossing.has_value(), inside) << "trial " << trial;
     if (!inside) continue;
     ++crossings;
     EXPECT_NEAR(crossing->t, t, 1e-12);
     EXPECT_LT((crossing->weights - w / normal.squaredNorm()).norm(), 1e-10);
-    EXPECT_LT((crossing->weights[0] * a + crossing->weights[1] * b + crossing->weights[2] * c - x).norm(), 1e-12);
+    EXPECT_LT(
+        (crossing->weights[0] * a + crossing->weights[1] * b + crossing->weights[2] * c - x).norm(),
+        1e-12);
   }
   EXPECT_GT(crossings, 500);
 }
@@ -50,20 +57,21 @@ struct CrossingScan {
   double t = 2;
 };
 
-CrossingScan scan_all(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& triangles, const Vector3d& from,
-              const Vector3d& to) {
+CrossingScan scan_all(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& triangles,
+                      const Vector3d& from, const Vector3d& to) {
   CrossingScan best;
   for (int i = 0; i < static_cast<int>(triangles.size()); ++i) {
     const Triangle& tri = triangles[static_cast<std::size_t>(i)];
-    const auto crossing =
-        segment_triangle_crossing(from, to, vertices.col(tri[0]), vertices.col(tri[1]), vertices.col(tri[2]));
+    const auto crossing = segment_triangle_crossing(from, to, vertices.col(tri[0]),
+                                                    vertices.col(tri[1]), vertices.col(tri[2]));
     if (crossing && crossing->t < best.t) best = {i, crossing->t};
   }
   return best;
 }
 
-void expect_tree_matches_scan(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& triangles,
-                              double extent, unsigned seed) {
+void expect_tree_matches_scan(const Eigen::Matrix3Xd& vertices,
+                              const std::vector<Triangle>& triangles, double extent,
+                              unsigned seed) {
   const AabbTree tree(vertices, triangles);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> coordinate(-extent, extent);
@@ -80,7 +88,8 @@ void expect_tree_matches_scan(const Eigen::Matrix3Xd& vertices, const std::vecto
     // Odd trials: short and long segments in random directions; even trials: aimed at a
     // surface vertex, stopping short of it or running past, so that many do cross.
     const Vector3d to =
-        trial % 2 ? Vector3d(from + std::pow(10.0, -2 + 2.0 * (trial % 7) / 6) * extent * testing::random_direction(rng))
+        trial % 2 ? Vector3d(from + std::pow(10.0, -2 + 2.0 * (trial % 7) / 6) * extent *
+                                        testing::random_direction(rng))
                   : Vector3d(from + reach(rng) * (Vector3d(vertices.col(vertex(rng))) - from));
     const CrossingScan scan = scan_all(vertices, triangles, from, to);
     const AabbCrossing hit = tree.first_crossing(from, to);
@@ -100,7 +109,8 @@ TEST(SegmentCrossing, TreeMatchesScanOnASphere) {
 }
 
 TEST(SegmentCrossing, TreeMatchesScanOnASheet) {
-  const TriangleSurface sheet = testing::equilateral_sheet(40, 40, 0.002);  // flat: boxes of zero height
+  const TriangleSurface sheet =
+      testing::equilateral_sheet(40, 40, 0.002);  // flat: boxes of zero height
   expect_tree_matches_scan(sheet.vertices, sheet.triangles, 0.04, 3);
 }
 

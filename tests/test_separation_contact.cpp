@@ -27,7 +27,8 @@ extern "C" void __libc_free(void* pointer);  // glibc's own, behind the one belo
 // Counts frees while the flag is set: a haptic path that allocated and released memory
 // would show here, one that kept it would show in mallinfo2's in-use bytes.
 extern "C" void free(void* pointer) {
-  if (pointer && counting_frees.load(std::memory_order_relaxed)) frees.fetch_add(1, std::memory_order_relaxed);
+  if (pointer && counting_frees.load(std::memory_order_relaxed))
+    frees.fetch_add(1, std::memory_order_relaxed);
   __libc_free(pointer);
 }
 #endif
@@ -72,14 +73,16 @@ TEST(SeparationContact, SlidingStopsAtACrackEdge) {
   const SeparationPatch& patch = default_two_layers().patch;
   SeparationState state = opened_strip(patch);
   const Eigen::Vector3d start(0.005, 0.0203, 0);
-  SeparationContact contact = begin_contact(patch, ContactMode::push, point_at(patch, start), start);
+  SeparationContact contact =
+      begin_contact(patch, ContactMode::push, point_at(patch, start), start);
   ASSERT_EQ(contact.mode, ContactMode::push);
   const Eigen::Vector3d press(0, 0, 0.001);
   for (int i = 1; i <= 100; ++i) step_contact(patch, state, contact, start + press * (i / 100.0));
   bool slid = false, stopped = false, tore = false;
   double stop_x = 0, force_at_stop = 0;
   for (int i = 1; i <= 1200 && !tore; ++i) {
-    const SeparationSample s = step_contact(patch, state, contact, start + press + Eigen::Vector3d(1e-5 * i, 0, 0));
+    const SeparationSample s =
+        step_contact(patch, state, contact, start + press + Eigen::Vector3d(1e-5 * i, 0, 0));
     const Eigen::Vector3d n = patch.normals[contact.point.triangle];
     const double normal = s.body_force.dot(n);
     const double tangential = (s.body_force - normal * n).norm();
@@ -96,7 +99,8 @@ TEST(SeparationContact, SlidingStopsAtACrackEdge) {
     }
     tore = s.separated > 0;
     if (stopped && !tore) {
-      EXPECT_NEAR(contact.position.x(), stop_x, 1e-12) << "c moved on from the crack edge before tearing, tick " << i;
+      EXPECT_NEAR(contact.position.x(), stop_x, 1e-12)
+          << "c moved on from the crack edge before tearing, tick " << i;
       EXPECT_GE(s.body_force.x(), force_at_stop - 1e-12) << "tick " << i;
       force_at_stop = s.body_force.x();
     }
@@ -111,9 +115,12 @@ TEST(SeparationContact, PushingToolLetsGoWhenItWouldPull) {
   const SeparationPatch& patch = default_two_layers().patch;
   SeparationState state = opened_strip(patch);
   const Eigen::Vector3d start(0.005, 0.0203, 0);
-  SeparationContact contact = begin_contact(patch, ContactMode::push, point_at(patch, start), start);
-  EXPECT_GT(step_contact(patch, state, contact, start + Eigen::Vector3d(0, 0, 2e-4)).body_force.z(), 0);
-  const SeparationSample away = step_contact(patch, state, contact, start - Eigen::Vector3d(0, 0, 1e-4));
+  SeparationContact contact =
+      begin_contact(patch, ContactMode::push, point_at(patch, start), start);
+  EXPECT_GT(step_contact(patch, state, contact, start + Eigen::Vector3d(0, 0, 2e-4)).body_force.z(),
+            0);
+  const SeparationSample away =
+      step_contact(patch, state, contact, start - Eigen::Vector3d(0, 0, 1e-4));
   EXPECT_TRUE(away.flags & kSeparationReleased);
   EXPECT_EQ(contact.mode, ContactMode::none);
   EXPECT_EQ(away.force, Eigen::Vector3d::Zero());
@@ -134,11 +141,14 @@ TEST(SeparationContact, EvaluationAllocatesNothingAndStaysBounded) {
   SeparationState state = make_separation_state(patch);
   const int node = nearest_patch_node(patch, Eigen::Vector3d(0, 0.02, 0));
   const Eigen::Vector3d start = patch.positions.col(node);
-  SeparationContact grasp = begin_contact(patch, ContactMode::grasp, contact_at_node(patch, node), start);
-  SeparationContact push = begin_contact(patch, ContactMode::push, contact_at_node(patch, node), start);
+  SeparationContact grasp =
+      begin_contact(patch, ContactMode::grasp, contact_at_node(patch, node), start);
+  SeparationContact push =
+      begin_contact(patch, ContactMode::push, contact_at_node(patch, node), start);
   const int middle = nearest_patch_node(patch, Eigen::Vector3d(0.02, 0.02, 0));
   const Eigen::Vector3d centre = patch.positions.col(middle);
-  SeparationContact stuck = begin_contact(patch, ContactMode::grasp, contact_at_node(patch, middle), centre);
+  SeparationContact stuck =
+      begin_contact(patch, ContactMode::grasp, contact_at_node(patch, middle), centre);
   LaserFibre fibre;
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int fractures = 0, clamped = 0, non_finite = 0;
@@ -149,19 +159,23 @@ TEST(SeparationContact, EvaluationAllocatesNothingAndStaysBounded) {
   counting_frees = true;
   for (int i = 1; i <= 3000; ++i) {
     const double t = i * 1e-3;
-    const Eigen::Vector3d pull = start + Eigen::Vector3d(0.004 * std::sin(3 * t), 0.002 * std::sin(5 * t), 0.012 * t);
+    const Eigen::Vector3d pull =
+        start + Eigen::Vector3d(0.004 * std::sin(3 * t), 0.002 * std::sin(5 * t), 0.012 * t);
     const SeparationSample s = step_contact(patch, state, grasp, pull);
     fractures += (s.flags & kSeparationFracture) != 0;
     clamped += (s.flags & kSeparationClamped) != 0;
     sum += s.force;
     if (!s.force.allFinite() || s.force.norm() > patch.force_limit * (1 + 1e-12)) ++non_finite;
     sum += step_contact(patch, state, push, start + Eigen::Vector3d(1e-5 * i, 0, 5e-4)).force;
-    const SeparationSample held = step_contact(patch, state, stuck, centre + Eigen::Vector3d(0, 0, 2e-5 * i));
+    const SeparationSample held =
+        step_contact(patch, state, stuck, centre + Eigen::Vector3d(0, 0, 2e-5 * i));
     clamped += (held.flags & kSeparationClamped) != 0;
-    if (!held.force.allFinite() || held.force.norm() > patch.force_limit * (1 + 1e-12)) ++non_finite;
+    if (!held.force.allFinite() || held.force.norm() > patch.force_limit * (1 + 1e-12))
+      ++non_finite;
     step_laser(patch, state, fibre, Eigen::Vector3d(0.02, 0.005 + 1e-5 * i, 0), true, 1e-3);
   }
-  const SeparationSample nan = step_contact(patch, state, grasp, Eigen::Vector3d(std::nan(""), 0, 0));
+  const SeparationSample nan =
+      step_contact(patch, state, grasp, Eigen::Vector3d(std::nan(""), 0, 0));
   counting_frees = false;
 #ifndef COHAPTIC_SANITIZER_OWNS_MALLOC  // the plain build counts (support/sanitizer_owns_malloc.h)
   EXPECT_EQ(frees.load(), 0) << "the haptic path freed memory it allocated";
@@ -177,7 +191,10 @@ TEST(SeparationContact, EvaluationAllocatesNothingAndStaysBounded) {
 #ifndef COHAPTIC_SANITIZER_OWNS_MALLOC
   // The counter does see a free.
   counting_frees = true;
-  { volatile auto* probe = new std::vector<int>(10); delete probe; }
+  {
+    volatile auto* probe = new std::vector<int>(10);
+    delete probe;
+  }
   counting_frees = false;
   EXPECT_GT(frees.load(), 0) << "free() is not counted in this program";
 #endif
@@ -189,16 +206,21 @@ TEST(SeparationContact, EvaluationAllocatesNothingAndStaysBounded) {
 TEST(SeparationContact, TwoCopiesAgreeBitForBit) {
   const TwoLayerSetup& setup = default_two_layers();
   const SeparationPatch server = setup.patch;
-  const SeparationPatch client = make_separation_patch(setup.interface, setup.fields, SeparationSettings{});
-  SeparationState server_state = make_separation_state(server), client_state = make_separation_state(client);
+  const SeparationPatch client =
+      make_separation_patch(setup.interface, setup.fields, SeparationSettings{});
+  SeparationState server_state = make_separation_state(server),
+                  client_state = make_separation_state(client);
   const int node = nearest_patch_node(server, Eigen::Vector3d(0, 0.016, 0));
   const Eigen::Vector3d start = server.positions.col(node);
-  SeparationContact server_contact = begin_contact(server, ContactMode::grasp, contact_at_node(server, node), start);
-  SeparationContact client_contact = begin_contact(client, ContactMode::grasp, contact_at_node(client, node), start);
+  SeparationContact server_contact =
+      begin_contact(server, ContactMode::grasp, contact_at_node(server, node), start);
+  SeparationContact client_contact =
+      begin_contact(client, ContactMode::grasp, contact_at_node(client, node), start);
   int fractures = 0;
   for (int i = 1; i <= 1500; ++i) {
     const double t = i * 1e-3;
-    const Eigen::Vector3d tool = start + Eigen::Vector3d(0.003 * t, 0.001 * std::sin(7 * t), 0.006 * t);
+    const Eigen::Vector3d tool =
+        start + Eigen::Vector3d(0.003 * t, 0.001 * std::sin(7 * t), 0.006 * t);
     const SeparationSample a = step_contact(server, server_state, server_contact, tool);
     const SeparationSample b = step_contact(client, client_state, client_contact, tool);
     ASSERT_EQ(a.force, b.force) << "tick " << i;

@@ -51,8 +51,10 @@ TEST(SeparationInterface, TwoBoxesShareTheirConformingFace) {
   for (int t = 0; t < interface.triangle_count(); ++t) {
     const Triangle& tri = interface.triangles[t];
     const Eigen::Vector3d a = interface.positions.col(tri[0]);
-    const Eigen::Vector3d normal = (interface.positions.col(tri[1]) - a).cross(interface.positions.col(tri[2]) - a);
-    EXPECT_GT(normal.normalized().z(), 1 - 1e-12) << "triangle " << t << " does not face the pulled layer";
+    const Eigen::Vector3d normal =
+        (interface.positions.col(tri[1]) - a).cross(interface.positions.col(tri[2]) - a);
+    EXPECT_GT(normal.normalized().z(), 1 - 1e-12)
+        << "triangle " << t << " does not face the pulled layer";
     for (int k = 0; k < 3; ++k) {
       EXPECT_DOUBLE_EQ(interface.positions(2, tri[k]), 0.0);
       rim_edges += interface.open_rim[t] >> k & 1;
@@ -60,8 +62,10 @@ TEST(SeparationInterface, TwoBoxesShareTheirConformingFace) {
   }
   EXPECT_EQ(rim_edges, 4 * 8);
   for (int k = 0; k < interface.node_count(); ++k)
-    EXPECT_EQ(bodies.pulled.mesh.nodes.col(interface.pulled_nodes[k]), bodies.base.mesh.nodes.col(interface.base_nodes[k]));
-  seal_rim_edges(interface, [&](const Eigen::Vector3d& m) { return m.x() > boxes.size.x() - 1e-9; });
+    EXPECT_EQ(bodies.pulled.mesh.nodes.col(interface.pulled_nodes[k]),
+              bodies.base.mesh.nodes.col(interface.base_nodes[k]));
+  seal_rim_edges(interface,
+                 [&](const Eigen::Vector3d& m) { return m.x() > boxes.size.x() - 1e-9; });
   rim_edges = 0;
   for (int t = 0; t < interface.triangle_count(); ++t)
     for (int k = 0; k < 3; ++k) rim_edges += interface.open_rim[t] >> k & 1;
@@ -73,7 +77,8 @@ TEST(SeparationInterface, TwoBoxesShareTheirConformingFace) {
     find_interface(apart, 1e-9);
     FAIL() << "bodies 1 mm apart share no interface";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("share no boundary triangle"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("share no boundary triangle"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -92,7 +97,8 @@ TEST(SeparationFields, ReproduceTheFullSparseSolveInEveryState) {
     settings.samples_per_axis = samples;
     settings.footprint_radii = {0.0, 1.1 * spacing};  // a point and a node with its 4 neighbours
     FieldPrecomputeReport report;
-    const SeparationFields fields = precompute_separation_fields(bodies, interface, settings, &report);
+    const SeparationFields fields =
+        precompute_separation_fields(bodies, interface, settings, &report);
     const SeparationPatch patch = make_separation_patch(interface, fields, SeparationSettings{});
     EXPECT_EQ(report.field_count, 81 * 2 * 3);
     for (double e : report.max_fit_error) EXPECT_LT(e, 1e-12);
@@ -100,7 +106,8 @@ TEST(SeparationFields, ReproduceTheFullSparseSolveInEveryState) {
     const NodeRegions regions = node_regions(interface.triangles, interface.node_count());
     const std::vector<double> abscissae = chebyshev_abscissae(samples, settings.max_deflection);
     std::mt19937 rng(12);
-    std::uniform_real_distribution<double> uniform(-settings.max_deflection, settings.max_deflection);
+    std::uniform_real_distribution<double> uniform(-settings.max_deflection,
+                                                   settings.max_deflection);
     const auto at = [&](double x, double y) {
       int best = 0;
       for (int k = 1; k < interface.node_count(); ++k)
@@ -125,13 +132,19 @@ TEST(SeparationFields, ReproduceTheFullSparseSolveInEveryState) {
             for (double sample : abscissae)
               if (sample != 0) deltas.push_back(sample * frame.col(a));
           for (int r = 0; r < 3; ++r) deltas.emplace_back(uniform(rng), uniform(rng), uniform(rng));
-          const std::vector<int> footprint = tool_footprint(interface, node, settings.footprint_radii[j]);
+          const std::vector<int> footprint =
+              tool_footprint(interface, node, settings.footprint_radii[j]);
           EXPECT_EQ(footprint.size(), j == 0 ? 1u : (node == corner ? 3u : node == rim ? 4u : 5u));
-          const std::vector<Eigen::Vector3d> full = footprint_forces(system, interface, footprint, deltas);
+          const std::vector<Eigen::Vector3d> full =
+              footprint_forces(system, interface, footprint, deltas);
           for (std::size_t i = 0; i < deltas.size(); ++i)
-            EXPECT_LT(relative(field_value(patch, node, j, static_cast<FieldState>(s), deltas[i]).force, full[i]), 1e-9)
+            EXPECT_LT(
+                relative(field_value(patch, node, j, static_cast<FieldState>(s), deltas[i]).force,
+                         full[i]),
+                1e-9)
                 << "degree " << degree << " node " << node << " tool node " << j << " state "
-                << field_state_name(static_cast<FieldState>(s)) << " deflection " << deltas[i].transpose();
+                << field_state_name(static_cast<FieldState>(s)) << " deflection "
+                << deltas[i].transpose();
         }
       }
     }
@@ -148,9 +161,12 @@ TEST(SeparationFields, MoreConnectionStoresMoreEnergy) {
   for (int node = 0; node < setup.patch.node_count(); ++node)
     for (int trial = 0; trial < 4; ++trial) {
       const Eigen::Vector3d delta(uniform(rng), uniform(rng), uniform(rng));
-      const double connected = field_value(setup.patch, node, 0, FieldState::connected, delta).energy;
-      const double local = field_value(setup.patch, node, 0, FieldState::locally_separated, delta).energy;
-      const double separated = field_value(setup.patch, node, 0, FieldState::separated, delta).energy;
+      const double connected =
+          field_value(setup.patch, node, 0, FieldState::connected, delta).energy;
+      const double local =
+          field_value(setup.patch, node, 0, FieldState::locally_separated, delta).energy;
+      const double separated =
+          field_value(setup.patch, node, 0, FieldState::separated, delta).energy;
       EXPECT_GE(connected, local * (1 - 1e-12)) << "node " << node;
       EXPECT_GE(local, separated * (1 - 1e-12)) << "node " << node;
       EXPECT_GT(separated, 0) << "node " << node;
@@ -169,7 +185,8 @@ TEST(PolynomialFit, InterpolatesItsDegreeAndLeavesAnOrthogonalResidualOtherwise)
     std::vector<double> f;
     for (double x : s) f.push_back(c[0] * x + c[1] * x * x + c[2] * x * x * x);
     const std::vector<double> fit = fit_polynomial_through_origin(s, f, 3);
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(fit[k], c[k], 1e-9 * std::abs(c[k])) << "count " << count;
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(fit[k], c[k], 1e-9 * std::abs(c[k])) << "count " << count;
     for (std::size_t i = 0; i < s.size(); ++i)
       EXPECT_NEAR(polynomial_value(fit.data(), 3, s[i]), f[i], 1e-9 * std::abs(f[i]));
   }
@@ -197,14 +214,18 @@ TEST(PolynomialFit, InterpolatesItsDegreeAndLeavesAnOrthogonalResidualOtherwise)
   EXPECT_LT(worst, 0.01 * largest);
   // The integral is the antiderivative: its derivative by central difference is the value.
   const double h = 1e-7, x = 0.003;
-  EXPECT_NEAR((polynomial_integral(fit.data(), 5, x + h) - polynomial_integral(fit.data(), 5, x - h)) / (2 * h),
-              polynomial_value(fit.data(), 5, x), 1e-6 * std::abs(polynomial_value(fit.data(), 5, x)));
+  EXPECT_NEAR(
+      (polynomial_integral(fit.data(), 5, x + h) - polynomial_integral(fit.data(), 5, x - h)) /
+          (2 * h),
+      polynomial_value(fit.data(), 5, x), 1e-6 * std::abs(polynomial_value(fit.data(), 5, x)));
 
   try {
     fit_polynomial_through_origin(chebyshev_abscissae(3, 0.01), std::vector<double>{1, 0, -1}, 3);
-    FAIL() << "three coefficients from two non-zero abscissae (the third Chebyshev point of three is 0)";
+    FAIL() << "three coefficients from two non-zero abscissae (the third Chebyshev point of three "
+              "is 0)";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("distinct non-zero samples"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("distinct non-zero samples"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -214,10 +235,12 @@ TEST(SeparationFieldCache, RoundTripsBitForBitAndRebuildsWhenCorrupt) {
   FieldSettings settings;
   settings.degree = 5;
   settings.samples_per_axis = 10;
-  const TwoLayerSetup first = make_two_layer_setup(boxes, settings, SeparationSettings{}, scratch.path);
+  const TwoLayerSetup first =
+      make_two_layer_setup(boxes, settings, SeparationSettings{}, scratch.path);
   EXPECT_FALSE(first.fields_from_cache);
   EXPECT_GT(first.report.total_seconds(), 0);
-  const TwoLayerSetup second = make_two_layer_setup(boxes, settings, SeparationSettings{}, scratch.path);
+  const TwoLayerSetup second =
+      make_two_layer_setup(boxes, settings, SeparationSettings{}, scratch.path);
   ASSERT_TRUE(second.fields_from_cache);
   EXPECT_EQ(second.fields.values, first.fields.values);  // bit for bit
   EXPECT_EQ(second.fields.degree, 5);
@@ -234,8 +257,10 @@ TEST(SeparationFieldCache, RoundTripsBitForBitAndRebuildsWhenCorrupt) {
     io.seekp(static_cast<std::streamoff>(fs::file_size(file) / 2));
     io.put('\x5a');
   }
-  EXPECT_EQ(load_separation_fields(file, key).problem, "checksum mismatch (truncated or corrupted)");
-  const CachedSeparationFields rebuilt = cached_separation_fields(scratch.path, first.bodies, first.interface, settings);
+  EXPECT_EQ(load_separation_fields(file, key).problem,
+            "checksum mismatch (truncated or corrupted)");
+  const CachedSeparationFields rebuilt =
+      cached_separation_fields(scratch.path, first.bodies, first.interface, settings);
   EXPECT_FALSE(rebuilt.from_cache);
   EXPECT_EQ(rebuilt.rebuilt_because, "checksum mismatch (truncated or corrupted)");
   EXPECT_EQ(rebuilt.fields.values, first.fields.values);
@@ -257,16 +282,22 @@ TEST(SeparationFieldCache, RoundTripsBitForBitAndRebuildsWhenCorrupt) {
 // three weights sum to one (a patch whose three fields are equal gives that field for any
 // areas). Algorithm V.2: at a vertex the nodal field, inside the triangles the weighted sum.
 TEST(SeparationBlend, PureStatesWeightsAndInterpolation) {
-  const TwoLayerSetup setup = make_two_layer_setup(small_boxes(), FieldSettings{}, SeparationSettings{});
+  const TwoLayerSetup setup =
+      make_two_layer_setup(small_boxes(), FieldSettings{}, SeparationSettings{});
   const SeparationPatch& patch = setup.patch;
   const Eigen::Vector3d delta(0.0012, -0.0007, 0.0021);
   const int node = 40;
   const auto pure = [&](FieldState s) { return field_value(patch, node, 0, s, delta).force; };
   EXPECT_EQ(nodal_separation_field(patch, node, 0, 0, 0, delta).force, pure(FieldState::connected));
-  EXPECT_LT(relative(nodal_separation_field(patch, node, 0, 1, 0, delta).force, pure(FieldState::locally_separated)), 1e-15);
-  EXPECT_LT(relative(nodal_separation_field(patch, node, 0, 0.3, 1, delta).force, pure(FieldState::separated)), 1e-15);
-  const Eigen::Vector3d mixed = 0.8 * (0.7 * pure(FieldState::connected) + 0.3 * pure(FieldState::locally_separated)) +
-                                0.2 * pure(FieldState::separated);
+  EXPECT_LT(relative(nodal_separation_field(patch, node, 0, 1, 0, delta).force,
+                     pure(FieldState::locally_separated)),
+            1e-15);
+  EXPECT_LT(relative(nodal_separation_field(patch, node, 0, 0.3, 1, delta).force,
+                     pure(FieldState::separated)),
+            1e-15);
+  const Eigen::Vector3d mixed =
+      0.8 * (0.7 * pure(FieldState::connected) + 0.3 * pure(FieldState::locally_separated)) +
+      0.2 * pure(FieldState::separated);
   EXPECT_LT(relative(nodal_separation_field(patch, node, 0, 0.3, 0.2, delta).force, mixed), 1e-14);
 
   SeparationPatch equal = patch;
@@ -288,7 +319,8 @@ TEST(SeparationBlend, PureStatesWeightsAndInterpolation) {
   const std::span<const int> region = patch.regions.of(node);
   separate_triangles(patch, state, std::vector<int>(region.begin(), region.end()));
   EXPECT_DOUBLE_EQ(local_separated_share(patch, state, node), 1.0);
-  EXPECT_NEAR(global_separated_share(patch, state), patch.region_areas[node] / patch.interface_area, 1e-15);
+  EXPECT_NEAR(global_separated_share(patch, state), patch.region_areas[node] / patch.interface_area,
+              1e-15);
 
   ContactPoint point;
   point.triangle = region.front();
@@ -297,12 +329,16 @@ TEST(SeparationBlend, PureStatesWeightsAndInterpolation) {
   point.weights = Eigen::Vector3d(tri[0] == node, tri[1] == node, tri[2] == node);
   const int k = tri[0] == node ? 0 : tri[1] == node ? 1 : 2;
   EXPECT_EQ(contact_field(patch, point, areas, delta).force,
-            nodal_separation_field(patch, node, 0, areas.local_separated[k], areas.global_separated, delta).force);
+            nodal_separation_field(patch, node, 0, areas.local_separated[k], areas.global_separated,
+                                   delta)
+                .force);
   point.weights = Eigen::Vector3d(0.2, 0.5, 0.3);
   Eigen::Vector3d expected = Eigen::Vector3d::Zero();
   for (int i = 0; i < 3; ++i)
-    expected += point.weights[i] *
-                nodal_separation_field(patch, tri[i], 0, areas.local_separated[i], areas.global_separated, delta).force;
+    expected +=
+        point.weights[i] * nodal_separation_field(patch, tri[i], 0, areas.local_separated[i],
+                                                  areas.global_separated, delta)
+                               .force;
   EXPECT_LT(relative(contact_field(patch, point, areas, delta).force, expected), 1e-14);
 }
 
@@ -321,11 +357,15 @@ TEST(SeparationBlend, InterpolatesOverTheToolTriangle) {
   SeparationState state = make_separation_state(patch);
   separate_triangles(patch, state, std::vector<int>{patch.regions.of(node).front()});
   const ContactAreas areas = contact_areas(patch, state, point.triangle);
-  const int k = patch.triangles[point.triangle][0] == node ? 0 : patch.triangles[point.triangle][1] == node ? 1 : 2;
+  const int k = patch.triangles[point.triangle][0] == node   ? 0
+                : patch.triangles[point.triangle][1] == node ? 1
+                                                             : 2;
   Eigen::Vector3d expected = Eigen::Vector3d::Zero();
   for (int j = 0; j < 3; ++j)
-    expected += point.tool_weights[j] *
-                nodal_separation_field(patch, node, j, areas.local_separated[k], areas.global_separated, delta).force;
+    expected +=
+        point.tool_weights[j] * nodal_separation_field(patch, node, j, areas.local_separated[k],
+                                                       areas.global_separated, delta)
+                                    .force;
   EXPECT_LT(relative(contact_field(patch, point, areas, delta).force, expected), 1e-14);
   for (int s = 0; s < kFieldStates; ++s)
     for (int j = 1; j < 3; ++j)

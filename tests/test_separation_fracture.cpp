@@ -21,8 +21,12 @@ namespace {
 using testing::default_two_layers;
 
 // On the default layers the interface has J_c = 75 J/m^2 and l_n = l_t = 5 mm.
-int rim_node() { return nearest_patch_node(default_two_layers().patch, Eigen::Vector3d(0, 0.02, 0)); }
-int centre_node() { return nearest_patch_node(default_two_layers().patch, Eigen::Vector3d(0.02, 0.02, 0)); }
+int rim_node() {
+  return nearest_patch_node(default_two_layers().patch, Eigen::Vector3d(0, 0.02, 0));
+}
+int centre_node() {
+  return nearest_patch_node(default_two_layers().patch, Eigen::Vector3d(0.02, 0.02, 0));
+}
 
 TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
   const SeparationPatch& patch = default_two_layers().patch;
@@ -44,7 +48,8 @@ TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
     switch (s.phase) {
       case PullPhase::loading:  // AB: the connected field F, nothing separated
         ++loading;
-        EXPECT_NEAR(s.force, field_value(patch, node, 0, FieldState::connected, delta).force.dot(n), 1e-12 * f_n);
+        EXPECT_NEAR(s.force, field_value(patch, node, 0, FieldState::connected, delta).force.dot(n),
+                    1e-12 * f_n);
         EXPECT_EQ(s.separated_area, 0);
         b = &s;
         break;
@@ -56,7 +61,8 @@ TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
       case PullPhase::unloading: {  // CA: D_n separated, F-bar (and the global share's F^e)
         ++unloading;
         EXPECT_EQ(s.local_separated, 1.0);
-        const double f_bar = field_value(patch, node, 0, FieldState::locally_separated, delta).force.dot(n);
+        const double f_bar =
+            field_value(patch, node, 0, FieldState::locally_separated, delta).force.dot(n);
         const double f_e = field_value(patch, node, 0, FieldState::separated, delta).force.dot(n);
         const double global = s.separated_area / patch.interface_area;
         EXPECT_NEAR(s.force, (1 - global) * f_bar + global * f_e, 1e-12 * f_n);
@@ -90,7 +96,9 @@ TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
   EXPECT_EQ(figure.series[3].y.front(), f_n);
   const std::string svg = render_svg(figure);
   std::size_t polylines = 0;
-  for (std::size_t at = svg.find("<polyline"); at != std::string::npos; at = svg.find("<polyline", at + 1)) ++polylines;
+  for (std::size_t at = svg.find("<polyline"); at != std::string::npos;
+       at = svg.find("<polyline", at + 1))
+    ++polylines;
   EXPECT_EQ(polylines, 4u);
   const LinePlot shares = pull_loop_area_plot(loop, patch.interface_area);
   EXPECT_EQ(shares.series[0].y.back(), 1.0);
@@ -116,17 +124,22 @@ TEST(SeparationFracture, EnergyBalanceAtOtherSpeedsAndAngles) {
         settings.speed = speed;
         settings.direction = std::cos(tilt) * Eigen::Vector3d::UnitZ() + std::sin(tilt) * towards;
         const PullLoop loop = run_pull_loop(patch, make_separation_state(patch), settings);
-        const std::string where = "speed " + std::to_string(speed) + " m/s, tilt " + std::to_string(tilt_deg) +
-                                  " deg towards " + (towards.x() == 1 ? "x" : "y");
+        const std::string where = "speed " + std::to_string(speed) + " m/s, tilt " +
+                                  std::to_string(tilt_deg) + " deg towards " +
+                                  (towards.x() == 1 ? "x" : "y");
         ASSERT_GT(loop.fracture_area, 0) << where;
-        EXPECT_NEAR(loop.threshold, patch.toughness * (patch.normal_length * std::cos(tilt) + patch.tangential_length * std::sin(tilt)),
+        EXPECT_NEAR(loop.threshold,
+                    patch.toughness * (patch.normal_length * std::cos(tilt) +
+                                       patch.tangential_length * std::sin(tilt)),
                     1e-12)
             << where;
-        EXPECT_NEAR(loop.fracture_work, patch.toughness * loop.fracture_area, 0.01 * patch.toughness * loop.fracture_area)
+        EXPECT_NEAR(loop.fracture_work, patch.toughness * loop.fracture_area,
+                    0.01 * patch.toughness * loop.fracture_area)
             << where;
         for (const PullLoopSample& s : loop.samples)
           if (s.phase == PullPhase::fracture) {
-            EXPECT_NEAR(s.force, loop.threshold, 0.02 * loop.threshold) << where << " at " << s.travel * 1e3 << " mm";
+            EXPECT_NEAR(s.force, loop.threshold, 0.02 * loop.threshold)
+                << where << " at " << s.travel * 1e3 << " mm";
           }
         EXPECT_GE(loop.net_work - loop.final_energy, 0) << where;
         EXPECT_GE(loop.final_energy, 0) << where;
@@ -142,8 +155,8 @@ struct Push {
 };
 
 template <typename Stop>
-Push push(const SeparationPatch& patch, SeparationState state, int node, const Eigen::Vector3d& direction, double step,
-          int max_ticks, const Stop& stop) {
+Push push(const SeparationPatch& patch, SeparationState state, int node,
+          const Eigen::Vector3d& direction, double step, int max_ticks, const Stop& stop) {
   Push p{std::move(state), {}, {}, {}};
   const Eigen::Vector3d start = patch.positions.col(node);
   p.contact = begin_contact(patch, ContactMode::grasp, contact_at_node(patch, node), start);
@@ -167,8 +180,8 @@ TEST(SeparationFracture, TangentialThresholdIsJcLt) {
   const SeparationPatch& patch = default_two_layers().patch;
   const int node = rim_node();
   const double f_t = patch.toughness * patch.tangential_length;
-  const Push p = push(patch, make_separation_state(patch), node, Eigen::Vector3d::UnitX(), 1e-5, 800,
-                      [](const SeparationSample&) { return false; });
+  const Push p = push(patch, make_separation_state(patch), node, Eigen::Vector3d::UnitX(), 1e-5,
+                      800, [](const SeparationSample&) { return false; });
   std::size_t first = p.samples.size();
   for (std::size_t i = 0; i < p.samples.size(); ++i)
     if (p.samples[i].flags & kSeparationFracture) {
@@ -184,10 +197,13 @@ TEST(SeparationFracture, TangentialThresholdIsJcLt) {
   for (std::size_t i = first; i < p.samples.size(); ++i) {
     EXPECT_NEAR(p.samples[i].body_force.x(), f_t, 0.02 * f_t) << "tick " << i;
     area += p.samples[i].separated;
-    if (i > first) work += 0.5 * (p.samples[i - 1].body_force + p.samples[i].body_force).dot(1e-5 * Eigen::Vector3d::UnitX());
+    if (i > first)
+      work += 0.5 * (p.samples[i - 1].body_force + p.samples[i].body_force)
+                        .dot(1e-5 * Eigen::Vector3d::UnitX());
   }
   const double travel = p.travel.back() - p.travel[first];
-  EXPECT_NEAR(area - p.samples[first].separated, patch.tangential_length * travel, 0.02 * patch.tangential_length * travel);
+  EXPECT_NEAR(area - p.samples[first].separated, patch.tangential_length * travel,
+              0.02 * patch.tangential_length * travel);
   EXPECT_NEAR(work, patch.toughness * (area - p.samples[first].separated), 0.01 * work);
   RecordProperty("tangential_plateau_N", std::to_string(p.samples.back().body_force.x()));
 }
@@ -199,14 +215,18 @@ TEST(SeparationFracture, NoCrackNoFractureUntilALaserGroove) {
   const SeparationPatch& patch = default_two_layers().patch;
   const int node = centre_node();
   const double f_t = patch.toughness * patch.tangential_length;
-  const auto ten_times = [&](const SeparationSample& s) { return tangential(patch, s, node) >= 10 * f_t; };
-  const Push intact = push(patch, make_separation_state(patch), node, Eigen::Vector3d::UnitX(), 2e-5, 5000, ten_times);
+  const auto ten_times = [&](const SeparationSample& s) {
+    return tangential(patch, s, node) >= 10 * f_t;
+  };
+  const Push intact = push(patch, make_separation_state(patch), node, Eigen::Vector3d::UnitX(),
+                           2e-5, 5000, ten_times);
   ASSERT_TRUE(ten_times(intact.samples.back())) << "did not reach 10 F_t";
   EXPECT_EQ(intact.state.separated_area, 0);
   const Eigen::Vector3d n = patch.normals[patch.regions.of(node).front()];
-  const Push pulled = push(patch, make_separation_state(patch), node, n, 2e-5, 5000, [&](const SeparationSample& s) {
-    return s.body_force.dot(n) >= 10 * patch.normal_threshold;
-  });
+  const Push pulled = push(patch, make_separation_state(patch), node, n, 2e-5, 5000,
+                           [&](const SeparationSample& s) {
+                             return s.body_force.dot(n) >= 10 * patch.normal_threshold;
+                           });
   ASSERT_GE(pulled.samples.back().body_force.dot(n), 10 * patch.normal_threshold);
   EXPECT_EQ(pulled.state.separated_area, 0);
 
@@ -217,7 +237,8 @@ TEST(SeparationFracture, NoCrackNoFractureUntilALaserGroove) {
   const Eigen::Vector3d from(0.0205, 0.012, 0), to(0.0205, 0.028, 0);
   const int ticks = static_cast<int>(std::ceil((to - from).norm() / (speed * dt)));
   for (int i = 0; i <= ticks; ++i)
-    step_laser(patch, grooved, fibre, from + (to - from) * std::min(1.0, double(i) / ticks), true, dt);
+    step_laser(patch, grooved, fibre, from + (to - from) * std::min(1.0, double(i) / ticks), true,
+               dt);
   const double groove = grooved.separated_area;
   ASSERT_GT(groove, 0);
   // The same push, 6 mm on from the node: it tears at F_t and goes on tearing, the
@@ -228,7 +249,8 @@ TEST(SeparationFracture, NoCrackNoFractureUntilALaserGroove) {
   for (const SeparationSample& s : opened.samples) largest = std::max(largest, s.body_force.x());
   EXPECT_LT(largest, 1.02 * f_t);
   EXPECT_NEAR(opened.samples.back().body_force.x(), f_t, 0.02 * f_t);
-  EXPECT_GT(opened.contact.position.x(), patch.positions(0, node) + 0.002) << "the contact point did not move on";
+  EXPECT_GT(opened.contact.position.x(), patch.positions(0, node) + 0.002)
+      << "the contact point did not move on";
 }
 
 }  // namespace

@@ -85,12 +85,12 @@ TEST(SeparationIr, WireRoundTripIsBitExact) {
   EXPECT_EQ(p.degree, q.degree);
   EXPECT_EQ(p.tool_node_count, q.tool_node_count);
   EXPECT_EQ(p.fields, q.fields);
-  for (const auto member : {&SeparationPatch::toughness, &SeparationPatch::normal_length, &SeparationPatch::tangential_length,
-                            &SeparationPatch::normal_threshold, &SeparationPatch::tangential_threshold,
-                            &SeparationPatch::friction, &SeparationPatch::laser_absorbed_power,
-                            &SeparationPatch::spot_diameter, &SeparationPatch::laser_reach,
-                            &SeparationPatch::vaporisation_energy, &SeparationPatch::vaporisation_speed,
-                            &SeparationPatch::force_limit})
+  for (const auto member : {&SeparationPatch::toughness, &SeparationPatch::normal_length,
+                            &SeparationPatch::tangential_length, &SeparationPatch::normal_threshold,
+                            &SeparationPatch::tangential_threshold, &SeparationPatch::friction,
+                            &SeparationPatch::laser_absorbed_power, &SeparationPatch::spot_diameter,
+                            &SeparationPatch::laser_reach, &SeparationPatch::vaporisation_energy,
+                            &SeparationPatch::vaporisation_speed, &SeparationPatch::force_limit})
     EXPECT_EQ(p.*member, q.*member);
   EXPECT_EQ(a.state.separated, b.state.separated);
   EXPECT_EQ(a.state.separated_area, b.state.separated_area);
@@ -113,8 +113,10 @@ TEST(SeparationIr, WireRoundTripIsBitExact) {
   EXPECT_EQ(got.force_limit, sent.force_limit);
   EXPECT_GT(sent.size_bytes(), p.fields.size() * sizeof(double));
   const std::size_t wire_bytes = wire::to_wire(sent).ByteSizeLong();
-  EXPECT_NEAR(static_cast<double>(wire_bytes), static_cast<double>(sent.size_bytes()), 0.1 * static_cast<double>(wire_bytes));
-  std::printf("  the default layers' IR: %zu bytes on the wire, %zu counted by size_bytes\n", wire_bytes, sent.size_bytes());
+  EXPECT_NEAR(static_cast<double>(wire_bytes), static_cast<double>(sent.size_bytes()),
+              0.1 * static_cast<double>(wire_bytes));
+  std::printf("  the default layers' IR: %zu bytes on the wire, %zu counted by size_bytes\n",
+              wire_bytes, sent.size_bytes());
 }
 
 // One user's instrument on the default layers, driven tick by tick on the server; the
@@ -173,12 +175,14 @@ ClientServerRun run_client_and_server(bool laser, int ticks, const Script& scrip
 TEST(SeparationIr, ClientForceEqualsTheServersThroughAPullThatTears) {
   // Forceps close on the flap's free rim and pull it straight up at 10 mm/s for 4 mm: the
   // paper's Fig. 10 loading and fracture phases (F_n is reached near 3 mm), then back down.
-  const Vector3d rim = default_two_layers().patch.positions.col(nearest_patch_node(default_two_layers().patch, Vector3d(0, 0.02, 0)));
+  const Vector3d rim = default_two_layers().patch.positions.col(
+      nearest_patch_node(default_two_layers().patch, Vector3d(0, 0.02, 0)));
   const ClientServerRun run = run_client_and_server(false, 800, [&](int i) {
     const double up = i <= 400 ? 1e-5 * i : 1e-5 * (800 - i);
     return SeparationDrive{rim + Vector3d(0, 0, up), i >= 5 ? 1u : 0u};
   });
-  EXPECT_GT(run.fractured, 0) << "the pull did not tear; peak " << run.largest_force << " N, area " << run.server_area;
+  EXPECT_GT(run.fractured, 0) << "the pull did not tear; peak " << run.largest_force << " N, area "
+                              << run.server_area;
   EXPECT_GT(run.in_contact, 700);
   EXPECT_GT(run.largest_force, 0.9 * default_two_layers().patch.normal_threshold);
   EXPECT_LE(run.largest_difference, 1e-9 * run.largest_force);
@@ -198,7 +202,8 @@ TEST(SeparationIr, ClientForceEqualsTheServersThroughALaserGrooveAndAPushThatOpe
     if (i <= cut) return SeparationDrive{from + (to - from) * (double(i) / cut), 1u};
     const int k = i - cut;
     if (k <= 50) return SeparationDrive{to + (grip - to) * (k / 50.0), 0u};  // laser off, jaws open
-    return SeparationDrive{grip + Vector3d(2e-5 * (k - 50), 0, 0), 2u};       // jaws closed, pushing along x
+    return SeparationDrive{grip + Vector3d(2e-5 * (k - 50), 0, 0),
+                           2u};  // jaws closed, pushing along x
   });
   EXPECT_GT(run.vaporised, 0.9 * patch.spot_diameter * (to - from).norm()) << "no groove";
   EXPECT_GT(run.fractured, 0) << "the push did not open the groove";
@@ -213,20 +218,26 @@ TEST(SeparationIr, ClientForceEqualsTheServersThroughALaserGrooveAndAPushThatOpe
 TEST(SeparationIr, FuzzSeedsReachTheEvaluation) {
   const PreparedIR free = testing::prepared_ir_seed("separation");
   EvaluationState free_state = make_evaluation_state(free);
-  EXPECT_EQ(evaluate_force(free, free_state, Vector3d(0.002, 0.001, 0.0001), {}, 1e-3, 0).force, Vector3d::Zero());
+  EXPECT_EQ(evaluate_force(free, free_state, Vector3d(0.002, 0.001, 0.0001), {}, 1e-3, 0).force,
+            Vector3d::Zero());
   const PreparedIR grasped = testing::prepared_ir_seed("separation_grasped");
   EvaluationState state = make_evaluation_state(grasped);
-  const auto field = [](double local, double global) { return (1 - global) * ((1 - local) * 300 + local * 150) + global * 60; };
+  const auto field = [](double local, double global) {
+    return (1 - global) * ((1 - local) * 300 + local * 150) + global * 60;
+  };
   const double k = 0.5 * field(0.25, 0.25) + 0.25 * field(0.5, 0.25) + 0.25 * field(0.25, 0.25);
-  const ForceSample pull = evaluate_force(grasped, state, Vector3d(0.002, 0.001, 0.0003), {}, 1e-3, 1);
+  const ForceSample pull =
+      evaluate_force(grasped, state, Vector3d(0.002, 0.001, 0.0003), {}, 1e-3, 1);
   EXPECT_TRUE(pull.flags & kInContact);
   EXPECT_NEAR(pull.force.z(), -k * 1e-4, 1e-15);
   EXPECT_NEAR(pull.force.head<2>().norm(), 0, 1e-15);
   // Jaws open: it lets go.
-  EXPECT_EQ(evaluate_force(grasped, state, Vector3d(0.002, 0.001, 0.0003), {}, 1e-3, 0).force, Vector3d::Zero());
+  EXPECT_EQ(evaluate_force(grasped, state, Vector3d(0.002, 0.001, 0.0003), {}, 1e-3, 0).force,
+            Vector3d::Zero());
 }
 
-void expect_separation_refused(const wire::IntermediateRepresentation& message, const std::string& fragment) {
+void expect_separation_refused(const wire::IntermediateRepresentation& message,
+                               const std::string& fragment) {
   try {
     wire::from_wire(message);
     ADD_FAILURE() << "accepted; expected an error containing \"" << fragment << "\"";

@@ -17,14 +17,15 @@ using testing::default_two_layers;
 
 // Sweeps the fibre from `from` towards `to` at `speed` with 1 ms ticks, for as many whole
 // ticks as fit; returns the area vaporised and sets `length` to the distance swept.
-double sweep(const SeparationPatch& patch, SeparationState& state, const Eigen::Vector3d& from, const Eigen::Vector3d& to,
-             double speed, bool on = true, double* length = nullptr) {
+double sweep(const SeparationPatch& patch, SeparationState& state, const Eigen::Vector3d& from,
+             const Eigen::Vector3d& to, double speed, bool on = true, double* length = nullptr) {
   LaserFibre fibre;
   const double dt = 1e-3;
   const Eigen::Vector3d step = (to - from).normalized() * speed * dt;
   const int ticks = static_cast<int>((to - from).norm() / (speed * dt));
   double area = 0;
-  for (int i = 0; i <= ticks; ++i) area += step_laser(patch, state, fibre, from + i * step, on, dt).vaporised;
+  for (int i = 0; i <= ticks; ++i)
+    area += step_laser(patch, state, fibre, from + i * step, on, dt).vaporised;
   if (length) *length = ticks * step.norm();
   return area;
 }
@@ -90,24 +91,31 @@ TEST(SeparationLaser, StripAreaIsTheExactIntersection) {
   const SeparationPatch& patch = default_two_layers().patch;
   const int t = 0;
   const Triangle& tri = patch.triangles[t];
-  const Eigen::Vector3d a = patch.positions.col(tri[0]), b = patch.positions.col(tri[1]), c = patch.positions.col(tri[2]);
+  const Eigen::Vector3d a = patch.positions.col(tri[0]), b = patch.positions.col(tri[1]),
+                        c = patch.positions.col(tri[2]);
   const Eigen::Vector3d centroid = (a + b + c) / 3;
   // A wide strip right over the triangle covers all of it.
-  EXPECT_NEAR(strip_area_in_triangle(patch, t, centroid - Eigen::Vector3d(0.01, 0, 0), centroid + Eigen::Vector3d(0.01, 0, 0), 0.05),
+  EXPECT_NEAR(strip_area_in_triangle(patch, t, centroid - Eigen::Vector3d(0.01, 0, 0),
+                                     centroid + Eigen::Vector3d(0.01, 0, 0), 0.05),
               patch.areas[t], 1e-15);
   // A strip far away covers none of it.
-  EXPECT_EQ(strip_area_in_triangle(patch, t, a + Eigen::Vector3d(0.01, 0.01, 0), a + Eigen::Vector3d(0.02, 0.01, 0), 1e-3), 0);
+  EXPECT_EQ(strip_area_in_triangle(patch, t, a + Eigen::Vector3d(0.01, 0.01, 0),
+                                   a + Eigen::Vector3d(0.02, 0.01, 0), 1e-3),
+            0);
   // A narrow strip along a line through a vertex and the opposite edge's midpoint, ending
   // inside: the intersection is that of the two half-strips with the triangle, here a
   // width w by the segment's length inside, to first order in w.
   const Eigen::Vector3d m = 0.5 * (b + c);
   const double w = 1e-6;
   const double expected = w * (m - a).norm();
-  EXPECT_NEAR(strip_area_in_triangle(patch, t, a - (m - a), m + (m - a), w), expected, 1e-3 * expected);
+  EXPECT_NEAR(strip_area_in_triangle(patch, t, a - (m - a), m + (m - a), w), expected,
+              1e-3 * expected);
   // Strips from two halves of a segment add up to the strip of the whole segment.
-  const Eigen::Vector3d p = a + 0.2 * (b - a) + 0.1 * (c - a), q = a + 0.3 * (b - a) + 0.6 * (c - a);
+  const Eigen::Vector3d p = a + 0.2 * (b - a) + 0.1 * (c - a),
+                        q = a + 0.3 * (b - a) + 0.6 * (c - a);
   const Eigen::Vector3d half = 0.5 * (p + q);
-  EXPECT_NEAR(strip_area_in_triangle(patch, t, p, half, 4e-4) + strip_area_in_triangle(patch, t, half, q, 4e-4),
+  EXPECT_NEAR(strip_area_in_triangle(patch, t, p, half, 4e-4) +
+                  strip_area_in_triangle(patch, t, half, q, 4e-4),
               strip_area_in_triangle(patch, t, p, q, 4e-4), 1e-15);
 }
 

@@ -23,8 +23,10 @@ using Eigen::Vector3d;
 
 const Model& two_layers_model() {
   static const Model model = [] {
-    Scene scene = load_scene(std::string(COHAPTIC_SOURCE_DIR) + "/scenes/separation/two_layers.yaml");
-    std::get<SeparationObjectSpec>(scene.objects[0].body).disk_cache = false;  // the test fits the fields itself
+    Scene scene =
+        load_scene(std::string(COHAPTIC_SOURCE_DIR) + "/scenes/separation/two_layers.yaml");
+    std::get<SeparationObjectSpec>(scene.objects[0].body).disk_cache =
+        false;  // the test fits the fields itself
     return build_model(scene);
   }();
   return model;
@@ -81,7 +83,8 @@ TEST(SeparationScene, TwoUsersTearAndCutOneInterfaceAndTheirIrsFollow) {
   const auto& layers = std::get<SeparationSimulation>(scene.body(0));
   const SeparationPatch& patch = *body.patch;
   const double dt = 1e-3;
-  const Vector3d rim(0, 0.02, 0.0002), from(0.0205, 0.012, 0.0002), to(0.0205, 0.028, 0.0002), grip(0.02, 0.02, 0.0002);
+  const Vector3d rim(0, 0.02, 0.0002), from(0.0205, 0.012, 0.0002), to(0.0205, 0.028, 0.0002),
+      grip(0.02, 0.02, 0.0002);
   const double groove_speed = 0.02;
   const int cut = static_cast<int>(std::round((to - from).norm() / (groove_speed * dt)));
   std::uint64_t last_epoch[2] = {0, 0};
@@ -117,18 +120,21 @@ TEST(SeparationScene, TwoUsersTearAndCutOneInterfaceAndTheirIrsFollow) {
       last_epoch[u] = ir.epoch;
       ++irs[u];
       // Each IR carries the server's separated state as it stood at that step.
-      EXPECT_EQ(std::get<SeparationIr>(ir.body).state.separated_area, layers.state().separated_area);
+      EXPECT_EQ(std::get<SeparationIr>(ir.body).state.separated_area,
+                layers.state().separated_area);
       EXPECT_EQ(std::get<SeparationIr>(ir.body).tool.laser, u == 1);
     }
   }
   // The groove: l_f wide along its length (flat ends), below v_s (Eqs. 15-17).
-  EXPECT_NEAR(vaporised_after_cut, patch.spot_diameter * (to - from).norm(), 0.02 * patch.spot_diameter * (to - from).norm());
+  EXPECT_NEAR(vaporised_after_cut, patch.spot_diameter * (to - from).norm(),
+              0.02 * patch.spot_diameter * (to - from).norm());
   EXPECT_GT(area_after_cut, 0);
   // The pull tore the flap at its free rim at F_n (the force held near the threshold).
   double rim_area = 0;
   for (int t = 0; t < patch.triangle_count(); ++t)
     if (patch.centroids[static_cast<std::size_t>(t)].x() < 0.006)
-      rim_area += layers.state().separated[static_cast<std::size_t>(t)] * patch.areas[static_cast<std::size_t>(t)];
+      rim_area += layers.state().separated[static_cast<std::size_t>(t)] *
+                  patch.areas[static_cast<std::size_t>(t)];
   EXPECT_GT(rim_area, 1e-6);
   EXPECT_GT(layers.fractured_area(), rim_area);
   EXPECT_NEAR(peak_pull, patch.normal_threshold, 0.05 * patch.normal_threshold);
@@ -148,7 +154,8 @@ TEST(SeparationScene, TwoUsersTearAndCutOneInterfaceAndTheirIrsFollow) {
 TEST(SeparationScene, TheFig10CommandWritesTheThreePhases) {
   const testing::ScratchDirectory scratch;
   const testing::ProgramRun run = testing::run_program(
-      COHAPTIC_LAB_EXE, "--log-level warn separation-pull --no-disk-cache --scene " + std::string(COHAPTIC_SOURCE_DIR) +
+      COHAPTIC_LAB_EXE, "--log-level warn separation-pull --no-disk-cache --scene " +
+                            std::string(COHAPTIC_SOURCE_DIR) +
                             "/scenes/separation/two_layers.yaml --out " + scratch.path.string());
   ASSERT_EQ(run.exit_code, 0) << run.out;
   EXPECT_NE(run.out.find("threshold J_c l = 0.4500 N"), std::string::npos) << run.out;

@@ -43,7 +43,8 @@ SeparationUserCheck check_separation_recording(const fs::path& file) {
   const record::Recording recording = record::read_recording(file);
   std::map<std::uint64_t, std::shared_ptr<const PreparedIR>> irs;
   for (const record::RecordedIr& recorded : recording.irs)
-    irs[recorded.ir().epoch()] = std::make_shared<const PreparedIR>(prepare_ir(wire::from_wire(recorded.ir())));
+    irs[recorded.ir().epoch()] =
+        std::make_shared<const PreparedIR>(prepare_ir(wire::from_wire(recorded.ir())));
   SeparationUserCheck check;
   for (const auto& [epoch, ir] : irs) check.irs.push_back(ir);
   std::map<std::uint64_t, EvaluationState> states;
@@ -56,9 +57,10 @@ SeparationUserCheck check_separation_recording(const fs::path& file) {
       break;
     }
     auto state = states.find(tick.ir_epoch());
-    if (state == states.end()) state = states.emplace(tick.ir_epoch(), make_evaluation_state(*ir->second)).first;
-    const ForceSample offline =
-        evaluate_force(*ir->second, state->second, wire::from_wire(tick.own()), {}, tick.dt(), tick.buttons());
+    if (state == states.end())
+      state = states.emplace(tick.ir_epoch(), make_evaluation_state(*ir->second)).first;
+    const ForceSample offline = evaluate_force(
+        *ir->second, state->second, wire::from_wire(tick.own()), {}, tick.dt(), tick.buttons());
     const Eigen::Vector3d evaluated = wire::from_wire(tick.evaluated());
     EXPECT_EQ(offline.force, evaluated) << file.filename() << " tick " << check.ticks;
     if (offline.force != evaluated) break;
@@ -75,7 +77,8 @@ double separated_where(const SeparationIr& ir, const Where& where) {
   double area = 0;
   for (int t = 0; t < ir.patch->triangle_count(); ++t)
     if (where(ir.patch->centroids[static_cast<std::size_t>(t)]))
-      area += ir.state.separated[static_cast<std::size_t>(t)] * ir.patch->areas[static_cast<std::size_t>(t)];
+      area += ir.state.separated[static_cast<std::size_t>(t)] *
+              ir.patch->areas[static_cast<std::size_t>(t)];
   return area;
 }
 
@@ -83,17 +86,21 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
   const fs::path dir = testing::scratch_directory("separation-session");
   auto server = std::make_unique<ChildProcess>(
       testing::server_program(),
-      std::vector<std::string>{"--scene", (kSeparationScenes / "two_layers.yaml").string(), "--listen", "127.0.0.1:0", "--duration",
-                               "60", "--report", (dir / "server.json").string(), "--cache-dir", (dir / "cache").string()},
+      std::vector<std::string>{"--scene", (kSeparationScenes / "two_layers.yaml").string(),
+                               "--listen", "127.0.0.1:0", "--duration", "60", "--report",
+                               (dir / "server.json").string(), "--cache-dir",
+                               (dir / "cache").string()},
       dir / "server.log");
   ASSERT_TRUE(testing::wait_for_output(*server, "listening on")) << server->log_text();
   const int port = testing::listening_port(server->log_text());
   const auto client = [&](const std::string& user, int slot, const std::string& script) {
     return std::make_unique<ChildProcess>(
         testing::client_program(),
-        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot", std::to_string(slot),
-                                 "--device", "script:" + (kSeparationScenes / "two_layers" / script).string(), "--record",
-                                 (dir / (user + ".mcap")).string(), "--report", (dir / (user + ".json")).string()},
+        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", user,
+                                 "--slot", std::to_string(slot), "--device",
+                                 "script:" + (kSeparationScenes / "two_layers" / script).string(),
+                                 "--record", (dir / (user + ".mcap")).string(), "--report",
+                                 (dir / (user + ".json")).string()},
         dir / (user + ".log"));
   };
   const auto forceps = client("alice", 0, "surgeon_a.yaml");
@@ -105,17 +112,19 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
 
   const SeparationUserCheck alice = check_separation_recording(dir / "alice.mcap");
   const SeparationUserCheck bob = check_separation_recording(dir / "bob.mcap");
-  std::printf("  alice: %d ticks, %d re-evaluated, %d in contact, peak %.3f N, %zu IRs\n", alice.ticks, alice.evaluated,
-              alice.in_contact, alice.peak_force, alice.irs.size());
-  std::printf("  bob: %d ticks, %d re-evaluated, %d in contact, peak %.3f N, %zu IRs\n", bob.ticks, bob.evaluated,
-              bob.in_contact, bob.peak_force, bob.irs.size());
+  std::printf("  alice: %d ticks, %d re-evaluated, %d in contact, peak %.3f N, %zu IRs\n",
+              alice.ticks, alice.evaluated, alice.in_contact, alice.peak_force, alice.irs.size());
+  std::printf("  bob: %d ticks, %d re-evaluated, %d in contact, peak %.3f N, %zu IRs\n", bob.ticks,
+              bob.evaluated, bob.in_contact, bob.peak_force, bob.irs.size());
   for (const SeparationUserCheck* user : {&alice, &bob}) {
     EXPECT_GT(user->evaluated, 3000);
     EXPECT_GT(user->in_contact, 500);
     ASSERT_GE(user->irs.size(), 3u);
   }
   for (const char* user : {"alice", "bob"})
-    EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / (std::string(user) + ".json")))["fades"]["count"], 0)
+    EXPECT_EQ(
+        nlohmann::json::parse(std::ifstream(dir / (std::string(user) + ".json")))["fades"]["count"],
+        0)
         << user << ": the force faded while pushing";
   const double f_n = std::get<SeparationIr>(alice.irs.front()->ir.body).patch->normal_threshold;
   EXPECT_GT(alice.peak_force, 0.8 * f_n) << "the forceps' pull reached the tear";
@@ -127,16 +136,21 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
     for (std::size_t i = 1; i < user->irs.size(); ++i)
       EXPECT_GE(std::get<SeparationIr>(user->irs[i]->ir.body).state.separated_area,
                 std::get<SeparationIr>(user->irs[i - 1]->ir.body).state.separated_area);
-  const SeparationUserCheck& later = alice.irs.back()->ir.simulation_time > bob.irs.back()->ir.simulation_time ? alice : bob;
+  const SeparationUserCheck& later =
+      alice.irs.back()->ir.simulation_time > bob.irs.back()->ir.simulation_time ? alice : bob;
   const auto& last = std::get<SeparationIr>(later.irs.back()->ir.body);
   const double rim = separated_where(last, [](const Eigen::Vector3d& c) { return c.x() < 0.006; });
-  const double groove = separated_where(last, [](const Eigen::Vector3d& c) { return std::abs(c.x() - 0.0205) < 0.002; });
+  const double groove = separated_where(
+      last, [](const Eigen::Vector3d& c) { return std::abs(c.x() - 0.0205) < 0.002; });
   const double cut_alone = last.patch->spot_diameter * 0.016;
-  std::printf("  server's separated area at the end: %.1f mm^2 (rim %.1f, groove's triangles %.1f; the cut alone %.1f)\n",
-              last.state.separated_area * 1e6, rim * 1e6, groove * 1e6, cut_alone * 1e6);
+  std::printf(
+      "  server's separated area at the end: %.1f mm^2 (rim %.1f, groove's triangles %.1f; the cut "
+      "alone %.1f)\n",
+      last.state.separated_area * 1e6, rim * 1e6, groove * 1e6, cut_alone * 1e6);
   EXPECT_GT(rim, 1e-6) << "the flap did not tear at its rim";
   EXPECT_GT(groove, 0.9 * cut_alone) << "no laser groove";
-  EXPECT_GT(last.state.separated_area, rim + cut_alone + 1e-6) << "the push did not open the groove";
+  EXPECT_GT(last.state.separated_area, rim + cut_alone + 1e-6)
+      << "the push did not open the groove";
 }
 
 }  // namespace

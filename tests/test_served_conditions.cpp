@@ -30,7 +30,8 @@ std::string parse_error(const std::string& text) {
 }
 
 TEST(ServedCondition, ParsesItsCommandLineFormAndNamesWhatIsWrong) {
-  const ServedCondition c = parse_served_condition("slow:protocol=P0,shift_ms=30,jitter_ms=2,loss=0.1,step_nodes=150,sim_rate_hz=40");
+  const ServedCondition c = parse_served_condition(
+      "slow:protocol=P0,shift_ms=30,jitter_ms=2,loss=0.1,step_nodes=150,sim_rate_hz=40");
   EXPECT_EQ(c.name, "slow");
   EXPECT_EQ(c.protocol, ServeProtocol::p0);
   EXPECT_EQ(c.shift_delay_ms, 30);
@@ -38,7 +39,8 @@ TEST(ServedCondition, ParsesItsCommandLineFormAndNamesWhatIsWrong) {
   EXPECT_EQ(c.loss, 0.1);
   EXPECT_EQ(c.step_nodes, 150);
   EXPECT_EQ(c.sim_rate_hz, 40);
-  EXPECT_EQ(c.describe(), "P0, shift 30 ms, jitter 2 ms, loss 0.1, 150 held nodes, simulation capped at 40 Hz");
+  EXPECT_EQ(c.describe(),
+            "P0, shift 30 ms, jitter 2 ms, loss 0.1, 150 held nodes, simulation capped at 40 Hz");
   LinkDelaySettings session;
   session.reorder = 0.05;
   session.seed = 9;
@@ -51,13 +53,15 @@ TEST(ServedCondition, ParsesItsCommandLineFormAndNamesWhatIsWrong) {
   EXPECT_EQ(plain.describe(), "P1");
 
   EXPECT_NE(parse_error(":protocol=P1").find("no name"), std::string::npos);
-  EXPECT_NE(parse_error("a:protocol=P2").find("protocol=P2 is neither P0 nor P1"), std::string::npos);
+  EXPECT_NE(parse_error("a:protocol=P2").find("protocol=P2 is neither P0 nor P1"),
+            std::string::npos);
   EXPECT_NE(parse_error("a:shift_ms=-1").find("shift_ms=-1 is not a delay"), std::string::npos);
   EXPECT_NE(parse_error("a:loss=1").find("loss=1 is not a probability"), std::string::npos);
   EXPECT_NE(parse_error("a:step_nodes=1.5").find("not a whole number"), std::string::npos);
   EXPECT_NE(parse_error("a:speed=3").find("unknown key speed"), std::string::npos);
   EXPECT_NE(parse_error("a:shift_ms").find("'shift_ms' is not key=value"), std::string::npos);
-  EXPECT_NE(parse_error("a:shift_ms=1,shift_ms=2").find("shift_ms is given twice"), std::string::npos);
+  EXPECT_NE(parse_error("a:shift_ms=1,shift_ms=2").find("shift_ms is given twice"),
+            std::string::npos);
   EXPECT_NE(parse_error("a:shift_ms=1x").find("--condition 'a:shift_ms=1x'"), std::string::npos);
 }
 
@@ -76,7 +80,9 @@ TEST(ConditionSwitch, ServesAKnownConditionOrTheNextAndCountsTheSwitches) {
     conditions.serve("C");
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("no condition named 'C' (this session serves A, B)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("no condition named 'C' (this session serves A, B)"),
+              std::string::npos)
+        << e.what();
   }
   EXPECT_EQ(conditions.served().index, 1) << "an unknown name switches nothing";
   EXPECT_EQ(conditions.serve_next(), 0) << "after the last, the first";
@@ -96,20 +102,23 @@ TEST(ControlSocket, AnswersEachLineAndSurvivesBadOnes) {
     served.push_back(command["serve"].get<std::string>());
     return {{"served", served.back()}};
   });
-  EXPECT_EQ(std::filesystem::status(path).permissions() & std::filesystem::perms::others_all, std::filesystem::perms::none)
+  EXPECT_EQ(std::filesystem::status(path).permissions() & std::filesystem::perms::others_all,
+            std::filesystem::perms::none)
       << "only the server's user may connect";
   std::thread io_thread([&] { io.run(); });
   {
     ControlClient client(path);
     EXPECT_EQ(client.ask_line(R"({"serve": "B"})"), (nlohmann::json{{"served", "B"}}));
-    EXPECT_EQ(client.ask_line("not json").at("error"), "not a JSON object on one line, e.g. {\"serve\": \"B\"}");
+    EXPECT_EQ(client.ask_line("not json").at("error"),
+              "not a JSON object on one line, e.g. {\"serve\": \"B\"}");
     EXPECT_EQ(client.ask_line(R"({"foo": 1})").at("error"), "unknown command");
     EXPECT_EQ(client.serve("A"), (nlohmann::json{{"served", "A"}})) << "the connection stays open";
     ControlClient second(path);
     EXPECT_EQ(second.ask({{"serve", "B"}}), (nlohmann::json{{"served", "B"}}));
     // A line over 4 KiB is answered, and the connection closed.
     const nlohmann::json reply = client.ask_line(std::string(5000, 'x'));
-    EXPECT_NE(reply.at("error").get<std::string>().find("at most 4096 bytes"), std::string::npos) << reply;
+    EXPECT_NE(reply.at("error").get<std::string>().find("at most 4096 bytes"), std::string::npos)
+        << reply;
   }
   asio::post(io, [&] { control.close(); });
   io_thread.join();  // nothing left to do once the socket is closed
@@ -120,15 +129,19 @@ TEST(ControlSocket, AnswersEachLineAndSurvivesBadOnes) {
   std::ofstream(dir / "file") << "x";
   asio::io_context again;
   try {
-    ControlSocket refused(again, dir / "file", [](const nlohmann::json&) { return nlohmann::json(); });
+    ControlSocket refused(again, dir / "file",
+                          [](const nlohmann::json&) { return nlohmann::json(); });
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("exists and is not a socket"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("exists and is not a socket"), std::string::npos)
+        << e.what();
   }
   {
-    asio::local::stream_protocol::acceptor stale(again, asio::local::stream_protocol::endpoint(path.string()));
+    asio::local::stream_protocol::acceptor stale(
+        again, asio::local::stream_protocol::endpoint(path.string()));
   }
-  EXPECT_NO_THROW(ControlSocket(again, path, [](const nlohmann::json&) { return nlohmann::json(); }));
+  EXPECT_NO_THROW(
+      ControlSocket(again, path, [](const nlohmann::json&) { return nlohmann::json(); }));
 }
 
 TEST(LinkDelay, NewSettingsApplyFromTheNextMessageAndAnOrderedLinkKeepsItsOrder) {

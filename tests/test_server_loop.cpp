@@ -55,7 +55,8 @@ using namespace std::chrono_literals;
 int movable_surface_node_count(const Model& model) {
   const ElasticBody& body = single_elastic_body(model);
   int count = 0;
-  for (int node : body.surface.nodes) count += body.dofs.fixed_axes[static_cast<std::size_t>(node)] != kAllAxes;
+  for (int node : body.surface.nodes)
+    count += body.dofs.fixed_axes[static_cast<std::size_t>(node)] != kAllAxes;
   return count;
 }
 
@@ -116,8 +117,11 @@ TEST(ToolInputs, APressBetweenTwoTakesIsCountedOnceAndAHeldButtonOnce) {
   tools.join(0);
   const Eigen::Vector3d at = Eigen::Vector3d::Zero();
   std::int64_t t = 1;
-  const auto sample = [&](std::uint32_t buttons) { return tools.update(0, true, at, buttons, t++, 0); };
-  for (const std::uint32_t buttons : {0u, 0b10u, 0b10u, 0u}) sample(buttons);  // button 1 pressed and released in a burst
+  const auto sample = [&](std::uint32_t buttons) {
+    return tools.update(0, true, at, buttons, t++, 0);
+  };
+  for (const std::uint32_t buttons : {0u, 0b10u, 0b10u, 0u})
+    sample(buttons);  // button 1 pressed and released in a burst
   tools.take(taken);
   EXPECT_EQ(taken[0].buttons, 0u);
   EXPECT_EQ(taken[0].pressed, 0b10u);
@@ -160,7 +164,8 @@ struct LoopRig {
 
 // Runs `loop` until it stops itself or `limit` passes; returns its result and the outboxes
 // (the steps' and the IR encoder's, in the order handed over).
-std::pair<std::optional<std::string>, std::vector<Outbox>> run_for(SimulationLoop& loop, std::chrono::milliseconds limit) {
+std::pair<std::optional<std::string>, std::vector<Outbox>> run_for(
+    SimulationLoop& loop, std::chrono::milliseconds limit) {
   std::atomic<bool> running{true};
   std::thread watchdog([&] {
     const auto end = std::chrono::steady_clock::now() + limit;
@@ -181,11 +186,12 @@ std::pair<std::optional<std::string>, std::vector<Outbox>> run_for(SimulationLoo
 TEST(SimulationLoop, AStepThatKeepsFailingEndsTheLoopAfterAHundredPacedSteps) {
   LoopRig rig(0);
   rig.options.step_nodes = movable_surface_node_count(*rig.cube.model);
-  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
-                      monotonic_now_ns());
+  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools,
+                      rig.statistics, nullptr, nullptr, nullptr, monotonic_now_ns());
   const auto start = std::chrono::steady_clock::now();
   const auto [stopped, outboxes] = run_for(loop, 20s);
-  const double elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_TRUE(stopped.has_value()) << "the loop did not stop on its own";
   EXPECT_NE(stopped->find("failed 100 steps in a row"), std::string::npos) << *stopped;
   EXPECT_NE(stopped->find("boundary nodes asked for"), std::string::npos) << *stopped;
@@ -204,8 +210,8 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
   // P0: every step sends the known tool's force, and only to its slot.
   {
     LoopRig rig(10, ServeProtocol::p0);
-    SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
-                        monotonic_now_ns());
+    SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools,
+                        rig.statistics, nullptr, nullptr, nullptr, monotonic_now_ns());
     const auto [stopped, outboxes] = run_for(loop, 400ms);
     EXPECT_FALSE(stopped.has_value()) << *stopped;
     const LoopSummary summary = rig.statistics.summary();
@@ -219,17 +225,19 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
       EXPECT_TRUE(outbox.datagrams[0].message.has_force());
     }
     EXPECT_EQ(summary.forces_sent, summary.steps);
-    EXPECT_GT(outboxes.back().datagrams[0].message.force().force().z(), 0) << "the pressed surface pushes back up";
+    EXPECT_GT(outboxes.back().datagrams[0].message.force().force().z(), 0)
+        << "the pressed surface pushes back up";
   }
   // P1: the first step builds slot 0's IR, which the encoder hands over in an outbox of its
   // own; keep-alives follow in the steps'.
   {
     LoopRig rig(10, ServeProtocol::p1);
-    SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr, nullptr, nullptr,
-                        monotonic_now_ns());
+    SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools,
+                        rig.statistics, nullptr, nullptr, nullptr, monotonic_now_ns());
     const auto [stopped, outboxes] = run_for(loop, 400ms);
     EXPECT_FALSE(stopped.has_value());
-    const auto first_ir = std::find_if(outboxes.begin(), outboxes.end(), [](const Outbox& o) { return !o.irs.empty(); });
+    const auto first_ir = std::find_if(outboxes.begin(), outboxes.end(),
+                                       [](const Outbox& o) { return !o.irs.empty(); });
     ASSERT_NE(first_ir, outboxes.end());
     ASSERT_EQ(first_ir->irs.size(), 1u);
     EXPECT_TRUE(first_ir->datagrams.empty()) << "an IR's outbox holds IRs only";
@@ -242,7 +250,8 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
       irs += outbox.irs.size();
       for (const auto& ir : outbox.irs) {
         ir_bytes += ir.message.compressed_ir().ByteSizeLong();
-        EXPECT_EQ(stream.open(ir.message.compressed_ir()).fem().rows_generation(), ir.message.compressed_ir().index());
+        EXPECT_EQ(stream.open(ir.message.compressed_ir()).fem().rows_generation(),
+                  ir.message.compressed_ir().index());
       }
       for (const auto& datagram : outbox.datagrams) {
         EXPECT_EQ(datagram.slot, 0);
@@ -261,8 +270,8 @@ TEST(SimulationLoop, StepsOnWithFewerStepNodesAndFillsEachStepsOutbox) {
 // A client opens and completes each.
 TEST(SimulationLoop, SendsComplianceRowsAndStartsEachNewUserOfASlotAfresh) {
   LoopRig rig(0, ServeProtocol::p1);
-  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
-                      nullptr, nullptr, monotonic_now_ns());
+  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools,
+                      rig.statistics, nullptr, nullptr, nullptr, monotonic_now_ns());
   const auto first_ir = [&](const Eigen::Vector3d& tool, std::int64_t sample_time) {
     rig.tools.update(0, true, tool, 0, sample_time, monotonic_now_ns());
     for (int step = 0; step < 20; ++step) {
@@ -307,11 +316,12 @@ TEST(SimulationLoop, SendsComplianceRowsAndStartsEachNewUserOfASlotAfresh) {
 TEST(SimulationLoop, SendsComplianceRowsUnderBTruncation) {
   LoopRig rig(60);
   rig.cube.model->scene.haptic.boundary_truncation = 0.2;
-  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
-                      nullptr, nullptr, monotonic_now_ns());
+  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools,
+                      rig.statistics, nullptr, nullptr, nullptr, monotonic_now_ns());
   std::vector<ToSlot<wire::Control>> sent;
   for (int step = 0; step < 40 && sent.size() < 2; ++step) {
-    if (step == 20) rig.tools.update(0, true, Eigen::Vector3d(-0.03, 0.02, -0.002), 0, 2, monotonic_now_ns());
+    if (step == 20)
+      rig.tools.update(0, true, Eigen::Vector3d(-0.03, 0.02, -0.002), 0, 2, monotonic_now_ns());
     Outbox outbox = loop.step(monotonic_now_ns());
     for (ToSlot<wire::Control>& ir : outbox.irs) sent.push_back(std::move(ir));
   }
@@ -324,7 +334,8 @@ TEST(SimulationLoop, SendsComplianceRowsUnderBTruncation) {
     const wire::IntermediateRepresentation message = stream.open(ir.message.compressed_ir());
     const wire::CondensedFem& fem = message.fem();
     EXPECT_GT(fem.rows_generation(), 0u);
-    EXPECT_GT(fem.truncated_node_ids_size(), 0) << "the step-delay nodes far from the tool are left out";
+    EXPECT_GT(fem.truncated_node_ids_size(), 0)
+        << "the step-delay nodes far from the tool are left out";
     IntermediateRepresentation completed = wire::from_wire(message);
     client.complete(condensed_fem(completed));
     EXPECT_EQ(condensed_fem(completed).m_tilde.cols(), static_cast<Eigen::Index>(fem.m_cols()));
@@ -346,8 +357,8 @@ TEST(SimulationLoop, ASwitchedConditionChangesHeldNodesAndProtocolAtTheNextStep)
   free_p1.name = "B";
   free_p1.protocol = ServeProtocol::p1;
   ConditionSwitch conditions({held_p0, free_p1});
-  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools, rig.statistics, nullptr,
-                      nullptr, nullptr, monotonic_now_ns(), &conditions);
+  SimulationLoop loop(*rig.cube.model, std::array{rig.cube.columns.get()}, rig.options, rig.tools,
+                      rig.statistics, nullptr, nullptr, nullptr, monotonic_now_ns(), &conditions);
   const auto forces = [](const Outbox& outbox) {
     return std::count_if(outbox.datagrams.begin(), outbox.datagrams.end(),
                          [](const ToSlot<wire::Datagram>& d) { return d.message.has_force(); });
@@ -367,9 +378,11 @@ TEST(SimulationLoop, ASwitchedConditionChangesHeldNodesAndProtocolAtTheNextStep)
   EXPECT_EQ(forces(switched), 0);
   ASSERT_EQ(switched.irs.size(), 1u) << "the user's IR, announced before it";
   wire::IrStreamReader stream;
-  IntermediateRepresentation ir = wire::from_wire(stream.open(switched.irs[0].message.compressed_ir()));
+  IntermediateRepresentation ir =
+      wire::from_wire(stream.open(switched.irs[0].message.compressed_ir()));
   const CondensedFemIr& fem = condensed_fem(ir);
-  EXPECT_EQ(fem.node_ids.size(), static_cast<std::size_t>(fem.row_node_count)) << "B holds no nodes, from the step it took effect";
+  EXPECT_EQ(fem.node_ids.size(), static_cast<std::size_t>(fem.row_node_count))
+      << "B holds no nodes, from the step it took effect";
   EXPECT_TRUE(fem.truncated_node_ids.empty());
   for (int step = 0; step < 5; ++step) {
     const Outbox outbox = loop.step(monotonic_now_ns());
@@ -400,21 +413,25 @@ segments:
   - {hold: 4}
   - {release: 3, speed: 5}
 )";
-  testing::ChildProcess server(testing::server_program(),
-                               {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--step-nodes",
-                                std::to_string(step_nodes), "--sim-rate-hz", "100", "--duration", "60", "--report",
-                                (dir / "server.json").string(), "--no-disk-cache"},
-                               dir / "server.log");
+  testing::ChildProcess server(
+      testing::server_program(),
+      {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0", "--step-nodes",
+       std::to_string(step_nodes), "--sim-rate-hz", "100", "--duration", "60", "--report",
+       (dir / "server.json").string(), "--no-disk-cache"},
+      dir / "server.log");
   ASSERT_TRUE(server.wait_for_log("listening on", 20s)) << server.log_text();
-  testing::ChildProcess client(testing::client_program(),
-                               {"--server", fmt::format("127.0.0.1:{}", testing::listening_port(server.log_text())),
-                                "--user", "alice", "--device", "script:" + (dir / "press.yaml").string()},
-                               dir / "client.log");
+  testing::ChildProcess client(
+      testing::client_program(),
+      {"--server", fmt::format("127.0.0.1:{}", testing::listening_port(server.log_text())),
+       "--user", "alice", "--device", "script:" + (dir / "press.yaml").string()},
+      dir / "client.log");
   const std::optional<int> status = server.wait(30s);
   ASSERT_TRUE(status.has_value()) << "the server did not end the session\n" << server.log_text();
   EXPECT_EQ(*status, 1) << server.log_text();
   const std::string log = server.log_text();
-  EXPECT_NE(log.find("the simulation failed 100 steps in a row, the last with: "), std::string::npos) << log;
+  EXPECT_NE(log.find("the simulation failed 100 steps in a row, the last with: "),
+            std::string::npos)
+      << log;
   EXPECT_NE(log.find("boundary nodes asked for"), std::string::npos) << log;
   // About a second of failures at 100 Hz: the first line, perhaps one more.
   std::size_t lines = 0;
@@ -427,9 +444,12 @@ segments:
   const nlohmann::json report = nlohmann::json::parse(in)["server"];
   EXPECT_EQ(report["failed_steps"]["count"], kMaxConsecutiveStepFailures);
   EXPECT_EQ(report["failed_steps"]["max_in_a_row"], kMaxConsecutiveStepFailures);
-  EXPECT_NE(report["failed_steps"]["last_error"].get<std::string>().find("boundary nodes asked for"), std::string::npos);
+  EXPECT_NE(
+      report["failed_steps"]["last_error"].get<std::string>().find("boundary nodes asked for"),
+      std::string::npos);
   // The client was told why, and is on its own again (it keeps trying to reconnect).
-  EXPECT_TRUE(client.wait_for_log("server said goodbye: the server's simulation failed", 10s)) << client.log_text();
+  EXPECT_TRUE(client.wait_for_log("server said goodbye: the server's simulation failed", 10s))
+      << client.log_text();
   client.signal(SIGINT);
   EXPECT_TRUE(client.wait(10s).has_value());
 }

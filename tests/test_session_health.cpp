@@ -22,18 +22,21 @@ namespace fs = std::filesystem;
 
 // `users` (each playing dir/<user>.yaml) on `scene`, the server given `server_arguments`: the
 // session's verdict.
-SessionVerdict verdict_of(const fs::path& dir, const fs::path& scene, const std::vector<std::string>& server_arguments,
+SessionVerdict verdict_of(const fs::path& dir, const fs::path& scene,
+                          const std::vector<std::string>& server_arguments,
                           const std::vector<std::string>& users) {
   std::vector<std::pair<std::string, fs::path>> scripts;
   for (const std::string& user : users) scripts.emplace_back(user, dir / (user + ".yaml"));
   testing::run_scripted_session(dir, scene, server_arguments, scripts);
   std::vector<nlohmann::json> clients;
-  for (const std::string& user : users) clients.push_back(nlohmann::json::parse(std::ifstream(dir / (user + ".json"))));
+  for (const std::string& user : users)
+    clients.push_back(nlohmann::json::parse(std::ifstream(dir / (user + ".json"))));
   return summarize_session(nlohmann::json::parse(std::ifstream(dir / "server.json")), clients);
 }
 
 // The cube session in a fresh directory, the server given `server_arguments`; its verdict.
-SessionVerdict press_the_cube(const std::string& name, const std::vector<std::string>& server_arguments) {
+SessionVerdict press_the_cube(const std::string& name,
+                              const std::vector<std::string>& server_arguments) {
   const fs::path dir = testing::scratch_directory(name);
   testing::CubeSceneOptions cube;
   cube.divisions = 6;
@@ -55,7 +58,8 @@ segments:
 }
 
 // The rope on the block, each shipped surgeon's script played once.
-SessionVerdict press_the_rope(const std::string& name, const std::vector<std::string>& server_arguments) {
+SessionVerdict press_the_rope(const std::string& name,
+                              const std::vector<std::string>& server_arguments) {
   const fs::path dir = testing::scratch_directory(name);
   const fs::path shipped = fs::path(COHAPTIC_SOURCE_DIR) / "scenes/objects";
   for (const std::string user : {"a", "b"}) {
@@ -75,16 +79,20 @@ bool mentions(const std::vector<std::string>& lines, const std::string& text) {
 
 // The fed session has no problem; the starved one is UNHEALTHY for its step rate and its
 // stale IRs (`users` named), and for nothing else.
-void expect_only_starvation(const SessionVerdict& fed, const SessionVerdict& starved, const std::vector<std::string>& users) {
+void expect_only_starvation(const SessionVerdict& fed, const SessionVerdict& starved,
+                            const std::vector<std::string>& users) {
   EXPECT_TRUE(fed.problems.empty()) << fed.report["problems"].dump(1);
   EXPECT_TRUE(fed.report["healthy"].get<bool>());
   EXPECT_FALSE(starved.report["healthy"].get<bool>());
-  EXPECT_TRUE(mentions(starved.problems, "Hz, below 90 % of its target 20 Hz: capped by --sim-rate-hz 2"))
+  EXPECT_TRUE(
+      mentions(starved.problems, "Hz, below 90 % of its target 20 Hz: capped by --sim-rate-hz 2"))
       << starved.report["problems"].dump(1);
   for (const std::string& user : users)
-    EXPECT_TRUE(mentions(starved.problems, user + ": IR age p99")) << starved.report["problems"].dump(1);
+    EXPECT_TRUE(mentions(starved.problems, user + ": IR age p99"))
+        << starved.report["problems"].dump(1);
   for (const std::string& problem : starved.problems)
-    EXPECT_TRUE(problem.find("step") != std::string::npos || problem.find("IR age") != std::string::npos ||
+    EXPECT_TRUE(problem.find("step") != std::string::npos ||
+                problem.find("IR age") != std::string::npos ||
                 problem.find("faded") != std::string::npos)
         << "a cause other than the starved server: " << problem;
 }

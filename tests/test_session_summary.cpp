@@ -11,7 +11,9 @@ namespace cohaptic {
 namespace {
 
 nlohmann::json healthy_server() {
-  return {{"server", {{"steps", 5000}, {"datagrams", {{"rejected", 0}}}, {"control_frames", {{"rejected", 0}}}}}};
+  return {
+      {"server",
+       {{"steps", 5000}, {"datagrams", {{"rejected", 0}}}, {"control_frames", {{"rejected", 0}}}}}};
 }
 
 // A client that did everything right: 16,000 ticks at 1 kHz, IRs received, coupled.
@@ -32,11 +34,13 @@ nlohmann::json healthy_client(const std::string& user) {
 }
 
 bool mentions(const std::vector<std::string>& lines, const std::string& text) {
-  return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(text) != std::string::npos; });
+  return std::any_of(lines.begin(), lines.end(),
+                     [&](const std::string& l) { return l.find(text) != std::string::npos; });
 }
 
 TEST(SessionSummary, TwoGoodClientsAreHealthy) {
-  const SessionVerdict verdict = summarize_session(healthy_server(), {healthy_client("a"), healthy_client("b")});
+  const SessionVerdict verdict =
+      summarize_session(healthy_server(), {healthy_client("a"), healthy_client("b")});
   EXPECT_TRUE(verdict.problems.empty()) << verdict.problems.front();
   EXPECT_TRUE(verdict.report["healthy"].get<bool>());
 }
@@ -46,7 +50,8 @@ TEST(SessionSummary, MissedDeadlinesAreTheLoopsOnlyBeyondWhatTheBareTimerMissed)
   nlohmann::json late = healthy_client("a");
   late["missed_deadlines"] = 40;
   SessionVerdict verdict = summarize_session(healthy_server(), {late, healthy_client("b")});
-  EXPECT_TRUE(mentions(verdict.problems, "a: 40 missed deadlines")) << verdict.report["problems"].dump();
+  EXPECT_TRUE(mentions(verdict.problems, "a: 40 missed deadlines"))
+      << verdict.report["problems"].dump();
 
   // The same 40 while the bare timer missed 30: the machine stalled; a note, not a failure.
   late["timer_floor"]["missed_deadlines"] = 30;
@@ -66,15 +71,19 @@ TEST(SessionSummary, MissedDeadlinesNameTheHostsStealTimePerCpu) {
   nlohmann::json stalled = healthy_client("a");
   stalled["missed_deadlines"] = 99;
   stalled["timer_floor"]["missed_deadlines"] = 100;
-  stalled["timer_floor"]["cpus"] = {{{"cpu", 0}, {"missed_deadlines", 0}, {"host_steal_ms", 0.0}},
-                                    {{"cpu", 1}, {"missed_deadlines", 100}, {"host_steal_ms", 100.0}}};
+  stalled["timer_floor"]["cpus"] = {
+      {{"cpu", 0}, {"missed_deadlines", 0}, {"host_steal_ms", 0.0}},
+      {{"cpu", 1}, {"missed_deadlines", 100}, {"host_steal_ms", 100.0}}};
   SessionVerdict verdict = summarize_session(healthy_server(), {stalled, healthy_client("b")});
   EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
-  EXPECT_TRUE(mentions(verdict.notes, "a: 99 missed deadlines (timer floor missed 100; host steal time: CPU 0 0 ms, CPU 1 100 ms)"))
+  EXPECT_TRUE(mentions(
+      verdict.notes,
+      "a: 99 missed deadlines (timer floor missed 100; host steal time: CPU 0 0 ms, CPU 1 100 ms)"))
       << verdict.report["notes"].dump();
   stalled["timer_floor"]["missed_deadlines"] = 0;  // no floor saw it: the loop's own
   verdict = summarize_session(healthy_server(), {stalled, healthy_client("b")});
-  EXPECT_TRUE(mentions(verdict.problems, "the bare timer floor 0; host steal time: CPU 0 0 ms, CPU 1 100 ms"))
+  EXPECT_TRUE(mentions(verdict.problems,
+                       "the bare timer floor 0; host steal time: CPU 0 0 ms, CPU 1 100 ms"))
       << verdict.report["problems"].dump();
 }
 
@@ -99,12 +108,14 @@ TEST(SessionSummary, EachFailedCriterionIsNamed) {
   server["server"]["datagrams"]["rejected"] = 7;
   const SessionVerdict verdict = summarize_session(server, {bad, healthy_client("b")});
   EXPECT_FALSE(verdict.report["healthy"].get<bool>());
-  for (const char* text : {"a: non-finite forces", "a: haptic rate 800.0 Hz", "a: nothing to compute forces from",
-                           "server: 7 datagrams rejected"})
-    EXPECT_TRUE(mentions(verdict.problems, text)) << text << " in " << verdict.report["problems"].dump();
+  for (const char* text : {"a: non-finite forces", "a: haptic rate 800.0 Hz",
+                           "a: nothing to compute forces from", "server: 7 datagrams rejected"})
+    EXPECT_TRUE(mentions(verdict.problems, text))
+        << text << " in " << verdict.report["problems"].dump();
   EXPECT_EQ(verdict.problems.size(), 4u) << verdict.report["problems"].dump();
   // Users far apart feel little of each other: the experiment's design, a note.
-  EXPECT_TRUE(mentions(verdict.notes, "a: coupling peak 0.010 N")) << verdict.report["notes"].dump();
+  EXPECT_TRUE(mentions(verdict.notes, "a: coupling peak 0.010 N"))
+      << verdict.report["notes"].dump();
   EXPECT_TRUE(summarize_session(healthy_server(), {}).problems.size() == 1);
 }
 
@@ -113,7 +124,8 @@ TEST(SessionSummary, FailedSimulationStepsMakeTheSessionUnhealthyNamingCountAndL
   server["server"]["failed_steps"] = {{"count", 0}, {"max_in_a_row", 0}, {"last_error", ""}};
   EXPECT_TRUE(summarize_session(server, {healthy_client("a")}).problems.empty());
 
-  server["server"]["failed_steps"] = {{"count", 12}, {"max_in_a_row", 4}, {"last_error", "contact solve: singular"}};
+  server["server"]["failed_steps"] = {
+      {"count", 12}, {"max_in_a_row", 4}, {"last_error", "contact solve: singular"}};
   const SessionVerdict verdict = summarize_session(server, {healthy_client("a")});
   EXPECT_FALSE(verdict.report["healthy"].get<bool>());
   ASSERT_EQ(verdict.problems.size(), 1u) << verdict.report["problems"].dump();
@@ -140,8 +152,10 @@ TEST(SessionSummary, AStarvedServerFadesTheForceLimitAndStaleIrsAreNamed) {
       if (c["who"] == who && c["criterion"] == what) return c;
     return nlohmann::json();
   };
-  EXPECT_EQ(criterion("server", "simulation step rate")["threshold"], ">= 18.0 Hz") << criteria.dump();
-  EXPECT_EQ(criterion("a", "IR age p99")["threshold"], "<= 200 ms") << criteria.dump();  // 4 steps at 20 Hz
+  EXPECT_EQ(criterion("server", "simulation step rate")["threshold"], ">= 18.0 Hz")
+      << criteria.dump();
+  EXPECT_EQ(criterion("a", "IR age p99")["threshold"], "<= 200 ms")
+      << criteria.dump();  // 4 steps at 20 Hz
   EXPECT_EQ(criterion("a", "IR age max")["value"], "180.0 ms") << criteria.dump();
   EXPECT_EQ(criterion("a", "force fades while pushing")["ok"], true) << criteria.dump();
 
@@ -153,15 +167,20 @@ TEST(SessionSummary, AStarvedServerFadesTheForceLimitAndStaleIrsAreNamed) {
   client["ir_age_ms"]["max"] = 500.0;
   verdict = summarize_session(server, {client});
   EXPECT_FALSE(verdict.report["healthy"].get<bool>());
-  for (const char* text : {"server: the simulation stepped at 0.3 Hz, below 90 % of its target 20 Hz: the server is starved",
-                           "a: the force faded 2 time(s) while pushing (376 ms in all, the longest 300 ms)",
-                           "a: 17 ticks (0.11 %) held at the force limit", "a: IR age p99 201.0 ms, above 200 ms",
-                           "a: IR age reached 500 ms, the age at which the force fades"})
-    EXPECT_TRUE(mentions(verdict.problems, text)) << text << " in " << verdict.report["problems"].dump();
+  for (const char* text :
+       {"server: the simulation stepped at 0.3 Hz, below 90 % of its target 20 Hz: the server is "
+        "starved",
+        "a: the force faded 2 time(s) while pushing (376 ms in all, the longest 300 ms)",
+        "a: 17 ticks (0.11 %) held at the force limit", "a: IR age p99 201.0 ms, above 200 ms",
+        "a: IR age reached 500 ms, the age at which the force fades"})
+    EXPECT_TRUE(mentions(verdict.problems, text))
+        << text << " in " << verdict.report["problems"].dump();
   EXPECT_EQ(verdict.problems.size(), 5u) << verdict.report["problems"].dump();
-  server["server"]["injected"] = {{"sim_rate_hz", 0.34}};  // a study capped it: the users feel it all the same
+  server["server"]["injected"] = {
+      {"sim_rate_hz", 0.34}};  // a study capped it: the users feel it all the same
   verdict = summarize_session(server, {client});
-  EXPECT_TRUE(mentions(verdict.problems, "below 90 % of its target 20 Hz: capped by --sim-rate-hz 0.34"))
+  EXPECT_TRUE(
+      mentions(verdict.problems, "below 90 % of its target 20 Hz: capped by --sim-rate-hz 0.34"))
       << verdict.report["problems"].dump();
 
   // Shift delay injected on the links lengthens the IR age the session is held to.

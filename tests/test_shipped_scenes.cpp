@@ -40,7 +40,8 @@ std::vector<std::string> scenes_with_surgeons() {
   for (const fs::directory_entry& entry : fs::recursive_directory_iterator(kSource / "scenes")) {
     if (entry.path().filename() != "surgeon_a.yaml") continue;
     const fs::path scene_dir = entry.path().parent_path();
-    if (fs::exists(scene_dir / "surgeon_b.yaml") && fs::exists(fs::path(scene_dir.string() + ".yaml")))
+    if (fs::exists(scene_dir / "surgeon_b.yaml") &&
+        fs::exists(fs::path(scene_dir.string() + ".yaml")))
       scenes.push_back(fs::relative(scene_dir, kSource / "scenes").generic_string());
   }
   std::sort(scenes.begin(), scenes.end());
@@ -52,11 +53,15 @@ std::vector<std::string> scenes_with_surgeons() {
 std::string run_demo(const std::string& scene, const fs::path& out, bool watched) {
   const fs::path scene_file = kSource / "scenes" / (scene + ".yaml");
   const int seconds = watched ? kWatchedSessionSeconds : kSessionSeconds;
-  std::vector<std::string> arguments = {
-      fmt::format("BUILD_DIR={}", COHAPTIC_BINARY_DIR), fmt::format("DEMO_OUT={}", out.string()),
-      "DEMO_PORT=0", fmt::format("DEMO_DURATION={}", seconds), fmt::format("DEMO_VIEW_PORT={}", watched ? "0" : "off"),
-      fmt::format("DEMO_WAIT_FOR_BROWSER={}", watched ? "1" : ""),
-      "bash", (kSource / "deploy/run-demo.sh").string(), scene_file.string()};
+  std::vector<std::string> arguments = {fmt::format("BUILD_DIR={}", COHAPTIC_BINARY_DIR),
+                                        fmt::format("DEMO_OUT={}", out.string()),
+                                        "DEMO_PORT=0",
+                                        fmt::format("DEMO_DURATION={}", seconds),
+                                        fmt::format("DEMO_VIEW_PORT={}", watched ? "0" : "off"),
+                                        fmt::format("DEMO_WAIT_FOR_BROWSER={}", watched ? "1" : ""),
+                                        "bash",
+                                        (kSource / "deploy/run-demo.sh").string(),
+                                        scene_file.string()};
   ChildProcess demo("/usr/bin/env", arguments, out / "demo.txt");
   std::unique_ptr<ChildProcess> browser;
   if (watched) {
@@ -66,15 +71,16 @@ std::string run_demo(const std::string& scene, const fs::path& out, bool watched
     if (std::regex_search(text, url, std::regex(R"(live view at (http://\S+))")))
       browser = std::make_unique<ChildProcess>(
           testing::node_program(),
-          std::vector<std::string>{(kSource / "tests/support/view_check.mjs").string(), "--url", url[1].str(),
-                                   "--screenshot", (out / "view.png").string(), "--min-force", "0", "--stay",
-                                   std::to_string(seconds + 2)},
+          std::vector<std::string>{(kSource / "tests/support/view_check.mjs").string(), "--url",
+                                   url[1].str(), "--screenshot", (out / "view.png").string(),
+                                   "--min-force", "0", "--stay", std::to_string(seconds + 2)},
           out / "view_check.log");
   }
   const std::optional<int> status = demo.wait(kDemoPatience);
   EXPECT_TRUE(status.has_value()) << "the demo did not finish: " << demo.log_text();
   if (browser) {
-    EXPECT_EQ(browser->wait(kDemoPatience), 0) << "the browser did not watch: " << browser->log_text();
+    EXPECT_EQ(browser->wait(kDemoPatience), 0)
+        << "the browser did not watch: " << browser->log_text();
     EXPECT_TRUE(fs::exists(out / "view.png"));
   }
   return demo.log_text();
@@ -83,20 +89,26 @@ std::string run_demo(const std::string& scene, const fs::path& out, bool watched
 class ShippedScene : public ::testing::TestWithParam<std::string> {};
 
 void expect_felt_without_fades(const std::string& scene, bool watched) {
-  const fs::path out = testing::scratch_directory(std::regex_replace(scene, std::regex("/"), "-") + (watched ? "-watched" : ""));
+  const fs::path out = testing::scratch_directory(std::regex_replace(scene, std::regex("/"), "-") +
+                                                  (watched ? "-watched" : ""));
   const std::string output = run_demo(scene, out, watched);
-  std::printf("%s", output.substr(output.find("\nwho ") == std::string::npos ? 0 : output.find("\nwho ")).c_str());
+  std::printf("%s",
+              output.substr(output.find("\nwho ") == std::string::npos ? 0 : output.find("\nwho "))
+                  .c_str());
   ASSERT_TRUE(fs::exists(out / "report.json")) << output;
   for (const char* client : {"client_a", "client_b"}) {
     SCOPED_TRACE(client);
     ASSERT_TRUE(fs::exists(out / (std::string(client) + ".json"))) << output;
     const json report = json::parse(std::ifstream(out / (std::string(client) + ".json")));
-    EXPECT_EQ(report["fades"]["count"], 0) << "the force faded while the surgeon pushed: " << report["fades"].dump()
-                                           << "; IR age " << report["ir_age_ms"].dump();
-    EXPECT_GT(report["force_n"]["peak"].get<double>(), 1e-4) << "the surgeon never touched the body";
+    EXPECT_EQ(report["fades"]["count"], 0)
+        << "the force faded while the surgeon pushed: " << report["fades"].dump() << "; IR age "
+        << report["ir_age_ms"].dump();
+    EXPECT_GT(report["force_n"]["peak"].get<double>(), 1e-4)
+        << "the surgeon never touched the body";
   }
   std::size_t verified = 0;
-  for (std::size_t at = output.find("verify: identical"); at != std::string::npos; at = output.find("verify: identical", at + 1))
+  for (std::size_t at = output.find("verify: identical"); at != std::string::npos;
+       at = output.find("verify: identical", at + 1))
     ++verified;
   EXPECT_EQ(verified, 2u) << "both clients' recordings verify bit for bit:\n" << output;
 }

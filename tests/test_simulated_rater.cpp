@@ -62,8 +62,8 @@ int rate(const SimulatedRaterSettings& s, double first, double second, unsigned 
   return rate_pair(s, with_magnitude(s.quality, first), with_magnitude(s.quality, second), rng);
 }
 
-double mean_rating(const SimulatedRaterSettings& s, const TrialMeasures& first, const TrialMeasures& second, int draws,
-                   unsigned seed) {
+double mean_rating(const SimulatedRaterSettings& s, const TrialMeasures& first,
+                   const TrialMeasures& second, int draws, unsigned seed) {
   std::mt19937 rng(seed);
   double sum = 0;
   for (int i = 0; i < draws; ++i) sum += rate_pair(s, first, second, rng);
@@ -99,7 +99,8 @@ TEST(SimulatedRaterDefaults, AreTheDocumentedWeberFractionsAndValid) {
 
 TEST(SimulatedRaterProperties, EqualMeasuresWithoutNoiseRateZero) {
   for (RatedQuality q : kQualities)
-    for (double value : {0.0, 0.3, 1.0, 50.0, 1000.0}) EXPECT_EQ(rate(noiseless(q), value, value), 0) << value;
+    for (double value : {0.0, 0.3, 1.0, 50.0, 1000.0})
+      EXPECT_EQ(rate(noiseless(q), value, value), 0) << value;
 }
 
 TEST(SimulatedRaterProperties, DifferencesBelowOneJndRateZeroWithoutNoise) {
@@ -121,8 +122,10 @@ TEST(SimulatedRaterProperties, LargeDifferencesSaturateAtTheScalesEnds) {
       const SimulatedRaterSettings s = noiseless(q, grades);
       // (Just above `grades` JNDs: exactly on a boundary, the log's round-off decides.)
       for (double jnds : {grades + 0.01, grades + 0.5, 10.0, 40.0}) {
-        EXPECT_EQ(rate(s, jnds_above(s, jnds), reference(q)), grades) << to_string(q) << " " << jnds;
-        EXPECT_EQ(rate(s, reference(q), jnds_above(s, jnds)), -grades) << to_string(q) << " " << jnds;
+        EXPECT_EQ(rate(s, jnds_above(s, jnds), reference(q)), grades)
+            << to_string(q) << " " << jnds;
+        EXPECT_EQ(rate(s, reference(q), jnds_above(s, jnds)), -grades)
+            << to_string(q) << " " << jnds;
       }
       // A zero magnitude against any other is as far apart as the scale goes.
       EXPECT_EQ(rate(s, reference(q), 0), grades);
@@ -132,7 +135,8 @@ TEST(SimulatedRaterProperties, LargeDifferencesSaturateAtTheScalesEnds) {
       noisy.noise_sd = 5;
       std::mt19937 rng(3);
       for (int i = 0; i < 2000; ++i) {
-        const int r = rate_pair(noisy, with_magnitude(q, jnds_above(s, 1)), with_magnitude(q, reference(q)), rng);
+        const int r = rate_pair(noisy, with_magnitude(q, jnds_above(s, 1)),
+                                with_magnitude(q, reference(q)), rng);
         EXPECT_LE(std::abs(r), grades);
       }
     }
@@ -149,7 +153,8 @@ TEST(SimulatedRaterProperties, MonotoneInTheDifference) {
         int previous = -s.grades;
         for (double jnds = -4; jnds <= 4; jnds += 0.125) {
           const int r = rate(s, jnds_above(s, jnds), reference(q), seed);
-          EXPECT_GE(r, previous) << to_string(q) << " noise " << noise_sd << " seed " << seed << " at " << jnds;
+          EXPECT_GE(r, previous) << to_string(q) << " noise " << noise_sd << " seed " << seed
+                                 << " at " << jnds;
           previous = r;
         }
       }
@@ -162,7 +167,8 @@ TEST(SimulatedRaterProperties, AntisymmetricInExpectation) {
   for (RatedQuality q : kQualities) {
     const SimulatedRaterSettings s = default_rater_settings(q);
     for (double jnds : {0.0, 0.4, 1.5, 2.7}) {
-      const TrialMeasures a = with_magnitude(q, jnds_above(s, jnds)), b = with_magnitude(q, reference(q));
+      const TrialMeasures a = with_magnitude(q, jnds_above(s, jnds)),
+                          b = with_magnitude(q, reference(q));
       const double forward = mean_rating(s, a, b, kDraws, 11);
       const double backward = mean_rating(s, b, a, kDraws, 12);
       // Each mean's standard error is below 1.3 / sqrt(20000) ~ 0.009: 0.05 is > 3.5 SE of the sum.
@@ -176,7 +182,8 @@ TEST(SimulatedRaterProperties, AntisymmetricInExpectation) {
 
 TEST(SimulatedRaterProperties, DeterministicForAGivenRngState) {
   const SimulatedRaterSettings s = default_rater_settings(RatedQuality::harder);
-  const TrialMeasures a = with_terminal_ratio(0.9), b = with_terminal_ratio(0.8);  // 0.84 JNDs: noise decides
+  const TrialMeasures a = with_terminal_ratio(0.9),
+                      b = with_terminal_ratio(0.8);  // 0.84 JNDs: noise decides
   std::mt19937 rng(5);
   std::vector<int> ratings;
   for (int i = 0; i < 201; ++i) {
@@ -189,7 +196,8 @@ TEST(SimulatedRaterProperties, DeterministicForAGivenRngState) {
     EXPECT_EQ(copy, rng) << i;
   }
   // The noise did matter: not every rating was the same.
-  EXPECT_NE(std::count(ratings.begin(), ratings.end(), ratings.front()), static_cast<std::ptrdiff_t>(ratings.size()));
+  EXPECT_NE(std::count(ratings.begin(), ratings.end(), ratings.front()),
+            static_cast<std::ptrdiff_t>(ratings.size()));
 }
 
 TEST(SimulatedRaterFiner, AP1LikeForceRatesFinerThanAP0LikeOne) {
@@ -203,13 +211,14 @@ TEST(SimulatedRaterFiner, AP1LikeForceRatesFinerThanAP0LikeOne) {
 
 TEST(SimulatedRaterFiner, RatesAboveTheContinuousRateFeelTheSame) {
   const SimulatedRaterSettings s = noiseless(RatedQuality::finer);
-  EXPECT_EQ(perceived_magnitude(RatedQuality::finer, with_update_rate(2000)), kContinuousForceRateHz);
+  EXPECT_EQ(perceived_magnitude(RatedQuality::finer, with_update_rate(2000)),
+            kContinuousForceRateHz);
   EXPECT_EQ(perceived_magnitude(RatedQuality::finer, with_update_rate(120)), 120);
   EXPECT_EQ(rate(s, 1000, kContinuousForceRateHz), 0);
   EXPECT_EQ(rate(s, 600, 1000), 0);
   // Below it, the log rate counts: 200 Hz against 500 Hz is ln(2.5) / ln(1.25) = 4.1 JNDs.
-  EXPECT_NEAR(difference_in_jnds(s, with_update_rate(200), with_update_rate(1000)), -std::log(2.5) / std::log(1.25),
-              1e-12);
+  EXPECT_NEAR(difference_in_jnds(s, with_update_rate(200), with_update_rate(1000)),
+              -std::log(2.5) / std::log(1.25), 1e-12);
 }
 
 TEST(SimulatedRaterHarder, AStifferTrialRatesHarder) {
@@ -239,8 +248,9 @@ ForceTrace press(double tau, std::size_t hold) {
 
 TEST(SimulatedRaterFromTraces, AShiftDelayedPressFeelsSofterAndAHeldForceCoarser) {
   const TrialMeasures prompt = measure_trial(press(0, 1));
-  const TrialMeasures delayed = measure_trial(press(0.1, 1));  // terminal ratio cos(0.2 pi) = 0.81: 1.5 JNDs
-  const TrialMeasures held = measure_trial(press(0, 20));      // a P0-like force at 50 Hz
+  const TrialMeasures delayed =
+      measure_trial(press(0.1, 1));  // terminal ratio cos(0.2 pi) = 0.81: 1.5 JNDs
+  const TrialMeasures held = measure_trial(press(0, 20));  // a P0-like force at 50 Hz
   std::mt19937 rng(1);
   EXPECT_EQ(rate_pair(noiseless(RatedQuality::harder), prompt, delayed, rng), 1);
   EXPECT_EQ(rate_pair(noiseless(RatedQuality::harder), delayed, prompt, rng), -1);
@@ -298,8 +308,10 @@ TEST(SimulatedRaterErrors, BadSettingsThrow) {
     change(s);
     return s;
   };
-  EXPECT_THROW(rate_pair(with([](auto& s) { s.just_noticeable_difference = 0; }), a, a, rng), Error);
-  EXPECT_THROW(rate_pair(with([](auto& s) { s.just_noticeable_difference = kNaN; }), a, a, rng), Error);
+  EXPECT_THROW(rate_pair(with([](auto& s) { s.just_noticeable_difference = 0; }), a, a, rng),
+               Error);
+  EXPECT_THROW(rate_pair(with([](auto& s) { s.just_noticeable_difference = kNaN; }), a, a, rng),
+               Error);
   EXPECT_THROW(rate_pair(with([](auto& s) { s.noise_sd = -0.1; }), a, a, rng), Error);
   EXPECT_THROW(rate_pair(with([](auto& s) { s.noise_sd = kNaN; }), a, a, rng), Error);
   EXPECT_THROW(rate_pair(with([](auto& s) { s.grades = 0; }), a, a, rng), Error);

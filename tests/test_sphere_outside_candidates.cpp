@@ -34,8 +34,8 @@ namespace {
 using testing::mm;
 using testing::relative_error;
 
-constexpr double kColumnSphereRadius = 10e-3;    // both spheres [m]
-constexpr double kColumnStandoff = 0.3e-3;  // B's clearance from its face at rest [m]
+constexpr double kColumnSphereRadius = 10e-3;  // both spheres [m]
+constexpr double kColumnStandoff = 0.3e-3;     // B's clearance from its face at rest [m]
 
 // 20 x 20 x 100 mm, 2.5 mm cells, foot fixed, touchable on its -x and +x faces.
 const std::string kColumnScene = R"(
@@ -71,9 +71,9 @@ struct ColumnPairProblem {
 // The whole body's compliance between every free touchable node's dofs (nothing held but
 // the foot), from one multi-right-hand-side CHOLMOD solve.
 struct ColumnTouchableCompliance {
-  std::vector<int> nodes;       // free touchable nodes
-  std::vector<int> first_row;   // per volume node: its first row in `block`, or -1
-  Eigen::MatrixXd block;        // 3 rows and 3 columns per node [m/N]
+  std::vector<int> nodes;      // free touchable nodes
+  std::vector<int> first_row;  // per volume node: its first row in `block`, or -1
+  Eigen::MatrixXd block;       // 3 rows and 3 columns per node [m/N]
 };
 
 ColumnTouchableCompliance column_touchable_compliance(const ElasticBody& body) {
@@ -90,8 +90,9 @@ ColumnTouchableCompliance column_touchable_compliance(const ElasticBody& body) {
   return c;
 }
 
-ColumnPairProblem solve_every_column_pair(const ElasticBody& body, const ColumnTouchableCompliance& c,
-                             const std::vector<Eigen::Vector3d>& centres) {
+ColumnPairProblem solve_every_column_pair(const ElasticBody& body,
+                                          const ColumnTouchableCompliance& c,
+                                          const std::vector<Eigen::Vector3d>& centres) {
   ColumnPairProblem problem;
   std::vector<double> gaps;
   for (int node : c.nodes) {
@@ -100,8 +101,10 @@ ColumnPairProblem solve_every_column_pair(const ElasticBody& body, const ColumnT
     for (int t = 0; t < static_cast<int>(centres.size()); ++t) {
       // x + s n on the sphere: s = -b -+ sqrt(b^2 - c); the node must reach the far crossing.
       const Eigen::Vector3d offset = x - centres[static_cast<std::size_t>(t)];
-      const double b = inward.dot(offset), c2 = offset.squaredNorm() - kColumnSphereRadius * kColumnSphereRadius;
-      if (b * b - c2 < 0 || -b - std::sqrt(b * b - c2) > 0) continue;  // missed, or the sphere is ahead
+      const double b = inward.dot(offset),
+                   c2 = offset.squaredNorm() - kColumnSphereRadius * kColumnSphereRadius;
+      if (b * b - c2 < 0 || -b - std::sqrt(b * b - c2) > 0)
+        continue;  // missed, or the sphere is ahead
       const double gap = b - std::sqrt(b * b - c2);
       if (gap >= kColumnSphereRadius) continue;  // far beyond anything the press can carry in
       problem.node.push_back(node);
@@ -116,8 +119,9 @@ ColumnPairProblem solve_every_column_pair(const ElasticBody& body, const ColumnT
   for (Eigen::Index p = 0; p < m; ++p)
     for (Eigen::Index q = 0; q < m; ++q)
       a(p, q) = problem.normal[static_cast<std::size_t>(p)].dot(
-          c.block.block<3, 3>(c.first_row[static_cast<std::size_t>(problem.node[static_cast<std::size_t>(p)])],
-                              c.first_row[static_cast<std::size_t>(problem.node[static_cast<std::size_t>(q)])]) *
+          c.block.block<3, 3>(
+              c.first_row[static_cast<std::size_t>(problem.node[static_cast<std::size_t>(p)])],
+              c.first_row[static_cast<std::size_t>(problem.node[static_cast<std::size_t>(q)])]) *
           problem.normal[static_cast<std::size_t>(q)]);
   a = 0.5 * (a + a.transpose()).eval();
   std::vector<std::uint8_t> active(static_cast<std::size_t>(m), 0);
@@ -125,7 +129,8 @@ ColumnPairProblem solve_every_column_pair(const ElasticBody& body, const ColumnT
   Eigen::MatrixXd factor(m, m);
   std::vector<int> order(static_cast<std::size_t>(m));
   // Nothing is held, so q is the rest gap itself (no free displacement).
-  if (!solve_unilateral_contact(a, problem.gap, active, problem.push, factor, order, std::numeric_limits<double>::infinity())
+  if (!solve_unilateral_contact(a, problem.gap, active, problem.push, factor, order,
+                                std::numeric_limits<double>::infinity())
            .solved)
     throw std::runtime_error("the pairs' normal compliance is not positive definite");
   problem.force.assign(centres.size(), Eigen::Vector3d::Zero());
@@ -140,15 +145,18 @@ ColumnPairProblem solve_every_column_pair(const ElasticBody& body, const ColumnT
 void expect_column_contact_conditions(const ElasticBody& body, const ColumnPairProblem& problem) {
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * body.mesh.node_count());
   for (std::size_t p = 0; p < problem.node.size(); ++p)
-    loads.segment<3>(3 * problem.node[p]) += problem.push[static_cast<Eigen::Index>(p)] * problem.normal[p];
+    loads.segment<3>(3 * problem.node[p]) +=
+        problem.push[static_cast<Eigen::Index>(p)] * problem.normal[p];
   const Eigen::VectorXd u = solve_static(body.stiffness, body.dofs, {}, loads).displacement;
   constexpr double kTolerance = 1e-12;  // [m], against millimetre gaps and displacements
   for (std::size_t p = 0; p < problem.node.size(); ++p) {
-    const double clearance = problem.gap[static_cast<Eigen::Index>(p)] + problem.normal[p].dot(u.segment<3>(3 * problem.node[p]));
+    const double clearance = problem.gap[static_cast<Eigen::Index>(p)] +
+                             problem.normal[p].dot(u.segment<3>(3 * problem.node[p]));
     const double push = problem.push[static_cast<Eigen::Index>(p)];
     EXPECT_GE(push, 0);
-    EXPECT_GE(clearance, -kTolerance) << "node " << body.mesh.node_tags[static_cast<std::size_t>(problem.node[p])]
-                                      << " inside sphere " << problem.tool[p];
+    EXPECT_GE(clearance, -kTolerance)
+        << "node " << body.mesh.node_tags[static_cast<std::size_t>(problem.node[p])]
+        << " inside sphere " << problem.tool[p];
     if (push > 0) {
       EXPECT_NEAR(clearance, 0, kTolerance) << "a pushed node is on its sphere";
     }
@@ -163,11 +171,13 @@ std::vector<std::int64_t> column_tags(const ElasticBody& body, const std::vector
 }
 
 // Mesh node tags of the IR's nodes in contact at the evaluation that left `state`.
-std::vector<std::int64_t> column_ir_contact_tags(const PreparedIR& prepared, const EvaluationState& state) {
+std::vector<std::int64_t> column_ir_contact_tags(const PreparedIR& prepared,
+                                                 const EvaluationState& state) {
   const CondensedFemIr& fem = condensed_fem(prepared.ir);
   std::vector<std::int64_t> tags;
   for (int i = 0; i < fem.row_node_count; ++i)
-    if (std::get<SphereContactState>(state.body).solve.push(i) > 0) tags.push_back(fem.node_ids[static_cast<std::size_t>(i)]);
+    if (std::get<SphereContactState>(state.body).solve.push(i) > 0)
+      tags.push_back(fem.node_ids[static_cast<std::size_t>(i)]);
   std::sort(tags.begin(), tags.end());
   return tags;
 }
@@ -182,7 +192,8 @@ TEST_P(SphereOutsideCandidates, ANodeTheColumnCarriesIntoASphereIsHeldAsTheFullS
   testing::CubeRig rig(kColumnScene);
   const ElasticBody& body = rig.body;
   const ColumnTouchableCompliance compliance = column_touchable_compliance(body);
-  const Eigen::Vector3d b_centre = mm(10, 0, -5) + Eigen::Vector3d(kColumnSphereRadius + kColumnStandoff, 0, 0);
+  const Eigen::Vector3d b_centre =
+      mm(10, 0, -5) + Eigen::Vector3d(kColumnSphereRadius + kColumnStandoff, 0, 0);
   int b_pushed = 0, carried_in = 0, b_beyond_one_triangle = 0;
   double worst = 0;
   for (int k = 0; k <= 4; ++k) {
@@ -197,7 +208,9 @@ TEST_P(SphereOutsideCandidates, ANodeTheColumnCarriesIntoASphereIsHeldAsTheFullS
       if (expected.tool[p] == 1) {
         ASSERT_GT(expected.gap[static_cast<Eigen::Index>(p)], 0) << "B holds a node at rest";
       }
-      if (expected.push[static_cast<Eigen::Index>(p)] > 0 && expected.gap[static_cast<Eigen::Index>(p)] > 0) ++carried_in;
+      if (expected.push[static_cast<Eigen::Index>(p)] > 0 &&
+          expected.gap[static_cast<Eigen::Index>(p)] > 0)
+        ++carried_in;
     }
     if (expected.force[1].norm() > 1e-3 * expected.force[0].norm()) ++b_pushed;
     int b_contacts = 0;
@@ -208,34 +221,47 @@ TEST_P(SphereOutsideCandidates, ANodeTheColumnCarriesIntoASphereIsHeldAsTheFullS
     // The server's simulation and each user's IR, evaluated at the tools' positions.
     Simulation simulation(body, rig.model->obstacles, *rig.columns, rig.model->scene.tools,
                           testing::unlimited_options(ContactModel::sphere, 0, patch_rings));
-    for (int user = 0; user < 2; ++user) simulation.set_tool(user, centres[static_cast<std::size_t>(user)]);
+    for (int user = 0; user < 2; ++user)
+      simulation.set_tool(user, centres[static_cast<std::size_t>(user)]);
     EXPECT_EQ(simulation.step(0).sphere_nodes_outside_patches, 0);
     for (int user = 0; user < 2; ++user) {
       const PreparedIR& prepared = *simulation.ir(user);
       std::vector<Eigen::Vector3d> remotes;
-      for (int r = 0; r < remote_count(prepared.ir); ++r) remotes.push_back(centres[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
+      for (int r = 0; r < remote_count(prepared.ir); ++r)
+        remotes.push_back(centres[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
       EvaluationState state = make_evaluation_state(prepared);
-      const ForceSample sample = evaluate_force(prepared, state, centres[static_cast<std::size_t>(user)], remotes, 1e-3);
-      ASSERT_FALSE(sample.flags & (kOutsidePatch | kContactUnresolved | kNonFinite)) << "user " << user;
-      const double error = relative_error(sample.force, expected.force[static_cast<std::size_t>(user)]);
-      EXPECT_LE(error, 1e-9) << "user " << user << ": IR " << sample.force.transpose() << " N, full solve "
+      const ForceSample sample =
+          evaluate_force(prepared, state, centres[static_cast<std::size_t>(user)], remotes, 1e-3);
+      ASSERT_FALSE(sample.flags & (kOutsidePatch | kContactUnresolved | kNonFinite))
+          << "user " << user;
+      const double error =
+          relative_error(sample.force, expected.force[static_cast<std::size_t>(user)]);
+      EXPECT_LE(error, 1e-9) << "user " << user << ": IR " << sample.force.transpose()
+                             << " N, full solve "
                              << expected.force[static_cast<std::size_t>(user)].transpose() << " N";
       worst = std::max(worst, error);
-      EXPECT_EQ(column_ir_contact_tags(prepared, state), column_tags(body, expected.contact_nodes())) << "user " << user;
+      EXPECT_EQ(column_ir_contact_tags(prepared, state),
+                column_tags(body, expected.contact_nodes()))
+          << "user " << user;
     }
 
     // The sphere model's own full solve.
-    const SphereContactSolution reference =
-        sphere_reactions_reference(body, {{centres[0], kColumnSphereRadius}, {centres[1], kColumnSphereRadius}});
+    const SphereContactSolution reference = sphere_reactions_reference(
+        body, {{centres[0], kColumnSphereRadius}, {centres[1], kColumnSphereRadius}});
     for (int t = 0; t < 2; ++t)
-      EXPECT_LE(relative_error(reference.reactions[static_cast<std::size_t>(t)], expected.force[static_cast<std::size_t>(t)]), 1e-9)
+      EXPECT_LE(relative_error(reference.reactions[static_cast<std::size_t>(t)],
+                               expected.force[static_cast<std::size_t>(t)]),
+                1e-9)
           << "reference, sphere " << t;
-    EXPECT_EQ(column_tags(body, reference.contact_nodes()), column_tags(body, expected.contact_nodes()));
+    EXPECT_EQ(column_tags(body, reference.contact_nodes()),
+              column_tags(body, expected.contact_nodes()));
     std::printf("  A %.1f mm deep: |F_A| = %.4f N, |F_B| = %.4f N, %zu nodes in contact\n", depth,
-                expected.force[0].norm(), expected.force[1].norm(), expected.contact_nodes().size());
+                expected.force[0].norm(), expected.force[1].norm(),
+                expected.contact_nodes().size());
   }
-  std::printf("  worst relative IR force error %.2e; %d node contacts carried in from outside a sphere\n", worst,
-              carried_in);
+  std::printf(
+      "  worst relative IR force error %.2e; %d node contacts carried in from outside a sphere\n",
+      worst, carried_in);
   // Not vacuous: the model that holds only nodes inside a sphere at rest gives B no force.
   EXPECT_GE(b_pushed, 3);
   EXPECT_GT(carried_in, 0);
@@ -243,7 +269,9 @@ TEST_P(SphereOutsideCandidates, ANodeTheColumnCarriesIntoASphereIsHeldAsTheFullS
 }
 
 INSTANTIATE_TEST_SUITE_P(PatchRings, SphereOutsideCandidates, ::testing::Values(1, 0),
-                         [](const ::testing::TestParamInfo<int>& rings) { return "Rings" + std::to_string(rings.param); });
+                         [](const ::testing::TestParamInfo<int>& rings) {
+                           return "Rings" + std::to_string(rings.param);
+                         });
 
 }  // namespace
 }  // namespace cohaptic

@@ -25,21 +25,26 @@ TEST(SpringLattice, PaperFrontObjectIsTheBoxLatticeTheSceneDeclares) {
   ASSERT_EQ(network.node_count(), 4 * 5 * 3);
   for (int n = 0; n < network.node_count(); ++n) EXPECT_DOUBLE_EQ(network.mass[n], 0.05);
 
-  const TetMesh mesh = make_box_mesh(Eigen::Vector3d(-0.0575, 0.01595, 0), Eigen::Vector3d(0.0575, 0.0989, 0.0575),
-                                     Eigen::Vector3i(3, 4, 2));
+  const TetMesh mesh =
+      make_box_mesh(Eigen::Vector3d(-0.0575, 0.01595, 0), Eigen::Vector3d(0.0575, 0.0989, 0.0575),
+                    Eigen::Vector3i(3, 4, 2));
   std::set<std::pair<int, int>> edges;
   for (const auto& tet : mesh.tets)
     for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) edges.insert(std::minmax(tet[static_cast<std::size_t>(a)], tet[static_cast<std::size_t>(b)]));
+      for (int b = a + 1; b < 4; ++b)
+        edges.insert(
+            std::minmax(tet[static_cast<std::size_t>(a)], tet[static_cast<std::size_t>(b)]));
   ASSERT_EQ(network.springs.size(), edges.size());
   for (const Spring& s : network.springs) {
     EXPECT_TRUE(edges.count(std::minmax(s.a, s.b))) << s.a << "-" << s.b;
     EXPECT_DOUBLE_EQ(s.stiffness, 100);
     EXPECT_DOUBLE_EQ(s.damping, 0.10);
-    EXPECT_NEAR(s.rest_length, (network.rest_positions.col(s.a) - network.rest_positions.col(s.b)).norm(), 1e-15);
+    EXPECT_NEAR(s.rest_length,
+                (network.rest_positions.col(s.a) - network.rest_positions.col(s.b)).norm(), 1e-15);
   }
   for (int n = 0; n < network.node_count(); ++n)
-    EXPECT_EQ(network.held[static_cast<std::size_t>(n)] != 0, network.rest_positions(2, n) == 0) << "node " << n;
+    EXPECT_EQ(network.held[static_cast<std::size_t>(n)] != 0, network.rest_positions(2, n) == 0)
+        << "node " << n;
 
   // 26 cell faces on the outside, two triangles each, enclosing the box.
   EXPECT_EQ(network.triangles.size(), 2u * 2 * (3 * 4 + 4 * 2 + 3 * 2));
@@ -49,7 +54,8 @@ TEST(SpringLattice, PaperFrontObjectIsTheBoxLatticeTheSceneDeclares) {
   ASSERT_EQ(body.section_count, 5);
   for (int n = 0; n < network.node_count(); ++n)
     EXPECT_EQ(body.section_of_node[static_cast<std::size_t>(n)],
-              std::lround((network.rest_positions(1, n) - 0.01595) / 0.024725)) << "node " << n;
+              std::lround((network.rest_positions(1, n) - 0.01595) / 0.024725))
+        << "node " << n;
   EXPECT_DOUBLE_EQ(network.parameters.node_damping, 0);
   EXPECT_EQ(network.parameters.gravity, Eigen::Vector3d::Zero());
 }
@@ -87,26 +93,35 @@ std::string lattice_error(const std::string& text) {
 }
 
 TEST(SpringLattice, SceneErrorsNameFileLineKeyAndExpectation) {
-  EXPECT_EQ(std::get<MassSpringModel>(build_model(parse_scene(kLatticeScene, "lattice.yaml")).bodies[0]).network.node_count(), 12);
+  EXPECT_EQ(
+      std::get<MassSpringModel>(build_model(parse_scene(kLatticeScene, "lattice.yaml")).bodies[0])
+          .network.node_count(),
+      12);
   const std::pair<std::string, std::vector<std::string>> cases[] = {
-      {lattice_scene_with("    lattice:\n", "    tube: {centre_line: [[0, 0, 0], [1, 0, 0]], radius: 1, sections: 2}\n    lattice:\n"),
+      {lattice_scene_with("    lattice:\n",
+                          "    tube: {centre_line: [[0, 0, 0], [1, 0, 0]], radius: 1, sections: "
+                          "2}\n    lattice:\n"),
        {"lattice.yaml:3:", "objects[0]", "exactly one of tube or lattice"}},
-      {lattice_scene_with("    fixed:\n", "    material: {youngs_modulus: 1, density: 1}\n    fixed:\n"),
+      {lattice_scene_with("    fixed:\n",
+                          "    material: {youngs_modulus: 1, density: 1}\n    fixed:\n"),
        {"lattice.yaml:10:", "objects[0].material", "a lattice takes no material"}},
       {lattice_scene_with("divisions: [1, 2, 1]", "divisions: [1, 0, 1]"),
        {"lattice.yaml:6:", "objects[0].lattice.box.divisions[1]", "an integer from 1 to 100"}},
       {lattice_scene_with("spring_damping: 0.1", "spring_damping: -0.1"),
        {"lattice.yaml:8:", "objects[0].lattice.spring_damping", ">= 0"}},
-      {lattice_scene_with("node_mass: 0.05", "node_mass: 0"), {"lattice.yaml:9:", "objects[0].lattice.node_mass", "positive mass"}},
+      {lattice_scene_with("node_mass: 0.05", "node_mass: 0"),
+       {"lattice.yaml:9:", "objects[0].lattice.node_mass", "positive mass"}},
       {lattice_scene_with("spring_stiffness: 100", "spring_stiffness: 100\n      material: 1"),
        {"lattice.yaml:", "objects[0].lattice", "material", "spring_stiffness"}},
-      {lattice_scene_with("point: [0, 0, 0], normal: [0, 0, 1]", "point: [0, 0, 50], normal: [0, 0, 1]"),
+      {lattice_scene_with("point: [0, 0, 0], normal: [0, 0, 1]",
+                          "point: [0, 0, 50], normal: [0, 0, 1]"),
        {"lattice.yaml:11:", "objects[0].fixed[0]", "selects no node"}},
   };
   for (const auto& [text, fragments] : cases) {
     const std::string message = lattice_error(text);
     for (const std::string& fragment : fragments)
-      EXPECT_NE(message.find(fragment), std::string::npos) << "message: " << message << "\nlacks: " << fragment;
+      EXPECT_NE(message.find(fragment), std::string::npos)
+          << "message: " << message << "\nlacks: " << fragment;
   }
 }
 

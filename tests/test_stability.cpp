@@ -55,7 +55,8 @@ TEST(PassivityController, BoundsWhatAnActiveEnvironmentGivesTheHand) {
     last_f = out;
   }
   const double uncontrolled = 20 * velocity.squaredNorm() * 2.0;  // 4 mJ over 2 s
-  EXPECT_LT(work_on_hand, 1e-4 + 1e-5) << "at most the tolerance and one tick's work; uncontrolled " << uncontrolled;
+  EXPECT_LT(work_on_hand, 1e-4 + 1e-5)
+      << "at most the tolerance and one tick's work; uncontrolled " << uncontrolled;
   EXPECT_GT(controller.active_ticks(), 1000);
   EXPECT_GT(controller.dissipated_energy(), 0.9 * uncontrolled);
 }
@@ -135,7 +136,9 @@ TEST(HapticLoop, PassivityControlStopsAnActiveForceFromFeedingTheHand) {
     channels->tracing = true;
     channels->force.back() = ForceSlot{Eigen::Vector3d(0.5, 0, 0), monotonic_now_ns(), 1, true};
     channels->force.publish();
-    ScriptedDevice device(Trajectory({0.0, 1.0}, {Eigen::Vector3d::Zero(), Eigen::Vector3d(0.02, 0, 0)}, "slide"), 3.3);
+    ScriptedDevice device(
+        Trajectory({0.0, 1.0}, {Eigen::Vector3d::Zero(), Eigen::Vector3d(0.02, 0, 0)}, "slide"),
+        3.3);
     HapticLoopSettings settings;
     settings.protocol = HapticProtocol::p0;
     settings.duration_s = 0.6;

@@ -80,8 +80,9 @@ std::string study_file_error(const fs::path& dir, const std::string& body) {
 
 TEST(StudyFile, CrossesTheFactorsAndOrdersTheTrialsAsAsked) {
   const fs::path dir = testing::scratch_directory("study-file");
-  write_study_files(dir, study_text("  shift_ms: [0, 30]\n  step_nodes: [0, 150]\n  protocol: [P0, P1]",
-                                    "{kind: random, seed: 7}", 2));
+  write_study_files(dir,
+                    study_text("  shift_ms: [0, 30]\n  step_nodes: [0, 150]\n  protocol: [P0, P1]",
+                               "{kind: random, seed: 7}", 2));
   const Study study = load_study(dir / "study.yaml");
   ASSERT_EQ(study.conditions.size(), 8u);
   ASSERT_EQ(study.trials.size(), 16u);
@@ -92,7 +93,8 @@ TEST(StudyFile, CrossesTheFactorsAndOrdersTheTrialsAsAsked) {
   // Each repetition runs every condition once; the seed makes the order reproducible and
   // the two repetitions differ.
   std::vector<std::string> first, second;
-  for (const StudyTrial& t : study.trials) (t.repetition == 1 ? first : second).push_back(t.condition.name());
+  for (const StudyTrial& t : study.trials)
+    (t.repetition == 1 ? first : second).push_back(t.condition.name());
   EXPECT_EQ(std::set<std::string>(first.begin(), first.end()), names);
   EXPECT_EQ(std::set<std::string>(second.begin(), second.end()), names);
   EXPECT_NE(first, second);
@@ -103,7 +105,8 @@ TEST(StudyFile, CrossesTheFactorsAndOrdersTheTrialsAsAsked) {
 
 TEST(StudyFile, ALatinSquareBalancesPositionsAndSuccessions) {
   const fs::path dir = testing::scratch_directory("study-latin");
-  write_study_files(dir, study_text("  step_nodes: [0, 150]\n  protocol: [P0, P1]", "{kind: latin_square}", 4));
+  write_study_files(
+      dir, study_text("  step_nodes: [0, 150]\n  protocol: [P0, P1]", "{kind: latin_square}", 4));
   const Study study = load_study(dir / "study.yaml");
   ASSERT_EQ(study.trials.size(), 16u);
   // Every condition once in every position, and every ordered pair of conditions once as
@@ -112,12 +115,15 @@ TEST(StudyFile, ALatinSquareBalancesPositionsAndSuccessions) {
   std::map<std::pair<std::string, std::string>, int> succession_count;
   for (std::size_t k = 0; k < study.trials.size(); ++k) {
     position_count[{k % 4, study.trials[k].condition.name()}]++;
-    if (k % 4 != 3) succession_count[{study.trials[k].condition.name(), study.trials[k + 1].condition.name()}]++;
+    if (k % 4 != 3)
+      succession_count[{study.trials[k].condition.name(), study.trials[k + 1].condition.name()}]++;
   }
   EXPECT_EQ(position_count.size(), 16u);
-  for (const auto& [key, count] : position_count) EXPECT_EQ(count, 1) << key.second << " at " << key.first;
+  for (const auto& [key, count] : position_count)
+    EXPECT_EQ(count, 1) << key.second << " at " << key.first;
   EXPECT_EQ(succession_count.size(), 12u);
-  for (const auto& [pair, count] : succession_count) EXPECT_EQ(count, 1) << pair.first << " -> " << pair.second;
+  for (const auto& [pair, count] : succession_count)
+    EXPECT_EQ(count, 1) << pair.first << " -> " << pair.second;
 }
 
 TEST(StudyFile, MistakesAreNamedWithTheirKey) {
@@ -137,7 +143,8 @@ TEST(StudyFile, MistakesAreNamedWithTheirKey) {
   EXPECT_NE(e.find("column of trials.csv"), std::string::npos) << e;
   body = study_text("  shift_ms: [0]");
   const std::string one = "  - {name: s1, device: script, trajectory: press.yaml}\n";
-  e = error_of(body.insert(body.find(one) + one.size(), "  - {name: s2, device: script, trajectory: press.yaml}\n"));
+  e = error_of(body.insert(body.find(one) + one.size(),
+                           "  - {name: s2, device: script, trajectory: press.yaml}\n"));
   EXPECT_NE(e.find("2 participants, but the scene"), std::string::npos) << e;
   e = error_of("scene: nowhere.yaml\nparticipants: []\nfactors: {}\n");
   EXPECT_NE(e.find("nowhere.yaml"), std::string::npos) << e;
@@ -161,7 +168,9 @@ TEST(Study, TwoConditionsRunWithTheRealProgramsAndAnInterruptedStudyContinues) {
     EXPECT_EQ(row.at("step_nodes"), "150");
     by_protocol[row.at("protocol")] = row;
   }
-  const auto value = [&](const char* protocol, const char* column) { return std::stod(by_protocol[protocol].at(column)); };
+  const auto value = [&](const char* protocol, const char* column) {
+    return std::stod(by_protocol[protocol].at(column));
+  };
   // P0: the hand meets each simulation step once, so the force changes at the simulation's
   // rate in contact: within 25 %, or 3 steps over the contact time when the simulation is
   // slow (a loaded machine), since the client's stroke and the server's pressing steps
@@ -171,8 +180,10 @@ TEST(Study, TwoConditionsRunWithTheRealProgramsAndAnInterruptedStudyContinues) {
   const double p0_sim = value("P0", "contact_sim_rate_hz");
   const double edge_margin = std::max(0.25 * p0_sim, 3 / value("P0", "contact_time_s"));
   const double p1_rate = value("P1", "force_update_rate_hz");
-  std::printf("  P0: force updates %.0f/s, simulation %.0f/s in contact; P1: force updates %.0f/s (simulation %.0f/s)\n",
-              p0_rate, p0_sim, p1_rate, value("P1", "contact_sim_rate_hz"));
+  std::printf(
+      "  P0: force updates %.0f/s, simulation %.0f/s in contact; P1: force updates %.0f/s "
+      "(simulation %.0f/s)\n",
+      p0_rate, p0_sim, p1_rate, value("P1", "contact_sim_rate_hz"));
   EXPECT_GT(p0_rate, 0);
   EXPECT_LE(p0_rate, p0_sim + edge_margin);
   EXPECT_GE(p0_rate, p0_sim - edge_margin);
@@ -180,7 +191,8 @@ TEST(Study, TwoConditionsRunWithTheRealProgramsAndAnInterruptedStudyContinues) {
   EXPECT_GT(p1_rate, 300);
   for (const char* protocol : {"P0", "P1"}) {
     EXPECT_GT(value(protocol, "peak_force_n"), 0.1) << protocol;
-    EXPECT_LT(value(protocol, "peak_force_n"), 3.3) << protocol << ": below the force limit, not clamped";
+    EXPECT_LT(value(protocol, "peak_force_n"), 3.3)
+        << protocol << ": below the force limit, not clamped";
     EXPECT_EQ(value(protocol, "n_strokes"), 1) << protocol;
   }
 
@@ -242,9 +254,11 @@ TEST(Study, OnAMachineSlowedByBusyProcessesAPressIsStillOneStroke) {
   const fs::path dir = testing::scratch_directory("study-slowed");
   std::vector<std::unique_ptr<ChildProcess>> busy;
   for (int i = 0; i < 3; ++i)
-    busy.push_back(std::make_unique<ChildProcess>("/bin/sh", std::vector<std::string>{"-c", "while :; do :; done"},
-                                                  dir / fmt::format("busy{}.log", i)));
-  write_study_files(dir, study_text("  step_nodes: [150]\n  protocol: [P1, P0]", "{kind: sequential}", 2));
+    busy.push_back(std::make_unique<ChildProcess>(
+        "/bin/sh", std::vector<std::string>{"-c", "while :; do :; done"},
+        dir / fmt::format("busy{}.log", i)));
+  write_study_files(
+      dir, study_text("  step_nodes: [150]\n  protocol: [P1, P0]", "{kind: sequential}", 2));
   StudyRunOptions options;
   options.out = dir / "out";
   options.server_program = testing::server_program();
@@ -256,15 +270,15 @@ TEST(Study, OnAMachineSlowedByBusyProcessesAPressIsStillOneStroke) {
   ASSERT_EQ(rows.size(), 4u);
   for (const auto& row : rows) {
     const std::string trial = row.at("condition") + " #" + row.at("repetition");
-    std::printf("  %s: %s stroke(s), %s fade(s) (%s s), peak %s N\n", trial.c_str(), row.at("n_strokes").c_str(),
-                row.at("fades").c_str(), row.at("fade_s").c_str(), row.at("peak_force_n").c_str());
+    std::printf("  %s: %s stroke(s), %s fade(s) (%s s), peak %s N\n", trial.c_str(),
+                row.at("n_strokes").c_str(), row.at("fades").c_str(), row.at("fade_s").c_str(),
+                row.at("peak_force_n").c_str());
     EXPECT_EQ(row.at("status"), "ok") << trial;
     EXPECT_EQ(std::stod(row.at("n_strokes")), 1) << trial;
     EXPECT_GE(std::stod(row.at("fades")), 0) << trial << ": the client's report counts its fades";
     EXPECT_GE(std::stod(row.at("fade_s")), 0) << trial;
   }
 }
-
 
 // A paired-comparison block: the conditions' trials, then simulated subjects' ratings.
 std::string paired_study_text(const std::string& factors, int subjects) {
@@ -304,7 +318,7 @@ TEST(PairedComparisonStudyFile, EverySubjectMeetsEveryPairOnceInABalancedOrder) 
   constexpr int kConditions = 4, kSubjects = 6;
   const std::vector<PresentedPair> plan = presentation_plan(kConditions, kSubjects);
   ASSERT_EQ(plan.size(), static_cast<std::size_t>(kSubjects * 6));
-  std::map<std::pair<int, int>, int> presented;     // (first, second) -> subjects
+  std::map<std::pair<int, int>, int> presented;       // (first, second) -> subjects
   std::map<std::pair<int, int>, int> first_position;  // (low, high) -> subjects that met it first
   for (int subject = 0; subject < kSubjects; ++subject) {
     std::set<std::pair<int, int>> met;
@@ -313,7 +327,8 @@ TEST(PairedComparisonStudyFile, EverySubjectMeetsEveryPairOnceInABalancedOrder) 
       EXPECT_NE(pair.first, pair.second);
       met.emplace(std::min(pair.first, pair.second), std::max(pair.first, pair.second));
       ++presented[{pair.first, pair.second}];
-      if (pair.position == 0) ++first_position[{std::min(pair.first, pair.second), std::max(pair.first, pair.second)}];
+      if (pair.position == 0)
+        ++first_position[{std::min(pair.first, pair.second), std::max(pair.first, pair.second)}];
     }
     EXPECT_EQ(met.size(), 6u) << "subject " << subject << " meets every pair once";
   }
@@ -330,10 +345,12 @@ TEST(PairedComparisonStudyFile, EverySubjectMeetsEveryPairOnceInABalancedOrder) 
 // With 150 nodes held P0's force changes only at the slowed simulation's rate, P1's at every
 // haptic tick: simulated subjects, rating from the trials' measures, find P1 finer, and
 // Scheffe's analysis says so beyond its 5 % yardstick.
-TEST(PairedComparisonStudy, SimulatedSubjectsRateEveryPairOnceAndTheAnalysisFindsP1FinerUnderStepDelay) {
+TEST(PairedComparisonStudy,
+     SimulatedSubjectsRateEveryPairOnceAndTheAnalysisFindsP1FinerUnderStepDelay) {
   const fs::path dir = testing::scratch_directory("paired-run");
   constexpr int kSubjects = 4;
-  write_study_files(dir, paired_study_text("  step_nodes: [0, 150]\n  protocol: [P0, P1]", kSubjects));
+  write_study_files(dir,
+                    paired_study_text("  step_nodes: [0, 150]\n  protocol: [P0, P1]", kSubjects));
   StudyRunOptions options;
   options.out = dir / "out";
   options.server_program = testing::server_program();
@@ -360,7 +377,8 @@ TEST(PairedComparisonStudy, SimulatedSubjectsRateEveryPairOnceAndTheAnalysisFind
     if (std::stod(row.at("level")) == 0.05) yardstick_05 = std::stod(row.at("yardstick"));
   ASSERT_GT(yardstick_05, 0);
   std::printf("  scale values: T0-P0 %.3f, T0-P1 %.3f, T150-P0 %.3f, T150-P1 %.3f; Y(0.05) %.3f\n",
-              scale.at("S0-T0-P0"), scale.at("S0-T0-P1"), scale.at("S0-T150-P0"), scale.at("S0-T150-P1"), yardstick_05);
+              scale.at("S0-T0-P0"), scale.at("S0-T0-P1"), scale.at("S0-T150-P0"),
+              scale.at("S0-T150-P1"), yardstick_05);
   EXPECT_GT(scale.at("S0-T150-P1") - scale.at("S0-T150-P0"), yardstick_05);
   bool found = false;
   for (const auto& row : testing::read_csv_table(options.out / "analysis" / "differences.csv"))
@@ -416,7 +434,8 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
     EXPECT_EQ(run_study(dir / "study.yaml", options), 0) << out.str();
     return out.str();
   };
-  EXPECT_NE(study_file_error(dir, person_study_text(2) + "participants: []\n").find("has no simulated participants"),
+  EXPECT_NE(study_file_error(dir, person_study_text(2) + "participants: []\n")
+                .find("has no simulated participants"),
             std::string::npos);
   write_study_files(dir, person_study_text(2));
   options.subject = 0;
@@ -428,7 +447,9 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
   EXPECT_NE(said.find("You are feeling: SECOND"), std::string::npos) << said;
   EXPECT_NE(said.find("stopped: run the same command again"), std::string::npos) << said;
   for (const char* secret : {"S0-T", "P0", "P1", "step", "150"})
-    EXPECT_EQ(said.find(secret), std::string::npos) << "the terminal names no condition: " << secret << "\n" << said;
+    EXPECT_EQ(said.find(secret), std::string::npos)
+        << "the terminal names no condition: " << secret << "\n"
+        << said;
   auto ratings = testing::read_csv_table(options.out / "ratings.csv");
   ASSERT_EQ(ratings.size(), 2u);
   EXPECT_EQ(ratings[0].at("rating"), "1");
@@ -439,7 +460,8 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
   said = session(1, "1\n\n0\n\ns\n-1\n\n2\ny\n");
   EXPECT_EQ(said.find("Practice"), std::string::npos) << said;
   EXPECT_NE(said.find("2 rated"), std::string::npos) << said;
-  EXPECT_NE(said.find("6 of 12 ratings"), std::string::npos) << "the analysis waits for subject 2\n" << said;
+  EXPECT_NE(said.find("6 of 12 ratings"), std::string::npos) << "the analysis waits for subject 2\n"
+                                                             << said;
   said = session(2, "n\n1\n\n1\n\n1\n\ns\n1\n\n1\n\n1\n\n");
   EXPECT_NE(said.find("wrote"), std::string::npos) << said;
   ratings = testing::read_csv_table(options.out / "ratings.csv");
@@ -450,7 +472,8 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
   // Every "s" is a switch, in switches.csv and in its pair's server recording.
   const auto switches = testing::read_csv_table(options.out / "switches.csv");
   EXPECT_EQ(switches.size(), 2u + 3u + 1u + 1u) << "practice 2, pairs 1 + 2, then 1, then 1";
-  const record::Recording pair = record::read_recording(options.out / "pairs" / "s01-p01" / "server.mcap");
+  const record::Recording pair =
+      record::read_recording(options.out / "pairs" / "s01-p01" / "server.mcap");
   std::vector<std::string> served;
   for (const record::SimulationStep& step : pair.steps)
     if (step.has_condition_switch()) served.push_back(step.condition_switch().name());
@@ -460,7 +483,8 @@ TEST(PairedComparisonStudy, PeopleRateEachPairSwitchingBlindAndAStoppedSessionCo
 // A subject's lines, each after a pause: a person typing, not a script read at once.
 class TypedLines : public std::streambuf {
  public:
-  explicit TypedLines(std::vector<std::pair<std::chrono::milliseconds, std::string>> lines) : lines_(std::move(lines)) {}
+  explicit TypedLines(std::vector<std::pair<std::chrono::milliseconds, std::string>> lines)
+      : lines_(std::move(lines)) {}
 
  protected:
   int_type underflow() override {
@@ -491,16 +515,22 @@ TEST(PairedComparisonStudy, AfterThePairsTimeASwitchIsRefusedAndTheSubjectStillR
   options.device = "script:" + (dir / "press.yaml").string();
   options.subject = 1;
   using std::chrono::milliseconds;
-  TypedLines typed({{milliseconds(0), "s"}, {milliseconds(1500), "s"}, {milliseconds(0), "n"}, {milliseconds(0), "+1"},
-                    {milliseconds(0), "y"}, {milliseconds(0), "q"}});
+  TypedLines typed({{milliseconds(0), "s"},
+                    {milliseconds(1500), "s"},
+                    {milliseconds(0), "n"},
+                    {milliseconds(0), "+1"},
+                    {milliseconds(0), "y"},
+                    {milliseconds(0), "q"}});
   std::istream in(&typed);
   std::ostringstream out;
   options.input = &in;
   options.output = &out;
   ASSERT_EQ(run_study(dir / "study.yaml", options), 0) << out.str();
   EXPECT_NE(out.str().find("You are feeling: SECOND"), std::string::npos) << out.str();
-  EXPECT_NE(out.str().find("The pair's time is up: go on to the next pair"), std::string::npos) << out.str();
-  EXPECT_EQ(testing::read_csv_table(options.out / "switches.csv").size(), 1u) << "the late switch was not made";
+  EXPECT_NE(out.str().find("The pair's time is up: go on to the next pair"), std::string::npos)
+      << out.str();
+  EXPECT_EQ(testing::read_csv_table(options.out / "switches.csv").size(), 1u)
+      << "the late switch was not made";
   EXPECT_EQ(testing::read_csv_table(options.out / "ratings.csv").size(), 1u);
 }
 
@@ -526,44 +556,53 @@ segments:
   const fs::path out = dir / "out";
   const auto session = [&](const std::string& name, const std::string& script) {
     ChildProcess lab(COHAPTIC_LAB_EXE,
-                     {"study", (dir / "study.yaml").string(), "--out", out.string(), "--subject", "1", "--device",
-                      "script:" + (dir / "button.yaml").string(), "--rating-page", "127.0.0.1:0", "--server-program",
-                      testing::server_program(), "--client-program", testing::client_program()},
+                     {"study", (dir / "study.yaml").string(), "--out", out.string(), "--subject",
+                      "1", "--device", "script:" + (dir / "button.yaml").string(), "--rating-page",
+                      "127.0.0.1:0", "--server-program", testing::server_program(),
+                      "--client-program", testing::client_program()},
                      dir / (name + "-lab.log"));
     EXPECT_TRUE(testing::wait_for_output(lab, "rating page at"));
     std::smatch match;
     const std::string log = lab.log_text();
     EXPECT_TRUE(std::regex_search(log, match, std::regex(R"(rating page at (http://\S+))"))) << log;
-    ChildProcess node(testing::node_program(),
-                      {(fs::path(COHAPTIC_SOURCE_DIR) / "tests/support/rating_check.mjs").string(), "--url", match[1].str(),
-                       "--script", script, "--screenshot", (dir / (name + ".png")).string()},
-                      dir / (name + "-browser.log"));
+    ChildProcess node(
+        testing::node_program(),
+        {(fs::path(COHAPTIC_SOURCE_DIR) / "tests/support/rating_check.mjs").string(), "--url",
+         match[1].str(), "--script", script, "--screenshot", (dir / (name + ".png")).string()},
+        dir / (name + "-browser.log"));
     EXPECT_EQ(node.wait(std::chrono::minutes(5)), 0) << node.log_text();
     EXPECT_EQ(lab.wait(std::chrono::minutes(1)), 0) << lab.log_text();
     const std::string output = node.log_text();
-    const nlohmann::json result = nlohmann::json::parse(output.substr(output.rfind("\n{\"") + 1), nullptr, false);
+    const nlohmann::json result =
+        nlohmann::json::parse(output.substr(output.rfind("\n{\"") + 1), nullptr, false);
     EXPECT_FALSE(result.is_discarded()) << output;
     EXPECT_TRUE(result.value("errors", nlohmann::json::array()).empty()) << output;
     for (const auto& text : result.value("texts", nlohmann::json::array()))
       for (const char* secret : {"S0-T", "P0", "P1", "T150", "step"})
-        EXPECT_EQ(text.get<std::string>().find(secret), std::string::npos) << "the page names no condition: " << text;
+        EXPECT_EQ(text.get<std::string>().find(secret), std::string::npos)
+            << "the page names no condition: " << text;
     return std::make_pair(result, lab.log_text());
   };
 
   // Each pair starts with the button's switch to SECOND. Practice: back by click, again by
   // key, then on; a pair rated 0 after choosing +1; a pair rated +2 by the arrow keys and
   // Enter; then a stop with a grade chosen.
-  auto [first, log] = session("first", "await:second,switch,key-switch,key-next;"
-                                       "await:second,switch,choose:+1,choose:0,screenshot,confirm;"
-                                       "await:second,key-down,key-down,key-up,key-enter;await:second,choose:-2,stop");
+  auto [first, log] =
+      session("first",
+              "await:second,switch,key-switch,key-next;"
+              "await:second,switch,choose:+1,choose:0,screenshot,confirm;"
+              "await:second,key-down,key-down,key-up,key-enter;await:second,choose:-2,stop");
   ASSERT_EQ(first["steps"].size(), 4u) << first.dump();
   EXPECT_EQ(first["steps"][0]["title"], "Practice pair 1 of 1 (not rated)");
   EXPECT_EQ(first["steps"][0]["screens"][1]["feeling"], "first");
   EXPECT_EQ(first["steps"][0]["screens"][2]["feeling"], "second");
   EXPECT_EQ(first["steps"][1]["screens"][1]["feeling"], "first");
   EXPECT_EQ(first["steps"][1]["screens"][3]["chosen_grade"], 0);
-  EXPECT_NE(first["final"]["note"].get<std::string>().find("Stopped"), std::string::npos) << first.dump();
-  EXPECT_NE(log.find("(rating page)"), std::string::npos) << "the terminal logs the page's commands\n" << log;
+  EXPECT_NE(first["final"]["note"].get<std::string>().find("Stopped"), std::string::npos)
+      << first.dump();
+  EXPECT_NE(log.find("(rating page)"), std::string::npos)
+      << "the terminal logs the page's commands\n"
+      << log;
   EXPECT_NE(log.find("(button) You are feeling: SECOND"), std::string::npos) << log;
   auto ratings = testing::read_csv_table(out / "ratings.csv");
   ASSERT_EQ(ratings.size(), 2u);
@@ -571,16 +610,21 @@ segments:
   EXPECT_EQ(ratings[1].at("rating"), "2");
 
   // Again: no practice, pairs 3 to 6; the analysis waits for subject 2.
-  auto [second, second_log] = session("second", "await:second,choose:-1,confirm;await:second,switch,choose:+1,confirm;"
-                                                 "await:second,choose:+2,confirm;await:second,key-up,key-enter");
+  auto [second, second_log] =
+      session("second",
+              "await:second,choose:-1,confirm;await:second,switch,choose:+1,confirm;"
+              "await:second,choose:+2,confirm;await:second,key-up,key-enter");
   ASSERT_EQ(second["steps"].size(), 4u) << second.dump();
   EXPECT_EQ(second["steps"][0]["title"], "Pair 3 of 6");
-  EXPECT_NE(second["final"]["note"].get<std::string>().find("Every pair is rated"), std::string::npos) << second.dump();
+  EXPECT_NE(second["final"]["note"].get<std::string>().find("Every pair is rated"),
+            std::string::npos)
+      << second.dump();
   EXPECT_EQ(second["final"]["rated"], 6);
   ratings = testing::read_csv_table(out / "ratings.csv");
   ASSERT_EQ(ratings.size(), 6u);
   const std::vector<std::string> expected = {"0", "2", "-1", "1", "2", "-2"};
-  for (std::size_t k = 0; k < expected.size(); ++k) EXPECT_EQ(ratings[k].at("rating"), expected[k]) << k;
+  for (std::size_t k = 0; k < expected.size(); ++k)
+    EXPECT_EQ(ratings[k].at("rating"), expected[k]) << k;
   EXPECT_NE(second_log.find("6 of 12 ratings"), std::string::npos) << second_log;
 
   // Every switch, pressed or clicked: the button's in each of the 8 pairs served (pair 3

@@ -36,7 +36,8 @@ std::string xml_problem(const std::string& xml) {
   };
   while (i < xml.size()) {
     const std::size_t lt = xml.find('<', i);
-    if (const std::string p = check_text(std::string_view(xml).substr(i, lt - i)); !p.empty()) return p;
+    if (const std::string p = check_text(std::string_view(xml).substr(i, lt - i)); !p.empty())
+      return p;
     if (lt == std::string::npos) break;
     if (xml.compare(lt, 2, "<?") == 0) {
       i = xml.find("?>", lt);
@@ -51,7 +52,8 @@ std::string xml_problem(const std::string& xml) {
     // Attribute values are quoted and escaped: an even number of quotes.
     if (std::count(tag.begin(), tag.end(), '"') % 2 != 0) return "odd quotes in <" + tag + ">";
     if (tag.starts_with("/")) {
-      if (open.empty() || open.back() != tag.substr(1)) return "unbalanced </" + tag.substr(1) + ">";
+      if (open.empty() || open.back() != tag.substr(1))
+        return "unbalanced </" + tag.substr(1) + ">";
       open.pop_back();
     } else {
       const std::string name = tag.substr(0, tag.find_first_of(" /"));
@@ -76,9 +78,11 @@ int count(const std::string& text, const std::string& what) {
 
 // Every number in a coordinate attribute parses and is finite; returns how many there were.
 int check_coordinates(const std::string& svg) {
-  static const std::regex attribute(R"re(\b(x|y|x1|y1|x2|y2|cx|cy|width|height|points)="([^"]*)")re");
+  static const std::regex attribute(
+      R"re(\b(x|y|x1|y1|x2|y2|cx|cy|width|height|points)="([^"]*)")re");
   int numbers = 0;
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), attribute); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), attribute);
+       it != std::sregex_iterator(); ++it) {
     std::string value = (*it)[2];
     for (char& ch : value)
       if (ch == ',') ch = ' ';
@@ -146,9 +150,11 @@ TEST(SvgPlot, BarChartHasOneRectPerFiniteBarAndErrorBars) {
   EXPECT_EQ(svg.find("nan"), std::string::npos);
 
   // Heights are proportional to the means, measured from the zero line.
-  static const std::regex rect(R"re(<rect class="bar" x="[^"]*" y="([^"]*)" width="[^"]*" height="([^"]*)")re");
+  static const std::regex rect(
+      R"re(<rect class="bar" x="[^"]*" y="([^"]*)" width="[^"]*" height="([^"]*)")re");
   std::vector<double> heights;
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), rect); it != std::sregex_iterator(); ++it)
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), rect); it != std::sregex_iterator();
+       ++it)
     heights.push_back(std::stod((*it)[2]));
   ASSERT_EQ(heights.size(), 4u);
   EXPECT_NEAR(heights[1] / heights[0], 5, 0.01);
@@ -156,7 +162,8 @@ TEST(SvgPlot, BarChartHasOneRectPerFiniteBarAndErrorBars) {
 }
 
 TEST(SvgPlot, TextAndColoursAreEscaped) {
-  EXPECT_EQ(xml_escape("a < b & c > \"d\" 'e'\x01"), "a &lt; b &amp; c &gt; &quot;d&quot; &apos;e&apos;");
+  EXPECT_EQ(xml_escape("a < b & c > \"d\" 'e'\x01"),
+            "a &lt; b &amp; c &gt; &quot;d&quot; &apos;e&apos;");
   LinePlot plot = three_series();
   plot.title = "F < 5 N & \"x\" > 0";
   plot.series[0].label = "<script>alert(1)</script>";
@@ -175,8 +182,11 @@ TEST(SvgPlot, NanEmptyConstantAndSinglePointSeriesDoNotCrash) {
   plot.series.push_back({"empty", {}, {}, "", false});
   plot.series.push_back({"all NaN", {kNaN, kNaN}, {1, kNaN}, "", false});
   plot.series.push_back({"constant", {0, 1, 2, 3}, {2, 2, 2, 2}, "", false});
-  plot.series.push_back(
-      {"with gaps", {0, kNaN, 2, 3, std::numeric_limits<double>::infinity()}, {1, 5, kNaN, 3, 4}, "", true});
+  plot.series.push_back({"with gaps",
+                         {0, kNaN, 2, 3, std::numeric_limits<double>::infinity()},
+                         {1, 5, kNaN, 3, 4},
+                         "",
+                         true});
   plot.series.push_back({"single", {1.5}, {2.5}, "", false});
   plot.series.push_back({"uneven", {0, 1, 2}, {1, 2}, "", false});
   const std::string svg = render_svg(plot);
@@ -204,7 +214,8 @@ TEST(SvgPlot, NanEmptyConstantAndSinglePointSeriesDoNotCrash) {
 TEST(SvgPlot, TicksAreRoundNumbersCoveringTheRange) {
   const struct {
     double lo, hi;
-  } cases[] = {{0, 1}, {0.013, 0.87}, {-3.7, 12.2}, {1000, 1003}, {-1e-6, 2e-6}, {42, 4200}, {0.1, 0.3}};
+  } cases[] = {{0, 1},        {0.013, 0.87}, {-3.7, 12.2}, {1000, 1003},
+               {-1e-6, 2e-6}, {42, 4200},    {0.1, 0.3}};
   for (const auto& c : cases) {
     const std::vector<double> ticks = nice_ticks(c.lo, c.hi);
     ASSERT_GE(ticks.size(), 3u) << c.lo << " " << c.hi;
@@ -213,7 +224,8 @@ TEST(SvgPlot, TicksAreRoundNumbersCoveringTheRange) {
     EXPECT_GE(ticks.back(), c.hi);
     const double step = ticks[1] - ticks[0];
     const double mantissa = step / std::pow(10.0, std::floor(std::log10(step) + 1e-9));
-    EXPECT_TRUE(std::abs(mantissa - 1) < 1e-6 || std::abs(mantissa - 2) < 1e-6 || std::abs(mantissa - 5) < 1e-6)
+    EXPECT_TRUE(std::abs(mantissa - 1) < 1e-6 || std::abs(mantissa - 2) < 1e-6 ||
+                std::abs(mantissa - 5) < 1e-6)
         << step;
     for (double t : ticks) EXPECT_NEAR(t / step, std::round(t / step), 1e-6) << t;
   }
@@ -234,7 +246,9 @@ TEST(SvgPlot, WriteSvgWritesTheWholeFile) {
   std::stringstream text;
   text << in.rdbuf();
   EXPECT_EQ(text.str(), render_svg(plot));
-  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()), 1);
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir),
+                          std::filesystem::directory_iterator()),
+            1);
   EXPECT_THROW(write_svg(dir / "missing" / "plot.svg", plot), Error);
 }
 

@@ -64,7 +64,8 @@ TEST(RemoteToolBuffer, NewestIgnoresTheDelayAndAdaptiveFollowsTheSampleAge) {
   std::uniform_int_distribution<int> jitter_us(0, 8000);
   for (int ms = 0; ms < 1000; ++ms) {
     const std::int64_t t = ms * 1'000'000LL;
-    const std::int64_t arrival = t + 10'000'000 + jitter_us(rng) * 1000LL;  // 10-18 ms old on arrival
+    const std::int64_t arrival =
+        t + 10'000'000 + jitter_us(rng) * 1000LL;  // 10-18 ms old on arrival
     newest.add(t, arrival, Eigen::Vector3d(ms, 0, 0), true);
     adaptive.add(t, arrival, Eigen::Vector3d(ms, 0, 0), true);
   }
@@ -172,7 +173,7 @@ TEST(ThreadHandOver, TheTripleBufferNeverShowsATornValueAndEndsOnTheNewest) {
 }
 
 TEST(Histogram, QuantilesOfKnownDistributions) {
-  Histogram h(1000, 100);  // 1 us bins up to 100 us
+  Histogram h(1000, 100);                                            // 1 us bins up to 100 us
   for (int v = 1; v <= 100000; ++v) h.record(v % 100 * 1000 + 500);  // uniform over the bins
   EXPECT_EQ(h.quantile(0.5), 50'000);
   EXPECT_EQ(h.quantile(0.99), 99'000);

@@ -33,13 +33,15 @@ TEST(ContactReference, EqualsTheOneShotFullSolveAndFactorsEachContactSetOnce) {
   int queries = 0;
   for (int trial = 0; trial < 30; ++trial) {
     // A near (-30, 0), B near (30, 20): never on triangles sharing a node.
-    const std::vector<PressedTool> tools = {{mm(-30 + along(rng), along(rng), -depth(rng)), 0},
-                                            {mm(30 + along(rng), 20 + along(rng), trial % 3 == 0 ? 1.0 : -depth(rng)), 0}};
+    const std::vector<PressedTool> tools = {
+        {mm(-30 + along(rng), along(rng), -depth(rng)), 0},
+        {mm(30 + along(rng), 20 + along(rng), trial % 3 == 0 ? 1.0 : -depth(rng)), 0}};
     const std::vector<Eigen::Vector3d> cached = reference.forces(tools);
-    const std::vector<ToolReaction> direct =
-        contact_reactions_reference(body, find_tool_contacts(body, tools), {}, ContactModel::node_translation);
+    const std::vector<ToolReaction> direct = contact_reactions_reference(
+        body, find_tool_contacts(body, tools), {}, ContactModel::node_translation);
     for (std::size_t u = 0; u < tools.size(); ++u)
-      EXPECT_LE((cached[u] - direct[u].reaction).norm(), 1e-9 * std::max(1e-3, direct[u].reaction.norm()))
+      EXPECT_LE((cached[u] - direct[u].reaction).norm(),
+                1e-9 * std::max(1e-3, direct[u].reaction.norm()))
           << "trial " << trial << " tool " << u;
     EXPECT_EQ(cached[1].isZero(), trial % 3 == 0) << "B above the face presses nothing";
     ++queries;
@@ -59,7 +61,8 @@ TEST(ContactReference, WithHeldNodesEqualsTheOneShotFullSolve) {
     const Eigen::Vector3d x = body.mesh.nodes.col(node);
     if (std::abs(x.z()) < 1e-9 && (std::abs(x.x()) > 0.05 || x.y() < -0.04)) {
       held.nodes.push_back(node);
-      held.displacement.emplace_back(1e-4, -2e-4, -3e-4 * static_cast<double>(held.nodes.size() % 3));
+      held.displacement.emplace_back(1e-4, -2e-4,
+                                     -3e-4 * static_cast<double>(held.nodes.size() % 3));
     }
   }
   ASSERT_EQ(held.nodes.size(), 28u);
@@ -69,20 +72,24 @@ TEST(ContactReference, WithHeldNodesEqualsTheOneShotFullSolve) {
     const std::vector<PressedTool> tools = {{mm(-20 + along(rng), along(rng), -depth(rng)), 0},
                                             {mm(20 + along(rng), 20 + along(rng), -depth(rng)), 0}};
     const std::vector<Eigen::Vector3d> cached = reference.forces(tools, held);
-    const std::vector<ToolReaction> direct =
-        contact_reactions_reference(body, find_tool_contacts(body, tools), held, ContactModel::node_translation);
+    const std::vector<ToolReaction> direct = contact_reactions_reference(
+        body, find_tool_contacts(body, tools), held, ContactModel::node_translation);
     for (std::size_t u = 0; u < tools.size(); ++u)
-      EXPECT_LE((cached[u] - direct[u].reaction).norm(), 1e-9 * direct[u].reaction.norm()) << "trial " << trial;
+      EXPECT_LE((cached[u] - direct[u].reaction).norm(), 1e-9 * direct[u].reaction.norm())
+          << "trial " << trial;
   }
   // A held node under a tool is not held: the tool wins, as in the simulation (the held
   // set may be a simulation step older than the tools).
   HeldNodes under = held;
   const std::vector<PressedTool> one = {{mm(-20, 0, -1), 0}, {mm(20, 20, 1), 0}};
-  under.nodes.push_back(body.surface.triangles[find_tool_contacts(body, one)[0].contact->triangle][0]);
+  under.nodes.push_back(
+      body.surface.triangles[find_tool_contacts(body, one)[0].contact->triangle][0]);
   under.displacement.emplace_back(0, 0, 1e-3);
   const Eigen::Vector3d tool_wins = reference.forces(one, under)[0];
-  const Eigen::Vector3d without = contact_reactions_reference(body, find_tool_contacts(body, one), held,
-                                                              ContactModel::node_translation)[0].reaction;
+  const Eigen::Vector3d without =
+      contact_reactions_reference(body, find_tool_contacts(body, one), held,
+                                  ContactModel::node_translation)[0]
+          .reaction;
   EXPECT_LE((tool_wins - without).norm(), 1e-9 * without.norm());
 }
 
@@ -103,8 +110,10 @@ TEST(Tradeoff, GridVariesOneKnobAtATimeFromTheScenesOwnSettings) {
   for (const TradeoffSetting& s : grid) {
     ++per_knob[s.knob];
     int differences = (s.divisions != 0) + (s.formulation != grid.front().formulation) +
-                      (s.contact_model != grid.front().contact_model) + (s.patch_rings != grid.front().patch_rings) +
-                      (s.precision != grid.front().precision) + (s.ir_rate_hz != grid.front().ir_rate_hz) +
+                      (s.contact_model != grid.front().contact_model) +
+                      (s.patch_rings != grid.front().patch_rings) +
+                      (s.precision != grid.front().precision) +
+                      (s.ir_rate_hz != grid.front().ir_rate_hz) +
                       (s.boundary_truncation != grid.front().boundary_truncation) +
                       (s.haptic_rate_hz != grid.front().haptic_rate_hz);
     EXPECT_EQ(differences, s.knob == "baseline" ? 0 : 1) << s.name();
@@ -112,7 +121,8 @@ TEST(Tradeoff, GridVariesOneKnobAtATimeFromTheScenesOwnSettings) {
   EXPECT_EQ(per_knob["divisions"], 2) << "8 is the scene's own";
   EXPECT_EQ(per_knob["haptic_rate_hz"], 3);
   EXPECT_EQ(per_knob.count("boundary_truncation"), 0u) << "no obstacle, nothing held";
-  EXPECT_EQ(single_elastic_object(scene_with(scene, grid[1])).mesh.box->divisions, Eigen::Vector3i(6, 6, 6));
+  EXPECT_EQ(single_elastic_object(scene_with(scene, grid[1])).mesh.box->divisions,
+            Eigen::Vector3i(6, 6, 6));
   // A 1 kHz comparison grid leaves out the haptic rates it cannot sample.
   per_knob.clear();
   for (const TradeoffSetting& s : tradeoff_grid(scene, {}, 1000)) ++per_knob[s.knob];
@@ -129,16 +139,20 @@ TEST(Tradeoff, GridVariesOneKnobAtATimeFromTheScenesOwnSettings) {
   const std::vector<TradeoffSetting> truncation = only_knobs(walled_grid, {"boundary_truncation"});
   ASSERT_EQ(truncation.size(), 4u);
   EXPECT_EQ(truncation[0].knob, "baseline");
-  for (std::size_t i = 1; i < truncation.size(); ++i) EXPECT_EQ(truncation[i].knob, "boundary_truncation");
+  for (std::size_t i = 1; i < truncation.size(); ++i)
+    EXPECT_EQ(truncation[i].knob, "boundary_truncation");
   EXPECT_EQ(only_knobs(walled_grid, {}).size(), walled_grid.size());
-  EXPECT_THROW(only_knobs(grid, {"boundary_truncation"}), Error) << "no obstacle: no truncation setting";
+  EXPECT_THROW(only_knobs(grid, {"boundary_truncation"}), Error)
+      << "no obstacle: no truncation setting";
 }
 
 TEST(Tradeoff, ErrorIsMeasuredAgainstTheReferenceNotAgainstItself) {
   const Scene scene = two_user_cube(6);
   const std::vector<Trajectory> motions = {
-      Trajectory({0, 0.1, 0.3, 0.4}, {mm(-30, -3, 1), mm(-30, -3, -2), mm(-10, -3, -2), mm(-10, -3, 1)}, "A"),
-      Trajectory({0, 0.1, 0.3, 0.4}, {mm(35, 30, 1), mm(35, 30, -1.5), mm(35, 30, -1.5), mm(35, 30, 1)}, "B")};
+      Trajectory({0, 0.1, 0.3, 0.4},
+                 {mm(-30, -3, 1), mm(-30, -3, -2), mm(-10, -3, -2), mm(-10, -3, 1)}, "A"),
+      Trajectory({0, 0.1, 0.3, 0.4},
+                 {mm(35, 30, 1), mm(35, 30, -1.5), mm(35, 30, -1.5), mm(35, 30, 1)}, "B")};
   const TradeoffSetting baseline = tradeoff_grid(scene, {}).front();
   TradeoffSetting finer = baseline;
   finer.divisions = 9;
@@ -156,10 +170,12 @@ TEST(Tradeoff, ErrorIsMeasuredAgainstTheReferenceNotAgainstItself) {
   const ReferenceTrace fine = reference_trace(scene_with(scene, finer), motions, 10000);
   EXPECT_EQ(fine.nodes, 1000);
   const TradeoffRow coarse = run_setting(scene, baseline, motions, fine);
-  EXPECT_NEAR(coarse.own_mesh_error_rms * fine.peak_force, self.own_mesh_error_rms * own.peak_force, 1e-12);
+  EXPECT_NEAR(coarse.own_mesh_error_rms * fine.peak_force, self.own_mesh_error_rms * own.peak_force,
+              1e-12);
   EXPECT_GT(coarse.error_rms, 10 * coarse.own_mesh_error_rms);
-  std::printf("  6-division cube: error %.2f %% against the 9-division solve, %.3f %% against its own\n",
-              100 * coarse.error_rms, 100 * coarse.own_mesh_error_rms);
+  std::printf(
+      "  6-division cube: error %.2f %% against the 9-division solve, %.3f %% against its own\n",
+      100 * coarse.error_rms, 100 * coarse.own_mesh_error_rms);
 
   // A slower haptic loop holds each force longer, so it strays further from the solve.
   TradeoffSetting slow = baseline;

@@ -54,12 +54,12 @@ constexpr std::uint64_t kTransportSession = 0x7e57'0001;
 
 // Frame i is i as 4 bytes: the tests can tell frames apart after they went through the queue.
 Bytes frame_of(std::uint32_t i) {
-  return {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8), static_cast<std::uint8_t>(i >> 16),
-          static_cast<std::uint8_t>(i >> 24)};
+  return {static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8),
+          static_cast<std::uint8_t>(i >> 16), static_cast<std::uint8_t>(i >> 24)};
 }
 std::uint32_t index_of(const Bytes& frame) {
-  return frame[0] | static_cast<std::uint32_t>(frame[1]) << 8 | static_cast<std::uint32_t>(frame[2]) << 16 |
-         static_cast<std::uint32_t>(frame[3]) << 24;
+  return frame[0] | static_cast<std::uint32_t>(frame[1]) << 8 |
+         static_cast<std::uint32_t>(frame[2]) << 16 | static_cast<std::uint32_t>(frame[3]) << 24;
 }
 
 TEST(BoundedWriteQueue, DropsTheOldestSupersededNewestWinsFrameAndRefusesWhenNothingCanGo) {
@@ -72,7 +72,8 @@ TEST(BoundedWriteQueue, DropsTheOldestSupersededNewestWinsFrameAndRefusesWhenNot
   // Full. A must-arrive frame: the only newest-wins frame waiting is the newest, so it stays.
   EXPECT_EQ(queue.push(frame_of(4), FrameKind::must_arrive), BoundedWriteQueue::Push::refused);
   // A newest-wins frame supersedes frame 2 (not frame 0, which is being written).
-  EXPECT_EQ(queue.push(frame_of(5), FrameKind::newest_wins), BoundedWriteQueue::Push::queued_after_drop);
+  EXPECT_EQ(queue.push(frame_of(5), FrameKind::newest_wins),
+            BoundedWriteQueue::Push::queued_after_drop);
   EXPECT_EQ(queue.dropped(), 1u);
   EXPECT_EQ(queue.waiting(), 3u);
   EXPECT_EQ(queue.begin_write(), nullptr);  // one at a time
@@ -97,7 +98,8 @@ TEST(BoundedWriteQueue, UnderRandomTrafficKeepsEveryMustArriveFrameAndTheNewestN
     bool any_newest_wins = false, in_flight = false;
     for (std::uint32_t i = 0; i < 400; ++i) {
       const bool newest_wins = random() % 3 != 0;
-      const auto pushed = queue.push(frame_of(i), newest_wins ? FrameKind::newest_wins : FrameKind::must_arrive);
+      const auto pushed =
+          queue.push(frame_of(i), newest_wins ? FrameKind::newest_wins : FrameKind::must_arrive);
       if (pushed == BoundedWriteQueue::Push::refused) {
         refused.insert(i);
       } else if (newest_wins) {
@@ -126,7 +128,8 @@ TEST(BoundedWriteQueue, UnderRandomTrafficKeepsEveryMustArriveFrameAndTheNewestN
     }
     EXPECT_TRUE(std::is_sorted(written.begin(), written.end())) << "frames left out of order";
     const std::set<std::uint32_t> arrived(written.begin(), written.end());
-    for (std::uint32_t i : must_arrive) EXPECT_TRUE(arrived.count(i)) << "must-arrive frame " << i << " was lost";
+    for (std::uint32_t i : must_arrive)
+      EXPECT_TRUE(arrived.count(i)) << "must-arrive frame " << i << " was lost";
     if (any_newest_wins) {
       EXPECT_TRUE(arrived.count(newest)) << "the newest newest-wins frame was lost";
     }
@@ -143,7 +146,8 @@ struct TcpPair {
   explicit TcpPair(int receive_buffer_bytes = 0) {
     tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
     client.open(tcp::v4());
-    if (receive_buffer_bytes > 0) client.set_option(asio::socket_base::receive_buffer_size(receive_buffer_bytes));
+    if (receive_buffer_bytes > 0)
+      client.set_option(asio::socket_base::receive_buffer_size(receive_buffer_bytes));
     client.connect(acceptor.local_endpoint());
     acceptor.accept(server);
   }
@@ -179,15 +183,21 @@ TEST(FramedConnection, CarriesSealedFramesInOrderBothWaysAndClosesOnABadTag) {
   std::map<std::string, CloseCause> closed;
   const auto handlers = [&](std::vector<std::string>& received, const std::string& side) {
     FramedConnection::Handlers h;
-    h.on_control = [&received](const wire::Control& control) { received.push_back(control.event().text()); };
+    h.on_control = [&received](const wire::Control& control) {
+      received.push_back(control.event().text());
+    };
     h.on_close = [&closed, side](CloseCause cause, const std::string&) { closed[side] = cause; };
     return h;
   };
-  auto server = FramedConnection::start(std::move(pair.server), reader_with(key), handlers(at_server, "server"));
-  auto client = FramedConnection::start(std::move(pair.client), reader_with(key), handlers(at_client, "client"));
-  wire::FrameSealer server_sealer(key, kTransportSession, 0), client_sealer(key, kTransportSession, 1);
+  auto server = FramedConnection::start(std::move(pair.server), reader_with(key),
+                                        handlers(at_server, "server"));
+  auto client = FramedConnection::start(std::move(pair.client), reader_with(key),
+                                        handlers(at_client, "client"));
+  wire::FrameSealer server_sealer(key, kTransportSession, 0),
+      client_sealer(key, kTransportSession, 1);
   for (int i = 0; i < 100; ++i) {
-    wire::Control to_client = event("count", std::to_string(i)), to_server = event("count", std::to_string(-i));
+    wire::Control to_client = event("count", std::to_string(i)),
+                  to_server = event("count", std::to_string(-i));
     server->send(server_sealer.seal(to_client), FrameKind::must_arrive);
     client->send(client_sealer.seal(to_server), FrameKind::must_arrive);
     pair.io.restart();
@@ -218,7 +228,8 @@ TEST(FramedConnection, AgainstAPeerThatStopsReadingItStaysBoundedAndTheFramesTha
   handlers.on_control = [](const wire::Control&) {};
   handlers.on_close = [&](CloseCause, const std::string&) { sender_closed = true; };
   pair.server.set_option(asio::socket_base::send_buffer_size(64 * 1024));
-  auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers));
+  auto sender =
+      FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers));
   wire::FrameSealer sealer(key, kTransportSession, 0);
   // 200 frames of 100 kB, every 20th a must-arrive event, the rest newest-wins "IRs".
   const std::string payload(100'000, 'p');
@@ -227,7 +238,8 @@ TEST(FramedConnection, AgainstAPeerThatStopsReadingItStaysBoundedAndTheFramesTha
   for (int i = 0; i < kFrames; ++i) {
     const bool must_arrive = i % 20 == 0;
     wire::Control control = event(must_arrive ? "event" : "ir", std::to_string(i) + " " + payload);
-    EXPECT_NE(sender->send(sealer.seal(control), must_arrive ? FrameKind::must_arrive : FrameKind::newest_wins),
+    EXPECT_NE(sender->send(sealer.seal(control),
+                           must_arrive ? FrameKind::must_arrive : FrameKind::newest_wins),
               FramedConnection::Sent::closed);
     pair.io.restart();
     pair.io.poll();  // the socket takes what it can
@@ -244,21 +256,29 @@ TEST(FramedConnection, AgainstAPeerThatStopsReadingItStaysBoundedAndTheFramesTha
     received.emplace_back(control.event().kind(), std::stoi(control.event().text()));
   };
   receiving.on_close = [](CloseCause, const std::string&) {};
-  auto reader = FramedConnection::start(std::move(pair.client), reader_with(key), std::move(receiving));
-  ASSERT_TRUE(pair.run_until([&] { return !received.empty() && received.back().second == kFrames - 1; }));
+  auto reader =
+      FramedConnection::start(std::move(pair.client), reader_with(key), std::move(receiving));
+  ASSERT_TRUE(
+      pair.run_until([&] { return !received.empty() && received.back().second == kFrames - 1; }));
   int irs = 0;
   std::vector<int> events;
   for (std::size_t i = 0; i < received.size(); ++i) {
     if (i > 0) {
       EXPECT_LT(received[i - 1].second, received[i].second);
     }
-    if (received[i].first == "event") events.push_back(received[i].second);
-    else ++irs;
+    if (received[i].first == "event")
+      events.push_back(received[i].second);
+    else
+      ++irs;
   }
-  EXPECT_EQ(events.size(), static_cast<std::size_t>(kFrames / 20)) << "a must-arrive frame was lost";
-  EXPECT_EQ(static_cast<std::uint64_t>(irs) + sender->frames_dropped(), static_cast<std::uint64_t>(kFrames - kFrames / 20));
-  std::printf("  %d frames to a peer that stopped reading: %lu newest-wins frames dropped, at most %zu waiting\n", kFrames,
-              static_cast<unsigned long>(sender->frames_dropped()), most_waiting);
+  EXPECT_EQ(events.size(), static_cast<std::size_t>(kFrames / 20))
+      << "a must-arrive frame was lost";
+  EXPECT_EQ(static_cast<std::uint64_t>(irs) + sender->frames_dropped(),
+            static_cast<std::uint64_t>(kFrames - kFrames / 20));
+  std::printf(
+      "  %d frames to a peer that stopped reading: %lu newest-wins frames dropped, at most %zu "
+      "waiting\n",
+      kFrames, static_cast<unsigned long>(sender->frames_dropped()), most_waiting);
 }
 
 TEST(FramedConnection, ClosesWhenFramesThatMustArrivePileUpUnread) {
@@ -269,7 +289,8 @@ TEST(FramedConnection, ClosesWhenFramesThatMustArrivePileUpUnread) {
   FramedConnection::Handlers handlers;
   handlers.on_control = [](const wire::Control&) {};
   handlers.on_close = [&](CloseCause c, const std::string&) { cause = c; };
-  auto sender = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers));
+  auto sender =
+      FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers));
   wire::FrameSealer sealer(key, kTransportSession, 0);
   const std::string payload(100'000, 'e');
   int sent = 0;
@@ -285,20 +306,21 @@ TEST(FramedConnection, ClosesWhenFramesThatMustArrivePileUpUnread) {
   EXPECT_EQ(sender->send(Bytes(10), FrameKind::must_arrive), FramedConnection::Sent::closed);
 }
 
-
 // A connection started on `pair.server` with `write_timeout`, keeping why it closed.
 struct WatchedSender {
   std::optional<CloseCause> cause;
   std::string why;
   std::shared_ptr<FramedConnection> connection;
-  WatchedSender(TcpPair& pair, const wire::TrafficKey& key, std::chrono::milliseconds write_timeout) {
+  WatchedSender(TcpPair& pair, const wire::TrafficKey& key,
+                std::chrono::milliseconds write_timeout) {
     FramedConnection::Handlers handlers;
     handlers.on_control = [](const wire::Control&) {};
     handlers.on_close = [this](CloseCause c, const std::string& w) {
       cause = c;
       why = w;
     };
-    connection = FramedConnection::start(std::move(pair.server), reader_with(key), std::move(handlers), write_timeout);
+    connection = FramedConnection::start(std::move(pair.server), reader_with(key),
+                                         std::move(handlers), write_timeout);
   }
   WatchedSender(const WatchedSender&) = delete;  // the handler holds `this`
   WatchedSender& operator=(const WatchedSender&) = delete;
@@ -313,7 +335,8 @@ TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWin
   wire::FrameSealer sealer(key, kTransportSession, 0);
   const std::string payload(100'000, 'i');
   const auto started = std::chrono::steady_clock::now();
-  // Newest-wins frames only, which the queue may always drop: without the timeout it would never close.
+  // Newest-wins frames only, which the queue may always drop: without the timeout it would never
+  // close.
   while (!watched.cause && std::chrono::steady_clock::now() - started < 10s) {
     wire::Control control = event("ir", payload);
     watched.connection->send(sealer.seal(control), FrameKind::newest_wins);
@@ -323,7 +346,8 @@ TEST(FramedConnection, ClosesWhenAWriteStallsPastTheTimeoutEvenWithOnlyNewestWin
   ASSERT_TRUE(watched.cause) << "still open after 10 s";
   EXPECT_EQ(*watched.cause, CloseCause::write_stalled);
   EXPECT_NE(watched.why.find("the peer stopped reading"), std::string::npos) << watched.why;
-  EXPECT_GE(std::chrono::steady_clock::now() - started, kTimeout) << "closed before any write could have stalled that long";
+  EXPECT_GE(std::chrono::steady_clock::now() - started, kTimeout)
+      << "closed before any write could have stalled that long";
   EXPECT_LE(watched.connection->frames_waiting(), kMaxWaitingFrames);
 }
 
@@ -368,7 +392,8 @@ TEST(FramedConnection, ClosesWhenThePeerStopsTakingFramesThatTheKernelStillTakes
   EXPECT_EQ(*watched.cause, CloseCause::write_stalled);
   EXPECT_NE(watched.why.find("the peer stopped reading"), std::string::npos) << watched.why;
   EXPECT_GE(std::chrono::steady_clock::now() - stopped, 2 * kTimeout);
-  EXPECT_LT(watched.connection->frames_waiting(), kMaxWaitingFrames) << "closed for the kernel's count, not the queue";
+  EXPECT_LT(watched.connection->frames_waiting(), kMaxWaitingFrames)
+      << "closed for the kernel's count, not the queue";
 }
 
 // ---- the UDP endpoint ----
@@ -379,7 +404,8 @@ TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) 
   wire::DatagramSealer user(key, kTransportSession, 1), stranger(key, kTransportSession, 2);
   auto inspector = std::make_unique<wire::DatagramInspector>(kTransportSession);
   inspector->allow_sender(1, key, user.salt());
-  DatagramEndpoint endpoint(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0), std::move(inspector));
+  DatagramEndpoint endpoint(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0),
+                            std::move(inspector));
   std::vector<std::pair<double, udp::endpoint>> received;
   endpoint.start([&](wire::Datagram&& datagram, const udp::endpoint& from, std::int64_t) {
     received.emplace_back(datagram.tool().position().x(), from);
@@ -403,9 +429,9 @@ TEST(DatagramEndpoint, HandsOverWhatPassesTheInspectorAndCountsTheRestByReason) 
   wire::Datagram forged_datagram = tool_sample(9);
   Bytes forged = user.seal(forged_datagram);
   forged[forged.size() - 3] ^= 0x10;
-  peer.send_to(asio::buffer(forged), to);                               // bad_tag
+  peer.send_to(asio::buffer(forged), to);                                // bad_tag
   peer.send_to(asio::buffer(Bytes(wire::kMaxDatagramBytes + 100)), to);  // oversized, seen whole
-  peer.send_to(asio::buffer(Bytes(3000)), to);                           // oversized, larger than the buffer
+  peer.send_to(asio::buffer(Bytes(3000)), to);  // oversized, larger than the buffer
   wire::Datagram from_stranger = tool_sample(8);
   peer.send_to(asio::buffer(stranger.seal(from_stranger)), to);  // unknown_sender
   peer.send_to(asio::buffer(first), to);                         // replayed
@@ -474,7 +500,8 @@ TEST(SourceRateLimiter, FollowsATokenBucketPerAddressOnADrivenClock) {
   EXPECT_EQ(limiter.sources(), 2u);
   limiter.charge(c, now + 1);
   EXPECT_EQ(limiter.sources(), 2u);
-  EXPECT_FALSE(limiter.limited(a, now + 1)) << "a was evicted: a new source starts with its first burst";
+  EXPECT_FALSE(limiter.limited(a, now + 1))
+      << "a was evicted: a new source starts with its first burst";
 }
 
 // A flood that rotates through 800 source addresses, one failing datagram each per round,
@@ -482,8 +509,13 @@ TEST(SourceRateLimiter, FollowsATokenBucketPerAddressOnADrivenClock) {
 // share one budget, so the datagrams inspected are bounded by that budget, not by the
 // number of addresses. A proven source (it sent a valid datagram) is never limited by it.
 TEST(SourceRateLimiter, RotatingSourceAddressesShareOneBudgetThatSparesAProvenSource) {
-  const RateLimit limit{.burst = 64, .first_burst = 4, .refill_per_s = 16, .all_sources_burst = 256,
-                        .all_sources_refill_per_s = 256, .max_sources = 256, .max_proven = 16};
+  const RateLimit limit{.burst = 64,
+                        .first_burst = 4,
+                        .refill_per_s = 16,
+                        .all_sources_burst = 256,
+                        .all_sources_refill_per_s = 256,
+                        .max_sources = 256,
+                        .max_proven = 16};
   SourceRateLimiter limiter(limit);
   const auto genuine = asio::ip::make_address("10.1.0.1");
   constexpr std::int64_t kRound = 10'000'000;  // 10 ms
@@ -500,10 +532,15 @@ TEST(SourceRateLimiter, RotatingSourceAddressesShareOneBudgetThatSparesAProvenSo
     genuine_limited += limiter.limited(genuine, now);
   }
   const double seconds = static_cast<double>(now) * 1e-9;
-  std::printf("  400,000 failing datagrams from 800 rotating sources in %.0f s: %lu inspected (budget %.0f)\n", seconds,
-              static_cast<unsigned long>(inspected), limit.all_sources_burst + limit.all_sources_refill_per_s * seconds);
-  EXPECT_LE(static_cast<double>(inspected), limit.all_sources_burst + limit.all_sources_refill_per_s * seconds + 1);
-  EXPECT_GE(static_cast<double>(inspected), limit.all_sources_refill_per_s * seconds * 0.9) << "the budget is spent";
+  std::printf(
+      "  400,000 failing datagrams from 800 rotating sources in %.0f s: %lu inspected (budget "
+      "%.0f)\n",
+      seconds, static_cast<unsigned long>(inspected),
+      limit.all_sources_burst + limit.all_sources_refill_per_s * seconds);
+  EXPECT_LE(static_cast<double>(inspected),
+            limit.all_sources_burst + limit.all_sources_refill_per_s * seconds + 1);
+  EXPECT_GE(static_cast<double>(inspected), limit.all_sources_refill_per_s * seconds * 0.9)
+      << "the budget is spent";
   EXPECT_EQ(genuine_limited, 0u);
 }
 
@@ -514,7 +551,8 @@ TEST(DatagramEndpoint, AFloodingSourceIsRateLimitedAndAnAdmittedPeerOnItsAddress
   auto inspector = std::make_unique<wire::DatagramInspector>(kTransportSession);
   inspector->allow_sender(1, key, user.salt());
   const RateLimit limit{.burst = 64, .refill_per_s = 16, .max_sources = 256};
-  DatagramEndpoint endpoint(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0), std::move(inspector), limit);
+  DatagramEndpoint endpoint(io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0),
+                            std::move(inspector), limit);
   int received = 0;
   endpoint.start([&](wire::Datagram&&, const udp::endpoint&, std::int64_t) { ++received; });
   const udp::endpoint to(asio::ip::make_address("127.0.0.1"), endpoint.port());
@@ -540,21 +578,28 @@ TEST(DatagramEndpoint, AFloodingSourceIsRateLimitedAndAnAdmittedPeerOnItsAddress
   }
   const wire::RejectionCounters& counters = endpoint.inspector().counters();
   const auto end = std::chrono::steady_clock::now() + 10s;
-  while (counters.accepted() + counters.rejected() < kGarbage + kSamples && std::chrono::steady_clock::now() < end) {
+  while (counters.accepted() + counters.rejected() < kGarbage + kSamples &&
+         std::chrono::steady_clock::now() < end) {
     io.restart();
     io.run_for(5ms);
   }
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   EXPECT_EQ(received, kSamples) << "an admitted peer's datagram was lost or refused";
-  EXPECT_EQ(counters.accepted() + counters.rejected(), static_cast<std::uint64_t>(kGarbage + kSamples))
+  EXPECT_EQ(counters.accepted() + counters.rejected(),
+            static_cast<std::uint64_t>(kGarbage + kSamples))
       << "the kernel dropped some: the test sends faster than it reads";
-  const std::uint64_t inspected_garbage = counters.rejected() - counters.count(wire::Rejection::rate_limited);
-  std::printf("  %d garbage datagrams in %.2f s: %lu inspected, %lu dropped unread (rate_limited); %d samples of an "
-              "admitted peer on the same address all accepted\n",
-              kGarbage, seconds, static_cast<unsigned long>(inspected_garbage),
-              static_cast<unsigned long>(counters.count(wire::Rejection::rate_limited)), received);
+  const std::uint64_t inspected_garbage =
+      counters.rejected() - counters.count(wire::Rejection::rate_limited);
+  std::printf(
+      "  %d garbage datagrams in %.2f s: %lu inspected, %lu dropped unread (rate_limited); %d "
+      "samples of an "
+      "admitted peer on the same address all accepted\n",
+      kGarbage, seconds, static_cast<unsigned long>(inspected_garbage),
+      static_cast<unsigned long>(counters.count(wire::Rejection::rate_limited)), received);
   EXPECT_LE(static_cast<double>(inspected_garbage), limit.burst + limit.refill_per_s * seconds + 1);
-  EXPECT_GE(counters.count(wire::Rejection::rate_limited), static_cast<std::uint64_t>(kGarbage) - inspected_garbage);
+  EXPECT_GE(counters.count(wire::Rejection::rate_limited),
+            static_cast<std::uint64_t>(kGarbage) - inspected_garbage);
 }
 
 // What the soak found: frames sent in a burst over the server's jittered TCP link were
@@ -567,10 +612,12 @@ TEST(DelayedDelivery, AnOrderedLinkWithJitterDeliversABurstInOrder) {
   std::vector<int> delivered;
   constexpr int kMessages = 5000;  // sent as fast as the loop goes: a burst, many within one jitter
   for (int i = 0; i < kMessages; ++i)
-    ASSERT_TRUE(deliver_over(link, io, monotonic_now_ns(), [&delivered, i](std::int64_t) { delivered.push_back(i); }));
+    ASSERT_TRUE(deliver_over(link, io, monotonic_now_ns(),
+                             [&delivered, i](std::int64_t) { delivered.push_back(i); }));
   io.run();
   ASSERT_EQ(delivered.size(), static_cast<std::size_t>(kMessages));
-  for (int i = 0; i < kMessages; ++i) ASSERT_EQ(delivered[static_cast<std::size_t>(i)], i) << "delivered out of order";
+  for (int i = 0; i < kMessages; ++i)
+    ASSERT_EQ(delivered[static_cast<std::size_t>(i)], i) << "delivered out of order";
 }
 
 }  // namespace

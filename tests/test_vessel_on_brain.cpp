@@ -19,7 +19,8 @@ namespace {
 // over the last 0.1 s of a 0.3 s hold [N]; the vein first settles on the brain for 0.3 s.
 double vein_press_force(double brain_youngs_modulus, bool with_brain) {
   Scene scene = load_scene(testing::source_path("scenes/objects/vessel_on_brain.yaml"));
-  std::get<ElasticObjectSpec>(scene.objects.at(1).body).material.youngs_modulus = brain_youngs_modulus;
+  std::get<ElasticObjectSpec>(scene.objects.at(1).body).material.youngs_modulus =
+      brain_youngs_modulus;
   if (!with_brain) scene.interactions.clear();
   const Model model = build_model(scene);
   const SceneCompliance compliance = prepare_scene_compliance(model, true, std::nullopt);
@@ -30,8 +31,10 @@ double vein_press_force(double brain_youngs_modulus, bool with_brain) {
   double time = 0, sum = 0;
   int samples = 0;
   for (int i = 0; i < 900; ++i, time += 0.001) {
-    const double pressed = i < 300 ? -1 : std::min((i - 300) / 300.0, 1.0);  // lowered 1.6 mm over 0.3 s
-    simulation.set_tool(0, pressed < 0 ? far : Eigen::Vector3d(above - Eigen::Vector3d(0, 0, 0.0016 * pressed)));
+    const double pressed =
+        i < 300 ? -1 : std::min((i - 300) / 300.0, 1.0);  // lowered 1.6 mm over 0.3 s
+    simulation.set_tool(
+        0, pressed < 0 ? far : Eigen::Vector3d(above - Eigen::Vector3d(0, 0, 0.0016 * pressed)));
     simulation.set_tool(1, far);
     simulation.step(time);
     EXPECT_TRUE(vein.state().positions.allFinite());

@@ -58,7 +58,9 @@ std::string data_url(const view::ViewServer& server, const std::string& query = 
 TEST(ViewServer, ServesThePageItsLibrariesAndItsSchemaAndNothingElse) {
   view::ViewServer server(local_options());
   server.start();
-  const auto get = [&](const std::string& path) { return testing::http_get("127.0.0.1", server.port(), path); };
+  const auto get = [&](const std::string& path) {
+    return testing::http_get("127.0.0.1", server.port(), path);
+  };
   const std::string page = get("/");
   EXPECT_EQ(page.rfind("HTTP/1.1 200", 0), 0u) << page.substr(0, 200);
   EXPECT_NE(page.find("<!DOCTYPE html>"), std::string::npos);
@@ -67,7 +69,8 @@ TEST(ViewServer, ServesThePageItsLibrariesAndItsSchemaAndNothingElse) {
   EXPECT_NE(get("/lib/three.module.min.js").find("REVISION"), std::string::npos);
   EXPECT_NE(get("/lib/protobuf.min.js").find("protobuf"), std::string::npos);
   EXPECT_NE(get("/proto/cohaptic/view.proto").find("package cohaptic.view;"), std::string::npos);
-  for (const char* path : {"/../CMakeLists.txt", "/lib/../../CMakeLists.txt", "/lib/SHA256SUMS", "/missing"})
+  for (const char* path :
+       {"/../CMakeLists.txt", "/lib/../../CMakeLists.txt", "/lib/SHA256SUMS", "/missing"})
     EXPECT_EQ(get(path).rfind("HTTP/1.1 404", 0), 0u) << path;
   EXPECT_EQ(server.counters().http_requests, 9u);
 }
@@ -82,7 +85,8 @@ TEST(ViewServer, AMissingLibraryIsAnErrorNamingItAndHowToRestoreIt) {
     EXPECT_NE(std::string(e.what()).find("index.html"), std::string::npos) << e.what();
   }
   // The page present, its libraries not: the message says how to restore them.
-  const std::filesystem::path web = std::filesystem::path(::testing::TempDir()) / "web-without-libraries";
+  const std::filesystem::path web =
+      std::filesystem::path(::testing::TempDir()) / "web-without-libraries";
   std::filesystem::create_directories(web);
   for (const char* file : {"index.html", "view.js", "style.css"})
     std::filesystem::copy_file(std::filesystem::path(COHAPTIC_VIEW_WEB_DIR) / file, web / file,
@@ -140,7 +144,8 @@ TEST(ViewServer, OffLoopbackATokenIsRequiredAndAForeignPageIsRefused) {
   WebSocketClient without(data_url(server));
   WebSocketClient wrong(data_url(server, "?token=abcdef0123456789abce"));
   WebSocketClient foreign(data_url(server, "?token=" + token), "http://elsewhere.example");
-  WebSocketClient right(data_url(server, "?token=" + token), "http://127.0.0.1:" + std::to_string(server.port()));
+  WebSocketClient right(data_url(server, "?token=" + token),
+                        "http://127.0.0.1:" + std::to_string(server.port()));
   EXPECT_FALSE(without.wait_open(10s));
   EXPECT_FALSE(wrong.wait_open(10s));
   EXPECT_FALSE(foreign.wait_open(10s));
@@ -156,25 +161,30 @@ TEST(ViewServer, OffLoopbackATokenIsRequiredAndAForeignPageIsRefused) {
 // DNS rebinding: a web page on a name made to resolve to 127.0.0.1 sends that name as Host
 // (and as Origin). Without a token only this machine's names are served the data.
 TEST(ViewServer, WithoutATokenOnlyThisMachinesNamesGetTheData) {
-  for (const char* host : {"127.0.0.1", "127.0.0.1:7480", "localhost:7480", "LOCALHOST", "[::1]:7480", "::1", "127.9.9.9"})
+  for (const char* host : {"127.0.0.1", "127.0.0.1:7480", "localhost:7480", "LOCALHOST",
+                           "[::1]:7480", "::1", "127.9.9.9"})
     EXPECT_TRUE(view::names_this_machine(host)) << host;
-  for (const char* host : {"evil.example", "evil.example:7480", "localhost.evil.example", "10.0.0.1:7480", "[::2]:80",
-                           "[::1", "", "127.0.0.1.nip.io:7480"})
+  for (const char* host : {"evil.example", "evil.example:7480", "localhost.evil.example",
+                           "10.0.0.1:7480", "[::2]:80", "[::1", "", "127.0.0.1.nip.io:7480"})
     EXPECT_FALSE(view::names_this_machine(host)) << host;
-  EXPECT_NE(view::handshake_refusal("/ws", "http://evil.example:7480", "evil.example:7480", "").find("evil.example"),
+  EXPECT_NE(view::handshake_refusal("/ws", "http://evil.example:7480", "evil.example:7480", "")
+                .find("evil.example"),
             std::string::npos);
-  EXPECT_EQ(view::handshake_refusal("/ws?token=abcdef0123456789abcd", "", "evil.example:7480", "abcdef0123456789abcd"), "")
+  EXPECT_EQ(view::handshake_refusal("/ws?token=abcdef0123456789abcd", "", "evil.example:7480",
+                                    "abcdef0123456789abcd"),
+            "")
       << "with a token, the token decides";
 
   view::ViewServer server(local_options());
   server.publish(view::Channel::scene, "scene");
   server.start();
   const auto upgrade = [&](const std::string& host) {
-    return testing::http_exchange("127.0.0.1", server.port(),
-                                  "GET /ws HTTP/1.1\r\nHost: " + host + "\r\nOrigin: http://" + host +
-                                      "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: "
-                                      "dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n",
-                                  true);
+    return testing::http_exchange(
+        "127.0.0.1", server.port(),
+        "GET /ws HTTP/1.1\r\nHost: " + host + "\r\nOrigin: http://" + host +
+            "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\nSec-WebSocket-Key: "
+            "dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n",
+        true);
   };
   const std::string port = std::to_string(server.port());
   EXPECT_EQ(upgrade("evil.example:" + port).rfind("HTTP/1.1 403", 0), 0u);
@@ -190,10 +200,11 @@ TEST(ViewServer, ARequestWithABodyIsRefusedUnreadAndBrowsersBeyondTheCapAreTurne
   view::ViewServer server(options);
   server.publish(view::Channel::scene, "scene");
   server.start();
-  const std::string post = testing::http_exchange(
-      "127.0.0.1", server.port(),
-      "POST / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 33554432\r\nConnection: close\r\n\r\n" +
-          std::string(4096, 'x'));
+  const std::string post =
+      testing::http_exchange("127.0.0.1", server.port(),
+                             "POST / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: "
+                             "33554432\r\nConnection: close\r\n\r\n" +
+                                 std::string(4096, 'x'));
   EXPECT_EQ(post.rfind("HTTP/1.1 413", 0), 0u) << post.substr(0, 200);
   std::vector<std::unique_ptr<WebSocketClient>> browsers;
   for (int k = 0; k < 3; ++k) {
@@ -204,7 +215,8 @@ TEST(ViewServer, ARequestWithABodyIsRefusedUnreadAndBrowsersBeyondTheCapAreTurne
   EXPECT_FALSE(fourth.wait_open(10s));
   EXPECT_EQ(fourth.refused_status(), 503);
   browsers.pop_back();  // one leaves: another may come
-  ASSERT_TRUE(testing::wait_until([&] { return server.counters().browsers == 2; }, "the browser to leave"));
+  ASSERT_TRUE(
+      testing::wait_until([&] { return server.counters().browsers == 2; }, "the browser to leave"));
   WebSocketClient fifth(data_url(server));
   EXPECT_TRUE(fifth.wait_open(10s));
 }
@@ -218,9 +230,10 @@ TEST(ViewServer, AMalformedOrOversizedMessageClosesThatBrowserAndNothingElse) {
   });
   server.publish(view::Channel::scene, "scene");
   server.start();
-  WebSocketClient oversized(data_url(server)), text(data_url(server)), garbage(data_url(server)), empty(data_url(server)),
-      good(data_url(server));
-  for (WebSocketClient* browser : {&oversized, &text, &garbage, &empty, &good}) ASSERT_TRUE(browser->wait_open(10s));
+  WebSocketClient oversized(data_url(server)), text(data_url(server)), garbage(data_url(server)),
+      empty(data_url(server)), good(data_url(server));
+  for (WebSocketClient* browser : {&oversized, &text, &garbage, &empty, &good})
+    ASSERT_TRUE(browser->wait_open(10s));
   view::Command seek;
   seek.set_seek(2.5);
   oversized.send_binary(std::string(2000, '\x22'));  // over the 1024-byte limit
@@ -228,7 +241,8 @@ TEST(ViewServer, AMalformedOrOversizedMessageClosesThatBrowserAndNothingElse) {
   garbage.send_binary("\xff\xff\xff\xff");
   empty.send_binary(view::Command().SerializeAsString());  // parses, but says nothing
   good.send_binary(seek.SerializeAsString());
-  for (WebSocketClient* browser : {&oversized, &text, &garbage, &empty}) EXPECT_TRUE(browser->wait_closed(10s));
+  for (WebSocketClient* browser : {&oversized, &text, &garbage, &empty})
+    EXPECT_TRUE(browser->wait_closed(10s));
   EXPECT_EQ(oversized.close_code(), 1009);  // message too big
   EXPECT_EQ(text.close_code(), 1007);       // invalid payload
   EXPECT_EQ(garbage.close_code(), 1007);
@@ -240,7 +254,8 @@ TEST(ViewServer, AMalformedOrOversizedMessageClosesThatBrowserAndNothingElse) {
   std::lock_guard lock(mutex);
   ASSERT_EQ(received.size(), 1u);
   EXPECT_EQ(received.front().seek(), 2.5);
-  EXPECT_EQ(server.counters().closed_for_bad_message, 3u);  // the oversized one websocketpp closes itself
+  EXPECT_EQ(server.counters().closed_for_bad_message,
+            3u);  // the oversized one websocketpp closes itself
 }
 
 TEST(ViewServer, AStalledBrowserGetsNothingNewWhileItsQueueIsFullAndTheOthersGetTheNewest) {
@@ -263,12 +278,15 @@ TEST(ViewServer, AStalledBrowserGetsNothingNewWhileItsQueueIsFullAndTheOthersGet
   server.publish(view::Channel::frame, "last");
   // The reader ends with the newest frame; the stalled browser took what the kernel's socket
   // buffers hold and then nothing: far fewer than were published, however many were.
-  ASSERT_TRUE(testing::wait_until([&] { return reader.last_message() == "last"; }, "the newest frame at the reader"));
+  ASSERT_TRUE(testing::wait_until([&] { return reader.last_message() == "last"; },
+                                  "the newest frame at the reader"));
   const view::ViewCounters counters = server.counters();
   const std::uint64_t to_stalled = counters.messages_sent - reader.message_count();
-  std::printf("  published %d frames of 100 kB: the reader got %zu, the stalled browser %llu; %llu dropped\n", kFrames + 1,
-              reader.message_count(), static_cast<unsigned long long>(to_stalled),
-              static_cast<unsigned long long>(counters.dropped));
+  std::printf(
+      "  published %d frames of 100 kB: the reader got %zu, the stalled browser %llu; %llu "
+      "dropped\n",
+      kFrames + 1, reader.message_count(), static_cast<unsigned long long>(to_stalled),
+      static_cast<unsigned long long>(counters.dropped));
   EXPECT_LT(to_stalled, static_cast<std::uint64_t>(kFrames / 4));
   EXPECT_GT(counters.dropped, static_cast<std::uint64_t>(kFrames / 2));
 }
@@ -278,7 +296,8 @@ TEST(ViewServer, AStalledBrowserGetsNothingNewWhileItsQueueIsFullAndTheOthersGet
 // a queue per browser (64 queues of 2 MB and more, were each frame copied per browser).
 TEST(ViewServer, BrowsersThatStopReadingShareOneCopyOfEachFrame) {
 #ifdef COHAPTIC_SANITIZER_OWNS_MALLOC
-  GTEST_SKIP() << "the sanitizer's allocator keeps freed blocks in quarantine, and the resident set counts them: "
+  GTEST_SKIP() << "the sanitizer's allocator keeps freed blocks in quarantine, and the resident "
+                  "set counts them: "
                   "the plain build measures";
 #endif
   view::ViewServerOptions options = local_options();
@@ -290,7 +309,8 @@ TEST(ViewServer, BrowsersThatStopReadingShareOneCopyOfEachFrame) {
     stalled.push_back(std::make_unique<testing::StalledWebSocket>("127.0.0.1", server.port()));
     ASSERT_TRUE(stalled.back()->upgraded());
   }
-  ASSERT_TRUE(testing::wait_until([&] { return server.counters().browsers == options.max_browsers; }, "every browser"));
+  ASSERT_TRUE(testing::wait_until(
+      [&] { return server.counters().browsers == options.max_browsers; }, "every browser"));
   const std::size_t rss_before = testing::usage_of(getpid()).value().rss_bytes;
   constexpr int kFrames = 40;
   for (int k = 1; k <= kFrames; ++k) {
@@ -300,11 +320,15 @@ TEST(ViewServer, BrowsersThatStopReadingShareOneCopyOfEachFrame) {
   std::this_thread::sleep_for(500ms);  // every send the server will make is made
   const std::size_t rss_after = testing::usage_of(getpid()).value().rss_bytes;
   const double grown_mb = (static_cast<double>(rss_after) - static_cast<double>(rss_before)) / 1e6;
-  std::printf("  %d browsers not reading, %d frames of 1 MB published: the process grew by %.1f MB; %llu frames "
-              "sent, %llu dropped\n",
-              options.max_browsers, kFrames, grown_mb, static_cast<unsigned long long>(server.counters().messages_sent),
-              static_cast<unsigned long long>(server.counters().dropped));
-  EXPECT_GE(server.counters().messages_sent, static_cast<std::uint64_t>(2 * options.max_browsers)) << "frames were sent";
+  std::printf(
+      "  %d browsers not reading, %d frames of 1 MB published: the process grew by %.1f MB; %llu "
+      "frames "
+      "sent, %llu dropped\n",
+      options.max_browsers, kFrames, grown_mb,
+      static_cast<unsigned long long>(server.counters().messages_sent),
+      static_cast<unsigned long long>(server.counters().dropped));
+  EXPECT_GE(server.counters().messages_sent, static_cast<std::uint64_t>(2 * options.max_browsers))
+      << "frames were sent";
   EXPECT_LT(grown_mb, 48.0);
 }
 
@@ -424,7 +448,8 @@ struct PressedCube {
   }
   PressedCube()
       : cube(soft()),
-        simulation(cube.body, cube.model->obstacles, *cube.columns, cube.model->scene.tools, options(*cube.model)) {
+        simulation(cube.body, cube.model->obstacles, *cube.columns, cube.model->scene.tools,
+                   options(*cube.model)) {
     simulation.set_tool(0, pressing);
     simulation.step(0);
     simulation.step(0.001);
@@ -458,7 +483,9 @@ TEST(LoadedColumns, GiveTheDisplacementOfTheGatheredComplianceAndRefuseAPosition
     displacement_of_rows(loads, outside);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(std::to_string(columns.volume_node_count())), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(std::to_string(columns.volume_node_count())),
+              std::string::npos)
+        << e.what();
   }
 }
 
@@ -469,7 +496,8 @@ TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes)
   PressedCube pressed;
   testing::CubeRig& cube = pressed.cube;
   const std::array columns{cube.columns.get()};
-  SceneSimulation scene(*cube.model, columns, cube.model->scene.tools, PressedCube::options(*cube.model));
+  SceneSimulation scene(*cube.model, columns, cube.model->scene.tools,
+                        PressedCube::options(*cube.model));
   const Eigen::Vector3d pressing = pressed.pressing;
   scene.set_tool(0, pressing);
   scene.step(0);
@@ -484,7 +512,8 @@ TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes)
   EXPECT_EQ(shown_scene.triangles, shown.triangles);
   const std::vector<view::ToolState> tools = {{true, pressing}, {false, Eigen::Vector3d::Zero()}};
   const std::vector<Eigen::Vector3d> forces = {simulation.force(0).force, Eigen::Vector3d::Zero()};
-  const view::FrameState state = view::frame_state(scene, columns, solve_elastic_states(scene), tools, forces);
+  const view::FrameState state =
+      view::frame_state(scene, columns, solve_elastic_states(scene), tools, forces);
   const view::Frame frame = view::view_frame(state, shown_scene, 7, 0.001, 999);
   EXPECT_EQ(frame.sequence(), 7u);
   EXPECT_EQ(frame.time(), 0.001);
@@ -494,7 +523,8 @@ TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes)
   const double largest = displacement.cwiseAbs().maxCoeff();
   ASSERT_EQ(frame.displacement_size(), displacement.size());
   for (Eigen::Index i = 0; i < displacement.size(); ++i)
-    ASSERT_NEAR(frame.displacement(static_cast<int>(i)), displacement.data()[i], 1e-6 * largest) << i;
+    ASSERT_NEAR(frame.displacement(static_cast<int>(i)), displacement.data()[i], 1e-6 * largest)
+        << i;
   ASSERT_EQ(frame.users_size(), 2);
   const view::UserFrame& user = frame.users(0);
   EXPECT_TRUE(user.present());
@@ -513,7 +543,8 @@ TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes)
     const int shown_node = static_cast<int>(user.contact_nodes(corner));
     const int volume_node = shown.nodes[static_cast<std::size_t>(shown_node)];
     EXPECT_EQ(cube.body.mesh.node_tags[static_cast<std::size_t>(volume_node)],
-              ir.node_ids[static_cast<std::size_t>(ir.patch.front().nodes[static_cast<std::size_t>(corner)])]);
+              ir.node_ids[static_cast<std::size_t>(
+                  ir.patch.front().nodes[static_cast<std::size_t>(corner)])]);
   }
   EXPECT_EQ(user.patch_nodes_size(), ir.patch_node_count);
   EXPECT_FALSE(frame.users(1).present());
@@ -522,8 +553,8 @@ TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes)
   EXPECT_EQ(frame.boundary_nodes(), 12u);
   ASSERT_EQ(frame.held_nodes_size(), 12);
   for (std::uint32_t held : frame.held_nodes())
-    EXPECT_NE(std::find(simulation.condensation().boundary_nodes().begin(), simulation.condensation().boundary_nodes().end(),
-                        shown.nodes[held]),
+    EXPECT_NE(std::find(simulation.condensation().boundary_nodes().begin(),
+                        simulation.condensation().boundary_nodes().end(), shown.nodes[held]),
               simulation.condensation().boundary_nodes().end());
 }
 
@@ -545,9 +576,10 @@ struct ViewedLoop {
   view::LiveView live;
   SimulationLoop loop;
   explicit ViewedLoop(record::SessionRecorder* recorder)
-      : live(*pressed.cube.model, std::array{pressed.cube.columns.get()}, wire::P0, {}, {}, recorder),
-        loop(*pressed.cube.model, std::array{pressed.cube.columns.get()}, options, tools, statistics, nullptr, &live,
-             recorder, now_ns) {
+      : live(*pressed.cube.model, std::array{pressed.cube.columns.get()}, wire::P0, {}, {},
+             recorder),
+        loop(*pressed.cube.model, std::array{pressed.cube.columns.get()}, options, tools,
+             statistics, nullptr, &live, recorder, now_ns) {
     tools.join(0);
     live.start();
   }
@@ -565,11 +597,14 @@ TEST(LiveView, BuildsNoFrameWhileNobodyWatchesAndTheSimulationsStateForABrowser)
   session.run(0.5);  // 15 frame periods
   EXPECT_EQ(session.live.frames_built(), 0u);
 
-  auto browser = std::make_unique<WebSocketClient>("ws://127.0.0.1:" + std::to_string(session.live.port()) + "/ws");
+  auto browser = std::make_unique<WebSocketClient>(
+      "ws://127.0.0.1:" + std::to_string(session.live.port()) + "/ws");
   ASSERT_TRUE(browser->wait_open(testing::kPatience));
-  ASSERT_TRUE(testing::wait_until([&] { return session.live.counters().browsers == 1; }, "the browser counted"));
+  ASSERT_TRUE(testing::wait_until([&] { return session.live.counters().browsers == 1; },
+                                  "the browser counted"));
   session.run(0.2);
-  ASSERT_TRUE(testing::wait_until([&] { return browser->message_count() >= 2; }, "the scene and a frame"));
+  ASSERT_TRUE(
+      testing::wait_until([&] { return browser->message_count() >= 2; }, "the scene and a frame"));
   EXPECT_GE(session.live.frames_built(), 1u);
   EXPECT_LE(session.live.frames_built(), 7u);  // at most one per 1/30 s of the 0.2 s stepped
   view::ServerMessage message;
@@ -583,16 +618,19 @@ TEST(LiveView, BuildsNoFrameWhileNobodyWatchesAndTheSimulationsStateForABrowser)
   EXPECT_TRUE(frame.users(0).pressing());
   EXPECT_FALSE(frame.users(1).present());
   EXPECT_EQ(frame.users(0).position(2), static_cast<float>(session.pressed.pressing.z()));
-  const ShownSurface shown = shown_surface(session.pressed.cube.body, session.pressed.cube.columns->row_nodes());
+  const ShownSurface shown =
+      shown_surface(session.pressed.cube.body, session.pressed.cube.columns->row_nodes());
   const Eigen::Matrix3Xd expected = session.pressed.simulation.displacement_of(shown.nodes);
   ASSERT_EQ(frame.displacement_size(), expected.size());
   double largest = 0;
-  for (float each : frame.displacement()) largest = std::max(largest, std::abs(static_cast<double>(each)));
+  for (float each : frame.displacement())
+    largest = std::max(largest, std::abs(static_cast<double>(each)));
   EXPECT_NEAR(largest, expected.cwiseAbs().maxCoeff(), 1e-5 * largest);
 
   // Gone again: no more frames.
   browser.reset();
-  ASSERT_TRUE(testing::wait_until([&] { return session.live.counters().browsers == 0; }, "the browser gone"));
+  ASSERT_TRUE(testing::wait_until([&] { return session.live.counters().browsers == 0; },
+                                  "the browser gone"));
   const std::uint64_t built = session.live.frames_built();
   session.run(0.5);
   EXPECT_EQ(session.live.frames_built(), built);
@@ -600,7 +638,8 @@ TEST(LiveView, BuildsNoFrameWhileNobodyWatchesAndTheSimulationsStateForABrowser)
 }
 
 TEST(LiveView, ARecordedSessionGetsItsFramesWithoutABrowser) {
-  const std::filesystem::path file = testing::scratch_directory("live_view_recorded") / "server.mcap";
+  const std::filesystem::path file =
+      testing::scratch_directory("live_view_recorded") / "server.mcap";
   {
     record::SessionRecorder recorder(file);
     ViewedLoop session(&recorder);
@@ -609,7 +648,8 @@ TEST(LiveView, ARecordedSessionGetsItsFramesWithoutABrowser) {
     // not taken yet would be replaced by the newer.
     for (std::uint64_t frame = 1; frame <= 15; ++frame) {
       session.run(0.033);
-      ASSERT_TRUE(testing::wait_until([&] { return session.live.frames_built() == frame; }, "the period's frame"));
+      ASSERT_TRUE(testing::wait_until([&] { return session.live.frames_built() == frame; },
+                                      "the period's frame"));
     }
     session.live.stop();
     recorder.close();

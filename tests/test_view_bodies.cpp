@@ -1,11 +1,11 @@
 // The live view on every body kind a scene can have (view/shown_scene.h, body_frame_state.h):
 // the shipped scenes of a mass-spring noodle, of two objects (a mass-spring box on an FEM box),
-// of an FEM pair (a slab pressing a block), of a laparoscopy tissue and of separating tissue, stepped by SceneSimulation as the server
-// steps them. Each frame's displacement is checked against what the body's own simulation
-// says by another way: a mass-spring node's state position minus its rest position, an FEM
-// body's displacement_of (the display's gathered solve, not the view's loaded columns), the
-// tissue's displayed() surface; the separating tissue, which has no displacement field, is
-// drawn at rest with both layers' boundary surfaces.
+// of an FEM pair (a slab pressing a block), of a laparoscopy tissue and of separating tissue,
+// stepped by SceneSimulation as the server steps them. Each frame's displacement is checked against
+// what the body's own simulation says by another way: a mass-spring node's state position minus its
+// rest position, an FEM body's displacement_of (the display's gathered solve, not the view's loaded
+// columns), the tissue's displayed() surface; the separating tissue, which has no displacement
+// field, is drawn at rest with both layers' boundary surfaces.
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -50,7 +50,8 @@ struct ViewedShippedScene {
     const int steps = static_cast<int>(seconds * 1000);
     for (int k = 1; k <= steps; ++k) {
       for (std::size_t user = 0; user < targets.size(); ++user) {
-        tools[user] = targets[user] + Eigen::Vector3d(0, 0, 0.004 * (1 - static_cast<double>(k) / steps));
+        tools[user] =
+            targets[user] + Eigen::Vector3d(0, 0, 0.004 * (1 - static_cast<double>(k) / steps));
         simulation.set_tool(static_cast<int>(user), tools[user]);
       }
       simulation.step(time += 0.001);
@@ -63,19 +64,22 @@ struct ViewedShippedScene {
       shown_tools[user] = {true, tools[user]};
       forces[user] = simulation.force(static_cast<int>(user)).force;
     }
-    const view::FrameState state =
-        view::frame_state(simulation, compliance.per_body, solve_elastic_states(simulation), shown_tools, forces);
+    const view::FrameState state = view::frame_state(
+        simulation, compliance.per_body, solve_elastic_states(simulation), shown_tools, forces);
     return view::view_frame(state, shown, 1, time, 1000);
   }
 };
 
-Scene load_shipped_view_scene(const std::string& relative) { return load_scene(testing::source_path(relative)); }
+Scene load_shipped_view_scene(const std::string& relative) {
+  return load_scene(testing::source_path(relative));
+}
 
 // A frame's displacement of `part`'s nodes, one column per node [m].
 Eigen::Matrix3Xd frame_part_displacement(const view::Frame& frame, const view::ShownPart& part) {
   Eigen::Matrix3Xd u(3, part.size());
   for (int k = 0; k < part.size(); ++k)
-    for (int axis = 0; axis < 3; ++axis) u(axis, k) = frame.displacement(3 * (part.offset + k) + axis);
+    for (int axis = 0; axis < 3; ++axis)
+      u(axis, k) = frame.displacement(3 * (part.offset + k) + axis);
   return u;
 }
 
@@ -85,17 +89,20 @@ void expect_view_scene_is_shown(const view::Scene& scene, const view::ShownScene
   for (int i = 0; i < scene.rest_positions_size(); ++i)
     EXPECT_EQ(scene.rest_positions(i), static_cast<float>(shown.rest.data()[i])) << i;
   ASSERT_EQ(scene.triangles_size(), 3 * static_cast<int>(shown.triangles.size()));
-  for (std::uint32_t corner : scene.triangles()) EXPECT_LT(corner, static_cast<std::uint32_t>(shown.node_count()));
+  for (std::uint32_t corner : scene.triangles())
+    EXPECT_LT(corner, static_cast<std::uint32_t>(shown.node_count()));
 }
 
 // A mass-spring body's shown nodes are its surface nodes, displaced to their state's positions.
-void expect_view_network_shown(const view::Frame& frame, const view::ShownPart& part, const MassSpringSimulation& body) {
+void expect_view_network_shown(const view::Frame& frame, const view::ShownPart& part,
+                               const MassSpringSimulation& body) {
   EXPECT_EQ(part.nodes, body.body().network.surface_nodes);
   const Eigen::Matrix3Xd u = frame_part_displacement(frame, part);
   Eigen::Matrix3Xd expected(3, part.size());
   for (int k = 0; k < part.size(); ++k) {
     const int node = part.nodes[static_cast<std::size_t>(k)];
-    expected.col(k) = body.state().positions.col(node) - body.body().network.rest_positions.col(node);
+    expected.col(k) =
+        body.state().positions.col(node) - body.body().network.rest_positions.col(node);
   }
   const double largest = expected.cwiseAbs().maxCoeff();
   EXPECT_GT(largest, 1e-4) << "the press moved the network";
@@ -107,8 +114,10 @@ TEST(ViewBodies, TheNoodlesFrameShowsItsNodesPositionsMinusRestTheIrsPatchAndThe
   const auto& body = std::get<MassSpringSimulation>(noodle.simulation.body(0));
   const MassSpringNetwork& network = body.body().network;
   ASSERT_EQ(noodle.shown.parts.size(), 1u);
-  EXPECT_EQ(noodle.shown.triangles.size(), network.triangles.size());  // every node of a triangle is a surface node
-  expect_view_scene_is_shown(view::view_scene(noodle.model, noodle.shown, wire::P1, {}, 30, "live"), noodle.shown);
+  EXPECT_EQ(noodle.shown.triangles.size(),
+            network.triangles.size());  // every node of a triangle is a surface node
+  expect_view_scene_is_shown(view::view_scene(noodle.model, noodle.shown, wire::P1, {}, 30, "live"),
+                             noodle.shown);
   // The 2 mm sphere midway along, down to 7 mm: the soft noodle sags under its weight from
   // its top face at 9.2 mm to about 6.7 mm in the first 0.1 s, and is pressed 1-2 mm.
   noodle.press({Eigen::Vector3d(0.043, 0, 0.007)}, 0.2);
@@ -190,10 +199,13 @@ TEST(ViewBodies, TheFemPairShowsBDentedByAsPushes) {
   for (int body = 0; body < 2; ++body) {
     SCOPED_TRACE(body);
     const view::ShownPart& part = pair.shown.parts[static_cast<std::size_t>(body)];
-    const Eigen::Matrix3Xd expected = std::get<Simulation>(pair.simulation.body(body)).displacement_of(part.nodes);
+    const Eigen::Matrix3Xd expected =
+        std::get<Simulation>(pair.simulation.body(body)).displacement_of(part.nodes);
     const double largest = expected.cwiseAbs().maxCoeff();
-    EXPECT_GT(largest, body == 0 ? 3e-3 : 1e-4);  // B sinks under A by a tenth of a millimetre or more
-    EXPECT_LT((frame_part_displacement(frame, part) - expected).cwiseAbs().maxCoeff(), 1e-6 * largest);
+    EXPECT_GT(largest,
+              body == 0 ? 3e-3 : 1e-4);  // B sinks under A by a tenth of a millimetre or more
+    EXPECT_LT((frame_part_displacement(frame, part) - expected).cwiseAbs().maxCoeff(),
+              1e-6 * largest);
   }
 }
 
@@ -209,30 +221,37 @@ TEST(ViewBodies, TheTissuesFrameIsItsDisplayedDent) {
   const Eigen::Matrix3Xd expected = body.displayed() - body.body().surface.vertices;
   const double largest = expected.cwiseAbs().maxCoeff();
   EXPECT_GT(largest, 1e-3);
-  EXPECT_LT((frame_part_displacement(frame, tissue.shown.parts[0]) - expected).cwiseAbs().maxCoeff(), 1e-6 * largest);
+  EXPECT_LT(
+      (frame_part_displacement(frame, tissue.shown.parts[0]) - expected).cwiseAbs().maxCoeff(),
+      1e-6 * largest);
   EXPECT_GT(frame.users(0).patch_nodes_size(), 0);
 }
 
 TEST(ViewBodies, TheSeparatingTissuesSceneHasBothLayersSurfacesDrawnAtRest) {
   Scene scene = load_shipped_view_scene("scenes/separation/two_layers.yaml");
-  std::get<SeparationObjectSpec>(scene.objects[0].body).disk_cache = false;  // no cache written by a test
+  std::get<SeparationObjectSpec>(scene.objects[0].body).disk_cache =
+      false;  // no cache written by a test
   ViewedShippedScene layers(scene);
   const auto& body = std::get<SeparationModel>(layers.model.bodies[0]);
   const BoundarySurface pulled = extract_boundary_surface(body.bodies.pulled.mesh);
   const BoundarySurface base = extract_boundary_surface(body.bodies.base.mesh);
-  const view::Scene message = view::view_scene(layers.model, layers.shown, wire::P1, {}, 30, "live");
+  const view::Scene message =
+      view::view_scene(layers.model, layers.shown, wire::P1, {}, 30, "live");
   expect_view_scene_is_shown(message, layers.shown);
   ASSERT_EQ(layers.shown.node_count(), static_cast<int>(pulled.nodes.size() + base.nodes.size()));
   EXPECT_EQ(layers.shown.triangles.size(), pulled.triangles.size() + base.triangles.size());
   // The pulled layer's surface first, then the base's, each node where its mesh has it.
   for (std::size_t k = 0; k < pulled.nodes.size(); ++k)
-    EXPECT_EQ(layers.shown.rest.col(static_cast<Eigen::Index>(k)), body.bodies.pulled.mesh.nodes.col(pulled.nodes[k]));
+    EXPECT_EQ(layers.shown.rest.col(static_cast<Eigen::Index>(k)),
+              body.bodies.pulled.mesh.nodes.col(pulled.nodes[k]));
   for (std::size_t k = 0; k < base.nodes.size(); ++k)
-    EXPECT_EQ(layers.shown.rest.col(static_cast<Eigen::Index>(pulled.nodes.size() + k)), body.bodies.base.mesh.nodes.col(base.nodes[k]));
+    EXPECT_EQ(layers.shown.rest.col(static_cast<Eigen::Index>(pulled.nodes.size() + k)),
+              body.bodies.base.mesh.nodes.col(base.nodes[k]));
   layers.press({Eigen::Vector3d(0.02, 0.02, 0.001)}, 0.01);
   const view::Frame frame = layers.frame();
   ASSERT_EQ(frame.displacement_size(), 3 * layers.shown.node_count());
-  EXPECT_TRUE(std::all_of(frame.displacement().begin(), frame.displacement().end(), [](float u) { return u == 0; }));
+  EXPECT_TRUE(std::all_of(frame.displacement().begin(), frame.displacement().end(),
+                          [](float u) { return u == 0; }));
   EXPECT_TRUE(frame.users(0).present());
 }
 

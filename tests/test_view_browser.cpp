@@ -33,8 +33,10 @@ constexpr std::chrono::milliseconds kBrowserPatience{240'000};
 
 const fs::path kSourceTree = COHAPTIC_SOURCE_DIR;
 
-// Runs view_check.mjs with `arguments`, expecting it to exit with `expected_status`; its JSON result.
-json check_page(const fs::path& dir, const std::string& name, const std::vector<std::string>& arguments, int expected_status = 0) {
+// Runs view_check.mjs with `arguments`, expecting it to exit with `expected_status`; its JSON
+// result.
+json check_page(const fs::path& dir, const std::string& name,
+                const std::vector<std::string>& arguments, int expected_status = 0) {
   std::vector<std::string> all = {(kSourceTree / "tests/support/view_check.mjs").string()};
   all.insert(all.end(), arguments.begin(), arguments.end());
   ChildProcess node(testing::node_program(), all, dir / (name + ".log"));
@@ -42,7 +44,8 @@ json check_page(const fs::path& dir, const std::string& name, const std::vector<
   const std::string output = node.log_text();
   EXPECT_EQ(status, expected_status) << output;
   const std::size_t start = output.rfind("\n{\"");
-  const json result = json::parse(output.substr(start == std::string::npos ? 0 : start + 1), nullptr, false);
+  const json result =
+      json::parse(output.substr(start == std::string::npos ? 0 : start + 1), nullptr, false);
   EXPECT_FALSE(result.is_discarded()) << output;
   return result.is_discarded() ? json::object() : result;
 }
@@ -81,14 +84,15 @@ segments:
   return dir;
 }
 
-// The demo's session (scenes/brain/surgeon_*.yaml): a directory holding each surgeon's script (a.yaml,
-// b.yaml) as the demo's, but holding its press until told to stop.
+// The demo's session (scenes/brain/surgeon_*.yaml): a directory holding each surgeon's script
+// (a.yaml, b.yaml) as the demo's, but holding its press until told to stop.
 fs::path brain_session(const std::string& name) {
   const fs::path dir = testing::scratch_directory(name);
   for (const auto& [user, surgeon] : {std::pair{"a", "surgeon_a"}, std::pair{"b", "surgeon_b"}}) {
     std::stringstream demo;
     demo << std::ifstream(kSourceTree / "scenes/brain" / (std::string(surgeon) + ".yaml")).rdbuf();
-    const std::string held = std::regex_replace(demo.str(), std::regex(R"(\{hold: [0-9.]+\})"), "{hold: 600}");
+    const std::string held =
+        std::regex_replace(demo.str(), std::regex(R"(\{hold: [0-9.]+\})"), "{hold: 600}");
     EXPECT_NE(held, demo.str()) << surgeon << ".yaml has no hold";
     std::ofstream(dir / (std::string(user) + ".yaml")) << held;
   }
@@ -105,8 +109,9 @@ struct ViewSession {
   ViewSession(fs::path directory, const fs::path& scene) : dir(std::move(directory)) {
     server = std::make_unique<ChildProcess>(
         testing::server_program(),
-        std::vector<std::string>{"--scene", scene.string(), "--listen", "127.0.0.1:0", "--view", "127.0.0.1:0", "--record",
-                                 (dir / "server.mcap").string(), "--no-disk-cache"},
+        std::vector<std::string>{"--scene", scene.string(), "--listen", "127.0.0.1:0", "--view",
+                                 "127.0.0.1:0", "--record", (dir / "server.mcap").string(),
+                                 "--no-disk-cache"},
         dir / "server.log");
     EXPECT_TRUE(testing::wait_for_output(*server, "live view at"));
     EXPECT_TRUE(testing::wait_for_output(*server, "listening on"));
@@ -117,8 +122,9 @@ struct ViewSession {
   std::unique_ptr<ChildProcess> client(const std::string& user, int slot) const {
     return std::make_unique<ChildProcess>(
         testing::client_program(),
-        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", "surgeon-" + user, "--slot",
-                                 std::to_string(slot), "--device", "hand:" + (dir / (user + ".yaml")).string(), "--report",
+        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user",
+                                 "surgeon-" + user, "--slot", std::to_string(slot), "--device",
+                                 "hand:" + (dir / (user + ".yaml")).string(), "--report",
                                  (dir / (user + ".json")).string()},
         dir / (user + ".log"));
   }
@@ -154,17 +160,23 @@ TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClients
   const auto a = session.client("a", 0);
   const auto b = session.client("b", 1);
 
-  const json live = check_page(session.dir, "live", {"--url", session.url, "--screenshot", (session.dir / "live.png").string()});
+  const json live =
+      check_page(session.dir, "live",
+                 {"--url", session.url, "--screenshot", (session.dir / "live.png").string()});
   ASSERT_FALSE(live.contains("error")) << live.dump();
   EXPECT_TRUE(live["errors"].empty()) << live["errors"].dump();
   const json& shown = live["shown"];
   const json& pixels = live["pixels"];
-  std::printf("  page: %d frames received, %d drawn (%.1f/s in this headless software renderer); mesh pixels %d of %d\n",
-              shown["framesReceived"].get<int>(), shown["framesDrawn"].get<int>(), shown["drawFps"].get<double>(),
-              pixels["mesh"]["matching"].get<int>(), pixels["mesh"]["sampled"].get<int>());
+  std::printf(
+      "  page: %d frames received, %d drawn (%.1f/s in this headless software renderer); mesh "
+      "pixels %d of %d\n",
+      shown["framesReceived"].get<int>(), shown["framesDrawn"].get<int>(),
+      shown["drawFps"].get<double>(), pixels["mesh"]["matching"].get<int>(),
+      pixels["mesh"]["sampled"].get<int>());
   // The mesh is drawn: inside its projected box most pixels are not the background, and a
   // corner of the stage away from it is.
-  EXPECT_GT(pixels["mesh"]["matching"].get<double>(), 0.3 * pixels["mesh"]["sampled"].get<double>());
+  EXPECT_GT(pixels["mesh"]["matching"].get<double>(),
+            0.3 * pixels["mesh"]["sampled"].get<double>());
   EXPECT_EQ(pixels["corner"]["matching"].get<int>(), 0);
   EXPECT_GT(shown["meshTriangles"].get<int>(), 100);
   ASSERT_EQ(shown["users"].size(), 2u);
@@ -178,10 +190,13 @@ TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClients
     EXPECT_TRUE(user["pressing"].get<bool>());
     EXPECT_GT(seen["tool"]["matching"].get<int>(), 10) << seen.dump();
     EXPECT_GT(user["force"][2].get<double>(), 0.01);
-    EXPECT_GT(user["force"][2].get<double>(), 5 * std::hypot(user["force"][0].get<double>(), user["force"][1].get<double>()));
+    EXPECT_GT(user["force"][2].get<double>(),
+              5 * std::hypot(user["force"][0].get<double>(), user["force"][1].get<double>()));
     EXPECT_TRUE(user["arrowVisible"].get<bool>());
     ASSERT_TRUE(seen["arrow"].is_object()) << seen.dump();
-    EXPECT_GE(seen["arrow"]["matching"].get<double>(), 0.75 * seen["arrow"]["sampled"].get<double>()) << seen.dump();
+    EXPECT_GE(seen["arrow"]["matching"].get<double>(),
+              0.75 * seen["arrow"]["sampled"].get<double>())
+        << seen.dump();
     // The strip chart moved on between two looks 1.5 s apart.
     const json& before = live["before"]["users"][slot]["chart"];
     const json& after = live["after"]["users"][slot]["chart"];
@@ -194,8 +209,9 @@ TEST(ViewInBrowser, ALiveTwoUserSessionIsDrawnWithToolsForcesChartsAndTheClients
   b->signal(SIGINT);
   ASSERT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
   ASSERT_EQ(b->wait(testing::kPatience), 0) << b->log_text();
-  const json final = check_page(session.dir, "final", {"--url", session.url, "--screenshot", (session.dir / "final.png").string(),
-                                                        "--final", "1"});
+  const json final = check_page(
+      session.dir, "final",
+      {"--url", session.url, "--screenshot", (session.dir / "final.png").string(), "--final", "1"});
   ASSERT_FALSE(final.contains("error")) << final.dump();
   for (int slot = 0; slot < 2; ++slot) {
     const json report = json::parse(std::ifstream(session.dir / (slot == 0 ? "a.json" : "b.json")));
@@ -229,8 +245,9 @@ TEST(ViewInBrowser, TheBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
   // the camera close to the tools. Held at their deepest, the 7 mm spheres feel a few
   // hundredths of a newton (docs/results/brain-convergence.md): this soft a brain gives no
   // more to a tip that fits the corridor.
-  const json brain = check_page(dir, "brain", {"--url", session.url, "--screenshot", (dir / "brain.png").string(),
-                                               "--min-force", "0.01", "--focus-tools", "1"});
+  const json brain = check_page(dir, "brain",
+                                {"--url", session.url, "--screenshot", (dir / "brain.png").string(),
+                                 "--min-force", "0.01", "--focus-tools", "1"});
   ASSERT_FALSE(brain.contains("error")) << brain.dump();
   EXPECT_TRUE(brain["errors"].empty()) << brain["errors"].dump();
   const json& shown = brain["shown"];
@@ -238,7 +255,8 @@ TEST(ViewInBrowser, TheBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
   EXPECT_EQ(shown["scene"]["name"], "brain");
   EXPECT_GT(shown["meshTriangles"].get<int>(), 1000);
   EXPECT_EQ(shown["scene"]["obstacles"], json::array({"inner_skull"}));
-  EXPECT_GT(pixels["mesh"]["matching"].get<double>(), 0.3 * pixels["mesh"]["sampled"].get<double>());
+  EXPECT_GT(pixels["mesh"]["matching"].get<double>(),
+            0.3 * pixels["mesh"]["sampled"].get<double>());
   const json& screen = brain["screen"];
   ASSERT_EQ(shown["users"].size(), 2u);
   double largest_force = 0;
@@ -257,20 +275,25 @@ TEST(ViewInBrowser, TheBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
     EXPECT_TRUE(user["arrowVisible"].get<bool>());
     EXPECT_GE(drawn["arrowPixels"].get<double>(), 20);
     EXPECT_TRUE(drawn["tipOutsideTool"].get<bool>());
-    EXPECT_GT(drawn["tipFromToolPixels"].get<double>(), drawn["toolRadiusPixels"].get<double>() + 5);
+    EXPECT_GT(drawn["tipFromToolPixels"].get<double>(),
+              drawn["toolRadiusPixels"].get<double>() + 5);
     ASSERT_TRUE(seen["arrow"].is_object());
-    EXPECT_GE(seen["arrow"]["matching"].get<double>(), 0.75 * seen["arrow"]["sampled"].get<double>());
+    EXPECT_GE(seen["arrow"]["matching"].get<double>(),
+              0.75 * seen["arrow"]["sampled"].get<double>());
   }
   // The arrow scale in the legend: a round length for a round force at or above the largest seen.
   std::smatch scale;
   const std::string arrow_scale = screen["arrowScale"];
-  ASSERT_TRUE(std::regex_match(arrow_scale, scale, std::regex(R"(arrow: ([0-9.]+) mm = ([0-9.]+) N)"))) << arrow_scale;
+  ASSERT_TRUE(
+      std::regex_match(arrow_scale, scale, std::regex(R"(arrow: ([0-9.]+) mm = ([0-9.]+) N)")))
+      << arrow_scale;
   EXPECT_GE(std::stod(scale[2].str()), largest_force);
   EXPECT_LE(std::stod(scale[2].str()), 10 * largest_force);
   EXPECT_EQ(screen["legendTitle"], "displacement |u| [mm]");
   EXPECT_FALSE(screen["rigidMotionRemoved"].get<bool>());
   // The scale bar: a round length, drawn as long on the screen as that length is at the tools
-  // (their 7 mm radius on the screen gives the pixels per mm there; the camera orbits their midpoint).
+  // (their 7 mm radius on the screen gives the pixels per mm there; the camera orbits their
+  // midpoint).
   const json& bar = screen["scaleBar"];
   std::smatch bar_text;
   const std::string bar_label = bar["text"];
@@ -279,14 +302,19 @@ TEST(ViewInBrowser, TheBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
   EXPECT_LE(bar["pixels"].get<double>(), 120) << bar.dump();
   EXPECT_NEAR(bar["pixels"].get<double>(), shown["scaleBar"]["pixels"].get<double>(), 1);
   const double pixels_per_mm = screen["users"][0]["toolRadiusPixels"].get<double>() / 7;
-  EXPECT_NEAR(bar["pixels"].get<double>() / std::stod(bar_text[1].str()), pixels_per_mm, 0.2 * pixels_per_mm) << bar.dump();
+  EXPECT_NEAR(bar["pixels"].get<double>() / std::stod(bar_text[1].str()), pixels_per_mm,
+              0.2 * pixels_per_mm)
+      << bar.dump();
   EXPECT_GE(pixels["scaleBar"]["sampled"].get<int>(), 15);
-  EXPECT_GE(pixels["scaleBar"]["matching"].get<double>(), 0.9 * pixels["scaleBar"]["sampled"].get<double>());
+  EXPECT_GE(pixels["scaleBar"]["matching"].get<double>(),
+            0.9 * pixels["scaleBar"]["sampled"].get<double>());
 
   // The same with the rigid motion removed (the page's D key): the brain swings on its stem
   // as the tools push it, the colour shows what is left, the dent, smaller but not gone.
-  const json rigid = check_page(dir, "rigid", {"--url", session.url, "--screenshot", (dir / "rigid.png").string(),
-                                               "--min-force", "0.01", "--focus-tools", "1", "--rigid-removed", "1"});
+  const json rigid =
+      check_page(dir, "rigid",
+                 {"--url", session.url, "--screenshot", (dir / "rigid.png").string(), "--min-force",
+                  "0.01", "--focus-tools", "1", "--rigid-removed", "1"});
   ASSERT_FALSE(rigid.contains("error")) << rigid.dump();
   EXPECT_TRUE(rigid["errors"].empty()) << rigid["errors"].dump();
   EXPECT_TRUE(rigid["screen"]["rigidMotionRemoved"].get<bool>());
@@ -296,22 +324,29 @@ TEST(ViewInBrowser, TheBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
   ASSERT_TRUE(frame["maxDeformationMm"].is_number()) << frame.dump();
   std::printf("  largest displacement %.2f mm, deformation with the rigid motion removed %.2f mm\n",
               frame["maxDisplacementMm"].get<double>(), frame["maxDeformationMm"].get<double>());
-  EXPECT_LT(frame["maxDeformationMm"].get<double>(), 0.8 * frame["maxDisplacementMm"].get<double>()) << frame.dump();
+  EXPECT_LT(frame["maxDeformationMm"].get<double>(), 0.8 * frame["maxDisplacementMm"].get<double>())
+      << frame.dump();
   EXPECT_GT(frame["maxDeformationMm"].get<double>(), 0.5) << frame.dump();
 
   // A screenshot whose condition is never met (no surgeon presses with 100 N): the script
   // gives up in its time (30 s by default; 10 s here), still writes the picture and says
   // which condition failed.
   const auto asked = std::chrono::steady_clock::now();
-  const json unmet = check_page(dir, "unmet", {"--url", session.url, "--screenshot", (dir / "unmet.png").string(),
-                                               "--min-force", "100", "--give-up", "10"}, 1);
+  const json unmet = check_page(dir, "unmet",
+                                {"--url", session.url, "--screenshot", (dir / "unmet.png").string(),
+                                 "--min-force", "100", "--give-up", "10"},
+                                1);
   EXPECT_LT(std::chrono::steady_clock::now() - asked, std::chrono::seconds(25));
   EXPECT_TRUE(fs::exists(dir / "unmet.png"));
   ASSERT_TRUE(unmet.contains("error")) << unmet.dump();
-  EXPECT_NE(unmet["error"].get<std::string>().find("gave up after 10 s: "), std::string::npos) << unmet["error"];
-  EXPECT_NE(unmet["error"].get<std::string>().find("pressing with at least 100 N"), std::string::npos) << unmet["error"];
+  EXPECT_NE(unmet["error"].get<std::string>().find("gave up after 10 s: "), std::string::npos)
+      << unmet["error"];
+  EXPECT_NE(unmet["error"].get<std::string>().find("pressing with at least 100 N"),
+            std::string::npos)
+      << unmet["error"];
   ASSERT_EQ(unmet["unmet"]["users"].size(), 2u) << unmet.dump();
-  for (const json& user : unmet["unmet"]["users"]) EXPECT_LT(user["forceN"].get<double>(), 100) << user.dump();
+  for (const json& user : unmet["unmet"]["users"])
+    EXPECT_LT(user["forceN"].get<double>(), 100) << user.dump();
   a->signal(SIGINT);
   b->signal(SIGINT);
   EXPECT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
@@ -340,7 +375,9 @@ TEST(ViewInBrowser, AReplayScrubsToAGivenTimeShowingThatTimesForceAndJumpsToTheP
   std::size_t peak = 0, peak_any = 0;
   double largest = -1;
   for (std::size_t k = 0; k < recording.view_frames.size(); ++k) {
-    if (magnitude(recording.view_frames[k].users(0)) > magnitude(recording.view_frames[peak].users(0))) peak = k;
+    if (magnitude(recording.view_frames[k].users(0)) >
+        magnitude(recording.view_frames[peak].users(0)))
+      peak = k;
     for (const view::UserFrame& user : recording.view_frames[k].users())
       if (magnitude(user) > largest) {
         largest = magnitude(user);
@@ -353,11 +390,14 @@ TEST(ViewInBrowser, AReplayScrubsToAGivenTimeShowingThatTimesForceAndJumpsToTheP
   const double target = 0.5 * (expected.time() + recording.view_frames[peak + 1].time());
 
   ChildProcess replay(COHAPTIC_LAB_EXE,
-                      {"replay", (session.dir / "server.mcap").string(), "--view", "127.0.0.1:0"}, session.dir / "replay.log");
+                      {"replay", (session.dir / "server.mcap").string(), "--view", "127.0.0.1:0"},
+                      session.dir / "replay.log");
   ASSERT_TRUE(testing::wait_for_output(replay, "in the live view at"));
   const std::string url = url_in(replay.log_text(), "in the live view at");
-  const json scrubbed = check_page(session.dir, "scrub", {"--url", url, "--screenshot", (session.dir / "scrub.png").string(),
-                                                           "--seek", fmt::format("{:.9f}", target)});
+  const json scrubbed =
+      check_page(session.dir, "scrub",
+                 {"--url", url, "--screenshot", (session.dir / "scrub.png").string(), "--seek",
+                  fmt::format("{:.9f}", target)});
   ASSERT_FALSE(scrubbed.contains("error")) << scrubbed.dump();
   const json& shown = scrubbed["shown"];
   EXPECT_NEAR(shown["timeline"]["time"].get<double>(), target, 1e-9);
@@ -366,18 +406,23 @@ TEST(ViewInBrowser, AReplayScrubsToAGivenTimeShowingThatTimesForceAndJumpsToTheP
     const view::UserFrame& recorded = expected.users(slot);
     const json& user = shown["users"][slot];
     SCOPED_TRACE("user " + std::to_string(slot));
-    for (int axis = 0; axis < 3; ++axis) EXPECT_EQ(user["force"][axis].get<double>(), static_cast<double>(recorded.force(axis)));
+    for (int axis = 0; axis < 3; ++axis)
+      EXPECT_EQ(user["force"][axis].get<double>(), static_cast<double>(recorded.force(axis)));
     // The chart ends at that time, at that force (floats, as the recording holds them).
     EXPECT_NEAR(user["chart"]["last"].get<double>(), expected.time(), 1e-6);
-    EXPECT_NEAR(user["chart"]["latest"].get<double>(), magnitude(recorded), 1e-6 * magnitude(recorded) + 1e-9);
+    EXPECT_NEAR(user["chart"]["latest"].get<double>(), magnitude(recorded),
+                1e-6 * magnitude(recorded) + 1e-9);
   }
   EXPECT_GT(shown["users"][0]["forceMagnitude"].get<double>(), 0.01);
-  EXPECT_GT(scrubbed["pixels"]["mesh"]["matching"].get<double>(), 0.3 * scrubbed["pixels"]["mesh"]["sampled"].get<double>());
+  EXPECT_GT(scrubbed["pixels"]["mesh"]["matching"].get<double>(),
+            0.3 * scrubbed["pixels"]["mesh"]["sampled"].get<double>());
 
-  const json jumped = check_page(session.dir, "jump", {"--url", url, "--screenshot", (session.dir / "jump.png").string(),
-                                                        "--jump", "peak"});
+  const json jumped = check_page(
+      session.dir, "jump",
+      {"--url", url, "--screenshot", (session.dir / "jump.png").string(), "--jump", "peak"});
   ASSERT_FALSE(jumped.contains("error")) << jumped.dump();
-  EXPECT_DOUBLE_EQ(jumped["shown"]["frame"]["time"].get<double>(), recording.view_frames[peak_any].time());
+  EXPECT_DOUBLE_EQ(jumped["shown"]["frame"]["time"].get<double>(),
+                   recording.view_frames[peak_any].time());
   replay.signal(SIGTERM);
   EXPECT_EQ(replay.wait(testing::kPatience), 0) << replay.log_text();
 }
@@ -386,7 +431,8 @@ TEST(ViewInBrowser, AReplayScrubsToAGivenTimeShowingThatTimesForceAndJumpsToTheP
 double largest_frame_displacement(const view::Frame& frame) {
   const auto u = [&](int i) { return static_cast<double>(frame.displacement(i)); };
   double largest = 0;
-  for (int i = 0; i + 2 < frame.displacement_size(); i += 3) largest = std::max(largest, std::hypot(u(i), u(i + 1), u(i + 2)));
+  for (int i = 0; i + 2 < frame.displacement_size(); i += 3)
+    largest = std::max(largest, std::hypot(u(i), u(i + 1), u(i + 2)));
   return largest;
 }
 
@@ -414,7 +460,8 @@ segments:
   {
     const auto a = session.client("a", 0);
     const auto b = session.client("b", 1);
-    live = check_page(dir, "live", {"--url", session.url, "--screenshot", (dir / "live.png").string()});
+    live = check_page(dir, "live",
+                      {"--url", session.url, "--screenshot", (dir / "live.png").string()});
     a->signal(SIGINT);
     b->signal(SIGINT);
     EXPECT_EQ(a->wait(testing::kPatience), 0) << a->log_text();
@@ -425,40 +472,54 @@ segments:
   EXPECT_TRUE(live["errors"].empty()) << live["errors"].dump();
   const json& shown = live["shown"];
   EXPECT_EQ(shown["scene"]["name"], "noodle");
-  EXPECT_EQ(shown["scene"]["objects"], json::array({{{"name", "noodle"}, {"model", "mass_spring"}, {"firstNode", 0},
-                                                      {"nodes", shown["scene"]["nodes"]}}}));
+  EXPECT_EQ(shown["scene"]["objects"], json::array({{{"name", "noodle"},
+                                                     {"model", "mass_spring"},
+                                                     {"firstNode", 0},
+                                                     {"nodes", shown["scene"]["nodes"]}}}));
   EXPECT_GT(shown["meshTriangles"].get<int>(), 100);
   // A thin tube seen obliquely covers less of its projected box than a cube does.
-  EXPECT_GT(live["pixels"]["mesh"]["matching"].get<double>(), 0.15 * live["pixels"]["mesh"]["sampled"].get<double>());
+  EXPECT_GT(live["pixels"]["mesh"]["matching"].get<double>(),
+            0.15 * live["pixels"]["mesh"]["sampled"].get<double>());
   EXPECT_EQ(live["pixels"]["corner"]["matching"].get<int>(), 0);
   ASSERT_EQ(shown["users"].size(), 2u);
 
   // The frame the page drew is the server's, as recorded; each user pressed the noodle.
   const record::Recording recording = record::read_recording(dir / "server.mcap");
   ASSERT_GT(recording.view_frames.size(), 10u);
-  const auto drawn = std::find_if(recording.view_frames.begin(), recording.view_frames.end(), [&](const view::Frame& frame) {
-    return frame.sequence() == shown["frame"]["sequence"].get<std::uint64_t>();
-  });
+  const auto drawn = std::find_if(
+      recording.view_frames.begin(), recording.view_frames.end(), [&](const view::Frame& frame) {
+        return frame.sequence() == shown["frame"]["sequence"].get<std::uint64_t>();
+      });
   ASSERT_NE(drawn, recording.view_frames.end());
-  EXPECT_NEAR(shown["frame"]["maxDisplacementMm"].get<double>(), largest_frame_displacement(*drawn) * 1e3, 1e-6);
+  EXPECT_NEAR(shown["frame"]["maxDisplacementMm"].get<double>(),
+              largest_frame_displacement(*drawn) * 1e3, 1e-6);
   EXPECT_GT(largest_frame_displacement(*drawn), 2e-3) << "the noodle settled and was pressed";
   for (int slot = 0; slot < 2; ++slot)
-    EXPECT_TRUE(std::any_of(recording.view_frames.begin(), recording.view_frames.end(), [&](const view::Frame& frame) {
-      return frame.users(slot).pressing() && frame.users(slot).patch_nodes_size() > 0;
-    })) << "user " << slot;
+    EXPECT_TRUE(std::any_of(recording.view_frames.begin(), recording.view_frames.end(),
+                            [&](const view::Frame& frame) {
+                              return frame.users(slot).pressing() &&
+                                     frame.users(slot).patch_nodes_size() > 0;
+                            }))
+        << "user " << slot;
 
   // The replay, halfway between two frames late in the session: the page shows the first.
   const std::size_t late = recording.view_frames.size() - 3;
   const view::Frame& expected = recording.view_frames[late];
   const double target = 0.5 * (expected.time() + recording.view_frames[late + 1].time());
-  ChildProcess replay(COHAPTIC_LAB_EXE, {"replay", (dir / "server.mcap").string(), "--view", "127.0.0.1:0"}, dir / "replay.log");
+  ChildProcess replay(COHAPTIC_LAB_EXE,
+                      {"replay", (dir / "server.mcap").string(), "--view", "127.0.0.1:0"},
+                      dir / "replay.log");
   ASSERT_TRUE(testing::wait_for_output(replay, "in the live view at"));
-  const json scrubbed = check_page(dir, "scrub", {"--url", url_in(replay.log_text(), "in the live view at"), "--screenshot",
-                                                  (dir / "scrub.png").string(), "--seek", fmt::format("{:.9f}", target)});
+  const json scrubbed =
+      check_page(dir, "scrub",
+                 {"--url", url_in(replay.log_text(), "in the live view at"), "--screenshot",
+                  (dir / "scrub.png").string(), "--seek", fmt::format("{:.9f}", target)});
   ASSERT_FALSE(scrubbed.contains("error")) << scrubbed.dump();
   EXPECT_DOUBLE_EQ(scrubbed["shown"]["frame"]["time"].get<double>(), expected.time());
-  EXPECT_NEAR(scrubbed["shown"]["frame"]["maxDisplacementMm"].get<double>(), largest_frame_displacement(expected) * 1e3, 1e-6);
-  EXPECT_GT(scrubbed["pixels"]["mesh"]["matching"].get<double>(), 0.15 * scrubbed["pixels"]["mesh"]["sampled"].get<double>());
+  EXPECT_NEAR(scrubbed["shown"]["frame"]["maxDisplacementMm"].get<double>(),
+              largest_frame_displacement(expected) * 1e3, 1e-6);
+  EXPECT_GT(scrubbed["pixels"]["mesh"]["matching"].get<double>(),
+            0.15 * scrubbed["pixels"]["mesh"]["sampled"].get<double>());
   replay.signal(SIGTERM);
   EXPECT_EQ(replay.wait(testing::kPatience), 0) << replay.log_text();
 }

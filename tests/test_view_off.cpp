@@ -24,11 +24,13 @@ TEST(LiveView, AViewThatCannotServeItsPageIsOffAndTheSessionGoesOn) {
   std::ofstream(dir / "cube.yaml") << testing::cube_scene_yaml(cube);
   std::ofstream(dir / "a.yaml") << "units: mm\nstart: [0, 0, 80]\nsegments:\n  - {hold: 1}\n";
 
-  testing::run_scripted_session(dir, dir / "cube.yaml", {"--view", "127.0.0.1:" + std::to_string(taken.port())},
+  testing::run_scripted_session(dir, dir / "cube.yaml",
+                                {"--view", "127.0.0.1:" + std::to_string(taken.port())},
                                 {{"a", dir / "a.yaml"}});
   std::ifstream in(dir / "server.log");
   const std::string log((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string off = "live view off: view: cannot listen on 127.0.0.1:" + std::to_string(taken.port());
+  const std::string off =
+      "live view off: view: cannot listen on 127.0.0.1:" + std::to_string(taken.port());
   EXPECT_NE(log.find(off), std::string::npos) << log;
   EXPECT_EQ(log.find("live view off"), log.rfind("live view off")) << "said once\n" << log;
   EXPECT_EQ(log.find("live view at"), std::string::npos) << log;

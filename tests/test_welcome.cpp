@@ -26,7 +26,8 @@ wire::Welcome correct_welcome() {
   welcome.set_force_limit(3.3);
   welcome.set_haptic_rate_hz(1000);
   welcome.set_ir_max_age_s(0.5);
-  for (int slot = 0; slot < 2; ++slot) welcome.add_users()->set_slot(static_cast<std::uint32_t>(slot));
+  for (int slot = 0; slot < 2; ++slot)
+    welcome.add_users()->set_slot(static_cast<std::uint32_t>(slot));
   return welcome;
 }
 
@@ -43,7 +44,8 @@ TEST(Welcome, ACorrectWelcomeIsTakenFieldByField) {
 }
 
 TEST(Welcome, ValuesACorrectServerNeverSendsAreRefusedByName) {
-  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN(),
+               inf = std::numeric_limits<double>::infinity();
   struct Case {
     std::function<void(wire::Welcome&)> change;
     std::string named;

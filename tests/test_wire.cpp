@@ -48,7 +48,8 @@ constexpr std::uint64_t kSalt = 0x5a17'0000'0000'00abull;
 
 TrafficKey key_of(std::uint8_t seed) {
   TrafficKey key;
-  for (std::size_t i = 0; i < key.bytes.size(); ++i) key.bytes[i] = static_cast<std::uint8_t>(seed + 7 * i);
+  for (std::size_t i = 0; i < key.bytes.size(); ++i)
+    key.bytes[i] = static_cast<std::uint8_t>(seed + 7 * i);
   return key;
 }
 
@@ -57,7 +58,8 @@ TrafficKey key_of(std::uint8_t seed) {
 class TempDir {
  public:
   TempDir() {
-    path_ = std::filesystem::temp_directory_path() / fmt::format("cohaptic-wire-{}-{}", ::getpid(), counter_++);
+    path_ = std::filesystem::temp_directory_path() /
+            fmt::format("cohaptic-wire-{}-{}", ::getpid(), counter_++);
     std::filesystem::create_directories(path_);
   }
   ~TempDir() { std::filesystem::remove_all(path_); }
@@ -88,7 +90,8 @@ std::string error_of(const std::function<void()>& f) {
 
 TEST(WireKeyFile, LoadsHexWithWhitespaceInEitherCase) {
   TempDir dir;
-  write_text(dir / "key.txt", "  00112233445566778899AABBCCDDEEFF\n\t00112233445566778899aabbccddeeff  \r\n");
+  write_text(dir / "key.txt",
+             "  00112233445566778899AABBCCDDEEFF\n\t00112233445566778899aabbccddeeff  \r\n");
   const SessionKey key = load_session_key(dir / "key.txt");
   for (std::size_t i = 0; i < 16; ++i) {
     EXPECT_EQ(key.bytes[i], static_cast<std::uint8_t>(0x11 * i));
@@ -101,10 +104,13 @@ TEST(WireKeyFile, RejectsMalformedFilesNamingFileAndProblem) {
   TempDir dir;
   write_text(dir / "short.txt", "0123456789ab\n");
   const std::string short_error = error_of([&] { load_session_key(dir / "short.txt"); });
-  EXPECT_NE(short_error.find("short.txt: expected 64 hexadecimal characters, found 12"), std::string::npos) << short_error;
+  EXPECT_NE(short_error.find("short.txt: expected 64 hexadecimal characters, found 12"),
+            std::string::npos)
+      << short_error;
 
   write_text(dir / "long.txt", std::string(66, 'a'));
-  EXPECT_NE(error_of([&] { load_session_key(dir / "long.txt"); }).find("found 66"), std::string::npos);
+  EXPECT_NE(error_of([&] { load_session_key(dir / "long.txt"); }).find("found 66"),
+            std::string::npos);
 
   write_text(dir / "bad.txt", std::string(40, 'a') + "g" + std::string(23, 'a'));
   const std::string bad_error = error_of([&] { load_session_key(dir / "bad.txt"); });
@@ -113,11 +119,13 @@ TEST(WireKeyFile, RejectsMalformedFilesNamingFileAndProblem) {
   EXPECT_NE(bad_error.find("column 41"), std::string::npos) << bad_error;
 
   write_text(dir / "zero.txt", std::string(64, '0'));
-  EXPECT_NE(error_of([&] { load_session_key(dir / "zero.txt"); }).find("all zeros"), std::string::npos);
+  EXPECT_NE(error_of([&] { load_session_key(dir / "zero.txt"); }).find("all zeros"),
+            std::string::npos);
 
   write_text(dir / "slot.txt", "participant two\n" + std::string(64, 'a'));
   const std::string slot_error = error_of([&] { load_key_file(dir / "slot.txt"); });
-  EXPECT_NE(slot_error.find("slot.txt: line 1: expected `participant K`"), std::string::npos) << slot_error;
+  EXPECT_NE(slot_error.find("slot.txt: line 1: expected `participant K`"), std::string::npos)
+      << slot_error;
   write_text(dir / "slot_hex.txt", "participant 2\n" + std::string(63, 'a') + "x");
   const std::string slot_hex_error = error_of([&] { load_key_file(dir / "slot_hex.txt"); });
   EXPECT_NE(slot_hex_error.find("'x' at line 2 column 64"), std::string::npos) << slot_hex_error;
@@ -196,12 +204,13 @@ TEST(WireKeyFile, DevelopmentKeyIsTheDocumentedText) {
 // sender id as the little-endian salt, "cohaptic" as the personalisation.
 std::array<std::uint8_t, 32> blake2b_kdf(const SessionKey& master, std::uint64_t id) {
   std::array<std::uint8_t, crypto_generichash_blake2b_SALTBYTES> salt{};
-  for (int i = 0; i < 8; ++i) salt[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(id >> (8 * i));
+  for (int i = 0; i < 8; ++i)
+    salt[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(id >> (8 * i));
   std::array<std::uint8_t, crypto_generichash_blake2b_PERSONALBYTES> personal{};
   std::memcpy(personal.data(), "cohaptic", 8);
   std::array<std::uint8_t, 32> out{};
-  crypto_generichash_blake2b_salt_personal(out.data(), out.size(), nullptr, 0, master.bytes.data(), master.bytes.size(),
-                                           salt.data(), personal.data());
+  crypto_generichash_blake2b_salt_personal(out.data(), out.size(), nullptr, 0, master.bytes.data(),
+                                           master.bytes.size(), salt.data(), personal.data());
   return out;
 }
 
@@ -242,38 +251,49 @@ TEST(WireTrafficKeys, AParticipantKeyOpensItsOwnSlotOnlyAndTheSessionKeyAny) {
 
 TEST(WireAead, SealIsXChaCha20Poly1305OverTheDocumentedNonce) {
   const TrafficKey key = key_of(3);
-  const Envelope envelope{kProtocolVersion, kEncryptedFlag, 7, 0x0102030405060708ull, 0x1112131415161718ull};
+  const Envelope envelope{kProtocolVersion, kEncryptedFlag, 7, 0x0102030405060708ull,
+                          0x1112131415161718ull};
   const Bytes body = {1, 2, 3, 4, 5, 250, 0, 17};
   Bytes message(kEnvelopeBytes + body.size() + kTagBytes);
   write_envelope(envelope, message.data());
   std::copy(body.begin(), body.end(), message.begin() + kEnvelopeBytes);
   seal_in_place(message, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key, true);
-  EXPECT_FALSE(std::equal(body.begin(), body.end(), message.begin() + kEnvelopeBytes));  // encrypted
+  EXPECT_FALSE(
+      std::equal(body.begin(), body.end(), message.begin() + kEnvelopeBytes));  // encrypted
 
   // The documented layout of the envelope and the nonce, byte by byte.
   EXPECT_EQ(Bytes(message.begin(), message.begin() + kEnvelopeBytes),
-            (Bytes{3, 1, 7, 0, 0, 0, 8, 7, 6, 5, 4, 3, 2, 1, 0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11}));
-  const Bytes nonce = {8, 7, 6, 5, 4, 3, 2, 1, 7, 0, 0, 0, 1, 0, 0, 0, 0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11};
-  // Independently: libsodium's combined decryption with that nonce and the envelope as associated data.
+            (Bytes{3, 1, 7, 0,    0,    0,    8,    7,    6,    5,    4,
+                   3, 2, 1, 0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11}));
+  const Bytes nonce = {8, 7, 6, 5, 4,    3,    2,    1,    7,    0,    0,    0,
+                       1, 0, 0, 0, 0x18, 0x17, 0x16, 0x15, 0x14, 0x13, 0x12, 0x11};
+  // Independently: libsodium's combined decryption with that nonce and the envelope as associated
+  // data.
   Bytes plain(body.size());
   unsigned long long plain_size = 0;
-  ASSERT_EQ(crypto_aead_xchacha20poly1305_ietf_decrypt(plain.data(), &plain_size, nullptr, message.data() + kEnvelopeBytes,
-                                                       body.size() + kTagBytes, message.data(), kEnvelopeBytes,
-                                                       nonce.data(), key.bytes.data()),
-            0);
+  ASSERT_EQ(
+      crypto_aead_xchacha20poly1305_ietf_decrypt(
+          plain.data(), &plain_size, nullptr, message.data() + kEnvelopeBytes,
+          body.size() + kTagBytes, message.data(), kEnvelopeBytes, nonce.data(), key.bytes.data()),
+      0);
   EXPECT_EQ(plain, body);
 
   Bytes scratch(body.size());
-  const auto opened = open_sealed(message, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key, true, scratch);
+  const auto opened = open_sealed(message, kEnvelopeBytes, make_nonce(Channel::datagram, envelope),
+                                  key, true, scratch);
   ASSERT_TRUE(opened);
   EXPECT_TRUE(std::equal(opened->begin(), opened->end(), body.begin(), body.end()));
   // Another key, channel, or any byte flipped: refused.
-  EXPECT_FALSE(open_sealed(message, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key_of(4), true, scratch));
-  EXPECT_FALSE(open_sealed(message, kEnvelopeBytes, make_nonce(Channel::frame, envelope), key, true, scratch));
+  EXPECT_FALSE(open_sealed(message, kEnvelopeBytes, make_nonce(Channel::datagram, envelope),
+                           key_of(4), true, scratch));
+  EXPECT_FALSE(open_sealed(message, kEnvelopeBytes, make_nonce(Channel::frame, envelope), key, true,
+                           scratch));
   for (std::size_t i = 0; i < message.size(); ++i) {
     Bytes flipped = message;
     flipped[i] ^= 0x04;
-    EXPECT_FALSE(open_sealed(flipped, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key, true, scratch)) << i;
+    EXPECT_FALSE(open_sealed(flipped, kEnvelopeBytes, make_nonce(Channel::datagram, envelope), key,
+                             true, scratch))
+        << i;
   }
 }
 
@@ -288,9 +308,9 @@ TEST(WireAead, InClearTheBodyIsReadableAndStillAuthenticated) {
   EXPECT_TRUE(std::equal(body.begin(), body.end(), message.begin() + kEnvelopeBytes));
   const Nonce nonce = make_nonce(Channel::datagram, envelope);
   // The tag is the AEAD's over an empty message with everything before it as associated data.
-  EXPECT_EQ(crypto_aead_xchacha20poly1305_ietf_decrypt_detached(nullptr, nullptr, message.data(), 0,
-                                                                message.data() + message.size() - kTagBytes, message.data(),
-                                                                message.size() - kTagBytes, nonce.data(), key.bytes.data()),
+  EXPECT_EQ(crypto_aead_xchacha20poly1305_ietf_decrypt_detached(
+                nullptr, nullptr, message.data(), 0, message.data() + message.size() - kTagBytes,
+                message.data(), message.size() - kTagBytes, nonce.data(), key.bytes.data()),
             0);
   ASSERT_TRUE(open_sealed(message, kEnvelopeBytes, nonce, key, false, {}));
   Bytes changed = message;
@@ -375,7 +395,8 @@ TEST(WireReplayWindow, MatchesASetOfSeenSequencesUnderRandomReordering) {
 
 // ---- datagrams ----
 
-Datagram tool_datagram(std::uint64_t sequence, std::uint32_t sender = 1, std::uint64_t session = kSession) {
+Datagram tool_datagram(std::uint64_t sequence, std::uint32_t sender = 1,
+                       std::uint64_t session = kSession) {
   Datagram d;
   Header* h = d.mutable_header();
   h->set_protocol_version(kProtocolVersion);
@@ -395,7 +416,8 @@ Datagram tool_datagram(std::uint64_t sequence, std::uint32_t sender = 1, std::ui
 }
 
 // Arbitrary body bytes sealed behind `envelope`, as a datagram or (with a length) a frame.
-Bytes sealed(const Bytes& body, const Envelope& envelope, const TrafficKey& key, Channel channel = Channel::datagram) {
+Bytes sealed(const Bytes& body, const Envelope& envelope, const TrafficKey& key,
+             Channel channel = Channel::datagram) {
   const std::size_t clear = channel == Channel::frame ? kFrameClearBytes : kEnvelopeBytes;
   Bytes out(clear + body.size() + kTagBytes);
   if (channel == Channel::frame) write_le(body.size(), kFrameLengthBytes, out.data());
@@ -415,13 +437,14 @@ struct InspectorRig {
     inspector.allow_sender(2, key2, kSalt + 1);
   }
   Bytes encode(const Datagram& d) const {
-    return encode_datagram(d, {d.header().sender() == 2 ? key2 : key, d.header().sender() == 2 ? kSalt + 1 : kSalt});
+    return encode_datagram(
+        d, {d.header().sender() == 2 ? key2 : key, d.header().sender() == 2 ? kSalt + 1 : kSalt});
   }
 };
 
 // Inspects `bytes` and checks that exactly the counter of `expected` (or accepted) rose by one.
-void expect_outcome(DatagramInspector& inspector, const Bytes& bytes, std::optional<Rejection> expected,
-                    const std::string& what) {
+void expect_outcome(DatagramInspector& inspector, const Bytes& bytes,
+                    std::optional<Rejection> expected, const std::string& what) {
   const std::map<std::string, std::uint64_t> before = inspector.counters().snapshot();
   const std::optional<Datagram> result = inspector.inspect(bytes);
   const std::map<std::string, std::uint64_t> after = inspector.counters().snapshot();
@@ -430,7 +453,8 @@ void expect_outcome(DatagramInspector& inspector, const Bytes& bytes, std::optio
   EXPECT_EQ(inspector.last_rejection(), expected) << what;
   ASSERT_EQ(before.size(), kRejectionCount + 1);
   for (const auto& [name, count] : after)
-    EXPECT_EQ(count - before.at(name), name == expected_name ? 1u : 0u) << what << ": counter " << name;
+    EXPECT_EQ(count - before.at(name), name == expected_name ? 1u : 0u)
+        << what << ": counter " << name;
 }
 
 TEST(WireDatagram, RoundTripsEveryBodyBehindTheDocumentedEnvelope) {
@@ -462,7 +486,8 @@ TEST(WireDatagram, RoundTripsEveryBodyBehindTheDocumentedEnvelope) {
   force.mutable_force()->set_flags(3);
   decoded = decode_datagram(encode_datagram(force, {key, kSalt}), key);
   ASSERT_TRUE(std::holds_alternative<Datagram>(decoded));
-  EXPECT_EQ(from_wire(std::get<Datagram>(decoded).force().force()), Eigen::Vector3d(0.5, -1.25, 3.0));
+  EXPECT_EQ(from_wire(std::get<Datagram>(decoded).force().force()),
+            Eigen::Vector3d(0.5, -1.25, 3.0));
   EXPECT_EQ(std::get<Datagram>(decoded).force().ir_epoch(), 12u);
 
   Datagram pong;
@@ -494,7 +519,10 @@ TEST(WireDatagram, EncoderRefusesOversizedDatagrams) {
   *big.mutable_header() = d.header();
   big.mutable_pong();
   // Unknown fields are kept and counted: grow the message past the limit with one.
-  big.mutable_pong()->GetReflection()->MutableUnknownFields(big.mutable_pong())->AddLengthDelimited(99, std::string(1400, 'x'));
+  big.mutable_pong()
+      ->GetReflection()
+      ->MutableUnknownFields(big.mutable_pong())
+      ->AddLengthDelimited(99, std::string(1400, 'x'));
   EXPECT_THROW(encode_datagram(big, {key_of(1), kSalt}), cohaptic::Error);
 }
 
@@ -519,67 +547,88 @@ TEST(WireDatagramInspector, RejectsEachHostileDatagramForItsReason) {
   const Envelope envelope{kProtocolVersion, kEncryptedFlag, 1, kSalt, 10};
 
   // Identity: another key, and slot 1's own key claiming slot 0.
-  expect_outcome(rig.inspector, encode_datagram(ten, {key_of(2), kSalt}), Rejection::bad_tag, "wrong key");
-  expect_outcome(rig.inspector, encode_datagram(ten, {rig.key2, kSalt}), Rejection::bad_tag, "slot 1's key, slot 0's name");
-  for (std::size_t i : {std::size_t{0} + 2, std::size_t{6}, std::size_t{14}, valid.size() / 2, valid.size() - 1}) {
+  expect_outcome(rig.inspector, encode_datagram(ten, {key_of(2), kSalt}), Rejection::bad_tag,
+                 "wrong key");
+  expect_outcome(rig.inspector, encode_datagram(ten, {rig.key2, kSalt}), Rejection::bad_tag,
+                 "slot 1's key, slot 0's name");
+  for (std::size_t i :
+       {std::size_t{0} + 2, std::size_t{6}, std::size_t{14}, valid.size() / 2, valid.size() - 1}) {
     Bytes flipped = valid;
     flipped[i] ^= 0x20;
-    const Rejection expected = i == 2 ? Rejection::unknown_sender : Rejection::bad_tag;  // byte 2: the sender's name
+    const Rejection expected =
+        i == 2 ? Rejection::unknown_sender : Rejection::bad_tag;  // byte 2: the sender's name
     expect_outcome(rig.inspector, flipped, expected, fmt::format("flipped byte {}", i));
   }
   // Size.
   for (std::size_t length : {std::size_t{0}, std::size_t{1}, kDatagramOverheadBytes - 1})
-    expect_outcome(rig.inspector, Bytes(valid.begin(), valid.begin() + static_cast<long>(length)), Rejection::truncated,
-                   fmt::format("truncated to {}", length));
-  for (std::size_t length : {kDatagramOverheadBytes, valid.size() - 1})  // the tag no longer where it was
-    expect_outcome(rig.inspector, Bytes(valid.begin(), valid.begin() + static_cast<long>(length)), Rejection::bad_tag,
-                   fmt::format("cut to {}", length));
+    expect_outcome(rig.inspector, Bytes(valid.begin(), valid.begin() + static_cast<long>(length)),
+                   Rejection::truncated, fmt::format("truncated to {}", length));
+  for (std::size_t length :
+       {kDatagramOverheadBytes, valid.size() - 1})  // the tag no longer where it was
+    expect_outcome(rig.inspector, Bytes(valid.begin(), valid.begin() + static_cast<long>(length)),
+                   Rejection::bad_tag, fmt::format("cut to {}", length));
   Bytes oversized = valid;
   oversized.resize(kMaxDatagramBytes + 1, 0);
   expect_outcome(rig.inspector, oversized, Rejection::oversized, "oversized");
-  expect_outcome(rig.inspector, sealed(Bytes(kMaxDatagramBytes - kDatagramOverheadBytes + 1, 0), envelope, rig.key),
-                 Rejection::oversized, "oversized with a valid tag");
-  // Versions and flags: a protocol 1 or 2 datagram starts with its protobuf (0x0a), not an envelope.
+  expect_outcome(
+      rig.inspector,
+      sealed(Bytes(kMaxDatagramBytes - kDatagramOverheadBytes + 1, 0), envelope, rig.key),
+      Rejection::oversized, "oversized with a valid tag");
+  // Versions and flags: a protocol 1 or 2 datagram starts with its protobuf (0x0a), not an
+  // envelope.
   Bytes v1 = body;
   v1.resize(v1.size() + 32, 0xab);
   expect_outcome(rig.inspector, v1, Rejection::bad_version, "protocol 1 or 2");
   Envelope newer = envelope;
   newer.version = kProtocolVersion + 1;
-  expect_outcome(rig.inspector, sealed(body, newer, rig.key), Rejection::bad_version, "a newer envelope version");
+  expect_outcome(rig.inspector, sealed(body, newer, rig.key), Rejection::bad_version,
+                 "a newer envelope version");
   Envelope flagged = envelope;
   flagged.flags |= 0x80;
-  expect_outcome(rig.inspector, sealed(body, flagged, rig.key), Rejection::bad_version, "unknown flag");
+  expect_outcome(rig.inspector, sealed(body, flagged, rig.key), Rejection::bad_version,
+                 "unknown flag");
   Datagram version = tool_datagram(11);
-  version.mutable_header()->set_protocol_version(kProtocolVersion - 1);  // an older peer, in a new envelope
-  expect_outcome(rig.inspector, rig.encode(version), Rejection::bad_version, "an older sealed header version");
+  version.mutable_header()->set_protocol_version(kProtocolVersion -
+                                                 1);  // an older peer, in a new envelope
+  expect_outcome(rig.inspector, rig.encode(version), Rejection::bad_version,
+                 "an older sealed header version");
   // In clear, where encryption is required.
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11), {rig.key, kSalt, false}), Rejection::cleartext, "clear");
-  // Authentic bytes that are not a Datagram (field 1 with the invalid wire type 7), or cut inside a field.
-  expect_outcome(rig.inspector, sealed(Bytes{0x0f, 0x01, 0x02}, envelope, rig.key), Rejection::truncated, "unparsable");
-  expect_outcome(rig.inspector, sealed(Bytes(body.begin(), body.end() - 3), envelope, rig.key), Rejection::truncated,
-                 "body cut inside a field");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11), {rig.key, kSalt, false}),
+                 Rejection::cleartext, "clear");
+  // Authentic bytes that are not a Datagram (field 1 with the invalid wire type 7), or cut inside a
+  // field.
+  expect_outcome(rig.inspector, sealed(Bytes{0x0f, 0x01, 0x02}, envelope, rig.key),
+                 Rejection::truncated, "unparsable");
+  expect_outcome(rig.inspector, sealed(Bytes(body.begin(), body.end() - 3), envelope, rig.key),
+                 Rejection::truncated, "body cut inside a field");
   // The sealed header must name the envelope's sender and sequence.
   Envelope other_sequence = envelope;
   other_sequence.sequence = 11;
-  expect_outcome(rig.inspector, sealed(body, other_sequence, rig.key), Rejection::bad_tag, "sequence disagrees");
+  expect_outcome(rig.inspector, sealed(body, other_sequence, rig.key), Rejection::bad_tag,
+                 "sequence disagrees");
   const std::string from_two = tool_datagram(10, 2).SerializeAsString();
-  expect_outcome(rig.inspector, sealed(Bytes(from_two.begin(), from_two.end()), envelope, rig.key), Rejection::bad_tag,
-                 "sender disagrees");
-  expect_outcome(rig.inspector, rig.encode(tool_datagram(11, 1, kSession + 1)), Rejection::wrong_session, "wrong session");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11, 7), {rig.key, kSalt}), Rejection::unknown_sender,
-                 "unknown sender");
-  // Authentic, but sealed by another sealer than the one the sender announced (a restarted peer's old traffic).
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11), {rig.key, kSalt + 9}), Rejection::replayed, "other salt");
+  expect_outcome(rig.inspector, sealed(Bytes(from_two.begin(), from_two.end()), envelope, rig.key),
+                 Rejection::bad_tag, "sender disagrees");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(11, 1, kSession + 1)),
+                 Rejection::wrong_session, "wrong session");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11, 7), {rig.key, kSalt}),
+                 Rejection::unknown_sender, "unknown sender");
+  // Authentic, but sealed by another sealer than the one the sender announced (a restarted peer's
+  // old traffic).
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(11), {rig.key, kSalt + 9}),
+                 Rejection::replayed, "other salt");
 
   Datagram nan = tool_datagram(12);
   nan.mutable_tool()->mutable_position()->set_y(std::numeric_limits<double>::quiet_NaN());
   expect_outcome(rig.inspector, rig.encode(nan), Rejection::non_finite, "NaN tool position");
   Datagram invalid_nan = nan;
   invalid_nan.mutable_tool()->set_valid(false);
-  expect_outcome(rig.inspector, rig.encode(invalid_nan), Rejection::non_finite, "NaN in an invalid sample");
+  expect_outcome(rig.inspector, rig.encode(invalid_nan), Rejection::non_finite,
+                 "NaN in an invalid sample");
   Datagram inf;
   *inf.mutable_header() = tool_datagram(13).header();
-  to_wire(Eigen::Vector3d(0, std::numeric_limits<double>::infinity(), 0), inf.mutable_force()->mutable_force());
+  to_wire(Eigen::Vector3d(0, std::numeric_limits<double>::infinity(), 0),
+          inf.mutable_force()->mutable_force());
   expect_outcome(rig.inspector, rig.encode(inf), Rejection::non_finite, "infinite force");
 
   Datagram empty = tool_datagram(14);
@@ -588,7 +637,8 @@ TEST(WireDatagramInspector, RejectsEachHostileDatagramForItsReason) {
 
   // Clock readings outside [0, 2^61) ns: a pong's INT64_MIN would overflow the client's
   // clock offset arithmetic (undefined behaviour).
-  constexpr std::int64_t kMin = std::numeric_limits<std::int64_t>::min(), kMax = std::numeric_limits<std::int64_t>::max();
+  constexpr std::int64_t kMin = std::numeric_limits<std::int64_t>::min(),
+                         kMax = std::numeric_limits<std::int64_t>::max();
   Datagram early = tool_datagram(15);
   early.mutable_header()->set_sender_time_ns(-1);
   expect_outcome(rig.inspector, rig.encode(early), Rejection::bad_time, "negative sender time");
@@ -605,36 +655,46 @@ TEST(WireDatagramInspector, RejectsEachHostileDatagramForItsReason) {
     pong.mutable_pong()->set_client_send_ns(field == 0 ? kMin : 1);
     pong.mutable_pong()->set_server_receive_ns(field == 1 ? kMax : 2);
     pong.mutable_pong()->set_server_send_ns(field == 2 ? -3 : 3);
-    expect_outcome(rig.inspector, rig.encode(pong), Rejection::bad_time, "pong field " + std::to_string(field));
+    expect_outcome(rig.inspector, rig.encode(pong), Rejection::bad_time,
+                   "pong field " + std::to_string(field));
   }
   Datagram answer;
   *answer.mutable_header() = tool_datagram(15).header();
   answer.mutable_force()->set_tool_time_ns(kMax);
-  expect_outcome(rig.inspector, rig.encode(answer), Rejection::bad_time, "force answering INT64_MAX");
+  expect_outcome(rig.inspector, rig.encode(answer), Rejection::bad_time,
+                 "force answering INT64_MAX");
 
   // None of the rejected packets moved the window: the valid one is still fresh, once.
   expect_outcome(rig.inspector, valid, std::nullopt, "valid");
   expect_outcome(rig.inspector, valid, Rejection::replayed, "the same bytes again");
   expect_outcome(rig.inspector, rig.encode(tool_datagram(100)), std::nullopt, "jump to 100");
-  expect_outcome(rig.inspector, rig.encode(tool_datagram(36)), Rejection::replayed, "older than the window");
-  expect_outcome(rig.inspector, rig.encode(tool_datagram(37)), std::nullopt, "oldest in the window");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(36)), Rejection::replayed,
+                 "older than the window");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(37)), std::nullopt,
+                 "oldest in the window");
 }
 
 TEST(WireDatagramInspector, AcceptsReorderedFreshSequencesAndKeepsWindowsPerSender) {
   InspectorRig rig;
   for (std::uint64_t s : {20, 23, 21, 22, 5})
-    expect_outcome(rig.inspector, rig.encode(tool_datagram(s)), std::nullopt, fmt::format("sequence {}", s));
+    expect_outcome(rig.inspector, rig.encode(tool_datagram(s)), std::nullopt,
+                   fmt::format("sequence {}", s));
   expect_outcome(rig.inspector, rig.encode(tool_datagram(21)), Rejection::replayed, "21 again");
   // Sender 2 has its own window.
   expect_outcome(rig.inspector, rig.encode(tool_datagram(21, 2)), std::nullopt, "21 from sender 2");
-  // A slot taken over by a new user (a new sealer, that said its last sequence was 3) starts afresh.
+  // A slot taken over by a new user (a new sealer, that said its last sequence was 3) starts
+  // afresh.
   rig.inspector.allow_sender(1, rig.key, kSalt + 5, 3);
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(3), {rig.key, kSalt + 5}), Rejection::replayed, "3: its last");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(4), {rig.key, kSalt + 5}), std::nullopt, "4: new user");
-  expect_outcome(rig.inspector, rig.encode(tool_datagram(30)), Rejection::replayed, "the old user's sealer");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(3), {rig.key, kSalt + 5}),
+                 Rejection::replayed, "3: its last");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(4), {rig.key, kSalt + 5}),
+                 std::nullopt, "4: new user");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(30)), Rejection::replayed,
+                 "the old user's sealer");
   rig.inspector.forget_sender(2);
   EXPECT_FALSE(rig.inspector.allows(2));
-  expect_outcome(rig.inspector, rig.encode(tool_datagram(22, 2)), Rejection::unknown_sender, "forgotten");
+  expect_outcome(rig.inspector, rig.encode(tool_datagram(22, 2)), Rejection::unknown_sender,
+                 "forgotten");
 }
 
 TEST(WireDatagramInspector, RejectedPacketsNeverAdvanceTheWindow) {
@@ -642,9 +702,12 @@ TEST(WireDatagramInspector, RejectedPacketsNeverAdvanceTheWindow) {
   expect_outcome(rig.inspector, rig.encode(tool_datagram(5)), std::nullopt, "5");
   Datagram far_nan = tool_datagram(1000);
   far_nan.mutable_tool()->mutable_position()->set_x(std::numeric_limits<double>::infinity());
-  expect_outcome(rig.inspector, rig.encode(far_nan), Rejection::non_finite, "authentic but infinite");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1000), {key_of(9), kSalt}), Rejection::bad_tag, "forged");
-  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1000), {rig.key, kSalt + 1}), Rejection::replayed, "other salt");
+  expect_outcome(rig.inspector, rig.encode(far_nan), Rejection::non_finite,
+                 "authentic but infinite");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1000), {key_of(9), kSalt}),
+                 Rejection::bad_tag, "forged");
+  expect_outcome(rig.inspector, encode_datagram(tool_datagram(1000), {rig.key, kSalt + 1}),
+                 Rejection::replayed, "other salt");
   EXPECT_EQ(*rig.inspector.window(1)->highest(), 5u);
   expect_outcome(rig.inspector, rig.encode(tool_datagram(6)), std::nullopt, "6 still fresh");
 }
@@ -653,18 +716,23 @@ TEST(WireDatagramInspector, ExpectedSessionCanBeLearnedOrIgnored) {
   const TrafficKey key = key_of(1);
   DatagramInspector inspector;  // no session expected yet
   inspector.allow_sender(kServerSender, key, kSalt);
-  expect_outcome(inspector, encode_datagram(tool_datagram(1, kServerSender, 77), {key, kSalt}), std::nullopt, "any session");
+  expect_outcome(inspector, encode_datagram(tool_datagram(1, kServerSender, 77), {key, kSalt}),
+                 std::nullopt, "any session");
   inspector.set_expected_session(78);
-  expect_outcome(inspector, encode_datagram(tool_datagram(2, kServerSender, 77), {key, kSalt}), Rejection::wrong_session, "77");
-  expect_outcome(inspector, encode_datagram(tool_datagram(3, kServerSender, 78), {key, kSalt}), std::nullopt, "78");
+  expect_outcome(inspector, encode_datagram(tool_datagram(2, kServerSender, 77), {key, kSalt}),
+                 Rejection::wrong_session, "77");
+  expect_outcome(inspector, encode_datagram(tool_datagram(3, kServerSender, 78), {key, kSalt}),
+                 std::nullopt, "78");
 }
 
 TEST(WireDatagramInspector, AcceptsDatagramsInClearOnlyWhereAllowed) {
   const TrafficKey key = key_of(1);
   DatagramInspector lenient(kSession, true);
   lenient.allow_sender(1, key, kSalt);
-  expect_outcome(lenient, encode_datagram(tool_datagram(1), {key, kSalt, false}), std::nullopt, "clear, allowed");
-  expect_outcome(lenient, encode_datagram(tool_datagram(2), {key, kSalt, true}), std::nullopt, "encrypted, always");
+  expect_outcome(lenient, encode_datagram(tool_datagram(1), {key, kSalt, false}), std::nullopt,
+                 "clear, allowed");
+  expect_outcome(lenient, encode_datagram(tool_datagram(2), {key, kSalt, true}), std::nullopt,
+                 "encrypted, always");
   Bytes tampered = encode_datagram(tool_datagram(3), {key, kSalt, false});
   tampered[kEnvelopeBytes + 5] ^= 1;  // readable, but not changeable
   expect_outcome(lenient, tampered, Rejection::bad_tag, "clear, tampered");
@@ -678,8 +746,11 @@ TEST(WireDatagramInspector, RandomBytesAndMutationsNeverThrowNorPassAsAuthentic)
   for (int i = 0; i < 20000; ++i) {
     Bytes garbage(length(rng));
     for (auto& b : garbage) b = static_cast<std::uint8_t>(byte(rng));
-    if (i % 2 && garbage.size() >= kEnvelopeBytes) {  // half with a well-formed envelope naming an allowed sender
-      write_envelope({kProtocolVersion, kEncryptedFlag, 1 + static_cast<std::uint32_t>(i % 4 == 1), rng(), rng()}, garbage.data());
+    if (i % 2 && garbage.size() >=
+                     kEnvelopeBytes) {  // half with a well-formed envelope naming an allowed sender
+      write_envelope({kProtocolVersion, kEncryptedFlag, 1 + static_cast<std::uint32_t>(i % 4 == 1),
+                      rng(), rng()},
+                     garbage.data());
     }
     std::optional<Datagram> result;
     ASSERT_NO_THROW(result = rig.inspector.inspect(garbage));
@@ -687,7 +758,8 @@ TEST(WireDatagramInspector, RandomBytesAndMutationsNeverThrowNorPassAsAuthentic)
   }
   EXPECT_EQ(rig.inspector.counters().accepted(), 0u);
   EXPECT_EQ(rig.inspector.counters().rejected(), 20000u);
-  EXPECT_GT(rig.inspector.counters().count(Rejection::bad_tag), 4000u);  // the envelopes led as far as the tag
+  EXPECT_GT(rig.inspector.counters().count(Rejection::bad_tag),
+            4000u);  // the envelopes led as far as the tag
 
   const Bytes valid = rig.encode(tool_datagram(50));
   ASSERT_TRUE(rig.inspector.inspect(valid));
@@ -696,13 +768,15 @@ TEST(WireDatagramInspector, RandomBytesAndMutationsNeverThrowNorPassAsAuthentic)
     Bytes m = valid;
     switch (rng() % 4) {
       case 0:  // flip one to four bits
-        for (std::size_t k = 0, n = 1 + rng() % 4; k < n; ++k) m[rng() % m.size()] ^= static_cast<std::uint8_t>(1u << (rng() % 8));
+        for (std::size_t k = 0, n = 1 + rng() % 4; k < n; ++k)
+          m[rng() % m.size()] ^= static_cast<std::uint8_t>(1u << (rng() % 8));
         break;
       case 1:  // truncate
         m.resize(rng() % m.size());
         break;
       case 2:  // append
-        for (std::size_t k = 0, n = 1 + rng() % 1400; k < n; ++k) m.push_back(static_cast<std::uint8_t>(byte(rng)));
+        for (std::size_t k = 0, n = 1 + rng() % 1400; k < n; ++k)
+          m.push_back(static_cast<std::uint8_t>(byte(rng)));
         break;
       default:  // overwrite a run
         for (std::size_t k = rng() % m.size(), n = 1 + rng() % 16; k < m.size() && n > 0; ++k, --n)
@@ -716,14 +790,16 @@ TEST(WireDatagramInspector, RandomBytesAndMutationsNeverThrowNorPassAsAuthentic)
       EXPECT_EQ(rig.inspector.last_rejection(), Rejection::replayed);
     } else {
       const Rejection r = *rig.inspector.last_rejection();
-      ASSERT_TRUE(r == Rejection::bad_tag || r == Rejection::truncated || r == Rejection::oversized ||
-                  r == Rejection::bad_version || r == Rejection::cleartext || r == Rejection::unknown_sender)
+      ASSERT_TRUE(r == Rejection::bad_tag || r == Rejection::truncated ||
+                  r == Rejection::oversized || r == Rejection::bad_version ||
+                  r == Rejection::cleartext || r == Rejection::unknown_sender)
           << "mutation " << i << ": " << to_string(r);
     }
   }
   EXPECT_EQ(rig.inspector.counters().accepted(), 1u);
   EXPECT_EQ(rig.inspector.counters().rejected(), 40000u);
-  EXPECT_EQ(rig.inspector.counters().count(Rejection::replayed), static_cast<std::uint64_t>(identical));
+  EXPECT_EQ(rig.inspector.counters().count(Rejection::replayed),
+            static_cast<std::uint64_t>(identical));
 }
 
 TEST(WireDatagramInspector, AuthenticGarbageBodiesNeverThrow) {
@@ -739,7 +815,8 @@ TEST(WireDatagramInspector, AuthenticGarbageBodiesNeverThrow) {
     } else {
       for (int k = 0; k < 3; ++k) body[rng() % body.size()] = static_cast<std::uint8_t>(rng());
     }
-    const Envelope envelope{kProtocolVersion, kEncryptedFlag, 1, kSalt, 1 + static_cast<std::uint64_t>(i)};
+    const Envelope envelope{kProtocolVersion, kEncryptedFlag, 1, kSalt,
+                            1 + static_cast<std::uint64_t>(i)};
     ASSERT_NO_THROW(rig.inspector.inspect(sealed(body, envelope, rig.key)));
   }
   const RejectionCounters& c = rig.inspector.counters();
@@ -749,14 +826,16 @@ TEST(WireDatagramInspector, AuthenticGarbageBodiesNeverThrow) {
 TEST(WireDatagramInspector, RejectionNamesAreTheEnumerators) {
   std::set<std::string> names;
   for (Rejection r : kAllRejections) names.insert(std::string(to_string(r)));
-  EXPECT_EQ(names, (std::set<std::string>{"oversized", "truncated", "bad_tag", "bad_version", "wrong_session",
-                                          "unknown_sender", "replayed", "non_finite", "empty", "cleartext",
-                                          "rate_limited", "bad_time"}));
+  EXPECT_EQ(names,
+            (std::set<std::string>{"oversized", "truncated", "bad_tag", "bad_version",
+                                   "wrong_session", "unknown_sender", "replayed", "non_finite",
+                                   "empty", "cleartext", "rate_limited", "bad_time"}));
 }
 
 // ---- TCP frames ----
 
-Control control_with(std::uint64_t sequence, const std::string& text, std::uint32_t sender = kServerSender) {
+Control control_with(std::uint64_t sequence, const std::string& text,
+                     std::uint32_t sender = kServerSender) {
   Control c;
   Header* h = c.mutable_header();
   h->set_protocol_version(kProtocolVersion);
@@ -770,10 +849,12 @@ Control control_with(std::uint64_t sequence, const std::string& text, std::uint3
 
 // A reader that opens the server's frames with `key`.
 FrameReader reader_for(const TrafficKey& key, FrameReaderOptions options = {}) {
-  return FrameReader([key](std::uint32_t sender) { return sender == kServerSender ? &key : nullptr; }, options);
+  return FrameReader(
+      [key](std::uint32_t sender) { return sender == kServerSender ? &key : nullptr; }, options);
 }
 
-Bytes frame_of(const Control& c, const TrafficKey& key, std::uint64_t salt = kSalt, bool encrypt = true) {
+Bytes frame_of(const Control& c, const TrafficKey& key, std::uint64_t salt = kSalt,
+               bool encrypt = true) {
   return encode_frame(c, {key, salt, encrypt});
 }
 
@@ -794,19 +875,23 @@ TEST(WireFrame, LayoutIsLengthEnvelopeSealedBodyTag) {
   const Bytes frame = frame_of(c, key);
   const std::string body = c.SerializeAsString();
   ASSERT_EQ(frame.size(), 4 + kEnvelopeBytes + body.size() + kTagBytes);
-  EXPECT_EQ(frame[0] | frame[1] << 8 | frame[2] << 16 | frame[3] << 24, static_cast<int>(body.size()));
+  EXPECT_EQ(frame[0] | frame[1] << 8 | frame[2] << 16 | frame[3] << 24,
+            static_cast<int>(body.size()));
   const Envelope envelope = *read_envelope(std::span(frame).subspan(4));
   EXPECT_EQ(envelope.sequence, 1u);
   EXPECT_EQ(envelope.sender, kServerSender);
   EXPECT_EQ(envelope.salt, kSalt);
-  // Encrypted: the body is not readable; libsodium opens it with the length and envelope as associated data.
-  EXPECT_NE(Bytes(frame.begin() + kFrameClearBytes, frame.end() - kTagBytes), Bytes(body.begin(), body.end()));
+  // Encrypted: the body is not readable; libsodium opens it with the length and envelope as
+  // associated data.
+  EXPECT_NE(Bytes(frame.begin() + kFrameClearBytes, frame.end() - kTagBytes),
+            Bytes(body.begin(), body.end()));
   Bytes plain(body.size());
   const Nonce nonce = make_nonce(Channel::frame, envelope);
-  ASSERT_EQ(crypto_aead_xchacha20poly1305_ietf_decrypt(plain.data(), nullptr, nullptr, frame.data() + kFrameClearBytes,
-                                                       body.size() + kTagBytes, frame.data(), kFrameClearBytes,
-                                                       nonce.data(), key.bytes.data()),
-            0);
+  ASSERT_EQ(
+      crypto_aead_xchacha20poly1305_ietf_decrypt(
+          plain.data(), nullptr, nullptr, frame.data() + kFrameClearBytes, body.size() + kTagBytes,
+          frame.data(), kFrameClearBytes, nonce.data(), key.bytes.data()),
+      0);
   EXPECT_EQ(plain, Bytes(body.begin(), body.end()));
 }
 
@@ -814,7 +899,10 @@ TEST(WireFrame, ReaderReassemblesOneByteFeedsAndSeveralFramesPerFeed) {
   const TrafficKey key = key_of(5);
   Bytes stream;
   for (int i = 1; i <= 3; ++i) {
-    const Bytes frame = frame_of(control_with(static_cast<std::uint64_t>(i), std::string(100 * static_cast<std::size_t>(i), static_cast<char>('a' + i))), key);
+    const Bytes frame = frame_of(
+        control_with(static_cast<std::uint64_t>(i),
+                     std::string(100 * static_cast<std::size_t>(i), static_cast<char>('a' + i))),
+        key);
     stream.insert(stream.end(), frame.begin(), frame.end());
   }
   FrameReader slow = reader_for(key);
@@ -826,7 +914,8 @@ TEST(WireFrame, ReaderReassemblesOneByteFeedsAndSeveralFramesPerFeed) {
   ASSERT_EQ(received.size(), 3u);
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(received[i].header().sequence(), static_cast<std::uint64_t>(i + 1));
-    EXPECT_EQ(received[i].event().text(), std::string(100 * static_cast<std::size_t>(i + 1), static_cast<char>('a' + i + 1)));
+    EXPECT_EQ(received[i].event().text(),
+              std::string(100 * static_cast<std::size_t>(i + 1), static_cast<char>('a' + i + 1)));
   }
   EXPECT_EQ(slow.buffered(), 0u);
 
@@ -886,7 +975,8 @@ TEST(WireFrame, TheClientsReaderTakesTheGreetingFirst) {
   newer.feed(other_version);
   const auto [newer_error, newer_reason] = frame_error(newer);
   EXPECT_EQ(newer_reason, Rejection::bad_version);
-  EXPECT_NE(newer_error.find("speaks protocol version 4, this program 3"), std::string::npos) << newer_error;
+  EXPECT_NE(newer_error.find("speaks protocol version 4, this program 3"), std::string::npos)
+      << newer_error;
   FrameReader silent = reader_for(key, {.expect_greeting = true});
   silent.feed(frame);  // a server that sends a frame first is no cohaptic 3 server
   EXPECT_EQ(frame_error(silent).second, Rejection::bad_version);
@@ -915,14 +1005,16 @@ TEST(WireFrame, ReaderRejectsOversizedLengthBeforeReceivingTheBody) {
   reader.feed(length);
   const auto [error, reason] = frame_error(reader);
   EXPECT_EQ(reason, Rejection::oversized);
-  EXPECT_NE(error.find("declared body length 1001 exceeds the limit of 1000"), std::string::npos) << error;
+  EXPECT_NE(error.find("declared body length 1001 exceeds the limit of 1000"), std::string::npos)
+      << error;
   // Sticky: the stream cannot be resynchronised.
   reader.feed(frame_of(control_with(1, "x"), key_of(5)));
   EXPECT_THROW(reader.next(), FrameError);
 
   FrameReader default_limit = reader_for(key_of(5));
   default_limit.feed(Bytes{0xff, 0xff, 0xff, 0xff});
-  EXPECT_NE(frame_error(default_limit).first.find("exceeds the limit of 67108864"), std::string::npos);
+  EXPECT_NE(frame_error(default_limit).first.find("exceeds the limit of 67108864"),
+            std::string::npos);
 }
 
 TEST(WireFrame, ReaderRejectsEachHostileFrameForItsReason) {
@@ -942,10 +1034,16 @@ TEST(WireFrame, ReaderRejectsEachHostileFrameForItsReason) {
   lengthened.push_back(0);  // one more byte, and the length claims it: the tag no longer matches
   lengthened[0] = static_cast<std::uint8_t>(lengthened[0] + 1);
   EXPECT_EQ(reason_of(lengthened).second, Rejection::bad_tag);
-  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello"), key_of(6))).second, Rejection::bad_tag);  // wrong key
-  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello", 4), key)).second, Rejection::unknown_sender);
-  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello"), key, kSalt, false)).second, Rejection::cleartext);
-  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello"), key, kSalt, false), {.allow_cleartext = true}).second, std::nullopt);
+  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello"), key_of(6))).second,
+            Rejection::bad_tag);  // wrong key
+  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello", 4), key)).second,
+            Rejection::unknown_sender);
+  EXPECT_EQ(reason_of(frame_of(control_with(1, "hello"), key, kSalt, false)).second,
+            Rejection::cleartext);
+  EXPECT_EQ(
+      reason_of(frame_of(control_with(1, "hello"), key, kSalt, false), {.allow_cleartext = true})
+          .second,
+      std::nullopt);
 
   // A protocol 1 or 2 frame: [length][protobuf starting 0x0a][HMAC].
   const std::string v1_body = control_with(1, "old").SerializeAsString();
@@ -958,11 +1056,14 @@ TEST(WireFrame, ReaderRejectsEachHostileFrameForItsReason) {
   EXPECT_NE(v1_error.find("envelope version byte 10"), std::string::npos) << v1_error;
 
   const Envelope envelope{kProtocolVersion, kEncryptedFlag, kServerSender, kSalt, 1};
-  const auto [parse_error, parse_reason] = reason_of(sealed(Bytes{0x0f, 0x01, 0x02}, envelope, key, Channel::frame));
+  const auto [parse_error, parse_reason] =
+      reason_of(sealed(Bytes{0x0f, 0x01, 0x02}, envelope, key, Channel::frame));
   EXPECT_EQ(parse_reason, Rejection::truncated);
   EXPECT_NE(parse_error.find("not a Control message"), std::string::npos) << parse_error;
   const std::string body = control_with(2, "x").SerializeAsString();
-  EXPECT_EQ(reason_of(sealed(Bytes(body.begin(), body.end()), envelope, key, Channel::frame)).second, Rejection::bad_tag)
+  EXPECT_EQ(
+      reason_of(sealed(Bytes(body.begin(), body.end()), envelope, key, Channel::frame)).second,
+      Rejection::bad_tag)
       << "sealed sequence 2, envelope 1";
   Control v1_header = control_with(1, "x");
   v1_header.mutable_header()->set_protocol_version(kProtocolVersion - 1);
@@ -984,7 +1085,8 @@ TEST(WireFrame, AStreamIsOneSealersStrictlyIncreasingSequence) {
   EXPECT_TRUE(replay.next());
   const auto [error, reason] = frame_error(replay);
   EXPECT_EQ(reason, Rejection::replayed);
-  EXPECT_NE(error.find("sequence 9 is not above the previous frame's 9"), std::string::npos) << error;
+  EXPECT_NE(error.find("sequence 9 is not above the previous frame's 9"), std::string::npos)
+      << error;
 
   // A frame of another connection's sealer, however new its sequence, is refused.
   FrameReader spliced = reader_for(key);
@@ -1039,7 +1141,8 @@ struct IrRig {
   explicit IrRig(IrPrecision precision) : rig(small_cube()) {
     SimulationOptions options;
     options.ir.precision = precision;
-    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2), options);
+    Simulation simulation(rig.body, rig.model->obstacles, *rig.columns, std::vector<ToolSpec>(2),
+                          options);
     simulation.set_tool(0, {0, 0, -0.002});
     simulation.set_tool(1, {0.03, 0, -0.002});
     simulation.step(0);
@@ -1058,16 +1161,19 @@ template <typename Derived>
 bool bit_equal(const Eigen::DenseBase<Derived>& a, const Eigen::DenseBase<Derived>& b) {
   // An empty matrix's data() may be null, which memcmp must not be given even for 0 bytes.
   return a.rows() == b.rows() && a.cols() == b.cols() &&
-         (a.size() == 0 ||
-          std::memcmp(a.derived().data(), b.derived().data(), static_cast<std::size_t>(a.size()) * sizeof(double)) == 0);
+         (a.size() == 0 || std::memcmp(a.derived().data(), b.derived().data(),
+                                       static_cast<std::size_t>(a.size()) * sizeof(double)) == 0);
 }
 
-bool bit_equal(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::memcmp(a.data(), b.data(), 3 * sizeof(double)) == 0; }
+bool bit_equal(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::memcmp(a.data(), b.data(), 3 * sizeof(double)) == 0;
+}
 
 void expect_same_ir(const cohaptic::IntermediateRepresentation& envelope_a,
                     const cohaptic::IntermediateRepresentation& envelope_b) {
   EXPECT_EQ(envelope_a.epoch, envelope_b.epoch);
-  EXPECT_EQ(std::memcmp(&envelope_a.simulation_time, &envelope_b.simulation_time, sizeof(double)), 0);
+  EXPECT_EQ(std::memcmp(&envelope_a.simulation_time, &envelope_b.simulation_time, sizeof(double)),
+            0);
   EXPECT_EQ(envelope_a.user, envelope_b.user);
   EXPECT_EQ(envelope_a.object, envelope_b.object);
   EXPECT_EQ(envelope_a.tool_radius, envelope_b.tool_radius);
@@ -1087,12 +1193,14 @@ void expect_same_ir(const cohaptic::IntermediateRepresentation& envelope_a,
     EXPECT_EQ(a.patch[i].surface_index, b.patch[i].surface_index);
     EXPECT_TRUE(bit_equal(a.patch[i].normal, b.patch[i].normal));
     EXPECT_EQ(a.patch[i].neighbours, b.patch[i].neighbours);
-    for (int k = 0; k < 3; ++k) EXPECT_TRUE(bit_equal(a.patch[i].edge_normals[k], b.patch[i].edge_normals[k]));
+    for (int k = 0; k < 3; ++k)
+      EXPECT_TRUE(bit_equal(a.patch[i].edge_normals[k], b.patch[i].edge_normals[k]));
   }
   EXPECT_TRUE(bit_equal(a.patch_vertex_normals, b.patch_vertex_normals));
   ASSERT_EQ(a.guard.size(), b.guard.size());
   for (std::size_t i = 0; i < a.guard.size(); ++i) {
-    for (int k = 0; k < 3; ++k) EXPECT_TRUE(bit_equal(a.guard[i].corners[k], b.guard[i].corners[k]));
+    for (int k = 0; k < 3; ++k)
+      EXPECT_TRUE(bit_equal(a.guard[i].corners[k], b.guard[i].corners[k]));
     EXPECT_TRUE(bit_equal(a.guard[i].normal, b.guard[i].normal));
   }
   ASSERT_EQ(a.remotes.size(), b.remotes.size());
@@ -1112,7 +1220,8 @@ void expect_same_ir(const cohaptic::IntermediateRepresentation& envelope_a,
 }
 
 // Through bytes, as it travels: to_wire, a Control frame, FrameReader, from_wire.
-cohaptic::IntermediateRepresentation through_the_wire(const cohaptic::IntermediateRepresentation& ir) {
+cohaptic::IntermediateRepresentation through_the_wire(
+    const cohaptic::IntermediateRepresentation& ir) {
   const TrafficKey key = key_of(8);
   Control control;
   HeaderStamp(kSession, kServerSender).stamp(*control.mutable_header());
@@ -1132,7 +1241,7 @@ TEST(WireIr, RoundTripIsBitExactInDouble) {
   ir.epoch = 0xfedcba9876543210ull;
   ir.simulation_time = 1.0 / 3.0;
   ir.object = 3;
-  ir.force_limit = std::numeric_limits<double>::infinity();  // "no limit" travels too
+  ir.force_limit = std::numeric_limits<double>::infinity();    // "no limit" travels too
   fem.m_tilde(0, 0) = std::nextafter(fem.m_tilde(0, 0), 0.0);  // a value float would not keep
   fem.rest_forces = Eigen::VectorXd::LinSpaced(fem.m_tilde.rows(), -0.1, 1.0 / 7.0);  // format 5
   const IntermediateRepresentation wire_ir = to_wire(ir);
@@ -1151,7 +1260,8 @@ TEST(WireIr, RoundTripIsBitExactInDouble) {
   const PreparedIR received = prepare_ir(through_the_wire(ir));
   const std::vector<Eigen::Vector3d> remote = {Eigen::Vector3d(0.03, 0, -0.002)};
   const Eigen::Vector3d tool(0.001, 0.0005, -0.003);
-  EXPECT_TRUE(bit_equal(testing::evaluate_static(received, tool, remote).force, testing::evaluate_static(original, tool, remote).force));
+  EXPECT_TRUE(bit_equal(testing::evaluate_static(received, tool, remote).force,
+                        testing::evaluate_static(original, tool, remote).force));
 }
 
 TEST(WireIr, RoundTripIsExactInFloat) {
@@ -1182,39 +1292,85 @@ TEST(WireIr, FromWireRejectsEveryInconsistency) {
   const std::vector<Case> cases = {
       {"format version", [](auto& w) { w.set_format_version(1); }, "format version 1, expected 2"},
       {"no body", [](auto& w) { w.clear_fem(); }, "no body of a kind this build knows"},
-      {"fixed_axes length", [](auto& w) { w.mutable_fem()->mutable_fixed_axes()->pop_back(); }, "fixed_axes bytes for"},
-      {"fixed_axes mask", [](auto& w) { (*w.mutable_fem()->mutable_fixed_axes())[0] = 8; }, "not a mask"},
-      {"row count", [](auto& w) { w.mutable_fem()->set_row_node_count(static_cast<std::uint32_t>(w.fem().node_ids_size() + 1)); }, "exceeds the"},
-      {"patch count", [](auto& w) { w.mutable_fem()->set_patch_node_count(w.fem().row_node_count() + 1); }, "exceeds row_node_count"},
-      {"rest positions", [](auto& w) { w.mutable_fem()->mutable_rest_positions()->RemoveLast(); }, "rest_positions has"},
-      {"NaN rest position", [nan](auto& w) { w.mutable_fem()->set_rest_positions(4, nan); }, "rest_positions[4] is not finite"},
+      {"fixed_axes length", [](auto& w) { w.mutable_fem()->mutable_fixed_axes()->pop_back(); },
+       "fixed_axes bytes for"},
+      {"fixed_axes mask", [](auto& w) { (*w.mutable_fem()->mutable_fixed_axes())[0] = 8; },
+       "not a mask"},
+      {"row count",
+       [](auto& w) {
+         w.mutable_fem()->set_row_node_count(
+             static_cast<std::uint32_t>(w.fem().node_ids_size() + 1));
+       },
+       "exceeds the"},
+      {"patch count",
+       [](auto& w) { w.mutable_fem()->set_patch_node_count(w.fem().row_node_count() + 1); },
+       "exceeds row_node_count"},
+      {"rest positions", [](auto& w) { w.mutable_fem()->mutable_rest_positions()->RemoveLast(); },
+       "rest_positions has"},
+      {"NaN rest position", [nan](auto& w) { w.mutable_fem()->set_rest_positions(4, nan); },
+       "rest_positions[4] is not finite"},
       {"empty patch", [](auto& w) { w.mutable_fem()->clear_patch(); }, "no triangle"},
-      {"two-node triangle", [](auto& w) { w.mutable_fem()->mutable_patch(0)->mutable_nodes()->RemoveLast(); }, "patch[0].nodes has 2 entries"},
-      {"node outside patch", [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_nodes(1, w.fem().patch_node_count()); }, "outside the patch"},
-      {"neighbour out of range", [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_neighbours(2, w.fem().patch_size()); }, "neighbours[2]"},
-      {"neighbour below -1", [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_neighbours(0, -2); }, "neighbours[0] = -2"},
-      {"two edge normals", [](auto& w) { w.mutable_fem()->mutable_patch(0)->mutable_edge_normals()->RemoveLast(); }, "edge_normals has 2"},
-      {"NaN normal", [nan](auto& w) { w.mutable_fem()->mutable_patch(0)->mutable_normal()->set_z(nan); }, "patch[0].normal has a non-finite"},
-      {"negative surface index", [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_surface_index(-1); }, "surface_index is negative"},
-      {"vertex normals", [](auto& w) { w.mutable_fem()->add_patch_vertex_normals(0); }, "patch_vertex_normals has"},
-      {"guard corners", [](auto& w) { w.mutable_fem()->add_guard()->add_corners(); }, "corners has 1 entries"},
-      {"remote node", [](auto& w) { w.mutable_fem()->mutable_remotes(0)->set_nodes(0, w.fem().row_node_count()); }, "outside the contact nodes"},
-      {"remote vertex normals", [](auto& w) { w.mutable_fem()->mutable_remotes(0)->clear_vertex_normals(); }, "vertex_normals has 0"},
-      {"remote radius", [](auto& w) { w.mutable_fem()->mutable_remotes(0)->set_tool_radius(-1); }, "tool_radius -1"},
-      {"contact model", [](auto& w) { w.mutable_fem()->set_contact_model(static_cast<CondensedFem::ContactModel>(7)); }, "unknown contact model 7"},
+      {"two-node triangle",
+       [](auto& w) { w.mutable_fem()->mutable_patch(0)->mutable_nodes()->RemoveLast(); },
+       "patch[0].nodes has 2 entries"},
+      {"node outside patch",
+       [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_nodes(1, w.fem().patch_node_count()); },
+       "outside the patch"},
+      {"neighbour out of range",
+       [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_neighbours(2, w.fem().patch_size()); },
+       "neighbours[2]"},
+      {"neighbour below -1",
+       [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_neighbours(0, -2); },
+       "neighbours[0] = -2"},
+      {"two edge normals",
+       [](auto& w) { w.mutable_fem()->mutable_patch(0)->mutable_edge_normals()->RemoveLast(); },
+       "edge_normals has 2"},
+      {"NaN normal",
+       [nan](auto& w) { w.mutable_fem()->mutable_patch(0)->mutable_normal()->set_z(nan); },
+       "patch[0].normal has a non-finite"},
+      {"negative surface index",
+       [](auto& w) { w.mutable_fem()->mutable_patch(0)->set_surface_index(-1); },
+       "surface_index is negative"},
+      {"vertex normals", [](auto& w) { w.mutable_fem()->add_patch_vertex_normals(0); },
+       "patch_vertex_normals has"},
+      {"guard corners", [](auto& w) { w.mutable_fem()->add_guard()->add_corners(); },
+       "corners has 1 entries"},
+      {"remote node",
+       [](auto& w) { w.mutable_fem()->mutable_remotes(0)->set_nodes(0, w.fem().row_node_count()); },
+       "outside the contact nodes"},
+      {"remote vertex normals",
+       [](auto& w) { w.mutable_fem()->mutable_remotes(0)->clear_vertex_normals(); },
+       "vertex_normals has 0"},
+      {"remote radius", [](auto& w) { w.mutable_fem()->mutable_remotes(0)->set_tool_radius(-1); },
+       "tool_radius -1"},
+      {"contact model",
+       [](auto& w) {
+         w.mutable_fem()->set_contact_model(static_cast<CondensedFem::ContactModel>(7));
+       },
+       "unknown contact model 7"},
       {"tool radius", [nan](auto& w) { w.set_tool_radius(nan); }, "tool_radius nan"},
       {"force limit", [](auto& w) { w.set_force_limit(-1); }, "force_limit -1"},
-      {"simulation time", [](auto& w) { w.set_simulation_time(std::numeric_limits<double>::infinity()); }, "simulation_time"},
+      {"simulation time",
+       [](auto& w) { w.set_simulation_time(std::numeric_limits<double>::infinity()); },
+       "simulation_time"},
       {"m_rows", [](auto& w) { w.mutable_fem()->set_m_rows(w.fem().m_rows() - 1); }, "m_rows"},
       {"m_cols", [](auto& w) { w.mutable_fem()->set_m_cols(w.fem().m_cols() + 3); }, "m_cols"},
-      {"M~ length", [](auto& w) { w.mutable_fem()->mutable_m_tilde_f64()->RemoveLast(); }, "M~ has"},
-      {"NaN in M~", [nan](auto& w) { w.mutable_fem()->set_m_tilde_f64(5, nan); }, "m_tilde_f64[5] is not finite"},
-      {"u_B length", [](auto& w) { w.mutable_fem()->add_boundary_displacement_f64(0); }, "u_B has 1 values, expected 0"},
-      {"rest forces length", [](auto& w) { w.mutable_fem()->add_rest_forces(0); }, "rest_forces has 1 values, expected m_rows"},
-      {"NaN rest force", [nan](auto& w) {
-         for (std::uint32_t i = 0; i < w.fem().m_rows(); ++i) w.mutable_fem()->add_rest_forces(i == 2 ? nan : 0.0);
-       }, "rest_forces[2] is not finite"},
-      {"mixed precision", [](auto& w) { w.mutable_fem()->add_boundary_displacement_f32(0); }, "mix f64 and f32"},
+      {"M~ length", [](auto& w) { w.mutable_fem()->mutable_m_tilde_f64()->RemoveLast(); },
+       "M~ has"},
+      {"NaN in M~", [nan](auto& w) { w.mutable_fem()->set_m_tilde_f64(5, nan); },
+       "m_tilde_f64[5] is not finite"},
+      {"u_B length", [](auto& w) { w.mutable_fem()->add_boundary_displacement_f64(0); },
+       "u_B has 1 values, expected 0"},
+      {"rest forces length", [](auto& w) { w.mutable_fem()->add_rest_forces(0); },
+       "rest_forces has 1 values, expected m_rows"},
+      {"NaN rest force",
+       [nan](auto& w) {
+         for (std::uint32_t i = 0; i < w.fem().m_rows(); ++i)
+           w.mutable_fem()->add_rest_forces(i == 2 ? nan : 0.0);
+       },
+       "rest_forces[2] is not finite"},
+      {"mixed precision", [](auto& w) { w.mutable_fem()->add_boundary_displacement_f32(0); },
+       "mix f64 and f32"},
       {"M~ in both", [](auto& w) { w.mutable_fem()->add_m_tilde_f32(1); }, "mix f64 and f32"},
       {"user", [](auto& w) { w.set_user(0x80000000u); }, "user = 2147483648"},
   };
@@ -1233,7 +1389,8 @@ TEST(WireIr, FromWireSurvivesMutatedBytes) {
   int parsed = 0, converted = 0;
   for (int i = 0; i < 3000; ++i) {
     std::string bytes = valid;
-    for (std::size_t k = 0, n = 1 + rng() % 6; k < n; ++k) bytes[rng() % bytes.size()] = static_cast<char>(rng());
+    for (std::size_t k = 0, n = 1 + rng() % 6; k < n; ++k)
+      bytes[rng() % bytes.size()] = static_cast<char>(rng());
     if (i % 3 == 0) bytes.resize(rng() % bytes.size());
     IntermediateRepresentation w;
     if (!w.ParseFromString(bytes)) continue;
@@ -1264,8 +1421,10 @@ TEST(WireSurfaceMesh, BoxSurfaceInCompactNumbering) {
   const Eigen::Vector3d centre(0, 0, -0.065);
   std::set<std::int64_t> ids;
   for (int i = 0; i < 56; ++i) {
-    const Eigen::Vector3d v(message.vertices(3 * i), message.vertices(3 * i + 1), message.vertices(3 * i + 2));
-    EXPECT_NEAR((v - centre).lpNorm<Eigen::Infinity>(), 0.065, 1e-12) << "vertex " << i << " is not on the cube's faces";
+    const Eigen::Vector3d v(message.vertices(3 * i), message.vertices(3 * i + 1),
+                            message.vertices(3 * i + 2));
+    EXPECT_NEAR((v - centre).lpNorm<Eigen::Infinity>(), 0.065, 1e-12)
+        << "vertex " << i << " is not on the cube's faces";
     ids.insert(message.node_ids(i));
     const int node = node_index_from_tag(body.mesh, message.node_ids(i));
     ASSERT_GE(node, 0);
@@ -1279,7 +1438,8 @@ TEST(WireSurfaceMesh, BoxSurfaceInCompactNumbering) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t v = message.triangles(3 * t + k);
       ASSERT_LT(v, 56u);
-      p[k] = Eigen::Vector3d(message.vertices(3 * v), message.vertices(3 * v + 1), message.vertices(3 * v + 2));
+      p[k] = Eigen::Vector3d(message.vertices(3 * v), message.vertices(3 * v + 1),
+                             message.vertices(3 * v + 2));
       const std::uint32_t w = message.triangles(3 * t + (k + 1) % 3);
       edges.insert({std::min(v, w), std::max(v, w)});
     }
@@ -1298,10 +1458,12 @@ TEST(WireSurfaceMesh, BoxSurfaceInCompactNumbering) {
 
   SurfaceMesh bad = message;
   bad.set_triangles(10, 56);
-  EXPECT_NE(error_of([&] { from_wire(bad); }).find("triangle 3 refers to vertex 56"), std::string::npos);
+  EXPECT_NE(error_of([&] { from_wire(bad); }).find("triangle 3 refers to vertex 56"),
+            std::string::npos);
   bad = message;
   bad.mutable_node_ids()->RemoveLast();
-  EXPECT_NE(error_of([&] { from_wire(bad); }).find("55 node ids for 56 vertices"), std::string::npos);
+  EXPECT_NE(error_of([&] { from_wire(bad); }).find("55 node ids for 56 vertices"),
+            std::string::npos);
   bad = message;
   bad.set_vertices(0, std::numeric_limits<double>::quiet_NaN());
   EXPECT_NE(error_of([&] { from_wire(bad); }).find("vertex 0 has a non-finite"), std::string::npos);

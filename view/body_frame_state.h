@@ -22,7 +22,7 @@ struct ElasticFrameState {
   std::vector<int> held_nodes;      ///< B, the condensation's boundary nodes (volume indices)
 };
 struct MassSpringFrameState {
-  Eigen::Matrix3Xd positions;       ///< every network node's [m]
+  Eigen::Matrix3Xd positions;  ///< every network node's [m]
 };
 struct TissueFrameState {
   std::vector<TissueDent> dents;
@@ -30,13 +30,16 @@ struct TissueFrameState {
 struct RestFrameState {};
 
 /// One alternative per body kind: what is drawn of it.
-using BodyFrameState = std::variant<ElasticFrameState, MassSpringFrameState, TissueFrameState, RestFrameState>;
+using BodyFrameState =
+    std::variant<ElasticFrameState, MassSpringFrameState, TissueFrameState, RestFrameState>;
 
 /// Body `body`'s state (simulation thread): `columns` and `state` are its compliance columns
 /// and its StateSolution when it is linear elastic (unused otherwise).
-BodyFrameState body_frame_state(const BodySimulation& body, ComplianceColumns* columns, const std::optional<StateSolution>& state);
+BodyFrameState body_frame_state(const BodySimulation& body, ComplianceColumns* columns,
+                                const std::optional<StateSolution>& state);
 
 /// The displacement of `part`'s shown nodes in `state` (any thread), one column per node [m].
-Eigen::Matrix3Xd part_displacement(const BodyFrameState& state, const ShownPart& part, const ShownScene& scene);
+Eigen::Matrix3Xd part_displacement(const BodyFrameState& state, const ShownPart& part,
+                                   const ShownScene& scene);
 
 }  // namespace cohaptic::view

@@ -25,8 +25,8 @@ bool names_this_machine(const std::string& host);
 /// accepted. Without a token the Host must name this machine (names_this_machine), so a
 /// page on a name rebound to 127.0.0.1 cannot read the session. The token is compared in a
 /// time that does not depend on where it differs.
-std::string handshake_refusal(const std::string& resource, const std::string& origin, const std::string& host,
-                              const std::string& token);
+std::string handshake_refusal(const std::string& resource, const std::string& origin,
+                              const std::string& host, const std::string& token);
 
 /// A browser's binary message as a Command; nothing unless it parses and has a body.
 std::optional<Command> parse_command(const std::string& payload);

@@ -8,20 +8,25 @@
 
 namespace cohaptic::view {
 
-LiveView::LiveView(const Model& model, std::span<ComplianceColumns* const> columns, wire::Protocol protocol,
-                   const record::InjectedDelays& injected, LiveViewOptions options, record::SessionRecorder* recorder)
+LiveView::LiveView(const Model& model, std::span<ComplianceColumns* const> columns,
+                   wire::Protocol protocol, const record::InjectedDelays& injected,
+                   LiveViewOptions options, record::SessionRecorder* recorder)
     : shown_(shown_scene(model, columns)),
       recorder_(recorder),
       period_ns_(static_cast<std::int64_t>(1e9 / options.rate_hz)),
-      server_({options.host, options.port, access_token(options.host, options.token_file), options.assets, options.proto}) {
+      server_({options.host, options.port, access_token(options.host, options.token_file),
+               options.assets, options.proto}) {
   const Scene scene = view_scene(model, shown_, protocol, injected, options.rate_hz, "live");
   if (recorder_) recorder_->view_scene(monotonic_now_ns(), scene);
   server_.publish(Channel::scene, server_message(scene));
 }
 
-void LiveView::publish_frame(std::int64_t now_ns, double time, FrameState state, std::uint64_t steps) {
+void LiveView::publish_frame(std::int64_t now_ns, double time, FrameState state,
+                             std::uint64_t steps) {
   const double interval_s = static_cast<double>(now_ns - last_frame_ns_) * 1e-9;
-  const double rate = last_frame_ns_ > 0 && interval_s > 0 ? static_cast<double>(steps - last_steps_) / interval_s : 0.0;
+  const double rate = last_frame_ns_ > 0 && interval_s > 0
+                          ? static_cast<double>(steps - last_steps_) / interval_s
+                          : 0.0;
   last_frame_ns_ = now_ns;
   last_steps_ = steps;
   next_frame_ns_ += period_ns_;
@@ -32,7 +37,8 @@ void LiveView::publish_frame(std::int64_t now_ns, double time, FrameState state,
     waiting = pending_.has_value();
     pending_ = PendingFrame{now_ns, time, rate, std::move(state)};
   }
-  if (!waiting) server_.post([this] { build_frame(); });  // else the build already posted takes this state
+  if (!waiting)
+    server_.post([this] { build_frame(); });  // else the build already posted takes this state
 }
 
 void LiveView::build_frame() {
@@ -48,7 +54,8 @@ void LiveView::build_frame() {
   server_.publish(Channel::frame, server_message(std::move(frame)));
 }
 
-void LiveView::publish_status(int slot, const std::string& user, const wire::ClientStatus& status, double time) {
+void LiveView::publish_status(int slot, const std::string& user, const wire::ClientStatus& status,
+                              double time) {
   UserStatus& entry = statuses_[slot];
   entry.set_slot(static_cast<std::uint32_t>(slot));
   entry.set_user(user);

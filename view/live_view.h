@@ -55,7 +55,8 @@ class LiveView {
   /// `model` and the columns must outlive it. Throws Error (a missing asset, an address in
   /// use, a bad token file).
   LiveView(const Model& model, std::span<ComplianceColumns* const> columns, wire::Protocol protocol,
-           const record::InjectedDelays& injected, LiveViewOptions options, record::SessionRecorder* recorder);
+           const record::InjectedDelays& injected, LiveViewOptions options,
+           record::SessionRecorder* recorder);
 
   void start() { server_.start(); }
   void stop() { server_.stop(); }
@@ -77,7 +78,8 @@ class LiveView {
   /// Frames built so far (any thread).
   std::uint64_t frames_built() const { return sequence_.load(); }
   /// A user's status report (I/O thread).
-  void publish_status(int slot, const std::string& user, const wire::ClientStatus& status, double time);
+  void publish_status(int slot, const std::string& user, const wire::ClientStatus& status,
+                      double time);
 
  private:
   struct PendingFrame {
@@ -108,10 +110,14 @@ class LiveView {
 template <class Body>
 std::string server_message(Body body) {
   ServerMessage message;
-  if constexpr (std::is_same_v<Body, Scene>) *message.mutable_scene() = std::move(body);
-  else if constexpr (std::is_same_v<Body, Frame>) *message.mutable_frame() = std::move(body);
-  else if constexpr (std::is_same_v<Body, Status>) *message.mutable_status() = std::move(body);
-  else *message.mutable_timeline() = std::move(body);
+  if constexpr (std::is_same_v<Body, Scene>)
+    *message.mutable_scene() = std::move(body);
+  else if constexpr (std::is_same_v<Body, Frame>)
+    *message.mutable_frame() = std::move(body);
+  else if constexpr (std::is_same_v<Body, Status>)
+    *message.mutable_status() = std::move(body);
+  else
+    *message.mutable_timeline() = std::move(body);
   return message.SerializeAsString();
 }
 

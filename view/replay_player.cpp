@@ -18,8 +18,10 @@ double force_norm(const UserFrame& user) {
 
 // |F_now - F_before| of one user between two frames; 0 unless present in both.
 double force_step(const UserFrame& now, const UserFrame& before) {
-  if (!now.present() || !before.present() || now.force_size() != 3 || before.force_size() != 3) return 0;
-  return std::hypot(now.force(0) - before.force(0), now.force(1) - before.force(1), now.force(2) - before.force(2));
+  if (!now.present() || !before.present() || now.force_size() != 3 || before.force_size() != 3)
+    return 0;
+  return std::hypot(now.force(0) - before.force(0), now.force(1) - before.force(1),
+                    now.force(2) - before.force(2));
 }
 
 }  // namespace
@@ -27,10 +29,12 @@ double force_step(const UserFrame& now, const UserFrame& before) {
 ReplayPlayer::ReplayPlayer(const record::Recording& recording)
     : frames_(recording.view_frames.begin(), recording.view_frames.end()) {
   if (frames_.empty() || recording.view_scenes.empty())
-    throw Error(fmt::format("{}: no view frames in this recording: record the session with cohaptic-server --record "
-                            "and --view to replay it in the browser",
-                            recording.file.string()));
-  std::stable_sort(frames_.begin(), frames_.end(), [](const Frame& a, const Frame& b) { return a.time() < b.time(); });
+    throw Error(fmt::format(
+        "{}: no view frames in this recording: record the session with cohaptic-server --record "
+        "and --view to replay it in the browser",
+        recording.file.string()));
+  std::stable_sort(frames_.begin(), frames_.end(),
+                   [](const Frame& a, const Frame& b) { return a.time() < b.time(); });
   scene_ = recording.view_scenes.front();
   scene_.set_source(recording.file.filename().string());
   for (const Tool& tool : scene_.tools()) {
@@ -52,7 +56,8 @@ ReplayPlayer::ReplayPlayer(const record::Recording& recording)
     *entry.status.mutable_figures() = received.status();
     entry.status.set_received_time(entry.time);
   }
-  std::stable_sort(statuses_.begin(), statuses_.end(), [](const auto& a, const auto& b) { return a.time < b.time; });
+  std::stable_sort(statuses_.begin(), statuses_.end(),
+                   [](const auto& a, const auto& b) { return a.time < b.time; });
 
   // A recording without forces (or with none finite) jumps to its start, never outside it.
   peak_force_time_ = largest_step_time_ = frames_.front().time();
@@ -102,20 +107,26 @@ void ReplayPlayer::command(const Command& command) {
       if (index_ + 1 >= frames_.size()) seek(frames_.front().time());  // at the end: from the start
       playing_ = true;
       break;
-    case Command::kPause: playing_ = false; break;
+    case Command::kPause:
+      playing_ = false;
+      break;
     case Command::kSpeed:
-      if (std::isfinite(command.speed()) && command.speed() > 0) speed_ = std::min(command.speed(), 100.0);
+      if (std::isfinite(command.speed()) && command.speed() > 0)
+        speed_ = std::min(command.speed(), 100.0);
       break;
     case Command::kSeek:
       if (std::isfinite(command.seek())) seek(command.seek());
       break;
     case Command::kJump:
-      if (command.jump() == Command::PEAK_FORCE) seek(peak_force_time_);
-      else if (command.jump() == Command::LARGEST_STEP) seek(largest_step_time_);
+      if (command.jump() == Command::PEAK_FORCE)
+        seek(peak_force_time_);
+      else if (command.jump() == Command::LARGEST_STEP)
+        seek(largest_step_time_);
       playing_ = false;
       break;
     case Command::kRating:  // the rating page's
-    case Command::BODY_NOT_SET: break;
+    case Command::BODY_NOT_SET:
+      break;
   }
 }
 
@@ -127,8 +138,9 @@ void ReplayPlayer::advance(double wall_seconds) {
 
 void ReplayPlayer::seek(double time) {
   time_ = std::clamp(time, frames_.front().time(), frames_.back().time());
-  const auto after = std::upper_bound(frames_.begin(), frames_.end(), time_,
-                                      [](double t, const Frame& frame) { return t < frame.time(); });
+  const auto after =
+      std::upper_bound(frames_.begin(), frames_.end(), time_,
+                       [](double t, const Frame& frame) { return t < frame.time(); });
   index_ = static_cast<std::size_t>(std::max<std::ptrdiff_t>(after - frames_.begin() - 1, 0));
 }
 

@@ -1,10 +1,10 @@
 // ReplayPlayer: a server recording played back in the live view's page
 // (`cohaptic-lab replay FILE --view HOST:PORT`, docs/live-view.md, "The live view"). It holds what
 // the recording has for the page (the view's Scene, with every frame's force magnitudes
-// added for the charts, every Frame, the users' status reports, all in simulation time) and a playback position: play, pause, speed, seek, and jumps to
-// the frame with the largest force and to the largest force step between two frames. One
-// position for all browsers watching (they watch together). No threads: the caller moves
-// it on with advance() and sends what changed. Units: s, N.
+// added for the charts, every Frame, the users' status reports, all in simulation time) and a
+// playback position: play, pause, speed, seek, and jumps to the frame with the largest force and to
+// the largest force step between two frames. One position for all browsers watching (they watch
+// together). No threads: the caller moves it on with advance() and sends what changed. Units: s, N.
 #pragma once
 
 #include <cstddef>

@@ -24,15 +24,15 @@
 namespace cohaptic::view {
 
 struct ShownPart {
-  int offset = 0;                ///< its first shown node
+  int offset = 0;  ///< its first shown node
   /// Per shown node of the part, the body's node: a volume node (linear elastic), a network
   /// node (mass-spring), a surface vertex (home-spring), a layer node (separation: the
   /// pulled layer's, then the base's numbered on after them).
   std::vector<int> nodes;
-  std::vector<int> index_of;     ///< per body node: its shown index (offset included), or -1
-  std::vector<int> row_positions;                       ///< linear elastic: per node, ComplianceColumns::row_position
-  std::unordered_map<std::int64_t, int> shown_of_tag;   ///< linear elastic: mesh tag -> shown index
-  const TissueDisplay* display = nullptr;               ///< home-spring: its display deformation's setup
+  std::vector<int> index_of;       ///< per body node: its shown index (offset included), or -1
+  std::vector<int> row_positions;  ///< linear elastic: per node, ComplianceColumns::row_position
+  std::unordered_map<std::int64_t, int> shown_of_tag;  ///< linear elastic: mesh tag -> shown index
+  const TissueDisplay* display = nullptr;  ///< home-spring: its display deformation's setup
 
   int size() const { return static_cast<int>(nodes.size()); }
 };

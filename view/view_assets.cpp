@@ -12,7 +12,7 @@ struct AssetFile {
   const char* url;
   const char* path;  // under its root
   const char* content_type;
-  bool library;      // shipped in view/web/lib by deploy/refresh-view-libs.sh
+  bool library;  // shipped in view/web/lib by deploy/refresh-view-libs.sh
 };
 
 constexpr AssetFile kLiveViewFiles[] = {
@@ -32,16 +32,19 @@ constexpr AssetFile kRatingFiles[] = {
 
 constexpr AssetFile kProtoFiles[] = {
     {"/proto/cohaptic/view.proto", "cohaptic/view.proto", "text/plain; charset=utf-8", false},
-    {"/proto/cohaptic/messages.proto", "cohaptic/messages.proto", "text/plain; charset=utf-8", false},
-    {"/proto/cohaptic/recording.proto", "cohaptic/recording.proto", "text/plain; charset=utf-8", false},
+    {"/proto/cohaptic/messages.proto", "cohaptic/messages.proto", "text/plain; charset=utf-8",
+     false},
+    {"/proto/cohaptic/recording.proto", "cohaptic/recording.proto", "text/plain; charset=utf-8",
+     false},
 };
 
 std::string read_file(const std::filesystem::path& file, bool library) {
   std::ifstream in(file, std::ios::binary);
   if (!in) {
-    const std::string how = library ? " (the view's libraries ship in view/web/lib: restore them from git, or run "
-                                      "deploy/refresh-view-libs.sh)"
-                                    : "";
+    const std::string how =
+        library ? " (the view's libraries ship in view/web/lib: restore them from git, or run "
+                  "deploy/refresh-view-libs.sh)"
+                : "";
     throw Error("view: cannot read " + file.string() + how);
   }
   std::ostringstream content;
@@ -51,13 +54,17 @@ std::string read_file(const std::filesystem::path& file, bool library) {
 
 }  // namespace
 
-AssetTable load_assets(const std::filesystem::path& web, const std::filesystem::path& proto, ViewPage page) {
+AssetTable load_assets(const std::filesystem::path& web, const std::filesystem::path& proto,
+                       ViewPage page) {
   AssetTable table;
   const auto add_web_files = [&](const auto& files) {
-    for (const AssetFile& file : files) table[file.url] = {file.content_type, read_file(web / file.path, file.library)};
+    for (const AssetFile& file : files)
+      table[file.url] = {file.content_type, read_file(web / file.path, file.library)};
   };
-  if (page == ViewPage::live_view) add_web_files(kLiveViewFiles);
-  else add_web_files(kRatingFiles);
+  if (page == ViewPage::live_view)
+    add_web_files(kLiveViewFiles);
+  else
+    add_web_files(kRatingFiles);
   for (const AssetFile& file : kProtoFiles)
     table[file.url] = {file.content_type, read_file(proto / file.path, false)};
   table["/index.html"] = table.at("/");

@@ -12,7 +12,8 @@ void add_point(google::protobuf::RepeatedField<float>& out, const Eigen::Vector3
 }
 
 // A plane obstacle as a square around the object's projection on it, twice the object's size.
-void add_plane(Obstacle& out, const Eigen::Vector3d& point, const Eigen::Vector3d& normal, const Eigen::Matrix3Xd& nodes) {
+void add_plane(Obstacle& out, const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+               const Eigen::Matrix3Xd& nodes) {
   const Eigen::Vector3d centre = nodes.rowwise().mean();
   const Eigen::Vector3d on_plane = centre - normal.dot(centre - point) * normal;
   const double half = (nodes.rowwise().maxCoeff() - nodes.rowwise().minCoeff()).norm();
@@ -24,13 +25,15 @@ void add_plane(Obstacle& out, const Eigen::Vector3d& point, const Eigen::Vector3
 
 }  // namespace
 
-Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
-                 double frame_rate_hz, const std::string& source) {
+Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol protocol,
+                 const record::InjectedDelays& injected, double frame_rate_hz,
+                 const std::string& source) {
   Scene scene;
   scene.set_scene_name(model.scene.name);
   scene.set_units(model.scene.units);
   scene.set_metres_per_unit(model.scene.metres_per_unit);
-  for (Eigen::Index node = 0; node < shown.rest.cols(); ++node) add_point(*scene.mutable_rest_positions(), shown.rest.col(node));
+  for (Eigen::Index node = 0; node < shown.rest.cols(); ++node)
+    add_point(*scene.mutable_rest_positions(), shown.rest.col(node));
   for (const Triangle& tri : shown.triangles)
     for (int corner : tri) scene.add_triangles(static_cast<std::uint32_t>(corner));
   for (std::size_t body = 0; body < shown.parts.size(); ++body) {
@@ -66,8 +69,10 @@ Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol pro
   return scene;
 }
 
-FrameState frame_state(const SceneSimulation& simulation, std::span<ComplianceColumns* const> columns,
-                       const std::vector<std::optional<StateSolution>>& states, const std::vector<ToolState>& tools,
+FrameState frame_state(const SceneSimulation& simulation,
+                       std::span<ComplianceColumns* const> columns,
+                       const std::vector<std::optional<StateSolution>>& states,
+                       const std::vector<ToolState>& tools,
                        std::span<const Eigen::Vector3d> forces) {
   FrameState state;
   for (int user = 0; user < simulation.user_count(); ++user) {
@@ -78,12 +83,14 @@ FrameState frame_state(const SceneSimulation& simulation, std::span<ComplianceCo
     out.pressing = simulation.pressing(user);
     out.ir = simulation.ir(user);
     out.body = simulation.body_of(user);
-    if (const auto* network = std::get_if<MassSpringSimulation>(&simulation.body(out.body)); network && out.pressing)
+    if (const auto* network = std::get_if<MassSpringSimulation>(&simulation.body(out.body));
+        network && out.pressing)
       out.contact_node = network->reaction(user).node;
   }
   for (int body = 0; body < simulation.body_count(); ++body) {
     const auto i = static_cast<std::size_t>(body);
-    state.bodies.push_back(body_frame_state(simulation.body(body), i < columns.size() ? columns[i] : nullptr, states[i]));
+    state.bodies.push_back(body_frame_state(simulation.body(body),
+                                            i < columns.size() ? columns[i] : nullptr, states[i]));
   }
   return state;
 }
@@ -100,20 +107,26 @@ void add_ir_nodes(UserFrame& out, const UserFrameState& user, const ShownScene& 
   };
   if (const auto* fem = std::get_if<CondensedFemIr>(&user.ir->ir.body)) {
     const auto tag_of = [&](int node) { return fem->node_ids[static_cast<std::size_t>(node)]; };
-    for (int node = 0; node < fem->patch_node_count; ++node) add(*out.mutable_patch_nodes(), shown.of_tag(body, tag_of(node)));
+    for (int node = 0; node < fem->patch_node_count; ++node)
+      add(*out.mutable_patch_nodes(), shown.of_tag(body, tag_of(node)));
     if (user.pressing && !fem->patch.empty())
-      for (int node : fem->patch.front().nodes) add(*out.mutable_contact_nodes(), shown.of_tag(body, tag_of(node)));
+      for (int node : fem->patch.front().nodes)
+        add(*out.mutable_contact_nodes(), shown.of_tag(body, tag_of(node)));
   } else if (const auto* network = std::get_if<MassSpringIr>(&user.ir->ir.body)) {
-    for (std::int32_t node : network->node_ids) add(*out.mutable_patch_nodes(), shown.of_node(body, node));
-    if (user.contact_node >= 0 && user.body == body) add(*out.mutable_contact_nodes(), shown.of_node(body, user.contact_node));
+    for (std::int32_t node : network->node_ids)
+      add(*out.mutable_patch_nodes(), shown.of_node(body, node));
+    if (user.contact_node >= 0 && user.body == body)
+      add(*out.mutable_contact_nodes(), shown.of_node(body, user.contact_node));
   } else if (const auto* tissue = std::get_if<HomeSpringPatch>(&user.ir->ir.body)) {
-    for (int vertex : tissue->surface_vertex) add(*out.mutable_patch_nodes(), shown.of_node(body, vertex));
+    for (int vertex : tissue->surface_vertex)
+      add(*out.mutable_patch_nodes(), shown.of_node(body, vertex));
   }
 }
 
 }  // namespace
 
-Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t sequence, double time, double sim_rate_hz) {
+Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t sequence,
+                 double time, double sim_rate_hz) {
   Frame frame;
   frame.set_sequence(sequence);
   frame.set_time(time);
@@ -121,11 +134,13 @@ Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t
   Eigen::Matrix3Xd displacement(3, shown.node_count());
   for (std::size_t body = 0; body < state.bodies.size(); ++body) {
     const ShownPart& part = shown.parts[body];
-    displacement.middleCols(part.offset, part.size()) = part_displacement(state.bodies[body], part, shown);
+    displacement.middleCols(part.offset, part.size()) =
+        part_displacement(state.bodies[body], part, shown);
   }
   auto& u = *frame.mutable_displacement();
   u.Reserve(static_cast<int>(displacement.size()));
-  for (Eigen::Index i = 0; i < displacement.size(); ++i) u.AddAlreadyReserved(static_cast<float>(displacement.data()[i]));
+  for (Eigen::Index i = 0; i < displacement.size(); ++i)
+    u.AddAlreadyReserved(static_cast<float>(displacement.data()[i]));
   for (std::size_t user = 0; user < state.users.size(); ++user) {
     const UserFrameState& each = state.users[user];
     UserFrame* out = frame.add_users();
@@ -143,7 +158,8 @@ Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t
     if (!fem) continue;
     boundary_nodes += static_cast<std::uint32_t>(fem->held_nodes.size());
     for (int node : fem->held_nodes)
-      if (const int index = shown.of_node(static_cast<int>(body), node); index >= 0) frame.add_held_nodes(static_cast<std::uint32_t>(index));
+      if (const int index = shown.of_node(static_cast<int>(body), node); index >= 0)
+        frame.add_held_nodes(static_cast<std::uint32_t>(index));
   }
   frame.set_boundary_nodes(boundary_nodes);
   return frame;

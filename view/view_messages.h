@@ -26,22 +26,24 @@ namespace cohaptic::view {
 
 /// Where each user's tool is, as the simulation step used it.
 struct ToolState {
-  bool present = false;                          ///< joined, and its tool known and fresh
+  bool present = false;                                ///< joined, and its tool known and fresh
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< [m]
 };
 
-/// The scene: `shown` (model's, at rest, with each object's name, model and shown nodes), the tools, the obstacles (a plane as a square of
-/// twice the shown surface's size around its projection), and the session's settings.
-Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol protocol, const record::InjectedDelays& injected,
-                 double frame_rate_hz, const std::string& source);
+/// The scene: `shown` (model's, at rest, with each object's name, model and shown nodes), the
+/// tools, the obstacles (a plane as a square of twice the shown surface's size around its
+/// projection), and the session's settings.
+Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol protocol,
+                 const record::InjectedDelays& injected, double frame_rate_hz,
+                 const std::string& source);
 
 /// One user as a frame shows it.
 struct UserFrameState {
   ToolState tool;
   Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< the force the server has for it [N]
   bool pressing = false;
-  std::shared_ptr<const PreparedIR> ir;             ///< its latest (immutable, shared with the simulation)
-  int body = -1;                                    ///< the body it is on
+  std::shared_ptr<const PreparedIR> ir;  ///< its latest (immutable, shared with the simulation)
+  int body = -1;                         ///< the body it is on
   int contact_node = -1;  ///< on a mass-spring body, while it presses: the node its tool drives
 };
 
@@ -54,14 +56,17 @@ struct FrameState {
 /// Takes a frame's state (simulation thread): each user's tool as `tools` says, its force
 /// (`forces`, per user: what P0 sends, Simulation::force), contact and IR; each body's state
 /// (`columns` and `states`: per body, its compliance columns and solve_elastic_states()'s).
-FrameState frame_state(const SceneSimulation& simulation, std::span<ComplianceColumns* const> columns,
-                       const std::vector<std::optional<StateSolution>>& states, const std::vector<ToolState>& tools,
+FrameState frame_state(const SceneSimulation& simulation,
+                       std::span<ComplianceColumns* const> columns,
+                       const std::vector<std::optional<StateSolution>>& states,
+                       const std::vector<ToolState>& tools,
                        std::span<const Eigen::Vector3d> forces);
 
 /// A frame at simulation time `time` [s] (any thread): the displacement of the shown nodes,
 /// each user's tool, its force, its IR patch (linear elastic, mass-spring and tissue IRs) and,
 /// while it presses, its contact (a linear elastic body's contact triangle, the mass-spring
 /// node its tool drives); the held nodes and |B| of the linear elastic bodies.
-Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t sequence, double time, double sim_rate_hz);
+Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t sequence,
+                 double time, double sim_rate_hz);
 
 }  // namespace cohaptic::view

@@ -35,10 +35,14 @@ constexpr int kBrowserSendBufferBytes = 256 << 10;
 
 // A binary WebSocket frame of `payload`, framed once (a server's frames are not masked) and
 // marked prepared, so that every browser's connection sends this one buffer, not a copy.
-WsServer::message_ptr prepared_frame(const WsServer::connection_ptr& connection, const std::string& payload) {
-  WsServer::message_ptr frame = connection->get_message(websocketpp::frame::opcode::binary, payload.size());
-  const websocketpp::frame::basic_header basic(websocketpp::frame::opcode::binary, payload.size(), true, false);
-  frame->set_header(websocketpp::frame::prepare_header(basic, websocketpp::frame::extended_header(payload.size())));
+WsServer::message_ptr prepared_frame(const WsServer::connection_ptr& connection,
+                                     const std::string& payload) {
+  WsServer::message_ptr frame =
+      connection->get_message(websocketpp::frame::opcode::binary, payload.size());
+  const websocketpp::frame::basic_header basic(websocketpp::frame::opcode::binary, payload.size(),
+                                               true, false);
+  frame->set_header(websocketpp::frame::prepare_header(
+      basic, websocketpp::frame::extended_header(payload.size())));
   frame->set_payload(payload);
   frame->set_prepared(true);
   return frame;
@@ -77,7 +81,9 @@ struct ViewServer::Impl {
   ViewCounters counters;
 
   Impl(ViewServerOptions o, CommandHandler handler)
-      : options(std::move(o)), on_command(std::move(handler)), assets(load_assets(options.assets, options.proto, options.page)) {
+      : options(std::move(o)),
+        on_command(std::move(handler)),
+        assets(load_assets(options.assets, options.proto, options.page)) {
     server.clear_access_channels(websocketpp::log::alevel::all);
     server.clear_error_channels(websocketpp::log::elevel::all);
     server.init_asio(&io);
@@ -93,13 +99,16 @@ struct ViewServer::Impl {
     server.set_open_handler([this](connection_hdl hdl) { opened(hdl); });
     server.set_close_handler([this](connection_hdl hdl) { closed(hdl); });
     server.set_fail_handler([this](connection_hdl hdl) { closed(hdl); });
-    server.set_message_handler([this](connection_hdl hdl, WsServer::message_ptr message) { received(hdl, message); });
+    server.set_message_handler(
+        [this](connection_hdl hdl, WsServer::message_ptr message) { received(hdl, message); });
     websocketpp::lib::error_code error;
     asio::error_code address_error;
     const auto address = asio::ip::make_address(options.host, address_error);
     if (address_error) throw Error("view: '" + options.host + "' is not an IP address");
     server.listen(asio::ip::tcp::endpoint(address, options.port), error);
-    if (error) throw Error("view: cannot listen on " + options.host + ":" + std::to_string(options.port) + ": " + error.message());
+    if (error)
+      throw Error("view: cannot listen on " + options.host + ":" + std::to_string(options.port) +
+                  ": " + error.message());
     port = server.get_local_endpoint(error).port();
     accept();
   }
@@ -110,15 +119,18 @@ struct ViewServer::Impl {
     const WsServer::connection_ptr connection = server.get_connection();
     websocketpp::lib::error_code error;
     if (connection)
-      server.async_accept(connection, [this, connection](const websocketpp::lib::error_code& accept_error) {
-        if (!accept_error) {
-          connection->start();
-          accept();
-        } else {
-          connection->terminate(accept_error);
-          accept_failed(accept_error);
-        }
-      }, error);
+      server.async_accept(
+          connection,
+          [this, connection](const websocketpp::lib::error_code& accept_error) {
+            if (!accept_error) {
+              connection->start();
+              accept();
+            } else {
+              connection->terminate(accept_error);
+              accept_failed(accept_error);
+            }
+          },
+          error);
     if (!connection || error) {
       if (connection) connection->terminate(error);
       accept_failed(error);
@@ -129,9 +141,12 @@ struct ViewServer::Impl {
     if (!server.is_listening()) return;  // stopping
     count([](ViewCounters& c) { ++c.accept_errors; });
     const std::int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                 std::chrono::steady_clock::now().time_since_epoch()).count();
-    if (now - last_accept_warning_ns > 1'000'000'000) {  // once a second at most: the counter has the rest
-      spdlog::warn("view: accept failed: {}; accepting again in {} ms", error.message(), kAcceptRetry.count());
+                                 std::chrono::steady_clock::now().time_since_epoch())
+                                 .count();
+    if (now - last_accept_warning_ns >
+        1'000'000'000) {  // once a second at most: the counter has the rest
+      spdlog::warn("view: accept failed: {}; accepting again in {} ms", error.message(),
+                   kAcceptRetry.count());
       last_accept_warning_ns = now;
     }
     accept_retry.expires_after(kAcceptRetry);
@@ -149,7 +164,9 @@ struct ViewServer::Impl {
   void http(connection_hdl hdl) {
     const WsServer::connection_ptr connection = server.get_con_from_hdl(hdl);
     count([](ViewCounters& c) { ++c.http_requests; });
-    const Asset* asset = connection->get_request().get_method() == "GET" ? find_asset(assets, connection->get_resource()) : nullptr;
+    const Asset* asset = connection->get_request().get_method() == "GET"
+                             ? find_asset(assets, connection->get_resource())
+                             : nullptr;
     if (!asset) {
       connection->set_status(websocketpp::http::status_code::not_found);
       connection->set_body("not found\n");
@@ -172,8 +189,10 @@ struct ViewServer::Impl {
     if (full) refusal = "already " + std::to_string(browsers.size()) + " browsers connected";
     if (refusal.empty()) return true;
     count([](ViewCounters& c) { ++c.refused; });
-    spdlog::warn("view: refused a browser from {}: {}", connection->get_remote_endpoint(), printable(refusal, 200));
-    connection->set_status(full ? websocketpp::http::status_code::service_unavailable : websocketpp::http::status_code::forbidden);
+    spdlog::warn("view: refused a browser from {}: {}", connection->get_remote_endpoint(),
+                 printable(refusal, 200));
+    connection->set_status(full ? websocketpp::http::status_code::service_unavailable
+                                : websocketpp::http::status_code::forbidden);
     return false;
   }
 
@@ -189,8 +208,8 @@ struct ViewServer::Impl {
       ++c.connections;
       c.browsers = static_cast<int>(browsers.size());
     });
-    spdlog::info("view: a browser connected from {} ({} now)", server.get_con_from_hdl(hdl)->get_remote_endpoint(),
-                 browsers.size());
+    spdlog::info("view: a browser connected from {} ({} now)",
+                 server.get_con_from_hdl(hdl)->get_remote_endpoint(), browsers.size());
     flush();
   }
 
@@ -202,7 +221,9 @@ struct ViewServer::Impl {
 
   void received(connection_hdl hdl, const WsServer::message_ptr& message) {
     const std::optional<Command> command =
-        message->get_opcode() == websocketpp::frame::opcode::binary ? parse_command(message->get_payload()) : std::nullopt;
+        message->get_opcode() == websocketpp::frame::opcode::binary
+            ? parse_command(message->get_payload())
+            : std::nullopt;
     if (!command) {
       count([](ViewCounters& c) { ++c.closed_for_bad_message; });
       websocketpp::lib::error_code error;
@@ -225,7 +246,8 @@ struct ViewServer::Impl {
     }
     if (!messages[static_cast<std::size_t>(Channel::scene)]) return;
     std::uint64_t sent = 0, bytes = 0, dropped = 0;
-    std::array<WsServer::message_ptr, kChannels> frames;  // framed on first use, shared by every browser
+    std::array<WsServer::message_ptr, kChannels>
+        frames;  // framed on first use, shared by every browser
     for (auto& [hdl, browser] : browsers) {
       websocketpp::lib::error_code error;
       const WsServer::connection_ptr connection = server.get_con_from_hdl(hdl, error);
@@ -237,7 +259,8 @@ struct ViewServer::Impl {
           dropped += sequences[channel] - 1 - browser.accounted[channel];
           browser.accounted[channel] = sequences[channel] - 1;
         }
-        if (channel != static_cast<std::size_t>(Channel::scene) && connection->get_buffered_amount() > options.max_buffered_bytes)
+        if (channel != static_cast<std::size_t>(Channel::scene) &&
+            connection->get_buffered_amount() > options.max_buffered_bytes)
           continue;  // caught up later, with whatever is newest then
         if (!frames[channel]) frames[channel] = prepared_frame(connection, *messages[channel]);
         error = connection->send(frames[channel]);
@@ -272,7 +295,8 @@ void ViewServer::stop() {
     websocketpp::lib::error_code error;
     s.server.stop_listening(error);
     s.accept_retry.cancel();
-    for (const auto& [hdl, browser] : s.browsers) s.server.close(hdl, websocketpp::close::status::going_away, "server stopped", error);
+    for (const auto& [hdl, browser] : s.browsers)
+      s.server.close(hdl, websocketpp::close::status::going_away, "server stopped", error);
     auto timer = std::make_shared<asio::steady_timer>(s.io, kCloseGrace);
     timer->async_wait([&s, timer](const asio::error_code&) { s.io.stop(); });
   });
@@ -284,7 +308,8 @@ std::uint16_t ViewServer::port() const { return impl_->port; }
 std::string ViewServer::url(bool with_token) const {
   const Impl& s = *impl_;
   const bool v6 = s.options.host.find(':') != std::string::npos;
-  std::string url = "http://" + (v6 ? "[" + s.options.host + "]" : s.options.host) + ":" + std::to_string(s.port) + "/";
+  std::string url = "http://" + (v6 ? "[" + s.options.host + "]" : s.options.host) + ":" +
+                    std::to_string(s.port) + "/";
   if (with_token && !s.options.token.empty()) url += "?token=" + s.options.token;
   return url;
 }

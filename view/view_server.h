@@ -39,14 +39,14 @@ class Command;
 
 struct ViewServerOptions {
   std::string host = "127.0.0.1";
-  std::uint16_t port = 0;                  ///< 0: any free port
-  std::string token;                       ///< required on the WebSocket when not empty
-  std::filesystem::path assets;            ///< view/web, with its libraries in lib/ (view_assets.h)
-  std::filesystem::path proto;             ///< the proto/ directory (the page decodes its view.proto)
+  std::uint16_t port = 0;        ///< 0: any free port
+  std::string token;             ///< required on the WebSocket when not empty
+  std::filesystem::path assets;  ///< view/web, with its libraries in lib/ (view_assets.h)
+  std::filesystem::path proto;   ///< the proto/ directory (the page decodes its view.proto)
   std::size_t max_command_bytes = 1024;
-  int max_browsers = 64;                   ///< connected at once; beyond, a handshake is refused (503)
+  int max_browsers = 64;  ///< connected at once; beyond, a handshake is refused (503)
   std::size_t max_buffered_bytes = 2u << 20;  ///< per browser: beyond this, new frames are dropped
-  ViewPage page = ViewPage::live_view;     ///< the page served at "/" (and what it needs)
+  ViewPage page = ViewPage::live_view;        ///< the page served at "/" (and what it needs)
 };
 
 /// The kinds of message a browser gets, in the order it gets them.
@@ -54,13 +54,14 @@ enum class Channel : std::size_t { scene, frame, status, timeline };
 inline constexpr std::size_t kChannels = 4;
 
 struct ViewCounters {
-  int browsers = 0;                        ///< connected now
-  std::uint64_t connections = 0;           ///< WebSocket connections opened, in all
-  std::uint64_t refused = 0;               ///< handshakes refused (token, origin, path)
+  int browsers = 0;               ///< connected now
+  std::uint64_t connections = 0;  ///< WebSocket connections opened, in all
+  std::uint64_t refused = 0;      ///< handshakes refused (token, origin, path)
   std::uint64_t closed_for_bad_message = 0;
   std::uint64_t messages_sent = 0, bytes_sent = 0;
-  std::uint64_t dropped = 0;               ///< messages superseded before a slow browser got them
-  std::uint64_t accept_errors = 0;         ///< accept() failed (out of file descriptors, say): tried again later
+  std::uint64_t dropped = 0;  ///< messages superseded before a slow browser got them
+  std::uint64_t accept_errors =
+      0;  ///< accept() failed (out of file descriptors, say): tried again later
   std::uint64_t http_requests = 0;
 };
 

@@ -25,17 +25,20 @@ std::string random_token() {
   return hex;
 }
 
-std::string access_token(const std::string& host, const std::optional<std::filesystem::path>& token_file) {
+std::string access_token(const std::string& host,
+                         const std::optional<std::filesystem::path>& token_file) {
   if (token_file) {
     std::ifstream in(*token_file);
     std::string token;
-    if (!in || !std::getline(in, token)) throw Error("view: cannot read the token file " + token_file->string());
+    if (!in || !std::getline(in, token))
+      throw Error("view: cannot read the token file " + token_file->string());
     while (!token.empty() && (token.back() == '\r' || token.back() == ' ')) token.pop_back();
     if (token.size() < 16)
       throw Error("view: the token in " + token_file->string() + " is shorter than 16 characters");
     for (char c : token)
       if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_')
-        throw Error("view: the token in " + token_file->string() + " may hold only letters, digits, '-' and '_'");
+        throw Error("view: the token in " + token_file->string() +
+                    " may hold only letters, digits, '-' and '_'");
     return token;
   }
   return is_loopback(host) ? std::string() : random_token();

@@ -18,6 +18,7 @@ std::string random_token();
 
 /// The token a view on `host` requires: the file's when given (Error if it cannot be read
 /// or is shorter than 16 characters), else none on loopback and a random one elsewhere.
-std::string access_token(const std::string& host, const std::optional<std::filesystem::path>& token_file);
+std::string access_token(const std::string& host,
+                         const std::optional<std::filesystem::path>& token_file);
 
 }  // namespace cohaptic::view

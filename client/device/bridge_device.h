@@ -45,8 +45,8 @@ struct BridgeOptions {
 
 /// A snapshot of what the bridge has seen since start().
 struct BridgeCounters {
-  std::uint64_t received = 0;        ///< datagrams read from the socket
-  std::uint64_t accepted = 0;        ///< poses taken as the newest
+  std::uint64_t received = 0;  ///< datagrams read from the socket
+  std::uint64_t accepted = 0;  ///< poses taken as the newest
   std::uint64_t bad_size = 0;
   std::uint64_t bad_magic = 0;
   std::uint64_t non_finite = 0;
@@ -54,8 +54,10 @@ struct BridgeCounters {
   std::uint64_t stale = 0;           ///< not newer than the newest pose accepted
   std::uint64_t receive_errors = 0;  ///< socket errors other than "would block"
   std::uint64_t forces_sent = 0;
-  std::uint64_t send_failed = 0;     ///< force packets the socket refused (e.g. buffer full)
-  std::uint64_t dropped() const { return bad_size + bad_magic + non_finite + foreign_source + stale; }
+  std::uint64_t send_failed = 0;  ///< force packets the socket refused (e.g. buffer full)
+  std::uint64_t dropped() const {
+    return bad_size + bad_magic + non_finite + foreign_source + stale;
+  }
 };
 
 class BridgeDevice : public HapticDevice {
@@ -84,10 +86,12 @@ class BridgeDevice : public HapticDevice {
 
  private:
   struct AtomicCounters {
-    std::atomic<std::uint64_t> received{0}, accepted{0}, bad_size{0}, bad_magic{0}, non_finite{0}, foreign_source{0},
-        stale{0}, receive_errors{0}, forces_sent{0}, send_failed{0};
+    std::atomic<std::uint64_t> received{0}, accepted{0}, bad_size{0}, bad_magic{0}, non_finite{0},
+        foreign_source{0}, stale{0}, receive_errors{0}, forces_sent{0}, send_failed{0};
   };
-  static void bump(std::atomic<std::uint64_t>& counter) { counter.fetch_add(1, std::memory_order_relaxed); }
+  static void bump(std::atomic<std::uint64_t>& counter) {
+    counter.fetch_add(1, std::memory_order_relaxed);
+  }
   /// Handles one datagram of `size` bytes from sender_.
   void take(std::size_t size, double time_s, bool& timed_out);
 

@@ -9,13 +9,16 @@ namespace cohaptic {
 BridgePeer::BridgePeer(const std::string& client_host, std::uint16_t client_port) : socket_(io_) {
   asio::error_code ec;
   asio::ip::udp::resolver resolver(io_);
-  const auto results = resolver.resolve(asio::ip::udp::v4(), client_host, std::to_string(client_port), ec);
+  const auto results =
+      resolver.resolve(asio::ip::udp::v4(), client_host, std::to_string(client_port), ec);
   if (ec || results.empty()) {
     // Not an IPv4 name: try IPv6 before giving up.
     asio::error_code ec6;
-    const auto results6 = resolver.resolve(asio::ip::udp::v6(), client_host, std::to_string(client_port), ec6);
+    const auto results6 =
+        resolver.resolve(asio::ip::udp::v6(), client_host, std::to_string(client_port), ec6);
     if (ec6 || results6.empty())
-      throw Error(fmt::format("bridge peer: cannot resolve '{}': {}", client_host, (ec ? ec : ec6).message()));
+      throw Error(fmt::format("bridge peer: cannot resolve '{}': {}", client_host,
+                              (ec ? ec : ec6).message()));
     client_ = results6.begin()->endpoint();
   } else {
     client_ = results.begin()->endpoint();
@@ -26,7 +29,8 @@ BridgePeer::BridgePeer(const std::string& client_host, std::uint16_t client_port
   if (ec) throw Error(fmt::format("bridge peer: cannot open a UDP socket: {}", ec.message()));
 }
 
-bool BridgePeer::send_pose(const Eigen::Vector3d& position, double device_time_s, std::uint32_t buttons, bool valid) {
+bool BridgePeer::send_pose(const Eigen::Vector3d& position, double device_time_s,
+                           std::uint32_t buttons, bool valid) {
   bridge::PosePacket packet;
   packet.sequence = sequence_;
   packet.device_time_s = device_time_s;
@@ -57,7 +61,9 @@ std::size_t BridgePeer::poll_forces() {
     const std::size_t size = socket_.receive_from(asio::buffer(rx_), sender_, 0, ec);
     if (ec) break;  // would block (or an error: try again next poll)
     bridge::ForcePacket packet;
-    if (sender_ != client_ || bridge::decode(std::span<const std::uint8_t>(rx_.data(), size), packet) != bridge::PacketStatus::ok ||
+    if (sender_ != client_ ||
+        bridge::decode(std::span<const std::uint8_t>(rx_.data(), size), packet) !=
+            bridge::PacketStatus::ok ||
         (newest_force_ && bridge::sequence_after(newest_force_->sequence, packet.sequence))) {
       ++forces_dropped_;
       continue;
@@ -75,6 +81,8 @@ std::uint16_t BridgePeer::local_port() const {
   return ec ? std::uint16_t{0} : endpoint.port();
 }
 
-std::string BridgePeer::client() const { return fmt::format("{}:{}", client_.address().to_string(), client_.port()); }
+std::string BridgePeer::client() const {
+  return fmt::format("{}:{}", client_.address().to_string(), client_.port());
+}
 
 }  // namespace cohaptic

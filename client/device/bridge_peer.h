@@ -28,7 +28,8 @@ class BridgePeer {
   BridgePeer(const std::string& client_host, std::uint16_t client_port);
 
   /// Sends a pose with the next sequence number (starting at 0). False if the socket refused it.
-  bool send_pose(const Eigen::Vector3d& position, double device_time_s, std::uint32_t buttons = 0, bool valid = true);
+  bool send_pose(const Eigen::Vector3d& position, double device_time_s, std::uint32_t buttons = 0,
+                 bool valid = true);
   /// Sends a pose packet as given (its own sequence), e.g. to test reordering.
   bool send_pose(const bridge::PosePacket& packet);
   /// Sends arbitrary bytes, e.g. to test how the client rejects them.

@@ -29,10 +29,14 @@ double get_f64(const std::uint8_t* at) {
 
 std::string_view to_string(PacketStatus status) {
   switch (status) {
-    case PacketStatus::ok: return "ok";
-    case PacketStatus::bad_size: return "bad size";
-    case PacketStatus::bad_magic: return "bad magic";
-    case PacketStatus::non_finite: return "non-finite value";
+    case PacketStatus::ok:
+      return "ok";
+    case PacketStatus::bad_size:
+      return "bad size";
+    case PacketStatus::bad_magic:
+      return "bad magic";
+    case PacketStatus::non_finite:
+      return "non-finite value";
   }
   return "?";
 }
@@ -71,7 +75,8 @@ PacketStatus decode(std::span<const std::uint8_t> bytes, PosePacket& out) {
   out.position = Eigen::Vector3d(get_f64(b + 16), get_f64(b + 24), get_f64(b + 32));
   out.buttons = get_u32(b + 40);
   out.flags = get_u32(b + 44);
-  if (!std::isfinite(out.device_time_s) || !out.position.allFinite()) return PacketStatus::non_finite;
+  if (!std::isfinite(out.device_time_s) || !out.position.allFinite())
+    return PacketStatus::non_finite;
   return PacketStatus::ok;
 }
 
@@ -84,7 +89,8 @@ PacketStatus decode(std::span<const std::uint8_t> bytes, ForcePacket& out) {
   out.force = Eigen::Vector3d(get_f64(b + 16), get_f64(b + 24), get_f64(b + 32));
   out.force_limit = get_f64(b + 40);
   out.flags = get_u32(b + 48);
-  if (!std::isfinite(out.device_time_s) || !out.force.allFinite() || !std::isfinite(out.force_limit))
+  if (!std::isfinite(out.device_time_s) || !out.force.allFinite() ||
+      !std::isfinite(out.force_limit))
     return PacketStatus::non_finite;
   return PacketStatus::ok;
 }

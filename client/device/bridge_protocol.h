@@ -39,7 +39,7 @@ inline constexpr std::size_t kPosePacketSize = 48;
 inline constexpr std::size_t kForcePacketSize = 56;
 inline constexpr std::array<std::uint8_t, 4> kPoseMagic{'C', 'H', 'B', '1'};
 inline constexpr std::array<std::uint8_t, 4> kForceMagic{'C', 'H', 'F', '1'};
-inline constexpr std::uint32_t kPoseValid = 1u << 0;   ///< PosePacket::flags
+inline constexpr std::uint32_t kPoseValid = 1u << 0;    ///< PosePacket::flags
 inline constexpr std::uint32_t kClientValid = 1u << 0;  ///< ForcePacket::flags
 
 struct PosePacket {

@@ -27,7 +27,8 @@ std::uint16_t parse_port(const std::string& text, const std::string& spec) {
   const char* end = text.data() + text.size();
   const auto [ptr, ec] = std::from_chars(text.data(), end, value);
   if (text.empty() || ec != std::errc() || ptr != end || value < 1 || value > 65535)
-    throw Error(fmt::format("device '{}': expected a port from 1 to 65535, found '{}'", spec, text));
+    throw Error(
+        fmt::format("device '{}': expected a port from 1 to 65535, found '{}'", spec, text));
   return static_cast<std::uint16_t>(value);
 }
 
@@ -38,7 +39,8 @@ BridgeOptions bridge_options(const std::string& args, const std::string& spec) {
     options.port = parse_port(args, spec);
   } else {
     std::string host = args.substr(0, colon);
-    if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+    if (host.size() >= 2 && host.front() == '[' && host.back() == ']')
+      host = host.substr(1, host.size() - 2);
     if (host.empty()) throw Error(fmt::format("device '{}': expected a host before ':PORT'", spec));
     options.host = host;
     options.port = parse_port(args.substr(colon + 1), spec);
@@ -51,8 +53,10 @@ BridgeOptions bridge_options(const std::string& args, const std::string& spec) {
 Trajectory replayed_motion(const std::string& args) {
   const auto colon = args.rfind(':');
   std::error_code ignored;
-  const bool has_user = colon != std::string::npos && colon + 1 < args.size() && !std::filesystem::exists(args, ignored);
-  return recorded_motion(has_user ? args.substr(0, colon) : args, has_user ? args.substr(colon + 1) : "");
+  const bool has_user = colon != std::string::npos && colon + 1 < args.size() &&
+                        !std::filesystem::exists(args, ignored);
+  return recorded_motion(has_user ? args.substr(0, colon) : args,
+                         has_user ? args.substr(colon + 1) : "");
 }
 
 // One entry per kind.
@@ -63,7 +67,8 @@ const std::vector<DeviceKind>& kinds() {
          return std::make_unique<ScriptedDevice>(load_trajectory(file), limit);
        },
        [](const std::string& file) -> std::optional<Trajectory> { return load_trajectory(file); }},
-      {"hand", "hand:FILE          a mass-spring-damper hand tracking the trajectory in FILE (closed loop)",
+      {"hand",
+       "hand:FILE          a mass-spring-damper hand tracking the trajectory in FILE (closed loop)",
        [](const std::string& file, double limit) -> std::unique_ptr<HapticDevice> {
          Trajectory reference = load_trajectory(file);
          const HandParameters parameters = load_hand_parameters(file).value_or(HandParameters{});
@@ -73,7 +78,9 @@ const std::vector<DeviceKind>& kinds() {
          load_hand_parameters(file);
          return load_trajectory(file);
        }},
-      {"bridge", "bridge:[HOST:]PORT an external program sending poses to UDP HOST:PORT (default host 127.0.0.1)",
+      {"bridge",
+       "bridge:[HOST:]PORT an external program sending poses to UDP HOST:PORT (default host "
+       "127.0.0.1)",
        [](const std::string& args, double limit) {
          return std::make_unique<BridgeDevice>(bridge_options(args, "bridge:" + args), limit);
        },
@@ -81,7 +88,9 @@ const std::vector<DeviceKind>& kinds() {
          bridge_options(args, "bridge:" + args);
          return std::nullopt;
        }},
-      {"replay", "replay:FILE[:USER] the hand motion of a recording: a client's own, or a server's USER (slot or name; open loop)",
+      {"replay",
+       "replay:FILE[:USER] the hand motion of a recording: a client's own, or a server's USER "
+       "(slot or name; open loop)",
        [](const std::string& args, double limit) -> std::unique_ptr<HapticDevice> {
          return std::make_unique<ScriptedDevice>(replayed_motion(args), limit);
        },

@@ -14,7 +14,8 @@ namespace cohaptic {
 namespace {
 
 // Adds a knot unless it is not later than the last (repeated samples of one time).
-void add_knot(std::vector<double>& times, std::vector<Eigen::Vector3d>& points, double t, const Eigen::Vector3d& p) {
+void add_knot(std::vector<double>& times, std::vector<Eigen::Vector3d>& points, double t,
+              const Eigen::Vector3d& p) {
   if (!times.empty() && t <= times.back()) return;
   times.push_back(t);
   points.push_back(p);
@@ -24,15 +25,17 @@ void add_knot(std::vector<double>& times, std::vector<Eigen::Vector3d>& points, 
 // (0 if none is given).
 int slot_of(const record::Recording& rec, const std::string& user) {
   if (user.empty()) return 0;
-  if (user.find_first_not_of("0123456789") == std::string::npos && user.size() < 4) return std::stoi(user);
+  if (user.find_first_not_of("0123456789") == std::string::npos && user.size() < 4)
+    return std::stoi(user);
   std::vector<std::string> names;
   for (const record::SessionEvent& event : rec.events) {
     if (event.kind() != "user_joined" || !event.has_slot()) continue;
     if (event.user() == user) return static_cast<int>(event.slot());
     names.push_back(fmt::format("'{}' (slot {})", event.user(), event.slot()));
   }
-  throw Error(fmt::format("{}: no user '{}' joined this session; give a slot number or one of: {}", rec.file.string(),
-                          user, names.empty() ? "(no joins recorded)" : fmt::format("{}", fmt::join(names, ", "))));
+  throw Error(fmt::format(
+      "{}: no user '{}' joined this session; give a slot number or one of: {}", rec.file.string(),
+      user, names.empty() ? "(no joins recorded)" : fmt::format("{}", fmt::join(names, ", "))));
 }
 
 }  // namespace
@@ -46,7 +49,8 @@ Trajectory recorded_motion(const std::filesystem::path& file, const std::string&
     for (const record::HapticTick& tick : rec.ticks)
       if (tick.own_valid()) {
         if (start < 0) start = tick.time_ns();
-        add_knot(times, points, static_cast<double>(tick.time_ns() - start) * 1e-9, wire::from_wire(tick.own()));
+        add_knot(times, points, static_cast<double>(tick.time_ns() - start) * 1e-9,
+                 wire::from_wire(tick.own()));
       }
   } else {
     const int slot = slot_of(rec, user);
@@ -55,10 +59,13 @@ Trajectory recorded_motion(const std::filesystem::path& file, const std::string&
       for (const record::ToolInput& tool : step.tools())
         if (static_cast<int>(tool.slot()) == slot && tool.known()) {
           if (start < 0) start = step.time_ns();
-          add_knot(times, points, static_cast<double>(step.time_ns() - start) * 1e-9, wire::from_wire(tool.position()));
+          add_knot(times, points, static_cast<double>(step.time_ns() - start) * 1e-9,
+                   wire::from_wire(tool.position()));
         }
   }
-  if (times.empty()) throw Error(fmt::format("{}: no recorded tool positions{}", file.string(), user.empty() ? "" : " for user " + user));
+  if (times.empty())
+    throw Error(fmt::format("{}: no recorded tool positions{}", file.string(),
+                            user.empty() ? "" : " for user " + user));
   return Trajectory(std::move(times), std::move(points), "replay:" + file.string());
 }
 

@@ -19,9 +19,12 @@ std::string trajectory_reach_warning(const Trajectory& path, const Eigen::Aligne
   const double diagonal = scene.diagonal().norm();
   if (nearest <= diagonal) return "";
   const Eigen::Vector3d low = scene.min(), high = scene.max();
-  return fmt::format("the tool's path ({}) stays {:.3g} m or more from the scene, which spans [{:.3g}, {:.3g}, {:.3g}] to "
-                     "[{:.3g}, {:.3g}, {:.3g}] m: it will touch nothing (is the file's unit right? units: mm or m)",
-                     path.source(), nearest, low.x(), low.y(), low.z(), high.x(), high.y(), high.z());
+  return fmt::format(
+      "the tool's path ({}) stays {:.3g} m or more from the scene, which spans [{:.3g}, {:.3g}, "
+      "{:.3g}] to "
+      "[{:.3g}, {:.3g}, {:.3g}] m: it will touch nothing (is the file's unit right? units: mm or "
+      "m)",
+      path.source(), nearest, low.x(), low.y(), low.z(), high.x(), high.y(), high.z());
 }
 
 }  // namespace cohaptic

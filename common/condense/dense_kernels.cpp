@@ -32,8 +32,8 @@ constexpr int kLanes = 4;
 // x <- G^-1 x for R right-hand sides (strides ld, ldx): column panels of G; after a
 // panel's diagonal block, every row below is updated by the whole panel at once.
 template <int R>
-void forward_substitution(Eigen::Index n, const double* __restrict g, Eigen::Index ld, double* __restrict x,
-                          Eigen::Index ldx) {
+void forward_substitution(Eigen::Index n, const double* __restrict g, Eigen::Index ld,
+                          double* __restrict x, Eigen::Index ldx) {
   for (Eigen::Index first = 0; first < n; first += kPanel) {
     const Eigen::Index width = std::min<Eigen::Index>(kPanel, n - first);
     for (Eigen::Index j = first; j < first + width; ++j) {
@@ -63,8 +63,8 @@ void forward_substitution(Eigen::Index n, const double* __restrict g, Eigen::Ind
 // block. The bottom panel takes the remainder, so it is the only partial one and has no
 // rows below.
 template <int R>
-void backward_substitution(Eigen::Index n, const double* __restrict g, Eigen::Index ld, double* __restrict x,
-                           Eigen::Index ldx) {
+void backward_substitution(Eigen::Index n, const double* __restrict g, Eigen::Index ld,
+                           double* __restrict x, Eigen::Index ldx) {
   Eigen::Index end = n;
   Eigen::Index width = n % kPanel == 0 ? kPanel : n % kPanel;
   while (end > 0) {
@@ -77,11 +77,13 @@ void backward_substitution(Eigen::Index n, const double* __restrict g, Eigen::In
       for (; i + kLanes <= n; i += kLanes)
         for (int r = 0; r < R; ++r)
           for (int p = 0; p < kPanel; ++p)
-            for (int l = 0; l < kLanes; ++l) partial[r][p][l] += panel[p * ld + i + l] * x[r * ldx + i + l];
+            for (int l = 0; l < kLanes; ++l)
+              partial[r][p][l] += panel[p * ld + i + l] * x[r * ldx + i + l];
       for (int r = 0; r < R; ++r)
         for (int p = 0; p < kPanel; ++p) {
           for (int l = 0; l < kLanes; ++l) dot[r][p] += partial[r][p][l];
-          for (Eigen::Index tail = i; tail < n; ++tail) dot[r][p] += panel[p * ld + tail] * x[r * ldx + tail];
+          for (Eigen::Index tail = i; tail < n; ++tail)
+            dot[r][p] += panel[p * ld + tail] * x[r * ldx + tail];
         }
     }
     for (Eigen::Index j = end - 1; j >= first; --j) {
@@ -130,28 +132,32 @@ void rank_update(Eigen::Index n, const double* g, Eigen::Index ld, double* out, 
   }
 }
 
-COHAPTIC_CPU_CLONES void narrow_rank_update(Eigen::Index n, const double* g, Eigen::Index ld, double* out,
-                                            Eigen::Index ld_out, double* w, Eigen::Index ldw, Eigen::Index k) {
+COHAPTIC_CPU_CLONES void narrow_rank_update(Eigen::Index n, const double* g, Eigen::Index ld,
+                                            double* out, Eigen::Index ld_out, double* w,
+                                            Eigen::Index ldw, Eigen::Index k) {
   if (k == 1) rank_update<1>(n, g, ld, out, ld_out, w, ldw);
   if (k == 2) rank_update<2>(n, g, ld, out, ld_out, w, ldw);
   if (k == 3) rank_update<3>(n, g, ld, out, ld_out, w, ldw);
 }
 
-COHAPTIC_CPU_CLONES void narrow_forward_substitution(Eigen::Index n, const double* g, Eigen::Index ld, double* x,
-                                                     Eigen::Index ldx, Eigen::Index columns) {
+COHAPTIC_CPU_CLONES void narrow_forward_substitution(Eigen::Index n, const double* g,
+                                                     Eigen::Index ld, double* x, Eigen::Index ldx,
+                                                     Eigen::Index columns) {
   if (columns == 1) forward_substitution<1>(n, g, ld, x, ldx);
   if (columns == 2) forward_substitution<2>(n, g, ld, x, ldx);
   if (columns == 3) forward_substitution<3>(n, g, ld, x, ldx);
 }
 
-COHAPTIC_CPU_CLONES void narrow_backward_substitution(Eigen::Index n, const double* g, Eigen::Index ld, double* x,
-                                                      Eigen::Index ldx, Eigen::Index columns) {
+COHAPTIC_CPU_CLONES void narrow_backward_substitution(Eigen::Index n, const double* g,
+                                                      Eigen::Index ld, double* x, Eigen::Index ldx,
+                                                      Eigen::Index columns) {
   if (columns == 1) backward_substitution<1>(n, g, ld, x, ldx);
   if (columns == 2) backward_substitution<2>(n, g, ld, x, ldx);
   if (columns == 3) backward_substitution<3>(n, g, ld, x, ldx);
 }
 
-COHAPTIC_CPU_CLONES double gathered_dot_kernel(const double* __restrict column, const int* __restrict index,
+COHAPTIC_CPU_CLONES double gathered_dot_kernel(const double* __restrict column,
+                                               const int* __restrict index,
                                                const double* __restrict values, Eigen::Index n) {
   double sum[kLanes] = {};
   Eigen::Index p = 0;
@@ -173,34 +179,41 @@ CBLAS_TRANSPOSE blas_transpose(Transposed transposed) {
 // x <- G^-1 x or G^-T x.
 void solve_lower(const ConstMatrixRef& g, MatrixRef x, Transposed transposed) {
   if (g.rows() != g.cols() || g.rows() != x.rows())
-    throw Error(fmt::format("{}: a {} x {} triangle against {} rows",
-                            transposed == Transposed::yes ? "solve_lower_transposed_in_place" : "solve_lower_in_place",
-                            g.rows(), g.cols(), x.rows()));
+    throw Error(fmt::format(
+        "{}: a {} x {} triangle against {} rows",
+        transposed == Transposed::yes ? "solve_lower_transposed_in_place" : "solve_lower_in_place",
+        g.rows(), g.cols(), x.rows()));
   if (x.rows() == 0 || x.cols() == 0) return;
   if (x.cols() <= kNarrowColumns) {
-    const auto narrow = transposed == Transposed::yes ? narrow_backward_substitution : narrow_forward_substitution;
+    const auto narrow =
+        transposed == Transposed::yes ? narrow_backward_substitution : narrow_forward_substitution;
     narrow(x.rows(), g.data(), g.outerStride(), x.data(), x.outerStride(), x.cols());
   } else {
-    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, blas_transpose(transposed), CblasNonUnit, blas_size(x.rows()),
-                blas_size(x.cols()), 1.0, g.data(), leading_dimension(g), x.data(), leading_dimension(x));
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, blas_transpose(transposed), CblasNonUnit,
+                blas_size(x.rows()), blas_size(x.cols()), 1.0, g.data(), leading_dimension(g),
+                x.data(), leading_dimension(x));
   }
 }
 
 }  // namespace
 
-void solve_lower_in_place(const ConstMatrixRef& g, MatrixRef x) { solve_lower(g, x, Transposed::no); }
+void solve_lower_in_place(const ConstMatrixRef& g, MatrixRef x) {
+  solve_lower(g, x, Transposed::no);
+}
 
-void solve_lower_transposed_in_place(const ConstMatrixRef& g, MatrixRef x) { solve_lower(g, x, Transposed::yes); }
+void solve_lower_transposed_in_place(const ConstMatrixRef& g, MatrixRef x) {
+  solve_lower(g, x, Transposed::yes);
+}
 
-void multiply(double alpha, const ConstMatrixRef& a, Transposed transposed_a, const ConstMatrixRef& b,
-              Transposed transposed_b, double beta, MatrixRef c) {
+void multiply(double alpha, const ConstMatrixRef& a, Transposed transposed_a,
+              const ConstMatrixRef& b, Transposed transposed_b, double beta, MatrixRef c) {
   const Eigen::Index rows = transposed_a == Transposed::yes ? a.cols() : a.rows();
   const Eigen::Index inner = transposed_a == Transposed::yes ? a.rows() : a.cols();
   const Eigen::Index b_inner = transposed_b == Transposed::yes ? b.cols() : b.rows();
   const Eigen::Index cols = transposed_b == Transposed::yes ? b.rows() : b.cols();
   if (rows != c.rows() || cols != c.cols() || inner != b_inner)
-    throw Error(fmt::format("multiply: op(a) {} x {} times op(b) {} x {} into {} x {}", rows, inner, b_inner, cols,
-                            c.rows(), c.cols()));
+    throw Error(fmt::format("multiply: op(a) {} x {} times op(b) {} x {} into {} x {}", rows, inner,
+                            b_inner, cols, c.rows(), c.cols()));
   if (rows == 0 || cols == 0) return;
   if (inner == 0) {  // BLAS semantics: beta = 0 ignores what c held, NaN included
     if (beta == 0)
@@ -209,23 +222,26 @@ void multiply(double alpha, const ConstMatrixRef& a, Transposed transposed_a, co
       c *= beta;
     return;
   }
-  cblas_dgemm(CblasColMajor, blas_transpose(transposed_a), blas_transpose(transposed_b), blas_size(rows),
-              blas_size(cols), blas_size(inner), alpha, a.data(), leading_dimension(a), b.data(),
-              leading_dimension(b), beta, c.data(), leading_dimension(c));
+  cblas_dgemm(CblasColMajor, blas_transpose(transposed_a), blas_transpose(transposed_b),
+              blas_size(rows), blas_size(cols), blas_size(inner), alpha, a.data(),
+              leading_dimension(a), b.data(), leading_dimension(b), beta, c.data(),
+              leading_dimension(c));
 }
 
-double gathered_dot(const double* column, const int* index, const double* values, Eigen::Index n) noexcept {
+double gathered_dot(const double* column, const int* index, const double* values,
+                    Eigen::Index n) noexcept {
   return gathered_dot_kernel(column, index, values, n);
 }
 
 void cholesky_rank_update(const ConstMatrixRef& g, MatrixRef w, MatrixRef updated) {
   const Eigen::Index n = g.rows();
   if (g.cols() != n || updated.rows() != n || updated.cols() != n || w.rows() != n || w.cols() > 3)
-    throw Error(fmt::format("cholesky_rank_update: a {} x {} factor, {} x {} updates (at most 3 columns), into {} x {}",
-                            n, g.cols(), w.rows(), w.cols(), updated.rows(), updated.cols()));
+    throw Error(fmt::format(
+        "cholesky_rank_update: a {} x {} factor, {} x {} updates (at most 3 columns), into {} x {}",
+        n, g.cols(), w.rows(), w.cols(), updated.rows(), updated.cols()));
   if (n == 0) return;
-  narrow_rank_update(n, g.data(), g.outerStride(), updated.data(), updated.outerStride(), w.data(), w.outerStride(),
-                     w.cols());
+  narrow_rank_update(n, g.data(), g.outerStride(), updated.data(), updated.outerStride(), w.data(),
+                     w.outerStride(), w.cols());
 }
 
 }  // namespace cohaptic

@@ -30,8 +30,8 @@ void solve_lower_transposed_in_place(const ConstMatrixRef& g, MatrixRef x);
 
 enum class Transposed { no, yes };
 /// c <- alpha op(a) op(b) + beta c, op(m) = m or m^T as `transposed_*` says.
-void multiply(double alpha, const ConstMatrixRef& a, Transposed transposed_a, const ConstMatrixRef& b,
-              Transposed transposed_b, double beta, MatrixRef c);
+void multiply(double alpha, const ConstMatrixRef& a, Transposed transposed_a,
+              const ConstMatrixRef& b, Transposed transposed_b, double beta, MatrixRef c);
 
 /// Rank-k update (k <= 3) of a lower Cholesky factor: from G (n x n, G G^T = L, positive
 /// diagonal) to G' with G' G'^T = L + W W^T, in O(k n^2) instead of the O(n^3) of factoring
@@ -46,6 +46,7 @@ void cholesky_rank_update(const ConstMatrixRef& g, MatrixRef w, MatrixRef update
 /// sum over p < n of column[index[p]] * values[p], summed in four interleaved partial sums
 /// (so the result does not depend on the CPU the kernel was built for): a row of a
 /// symmetric matrix, read down its column, against a vector on some of its entries.
-double gathered_dot(const double* column, const int* index, const double* values, Eigen::Index n) noexcept;
+double gathered_dot(const double* column, const int* index, const double* values,
+                    Eigen::Index n) noexcept;
 
 }  // namespace cohaptic

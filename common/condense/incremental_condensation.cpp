@@ -32,7 +32,8 @@ void remove_from_lower_triangle(Eigen::MatrixXd& buffer, int size, int first, in
   remove_rows(buffer, size, first, first, count);
   const Eigen::Index stride = buffer.rows();
   for (int col = first + count; col < size; ++col)
-    std::memmove(buffer.data() + (col - count) * stride + (col - count), buffer.data() + col * stride + col,
+    std::memmove(buffer.data() + (col - count) * stride + (col - count),
+                 buffer.data() + col * stride + col,
                  sizeof(double) * static_cast<std::size_t>(size - col));
 }
 
@@ -40,13 +41,15 @@ void remove_from_lower_triangle(Eigen::MatrixXd& buffer, int size, int first, in
 double symmetric_frobenius_norm(const Eigen::Ref<const Eigen::MatrixXd>& lower) {
   double squared = 0;
   for (Eigen::Index j = 0; j < lower.cols(); ++j)
-    squared += lower(j, j) * lower(j, j) + 2 * lower.col(j).tail(lower.rows() - j - 1).squaredNorm();
+    squared +=
+        lower(j, j) * lower(j, j) + 2 * lower.col(j).tail(lower.rows() - j - 1).squaredNorm();
   return std::sqrt(squared);
 }
 
 }  // namespace
 
-IncrementalCondensation::IncrementalCondensation(ComplianceSource& columns, const DofMap& dofs, Options options)
+IncrementalCondensation::IncrementalCondensation(ComplianceSource& columns, const DofMap& dofs,
+                                                 Options options)
     : columns_(columns), dofs_(dofs), options_(options) {}
 
 bool IncrementalCondensation::in_boundary(int node) const {
@@ -79,22 +82,28 @@ int IncrementalCondensation::slot_of(int node) const {
 }
 
 Eigen::MatrixXd IncrementalCondensation::column_rows_at_boundary(int node) {
-  return gather_compliance(columns_, b_dofs_, free_dofs_of_nodes(dofs_, std::span<const int>(&node, 1)));
+  return gather_compliance(columns_, b_dofs_,
+                           free_dofs_of_nodes(dofs_, std::span<const int>(&node, 1)));
 }
 
-Eigen::MatrixXd IncrementalCondensation::compliance_to_slots(std::span<const int> row_dofs, std::size_t first_slot) {
+Eigen::MatrixXd IncrementalCondensation::compliance_to_slots(std::span<const int> row_dofs,
+                                                             std::size_t first_slot) {
   std::vector<int> dofs;
   std::vector<Eigen::Index> column_of;
   for (std::size_t s = first_slot; s < cached_.size(); ++s) {
-    const std::vector<int> node_dofs = free_dofs_of_nodes(dofs_, std::span<const int>(&cached_[s].node, 1));
+    const std::vector<int> node_dofs =
+        free_dofs_of_nodes(dofs_, std::span<const int>(&cached_[s].node, 1));
     for (std::size_t axis = 0; axis < node_dofs.size(); ++axis) {
       dofs.push_back(node_dofs[axis]);
-      column_of.push_back(3 * static_cast<Eigen::Index>(s - first_slot) + static_cast<Eigen::Index>(axis));
+      column_of.push_back(3 * static_cast<Eigen::Index>(s - first_slot) +
+                          static_cast<Eigen::Index>(axis));
     }
   }
   const Eigen::MatrixXd gathered = gather_compliance(columns_, row_dofs, dofs);
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(gathered.rows(), 3 * static_cast<Eigen::Index>(cached_.size() - first_slot));
-  for (std::size_t j = 0; j < column_of.size(); ++j) out.col(column_of[j]) = gathered.col(static_cast<Eigen::Index>(j));
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(
+      gathered.rows(), 3 * static_cast<Eigen::Index>(cached_.size() - first_slot));
+  for (std::size_t j = 0; j < column_of.size(); ++j)
+    out.col(column_of[j]) = gathered.col(static_cast<Eigen::Index>(j));
   return out;
 }
 
@@ -117,7 +126,8 @@ void IncrementalCondensation::add_boundary_node(int node) {
   const Eigen::LLT<Eigen::MatrixXd> rho(lambda - g.transpose() * g);
   if (rho.info() != Eigen::Success)
     throw NumericalError(fmt::format(
-        "node {} cannot join the boundary set: L_BB would not be positive definite (the node duplicates "
+        "node {} cannot join the boundary set: L_BB would not be positive definite (the node "
+        "duplicates "
         "others, or the set is numerically singular; condition estimate of L_BB {:.3g})",
         node, n > 0 ? cholesky_condition_estimate(g_old) : 1.0));
   const Eigen::MatrixXd rho_lower = rho.matrixL();
@@ -141,8 +151,10 @@ void IncrementalCondensation::add_boundary_node(int node) {
   after_update();
 }
 
-void IncrementalCondensation::update_cached_z_for_join(std::span<const int> new_dofs, const Eigen::MatrixXd& l,
-                                                       const Eigen::MatrixXd& g, const Eigen::MatrixXd& rho_lower) {
+void IncrementalCondensation::update_cached_z_for_join(std::span<const int> new_dofs,
+                                                       const Eigen::MatrixXd& l,
+                                                       const Eigen::MatrixXd& g,
+                                                       const Eigen::MatrixXd& rho_lower) {
   // Z' = [Z - q t; t] with q = L_BB^-1 l and t = (rho rho^T)^-1 (L_bc - l^T Z).
   const int n = n_;
   const auto k = static_cast<Eigen::Index>(new_dofs.size());
@@ -178,7 +190,8 @@ void IncrementalCondensation::remove_boundary_node(int node) {
   // up; the columns before the node only lose k rows.
   if (below > 0) {
     Eigen::MatrixXd dropped = g_.block(first + k, first, below, k);
-    cholesky_rank_update(g_.block(first + k, first + k, below, below), dropped, g_.block(first, first, below, below));
+    cholesky_rank_update(g_.block(first + k, first + k, below, below), dropped,
+                         g_.block(first, first, below, below));
   }
   remove_rows(g_, n, first, first, k);
   remove_from_lower_triangle(l_bb_, n, first, k);
@@ -201,14 +214,18 @@ void IncrementalCondensation::update_cached_z_for_leave(int first, int k) {
   Eigen::MatrixXd inverse_columns = Eigen::MatrixXd::Zero(n, k);
   inverse_columns.middleRows(first, k).setIdentity();
   // G^-1 E_b is zero above the node's rows: the forward solve starts there.
-  solve_lower_in_place(g_.block(first, first, n - first, n - first), inverse_columns.bottomRows(n - first));
+  solve_lower_in_place(g_.block(first, first, n - first, n - first),
+                       inverse_columns.bottomRows(n - first));
   solve_lower_transposed_in_place(g_.topLeftCorner(n, n), inverse_columns);
   const Eigen::LLT<Eigen::MatrixXd> n_bb(inverse_columns.middleRows(first, k));
   if (n_bb.info() != Eigen::Success)
-    throw NumericalError(fmt::format("boundary node at dof {} cannot leave: L_BB^-1 has lost positive definiteness "
-                                     "({} boundary dofs)", first, n));
+    throw NumericalError(
+        fmt::format("boundary node at dof {} cannot leave: L_BB^-1 has lost positive definiteness "
+                    "({} boundary dofs)",
+                    first, n));
   const Eigen::MatrixXd h = n_bb.solve(z_.block(first, 0, k, columns));
-  multiply(-1, inverse_columns.topRows(first), Transposed::no, h, Transposed::no, 1, z_.block(0, 0, first, columns));
+  multiply(-1, inverse_columns.topRows(first), Transposed::no, h, Transposed::no, 1,
+           z_.block(0, 0, first, columns));
   multiply(-1, inverse_columns.bottomRows(below), Transposed::no, h, Transposed::no, 1,
            z_.block(first + k, 0, below, columns));
   remove_rows(z_, n, columns, first, k);
@@ -221,7 +238,8 @@ void IncrementalCondensation::set_boundary_nodes(std::span<const int> nodes) {
     if (std::find(nodes.begin(), nodes.end(), node) == nodes.end()) remove_boundary_node(node);
   std::vector<int> joining;
   for (int node : nodes)
-    if (!in_boundary(node) && std::find(joining.begin(), joining.end(), node) == joining.end()) joining.push_back(node);
+    if (!in_boundary(node) && std::find(joining.begin(), joining.end(), node) == joining.end())
+      joining.push_back(node);
   columns_.compute_columns(joining);  // one multi-right-hand-side solve for them all
   // Many at once (a step-delay set): append them to L_BB and factor once, O(|B|^3 / 3),
   // cheaper than as many bordering steps.
@@ -248,7 +266,8 @@ void IncrementalCondensation::set_boundary_nodes(std::span<const int> nodes) {
   n_ += k;
   stats_.joins += static_cast<long>(joining.size());
   factor_from_scratch(
-      "the boundary nodes cannot be held together: L_BB is not positive definite (duplicate nodes, or a numerically "
+      "the boundary nodes cannot be held together: L_BB is not positive definite (duplicate nodes, "
+      "or a numerically "
       "singular set)");
   stats_.factor_ms += watch.lap_ms();
 }
@@ -257,7 +276,9 @@ void IncrementalCondensation::compute_z(std::span<const int> nodes) {
   const std::size_t first_new = cached_.size();
   for (int node : nodes)
     if (slot_of(node) < 0)
-      cached_.push_back({node, static_cast<int>(free_dofs_of_nodes(dofs_, std::span<const int>(&node, 1)).size()), clock_});
+      cached_.push_back(
+          {node, static_cast<int>(free_dofs_of_nodes(dofs_, std::span<const int>(&node, 1)).size()),
+           clock_});
   if (cached_.size() == first_new) return;
   ensure_slot_capacity(cached_.size());
   const auto first_column = 3 * static_cast<Eigen::Index>(first_new);
@@ -272,7 +293,8 @@ void IncrementalCondensation::compute_z(std::span<const int> nodes) {
 CondensedOperator IncrementalCondensation::condense(std::span<const int> contact_nodes) {
   ++clock_;
   for (int node : contact_nodes)
-    if (in_boundary(node)) throw Error(fmt::format("node {} is both a contact and a boundary node", node));
+    if (in_boundary(node))
+      throw Error(fmt::format("node {} is both a contact and a boundary node", node));
   if (options_.naive) return naive_condensation(columns_, dofs_, contact_nodes, b_nodes_);
   Stopwatch watch;
   compute_z(contact_nodes);
@@ -297,9 +319,10 @@ CondensedOperator IncrementalCondensation::condense(std::span<const int> contact
   s = 0.5 * (s + s.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(s);
   if (llt.info() != Eigen::Success)
-    throw NumericalError(fmt::format(
-        "the condensed compliance of {} contact dofs (with {} boundary dofs held) is not positive definite",
-        m, n_));
+    throw NumericalError(
+        fmt::format("the condensed compliance of {} contact dofs (with {} boundary dofs held) is "
+                    "not positive definite",
+                    m, n_));
   op.condition_estimate = cholesky_condition_estimate(llt.matrixL());
   op.m_cc = llt.solve(Eigen::MatrixXd::Identity(m, m));
   op.m_cc = 0.5 * (op.m_cc + op.m_cc.transpose()).eval();
@@ -314,8 +337,9 @@ CondensedOperator IncrementalCondensation::condense(std::span<const int> contact
 void IncrementalCondensation::forget_least_recently_used() {
   // Keep the cache bounded: the last slot fills the one freed, so slots stay contiguous.
   while (cached_.size() > options_.z_cache_nodes) {
-    const auto oldest = std::min_element(cached_.begin(), cached_.end(),
-                                         [](const CachedNode& a, const CachedNode& b) { return a.last_used < b.last_used; });
+    const auto oldest = std::min_element(
+        cached_.begin(), cached_.end(),
+        [](const CachedNode& a, const CachedNode& b) { return a.last_used < b.last_used; });
     if (oldest->last_used == clock_) break;
     drop_slot(static_cast<std::size_t>(oldest - cached_.begin()));
   }
@@ -324,8 +348,10 @@ void IncrementalCondensation::forget_least_recently_used() {
 void IncrementalCondensation::drop_slot(std::size_t slot) {
   const std::size_t last = cached_.size() - 1;
   if (slot != last) {
-    z_.block(0, 3 * static_cast<Eigen::Index>(slot), n_, 3) = z_.block(0, 3 * static_cast<Eigen::Index>(last), n_, 3);
-    l_bz_.block(0, 3 * static_cast<Eigen::Index>(slot), n_, 3) = l_bz_.block(0, 3 * static_cast<Eigen::Index>(last), n_, 3);
+    z_.block(0, 3 * static_cast<Eigen::Index>(slot), n_, 3) =
+        z_.block(0, 3 * static_cast<Eigen::Index>(last), n_, 3);
+    l_bz_.block(0, 3 * static_cast<Eigen::Index>(slot), n_, 3) =
+        l_bz_.block(0, 3 * static_cast<Eigen::Index>(last), n_, 3);
     cached_[slot] = cached_.back();
   }
   cached_.pop_back();
@@ -337,7 +363,8 @@ void IncrementalCondensation::forget_node(int node) {
 }
 
 Eigen::MatrixXd IncrementalCondensation::solve_boundary(const Eigen::MatrixXd& rhs) const {
-  if (rhs.rows() != n_) throw Error(fmt::format("solve_boundary: {} rows for {} boundary dofs", rhs.rows(), n_));
+  if (rhs.rows() != n_)
+    throw Error(fmt::format("solve_boundary: {} rows for {} boundary dofs", rhs.rows(), n_));
   Eigen::MatrixXd x = rhs;
   solve_lower_in_place(g_.topLeftCorner(n_, n_), x);
   solve_lower_transposed_in_place(g_.topLeftCorner(n_, n_), x);
@@ -361,7 +388,8 @@ double IncrementalCondensation::check_residuals() {
     const double l_norm = symmetric_frobenius_norm(l);
     // A deterministic probe vector: the factor must reproduce L_BB on it.
     Eigen::VectorXd x(n_);
-    for (int i = 0; i < n_; ++i) x[i] = std::sin(1.0 + 0.7 * i + 0.013 * static_cast<double>(stats_.residual_checks));
+    for (int i = 0; i < n_; ++i)
+      x[i] = std::sin(1.0 + 0.7 * i + 0.013 * static_cast<double>(stats_.residual_checks));
     const Eigen::VectorXd gx = g.triangularView<Eigen::Lower>().transpose() * x;
     const Eigen::VectorXd ggx = g.triangularView<Eigen::Lower>() * gx;
     const Eigen::VectorXd lx = l.selfadjointView<Eigen::Lower>() * x;
@@ -390,7 +418,8 @@ void IncrementalCondensation::factor_from_scratch(const char* failure) {
     Eigen::Ref<Eigen::MatrixXd> g = g_.topLeftCorner(n_, n_);
     g.triangularView<Eigen::Lower>() = l_bb_.topLeftCorner(n_, n_);
     const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> llt(g);  // in place, lower triangle
-    if (llt.info() != Eigen::Success) throw NumericalError(fmt::format("{} ({} boundary dofs)", failure, n_));
+    if (llt.info() != Eigen::Success)
+      throw NumericalError(fmt::format("{} ({} boundary dofs)", failure, n_));
   }
   // Every cached Z again, from the compliance itself.
   if (cached_.empty()) return;

@@ -95,8 +95,8 @@ class IncrementalCondensation {
   Eigen::Index cached_columns() const { return 3 * static_cast<Eigen::Index>(cached_.size()); }
   /// L[row_dofs, dofs of the cached slots from first_slot on], in the slots' column layout.
   Eigen::MatrixXd compliance_to_slots(std::span<const int> row_dofs, std::size_t first_slot);
-  void update_cached_z_for_join(std::span<const int> new_dofs, const Eigen::MatrixXd& l, const Eigen::MatrixXd& g,
-                                const Eigen::MatrixXd& rho_lower);
+  void update_cached_z_for_join(std::span<const int> new_dofs, const Eigen::MatrixXd& l,
+                                const Eigen::MatrixXd& g, const Eigen::MatrixXd& rho_lower);
   void update_cached_z_for_leave(int first, int k);
   void forget_least_recently_used();
   void drop_slot(std::size_t slot);
@@ -110,9 +110,9 @@ class IncrementalCondensation {
   const DofMap& dofs_;
   Options options_;
   std::vector<int> b_nodes_;
-  std::vector<int> b_dofs_;        // global free dofs of B, in B order
-  std::vector<int> b_node_offset_; // first position of each B node's dofs in b_dofs_
-  int n_ = 0;                      // |b_dofs_|
+  std::vector<int> b_dofs_;         // global free dofs of B, in B order
+  std::vector<int> b_node_offset_;  // first position of each B node's dofs in b_dofs_
+  int n_ = 0;                       // |b_dofs_|
   // Capacity buffers, all with the same number of rows (>= n_), so that a join writes
   // its rows in place and a leave moves rows within them.
   Eigen::MatrixXd l_bb_;  // lower triangle of the top-left n x n is L_BB

@@ -16,7 +16,8 @@ double cholesky_condition_estimate(const Eigen::MatrixXd& factor) {
   return ratio * ratio;
 }
 
-CondensedOperator naive_condensation(ComplianceSource& columns, const DofMap& dofs, std::span<const int> contact_nodes,
+CondensedOperator naive_condensation(ComplianceSource& columns, const DofMap& dofs,
+                                     std::span<const int> contact_nodes,
                                      std::span<const int> boundary_nodes) {
   CondensedOperator op;
   op.contact_dofs = free_dofs_of_nodes(dofs, contact_nodes);
@@ -30,17 +31,19 @@ CondensedOperator naive_condensation(ComplianceSource& columns, const DofMap& do
   l_aa = 0.5 * (l_aa + l_aa.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(l_aa);
   if (llt.info() != Eigen::Success)
-    throw NumericalError(fmt::format(
-        "L_AA ({} dofs: {} contact, {} boundary) is not positive definite: a node in both C and B, or "
-        "coincident nodes?",
-        a, c, a - c));
+    throw NumericalError(
+        fmt::format("L_AA ({} dofs: {} contact, {} boundary) is not positive definite: a node in "
+                    "both C and B, or "
+                    "coincident nodes?",
+                    a, c, a - c));
   // Rows of C of L_AA^-1 = (L_AA^-1 E_C)^T, L_AA symmetric.
   const Eigen::MatrixXd x = llt.solve(Eigen::MatrixXd::Identity(a, c));
   const Eigen::MatrixXd m_ca = x.transpose();
   op.m_cc = 0.5 * (m_ca.leftCols(c) + m_ca.leftCols(c).transpose());
   op.m_cb = m_ca.rightCols(a - c);
   const Eigen::LLT<Eigen::MatrixXd> s_llt(op.m_cc.inverse());
-  op.condition_estimate = s_llt.info() == Eigen::Success ? cholesky_condition_estimate(s_llt.matrixL()) : INFINITY;
+  op.condition_estimate =
+      s_llt.info() == Eigen::Success ? cholesky_condition_estimate(s_llt.matrixL()) : INFINITY;
   return op;
 }
 

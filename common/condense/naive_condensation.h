@@ -12,7 +12,8 @@ namespace cohaptic {
 
 /// Throws NumericalError (with a condition estimate) if L_AA is not positive definite,
 /// e.g. when C and B share a node.
-CondensedOperator naive_condensation(ComplianceSource& columns, const DofMap& dofs, std::span<const int> contact_nodes,
+CondensedOperator naive_condensation(ComplianceSource& columns, const DofMap& dofs,
+                                     std::span<const int> contact_nodes,
                                      std::span<const int> boundary_nodes);
 
 /// Squared ratio of the largest to the smallest diagonal entry of a Cholesky factor.

@@ -14,7 +14,8 @@ constexpr Eigen::Index kFirstCapacity = 64;
 
 }  // namespace
 
-NormalCompliance::NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& directions,
+NormalCompliance::NormalCompliance(ComplianceColumns& columns, const DofMap& dofs,
+                                   const Eigen::Matrix3Xd& directions,
                                    Eigen::Index expected_candidates)
     : columns_(columns),
       dofs_(dofs),
@@ -24,7 +25,9 @@ NormalCompliance::NormalCompliance(ComplianceColumns& columns, const DofMap& dof
 }
 
 int NormalCompliance::slot_of(int node) const {
-  return node >= 0 && node < static_cast<int>(slot_of_node_.size()) ? slot_of_node_[static_cast<std::size_t>(node)] : -1;
+  return node >= 0 && node < static_cast<int>(slot_of_node_.size())
+             ? slot_of_node_[static_cast<std::size_t>(node)]
+             : -1;
 }
 
 bool NormalCompliance::current(int node) const {
@@ -55,15 +58,19 @@ void NormalCompliance::grow(Eigen::Index capacity) {
   nonnegative_.resize(static_cast<std::size_t>(capacity), 1);
 }
 
-bool NormalCompliance::update(std::span<const int> nodes, const IncrementalCondensation& condensation,
+bool NormalCompliance::update(std::span<const int> nodes,
+                              const IncrementalCondensation& condensation,
                               const Eigen::VectorXd& boundary_displacement) {
   condensation_ = &condensation;
   std::vector<char> wanted(slot_of_node_.size(), 0);
   for (int node : nodes) {
-    if (node < 0 || node >= static_cast<int>(wanted.size()) || wanted[static_cast<std::size_t>(node)])
-      throw Error(fmt::format("normal compliance: candidate node {} is listed twice or is no mesh node", node));
+    if (node < 0 || node >= static_cast<int>(wanted.size()) ||
+        wanted[static_cast<std::size_t>(node)])
+      throw Error(fmt::format(
+          "normal compliance: candidate node {} is listed twice or is no mesh node", node));
     if (condensation.in_boundary(node))
-      throw Error(fmt::format("normal compliance: candidate node {} is held as a boundary node", node));
+      throw Error(
+          fmt::format("normal compliance: candidate node {} is held as a boundary node", node));
     wanted[static_cast<std::size_t>(node)] = 1;
   }
   // Leaving nodes (and those with a new direction) free their slots; joining nodes take the
@@ -109,19 +116,21 @@ bool NormalCompliance::update(std::span<const int> nodes, const IncrementalConde
     q_ = p_;
   }
   if (static_cast<Eigen::Index>(boundary_dofs_.size()) != boundary_displacement.size())
-    throw Error(fmt::format("normal compliance: {} held displacements for {} free dofs of B", boundary_displacement.size(),
-                            boundary_dofs_.size()));
+    throw Error(fmt::format("normal compliance: {} held displacements for {} free dofs of B",
+                            boundary_displacement.size(), boundary_dofs_.size()));
   std::vector<int> every_slot;
   for (int slot = 0; slot < slot_count(); ++slot)
     if (node_of(slot) >= 0) every_slot.push_back(slot);
   // A joining slot's W0 and P; with a new B, every slot's P (W0 is kept).
-  add_columns(boundary_changed ? std::span<const int>(every_slot) : std::span<const int>(joined), joined);
+  add_columns(boundary_changed ? std::span<const int>(every_slot) : std::span<const int>(joined),
+              joined);
   condense(boundary_changed ? std::span<const int>(every_slot) : std::span<const int>(joined));
   free_clearance_.setZero();
   if (!boundary_dofs_.empty())
     for (int slot : every_slot) free_clearance_[slot] = q_.col(slot).dot(boundary_displacement);
   find_nonnegative_rows(joined, boundary_changed);
-  const bool kept_slots = static_cast<Eigen::Index>(every_slot.size()) > static_cast<Eigen::Index>(joined.size());
+  const bool kept_slots =
+      static_cast<Eigen::Index>(every_slot.size()) > static_cast<Eigen::Index>(joined.size());
   return boundary_changed && kept_slots;
 }
 
@@ -134,9 +143,11 @@ void NormalCompliance::add_columns(std::span<const int> slots, std::span<const i
   for (int slot : joined) is_joined[static_cast<std::size_t>(slot)] = 1;
   std::vector<int> row_of_slot(static_cast<std::size_t>(slot_count()), -1);
   for (int slot = 0; slot < slot_count(); ++slot)
-    if (node_of(slot) >= 0) row_of_slot[static_cast<std::size_t>(slot)] = columns_.row_position(node_of(slot));
+    if (node_of(slot) >= 0)
+      row_of_slot[static_cast<std::size_t>(slot)] = columns_.row_position(node_of(slot));
   std::vector<Eigen::Index> row_of_boundary_dof;
-  for (int dof : boundary_dofs_) row_of_boundary_dof.push_back(3 * columns_.row_position(dof / 3) + dof % 3);
+  for (int dof : boundary_dofs_)
+    row_of_boundary_dof.push_back(3 * columns_.row_position(dof / 3) + dof % 3);
   for (int b : slots) {
     // L[rows, b] n_b: the displacement of every row node under b's unit normal push.
     const Eigen::VectorXd moved = columns_.column(node_of(b)) * normal(b);
@@ -145,7 +156,8 @@ void NormalCompliance::add_columns(std::span<const int> slots, std::span<const i
     if (!is_joined[static_cast<std::size_t>(b)]) continue;  // its W0 is kept
     for (int a = 0; a < slot_count(); ++a) {
       const int row = row_of_slot[static_cast<std::size_t>(a)];
-      if (row < 0 || (is_joined[static_cast<std::size_t>(a)] && a > b)) continue;  // two joined: the pair once
+      if (row < 0 || (is_joined[static_cast<std::size_t>(a)] && a > b))
+        continue;  // two joined: the pair once
       w0_(a, b) = w0_(b, a) = normal(a).dot(moved.segment<3>(3 * row));
     }
   }
@@ -154,10 +166,12 @@ void NormalCompliance::add_columns(std::span<const int> slots, std::span<const i
 void NormalCompliance::condense(std::span<const int> slots) {
   if (slots.empty()) return;
   Eigen::MatrixXd p_listed(p_.rows(), static_cast<Eigen::Index>(slots.size()));
-  for (std::size_t i = 0; i < slots.size(); ++i) p_listed.col(static_cast<Eigen::Index>(i)) = p_.col(slots[i]);
+  for (std::size_t i = 0; i < slots.size(); ++i)
+    p_listed.col(static_cast<Eigen::Index>(i)) = p_.col(slots[i]);
   if (p_.rows() > 0) {
     const Eigen::MatrixXd q_listed = condensation_->solve_boundary(p_listed);
-    for (std::size_t i = 0; i < slots.size(); ++i) q_.col(slots[i]) = q_listed.col(static_cast<Eigen::Index>(i));
+    for (std::size_t i = 0; i < slots.size(); ++i)
+      q_.col(slots[i]) = q_listed.col(static_cast<Eigen::Index>(i));
   }
   // Each pair once, P of the lower slot against Q of the higher, so that W is symmetric
   // bit for bit whichever way a pair was reached.
@@ -177,7 +191,8 @@ void NormalCompliance::find_nonnegative_rows(std::span<const int> joined, bool a
   const auto scan = [&](int a) {
     bool nonnegative = true;
     if (node_of(a) >= 0)
-      for (int b = 0; b < slot_count() && nonnegative; ++b) nonnegative = node_of(b) < 0 || w_(a, b) >= 0;
+      for (int b = 0; b < slot_count() && nonnegative; ++b)
+        nonnegative = node_of(b) < 0 || w_(a, b) >= 0;
     nonnegative_[static_cast<std::size_t>(a)] = nonnegative;
   };
   if (all) {

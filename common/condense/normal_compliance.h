@@ -12,15 +12,15 @@
 // it depends on where the tools are, only on each node's direction.
 //
 // Candidates live in slots: a node keeps its slot while it stays a candidate along the same
-// direction, and a leaving node's slot is reused, so W's entries and the indices of a contact solve over
-// the slots (incremental_contact_solve.h) stay put while the set changes. A joining node
-// costs one column solve (cached in ComplianceColumns) and its row of W0, P and Q,
-// O(|C| + |B|^2); a change of B recomputes P, Q and W, O(|B|^2 |C| + |B| |C|^2), keeping W0;
-// a change of u_B only q0, O(|B| |C|). W is exactly symmetric (each pair is computed once).
-// The slots' capacity doubles when they run out, copying W0, W, P and Q: a step that has
-// to grow a large capacity stalls (the first wide press against an obstacle, say), so the
-// owner gives, at construction, as many slots as candidates can ever be, up to
-// kMaxInitialCapacity. Units: m/N, m. Not thread-safe: the simulation loop owns it.
+// direction, and a leaving node's slot is reused, so W's entries and the indices of a contact solve
+// over the slots (incremental_contact_solve.h) stay put while the set changes. A joining node costs
+// one column solve (cached in ComplianceColumns) and its row of W0, P and Q, O(|C| + |B|^2); a
+// change of B recomputes P, Q and W, O(|B|^2 |C| + |B| |C|^2), keeping W0; a change of u_B only q0,
+// O(|B| |C|). W is exactly symmetric (each pair is computed once). The slots' capacity doubles when
+// they run out, copying W0, W, P and Q: a step that has to grow a large capacity stalls (the first
+// wide press against an obstacle, say), so the owner gives, at construction, as many slots as
+// candidates can ever be, up to kMaxInitialCapacity. Units: m/N, m. Not thread-safe: the simulation
+// loop owns it.
 #pragma once
 
 #include <Eigen/Core>
@@ -44,8 +44,8 @@ class NormalCompliance {
   /// must outlive it; every candidate and every node of B must be a row node of `columns`.
   /// `expected_candidates`: how many candidates there may be at once (the capacity made
   /// now: at least 64, at most kMaxInitialCapacity).
-  NormalCompliance(ComplianceColumns& columns, const DofMap& dofs, const Eigen::Matrix3Xd& directions,
-                   Eigen::Index expected_candidates = 0);
+  NormalCompliance(ComplianceColumns& columns, const DofMap& dofs,
+                   const Eigen::Matrix3Xd& directions, Eigen::Index expected_candidates = 0);
 
   /// The candidates become `nodes` (each once, none in B), under the held set of
   /// `condensation` held at `boundary_displacement` (free dofs of B in its order). A node
@@ -58,7 +58,9 @@ class NormalCompliance {
   int slot_count() const { return static_cast<int>(node_of_slot_.size()); }
   /// The slots' capacity: W's rows (a contact solve over the slots needs this many).
   Eigen::Index capacity() const { return w_.rows(); }
-  int node_of(int slot) const { return node_of_slot_[static_cast<std::size_t>(slot)]; }  ///< -1: free
+  int node_of(int slot) const {
+    return node_of_slot_[static_cast<std::size_t>(slot)];
+  }                             ///< -1: free
   int slot_of(int node) const;  ///< -1 if not a candidate
   /// The direction the slot's node was taken with.
   Eigen::Vector3d normal(int slot) const { return slot_direction_.col(slot); }
@@ -91,11 +93,11 @@ class NormalCompliance {
   std::vector<int> node_of_slot_;
   std::vector<int> slot_of_node_;  // per volume node
   std::vector<int> free_slots_;
-  std::vector<int> boundary_;      // B as of the last update
+  std::vector<int> boundary_;  // B as of the last update
   std::vector<int> boundary_dofs_;
   const IncrementalCondensation* condensation_ = nullptr;
-  Eigen::MatrixXd w0_, w_;         // capacity square
-  Eigen::MatrixXd p_, q_;          // B's free dofs x capacity
+  Eigen::MatrixXd w0_, w_;  // capacity square
+  Eigen::MatrixXd p_, q_;   // B's free dofs x capacity
   Eigen::VectorXd free_clearance_;
   std::vector<std::uint8_t> nonnegative_;
 };

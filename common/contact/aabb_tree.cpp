@@ -11,7 +11,8 @@ namespace cohaptic {
 namespace {
 
 /// Squared distance from p to the box [lo, hi] (zero inside).
-double box_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+double box_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& lo,
+                     const Eigen::Vector3d& hi) {
   double d2 = 0;
   for (int k = 0; k < 3; ++k) {
     const double below = lo[k] - p[k], above = p[k] - hi[k];
@@ -47,7 +48,8 @@ bool segment_box_interval(const Eigen::Vector3d& from, const Eigen::Vector3d& d,
 
 }  // namespace
 
-AabbTree::AabbTree(const TriangleSurface& surface) : AabbTree(surface.vertices, surface.triangles) {}
+AabbTree::AabbTree(const TriangleSurface& surface)
+    : AabbTree(surface.vertices, surface.triangles) {}
 
 AabbTree::AabbTree(const Eigen::Matrix3Xd& vertices, std::span<const Triangle> triangles) {
   const int n = static_cast<int>(triangles.size());
@@ -58,13 +60,15 @@ AabbTree::AabbTree(const Eigen::Matrix3Xd& vertices, std::span<const Triangle> t
     for (int k = 0; k < 3; ++k) {
       const int v = triangles[t][k];
       if (v < 0 || v >= vertices.cols())
-        throw Error(fmt::format("AABB tree: triangle {} refers to vertex {}, but there are {} vertices", t, v,
-                                vertices.cols()));
+        throw Error(
+            fmt::format("AABB tree: triangle {} refers to vertex {}, but there are {} vertices", t,
+                        v, vertices.cols()));
       if (!vertices.col(v).allFinite())
         throw Error(fmt::format("AABB tree: vertex {} (used by triangle {}) is not finite", v, t));
     }
     // Kept in input order for now; permuted into leaf order once the tree is built.
-    corners_[t] = {vertices.col(triangles[t][0]), vertices.col(triangles[t][1]), vertices.col(triangles[t][2])};
+    corners_[t] = {vertices.col(triangles[t][0]), vertices.col(triangles[t][1]),
+                   vertices.col(triangles[t][2])};
     centroids[t] = (corners_[t].a + corners_[t].b + corners_[t].c) / 3;
   }
   std::vector<int> order(triangles.size());
@@ -81,8 +85,8 @@ AabbTree::AabbTree(const Eigen::Matrix3Xd& vertices, std::span<const Triangle> t
   triangle_index_ = std::move(order);
 }
 
-int AabbTree::build(std::vector<int>& order, const std::vector<Eigen::Vector3d>& centroids, int begin, int end,
-                    int level) {
+int AabbTree::build(std::vector<int>& order, const std::vector<Eigen::Vector3d>& centroids,
+                    int begin, int end, int level) {
   depth_ = std::max(depth_, level);
   const int index = static_cast<int>(nodes_.size());
   nodes_.emplace_back();
@@ -133,7 +137,8 @@ AabbHit AabbTree::closest_triangle(const Eigen::Vector3d& p, double max_distance
     for (;;) {
       const Node& current = nodes_[node];
       if (current.count > 0) {
-        for (int slot = current.first_or_right; slot < current.first_or_right + current.count; ++slot) {
+        for (int slot = current.first_or_right; slot < current.first_or_right + current.count;
+             ++slot) {
           const Corners& c = corners_[slot];
           const TriangleClosestPoint q = closest_point_on_triangle(p, c.a, c.b, c.c);
           const double d2 = (p - q.point).squaredNorm();
@@ -166,7 +171,8 @@ AabbHit AabbTree::closest_triangle(const Eigen::Vector3d& p, double max_distance
   return hit;
 }
 
-AabbCrossing AabbTree::first_crossing(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const noexcept {
+AabbCrossing AabbTree::first_crossing(const Eigen::Vector3d& from,
+                                      const Eigen::Vector3d& to) const noexcept {
   AabbCrossing hit;
   const Eigen::Vector3d d = to - from;
   if (nodes_.empty() || !from.allFinite() || !d.allFinite()) return hit;
@@ -186,12 +192,14 @@ AabbCrossing AabbTree::first_crossing(const Eigen::Vector3d& from, const Eigen::
     for (;;) {
       const Node& current = nodes_[node];
       if (current.count > 0) {
-        for (int slot = current.first_or_right; slot < current.first_or_right + current.count; ++slot) {
+        for (int slot = current.first_or_right; slot < current.first_or_right + current.count;
+             ++slot) {
           const Corners& c = corners_[slot];
           const auto crossing = segment_triangle_crossing(from, to, c.a, c.b, c.c);
           if (!crossing) continue;
           const int t = triangle_index_[slot];
-          if (crossing->t < best_t || (crossing->t == best_t && (hit.triangle < 0 || t < hit.triangle))) {
+          if (crossing->t < best_t ||
+              (crossing->t == best_t && (hit.triangle < 0 || t < hit.triangle))) {
             best_t = crossing->t;
             hit.triangle = t;
             hit.crossing = *crossing;
@@ -201,8 +209,10 @@ AabbCrossing AabbTree::first_crossing(const Eigen::Vector3d& from, const Eigen::
       }
       int near = node + 1, far = current.first_or_right;
       double near_enter = 0, far_enter = 0;
-      const bool near_hit = segment_box_interval(from, d, best_t, nodes_[near].lo, nodes_[near].hi, near_enter);
-      const bool far_hit = segment_box_interval(from, d, best_t, nodes_[far].lo, nodes_[far].hi, far_enter);
+      const bool near_hit =
+          segment_box_interval(from, d, best_t, nodes_[near].lo, nodes_[near].hi, near_enter);
+      const bool far_hit =
+          segment_box_interval(from, d, best_t, nodes_[far].lo, nodes_[far].hi, far_enter);
       if (!near_hit && !far_hit) break;
       if (!near_hit || (far_hit && far_enter < near_enter)) {
         std::swap(near, far);
@@ -219,7 +229,8 @@ AabbCrossing AabbTree::first_crossing(const Eigen::Vector3d& from, const Eigen::
   return hit;
 }
 
-void AabbTree::triangles_near(const Eigen::Vector3d& p, double max_distance, std::vector<int>& out) const {
+void AabbTree::triangles_near(const Eigen::Vector3d& p, double max_distance,
+                              std::vector<int>& out) const {
   if (nodes_.empty() || !(max_distance >= 0)) return;
   const double reach2 = max_distance * max_distance;
   std::array<int, kMaxDepth + 1> stack;  // one pending sibling per level, and the root
@@ -231,7 +242,8 @@ void AabbTree::triangles_near(const Eigen::Vector3d& p, double max_distance, std
     if (node.count > 0) {
       for (int slot = node.first_or_right; slot < node.first_or_right + node.count; ++slot) {
         const Corners& c = corners_[slot];
-        const Eigen::Vector3d lo = c.a.cwiseMin(c.b).cwiseMin(c.c), hi = c.a.cwiseMax(c.b).cwiseMax(c.c);
+        const Eigen::Vector3d lo = c.a.cwiseMin(c.b).cwiseMin(c.c),
+                              hi = c.a.cwiseMax(c.b).cwiseMax(c.c);
         if (box_distance2(p, lo, hi) <= reach2) out.push_back(triangle_index_[slot]);
       }
     } else {

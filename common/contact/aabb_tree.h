@@ -28,13 +28,13 @@
 namespace cohaptic {
 
 struct AabbHit {
-  int triangle = -1;                                               ///< -1: none within reach
-  TriangleClosestPoint closest{};                                  ///< point and area coordinates
-  double distance2 = std::numeric_limits<double>::infinity();     ///< squared distance to p
+  int triangle = -1;                                           ///< -1: none within reach
+  TriangleClosestPoint closest{};                              ///< point and area coordinates
+  double distance2 = std::numeric_limits<double>::infinity();  ///< squared distance to p
 };
 
 struct AabbCrossing {
-  int triangle = -1;                 ///< -1: the segment crosses nothing
+  int triangle = -1;                   ///< -1: the segment crosses nothing
   SegmentTriangleCrossing crossing{};  ///< where along the segment, and where on the triangle
 };
 
@@ -58,7 +58,8 @@ class AabbTree {
   /// The triangle the segment from -> to crosses first (smallest segment parameter; ties
   /// to the lowest index, as a linear scan would), as segment_triangle_crossing decides
   /// for each triangle; triangle -1 if it crosses none.
-  AabbCrossing first_crossing(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const noexcept;
+  AabbCrossing first_crossing(const Eigen::Vector3d& from,
+                              const Eigen::Vector3d& to) const noexcept;
 
   /// Appends to `out` the input index of every triangle whose bounding box is within
   /// `max_distance` of `p` (inclusive): a superset of the triangles within that distance, in
@@ -80,7 +81,8 @@ class AabbTree {
     Eigen::Vector3d a, b, c;
   };
 
-  int build(std::vector<int>& order, const std::vector<Eigen::Vector3d>& centroids, int begin, int end, int level);
+  int build(std::vector<int>& order, const std::vector<Eigen::Vector3d>& centroids, int begin,
+            int end, int level);
 
   std::vector<Node> nodes_;
   std::vector<Corners> corners_;     ///< per slot, in leaf order

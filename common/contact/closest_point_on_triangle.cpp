@@ -10,7 +10,7 @@ namespace {
 
 // Zero-area triangle: its closest point lies on one of its edges; take the best of the three.
 TriangleClosestPoint closest_point_on_edges(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+                                            const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
   TriangleClosestPoint best{a, {1, 0, 0}};
   double best_distance = (p - a).squaredNorm();
   const Eigen::Vector3d corners[3] = {a, b, c};
@@ -38,7 +38,8 @@ TriangleClosestPoint closest_point_on_triangle(const Eigen::Vector3d& p, const E
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
   // Degenerate (sine of the angle at a below 1e-12): the face formula below would divide
   // rounding noise by rounding noise, so use the edges instead.
-  if (ab.cross(ac).squaredNorm() <= 1e-24 * ab.squaredNorm() * ac.squaredNorm()) return closest_point_on_edges(p, a, b, c);
+  if (ab.cross(ac).squaredNorm() <= 1e-24 * ab.squaredNorm() * ac.squaredNorm())
+    return closest_point_on_edges(p, a, b, c);
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return {a, {1, 0, 0}};
 

@@ -4,12 +4,13 @@
 
 namespace cohaptic {
 
-std::vector<int> contact_patch(const BoundarySurface& surface, int triangle, int rings, const std::vector<bool>& allowed) {
+std::vector<int> contact_patch(const BoundarySurface& surface, int triangle, int rings,
+                               const std::vector<bool>& allowed) {
   return contact_patch(surface, std::span<const int>(&triangle, 1), rings, allowed);
 }
 
-std::vector<int> contact_patch(const BoundarySurface& surface, std::span<const int> seeds, int rings,
-                               const std::vector<bool>& allowed) {
+std::vector<int> contact_patch(const BoundarySurface& surface, std::span<const int> seeds,
+                               int rings, const std::vector<bool>& allowed) {
   std::vector<int> patch;
   std::vector<bool> in_patch(surface.triangles.size(), false);
   for (int t : seeds)

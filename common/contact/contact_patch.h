@@ -13,10 +13,11 @@
 namespace cohaptic {
 
 /// `allowed[t]` says whether surface triangle t may join (touchable, and free of held nodes).
-std::vector<int> contact_patch(const BoundarySurface& surface, int triangle, int rings, const std::vector<bool>& allowed);
+std::vector<int> contact_patch(const BoundarySurface& surface, int triangle, int rings,
+                               const std::vector<bool>& allowed);
 
 /// The same grown from several triangles at once; `seeds` come first, in their order.
-std::vector<int> contact_patch(const BoundarySurface& surface, std::span<const int> seeds, int rings,
-                               const std::vector<bool>& allowed);
+std::vector<int> contact_patch(const BoundarySurface& surface, std::span<const int> seeds,
+                               int rings, const std::vector<bool>& allowed);
 
 }  // namespace cohaptic

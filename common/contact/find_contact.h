@@ -34,13 +34,16 @@ struct ContactQuery {
 
 /// The triangle of `triangles` nearest p (ties as above). Its signed_distance is the
 /// height of p above that triangle's plane, not a surface distance.
-SurfacePoint nearest_triangle(const TetMesh& mesh, const BoundarySurface& surface, const SurfacePseudoNormals& normals,
-                              std::span<const int> triangles, const Eigen::Vector3d& p);
+SurfacePoint nearest_triangle(const TetMesh& mesh, const BoundarySurface& surface,
+                              const SurfacePseudoNormals& normals, std::span<const int> triangles,
+                              const Eigen::Vector3d& p);
 
 /// `surface_candidates` limits the search for the surface distance (every triangle if empty;
 /// see NearestTriangleCandidates), as `touchable_triangles` does for the contact triangle.
-ContactQuery find_contact(const TetMesh& mesh, const BoundarySurface& surface, const SurfacePseudoNormals& normals,
-                          std::span<const int> touchable_triangles, const Eigen::Vector3d& tool_position,
-                          double tool_radius, std::span<const int> surface_candidates = {});
+ContactQuery find_contact(const TetMesh& mesh, const BoundarySurface& surface,
+                          const SurfacePseudoNormals& normals,
+                          std::span<const int> touchable_triangles,
+                          const Eigen::Vector3d& tool_position, double tool_radius,
+                          std::span<const int> surface_candidates = {});
 
 }  // namespace cohaptic

@@ -32,7 +32,8 @@ double IncrementalContactSolve::push(int candidate) const {
 }
 
 void IncrementalContactSolve::clear() noexcept {
-  for (int p = 0; p < size_; ++p) position_[static_cast<std::size_t>(members_[static_cast<std::size_t>(p)])] = -1;
+  for (int p = 0; p < size_; ++p)
+    position_[static_cast<std::size_t>(members_[static_cast<std::size_t>(p)])] = -1;
   size_ = 0;
   w_push_count_ = 0;
 }
@@ -42,7 +43,8 @@ void IncrementalContactSolve::remove(int candidate) noexcept {
   if (const int p = position_[static_cast<std::size_t>(candidate)]; p >= 0) leave(p);
 }
 
-bool IncrementalContactSolve::start_from(const Eigen::Ref<const Eigen::MatrixXd>& w, std::span<const int> set) {
+bool IncrementalContactSolve::start_from(const Eigen::Ref<const Eigen::MatrixXd>& w,
+                                         std::span<const int> set) {
   clear();
   const auto k = static_cast<Eigen::Index>(set.size());
   for (int j : set)
@@ -50,7 +52,8 @@ bool IncrementalContactSolve::start_from(const Eigen::Ref<const Eigen::MatrixXd>
   if (k == 0) return true;
   Eigen::MatrixXd w_kk(k, k);
   for (Eigen::Index a = 0; a < k; ++a)
-    for (Eigen::Index b = 0; b < k; ++b) w_kk(a, b) = w(set[static_cast<std::size_t>(a)], set[static_cast<std::size_t>(b)]);
+    for (Eigen::Index b = 0; b < k; ++b)
+      w_kk(a, b) = w(set[static_cast<std::size_t>(a)], set[static_cast<std::size_t>(b)]);
   const Eigen::LLT<Eigen::MatrixXd> llt(w_kk);
   if (llt.info() != Eigen::Success) return false;
   factor_.topLeftCorner(k, k) = llt.matrixL();
@@ -95,12 +98,14 @@ void IncrementalContactSolve::leave(int p) noexcept {
     cholesky_rank_update(factor_.block(p + 1, p + 1, below, below), scratch_.head(below),
                          factor_.block(p, p, below, below));
     for (Eigen::Index c = 0; c < p; ++c)
-      std::copy(factor_.col(c).data() + p + 1, factor_.col(c).data() + k, factor_.col(c).data() + p);
+      std::copy(factor_.col(c).data() + p + 1, factor_.col(c).data() + k,
+                factor_.col(c).data() + p);
   }
   position_[static_cast<std::size_t>(members_[static_cast<std::size_t>(p)])] = -1;
   for (Eigen::Index q = p; q + 1 < k; ++q) {
     members_[static_cast<std::size_t>(q)] = members_[static_cast<std::size_t>(q + 1)];
-    position_[static_cast<std::size_t>(members_[static_cast<std::size_t>(q)])] = static_cast<int>(q);
+    position_[static_cast<std::size_t>(members_[static_cast<std::size_t>(q)])] =
+        static_cast<int>(q);
     push_[q] = push_[q + 1];
   }
   --size_;
@@ -149,10 +154,12 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
     const bool down_columns = m > 4 * k;
     w_push_count_ = 0;
     if (down_columns) {
-      result.work += static_cast<double>(k) * static_cast<double>(m);  // the budget sees the whole pass
+      result.work +=
+          static_cast<double>(k) * static_cast<double>(m);  // the budget sees the whole pass
       w_push_.head(m).setZero();
       for (Eigen::Index p = 0; p < k; ++p)
-        w_push_.head(m).noalias() += push_[p] * w.col(members_[static_cast<std::size_t>(p)]).head(m);
+        w_push_.head(m).noalias() +=
+            push_[p] * w.col(members_[static_cast<std::size_t>(p)]).head(m);
       w_push_count_ = m;
     }
 
@@ -169,7 +176,9 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
       if (!any_negative && q[j] >= 0 && nonnegative_row[static_cast<std::size_t>(j)]) continue;
       // W_jK lambda_K, read down column j (W is symmetric), unless read down K's columns.
       if (!down_columns) result.work += static_cast<double>(k);
-      const double reach = down_columns ? w_push_[j] : gathered_dot(w.col(j).data(), members_.data(), push_.data(), k);
+      const double reach = down_columns
+                               ? w_push_[j]
+                               : gathered_dot(w.col(j).data(), members_.data(), push_.data(), k);
       if (q[j] + reach < -clearance_tolerance) offending_.push_back(j);
     }
     if (offending_.empty()) {
@@ -177,7 +186,8 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
       result.solved = true;
       return result;
     }
-    if (!rule_.block_move(static_cast<int>(offending_.size()))) {  // Murty: only the candidate of largest index
+    if (!rule_.block_move(
+            static_cast<int>(offending_.size()))) {  // Murty: only the candidate of largest index
       const auto largest = std::max_element(offending_.begin(), offending_.end());
       const bool leaves = largest - offending_.begin() < leaving;
       offending_.assign(1, *largest);
@@ -191,13 +201,15 @@ UnilateralSolveResult IncrementalContactSolve::solve(const Eigen::Ref<const Eige
     });
     // Past the budget the moves stop too (after one at least): the next call goes on.
     bool moved = false;
-    for (auto it = offending_.begin(); it != joining && !(moved && result.work > max_work); ++it, moved = true) {
+    for (auto it = offending_.begin(); it != joining && !(moved && result.work > max_work);
+         ++it, moved = true) {
       const int p = position_[static_cast<std::size_t>(*it)];
       result.work += 2.0 * static_cast<double>(size_ - p) * static_cast<double>(size_ - p);
       leave(p);
     }
     std::sort(joining, offending_.end());
-    for (auto it = joining; it != offending_.end() && !(moved && result.work > max_work); ++it, moved = true) {
+    for (auto it = joining; it != offending_.end() && !(moved && result.work > max_work);
+         ++it, moved = true) {
       result.work += 0.5 * static_cast<double>(size_) * static_cast<double>(size_) + size_;
       if (!join(w, *it)) {  // W_KK lost positive definiteness: no answer, and no set to keep
         clear();

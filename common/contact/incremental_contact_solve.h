@@ -45,17 +45,23 @@ class IncrementalContactSolve {
 
   int capacity() const { return static_cast<int>(position_.size()); }
   /// K: candidate indices in the factor's order.
-  std::span<const int> members() const { return {members_.data(), static_cast<std::size_t>(size_)}; }
+  std::span<const int> members() const {
+    return {members_.data(), static_cast<std::size_t>(size_)};
+  }
   /// The last solve's push [N] of members()[p].
   double member_push(int p) const { return push_[static_cast<Eigen::Index>(p)]; }
   /// All of them, in members() order.
-  std::span<const double> member_pushes() const { return {push_.data(), static_cast<std::size_t>(size_)}; }
+  std::span<const double> member_pushes() const {
+    return {push_.data(), static_cast<std::size_t>(size_)};
+  }
   /// The push of candidate i [N] (zero outside K).
   double push(int candidate) const;
   /// W_iK lambda_K for every candidate i of the last solve's q, as its last pass found them
   /// with the set it returned, when that pass read them down the members' columns (many
   /// more candidates than members); empty otherwise.
-  std::span<const double> w_push() const { return {w_push_.data(), static_cast<std::size_t>(w_push_count_)}; }
+  std::span<const double> w_push() const {
+    return {w_push_.data(), static_cast<std::size_t>(w_push_count_)};
+  }
   bool in_set(int candidate) const { return position_[static_cast<std::size_t>(candidate)] >= 0; }
   /// L, lower triangular, W_KK = L L^T (members() order).
   Eigen::Ref<const Eigen::MatrixXd> factor() const { return factor_.topLeftCorner(size_, size_); }
@@ -75,8 +81,10 @@ class IncrementalContactSolve {
   /// `nonnegative_row[j]` (q.size() entries) is non-zero when row j of W has no negative
   /// entry. Stops past `max_work` multiply-adds. solved is false if the budget ran out or
   /// W_KK lost positive definiteness (then K is emptied).
-  UnilateralSolveResult solve(const Eigen::Ref<const Eigen::MatrixXd>& w, const Eigen::Ref<const Eigen::VectorXd>& q,
-                              std::span<const std::uint8_t> nonnegative_row, double max_work) noexcept;
+  UnilateralSolveResult solve(const Eigen::Ref<const Eigen::MatrixXd>& w,
+                              const Eigen::Ref<const Eigen::VectorXd>& q,
+                              std::span<const std::uint8_t> nonnegative_row,
+                              double max_work) noexcept;
 
  private:
   /// Appends candidate j to K (borders the factor); false if the pivot is not positive.
@@ -84,17 +92,16 @@ class IncrementalContactSolve {
   /// Removes the member at factor position p (rank-one update of the rows below).
   void leave(int p) noexcept;
 
-
   int size_ = 0;
-  PivotRule rule_;  // since the last solved call
-  Eigen::MatrixXd factor_;       // lower triangle of the top-left size_ x size_: L, W_KK = L L^T
-  Eigen::VectorXd push_;         // per factor position: the pushes of the last solve
-  Eigen::VectorXd w_push_;       // per candidate: W_iK lambda_K of the last pass read down the columns
-  int w_push_count_ = 0;         // its valid length: 0 once K has changed since
-  Eigen::VectorXd scratch_;      // a column for borders and updates
-  std::vector<int> members_;     // per factor position: the candidate
-  std::vector<int> position_;    // per candidate: its factor position, or -1
-  std::vector<int> offending_;   // candidates that break a condition in this pass
+  PivotRule rule_;            // since the last solved call
+  Eigen::MatrixXd factor_;    // lower triangle of the top-left size_ x size_: L, W_KK = L L^T
+  Eigen::VectorXd push_;      // per factor position: the pushes of the last solve
+  Eigen::VectorXd w_push_;    // per candidate: W_iK lambda_K of the last pass read down the columns
+  int w_push_count_ = 0;      // its valid length: 0 once K has changed since
+  Eigen::VectorXd scratch_;   // a column for borders and updates
+  std::vector<int> members_;  // per factor position: the candidate
+  std::vector<int> position_;   // per candidate: its factor position, or -1
+  std::vector<int> offending_;  // candidates that break a condition in this pass
 };
 
 }  // namespace cohaptic

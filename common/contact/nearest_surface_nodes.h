@@ -15,8 +15,8 @@ namespace cohaptic {
 /// The `count` surface nodes nearest any of `points` [m], nearest first, skipping fully
 /// fixed nodes and nodes marked in `excluded` (per volume node; may be empty). Throws
 /// Error if the surface has fewer such nodes.
-std::vector<int> nearest_surface_nodes(const TetMesh& mesh, const BoundarySurface& surface, const DofMap& dofs,
-                                       std::span<const Eigen::Vector3d> points, int count,
-                                       const std::vector<bool>& excluded);
+std::vector<int> nearest_surface_nodes(const TetMesh& mesh, const BoundarySurface& surface,
+                                       const DofMap& dofs, std::span<const Eigen::Vector3d> points,
+                                       int count, const std::vector<bool>& excluded);
 
 }  // namespace cohaptic

@@ -5,10 +5,12 @@
 
 namespace cohaptic {
 
-NearestTriangleCandidates::NearestTriangleCandidates(const TetMesh& mesh, const BoundarySurface& surface,
+NearestTriangleCandidates::NearestTriangleCandidates(const TetMesh& mesh,
+                                                     const BoundarySurface& surface,
                                                      std::span<const int> touchable_triangles)
     : all_(mesh.nodes, surface.triangles),
-      every_triangle_touchable_(static_cast<int>(touchable_triangles.size()) == surface.triangle_count()) {
+      every_triangle_touchable_(static_cast<int>(touchable_triangles.size()) ==
+                                surface.triangle_count()) {
   if (every_triangle_touchable_) return;
   touchable_index_.assign(touchable_triangles.begin(), touchable_triangles.end());
   std::vector<Triangle> touchable;
@@ -17,8 +19,8 @@ NearestTriangleCandidates::NearestTriangleCandidates(const TetMesh& mesh, const 
   touchable_ = AabbTree(mesh.nodes, touchable);
 }
 
-void NearestTriangleCandidates::near(const AabbTree& tree, std::span<const int> index, const Eigen::Vector3d& p,
-                                     std::vector<int>& out) {
+void NearestTriangleCandidates::near(const AabbTree& tree, std::span<const int> index,
+                                     const Eigen::Vector3d& p, std::vector<int>& out) {
   out.clear();
   const AabbHit nearest = tree.closest_triangle(p);
   if (nearest.triangle < 0) return;
@@ -31,8 +33,10 @@ void NearestTriangleCandidates::near(const AabbTree& tree, std::span<const int> 
 void NearestTriangleCandidates::find(const Eigen::Vector3d& p, std::vector<int>& surface,
                                      std::vector<int>& touchable) const {
   near(all_, {}, p, surface);
-  if (every_triangle_touchable_) touchable = surface;
-  else near(touchable_, touchable_index_, p, touchable);
+  if (every_triangle_touchable_)
+    touchable = surface;
+  else
+    near(touchable_, touchable_index_, p, touchable);
 }
 
 }  // namespace cohaptic

@@ -28,17 +28,20 @@ class NearestTriangleCandidates {
 
   NearestTriangleCandidates() = default;
   /// `touchable_triangles`: surface triangle indices, ascending.
-  NearestTriangleCandidates(const TetMesh& mesh, const BoundarySurface& surface, std::span<const int> touchable_triangles);
+  NearestTriangleCandidates(const TetMesh& mesh, const BoundarySurface& surface,
+                            std::span<const int> touchable_triangles);
 
   /// Replaces `surface` by the candidates among every surface triangle and `touchable` by
   /// those among the touchable triangles (surface triangle indices, ascending).
   void find(const Eigen::Vector3d& p, std::vector<int>& surface, std::vector<int>& touchable) const;
 
  private:
-  static void near(const AabbTree& tree, std::span<const int> index, const Eigen::Vector3d& p, std::vector<int>& out);
+  static void near(const AabbTree& tree, std::span<const int> index, const Eigen::Vector3d& p,
+                   std::vector<int>& out);
 
   AabbTree all_, touchable_;
-  std::vector<int> touchable_index_;  ///< touchable tree's triangle k is surface triangle touchable_index_[k]
+  std::vector<int>
+      touchable_index_;  ///< touchable tree's triangle k is surface triangle touchable_index_[k]
   bool every_triangle_touchable_ = false;
 };
 

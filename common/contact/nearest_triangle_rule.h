@@ -36,9 +36,11 @@ class NearestTriangleRule {
     const double tie = kNearestTieAbsolute2 + kNearestTieRelative2 * distance2_;
     const bool same_distance = std::abs(d2 - distance2_) <= tie;
     const bool deeper = height < height_ - kNearestHeightRelative * std::abs(height_);
-    const bool same_height = !deeper && height <= height_ + kNearestHeightRelative * std::abs(height_);
-    const bool taken = surface_index_ < 0 || strictly_nearer(d2, distance2_) ||
-                       (same_distance && (deeper || (same_height && surface_index < surface_index_)));
+    const bool same_height =
+        !deeper && height <= height_ + kNearestHeightRelative * std::abs(height_);
+    const bool taken =
+        surface_index_ < 0 || strictly_nearer(d2, distance2_) ||
+        (same_distance && (deeper || (same_height && surface_index < surface_index_)));
     if (taken) {
       distance2_ = std::min(d2, distance2_);
       height_ = height;

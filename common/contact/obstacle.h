@@ -14,7 +14,7 @@ namespace cohaptic {
 
 struct Obstacle {
   std::string name;
-  TriangleSurface surface;  ///< [m]; empty for a plane
+  TriangleSurface surface;                                           ///< [m]; empty for a plane
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> plane;  ///< point [m], unit normal
 };
 

@@ -28,7 +28,8 @@ class ObstacleClearance {
 
   ObstacleClearance() = default;
   /// One point per column of `rest_points`, anchored there with its clearance to `obstacles`.
-  ObstacleClearance(std::span<const ObstacleDistance> obstacles, const Eigen::Matrix3Xd& rest_points);
+  ObstacleClearance(std::span<const ObstacleDistance> obstacles,
+                    const Eigen::Matrix3Xd& rest_points);
 
   /// A lower bound of point i's distance to the nearest obstacle at `position` [m].
   double lower_bound(std::size_t i, const Eigen::Vector3d& position) const {
@@ -46,7 +47,8 @@ class ObstacleClearance {
   }
   /// A query found point i at `position` at `clearance` from the nearest obstacle (<= 0 when
   /// it penetrates one), whose normal there is `normal`: it becomes the point's anchor.
-  void record(std::size_t i, const Eigen::Vector3d& position, double clearance, const Eigen::Vector3d& normal) {
+  void record(std::size_t i, const Eigen::Vector3d& position, double clearance,
+              const Eigen::Vector3d& normal) {
     const auto k = static_cast<Eigen::Index>(i);
     anchors_.col(k) = position;
     normals_.col(k) = normal;

@@ -19,17 +19,22 @@ namespace cohaptic {
 /// One per volume node: the constraint of the nearest of `obstacles` on each surface node
 /// (tool -1, obstacle its index); obstacle -1 for every other node, for all without
 /// obstacles, and for a node the obstacle's normal cannot hold (holdable, sphere_contact.h).
-std::vector<SphereConstraint> obstacle_constraints(const TetMesh& mesh, const BoundarySurface& surface,
-                                                   const DofMap& dofs, std::span<const ObstacleDistance> obstacles);
+std::vector<SphereConstraint> obstacle_constraints(const TetMesh& mesh,
+                                                   const BoundarySurface& surface,
+                                                   const DofMap& dofs,
+                                                   std::span<const ObstacleDistance> obstacles);
 
 /// The same from the obstacles as compiled, their allowed side decided by the surface's
 /// rest nodes (ObstacleDistance). Throws Error as ObstacleDistance does.
-std::vector<SphereConstraint> obstacle_constraints(const TetMesh& mesh, const BoundarySurface& surface,
-                                                   const DofMap& dofs, std::span<const Obstacle> obstacles);
+std::vector<SphereConstraint> obstacle_constraints(const TetMesh& mesh,
+                                                   const BoundarySurface& surface,
+                                                   const DofMap& dofs,
+                                                   std::span<const Obstacle> obstacles);
 
 /// The obstacle constraint on `node` of `constraints` (one per volume node, or empty), or
 /// null if none holds it.
-inline const SphereConstraint* obstacle_at(std::span<const SphereConstraint> constraints, int node) {
+inline const SphereConstraint* obstacle_at(std::span<const SphereConstraint> constraints,
+                                           int node) {
   if (constraints.empty()) return nullptr;
   const SphereConstraint& constraint = constraints[static_cast<std::size_t>(node)];
   return constraint.obstacle >= 0 ? &constraint : nullptr;

@@ -15,7 +15,8 @@ namespace {
 
 /// Six times the volume enclosed by a closed surface: > 0 when its triangles face outwards.
 double six_volume(const TriangleSurface& surface) {
-  const Eigen::Vector3d origin = surface.vertices.rowwise().mean();  // keeps the sum well conditioned
+  const Eigen::Vector3d origin =
+      surface.vertices.rowwise().mean();  // keeps the sum well conditioned
   double sum = 0;
   for (const Triangle& tri : surface.triangles) {
     const Eigen::Vector3d a = surface.vertices.col(tri[0]) - origin;
@@ -28,12 +29,15 @@ double six_volume(const TriangleSurface& surface) {
 
 }  // namespace
 
-ObstacleDistance::ObstacleDistance(const Obstacle& obstacle, const Eigen::Matrix3Xd& reference_points)
+ObstacleDistance::ObstacleDistance(const Obstacle& obstacle,
+                                   const Eigen::Matrix3Xd& reference_points)
     : name_(obstacle.name) {
   if (obstacle.plane) {
     const auto& [point, normal] = *obstacle.plane;
     if (!point.allFinite() || !normal.allFinite() || normal.norm() == 0)
-      throw Error(fmt::format("obstacle '{}': the plane's point or normal is not finite, or its normal is zero", name_));
+      throw Error(fmt::format(
+          "obstacle '{}': the plane's point or normal is not finite, or its normal is zero",
+          name_));
     is_plane_ = true;
     plane_point_ = point;
     plane_normal_ = normal.normalized();
@@ -46,15 +50,18 @@ ObstacleDistance::ObstacleDistance(const Obstacle& obstacle, const Eigen::Matrix
   tree_ = AabbTree(surface_);  // checks the indices and that the vertices are finite
   neighbours_ = triangle_edge_neighbours(surface_.triangles);
   int open_sides = 0;
-  for (const auto& sides : neighbours_) open_sides += static_cast<int>(std::count(sides.begin(), sides.end(), -1));
+  for (const auto& sides : neighbours_)
+    open_sides += static_cast<int>(std::count(sides.begin(), sides.end(), -1));
   closed_ = open_sides == 0;
 
   face_normals_.reserve(surface_.triangles.size());
   vertex_normals_ = Eigen::Matrix3Xd::Zero(3, surface_.vertex_count());
   for (const Triangle& tri : surface_.triangles) {
     const Eigen::Vector3d x0 = surface_.vertices.col(tri[0]);
-    const Eigen::Vector3d cross = (surface_.vertices.col(tri[1]) - x0).cross(surface_.vertices.col(tri[2]) - x0);
-    const Eigen::Vector3d n = cross.norm() > 0 ? Eigen::Vector3d(cross.normalized()) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d cross =
+        (surface_.vertices.col(tri[1]) - x0).cross(surface_.vertices.col(tri[2]) - x0);
+    const Eigen::Vector3d n =
+        cross.norm() > 0 ? Eigen::Vector3d(cross.normalized()) : Eigen::Vector3d::Zero();
     face_normals_.push_back(n);
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d x = surface_.vertices.col(tri[k]);
@@ -72,8 +79,10 @@ ObstacleDistance::ObstacleDistance(const Obstacle& obstacle, const Eigen::Matrix
   on_surface_ = 1e-9 * extent.norm();
   if (!closed_)
     spdlog::warn(
-        "obstacle '{}' is not a closed, consistently oriented surface: {} of its {} triangle sides have no "
-        "consistently oriented neighbour; the signed distance uses face normals there, and its sign beyond the "
+        "obstacle '{}' is not a closed, consistently oriented surface: {} of its {} triangle sides "
+        "have no "
+        "consistently oriented neighbour; the signed distance uses face normals there, and its "
+        "sign beyond the "
         "surface's rim may be wrong",
         name_, open_sides, 3 * surface_.triangle_count());
 
@@ -81,7 +90,8 @@ ObstacleDistance::ObstacleDistance(const Obstacle& obstacle, const Eigen::Matrix
   const double front_is_outside = !closed_ || six_volume(surface_) >= 0 ? 1.0 : -1.0;
   const Eigen::Index count = reference_points.cols();
   if (count == 0)
-    throw Error(fmt::format("obstacle '{}': no reference points to decide which side of it the object is on", name_));
+    throw Error(fmt::format(
+        "obstacle '{}': no reference points to decide which side of it the object is on", name_));
   Eigen::Index inside = 0, outside = 0;
   for (Eigen::Index i = 0; i < count; ++i) {
     const Eigen::Vector3d p = reference_points.col(i);
@@ -98,11 +108,14 @@ ObstacleDistance::ObstacleDistance(const Obstacle& obstacle, const Eigen::Matrix
     allowed_inside_ = false;
     allowed_sign_ = front_is_outside;
   } else {
-    const auto percent = [&](Eigen::Index n) { return 100.0 * static_cast<double>(n) / static_cast<double>(count); };
+    const auto percent = [&](Eigen::Index n) {
+      return 100.0 * static_cast<double>(n) / static_cast<double>(count);
+    };
     const Eigen::Index on = count - inside - outside;
-    throw Error(fmt::format("the object is not on one side of obstacle '{}': {:.0f} % inside, {:.0f} % outside{}",
-                            name_, percent(inside), percent(outside),
-                            on > 0 ? fmt::format(", {:.0f} % on it", percent(on)) : std::string()));
+    throw Error(fmt::format(
+        "the object is not on one side of obstacle '{}': {:.0f} % inside, {:.0f} % outside{}",
+        name_, percent(inside), percent(outside),
+        on > 0 ? fmt::format(", {:.0f} % on it", percent(on)) : std::string()));
   }
 }
 
@@ -137,11 +150,13 @@ ObstaclePoint ObstacleDistance::closest_front_positive(const Eigen::Vector3d& p)
   const double distance = std::sqrt(hit.distance2);
   const bool behind = delta.dot(n) < 0;
   result.signed_distance = behind ? -distance : distance;
-  result.normal = distance > on_surface_ ? Eigen::Vector3d((behind ? -delta : delta) / distance) : n;
+  result.normal =
+      distance > on_surface_ ? Eigen::Vector3d((behind ? -delta : delta) / distance) : n;
   return result;
 }
 
-Eigen::Vector3d ObstacleDistance::feature_normal(int triangle, const Eigen::Vector3d& weights) const {
+Eigen::Vector3d ObstacleDistance::feature_normal(int triangle,
+                                                 const Eigen::Vector3d& weights) const {
   const Triangle& tri = surface_.triangles[triangle];
   int zeros = 0, nonzero_vertex = 0, zero_vertex = 0;
   for (int k = 0; k < 3; ++k) {
@@ -164,7 +179,8 @@ Eigen::Vector3d ObstacleDistance::feature_normal(int triangle, const Eigen::Vect
   }
   if (face_normals_[triangle].squaredNorm() > 0) return face_normals_[triangle];
   // A degenerate triangle on an open side: blend its vertices' pseudo-normals.
-  const Eigen::Vector3d blend = weights[0] * vertex_normals_.col(tri[0]) + weights[1] * vertex_normals_.col(tri[1]) +
+  const Eigen::Vector3d blend = weights[0] * vertex_normals_.col(tri[0]) +
+                                weights[1] * vertex_normals_.col(tri[1]) +
                                 weights[2] * vertex_normals_.col(tri[2]);
   return blend.squaredNorm() > 0 ? Eigen::Vector3d(blend.normalized()) : Eigen::Vector3d::Zero();
 }

@@ -70,7 +70,8 @@ class ObstacleDistance {
   std::vector<Eigen::Vector3d> face_normals_;   ///< unit, along (b-a)x(c-a); zero if degenerate
   Eigen::Matrix3Xd vertex_normals_;             ///< unit angle-weighted pseudo-normals
   double allowed_sign_ = 1;  ///< multiplies the front-positive distance into allowed-positive
-  double on_surface_ = 0;    ///< below this distance, p counts as on the surface (normal = pseudo-normal)
+  double on_surface_ =
+      0;  ///< below this distance, p counts as on the surface (normal = pseudo-normal)
 };
 
 }  // namespace cohaptic

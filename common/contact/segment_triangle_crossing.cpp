@@ -5,11 +5,9 @@
 
 namespace cohaptic {
 
-std::optional<SegmentTriangleCrossing> segment_triangle_crossing(const Eigen::Vector3d& from,
-                                                                 const Eigen::Vector3d& to,
-                                                                 const Eigen::Vector3d& a,
-                                                                 const Eigen::Vector3d& b,
-                                                                 const Eigen::Vector3d& c) noexcept {
+std::optional<SegmentTriangleCrossing> segment_triangle_crossing(
+    const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& a,
+    const Eigen::Vector3d& b, const Eigen::Vector3d& c) noexcept {
   // Moeller and Trumbore: solve from + t d = a + s (b - a) + r (c - a) by Cramer's rule.
   const Eigen::Vector3d d = to - from;
   const Eigen::Vector3d e1 = b - a, e2 = c - a;

@@ -10,11 +10,13 @@
 namespace cohaptic {
 namespace {
 
-constexpr double kSmallestFreeNormal = 1e-6;  // below it the node's support holds it along the normal
+constexpr double kSmallestFreeNormal =
+    1e-6;  // below it the node's support holds it along the normal
 
 }  // namespace
 
-double sphere_gap(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal, const SphereTool& tool) noexcept {
+double sphere_gap(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
+                  const SphereTool& tool) noexcept {
   constexpr double kNone = std::numeric_limits<double>::infinity();
   if (!tool.centre.allFinite() || !(tool.radius > 0)) return kNone;
   // The line x + s n meets the sphere where s^2 + 2 b s + c = 0.
@@ -35,36 +37,43 @@ bool holdable(const Eigen::Vector3d& normal, AxisMask fixed) noexcept {
   return free_part.norm() >= kSmallestFreeNormal;
 }
 
-std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
-                                                  AxisMask fixed, std::span<const SphereTool> tools) noexcept {
+std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest,
+                                                  const Eigen::Vector3d& normal, AxisMask fixed,
+                                                  std::span<const SphereTool> tools) noexcept {
   if (!holdable(normal, fixed)) return std::nullopt;
   std::optional<SphereConstraint> nearest;
   for (int t = 0; t < static_cast<int>(tools.size()); ++t) {
     const double gap = sphere_gap(rest, normal, tools[static_cast<std::size_t>(t)]);
-    if (gap == std::numeric_limits<double>::infinity() || (nearest && !(gap < nearest->gap))) continue;
+    if (gap == std::numeric_limits<double>::infinity() || (nearest && !(gap < nearest->gap)))
+      continue;
     nearest = SphereConstraint{t, gap, normal};
   }
   return nearest;
 }
 
-std::optional<SphereConstraint> node_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
-                                                AxisMask fixed, std::span<const SphereTool> tools,
+std::optional<SphereConstraint> node_constraint(const Eigen::Vector3d& rest,
+                                                const Eigen::Vector3d& normal, AxisMask fixed,
+                                                std::span<const SphereTool> tools,
                                                 const SphereConstraint* obstacle) noexcept {
   std::optional<SphereConstraint> constraint = sphere_constraint(rest, normal, fixed, tools);
   if (obstacle && (!constraint || obstacle->gap < constraint->gap)) constraint = *obstacle;
   return constraint;
 }
 
-Eigen::Matrix3Xd contact_normals(const TetMesh& mesh, const BoundarySurface& surface, std::span<const int> triangles) {
+Eigen::Matrix3Xd contact_normals(const TetMesh& mesh, const BoundarySurface& surface,
+                                 std::span<const int> triangles) {
   Eigen::Matrix3Xd normals = Eigen::Matrix3Xd::Zero(3, mesh.node_count());
   for (int t : triangles) {
     const Triangle& tri = surface.triangles[static_cast<std::size_t>(t)];
-    const Eigen::Vector3d a = mesh.nodes.col(tri[0]), b = mesh.nodes.col(tri[1]), c = mesh.nodes.col(tri[2]);
+    const Eigen::Vector3d a = mesh.nodes.col(tri[0]), b = mesh.nodes.col(tri[1]),
+                          c = mesh.nodes.col(tri[2]);
     const Eigen::Vector3d face = (b - a).cross(c - a).normalized();
     const std::array<Eigen::Vector3d, 3> corner = {a, b, c};
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d e1 = corner[static_cast<std::size_t>((k + 1) % 3)] - corner[static_cast<std::size_t>(k)];
-      const Eigen::Vector3d e2 = corner[static_cast<std::size_t>((k + 2) % 3)] - corner[static_cast<std::size_t>(k)];
+      const Eigen::Vector3d e1 =
+          corner[static_cast<std::size_t>((k + 1) % 3)] - corner[static_cast<std::size_t>(k)];
+      const Eigen::Vector3d e2 =
+          corner[static_cast<std::size_t>((k + 2) % 3)] - corner[static_cast<std::size_t>(k)];
       const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
       normals.col(tri[k]) -= angle * face;  // inward
     }
@@ -83,22 +92,26 @@ std::vector<int> triangle_nodes(const BoundarySurface& surface, std::span<const 
   return nodes;
 }
 
-SphereCandidates sphere_candidates(const TetMesh& mesh, const DofMap& dofs, const Eigen::Matrix3Xd& normals,
-                                   std::span<const int> nodes, std::span<const SphereTool> tools) {
+SphereCandidates sphere_candidates(const TetMesh& mesh, const DofMap& dofs,
+                                   const Eigen::Matrix3Xd& normals, std::span<const int> nodes,
+                                   std::span<const SphereTool> tools) {
   SphereCandidates candidates;
   for (int node : nodes)
-    if (const auto constraint = sphere_constraint(mesh.nodes.col(node), normals.col(node), dofs.fixed_axes[node], tools)) {
+    if (const auto constraint = sphere_constraint(mesh.nodes.col(node), normals.col(node),
+                                                  dofs.fixed_axes[node], tools)) {
       candidates.nodes.push_back(node);
       candidates.constraints.push_back(*constraint);
     }
   return candidates;
 }
 
-SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, const Eigen::Matrix3Xd& normals,
-                                       std::span<const int> nodes, std::span<const SphereTool> tools) {
+SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs,
+                                       const Eigen::Matrix3Xd& normals, std::span<const int> nodes,
+                                       std::span<const SphereTool> tools) {
   SphereCandidates held;
   for (int node : nodes)
-    if (const auto constraint = sphere_constraint(mesh.nodes.col(node), normals.col(node), dofs.fixed_axes[node], tools);
+    if (const auto constraint = sphere_constraint(mesh.nodes.col(node), normals.col(node),
+                                                  dofs.fixed_axes[node], tools);
         constraint && constraint->gap < 0) {
       held.nodes.push_back(node);
       held.constraints.push_back(*constraint);
@@ -106,8 +119,9 @@ SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, 
   return held;
 }
 
-std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface, const AabbTree& surface_tree,
-                              int nearest, const SphereTool& tool, int rings, const std::vector<bool>& allowed,
+std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface,
+                              const AabbTree& surface_tree, int nearest, const SphereTool& tool,
+                              int rings, const std::vector<bool>& allowed,
                               std::span<const int> carried) {
   // Seeds beside `nearest`, ascending: the allowed triangles with a node held at rest, as
   // nodes_held_by_spheres decides (every one has its box within the radius of the centre),

@@ -51,16 +51,17 @@ struct SphereTool {
 
 /// One candidate node's constraint.
 struct SphereConstraint {
-  int tool = -1;                                     ///< index of the sphere with the least gap, or -1
-  double gap = 0;                                    ///< [m]: negative inside, positive outside
+  int tool = -1;   ///< index of the sphere with the least gap, or -1
+  double gap = 0;  ///< [m]: negative inside, positive outside
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< the push's unit direction
-  int obstacle = -1;                                 ///< the obstacle holding it (then tool = -1), or -1
+  int obstacle = -1;  ///< the obstacle holding it (then tool = -1), or -1
 };
 
 /// The gap [m] of a node at `rest` with inward unit `normal` to `tool`: +inf when the line
 /// along the normal misses the sphere or meets it only ahead of the node, or the tool is
 /// absent (non-finite centre, no radius).
-double sphere_gap(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal, const SphereTool& tool) noexcept;
+double sphere_gap(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
+                  const SphereTool& tool) noexcept;
 
 /// Whether the model can hold a node with inward `normal` and `fixed` axes (see above).
 bool holdable(const Eigen::Vector3d& normal, AxisMask fixed) noexcept;
@@ -68,19 +69,22 @@ bool holdable(const Eigen::Vector3d& normal, AxisMask fixed) noexcept;
 /// The constraint on a node at `rest` with inward `normal` and `fixed` axes, from the
 /// sphere of `tools` with the least gap (ties to the lower index); none if no sphere
 /// constrains it or the model cannot hold it.
-std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
-                                                  AxisMask fixed, std::span<const SphereTool> tools) noexcept;
+std::optional<SphereConstraint> sphere_constraint(const Eigen::Vector3d& rest,
+                                                  const Eigen::Vector3d& normal, AxisMask fixed,
+                                                  std::span<const SphereTool> tools) noexcept;
 
 /// The constraint on a node from `tools` (sphere_constraint) or from its `obstacle`
 /// constraint (null: none), whichever has the least gap, ties to a sphere.
-std::optional<SphereConstraint> node_constraint(const Eigen::Vector3d& rest, const Eigen::Vector3d& normal,
-                                                AxisMask fixed, std::span<const SphereTool> tools,
+std::optional<SphereConstraint> node_constraint(const Eigen::Vector3d& rest,
+                                                const Eigen::Vector3d& normal, AxisMask fixed,
+                                                std::span<const SphereTool> tools,
                                                 const SphereConstraint* obstacle) noexcept;
 
 /// The inward unit normal of every node of `triangles` (a body's touchable triangles): the
 /// angle-weighted mean of their outward normals, reversed; zero for every other node (one
 /// column per volume node).
-Eigen::Matrix3Xd contact_normals(const TetMesh& mesh, const BoundarySurface& surface, std::span<const int> triangles);
+Eigen::Matrix3Xd contact_normals(const TetMesh& mesh, const BoundarySurface& surface,
+                                 std::span<const int> triangles);
 
 /// The distinct nodes of surface `triangles`, ascending (the candidates of the touchable
 /// triangles, say).
@@ -93,12 +97,14 @@ struct SphereCandidates {
 };
 
 /// Of `nodes`, every candidate of `tools`, in order; `normals` per volume node (contact_normals).
-SphereCandidates sphere_candidates(const TetMesh& mesh, const DofMap& dofs, const Eigen::Matrix3Xd& normals,
-                                   std::span<const int> nodes, std::span<const SphereTool> tools);
+SphereCandidates sphere_candidates(const TetMesh& mesh, const DofMap& dofs,
+                                   const Eigen::Matrix3Xd& normals, std::span<const int> nodes,
+                                   std::span<const SphereTool> tools);
 
 /// Of `nodes`, those that `tools` hold at rest (the candidates inside a sphere), in order.
-SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, const Eigen::Matrix3Xd& normals,
-                                       std::span<const int> nodes, std::span<const SphereTool> tools);
+SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs,
+                                       const Eigen::Matrix3Xd& normals, std::span<const int> nodes,
+                                       std::span<const SphereTool> tools);
 
 /// The patch of a sphere tool: `nearest` (the allowed triangle nearest the centre) first,
 /// then every allowed triangle with a node inside the sphere or among `carried`, then
@@ -109,8 +115,9 @@ SphereCandidates nodes_held_by_spheres(const TetMesh& mesh, const DofMap& dofs, 
 /// (the simulation finds them: a bulge can carry a node in beyond the rings).
 /// `surface_tree`: an AabbTree over the surface's triangles (indices as in `surface`),
 /// through which only the triangles near the sphere are looked at.
-std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface, const AabbTree& surface_tree,
-                              int nearest, const SphereTool& tool, int rings, const std::vector<bool>& allowed,
+std::vector<int> sphere_patch(const TetMesh& mesh, const BoundarySurface& surface,
+                              const AabbTree& surface_tree, int nearest, const SphereTool& tool,
+                              int rings, const std::vector<bool>& allowed,
                               std::span<const int> carried = {});
 
 }  // namespace cohaptic

@@ -27,24 +27,31 @@ SurfacePseudoNormals compute_pseudo_normals(const TetMesh& mesh, const BoundaryS
 
 TriangleFeature feature_of(const Eigen::Vector3d& weights) {
   const int zeros = (weights[0] == 0) + (weights[1] == 0) + (weights[2] == 0);
-  if (zeros == 1) return {TriangleFeature::Kind::edge, ((weights[0] == 0 ? 0 : weights[1] == 0 ? 1 : 2) + 1) % 3};
-  if (zeros == 2) return {TriangleFeature::Kind::vertex, weights[0] != 0 ? 0 : weights[1] != 0 ? 1 : 2};
+  if (zeros == 1)
+    return {TriangleFeature::Kind::edge, ((weights[0] == 0 ? 0 : weights[1] == 0 ? 1 : 2) + 1) % 3};
+  if (zeros == 2)
+    return {TriangleFeature::Kind::vertex, weights[0] != 0 ? 0 : weights[1] != 0 ? 1 : 2};
   return {};
 }
 
-Eigen::Vector3d edge_pseudo_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals, int triangle, int k) {
+Eigen::Vector3d edge_pseudo_normal(const BoundarySurface& surface,
+                                   const SurfacePseudoNormals& normals, int triangle, int k) {
   const int neighbour = surface.triangle_neighbours[triangle][k];
-  return neighbour >= 0 ? Eigen::Vector3d((normals.face[triangle] + normals.face[neighbour]).normalized())
-                        : normals.face[triangle];
+  return neighbour >= 0
+             ? Eigen::Vector3d((normals.face[triangle] + normals.face[neighbour]).normalized())
+             : normals.face[triangle];
 }
 
-Eigen::Vector3d feature_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals, int triangle,
-                               const Eigen::Vector3d& weights) {
+Eigen::Vector3d feature_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals,
+                               int triangle, const Eigen::Vector3d& weights) {
   const TriangleFeature feature = feature_of(weights);
   switch (feature.kind) {
-    case TriangleFeature::Kind::vertex: return normals.vertex.col(surface.triangles[triangle][feature.index]);
-    case TriangleFeature::Kind::edge: return edge_pseudo_normal(surface, normals, triangle, feature.index);
-    case TriangleFeature::Kind::face: break;
+    case TriangleFeature::Kind::vertex:
+      return normals.vertex.col(surface.triangles[triangle][feature.index]);
+    case TriangleFeature::Kind::edge:
+      return edge_pseudo_normal(surface, normals, triangle, feature.index);
+    case TriangleFeature::Kind::face:
+      break;
   }
   return normals.face[triangle];
 }
@@ -56,8 +63,8 @@ SurfacePoint closest_surface_point(const TetMesh& mesh, const BoundarySurface& s
   double best_distance2 = std::numeric_limits<double>::infinity();
   const auto consider = [&](int t) {
     const Triangle& tri = surface.triangles[t];
-    const TriangleClosestPoint q =
-        closest_point_on_triangle(p, mesh.nodes.col(tri[0]), mesh.nodes.col(tri[1]), mesh.nodes.col(tri[2]));
+    const TriangleClosestPoint q = closest_point_on_triangle(
+        p, mesh.nodes.col(tri[0]), mesh.nodes.col(tri[1]), mesh.nodes.col(tri[2]));
     const double d2 = (p - q.point).squaredNorm();
     if (d2 < best_distance2) {
       best_distance2 = d2;

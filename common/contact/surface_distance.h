@@ -22,9 +22,9 @@ struct SurfacePseudoNormals {
 SurfacePseudoNormals compute_pseudo_normals(const TetMesh& mesh, const BoundarySurface& surface);
 
 struct SurfacePoint {
-  int triangle = -1;              ///< surface triangle index
-  TriangleClosestPoint closest;   ///< point on that triangle and its area coordinates
-  double signed_distance = 0;     ///< [m], negative inside
+  int triangle = -1;             ///< surface triangle index
+  TriangleClosestPoint closest;  ///< point on that triangle and its area coordinates
+  double signed_distance = 0;    ///< [m], negative inside
 };
 
 /// The feature of a triangle that a point with area coordinates `weights` lies on: its
@@ -38,11 +38,12 @@ TriangleFeature feature_of(const Eigen::Vector3d& weights);
 
 /// Normalised sum of the normals of `triangle` and the triangle across its edge (k, k+1)
 /// (the face normal alone where the edge has no single neighbour).
-Eigen::Vector3d edge_pseudo_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals, int triangle, int k);
+Eigen::Vector3d edge_pseudo_normal(const BoundarySurface& surface,
+                                   const SurfacePseudoNormals& normals, int triangle, int k);
 
 /// The pseudo-normal at the feature of `triangle` that `weights` lies on.
-Eigen::Vector3d feature_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals, int triangle,
-                               const Eigen::Vector3d& weights);
+Eigen::Vector3d feature_normal(const BoundarySurface& surface, const SurfacePseudoNormals& normals,
+                               int triangle, const Eigen::Vector3d& weights);
 
 /// Closest point among `candidates` (every surface triangle if empty). The sign is
 /// meaningful when the candidates cover the whole closed surface.

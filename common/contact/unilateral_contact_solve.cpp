@@ -29,7 +29,8 @@ bool factor_active_block(const Eigen::Ref<const Eigen::MatrixXd>& a, std::span<c
 
 // lambda_S = -A_SS^-1 q_S through the factor, in place in `lambda`; zero elsewhere.
 void solve_active_block(const Eigen::Ref<const Eigen::VectorXd>& q, std::span<const int> order,
-                        const Eigen::Ref<Eigen::MatrixXd>& factor, Eigen::Ref<Eigen::VectorXd> lambda) noexcept {
+                        const Eigen::Ref<Eigen::MatrixXd>& factor,
+                        Eigen::Ref<Eigen::VectorXd> lambda) noexcept {
   lambda.setZero();
   const auto k = static_cast<Eigen::Index>(order.size());
   for (Eigen::Index i = 0; i < k; ++i) {
@@ -66,9 +67,10 @@ void PivotRule::reset() noexcept {
 
 UnilateralSolveResult solve_unilateral_contact(const Eigen::Ref<const Eigen::MatrixXd>& a,
                                                const Eigen::Ref<const Eigen::VectorXd>& q,
-                                               std::span<std::uint8_t> active, Eigen::Ref<Eigen::VectorXd> lambda,
-                                               Eigen::Ref<Eigen::MatrixXd> factor, std::span<int> order,
-                                               double max_work) noexcept {
+                                               std::span<std::uint8_t> active,
+                                               Eigen::Ref<Eigen::VectorXd> lambda,
+                                               Eigen::Ref<Eigen::MatrixXd> factor,
+                                               std::span<int> order, double max_work) noexcept {
   UnilateralSolveResult result;
   const auto m = static_cast<int>(q.size());
   // Scales of the clearances [m] and of the pushes [N], for the round-off allowances.
@@ -87,7 +89,8 @@ UnilateralSolveResult solve_unilateral_contact(const Eigen::Ref<const Eigen::Mat
       if (active[i]) order[static_cast<std::size_t>(k++)] = i;
     const std::span<const int> set = order.first(static_cast<std::size_t>(k));
     ++result.trials;
-    result.work += static_cast<double>(k) * k * k / 3 + static_cast<double>(m - k) * k + static_cast<double>(k) * k;
+    result.work += static_cast<double>(k) * k * k / 3 + static_cast<double>(m - k) * k +
+                   static_cast<double>(k) * k;
     if (!factor_active_block(a, set, factor)) return result;
     solve_active_block(q, set, factor, lambda);
 

@@ -59,8 +59,9 @@ struct UnilateralSolveResult {
 /// active nodes).
 UnilateralSolveResult solve_unilateral_contact(const Eigen::Ref<const Eigen::MatrixXd>& a,
                                                const Eigen::Ref<const Eigen::VectorXd>& q,
-                                               std::span<std::uint8_t> active, Eigen::Ref<Eigen::VectorXd> lambda,
-                                               Eigen::Ref<Eigen::MatrixXd> factor, std::span<int> order,
-                                               double max_work) noexcept;
+                                               std::span<std::uint8_t> active,
+                                               Eigen::Ref<Eigen::VectorXd> lambda,
+                                               Eigen::Ref<Eigen::MatrixXd> factor,
+                                               std::span<int> order, double max_work) noexcept;
 
 }  // namespace cohaptic

@@ -43,18 +43,20 @@ struct WorkingSetScratch {
 struct WorkingSetSolveResult {
   UnilateralSolveResult inner;  ///< summed over the passes; solved is false on any failure
   int passes = 0;
-  int largest_set = 0;          ///< |K| at the end
-  bool set_too_large = false;   ///< K outgrew max_set (then solved is false)
+  int largest_set = 0;         ///< |K| at the end
+  bool set_too_large = false;  ///< K outgrew max_set (then solved is false)
 };
 
 /// `q` has m entries; `active` (m) is the warm start on entry (non-zero: in contact) and the
 /// final set on exit; `lambda` (m) the pushes [N], zero outside the set. `max_set` bounds
 /// |K| and `max_work` the multiply-adds of all passes.
 template <class Entry, class OnSet, class Matrix, class Vector>
-WorkingSetSolveResult solve_unilateral_over_candidates(const Eigen::Ref<const Eigen::VectorXd>& q, Entry&& entry,
-                                                       OnSet&& on_set, int max_set, std::span<std::uint8_t> active,
+WorkingSetSolveResult solve_unilateral_over_candidates(const Eigen::Ref<const Eigen::VectorXd>& q,
+                                                       Entry&& entry, OnSet&& on_set, int max_set,
+                                                       std::span<std::uint8_t> active,
                                                        Eigen::Ref<Eigen::VectorXd> lambda,
-                                                       WorkingSetScratch<Matrix, Vector>& scratch, double max_work) {
+                                                       WorkingSetScratch<Matrix, Vector>& scratch,
+                                                       double max_work) {
   WorkingSetSolveResult result;
   const auto m = static_cast<int>(q.size());
   // K starts as the warm start and every candidate that penetrates with no push, all of it
@@ -80,7 +82,8 @@ WorkingSetSolveResult solve_unilateral_over_candidates(const Eigen::Ref<const Ei
     }
     ++result.passes;
     for (int i = 0, k = 0; i < m; ++i)
-      if (scratch.in_set[static_cast<std::size_t>(i)]) scratch.members[static_cast<std::size_t>(k++)] = i;
+      if (scratch.in_set[static_cast<std::size_t>(i)])
+        scratch.members[static_cast<std::size_t>(k++)] = i;
     const std::span<const int> members = scratch.members.first(static_cast<std::size_t>(size));
     on_set(members);
     scratch.a.resize(size, size);
@@ -91,12 +94,13 @@ WorkingSetSolveResult solve_unilateral_over_candidates(const Eigen::Ref<const Ei
       const int i = members[static_cast<std::size_t>(r)];
       scratch.q[r] = q[i];
       scratch.member_active[static_cast<std::size_t>(r)] = active[static_cast<std::size_t>(i)];
-      for (int c = 0; c <= r; ++c) scratch.a(r, c) = scratch.a(c, r) = entry(i, members[static_cast<std::size_t>(c)]);
+      for (int c = 0; c <= r; ++c)
+        scratch.a(r, c) = scratch.a(c, r) = entry(i, members[static_cast<std::size_t>(c)]);
     }
     const double work_left = max_work - result.inner.work;
-    const UnilateralSolveResult pass =
-        solve_unilateral_contact(scratch.a, scratch.q, scratch.member_active.first(static_cast<std::size_t>(size)),
-                                 scratch.lambda, scratch.factor, scratch.order, work_left);
+    const UnilateralSolveResult pass = solve_unilateral_contact(
+        scratch.a, scratch.q, scratch.member_active.first(static_cast<std::size_t>(size)),
+        scratch.lambda, scratch.factor, scratch.order, work_left);
     result.inner.trials += pass.trials;
     result.inner.work += pass.work;
     if (!pass.solved) return result;
@@ -107,7 +111,8 @@ WorkingSetSolveResult solve_unilateral_over_candidates(const Eigen::Ref<const Ei
       if (scratch.in_set[static_cast<std::size_t>(j)]) continue;
       double clearance = q[j];
       for (int r = 0; r < size; ++r)
-        if (scratch.lambda[r] != 0) clearance += entry(j, members[static_cast<std::size_t>(r)]) * scratch.lambda[r];
+        if (scratch.lambda[r] != 0)
+          clearance += entry(j, members[static_cast<std::size_t>(r)]) * scratch.lambda[r];
       result.inner.work += 9.0 * size;
       if (clearance < 0) {
         scratch.in_set[static_cast<std::size_t>(j)] = 1;

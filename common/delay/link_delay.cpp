@@ -10,8 +10,8 @@
 namespace cohaptic {
 
 std::string LinkDelaySettings::describe() const {
-  return fmt::format("{:g} ms + U(0, {:g}) ms jitter, {:g} % loss, {:g} % reordered, seed {}", delay_ms, jitter_ms,
-                     100 * loss, 100 * reorder, seed);
+  return fmt::format("{:g} ms + U(0, {:g}) ms jitter, {:g} % loss, {:g} % reordered, seed {}",
+                     delay_ms, jitter_ms, 100 * loss, 100 * reorder, seed);
 }
 
 void validate(const LinkDelaySettings& s) {
@@ -19,7 +19,8 @@ void validate(const LinkDelaySettings& s) {
     throw Error(fmt::format("shift delay must be between 0 and 10000 ms, got {}", s.delay_ms));
   if (!std::isfinite(s.jitter_ms) || s.jitter_ms < 0 || s.jitter_ms > 10000)
     throw Error(fmt::format("jitter must be between 0 and 10000 ms, got {}", s.jitter_ms));
-  if (!(s.loss >= 0 && s.loss < 1)) throw Error(fmt::format("loss must be a probability in [0, 1), got {}", s.loss));
+  if (!(s.loss >= 0 && s.loss < 1))
+    throw Error(fmt::format("loss must be a probability in [0, 1), got {}", s.loss));
   if (!(s.reorder >= 0 && s.reorder < 1))
     throw Error(fmt::format("reordering must be a probability in [0, 1), got {}", s.reorder));
 }
@@ -48,7 +49,8 @@ std::optional<std::int64_t> LinkDelay::delay_ns(std::int64_t now_ns) {
     ++counters_.reordered;
   }
   auto delay = static_cast<std::int64_t>(delay_ms * 1e6);
-  if (ordered_) {  // strictly after the previous delivery: timers due at one instant may fire in any order
+  if (ordered_) {  // strictly after the previous delivery: timers due at one instant may fire in
+                   // any order
     if (delivered_before_) delay = std::max(delay, last_delivery_ns_ - now_ns + 1);
     last_delivery_ns_ = now_ns + delay;
     delivered_before_ = true;

@@ -20,7 +20,8 @@ SparseMatrix element_stiffness(const TetMesh& mesh, const Eigen::Matrix<double, 
     for (int i = 0; i < 4; ++i)
       for (int j = 0; j < 4; ++j)
         for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) triplets.emplace_back(3 * tet[i] + a, 3 * tet[j] + b, ke(3 * i + a, 3 * j + b));
+          for (int b = 0; b < 3; ++b)
+            triplets.emplace_back(3 * tet[i] + a, 3 * tet[j] + b, ke(3 * i + a, 3 * j + b));
   }
   const int n = 3 * mesh.node_count();
   SparseMatrix k(n, n);
@@ -83,7 +84,8 @@ SparseMatrix restrict_to_dofs(const SparseMatrix& k, const std::vector<int>& dof
   for (int col = 0; col < k.outerSize(); ++col) {
     if (position[col] < 0) continue;
     for (SparseMatrix::InnerIterator it(k, col); it; ++it)
-      if (position[it.row()] >= 0) triplets.emplace_back(position[it.row()], position[col], it.value());
+      if (position[it.row()] >= 0)
+        triplets.emplace_back(position[it.row()], position[col], it.value());
   }
   const auto m = static_cast<int>(dofs.size());
   SparseMatrix restricted(m, m);

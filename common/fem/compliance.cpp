@@ -8,12 +8,18 @@
 
 namespace cohaptic {
 
-ComplianceColumns::ComplianceColumns(const DeferredCholesky& factor, const DofMap& dofs, std::vector<int> row_nodes)
-    : factor_(factor), dofs_(dofs), row_nodes_(std::move(row_nodes)), row_position_(static_cast<std::size_t>(dofs.node_count()), -1) {
+ComplianceColumns::ComplianceColumns(const DeferredCholesky& factor, const DofMap& dofs,
+                                     std::vector<int> row_nodes)
+    : factor_(factor),
+      dofs_(dofs),
+      row_nodes_(std::move(row_nodes)),
+      row_position_(static_cast<std::size_t>(dofs.node_count()), -1) {
   for (int i = 0; i < static_cast<int>(row_nodes_.size()); ++i) {
     const int node = row_nodes_[i];
-    if (node < 0 || node >= dofs.node_count()) throw Error(fmt::format("compliance: row node {} out of range", node));
-    if (row_position_[node] >= 0) throw Error(fmt::format("compliance: row node {} listed twice", node));
+    if (node < 0 || node >= dofs.node_count())
+      throw Error(fmt::format("compliance: row node {} out of range", node));
+    if (row_position_[node] >= 0)
+      throw Error(fmt::format("compliance: row node {} listed twice", node));
     row_position_[node] = i;
   }
 }
@@ -31,7 +37,8 @@ void ComplianceColumns::compute_columns(const std::vector<int>& nodes) {
   // row node is solved alone.
   std::vector<int> groups, singles;
   for (int node : nodes) {
-    if (node < 0 || node >= dofs_.node_count()) throw Error(fmt::format("compliance: node {} out of range", node));
+    if (node < 0 || node >= dofs_.node_count())
+      throw Error(fmt::format("compliance: node {} out of range", node));
     if (has_column(node)) continue;
     const int position = row_position(node);
     std::vector<int>& list = position >= 0 ? groups : singles;
@@ -97,26 +104,31 @@ Eigen::MatrixXd ComplianceColumns::gather(const std::vector<int>& nodes) {
 
 void ComplianceColumns::insert_column(int node, ComplianceColumn column) {
   if (column.rows() != static_cast<Eigen::Index>(3 * row_nodes_.size()))
-    throw Error(fmt::format("compliance: column for node {} has {} rows, expected {}", node, column.rows(),
-                            3 * row_nodes_.size()));
+    throw Error(fmt::format("compliance: column for node {} has {} rows, expected {}", node,
+                            column.rows(), 3 * row_nodes_.size()));
   columns_[node] = std::move(column);
 }
 
-Eigen::MatrixXd ComplianceColumns::dof_block(std::span<const int> row_dofs, std::span<const int> col_dofs) {
+Eigen::MatrixXd ComplianceColumns::dof_block(std::span<const int> row_dofs,
+                                             std::span<const int> col_dofs) {
   std::vector<int> row_index(row_dofs.size());
   for (std::size_t i = 0; i < row_dofs.size(); ++i) {
     const int position = row_position(row_dofs[i] / 3);
     if (position < 0)
-      throw Error(fmt::format("compliance rows are not kept for node {} (not touchable or on the surface)", row_dofs[i] / 3));
+      throw Error(
+          fmt::format("compliance rows are not kept for node {} (not touchable or on the surface)",
+                      row_dofs[i] / 3));
     row_index[i] = 3 * position + row_dofs[i] % 3;
   }
   // Missing columns are solved on first use, in their fixed groups (see compute_columns).
-  Eigen::MatrixXd block(static_cast<Eigen::Index>(row_dofs.size()), static_cast<Eigen::Index>(col_dofs.size()));
+  Eigen::MatrixXd block(static_cast<Eigen::Index>(row_dofs.size()),
+                        static_cast<Eigen::Index>(col_dofs.size()));
   for (std::size_t j = 0; j < col_dofs.size(); ++j) {
     const ComplianceColumn& node_column = column(col_dofs[j] / 3);
     const int axis = col_dofs[j] % 3;
     for (std::size_t i = 0; i < row_dofs.size(); ++i)
-      block(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = node_column(row_index[i], axis);
+      block(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
+          node_column(row_index[i], axis);
   }
   return block;
 }

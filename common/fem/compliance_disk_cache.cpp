@@ -91,7 +91,8 @@ struct HashingReader {
   std::uintmax_t remaining;  // bytes left before the checksum
   PipelinedHasher hasher;
   bool read(void* out, std::size_t size) {
-    if (size > remaining || !in.read(static_cast<char*>(out), static_cast<std::streamsize>(size))) return false;
+    if (size > remaining || !in.read(static_cast<char*>(out), static_cast<std::streamsize>(size)))
+      return false;
     remaining -= size;
     return true;
   }
@@ -107,7 +108,9 @@ struct HashingReader {
     return true;
   }
   template <typename T>
-  bool value(T& v) { return bytes(&v, sizeof v); }
+  bool value(T& v) {
+    return bytes(&v, sizeof v);
+  }
 };
 
 // Writes plain values to a cache file through `out`, hashing every byte written, on the
@@ -124,25 +127,31 @@ struct HashingWriter {
     hasher.keep(data, count * sizeof(double));
   }
   template <typename T>
-  void value(const T& v) { bytes(&v, sizeof v); }
+  void value(const T& v) {
+    bytes(&v, sizeof v);
+  }
 };
 
 }  // namespace
 
-Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
-                            const std::vector<int>& row_nodes, ComplianceRoute route) {
+Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& material,
+                            const DofMap& dofs, const std::vector<int>& row_nodes,
+                            ComplianceRoute route) {
   ContentHasher h;
   h.text("cohaptic compliance cache").value(kComplianceCacheFormatVersion);
   h.matrix(mesh.nodes);
   h.values(std::span<const Tet>(mesh.tets));
-  h.value(material.youngs_modulus).value(material.poisson_ratio).value(static_cast<int>(material.formulation));
+  h.value(material.youngs_modulus)
+      .value(material.poisson_ratio)
+      .value(static_cast<int>(material.formulation));
   h.values(std::span<const AxisMask>(dofs.fixed_axes));
   h.values(std::span<const int>(row_nodes));
   h.value(static_cast<int>(route));
   return h.finish();
 }
 
-std::filesystem::path compliance_cache_file(const std::filesystem::path& directory, const Digest& key) {
+std::filesystem::path compliance_cache_file(const std::filesystem::path& directory,
+                                            const Digest& key) {
   return directory / ("compliance-" + to_hex(key).substr(0, 32) + ".bin");
 }
 
@@ -172,7 +181,8 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
     return result;
   }
   if (!r.value(version) || version != kComplianceCacheFormatVersion) {
-    result.problem = fmt::format("format version {} (this build reads {})", version, kComplianceCacheFormatVersion);
+    result.problem = fmt::format("format version {} (this build reads {})", version,
+                                 kComplianceCacheFormatVersion);
     return result;
   }
   if (!r.value(stored_key) || stored_key != key) {
@@ -196,7 +206,8 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
   }
   const std::uintmax_t column_bytes = sizeof(int) + 9 * std::uintmax_t{row_count} * sizeof(double);
   if (column_count > r.remaining / column_bytes) {
-    result.problem = fmt::format("{} columns announced, {} bytes left for them", column_count, r.remaining);
+    result.problem =
+        fmt::format("{} columns announced, {} bytes left for them", column_count, r.remaining);
     return result;
   }
   loaded.reserve(column_count);
@@ -211,7 +222,9 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
       result.problem = fmt::format("column {} names node {}, outside the mesh", c, node);
       return result;
     }
-    ComplianceColumn& column = loaded.emplace_back(node, ComplianceColumn(3 * static_cast<Eigen::Index>(row_count), 3)).second;
+    ComplianceColumn& column =
+        loaded.emplace_back(node, ComplianceColumn(3 * static_cast<Eigen::Index>(row_count), 3))
+            .second;
     if (!r.column(column.data(), static_cast<std::size_t>(column.size()))) {
       result.problem = fmt::format("truncated at column {}", c);
       return result;
@@ -233,11 +246,13 @@ ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, con
   return result;
 }
 
-void save_compliance_cache(const std::filesystem::path& file, const Digest& key, const ComplianceColumns& columns,
-                           ProgressLog* progress) {
+void save_compliance_cache(const std::filesystem::path& file, const Digest& key,
+                           const ComplianceColumns& columns, ProgressLog* progress) {
   std::error_code ec;
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
-  if (ec) throw Error(fmt::format("{}: cannot create the cache directory: {}", file.parent_path().string(), ec.message()));
+  if (ec)
+    throw Error(fmt::format("{}: cannot create the cache directory: {}",
+                            file.parent_path().string(), ec.message()));
   // Sorted by node so the same columns always give the same file.
   std::vector<int> nodes;
   for (const auto& entry : columns.columns()) nodes.push_back(entry.first);

@@ -32,11 +32,13 @@ constexpr std::uint32_t kComplianceCacheFormatVersion = 5;
 /// node's at once by the Schur complement (schur_compliance.h).
 enum class ComplianceRoute : int { solves = 0, schur = 1 };
 
-Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& material, const DofMap& dofs,
-                            const std::vector<int>& row_nodes, ComplianceRoute route);
+Digest compliance_cache_key(const TetMesh& mesh, const LinearElasticMaterial& material,
+                            const DofMap& dofs, const std::vector<int>& row_nodes,
+                            ComplianceRoute route);
 
 /// The file for `key` inside `directory`.
-std::filesystem::path compliance_cache_file(const std::filesystem::path& directory, const Digest& key);
+std::filesystem::path compliance_cache_file(const std::filesystem::path& directory,
+                                            const Digest& key);
 
 struct ComplianceCacheLoad {
   bool loaded = false;
@@ -48,12 +50,13 @@ struct ComplianceCacheLoad {
 /// `key`; otherwise leaves `columns` untouched and says why. Never throws for a bad file.
 /// `progress`, if given, counts the columns read.
 ComplianceCacheLoad load_compliance_cache(const std::filesystem::path& file, const Digest& key,
-                                          ComplianceColumns& columns, ProgressLog* progress = nullptr);
+                                          ComplianceColumns& columns,
+                                          ProgressLog* progress = nullptr);
 
 /// Writes every cached column, atomically (temporary file, then rename). Throws Error
 /// naming the file and the reason (e.g. a full disk); an existing cache is left intact.
 /// `progress`, if given, counts the columns written, then shows the sync to disk.
-void save_compliance_cache(const std::filesystem::path& file, const Digest& key, const ComplianceColumns& columns,
-                           ProgressLog* progress = nullptr);
+void save_compliance_cache(const std::filesystem::path& file, const Digest& key,
+                           const ComplianceColumns& columns, ProgressLog* progress = nullptr);
 
 }  // namespace cohaptic

@@ -18,7 +18,8 @@ class ComplianceSource {
   /// together, in one multi-right-hand-side solve). Throws Error if it cannot.
   virtual void compute_columns(const std::vector<int>& nodes) = 0;
   /// L[row_dofs, col_dofs]. Throws Error naming the node whose block is not available.
-  virtual Eigen::MatrixXd dof_block(std::span<const int> row_dofs, std::span<const int> col_dofs) = 0;
+  virtual Eigen::MatrixXd dof_block(std::span<const int> row_dofs,
+                                    std::span<const int> col_dofs) = 0;
 
  protected:
   ComplianceSource() = default;

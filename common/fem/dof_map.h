@@ -21,7 +21,9 @@ struct DofMap {
 
   int node_count() const { return static_cast<int>(fixed_axes.size()); }
   int free_count() const { return static_cast<int>(free_dofs.size()); }
-  bool is_fixed(int node, int axis) const { return (fixed_axes[static_cast<std::size_t>(node)] >> axis) & 1u; }
+  bool is_fixed(int node, int axis) const {
+    return (fixed_axes[static_cast<std::size_t>(node)] >> axis) & 1u;
+  }
 };
 
 DofMap make_dof_map(std::vector<AxisMask> fixed_axes);

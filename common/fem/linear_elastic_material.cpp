@@ -9,9 +9,12 @@ namespace cohaptic {
 
 void validate(const LinearElasticMaterial& material) {
   if (!std::isfinite(material.youngs_modulus) || material.youngs_modulus <= 0)
-    throw Error(fmt::format("Young's modulus must be a positive number of pascals, got {}", material.youngs_modulus));
-  if (!std::isfinite(material.poisson_ratio) || material.poisson_ratio <= -1 || material.poisson_ratio >= 0.5)
-    throw Error(fmt::format("Poisson's ratio must lie in (-1, 0.5), got {}", material.poisson_ratio));
+    throw Error(fmt::format("Young's modulus must be a positive number of pascals, got {}",
+                            material.youngs_modulus));
+  if (!std::isfinite(material.poisson_ratio) || material.poisson_ratio <= -1 ||
+      material.poisson_ratio >= 0.5)
+    throw Error(
+        fmt::format("Poisson's ratio must lie in (-1, 0.5), got {}", material.poisson_ratio));
 }
 
 Eigen::Matrix<double, 6, 6> elasticity_matrix(const LinearElasticMaterial& material) {

@@ -25,7 +25,9 @@ struct LinearElasticMaterial {
   double poisson_ratio = 0;   ///< nu, in (-1, 0.5)
   ElementFormulation formulation = ElementFormulation::linear_tet;
 
-  double lame_lambda() const { return youngs_modulus * poisson_ratio / ((1 + poisson_ratio) * (1 - 2 * poisson_ratio)); }
+  double lame_lambda() const {
+    return youngs_modulus * poisson_ratio / ((1 + poisson_ratio) * (1 - 2 * poisson_ratio));
+  }
   double shear_modulus() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
   double bulk_modulus() const { return youngs_modulus / (3 * (1 - 2 * poisson_ratio)); }
 };

@@ -28,12 +28,13 @@ namespace cohaptic {
 /// of the whole (the factorisation's, as CHOLMOD's analysis counts them, and the inverse's),
 /// the machine's dense flop rate, and each part as it begins and ends. Throws NumericalError
 /// if K is not positive definite or CHOLMOD fails.
-Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> rows, ProgressLog* progress = nullptr);
+Eigen::MatrixXd schur_compliance(const SparseMatrix& k, std::span<const int> rows,
+                                 ProgressLog* progress = nullptr);
 
 /// Every row node's column block of `columns` that is missing, all at once by the Schur route
 /// on K_ff (`k_ff`, in `dofs`' free indices): L[row_nodes, row_nodes] in one go. Returns the
 /// columns added.
-std::size_t compute_row_columns_by_schur(ComplianceColumns& columns, const SparseMatrix& k_ff, const DofMap& dofs,
-                                         ProgressLog* progress = nullptr);
+std::size_t compute_row_columns_by_schur(ComplianceColumns& columns, const SparseMatrix& k_ff,
+                                         const DofMap& dofs, ProgressLog* progress = nullptr);
 
 }  // namespace cohaptic

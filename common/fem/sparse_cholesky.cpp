@@ -32,16 +32,19 @@ CholeskyWorkspace::~CholeskyWorkspace() = default;
 CholeskyWorkspace::CholeskyWorkspace(CholeskyWorkspace&&) noexcept = default;
 CholeskyWorkspace& CholeskyWorkspace::operator=(CholeskyWorkspace&&) noexcept = default;
 
-SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row, ProgressLog* progress)
+SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row,
+                               ProgressLog* progress)
     : impl_(std::make_unique<Impl>()), size_(static_cast<int>(matrix.rows())) {
   if (matrix.rows() != matrix.cols())
-    throw NumericalError(fmt::format("cannot factor a {}x{} matrix: not square", matrix.rows(), matrix.cols()));
+    throw NumericalError(
+        fmt::format("cannot factor a {}x{} matrix: not square", matrix.rows(), matrix.cols()));
   if (!matrix.isCompressed()) throw NumericalError("cannot factor an uncompressed sparse matrix");
   cholmod_sparse view = cholmod_view_of(matrix);
   cholmod_common& c = impl_->common;
   impl_->factor = cholmod_analyze(&view, &c);
   if (impl_->factor == nullptr || c.status < CHOLMOD_OK)
-    throw NumericalError(fmt::format("CHOLMOD analysis of a {0}x{0} matrix failed (status {1})", size_, c.status));
+    throw NumericalError(
+        fmt::format("CHOLMOD analysis of a {0}x{0} matrix failed (status {1})", size_, c.status));
   if (progress) {
     progress->set_total(c.fl);
     progress->begin_part(c.fl, dense_flop_rate());
@@ -63,7 +66,8 @@ SparseCholesky::SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_
         row >= 0 && name_row ? "first failure at " + name_row(row) : fmt::format("row {}", row)));
   }
   if (!ok || c.status < CHOLMOD_OK)
-    throw NumericalError(fmt::format("CHOLMOD factorisation of a {0}x{0} matrix failed (status {1})", size_, c.status));
+    throw NumericalError(fmt::format(
+        "CHOLMOD factorisation of a {0}x{0} matrix failed (status {1})", size_, c.status));
   reciprocal_condition_ = cholmod_rcond(impl_->factor, &c);
   factor_nonzeros_ = c.lnz;
 }
@@ -75,9 +79,11 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
   return solve(rhs, workspace);
 }
 
-Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs, CholeskyWorkspace& workspace) const {
+Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs,
+                                      CholeskyWorkspace& workspace) const {
   if (rhs.rows() != size_)
-    throw NumericalError(fmt::format("solve: right-hand side has {} rows, the factor {}", rhs.rows(), size_));
+    throw NumericalError(
+        fmt::format("solve: right-hand side has {} rows, the factor {}", rhs.rows(), size_));
   Eigen::MatrixXd x(rhs.rows(), rhs.cols());
   if (rhs.cols() == 0) return x;
   cholmod_dense b{};
@@ -89,11 +95,13 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs, CholeskyWorksp
   b.xtype = CHOLMOD_REAL;
   b.dtype = CHOLMOD_DOUBLE;
   CholeskyWorkspace::Impl& w = *workspace.impl_;
-  if (!cholmod_solve2(CHOLMOD_A, impl_->factor, &b, nullptr, &w.solution, nullptr, &w.work_y, &w.work_e, &w.common))
+  if (!cholmod_solve2(CHOLMOD_A, impl_->factor, &b, nullptr, &w.solution, nullptr, &w.work_y,
+                      &w.work_e, &w.common))
     throw NumericalError(fmt::format("CHOLMOD solve failed (status {})", w.common.status));
   const auto* values = static_cast<const double*>(w.solution->x);
   const auto leading = static_cast<Eigen::Index>(w.solution->d);
-  for (Eigen::Index j = 0; j < x.cols(); ++j) x.col(j) = Eigen::Map<const Eigen::VectorXd>(values + j * leading, x.rows());
+  for (Eigen::Index j = 0; j < x.cols(); ++j)
+    x.col(j) = Eigen::Map<const Eigen::VectorXd>(values + j * leading, x.rows());
   return x;
 }
 

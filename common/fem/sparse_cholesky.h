@@ -41,7 +41,8 @@ class SparseCholesky {
   /// is told the factorisation's flops (as CHOLMOD's analysis counts them) as its total, the
   /// machine's dense flop rate, and the part's begin and end. Throws NumericalError naming
   /// the row where positive definiteness failed.
-  explicit SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row = {}, ProgressLog* progress = nullptr);
+  explicit SparseCholesky(const SparseMatrix& matrix, const RowNamer& name_row = {},
+                          ProgressLog* progress = nullptr);
   ~SparseCholesky();
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;

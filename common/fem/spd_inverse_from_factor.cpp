@@ -9,7 +9,8 @@
 
 // LAPACK (OpenBLAS's own, parallel dtrtri and dlauum), Fortran interface.
 extern "C" {
-void dtrtri_(const char* uplo, const char* diag, const int* n, double* a, const int* lda, int* info);
+void dtrtri_(const char* uplo, const char* diag, const int* n, double* a, const int* lda,
+             int* info);
 void dlauum_(const char* uplo, const int* n, double* a, const int* lda, int* info);
 }
 
@@ -27,7 +28,8 @@ void mirror_lower_to_upper(Eigen::MatrixXd& a) {
   for (Eigen::Index j0 = 0; j0 < m; j0 += kTile)
     for (Eigen::Index i0 = j0; i0 < m; i0 += kTile)
       for (Eigen::Index j = j0; j < std::min(j0 + kTile, m); ++j)
-        for (Eigen::Index i = std::max(i0, j + 1); i < std::min(i0 + kTile, m); ++i) a(j, i) = a(i, j);
+        for (Eigen::Index i = std::max(i0, j + 1); i < std::min(i0 + kTile, m); ++i)
+          a(j, i) = a(i, j);
 }
 
 }  // namespace
@@ -43,12 +45,14 @@ void invert_spd_from_factor(Eigen::MatrixXd& factor, ProgressLog* progress) {
   if (progress) progress->begin_part(triangular_part_flops(m), dense_flop_rate());
   dtrtri_("L", "N", &m, factor.data(), &m, &info);
   if (info != 0)
-    throw NumericalError(fmt::format("the {0}x{0} Cholesky factor cannot be inverted: LAPACK dtrtri returned {1}", m, info));
+    throw NumericalError(fmt::format(
+        "the {0}x{0} Cholesky factor cannot be inverted: LAPACK dtrtri returned {1}", m, info));
   if (progress) progress->add(triangular_part_flops(m));
   // S^-1 = Z^T Z: its lower triangle, in place.
   if (progress) progress->begin_part(triangular_part_flops(m), dense_flop_rate());
   dlauum_("L", &m, factor.data(), &m, &info);
-  if (info != 0) throw NumericalError(fmt::format("LAPACK dlauum returned {} on a {}x{} matrix", info, m, m));
+  if (info != 0)
+    throw NumericalError(fmt::format("LAPACK dlauum returned {} on a {}x{} matrix", info, m, m));
   if (progress) progress->add(triangular_part_flops(m));
   mirror_lower_to_upper(factor);
 }

@@ -33,12 +33,14 @@ class ConstrainedStaticSolver {
  public:
   /// Factors K_UU for the given prescribed dofs. Throws Error for a prescribed dof that is
   /// fixed, out of range or given twice; NumericalError if K_UU is not positive definite.
-  ConstrainedStaticSolver(const SparseMatrix& stiffness, const DofMap& dofs, std::vector<int> prescribed_dofs);
+  ConstrainedStaticSolver(const SparseMatrix& stiffness, const DofMap& dofs,
+                          std::vector<int> prescribed_dofs);
   ~ConstrainedStaticSolver();
 
   /// `prescribed_values` aligned with the constructor's dofs [m]; `applied_forces` 3N [N]
   /// or empty. Loads on constrained dofs are carried by the constraint.
-  StaticSolution solve(const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& applied_forces = {}) const;
+  StaticSolution solve(const Eigen::VectorXd& prescribed_values,
+                       const Eigen::VectorXd& applied_forces = {}) const;
 
   /// The compliance between global dofs with every prescribed dof held at zero [m/N]:
   /// entry (i, j) is the displacement of rows[i] under a unit force at columns[j]. Rows

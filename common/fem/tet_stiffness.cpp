@@ -4,9 +4,11 @@
 
 namespace cohaptic {
 
-Eigen::Matrix<double, 3, 4> tet_shape_gradients(const Eigen::Matrix<double, 3, 4>& corners, double& volume) {
+Eigen::Matrix<double, 3, 4> tet_shape_gradients(const Eigen::Matrix<double, 3, 4>& corners,
+                                                double& volume) {
   Eigen::Matrix3d edges;
-  edges << corners.col(1) - corners.col(0), corners.col(2) - corners.col(0), corners.col(3) - corners.col(0);
+  edges << corners.col(1) - corners.col(0), corners.col(2) - corners.col(0),
+      corners.col(3) - corners.col(0);
   volume = edges.determinant() / 6.0;
   // Barycentric coordinates xi = J^-1 (x - x0): the gradient of N_i (i = 1..3) is row i of J^-1.
   const Eigen::Matrix3d inverse = edges.inverse();
@@ -34,7 +36,8 @@ TetStrainMatrix tet_strain_matrix(const Eigen::Matrix<double, 3, 4>& gradients) 
   return b;
 }
 
-TetStiffness tet_stiffness(const Eigen::Matrix<double, 3, 4>& corners, const Eigen::Matrix<double, 6, 6>& elasticity) {
+TetStiffness tet_stiffness(const Eigen::Matrix<double, 3, 4>& corners,
+                           const Eigen::Matrix<double, 6, 6>& elasticity) {
   double volume = 0;
   const TetStrainMatrix b = tet_strain_matrix(tet_shape_gradients(corners, volume));
   return volume * b.transpose() * elasticity * b;

@@ -14,12 +14,14 @@ using TetStrainMatrix = Eigen::Matrix<double, 6, 12>;
 
 /// Shape-function gradients (one column per node) of the tetrahedron x0..x3, and its
 /// signed volume in `volume`.
-Eigen::Matrix<double, 3, 4> tet_shape_gradients(const Eigen::Matrix<double, 3, 4>& corners, double& volume);
+Eigen::Matrix<double, 3, 4> tet_shape_gradients(const Eigen::Matrix<double, 3, 4>& corners,
+                                                double& volume);
 
 /// Strain-displacement matrix B from the shape-function gradients.
 TetStrainMatrix tet_strain_matrix(const Eigen::Matrix<double, 3, 4>& gradients);
 
 /// K_e for the tetrahedron with corners x0..x3 (columns) and elasticity matrix D.
-TetStiffness tet_stiffness(const Eigen::Matrix<double, 3, 4>& corners, const Eigen::Matrix<double, 6, 6>& elasticity);
+TetStiffness tet_stiffness(const Eigen::Matrix<double, 3, 4>& corners,
+                           const Eigen::Matrix<double, 6, 6>& elasticity);
 
 }  // namespace cohaptic

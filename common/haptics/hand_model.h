@@ -20,8 +20,8 @@
 // the part of the hand, fingers and stylus that moves with the tool tip when the wrist and
 // fingers are compliant (a whole hand is about 0.4 kg); sqrt(k/m) = 38.7 rad/s (6.2 Hz)
 // puts the arm's natural frequency inside the band of voluntary hand motion (up to about
-// 10 Hz) and below physiological tremor (8-12 Hz); c gives a damping ratio c / (2 sqrt(k m)) = 0.52, a
-// moderately damped, not stiffened, grip. Published fingertip and wrist impedance
+// 10 Hz) and below physiological tremor (8-12 Hz); c gives a damping ratio c / (2 sqrt(k m)) =
+// 0.52, a moderately damped, not stiffened, grip. Published fingertip and wrist impedance
 // identifications span roughly an order of magnitude around these values; change them in
 // the file's `hand:` map (SI: mass [kg], stiffness [N/m], damping [N s/m]).
 //
@@ -103,7 +103,8 @@ void validate_hand_parameters(const HandParameters& parameters);
 /// The optional `hand:` map of a trajectory file ({mass, stiffness, damping}, SI; each key
 /// optional, defaults above); nothing if the file has no `hand:`. Only `hand:` is read.
 /// Errors are ParseErrors naming the file, line and key.
-std::optional<HandParameters> parse_hand_parameters(const std::string& yaml, const std::string& name);
+std::optional<HandParameters> parse_hand_parameters(const std::string& yaml,
+                                                    const std::string& name);
 std::optional<HandParameters> load_hand_parameters(const std::filesystem::path& file);
 
 }  // namespace cohaptic

@@ -31,7 +31,8 @@ Eigen::Vector3d PassivityController::filter(double time_s, const Eigen::Vector3d
   if (energy_ < -energy_tolerance_ && speed_squared > 0) {
     // A damper b applied for one period T changes the velocity of a mass m by at most the
     // fraction b T / m: kept at 1/2, it cannot reverse the hand by itself.
-    const double alpha = std::min(-(energy_ + energy_tolerance_) / (period * speed_squared), 0.5 * moving_mass_ / period);
+    const double alpha = std::min(-(energy_ + energy_tolerance_) / (period * speed_squared),
+                                  0.5 * moving_mass_ / period);
     output = limited(environment - alpha * step / period);
     ++active_ticks_;
   }

@@ -44,7 +44,8 @@ class PassivityController {
   /// The force to output at tick time `time_s` with the tool at `position`, given the
   /// environment's force `environment_force`, limited to the force limit. Call once per
   /// tick, in time order, and write exactly what it returns.
-  Eigen::Vector3d filter(double time_s, const Eigen::Vector3d& position, const Eigen::Vector3d& environment_force);
+  Eigen::Vector3d filter(double time_s, const Eigen::Vector3d& position,
+                         const Eigen::Vector3d& environment_force);
 
   /// No force was output since the last filter() (the device was not valid): the next
   /// filter() starts a new interval. The energy observed so far is kept.
@@ -67,7 +68,8 @@ class PassivityController {
   double last_time_ = 0;
   Eigen::Vector3d last_position_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d last_output_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d last_damping_ = Eigen::Vector3d::Zero();  // output minus the limited environment force
+  Eigen::Vector3d last_damping_ =
+      Eigen::Vector3d::Zero();  // output minus the limited environment force
   double energy_ = 0, dissipated_ = 0;
   long active_ticks_ = 0;
 };

@@ -9,13 +9,17 @@
 namespace cohaptic {
 
 ScriptedDevice::ScriptedDevice(Trajectory trajectory, double force_limit)
-    : trajectory_(std::move(trajectory)), force_limit_(force_limit), last_force_time_(-std::numeric_limits<double>::infinity()) {
+    : trajectory_(std::move(trajectory)),
+      force_limit_(force_limit),
+      last_force_time_(-std::numeric_limits<double>::infinity()) {
   if (!(force_limit_ > 0) || !std::isfinite(force_limit_))
-    throw Error(fmt::format("scripted device {}: expected a positive force limit in N, found {}", trajectory_.source(), force_limit_));
+    throw Error(fmt::format("scripted device {}: expected a positive force limit in N, found {}",
+                            trajectory_.source(), force_limit_));
 }
 
 std::string ScriptedDevice::describe() const {
-  return fmt::format("script:{} ({:.3f} s, force limit {} N)", trajectory_.source(), trajectory_.duration(), force_limit_);
+  return fmt::format("script:{} ({:.3f} s, force limit {} N)", trajectory_.source(),
+                     trajectory_.duration(), force_limit_);
 }
 
 DeviceState ScriptedDevice::read(double time_s) {

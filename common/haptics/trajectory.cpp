@@ -10,21 +10,29 @@
 
 namespace cohaptic {
 
-Trajectory::Trajectory(std::vector<double> times, std::vector<Eigen::Vector3d> points, std::string source,
-                       std::vector<std::uint32_t> buttons)
-    : times_(std::move(times)), points_(std::move(points)), source_(std::move(source)), buttons_(std::move(buttons)) {
+Trajectory::Trajectory(std::vector<double> times, std::vector<Eigen::Vector3d> points,
+                       std::string source, std::vector<std::uint32_t> buttons)
+    : times_(std::move(times)),
+      points_(std::move(points)),
+      source_(std::move(source)),
+      buttons_(std::move(buttons)) {
   if (times_.empty() || times_.size() != points_.size())
-    throw Error(fmt::format("trajectory {}: expected as many knot times as points (at least one), found {} and {}", source_,
-                            times_.size(), points_.size()));
+    throw Error(fmt::format(
+        "trajectory {}: expected as many knot times as points (at least one), found {} and {}",
+        source_, times_.size(), points_.size()));
   if (!buttons_.empty() && buttons_.size() != times_.size())
-    throw Error(fmt::format("trajectory {}: expected no buttons or one entry per knot ({}), found {}", source_, times_.size(),
-                            buttons_.size()));
-  if (times_[0] != 0.0) throw Error(fmt::format("trajectory {}: the first knot must be at t = 0, found {}", source_, times_[0]));
+    throw Error(
+        fmt::format("trajectory {}: expected no buttons or one entry per knot ({}), found {}",
+                    source_, times_.size(), buttons_.size()));
+  if (times_[0] != 0.0)
+    throw Error(fmt::format("trajectory {}: the first knot must be at t = 0, found {}", source_,
+                            times_[0]));
   for (std::size_t i = 0; i < times_.size(); ++i) {
     if (!std::isfinite(times_[i]) || !points_[i].allFinite())
       throw Error(fmt::format("trajectory {}: knot {} is not finite", source_, i));
     if (i > 0 && !(times_[i] > times_[i - 1]))
-      throw Error(fmt::format("trajectory {}: knot times must increase, found {} after {}", source_, times_[i], times_[i - 1]));
+      throw Error(fmt::format("trajectory {}: knot times must increase, found {} after {}", source_,
+                              times_[i], times_[i - 1]));
   }
 }
 
@@ -63,12 +71,13 @@ constexpr std::int64_t kMaxRepeat = 100000;
 // One segment as read from the file, lengths already in metres.
 struct Segment {
   enum class Kind { move_to, move_by, press, release, hold } kind;
-  Eigen::Vector3d vector = Eigen::Vector3d::Zero();  // target (move_to), offset (move_by), direction (press)
-  bool has_direction = false;                        // press: direction given explicitly
-  double amount = 0;                                 // depth (press), distance (release), seconds (hold)
-  double speed = 0;                                  // m/s
-  std::uint32_t buttons = 0;                         // held during the segment
-  Cursor where;                                      // for errors found while playing (release before press)
+  Eigen::Vector3d vector =
+      Eigen::Vector3d::Zero();  // target (move_to), offset (move_by), direction (press)
+  bool has_direction = false;   // press: direction given explicitly
+  double amount = 0;            // depth (press), distance (release), seconds (hold)
+  double speed = 0;             // m/s
+  std::uint32_t buttons = 0;    // held during the segment
+  Cursor where;                 // for errors found while playing (release before press)
 };
 
 double metres_per(const Cursor& units) {
@@ -86,9 +95,11 @@ Segment parse_segment(const Cursor& c, double scale) {
   std::string kind;
   for (const char* k : kinds) {
     if (auto found = c.find(k)) {
-      if (kind_cursor) found->fail_message(fmt::format("a segment has exactly one of move_to, move_by, press, release or hold; "
-                                                       "this one also has {}",
-                                                       kind));
+      if (kind_cursor)
+        found->fail_message(
+            fmt::format("a segment has exactly one of move_to, move_by, press, release or hold; "
+                        "this one also has {}",
+                        kind));
       kind_cursor = found;
       kind = k;
     }
@@ -98,10 +109,13 @@ Segment parse_segment(const Cursor& c, double scale) {
   Segment s{Segment::Kind::hold, Eigen::Vector3d::Zero(), false, 0, 0, 0, c};
   if (auto buttons = c.find("buttons")) {
     const std::int64_t mask = buttons->integer();
-    if (mask < 0 || mask > std::int64_t{0xffffffff}) buttons->fail("a button mask from 0 to 4294967295 (bit i = button i)");
+    if (mask < 0 || mask > std::int64_t{0xffffffff})
+      buttons->fail("a button mask from 0 to 4294967295 (bit i = button i)");
     s.buttons = static_cast<std::uint32_t>(mask);
   }
-  auto speed = [&] { return c.at("speed").positive("a positive speed (in units per second)") * scale; };
+  auto speed = [&] {
+    return c.at("speed").positive("a positive speed (in units per second)") * scale;
+  };
   if (kind == "move_to" || kind == "move_by") {
     c.only_keys({kind.c_str(), "speed", "buttons"});
     s.kind = kind == "move_to" ? Segment::Kind::move_to : Segment::Kind::move_by;
@@ -149,7 +163,8 @@ Trajectory parse_trajectory(const std::string& yaml, const std::string& name) {
   std::int64_t repeat = 1;
   if (auto r = top.find("repeat")) {
     repeat = r->integer();
-    if (repeat < 1 || repeat > kMaxRepeat) r->fail(fmt::format("an integer from 1 to {}", kMaxRepeat));
+    if (repeat < 1 || repeat > kMaxRepeat)
+      r->fail(fmt::format("an integer from 1 to {}", kMaxRepeat));
   }
   // `hand` is validated by parse_hand_parameters (hand_model.h); a script ignores it.
 
@@ -192,11 +207,14 @@ Trajectory parse_trajectory(const std::string& yaml, const std::string& name) {
           go(here + s.vector, s.speed);
           break;
         case Segment::Kind::press:
-          press_direction = s.has_direction ? s.vector : press_direction.value_or(Eigen::Vector3d(0, 0, -1));
+          press_direction =
+              s.has_direction ? s.vector : press_direction.value_or(Eigen::Vector3d(0, 0, -1));
           go(here + s.amount * *press_direction, s.speed);
           break;
         case Segment::Kind::release:
-          if (!press_direction) s.where.fail_message("release before any press (release moves back along the last press direction)");
+          if (!press_direction)
+            s.where.fail_message(
+                "release before any press (release moves back along the last press direction)");
           go(here - s.amount * *press_direction, s.speed);
           break;
         case Segment::Kind::hold:

@@ -4,7 +4,8 @@
 //   units: mm
 //   start: [0, 0, 20]          # where the tool is at t = 0 (required)
 //   segments:                  # played in order (at least one)
-//     - {move_to: [0, 0, 2], speed: 20}                # straight line to a point at a constant speed
+//     - {move_to: [0, 0, 2], speed: 20}                # straight line to a point, at a
+//                                                      #   constant speed
 //     - {press: 15, speed: 5, direction: [0, 0, -1]}   # move by 15 along direction (normalised;
 //                                                      #   default: the previous press's, else -z)
 //     - {hold: 1.0}                                    # stay still for 1 s

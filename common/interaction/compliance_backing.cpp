@@ -11,7 +11,8 @@
 
 namespace cohaptic {
 
-Eigen::MatrixXd target_normal_compliance(std::span<const PolygonCollision> collisions, ComplianceColumns& columns) {
+Eigen::MatrixXd target_normal_compliance(std::span<const PolygonCollision> collisions,
+                                         ComplianceColumns& columns) {
   const auto count = static_cast<Eigen::Index>(collisions.size());
   std::vector<int> polygon_nodes;
   for (const PolygonCollision& collision : collisions)
@@ -40,9 +41,10 @@ Eigen::MatrixXd target_normal_compliance(std::span<const PolygonCollision> colli
       for (std::size_t a = 0; a < 3; ++a)
         for (std::size_t b = 0; b < 3; ++b) {
           const Eigen::Matrix3d block =
-              polygon_columns[static_cast<std::size_t>(j)][b]->middleRows<3>(polygon_rows[static_cast<std::size_t>(i)][a]);
-          value += ci.weights[static_cast<Eigen::Index>(a)] * cj.weights[static_cast<Eigen::Index>(b)] *
-                   ci.normal.dot(block * cj.normal);
+              polygon_columns[static_cast<std::size_t>(j)][b]->middleRows<3>(
+                  polygon_rows[static_cast<std::size_t>(i)][a]);
+          value += ci.weights[static_cast<Eigen::Index>(a)] *
+                   cj.weights[static_cast<Eigen::Index>(b)] * ci.normal.dot(block * cj.normal);
         }
       compliance(i, j) = value;
       compliance(j, i) = value;  // exactly symmetric, as the wire and the check want
@@ -51,7 +53,8 @@ Eigen::MatrixXd target_normal_compliance(std::span<const PolygonCollision> colli
   return compliance;
 }
 
-NodeBacking compliance_backing(std::span<const PolygonCollision> collisions, ComplianceColumns& columns,
+NodeBacking compliance_backing(std::span<const PolygonCollision> collisions,
+                               ComplianceColumns& columns,
                                const Eigen::Ref<const Eigen::VectorXd>& masses, double time_step,
                                double damping_ratio) {
   const auto count = static_cast<Eigen::Index>(collisions.size());

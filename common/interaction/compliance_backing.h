@@ -29,12 +29,14 @@ namespace cohaptic {
 /// B's normal compliance at the targets of `collisions` (the first term above, without the
 /// contact compliance), |collisions| square and exactly symmetric; `columns` are B's, their
 /// row nodes including every polygon node.
-Eigen::MatrixXd target_normal_compliance(std::span<const PolygonCollision> collisions, ComplianceColumns& columns);
+Eigen::MatrixXd target_normal_compliance(std::span<const PolygonCollision> collisions,
+                                         ComplianceColumns& columns);
 
 /// The backing of `collisions` (targets on B's rest surface, active nodes of the front
 /// body whose node masses are `masses`); `columns` are B's, their row nodes including every
 /// polygon node; `time_step` the front body's substep [s] > 0.
-NodeBacking compliance_backing(std::span<const PolygonCollision> collisions, ComplianceColumns& columns,
+NodeBacking compliance_backing(std::span<const PolygonCollision> collisions,
+                               ComplianceColumns& columns,
                                const Eigen::Ref<const Eigen::VectorXd>& masses, double time_step,
                                double damping_ratio);
 

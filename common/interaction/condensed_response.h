@@ -31,8 +31,8 @@ struct CondensedResponseWorkspace {
 /// `forces` (3 per node; zero on fixed axes). Throws NumericalError when L_cc is not
 /// positive definite (a node listed twice).
 void condensed_reaction(ComplianceColumns& columns, const DofMap& dofs, std::span<const int> nodes,
-                        const Eigen::Ref<const Eigen::VectorXd>& displacement, Eigen::Ref<Eigen::VectorXd> forces,
-                        CondensedResponseWorkspace& workspace);
+                        const Eigen::Ref<const Eigen::VectorXd>& displacement,
+                        Eigen::Ref<Eigen::VectorXd> forces, CondensedResponseWorkspace& workspace);
 
 /// u of every row node of `columns` (3 per row node, row order) under forces `forces` at
 /// `nodes` (3 per node) [m], written to `row_displacement` (sized 3 |columns.row_nodes()|).
@@ -42,6 +42,7 @@ void condensed_deformation(ComplianceColumns& columns, std::span<const int> node
 
 /// L_cc^-1 over the 3|nodes| dofs of `nodes` (zero rows and columns on fixed axes): the
 /// behind body's stiffness condensed onto its displaced nodes [N/m].
-Eigen::MatrixXd condensed_stiffness(ComplianceColumns& columns, const DofMap& dofs, std::span<const int> nodes);
+Eigen::MatrixXd condensed_stiffness(ComplianceColumns& columns, const DofMap& dofs,
+                                    std::span<const int> nodes);
 
 }  // namespace cohaptic

@@ -27,8 +27,8 @@ ForcibleDisplacement forcible_displacement(std::span<const PolygonCollision> col
   std::sort(result.nodes.begin(), result.nodes.end());
   result.nodes.erase(std::unique(result.nodes.begin(), result.nodes.end()), result.nodes.end());
   const auto position = [&](int node) {
-    return static_cast<Eigen::Index>(std::lower_bound(result.nodes.begin(), result.nodes.end(), node) -
-                                     result.nodes.begin());
+    return static_cast<Eigen::Index>(
+        std::lower_bound(result.nodes.begin(), result.nodes.end(), node) - result.nodes.begin());
   };
   const auto node_count = static_cast<Eigen::Index>(result.nodes.size());
   const auto collision_count = static_cast<Eigen::Index>(collisions.size());
@@ -43,7 +43,8 @@ ForcibleDisplacement forcible_displacement(std::span<const PolygonCollision> col
       for (int axis = 0; axis < 3; ++axis) {
         Eigen::Vector3d free_weights = collision.weights;
         for (std::size_t corner = 0; corner < 3; ++corner)
-          if ((passive_fixed_axes[static_cast<std::size_t>(collision.polygon[corner])] >> axis) & 1u)
+          if ((passive_fixed_axes[static_cast<std::size_t>(collision.polygon[corner])] >> axis) &
+              1u)
             free_weights[static_cast<Eigen::Index>(corner)] = 0;
         if (free_weights.norm() <= kRankThreshold) continue;
         const Eigen::Vector3d share = free_weights / free_weights.squaredNorm();
@@ -56,7 +57,8 @@ ForcibleDisplacement forcible_displacement(std::span<const PolygonCollision> col
     return result;
   }
 
-  Eigen::MatrixXd conditions(collision_count, node_count);  // row k: w of collision k over the nodes
+  Eigen::MatrixXd conditions(collision_count,
+                             node_count);  // row k: w of collision k over the nodes
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> decomposition;
   decomposition.setThreshold(kRankThreshold);
   for (int axis = 0; axis < 3; ++axis) {
@@ -71,9 +73,11 @@ ForcibleDisplacement forcible_displacement(std::span<const PolygonCollision> col
     }
     if (conditions.isZero(0)) continue;
     decomposition.compute(conditions);
-    const Eigen::MatrixXd least_norm = decomposition.pseudoInverse();  // node_count x collision_count
+    const Eigen::MatrixXd least_norm =
+        decomposition.pseudoInverse();  // node_count x collision_count
     for (Eigen::Index j = 0; j < node_count; ++j)
-      for (Eigen::Index k = 0; k < collision_count; ++k) result.map(3 * j + axis, 3 * k + axis) = least_norm(j, k);
+      for (Eigen::Index k = 0; k < collision_count; ++k)
+        result.map(3 * j + axis, 3 * k + axis) = least_norm(j, k);
   }
   result.displacement = result.map * stacked_gaps(collisions);
   return result;

@@ -54,28 +54,32 @@ struct InteractionStep {
   ForcibleDisplacement displacement;
   Eigen::VectorXd passive_forces;       ///< f_c, 3 per displaced node [N]
   Eigen::VectorXd passive_deformation;  ///< u of every row node of the passive columns [m]
-  Eigen::VectorXd active_forces;        ///< reaction on each colliding active node, 3 per collision [N]
+  Eigen::VectorXd active_forces;  ///< reaction on each colliding active node, 3 per collision [N]
 };
 
 /// The collisions of the listed pairs (update of pairs is the caller's; see interaction_step).
-std::vector<PolygonCollision> find_polygon_collisions(const NodePairList& list, const InteractingBodies& bodies);
+std::vector<PolygonCollision> find_polygon_collisions(const NodePairList& list,
+                                                      const InteractingBodies& bodies);
 
 /// The pairs whose active node is behind a polygon around its passive node or at most
 /// `reach` [m] in front of it (the detailed test's target, without the instant test): the
 /// nodes a backing must hold before the next step, collided or about to.
-std::vector<PolygonCollision> find_polygons_within(const NodePairList& list, const InteractingBodies& bodies,
-                                                   double reach);
+std::vector<PolygonCollision> find_polygons_within(const NodePairList& list,
+                                                   const InteractingBodies& bodies, double reach);
 
 /// The pairs as a server step keeps them (Sec. 2.5): each walked to the nearest passive node,
 /// then grown from the neighbours of every colliding node; then find_polygons_within(reach).
-std::vector<PolygonCollision> keep_pairs_and_find_within(NodePairList& list, const InteractingBodies& bodies,
+std::vector<PolygonCollision> keep_pairs_and_find_within(NodePairList& list,
+                                                         const InteractingBodies& bodies,
                                                          double reach);
 
 /// Reaction on the active nodes: -map^T passive_forces, 3 per collision [N].
-Eigen::VectorXd convey_reaction(const ForcibleDisplacement& displacement, const Eigen::VectorXd& passive_forces);
+Eigen::VectorXd convey_reaction(const ForcibleDisplacement& displacement,
+                                const Eigen::VectorXd& passive_forces);
 
 /// One step; `list` is updated and grown.
-InteractionStep interaction_step(NodePairList& list, const InteractingBodies& bodies, InteractionWorkflow workflow,
+InteractionStep interaction_step(NodePairList& list, const InteractingBodies& bodies,
+                                 InteractionWorkflow workflow,
                                  CondensedResponseWorkspace& workspace);
 
 }  // namespace cohaptic

@@ -32,12 +32,14 @@ struct LinearBacking {
 /// condensed stiffness on those nodes is `passive_stiffness` (3|displaced| square);
 /// `active_rest_positions` per front-body node [m].
 LinearBacking build_linear_backing(std::span<const PolygonCollision> collisions,
-                                   const ForcibleDisplacement& displacement, const Eigen::MatrixXd& passive_stiffness,
+                                   const ForcibleDisplacement& displacement,
+                                   const Eigen::MatrixXd& passive_stiffness,
                                    const Eigen::Ref<const Eigen::Matrix3Xd>& active_rest_positions);
 
 /// f = -K (u - u*) for displacements u (3 per node of backing.nodes); f and u sized
 /// 3|nodes|.
-void evaluate_linear_backing(const LinearBacking& backing, const Eigen::Ref<const Eigen::VectorXd>& displacement,
+void evaluate_linear_backing(const LinearBacking& backing,
+                             const Eigen::Ref<const Eigen::VectorXd>& displacement,
                              Eigen::Ref<Eigen::VectorXd> force) noexcept;
 
 }  // namespace cohaptic

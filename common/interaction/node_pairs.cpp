@@ -4,8 +4,10 @@
 
 namespace cohaptic {
 
-NodePairList make_node_pairs(std::span<const int> active_nodes, const NodePositions& active_positions,
-                             std::span<const int> passive_nodes, const NodePositions& passive_positions) {
+NodePairList make_node_pairs(std::span<const int> active_nodes,
+                             const NodePositions& active_positions,
+                             std::span<const int> passive_nodes,
+                             const NodePositions& passive_positions) {
   NodePairList list;
   list.paired.assign(static_cast<std::size_t>(active_positions.cols()), 0);
   list.pairs.reserve(list.paired.size());
@@ -15,7 +17,8 @@ NodePairList make_node_pairs(std::span<const int> active_nodes, const NodePositi
     int nearest = passive_nodes.front();
     double nearest_squared = std::numeric_limits<double>::infinity();
     for (const int passive : passive_nodes) {
-      const double squared = (passive_positions.col(passive) - active_positions.col(active)).squaredNorm();
+      const double squared =
+          (passive_positions.col(passive) - active_positions.col(active)).squaredNorm();
       if (squared < nearest_squared) {
         nearest_squared = squared;
         nearest = passive;
@@ -27,7 +30,8 @@ NodePairList make_node_pairs(std::span<const int> active_nodes, const NodePositi
   return list;
 }
 
-int walk_to_nearest_node(const Eigen::Vector3d& point, int start, const NodePositions& passive_positions,
+int walk_to_nearest_node(const Eigen::Vector3d& point, int start,
+                         const NodePositions& passive_positions,
                          const SurfaceAdjacency& passive_surface) noexcept {
   int node = start;
   double squared = (passive_positions.col(node) - point).squaredNorm();
@@ -45,20 +49,23 @@ int walk_to_nearest_node(const Eigen::Vector3d& point, int start, const NodePosi
   return node;
 }
 
-int update_node_pairs(NodePairList& list, const NodePositions& active_positions, const NodePositions& passive_positions,
+int update_node_pairs(NodePairList& list, const NodePositions& active_positions,
+                      const NodePositions& passive_positions,
                       const SurfaceAdjacency& passive_surface) noexcept {
   int changed = 0;
   for (NodePair& pair : list.pairs) {
-    const int nearest =
-        walk_to_nearest_node(active_positions.col(pair.active), pair.passive, passive_positions, passive_surface);
+    const int nearest = walk_to_nearest_node(active_positions.col(pair.active), pair.passive,
+                                             passive_positions, passive_surface);
     changed += nearest != pair.passive;
     pair.passive = nearest;
   }
   return changed;
 }
 
-int add_neighbour_pairs(NodePairList& list, std::span<const int> colliding, const NodePositions& active_positions,
-                        const SurfaceAdjacency& active_surface, const NodePositions& passive_positions,
+int add_neighbour_pairs(NodePairList& list, std::span<const int> colliding,
+                        const NodePositions& active_positions,
+                        const SurfaceAdjacency& active_surface,
+                        const NodePositions& passive_positions,
                         const SurfaceAdjacency& passive_surface) {
   int added = 0;
   for (const int index : colliding) {
@@ -68,8 +75,9 @@ int add_neighbour_pairs(NodePairList& list, std::span<const int> colliding, cons
       char& paired = list.paired[static_cast<std::size_t>(neighbour)];
       if (paired) continue;
       paired = 1;
-      list.pairs.push_back({neighbour, walk_to_nearest_node(active_positions.col(neighbour), pair.passive,
-                                                            passive_positions, passive_surface)});
+      list.pairs.push_back(
+          {neighbour, walk_to_nearest_node(active_positions.col(neighbour), pair.passive,
+                                           passive_positions, passive_surface)});
       ++added;
     }
   }

@@ -31,21 +31,27 @@ struct NodePairList {
 };
 
 /// Pairs each of `active_nodes` with the nearest of `passive_nodes` (brute force).
-NodePairList make_node_pairs(std::span<const int> active_nodes, const NodePositions& active_positions,
-                             std::span<const int> passive_nodes, const NodePositions& passive_positions);
+NodePairList make_node_pairs(std::span<const int> active_nodes,
+                             const NodePositions& active_positions,
+                             std::span<const int> passive_nodes,
+                             const NodePositions& passive_positions);
 
 /// From `start`, the surface neighbour nearer `point` while there is one: a local nearest.
-int walk_to_nearest_node(const Eigen::Vector3d& point, int start, const NodePositions& passive_positions,
+int walk_to_nearest_node(const Eigen::Vector3d& point, int start,
+                         const NodePositions& passive_positions,
                          const SurfaceAdjacency& passive_surface) noexcept;
 
 /// Update of pairs: every passive node walked to its local nearest. Returns how many changed.
-int update_node_pairs(NodePairList& list, const NodePositions& active_positions, const NodePositions& passive_positions,
+int update_node_pairs(NodePairList& list, const NodePositions& active_positions,
+                      const NodePositions& passive_positions,
                       const SurfaceAdjacency& passive_surface) noexcept;
 
 /// Addition of pairs: the surface neighbours of the active node of each pair in
 /// `colliding` (indices into list.pairs) that are not yet paired. Returns how many joined.
-int add_neighbour_pairs(NodePairList& list, std::span<const int> colliding, const NodePositions& active_positions,
-                        const SurfaceAdjacency& active_surface, const NodePositions& passive_positions,
+int add_neighbour_pairs(NodePairList& list, std::span<const int> colliding,
+                        const NodePositions& active_positions,
+                        const SurfaceAdjacency& active_surface,
+                        const NodePositions& passive_positions,
                         const SurfaceAdjacency& passive_surface);
 
 }  // namespace cohaptic

@@ -19,7 +19,8 @@ double doubled_area(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Ei
 
 }  // namespace
 
-bool instant_collision_test(const Eigen::Vector3d& active, int passive_node, const NodePositions& passive_positions,
+bool instant_collision_test(const Eigen::Vector3d& active, int passive_node,
+                            const NodePositions& passive_positions,
                             const SurfaceAdjacency& passive_surface) noexcept {
   const auto around = passive_surface.triangles_around(passive_node);
   if (around.empty()) return false;
@@ -27,15 +28,16 @@ bool instant_collision_test(const Eigen::Vector3d& active, int passive_node, con
   for (const int t : around) {
     const Triangle& tri = passive_surface.triangles[static_cast<std::size_t>(t)];
     const Eigen::Vector3d a = corner(passive_positions, tri, 0);
-    const Eigen::Vector3d normal = (corner(passive_positions, tri, 1) - a).cross(corner(passive_positions, tri, 2) - a);
+    const Eigen::Vector3d normal =
+        (corner(passive_positions, tri, 1) - a).cross(corner(passive_positions, tri, 2) - a);
     if ((active - passive).dot(normal) > 0) return false;
   }
   return true;
 }
 
-std::optional<PolygonTarget> detailed_collision_test(const Eigen::Vector3d& active, int passive_node,
-                                                     const NodePositions& passive_positions,
-                                                     const SurfaceAdjacency& passive_surface) noexcept {
+std::optional<PolygonTarget> detailed_collision_test(
+    const Eigen::Vector3d& active, int passive_node, const NodePositions& passive_positions,
+    const SurfaceAdjacency& passive_surface) noexcept {
   std::optional<PolygonTarget> nearest;
   double nearest_distance = std::numeric_limits<double>::infinity();
   for (const int t : passive_surface.triangles_around(passive_node)) {
@@ -51,7 +53,8 @@ std::optional<PolygonTarget> detailed_collision_test(const Eigen::Vector3d& acti
     const double distance = std::abs(height);
     if (distance >= nearest_distance) continue;
     const Eigen::Vector3d foot = active - height * normal;
-    const Eigen::Vector3d weights(doubled_area(foot, b, c, normal), doubled_area(foot, c, a, normal),
+    const Eigen::Vector3d weights(doubled_area(foot, b, c, normal),
+                                  doubled_area(foot, c, a, normal),
                                   doubled_area(foot, a, b, normal));
     if (weights.minCoeff() < 0) continue;
     nearest_distance = distance;
@@ -60,10 +63,11 @@ std::optional<PolygonTarget> detailed_collision_test(const Eigen::Vector3d& acti
   return nearest;
 }
 
-std::optional<PolygonTarget> node_polygon_collision(const Eigen::Vector3d& active, int passive_node,
-                                                    const NodePositions& passive_positions,
-                                                    const SurfaceAdjacency& passive_surface) noexcept {
-  if (!instant_collision_test(active, passive_node, passive_positions, passive_surface)) return std::nullopt;
+std::optional<PolygonTarget> node_polygon_collision(
+    const Eigen::Vector3d& active, int passive_node, const NodePositions& passive_positions,
+    const SurfaceAdjacency& passive_surface) noexcept {
+  if (!instant_collision_test(active, passive_node, passive_positions, passive_surface))
+    return std::nullopt;
   return detailed_collision_test(active, passive_node, passive_positions, passive_surface);
 }
 

@@ -35,18 +35,19 @@ struct PolygonTarget {
 
 /// Eq. (0) for `active` against the polygons around `passive_node`; false when the node is
 /// on no polygon.
-bool instant_collision_test(const Eigen::Vector3d& active, int passive_node, const NodePositions& passive_positions,
+bool instant_collision_test(const Eigen::Vector3d& active, int passive_node,
+                            const NodePositions& passive_positions,
                             const SurfaceAdjacency& passive_surface) noexcept;
 
 /// The detailed test and the target point: empty when no foot of the perpendicular from
 /// `active` falls inside a polygon around `passive_node`.
-std::optional<PolygonTarget> detailed_collision_test(const Eigen::Vector3d& active, int passive_node,
-                                                     const NodePositions& passive_positions,
-                                                     const SurfaceAdjacency& passive_surface) noexcept;
+std::optional<PolygonTarget> detailed_collision_test(
+    const Eigen::Vector3d& active, int passive_node, const NodePositions& passive_positions,
+    const SurfaceAdjacency& passive_surface) noexcept;
 
 /// Both tests in the paper's order: the target point, or empty when there is no collision.
-std::optional<PolygonTarget> node_polygon_collision(const Eigen::Vector3d& active, int passive_node,
-                                                    const NodePositions& passive_positions,
-                                                    const SurfaceAdjacency& passive_surface) noexcept;
+std::optional<PolygonTarget> node_polygon_collision(
+    const Eigen::Vector3d& active, int passive_node, const NodePositions& passive_positions,
+    const SurfaceAdjacency& passive_surface) noexcept;
 
 }  // namespace cohaptic

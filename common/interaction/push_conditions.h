@@ -53,17 +53,17 @@ struct BehindBody {
 };
 
 struct PushSample {
-  double depth = 0;               ///< [m]
-  double force = 0;               ///< the tool's force along the push axis [N]
-  Eigen::VectorXd displacement;   ///< A's, 3 per node [m]
+  double depth = 0;                          ///< [m]
+  double force = 0;                          ///< the tool's force along the push axis [N]
+  Eigen::VectorXd displacement;              ///< A's, 3 per node [m]
   std::vector<PolygonCollision> collisions;  ///< on B: the back nodes pressing B
   ForcibleDisplacement forcible;             ///< on B: B's displaced nodes per gap
-  int released = 0;               ///< on B: back nodes released because B would pull them
+  int released = 0;  ///< on B: back nodes released because B would pull them
 };
 
 /// The push to each of `depths` [m] in `condition`; `behind` is required for on_behind
 /// (throws Error without it, or when no back node touches B).
-std::vector<PushSample> push_front(const PushedFront& front, BackCondition condition, const BehindBody* behind,
-                                   std::span<const double> depths);
+std::vector<PushSample> push_front(const PushedFront& front, BackCondition condition,
+                                   const BehindBody* behind, std::span<const double> depths);
 
 }  // namespace cohaptic

@@ -10,9 +10,11 @@ namespace cohaptic {
 namespace {
 
 // CSR from per-node lists.
-void to_csr(const std::vector<std::vector<int>>& lists, std::vector<int>& offsets, std::vector<int>& values) {
+void to_csr(const std::vector<std::vector<int>>& lists, std::vector<int>& offsets,
+            std::vector<int>& values) {
   offsets.assign(lists.size() + 1, 0);
-  for (std::size_t i = 0; i < lists.size(); ++i) offsets[i + 1] = offsets[i] + static_cast<int>(lists[i].size());
+  for (std::size_t i = 0; i < lists.size(); ++i)
+    offsets[i + 1] = offsets[i] + static_cast<int>(lists[i].size());
   values.clear();
   values.reserve(static_cast<std::size_t>(offsets.back()));
   for (const auto& list : lists) values.insert(values.end(), list.begin(), list.end());
@@ -27,8 +29,10 @@ SurfaceAdjacency make_surface_adjacency(std::vector<Triangle> triangles, int nod
     const Triangle& tri = triangles[t];
     for (int k = 0; k < 3; ++k) {
       if (tri[k] < 0 || tri[k] >= node_count)
-        throw Error(fmt::format("surface triangle {} names node {}, outside 0..{}", t, tri[k], node_count - 1));
-      if (tri[k] == tri[(k + 1) % 3]) throw Error(fmt::format("surface triangle {} repeats node {}", t, tri[k]));
+        throw Error(fmt::format("surface triangle {} names node {}, outside 0..{}", t, tri[k],
+                                node_count - 1));
+      if (tri[k] == tri[(k + 1) % 3])
+        throw Error(fmt::format("surface triangle {} repeats node {}", t, tri[k]));
     }
     for (int k = 0; k < 3; ++k) {
       const auto node = static_cast<std::size_t>(tri[k]);

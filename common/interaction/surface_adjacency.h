@@ -23,11 +23,16 @@ struct SurfaceAdjacency {
   std::vector<int> neighbour_list;     ///< nodes sharing a surface edge, ascending
 
   int node_count() const { return static_cast<int>(triangle_offsets.size()) - 1; }
-  std::span<const int> triangles_around(int node) const { return slice(triangle_offsets, triangle_list, node); }
-  std::span<const int> neighbours(int node) const { return slice(neighbour_offsets, neighbour_list, node); }
+  std::span<const int> triangles_around(int node) const {
+    return slice(triangle_offsets, triangle_list, node);
+  }
+  std::span<const int> neighbours(int node) const {
+    return slice(neighbour_offsets, neighbour_list, node);
+  }
 
  private:
-  static std::span<const int> slice(const std::vector<int>& offsets, const std::vector<int>& list, int node) {
+  static std::span<const int> slice(const std::vector<int>& offsets, const std::vector<int>& list,
+                                    int node) {
     const auto begin = static_cast<std::size_t>(offsets[static_cast<std::size_t>(node)]);
     const auto end = static_cast<std::size_t>(offsets[static_cast<std::size_t>(node) + 1]);
     return {list.data() + begin, end - begin};

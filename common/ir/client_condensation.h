@@ -12,9 +12,9 @@
 //
 // An IR it cannot complete (a generation that does not follow the one held, a row count
 // that does not match the added nodes' free dofs, non-finite rows, a held node whose
-// fixed axes changed, a node listed twice, also as kept and truncated) throws Error saying which, and changes nothing:
-// the next IR that follows the held generation still completes exactly. Units: m/N, N/m.
-// Not thread-safe: one I/O thread owns it.
+// fixed axes changed, a node listed twice, also as kept and truncated) throws Error saying which,
+// and changes nothing: the next IR that follows the held generation still completes exactly. Units:
+// m/N, N/m. Not thread-safe: one I/O thread owns it.
 #pragma once
 
 #include <cstdint>

@@ -4,7 +4,8 @@
 
 namespace cohaptic {
 
-std::vector<std::int64_t> held_after(std::span<const std::int64_t> held, std::span<const std::int64_t> ir_nodes) {
+std::vector<std::int64_t> held_after(std::span<const std::int64_t> held,
+                                     std::span<const std::int64_t> ir_nodes) {
   const std::unordered_set<std::int64_t> in_ir(ir_nodes.begin(), ir_nodes.end());
   std::vector<std::int64_t> after;
   after.reserve(ir_nodes.size());

@@ -30,6 +30,7 @@ struct ComplianceRows {
 };
 
 /// The nodes held after an IR with nodes `ir_nodes`, given those held before (the rule above).
-std::vector<std::int64_t> held_after(std::span<const std::int64_t> held, std::span<const std::int64_t> ir_nodes);
+std::vector<std::int64_t> held_after(std::span<const std::int64_t> held,
+                                     std::span<const std::int64_t> ir_nodes);
 
 }  // namespace cohaptic

@@ -23,7 +23,8 @@ class ComplianceRowsSender {
   /// the mesh node of each of ir.held_node_ids() (with B truncation these include the held
   /// nodes the IR leaves out). The client holds all of them afterwards. Throws Error if the
   /// sizes do not match.
-  void convert(CondensedFemIr& ir, std::span<const int> mesh_nodes, ComplianceSource& columns, const DofMap& dofs);
+  void convert(CondensedFemIr& ir, std::span<const int> mesh_nodes, ComplianceSource& columns,
+               const DofMap& dofs);
   /// The client holds nothing (a new user of the slot, another body): the next IR starts
   /// generation 1 with every row.
   void restart();

@@ -20,7 +20,8 @@ namespace cohaptic {
 
 constexpr int kMaxContactDofs = 9 * kMaxUsers;
 
-using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxContactDofs, kMaxContactDofs>;
+using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor,
+                                  kMaxContactDofs, kMaxContactDofs>;
 using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxContactDofs, 1>;
 
 /// One contact dof: its tool, axis and the area coordinate of its node in that tool's triangle.
@@ -33,8 +34,10 @@ struct ContactDof {
 /// Fills `nodal_forces` (per dof, the tool's force on the node) and `tool_forces` (the
 /// force each tool applies to the object). Returns false if a system was not positive
 /// definite (the outputs are then meaningless).
-bool solve_contact_forces(ContactModel model, const SmallMatrix& compliance, const SmallVector& free_displacement,
-                          std::span<const ContactDof> dofs, std::span<const Eigen::Vector3d> tool_displacement,
-                          SmallVector& nodal_forces, std::span<Eigen::Vector3d> tool_forces) noexcept;
+bool solve_contact_forces(ContactModel model, const SmallMatrix& compliance,
+                          const SmallVector& free_displacement, std::span<const ContactDof> dofs,
+                          std::span<const Eigen::Vector3d> tool_displacement,
+                          SmallVector& nodal_forces,
+                          std::span<Eigen::Vector3d> tool_forces) noexcept;
 
 }  // namespace cohaptic

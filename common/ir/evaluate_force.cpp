@@ -34,7 +34,8 @@ struct PatchPoint {
   bool on_border = false;  // nearest the patch's rim or beyond it
 };
 
-PatchPoint nearest_on_patch(const CondensedFemIr& ir, const PreparedFem& prepared, const Eigen::Vector3d& p) {
+PatchPoint nearest_on_patch(const CondensedFemIr& ir, const PreparedFem& prepared,
+                            const Eigen::Vector3d& p) {
   PatchPoint best;
   NearestTriangleRule rule;  // on the patch's surface indices: the server's choice (find_contact.h)
   for (int t = 0; t < static_cast<int>(ir.patch.size()); ++t) {
@@ -62,7 +63,8 @@ PatchPoint nearest_on_patch(const CondensedFemIr& ir, const PreparedFem& prepare
   // Beyond the rim the guard ring decides the side, with its faces' normals.
   double guard_distance2 = rule.distance2();
   for (const IrGuardTriangle& guard : ir.guard) {
-    const TriangleClosestPoint q = closest_point_on_triangle(p, guard.corners[0], guard.corners[1], guard.corners[2]);
+    const TriangleClosestPoint q =
+        closest_point_on_triangle(p, guard.corners[0], guard.corners[1], guard.corners[2]);
     const double d2 = (p - q.point).squaredNorm();
     if (strictly_nearer(d2, guard_distance2)) {
       guard_distance2 = d2;
@@ -82,13 +84,18 @@ void check_fem_geometry(const CondensedFemIr& ir) {
   if (!ir.rest_positions.allFinite()) throw Error("intermediate representation: non-finite values");
   for (const IrTriangle& tri : ir.patch)
     for (int k = 0; k < 3; ++k)
-      if (tri.nodes[k] < 0 || tri.nodes[k] >= ir.patch_node_count || tri.neighbours[k] >= static_cast<int>(ir.patch.size()))
-        throw Error("intermediate representation: a patch triangle refers to a node or triangle outside the patch");
+      if (tri.nodes[k] < 0 || tri.nodes[k] >= ir.patch_node_count ||
+          tri.neighbours[k] >= static_cast<int>(ir.patch.size()))
+        throw Error(
+            "intermediate representation: a patch triangle refers to a node or triangle outside "
+            "the patch");
   if (static_cast<int>(ir.remotes.size()) >= kMaxUsers)
-    throw Error(fmt::format("intermediate representation: {} remote users, at most {} supported", ir.remotes.size(), kMaxUsers - 1));
+    throw Error(fmt::format("intermediate representation: {} remote users, at most {} supported",
+                            ir.remotes.size(), kMaxUsers - 1));
   for (const IrRemoteContact& remote : ir.remotes)
     for (int node : remote.nodes)
-      if (node < 0 || node >= rows) throw Error("intermediate representation: a remote contact refers to a non-contact node");
+      if (node < 0 || node >= rows)
+        throw Error("intermediate representation: a remote contact refers to a non-contact node");
   if (ir.patch_vertex_normals.cols() != ir.patch_node_count || !ir.patch_vertex_normals.allFinite())
     throw Error("intermediate representation: patch vertex normals missing or not finite");
 }
@@ -97,18 +104,24 @@ void check_fem_geometry(const CondensedFemIr& ir) {
 void prepare_m_tilde(const CondensedFemIr& ir, PreparedFem& prepared, double& condition_estimate) {
   const int rows = ir.row_node_count;
   if (ir.compliance_rows)
-    throw Error("intermediate representation: it carries compliance rows, not M~ (a ClientCondensation completes it first)");
-  if (ir.sphere) throw Error("intermediate representation: a sphere contact part under another contact model");
+    throw Error(
+        "intermediate representation: it carries compliance rows, not M~ (a ClientCondensation "
+        "completes it first)");
+  if (ir.sphere)
+    throw Error("intermediate representation: a sphere contact part under another contact model");
   const std::vector<int> row_dofs = ir_dofs(ir, 0, rows);
   const std::vector<int> boundary_dofs = ir_dofs(ir, rows, ir.node_count());
   const auto x = static_cast<Eigen::Index>(row_dofs.size());
   const auto b = static_cast<Eigen::Index>(boundary_dofs.size());
   if (ir.m_tilde.rows() != x || ir.m_tilde.cols() != x + b || ir.boundary_displacement.size() != b)
-    throw Error(fmt::format("intermediate representation: M~ is {}x{} and u_B {} long, expected {}x{} and {}",
-                            ir.m_tilde.rows(), ir.m_tilde.cols(), ir.boundary_displacement.size(), x, x + b, b));
+    throw Error(fmt::format(
+        "intermediate representation: M~ is {}x{} and u_B {} long, expected {}x{} and {}",
+        ir.m_tilde.rows(), ir.m_tilde.cols(), ir.boundary_displacement.size(), x, x + b, b));
   if (ir.rest_forces.size() != 0 && ir.rest_forces.size() != x)
-    throw Error(fmt::format("intermediate representation: {} rest forces for {} contact dofs", ir.rest_forces.size(), x));
-  if (!ir.m_tilde.allFinite() || !ir.boundary_displacement.allFinite() || !ir.rest_forces.allFinite())
+    throw Error(fmt::format("intermediate representation: {} rest forces for {} contact dofs",
+                            ir.rest_forces.size(), x));
+  if (!ir.m_tilde.allFinite() || !ir.boundary_displacement.allFinite() ||
+      !ir.rest_forces.allFinite())
     throw Error("intermediate representation: non-finite values");
 
   // M_CC is symmetric as every server builds it (to round-off at most): an asymmetric one
@@ -117,11 +130,13 @@ void prepare_m_tilde(const CondensedFemIr& ir, PreparedFem& prepared, double& co
   const double asymmetry = x > 0 ? (sent_m_cc - sent_m_cc.transpose()).cwiseAbs().maxCoeff() : 0.0;
   const double scale = x > 0 ? sent_m_cc.cwiseAbs().maxCoeff() : 0.0;
   if (asymmetry > kMaxRelativeAsymmetry * scale)
-    throw Error(fmt::format("intermediate representation: M_CC is not symmetric (|M - M^T| up to {:g}, |M| up to {:g})",
-                            asymmetry, scale));
+    throw Error(fmt::format(
+        "intermediate representation: M_CC is not symmetric (|M - M^T| up to {:g}, |M| up to {:g})",
+        asymmetry, scale));
   const Eigen::MatrixXd m_cc = 0.5 * (sent_m_cc + sent_m_cc.transpose());
   const Eigen::LLT<Eigen::MatrixXd> llt(m_cc);
-  if (llt.info() != Eigen::Success) throw Error("intermediate representation: M_CC is not positive definite");
+  if (llt.info() != Eigen::Success)
+    throw Error("intermediate representation: M_CC is not positive definite");
   prepared.compliance = llt.solve(Eigen::MatrixXd::Identity(x, x));
   prepared.compliance = 0.5 * (prepared.compliance + prepared.compliance.transpose()).eval();
   // Unloaded by the tools, C carries no force: M_CC u0 + M_CB u_B + f_rest = 0.
@@ -131,10 +146,12 @@ void prepare_m_tilde(const CondensedFemIr& ir, PreparedFem& prepared, double& co
   condition_estimate = cholesky_condition_estimate(llt.matrixL());
 
   prepared.dof_index.assign(static_cast<std::size_t>(rows), {-1, -1, -1});
-  for (int i = 0; i < static_cast<int>(row_dofs.size()); ++i) prepared.dof_index[row_dofs[i] / 3][row_dofs[i] % 3] = i;
+  for (int i = 0; i < static_cast<int>(row_dofs.size()); ++i)
+    prepared.dof_index[row_dofs[i] / 3][row_dofs[i] % 3] = i;
 }
 
-PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, double& condition_estimate) {
+PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius,
+                                  double& condition_estimate) {
   check_fem_geometry(ir);
   PreparedFem prepared;
   if (ir.contact_model == ContactModel::sphere)
@@ -144,13 +161,16 @@ PreparedFem prepare_condensed_fem(const CondensedFemIr& ir, double tool_radius, 
   prepared.on_patch_border.assign(static_cast<std::size_t>(ir.patch_node_count), false);
   for (const IrTriangle& tri : ir.patch)
     for (int k = 0; k < 3; ++k)
-      if (tri.neighbours[k] < 0) prepared.on_patch_border[tri.nodes[k]] = prepared.on_patch_border[tri.nodes[(k + 1) % 3]] = true;
+      if (tri.neighbours[k] < 0)
+        prepared.on_patch_border[tri.nodes[k]] = prepared.on_patch_border[tri.nodes[(k + 1) % 3]] =
+            true;
   return prepared;
 }
 
 // The condensed FEM body's force: `envelope` holds the tool radius and the force limit.
-ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
-                                   const PreparedFem& prepared, const Eigen::Vector3d& own_tool,
+ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope,
+                                   const CondensedFemIr& ir, const PreparedFem& prepared,
+                                   const Eigen::Vector3d& own_tool,
                                    std::span<const Eigen::Vector3d> remote_tools) noexcept {
   ForceSample sample;
   if (!own_tool.allFinite()) {
@@ -170,7 +190,8 @@ ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, c
   int pressing_count = 1;
   pressing[0].nodes = own_triangle.nodes;
   pressing[0].weights = own.closest.weights;
-  pressing[0].displacement = own_tool - envelope.tool_radius * own_triangle.normal - own.closest.point;
+  pressing[0].displacement =
+      own_tool - envelope.tool_radius * own_triangle.normal - own.closest.point;
   sample.depth = -pressing[0].displacement.dot(own_triangle.normal);
 
   // 2. Remote tools against their triangles; an unpressed remote's nodes stay unloaded.
@@ -178,16 +199,19 @@ ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, c
     const IrRemoteContact& remote = ir.remotes[r];
     const Eigen::Vector3d& p = remote_tools[r];
     if (!p.allFinite()) continue;
-    const TriangleClosestPoint q = closest_point_on_triangle(p, ir.rest_positions.col(remote.nodes[0]),
-                                                             ir.rest_positions.col(remote.nodes[1]),
-                                                             ir.rest_positions.col(remote.nodes[2]));
+    const TriangleClosestPoint q = closest_point_on_triangle(
+        p, ir.rest_positions.col(remote.nodes[0]), ir.rest_positions.col(remote.nodes[1]),
+        ir.rest_positions.col(remote.nodes[2]));
     const TriangleFeature feature = feature_of(q.weights);
-    const Eigen::Vector3d& sign_normal = feature.kind == TriangleFeature::Kind::edge     ? remote.edge_normals[feature.index]
-                                         : feature.kind == TriangleFeature::Kind::vertex ? remote.vertex_normals[feature.index]
-                                                                                          : remote.normal;
+    const Eigen::Vector3d& sign_normal =
+        feature.kind == TriangleFeature::Kind::edge     ? remote.edge_normals[feature.index]
+        : feature.kind == TriangleFeature::Kind::vertex ? remote.vertex_normals[feature.index]
+                                                        : remote.normal;
     if (!((p - q.point).dot(sign_normal) < remote.tool_radius)) continue;
-    bool overlaps = false;  // with the own tool's triangle or an earlier remote's: a node follows one tool
-    for (int t = 0; t < pressing_count; ++t) overlaps |= share_a_node(remote.nodes, pressing[t].nodes);
+    bool overlaps =
+        false;  // with the own tool's triangle or an earlier remote's: a node follows one tool
+    for (int t = 0; t < pressing_count; ++t)
+      overlaps |= share_a_node(remote.nodes, pressing[t].nodes);
     if (overlaps) {
       sample.flags |= kRemoteOverlap;
       continue;
@@ -226,9 +250,10 @@ ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, c
   }
   SmallVector nodal_forces;
   std::array<Eigen::Vector3d, kMaxUsers> tool_forces{};
-  const bool solved = solve_contact_forces(ir.contact_model, l_zz, u0, std::span(z_dofs.data(), static_cast<std::size_t>(z)),
-                                           std::span(displacement.data(), static_cast<std::size_t>(pressing_count)),
-                                           nodal_forces, std::span(tool_forces.data(), static_cast<std::size_t>(pressing_count)));
+  const bool solved = solve_contact_forces(
+      ir.contact_model, l_zz, u0, std::span(z_dofs.data(), static_cast<std::size_t>(z)),
+      std::span(displacement.data(), static_cast<std::size_t>(pressing_count)), nodal_forces,
+      std::span(tool_forces.data(), static_cast<std::size_t>(pressing_count)));
   const Eigen::Vector3d contact_force = tool_forces[0];
 
   // 4. Safety: never a non-finite or unbounded force.
@@ -239,7 +264,8 @@ ForceSample evaluate_condensed_fem(const IntermediateRepresentation& envelope, c
 
 ForceSample evaluate_mass_spring(const IntermediateRepresentation& envelope, const MassSpringIr& ir,
                                  const PreparedMassSpring& prepared, MassSpringPatchState& state,
-                                 const Eigen::Vector3d& own_tool, std::span<const Eigen::Vector3d> remote_tools,
+                                 const Eigen::Vector3d& own_tool,
+                                 std::span<const Eigen::Vector3d> remote_tools,
                                  double dt) noexcept {
   const NetworkToolReaction reaction =
       advance_mass_spring(ir, prepared, state, own_tool, envelope.tool_radius, remote_tools, dt);
@@ -247,13 +273,15 @@ ForceSample evaluate_mass_spring(const IntermediateRepresentation& envelope, con
   sample.force = reaction.force;
   sample.depth = reaction.depth;
   if (reaction.colliding) sample.flags |= kInContact;
-  if (remote_tools.size() + 1 > static_cast<std::size_t>(kMaxNetworkTools)) sample.flags |= kTooManyRemotes;
+  if (remote_tools.size() + 1 > static_cast<std::size_t>(kMaxNetworkTools))
+    sample.flags |= kTooManyRemotes;
   limit_force(sample, state.network.positions.allFinite(), envelope.force_limit);
   return sample;
 }
 
 ForceSample evaluate_home_spring_body(const IntermediateRepresentation& envelope,
-                                      const PreparedHomeSpringPatch& prepared, const Eigen::Vector3d& own_tool) noexcept {
+                                      const PreparedHomeSpringPatch& prepared,
+                                      const Eigen::Vector3d& own_tool) noexcept {
   const HomeSpringContact contact = evaluate_home_spring(prepared, own_tool);
   ForceSample sample;
   sample.force = contact.force;
@@ -272,8 +300,12 @@ struct BodyPreparer {
   PreparedBody operator()(const CondensedFemIr& fem) const {
     return prepare_condensed_fem(fem, tool_radius, condition_estimate);
   }
-  PreparedBody operator()(const MassSpringIr& network) const { return prepare_mass_spring(network); }
-  PreparedBody operator()(const HomeSpringPatch& patch) const { return prepare_home_spring_patch(patch); }
+  PreparedBody operator()(const MassSpringIr& network) const {
+    return prepare_mass_spring(network);
+  }
+  PreparedBody operator()(const HomeSpringPatch& patch) const {
+    return prepare_home_spring_patch(patch);
+  }
   PreparedBody operator()(const SeparationIr& separation) const {
     validate_separation_ir(separation);
     return PreparedSeparation{};
@@ -305,34 +337,41 @@ EvaluationState make_evaluation_state(const PreparedIR& prepared) {
   EvaluationState state;
   if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
     state.body = make_mass_spring_state(*network, std::get<PreparedMassSpring>(prepared.body));
-  else if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body); fem && fem->contact_model == ContactModel::sphere)
-    state.body = make_sphere_contact_state(std::get<PreparedFem>(prepared.body).sphere, fem->row_node_count);
+  else if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body);
+           fem && fem->contact_model == ContactModel::sphere)
+    state.body =
+        make_sphere_contact_state(std::get<PreparedFem>(prepared.body).sphere, fem->row_node_count);
   else if (const auto* separation = std::get_if<SeparationIr>(&prepared.ir.body))
     state.body = SeparationEvaluation{separation->state, separation->tool_state};
   return state;
 }
 
-ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, const Eigen::Vector3d& own_tool,
-                           std::span<const Eigen::Vector3d> remote_tools, double dt, std::uint32_t buttons) noexcept {
+ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state,
+                           const Eigen::Vector3d& own_tool,
+                           std::span<const Eigen::Vector3d> remote_tools, double dt,
+                           std::uint32_t buttons) noexcept {
   // get_if, not visit: nothing on this path may throw. prepare_ir made the kinds match.
   if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body))
     if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body)) {
       if (fem->contact_model == ContactModel::sphere)
-        return evaluate_sphere_contact(prepared.ir, *fem, *prepared_fem, std::get_if<SphereContactState>(&state.body),
-                                       own_tool, remote_tools);
+        return evaluate_sphere_contact(prepared.ir, *fem, *prepared_fem,
+                                       std::get_if<SphereContactState>(&state.body), own_tool,
+                                       remote_tools);
       return evaluate_condensed_fem(prepared.ir, *fem, *prepared_fem, own_tool, remote_tools);
     }
   if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
     if (const auto* prepared_network = std::get_if<PreparedMassSpring>(&prepared.body))
       if (auto* network_state = std::get_if<MassSpringPatchState>(&state.body))
-        return evaluate_mass_spring(prepared.ir, *network, *prepared_network, *network_state, own_tool, remote_tools, dt);
+        return evaluate_mass_spring(prepared.ir, *network, *prepared_network, *network_state,
+                                    own_tool, remote_tools, dt);
   if (std::holds_alternative<HomeSpringPatch>(prepared.ir.body))
     if (const auto* prepared_patch = std::get_if<PreparedHomeSpringPatch>(&prepared.body))
       return evaluate_home_spring_body(prepared.ir, *prepared_patch, own_tool);
   if (const auto* separation = std::get_if<SeparationIr>(&prepared.ir.body))
     if (auto* separation_state = std::get_if<SeparationEvaluation>(&state.body))
-      return step_separation_force(*separation->patch, separation_state->state, separation_state->tool, separation->tool,
-                                   own_tool, buttons, dt, prepared.ir.force_limit);
+      return step_separation_force(*separation->patch, separation_state->state,
+                                   separation_state->tool, separation->tool, own_tool, buttons, dt,
+                                   prepared.ir.force_limit);
   ForceSample unknown;
   unknown.flags = kNonFinite;
   return unknown;

@@ -54,9 +54,11 @@ namespace cohaptic {
 
 /// What prepare_ir derives from a CondensedFemIr.
 struct PreparedFem {
-  Eigen::MatrixXd compliance;         ///< L~ over the free dofs of the contact nodes [m/N] (not for spheres)
+  Eigen::MatrixXd
+      compliance;  ///< L~ over the free dofs of the contact nodes [m/N] (not for spheres)
   Eigen::VectorXd free_displacement;  ///< u0 over the same dofs [m] (not for spheres)
-  std::vector<std::array<int, 3>> dof_index;  ///< per contact node and axis: row in L~, or -1 if fixed
+  std::vector<std::array<int, 3>>
+      dof_index;                      ///< per contact node and axis: row in L~, or -1 if fixed
   std::vector<bool> on_patch_border;  ///< per patch node
   PreparedSphereContact sphere;       ///< the sphere contact model's (evaluate_sphere_contact.h)
 };
@@ -65,7 +67,8 @@ struct PreparedFem {
 struct PreparedSeparation {};
 
 /// One alternative per IrBody alternative, in the same order.
-using PreparedBody = std::variant<PreparedFem, PreparedMassSpring, PreparedHomeSpringPatch, PreparedSeparation>;
+using PreparedBody =
+    std::variant<PreparedFem, PreparedMassSpring, PreparedHomeSpringPatch, PreparedSeparation>;
 
 /// An IR and what its evaluation needs, computed once: `body` holds the alternative that
 /// matches ir.body's kind (PreparedFem for CondensedFemIr, PreparedMassSpring for
@@ -74,7 +77,7 @@ using PreparedBody = std::variant<PreparedFem, PreparedMassSpring, PreparedHomeS
 struct PreparedIR {
   IntermediateRepresentation ir;
   PreparedBody body;
-  double condition_estimate = 1;      ///< of the body's operator (L~ for FEM)
+  double condition_estimate = 1;  ///< of the body's operator (L~ for FEM)
 };
 
 /// Checks sizes, finiteness, symmetry (to 1e-9 of the largest entry) and positive
@@ -98,19 +101,21 @@ struct EvaluationState {
 EvaluationState make_evaluation_state(const PreparedIR& prepared);
 
 enum ForceFlag : std::uint8_t {
-  kInContact = 1,         ///< the own tool presses the surface
-  kClamped = 2,           ///< scaled down to the force limit
-  kNonFinite = 4,         ///< a non-finite input or result: force set to zero
-  kOutsidePatch = 8,      ///< the tool is past the patch border: held on it until the next IR
-  kRemoteOverlap = 16,    ///< a remote triangle shares a node with the own one or an earlier remote's: that remote ignored
-  kTooManyRemotes = 32,   ///< remotes beyond kMaxUsers - 1 ignored
-  kContactUnresolved = 64,  ///< sphere model: the contact solve did not finish in its budget (zero force)
+  kInContact = 1,        ///< the own tool presses the surface
+  kClamped = 2,          ///< scaled down to the force limit
+  kNonFinite = 4,        ///< a non-finite input or result: force set to zero
+  kOutsidePatch = 8,     ///< the tool is past the patch border: held on it until the next IR
+  kRemoteOverlap = 16,   ///< a remote triangle shares a node with the own one or an earlier
+                         ///< remote's: that remote ignored
+  kTooManyRemotes = 32,  ///< remotes beyond kMaxUsers - 1 ignored
+  kContactUnresolved =
+      64,  ///< sphere model: the contact solve did not finish in its budget (zero force)
 };
 
 struct ForceSample {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< reaction on the own tool [N]
-  int triangle = -1;     ///< patch triangle nearest the tool
-  double depth = 0;      ///< penetration below that triangle's plane [m]
+  int triangle = -1;                                ///< patch triangle nearest the tool
+  double depth = 0;                                 ///< penetration below that triangle's plane [m]
   std::uint8_t flags = 0;
 };
 
@@ -125,7 +130,9 @@ void limit_force(ForceSample& sample, bool evaluated, double force_limit) noexce
 /// since the previous call (the haptic loop's nominal period). A state of another kind
 /// than the body's gives a zero force flagged kNonFinite. `buttons` are the own tool's
 /// (bit i = button i held); only the separation body reads them.
-ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state, const Eigen::Vector3d& own_tool,
-                           std::span<const Eigen::Vector3d> remote_tools, double dt, std::uint32_t buttons = 0) noexcept;
+ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state,
+                           const Eigen::Vector3d& own_tool,
+                           std::span<const Eigen::Vector3d> remote_tools, double dt,
+                           std::uint32_t buttons = 0) noexcept;
 
 }  // namespace cohaptic

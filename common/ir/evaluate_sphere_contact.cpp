@@ -8,9 +8,9 @@
 
 namespace cohaptic {
 
-ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
-                                    const PreparedFem& prepared, SphereContactState* state,
-                                    const Eigen::Vector3d& own_tool,
+ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope,
+                                    const CondensedFemIr& ir, const PreparedFem& prepared,
+                                    SphereContactState* state, const Eigen::Vector3d& own_tool,
                                     std::span<const Eigen::Vector3d> remote_tools) noexcept {
   ForceSample sample;
   const int m = ir.row_node_count;
@@ -43,7 +43,8 @@ ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, 
       gap = sphere.obstacle_gaps[i];
     else if (sphere.normals.col(i).squaredNorm() > 0)
       for (std::size_t t = 0; t < tool_count; ++t)
-        if (const double g = sphere_gap(ir.rest_positions.col(i), sphere.normals.col(i), tools[t]); g < gap) {
+        if (const double g = sphere_gap(ir.rest_positions.col(i), sphere.normals.col(i), tools[t]);
+            g < gap) {
           gap = g;
           holder = static_cast<std::int8_t>(t);
         }
@@ -58,8 +59,9 @@ ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, 
   for (Eigen::Index c = 0; c < outside.cols(); ++c)
     if ((outside.col(c) - own_tool).norm() < envelope.tool_radius) sample.flags |= kOutsidePatch;
 
-  const UnilateralSolveResult solved = state->solve.solve(sphere.normal_compliance, state->clearance,
-                                                          prepared.sphere.nonnegative_rows, state->work_budget);
+  const UnilateralSolveResult solved =
+      state->solve.solve(sphere.normal_compliance, state->clearance,
+                         prepared.sphere.nonnegative_rows, state->work_budget);
   if (!solved.solved) {
     sample.flags |= kContactUnresolved;
     return sample;

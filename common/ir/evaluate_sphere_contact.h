@@ -30,9 +30,9 @@ namespace cohaptic {
 /// `envelope` holds the own tool's radius and the force limit; `ir` is its body, `prepared`
 /// what prepare_ir derived from it; `state` (made for this IR by make_evaluation_state) is
 /// read and advanced.
-ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope, const CondensedFemIr& ir,
-                                    const PreparedFem& prepared, SphereContactState* state,
-                                    const Eigen::Vector3d& own_tool,
+ForceSample evaluate_sphere_contact(const IntermediateRepresentation& envelope,
+                                    const CondensedFemIr& ir, const PreparedFem& prepared,
+                                    SphereContactState* state, const Eigen::Vector3d& own_tool,
                                     std::span<const Eigen::Vector3d> remote_tools) noexcept;
 
 }  // namespace cohaptic

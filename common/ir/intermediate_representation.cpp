@@ -15,26 +15,34 @@ std::size_t IntermediateRepresentation::size_bytes() const {
 
 std::size_t CondensedFemIr::size_bytes() const {
   const std::size_t scalar = precision == IrPrecision::f32 ? sizeof(float) : sizeof(double);
-  constexpr std::size_t kHeader = 1 + 1 + 4 + 4;  // contact model, precision, patch and row node counts
+  constexpr std::size_t kHeader =
+      1 + 1 + 4 + 4;  // contact model, precision, patch and row node counts
   const std::size_t nodes = node_ids.size() * (sizeof(std::int64_t) + sizeof(AxisMask)) +
                             static_cast<std::size_t>(rest_positions.size()) * sizeof(double);
-  const std::size_t triangles = patch.size() * (7 * sizeof(std::int32_t) + 4 * 3 * sizeof(double)) +
-                               static_cast<std::size_t>(patch_vertex_normals.size()) * sizeof(double) +
-                               guard.size() * 4 * 3 * sizeof(double);
-  const std::size_t remote = remotes.size() * (sizeof(std::int32_t) * 4 + (1 + 7 * 3) * sizeof(double));
-  const std::size_t matrix = static_cast<std::size_t>(m_tilde.size() + boundary_displacement.size()) * scalar +
-                             static_cast<std::size_t>(rest_forces.size()) * sizeof(double) +
-                             (compliance_rows ? 8 + static_cast<std::size_t>(compliance_rows->rows.size()) * sizeof(double) : 0);
+  const std::size_t triangles =
+      patch.size() * (7 * sizeof(std::int32_t) + 4 * 3 * sizeof(double)) +
+      static_cast<std::size_t>(patch_vertex_normals.size()) * sizeof(double) +
+      guard.size() * 4 * 3 * sizeof(double);
+  const std::size_t remote =
+      remotes.size() * (sizeof(std::int32_t) * 4 + (1 + 7 * 3) * sizeof(double));
+  const std::size_t matrix =
+      static_cast<std::size_t>(m_tilde.size() + boundary_displacement.size()) * scalar +
+      static_cast<std::size_t>(rest_forces.size()) * sizeof(double) +
+      (compliance_rows ? 8 + static_cast<std::size_t>(compliance_rows->rows.size()) * sizeof(double)
+                       : 0);
   const std::size_t truncated =  // sent with compliance rows only
       compliance_rows ? truncated_node_ids.size() * (sizeof(std::int64_t) + sizeof(AxisMask)) : 0;
   std::size_t sphere_bytes = 0;
   if (sphere) {  // W as its upper triangle, at the stored precision (f64 as rows)
     const auto n = static_cast<std::size_t>(sphere->normal_compliance.rows());
-    sphere_bytes = static_cast<std::size_t>(sphere->normals.size() + sphere->free_clearance.size()) * sizeof(double) +
-                   n * (n + 1) / 2 * scalar + sphere->contacts.size() * sizeof(std::int32_t) +
-                   sphere->held_node_ids.size() * sizeof(std::int64_t) +
-                   static_cast<std::size_t>((sphere->obstacle_gaps.array() < std::numeric_limits<double>::infinity()).count()) *
-                       (sizeof(std::uint32_t) + sizeof(double));
+    sphere_bytes =
+        static_cast<std::size_t>(sphere->normals.size() + sphere->free_clearance.size()) *
+            sizeof(double) +
+        n * (n + 1) / 2 * scalar + sphere->contacts.size() * sizeof(std::int32_t) +
+        sphere->held_node_ids.size() * sizeof(std::int64_t) +
+        static_cast<std::size_t>(
+            (sphere->obstacle_gaps.array() < std::numeric_limits<double>::infinity()).count()) *
+            (sizeof(std::uint32_t) + sizeof(double));
   }
   return kHeader + nodes + triangles + remote + matrix + truncated + sphere_bytes;
 }
@@ -47,33 +55,43 @@ std::vector<std::int64_t> CondensedFemIr::held_node_ids() const {
 
 const CondensedFemIr& condensed_fem(const IntermediateRepresentation& ir) {
   if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body)) return *fem;
-  throw Error(fmt::format("the IR of user {} (epoch {}) is not a condensed FEM body", ir.user, ir.epoch));
+  throw Error(
+      fmt::format("the IR of user {} (epoch {}) is not a condensed FEM body", ir.user, ir.epoch));
 }
 
 CondensedFemIr& condensed_fem(IntermediateRepresentation& ir) {
-  return const_cast<CondensedFemIr&>(condensed_fem(static_cast<const IntermediateRepresentation&>(ir)));
+  return const_cast<CondensedFemIr&>(
+      condensed_fem(static_cast<const IntermediateRepresentation&>(ir)));
 }
 
 std::size_t MassSpringIr::size_bytes() const {
-  constexpr std::size_t kParameters = (3 + 3 + 3 + 3 + 2) * sizeof(double) + 1;  // gravity .. time step, plane
+  constexpr std::size_t kParameters =
+      (3 + 3 + 3 + 3 + 2) * sizeof(double) + 1;  // gravity .. time step, plane
   const std::size_t nodes = node_ids.size() * (sizeof(std::int32_t) + 7 * sizeof(double) + 1);
-  const std::size_t springs_bytes = springs.size() * (2 * sizeof(std::int32_t) + 3 * sizeof(double));
+  const std::size_t springs_bytes =
+      springs.size() * (2 * sizeof(std::int32_t) + 3 * sizeof(double));
   const std::size_t tools = remote_users.size() * (sizeof(std::int32_t) + sizeof(double)) +
                             presses.size() * (1 + 3 * sizeof(double));
   const std::size_t backed = backing.nodes.size();
-  const std::size_t backing_bytes = backed * (sizeof(std::int32_t) + 8 * sizeof(double)) + backed * backed * sizeof(double);
-  return kParameters + nodes + springs_bytes + triangles.size() * 3 * sizeof(std::int32_t) + tools + backing_bytes;
+  const std::size_t backing_bytes =
+      backed * (sizeof(std::int32_t) + 8 * sizeof(double)) + backed * backed * sizeof(double);
+  return kParameters + nodes + springs_bytes + triangles.size() * 3 * sizeof(std::int32_t) + tools +
+         backing_bytes;
 }
 
 int remote_count(const IntermediateRepresentation& ir) noexcept {
-  if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body)) return static_cast<int>(fem->remotes.size());
-  if (const auto* network = std::get_if<MassSpringIr>(&ir.body)) return static_cast<int>(network->remote_users.size());
+  if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body))
+    return static_cast<int>(fem->remotes.size());
+  if (const auto* network = std::get_if<MassSpringIr>(&ir.body))
+    return static_cast<int>(network->remote_users.size());
   return 0;
 }
 
 int remote_user(const IntermediateRepresentation& ir, int i) noexcept {
-  if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body)) return fem->remotes[static_cast<std::size_t>(i)].user;
-  if (const auto* network = std::get_if<MassSpringIr>(&ir.body)) return network->remote_users[static_cast<std::size_t>(i)];
+  if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body))
+    return fem->remotes[static_cast<std::size_t>(i)].user;
+  if (const auto* network = std::get_if<MassSpringIr>(&ir.body))
+    return network->remote_users[static_cast<std::size_t>(i)];
   return -1;
 }
 

@@ -6,10 +6,10 @@
 // tissue's is in separation_ir.h.
 //
 // CondensedFemIr, the linear elastic body's (the paper's Sec. II-C): the local contact
-// geometry and M~ = (M_CC M_CB). Nodes are numbered locally: first the user's own contact patch (the triangle nearest its
-// tool and `patch_rings` rings of neighbours), then the other users' contact triangles
-// (nodes not already in the patch), then the colliding boundary nodes B. The first
-// `row_node_count` nodes (patch and remote contacts) are the contact nodes C: M~ has a row
+// geometry and M~ = (M_CC M_CB). Nodes are numbered locally: first the user's own contact patch
+// (the triangle nearest its tool and `patch_rings` rings of neighbours), then the other users'
+// contact triangles (nodes not already in the patch), then the colliding boundary nodes B. The
+// first `row_node_count` nodes (patch and remote contacts) are the contact nodes C: M~ has a row
 // per free dof of C and a column per free dof of every node, node-major, axes x, y, z,
 // fixed axes left out. With f = M~ (u_C, u_B) (+ f_rest, rest_forces, when the body carries
 // other loads): the forces on C for prescribed displacements of C and B, every other node
@@ -40,31 +40,35 @@ namespace cohaptic {
 enum class IrPrecision { f64, f32 };
 
 struct IrTriangle {
-  std::array<int, 3> nodes{};          ///< local node indices, counter-clockwise seen from outside
-  int surface_index = 0;               ///< index on the server's surface: ties at edges go to the lower
+  std::array<int, 3> nodes{};  ///< local node indices, counter-clockwise seen from outside
+  int surface_index = 0;       ///< index on the server's surface: ties at edges go to the lower
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit outward normal at rest
-  std::array<int, 3> neighbours{-1, -1, -1};  ///< patch triangle across edge (k, k+1), or -1
+  std::array<int, 3> neighbours{-1, -1, -1};         ///< patch triangle across edge (k, k+1), or -1
   /// The whole surface's pseudo-normal at edge (k, k+1), inside the patch or at its rim:
   /// with it the sign of a point nearest an edge is the whole surface's.
-  std::array<Eigen::Vector3d, 3> edge_normals{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<Eigen::Vector3d, 3> edge_normals{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                              Eigen::Vector3d::Zero()};
 };
 
 /// A surface triangle bordering the patch: geometry only (no force), so that the client can
 /// tell a tool beyond the patch's rim (beside the object, or over an untouchable region).
 struct IrGuardTriangle {
-  std::array<Eigen::Vector3d, 3> corners{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::array<Eigen::Vector3d, 3> corners{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                         Eigen::Vector3d::Zero()};
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
 };
 
 struct IrRemoteContact {
-  int user = 0;                         ///< the other user's slot
-  std::array<int, 3> nodes{};           ///< local node indices of their nearest triangle
+  int user = 0;                ///< the other user's slot
+  std::array<int, 3> nodes{};  ///< local node indices of their nearest triangle
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   /// The whole surface's pseudo-normals at the triangle's edges (k, k+1) and vertices,
   /// to tell whether the remote tool presses.
-  std::array<Eigen::Vector3d, 3> edge_normals{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-  std::array<Eigen::Vector3d, 3> vertex_normals{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-  double tool_radius = 0;               ///< [m]
+  std::array<Eigen::Vector3d, 3> edge_normals{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                              Eigen::Vector3d::Zero()};
+  std::array<Eigen::Vector3d, 3> vertex_normals{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                                Eigen::Vector3d::Zero()};
+  double tool_radius = 0;  ///< [m]
 };
 
 /// Asymmetry tolerated in a received matrix that must be symmetric (M_CC, W), relative to
@@ -80,15 +84,17 @@ inline constexpr double kMaxRelativeAsymmetry = 1e-9;
 /// clearance is g + q0 + (W lambda); neither depends on where the tools are. B itself
 /// travels only as its tags.
 struct SphereContactIr {
-  Eigen::Matrix3Xd normals;            ///< per row node: its push's unit direction, zero for a node the model cannot hold
-  Eigen::VectorXd free_clearance;      ///< q0 per row node [m]
+  Eigen::Matrix3Xd
+      normals;  ///< per row node: its push's unit direction, zero for a node the model cannot hold
+  Eigen::VectorXd free_clearance;  ///< q0 per row node [m]
   /// W, row nodes square, symmetric [m/N]; the rows and columns of a node the model cannot
   /// hold are zero.
   Eigen::MatrixXd normal_compliance;
   /// Per row node: the gap at rest [m] to the rigid obstacle that holds it, along its normal
   /// (then the obstacle's), or +inf for a node the spheres hold (sphere_contact.h).
   Eigen::VectorXd obstacle_gaps;
-  std::vector<int> contacts;           ///< row nodes the server's state pushes (ascending): the first tick's set
+  std::vector<int>
+      contacts;  ///< row nodes the server's state pushes (ascending): the first tick's set
   std::vector<std::int64_t> held_node_ids;  ///< B's tags: the nodes W and q0 hold where they are
 };
 
@@ -102,12 +108,13 @@ struct CondensedFemIr {
   int patch_node_count = 0;
   int row_node_count = 0;
 
-  std::vector<IrTriangle> patch;   ///< own patch; patch[0] is the triangle nearest the tool
-  Eigen::Matrix3Xd patch_vertex_normals;  ///< per patch node: the whole surface's angle-weighted normal
-  std::vector<IrGuardTriangle> guard;     ///< the ring of surface triangles around the patch
+  std::vector<IrTriangle> patch;  ///< own patch; patch[0] is the triangle nearest the tool
+  Eigen::Matrix3Xd
+      patch_vertex_normals;  ///< per patch node: the whole surface's angle-weighted normal
+  std::vector<IrGuardTriangle> guard;  ///< the ring of surface triangles around the patch
   std::vector<IrRemoteContact> remotes;
 
-  Eigen::MatrixXd m_tilde;                ///< rows: free dofs of C; columns: free dofs of all nodes [N/m]
+  Eigen::MatrixXd m_tilde;  ///< rows: free dofs of C; columns: free dofs of all nodes [N/m]
   Eigen::VectorXd boundary_displacement;  ///< u_B, free dofs of B [m]
   /// f_rest, per free dof of C, or empty (none): loads the body carries besides the tools
   /// and B act on C as f = M~ (u_C, u_B) + f_rest. An FEM pair's front: the support of the
@@ -147,12 +154,12 @@ struct IntermediateRepresentation {
   static constexpr std::uint32_t kFormatVersion = 7;
   static constexpr std::uint32_t kOldestReadableVersion = 2;
 
-  std::uint64_t epoch = 0;         ///< increases with every IR built for this user
-  double simulation_time = 0;      ///< [s] of the state it was built from
+  std::uint64_t epoch = 0;     ///< increases with every IR built for this user
+  double simulation_time = 0;  ///< [s] of the state it was built from
   int user = 0;
-  int object = 0;                  ///< the scene object (body) it describes
-  double tool_radius = 0;          ///< own tool [m], 0 for a point
-  double force_limit = 0;          ///< [N], the scene's haptic limit
+  int object = 0;          ///< the scene object (body) it describes
+  double tool_radius = 0;  ///< own tool [m], 0 for a point
+  double force_limit = 0;  ///< [N], the scene's haptic limit
   IrBody body;
 
   /// Bytes of the content as sent: the envelope and the body.

@@ -14,20 +14,27 @@ PreparedMassSpring prepare_mass_spring(const MassSpringIr& ir) {
   const auto columns = static_cast<std::size_t>(ir.positions.cols());
   if (columns != nodes || static_cast<std::size_t>(ir.velocities.cols()) != nodes ||
       static_cast<std::size_t>(ir.mass.size()) != nodes || ir.held.size() != nodes)
-    throw Error(fmt::format("intermediate representation: a mass-spring body of {} nodes with {} positions, {} "
-                            "velocities, {} masses and {} held flags", nodes, columns, ir.velocities.cols(),
-                            ir.mass.size(), ir.held.size()));
-  if (!ir.velocities.allFinite()) throw Error("intermediate representation: a mass-spring velocity is not finite");
-  if (ir.remote_users.size() != ir.remote_radii.size() || ir.presses.size() != ir.remote_users.size() + 1)
-    throw Error(fmt::format("intermediate representation: {} remote users, {} radii and {} presses (expected one more)",
-                            ir.remote_users.size(), ir.remote_radii.size(), ir.presses.size()));
+    throw Error(fmt::format(
+        "intermediate representation: a mass-spring body of {} nodes with {} positions, {} "
+        "velocities, {} masses and {} held flags",
+        nodes, columns, ir.velocities.cols(), ir.mass.size(), ir.held.size()));
+  if (!ir.velocities.allFinite())
+    throw Error("intermediate representation: a mass-spring velocity is not finite");
+  if (ir.remote_users.size() != ir.remote_radii.size() ||
+      ir.presses.size() != ir.remote_users.size() + 1)
+    throw Error(fmt::format(
+        "intermediate representation: {} remote users, {} radii and {} presses (expected one more)",
+        ir.remote_users.size(), ir.remote_radii.size(), ir.presses.size()));
   if (ir.presses.size() > static_cast<std::size_t>(kMaxNetworkTools))
-    throw Error(fmt::format("intermediate representation: {} tools on a mass-spring body, at most {} supported",
-                            ir.presses.size(), kMaxNetworkTools));
+    throw Error(fmt::format(
+        "intermediate representation: {} tools on a mass-spring body, at most {} supported",
+        ir.presses.size(), kMaxNetworkTools));
   for (double radius : ir.remote_radii)
-    if (!(std::isfinite(radius) && radius >= 0)) throw Error("intermediate representation: a remote tool radius out of range");
+    if (!(std::isfinite(radius) && radius >= 0))
+      throw Error("intermediate representation: a remote tool radius out of range");
   for (const ToolPress& press : ir.presses)
-    if (!press.previous.allFinite()) throw Error("intermediate representation: a tool's previous position is not finite");
+    if (!press.previous.allFinite())
+      throw Error("intermediate representation: a tool's previous position is not finite");
   PreparedMassSpring prepared;
   MassSpringNetwork& network = prepared.network;
   network.rest_positions = ir.positions;
@@ -40,14 +47,16 @@ PreparedMassSpring prepare_mass_spring(const MassSpringIr& ir) {
   for (const auto& triangle : network.triangles)
     for (int node : triangle)
       if (node < 0 || static_cast<std::size_t>(node) >= nodes)
-        throw Error(fmt::format("intermediate representation: a triangle names node {} of {}", node, nodes));
+        throw Error(fmt::format("intermediate representation: a triangle names node {} of {}", node,
+                                nodes));
   index_surface(network);
   check_network(network, "intermediate representation");
   check_node_backing(ir.backing, static_cast<int>(nodes), "intermediate representation");
   return prepared;
 }
 
-MassSpringPatchState make_mass_spring_state(const MassSpringIr& ir, const PreparedMassSpring& prepared) {
+MassSpringPatchState make_mass_spring_state(const MassSpringIr& ir,
+                                            const PreparedMassSpring& prepared) {
   MassSpringPatchState state;
   state.network = make_state(prepared.network);
   state.network.velocities = ir.velocities;
@@ -56,9 +65,11 @@ MassSpringPatchState make_mass_spring_state(const MassSpringIr& ir, const Prepar
   return state;
 }
 
-NetworkToolReaction advance_mass_spring(const MassSpringIr& ir, const PreparedMassSpring& prepared, MassSpringPatchState& state,
-                                 const Eigen::Vector3d& own_tool, double own_radius,
-                                 std::span<const Eigen::Vector3d> remote_tools, double dt) noexcept {
+NetworkToolReaction advance_mass_spring(const MassSpringIr& ir, const PreparedMassSpring& prepared,
+                                        MassSpringPatchState& state,
+                                        const Eigen::Vector3d& own_tool, double own_radius,
+                                        std::span<const Eigen::Vector3d> remote_tools,
+                                        double dt) noexcept {
   if (!(dt > 0) || !std::isfinite(dt)) return {};
   std::array<ToolOnNetwork, kMaxNetworkTools> tools;
   std::array<NetworkToolReaction, kMaxNetworkTools> reactions;

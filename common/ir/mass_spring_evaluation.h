@@ -19,7 +19,8 @@
 namespace cohaptic {
 
 struct PreparedMassSpring {
-  MassSpringNetwork network;  ///< the IR's sub-network, checked and indexed; rest_positions = the IR's positions
+  MassSpringNetwork
+      network;  ///< the IR's sub-network, checked and indexed; rest_positions = the IR's positions
 };
 
 /// What a mass–spring body's evaluation changes from tick to tick.
@@ -31,13 +32,16 @@ struct MassSpringPatchState {
 /// Throws Error naming the problem (sizes, indices, signs, too many remote tools).
 PreparedMassSpring prepare_mass_spring(const MassSpringIr& ir);
 
-MassSpringPatchState make_mass_spring_state(const MassSpringIr& ir, const PreparedMassSpring& prepared);
+MassSpringPatchState make_mass_spring_state(const MassSpringIr& ir,
+                                            const PreparedMassSpring& prepared);
 
 /// Advances `state` by dt [s] with the tools at `own_tool` (radius own_radius) and
 /// remote_tools[i] (radius ir.remote_radii[i]; NaN: absent); the own tool's reaction.
 /// dt <= 0 or not finite: nothing moves and the reaction is zero.
-NetworkToolReaction advance_mass_spring(const MassSpringIr& ir, const PreparedMassSpring& prepared, MassSpringPatchState& state,
-                                 const Eigen::Vector3d& own_tool, double own_radius,
-                                 std::span<const Eigen::Vector3d> remote_tools, double dt) noexcept;
+NetworkToolReaction advance_mass_spring(const MassSpringIr& ir, const PreparedMassSpring& prepared,
+                                        MassSpringPatchState& state,
+                                        const Eigen::Vector3d& own_tool, double own_radius,
+                                        std::span<const Eigen::Vector3d> remote_tools,
+                                        double dt) noexcept;
 
 }  // namespace cohaptic

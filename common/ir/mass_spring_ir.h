@@ -37,10 +37,10 @@ struct MassSpringIr {
   std::vector<Spring> springs;
   std::vector<std::array<int, 3>> triangles;
   MassSpringParameters parameters;
-  std::vector<int> remote_users;       ///< the other users whose tools act on the sub-network
-  std::vector<double> remote_radii;    ///< their tool radii [m]
-  std::vector<ToolPress> presses;      ///< 1 + remote_users.size(): own, then remotes
-  NodeBacking backing;                 ///< local nodes; empty: nothing behind the body
+  std::vector<int> remote_users;     ///< the other users whose tools act on the sub-network
+  std::vector<double> remote_radii;  ///< their tool radii [m]
+  std::vector<ToolPress> presses;    ///< 1 + remote_users.size(): own, then remotes
+  NodeBacking backing;               ///< local nodes; empty: nothing behind the body
 
   int node_count() const { return static_cast<int>(node_ids.size()); }
   /// Bytes of the content as sent.

@@ -9,8 +9,9 @@
 
 namespace cohaptic {
 
-ForceSample step_separation_force(const SeparationPatch& patch, SeparationState& state, SeparationToolState& tool,
-                                  const SeparationToolSettings& settings, const Eigen::Vector3d& tip, std::uint32_t buttons,
-                                  double dt, double force_limit) noexcept;
+ForceSample step_separation_force(const SeparationPatch& patch, SeparationState& state,
+                                  SeparationToolState& tool, const SeparationToolSettings& settings,
+                                  const Eigen::Vector3d& tip, std::uint32_t buttons, double dt,
+                                  double force_limit) noexcept;
 
 }  // namespace cohaptic

@@ -12,7 +12,9 @@ enum class ContactModel { node_translation, point_constraint, sphere };
 
 /// The scene file's name of a contact model.
 inline const char* contact_model_name(ContactModel model) {
-  return model == ContactModel::node_translation ? "translation" : model == ContactModel::point_constraint ? "point" : "sphere";
+  return model == ContactModel::node_translation   ? "translation"
+         : model == ContactModel::point_constraint ? "point"
+                                                   : "sphere";
 }
 
 }  // namespace cohaptic

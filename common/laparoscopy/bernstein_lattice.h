@@ -16,8 +16,9 @@
 namespace cohaptic {
 
 inline constexpr int kLatticeControlPoints = 64;
-using LatticeBasis = Eigen::Matrix<double, kLatticeControlPoints, 1>;         ///< B of Eq. 3, as a column
-using LatticeControl = Eigen::Matrix<double, 3, kLatticeControlPoints>;       ///< P (or dP), a column per point
+using LatticeBasis = Eigen::Matrix<double, kLatticeControlPoints, 1>;  ///< B of Eq. 3, as a column
+using LatticeControl =
+    Eigen::Matrix<double, 3, kLatticeControlPoints>;  ///< P (or dP), a column per point
 
 struct BernsteinLattice {
   Eigen::Vector3d lo = Eigen::Vector3d::Zero();  ///< box corner at (u, v, w) = 0 [m]
@@ -33,7 +34,8 @@ BernsteinLattice identity_lattice(const Eigen::Vector3d& lo, const Eigen::Vector
 Eigen::Vector4d cubic_bernstein(double t) noexcept;
 
 /// (u, v, w) of x in the lattice's box.
-Eigen::Vector3d lattice_coordinates(const BernsteinLattice& lattice, const Eigen::Vector3d& x) noexcept;
+Eigen::Vector3d lattice_coordinates(const BernsteinLattice& lattice,
+                                    const Eigen::Vector3d& x) noexcept;
 
 /// B of Eq. 3 at x: the 64 products B_i(u) B_j(v) B_k(w).
 LatticeBasis lattice_basis(const BernsteinLattice& lattice, const Eigen::Vector3d& x) noexcept;
@@ -48,6 +50,7 @@ LatticeBinding bind_to_lattice(const BernsteinLattice& lattice, const Eigen::Mat
 
 /// deformed.col(v) = Q of vertex v under `control` (deformed sized like the binding by the
 /// caller). noexcept, allocation-free.
-void deform_ffd(const LatticeBinding& binding, const LatticeControl& control, Eigen::Matrix3Xd& deformed) noexcept;
+void deform_ffd(const LatticeBinding& binding, const LatticeControl& control,
+                Eigen::Matrix3Xd& deformed) noexcept;
 
 }  // namespace cohaptic

@@ -17,12 +17,14 @@
 namespace cohaptic {
 
 /// Eq. 7 for one point of basis `basis` moved by `displacement`. noexcept, allocation-free.
-LatticeControl single_point_manipulation(const LatticeBasis& basis, const Eigen::Vector3d& displacement) noexcept;
+LatticeControl single_point_manipulation(const LatticeBasis& basis,
+                                         const Eigen::Vector3d& displacement) noexcept;
 
 /// Eq. 6: bases column per point (64 x m), displacements column per point (3 x m).
 /// Throws NumericalError when the points' bases are (nearly) dependent (e.g. a point given
 /// twice), and Error when the sizes disagree or there is no point.
-LatticeControl least_squares_manipulation(const Eigen::Matrix<double, kLatticeControlPoints, Eigen::Dynamic>& bases,
-                                          const Eigen::Matrix3Xd& displacements);
+LatticeControl least_squares_manipulation(
+    const Eigen::Matrix<double, kLatticeControlPoints, Eigen::Dynamic>& bases,
+    const Eigen::Matrix3Xd& displacements);
 
 }  // namespace cohaptic

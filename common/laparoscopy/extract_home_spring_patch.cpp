@@ -7,8 +7,9 @@
 
 namespace cohaptic {
 
-HomeSpringPatch extract_home_spring_patch(const HomeSpringSurface& surface, const Eigen::Vector3d& centre,
-                                          double radius, const HomeSpringStiffness& stiffness,
+HomeSpringPatch extract_home_spring_patch(const HomeSpringSurface& surface,
+                                          const Eigen::Vector3d& centre, double radius,
+                                          const HomeSpringStiffness& stiffness,
                                           const Eigen::Vector3d& trocar_pivot) {
   const int surface_vertices = static_cast<int>(surface.rest_positions.cols());
   if (surface.rings.offsets.size() != static_cast<std::size_t>(surface_vertices) + 1)
@@ -19,14 +20,16 @@ HomeSpringPatch extract_home_spring_patch(const HomeSpringSurface& surface, cons
   std::vector<Triangle> region;
   for (const Triangle& tri : surface.triangles) {
     bool inside = true;
-    for (const int v : tri) inside = inside && (surface.rest_positions.col(v) - centre).squaredNorm() <= radius2;
+    for (const int v : tri)
+      inside = inside && (surface.rest_positions.col(v) - centre).squaredNorm() <= radius2;
     if (!inside) continue;
     region.push_back(tri);
     for (const int v : tri) touchable[static_cast<std::size_t>(v)] = 1;
   }
   if (region.empty())
-    throw Error(fmt::format("home-spring patch: no surface triangle lies within {} m of ({}, {}, {})", radius,
-                            centre.x(), centre.y(), centre.z()));
+    throw Error(
+        fmt::format("home-spring patch: no surface triangle lies within {} m of ({}, {}, {})",
+                    radius, centre.x(), centre.y(), centre.z()));
 
   HomeSpringPatch patch;
   std::unordered_map<int, int> local;  // surface index -> patch index
@@ -47,9 +50,11 @@ HomeSpringPatch extract_home_spring_patch(const HomeSpringSurface& surface, cons
   }
   patch.rest_positions.resize(3, static_cast<Eigen::Index>(patch.surface_vertex.size()));
   for (std::size_t i = 0; i < patch.surface_vertex.size(); ++i)
-    patch.rest_positions.col(static_cast<Eigen::Index>(i)) = surface.rest_positions.col(patch.surface_vertex[i]);
+    patch.rest_positions.col(static_cast<Eigen::Index>(i)) =
+        surface.rest_positions.col(patch.surface_vertex[i]);
   patch.triangles.reserve(region.size());
-  for (const Triangle& tri : region) patch.triangles.push_back({local.at(tri[0]), local.at(tri[1]), local.at(tri[2])});
+  for (const Triangle& tri : region)
+    patch.triangles.push_back({local.at(tri[0]), local.at(tri[1]), local.at(tri[2])});
   patch.home_stiffness = stiffness.home;
   patch.neighbour_stiffness = stiffness.neighbour;
   patch.trocar_pivot = trocar_pivot;

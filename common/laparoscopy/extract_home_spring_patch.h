@@ -18,7 +18,7 @@ namespace cohaptic {
 struct HomeSpringSurface {
   const Eigen::Matrix3Xd& rest_positions;  ///< the body's surface vertices at rest [m]
   std::span<const Triangle> triangles;
-  const VertexRings& rings;                ///< vertex_rings(triangles, vertex count)
+  const VertexRings& rings;  ///< vertex_rings(triangles, vertex count)
 };
 
 struct HomeSpringStiffness {
@@ -28,8 +28,9 @@ struct HomeSpringStiffness {
 
 /// The validated patch within `radius` of `centre`, not grasped; throws Error when no
 /// triangle lies wholly within reach (naming the centre and the radius).
-HomeSpringPatch extract_home_spring_patch(const HomeSpringSurface& surface, const Eigen::Vector3d& centre,
-                                          double radius, const HomeSpringStiffness& stiffness,
+HomeSpringPatch extract_home_spring_patch(const HomeSpringSurface& surface,
+                                          const Eigen::Vector3d& centre, double radius,
+                                          const HomeSpringStiffness& stiffness,
                                           const Eigen::Vector3d& trocar_pivot);
 
 }  // namespace cohaptic

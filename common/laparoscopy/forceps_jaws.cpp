@@ -10,9 +10,11 @@
 namespace cohaptic {
 namespace {
 
-Eigen::Vector3d jaw_tip(const ForcepsGeometry& geometry, const ShaftFrame& shaft, int jaw, double angle) noexcept {
+Eigen::Vector3d jaw_tip(const ForcepsGeometry& geometry, const ShaftFrame& shaft, int jaw,
+                        double angle) noexcept {
   const double side = jaw == 0 ? 1.0 : -1.0;
-  return shaft.tool + geometry.jaw_length * (std::cos(angle) * shaft.axis + side * std::sin(angle) * shaft.opening);
+  return shaft.tool + geometry.jaw_length *
+                          (std::cos(angle) * shaft.axis + side * std::sin(angle) * shaft.opening);
 }
 
 }  // namespace
@@ -20,11 +22,14 @@ Eigen::Vector3d jaw_tip(const ForcepsGeometry& geometry, const ShaftFrame& shaft
 ForcepsJaws open_forceps(const ForcepsGeometry& geometry) {
   const auto positive = [](double x) { return x > 0 && std::isfinite(x); };
   if (!positive(geometry.jaw_length))
-    throw Error(fmt::format("forceps: jaw_length is {} m, expected positive and finite", geometry.jaw_length));
+    throw Error(fmt::format("forceps: jaw_length is {} m, expected positive and finite",
+                            geometry.jaw_length));
   if (!positive(geometry.open_angle) || !(geometry.open_angle < std::numbers::pi / 2))
-    throw Error(fmt::format("forceps: open_angle is {} rad, expected in (0, pi/2)", geometry.open_angle));
+    throw Error(
+        fmt::format("forceps: open_angle is {} rad, expected in (0, pi/2)", geometry.open_angle));
   if (!positive(geometry.closing_step))
-    throw Error(fmt::format("forceps: closing_step is {} rad, expected positive and finite", geometry.closing_step));
+    throw Error(fmt::format("forceps: closing_step is {} rad, expected positive and finite",
+                            geometry.closing_step));
   ForcepsJaws jaws;
   jaws.angle = {geometry.open_angle, geometry.open_angle};
   return jaws;
@@ -35,8 +40,8 @@ std::array<Eigen::Vector3d, 2> jaw_tips(const ForcepsGeometry& geometry, const S
   return {jaw_tip(geometry, shaft, 0, jaws.angle[0]), jaw_tip(geometry, shaft, 1, jaws.angle[1])};
 }
 
-void step_forceps(const ForcepsGeometry& geometry, const ShaftFrame& shaft, bool closing, const AabbTree& surface,
-                  ForcepsJaws& jaws) noexcept {
+void step_forceps(const ForcepsGeometry& geometry, const ShaftFrame& shaft, bool closing,
+                  const AabbTree& surface, ForcepsJaws& jaws) noexcept {
   if (!closing) {
     jaws = ForcepsJaws{};
     jaws.angle = {geometry.open_angle, geometry.open_angle};

@@ -19,17 +19,19 @@
 namespace cohaptic {
 
 struct ForcepsGeometry {
-  double jaw_length = 0.02;     ///< |B A_k| [m]
-  double open_angle = 0.5;      ///< each jaw's angle from the axis when open [rad]
-  double closing_step = 0.01;   ///< closing increment per step while the button is held [rad]
+  double jaw_length = 0.02;    ///< |B A_k| [m]
+  double open_angle = 0.5;     ///< each jaw's angle from the axis when open [rad]
+  double closing_step = 0.01;  ///< closing increment per step while the button is held [rad]
 };
 
 struct ForcepsJaws {
-  std::array<double, 2> angle{};                       ///< from the axis [rad]; jaw 0 on +opening
-  std::array<bool, 2> stopped{};                       ///< stopped by the object
-  std::array<Eigen::Vector3d, 2> contact{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};  ///< where each crossed the surface [m]
+  std::array<double, 2> angle{};  ///< from the axis [rad]; jaw 0 on +opening
+  std::array<bool, 2> stopped{};  ///< stopped by the object
+  std::array<Eigen::Vector3d, 2> contact{
+      Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};  ///< where each crossed the surface [m]
   bool grasping = false;
-  Eigen::Vector3d grasp_point = Eigen::Vector3d::Zero();    ///< midway between the contacts, held while grasping [m]
+  Eigen::Vector3d grasp_point =
+      Eigen::Vector3d::Zero();  ///< midway between the contacts, held while grasping [m]
   Eigen::Vector3d tool_at_grasp = Eigen::Vector3d::Zero();  ///< B when both jaws stopped [m]
 };
 
@@ -43,7 +45,7 @@ std::array<Eigen::Vector3d, 2> jaw_tips(const ForcepsGeometry& geometry, const S
 
 /// One step of the jaws against `surface` (the object's rest surface) with the button
 /// `closing` held or not.
-void step_forceps(const ForcepsGeometry& geometry, const ShaftFrame& shaft, bool closing, const AabbTree& surface,
-                  ForcepsJaws& jaws) noexcept;
+void step_forceps(const ForcepsGeometry& geometry, const ShaftFrame& shaft, bool closing,
+                  const AabbTree& surface, ForcepsJaws& jaws) noexcept;
 
 }  // namespace cohaptic

@@ -10,7 +10,8 @@ PreparedHomeSpringPatch prepare_home_spring_patch(HomeSpringPatch patch) {
   return PreparedHomeSpringPatch{std::move(patch), std::move(tree)};
 }
 
-HomeSpringContact evaluate_home_spring(const PreparedHomeSpringPatch& prepared, const Eigen::Vector3d& tool) noexcept {
+HomeSpringContact evaluate_home_spring(const PreparedHomeSpringPatch& prepared,
+                                       const Eigen::Vector3d& tool) noexcept {
   const HomeSpringPatch& patch = prepared.patch;
   HomeSpringContact contact;
   if (!tool.allFinite()) return contact;

@@ -29,12 +29,13 @@ PreparedHomeSpringPatch prepare_home_spring_patch(HomeSpringPatch patch);
 
 struct HomeSpringContact {
   bool touching = false;
-  int vertex = -1;                                                ///< patch vertex the force acts on
-  Eigen::Vector3d contact_point = Eigen::Vector3d::Zero();        ///< P on the rest surface [m]
-  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();         ///< u = P_current - P_original [m]
-  Eigen::Vector3d force = Eigen::Vector3d::Zero();                ///< on the tool, -F_total [N]
+  int vertex = -1;                                          ///< patch vertex the force acts on
+  Eigen::Vector3d contact_point = Eigen::Vector3d::Zero();  ///< P on the rest surface [m]
+  Eigen::Vector3d displacement = Eigen::Vector3d::Zero();   ///< u = P_current - P_original [m]
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();          ///< on the tool, -F_total [N]
 };
 
-HomeSpringContact evaluate_home_spring(const PreparedHomeSpringPatch& prepared, const Eigen::Vector3d& tool) noexcept;
+HomeSpringContact evaluate_home_spring(const PreparedHomeSpringPatch& prepared,
+                                       const Eigen::Vector3d& tool) noexcept;
 
 }  // namespace cohaptic

@@ -2,7 +2,8 @@
 
 namespace cohaptic {
 
-double home_spring_energy(const HomeSpringPatch& patch, int vertex, const Eigen::Vector3d& displacement) noexcept {
+double home_spring_energy(const HomeSpringPatch& patch, int vertex,
+                          const Eigen::Vector3d& displacement) noexcept {
   const Eigen::Vector3d rest = patch.rest_positions.col(vertex);
   const Eigen::Vector3d current = rest + displacement;
   double ring = 0;
@@ -11,10 +12,12 @@ double home_spring_energy(const HomeSpringPatch& patch, int vertex, const Eigen:
     const double stretch = (current - neighbour).norm() - (rest - neighbour).norm();
     ring += stretch * stretch;
   }
-  return 0.5 * patch.home_stiffness * displacement.squaredNorm() + 0.5 * patch.neighbour_stiffness * ring;
+  return 0.5 * patch.home_stiffness * displacement.squaredNorm() +
+         0.5 * patch.neighbour_stiffness * ring;
 }
 
-Eigen::Vector3d home_spring_load(const HomeSpringPatch& patch, int vertex, const Eigen::Vector3d& displacement) noexcept {
+Eigen::Vector3d home_spring_load(const HomeSpringPatch& patch, int vertex,
+                                 const Eigen::Vector3d& displacement) noexcept {
   const Eigen::Vector3d rest = patch.rest_positions.col(vertex);
   const Eigen::Vector3d current = rest + displacement;
   Eigen::Vector3d ring = Eigen::Vector3d::Zero();

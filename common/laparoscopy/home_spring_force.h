@@ -19,9 +19,11 @@
 namespace cohaptic {
 
 /// E(u) [J] for touchable vertex `vertex` displaced by `displacement`.
-double home_spring_energy(const HomeSpringPatch& patch, int vertex, const Eigen::Vector3d& displacement) noexcept;
+double home_spring_energy(const HomeSpringPatch& patch, int vertex,
+                          const Eigen::Vector3d& displacement) noexcept;
 
 /// Eq. 8's F_total [N] = grad E(u): the load holding `vertex` displaced by `displacement`.
-Eigen::Vector3d home_spring_load(const HomeSpringPatch& patch, int vertex, const Eigen::Vector3d& displacement) noexcept;
+Eigen::Vector3d home_spring_load(const HomeSpringPatch& patch, int vertex,
+                                 const Eigen::Vector3d& displacement) noexcept;
 
 }  // namespace cohaptic

@@ -22,8 +22,8 @@
 namespace cohaptic {
 
 struct HomeSpringGrasp {
-  int vertex = -1;                                             ///< grasped vertex; -1: none
-  Eigen::Vector3d tool_at_grasp = Eigen::Vector3d::Zero();     ///< tool point when the jaws closed [m]
+  int vertex = -1;                                          ///< grasped vertex; -1: none
+  Eigen::Vector3d tool_at_grasp = Eigen::Vector3d::Zero();  ///< tool point when the jaws closed [m]
 
   bool active() const { return vertex >= 0; }
 };

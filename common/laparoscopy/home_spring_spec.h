@@ -17,7 +17,7 @@ namespace cohaptic {
 /// A flat sheet in the plane z = min.z: divisions.x by divisions.y rectangular cells over
 /// [min.x, min.x + size.x] x [min.y, min.y + size.y], two triangles each, facing +z.
 struct TissueGridSpec {
-  Eigen::Vector3d min = Eigen::Vector3d::Zero();  ///< [m]
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();   ///< [m]
   Eigen::Vector2d size = Eigen::Vector2d::Ones();  ///< [m], both > 0
   Eigen::Vector2i divisions = Eigen::Vector2i::Ones();
 };
@@ -25,22 +25,24 @@ struct TissueGridSpec {
 enum class TissueDisplayKind { polynomial, ffd };
 
 struct HomeSpringObjectSpec {
-  std::filesystem::path surface_file;  ///< FreeSurfer .asc (resolved against the scene's directory), or
+  std::filesystem::path
+      surface_file;  ///< FreeSurfer .asc (resolved against the scene's directory), or
   std::optional<TissueGridSpec> grid;  ///< a generated sheet: exactly one of the two
   double home_stiffness = 0;           ///< k1 [N/m], > 0
   double neighbour_stiffness = 0;      ///< k2 [N/m], >= 0
-  double patch_radius = 0;             ///< the IR's patch: triangles within it of the contact vertex [m]
+  double patch_radius = 0;  ///< the IR's patch: triangles within it of the contact vertex [m]
   TissueDisplayKind display = TissueDisplayKind::polynomial;
-  double display_radius = 0;           ///< R of Eq. 1 (and the FFD lattice's margin) [m]
+  double display_radius = 0;  ///< R of Eq. 1 (and the FFD lattice's margin) [m]
 };
 
 /// A probe's or forceps' shaft through its trocar, and the forceps' jaws (forceps_jaws.h).
 struct InstrumentSpec {
-  Eigen::Vector3d trocar = Eigen::Vector3d::Zero();    ///< the pivot [m]
-  Eigen::Vector3d opening = Eigen::Vector3d::UnitX();  ///< forceps: the jaws open along it, projected off the shaft
-  double jaw_length = 0.01;     ///< forceps [m]
-  double open_angle = 0.5;      ///< forceps: each jaw's angle from the shaft when open [rad]
-  double closing_step = 0.02;   ///< forceps: closing per server step while button 0 is held [rad]
+  Eigen::Vector3d trocar = Eigen::Vector3d::Zero();  ///< the pivot [m]
+  Eigen::Vector3d opening =
+      Eigen::Vector3d::UnitX();  ///< forceps: the jaws open along it, projected off the shaft
+  double jaw_length = 0.01;      ///< forceps [m]
+  double open_angle = 0.5;       ///< forceps: each jaw's angle from the shaft when open [rad]
+  double closing_step = 0.02;    ///< forceps: closing per server step while button 0 is held [rad]
 };
 
 }  // namespace cohaptic

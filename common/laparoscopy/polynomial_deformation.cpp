@@ -16,11 +16,14 @@ double polynomial_depth_fraction(double r, double radius) noexcept {
   return fraction_of_squares(r * r, radius * radius);
 }
 
-void deform_polynomial(const Eigen::Matrix3Xd& rest, const PolynomialDent& dent, Eigen::Matrix3Xd& deformed) noexcept {
+void deform_polynomial(const Eigen::Matrix3Xd& rest, const PolynomialDent& dent,
+                       Eigen::Matrix3Xd& deformed) noexcept {
   const Eigen::Vector3d push = dent.tool_point - dent.contact_point;  // |push| = a0, along AP
   const double radius2 = dent.radius > 0 ? dent.radius * dent.radius : 0;
   for (Eigen::Index v = 0; v < rest.cols(); ++v)
-    deformed.col(v) = rest.col(v) + fraction_of_squares((rest.col(v) - dent.contact_point).squaredNorm(), radius2) * push;
+    deformed.col(v) =
+        rest.col(v) +
+        fraction_of_squares((rest.col(v) - dent.contact_point).squaredNorm(), radius2) * push;
 }
 
 }  // namespace cohaptic

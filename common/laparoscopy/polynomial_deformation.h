@@ -22,6 +22,7 @@ struct PolynomialDent {
 double polynomial_depth_fraction(double r, double radius) noexcept;
 
 /// deformed = rest moved by the dent (same size as rest; the caller sizes it once).
-void deform_polynomial(const Eigen::Matrix3Xd& rest, const PolynomialDent& dent, Eigen::Matrix3Xd& deformed) noexcept;
+void deform_polynomial(const Eigen::Matrix3Xd& rest, const PolynomialDent& dent,
+                       Eigen::Matrix3Xd& deformed) noexcept;
 
 }  // namespace cohaptic

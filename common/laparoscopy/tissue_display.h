@@ -22,11 +22,11 @@ namespace cohaptic {
 enum class DisplayDeformation { polynomial, ffd_one_point };
 
 struct TissueDisplay {
-  Eigen::Matrix3Xd rest;           ///< surface vertices at rest [m]
-  double radius = 0;               ///< radius of influence R [m]
+  Eigen::Matrix3Xd rest;  ///< surface vertices at rest [m]
+  double radius = 0;      ///< radius of influence R [m]
   DisplayDeformation method = DisplayDeformation::polynomial;
-  BernsteinLattice lattice;        ///< the rest vertices' bounding box grown by R on every side
-  LatticeBinding binding;          ///< the rest vertices' basis values in it
+  BernsteinLattice lattice;  ///< the rest vertices' bounding box grown by R on every side
+  LatticeBinding binding;    ///< the rest vertices' basis values in it
 };
 
 /// Throws Error when there is no vertex, a vertex is not finite, or R is not positive and

@@ -13,10 +13,13 @@ VertexRings vertex_rings(std::span<const Triangle> triangles, int vertex_count) 
     for (int k = 0; k < 3; ++k) {
       const int v = triangles[t][static_cast<std::size_t>(k)];
       if (v < 0 || v >= vertex_count)
-        throw Error(fmt::format("vertex rings: triangle {} names vertex {}, but there are {} vertices", t, v, vertex_count));
+        throw Error(
+            fmt::format("vertex rings: triangle {} names vertex {}, but there are {} vertices", t,
+                        v, vertex_count));
     }
     for (int k = 0; k < 3; ++k) {
-      const int a = triangles[t][static_cast<std::size_t>(k)], b = triangles[t][static_cast<std::size_t>((k + 1) % 3)];
+      const int a = triangles[t][static_cast<std::size_t>(k)],
+                b = triangles[t][static_cast<std::size_t>((k + 1) % 3)];
       rings[static_cast<std::size_t>(a)].push_back(b);
       rings[static_cast<std::size_t>(b)].push_back(a);
     }

@@ -11,7 +11,7 @@
 namespace cohaptic {
 
 struct VertexRings {
-  std::vector<int> offsets;   ///< vertex v's ring: vertices[offsets[v] .. offsets[v + 1])
+  std::vector<int> offsets;  ///< vertex v's ring: vertices[offsets[v] .. offsets[v + 1])
   std::vector<int> vertices;
 
   std::span<const int> ring(int vertex) const {

@@ -18,7 +18,8 @@ struct HapticNodeForce {
 };
 
 HapticNodeForce haptic_node_force(double mass, const Eigen::Vector3d& x, const Eigen::Vector3d& v,
-                                  const Eigen::Vector3d& other_forces, const Eigen::Vector3d& target,
-                                  const Eigen::Vector3d& normal, double tool_friction, double h) noexcept;
+                                  const Eigen::Vector3d& other_forces,
+                                  const Eigen::Vector3d& target, const Eigen::Vector3d& normal,
+                                  double tool_friction, double h) noexcept;
 
 }  // namespace cohaptic

@@ -15,11 +15,14 @@ int drive_of(std::span<const NodeDrive> drives, int node) noexcept {
 
 }  // namespace
 
-void step_network(const MassSpringNetwork& network, MassSpringState& state, std::span<const NodeDrive> drives,
-                  std::span<Eigen::Vector3d> applied, double h, const NodeBacking* backing) noexcept {
+void step_network(const MassSpringNetwork& network, MassSpringState& state,
+                  std::span<const NodeDrive> drives, std::span<Eigen::Vector3d> applied, double h,
+                  const NodeBacking* backing) noexcept {
   const MassSpringParameters& p = network.parameters;
   internal_forces(network, state.positions, state.velocities, state.forces);
-  if (backing) add_node_backing_forces(*backing, state.backing, state.positions, state.velocities, state.forces);
+  if (backing)
+    add_node_backing_forces(*backing, state.backing, state.positions, state.velocities,
+                            state.forces);
   for (std::size_t i = 0; i < drives.size(); ++i) applied[i].setZero();
   for (int n = 0; n < network.node_count(); ++n) {
     auto x = state.positions.col(n);

@@ -30,7 +30,8 @@ struct NodeDrive {
 /// `backing` (may be null): a body behind this one pressing back on some nodes
 /// (node_backing.h), over the network's node indices, solved in state.backing (prepared
 /// for it by prepare_backing_solve).
-void step_network(const MassSpringNetwork& network, MassSpringState& state, std::span<const NodeDrive> drives,
-                  std::span<Eigen::Vector3d> applied, double h, const NodeBacking* backing = nullptr) noexcept;
+void step_network(const MassSpringNetwork& network, MassSpringState& state,
+                  std::span<const NodeDrive> drives, std::span<Eigen::Vector3d> applied, double h,
+                  const NodeBacking* backing = nullptr) noexcept;
 
 }  // namespace cohaptic

@@ -12,9 +12,11 @@ void internal_forces(const MassSpringNetwork& network, const Eigen::Matrix3Xd& p
     const double length = l.norm();
     if (!(length > 0)) continue;
     const Eigen::Vector3d direction = l / length;
-    const double stretch_rate = (velocities.col(spring.b) - velocities.col(spring.a)).dot(direction);
+    const double stretch_rate =
+        (velocities.col(spring.b) - velocities.col(spring.a)).dot(direction);
     const Eigen::Vector3d on_a =
-        (spring.stiffness * (length - spring.rest_length) + spring.damping * stretch_rate) * direction;
+        (spring.stiffness * (length - spring.rest_length) + spring.damping * stretch_rate) *
+        direction;
     forces.col(spring.a) += on_a;
     forces.col(spring.b) -= on_a;
   }
@@ -23,7 +25,8 @@ void internal_forces(const MassSpringNetwork& network, const Eigen::Matrix3Xd& p
 double potential_energy(const MassSpringNetwork& network, const Eigen::Matrix3Xd& positions) {
   double energy = 0;
   for (const Spring& spring : network.springs) {
-    const double stretch = (positions.col(spring.b) - positions.col(spring.a)).norm() - spring.rest_length;
+    const double stretch =
+        (positions.col(spring.b) - positions.col(spring.a)).norm() - spring.rest_length;
     energy += 0.5 * spring.stiffness * stretch * stretch;
   }
   for (int n = 0; n < network.node_count(); ++n)
@@ -33,7 +36,8 @@ double potential_energy(const MassSpringNetwork& network, const Eigen::Matrix3Xd
 
 double kinetic_energy(const MassSpringNetwork& network, const Eigen::Matrix3Xd& velocities) {
   double energy = 0;
-  for (int n = 0; n < network.node_count(); ++n) energy += 0.5 * network.mass[n] * velocities.col(n).squaredNorm();
+  for (int n = 0; n < network.node_count(); ++n)
+    energy += 0.5 * network.mass[n] * velocities.col(n).squaredNorm();
   return energy;
 }
 

@@ -10,7 +10,8 @@ namespace cohaptic {
 namespace {
 
 // The springs' forces on every dof (no dampers: the network at rest).
-void spring_forces(const MassSpringNetwork& network, const Eigen::Matrix3Xd& x, Eigen::VectorXd& force) {
+void spring_forces(const MassSpringNetwork& network, const Eigen::Matrix3Xd& x,
+                   Eigen::VectorXd& force) {
   force.setZero();
   for (const Spring& s : network.springs) {
     const Eigen::Vector3d l = x.col(s.b) - x.col(s.a);
@@ -24,7 +25,8 @@ void spring_forces(const MassSpringNetwork& network, const Eigen::Matrix3Xd& x, 
 
 }  // namespace
 
-NetworkEquilibrium network_equilibrium(const MassSpringNetwork& network, std::span<const PrescribedDisplacement> prescribed,
+NetworkEquilibrium network_equilibrium(const MassSpringNetwork& network,
+                                       std::span<const PrescribedDisplacement> prescribed,
                                        const Eigen::Matrix3Xd& start, double tolerance) {
   const int dofs = 3 * network.node_count();
   std::vector<bool> set(static_cast<std::size_t>(dofs), false);
@@ -52,12 +54,14 @@ NetworkEquilibrium network_equilibrium(const MassSpringNetwork& network, std::sp
     Eigen::MatrixXd k(count, count);
     for (Eigen::Index i = 0; i < count; ++i) {
       residual[i] = force[free[static_cast<std::size_t>(i)]];
-      for (Eigen::Index j = 0; j < count; ++j) k(i, j) = tangent(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]);
+      for (Eigen::Index j = 0; j < count; ++j)
+        k(i, j) = tangent(free[static_cast<std::size_t>(i)], free[static_cast<std::size_t>(j)]);
     }
     if (count == 0 || residual.cwiseAbs().maxCoeff() <= tolerance) break;
     if (result.iterations == 50)  // Newton converges in a few from a nearby equilibrium
-      throw Error(fmt::format("network equilibrium: Newton left a free force of {} N after 50 iterations",
-                              residual.cwiseAbs().maxCoeff()));
+      throw Error(
+          fmt::format("network equilibrium: Newton left a free force of {} N after 50 iterations",
+                      residual.cwiseAbs().maxCoeff()));
     const Eigen::VectorXd step = k.partialPivLu().solve(residual);
     for (Eigen::Index i = 0; i < count; ++i) {
       const int d = free[static_cast<std::size_t>(i)];

@@ -18,14 +18,16 @@ namespace cohaptic {
 
 struct NetworkEquilibrium {
   Eigen::Matrix3Xd positions;  ///< [m]
-  Eigen::VectorXd reaction;    ///< the force holding each prescribed dof, 3 per node (0 elsewhere) [N]
+  Eigen::VectorXd
+      reaction;  ///< the force holding each prescribed dof, 3 per node (0 elsewhere) [N]
   int iterations = 0;
 };
 
 /// Equilibrium with `prescribed` dofs displaced from rest (network.held nodes stay at rest),
 /// starting Newton from `start` (e.g. a nearby equilibrium). Throws Error if Newton does not
 /// bring the free forces below `tolerance` [N] in 50 iterations.
-NetworkEquilibrium network_equilibrium(const MassSpringNetwork& network, std::span<const PrescribedDisplacement> prescribed,
+NetworkEquilibrium network_equilibrium(const MassSpringNetwork& network,
+                                       std::span<const PrescribedDisplacement> prescribed,
                                        const Eigen::Matrix3Xd& start, double tolerance = 1e-10);
 
 }  // namespace cohaptic

@@ -20,6 +20,7 @@ namespace cohaptic {
 
 /// K over the 3 |positions| dofs of the network's nodes at `positions` (its rest positions:
 /// the linearised network).
-SparseMatrix network_stiffness(const Eigen::Ref<const Eigen::Matrix3Xd>& positions, std::span<const Spring> springs);
+SparseMatrix network_stiffness(const Eigen::Ref<const Eigen::Matrix3Xd>& positions,
+                               std::span<const Spring> springs);
 
 }  // namespace cohaptic

@@ -18,8 +18,8 @@ constexpr double kBackingSolveTrials = 20;
 
 bool backing_solve_fits(const NodeBacking& backing, const NodeBackingSolve& solve) noexcept {
   const auto count = static_cast<Eigen::Index>(backing.nodes.size());
-  return solve.pushes.size() == count && solve.gaps.size() == count && solve.solved.size() == count &&
-         static_cast<Eigen::Index>(solve.active.size()) == count &&
+  return solve.pushes.size() == count && solve.gaps.size() == count &&
+         solve.solved.size() == count && static_cast<Eigen::Index>(solve.active.size()) == count &&
          static_cast<Eigen::Index>(solve.order.size()) == count && solve.factor.rows() == count &&
          solve.factor.cols() == count;
 }
@@ -50,7 +50,8 @@ void add_node_backing_forces(const NodeBacking& backing, NodeBackingSolve& solve
   bool touching = false;
   for (Eigen::Index i = 0; i < count; ++i) {
     const int node = backing.nodes[static_cast<std::size_t>(i)];
-    solve.gaps[i] = (positions.col(node) - backing.targets.segment<3>(3 * i)).dot(backing.normals.segment<3>(3 * i)) +
+    solve.gaps[i] = (positions.col(node) - backing.targets.segment<3>(3 * i))
+                        .dot(backing.normals.segment<3>(3 * i)) +
                     backing.offsets[i];
     touching = touching || solve.gaps[i] < 0;
   }
@@ -63,7 +64,8 @@ void add_node_backing_forces(const NodeBacking& backing, NodeBackingSolve& solve
   const double m = static_cast<double>(count);
   const double budget = kBackingSolveTrials * (m * m * m / 3 + 2 * m * m);
   const UnilateralSolveResult result =
-      solve_unilateral_contact(backing.compliance, solve.gaps, solve.active, solve.solved, solve.factor, solve.order, budget);
+      solve_unilateral_contact(backing.compliance, solve.gaps, solve.active, solve.solved,
+                               solve.factor, solve.order, budget);
   if (result.solved) {
     solve.pushes = solve.solved;
   } else {
@@ -84,12 +86,14 @@ void add_node_backing_forces(const NodeBacking& backing, NodeBackingSolve& solve
   }
 }
 
-double backing_energy(const NodeBacking& backing, const Eigen::Ref<const Eigen::VectorXd>& pushes) noexcept {
+double backing_energy(const NodeBacking& backing,
+                      const Eigen::Ref<const Eigen::VectorXd>& pushes) noexcept {
   if (backing.empty()) return 0;
   return 0.5 * pushes.dot(backing.compliance * pushes);
 }
 
-NodeBacking sub_network_backing(const NodeBacking& whole, const Eigen::Ref<const Eigen::VectorXd>& pushes,
+NodeBacking sub_network_backing(const NodeBacking& whole,
+                                const Eigen::Ref<const Eigen::VectorXd>& pushes,
                                 std::span<const std::int32_t> body_nodes) {
   std::vector<Eigen::Index> kept, outside;
   NodeBacking sub;
@@ -110,7 +114,8 @@ NodeBacking sub_network_backing(const NodeBacking& whole, const Eigen::Ref<const
   sub.normals.resize(3 * count);
   for (Eigen::Index a = 0; a < count; ++a) {
     const Eigen::Index i = kept[static_cast<std::size_t>(a)];
-    for (Eigen::Index b = 0; b < count; ++b) sub.compliance(a, b) = whole.compliance(i, kept[static_cast<std::size_t>(b)]);
+    for (Eigen::Index b = 0; b < count; ++b)
+      sub.compliance(a, b) = whole.compliance(i, kept[static_cast<std::size_t>(b)]);
     double offset = whole.offsets[i];
     for (Eigen::Index j : outside) offset += whole.compliance(i, j) * pushes[j];
     sub.offsets[a] = offset;
@@ -123,23 +128,27 @@ NodeBacking sub_network_backing(const NodeBacking& whole, const Eigen::Ref<const
 
 void check_node_backing(const NodeBacking& backing, int node_count, const char* what) {
   const auto count = static_cast<Eigen::Index>(backing.nodes.size());
-  if (backing.compliance.rows() != count || backing.compliance.cols() != count || backing.offsets.size() != count ||
-      backing.damping.size() != count || backing.targets.size() != 3 * count || backing.normals.size() != 3 * count)
-    throw Error(fmt::format("{}: the backing of {} nodes needs a {}x{} compliance, {} offsets and dampings and {} "
-                            "targets and normals, not {}x{}, {}, {}, {} and {}",
-                            what, count, count, count, count, 3 * count, backing.compliance.rows(),
-                            backing.compliance.cols(), backing.offsets.size(), backing.damping.size(),
-                            backing.targets.size(), backing.normals.size()));
+  if (backing.compliance.rows() != count || backing.compliance.cols() != count ||
+      backing.offsets.size() != count || backing.damping.size() != count ||
+      backing.targets.size() != 3 * count || backing.normals.size() != 3 * count)
+    throw Error(fmt::format(
+        "{}: the backing of {} nodes needs a {}x{} compliance, {} offsets and dampings and {} "
+        "targets and normals, not {}x{}, {}, {}, {} and {}",
+        what, count, count, count, count, 3 * count, backing.compliance.rows(),
+        backing.compliance.cols(), backing.offsets.size(), backing.damping.size(),
+        backing.targets.size(), backing.normals.size()));
   for (std::size_t k = 0; k < backing.nodes.size(); ++k) {
     const int node = backing.nodes[k];
     if (node < 0 || node >= node_count)
-      throw Error(fmt::format("{}: backed node {} is {}, not a node of the {}", what, k, node, node_count));
+      throw Error(
+          fmt::format("{}: backed node {} is {}, not a node of the {}", what, k, node, node_count));
     if (std::count(backing.nodes.begin(), backing.nodes.end(), node) > 1)
       throw Error(fmt::format("{}: node {} is backed twice", what, node));
   }
-  if (!backing.compliance.allFinite() || !backing.offsets.allFinite() || !backing.damping.allFinite() ||
-      !backing.targets.allFinite() || !backing.normals.allFinite())
-    throw Error(fmt::format("{}: the backing's compliance, offsets, damping, targets or normals are not finite", what));
+  if (!backing.compliance.allFinite() || !backing.offsets.allFinite() ||
+      !backing.damping.allFinite() || !backing.targets.allFinite() || !backing.normals.allFinite())
+    throw Error(fmt::format(
+        "{}: the backing's compliance, offsets, damping, targets or normals are not finite", what));
   if (count > 0) {
     const double scale = backing.compliance.cwiseAbs().maxCoeff();
     if ((backing.compliance - backing.compliance.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale)
@@ -149,11 +158,11 @@ void check_node_backing(const NodeBacking& backing, int node_count, const char* 
   }
   for (Eigen::Index k = 0; k < count; ++k) {
     if (backing.damping[k] < 0)
-      throw Error(fmt::format("{}: backed node {} has damping {} N s/m (it may not be negative)", what, k,
-                              backing.damping[k]));
+      throw Error(fmt::format("{}: backed node {} has damping {} N s/m (it may not be negative)",
+                              what, k, backing.damping[k]));
     if (std::abs(backing.normals.segment<3>(3 * k).norm() - 1) > 1e-6)
-      throw Error(fmt::format("{}: backed node {} has a normal of length {}, not a unit normal", what, k,
-                              backing.normals.segment<3>(3 * k).norm()));
+      throw Error(fmt::format("{}: backed node {} has a normal of length {}, not a unit normal",
+                              what, k, backing.normals.segment<3>(3 * k).norm()));
   }
 }
 

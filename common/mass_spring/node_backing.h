@@ -67,12 +67,14 @@ void add_node_backing_forces(const NodeBacking& backing, NodeBackingSolve& solve
                              Eigen::Ref<Eigen::Matrix3Xd> forces) noexcept;
 
 /// B's elastic energy under `pushes` [J]: lambda.A lambda / 2, the backing's potential.
-double backing_energy(const NodeBacking& backing, const Eigen::Ref<const Eigen::VectorXd>& pushes) noexcept;
+double backing_energy(const NodeBacking& backing,
+                      const Eigen::Ref<const Eigen::VectorXd>& pushes) noexcept;
 
 /// The backing of a sub-network: the backed nodes among `body_nodes` (the body's node of
 /// each local node), in local indices; the `pushes` of the others (the whole backing's,
 /// per its node) are held and displace B's surface under the kept ones (their offsets).
-NodeBacking sub_network_backing(const NodeBacking& whole, const Eigen::Ref<const Eigen::VectorXd>& pushes,
+NodeBacking sub_network_backing(const NodeBacking& whole,
+                                const Eigen::Ref<const Eigen::VectorXd>& pushes,
                                 std::span<const std::int32_t> body_nodes);
 
 /// Throws Error naming `what` when sizes, node indices (below node_count) or values are bad

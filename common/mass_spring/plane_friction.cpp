@@ -2,8 +2,9 @@
 
 namespace cohaptic {
 
-Eigen::Vector3d plane_reaction(const SupportPlane& plane, const Eigen::Vector3d& x, const Eigen::Vector3d& v,
-                               const Eigen::Vector3d& force, double mass, double h, bool& sliding) noexcept {
+Eigen::Vector3d plane_reaction(const SupportPlane& plane, const Eigen::Vector3d& x,
+                               const Eigen::Vector3d& v, const Eigen::Vector3d& force, double mass,
+                               double h, bool& sliding) noexcept {
   sliding = false;
   const Eigen::Vector3d& n = plane.normal;
   const double pressing = force.dot(n);
@@ -37,7 +38,8 @@ void settle_on_plane(const SupportPlane& plane, const Eigen::Vector3d& v_before,
   }
 }
 
-void keep_above(const SupportPlane& plane, Eigen::Ref<Eigen::Vector3d> x, Eigen::Ref<Eigen::Vector3d> v) noexcept {
+void keep_above(const SupportPlane& plane, Eigen::Ref<Eigen::Vector3d> x,
+                Eigen::Ref<Eigen::Vector3d> v) noexcept {
   const double height = height_above(plane, x);
   if (height >= 0) return;
   x -= height * plane.normal;

@@ -29,13 +29,16 @@ namespace cohaptic {
 inline constexpr double kPlaneTouchTolerance = 1e-9;
 
 /// Height of `x` above the plane [m] (negative below).
-inline double height_above(const SupportPlane& plane, const Eigen::Vector3d& x) { return (x - plane.point).dot(plane.normal); }
+inline double height_above(const SupportPlane& plane, const Eigen::Vector3d& x) {
+  return (x - plane.point).dot(plane.normal);
+}
 
 /// The plane's normal and friction force on a node of mass `mass` at `x` with velocity `v`
 /// carrying the force `force`, for a step of h [s]; zero when it does not touch or does not
 /// press. Sets `sliding` when the dynamic law applied.
-Eigen::Vector3d plane_reaction(const SupportPlane& plane, const Eigen::Vector3d& x, const Eigen::Vector3d& v,
-                               const Eigen::Vector3d& force, double mass, double h, bool& sliding) noexcept;
+Eigen::Vector3d plane_reaction(const SupportPlane& plane, const Eigen::Vector3d& x,
+                               const Eigen::Vector3d& v, const Eigen::Vector3d& force, double mass,
+                               double h, bool& sliding) noexcept;
 
 /// After the velocity update of a touching node: removes a velocity into the plane
 /// (Eq. 6) and, if dynamic friction reversed the sliding direction `v_before` within the
@@ -44,6 +47,7 @@ void settle_on_plane(const SupportPlane& plane, const Eigen::Vector3d& v_before,
                      Eigen::Ref<Eigen::Vector3d> v) noexcept;
 
 /// Moves a node below the plane back onto it and removes its velocity into the plane.
-void keep_above(const SupportPlane& plane, Eigen::Ref<Eigen::Vector3d> x, Eigen::Ref<Eigen::Vector3d> v) noexcept;
+void keep_above(const SupportPlane& plane, Eigen::Ref<Eigen::Vector3d> x,
+                Eigen::Ref<Eigen::Vector3d> v) noexcept;
 
 }  // namespace cohaptic

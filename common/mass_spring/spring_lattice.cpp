@@ -13,9 +13,10 @@ SpringLattice spring_lattice(const SpringLatticeSpec& spec) {
   if (!(spec.size.array() > 0).all() || !(spec.divisions.array() >= 1).all())
     throw Error("a spring lattice needs a positive size and at least one division along each axis");
   if (!(spec.spring_stiffness > 0) || !(spec.spring_damping >= 0) || !(spec.node_mass > 0))
-    throw Error(fmt::format("a spring lattice needs a positive spring stiffness ({}) and node mass ({}) and a "
-                            "non-negative spring damping ({})", spec.spring_stiffness, spec.node_mass,
-                            spec.spring_damping));
+    throw Error(fmt::format(
+        "a spring lattice needs a positive spring stiffness ({}) and node mass ({}) and a "
+        "non-negative spring damping ({})",
+        spec.spring_stiffness, spec.node_mass, spec.spring_damping));
   SpringLattice lattice;
   const TetMesh mesh = make_box_mesh(spec.min_corner, spec.size, spec.divisions);
   MassSpringNetwork& network = lattice.network;
@@ -33,7 +34,8 @@ SpringLattice spring_lattice(const SpringLatticeSpec& spec) {
   const Eigen::Vector3i points = spec.divisions.array() + 1;
   const int stride = axis == 0 ? 1 : axis == 1 ? points.x() : points.x() * points.y();
   lattice.section_count = points[axis];
-  for (int n = 0; n < mesh.node_count(); ++n) lattice.section_of_node.push_back(n / stride % points[axis]);
+  for (int n = 0; n < mesh.node_count(); ++n)
+    lattice.section_of_node.push_back(n / stride % points[axis]);
   return lattice;
 }
 

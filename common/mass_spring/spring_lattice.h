@@ -19,9 +19,9 @@ struct SpringLatticeSpec {
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();  ///< [m]
   Eigen::Vector3d size = Eigen::Vector3d::Zero();        ///< [m], each > 0
   Eigen::Vector3i divisions = Eigen::Vector3i::Ones();   ///< cells per axis, each >= 1
-  double spring_stiffness = 0;  ///< every spring's k [N/m] > 0
-  double spring_damping = 0;    ///< every spring's k^d [N s/m] >= 0
-  double node_mass = 0;         ///< every node's [kg] > 0
+  double spring_stiffness = 0;                           ///< every spring's k [N/m] > 0
+  double spring_damping = 0;                             ///< every spring's k^d [N s/m] >= 0
+  double node_mass = 0;                                  ///< every node's [kg] > 0
 };
 
 /// The network (nothing held, parameters left default); `section_of_node` is each node's

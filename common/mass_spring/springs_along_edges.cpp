@@ -19,7 +19,8 @@ std::vector<Spring> springs_along_edges(const TetMesh& mesh, double stiffness, d
   springs.reserve(edges.size());
   for (const auto& [a, b] : edges) {
     const double length = (mesh.nodes.col(b) - mesh.nodes.col(a)).norm();
-    if (!(length > 0)) throw Error(fmt::format("springs along edges: nodes {} and {} are at one point", a, b));
+    if (!(length > 0))
+      throw Error(fmt::format("springs along edges: nodes {} and {} are at one point", a, b));
     springs.push_back({a, b, length, stiffness, damping});
   }
   return springs;

@@ -7,7 +7,8 @@
 namespace cohaptic {
 namespace {
 
-Eigen::Vector3d closest_point_on_edge(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+Eigen::Vector3d closest_point_on_edge(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                      const Eigen::Vector3d& b) {
   const Eigen::Vector3d edge = b - a;
   const double length2 = edge.squaredNorm();
   if (!(length2 > 0)) return a;
@@ -19,8 +20,8 @@ Eigen::Vector3d closest_point_on_edge(const Eigen::Vector3d& p, const Eigen::Vec
 
 }  // namespace
 
-Eigen::Vector3d closest_point_on_face(const Eigen::Vector3d& p, const Eigen::Vector3d& sn, const Eigen::Vector3d& b,
-                                      const Eigen::Vector3d& c) noexcept {
+Eigen::Vector3d closest_point_on_face(const Eigen::Vector3d& p, const Eigen::Vector3d& sn,
+                                      const Eigen::Vector3d& b, const Eigen::Vector3d& c) noexcept {
   const Eigen::Vector3d normal = (b - sn).cross(c - sn);
   const double area2 = normal.squaredNorm();
   if (area2 > 0) {
@@ -31,7 +32,8 @@ Eigen::Vector3d closest_point_on_face(const Eigen::Vector3d& p, const Eigen::Vec
     if (inside) return foot;
   }
   Eigen::Vector3d best = closest_point_on_edge(p, sn, b);
-  for (const Eigen::Vector3d& candidate : {closest_point_on_edge(p, b, c), closest_point_on_edge(p, c, sn)})
+  for (const Eigen::Vector3d& candidate :
+       {closest_point_on_edge(p, b, c), closest_point_on_edge(p, c, sn)})
     if ((candidate - p).squaredNorm() < (best - p).squaredNorm()) best = candidate;
   return best;
 }

@@ -18,19 +18,20 @@ namespace cohaptic {
 
 struct SurfaceContact {
   bool colliding = false;
-  int nearest_node = -1;   ///< s_n, -1 for a network without surface
-  int triangle = -1;       ///< the triangle of x_s
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();   ///< x_s [m]
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ(); ///< N_s, unit outward
-  double depth = 0;        ///< (x_s - x_h) . N_s + r [m]: >= 0 when colliding
+  int nearest_node = -1;                              ///< s_n, -1 for a network without surface
+  int triangle = -1;                                  ///< the triangle of x_s
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();    ///< x_s [m]
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< N_s, unit outward
+  double depth = 0;  ///< (x_s - x_h) . N_s + r [m]: >= 0 when colliding
 };
 
-SurfaceContact find_surface_contact(const MassSpringNetwork& network, const Eigen::Matrix3Xd& positions,
-                                    const Eigen::Vector3d& tool, double radius) noexcept;
+SurfaceContact find_surface_contact(const MassSpringNetwork& network,
+                                    const Eigen::Matrix3Xd& positions, const Eigen::Vector3d& tool,
+                                    double radius) noexcept;
 
 /// The closest point to p on triangle (sn, b, c) by the paper's construction (Eq. 4 for the
 /// interior, then edges and their ends).
-Eigen::Vector3d closest_point_on_face(const Eigen::Vector3d& p, const Eigen::Vector3d& sn, const Eigen::Vector3d& b,
-                                      const Eigen::Vector3d& c) noexcept;
+Eigen::Vector3d closest_point_on_face(const Eigen::Vector3d& p, const Eigen::Vector3d& sn,
+                                      const Eigen::Vector3d& b, const Eigen::Vector3d& c) noexcept;
 
 }  // namespace cohaptic

@@ -7,10 +7,13 @@
 namespace cohaptic {
 
 double thermal_stiffness_factor(const HeatedRegion& region) {
-  const double factor = 1 - region.coupling * region.expansion_coefficient * region.temperature_rise;
+  const double factor =
+      1 - region.coupling * region.expansion_coefficient * region.temperature_rise;
   if (!(factor > 0) || !(factor <= 1))
-    throw Error(fmt::format("heating by {} K with alpha_L {} /K and c {} scales the springs by {}: expected a factor "
-                            "in (0, 1]", region.temperature_rise, region.expansion_coefficient, region.coupling, factor));
+    throw Error(fmt::format(
+        "heating by {} K with alpha_L {} /K and c {} scales the springs by {}: expected a factor "
+        "in (0, 1]",
+        region.temperature_rise, region.expansion_coefficient, region.coupling, factor));
   return factor;
 }
 
@@ -18,7 +21,8 @@ int heat_springs(MassSpringNetwork& network, const HeatedRegion& region) {
   const double factor = thermal_stiffness_factor(region);
   auto inside = [&](int node) {
     const auto x = network.rest_positions.col(node);
-    return (x.array() >= region.box_min.array()).all() && (x.array() <= region.box_max.array()).all();
+    return (x.array() >= region.box_min.array()).all() &&
+           (x.array() <= region.box_max.array()).all();
   };
   int heated = 0;
   for (Spring& spring : network.springs)

@@ -1,5 +1,6 @@
 // Temperature-dependent stiffness (the thin-objects paper, Sec. 4.5, after Terzopoulos):
-//   k_c(theta) = k_c(theta0) - nu_c (theta - theta0),  nu_c = c alpha_L E sum Vol(T_c)/|l_c|^2  (Eq. 7)
+//   k_c(theta) = k_c(theta0) - nu_c (theta - theta0),
+//   nu_c = c alpha_L E sum Vol(T_c)/|l_c|^2                                     (Eq. 7)
 // Since Eq. (1) gives k_c(theta0) = E sum Vol(T_c)/|l_c|^2, nu_c = c alpha_L k_c(theta0): a
 // heated spring's stiffness, and with Eq. (2) its damping, scale by the one factor
 //   1 - c alpha_L (theta - theta0),

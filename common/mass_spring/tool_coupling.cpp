@@ -13,8 +13,9 @@ int substeps_for(const MassSpringNetwork& network, double period) noexcept {
   return std::isfinite(steps) ? std::clamp(static_cast<int>(steps), 1, 1'000'000) : 1;
 }
 
-void advance_with_tools(const MassSpringNetwork& network, MassSpringState& state, std::span<const ToolOnNetwork> tools,
-                        std::span<ToolPress> presses, std::span<NetworkToolReaction> reactions, double period,
+void advance_with_tools(const MassSpringNetwork& network, MassSpringState& state,
+                        std::span<const ToolOnNetwork> tools, std::span<ToolPress> presses,
+                        std::span<NetworkToolReaction> reactions, double period,
                         const NodeBacking* backing) noexcept {
   const std::size_t count = std::min(tools.size(), static_cast<std::size_t>(kMaxNetworkTools));
   std::array<NodeDrive, kMaxNetworkTools> drives;
@@ -28,7 +29,8 @@ void advance_with_tools(const MassSpringNetwork& network, MassSpringState& state
       presses[i].pressing = false;
       continue;
     }
-    const SurfaceContact contact = find_surface_contact(network, state.positions, tool.position, tool.radius);
+    const SurfaceContact contact =
+        find_surface_contact(network, state.positions, tool.position, tool.radius);
     if (!contact.colliding || network.held[static_cast<std::size_t>(contact.nearest_node)]) {
       presses[i].pressing = false;
       continue;

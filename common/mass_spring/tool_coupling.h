@@ -28,7 +28,7 @@ inline constexpr int kMaxNetworkTools = 8;
 
 /// What a tool carries from one period to the next.
 struct ToolPress {
-  bool pressing = false;                            ///< collided in the previous period
+  bool pressing = false;                               ///< collided in the previous period
   Eigen::Vector3d previous = Eigen::Vector3d::Zero();  ///< its position then [m]
 };
 
@@ -40,15 +40,16 @@ struct ToolOnNetwork {
 struct NetworkToolReaction {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< on the tool [N]
   bool colliding = false;
-  int node = -1;          ///< the driven node
-  double depth = 0;       ///< at the start of the period [m]
+  int node = -1;     ///< the driven node
+  double depth = 0;  ///< at the start of the period [m]
 };
 
 /// Advances `state` by `period` [s] (> 0) with `tools` pressing; presses[i] and reactions[i]
 /// belong to tools[i] (both at least as long as tools; at most kMaxNetworkTools used).
 /// `backing` (may be null) presses back on the network every substep (step_network).
-void advance_with_tools(const MassSpringNetwork& network, MassSpringState& state, std::span<const ToolOnNetwork> tools,
-                        std::span<ToolPress> presses, std::span<NetworkToolReaction> reactions, double period,
+void advance_with_tools(const MassSpringNetwork& network, MassSpringState& state,
+                        std::span<const ToolOnNetwork> tools, std::span<ToolPress> presses,
+                        std::span<NetworkToolReaction> reactions, double period,
                         const NodeBacking* backing = nullptr) noexcept;
 
 /// The number of integrator steps for `period`.

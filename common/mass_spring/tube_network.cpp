@@ -18,7 +18,8 @@ int ring(int section, int k) { return kSectionNodes * section + 1 + (k + kRingNo
 // Points evenly spaced by arc length along the polyline.
 std::vector<Eigen::Vector3d> resample(const std::vector<Eigen::Vector3d>& line, int count) {
   std::vector<double> arc{0};
-  for (std::size_t i = 1; i < line.size(); ++i) arc.push_back(arc.back() + (line[i] - line[i - 1]).norm());
+  for (std::size_t i = 1; i < line.size(); ++i)
+    arc.push_back(arc.back() + (line[i] - line[i - 1]).norm());
   std::vector<Eigen::Vector3d> points;
   std::size_t segment = 1;
   for (int i = 0; i < count; ++i) {
@@ -31,7 +32,8 @@ std::vector<Eigen::Vector3d> resample(const std::vector<Eigen::Vector3d>& line, 
   return points;
 }
 
-double tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+double tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                  const Eigen::Vector3d& d) {
   return std::abs((b - a).cross(c - a).dot(d - a)) / 6;
 }
 
@@ -41,7 +43,8 @@ std::vector<std::array<int, 6>> tube_elements(int sections) {
   std::vector<std::array<int, 6>> prisms;
   for (int i = 0; i + 1 < sections; ++i)
     for (int k = 0; k < kRingNodes; ++k)
-      prisms.push_back({centre(i), ring(i, k), ring(i, k + 1), centre(i + 1), ring(i + 1, k), ring(i + 1, k + 1)});
+      prisms.push_back({centre(i), ring(i, k), ring(i, k + 1), centre(i + 1), ring(i + 1, k),
+                        ring(i + 1, k + 1)});
   return prisms;
 }
 
@@ -53,20 +56,25 @@ double prism_volume(const Eigen::Matrix3Xd& x, const std::array<int, 6>& p) {
 
 double enclosed_volume(const MassSpringNetwork& network, const Eigen::Matrix3Xd& x) {
   double six_volume = 0;
-  for (const auto& t : network.triangles) six_volume += x.col(t[0]).dot(x.col(t[1]).cross(x.col(t[2])));
+  for (const auto& t : network.triangles)
+    six_volume += x.col(t[0]).dot(x.col(t[1]).cross(x.col(t[2])));
   return six_volume / 6;
 }
 
 MassSpringNetwork tube_network(const TubeGeometry& geometry, const TubeMaterial& material) {
-  if (geometry.centre_line.size() < 2) throw Error("a tube's centre line needs at least two points");
+  if (geometry.centre_line.size() < 2)
+    throw Error("a tube's centre line needs at least two points");
   double length = 0;
   for (std::size_t i = 1; i < geometry.centre_line.size(); ++i)
     length += (geometry.centre_line[i] - geometry.centre_line[i - 1]).norm();
   if (!(length > 0) || !std::isfinite(length)) throw Error("a tube's centre line has no length");
-  if (!(geometry.radius > 0)) throw Error(fmt::format("a tube needs a positive radius, not {}", geometry.radius));
-  if (geometry.sections < 2) throw Error(fmt::format("a tube needs at least 2 sections, not {}", geometry.sections));
+  if (!(geometry.radius > 0))
+    throw Error(fmt::format("a tube needs a positive radius, not {}", geometry.radius));
+  if (geometry.sections < 2)
+    throw Error(fmt::format("a tube needs at least 2 sections, not {}", geometry.sections));
   if (!(material.youngs_modulus > 0) || !(material.density > 0) || !(material.spring_damping >= 0))
-    throw Error("a tube needs a positive Young's modulus and density and a non-negative spring damping");
+    throw Error(
+        "a tube needs a positive Young's modulus and density and a non-negative spring damping");
 
   const int sections = geometry.sections;
   const std::vector<Eigen::Vector3d> centres = resample(geometry.centre_line, sections);
@@ -79,7 +87,9 @@ MassSpringNetwork tube_network(const TubeGeometry& geometry, const TubeMaterial&
   u.normalize();
   for (int i = 0; i < sections; ++i) {
     const Eigen::Vector3d tangent =
-        (centres[static_cast<std::size_t>(std::min(i + 1, sections - 1))] - centres[static_cast<std::size_t>(std::max(i - 1, 0))]).normalized();
+        (centres[static_cast<std::size_t>(std::min(i + 1, sections - 1))] -
+         centres[static_cast<std::size_t>(std::max(i - 1, 0))])
+            .normalized();
     u = Eigen::Quaterniond::FromTwoVectors(previous_tangent, tangent) * u;
     u = (u - u.dot(tangent) * tangent).normalized();
     previous_tangent = tangent;
@@ -88,14 +98,16 @@ MassSpringNetwork tube_network(const TubeGeometry& geometry, const TubeMaterial&
     for (int k = 0; k < kRingNodes; ++k) {
       const double angle = 2 * std::numbers::pi * (k + 0.5) / kRingNodes;
       network.rest_positions.col(ring(i, k)) =
-          centres[static_cast<std::size_t>(i)] + geometry.radius * (std::cos(angle) * u + std::sin(angle) * w);
+          centres[static_cast<std::size_t>(i)] +
+          geometry.radius * (std::cos(angle) * u + std::sin(angle) * w);
     }
   }
 
   const int nodes = kSectionNodes * sections;
   network.mass = Eigen::VectorXd::Zero(nodes);
   network.held.assign(static_cast<std::size_t>(nodes), 0);
-  std::map<std::pair<int, int>, double> element_volume;  // per spring: volume of the elements holding both ends
+  std::map<std::pair<int, int>, double>
+      element_volume;  // per spring: volume of the elements holding both ends
   auto add_spring = [&](int a, int b) { element_volume.emplace(std::minmax(a, b), 0.0); };
   for (int i = 0; i < sections; ++i)
     for (int k = 0; k < kRingNodes; ++k) {
@@ -114,7 +126,8 @@ MassSpringNetwork tube_network(const TubeGeometry& geometry, const TubeMaterial&
     for (int node : prism) network.mass[node] += material.density * volume / 6;
     for (int a = 0; a < 6; ++a)
       for (int b = a + 1; b < 6; ++b)
-        if (auto found = element_volume.find(std::minmax(prism[static_cast<std::size_t>(a)], prism[static_cast<std::size_t>(b)]));
+        if (auto found = element_volume.find(std::minmax(prism[static_cast<std::size_t>(a)],
+                                                         prism[static_cast<std::size_t>(b)]));
             found != element_volume.end())
           found->second += volume;
   }
@@ -122,7 +135,8 @@ MassSpringNetwork tube_network(const TubeGeometry& geometry, const TubeMaterial&
     Spring spring;
     spring.a = ends.first;
     spring.b = ends.second;
-    spring.rest_length = (network.rest_positions.col(spring.b) - network.rest_positions.col(spring.a)).norm();
+    spring.rest_length =
+        (network.rest_positions.col(spring.b) - network.rest_positions.col(spring.a)).norm();
     spring.stiffness = material.youngs_modulus * volume / (spring.rest_length * spring.rest_length);
     spring.damping = material.spring_damping * spring.stiffness;
     network.springs.push_back(spring);
@@ -135,7 +149,8 @@ MassSpringNetwork tube_network(const TubeGeometry& geometry, const TubeMaterial&
     }
   for (int k = 0; k < kRingNodes; ++k) {
     network.triangles.push_back({centre(0), ring(0, k + 1), ring(0, k)});
-    network.triangles.push_back({centre(sections - 1), ring(sections - 1, k), ring(sections - 1, k + 1)});
+    network.triangles.push_back(
+        {centre(sections - 1), ring(sections - 1, k), ring(sections - 1, k + 1)});
   }
   index_surface(network);
   return network;

@@ -43,8 +43,7 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
   for (int t = 0; t < mesh.tet_count(); ++t) {
     const Tet& e = mesh.tets[t];
     for (const auto& f : kOutwardFaces) {
-      Triangle tri{e[f[0]], e[f[1]],
-                   e[f[2]]};
+      Triangle tri{e[f[0]], e[f[1]], e[f[2]]};
       FaceKey key{tri};
       std::sort(key.sorted.begin(), key.sorted.end());
       FaceUse& use = faces[key];
@@ -52,8 +51,8 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
         throw MeshError(fmt::format(
             "non-manifold volume: the face with nodes {} {} {} belongs to more than two "
             "tetrahedra (one is element {})",
-            mesh.node_tags[tri[0]], mesh.node_tags[tri[1]],
-            mesh.node_tags[tri[2]], mesh.tet_tags[t]));
+            mesh.node_tags[tri[0]], mesh.node_tags[tri[1]], mesh.node_tags[tri[2]],
+            mesh.tet_tags[t]));
       }
       use.tet = t;
       use.oriented = tri;
@@ -95,7 +94,8 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
     surface.node_triangle_offsets[i + 1] += surface.node_triangle_offsets[i];
   }
   surface.node_triangle_list.resize(static_cast<std::size_t>(surface.node_triangle_offsets[n]));
-  std::vector<int> fill(surface.node_triangle_offsets.begin(), surface.node_triangle_offsets.end() - 1);
+  std::vector<int> fill(surface.node_triangle_offsets.begin(),
+                        surface.node_triangle_offsets.end() - 1);
   for (int t = 0; t < surface.triangle_count(); ++t)
     for (int v : surface.triangles[t])
       surface.node_triangle_list[static_cast<std::size_t>(fill[v]++)] = t;
@@ -105,14 +105,16 @@ BoundarySurface extract_boundary_surface(const TetMesh& mesh) {
 
 std::vector<std::array<int, 3>> triangle_edge_neighbours(const std::vector<Triangle>& triangles) {
   const auto edge_key = [](int from, int to) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(from)) << 32) | static_cast<std::uint32_t>(to);
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(from)) << 32) |
+           static_cast<std::uint32_t>(to);
   };
   // Directed edge -> owning triangle; -1 once the same directed edge is seen twice.
   std::unordered_map<std::uint64_t, int> owner;
   owner.reserve(triangles.size() * 3);
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t)
     for (int k = 0; k < 3; ++k) {
-      const auto [it, inserted] = owner.emplace(edge_key(triangles[t][k], triangles[t][(k + 1) % 3]), t);
+      const auto [it, inserted] =
+          owner.emplace(edge_key(triangles[t][k], triangles[t][(k + 1) % 3]), t);
       if (!inserted) it->second = -1;
     }
   std::vector<std::array<int, 3>> neighbours(triangles.size(), {-1, -1, -1});
@@ -120,7 +122,8 @@ std::vector<std::array<int, 3>> triangle_edge_neighbours(const std::vector<Trian
     for (int k = 0; k < 3; ++k) {
       const auto forward = owner.find(edge_key(triangles[t][k], triangles[t][(k + 1) % 3]));
       const auto reverse = owner.find(edge_key(triangles[t][(k + 1) % 3], triangles[t][k]));
-      if (forward->second >= 0 && reverse != owner.end() && reverse->second >= 0) neighbours[t][k] = reverse->second;
+      if (forward->second >= 0 && reverse != owner.end() && reverse->second >= 0)
+        neighbours[t][k] = reverse->second;
     }
   return neighbours;
 }

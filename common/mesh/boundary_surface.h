@@ -20,7 +20,7 @@ struct BoundarySurface {
   /// Per triangle, the triangle across edge k = (v_k, v_k+1), or -1 where the edge is
   /// not shared by exactly two consistently oriented triangles (a non-manifold edge).
   std::vector<std::array<int, 3>> triangle_neighbours;
-  std::vector<int> nodes;           ///< sorted volume node indices on the surface
+  std::vector<int> nodes;                  ///< sorted volume node indices on the surface
   std::vector<int> node_triangle_offsets;  ///< CSR offsets, size node_count + 1
   std::vector<int> node_triangle_list;     ///< CSR values: triangle indices
 

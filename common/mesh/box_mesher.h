@@ -21,7 +21,8 @@ namespace cohaptic {
 /// Box [min_corner, min_corner + size] with `divisions` cells along each axis (each >= 1),
 /// graded by `grading` (each > 0) per axis after `uniform_cells` (each from 0 to the divisions).
 TetMesh make_box_mesh(const Eigen::Vector3d& min_corner, const Eigen::Vector3d& size,
-                      const Eigen::Vector3i& divisions, const Eigen::Vector3d& grading = Eigen::Vector3d::Ones(),
+                      const Eigen::Vector3i& divisions,
+                      const Eigen::Vector3d& grading = Eigen::Vector3d::Ones(),
                       const Eigen::Vector3i& uniform_cells = Eigen::Vector3i::Zero());
 
 }  // namespace cohaptic

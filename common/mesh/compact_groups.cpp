@@ -8,8 +8,8 @@
 namespace cohaptic {
 namespace {
 
-void bisect(const Eigen::Matrix3Xd& positions, std::vector<int>::iterator begin, std::vector<int>::iterator end,
-            int group_size) {
+void bisect(const Eigen::Matrix3Xd& positions, std::vector<int>::iterator begin,
+            std::vector<int>::iterator end, int group_size) {
   const auto count = end - begin;
   if (count <= group_size) return;
   Eigen::Vector3d lo = positions.col(*begin), hi = lo;
@@ -31,11 +31,14 @@ void bisect(const Eigen::Matrix3Xd& positions, std::vector<int>::iterator begin,
 
 }  // namespace
 
-std::vector<int> order_in_compact_groups(const Eigen::Matrix3Xd& positions, std::vector<int> ids, int group_size) {
-  if (group_size < 1) throw Error(fmt::format("order_in_compact_groups: group size {} is not positive", group_size));
+std::vector<int> order_in_compact_groups(const Eigen::Matrix3Xd& positions, std::vector<int> ids,
+                                         int group_size) {
+  if (group_size < 1)
+    throw Error(fmt::format("order_in_compact_groups: group size {} is not positive", group_size));
   for (int id : ids)
     if (id < 0 || id >= positions.cols())
-      throw Error(fmt::format("order_in_compact_groups: id {} out of range (0 to {})", id, positions.cols() - 1));
+      throw Error(fmt::format("order_in_compact_groups: id {} out of range (0 to {})", id,
+                              positions.cols() - 1));
   bisect(positions, ids.begin(), ids.end(), group_size);
   return ids;
 }

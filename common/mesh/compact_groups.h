@@ -15,6 +15,7 @@
 namespace cohaptic {
 
 /// `ids` reordered; `positions` holds the point of id k in column k.
-std::vector<int> order_in_compact_groups(const Eigen::Matrix3Xd& positions, std::vector<int> ids, int group_size);
+std::vector<int> order_in_compact_groups(const Eigen::Matrix3Xd& positions, std::vector<int> ids,
+                                         int group_size);
 
 }  // namespace cohaptic

@@ -20,20 +20,24 @@ std::string name_some(const std::vector<std::string>& names) {
   std::string out;
   for (int i = 0; i < std::min<int>(kMaxNamed, static_cast<int>(names.size())); ++i)
     out += (i ? ", " : "") + names[i];
-  if (static_cast<int>(names.size()) > kMaxNamed) out += fmt::format(" and {} more", names.size() - kMaxNamed);
+  if (static_cast<int>(names.size()) > kMaxNamed)
+    out += fmt::format(" and {} more", names.size() - kMaxNamed);
   return out;
 }
 
 double longest_edge(const TetMesh& mesh, const Tet& tet) {
   double longest = 0;
   for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j) longest = std::max(longest, (mesh.nodes.col(tet[i]) - mesh.nodes.col(tet[j])).norm());
+    for (int j = i + 1; j < 4; ++j)
+      longest = std::max(longest, (mesh.nodes.col(tet[i]) - mesh.nodes.col(tet[j])).norm());
   return longest;
 }
 
 struct UnionFind {
   std::vector<int> parent;
-  explicit UnionFind(int n) : parent(static_cast<std::size_t>(n)) { std::iota(parent.begin(), parent.end(), 0); }
+  explicit UnionFind(int n) : parent(static_cast<std::size_t>(n)) {
+    std::iota(parent.begin(), parent.end(), 0);
+  }
   int find(int x) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
@@ -65,16 +69,19 @@ void check_duplicate_nodes(const TetMesh& mesh, double tolerance, MeshCheckRepor
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
-          const auto range = buckets.equal_range(key(c + Cell(std::int64_t{dx}, std::int64_t{dy}, std::int64_t{dz})));
+          const auto range = buckets.equal_range(
+              key(c + Cell(std::int64_t{dx}, std::int64_t{dy}, std::int64_t{dz})));
           for (auto it = range.first; it != range.second; ++it)
             if ((mesh.nodes.col(it->second) - x).norm() <= tolerance)
-              pairs.push_back(fmt::format("{} and {}", mesh.node_tags[it->second], mesh.node_tags[n]));
+              pairs.push_back(
+                  fmt::format("{} and {}", mesh.node_tags[it->second], mesh.node_tags[n]));
         }
     buckets.emplace(key(c), n);
   }
   if (!pairs.empty())
-    report.warnings.push_back(fmt::format(
-        "{} pair(s) of coincident nodes (the mesh is cracked there): nodes {}", pairs.size(), name_some(pairs)));
+    report.warnings.push_back(
+        fmt::format("{} pair(s) of coincident nodes (the mesh is cracked there): nodes {}",
+                    pairs.size(), name_some(pairs)));
 }
 
 void check_connectivity(const TetMesh& mesh, MeshCheckReport& report) {
@@ -103,8 +110,9 @@ void check_connectivity(const TetMesh& mesh, MeshCheckReport& report) {
     for (const auto& [root, info] : part_size_and_first)
       names.push_back(fmt::format("{} elements containing node {}", info.first,
                                   mesh.node_tags[mesh.tets[info.second][0]]));
-    report.warnings.push_back(fmt::format(
-        "the mesh has {} disconnected parts (each needs its own fixed region): {}", report.parts, name_some(names)));
+    report.warnings.push_back(
+        fmt::format("the mesh has {} disconnected parts (each needs its own fixed region): {}",
+                    report.parts, name_some(names)));
   }
 }
 
@@ -119,7 +127,8 @@ double min_dihedral_angle_deg(const TetMesh& mesh, int t) {
     int v[3], k = 0;
     for (int i = 0; i < 4; ++i)
       if (i != skip) v[k++] = e[i];
-    Eigen::Vector3d n = (mesh.nodes.col(v[1]) - mesh.nodes.col(v[0])).cross(mesh.nodes.col(v[2]) - mesh.nodes.col(v[0]));
+    Eigen::Vector3d n = (mesh.nodes.col(v[1]) - mesh.nodes.col(v[0]))
+                            .cross(mesh.nodes.col(v[2]) - mesh.nodes.col(v[0]));
     // Orient outward: away from the skipped node.
     if (n.dot(mesh.nodes.col(e[skip]) - mesh.nodes.col(v[0])) > 0) n = -n;
     normal[skip] = n.normalized();
@@ -151,11 +160,13 @@ MeshCheckReport check_tet_mesh(TetMesh& mesh, const MeshCheckOptions& options) {
       ++positive_count;
   }
   if (!degenerate.empty())
-    throw MeshError(fmt::format("{} zero-volume tetrahedra: element {}", degenerate.size(), name_some(degenerate)));
+    throw MeshError(fmt::format("{} zero-volume tetrahedra: element {}", degenerate.size(),
+                                name_some(degenerate)));
   if (!negative.empty() && positive_count > 0)
-    throw MeshError(fmt::format(
-        "{} inverted tetrahedra (negative volume while {} others are positive; the mesh is tangled): element {}",
-        negative.size(), positive_count, name_some(negative)));
+    throw MeshError(
+        fmt::format("{} inverted tetrahedra (negative volume while {} others are positive; the "
+                    "mesh is tangled): element {}",
+                    negative.size(), positive_count, name_some(negative)));
   if (!negative.empty()) {
     for (Tet& tet : mesh.tets) std::swap(tet[2], tet[3]);
     report.notes.push_back("all tetrahedra were negatively oriented: reoriented");
@@ -166,33 +177,40 @@ MeshCheckReport check_tet_mesh(TetMesh& mesh, const MeshCheckOptions& options) {
   for (int t = 0; t < mesh.tet_count(); ++t) {
     const double angle = min_dihedral_angle_deg(mesh, t);
     report.min_dihedral_deg = std::min(report.min_dihedral_deg, angle);
-    if (angle < options.sliver_angle_deg) slivers.push_back(fmt::format("{} ({:.3g} deg)", mesh.tet_tags[t], angle));
+    if (angle < options.sliver_angle_deg)
+      slivers.push_back(fmt::format("{} ({:.3g} deg)", mesh.tet_tags[t], angle));
   }
   if (!slivers.empty())
-    report.warnings.push_back(fmt::format(
-        "{} sliver tetrahedra (smallest dihedral angle below {} deg; they make the stiffness ill-conditioned): "
-        "element {}",
-        slivers.size(), options.sliver_angle_deg, name_some(slivers)));
+    report.warnings.push_back(
+        fmt::format("{} sliver tetrahedra (smallest dihedral angle below {} deg; they make the "
+                    "stiffness ill-conditioned): "
+                    "element {}",
+                    slivers.size(), options.sliver_angle_deg, name_some(slivers)));
 
-  const double diagonal = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
+  const double diagonal =
+      (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
   check_duplicate_nodes(mesh, std::max(options.duplicate_tolerance * diagonal, 1e-300), report);
   check_connectivity(mesh, report);
   return report;
 }
 
-std::vector<std::string> check_boundary_surface(const TetMesh& mesh, const BoundarySurface& surface) {
+std::vector<std::string> check_boundary_surface(const TetMesh& mesh,
+                                                const BoundarySurface& surface) {
   std::vector<std::string> findings;
   std::set<std::pair<int, int>> non_manifold_edges;
   for (int t = 0; t < surface.triangle_count(); ++t)
     for (int k = 0; k < 3; ++k) {
       const int a = surface.triangles[t][k], b = surface.triangles[t][(k + 1) % 3];
-      if (surface.triangle_neighbours[t][k] < 0) non_manifold_edges.emplace(std::min(a, b), std::max(a, b));
+      if (surface.triangle_neighbours[t][k] < 0)
+        non_manifold_edges.emplace(std::min(a, b), std::max(a, b));
     }
   std::vector<std::string> edges;
-  for (const auto& [a, b] : non_manifold_edges) edges.push_back(fmt::format("{}-{}", mesh.node_tags[a], mesh.node_tags[b]));
+  for (const auto& [a, b] : non_manifold_edges)
+    edges.push_back(fmt::format("{}-{}", mesh.node_tags[a], mesh.node_tags[b]));
   if (!edges.empty())
-    findings.push_back(fmt::format("{} non-manifold surface edge(s) (more than two surface triangles meet): {}",
-                                   edges.size(), name_some(edges)));
+    findings.push_back(
+        fmt::format("{} non-manifold surface edge(s) (more than two surface triangles meet): {}",
+                    edges.size(), name_some(edges)));
   // A manifold surface vertex has one fan of triangles: walking neighbours around it
   // from any of its triangles reaches all of them.
   std::vector<std::string> vertices;
@@ -204,18 +222,21 @@ std::vector<std::string> check_boundary_surface(const TetMesh& mesh, const Bound
         if (neighbour < 0) continue;
         const Triangle& tri = surface.triangles[neighbour];
         const bool touches = std::find(tri.begin(), tri.end(), node) != tri.end();
-        if (touches && std::find(fan.begin(), fan.end(), neighbour) == fan.end()) fan.push_back(neighbour);
+        if (touches && std::find(fan.begin(), fan.end(), neighbour) == fan.end())
+          fan.push_back(neighbour);
       }
     }
     if (fan.size() != around.size()) vertices.push_back(std::to_string(mesh.node_tags[node]));
   }
   if (!vertices.empty())
-    findings.push_back(fmt::format("{} non-manifold surface vertex(es) (parts of the surface touch at a point): node {}",
-                                   vertices.size(), name_some(vertices)));
+    findings.push_back(fmt::format(
+        "{} non-manifold surface vertex(es) (parts of the surface touch at a point): node {}",
+        vertices.size(), name_some(vertices)));
   return findings;
 }
 
-std::vector<std::string> check_triangle_surface(const TriangleSurface& surface, const std::string& name) {
+std::vector<std::string> check_triangle_surface(const TriangleSurface& surface,
+                                                const std::string& name) {
   std::vector<std::string> findings;
   std::map<std::pair<int, int>, int> edge_uses;
   for (const Triangle& tri : surface.triangles)
@@ -230,11 +251,11 @@ std::vector<std::string> check_triangle_surface(const TriangleSurface& surface, 
     if (uses > 2) non_manifold.push_back(label);
   }
   if (!open.empty())
-    findings.push_back(fmt::format("{}: open surface, {} boundary edge(s) between vertices {}", name, open.size(),
-                                   name_some(open)));
+    findings.push_back(fmt::format("{}: open surface, {} boundary edge(s) between vertices {}",
+                                   name, open.size(), name_some(open)));
   if (!non_manifold.empty())
-    findings.push_back(fmt::format("{}: {} non-manifold edge(s) between vertices {}", name, non_manifold.size(),
-                                   name_some(non_manifold)));
+    findings.push_back(fmt::format("{}: {} non-manifold edge(s) between vertices {}", name,
+                                   non_manifold.size(), name_some(non_manifold)));
   return findings;
 }
 

@@ -19,6 +19,7 @@ struct GmshScript {
 /// The 3-D mesh of `script` (.msh), made by gmsh (found on PATH) unless `cache_directory`
 /// holds it already. Logs while gmsh runs (it may take seconds). Throws Error naming the
 /// script if gmsh is missing, fails (with the end of its output) or writes no mesh.
-std::filesystem::path mesh_with_gmsh(const GmshScript& script, const std::filesystem::path& cache_directory);
+std::filesystem::path mesh_with_gmsh(const GmshScript& script,
+                                     const std::filesystem::path& cache_directory);
 
 }  // namespace cohaptic

@@ -17,11 +17,11 @@ struct NodeSelector {
   enum class Kind { surface, box, plane, node_tags };
   Kind kind = Kind::surface;
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();  ///< [m]
-  Eigen::Vector3d plane_point = Eigen::Vector3d::Zero();  ///< [m]
-  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();  ///< unit
-  std::optional<double> tolerance;   ///< [m]; default: 1e-6 of the mesh's bounding-box diagonal
+  Eigen::Vector3d plane_point = Eigen::Vector3d::Zero();                                 ///< [m]
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();                               ///< unit
+  std::optional<double> tolerance;  ///< [m]; default: 1e-6 of the mesh's bounding-box diagonal
   std::vector<std::int64_t> node_tags;
-  std::string where;                 ///< "file:line: key.path" it came from, for messages
+  std::string where;  ///< "file:line: key.path" it came from, for messages
 };
 
 }  // namespace cohaptic

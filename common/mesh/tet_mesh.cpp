@@ -21,7 +21,8 @@ int node_index_from_tag(const TetMesh& mesh, std::int64_t tag) {
 
 std::unordered_map<std::int64_t, int> node_indices_by_tag(const TetMesh& mesh) {
   std::unordered_map<std::int64_t, int> index_of_tag;
-  for (std::size_t n = 0; n < mesh.node_tags.size(); ++n) index_of_tag.emplace(mesh.node_tags[n], static_cast<int>(n));
+  for (std::size_t n = 0; n < mesh.node_tags.size(); ++n)
+    index_of_tag.emplace(mesh.node_tags[n], static_cast<int>(n));
   return index_of_tag;
 }
 

@@ -29,8 +29,8 @@ constexpr bool share_a_node(const Triangle& a, const Triangle& b) noexcept {
 }
 
 struct TetMesh {
-  Eigen::Matrix3Xd nodes;             ///< rest positions [m], one column per node
-  std::vector<Tet> tets;              ///< 0-based node indices
+  Eigen::Matrix3Xd nodes;               ///< rest positions [m], one column per node
+  std::vector<Tet> tets;                ///< 0-based node indices
   std::vector<std::int64_t> node_tags;  ///< id of each node in its source (1-based if generated)
   std::vector<std::int64_t> tet_tags;   ///< id of each tetrahedron in its source
 

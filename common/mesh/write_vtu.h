@@ -28,12 +28,14 @@ struct VtuPointField {
 /// has not mesh.node_count() columns, has no rows, a non-finite value, an empty or
 /// repeated name, or the reserved name "node_tag"; throws Error naming the path and the
 /// system's reason if the file cannot be written.
-void write_vtu(const std::filesystem::path& path, const TetMesh& mesh, const std::vector<VtuPointField>& point_fields);
+void write_vtu(const std::filesystem::path& path, const TetMesh& mesh,
+               const std::vector<VtuPointField>& point_fields);
 
 /// The same for a triangle surface (VTK_TRIANGLE cells, no element tags): e.g. a deformed
 /// boundary surface for display.
 void write_surface_vtu(const std::filesystem::path& path, const Eigen::Matrix3Xd& vertices,
-                       const std::vector<Triangle>& triangles, const std::vector<std::int64_t>& vertex_tags,
+                       const std::vector<Triangle>& triangles,
+                       const std::vector<std::int64_t>& vertex_tags,
                        const std::vector<VtuPointField>& point_fields);
 
 }  // namespace cohaptic

@@ -16,13 +16,16 @@
 namespace cohaptic {
 
 std::vector<int> compliance_row_nodes(const ElasticBody& body, bool whole_surface) {
-  return order_in_compact_groups(body.mesh.nodes, whole_surface ? body.surface.nodes : body.touchable_nodes,
+  return order_in_compact_groups(body.mesh.nodes,
+                                 whole_surface ? body.surface.nodes : body.touchable_nodes,
                                  ComplianceColumns::kGroupSize);
 }
 
 std::filesystem::path default_cache_directory() {
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "cohaptic";
-  if (const char* home = std::getenv("HOME"); home && *home) return std::filesystem::path(home) / ".cache" / "cohaptic";
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    return std::filesystem::path(xdg) / "cohaptic";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return std::filesystem::path(home) / ".cache" / "cohaptic";
   return ".cohaptic-cache";
 }
 
@@ -31,16 +34,19 @@ namespace {
 // Precomputed touchable columns that are at least half of the row nodes come by the Schur
 // complement (every row node's at once, BLAS on kFactorBlasThreads threads); any others by solves.
 ComplianceRoute route_of(const ElasticBody& body, const ComplianceColumns& columns) {
-  return body.spec.compliance.precompute_touchable && 2 * body.touchable_nodes.size() >= columns.row_nodes().size()
+  return body.spec.compliance.precompute_touchable &&
+                 2 * body.touchable_nodes.size() >= columns.row_nodes().size()
              ? ComplianceRoute::schur
              : ComplianceRoute::solves;
 }
 
 Digest cache_key(const ElasticBody& body, const ComplianceColumns& columns) {
-  return compliance_cache_key(body.mesh, body.spec.material, body.dofs, columns.row_nodes(), route_of(body, columns));
+  return compliance_cache_key(body.mesh, body.spec.material, body.dofs, columns.row_nodes(),
+                              route_of(body, columns));
 }
 
-void precompute_touchable_columns(const ElasticBody& body, ComplianceColumns& columns, ProgressLog& progress) {
+void precompute_touchable_columns(const ElasticBody& body, ComplianceColumns& columns,
+                                  ProgressLog& progress) {
   std::size_t missing = 0;
   for (int node : body.touchable_nodes) missing += columns.has_column(node) ? 0 : 1;
   if (missing == 0) return;
@@ -49,9 +55,12 @@ void precompute_touchable_columns(const ElasticBody& body, ComplianceColumns& co
     columns.compute_columns(body.touchable_nodes);
     return;
   }
-  spdlog::info("compliance: {} row nodes at once (Schur complement, BLAS on {} threads, OpenBLAS's {} kernels)",
-               columns.row_nodes().size(), kFactorBlasThreads, blas_kernels());
-  compute_row_columns_by_schur(columns, restrict_to_dofs(body.stiffness, body.dofs.free_dofs), body.dofs, &progress);
+  spdlog::info(
+      "compliance: {} row nodes at once (Schur complement, BLAS on {} threads, OpenBLAS's {} "
+      "kernels)",
+      columns.row_nodes().size(), kFactorBlasThreads, blas_kernels());
+  compute_row_columns_by_schur(columns, restrict_to_dofs(body.stiffness, body.dofs.free_dofs),
+                               body.dofs, &progress);
 }
 
 }  // namespace
@@ -66,9 +75,11 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
     const Digest key = cache_key(body, columns);
     setup.cache_file = compliance_cache_file(*cache_directory, key);
     progress.set_phase("loading " + setup.cache_file.string());
-    const ComplianceCacheLoad load = load_compliance_cache(setup.cache_file, key, columns, &progress);
+    const ComplianceCacheLoad load =
+        load_compliance_cache(setup.cache_file, key, columns, &progress);
     setup.from_disk = load.loaded;
-    setup.note = load.loaded ? fmt::format("loaded {} columns from {}", load.columns, setup.cache_file.string())
+    setup.note = load.loaded ? fmt::format("loaded {} columns from {}", load.columns,
+                                           setup.cache_file.string())
                              : fmt::format("cache {}: {}", setup.cache_file.string(), load.problem);
     if (!load.loaded && load.problem != "no cache file")
       spdlog::warn("compliance {}; rebuilding it", setup.note);
@@ -87,17 +98,19 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
   if (use_disk && columns.column_count() > before) {
     progress.set_phase("saving the columns to " + setup.cache_file.string());
     save_compliance(body, columns, *cache_directory, &progress);
-    setup.note += fmt::format("; computed {} columns and saved them", columns.column_count() - before);
+    setup.note +=
+        fmt::format("; computed {} columns and saved them", columns.column_count() - before);
   }
   setup.columns = columns.column_count();
   setup.ms = watch.elapsed_ms();
-  spdlog::info("compliance: {} columns of {} rows ready in {:.1f} ms{}", setup.columns, 3 * columns.row_nodes().size(),
-               setup.ms, setup.note.empty() ? "" : " (" + setup.note + ")");
+  spdlog::info("compliance: {} columns of {} rows ready in {:.1f} ms{}", setup.columns,
+               3 * columns.row_nodes().size(), setup.ms,
+               setup.note.empty() ? "" : " (" + setup.note + ")");
   return setup;
 }
 
-void save_compliance(const ElasticBody& body, const ComplianceColumns& columns, const std::filesystem::path& cache_directory,
-                     ProgressLog* progress) {
+void save_compliance(const ElasticBody& body, const ComplianceColumns& columns,
+                     const std::filesystem::path& cache_directory, ProgressLog* progress) {
   const Digest key = cache_key(body, columns);
   try {
     save_compliance_cache(compliance_cache_file(cache_directory, key), key, columns, progress);

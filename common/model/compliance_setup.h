@@ -21,10 +21,10 @@ std::vector<int> compliance_row_nodes(const ElasticBody& body, bool whole_surfac
 
 struct ComplianceSetup {
   bool from_disk = false;
-  std::size_t columns = 0;          ///< columns available after setup
-  double ms = 0;                    ///< time spent (load or solve, and save)
-  std::filesystem::path cache_file; ///< empty when the disk cache is off
-  std::string note;                 ///< what happened with the cache, for the log
+  std::size_t columns = 0;           ///< columns available after setup
+  double ms = 0;                     ///< time spent (load or solve, and save)
+  std::filesystem::path cache_file;  ///< empty when the disk cache is off
+  std::string note;                  ///< what happened with the cache, for the log
 };
 
 /// $XDG_CACHE_HOME/cohaptic, else $HOME/.cache/cohaptic, else ./.cohaptic-cache.
@@ -38,7 +38,7 @@ ComplianceSetup prepare_compliance(const ElasticBody& body, ComplianceColumns& c
 
 /// Saves the columns computed so far (e.g. on-demand columns at shutdown), reporting to
 /// `progress` if given. Logs failures.
-void save_compliance(const ElasticBody& body, const ComplianceColumns& columns, const std::filesystem::path& cache_directory,
-                     ProgressLog* progress = nullptr);
+void save_compliance(const ElasticBody& body, const ComplianceColumns& columns,
+                     const std::filesystem::path& cache_directory, ProgressLog* progress = nullptr);
 
 }  // namespace cohaptic

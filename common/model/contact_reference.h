@@ -31,7 +31,8 @@ class ContactReference {
   /// Force on each tool [N] (zero for a tool that presses nothing), with `held` nodes at
   /// their displacements (but those under a tool). Throws Error if two tools press
   /// triangles sharing a node.
-  std::vector<Eigen::Vector3d> forces(const std::vector<PressedTool>& tools, const HeldNodes& held = {});
+  std::vector<Eigen::Vector3d> forces(const std::vector<PressedTool>& tools,
+                                      const HeldNodes& held = {});
 
   /// Factorisations so far (contact sets, and contact-and-held sets).
   std::size_t factorisations() const { return factorisations_; }
@@ -44,7 +45,8 @@ class ContactReference {
     Eigen::MatrixXd nodal_per_displacement;
   };
   const ContactSet& contact_set(const std::vector<ContactQuery>& contacts);
-  std::vector<Eigen::Vector3d> forces_with_held(const std::vector<ContactQuery>& contacts, const HeldNodes& held);
+  std::vector<Eigen::Vector3d> forces_with_held(const std::vector<ContactQuery>& contacts,
+                                                const HeldNodes& held);
 
   const ElasticBody& body_;
   std::map<std::vector<int>, ContactSet> sets_;  // keyed by contact triangle per tool (-1: none)

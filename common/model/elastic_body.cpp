@@ -15,31 +15,35 @@ namespace cohaptic {
 namespace {
 
 TetMesh load_mesh(const MeshSpec& spec, double metres_per_unit) {
-  if (spec.box) return make_box_mesh(spec.box->min_corner, spec.box->size, spec.box->divisions, spec.box->grading,
-                                       spec.box->uniform_cells);
+  if (spec.box)
+    return make_box_mesh(spec.box->min_corner, spec.box->size, spec.box->divisions,
+                         spec.box->grading, spec.box->uniform_cells);
   const std::filesystem::path file =
       spec.gmsh ? mesh_with_gmsh(*spec.gmsh, default_cache_directory() / "meshes") : spec.file;
   GmshMesh gmsh = read_gmsh(file);
   if (gmsh.unused_nodes_dropped > 0)
-    spdlog::info("{}: dropped {} nodes that no tetrahedron uses", file.string(), gmsh.unused_nodes_dropped);
+    spdlog::info("{}: dropped {} nodes that no tetrahedron uses", file.string(),
+                 gmsh.unused_nodes_dropped);
   gmsh.mesh.nodes *= metres_per_unit;
   return std::move(gmsh.mesh);
 }
 
 // "node <tag> axis <x|y|z>" for global dof `dof`.
 std::string dof_name(const std::vector<std::int64_t>& node_tags, int dof) {
-  return fmt::format("node {} axis {}", node_tags[static_cast<std::size_t>(dof / 3)], "xyz"[dof % 3]);
+  return fmt::format("node {} axis {}", node_tags[static_cast<std::size_t>(dof / 3)],
+                     "xyz"[dof % 3]);
 }
 
 }  // namespace
 
 std::string ElasticBody::describe_dof(int dof) const { return dof_name(mesh.node_tags, dof); }
 
-std::vector<int> select_nodes(const NodeSelector& selector, const TetMesh& mesh, const BoundarySurface& surface,
-                              bool surface_only) {
+std::vector<int> select_nodes(const NodeSelector& selector, const TetMesh& mesh,
+                              const BoundarySurface& surface, bool surface_only) {
   std::vector<bool> on_surface(static_cast<std::size_t>(mesh.node_count()), false);
   for (int node : surface.nodes) on_surface[node] = true;
-  const double diagonal = (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
+  const double diagonal =
+      (mesh.nodes.rowwise().maxCoeff() - mesh.nodes.rowwise().minCoeff()).norm();
   const double tolerance = selector.tolerance.value_or(1e-6 * diagonal);
 
   std::vector<int> selected;
@@ -48,7 +52,8 @@ std::vector<int> select_nodes(const NodeSelector& selector, const TetMesh& mesh,
     for (std::int64_t tag : selector.node_tags) {
       const auto it = index_of_tag.find(tag);
       if (it == index_of_tag.end())
-        throw SceneError(fmt::format("{}: node {} is not in the mesh (or no tetrahedron uses it)", selector.where, tag));
+        throw SceneError(fmt::format("{}: node {} is not in the mesh (or no tetrahedron uses it)",
+                                     selector.where, tag));
       if (surface_only && !on_surface[it->second])
         throw SceneError(fmt::format("{}: node {} is not on the surface", selector.where, tag));
       selected.push_back(it->second);
@@ -59,15 +64,19 @@ std::vector<int> select_nodes(const NodeSelector& selector, const TetMesh& mesh,
       const Eigen::Vector3d x = mesh.nodes.col(n);
       bool chosen = false;
       switch (selector.kind) {
-        case NodeSelector::Kind::surface: chosen = on_surface[n]; break;
+        case NodeSelector::Kind::surface:
+          chosen = on_surface[n];
+          break;
         case NodeSelector::Kind::box:
           chosen = ((x.array() >= selector.box_min.array() - tolerance) &&
-                    (x.array() <= selector.box_max.array() + tolerance)).all();
+                    (x.array() <= selector.box_max.array() + tolerance))
+                       .all();
           break;
         case NodeSelector::Kind::plane:
           chosen = std::abs((x - selector.plane_point).dot(selector.plane_normal)) <= tolerance;
           break;
-        case NodeSelector::Kind::node_tags: break;
+        case NodeSelector::Kind::node_tags:
+          break;
       }
       if (chosen) selected.push_back(n);
     }
@@ -75,12 +84,13 @@ std::vector<int> select_nodes(const NodeSelector& selector, const TetMesh& mesh,
   std::sort(selected.begin(), selected.end());
   selected.erase(std::unique(selected.begin(), selected.end()), selected.end());
   if (selected.empty())
-    throw SceneError(fmt::format("{}: selects no {}node of the mesh (check coordinates and units)", selector.where,
-                                 surface_only ? "surface " : ""));
+    throw SceneError(fmt::format("{}: selects no {}node of the mesh (check coordinates and units)",
+                                 selector.where, surface_only ? "surface " : ""));
   return selected;
 }
 
-ElasticBody build_elastic_body(const ObjectSpec& object, const ElasticObjectSpec& spec, double metres_per_unit) {
+ElasticBody build_elastic_body(const ObjectSpec& object, const ElasticObjectSpec& spec,
+                               double metres_per_unit) {
   ElasticBody body;
   body.name = object.name;
   body.spec = spec;
@@ -92,7 +102,8 @@ ElasticBody build_elastic_body(const ObjectSpec& object, const ElasticObjectSpec
   for (const std::string& note : body.mesh_report.notes) spdlog::info("mesh: {}", note);
   for (const std::string& warning : body.mesh_report.warnings) spdlog::warn("mesh: {}", warning);
   body.surface = extract_boundary_surface(body.mesh);
-  for (const std::string& finding : check_boundary_surface(body.mesh, body.surface)) spdlog::warn("mesh: {}", finding);
+  for (const std::string& finding : check_boundary_surface(body.mesh, body.surface))
+    spdlog::warn("mesh: {}", finding);
   body.normals = compute_pseudo_normals(body.mesh, body.surface);
   body.surface_tree = AabbTree(body.mesh.nodes, body.surface.triangles);
 
@@ -109,11 +120,13 @@ ElasticBody build_elastic_body(const ObjectSpec& object, const ElasticObjectSpec
     if (touchable[node]) body.touchable_nodes.push_back(node);
   for (int t = 0; t < body.surface.triangle_count(); ++t) {
     const Triangle& tri = body.surface.triangles[t];
-    if (touchable[tri[0]] && touchable[tri[1]] && touchable[tri[2]]) body.touchable_triangles.push_back(t);
+    if (touchable[tri[0]] && touchable[tri[1]] && touchable[tri[2]])
+      body.touchable_triangles.push_back(t);
   }
   if (body.touchable_triangles.empty())
-    throw SceneError(fmt::format("{}.touchable: selects {} surface nodes but no whole surface triangle", object.where,
-                                 body.touchable_nodes.size()));
+    throw SceneError(
+        fmt::format("{}.touchable: selects {} surface nodes but no whole surface triangle",
+                    object.where, body.touchable_nodes.size()));
   body.contact_normals = contact_normals(body.mesh, body.surface, body.touchable_triangles);
 
   body.timings.mesh_ms = watch.lap_ms();
@@ -122,15 +135,17 @@ ElasticBody build_elastic_body(const ObjectSpec& object, const ElasticObjectSpec
   body.timings.assemble_ms = watch.lap_ms();
 
   // The namer outlives this function's `body` (moved into the model): it keeps what it reads.
-  body.free_factor = DeferredCholesky(
-      restrict_to_dofs(body.stiffness, body.dofs.free_dofs),
-      [tags = body.mesh.node_tags, free_dofs = body.dofs.free_dofs](int row) {
-        return dof_name(tags, free_dofs[static_cast<std::size_t>(row)]);
-      });
+  body.free_factor =
+      DeferredCholesky(restrict_to_dofs(body.stiffness, body.dofs.free_dofs),
+                       [tags = body.mesh.node_tags, free_dofs = body.dofs.free_dofs](int row) {
+                         return dof_name(tags, free_dofs[static_cast<std::size_t>(row)]);
+                       });
 
-  spdlog::info("object '{}' (linear elastic): {} nodes, {} tetrahedra, {} surface triangles, {} free dofs, {} touchable nodes",
-               object.name, body.mesh.node_count(), body.mesh.tet_count(), body.surface.triangle_count(),
-               body.dofs.free_count(), body.touchable_nodes.size());
+  spdlog::info(
+      "object '{}' (linear elastic): {} nodes, {} tetrahedra, {} surface triangles, {} free dofs, "
+      "{} touchable nodes",
+      object.name, body.mesh.node_count(), body.mesh.tet_count(), body.surface.triangle_count(),
+      body.dofs.free_count(), body.touchable_nodes.size());
   return body;
 }
 

@@ -31,7 +31,7 @@ struct HomeSpringBody {
 /// Builds the body; throws SceneError naming `where` for a surface that cannot be read, has
 /// no triangle or a degenerate one, or a patch radius below the longest edge. Surface files
 /// are scaled by `metres_per_unit`.
-HomeSpringBody build_home_spring_body(const std::string& name, const HomeSpringObjectSpec& spec, const std::string& where,
-                                      double metres_per_unit);
+HomeSpringBody build_home_spring_body(const std::string& name, const HomeSpringObjectSpec& spec,
+                                      const std::string& where, double metres_per_unit);
 
 }  // namespace cohaptic

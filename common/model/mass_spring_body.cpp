@@ -9,7 +9,8 @@
 
 namespace cohaptic {
 
-MassSpringModel build_mass_spring_body(const std::string& name, const MassSpringObjectSpec& spec, const std::string& where) {
+MassSpringModel build_mass_spring_body(const std::string& name, const MassSpringObjectSpec& spec,
+                                       const std::string& where) {
   MassSpringModel body;
   body.name = name;
   body.spec = spec;
@@ -22,7 +23,8 @@ MassSpringModel build_mass_spring_body(const std::string& name, const MassSpring
     } else {
       body.network = tube_network(spec.tube, spec.material);
       body.section_count = spec.tube.sections;
-      for (int n = 0; n < body.network.node_count(); ++n) body.section_of_node.push_back(n / kSectionNodes);
+      for (int n = 0; n < body.network.node_count(); ++n)
+        body.section_of_node.push_back(n / kSectionNodes);
     }
     if (!spec.fixed.empty()) {
       // select_nodes reads the nodes, their tags (index + 1) and which are on the surface.
@@ -32,9 +34,11 @@ MassSpringModel build_mass_spring_body(const std::string& name, const MassSpring
       BoundarySurface surface;
       surface.nodes = body.network.surface_nodes;
       for (const NodeSelector& selector : spec.fixed)
-        for (int node : select_nodes(selector, nodes, surface, false)) body.network.held[static_cast<std::size_t>(node)] = 1;
+        for (int node : select_nodes(selector, nodes, surface, false))
+          body.network.held[static_cast<std::size_t>(node)] = 1;
     }
-    for (const HeatedRegion& region : spec.heated) body.heated_springs += heat_springs(body.network, region);
+    for (const HeatedRegion& region : spec.heated)
+      body.heated_springs += heat_springs(body.network, region);
   } catch (const SceneError&) {
     throw;
   } catch (const Error& e) {
@@ -48,8 +52,10 @@ MassSpringModel build_mass_spring_body(const std::string& name, const MassSpring
   body.critical_time_step = critical_time_step(body.network);
   p.time_step = spec.time_step.value_or(kDefaultStepFraction * body.critical_time_step);
   if (p.time_step >= body.critical_time_step)
-    throw SceneError(fmt::format("{}: time_step {} s is at or above the network's critical step {:.3g} s (2/omega_max): "
-                                 "the integrator would diverge", where, p.time_step, body.critical_time_step));
+    throw SceneError(fmt::format(
+        "{}: time_step {} s is at or above the network's critical step {:.3g} s (2/omega_max): "
+        "the integrator would diverge",
+        where, p.time_step, body.critical_time_step));
   check_network(body.network, where.c_str());
   return body;
 }

@@ -14,9 +14,9 @@
 namespace cohaptic {
 
 struct MassSpringModel {
-  std::string name;               ///< the scene object's name
+  std::string name;  ///< the scene object's name
   MassSpringObjectSpec spec;
-  MassSpringNetwork network;      ///< rest_positions is the initial state
+  MassSpringNetwork network;  ///< rest_positions is the initial state
   std::vector<int> section_of_node;
   int section_count = 0;
   double critical_time_step = 0;  ///< 2/omega_max at rest [s]
@@ -25,6 +25,7 @@ struct MassSpringModel {
 
 /// Builds the body; throws SceneError naming `where` for a spec the generator rejects, a
 /// heating factor out of range, or a time step above the critical one.
-MassSpringModel build_mass_spring_body(const std::string& name, const MassSpringObjectSpec& spec, const std::string& where);
+MassSpringModel build_mass_spring_body(const std::string& name, const MassSpringObjectSpec& spec,
+                                       const std::string& where);
 
 }  // namespace cohaptic

@@ -11,7 +11,8 @@
 
 namespace cohaptic {
 
-void use_separation_field_cache(Scene& scene, const std::optional<std::filesystem::path>& directory) {
+void use_separation_field_cache(Scene& scene,
+                                const std::optional<std::filesystem::path>& directory) {
   for (ObjectSpec& object : scene.objects)
     if (auto* separation = std::get_if<SeparationObjectSpec>(&object.body)) {
       separation->disk_cache = separation->disk_cache && directory.has_value();
@@ -19,8 +20,8 @@ void use_separation_field_cache(Scene& scene, const std::optional<std::filesyste
     }
 }
 
-SeparationModel build_separation_body(const std::string& name, const SeparationObjectSpec& spec, double force_limit,
-                                      const std::string& where) {
+SeparationModel build_separation_body(const std::string& name, const SeparationObjectSpec& spec,
+                                      double force_limit, const std::string& where) {
   SeparationModel body;
   body.name = name;
   body.spec = spec;
@@ -29,8 +30,9 @@ SeparationModel build_separation_body(const std::string& name, const SeparationO
   TwoLayerSetup setup;
   try {
     validate(spec.fields);
-    const std::filesystem::path cache =
-        !spec.disk_cache ? std::filesystem::path{} : spec.cache_directory.empty() ? default_cache_directory() : spec.cache_directory;
+    const std::filesystem::path cache = !spec.disk_cache               ? std::filesystem::path{}
+                                        : spec.cache_directory.empty() ? default_cache_directory()
+                                                                       : spec.cache_directory;
     setup = make_two_layer_setup(spec.layers, spec.fields, settings, cache);
   } catch (const SceneError&) {
     throw;
@@ -42,9 +44,10 @@ SeparationModel build_separation_body(const std::string& name, const SeparationO
   body.report = setup.report;
   body.fields_from_cache = setup.fields_from_cache;
   body.patch = std::make_shared<const SeparationPatch>(std::move(setup.patch));
-  spdlog::info("separation body '{}': {} interface nodes, {} triangles, fields of degree {} {} ({:.2f} s)", name,
-               body.patch->node_count(), body.patch->triangle_count(), body.patch->degree,
-               body.fields_from_cache ? "from the cache" : "fitted to the FEM", body.report.total_seconds());
+  spdlog::info(
+      "separation body '{}': {} interface nodes, {} triangles, fields of degree {} {} ({:.2f} s)",
+      name, body.patch->node_count(), body.patch->triangle_count(), body.patch->degree,
+      body.fields_from_cache ? "from the cache" : "fitted to the FEM", body.report.total_seconds());
   return body;
 }
 

@@ -26,13 +26,14 @@ struct SeparationModel {
 };
 
 /// The program's cache for every separation object of `scene`: `directory`, or none at all.
-void use_separation_field_cache(Scene& scene, const std::optional<std::filesystem::path>& directory);
+void use_separation_field_cache(Scene& scene,
+                                const std::optional<std::filesystem::path>& directory);
 
 /// Builds the body (the fields from spec.cache_directory, or the default cache directory,
 /// when spec.disk_cache);
 /// `force_limit` [N] is the scene's haptic limit, which the patch's own limit may not
 /// exceed. Throws SceneError naming `where` for settings the generator or the fields refuse.
-SeparationModel build_separation_body(const std::string& name, const SeparationObjectSpec& spec, double force_limit,
-                                      const std::string& where);
+SeparationModel build_separation_body(const std::string& name, const SeparationObjectSpec& spec,
+                                      double force_limit, const std::string& where);
 
 }  // namespace cohaptic

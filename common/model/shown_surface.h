@@ -12,9 +12,9 @@
 namespace cohaptic {
 
 struct ShownSurface {
-  std::vector<int> nodes;            ///< volume node indices, in the order given
-  std::vector<Triangle> triangles;   ///< outward, indices into `nodes`
-  std::vector<int> index_of;         ///< per volume node: its index in `nodes`, or -1
+  std::vector<int> nodes;           ///< volume node indices, in the order given
+  std::vector<Triangle> triangles;  ///< outward, indices into `nodes`
+  std::vector<int> index_of;        ///< per volume node: its index in `nodes`, or -1
 };
 
 /// The surface over `row_nodes` (a ComplianceColumns' row nodes).

@@ -18,7 +18,8 @@ std::vector<int> SphereContactSolution::contact_nodes() const {
   return nodes;
 }
 
-SphereContactReference::SphereContactReference(const ElasticBody& body, std::vector<SphereConstraint> obstacles)
+SphereContactReference::SphereContactReference(const ElasticBody& body,
+                                               std::vector<SphereConstraint> obstacles)
     : body_(body),
       obstacles_(std::move(obstacles)),
       candidates_(triangle_nodes(body.surface, body.touchable_triangles)),
@@ -41,7 +42,8 @@ void SphereContactReference::factor_for(const HeldNodes& held) {
   for (int node : held.nodes)
     for (int axis = 0; axis < 3; ++axis)
       if (!body_.dofs.is_fixed(node, axis)) prescribed.push_back(3 * node + axis);
-  solver_ = std::make_unique<ConstrainedStaticSolver>(body_.stiffness, body_.dofs, std::move(prescribed));
+  solver_ =
+      std::make_unique<ConstrainedStaticSolver>(body_.stiffness, body_.dofs, std::move(prescribed));
   held_key_ = held.nodes;
   columns_.clear();
   ++factorisations_;
@@ -60,13 +62,15 @@ void SphereContactReference::compute_columns(const std::vector<int>& nodes) {
 
 const Eigen::MatrixXd& SphereContactReference::columns_of(int node) { return columns_.at(node); }
 
-SphereContactSolution SphereContactReference::solve(const std::vector<PressedTool>& tools, const HeldNodes& held,
+SphereContactSolution SphereContactReference::solve(const std::vector<PressedTool>& tools,
+                                                    const HeldNodes& held,
                                                     Eigen::VectorXd* displacement) {
   std::vector<SphereTool> spheres;
   for (std::size_t t = 0; t < tools.size(); ++t) {
     if (!(tools[t].radius > 0))
-      throw Error(fmt::format("sphere contact: tool {} is a point (radius {}); the sphere model needs spheres", t + 1,
-                              tools[t].radius));
+      throw Error(fmt::format(
+          "sphere contact: tool {} is a point (radius {}); the sphere model needs spheres", t + 1,
+          tools[t].radius));
     spheres.push_back({tools[t].position, tools[t].radius});
   }
   factor_for(held);
@@ -76,9 +80,10 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   SphereCandidates candidates;
   for (int node : candidates_)
     if (!is_held[static_cast<std::size_t>(node)])
-      if (const auto constraint = node_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
-                                                  body_.dofs.fixed_axes[static_cast<std::size_t>(node)], spheres,
-                                                  obstacle_at(obstacles_, node))) {
+      if (const auto constraint =
+              node_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
+                              body_.dofs.fixed_axes[static_cast<std::size_t>(node)], spheres,
+                              obstacle_at(obstacles_, node))) {
         candidates.nodes.push_back(node);
         candidates.constraints.push_back(*constraint);
       }
@@ -95,9 +100,11 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   for (std::size_t h = 0; h < held.nodes.size(); ++h)
     for (int axis = 0; axis < 3; ++axis)
       if (!body_.dofs.is_fixed(held.nodes[h], axis)) values.push_back(held.displacement[h][axis]);
-  const Eigen::Map<const Eigen::VectorXd> held_values(values.data(), static_cast<Eigen::Index>(values.size()));
+  const Eigen::Map<const Eigen::VectorXd> held_values(values.data(),
+                                                      static_cast<Eigen::Index>(values.size()));
   Eigen::VectorXd u0 = Eigen::VectorXd::Zero(3 * body_.mesh.node_count());
-  if (!held.nodes.empty() || (displacement && m == 0)) u0 = solver_->solve(held_values).displacement;
+  if (!held.nodes.empty() || (displacement && m == 0))
+    u0 = solver_->solve(held_values).displacement;
   if (m == 0) {
     if (displacement) *displacement = u0;
     return solution;
@@ -111,8 +118,10 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   // Which touch: the working set over every candidate, columns only for its members.
   const auto entry = [&](int i, int j) {
     const Eigen::MatrixXd& column = columns_of(candidates.nodes[static_cast<std::size_t>(j)]);
-    const int row = candidate_row_[static_cast<std::size_t>(candidates.nodes[static_cast<std::size_t>(i)])];
-    const Eigen::Vector3d moved = column.middleRows<3>(row) * candidates.constraints[static_cast<std::size_t>(j)].normal;
+    const int row =
+        candidate_row_[static_cast<std::size_t>(candidates.nodes[static_cast<std::size_t>(i)])];
+    const Eigen::Vector3d moved =
+        column.middleRows<3>(row) * candidates.constraints[static_cast<std::size_t>(j)].normal;
     return candidates.constraints[static_cast<std::size_t>(i)].normal.dot(moved);
   };
   const auto prepare_columns = [&](std::span<const int> set) {
@@ -120,16 +129,21 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
     for (int i : set) nodes.push_back(candidates.nodes[static_cast<std::size_t>(i)]);
     compute_columns(nodes);
   };
-  std::vector<std::uint8_t> active(static_cast<std::size_t>(m), 0), member_active(active.size()), in_set(active.size());
+  std::vector<std::uint8_t> active(static_cast<std::size_t>(m), 0), member_active(active.size()),
+      in_set(active.size());
   std::vector<int> members(active.size()), order(active.size());
-  WorkingSetScratch<Eigen::MatrixXd, Eigen::VectorXd> scratch{{}, {}, {}, {}, members, member_active, order, in_set};
-  const WorkingSetSolveResult result =
-      solve_unilateral_over_candidates(q, entry, prepare_columns, static_cast<int>(m), active, solution.pushes, scratch,
-                                       std::numeric_limits<double>::infinity());
-  if (!result.inner.solved) throw NumericalError("sphere contact: the candidates' normal compliance is not positive definite");
+  WorkingSetScratch<Eigen::MatrixXd, Eigen::VectorXd> scratch{
+      {}, {}, {}, {}, members, member_active, order, in_set};
+  const WorkingSetSolveResult result = solve_unilateral_over_candidates(
+      q, entry, prepare_columns, static_cast<int>(m), active, solution.pushes, scratch,
+      std::numeric_limits<double>::infinity());
+  if (!result.inner.solved)
+    throw NumericalError(
+        "sphere contact: the candidates' normal compliance is not positive definite");
   for (Eigen::Index i = 0; i < m; ++i) {
     const SphereConstraint& c = candidates.constraints[static_cast<std::size_t>(i)];
-    if (c.tool >= 0) solution.reactions[static_cast<std::size_t>(c.tool)] -= solution.pushes[i] * c.normal;
+    if (c.tool >= 0)
+      solution.reactions[static_cast<std::size_t>(c.tool)] -= solution.pushes[i] * c.normal;
   }
   if (displacement) {
     Eigen::VectorXd loads = Eigen::VectorXd::Zero(3 * body_.mesh.node_count());
@@ -141,8 +155,10 @@ SphereContactSolution SphereContactReference::solve(const std::vector<PressedToo
   return solution;
 }
 
-SphereContactSolution sphere_reactions_reference(const ElasticBody& body, const std::vector<PressedTool>& tools,
-                                                 const HeldNodes& held, Eigen::VectorXd* displacement,
+SphereContactSolution sphere_reactions_reference(const ElasticBody& body,
+                                                 const std::vector<PressedTool>& tools,
+                                                 const HeldNodes& held,
+                                                 Eigen::VectorXd* displacement,
                                                  std::vector<SphereConstraint> obstacles) {
   return SphereContactReference(body, std::move(obstacles)).solve(tools, held, displacement);
 }

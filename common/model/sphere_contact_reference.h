@@ -3,8 +3,8 @@
 //
 // The candidates are the nodes of the touchable triangles and those a rigid obstacle
 // constrains (obstacle_constraints.h), less the held boundary nodes B, each held by the
-// sphere or obstacle with the least gap (node_constraint). K is factored (CHOLMOD) with B's dofs prescribed; one
-// solve gives the candidates' displacement u0 under B's displacements alone, and
+// sphere or obstacle with the least gap (node_constraint). K is factored (CHOLMOD) with B's dofs
+// prescribed; one solve gives the candidates' displacement u0 under B's displacements alone, and
 // multi-right-hand-side solves the compliance L under unit forces at the free dofs of the
 // working set's nodes (working_set_contact_solve.h), over the rows of every candidate. With
 // A = N^T L N and q = g + N^T u0 the unilateral problem is solved over every candidate,
@@ -31,10 +31,10 @@
 namespace cohaptic {
 
 struct SphereContactSolution {
-  std::vector<int> candidates;                 ///< every candidate (volume node), ascending
-  std::vector<SphereConstraint> constraints;   ///< per candidate
-  Eigen::VectorXd pushes;                      ///< lambda per candidate [N]; 0: released
-  std::vector<Eigen::Vector3d> reactions;      ///< force on each tool [N] (zero if it holds nothing)
+  std::vector<int> candidates;                ///< every candidate (volume node), ascending
+  std::vector<SphereConstraint> constraints;  ///< per candidate
+  Eigen::VectorXd pushes;                     ///< lambda per candidate [N]; 0: released
+  std::vector<Eigen::Vector3d> reactions;     ///< force on each tool [N] (zero if it holds nothing)
 
   /// The candidates in contact (lambda > 0), ascending.
   std::vector<int> contact_nodes() const;
@@ -44,7 +44,8 @@ class SphereContactReference {
  public:
   /// `body` must outlive the reference. `obstacles`: per volume node, its obstacle
   /// constraint (obstacle_constraints.h), or empty for none.
-  explicit SphereContactReference(const ElasticBody& body, std::vector<SphereConstraint> obstacles = {});
+  explicit SphereContactReference(const ElasticBody& body,
+                                  std::vector<SphereConstraint> obstacles = {});
   ~SphereContactReference();
 
   /// Every tool is a sphere (radius > 0). Also returns the displacement field (3N) if asked.
@@ -61,9 +62,9 @@ class SphereContactReference {
 
   const ElasticBody& body_;
   std::vector<SphereConstraint> obstacles_;  // per volume node, or empty
-  std::vector<int> candidates_;      // nodes of the touchable triangles and the obstacles', ascending
-  std::vector<int> candidate_row_;   // per volume node: its first row (3 per candidate), or -1
-  std::vector<int> row_dofs_;        // global dof of each row
+  std::vector<int> candidates_;  // nodes of the touchable triangles and the obstacles', ascending
+  std::vector<int> candidate_row_;  // per volume node: its first row (3 per candidate), or -1
+  std::vector<int> row_dofs_;       // global dof of each row
   std::vector<int> held_key_;
   std::unique_ptr<ConstrainedStaticSolver> solver_;
   std::unordered_map<int, Eigen::MatrixXd> columns_;  // node -> rows x 3 (its x, y, z unit forces)
@@ -71,8 +72,10 @@ class SphereContactReference {
 };
 
 /// One-shot: SphereContactReference(body, obstacles).solve(tools, held).
-SphereContactSolution sphere_reactions_reference(const ElasticBody& body, const std::vector<PressedTool>& tools,
-                                                 const HeldNodes& held = {}, Eigen::VectorXd* displacement = nullptr,
+SphereContactSolution sphere_reactions_reference(const ElasticBody& body,
+                                                 const std::vector<PressedTool>& tools,
+                                                 const HeldNodes& held = {},
+                                                 Eigen::VectorXd* displacement = nullptr,
                                                  std::vector<SphereConstraint> obstacles = {});
 
 }  // namespace cohaptic

@@ -14,8 +14,9 @@ const Triangle& contact_triangle(const ElasticBody& body, const ContactQuery& qu
 }
 
 // Prescribed dofs and values for the held nodes, and (node translation) the contact nodes.
-void prescribe(const ElasticBody& body, const std::vector<int>& nodes, const std::vector<Eigen::Vector3d>& values,
-               std::vector<int>& dofs, std::vector<double>& prescribed) {
+void prescribe(const ElasticBody& body, const std::vector<int>& nodes,
+               const std::vector<Eigen::Vector3d>& values, std::vector<int>& dofs,
+               std::vector<double>& prescribed) {
   for (std::size_t i = 0; i < nodes.size(); ++i)
     for (int axis = 0; axis < 3; ++axis)
       if (!body.dofs.is_fixed(nodes[i], axis)) {
@@ -26,7 +27,8 @@ void prescribe(const ElasticBody& body, const std::vector<int>& nodes, const std
 
 }  // namespace
 
-std::vector<ContactQuery> find_tool_contacts(const ElasticBody& body, const std::vector<PressedTool>& tools) {
+std::vector<ContactQuery> find_tool_contacts(const ElasticBody& body,
+                                             const std::vector<PressedTool>& tools) {
   std::vector<ContactQuery> contacts;
   std::vector<int> owner(static_cast<std::size_t>(body.mesh.node_count()), -1);
   for (std::size_t t = 0; t < tools.size(); ++t) {
@@ -35,16 +37,19 @@ std::vector<ContactQuery> find_tool_contacts(const ElasticBody& body, const std:
     if (!contacts.back().contact) continue;
     for (int node : contact_triangle(body, contacts.back())) {
       if (owner[node] >= 0)
-        throw Error(fmt::format("tools {} and {} press triangles that share node {}: move them apart", owner[node] + 1,
-                                t + 1, body.mesh.node_tags[node]));
+        throw Error(
+            fmt::format("tools {} and {} press triangles that share node {}: move them apart",
+                        owner[node] + 1, t + 1, body.mesh.node_tags[node]));
       owner[node] = static_cast<int>(t);
     }
   }
   return contacts;
 }
 
-std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body, const std::vector<ContactQuery>& contacts,
-                                                      const HeldNodes& held, ContactModel contact_model,
+std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body,
+                                                      const std::vector<ContactQuery>& contacts,
+                                                      const HeldNodes& held,
+                                                      ContactModel contact_model,
                                                       Eigen::VectorXd* displacement) {
   std::vector<bool> is_held(static_cast<std::size_t>(body.mesh.node_count()), false);
   for (int node : held.nodes) is_held[node] = true;
@@ -54,7 +59,8 @@ std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body, c
     pressing.push_back(t);
     for (int node : contact_triangle(body, contacts[t]))
       if (is_held[node])
-        throw Error(fmt::format("node {} is both held and under tool {}", body.mesh.node_tags[node], t + 1));
+        throw Error(fmt::format("node {} is both held and under tool {}", body.mesh.node_tags[node],
+                                t + 1));
   }
 
   std::vector<int> dofs;
@@ -78,7 +84,8 @@ std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body, c
       const Triangle& tri = contact_triangle(body, contacts[t]);
       for (int i = 0; i < 3; ++i)
         for (int axis = 0; axis < 3; ++axis)
-          reactions[t].nodal_forces(axis, i) = body.dofs.is_fixed(tri[i], axis) ? 0.0 : solution.reaction[3 * tri[i] + axis];
+          reactions[t].nodal_forces(axis, i) =
+              body.dofs.is_fixed(tri[i], axis) ? 0.0 : solution.reaction[3 * tri[i] + axis];
       reactions[t].reaction = -(reactions[t].nodal_forces * contacts[t].contact->weights);
     }
     if (displacement) *displacement = solution.displacement;
@@ -87,13 +94,15 @@ std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body, c
 
   // Point constraint: superpose the held-nodes case and a unit load per tool and axis.
   const ConstrainedStaticSolver solver(body.stiffness, body.dofs, dofs);
-  const Eigen::VectorXd held_values = Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  const Eigen::VectorXd held_values =
+      Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
   const StaticSolution base = solver.solve(held_values);
   const auto m = static_cast<Eigen::Index>(3 * pressing.size());
   const auto contact_point_displacement = [&](const Eigen::VectorXd& u, std::size_t t) {
     const Triangle& tri = contact_triangle(body, contacts[t]);
     const Eigen::Vector3d& w = contacts[t].contact->weights;
-    return Eigen::Vector3d(w[0] * u.segment<3>(3 * tri[0]) + w[1] * u.segment<3>(3 * tri[1]) + w[2] * u.segment<3>(3 * tri[2]));
+    return Eigen::Vector3d(w[0] * u.segment<3>(3 * tri[0]) + w[1] * u.segment<3>(3 * tri[1]) +
+                           w[2] * u.segment<3>(3 * tri[2]));
   };
   std::vector<StaticSolution> unit(static_cast<std::size_t>(m));
   Eigen::MatrixXd a(m, m);
@@ -103,13 +112,16 @@ std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body, c
     Eigen::VectorXd load = Eigen::VectorXd::Zero(3 * body.mesh.node_count());
     const Triangle& tri = contact_triangle(body, contacts[t]);
     for (int i = 0; i < 3; ++i) load[3 * tri[i] + k % 3] = contacts[t].contact->weights[i];
-    unit[static_cast<std::size_t>(k)] = solver.solve(Eigen::VectorXd::Zero(held_values.size()), load);
+    unit[static_cast<std::size_t>(k)] =
+        solver.solve(Eigen::VectorXd::Zero(held_values.size()), load);
     for (std::size_t j = 0; j < pressing.size(); ++j)
-      a.block<3, 1>(3 * static_cast<Eigen::Index>(j), k) = contact_point_displacement(unit[static_cast<std::size_t>(k)].displacement, pressing[j]);
+      a.block<3, 1>(3 * static_cast<Eigen::Index>(j), k) =
+          contact_point_displacement(unit[static_cast<std::size_t>(k)].displacement, pressing[j]);
   }
   for (std::size_t j = 0; j < pressing.size(); ++j)
     rhs.segment<3>(3 * static_cast<Eigen::Index>(j)) =
-        contacts[pressing[j]].contact->displacement - contact_point_displacement(base.displacement, pressing[j]);
+        contacts[pressing[j]].contact->displacement -
+        contact_point_displacement(base.displacement, pressing[j]);
   const Eigen::VectorXd lambda = a.partialPivLu().solve(rhs);
   for (std::size_t j = 0; j < pressing.size(); ++j) {
     const Eigen::Vector3d force = lambda.segment<3>(3 * static_cast<Eigen::Index>(j));
@@ -123,7 +135,8 @@ std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body, c
   }
   if (displacement) {
     *displacement = base.displacement;
-    for (Eigen::Index k = 0; k < m; ++k) *displacement += lambda[k] * unit[static_cast<std::size_t>(k)].displacement;
+    for (Eigen::Index k = 0; k < m; ++k)
+      *displacement += lambda[k] * unit[static_cast<std::size_t>(k)].displacement;
   }
   return reactions;
 }

@@ -32,19 +32,23 @@ struct HeldNodes {
 };
 
 struct ToolReaction {
-  ContactQuery query;                                      ///< contact empty: the tool touches nothing
-  Eigen::Matrix3d nodal_forces = Eigen::Matrix3d::Zero();  ///< column i: tool force on contact node i [N]
-  Eigen::Vector3d reaction = Eigen::Vector3d::Zero();      ///< force on the tool [N]
+  ContactQuery query;  ///< contact empty: the tool touches nothing
+  Eigen::Matrix3d nodal_forces =
+      Eigen::Matrix3d::Zero();  ///< column i: tool force on contact node i [N]
+  Eigen::Vector3d reaction = Eigen::Vector3d::Zero();  ///< force on the tool [N]
 };
 
 /// Finds every tool's contact. Throws Error if two tools press triangles sharing a node
 /// (one node cannot follow two tools).
-std::vector<ContactQuery> find_tool_contacts(const ElasticBody& body, const std::vector<PressedTool>& tools);
+std::vector<ContactQuery> find_tool_contacts(const ElasticBody& body,
+                                             const std::vector<PressedTool>& tools);
 
 /// Full sparse solve; also returns the displacement field (3N) if asked. Throws Error if a
 /// held node is also a contact node.
-std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body, const std::vector<ContactQuery>& contacts,
-                                                      const HeldNodes& held, ContactModel contact_model,
+std::vector<ToolReaction> contact_reactions_reference(const ElasticBody& body,
+                                                      const std::vector<ContactQuery>& contacts,
+                                                      const HeldNodes& held,
+                                                      ContactModel contact_model,
                                                       Eigen::VectorXd* displacement = nullptr);
 
 }  // namespace cohaptic

@@ -9,7 +9,6 @@
 #include "common/scene/parse_separation.h"
 #include "common/util/yaml_cursor.h"
 
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -23,7 +22,8 @@ namespace cohaptic {
 namespace {
 
 [[noreturn]] void raise_scene_error(const std::string& file, int line, const std::string& message) {
-  throw SceneError(line > 0 ? fmt::format("{}:{}: {}", file, line, message) : fmt::format("{}: {}", file, message));
+  throw SceneError(line > 0 ? fmt::format("{}:{}: {}", file, line, message)
+                            : fmt::format("{}: {}", file, message));
 }
 
 using Cursor = YamlCursor;
@@ -35,10 +35,14 @@ double metres_per(const Cursor& units) {
 
 const char* tool_shape_name(ToolShape shape) {
   switch (shape) {
-    case ToolShape::point: return "point";
-    case ToolShape::sphere: return "sphere";
-    case ToolShape::probe: return "probe";
-    case ToolShape::forceps: return "forceps";
+    case ToolShape::point:
+      return "point";
+    case ToolShape::sphere:
+      return "sphere";
+    case ToolShape::probe:
+      return "probe";
+    case ToolShape::forceps:
+      return "forceps";
   }
   return "?";
 }
@@ -48,7 +52,8 @@ AxisMask parse_axes(const Cursor& c) {
   AxisMask mask = 0;
   for (char ch : text) {
     const int axis = ch == 'x' ? 0 : ch == 'y' ? 1 : ch == 'z' ? 2 : -1;
-    if (axis < 0 || (mask >> axis) & 1u) c.fail("a combination of x, y and z, each at most once (e.g. xyz or z)");
+    if (axis < 0 || (mask >> axis) & 1u)
+      c.fail("a combination of x, y and z, each at most once (e.g. xyz or z)");
     mask = static_cast<AxisMask>(mask | (1u << axis));
   }
   if (mask == 0) c.fail("at least one axis");
@@ -61,7 +66,9 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const SceneFiles& files) {
   const auto file = c.find("file");
   const auto gmsh = c.find("gmsh");
   const auto box = c.find("box");
-  if (static_cast<int>(static_cast<bool>(file)) + static_cast<bool>(gmsh) + static_cast<bool>(box) != 1)
+  if (static_cast<int>(static_cast<bool>(file)) + static_cast<bool>(gmsh) +
+          static_cast<bool>(box) !=
+      1)
     c.fail("exactly one of file, gmsh or box");
   const auto set = c.find("set");
   if (set && !gmsh) set->fail("only with gmsh (the script's parameters)");
@@ -75,7 +82,8 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const SceneFiles& files) {
       GmshScript script{resolved, {}};
       if (set) {
         if (!set->is_map()) set->fail("a map of the script's parameters to numbers");
-        for (const std::string& name : set->keys()) script.parameters[name] = set->at(name).number();
+        for (const std::string& name : set->keys())
+          script.parameters[name] = set->at(name).number();
       }
       mesh.gmsh = std::move(script);
     }
@@ -87,7 +95,8 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const SceneFiles& files) {
     spec.size = size.vec3() * scale;
     if (!(spec.size.array() > 0).all()) size.fail("three positive lengths");
     const Cursor divisions = box->at("divisions");
-    if (!divisions.is_sequence() || divisions.items().size() != 3) divisions.fail("a list of 3 integers");
+    if (!divisions.is_sequence() || divisions.items().size() != 3)
+      divisions.fail("a list of 3 integers");
     const auto parts = divisions.items();
     for (int i = 0; i < 3; ++i) {
       const std::int64_t d = parts[i].integer();
@@ -96,14 +105,18 @@ MeshSpec parse_mesh(const Cursor& c, double scale, const SceneFiles& files) {
     }
     const std::int64_t nodes = (spec.divisions.cast<std::int64_t>().array() + 1).prod();
     if (nodes > kMaxBodyNodes)
-      divisions.fail(fmt::format("divisions giving at most {} nodes, not {}", kMaxBodyNodes, nodes));
+      divisions.fail(
+          fmt::format("divisions giving at most {} nodes, not {}", kMaxBodyNodes, nodes));
     if (auto grading = box->find("grading")) {
-      if (!grading->is_sequence() || grading->items().size() != 3) grading->fail("a list of 3 ratios");
+      if (!grading->is_sequence() || grading->items().size() != 3)
+        grading->fail("a list of 3 ratios");
       const auto ratios = grading->items();
-      for (int i = 0; i < 3; ++i) spec.grading[i] = ratios[i].number_in(0.2, 5, false, false, "a ratio from 0.2 to 5");
+      for (int i = 0; i < 3; ++i)
+        spec.grading[i] = ratios[i].number_in(0.2, 5, false, false, "a ratio from 0.2 to 5");
     }
     if (auto uniform = box->find("uniform_cells")) {
-      if (!uniform->is_sequence() || uniform->items().size() != 3) uniform->fail("a list of 3 integers");
+      if (!uniform->is_sequence() || uniform->items().size() != 3)
+        uniform->fail("a list of 3 integers");
       const auto cells = uniform->items();
       for (int i = 0; i < 3; ++i) {
         const std::int64_t count = cells[i].integer();
@@ -127,12 +140,16 @@ ElasticObjectSpec parse_elastic_object(const Cursor& c, double scale, const Scen
   material.only_keys({"model", "youngs_modulus", "poisson_ratio", "element"});
   if (auto model = material.find("model")) model->choice({"linear_elastic"});
   if (auto element = material.find("element"))
-    object.material.formulation = element->choice({"linear_tet", "nodal_pressure_tet"}) == "linear_tet"
-                                      ? ElementFormulation::linear_tet
-                                      : ElementFormulation::nodal_pressure_tet;
-  object.material.youngs_modulus = material.at("youngs_modulus").number_in(0, INFINITY, true, true, "a positive modulus in Pa");
-  object.material.poisson_ratio =
-      material.at("poisson_ratio").number_in(-1, 0.5, true, true, "a number in (-1, 0.5): 0.5 is incompressible, which linear tetrahedra cannot represent");
+    object.material.formulation =
+        element->choice({"linear_tet", "nodal_pressure_tet"}) == "linear_tet"
+            ? ElementFormulation::linear_tet
+            : ElementFormulation::nodal_pressure_tet;
+  object.material.youngs_modulus =
+      material.at("youngs_modulus").number_in(0, INFINITY, true, true, "a positive modulus in Pa");
+  object.material.poisson_ratio = material.at("poisson_ratio")
+                                      .number_in(-1, 0.5, true, true,
+                                                 "a number in (-1, 0.5): 0.5 is incompressible, "
+                                                 "which linear tetrahedra cannot represent");
 
   const Cursor fixed = c.at("fixed");
   for (const Cursor& item : fixed.items()) {
@@ -142,7 +159,8 @@ ElasticObjectSpec parse_elastic_object(const Cursor& c, double scale, const Scen
     if (auto axes = item.find("axes")) region.axes = parse_axes(*axes);
     object.fixed.push_back(region);
   }
-  if (object.fixed.empty()) fixed.fail("at least one fixed region (an unfixed object has no static solution)");
+  if (object.fixed.empty())
+    fixed.fail("at least one fixed region (an unfixed object has no static solution)");
 
   if (auto touchable = c.find("touchable")) {
     for (const Cursor& item : touchable->items()) {
@@ -158,8 +176,10 @@ ElasticObjectSpec parse_elastic_object(const Cursor& c, double scale, const Scen
   if (auto compliance = c.find("compliance")) {
     compliance->only_keys({"precompute", "disk_cache"});
     if (auto precompute = compliance->find("precompute"))
-      object.compliance.precompute_touchable = precompute->choice({"touchable", "on_demand"}) == "touchable";
-    if (auto disk_cache = compliance->find("disk_cache")) object.compliance.disk_cache = disk_cache->boolean();
+      object.compliance.precompute_touchable =
+          precompute->choice({"touchable", "on_demand"}) == "touchable";
+    if (auto disk_cache = compliance->find("disk_cache"))
+      object.compliance.disk_cache = disk_cache->boolean();
   }
   return object;
 }
@@ -170,11 +190,17 @@ ObjectSpec parse_object(const Cursor& c, double scale, const SceneFiles& files) 
   object.where = c.location();
   object.name = c.at("name").text();
   const std::string model =
-      c.find("model") ? c.at("model").choice({"linear_elastic", "mass_spring", "home_spring", "separation"}) : "linear_elastic";
-  if (model == "linear_elastic") object.body = parse_elastic_object(c, scale, files);
-  else if (model == "mass_spring") object.body = parse_mass_spring_object(c, scale);
-  else if (model == "home_spring") object.body = parse_home_spring_object(c, scale, files);
-  else object.body = parse_separation_object(c, scale);
+      c.find("model")
+          ? c.at("model").choice({"linear_elastic", "mass_spring", "home_spring", "separation"})
+          : "linear_elastic";
+  if (model == "linear_elastic")
+    object.body = parse_elastic_object(c, scale, files);
+  else if (model == "mass_spring")
+    object.body = parse_mass_spring_object(c, scale);
+  else if (model == "home_spring")
+    object.body = parse_home_spring_object(c, scale, files);
+  else
+    object.body = parse_separation_object(c, scale);
   return object;
 }
 
@@ -184,7 +210,8 @@ ObstacleSpec parse_obstacle(const Cursor& c, double scale, const SceneFiles& fil
   obstacle.name = c.at("name").text();
   const auto surface = c.find("surface");
   const auto plane = c.find("plane");
-  if (static_cast<bool>(surface) == static_cast<bool>(plane)) c.fail("exactly one of surface (a file) or plane");
+  if (static_cast<bool>(surface) == static_cast<bool>(plane))
+    c.fail("exactly one of surface (a file) or plane");
   if (surface) {
     obstacle.surface_file = files.resolve(*surface, "surface file");
   } else {
@@ -201,7 +228,10 @@ ToolSpec parse_tool(const Cursor& c, double scale) {
   tool.name = c.at("name").text();
   if (auto shape = c.find("shape")) {
     const std::string name = shape->choice({"point", "sphere", "probe", "forceps"});
-    tool.shape = name == "point" ? ToolShape::point : name == "sphere" ? ToolShape::sphere : name == "probe" ? ToolShape::probe : ToolShape::forceps;
+    tool.shape = name == "point"    ? ToolShape::point
+                 : name == "sphere" ? ToolShape::sphere
+                 : name == "probe"  ? ToolShape::probe
+                                    : ToolShape::forceps;
   }
   if (tool.shape == ToolShape::probe || tool.shape == ToolShape::forceps)
     tool.instrument = parse_instrument(c, scale, tool.shape == ToolShape::forceps);
@@ -212,22 +242,28 @@ ToolSpec parse_tool(const Cursor& c, double scale) {
   if (tool.shape == ToolShape::sphere)
     tool.radius = c.at("radius").number_in(0, INFINITY, true, true, "a positive radius") * scale;
   else if (auto radius = c.find("radius"))
-    radius->fail_message(fmt::format("a {} tool has no radius (use shape: sphere)", tool_shape_name(tool.shape)));
+    radius->fail_message(
+        fmt::format("a {} tool has no radius (use shape: sphere)", tool_shape_name(tool.shape)));
   return tool;
 }
 
 HapticSettings parse_haptic(const Cursor& c) {
-  c.only_keys({"rate_hz", "force_limit", "contact_model", "patch_rings", "boundary_truncation", "min_sim_rate_hz"});
+  c.only_keys({"rate_hz", "force_limit", "contact_model", "patch_rings", "boundary_truncation",
+               "min_sim_rate_hz"});
   HapticSettings haptic;
-  if (auto rate = c.find("rate_hz")) haptic.rate_hz = rate->number_in(1, 100000, false, false, "a rate from 1 to 100000 Hz");
-  if (auto limit = c.find("force_limit")) haptic.force_limit_n = limit->number_in(0, 1000, true, false, "a force limit in N, in (0, 1000]");
+  if (auto rate = c.find("rate_hz"))
+    haptic.rate_hz = rate->number_in(1, 100000, false, false, "a rate from 1 to 100000 Hz");
+  if (auto limit = c.find("force_limit"))
+    haptic.force_limit_n =
+        limit->number_in(0, 1000, true, false, "a force limit in N, in (0, 1000]");
   if (auto rings = c.find("patch_rings")) {
     const std::int64_t value = rings->integer();
     if (value < 0 || value > 4) rings->fail("an integer from 0 to 4");
     haptic.patch_rings = static_cast<int>(value);
   }
   if (auto rate = c.find("min_sim_rate_hz"))
-    haptic.min_sim_rate_hz = rate->number_in(0, 100000, true, false, "a rate above 0 and at most 100000 Hz");
+    haptic.min_sim_rate_hz =
+        rate->number_in(0, 100000, true, false, "a rate above 0 and at most 100000 Hz");
   if (auto truncation = c.find("boundary_truncation"))
     haptic.boundary_truncation = truncation->number_in(0, 1, false, true, "a fraction in [0, 1)");
   if (auto model = c.find("contact_model")) {
@@ -254,11 +290,14 @@ NetworkSettings parse_network(const Cursor& c, std::size_t tools) {
 
 }  // namespace
 
-Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file, const SceneFileAccess& access) {
+Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file,
+                  const SceneFileAccess& access) {
   const std::string file_name = file.string();
-  const Cursor top(load_yaml(yaml_text, file_name, raise_scene_error), "", &file_name, 1, raise_scene_error);
+  const Cursor top(load_yaml(yaml_text, file_name, raise_scene_error), "", &file_name, 1,
+                   raise_scene_error);
   if (!top.is_map()) top.fail("a map of scene settings");
-  top.only_keys({"name", "units", "objects", "interactions", "obstacles", "tools", "haptic", "network"});
+  top.only_keys(
+      {"name", "units", "objects", "interactions", "obstacles", "tools", "haptic", "network"});
 
   Scene scene;
   scene.file = file;
@@ -268,22 +307,26 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
     scene.units = units->text();
   }
   const double scale = scene.metres_per_unit;
-  const SceneFiles files{file.has_parent_path() ? file.parent_path() : std::filesystem::path("."), access};
+  const SceneFiles files{file.has_parent_path() ? file.parent_path() : std::filesystem::path("."),
+                         access};
 
   const Cursor objects = top.at("objects");
   std::set<std::string> object_names;
   for (const Cursor& item : objects.items()) {
     scene.objects.push_back(parse_object(item, scale, files));
-    if (!object_names.insert(scene.objects.back().name).second) item.at("name").fail("an object name not used before");
+    if (!object_names.insert(scene.objects.back().name).second)
+      item.at("name").fail("an object name not used before");
   }
   if (scene.objects.empty()) objects.fail("at least one object");
-  if (auto interactions = top.find("interactions")) scene.interactions = parse_interactions(*interactions, scene.objects);
+  if (auto interactions = top.find("interactions"))
+    scene.interactions = parse_interactions(*interactions, scene.objects);
 
   if (auto obstacles = top.find("obstacles")) {
     std::set<std::string> obstacle_names;
     for (const Cursor& item : obstacles->items()) {
       scene.obstacles.push_back(parse_obstacle(item, scale, files));
-      if (!obstacle_names.insert(scene.obstacles.back().name).second) item.at("name").fail("an obstacle name not used before");
+      if (!obstacle_names.insert(scene.obstacles.back().name).second)
+        item.at("name").fail("an obstacle name not used before");
     }
   }
 
@@ -291,11 +334,13 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
   std::set<std::string> tool_names;
   for (const Cursor& item : tools.items()) {
     scene.tools.push_back(parse_tool(item, scale));
-    if (!tool_names.insert(scene.tools.back().name).second) item.at("name").fail("a tool name not used before");
+    if (!tool_names.insert(scene.tools.back().name).second)
+      item.at("name").fail("a tool name not used before");
   }
   if (scene.tools.empty()) tools.fail("at least one tool");
   if (scene.tools.size() > static_cast<std::size_t>(kMaxUsers))
-    tools.fail(fmt::format("at most {} tools (one per user; the haptic loop holds that many)", kMaxUsers));
+    tools.fail(
+        fmt::format("at most {} tools (one per user; the haptic loop holds that many)", kMaxUsers));
   const std::vector<Cursor> object_items = objects.items();
   for (std::size_t i = 0; i < scene.objects.size(); ++i)
     if (const auto* separation = std::get_if<SeparationObjectSpec>(&scene.objects[i].body))
@@ -307,29 +352,39 @@ Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& fil
   if (haptic) scene.haptic = parse_haptic(*haptic);
   // The sphere model is the default when every tool is a sphere, and needs sphere tools.
   const std::optional<Cursor> contact_model = haptic ? haptic->find("contact_model") : std::nullopt;
-  const auto point = std::find_if(scene.tools.begin(), scene.tools.end(),
-                                  [](const ToolSpec& tool) { return tool.shape != ToolShape::sphere; });
-  if (!contact_model && point == scene.tools.end()) scene.haptic.contact_model = ContactModel::sphere;
-  if (contact_model && scene.haptic.contact_model == ContactModel::sphere && point != scene.tools.end())
-    contact_model->fail_message(fmt::format("the sphere contact model needs sphere tools, and tool '{}' is a {} "
-                                            "(give it shape: sphere and a radius, or use translation or point)",
-                                            point->name, tool_shape_name(point->shape)));
+  const auto point = std::find_if(scene.tools.begin(), scene.tools.end(), [](const ToolSpec& tool) {
+    return tool.shape != ToolShape::sphere;
+  });
+  if (!contact_model && point == scene.tools.end())
+    scene.haptic.contact_model = ContactModel::sphere;
+  if (contact_model && scene.haptic.contact_model == ContactModel::sphere &&
+      point != scene.tools.end())
+    contact_model->fail_message(
+        fmt::format("the sphere contact model needs sphere tools, and tool '{}' is a {} "
+                    "(give it shape: sphere and a radius, or use translation or point)",
+                    point->name, tool_shape_name(point->shape)));
   for (const InteractionSpec& interaction : scene.interactions)
-    if (const auto front = std::find_if(scene.objects.begin(), scene.objects.end(),
-                                        [&](const ObjectSpec& o) { return o.name == interaction.front; });
-        std::holds_alternative<ElasticObjectSpec>(front->body) && scene.haptic.contact_model != ContactModel::node_translation)
-      throw SceneError(fmt::format("{}: the linear elastic front object '{}' presses on '{}' under the translation "
-                                   "contact model only, and this scene's is '{}' (haptic: {{contact_model: translation}})",
-                                   interaction.where, interaction.front, interaction.behind,
-                                   contact_model_name(scene.haptic.contact_model)));
+    if (const auto front =
+            std::find_if(scene.objects.begin(), scene.objects.end(),
+                         [&](const ObjectSpec& o) { return o.name == interaction.front; });
+        std::holds_alternative<ElasticObjectSpec>(front->body) &&
+        scene.haptic.contact_model != ContactModel::node_translation)
+      throw SceneError(fmt::format(
+          "{}: the linear elastic front object '{}' presses on '{}' under the translation "
+          "contact model only, and this scene's is '{}' (haptic: {{contact_model: translation}})",
+          interaction.where, interaction.front, interaction.behind,
+          contact_model_name(scene.haptic.contact_model)));
   scene.network.max_participants = static_cast<int>(scene.tools.size());
-  if (auto network = top.find("network")) scene.network = parse_network(*network, scene.tools.size());
+  if (auto network = top.find("network"))
+    scene.network = parse_network(*network, scene.tools.size());
   return scene;
 }
 
 Scene load_scene(const std::filesystem::path& file) {
   std::ifstream in(file);
-  if (!in) throw SceneError(fmt::format("{}: cannot open the scene file: {}", file.string(), std::strerror(errno)));
+  if (!in)
+    throw SceneError(
+        fmt::format("{}: cannot open the scene file: {}", file.string(), std::strerror(errno)));
   std::stringstream text;
   text << in.rdbuf();
   return parse_scene(text.str(), file);

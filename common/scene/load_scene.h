@@ -23,6 +23,7 @@ Scene load_scene(const std::filesystem::path& file);
 
 /// Parses scene text; `file` names it in messages and resolves relative mesh paths; the
 /// files it names are read as `access` allows (scene_files.h).
-Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file, const SceneFileAccess& access = {});
+Scene parse_scene(const std::string& yaml_text, const std::filesystem::path& file,
+                  const SceneFileAccess& access = {});
 
 }  // namespace cohaptic

@@ -13,7 +13,8 @@ namespace cohaptic {
 
 /// `c` is the object's map (with name and model); lengths are scaled by `scale` [m/unit];
 /// a surface file is resolved and checked by `files`.
-HomeSpringObjectSpec parse_home_spring_object(const YamlCursor& c, double scale, const SceneFiles& files);
+HomeSpringObjectSpec parse_home_spring_object(const YamlCursor& c, double scale,
+                                              const SceneFiles& files);
 
 /// The instrument keys of a tool map `c` (trocar; for forceps, jaws); `forceps` says which.
 InstrumentSpec parse_instrument(const YamlCursor& c, double scale, bool forceps);

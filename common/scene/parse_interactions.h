@@ -13,6 +13,7 @@
 namespace cohaptic {
 
 /// `list` is the `interactions` value; `objects` the scene's parsed objects.
-std::vector<InteractionSpec> parse_interactions(const YamlCursor& list, const std::vector<ObjectSpec>& objects);
+std::vector<InteractionSpec> parse_interactions(const YamlCursor& list,
+                                                const std::vector<ObjectSpec>& objects);
 
 }  // namespace cohaptic

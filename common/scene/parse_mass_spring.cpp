@@ -26,7 +26,8 @@ TubeGeometry parse_tube(const YamlCursor& c, double scale) {
   tube.radius = c.at("radius").positive("a positive radius") * scale;
   const auto sections = c.find("sections");
   const auto spacing = c.find("section_spacing");
-  if (static_cast<bool>(sections) == static_cast<bool>(spacing)) c.fail("exactly one of sections or section_spacing");
+  if (static_cast<bool>(sections) == static_cast<bool>(spacing))
+    c.fail("exactly one of sections or section_spacing");
   if (sections) {
     const std::int64_t count = sections->integer();
     if (count < 2 || count > 100000) sections->fail("an integer from 2 to 100000");
@@ -34,14 +35,16 @@ TubeGeometry parse_tube(const YamlCursor& c, double scale) {
   } else {
     const double step = spacing->positive("a positive length") * scale;
     const double count = std::round(length / step) + 1;
-    if (count < 2 || count > 100000) spacing->fail("a spacing giving 2 to 100000 sections along the centre line");
+    if (count < 2 || count > 100000)
+      spacing->fail("a spacing giving 2 to 100000 sections along the centre line");
     tube.sections = static_cast<int>(count);
   }
   // tube_network: a centre node and kRingNodes ring nodes per section.
   const std::int64_t nodes = std::int64_t{kSectionNodes} * tube.sections;
   if (nodes > kMaxBodyNodes) {
-    const std::string expected = fmt::format("at most {} nodes ({} per section), not {} ({} sections)", kMaxBodyNodes,
-                                             kSectionNodes, nodes, tube.sections);
+    const std::string expected =
+        fmt::format("at most {} nodes ({} per section), not {} ({} sections)", kMaxBodyNodes,
+                    kSectionNodes, nodes, tube.sections);
     if (sections) sections->fail("sections giving " + expected);
     spacing->fail("a spacing giving " + expected);
   }
@@ -56,7 +59,8 @@ SupportPlane parse_plane(const YamlCursor& c, double scale) {
   SupportPlane plane;
   plane.point = c.at("point").vec3() * scale;
   plane.normal = c.at("normal").direction("a non-zero normal vector");
-  plane.static_friction = c.at("static_friction").number_in(0, INFINITY, false, true, "a friction coefficient >= 0");
+  plane.static_friction =
+      c.at("static_friction").number_in(0, INFINITY, false, true, "a friction coefficient >= 0");
   const YamlCursor dynamic = c.at("dynamic_friction");
   plane.dynamic_friction = dynamic.number_in(0, plane.static_friction, false, false,
                                              "a friction coefficient from 0 up to the static one");
@@ -75,7 +79,8 @@ SpringLatticeSpec parse_lattice(const YamlCursor& c, double scale) {
   lattice.size = size.vec3() * scale;
   if (!(lattice.size.array() > 0).all()) size.fail("three positive lengths");
   const YamlCursor divisions = box.at("divisions");
-  if (!divisions.is_sequence() || divisions.items().size() != 3) divisions.fail("a list of 3 integers");
+  if (!divisions.is_sequence() || divisions.items().size() != 3)
+    divisions.fail("a list of 3 integers");
   const auto parts = divisions.items();
   for (int i = 0; i < 3; ++i) {
     const std::int64_t d = parts[static_cast<std::size_t>(i)].integer();
@@ -83,9 +88,11 @@ SpringLatticeSpec parse_lattice(const YamlCursor& c, double scale) {
     lattice.divisions[i] = static_cast<int>(d);
   }
   const std::int64_t nodes = (lattice.divisions.cast<std::int64_t>().array() + 1).prod();
-  if (nodes > kMaxBodyNodes) divisions.fail(fmt::format("divisions giving at most {} nodes, not {}", kMaxBodyNodes, nodes));
+  if (nodes > kMaxBodyNodes)
+    divisions.fail(fmt::format("divisions giving at most {} nodes, not {}", kMaxBodyNodes, nodes));
   lattice.spring_stiffness = c.at("spring_stiffness").positive("a positive stiffness in N/m");
-  lattice.spring_damping = c.at("spring_damping").number_in(0, INFINITY, false, true, "a damping in N s/m, >= 0");
+  lattice.spring_damping =
+      c.at("spring_damping").number_in(0, INFINITY, false, true, "a damping in N s/m, >= 0");
   lattice.node_mass = c.at("node_mass").positive("a positive mass in kg");
   return lattice;
 }
@@ -97,42 +104,56 @@ HeatedRegion parse_heated(const YamlCursor& c, double scale) {
   box.only_keys({"min", "max"});
   region.box_min = box.at("min").vec3() * scale;
   region.box_max = box.at("max").vec3() * scale;
-  if ((region.box_max.array() < region.box_min.array()).any()) box.at("max").fail("a corner not below min on any axis");
-  region.temperature_rise = c.at("temperature_rise").number_in(0, INFINITY, false, true, "a temperature rise >= 0 in K");
+  if ((region.box_max.array() < region.box_min.array()).any())
+    box.at("max").fail("a corner not below min on any axis");
+  region.temperature_rise =
+      c.at("temperature_rise").number_in(0, INFINITY, false, true, "a temperature rise >= 0 in K");
   region.expansion_coefficient =
-      c.at("expansion_coefficient").number_in(0, INFINITY, false, true, "a linear expansion coefficient >= 0 in 1/K");
-  if (auto coupling = c.find("coupling")) region.coupling = coupling->positive("a positive constant c");
-  const double factor = 1 - region.coupling * region.expansion_coefficient * region.temperature_rise;
+      c.at("expansion_coefficient")
+          .number_in(0, INFINITY, false, true, "a linear expansion coefficient >= 0 in 1/K");
+  if (auto coupling = c.find("coupling"))
+    region.coupling = coupling->positive("a positive constant c");
+  const double factor =
+      1 - region.coupling * region.expansion_coefficient * region.temperature_rise;
   if (!(factor > 0))
-    c.fail_message(fmt::format("coupling x expansion_coefficient x temperature_rise is {}: Eq. (7) would leave the "
-                               "springs with no stiffness (it must stay below 1)", 1 - factor));
+    c.fail_message(fmt::format(
+        "coupling x expansion_coefficient x temperature_rise is {}: Eq. (7) would leave the "
+        "springs with no stiffness (it must stay below 1)",
+        1 - factor));
   return region;
 }
 
 }  // namespace
 
 MassSpringObjectSpec parse_mass_spring_object(const YamlCursor& c, double scale) {
-  c.only_keys({"name", "model", "tube", "lattice", "material", "fixed", "node_damping", "plane", "tool_friction",
-               "gravity", "time_step", "heated", "ir"});
+  c.only_keys({"name", "model", "tube", "lattice", "material", "fixed", "node_damping", "plane",
+               "tool_friction", "gravity", "time_step", "heated", "ir"});
   MassSpringObjectSpec object;
   const auto tube = c.find("tube");
   const auto lattice = c.find("lattice");
-  if (static_cast<bool>(tube) == static_cast<bool>(lattice)) c.fail("exactly one of tube or lattice");
+  if (static_cast<bool>(tube) == static_cast<bool>(lattice))
+    c.fail("exactly one of tube or lattice");
   if (lattice) {
     // A lattice's springs are given directly: no material to derive them from.
-    if (auto material = c.find("material")) material->fail_message("a lattice takes no material (its springs and masses are in lattice:)");
+    if (auto material = c.find("material"))
+      material->fail_message(
+          "a lattice takes no material (its springs and masses are in lattice:)");
     object.lattice = parse_lattice(*lattice, scale);
     object.node_damping = 0;
-    if (auto beta = c.find("node_damping")) object.node_damping = beta->number_in(0, INFINITY, false, true, "beta in N s/m, >= 0");
+    if (auto beta = c.find("node_damping"))
+      object.node_damping = beta->number_in(0, INFINITY, false, true, "beta in N s/m, >= 0");
   } else {
-    if (auto beta = c.find("node_damping")) beta->fail_message("a tube's node_damping goes in its material");
+    if (auto beta = c.find("node_damping"))
+      beta->fail_message("a tube's node_damping goes in its material");
     object.tube = parse_tube(*tube, scale);
     const YamlCursor material = c.at("material");
     material.only_keys({"youngs_modulus", "density", "spring_damping", "node_damping"});
-    object.material.youngs_modulus = material.at("youngs_modulus").positive("a positive modulus in Pa");
+    object.material.youngs_modulus =
+        material.at("youngs_modulus").positive("a positive modulus in Pa");
     object.material.density = material.at("density").positive("a positive density in kg/m^3");
     if (auto alpha = material.find("spring_damping"))
-      object.material.spring_damping = alpha->number_in(0, INFINITY, false, true, "alpha of Eq. (2) in s, >= 0");
+      object.material.spring_damping =
+          alpha->number_in(0, INFINITY, false, true, "alpha of Eq. (2) in s, >= 0");
     if (auto beta = material.find("node_damping"))
       object.node_damping = beta->number_in(0, INFINITY, false, true, "beta in N s/m, >= 0");
   }
@@ -143,11 +164,15 @@ MassSpringObjectSpec parse_mass_spring_object(const YamlCursor& c, double scale)
       object.fixed.push_back(parse_node_selector(item, scale));
     }
   if (auto plane = c.find("plane")) object.plane = parse_plane(*plane, scale);
-  if (auto mu = c.find("tool_friction")) object.tool_friction = mu->number_in(0, INFINITY, false, true, "a friction coefficient >= 0");
-  if (auto gravity = c.find("gravity")) object.gravity = gravity->vec3();  // m/s^2 whatever the length unit
-  if (auto step = c.find("time_step")) object.time_step = step->number_in(0, 0.1, true, false, "a time step in s, in (0, 0.1]");
+  if (auto mu = c.find("tool_friction"))
+    object.tool_friction = mu->number_in(0, INFINITY, false, true, "a friction coefficient >= 0");
+  if (auto gravity = c.find("gravity"))
+    object.gravity = gravity->vec3();  // m/s^2 whatever the length unit
+  if (auto step = c.find("time_step"))
+    object.time_step = step->number_in(0, 0.1, true, false, "a time step in s, in (0, 0.1]");
   if (auto heated = c.find("heated"))
-    for (const YamlCursor& item : heated->items()) object.heated.push_back(parse_heated(item, scale));
+    for (const YamlCursor& item : heated->items())
+      object.heated.push_back(parse_heated(item, scale));
   if (auto ir = c.find("ir")) {
     ir->only_keys({"sections", "rate_hz", "near_distance"});
     if (auto sections = ir->find("sections")) {
@@ -155,8 +180,10 @@ MassSpringObjectSpec parse_mass_spring_object(const YamlCursor& c, double scale)
       if (count < 1 || count > 100000) sections->fail("an integer from 1 to 100000");
       object.ir.sections = static_cast<int>(count);
     }
-    if (auto rate = ir->find("rate_hz")) object.ir.rate_hz = rate->number_in(0, 100000, true, false, "a rate in Hz, in (0, 100000]");
-    if (auto near = ir->find("near_distance")) object.ir.near_distance = near->positive("a positive length") * scale;
+    if (auto rate = ir->find("rate_hz"))
+      object.ir.rate_hz = rate->number_in(0, 100000, true, false, "a rate in Hz, in (0, 100000]");
+    if (auto near = ir->find("near_distance"))
+      object.ir.near_distance = near->positive("a positive length") * scale;
   }
   return object;
 }

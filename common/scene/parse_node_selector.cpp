@@ -19,7 +19,8 @@ NodeSelector parse_node_selector(const YamlCursor& c, double scale) {
     s.kind = NodeSelector::Kind::box;
     s.box_min = box->at("min").vec3() * scale;
     s.box_max = box->at("max").vec3() * scale;
-    if ((s.box_max.array() < s.box_min.array()).any()) box->at("max").fail("a corner not below min on any axis");
+    if ((s.box_max.array() < s.box_min.array()).any())
+      box->at("max").fail("a corner not below min on any axis");
     ++kinds;
   }
   if (auto plane = c.find("plane")) {

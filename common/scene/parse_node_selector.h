@@ -1,5 +1,5 @@
-// The scene file's node selectors (docs/scene-files.md, "Scene files": surface, box, plane or nodes),
-// validated with the scene loader's errors (file:line: key.path: expected ..., found ...).
+// The scene file's node selectors (docs/scene-files.md, "Scene files": surface, box, plane or
+// nodes), validated with the scene loader's errors (file:line: key.path: expected ..., found ...).
 #pragma once
 
 #include "common/mesh/node_selector.h"

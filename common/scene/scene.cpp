@@ -8,11 +8,12 @@ namespace cohaptic {
 
 const ElasticObjectSpec& single_elastic_object(const Scene& scene) {
   if (scene.objects.size() != 1)
-    throw Error(fmt::format("{}: {} objects; this works on a scene with one linear_elastic object", scene.file.string(),
-                            scene.objects.size()));
+    throw Error(fmt::format("{}: {} objects; this works on a scene with one linear_elastic object",
+                            scene.file.string(), scene.objects.size()));
   const auto* spec = std::get_if<ElasticObjectSpec>(&scene.objects.front().body);
-  if (!spec) throw Error(fmt::format("{}: object '{}' is not linear_elastic", scene.objects.front().where,
-                                     scene.objects.front().name));
+  if (!spec)
+    throw Error(fmt::format("{}: object '{}' is not linear_elastic", scene.objects.front().where,
+                            scene.objects.front().name));
   return *spec;
 }
 

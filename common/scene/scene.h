@@ -33,8 +33,10 @@ struct BoxMeshSpec {
   Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();  ///< [m]
   Eigen::Vector3d size = Eigen::Vector3d::Zero();        ///< [m]
   Eigen::Vector3i divisions = Eigen::Vector3i::Ones();
-  Eigen::Vector3d grading = Eigen::Vector3d::Ones();     ///< per axis: each cell / the one before (box_mesher.h)
-  Eigen::Vector3i uniform_cells = Eigen::Vector3i::Zero();  ///< per axis: equal cells on the fine side first
+  Eigen::Vector3d grading =
+      Eigen::Vector3d::Ones();  ///< per axis: each cell / the one before (box_mesher.h)
+  Eigen::Vector3i uniform_cells =
+      Eigen::Vector3i::Zero();  ///< per axis: equal cells on the fine side first
 };
 
 /// Exactly one of a mesh file (.msh 2.2/4.1, resolved against the scene's directory), a
@@ -51,8 +53,9 @@ struct FixedRegion {
 };
 
 struct ComplianceSettings {
-  bool precompute_touchable = true;  ///< whole touchable block up front (small meshes) or per node on demand
-  bool disk_cache = true;            ///< persist computed columns, keyed by a content hash
+  bool precompute_touchable =
+      true;                ///< whole touchable block up front (small meshes) or per node on demand
+  bool disk_cache = true;  ///< persist computed columns, keyed by a content hash
 };
 
 /// `model: linear_elastic`: a solid of linear elastic tetrahedra, condensed for the haptic
@@ -61,14 +64,16 @@ struct ElasticObjectSpec {
   MeshSpec mesh;
   LinearElasticMaterial material;
   std::vector<FixedRegion> fixed;
-  std::vector<NodeSelector> touchable;  ///< surface nodes a tool may press; triangles with all three
+  std::vector<NodeSelector>
+      touchable;  ///< surface nodes a tool may press; triangles with all three
   ComplianceSettings compliance;
 };
 
 /// One alternative per body model a scene may ask for (`model:` in the file). Adding a
 /// model adds an alternative here, and the compiler then names every place that must
 /// learn it (the compiled body, its simulation, its IR body).
-using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec, HomeSpringObjectSpec, SeparationObjectSpec>;
+using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec, HomeSpringObjectSpec,
+                              SeparationObjectSpec>;
 
 /// A deformable object of the scene: its name (unique in the scene) and its model's spec.
 struct ObjectSpec {
@@ -87,7 +92,7 @@ struct ObstacleSpec {
 struct ToolSpec {
   std::string name;
   ToolShape shape = ToolShape::point;
-  double radius = 0;  ///< [m], > 0 for a sphere
+  double radius = 0;                         ///< [m], > 0 for a sphere
   std::optional<InstrumentSpec> instrument;  ///< set exactly for probe and forceps
 };
 
@@ -122,9 +127,9 @@ struct InteractionSpec {
 };
 
 struct Scene {
-  std::filesystem::path file;   ///< where it was loaded from (empty if built in code)
+  std::filesystem::path file;  ///< where it was loaded from (empty if built in code)
   std::string name;
-  std::string units = "m";      ///< the length unit of the file
+  std::string units = "m";  ///< the length unit of the file
   double metres_per_unit = 1;
   std::vector<ObjectSpec> objects;  ///< at least one; the tools may press any of them
   std::vector<InteractionSpec> interactions;

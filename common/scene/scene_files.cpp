@@ -23,19 +23,24 @@ std::filesystem::path SceneFiles::resolve(const YamlCursor& at, const std::strin
   if (access.confined_to) {
     std::error_code error;
     const std::filesystem::path real = std::filesystem::weakly_canonical(resolved, error);
-    const std::filesystem::path folder = std::filesystem::weakly_canonical(*access.confined_to, error);
+    const std::filesystem::path folder =
+        std::filesystem::weakly_canonical(*access.confined_to, error);
     if (error || !is_inside(real, folder))
-      at.fail_message(fmt::format("{} {} is outside {}, the only folder this scene's files may be read from", what,
-                                  resolved.string(), access.confined_to->string()));
+      at.fail_message(
+          fmt::format("{} {} is outside {}, the only folder this scene's files may be read from",
+                      what, resolved.string(), access.confined_to->string()));
   }
-  if (const auto why = why_not_a_regular_file(resolved)) at.fail_message(fmt::format("{} {} {}", what, resolved.string(), *why));
+  if (const auto why = why_not_a_regular_file(resolved))
+    at.fail_message(fmt::format("{} {} {}", what, resolved.string(), *why));
   return resolved;
 }
 
 void SceneFiles::require_gmsh_allowed(const YamlCursor& at) const {
   if (!access.gmsh_scripts)
-    at.fail_message("a gmsh script, and gmsh reads whatever its script names: here only mesh files, surfaces and boxes "
-                    "are allowed");
+    at.fail_message(
+        "a gmsh script, and gmsh reads whatever its script names: here only mesh files, surfaces "
+        "and boxes "
+        "are allowed");
 }
 
 }  // namespace cohaptic

@@ -33,7 +33,8 @@ double LocalGrowth::total_room() const noexcept {
   return sum;
 }
 
-LocalGrowth local_growth_order(const SeparationPatch& patch, const SeparationState& state, const ContactRegion& region,
+LocalGrowth local_growth_order(const SeparationPatch& patch, const SeparationState& state,
+                               const ContactRegion& region,
                                const Eigen::Vector3d& origin) noexcept {
   // Work on a copy of the region's shares: filling one triangle may open its neighbours.
   std::array<double, ContactRegion::kCapacity> separated{};
@@ -67,8 +68,9 @@ LocalGrowth local_growth_order(const SeparationPatch& patch, const SeparationSta
   return order;
 }
 
-ContactAreas areas_after_growth(const SeparationPatch& patch, const SeparationState& state, const ContactPoint& contact,
-                                const LocalGrowth& order, double local, double far) noexcept {
+ContactAreas areas_after_growth(const SeparationPatch& patch, const SeparationState& state,
+                                const ContactPoint& contact, const LocalGrowth& order, double local,
+                                double far) noexcept {
   ContactAreas areas = contact_areas(patch, state, contact.triangle);
   const Triangle& nodes = patch.triangles[contact.triangle];
   double left = local;
@@ -77,21 +79,25 @@ ContactAreas areas_after_growth(const SeparationPatch& patch, const SeparationSt
     left -= added;
     for (int k = 0; k < 3; ++k)
       if (in_region_of(patch, nodes[k], order.triangles[i]))
-        areas.local_separated[k] = std::min(areas.local_separated[k] + added / patch.region_areas[nodes[k]], 1.0);
+        areas.local_separated[k] =
+            std::min(areas.local_separated[k] + added / patch.region_areas[nodes[k]], 1.0);
   }
-  areas.global_separated = std::min((state.separated_area + local + far) / patch.interface_area, 1.0);
+  areas.global_separated =
+      std::min((state.separated_area + local + far) / patch.interface_area, 1.0);
   return areas;
 }
 
-double apply_local_growth(const SeparationPatch& patch, SeparationState& state, const LocalGrowth& order,
-                          double amount) noexcept {
+double apply_local_growth(const SeparationPatch& patch, SeparationState& state,
+                          const LocalGrowth& order, double amount) noexcept {
   double done = 0;
   for (int i = 0; i < order.count && done < amount; ++i)
-    done += separate_in_triangle(patch, state, order.triangles[i], std::min(amount - done, order.room[i]));
+    done += separate_in_triangle(patch, state, order.triangles[i],
+                                 std::min(amount - done, order.room[i]));
   return done;
 }
 
-double front_room(const SeparationPatch& patch, const SeparationState& state, const ContactRegion* excluded) noexcept {
+double front_room(const SeparationPatch& patch, const SeparationState& state,
+                  const ContactRegion* excluded) noexcept {
   double room = 0;
   for (int t = 0; t < patch.triangle_count(); ++t)
     if (can_grow(patch, state, t) && !(excluded && excluded->contains(t)))
@@ -99,7 +105,8 @@ double front_room(const SeparationPatch& patch, const SeparationState& state, co
   return room;
 }
 
-double grow_nearest(const SeparationPatch& patch, SeparationState& state, const Eigen::Vector3d& origin, double amount,
+double grow_nearest(const SeparationPatch& patch, SeparationState& state,
+                    const Eigen::Vector3d& origin, double amount,
                     const ContactRegion* excluded) noexcept {
   double done = 0;
   // Each pass fills (or finishes the amount in) one triangle; bounded by the triangle count.

@@ -36,24 +36,27 @@ struct LocalGrowth {
   double total_room() const noexcept;
 };
 
-LocalGrowth local_growth_order(const SeparationPatch& patch, const SeparationState& state, const ContactRegion& region,
-                               const Eigen::Vector3d& origin) noexcept;
+LocalGrowth local_growth_order(const SeparationPatch& patch, const SeparationState& state,
+                               const ContactRegion& region, const Eigen::Vector3d& origin) noexcept;
 
 /// The contact's separated shares after `local` [m^2] of local growth and `far` of growth
 /// elsewhere, without changing the state.
-ContactAreas areas_after_growth(const SeparationPatch& patch, const SeparationState& state, const ContactPoint& contact,
-                                const LocalGrowth& order, double local, double far) noexcept;
+ContactAreas areas_after_growth(const SeparationPatch& patch, const SeparationState& state,
+                                const ContactPoint& contact, const LocalGrowth& order, double local,
+                                double far) noexcept;
 
 /// Separates `amount` along `order`; returns the area separated.
-double apply_local_growth(const SeparationPatch& patch, SeparationState& state, const LocalGrowth& order,
-                          double amount) noexcept;
+double apply_local_growth(const SeparationPatch& patch, SeparationState& state,
+                          const LocalGrowth& order, double amount) noexcept;
 
 /// Room at the front outside `excluded` (may be null) as it stands now [m^2].
-double front_room(const SeparationPatch& patch, const SeparationState& state, const ContactRegion* excluded) noexcept;
+double front_room(const SeparationPatch& patch, const SeparationState& state,
+                  const ContactRegion* excluded) noexcept;
 
 /// Separates up to `amount` at the front outside `excluded` (may be null), nearest
 /// `origin` first; returns the area separated.
-double grow_nearest(const SeparationPatch& patch, SeparationState& state, const Eigen::Vector3d& origin, double amount,
+double grow_nearest(const SeparationPatch& patch, SeparationState& state,
+                    const Eigen::Vector3d& origin, double amount,
                     const ContactRegion* excluded) noexcept;
 
 }  // namespace cohaptic

@@ -10,18 +10,23 @@
 
 namespace cohaptic {
 
-double opening_length(const SeparationPatch& patch, const Eigen::Vector3d& n, const Eigen::Vector3d& v) noexcept {
+double opening_length(const SeparationPatch& patch, const Eigen::Vector3d& n,
+                      const Eigen::Vector3d& v) noexcept {
   const double along_normal = v.dot(n);
-  return patch.normal_length * std::max(0.0, along_normal) + patch.tangential_length * (v - along_normal * n).norm();
+  return patch.normal_length * std::max(0.0, along_normal) +
+         patch.tangential_length * (v - along_normal * n).norm();
 }
 
-double opening_force(const Eigen::Vector3d& force, const Eigen::Vector3d& n, const Eigen::Vector3d& v) noexcept {
+double opening_force(const Eigen::Vector3d& force, const Eigen::Vector3d& n,
+                     const Eigen::Vector3d& v) noexcept {
   const double normal_force = force.dot(n), along_normal = v.dot(n);
-  return std::max(0.0, normal_force) * std::max(0.0, along_normal) + (force - normal_force * n).dot(v - along_normal * n);
+  return std::max(0.0, normal_force) * std::max(0.0, along_normal) +
+         (force - normal_force * n).dot(v - along_normal * n);
 }
 
-FractureStep fracture_step(const SeparationPatch& patch, SeparationState& state, const ContactPoint& contact,
-                           const Eigen::Vector3d& contact_position, const Eigen::Vector3d& delta_old,
+FractureStep fracture_step(const SeparationPatch& patch, SeparationState& state,
+                           const ContactPoint& contact, const Eigen::Vector3d& contact_position,
+                           const Eigen::Vector3d& delta_old,
                            const Eigen::Vector3d& delta_new) noexcept {
   FractureStep result;
   const Eigen::Vector3d move = delta_new - delta_old;
@@ -63,7 +68,9 @@ FractureStep fracture_step(const SeparationPatch& patch, SeparationState& state,
   // The opening force minus the threshold after `local` in the region and the rest of
   // `amount` elsewhere.
   const auto excess_after = [&](double local, double amount) {
-    return drive(areas_after_growth(patch, state, contact, order, local, amount - local), delta_new) - threshold;
+    return drive(areas_after_growth(patch, state, contact, order, local, amount - local),
+                 delta_new) -
+           threshold;
   };
   const auto least_local = [&](double amount) { return std::max(0.0, amount - far_room); };
   double amount = total;

@@ -35,10 +35,12 @@
 namespace cohaptic {
 
 /// l(v): the crack front a move along unit direction `v` opens, at interface normal `n` [m].
-double opening_length(const SeparationPatch& patch, const Eigen::Vector3d& n, const Eigen::Vector3d& v) noexcept;
+double opening_length(const SeparationPatch& patch, const Eigen::Vector3d& n,
+                      const Eigen::Vector3d& v) noexcept;
 
 /// f(v): the part of force F [N] that works to open the crack on a move along `v`.
-double opening_force(const Eigen::Vector3d& force, const Eigen::Vector3d& n, const Eigen::Vector3d& v) noexcept;
+double opening_force(const Eigen::Vector3d& force, const Eigen::Vector3d& n,
+                     const Eigen::Vector3d& v) noexcept;
 
 struct FractureStep {
   double separated = 0;        ///< area separated [m^2]
@@ -49,8 +51,9 @@ struct FractureStep {
   double threshold = 0;                                 ///< J_c l(v) [N]
 };
 
-FractureStep fracture_step(const SeparationPatch& patch, SeparationState& state, const ContactPoint& contact,
-                           const Eigen::Vector3d& contact_position, const Eigen::Vector3d& delta_old,
+FractureStep fracture_step(const SeparationPatch& patch, SeparationState& state,
+                           const ContactPoint& contact, const Eigen::Vector3d& contact_position,
+                           const Eigen::Vector3d& delta_old,
                            const Eigen::Vector3d& delta_new) noexcept;
 
 /// The shortest l_n for which a pull along the normal at `node` of a fully connected

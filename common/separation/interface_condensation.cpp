@@ -12,9 +12,11 @@
 namespace cohaptic {
 namespace {
 
-Eigen::MatrixXd body_interface_compliance(const SeparationBody& body, const std::vector<int>& nodes, const char* name) {
+Eigen::MatrixXd body_interface_compliance(const SeparationBody& body, const std::vector<int>& nodes,
+                                          const char* name) {
   const DofMap dofs = make_dof_map(body.fixed_axes);
-  const SparseMatrix k_ff = restrict_to_dofs(assemble_stiffness(body.mesh, body.material), dofs.free_dofs);
+  const SparseMatrix k_ff =
+      restrict_to_dofs(assemble_stiffness(body.mesh, body.material), dofs.free_dofs);
   try {
     const SparseCholesky factor(k_ff, [&](int row) {
       const int dof = dofs.free_dofs[row];
@@ -23,9 +25,10 @@ Eigen::MatrixXd body_interface_compliance(const SeparationBody& body, const std:
     ComplianceColumns columns(factor, dofs, nodes);
     return columns.gather(nodes);
   } catch (const NumericalError& e) {
-    throw NumericalError(fmt::format("separation: the {} body's stiffness is singular ({}); its supports must leave "
-                                     "it no rigid motion on its own",
-                                     name, e.what()));
+    throw NumericalError(
+        fmt::format("separation: the {} body's stiffness is singular ({}); its supports must leave "
+                    "it no rigid motion on its own",
+                    name, e.what()));
   }
 }
 
@@ -39,12 +42,15 @@ std::vector<int> dofs_of(std::span<const int> nodes) {
 
 Eigen::MatrixXd rows_of(const Eigen::MatrixXd& m, const std::vector<int>& rows) {
   Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
-  for (std::size_t i = 0; i < rows.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
   return out;
 }
 
-Eigen::MatrixXd block_of(const Eigen::MatrixXd& m, const std::vector<int>& rows, const std::vector<int>& cols) {
-  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(cols.size()));
+Eigen::MatrixXd block_of(const Eigen::MatrixXd& m, const std::vector<int>& rows,
+                         const std::vector<int>& cols) {
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()),
+                      static_cast<Eigen::Index>(cols.size()));
   for (std::size_t i = 0; i < rows.size(); ++i)
     for (std::size_t j = 0; j < cols.size(); ++j)
       out(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = m(rows[i], cols[j]);
@@ -53,17 +59,20 @@ Eigen::MatrixXd block_of(const Eigen::MatrixXd& m, const std::vector<int>& rows,
 
 }  // namespace
 
-InterfaceCompliance interface_compliance(const SeparationBodies& bodies, const SeparationInterface& interface) {
+InterfaceCompliance interface_compliance(const SeparationBodies& bodies,
+                                         const SeparationInterface& interface) {
   for (int k = 0; k < interface.node_count(); ++k)
     if (bodies.pulled.fixed_axes[interface.pulled_nodes[k]] != 0)
-      throw Error(fmt::format("separation: interface node {} of the pulled body is supported; the force fields need "
-                              "every interface node of the pulled body free",
-                              bodies.pulled.mesh.node_tags[interface.pulled_nodes[k]]));
+      throw Error(fmt::format(
+          "separation: interface node {} of the pulled body is supported; the force fields need "
+          "every interface node of the pulled body free",
+          bodies.pulled.mesh.node_tags[interface.pulled_nodes[k]]));
   const auto start = std::chrono::steady_clock::now();
   InterfaceCompliance compliance;
   compliance.pulled = body_interface_compliance(bodies.pulled, interface.pulled_nodes, "pulled");
   compliance.base = body_interface_compliance(bodies.base, interface.base_nodes, "base");
-  compliance.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  compliance.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return compliance;
 }
 
@@ -78,8 +87,8 @@ TiedInterface::TiedInterface(const InterfaceCompliance& compliance) : l1_(compli
   h_l1_ = h_ * l1_;
 }
 
-TiedInterface::FootprintCompliances TiedInterface::footprint_compliances(std::span<const int> footprint,
-                                                                        std::span<const int> released) const {
+TiedInterface::FootprintCompliances TiedInterface::footprint_compliances(
+    std::span<const int> footprint, std::span<const int> released) const {
   const std::vector<int> f = dofs_of(footprint);
   const std::vector<int> r = dofs_of(released);
   Eigen::MatrixXd v(l1_.rows(), static_cast<Eigen::Index>(f.size()));  // V = L1_:F
@@ -95,8 +104,12 @@ TiedInterface::FootprintCompliances TiedInterface::footprint_compliances(std::sp
   const Eigen::MatrixXd h_rr = block_of(h_, r, r);
   const Eigen::MatrixXd z = w_r - h_rr * v_r;
   const Eigen::MatrixXd released_tied =
-      r.empty() ? tied : Eigen::MatrixXd(tied - v_r.transpose() * w_r - z.transpose() * v_r - z.transpose() * h_rr.ldlt().solve(z));
-  const auto symmetric = [](const Eigen::MatrixXd& m) { return Eigen::MatrixXd(0.5 * (m + m.transpose())); };
+      r.empty() ? tied
+                : Eigen::MatrixXd(tied - v_r.transpose() * w_r - z.transpose() * v_r -
+                                  z.transpose() * h_rr.ldlt().solve(z));
+  const auto symmetric = [](const Eigen::MatrixXd& m) {
+    return Eigen::MatrixXd(0.5 * (m + m.transpose()));
+  };
   FootprintCompliances c;
   c.separated = block_of(l1_, f, f);
   c.connected = symmetric(c.separated - tied);
@@ -109,7 +122,8 @@ Eigen::Matrix3d rigid_footprint_stiffness(const Eigen::MatrixXd& footprint_compl
   Eigen::MatrixXd e(footprint_compliance.rows(), 3);
   for (Eigen::Index i = 0; i < count; ++i) e.middleRows<3>(3 * i).setIdentity();
   const Eigen::LLT<Eigen::MatrixXd> llt(footprint_compliance);
-  if (llt.info() != Eigen::Success) throw NumericalError("separation: a footprint's compliance is not positive definite");
+  if (llt.info() != Eigen::Success)
+    throw NumericalError("separation: a footprint's compliance is not positive definite");
   const Eigen::Matrix3d k = e.transpose() * llt.solve(e);
   return 0.5 * (k + k.transpose());
 }

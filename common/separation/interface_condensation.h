@@ -29,7 +29,8 @@ struct InterfaceCompliance {
 
 /// Throws Error if an interface node of the pulled body is supported (the fields need it
 /// free), NumericalError (naming the body) if a body's supports leave it a rigid motion.
-InterfaceCompliance interface_compliance(const SeparationBodies& bodies, const SeparationInterface& interface);
+InterfaceCompliance interface_compliance(const SeparationBodies& bodies,
+                                         const SeparationInterface& interface);
 
 class TiedInterface {
  public:
@@ -44,7 +45,8 @@ class TiedInterface {
     Eigen::MatrixXd locally_separated;  ///< every pair tied but `released`
     Eigen::MatrixXd separated;          ///< no pair tied
   };
-  FootprintCompliances footprint_compliances(std::span<const int> footprint, std::span<const int> released) const;
+  FootprintCompliances footprint_compliances(std::span<const int> footprint,
+                                             std::span<const int> released) const;
 
  private:
   const Eigen::MatrixXd& l1_;

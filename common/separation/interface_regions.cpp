@@ -18,20 +18,24 @@ NodeRegions node_regions(const std::vector<Triangle>& triangles, int node_count)
   return regions;
 }
 
-Eigen::Vector3d region_normal(const Eigen::Matrix3Xd& positions, const std::vector<Triangle>& triangles,
-                              std::span<const int> region) {
+Eigen::Vector3d region_normal(const Eigen::Matrix3Xd& positions,
+                              const std::vector<Triangle>& triangles, std::span<const int> region) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (int t : region) {
     const Triangle& tri = triangles[t];
     const Eigen::Vector3d a = positions.col(tri[0]);
-    sum += (positions.col(tri[1]) - a).cross(positions.col(tri[2]) - a);  // twice the area along the normal
+    sum += (positions.col(tri[1]) - a)
+               .cross(positions.col(tri[2]) - a);  // twice the area along the normal
   }
   return sum.normalized();
 }
 
-std::vector<int> nodes_released_with(const NodeRegions& regions, const std::vector<Triangle>& triangles, int node) {
+std::vector<int> nodes_released_with(const NodeRegions& regions,
+                                     const std::vector<Triangle>& triangles, int node) {
   const std::span<const int> released = regions.of(node);
-  const auto is_released = [&](int t) { return std::binary_search(released.begin(), released.end(), t); };
+  const auto is_released = [&](int t) {
+    return std::binary_search(released.begin(), released.end(), t);
+  };
   std::vector<int> nodes;
   for (int t : released)
     for (int candidate : triangles[t]) {

@@ -29,10 +29,11 @@ NodeRegions node_regions(const std::vector<Triangle>& triangles, int node_count)
 
 /// The unit normal of a region: the area-weighted mean of its triangles' normals
 /// ((p1 - p0) x (p2 - p0) directions).
-Eigen::Vector3d region_normal(const Eigen::Matrix3Xd& positions, const std::vector<Triangle>& triangles,
-                              std::span<const int> region);
+Eigen::Vector3d region_normal(const Eigen::Matrix3Xd& positions,
+                              const std::vector<Triangle>& triangles, std::span<const int> region);
 
 /// The nodes left without a connected triangle when the triangles of D_node are released.
-std::vector<int> nodes_released_with(const NodeRegions& regions, const std::vector<Triangle>& triangles, int node);
+std::vector<int> nodes_released_with(const NodeRegions& regions,
+                                     const std::vector<Triangle>& triangles, int node);
 
 }  // namespace cohaptic

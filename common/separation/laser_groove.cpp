@@ -16,14 +16,16 @@ struct Polygon {
 };
 
 // The part of `polygon` where (p - origin) . normal <= 0 (Sutherland–Hodgman, one edge).
-Polygon clip(const Polygon& polygon, const Eigen::Vector2d& origin, const Eigen::Vector2d& normal) noexcept {
+Polygon clip(const Polygon& polygon, const Eigen::Vector2d& origin,
+             const Eigen::Vector2d& normal) noexcept {
   Polygon out;
   for (int i = 0; i < polygon.count; ++i) {
     const Eigen::Vector2d& p = polygon.corners[i];
     const Eigen::Vector2d& q = polygon.corners[(i + 1) % polygon.count];
     const double dp = (p - origin).dot(normal), dq = (q - origin).dot(normal);
     if (dp <= 0) out.corners[out.count++] = p;
-    if ((dp < 0 && dq > 0) || (dp > 0 && dq < 0)) out.corners[out.count++] = p + dp / (dp - dq) * (q - p);
+    if ((dp < 0 && dq > 0) || (dp > 0 && dq < 0))
+      out.corners[out.count++] = p + dp / (dp - dq) * (q - p);
   }
   return out;
 }
@@ -40,20 +42,23 @@ double polygon_area(const Polygon& polygon) noexcept {
 
 }  // namespace
 
-double strip_area_in_triangle(const SeparationPatch& patch, int t, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                              double width) noexcept {
+double strip_area_in_triangle(const SeparationPatch& patch, int t, const Eigen::Vector3d& a,
+                              const Eigen::Vector3d& b, double width) noexcept {
   const Triangle& tri = patch.triangles[t];
   const Eigen::Vector3d origin = patch.positions.col(tri[0]);
   const Eigen::Vector3d e1 = (patch.positions.col(tri[1]) - origin).normalized();
   const Eigen::Vector3d e2 = patch.normals[t].cross(e1);
-  const auto in_plane = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d((p - origin).dot(e1), (p - origin).dot(e2)); };
+  const auto in_plane = [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector2d((p - origin).dot(e1), (p - origin).dot(e2));
+  };
   const Eigen::Vector2d pa = in_plane(a), pb = in_plane(b);
   const double length = (pb - pa).norm();
   if (!(length > 0)) return 0;
   const Eigen::Vector2d along = (pb - pa) / length;
   const Eigen::Vector2d across(-along.y(), along.x());
   Polygon polygon;
-  for (int k = 0; k < 3; ++k) polygon.corners[polygon.count++] = in_plane(patch.positions.col(tri[k]));
+  for (int k = 0; k < 3; ++k)
+    polygon.corners[polygon.count++] = in_plane(patch.positions.col(tri[k]));
   polygon = clip(polygon, pa, -along);
   polygon = clip(polygon, pb, along);
   polygon = clip(polygon, pa + 0.5 * width * across, across);
@@ -61,8 +66,8 @@ double strip_area_in_triangle(const SeparationPatch& patch, int t, const Eigen::
   return polygon.count >= 3 ? polygon_area(polygon) : 0.0;
 }
 
-LaserSample step_laser(const SeparationPatch& patch, SeparationState& state, LaserFibre& fibre, const Eigen::Vector3d& tip,
-                       bool on, double dt) noexcept {
+LaserSample step_laser(const SeparationPatch& patch, SeparationState& state, LaserFibre& fibre,
+                       const Eigen::Vector3d& tip, bool on, double dt) noexcept {
   LaserSample sample;
   if (!on || !tip.allFinite() || !(dt > 0)) {
     fibre.firing = false;
@@ -93,9 +98,11 @@ LaserSample step_laser(const SeparationPatch& patch, SeparationState& state, Las
     if ((tri_hi.array() < lo.array()).any() || (tri_lo.array() > hi.array()).any()) continue;
     const Eigen::Vector3d n = patch.normals[t];
     const Eigen::Vector3d corner = patch.positions.col(tri[0]);
-    if (std::abs((from - corner).dot(n)) > patch.laser_reach || std::abs((tip - corner).dot(n)) > patch.laser_reach)
+    if (std::abs((from - corner).dot(n)) > patch.laser_reach ||
+        std::abs((tip - corner).dot(n)) > patch.laser_reach)
       continue;
-    sample.vaporised += separate_in_triangle(patch, state, t, strip_area_in_triangle(patch, t, from, tip, width));
+    sample.vaporised +=
+        separate_in_triangle(patch, state, t, strip_area_in_triangle(patch, t, from, tip, width));
   }
   sample.vaporising = sample.vaporised > 0;
   return sample;

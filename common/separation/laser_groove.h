@@ -31,12 +31,12 @@ struct LaserSample {
 };
 
 /// One tick of length dt [s] with the fibre's tip at `tip` and the laser `on`.
-LaserSample step_laser(const SeparationPatch& patch, SeparationState& state, LaserFibre& fibre, const Eigen::Vector3d& tip,
-                       bool on, double dt) noexcept;
+LaserSample step_laser(const SeparationPatch& patch, SeparationState& state, LaserFibre& fibre,
+                       const Eigen::Vector3d& tip, bool on, double dt) noexcept;
 
 /// The area of triangle t covered by the strip of `width` along segment a-b, both
 /// projected on the triangle's plane [m^2].
-double strip_area_in_triangle(const SeparationPatch& patch, int t, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                              double width) noexcept;
+double strip_area_in_triangle(const SeparationPatch& patch, int t, const Eigen::Vector3d& a,
+                              const Eigen::Vector3d& b, double width) noexcept;
 
 }  // namespace cohaptic

@@ -10,14 +10,15 @@ constexpr int kMaxCrossings = 256;
 
 Eigen::Vector3d point_at(const SeparationPatch& patch, int t, const Eigen::Vector3d& w) noexcept {
   const Triangle& tri = patch.triangles[t];
-  return w[0] * patch.positions.col(tri[0]) + w[1] * patch.positions.col(tri[1]) + w[2] * patch.positions.col(tri[2]);
+  return w[0] * patch.positions.col(tri[0]) + w[1] * patch.positions.col(tri[1]) +
+         w[2] * patch.positions.col(tri[2]);
 }
 
 }  // namespace
 
 PatchWalk walk_on_patch(const SeparationPatch& patch, const SeparationState& state, int triangle,
-                        const Eigen::Vector3d& weights, const Eigen::Vector3d& direction, double distance,
-                        bool stop_at_crack_edges) noexcept {
+                        const Eigen::Vector3d& weights, const Eigen::Vector3d& direction,
+                        double distance, bool stop_at_crack_edges) noexcept {
   PatchWalk walk;
   walk.triangle = triangle;
   walk.weights = weights;
@@ -30,7 +31,8 @@ PatchWalk walk_on_patch(const SeparationPatch& patch, const SeparationState& sta
     d.normalize();
     // d = u e1 + v e2 in the triangle's plane, so the area coordinates change at (-u-v, u, v).
     const Eigen::Vector3d a = patch.positions.col(tri[0]);
-    const Eigen::Vector3d e1 = patch.positions.col(tri[1]) - a, e2 = patch.positions.col(tri[2]) - a;
+    const Eigen::Vector3d e1 = patch.positions.col(tri[1]) - a,
+                          e2 = patch.positions.col(tri[2]) - a;
     const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
     const double det = g11 * g22 - g12 * g12;
     if (!(det > 0)) break;

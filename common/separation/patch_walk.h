@@ -24,7 +24,7 @@ struct PatchWalk {
 /// Walks `distance` from the point with area coordinates `weights` on `triangle`, along
 /// `direction` projected on each triangle's plane.
 PatchWalk walk_on_patch(const SeparationPatch& patch, const SeparationState& state, int triangle,
-                        const Eigen::Vector3d& weights, const Eigen::Vector3d& direction, double distance,
-                        bool stop_at_crack_edges) noexcept;
+                        const Eigen::Vector3d& weights, const Eigen::Vector3d& direction,
+                        double distance, bool stop_at_crack_edges) noexcept;
 
 }  // namespace cohaptic

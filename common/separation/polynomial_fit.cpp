@@ -10,7 +10,8 @@
 
 namespace cohaptic {
 
-std::vector<double> fit_polynomial_through_origin(std::span<const double> s, std::span<const double> f, int degree) {
+std::vector<double> fit_polynomial_through_origin(std::span<const double> s,
+                                                  std::span<const double> f, int degree) {
   if (degree < 1) throw Error(fmt::format("polynomial fit: degree must be >= 1, got {}", degree));
   if (s.size() != f.size())
     throw Error(fmt::format("polynomial fit: {} abscissae but {} values", s.size(), f.size()));
@@ -23,11 +24,13 @@ std::vector<double> fit_polynomial_through_origin(std::span<const double> s, std
   std::vector<double> distinct;  // non-zero at the scale of the samples
   for (double x : s)
     if (std::abs(x) > 1e-12 * scale &&
-        std::none_of(distinct.begin(), distinct.end(), [&](double d) { return std::abs(d - x) <= 1e-12 * scale; }))
+        std::none_of(distinct.begin(), distinct.end(),
+                     [&](double d) { return std::abs(d - x) <= 1e-12 * scale; }))
       distinct.push_back(x);
   if (static_cast<int>(distinct.size()) < degree)
-    throw Error(fmt::format("polynomial fit: degree {} needs at least {} distinct non-zero samples, got {}", degree,
-                            degree, distinct.size()));
+    throw Error(
+        fmt::format("polynomial fit: degree {} needs at least {} distinct non-zero samples, got {}",
+                    degree, degree, distinct.size()));
   const auto rows = static_cast<Eigen::Index>(s.size());
   Eigen::MatrixXd vandermonde(rows, degree);
   Eigen::VectorXd values(rows);
@@ -62,7 +65,8 @@ double polynomial_integral(const double* c, int degree, double s) noexcept {
 std::vector<double> chebyshev_abscissae(int count, double half_range) {
   std::vector<double> s(static_cast<std::size_t>(std::max(count, 0)));
   for (int i = 0; i < count; ++i)
-    s[static_cast<std::size_t>(i)] = half_range * std::cos((2 * i + 1) * std::numbers::pi / (2 * count));
+    s[static_cast<std::size_t>(i)] =
+        half_range * std::cos((2 * i + 1) * std::numbers::pi / (2 * count));
   if (count % 2 == 1) s[static_cast<std::size_t>(count / 2)] = 0;  // exactly, not cos(pi / 2)
   return s;
 }

@@ -14,7 +14,8 @@ namespace cohaptic {
 
 /// c_1..c_d. Throws Error if degree < 1, the spans differ in length, a value is not
 /// finite, or fewer than `degree` distinct non-zero abscissae are given.
-std::vector<double> fit_polynomial_through_origin(std::span<const double> s, std::span<const double> f, int degree);
+std::vector<double> fit_polynomial_through_origin(std::span<const double> s,
+                                                  std::span<const double> f, int degree);
 
 /// f(s) by Horner's rule; `c` holds c_1..c_degree.
 double polynomial_value(const double* c, int degree, double s) noexcept;

@@ -7,9 +7,9 @@
 // Phases: AB, loading up to point B, where the force first meets the fracture threshold (a
 // sample is inserted there, inside the tick that crossed it); BC, from B to the turn (the
 // tick that reaches C is redone in 32 sub-ticks and the loop turns at the first that does),
-// so that BC starts and ends at B and C whatever the tick; CA, the way back. Works (trapezoidal over the samples, F . dx, F the force on the pulled
-// body) are what the hand does on the tissue: net_work >= 0 means the loop took energy
-// from the hand (passive). Units: m, s, N, J, m^2.
+// so that BC starts and ends at B and C whatever the tick; CA, the way back. Works (trapezoidal
+// over the samples, F . dx, F the force on the pulled body) are what the hand does on the tissue:
+// net_work >= 0 means the loop took energy from the hand (passive). Units: m, s, N, J, m^2.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,7 +20,7 @@
 namespace cohaptic {
 
 struct PullLoopSettings {
-  int node = 0;                                        ///< interface node held
+  int node = 0;                                         ///< interface node held
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  ///< unit; zero: the node's normal
   double speed = 0.01;                                  ///< [m/s]
   double tick = 1e-3;                                   ///< [s]
@@ -42,17 +42,18 @@ struct PullLoopSample {
 
 struct PullLoop {
   std::vector<PullLoopSample> samples;
-  double threshold = 0;          ///< J_c l(direction): F_n = J_c l_n for a normal pull [N]
-  double fracture_work = 0;      ///< the hand's work over BC [J]
-  double fracture_area = 0;      ///< area separated over BC [m^2]
-  double fracture_travel = 0;    ///< normal travel over BC [m]
-  double net_work = 0;           ///< over the whole loop [J]
-  double turn_travel = 0;        ///< where it turned back [m]
-  double final_energy = 0;       ///< the fields' potential at the end [J] (c may have moved)
+  double threshold = 0;        ///< J_c l(direction): F_n = J_c l_n for a normal pull [N]
+  double fracture_work = 0;    ///< the hand's work over BC [J]
+  double fracture_area = 0;    ///< area separated over BC [m^2]
+  double fracture_travel = 0;  ///< normal travel over BC [m]
+  double net_work = 0;         ///< over the whole loop [J]
+  double turn_travel = 0;      ///< where it turned back [m]
+  double final_energy = 0;     ///< the fields' potential at the end [J] (c may have moved)
 };
 
 /// Throws Error for a node out of range or a non-positive speed, tick or max_travel.
-PullLoop run_pull_loop(const SeparationPatch& patch, const SeparationState& initial, const PullLoopSettings& settings);
+PullLoop run_pull_loop(const SeparationPatch& patch, const SeparationState& initial,
+                       const PullLoopSettings& settings);
 
 /// Where a tool holding interface node `node` touches: c on the node's first triangle.
 ContactPoint contact_at_node(const SeparationPatch& patch, int node);

@@ -14,7 +14,9 @@ LinePlot pull_loop_force_plot(const PullLoop& loop) {
   double largest = 0;
   const PullLoopSample* previous = nullptr;
   for (const PullLoopSample& s : loop.samples) {
-    Series& series = plot.series[s.phase == PullPhase::loading ? 0 : s.phase == PullPhase::fracture ? 1 : 2];
+    Series& series = plot.series[s.phase == PullPhase::loading    ? 0
+                                 : s.phase == PullPhase::fracture ? 1
+                                                                  : 2];
     if (series.x.empty() && previous) {  // join the phases
       series.x.push_back(1e3 * previous->travel);
       series.y.push_back(previous->force);
@@ -24,7 +26,8 @@ LinePlot pull_loop_force_plot(const PullLoop& loop) {
     largest = std::max(largest, s.travel);
     previous = &s;
   }
-  plot.series.push_back(Series{"J_c l", {0.0, 1e3 * largest}, {loop.threshold, loop.threshold}, "#7f7f7f", false});
+  plot.series.push_back(
+      Series{"J_c l", {0.0, 1e3 * largest}, {loop.threshold, loop.threshold}, "#7f7f7f", false});
   return plot;
 }
 

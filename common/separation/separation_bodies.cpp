@@ -11,7 +11,8 @@
 namespace cohaptic {
 
 SeparationInterface find_interface(const SeparationBodies& bodies, double tolerance) {
-  if (!(tolerance > 0)) throw Error(fmt::format("separation interface: tolerance must be positive, got {}", tolerance));
+  if (!(tolerance > 0))
+    throw Error(fmt::format("separation interface: tolerance must be positive, got {}", tolerance));
   const TetMesh& pulled = bodies.pulled.mesh;
   const TetMesh& base = bodies.base.mesh;
   const BoundarySurface pulled_surface = extract_boundary_surface(pulled);
@@ -19,7 +20,8 @@ SeparationInterface find_interface(const SeparationBodies& bodies, double tolera
 
   // Base boundary nodes sorted by x: each pulled node searches a window of width 2 tolerance.
   std::vector<int> base_by_x = base_surface.nodes;
-  std::sort(base_by_x.begin(), base_by_x.end(), [&](int a, int b) { return base.nodes(0, a) < base.nodes(0, b); });
+  std::sort(base_by_x.begin(), base_by_x.end(),
+            [&](int a, int b) { return base.nodes(0, a) < base.nodes(0, b); });
   std::vector<int> partner(static_cast<std::size_t>(pulled.node_count()), -1);
   for (int node : pulled_surface.nodes) {
     const Eigen::Vector3d p = pulled.nodes.col(node);
@@ -28,9 +30,9 @@ SeparationInterface find_interface(const SeparationBodies& bodies, double tolera
     for (; it != base_by_x.end() && base.nodes(0, *it) <= p.x() + tolerance; ++it) {
       if ((base.nodes.col(*it) - p).norm() > tolerance) continue;
       if (partner[node] >= 0)
-        throw Error(fmt::format("separation interface: pulled node {} has two base nodes ({} and {}) within {} m",
-                                pulled.node_tags[node], base.node_tags[partner[node]], base.node_tags[*it],
-                                tolerance));
+        throw Error(fmt::format(
+            "separation interface: pulled node {} has two base nodes ({} and {}) within {} m",
+            pulled.node_tags[node], base.node_tags[partner[node]], base.node_tags[*it], tolerance));
       partner[node] = *it;
     }
   }
@@ -63,43 +65,51 @@ SeparationInterface find_interface(const SeparationBodies& bodies, double tolera
     interface.triangles.push_back({local[0], local[2], local[1]});
   }
   if (interface.triangles.empty())
-    throw Error(fmt::format("separation interface: the bodies share no boundary triangle within {} m", tolerance));
+    throw Error(fmt::format(
+        "separation interface: the bodies share no boundary triangle within {} m", tolerance));
 
   interface.positions.resize(3, interface.node_count());
-  for (int k = 0; k < interface.node_count(); ++k) interface.positions.col(k) = pulled.nodes.col(interface.pulled_nodes[k]);
+  for (int k = 0; k < interface.node_count(); ++k)
+    interface.positions.col(k) = pulled.nodes.col(interface.pulled_nodes[k]);
   interface.neighbours = triangle_edge_neighbours(interface.triangles);
   interface.open_rim.assign(interface.triangles.size(), 0);
   for (int t = 0; t < interface.triangle_count(); ++t)
     for (int k = 0; k < 3; ++k)
-      if (interface.neighbours[t][k] < 0) interface.open_rim[t] |= static_cast<std::uint8_t>(1u << k);
+      if (interface.neighbours[t][k] < 0)
+        interface.open_rim[t] |= static_cast<std::uint8_t>(1u << k);
   return interface;
 }
 
-void seal_rim_edges(SeparationInterface& interface, const std::function<bool(const Eigen::Vector3d&)>& sealed) {
+void seal_rim_edges(SeparationInterface& interface,
+                    const std::function<bool(const Eigen::Vector3d&)>& sealed) {
   for (int t = 0; t < interface.triangle_count(); ++t)
     for (int k = 0; k < 3; ++k) {
       if ((interface.open_rim[t] >> k & 1u) == 0) continue;
       const Triangle& tri = interface.triangles[t];
-      const Eigen::Vector3d midpoint = 0.5 * (interface.positions.col(tri[k]) + interface.positions.col(tri[(k + 1) % 3]));
+      const Eigen::Vector3d midpoint =
+          0.5 * (interface.positions.col(tri[k]) + interface.positions.col(tri[(k + 1) % 3]));
       if (sealed(midpoint)) interface.open_rim[t] &= static_cast<std::uint8_t>(~(1u << k));
     }
 }
 
 SeparationBodies make_two_layer_boxes(const TwoLayerBoxes& boxes) {
   if (boxes.pulled_layers < 1 || boxes.base_layers < 1)
-    throw Error(fmt::format("two-layer boxes: layers must be >= 1, got pulled {} and base {}", boxes.pulled_layers,
-                            boxes.base_layers));
+    throw Error(fmt::format("two-layer boxes: layers must be >= 1, got pulled {} and base {}",
+                            boxes.pulled_layers, boxes.base_layers));
   if (!(boxes.pulled_thickness > 0) || !(boxes.base_thickness > 0))
-    throw Error(fmt::format("two-layer boxes: thicknesses must be positive, got pulled {} m and base {} m",
-                            boxes.pulled_thickness, boxes.base_thickness));
+    throw Error(
+        fmt::format("two-layer boxes: thicknesses must be positive, got pulled {} m and base {} m",
+                    boxes.pulled_thickness, boxes.base_thickness));
   validate(boxes.pulled_material);
   validate(boxes.base_material);
   const double a = boxes.size.x(), b = boxes.size.y();
   SeparationBodies bodies;
-  bodies.pulled.mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(a, b, boxes.pulled_thickness),
-                                     Eigen::Vector3i(boxes.divisions.x(), boxes.divisions.y(), boxes.pulled_layers));
-  bodies.base.mesh = make_box_mesh(Eigen::Vector3d(0, 0, -boxes.base_thickness), Eigen::Vector3d(a, b, boxes.base_thickness),
-                                   Eigen::Vector3i(boxes.divisions.x(), boxes.divisions.y(), boxes.base_layers));
+  bodies.pulled.mesh =
+      make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d(a, b, boxes.pulled_thickness),
+                    Eigen::Vector3i(boxes.divisions.x(), boxes.divisions.y(), boxes.pulled_layers));
+  bodies.base.mesh = make_box_mesh(
+      Eigen::Vector3d(0, 0, -boxes.base_thickness), Eigen::Vector3d(a, b, boxes.base_thickness),
+      Eigen::Vector3i(boxes.divisions.x(), boxes.divisions.y(), boxes.base_layers));
   bodies.pulled.material = boxes.pulled_material;
   bodies.base.material = boxes.base_material;
 
@@ -111,7 +121,8 @@ SeparationBodies make_two_layer_boxes(const TwoLayerBoxes& boxes) {
   }
   bodies.base.fixed_axes.assign(static_cast<std::size_t>(bodies.base.mesh.node_count()), 0);
   for (int n = 0; n < bodies.base.mesh.node_count(); ++n)
-    if (bodies.base.mesh.nodes(2, n) < -boxes.base_thickness + on_face) bodies.base.fixed_axes[n] = kAllAxes;
+    if (bodies.base.mesh.nodes(2, n) < -boxes.base_thickness + on_face)
+      bodies.base.fixed_axes[n] = kAllAxes;
   return bodies;
 }
 

@@ -54,7 +54,8 @@ struct SeparationInterface {
 SeparationInterface find_interface(const SeparationBodies& bodies, double tolerance);
 
 /// Closes the rim edges whose midpoint satisfies `sealed` (where the layers go on).
-void seal_rim_edges(SeparationInterface& interface, const std::function<bool(const Eigen::Vector3d&)>& sealed);
+void seal_rim_edges(SeparationInterface& interface,
+                    const std::function<bool(const Eigen::Vector3d&)>& sealed);
 
 /// Two stacked boxes: the base [0, a] x [0, b] x [-base_thickness, 0] and the pulled
 /// layer [0, a] x [0, b] x [0, pulled_thickness], with the same divisions in x and y so

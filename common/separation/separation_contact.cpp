@@ -15,8 +15,8 @@ struct Evaluation {
   Eigen::Vector3d tangential = Eigen::Vector3d::Zero();  ///< F - (F . n) n
 };
 
-Evaluation evaluate(const SeparationPatch& patch, const SeparationState& state, const SeparationContact& contact,
-                    const Eigen::Vector3d& tool) noexcept {
+Evaluation evaluate(const SeparationPatch& patch, const SeparationState& state,
+                    const SeparationContact& contact, const Eigen::Vector3d& tool) noexcept {
   Evaluation e;
   e.value = contact_field(patch, contact.point, contact_areas(patch, state, contact.point.triangle),
                           contact_deflection(contact, tool));
@@ -46,8 +46,9 @@ struct Slide {
 // towards stiffer nodes at the same deflection): the slip is cut short where the energy
 // would rise above its value before it, so that a slip never feeds the hand.
 template <typename Excess>
-Slide slide_until(const SeparationPatch& patch, const SeparationState& state, const SeparationContact& contact,
-                  const Eigen::Vector3d& tool, bool stop_at_crack_edges, const Excess& excess) noexcept {
+Slide slide_until(const SeparationPatch& patch, const SeparationState& state,
+                  const SeparationContact& contact, const Eigen::Vector3d& tool,
+                  bool stop_at_crack_edges, const Excess& excess) noexcept {
   Slide slide{contact, PatchWalk{}};
   slide.walk.triangle = contact.point.triangle;
   slide.walk.weights = contact.point.weights;
@@ -58,34 +59,38 @@ Slide slide_until(const SeparationPatch& patch, const SeparationState& state, co
   if (!(tangential > 0) || !(start_excess > 0)) return slide;
   const Eigen::Vector3d direction = start.tangential / tangential;
   const auto walk = [&](double distance) {
-    return walk_on_patch(patch, state, contact.point.triangle, contact.point.weights, direction, distance,
-                         stop_at_crack_edges);
+    return walk_on_patch(patch, state, contact.point.triangle, contact.point.weights, direction,
+                         distance, stop_at_crack_edges);
   };
   const auto along_at = [&](const PatchWalk& w) {
     return evaluate(patch, state, moved_to(contact, w), tool).tangential.dot(direction);
   };
-  const auto excess_at = [&](const PatchWalk& w) { return excess(evaluate(patch, state, moved_to(contact, w), tool)); };
+  const auto excess_at = [&](const PatchWalk& w) {
+    return excess(evaluate(patch, state, moved_to(contact, w), tool));
+  };
   // How far F_t . d stays positive: from the deflection's own length, doubled a few times.
   const Eigen::Vector3d n = patch.normals[contact.point.triangle];
   const Eigen::Vector3d delta = contact_deflection(contact, tool);
   double distance = std::max((delta - delta.dot(n) * n).norm(), 1e-9);
   PatchWalk end = walk(distance);
-  for (int doubling = 0; doubling < 8 && end.stop == PatchWalk::Stop::none && along_at(end) > 0; ++doubling)
+  for (int doubling = 0; doubling < 8 && end.stop == PatchWalk::Stop::none && along_at(end) > 0;
+       ++doubling)
     end = walk(distance *= 2);
   double along_end = along_at(end);
   if (along_end < 0) {
-    end = walk(bracketed_root([&](double s) { return along_at(walk(s)); }, 0.0, end.travelled, tangential, along_end,
-                              1e-12 * tangential));
+    end = walk(bracketed_root([&](double s) { return along_at(walk(s)); }, 0.0, end.travelled,
+                              tangential, along_end, 1e-12 * tangential));
   }
   const double end_excess = excess_at(end);
   double length = end.travelled;
   if (end_excess < 0)
-    length = bracketed_root([&](double s) { return excess_at(walk(s)); }, 0.0, end.travelled, start_excess, end_excess,
-                            1e-12 * start_excess);
+    length = bracketed_root([&](double s) { return excess_at(walk(s)); }, 0.0, end.travelled,
+                            start_excess, end_excess, 1e-12 * start_excess);
   // The energy guard: the last of 16 even steps up to `length` whose energy is no higher
   // than at the start, then the crossing between it and the next step.
   const auto energy_rise = [&](double s) {
-    return evaluate(patch, state, moved_to(contact, walk(s)), tool).value.energy - start.value.energy;
+    return evaluate(patch, state, moved_to(contact, walk(s)), tool).value.energy -
+           start.value.energy;
   };
   constexpr int kSteps = 16;
   double allowed = 0;
@@ -93,7 +98,8 @@ Slide slide_until(const SeparationPatch& patch, const SeparationState& state, co
     const double s = length * i / kSteps;
     const double rise = energy_rise(s);
     if (rise > 0) {
-      allowed = bracketed_root(energy_rise, allowed, s, energy_rise(allowed), rise, 1e-12 * std::abs(start.value.energy));
+      allowed = bracketed_root(energy_rise, allowed, s, energy_rise(allowed), rise,
+                               1e-12 * std::abs(start.value.energy));
       if (energy_rise(allowed) > 0) allowed = length * (i - 1) / kSteps;
       break;
     }
@@ -106,10 +112,11 @@ Slide slide_until(const SeparationPatch& patch, const SeparationState& state, co
 
 }  // namespace
 
-SeparationContact begin_contact(const SeparationPatch& patch, ContactMode mode, const ContactPoint& point,
-                                const Eigen::Vector3d& tool) noexcept {
+SeparationContact begin_contact(const SeparationPatch& patch, ContactMode mode,
+                                const ContactPoint& point, const Eigen::Vector3d& tool) noexcept {
   SeparationContact contact;
-  if (point.triangle < 0 || point.triangle >= patch.triangle_count() || !tool.allFinite()) return contact;
+  if (point.triangle < 0 || point.triangle >= patch.triangle_count() || !tool.allFinite())
+    return contact;
   for (int j : point.tool_nodes)
     if (j < 0 || j >= patch.tool_node_count) return contact;
   const auto valid_weights = [](const Eigen::Vector3d& w) {
@@ -119,15 +126,16 @@ SeparationContact begin_contact(const SeparationPatch& patch, ContactMode mode, 
   const Triangle& tri = patch.triangles[point.triangle];
   contact.mode = mode;
   contact.point = point;
-  contact.position = point.weights[0] * patch.positions.col(tri[0]) + point.weights[1] * patch.positions.col(tri[1]) +
+  contact.position = point.weights[0] * patch.positions.col(tri[0]) +
+                     point.weights[1] * patch.positions.col(tri[1]) +
                      point.weights[2] * patch.positions.col(tri[2]);
   contact.tool_offset = tool - contact.position;
   contact.last_tool = tool;
   return contact;
 }
 
-SeparationSample step_contact(const SeparationPatch& patch, SeparationState& state, SeparationContact& contact,
-                              const Eigen::Vector3d& tool) noexcept {
+SeparationSample step_contact(const SeparationPatch& patch, SeparationState& state,
+                              SeparationContact& contact, const Eigen::Vector3d& tool) noexcept {
   SeparationSample sample;
   if (contact.mode == ContactMode::none) return sample;
   if (!tool.allFinite()) {
@@ -159,7 +167,8 @@ SeparationSample step_contact(const SeparationPatch& patch, SeparationState& sta
   Evaluation e = evaluate(patch, state, contact, tool);
   if (contact.mode == ContactMode::push && e.normal < 0) {
     contact.mode = ContactMode::none;
-    sample.flags = static_cast<std::uint16_t>((sample.flags & ~kSeparationInContact) | kSeparationReleased);
+    sample.flags =
+        static_cast<std::uint16_t>((sample.flags & ~kSeparationInContact) | kSeparationReleased);
     return sample;
   }
   if (contact.mode == ContactMode::push && e.tangential.norm() > patch.friction * e.normal) {
@@ -168,7 +177,8 @@ SeparationSample step_contact(const SeparationPatch& patch, SeparationState& sta
     });
     contact = slide.contact;
     if (slide.walk.travelled > 0) sample.flags |= kSeparationSliding;
-    if (slide.walk.stop == PatchWalk::Stop::crack_edge) sample.flags |= kSeparationStoppedAtCrackEdge;
+    if (slide.walk.stop == PatchWalk::Stop::crack_edge)
+      sample.flags |= kSeparationStoppedAtCrackEdge;
   }
 
   e = evaluate(patch, state, contact, tool);

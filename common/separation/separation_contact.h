@@ -57,7 +57,7 @@ struct SeparationSample {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();       ///< on the hand: -F, limited [N]
   Eigen::Vector3d body_force = Eigen::Vector3d::Zero();  ///< F on the pulled body [N]
   Eigen::Vector3d deflection = Eigen::Vector3d::Zero();  ///< delta [m]
-  double energy = 0;           ///< the fields' potential at delta [J]
+  double energy = 0;                                     ///< the fields' potential at delta [J]
   double separated = 0;        ///< area separated by fracture this tick [m^2]
   double fracture_motion = 0;  ///< the part of the tool's move that fractured [m]
   std::uint16_t flags = 0;
@@ -65,15 +65,16 @@ struct SeparationSample {
 
 /// A contact at `point` (c on its patch triangle) with the tool's contact point at `tool`.
 /// Mode none (no contact) if the triangle, a tool node or a weight is invalid.
-SeparationContact begin_contact(const SeparationPatch& patch, ContactMode mode, const ContactPoint& point,
-                                const Eigen::Vector3d& tool) noexcept;
+SeparationContact begin_contact(const SeparationPatch& patch, ContactMode mode,
+                                const ContactPoint& point, const Eigen::Vector3d& tool) noexcept;
 
 /// The deflection the fields see.
-inline Eigen::Vector3d contact_deflection(const SeparationContact& contact, const Eigen::Vector3d& tool) noexcept {
+inline Eigen::Vector3d contact_deflection(const SeparationContact& contact,
+                                          const Eigen::Vector3d& tool) noexcept {
   return tool - contact.tool_offset - contact.position;
 }
 
-SeparationSample step_contact(const SeparationPatch& patch, SeparationState& state, SeparationContact& contact,
-                              const Eigen::Vector3d& tool) noexcept;
+SeparationSample step_contact(const SeparationPatch& patch, SeparationState& state,
+                              SeparationContact& contact, const Eigen::Vector3d& tool) noexcept;
 
 }  // namespace cohaptic

@@ -21,12 +21,15 @@ struct Header {
   std::int32_t tool_node_count;
   std::uint64_t value_count;
 };
-static_assert(sizeof(Header) == 64, "the header has no padding: its bytes are checksummed as they are");
+static_assert(sizeof(Header) == 64,
+              "the header has no padding: its bytes are checksummed as they are");
 
 void hash_body(ContentHasher& h, const SeparationBody& body) {
   h.matrix(body.mesh.nodes);
   h.values(std::span<const Tet>(body.mesh.tets));
-  h.value(body.material.youngs_modulus).value(body.material.poisson_ratio).value(static_cast<int>(body.material.formulation));
+  h.value(body.material.youngs_modulus)
+      .value(body.material.poisson_ratio)
+      .value(static_cast<int>(body.material.formulation));
   h.values(std::span<const AxisMask>(body.fixed_axes));
 }
 
@@ -46,7 +49,8 @@ Digest separation_fields_key(const SeparationBodies& bodies, const SeparationInt
   return h.finish();
 }
 
-std::filesystem::path separation_fields_file(const std::filesystem::path& directory, const Digest& key) {
+std::filesystem::path separation_fields_file(const std::filesystem::path& directory,
+                                             const Digest& key) {
   return directory / ("separation-" + to_hex(key).substr(0, 32) + ".bin");
 }
 
@@ -64,7 +68,8 @@ SeparationFieldsLoad load_separation_fields(const std::filesystem::path& file, c
     return result;
   }
   if (header.version != kSeparationCacheFormatVersion) {
-    result.problem = fmt::format("format version {} (this build reads {})", header.version, kSeparationCacheFormatVersion);
+    result.problem = fmt::format("format version {} (this build reads {})", header.version,
+                                 kSeparationCacheFormatVersion);
     return result;
   }
   if (header.key != key) {
@@ -72,25 +77,30 @@ SeparationFieldsLoad load_separation_fields(const std::filesystem::path& file, c
     return result;
   }
   const std::uint64_t expected = static_cast<std::uint64_t>(std::max(header.node_count, 0)) *
-                                 static_cast<std::uint64_t>(std::max(header.tool_node_count, 0)) * kFieldStates *
+                                 static_cast<std::uint64_t>(std::max(header.tool_node_count, 0)) *
+                                 kFieldStates *
                                  SeparationFields::block_size(std::max(header.degree, 0));
-  if (header.degree < 1 || header.node_count < 1 || header.tool_node_count < 1 || header.value_count != expected ||
+  if (header.degree < 1 || header.node_count < 1 || header.tool_node_count < 1 ||
+      header.value_count != expected ||
       read.body.size() != sizeof header + expected * sizeof(double)) {
-    result.problem = fmt::format("inconsistent sizes (degree {}, {} nodes, {} tool nodes, {} values, {} bytes)",
-                                 header.degree, header.node_count, header.tool_node_count, header.value_count,
-                                 read.body.size());
+    result.problem =
+        fmt::format("inconsistent sizes (degree {}, {} nodes, {} tool nodes, {} values, {} bytes)",
+                    header.degree, header.node_count, header.tool_node_count, header.value_count,
+                    read.body.size());
     return result;
   }
   result.fields.degree = header.degree;
   result.fields.node_count = header.node_count;
   result.fields.tool_node_count = header.tool_node_count;
   result.fields.values.resize(expected);
-  std::memcpy(result.fields.values.data(), read.body.data() + sizeof header, expected * sizeof(double));
+  std::memcpy(result.fields.values.data(), read.body.data() + sizeof header,
+              expected * sizeof(double));
   result.loaded = true;
   return result;
 }
 
-void save_separation_fields(const std::filesystem::path& file, const Digest& key, const SeparationFields& fields) {
+void save_separation_fields(const std::filesystem::path& file, const Digest& key,
+                            const SeparationFields& fields) {
   Header header{};
   std::memcpy(header.magic, kMagic, sizeof kMagic);
   header.version = kSeparationCacheFormatVersion;
@@ -101,12 +111,15 @@ void save_separation_fields(const std::filesystem::path& file, const Digest& key
   header.value_count = fields.values.size();
   std::vector<char> bytes(sizeof header + fields.values.size() * sizeof(double));
   std::memcpy(bytes.data(), &header, sizeof header);
-  std::memcpy(bytes.data() + sizeof header, fields.values.data(), fields.values.size() * sizeof(double));
+  std::memcpy(bytes.data() + sizeof header, fields.values.data(),
+              fields.values.size() * sizeof(double));
   write_checksummed_file(file, std::string_view(bytes.data(), bytes.size()));
 }
 
-CachedSeparationFields cached_separation_fields(const std::filesystem::path& directory, const SeparationBodies& bodies,
-                                                const SeparationInterface& interface, const FieldSettings& settings) {
+CachedSeparationFields cached_separation_fields(const std::filesystem::path& directory,
+                                                const SeparationBodies& bodies,
+                                                const SeparationInterface& interface,
+                                                const FieldSettings& settings) {
   validate(settings);
   const Digest key = separation_fields_key(bodies, interface, settings);
   const std::filesystem::path file = separation_fields_file(directory, key);

@@ -26,7 +26,8 @@ Digest separation_fields_key(const SeparationBodies& bodies, const SeparationInt
                              const FieldSettings& settings);
 
 /// The file for `key` inside `directory`.
-std::filesystem::path separation_fields_file(const std::filesystem::path& directory, const Digest& key);
+std::filesystem::path separation_fields_file(const std::filesystem::path& directory,
+                                             const Digest& key);
 
 struct SeparationFieldsLoad {
   bool loaded = false;
@@ -39,17 +40,20 @@ struct SeparationFieldsLoad {
 SeparationFieldsLoad load_separation_fields(const std::filesystem::path& file, const Digest& key);
 
 /// Writes atomically (temporary file, then rename). Throws Error naming the file.
-void save_separation_fields(const std::filesystem::path& file, const Digest& key, const SeparationFields& fields);
+void save_separation_fields(const std::filesystem::path& file, const Digest& key,
+                            const SeparationFields& fields);
 
 struct CachedSeparationFields {
   SeparationFields fields;
   bool from_cache = false;
-  std::string rebuilt_because;  ///< the load problem when the fields were recomputed
+  std::string rebuilt_because;   ///< the load problem when the fields were recomputed
   FieldPrecomputeReport report;  ///< zero when loaded
 };
 
 /// Loads the fields from `directory`, or precomputes and saves them there.
-CachedSeparationFields cached_separation_fields(const std::filesystem::path& directory, const SeparationBodies& bodies,
-                                                const SeparationInterface& interface, const FieldSettings& settings);
+CachedSeparationFields cached_separation_fields(const std::filesystem::path& directory,
+                                                const SeparationBodies& bodies,
+                                                const SeparationInterface& interface,
+                                                const FieldSettings& settings);
 
 }  // namespace cohaptic

@@ -31,9 +31,9 @@ constexpr int kFieldStates = 3;
 const char* field_state_name(FieldState state);
 
 struct FieldSettings {
-  int degree = 3;                           ///< the paper used 3 and proposes 5
-  int samples_per_axis = 6;                 ///< non-zero ones (an odd count has a zero) >= degree
-  double max_deflection = 0.005;            ///< half range of the sampled deflections [m]
+  int degree = 3;                            ///< the paper used 3 and proposes 5
+  int samples_per_axis = 6;                  ///< non-zero ones (an odd count has a zero) >= degree
+  double max_deflection = 0.005;             ///< half range of the sampled deflections [m]
   std::vector<double> footprint_radii{0.0};  ///< per tool node [m]; 0: the node alone
 };
 
@@ -59,25 +59,33 @@ struct FieldPrecomputeReport {
   double tie_seconds = 0;         ///< forming (L1 + L2)^-1
   double stiffness_seconds = 0;   ///< every field's condensed stiffness (the three states together)
   double fit_seconds = 0;         ///< frames, samples and fits of every field
-  /// Per state: max over fields and samples of |F_fit - F_fem| / max over the field's samples |F_fem|.
+  /// Per state: max over fields and samples of |F_fit - F_fem| / max over the field's samples
+  /// |F_fem|.
   std::array<double, kFieldStates> max_fit_error{};
   int field_count = 0;  ///< nodes x tool nodes x 3
-  double total_seconds() const { return compliance_seconds + tie_seconds + stiffness_seconds + fit_seconds; }
+  double total_seconds() const {
+    return compliance_seconds + tie_seconds + stiffness_seconds + fit_seconds;
+  }
 };
 
 /// The FEM force for one field at deflection `delta`: K delta, K the stiffness the rigid
 /// footprint of (node, tool node) meets in `state` (what the fit is fitted to).
 struct FieldStiffnesses {
-  std::vector<std::array<Eigen::Matrix3d, kFieldStates>> stiffness;  ///< [node * tool_nodes + tool node]
+  std::vector<std::array<Eigen::Matrix3d, kFieldStates>>
+      stiffness;  ///< [node * tool_nodes + tool node]
 };
 
 /// Condenses both bodies onto the interface (CHOLMOD), forms every field's stiffness.
-FieldStiffnesses field_stiffnesses(const SeparationBodies& bodies, const SeparationInterface& interface,
-                                   const FieldSettings& settings, FieldPrecomputeReport* report = nullptr);
+FieldStiffnesses field_stiffnesses(const SeparationBodies& bodies,
+                                   const SeparationInterface& interface,
+                                   const FieldSettings& settings,
+                                   FieldPrecomputeReport* report = nullptr);
 
 /// Frames, samples and fits for every field (Algorithm V.1).
-SeparationFields precompute_separation_fields(const SeparationBodies& bodies, const SeparationInterface& interface,
-                                              const FieldSettings& settings, FieldPrecomputeReport* report = nullptr);
+SeparationFields precompute_separation_fields(const SeparationBodies& bodies,
+                                              const SeparationInterface& interface,
+                                              const FieldSettings& settings,
+                                              FieldPrecomputeReport* report = nullptr);
 
 /// Interface nodes within `radius` of `node` (the node itself first).
 std::vector<int> tool_footprint(const SeparationInterface& interface, int node, double radius);

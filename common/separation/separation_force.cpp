@@ -21,8 +21,9 @@ FieldValue field_value(const SeparationPatch& patch, int node, int tool_node, Fi
   return value;
 }
 
-FieldValue nodal_separation_field(const SeparationPatch& patch, int node, int tool_node, double local_separated,
-                                  double global_separated, const Eigen::Vector3d& delta) noexcept {
+FieldValue nodal_separation_field(const SeparationPatch& patch, int node, int tool_node,
+                                  double local_separated, double global_separated,
+                                  const Eigen::Vector3d& delta) noexcept {
   const double weights[kFieldStates] = {(1 - global_separated) * (1 - local_separated),
                                         (1 - global_separated) * local_separated, global_separated};
   FieldValue sum;
@@ -35,15 +36,17 @@ FieldValue nodal_separation_field(const SeparationPatch& patch, int node, int to
   return sum;
 }
 
-ContactAreas contact_areas(const SeparationPatch& patch, const SeparationState& state, int triangle) noexcept {
+ContactAreas contact_areas(const SeparationPatch& patch, const SeparationState& state,
+                           int triangle) noexcept {
   ContactAreas areas;
-  for (int k = 0; k < 3; ++k) areas.local_separated[k] = local_separated_share(patch, state, patch.triangles[triangle][k]);
+  for (int k = 0; k < 3; ++k)
+    areas.local_separated[k] = local_separated_share(patch, state, patch.triangles[triangle][k]);
   areas.global_separated = global_separated_share(patch, state);
   return areas;
 }
 
-FieldValue contact_field(const SeparationPatch& patch, const ContactPoint& contact, const ContactAreas& areas,
-                         const Eigen::Vector3d& delta) noexcept {
+FieldValue contact_field(const SeparationPatch& patch, const ContactPoint& contact,
+                         const ContactAreas& areas, const Eigen::Vector3d& delta) noexcept {
   FieldValue sum;
   const Triangle& nodes = patch.triangles[contact.triangle];
   for (int k = 0; k < 3; ++k) {
@@ -51,8 +54,9 @@ FieldValue contact_field(const SeparationPatch& patch, const ContactPoint& conta
     for (int l = 0; l < 3; ++l) {
       const double w = contact.weights[k] * contact.tool_weights[l];
       if (w == 0) continue;
-      const FieldValue v = nodal_separation_field(patch, nodes[k], contact.tool_nodes[l], areas.local_separated[k],
-                                                  areas.global_separated, delta);
+      const FieldValue v =
+          nodal_separation_field(patch, nodes[k], contact.tool_nodes[l], areas.local_separated[k],
+                                 areas.global_separated, delta);
       sum.force += w * v.force;
       sum.energy += w * v.energy;
     }

@@ -30,15 +30,16 @@ FieldValue field_value(const SeparationPatch& patch, int node, int tool_node, Fi
                        const Eigen::Vector3d& delta) noexcept;
 
 /// Eq. 2 at one node and tool node, for the separated shares A(R-bar_i) and A(S-bar).
-FieldValue nodal_separation_field(const SeparationPatch& patch, int node, int tool_node, double local_separated,
-                                  double global_separated, const Eigen::Vector3d& delta) noexcept;
+FieldValue nodal_separation_field(const SeparationPatch& patch, int node, int tool_node,
+                                  double local_separated, double global_separated,
+                                  const Eigen::Vector3d& delta) noexcept;
 
 /// Where a tool touches the patch: c on a patch triangle and x on a tool triangle.
 struct ContactPoint {
-  int triangle = -1;                               ///< patch triangle of c
+  int triangle = -1;                                  ///< patch triangle of c
   Eigen::Vector3d weights = Eigen::Vector3d::Zero();  ///< alpha: c's area coordinates
-  std::array<int, 3> tool_nodes{0, 0, 0};          ///< tool triangle (repeat a node for a point tool)
-  Eigen::Vector3d tool_weights{1, 0, 0};           ///< beta: x's area coordinates
+  std::array<int, 3> tool_nodes{0, 0, 0};  ///< tool triangle (repeat a node for a point tool)
+  Eigen::Vector3d tool_weights{1, 0, 0};   ///< beta: x's area coordinates
 };
 
 /// The separated shares the contact's force depends on: A(R-bar) of the contact
@@ -48,10 +49,11 @@ struct ContactAreas {
   double global_separated = 0;
 };
 
-ContactAreas contact_areas(const SeparationPatch& patch, const SeparationState& state, int triangle) noexcept;
+ContactAreas contact_areas(const SeparationPatch& patch, const SeparationState& state,
+                           int triangle) noexcept;
 
 /// Algorithm V.2's interpolated force and its potential.
-FieldValue contact_field(const SeparationPatch& patch, const ContactPoint& contact, const ContactAreas& areas,
-                         const Eigen::Vector3d& delta) noexcept;
+FieldValue contact_field(const SeparationPatch& patch, const ContactPoint& contact,
+                         const ContactAreas& areas, const Eigen::Vector3d& delta) noexcept;
 
 }  // namespace cohaptic

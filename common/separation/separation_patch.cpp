@@ -8,19 +8,23 @@
 
 namespace cohaptic {
 
-SeparationPatch make_separation_patch(const SeparationInterface& interface, const SeparationFields& fields,
+SeparationPatch make_separation_patch(const SeparationInterface& interface,
+                                      const SeparationFields& fields,
                                       const SeparationSettings& settings) {
   validate(settings);
   if (fields.node_count != interface.node_count())
-    throw Error(fmt::format("separation patch: the fields have {} nodes, the interface {}", fields.node_count,
-                            interface.node_count()));
-  const std::size_t expected = static_cast<std::size_t>(fields.node_count) * fields.tool_node_count * kFieldStates *
+    throw Error(fmt::format("separation patch: the fields have {} nodes, the interface {}",
+                            fields.node_count, interface.node_count()));
+  const std::size_t expected = static_cast<std::size_t>(fields.node_count) *
+                               fields.tool_node_count * kFieldStates *
                                SeparationFields::block_size(fields.degree);
   if (fields.degree < 1 || fields.tool_node_count < 1 || fields.values.size() != expected)
-    throw Error(fmt::format("separation patch: {} field values for degree {} and {} tool nodes (expected {})",
-                            fields.values.size(), fields.degree, fields.tool_node_count, expected));
+    throw Error(fmt::format(
+        "separation patch: {} field values for degree {} and {} tool nodes (expected {})",
+        fields.values.size(), fields.degree, fields.tool_node_count, expected));
   for (std::size_t i = 0; i < fields.values.size(); ++i)
-    if (!std::isfinite(fields.values[i])) throw Error(fmt::format("separation patch: field value {} is not finite", i));
+    if (!std::isfinite(fields.values[i]))
+      throw Error(fmt::format("separation patch: field value {} is not finite", i));
 
   SeparationPatch patch;
   patch.positions = interface.positions;
@@ -41,10 +45,11 @@ SeparationPatch make_separation_patch(const SeparationInterface& interface, cons
   patch.region_areas.assign(static_cast<std::size_t>(interface.node_count()), 0.0);
   for (int n = 0; n < interface.node_count(); ++n) {
     const std::span<const int> region = patch.regions.of(n);
-    if (region.empty()) throw Error(fmt::format("separation patch: interface node {} has no triangle", n));
+    if (region.empty())
+      throw Error(fmt::format("separation patch: interface node {} has no triangle", n));
     if (static_cast<int>(region.size()) > SeparationPatch::kMaxRegionTriangles)
-      throw Error(fmt::format("separation patch: interface node {} has {} triangles (at most {})", n, region.size(),
-                              SeparationPatch::kMaxRegionTriangles));
+      throw Error(fmt::format("separation patch: interface node {} has {} triangles (at most {})",
+                              n, region.size(), SeparationPatch::kMaxRegionTriangles));
     for (int t : region) patch.region_areas[n] += patch.areas[t];
   }
 

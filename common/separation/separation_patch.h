@@ -62,16 +62,19 @@ struct SeparationPatch {
   int triangle_count() const { return static_cast<int>(triangles.size()); }
   /// The field block (frame, then coefficients) of (node, tool node, state).
   const double* field(int node, int tool_node, FieldState state) const {
-    return fields.data() + ((static_cast<std::size_t>(node) * static_cast<std::size_t>(tool_node_count) +
-                             static_cast<std::size_t>(tool_node)) * kFieldStates +
-                            static_cast<std::size_t>(state)) *
-                               static_cast<std::size_t>(SeparationFields::block_size(degree));
+    return fields.data() +
+           ((static_cast<std::size_t>(node) * static_cast<std::size_t>(tool_node_count) +
+             static_cast<std::size_t>(tool_node)) *
+                kFieldStates +
+            static_cast<std::size_t>(state)) *
+               static_cast<std::size_t>(SeparationFields::block_size(degree));
   }
 };
 
 /// Checks that the fields belong to the interface and the settings are valid; throws
 /// Error naming the mismatch (or a region larger than kMaxRegionTriangles).
-SeparationPatch make_separation_patch(const SeparationInterface& interface, const SeparationFields& fields,
+SeparationPatch make_separation_patch(const SeparationInterface& interface,
+                                      const SeparationFields& fields,
                                       const SeparationSettings& settings);
 
 }  // namespace cohaptic

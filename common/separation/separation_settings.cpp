@@ -10,7 +10,8 @@ namespace {
 
 void require_positive(double value, const char* name) {
   if (!(value > 0) || !std::isfinite(value))
-    throw Error(fmt::format("separation settings: {} must be a positive number, got {}", name, value));
+    throw Error(
+        fmt::format("separation settings: {} must be a positive number, got {}", name, value));
 }
 
 }  // namespace
@@ -20,12 +21,14 @@ void validate(const SeparationSettings& settings) {
   require_positive(settings.fracture.normal_length, "fracture.normal_length (l_n)");
   require_positive(settings.fracture.tangential_length, "fracture.tangential_length (l_t)");
   if (!(settings.fracture.friction >= 0) || !std::isfinite(settings.fracture.friction))
-    throw Error(fmt::format("separation settings: fracture.friction must be >= 0, got {}", settings.fracture.friction));
+    throw Error(fmt::format("separation settings: fracture.friction must be >= 0, got {}",
+                            settings.fracture.friction));
   require_positive(settings.laser.power, "laser.power (P)");
   require_positive(settings.laser.absorbed_fraction, "laser.absorbed_fraction (alpha)");
   if (settings.laser.absorbed_fraction > 1)
-    throw Error(fmt::format("separation settings: laser.absorbed_fraction (alpha) must be at most 1, got {}",
-                            settings.laser.absorbed_fraction));
+    throw Error(fmt::format(
+        "separation settings: laser.absorbed_fraction (alpha) must be at most 1, got {}",
+        settings.laser.absorbed_fraction));
   require_positive(settings.laser.spot_diameter, "laser.spot_diameter (l_f)");
   require_positive(settings.laser.reach, "laser.reach");
   require_positive(settings.tissue.density, "tissue.density (rho)");

@@ -39,10 +39,10 @@ struct FractureSettings {
 };
 
 struct TissueThermal {
-  double density = 1000;          ///< rho [kg/m^3]
-  double specific_heat = 4180;    ///< c_p [J/(kg K)]
-  double temperature_rise = 63;   ///< dT, body temperature to boiling [K]
-  double latent_heat = 2.26e6;    ///< H [J/kg]
+  double density = 1000;         ///< rho [kg/m^3]
+  double specific_heat = 4180;   ///< c_p [J/(kg K)]
+  double temperature_rise = 63;  ///< dT, body temperature to boiling [K]
+  double latent_heat = 2.26e6;   ///< H [J/kg]
 };
 
 struct LaserSettings {

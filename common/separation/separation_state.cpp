@@ -13,15 +13,18 @@ SeparationState make_separation_state(const SeparationPatch& patch) {
   return state;
 }
 
-void separate_triangles(const SeparationPatch& patch, SeparationState& state, std::span<const int> triangles) {
+void separate_triangles(const SeparationPatch& patch, SeparationState& state,
+                        std::span<const int> triangles) {
   for (int t : triangles) {
     if (t < 0 || t >= patch.triangle_count())
-      throw Error(fmt::format("separation: triangle {} is not on the patch ({} triangles)", t, patch.triangle_count()));
+      throw Error(fmt::format("separation: triangle {} is not on the patch ({} triangles)", t,
+                              patch.triangle_count()));
     separate_in_triangle(patch, state, t, patch.areas[t]);
   }
 }
 
-double separate_in_triangle(const SeparationPatch& patch, SeparationState& state, int t, double area) noexcept {
+double separate_in_triangle(const SeparationPatch& patch, SeparationState& state, int t,
+                            double area) noexcept {
   const double room = (1 - state.separated[t]) * patch.areas[t];
   const double added = std::clamp(area, 0.0, room);
   if (added >= room) {
@@ -33,7 +36,8 @@ double separate_in_triangle(const SeparationPatch& patch, SeparationState& state
   return added;
 }
 
-double local_separated_share(const SeparationPatch& patch, const SeparationState& state, int node) noexcept {
+double local_separated_share(const SeparationPatch& patch, const SeparationState& state,
+                             int node) noexcept {
   double separated = 0;
   for (int t : patch.regions.of(node)) separated += state.separated[t] * patch.areas[t];
   return std::min(separated / patch.region_areas[node], 1.0);

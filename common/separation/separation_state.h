@@ -27,20 +27,26 @@ struct SeparationState {
 SeparationState make_separation_state(const SeparationPatch& patch);
 
 /// Fully separates `triangles` (an initial crack). Throws Error for an index out of range.
-void separate_triangles(const SeparationPatch& patch, SeparationState& state, std::span<const int> triangles);
+void separate_triangles(const SeparationPatch& patch, SeparationState& state,
+                        std::span<const int> triangles);
 
 /// Separates up to `area` [m^2] more of triangle t; returns the area actually added.
-double separate_in_triangle(const SeparationPatch& patch, SeparationState& state, int t, double area) noexcept;
+double separate_in_triangle(const SeparationPatch& patch, SeparationState& state, int t,
+                            double area) noexcept;
 
 /// A(R-bar_n): the separated share of the region around node n.
-double local_separated_share(const SeparationPatch& patch, const SeparationState& state, int node) noexcept;
+double local_separated_share(const SeparationPatch& patch, const SeparationState& state,
+                             int node) noexcept;
 
 /// A(S-bar): the separated share of the whole interface.
-inline double global_separated_share(const SeparationPatch& patch, const SeparationState& state) noexcept {
+inline double global_separated_share(const SeparationPatch& patch,
+                                     const SeparationState& state) noexcept {
   return state.separated_area / patch.interface_area;
 }
 
-inline bool is_open(const SeparationState& state, int t) noexcept { return state.separated[static_cast<std::size_t>(t)] > 0; }
+inline bool is_open(const SeparationState& state, int t) noexcept {
+  return state.separated[static_cast<std::size_t>(t)] > 0;
+}
 
 /// Whether a crack may grow into triangle t (see above) when share(m) is the separated
 /// share of triangle m.
@@ -54,7 +60,8 @@ bool crack_may_grow(const SeparationPatch& patch, int t, const Share& share) noe
 }
 
 inline bool can_grow(const SeparationPatch& patch, const SeparationState& state, int t) noexcept {
-  return crack_may_grow(patch, t, [&](int m) { return state.separated[static_cast<std::size_t>(m)]; });
+  return crack_may_grow(patch, t,
+                        [&](int m) { return state.separated[static_cast<std::size_t>(m)]; });
 }
 
 }  // namespace cohaptic

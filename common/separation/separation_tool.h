@@ -30,7 +30,9 @@ struct SeparationToolSettings {
 inline constexpr std::uint32_t kLaserFireButton = 1u;  ///< button 0 of a laser tool
 
 /// The button that closes the jaws: button 1 on a laser tool, button 0 otherwise.
-inline std::uint32_t jaw_button(const SeparationToolSettings& settings) noexcept { return settings.laser ? 2u : 1u; }
+inline std::uint32_t jaw_button(const SeparationToolSettings& settings) noexcept {
+  return settings.laser ? 2u : 1u;
+}
 
 struct SeparationToolState {
   SeparationContact contact;
@@ -45,11 +47,14 @@ struct SeparationToolSample {
 };
 
 /// The point of the patch nearest `p` (a point tool: tool node 0), and its distance [m].
-ContactPoint nearest_patch_point(const SeparationPatch& patch, const Eigen::Vector3d& p, double& distance) noexcept;
+ContactPoint nearest_patch_point(const SeparationPatch& patch, const Eigen::Vector3d& p,
+                                 double& distance) noexcept;
 
 /// One tick of length dt [s] with the tip at `tip` and `buttons` held.
-SeparationToolSample step_separation_tool(const SeparationPatch& patch, SeparationState& state, SeparationToolState& tool,
-                                          const SeparationToolSettings& settings, const Eigen::Vector3d& tip,
-                                          std::uint32_t buttons, double dt) noexcept;
+SeparationToolSample step_separation_tool(const SeparationPatch& patch, SeparationState& state,
+                                          SeparationToolState& tool,
+                                          const SeparationToolSettings& settings,
+                                          const Eigen::Vector3d& tip, std::uint32_t buttons,
+                                          double dt) noexcept;
 
 }  // namespace cohaptic

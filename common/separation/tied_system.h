@@ -16,18 +16,21 @@
 namespace cohaptic {
 
 struct TiedSystem {
-  SparseMatrix stiffness;          ///< both bodies, merged numbering
-  DofMap dofs;                     ///< both bodies' supports
+  SparseMatrix stiffness;             ///< both bodies, merged numbering
+  DofMap dofs;                        ///< both bodies' supports
   std::vector<int> pulled_to_merged;  ///< per node of the pulled body
 };
 
 /// `tied` per interface node: whether its pair is one node.
-TiedSystem tied_system(const SeparationBodies& bodies, const SeparationInterface& interface, const std::vector<bool>& tied);
+TiedSystem tied_system(const SeparationBodies& bodies, const SeparationInterface& interface,
+                       const std::vector<bool>& tied);
 
 /// The forces a rigid footprint (interface nodes of the pulled body, all displaced by one
 /// of `deltas`, every other free node unloaded) applies to the bodies: one factorisation
 /// for the footprint, one full sparse solve per deflection.
-std::vector<Eigen::Vector3d> footprint_forces(const TiedSystem& system, const SeparationInterface& interface,
-                                              std::span<const int> footprint, std::span<const Eigen::Vector3d> deltas);
+std::vector<Eigen::Vector3d> footprint_forces(const TiedSystem& system,
+                                              const SeparationInterface& interface,
+                                              std::span<const int> footprint,
+                                              std::span<const Eigen::Vector3d> deltas);
 
 }  // namespace cohaptic

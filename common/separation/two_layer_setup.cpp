@@ -5,17 +5,21 @@
 namespace cohaptic {
 
 TwoLayerSetup make_two_layer_setup(const TwoLayerBoxes& boxes, const FieldSettings& field_settings,
-                                   const SeparationSettings& settings, const std::filesystem::path& cache_directory) {
+                                   const SeparationSettings& settings,
+                                   const std::filesystem::path& cache_directory) {
   TwoLayerSetup setup;
   setup.bodies = make_two_layer_boxes(boxes);
   const double spacing = boxes.size.minCoeff() / boxes.divisions.maxCoeff();
   setup.interface = find_interface(setup.bodies, 1e-6 * spacing);
   const double end = boxes.size.x() - 1e-6 * spacing;
-  seal_rim_edges(setup.interface, [end](const Eigen::Vector3d& midpoint) { return midpoint.x() > end; });
+  seal_rim_edges(setup.interface,
+                 [end](const Eigen::Vector3d& midpoint) { return midpoint.x() > end; });
   if (cache_directory.empty()) {
-    setup.fields = precompute_separation_fields(setup.bodies, setup.interface, field_settings, &setup.report);
+    setup.fields =
+        precompute_separation_fields(setup.bodies, setup.interface, field_settings, &setup.report);
   } else {
-    CachedSeparationFields cached = cached_separation_fields(cache_directory, setup.bodies, setup.interface, field_settings);
+    CachedSeparationFields cached =
+        cached_separation_fields(cache_directory, setup.bodies, setup.interface, field_settings);
     setup.fields = std::move(cached.fields);
     setup.report = cached.report;
     setup.fields_from_cache = cached.from_cache;

@@ -22,7 +22,8 @@ struct TwoLayerSetup {
 
 /// `cache_directory` empty: precompute without a cache.
 TwoLayerSetup make_two_layer_setup(const TwoLayerBoxes& boxes, const FieldSettings& field_settings,
-                                   const SeparationSettings& settings, const std::filesystem::path& cache_directory = {});
+                                   const SeparationSettings& settings,
+                                   const std::filesystem::path& cache_directory = {});
 
 /// The patch node nearest `point` [m].
 int nearest_patch_node(const SeparationPatch& patch, const Eigen::Vector3d& point);

@@ -45,8 +45,9 @@ BodyInteraction make_body_interaction(int front, const MassSpringModel& front_bo
 
 /// One step at the front body's current positions; `columns` are the behind body's (row
 /// nodes: at least its surface). Returns the backing the front body feels until the next.
-NodeBacking step_body_interaction(BodyInteraction& interaction, const Eigen::Matrix3Xd& front_positions,
-                                    const MassSpringModel& front_body, const ElasticBody& behind_body,
-                                    ComplianceColumns& columns);
+NodeBacking step_body_interaction(BodyInteraction& interaction,
+                                  const Eigen::Matrix3Xd& front_positions,
+                                  const MassSpringModel& front_body, const ElasticBody& behind_body,
+                                  ComplianceColumns& columns);
 
 }  // namespace cohaptic

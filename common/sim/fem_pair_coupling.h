@@ -31,8 +31,8 @@
 namespace cohaptic {
 
 struct FemPairContact {
-  bool solved = false;                ///< false: A_A + A_B not positive definite (nothing gives way)
-  Eigen::MatrixXd front_compliance;   ///< A_A, |collisions| square [m/N]
+  bool solved = false;               ///< false: A_A + A_B not positive definite (nothing gives way)
+  Eigen::MatrixXd front_compliance;  ///< A_A, |collisions| square [m/N]
   Eigen::MatrixXd behind_compliance;  ///< A_B, |collisions| square [m/N]
   Eigen::VectorXd free_gaps;          ///< g_free = gap . n per collision [m]
   Eigen::VectorXd pushes;             ///< lambda per collision [N], zero where released
@@ -43,8 +43,10 @@ struct FemPairContact {
 /// The coupled contact of `collisions` (active: A's nodes, found at A's state without B;
 /// polygons: B's). `front_held_dofs` are free global dofs of A held where they are (the
 /// tools'); A's row nodes must include them and the active nodes, B's the polygon nodes.
-FemPairContact solve_fem_pair_contact(std::span<const PolygonCollision> collisions, ComplianceColumns& front_columns,
-                                      std::span<const int> front_held_dofs, ComplianceColumns& behind_columns);
+FemPairContact solve_fem_pair_contact(std::span<const PolygonCollision> collisions,
+                                      ComplianceColumns& front_columns,
+                                      std::span<const int> front_held_dofs,
+                                      ComplianceColumns& behind_columns);
 
 /// B's displacement under the pushes, u_B = -L_B W N lambda, 3 per row node of
 /// `behind_columns` [m].

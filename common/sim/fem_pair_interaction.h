@@ -42,7 +42,7 @@ struct FemPairInteraction {
   NodePairList pairs;
   std::vector<PolygonCollision> collisions;  ///< the latest step's candidates
   FemPairContact contact;                    ///< the latest step's coupled solve
-  long failures = 0;                         ///< steps whose coupled problem was not positive definite
+  long failures = 0;  ///< steps whose coupled problem was not positive definite
 };
 
 /// The pushes of a step as loads on each body, and B as A's support on the pushing set.
@@ -52,7 +52,7 @@ struct FemPairLoads {
   std::vector<int> support_nodes;      ///< S: A's nodes that push, in candidate order
   Eigen::Matrix3Xd support_normals;    ///< B's outward normal at each
   Eigen::MatrixXd support_compliance;  ///< A_B,SS [m/N]
-  Eigen::VectorXd support_gaps;        ///< g0 per node of S: its gap to its polygon's plane at rest [m]
+  Eigen::VectorXd support_gaps;  ///< g0 per node of S: its gap to its polygon's plane at rest [m]
 };
 
 /// Pairs every surface node of A at rest with the nearest surface node of B.
@@ -67,8 +67,9 @@ FemPairLoads step_fem_pair(FemPairInteraction& interaction, const ElasticBody& f
 
 /// The step as A's Simulation's coupling: the loads set on both simulations, and A's
 /// support replaced when S changed.
-void couple_fem_pair(FemPairInteraction& interaction, Simulation& front, const ElasticBody& front_body,
-                     ComplianceColumns& front_columns, Simulation& behind, const ElasticBody& behind_body,
+void couple_fem_pair(FemPairInteraction& interaction, Simulation& front,
+                     const ElasticBody& front_body, ComplianceColumns& front_columns,
+                     Simulation& behind, const ElasticBody& behind_body,
                      ComplianceColumns& behind_columns);
 
 }  // namespace cohaptic

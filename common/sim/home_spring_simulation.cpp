@@ -38,11 +38,15 @@ ForcepsGeometry jaw_geometry(const InstrumentSpec& instrument) {
 
 }  // namespace
 
-HomeSpringSimulation::HomeSpringSimulation(const HomeSpringBody& body, int object, const std::vector<ToolSpec>& tools,
-                                           double force_limit)
-    : body_(body), object_(object), force_limit_(force_limit),
-      beyond_tip_((body.surface.vertices.rowwise().maxCoeff() - body.surface.vertices.rowwise().minCoeff()).norm() +
-                  body.longest_edge),
+HomeSpringSimulation::HomeSpringSimulation(const HomeSpringBody& body, int object,
+                                           const std::vector<ToolSpec>& tools, double force_limit)
+    : body_(body),
+      object_(object),
+      force_limit_(force_limit),
+      beyond_tip_(
+          (body.surface.vertices.rowwise().maxCoeff() - body.surface.vertices.rowwise().minCoeff())
+              .norm() +
+          body.longest_edge),
       users_(tools.size()) {
   for (std::size_t u = 0; u < tools.size(); ++u) {
     UserState& user = users_[u];
@@ -52,14 +56,17 @@ HomeSpringSimulation::HomeSpringSimulation(const HomeSpringBody& body, int objec
   }
 }
 
-void HomeSpringSimulation::set_tool(int user, const Eigen::Vector3d& position, std::uint32_t buttons) {
+void HomeSpringSimulation::set_tool(int user, const Eigen::Vector3d& position,
+                                    std::uint32_t buttons) {
   UserState& state = users_[static_cast<std::size_t>(user)];
   state.known = position.allFinite();
   state.position = position;
   state.buttons = buttons;
 }
 
-void HomeSpringSimulation::clear_tool(int user) { users_[static_cast<std::size_t>(user)].known = false; }
+void HomeSpringSimulation::clear_tool(int user) {
+  users_[static_cast<std::size_t>(user)].known = false;
+}
 
 void HomeSpringSimulation::continue_epochs(int user, std::uint64_t epoch) {
   UserState& state = users_[static_cast<std::size_t>(user)];
@@ -88,7 +95,9 @@ void HomeSpringSimulation::step_user(int u, double time, StepReport& report) {
   }
   const auto shaft = shaft_frame(user.instrument->trocar, user.position, user.instrument->opening);
   if (!shaft) return;
-  if (user.forceps) step_forceps(jaw_geometry(*user.instrument), *shaft, (user.buttons & 1u) != 0, body_.tree, user.jaws);
+  if (user.forceps)
+    step_forceps(jaw_geometry(*user.instrument), *shaft, (user.buttons & 1u) != 0, body_.tree,
+                 user.jaws);
 
   int centre = -1;
   if (user.jaws.grasping) {
@@ -97,30 +106,38 @@ void HomeSpringSimulation::step_user(int u, double time, StepReport& report) {
   } else {
     // The shaft's line on through the tip, far enough to leave the tissue's bounds.
     const double reach = (user.position - shaft->pivot).norm() + beyond_tip_;
-    const AabbCrossing hit = body_.tree.first_crossing(shaft->pivot, shaft->pivot + reach * shaft->axis);
+    const AabbCrossing hit =
+        body_.tree.first_crossing(shaft->pivot, shaft->pivot + reach * shaft->axis);
     if (hit.triangle >= 0)
-      centre = nearest_tissue_corner(body_, hit.triangle, shaft->pivot + hit.crossing.t * reach * shaft->axis);
+      centre = nearest_tissue_corner(body_, hit.triangle,
+                                     shaft->pivot + hit.crossing.t * reach * shaft->axis);
     else if (user.grasped)
-      centre = user.centre;  // released with the line off the tissue: the same patch, without the grasp
+      centre =
+          user.centre;  // released with the line off the tissue: the same patch, without the grasp
   }
   if (centre >= 0 && (!user.ir || centre != user.centre || user.jaws.grasping != user.grasped))
     publish_ir(u, centre, time, report);
   if (!user.ir) return;
 
-  const HomeSpringContact contact = evaluate_home_spring(std::get<PreparedHomeSpringPatch>(user.ir->body), user.position);
+  const HomeSpringContact contact =
+      evaluate_home_spring(std::get<PreparedHomeSpringPatch>(user.ir->body), user.position);
   user.pressing = contact.touching;
   const bool grasping = user.jaws.grasping;
   user.dent_from = grasping ? user.jaws.grasp_point : contact.contact_point;
-  user.dent_to = grasping ? Eigen::Vector3d(user.dent_from + (user.position - user.jaws.tool_at_grasp)) : user.position;
+  user.dent_to = grasping
+                     ? Eigen::Vector3d(user.dent_from + (user.position - user.jaws.tool_at_grasp))
+                     : user.position;
 }
 
 void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport& report) {
   UserState& user = users_[static_cast<std::size_t>(u)];
   const HomeSpringObjectSpec& spec = body_.spec;
-  HomeSpringPatch patch = extract_home_spring_patch({body_.surface.vertices, body_.surface.triangles, body_.rings},
-                                                    body_.surface.vertices.col(centre), spec.patch_radius,
-                                                    {spec.home_stiffness, spec.neighbour_stiffness}, user.instrument->trocar);
-  if (user.jaws.grasping) patch.grasp = {nearest_touchable_vertex(patch, user.jaws.grasp_point), user.jaws.tool_at_grasp};
+  HomeSpringPatch patch = extract_home_spring_patch(
+      {body_.surface.vertices, body_.surface.triangles, body_.rings},
+      body_.surface.vertices.col(centre), spec.patch_radius,
+      {spec.home_stiffness, spec.neighbour_stiffness}, user.instrument->trocar);
+  if (user.jaws.grasping)
+    patch.grasp = {nearest_touchable_vertex(patch, user.jaws.grasp_point), user.jaws.tool_at_grasp};
   IntermediateRepresentation ir;
   ir.epoch = ++user.epoch;
   ir.simulation_time = time;

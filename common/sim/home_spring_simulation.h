@@ -17,7 +17,8 @@
 // force() is the P0 force: the client's evaluate_force on the user's IR. The display
 // deformation (displayed(), computed when asked, not every step) dents the rest surface per
 // pressing user: P the contact point and A the tip for a probe; P the grasp point, fixed,
-// and A it moved by the pull for grasping forceps; the users' dents add. Units: SI; times in s of the simulation's clock.
+// and A it moved by the pull for grasping forceps; the users' dents add. Units: SI; times in s of
+// the simulation's clock.
 #pragma once
 
 #include <Eigen/Core>
@@ -48,7 +49,8 @@ class HomeSpringSimulation {
  public:
   /// One user per tool; `body` must outlive it. `object` is the body's index in the scene
   /// (the IRs' object); `force_limit` [N] goes into every IR.
-  HomeSpringSimulation(const HomeSpringBody& body, int object, const std::vector<ToolSpec>& tools, double force_limit);
+  HomeSpringSimulation(const HomeSpringBody& body, int object, const std::vector<ToolSpec>& tools,
+                       double force_limit);
 
   // The members SceneSimulation visits, as Simulation has them.
   int user_count() const { return static_cast<int>(users_.size()); }
@@ -58,7 +60,9 @@ class HomeSpringSimulation {
   void continue_epochs(int user, std::uint64_t epoch);  ///< the user's next epoch is above `epoch`
   StepReport step(double time);
   /// Null until the user's shaft first aimed at the tissue.
-  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
+  std::shared_ptr<const PreparedIR> ir(int user) const {
+    return users_[static_cast<std::size_t>(user)].ir;
+  }
   /// The shaft crosses the rest surface, or the forceps grasp.
   bool pressing(int user) const { return users_[static_cast<std::size_t>(user)].pressing; }
   /// P0: the user's IR evaluated at its tool's position now (zero without an IR).
@@ -84,9 +88,10 @@ class HomeSpringSimulation {
     std::uint32_t buttons = 0;
     ForcepsJaws jaws;
     bool pressing = false;
-    Eigen::Vector3d dent_from = Eigen::Vector3d::Zero(), dent_to = Eigen::Vector3d::Zero();  // P -> A while pressing
-    int centre = -1;           // surface vertex the IR's patch is built around
-    bool grasped = false;      // the IR's grasp
+    Eigen::Vector3d dent_from = Eigen::Vector3d::Zero(),
+                    dent_to = Eigen::Vector3d::Zero();  // P -> A while pressing
+    int centre = -1;       // surface vertex the IR's patch is built around
+    bool grasped = false;  // the IR's grasp
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
     EvaluationState evaluation;  // P0
@@ -97,7 +102,8 @@ class HomeSpringSimulation {
   const HomeSpringBody& body_;
   int object_;
   double force_limit_;
-  double beyond_tip_;  // how far past the tip the shaft's line is followed: across the tissue's bounds [m]
+  double beyond_tip_;  // how far past the tip the shaft's line is followed: across the tissue's
+                       // bounds [m]
   std::vector<UserState> users_;
 };
 

@@ -8,11 +8,12 @@
 namespace cohaptic {
 namespace {
 
-void add_loads(ComplianceColumns& columns, const std::vector<int>& dofs, const Eigen::VectorXd& forces,
-               std::vector<LoadedColumn>& loads) {
+void add_loads(ComplianceColumns& columns, const std::vector<int>& dofs,
+               const Eigen::VectorXd& forces, std::vector<LoadedColumn>& loads) {
   columns.compute_columns(nodes_of_dofs(dofs));  // one solve per group for any missing
   for (std::size_t j = 0; j < dofs.size(); ++j)
-    loads.push_back({&columns.column(dofs[j] / 3), dofs[j] % 3, forces[static_cast<Eigen::Index>(j)]});
+    loads.push_back(
+        {&columns.column(dofs[j] / 3), dofs[j] % 3, forces[static_cast<Eigen::Index>(j)]});
 }
 
 }  // namespace
@@ -26,17 +27,20 @@ std::vector<LoadedColumn> loaded_columns(ComplianceColumns& columns, const State
   return loads;
 }
 
-Eigen::Matrix3Xd displacement_of_rows(std::span<const LoadedColumn> loads, std::span<const int> row_positions) {
+Eigen::Matrix3Xd displacement_of_rows(std::span<const LoadedColumn> loads,
+                                      std::span<const int> row_positions) {
   Eigen::Matrix3Xd u = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(row_positions.size()));
   if (loads.empty()) return u;
   const Eigen::Index rows = loads.front().column->rows() / 3;  // every column has the same rows
   for (const int position : row_positions)
     if (position < 0 || position >= rows)
-      throw Error(fmt::format("displacement_of_rows: row position {} outside the {} row nodes", position, rows));
+      throw Error(fmt::format("displacement_of_rows: row position {} outside the {} row nodes",
+                              position, rows));
   for (const LoadedColumn& load : loads) {
     const auto along = load.column->col(load.axis);
     for (std::size_t k = 0; k < row_positions.size(); ++k)
-      u.col(static_cast<Eigen::Index>(k)) += load.force * along.segment<3>(3 * static_cast<Eigen::Index>(row_positions[k]));
+      u.col(static_cast<Eigen::Index>(k)) +=
+          load.force * along.segment<3>(3 * static_cast<Eigen::Index>(row_positions[k]));
   }
   return u;
 }

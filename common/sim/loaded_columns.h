@@ -30,6 +30,7 @@ std::vector<LoadedColumn> loaded_columns(ComplianceColumns& columns, const State
 
 /// The displacement [m] of the row nodes at `row_positions` (ComplianceColumns::row_position)
 /// under `loads`, one column each.
-Eigen::Matrix3Xd displacement_of_rows(std::span<const LoadedColumn> loads, std::span<const int> row_positions);
+Eigen::Matrix3Xd displacement_of_rows(std::span<const LoadedColumn> loads,
+                                      std::span<const int> row_positions);
 
 }  // namespace cohaptic

@@ -15,11 +15,18 @@
 
 namespace cohaptic {
 
-MassSpringSimulation::MassSpringSimulation(const MassSpringModel& body, int object, const std::vector<ToolSpec>& tools,
-                                           double force_limit, double period)
-    : body_(body), object_(object), force_limit_(force_limit), period_(period), state_(make_state(body.network)) {
+MassSpringSimulation::MassSpringSimulation(const MassSpringModel& body, int object,
+                                           const std::vector<ToolSpec>& tools, double force_limit,
+                                           double period)
+    : body_(body),
+      object_(object),
+      force_limit_(force_limit),
+      period_(period),
+      state_(make_state(body.network)) {
   if (!(period > 0) || !std::isfinite(period))
-    throw Error(fmt::format("mass-spring simulation of '{}': the period must be positive and finite, not {}", body.name, period));
+    throw Error(fmt::format(
+        "mass-spring simulation of '{}': the period must be positive and finite, not {}", body.name,
+        period));
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
   tools_.resize(tools.size());
@@ -33,7 +40,9 @@ void MassSpringSimulation::set_tool(int user, const Eigen::Vector3d& position) {
   state.position = position;
 }
 
-void MassSpringSimulation::clear_tool(int user) { users_[static_cast<std::size_t>(user)].known = false; }
+void MassSpringSimulation::clear_tool(int user) {
+  users_[static_cast<std::size_t>(user)].known = false;
+}
 
 void MassSpringSimulation::continue_epochs(int user, std::uint64_t epoch) {
   UserState& state = users_[static_cast<std::size_t>(user)];
@@ -42,12 +51,14 @@ void MassSpringSimulation::continue_epochs(int user, std::uint64_t epoch) {
 
 Eigen::Vector3d MassSpringSimulation::tool_position(int user) const {
   const UserState& state = users_[static_cast<std::size_t>(user)];
-  return state.known ? state.position : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  return state.known ? state.position
+                     : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 }
 
 double MassSpringSimulation::distance_to_surface(const Eigen::Vector3d& point) const {
   double nearest = std::numeric_limits<double>::infinity();
-  for (int node : body_.network.surface_nodes) nearest = std::min(nearest, (state_.positions.col(node) - point).norm());
+  for (int node : body_.network.surface_nodes)
+    nearest = std::min(nearest, (state_.positions.col(node) - point).norm());
   return nearest;
 }
 
@@ -55,7 +66,8 @@ StepReport MassSpringSimulation::step(double time) {
   const double period = started_ ? std::clamp(time - time_, 0.0, kMassSpringMaxStepPeriod) : 0;
   started_ = true;
   time_ = time;
-  for (std::size_t u = 0; u < users_.size(); ++u) tools_[u] = {tool_position(static_cast<int>(u)), users_[u].radius};
+  for (std::size_t u = 0; u < users_.size(); ++u)
+    tools_[u] = {tool_position(static_cast<int>(u)), users_[u].radius};
   // A nanosecond's slack: a step a period after the previous one advances although the
   // difference of their times rounds a bit short.
   pending_ += period;
@@ -66,9 +78,11 @@ StepReport MassSpringSimulation::step(double time) {
   }
   if (state_.backing.failures > reported_backing_failures_) {
     // Never silently wrong: a failed solve held the last pushes (node_backing.h).
-    spdlog::warn("mass-spring object '{}': the contact solve of the body behind it failed in {} of {} substeps so far "
-                 "(each held its previous pushes)",
-                 body_.name, state_.backing.failures, state_.backing.evaluations);
+    spdlog::warn(
+        "mass-spring object '{}': the contact solve of the body behind it failed in {} of {} "
+        "substeps so far "
+        "(each held its previous pushes)",
+        body_.name, state_.backing.failures, state_.backing.evaluations);
     reported_backing_failures_ = state_.backing.failures;
   }
 
@@ -79,7 +93,8 @@ StepReport MassSpringSimulation::step(double time) {
     UserState& user = users_[u];
     user.pressing = reactions_[u].colliding;
     if (!user.known) continue;
-    const bool near = user.pressing || distance_to_surface(user.position) - user.radius <= settings.near_distance;
+    const bool near =
+        user.pressing || distance_to_surface(user.position) - user.radius <= settings.near_distance;
     // A nanosecond's slack: steps at a rate's exact multiples of 1/rate_hz are due although
     // their difference rounds a bit short.
     const bool due = !user.ir || time - user.last_ir_time >= 1 / settings.rate_hz - 1e-9;
@@ -91,7 +106,9 @@ StepReport MassSpringSimulation::step(double time) {
 
 void MassSpringSimulation::publish_ir(int user, double time, StepReport& report) {
   UserState& state = users_[static_cast<std::size_t>(user)];
-  const int contact = find_surface_contact(body_.network, state_.positions, state.position, state.radius).nearest_node;
+  const int contact =
+      find_surface_contact(body_.network, state_.positions, state.position, state.radius)
+          .nearest_node;
   IntermediateRepresentation ir;
   ir.epoch = state.epoch + 1;
   ir.simulation_time = time;
@@ -103,12 +120,15 @@ void MassSpringSimulation::publish_ir(int user, double time, StepReport& report)
   body.presses.push_back(presses_[static_cast<std::size_t>(user)]);
   for (int other = 0; other < user_count(); ++other) {
     const UserState& remote = users_[static_cast<std::size_t>(other)];
-    if (other == user || !remote.known || body.presses.size() >= static_cast<std::size_t>(kMaxNetworkTools)) continue;
+    if (other == user || !remote.known ||
+        body.presses.size() >= static_cast<std::size_t>(kMaxNetworkTools))
+      continue;
     body.remote_users.push_back(other);
     body.remote_radii.push_back(remote.radius);
     body.presses.push_back(presses_[static_cast<std::size_t>(other)]);
   }
-  if (!backing_.empty()) body.backing = sub_network_backing(backing_, state_.backing.pushes, body.node_ids);
+  if (!backing_.empty())
+    body.backing = sub_network_backing(backing_, state_.backing.pushes, body.node_ids);
   report.ir_bytes += body.size_bytes();
   ir.body = std::move(body);
   auto prepared = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
@@ -127,7 +147,8 @@ ForceSample MassSpringSimulation::force(int user, double dt) {
   std::array<Eigen::Vector3d, kMaxNetworkTools> remotes;
   const std::size_t count = network.remote_users.size();
   for (std::size_t r = 0; r < count; ++r) remotes[r] = tool_position(network.remote_users[r]);
-  return evaluate_force(*state.ir, state.evaluation, tool_position(user), std::span(remotes.data(), count), dt);
+  return evaluate_force(*state.ir, state.evaluation, tool_position(user),
+                        std::span(remotes.data(), count), dt);
 }
 
 }  // namespace cohaptic

@@ -42,8 +42,8 @@ class MassSpringSimulation {
   /// One user per tool; `body` must outlive it. `object` is the body's index in the scene
   /// (the IRs' object); `force_limit` [N] goes into every IR; `period` [s] > 0 is the fixed
   /// period the network is advanced by (the haptic loop's nominal period).
-  MassSpringSimulation(const MassSpringModel& body, int object, const std::vector<ToolSpec>& tools, double force_limit,
-                       double period);
+  MassSpringSimulation(const MassSpringModel& body, int object, const std::vector<ToolSpec>& tools,
+                       double force_limit, double period);
 
   // The members SceneSimulation visits, as Simulation has them (set_tool, clear_tool,
   // continue_epochs, step, ir, pressing), and force with the period to advance by.
@@ -53,14 +53,18 @@ class MassSpringSimulation {
   void continue_epochs(int user, std::uint64_t epoch);  ///< the user's next epoch is above `epoch`
   StepReport step(double time);
   /// Null until the user's tool came near the body.
-  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
+  std::shared_ptr<const PreparedIR> ir(int user) const {
+    return users_[static_cast<std::size_t>(user)].ir;
+  }
   bool pressing(int user) const { return users_[static_cast<std::size_t>(user)].pressing; }
   /// P0: advances the user's server-held evaluation of its IR by `dt` [s] at the current
   /// tool positions and returns its force (zero without an IR).
   ForceSample force(int user, double dt);
   /// The whole network's reaction on the user's tool in the latest step: what the user
   /// would feel if the server's own step drove its force (the trade-off's reference).
-  const NetworkToolReaction& reaction(int user) const { return reactions_[static_cast<std::size_t>(user)]; }
+  const NetworkToolReaction& reaction(int user) const {
+    return reactions_[static_cast<std::size_t>(user)];
+  }
   /// The body behind this one pressing back on its colliding nodes from the next step on
   /// (SceneSimulation's interactions; an empty backing: nothing behind it).
   void set_backing(NodeBacking backing) {
@@ -91,17 +95,17 @@ class MassSpringSimulation {
   const MassSpringModel& body_;
   int object_;
   double force_limit_;
-  double period_;                               // of each advance [s]
-  double pending_ = 0;                          // time stepped but not yet advanced [s]
+  double period_;       // of each advance [s]
+  double pending_ = 0;  // time stepped but not yet advanced [s]
   MassSpringState state_;
   std::vector<UserState> users_;
-  std::vector<ToolOnNetwork> tools_;            // per user, for each step
-  std::vector<ToolPress> presses_;              // per user: the whole network's contact memory
-  std::vector<NetworkToolReaction> reactions_;  // per user, of the latest step
-  NodeBacking backing_;                         // the body behind this one, if any
+  std::vector<ToolOnNetwork> tools_;             // per user, for each step
+  std::vector<ToolPress> presses_;               // per user: the whole network's contact memory
+  std::vector<NetworkToolReaction> reactions_;   // per user, of the latest step
+  NodeBacking backing_;                          // the body behind this one, if any
   std::uint64_t reported_backing_failures_ = 0;  // of state_.backing.failures, logged so far
   bool started_ = false;
-  double time_ = 0;                             // of the latest step [s]
+  double time_ = 0;  // of the latest step [s]
 };
 
 }  // namespace cohaptic

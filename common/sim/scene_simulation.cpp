@@ -18,20 +18,24 @@ struct SimulationMaker {
   const SimulationOptions& options;
   int object;
   std::unique_ptr<BodySimulation> operator()(const ElasticBody& body) const {
-    if (!columns) throw Error(fmt::format("scene simulation: no compliance columns for the linear elastic object '{}'", body.name));
-    return std::make_unique<BodySimulation>(std::in_place_type<Simulation>, body, model.obstacles, *columns, tools, options);
+    if (!columns)
+      throw Error(fmt::format(
+          "scene simulation: no compliance columns for the linear elastic object '{}'", body.name));
+    return std::make_unique<BodySimulation>(std::in_place_type<Simulation>, body, model.obstacles,
+                                            *columns, tools, options);
   }
   std::unique_ptr<BodySimulation> operator()(const MassSpringModel& body) const {
-    return std::make_unique<BodySimulation>(std::in_place_type<MassSpringSimulation>, body, object, tools,
-                                            model.scene.haptic.force_limit_n, 1 / model.scene.haptic.rate_hz);
+    return std::make_unique<BodySimulation>(std::in_place_type<MassSpringSimulation>, body, object,
+                                            tools, model.scene.haptic.force_limit_n,
+                                            1 / model.scene.haptic.rate_hz);
   }
   std::unique_ptr<BodySimulation> operator()(const HomeSpringBody& body) const {
-    return std::make_unique<BodySimulation>(std::in_place_type<HomeSpringSimulation>, body, object, tools,
-                                            model.scene.haptic.force_limit_n);
+    return std::make_unique<BodySimulation>(std::in_place_type<HomeSpringSimulation>, body, object,
+                                            tools, model.scene.haptic.force_limit_n);
   }
   std::unique_ptr<BodySimulation> operator()(const SeparationModel& body) const {
-    return std::make_unique<BodySimulation>(std::in_place_type<SeparationSimulation>, body, object, tools,
-                                            model.scene.haptic.force_limit_n);
+    return std::make_unique<BodySimulation>(std::in_place_type<SeparationSimulation>, body, object,
+                                            tools, model.scene.haptic.force_limit_n);
   }
 };
 
@@ -45,52 +49,62 @@ int body_index(const Model& model, const std::string& name) {
 }  // namespace
 
 SceneSimulation::SceneSimulation(const Model& model, std::span<ComplianceColumns* const> columns,
-                                 const std::vector<ToolSpec>& tools, const SimulationOptions& options)
+                                 const std::vector<ToolSpec>& tools,
+                                 const SimulationOptions& options)
     : model_(model), users_(tools.size()), columns_(columns.begin(), columns.end()) {
   if (columns.size() != model.bodies.size())
-    throw Error(fmt::format("scene simulation: {} compliance column sets for {} bodies", columns.size(), model.bodies.size()));
+    throw Error(fmt::format("scene simulation: {} compliance column sets for {} bodies",
+                            columns.size(), model.bodies.size()));
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
-    bodies_.push_back(std::visit(SimulationMaker{model, columns[i], tools, options, static_cast<int>(i)}, model.bodies[i]));
+    bodies_.push_back(std::visit(
+        SimulationMaker{model, columns[i], tools, options, static_cast<int>(i)}, model.bodies[i]));
   for (const InteractionSpec& spec : model.scene.interactions) {
     const int front = body_index(model, spec.front);
     const int behind = body_index(model, spec.behind);
     const BodyModel& front_model = model.bodies[static_cast<std::size_t>(front)];
-    const auto* behind_body = std::get_if<ElasticBody>(&model.bodies[static_cast<std::size_t>(behind)]);
+    const auto* behind_body =
+        std::get_if<ElasticBody>(&model.bodies[static_cast<std::size_t>(behind)]);
     if (const auto* network = std::get_if<MassSpringModel>(&front_model); network && behind_body)
       interactions_.push_back(make_body_interaction(front, *network, behind, *behind_body));
     else if (std::holds_alternative<ElasticBody>(front_model) && behind_body)
       add_fem_pair(spec, front, behind, options);
     else
-      throw Error(fmt::format("{}: the interaction needs a mass-spring or linear elastic front and a linear elastic "
-                              "behind object",
-                              spec.where));
+      throw Error(fmt::format(
+          "{}: the interaction needs a mass-spring or linear elastic front and a linear elastic "
+          "behind object",
+          spec.where));
   }
 }
 
-void SceneSimulation::add_fem_pair(const InteractionSpec& spec, int front, int behind, const SimulationOptions& options) {
+void SceneSimulation::add_fem_pair(const InteractionSpec& spec, int front, int behind,
+                                   const SimulationOptions& options) {
   // The coupled solve holds each tool's dofs where they are: the translation model's contact.
   if (options.ir.contact_model != ContactModel::node_translation)
-    throw Error(fmt::format("{}: a linear elastic front object presses on another under the translation contact model "
-                            "only, and this scene's is '{}' (haptic: {{contact_model: translation}})",
-                            spec.where, contact_model_name(options.ir.contact_model)));
+    throw Error(fmt::format(
+        "{}: a linear elastic front object presses on another under the translation contact model "
+        "only, and this scene's is '{}' (haptic: {{contact_model: translation}})",
+        spec.where, contact_model_name(options.ir.contact_model)));
   // Each pair sets both bodies' applied loads: a body in two pairs would lose one's.
   for (const auto& pair : fem_pairs_)
     for (const int body : {front, behind})
       if (body == pair->front || body == pair->behind)
-        throw Error(fmt::format("{}: object '{}' is in an earlier pair of linear elastic objects already (one such pair "
-                                "per object)",
-                                spec.where, body_name(model_, body)));
+        throw Error(
+            fmt::format("{}: object '{}' is in an earlier pair of linear elastic objects already "
+                        "(one such pair "
+                        "per object)",
+                        spec.where, body_name(model_, body)));
   const auto& front_body = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(front)]);
   const auto& behind_body = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(behind)]);
-  auto& pair = *fem_pairs_.emplace_back(
-      std::make_unique<FemPairInteraction>(make_fem_pair_interaction(front, front_body, behind, behind_body)));
+  auto& pair = *fem_pairs_.emplace_back(std::make_unique<FemPairInteraction>(
+      make_fem_pair_interaction(front, front_body, behind, behind_body)));
   Simulation& behind_simulation = std::get<Simulation>(*bodies_[static_cast<std::size_t>(behind)]);
   ComplianceColumns* front_columns = columns_[static_cast<std::size_t>(front)];
   ComplianceColumns* behind_columns = columns_[static_cast<std::size_t>(behind)];
   std::get<Simulation>(*bodies_[static_cast<std::size_t>(front)])
       .set_coupling([&pair, &front_body, front_columns, &behind_simulation, &behind_body,
                      behind_columns](Simulation& simulation) {
-        couple_fem_pair(pair, simulation, front_body, *front_columns, behind_simulation, behind_body, *behind_columns);
+        couple_fem_pair(pair, simulation, front_body, *front_columns, behind_simulation,
+                        behind_body, *behind_columns);
       });
 }
 
@@ -101,10 +115,13 @@ bool SceneSimulation::condenses_over_support(int body_index) const {
 
 void SceneSimulation::run_interactions() {
   for (BodyInteraction& interaction : interactions_) {
-    auto& front = std::get<MassSpringSimulation>(*bodies_[static_cast<std::size_t>(interaction.front)]);
-    const auto& behind = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(interaction.behind)]);
-    front.set_backing(step_body_interaction(interaction, front.state().positions, front.body(), behind,
-                                            *columns_[static_cast<std::size_t>(interaction.behind)]));
+    auto& front =
+        std::get<MassSpringSimulation>(*bodies_[static_cast<std::size_t>(interaction.front)]);
+    const auto& behind =
+        std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(interaction.behind)]);
+    front.set_backing(
+        step_body_interaction(interaction, front.state().positions, front.body(), behind,
+                              *columns_[static_cast<std::size_t>(interaction.behind)]));
   }
 }
 
@@ -118,16 +135,22 @@ void SceneSimulation::set_tool(int user, const Eigen::Vector3d& position, std::u
 void SceneSimulation::clear_tool(int user) { users_[static_cast<std::size_t>(user)].known = false; }
 
 bool SceneSimulation::pressing(int user) const {
-  return std::visit([user](const auto& simulation) { return simulation.pressing(user); }, body(body_of(user)));
+  return std::visit([user](const auto& simulation) { return simulation.pressing(user); },
+                    body(body_of(user)));
 }
 
 double SceneSimulation::distance_to_body(int body_index, const Eigen::Vector3d& point) const {
-  if (const auto* network = std::get_if<MassSpringSimulation>(&body(body_index))) return network->distance_to_surface(point);
-  if (const auto* tissue = std::get_if<HomeSpringSimulation>(&body(body_index))) return tissue->distance_to_surface(point);
-  if (const auto* layers = std::get_if<SeparationSimulation>(&body(body_index))) return layers->distance_to_interface(point);
-  const ElasticBody& elastic = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(body_index)]);
+  if (const auto* network = std::get_if<MassSpringSimulation>(&body(body_index)))
+    return network->distance_to_surface(point);
+  if (const auto* tissue = std::get_if<HomeSpringSimulation>(&body(body_index)))
+    return tissue->distance_to_surface(point);
+  if (const auto* layers = std::get_if<SeparationSimulation>(&body(body_index)))
+    return layers->distance_to_interface(point);
+  const ElasticBody& elastic =
+      std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(body_index)]);
   double nearest = std::numeric_limits<double>::infinity();
-  for (int node : elastic.touchable_nodes) nearest = std::min(nearest, (elastic.mesh.nodes.col(node) - point).norm());
+  for (int node : elastic.touchable_nodes)
+    nearest = std::min(nearest, (elastic.mesh.nodes.col(node) - point).norm());
   return nearest;
 }
 
@@ -146,7 +169,8 @@ void SceneSimulation::assign_bodies() {
     if (nearest == user.body) continue;
     user.body = nearest;
     const std::uint64_t epoch = user.ir ? user.ir->ir.epoch : 0;
-    std::visit([&](auto& simulation) { simulation.continue_epochs(u, epoch); }, *bodies_[static_cast<std::size_t>(nearest)]);
+    std::visit([&](auto& simulation) { simulation.continue_epochs(u, epoch); },
+               *bodies_[static_cast<std::size_t>(nearest)]);
   }
 }
 
@@ -168,9 +192,13 @@ StepReport SceneSimulation::step(double time) {
         [&](auto& body_simulation) {
           for (int u = 0; u < user_count(); ++u) {
             const UserState& user = users_[static_cast<std::size_t>(u)];
-            if (!user.known || user.body != b) body_simulation.clear_tool(u);
-            else if constexpr (requires { body_simulation.set_tool(u, user.position, user.buttons); })
-              body_simulation.set_tool(u, user.position, user.buttons);  // a body whose tools have buttons
+            if (!user.known || user.body != b)
+              body_simulation.clear_tool(u);
+            else if constexpr (requires {
+                                 body_simulation.set_tool(u, user.position, user.buttons);
+                               })
+              body_simulation.set_tool(u, user.position,
+                                       user.buttons);  // a body whose tools have buttons
             else
               body_simulation.set_tool(u, user.position);
           }
@@ -180,9 +208,11 @@ StepReport SceneSimulation::step(double time) {
   }
   for (int u = 0; u < user_count(); ++u) {
     UserState& user = users_[static_cast<std::size_t>(u)];
-    auto latest = std::visit([u](const auto& simulation) { return simulation.ir(u); }, body(user.body));
+    auto latest =
+        std::visit([u](const auto& simulation) { return simulation.ir(u); }, body(user.body));
     // A body the user left long ago may still hold an older IR for it: never hand one back.
-    user.changed = latest && latest != user.ir && (!user.ir || latest->ir.epoch > user.ir->ir.epoch);
+    user.changed =
+        latest && latest != user.ir && (!user.ir || latest->ir.epoch > user.ir->ir.epoch);
     if (user.changed) user.ir = std::move(latest);
   }
   return report;
@@ -190,7 +220,8 @@ StepReport SceneSimulation::step(double time) {
 
 ForceSample SceneSimulation::force(int user) {
   BodySimulation& simulation = *bodies_[static_cast<std::size_t>(body_of(user))];
-  if (auto* network = std::get_if<MassSpringSimulation>(&simulation)) return network->force(user, period_);
+  if (auto* network = std::get_if<MassSpringSimulation>(&simulation))
+    return network->force(user, period_);
   if (auto* tissue = std::get_if<HomeSpringSimulation>(&simulation)) return tissue->force(user);
   if (auto* layers = std::get_if<SeparationSimulation>(&simulation)) return layers->force(user);
   return std::get<Simulation>(simulation).force(user);

@@ -36,15 +36,16 @@
 namespace cohaptic {
 
 /// One alternative per BodyModel alternative, in the same order.
-using BodySimulation = std::variant<Simulation, MassSpringSimulation, HomeSpringSimulation, SeparationSimulation>;
+using BodySimulation =
+    std::variant<Simulation, MassSpringSimulation, HomeSpringSimulation, SeparationSimulation>;
 
 class SceneSimulation {
  public:
   /// One user per tool. columns[i] holds body i's compliance columns when it is linear
   /// elastic (rows as Simulation requires), null otherwise; `model` and the columns must
   /// outlive it. `options` applies to the FEM bodies.
-  SceneSimulation(const Model& model, std::span<ComplianceColumns* const> columns, const std::vector<ToolSpec>& tools,
-                  const SimulationOptions& options);
+  SceneSimulation(const Model& model, std::span<ComplianceColumns* const> columns,
+                  const std::vector<ToolSpec>& tools, const SimulationOptions& options);
 
   int user_count() const { return static_cast<int>(users_.size()); }
   int body_count() const { return static_cast<int>(bodies_.size()); }
@@ -60,7 +61,9 @@ class SceneSimulation {
   void set_step_delay_nodes(int nodes);
 
   /// The user's latest IR; null until its body built one.
-  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
+  std::shared_ptr<const PreparedIR> ir(int user) const {
+    return users_[static_cast<std::size_t>(user)].ir;
+  }
   /// True if ir(user) changed in the latest step.
   bool ir_changed(int user) const { return users_[static_cast<std::size_t>(user)].changed; }
   /// P0: the reaction force on `user`'s tool now, from its IR (zero without one). A dynamic
@@ -78,7 +81,9 @@ class SceneSimulation {
   const std::vector<BodyInteraction>& interactions() const { return interactions_; }
   /// The scene's FEM pairs in scene order, as of the latest step.
   int fem_pair_count() const { return static_cast<int>(fem_pairs_.size()); }
-  const FemPairInteraction& fem_pair(int i) const { return *fem_pairs_[static_cast<std::size_t>(i)]; }
+  const FemPairInteraction& fem_pair(int i) const {
+    return *fem_pairs_[static_cast<std::size_t>(i)];
+  }
   /// True when `body`'s IRs condense over a support (the front of an FEM pair that pushes):
   /// their M~ is not of the body's own compliance.
   bool condenses_over_support(int body) const;
@@ -92,7 +97,8 @@ class SceneSimulation {
     std::shared_ptr<const PreparedIR> ir;
     bool changed = false;
   };
-  void add_fem_pair(const InteractionSpec& spec, int front, int behind, const SimulationOptions& options);
+  void add_fem_pair(const InteractionSpec& spec, int front, int behind,
+                    const SimulationOptions& options);
   void assign_bodies();
   void run_interactions();
   double distance_to_body(int body, const Eigen::Vector3d& point) const;
@@ -102,7 +108,8 @@ class SceneSimulation {
   std::vector<UserState> users_;
   std::vector<ComplianceColumns*> columns_;  // per body, null unless linear elastic
   std::vector<BodyInteraction> interactions_;
-  std::vector<std::unique_ptr<FemPairInteraction>> fem_pairs_;  // at fixed addresses: the front's coupling holds one
+  std::vector<std::unique_ptr<FemPairInteraction>>
+      fem_pairs_;  // at fixed addresses: the front's coupling holds one
   bool started_ = false;
   double time_ = 0;    // of the latest step [s]
   double period_ = 0;  // of the latest step [s]

@@ -7,9 +7,13 @@
 
 namespace cohaptic {
 
-SeparationSimulation::SeparationSimulation(const SeparationModel& body, int object, const std::vector<ToolSpec>& tools,
-                                           double force_limit)
-    : body_(body), object_(object), force_limit_(force_limit), state_(make_separation_state(*body.patch)), users_(tools.size()) {
+SeparationSimulation::SeparationSimulation(const SeparationModel& body, int object,
+                                           const std::vector<ToolSpec>& tools, double force_limit)
+    : body_(body),
+      object_(object),
+      force_limit_(force_limit),
+      state_(make_separation_state(*body.patch)),
+      users_(tools.size()) {
   for (std::size_t u = 0; u < tools.size(); ++u) {
     users_[u].settings.grasp_reach = body.spec.grasp_reach;
     for (const SeparationInstrumentSpec& instrument : body.spec.instruments)
@@ -17,14 +21,17 @@ SeparationSimulation::SeparationSimulation(const SeparationModel& body, int obje
   }
 }
 
-void SeparationSimulation::set_tool(int user, const Eigen::Vector3d& position, std::uint32_t buttons) {
+void SeparationSimulation::set_tool(int user, const Eigen::Vector3d& position,
+                                    std::uint32_t buttons) {
   UserState& state = users_[static_cast<std::size_t>(user)];
   state.known = position.allFinite();
   state.position = position;
   state.buttons = buttons;
 }
 
-void SeparationSimulation::clear_tool(int user) { users_[static_cast<std::size_t>(user)].known = false; }
+void SeparationSimulation::clear_tool(int user) {
+  users_[static_cast<std::size_t>(user)].known = false;
+}
 
 void SeparationSimulation::continue_epochs(int user, std::uint64_t epoch) {
   UserState& state = users_[static_cast<std::size_t>(user)];
@@ -54,7 +61,8 @@ StepReport SeparationSimulation::step(double time) {
     }
     const double before = state_.separated_area;
     const bool firing = user.settings.laser && (user.buttons & kLaserFireButton) != 0;
-    user.force = step_separation_force(patch, state_, user.tool, user.settings, user.position, user.buttons, dt, force_limit_);
+    user.force = step_separation_force(patch, state_, user.tool, user.settings, user.position,
+                                       user.buttons, dt, force_limit_);
     (firing ? vaporised_ : fractured_) += state_.separated_area - before;
   }
 
@@ -75,7 +83,8 @@ StepReport SeparationSimulation::step(double time) {
 bool SeparationSimulation::ir_stale(const UserState& user) const {
   if (!user.ir) return true;
   const auto& sent = std::get<SeparationIr>(user.ir->ir.body);
-  return sent.state.separated_area != state_.separated_area || sent.tool_state.contact.mode != user.tool.contact.mode ||
+  return sent.state.separated_area != state_.separated_area ||
+         sent.tool_state.contact.mode != user.tool.contact.mode ||
          sent.tool_state.jaws_closed != user.tool.jaws_closed;
 }
 

@@ -29,7 +29,8 @@ class SeparationSimulation {
  public:
   /// One user per tool; `body` must outlive it. `object` is the body's index in the scene
   /// (the IRs' object); `force_limit` [N] goes into every IR.
-  SeparationSimulation(const SeparationModel& body, int object, const std::vector<ToolSpec>& tools, double force_limit);
+  SeparationSimulation(const SeparationModel& body, int object, const std::vector<ToolSpec>& tools,
+                       double force_limit);
 
   // The members SceneSimulation visits, as Simulation has them.
   int user_count() const { return static_cast<int>(users_.size()); }
@@ -38,7 +39,9 @@ class SeparationSimulation {
   void continue_epochs(int user, std::uint64_t epoch);  ///< the user's next epoch is above `epoch`
   StepReport step(double time);
   /// Null until the user's tool was known at a step.
-  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
+  std::shared_ptr<const PreparedIR> ir(int user) const {
+    return users_[static_cast<std::size_t>(user)].ir;
+  }
   /// The user's instrument grasps the tissue.
   bool pressing(int user) const;
   /// P0: the latest step's force on the user's tool (zero before its first).
@@ -48,9 +51,13 @@ class SeparationSimulation {
 
   const SeparationModel& body() const { return body_; }
   const SeparationState& state() const { return state_; }
-  const SeparationToolSettings& instrument(int user) const { return users_[static_cast<std::size_t>(user)].settings; }
-  double fractured_area() const { return fractured_; }   ///< separated by the tools' forces so far [m^2]
-  double vaporised_area() const { return vaporised_; }   ///< separated by the laser so far [m^2]
+  const SeparationToolSettings& instrument(int user) const {
+    return users_[static_cast<std::size_t>(user)].settings;
+  }
+  double fractured_area() const {
+    return fractured_;
+  }  ///< separated by the tools' forces so far [m^2]
+  double vaporised_area() const { return vaporised_; }  ///< separated by the laser so far [m^2]
 
  private:
   struct UserState {

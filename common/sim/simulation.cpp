@@ -23,16 +23,18 @@ constexpr int kHoldingSphere = -2;
 
 }  // namespace
 
-Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstacles, ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
+Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstacles,
+                       ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
                        SimulationOptions options)
     : body_(body),
       columns_(columns),
       options_(options),
-      condensation_(columns, body.dofs, [&] {
-        IncrementalCondensation::Options condensation;
-        condensation.naive = options.naive_every_step;
-        return condensation;
-      }()),
+      condensation_(columns, body.dofs,
+                    [&] {
+                      IncrementalCondensation::Options condensation;
+                      condensation.naive = options.naive_every_step;
+                      return condensation;
+                    }()),
       candidates_(body.mesh, body.surface, body.touchable_triangles),
       touchable_triangle_(body.surface.triangles.size(), false) {
   for (int t : body.touchable_triangles) touchable_triangle_[t] = true;
@@ -60,7 +62,9 @@ void Simulation::set_tool(int user, const Eigen::Vector3d& position) {
 
 void Simulation::clear_tool(int user) { users_[user].known = false; }
 
-void Simulation::continue_epochs(int user, std::uint64_t epoch) { users_[user].epoch = std::max(users_[user].epoch, epoch); }
+void Simulation::continue_epochs(int user, std::uint64_t epoch) {
+  users_[user].epoch = std::max(users_[user].epoch, epoch);
+}
 
 void Simulation::hold(int node, const HeldNode& held) {
   condensation_.add_boundary_node(node);
@@ -74,9 +78,12 @@ void Simulation::release(int node) {
   boundary_dirty_ = true;
 }
 
-std::vector<Eigen::Vector3d> Simulation::boundary_displacement() const { return boundary_displacement(condensation_); }
+std::vector<Eigen::Vector3d> Simulation::boundary_displacement() const {
+  return boundary_displacement(condensation_);
+}
 
-std::vector<Eigen::Vector3d> Simulation::boundary_displacement(const IncrementalCondensation& condensation) const {
+std::vector<Eigen::Vector3d> Simulation::boundary_displacement(
+    const IncrementalCondensation& condensation) const {
   std::vector<Eigen::Vector3d> out;
   for (int node : condensation.boundary_nodes()) out.push_back(held_.at(node).displacement);
   return out;
@@ -88,7 +95,8 @@ void Simulation::set_support(std::unique_ptr<SupportedCompliance> support) {
   if (support_) {
     IncrementalCondensation::Options options;
     options.naive = options_.naive_every_step;
-    supported_condensation_ = std::make_unique<IncrementalCondensation>(*support_, body_.dofs, options);
+    supported_condensation_ =
+        std::make_unique<IncrementalCondensation>(*support_, body_.dofs, options);
   }
   support_changed_ = true;
 }
@@ -119,7 +127,8 @@ std::vector<PressingContact> Simulation::pressing_contacts() const {
       if (std::any_of(contacts.begin(), contacts.end(),
                       [&](const PressingContact& taken) { return share_a_node(taken.nodes, tri); }))
         continue;
-      contacts.push_back({{tri[0], tri[1], tri[2]}, user.contact->weights, user.contact->displacement});
+      contacts.push_back(
+          {{tri[0], tri[1], tri[2]}, user.contact->weights, user.contact->displacement});
     }
   return contacts;
 }
@@ -129,12 +138,14 @@ StateSolution Simulation::solve(std::span<const PressingContact> contacts) const
                      options_.ir.contact_model, applied_);
 }
 
-StateSolution Simulation::solve() const { return sphere_model() ? solve_spheres(spheres()) : solve(pressing_contacts()); }
+StateSolution Simulation::solve() const {
+  return sphere_model() ? solve_spheres(spheres()) : solve(pressing_contacts());
+}
 
 StateSolution Simulation::solve_unloaded() const {
   if (sphere_model()) return solve_spheres(spheres());  // in no FEM pair (refused), so never loaded
-  return solve_state(columns_, condensation_, body_.dofs, pressing_contacts(), boundary_dof_displacement(),
-                     options_.ir.contact_model);
+  return solve_state(columns_, condensation_, body_.dofs, pressing_contacts(),
+                     boundary_dof_displacement(), options_.ir.contact_model);
 }
 
 std::vector<SphereTool> Simulation::spheres() const {
@@ -147,7 +158,8 @@ std::vector<SphereTool> Simulation::spheres() const {
 StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) const {
   std::vector<int> candidates;
   for (const UserState& user : users_)
-    if (user.known) candidates.insert(candidates.end(), user.sphere_nodes.begin(), user.sphere_nodes.end());
+    if (user.known)
+      candidates.insert(candidates.end(), user.sphere_nodes.begin(), user.sphere_nodes.end());
   return sphere_solve_->solve(condensation_, candidates, spheres, boundary_dof_displacement());
 }
 
@@ -159,9 +171,11 @@ bool Simulation::sphere_irs_stand() const {
   const auto stands = [&](int node) {
     if (!built_sphere_rows_[static_cast<std::size_t>(node)]) return false;
     const int slot = normal.slot_of(node);
-    const auto built = std::lower_bound(built_row_directions_.begin(), built_row_directions_.end(), node,
-                                        [](const auto& entry, int n) { return entry.first < n; });
-    return slot < 0 || built == built_row_directions_.end() || built->first != node || normal.normal(slot) == built->second;
+    const auto built =
+        std::lower_bound(built_row_directions_.begin(), built_row_directions_.end(), node,
+                         [](const auto& entry, int n) { return entry.first < n; });
+    return slot < 0 || built == built_row_directions_.end() || built->first != node ||
+           normal.normal(slot) == built->second;
   };
   for (const UserState& user : users_) {
     if (!user.known) continue;
@@ -171,28 +185,35 @@ bool Simulation::sphere_irs_stand() const {
   return std::ranges::all_of(sphere_solve_->obstacle_contacts(), stands);
 }
 
-void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
+void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool,
+                             std::vector<bool>& in_patch,
                              const std::vector<bool>& touchable) const {
   const SphereTool sphere{user.position, user.radius};
   const int rings = options_.ir.patch_rings;
-  user.sphere_patch_nodes = triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, body_.surface_tree, user.nearest, sphere, rings, touchable));
+  user.sphere_patch_nodes =
+      triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, body_.surface_tree,
+                                                 user.nearest, sphere, rings, touchable));
   // Carried nodes the patch now holds anyway are no longer carried.
   std::erase_if(user.sphere_carried, [&](int node) {
-    return std::find(user.sphere_patch_nodes.begin(), user.sphere_patch_nodes.end(), node) != user.sphere_patch_nodes.end();
+    return std::find(user.sphere_patch_nodes.begin(), user.sphere_patch_nodes.end(), node) !=
+           user.sphere_patch_nodes.end();
   });
   const std::vector<int> nodes =
       user.sphere_carried.empty()
           ? user.sphere_patch_nodes
-          : triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, body_.surface_tree, user.nearest, sphere, rings, touchable,
-                                                       user.sphere_carried));
+          : triangle_nodes(body_.surface,
+                           sphere_patch(body_.mesh, body_.surface, body_.surface_tree, user.nearest,
+                                        sphere, rings, touchable, user.sphere_carried));
   for (int node : nodes) under_tool[node] = in_patch[node] = true;
   user.sphere_nodes = nodes;
-  user.sphere_holds = nodes_held_by_spheres(body_.mesh, body_.dofs, body_.contact_normals, nodes, std::span(&sphere, 1)).nodes;
+  user.sphere_holds = nodes_held_by_spheres(body_.mesh, body_.dofs, body_.contact_normals, nodes,
+                                            std::span(&sphere, 1))
+                          .nodes;
   user.pressing = !user.sphere_holds.empty() || !user.sphere_carried.empty();
 }
 
-bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, std::vector<bool>& in_patch,
-                                                 StepReport& report) {
+bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool,
+                                                 std::vector<bool>& in_patch, StepReport& report) {
   constexpr int kMaxCarryPasses = 4;  // each pass only adds nodes; in practice one settles it
   std::vector<int> user_of_sphere;    // spheres() lists the known users in order
   for (std::size_t u = 0; u < users_.size(); ++u)
@@ -208,28 +229,35 @@ bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, 
     const std::span<const int> obstacle_rows = sphere_solve_->obstacle_rows();
     for (std::size_t i = 0; i < state.contact_dofs.size(); ++i) {
       const int node = state.contact_dofs[i] / 3;
-      if (state.contact_forces[static_cast<Eigen::Index>(i)] == 0.0 || (!pushed.empty() && pushed.back() == node))
+      if (state.contact_forces[static_cast<Eigen::Index>(i)] == 0.0 ||
+          (!pushed.empty() && pushed.back() == node))
         continue;  // not pushed, or its other axes
       pushed.push_back(node);
-      if (in_patch[node] || std::binary_search(obstacle_rows.begin(), obstacle_rows.end(), node)) continue;
+      if (in_patch[node] || std::binary_search(obstacle_rows.begin(), obstacle_rows.end(), node))
+        continue;
       const SphereConstraint constraint =
-          sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node), body_.dofs.fixed_axes[node], tools)
+          sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
+                            body_.dofs.fixed_axes[node], tools)
               .value();
       left_out.emplace_back(node, user_of_sphere[static_cast<std::size_t>(constraint.tool)]);
     }
     if (left_out.empty()) {
       // A carried node the state no longer pushes leaves its patch from the next step on.
       for (UserState& user : users_)
-        std::erase_if(user.sphere_carried,
-                      [&](int node) { return std::find(pushed.begin(), pushed.end(), node) == pushed.end(); });
+        std::erase_if(user.sphere_carried, [&](int node) {
+          return std::find(pushed.begin(), pushed.end(), node) == pushed.end();
+        });
       return boundary_changed;
     }
     if (pass == kMaxCarryPasses) {
       report.sphere_nodes_outside_patches = static_cast<int>(left_out.size());
       return boundary_changed;
     }
-    for (const auto& [node, user] : left_out) users_[static_cast<std::size_t>(user)].sphere_carried.push_back(node);
-    for (const auto& [node, user] : left_out) mark_sphere(users_[static_cast<std::size_t>(user)], under_tool, in_patch, touchable_triangle_);
+    for (const auto& [node, user] : left_out)
+      users_[static_cast<std::size_t>(user)].sphere_carried.push_back(node);
+    for (const auto& [node, user] : left_out)
+      mark_sphere(users_[static_cast<std::size_t>(user)], under_tool, in_patch,
+                  touchable_triangle_);
     boundary_changed |= update_boundary(under_tool, in_patch);
   }
 }
@@ -246,7 +274,8 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
     const int node = condensation_.boundary_nodes()[b];
     Eigen::Vector3d force = Eigen::Vector3d::Zero();
     for (int axis = 0; axis < 3; ++axis)
-      if (!body_.dofs.is_fixed(node, axis)) force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
+      if (!body_.dofs.is_fixed(node, axis))
+        force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
     const HeldNode& held = held_.at(node);
     if (held.obstacle < 0) continue;
     const Eigen::Vector3d at = body_.mesh.nodes.col(node) + held.displacement;
@@ -266,7 +295,8 @@ bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
         estimate < options_.near_obstacle_distance && !columns_.has_column(node))
       near_obstacles_.push_back({node, estimate});
     if (clearance_.certainly_clear(i, moved)) continue;
-    ObstaclePoint nearest{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), std::numeric_limits<double>::infinity(), -1};
+    ObstaclePoint nearest{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                          std::numeric_limits<double>::infinity(), -1};
     for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
       const ObstaclePoint hit = obstacles_[o].closest_point(moved);
       if (hit.signed_distance < nearest.signed_distance) nearest = hit;
@@ -298,7 +328,8 @@ void Simulation::release_step_delay_nodes() {
   for (int node : step_nodes) release(node);
 }
 
-bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch) {
+bool Simulation::update_boundary(const std::vector<bool>& under_tool,
+                                 const std::vector<bool>& in_patch) {
   boundary_dirty_ = false;
   const std::vector<int> current = condensation_.boundary_nodes();
   for (int node : current)
@@ -314,20 +345,24 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool, const std:
   for (const auto& [node, held] : held_) step_delay_held |= held.obstacle < 0;
   if (options_.step_delay_nodes > 0 && !contact_points.empty() && !step_delay_held) {
     // Chosen outside every user's patch, so that the patches keep their triangles.
-    const std::vector<int> nodes = nearest_surface_nodes(body_.mesh, body_.surface, body_.dofs, contact_points, options_.step_delay_nodes, in_patch);
+    const std::vector<int> nodes = nearest_surface_nodes(
+        body_.mesh, body_.surface, body_.dofs, contact_points, options_.step_delay_nodes, in_patch);
     std::vector<int> fresh;
     for (int node : nodes)
       if (!held_.count(node)) fresh.push_back(node);
     // Held where they were before the touch: the previous step's state.
-    const Eigen::Matrix3Xd u =
-        displacement_of_nodes(columns_, sphere_model() ? solve_spheres(previous_spheres_) : solve(previous_contacts_), fresh);
-    for (std::size_t i = 0; i < fresh.size(); ++i) hold(fresh[i], {u.col(static_cast<Eigen::Index>(i)), -1});
+    const Eigen::Matrix3Xd u = displacement_of_nodes(
+        columns_, sphere_model() ? solve_spheres(previous_spheres_) : solve(previous_contacts_),
+        fresh);
+    for (std::size_t i = 0; i < fresh.size(); ++i)
+      hold(fresh[i], {u.col(static_cast<Eigen::Index>(i)), -1});
   } else if (contact_points.empty() && step_delay_held) {
     release_step_delay_nodes();
   }
 
   // Under the sphere contact model the state solve holds the obstacles' nodes itself.
-  for (int pass = 0; pass < options_.obstacle_iterations && !obstacles_.empty() && !sphere_model(); ++pass)
+  for (int pass = 0; pass < options_.obstacle_iterations && !obstacles_.empty() && !sphere_model();
+       ++pass)
     if (!update_obstacle_contacts(under_tool)) break;
   return boundary_dirty_;
 }
@@ -352,25 +387,27 @@ StepReport Simulation::step(double time) {
       continue;
     }
     candidates_.find(user.position, surface_candidates_, touchable_candidates_);
-    user.contact = find_contact(body_.mesh, body_.surface, body_.normals, touchable_candidates_, user.position,
-                                user.radius, surface_candidates_)
+    user.contact = find_contact(body_.mesh, body_.surface, body_.normals, touchable_candidates_,
+                                user.position, user.radius, surface_candidates_)
                        .contact;
     user.pressing = user.contact.has_value();
     // A contact's triangle is the nearest touchable one, found by the same rule.
     user.nearest = user.pressing ? user.contact->triangle
-                                 : nearest_triangle(body_.mesh, body_.surface, body_.normals, touchable_candidates_,
-                                                    user.position)
+                                 : nearest_triangle(body_.mesh, body_.surface, body_.normals,
+                                                    touchable_candidates_, user.position)
                                        .triangle;
     for (int node : body_.surface.triangles[user.nearest]) under_tool[node] = true;
     if (options_.step_delay_nodes > 0)  // only step-delay nodes are chosen outside the patches
-      for (int t : contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable_triangle_))
+      for (int t :
+           contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable_triangle_))
         for (int node : body_.surface.triangles[t]) in_patch[node] = true;
     if (sphere_model()) mark_sphere(user, under_tool, in_patch, touchable_triangle_);
   }
 
   Stopwatch watch;
   bool boundary_changed = update_boundary(under_tool, in_patch);
-  if (sphere_model()) boundary_changed |= carry_pushed_nodes_into_patches(under_tool, in_patch, report);
+  if (sphere_model())
+    boundary_changed |= carry_pushed_nodes_into_patches(under_tool, in_patch, report);
   if (coupling_) coupling_(*this);
   std::vector<int>& nearest = step_nearest_;
   nearest.clear();
@@ -378,9 +415,12 @@ StepReport Simulation::step(double time) {
     const UserState& user = users_[u];
     // A sphere that holds nothing follows its nearest triangle, so that its IR is there when
     // it touches; once it holds nodes, their being row nodes is what counts (below).
-    const bool follows_nearest = !sphere_model() || (user.sphere_holds.empty() && user.sphere_carried.empty());
+    const bool follows_nearest =
+        !sphere_model() || (user.sphere_holds.empty() && user.sphere_carried.empty());
     nearest.push_back(!user.known ? -1 : follows_nearest ? user.nearest : kHoldingSphere);
-    if (user.known) tools.push_back({static_cast<int>(u), user.position, user.radius, user.nearest, user.sphere_carried});
+    if (user.known)
+      tools.push_back(
+          {static_cast<int>(u), user.position, user.radius, user.nearest, user.sphere_carried});
   }
   // Under naive_every_step M~ is computed again every step, as the paper's conventional loop
   // did (that cost is the step delay), but with unchanged sets it is the same IR: a new one
@@ -398,12 +438,15 @@ StepReport Simulation::step(double time) {
     const std::vector<Eigen::Vector3d> held = boundary_displacement(condensation);
     RestDisplacement rest_displacement;  // the support's load at rest, if any
     if (support_ && support_->loads_at_rest())
-      rest_displacement = [support = support_.get()](std::span<const int> dofs) { return support->rest_displacement(dofs); };
+      rest_displacement = [support = support_.get()](std::span<const int> dofs) {
+        return support->rest_displacement(dofs);
+      };
     SphereIrSource sphere;
     if (sphere_model()) {
-      sphere = {&sphere_solve_->normal_compliance(), sphere_solve_->contact_slots(), sphere_solve_->obstacle_rows(),
-                sphere_solve_->obstacle_constraints()};
-      if (sets_changed) built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
+      sphere = {&sphere_solve_->normal_compliance(), sphere_solve_->contact_slots(),
+                sphere_solve_->obstacle_rows(), sphere_solve_->obstacle_constraints()};
+      if (sets_changed)
+        built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
     }
     // One user's IR, and (when the sets changed) prepared for the server's own evaluation.
     struct BuiltIr {
@@ -412,8 +455,9 @@ StepReport Simulation::step(double time) {
       std::size_t bytes = 0;
     };
     const auto build = [&](std::size_t i) {
-      IntermediateRepresentation ir = build_ir(body_, condensation, tools, i, held, options_.ir,
-                                               users_[tools[i].user].epoch + 1, time, rest_displacement, sphere);
+      IntermediateRepresentation ir =
+          build_ir(body_, condensation, tools, i, held, options_.ir,
+                   users_[tools[i].user].epoch + 1, time, rest_displacement, sphere);
       BuiltIr built;
       if (!sets_changed) return built;
       built.bytes = ir.size_bytes();
@@ -427,11 +471,13 @@ StepReport Simulation::step(double time) {
       // support's load is touched), so the users' IRs are built side by side, one thread per
       // further user, joined here: a rebuild that changes every IR costs about one build.
       std::vector<std::future<BuiltIr>> others;
-      for (std::size_t i = 1; i < tools.size(); ++i) others.push_back(std::async(std::launch::async, build, i));
+      for (std::size_t i = 1; i < tools.size(); ++i)
+        others.push_back(std::async(std::launch::async, build, i));
       built[0] = build(0);  // should it throw, the futures' destructors join their threads first
       for (std::size_t i = 1; i < tools.size(); ++i) built[i] = others[i - 1].get();
     } else {
-      for (std::size_t i = 0; i < tools.size(); ++i) built[i] = build(i);  // condense() updates the condensation
+      for (std::size_t i = 0; i < tools.size(); ++i)
+        built[i] = build(i);  // condense() updates the condensation
     }
     for (std::size_t i = 0; i < tools.size() && sets_changed; ++i) {
       UserState& user = users_[tools[i].user];
@@ -448,7 +494,9 @@ StepReport Simulation::step(double time) {
       built_row_directions_.clear();
       const NormalCompliance& normal = sphere_solve_->normal_compliance();
       for (int node = 0; node < body_.mesh.node_count(); ++node)
-        if (const int slot = built_sphere_rows_[static_cast<std::size_t>(node)] ? normal.slot_of(node) : -1; slot >= 0)
+        if (const int slot =
+                built_sphere_rows_[static_cast<std::size_t>(node)] ? normal.slot_of(node) : -1;
+            slot >= 0)
           built_row_directions_.emplace_back(node, normal.normal(slot));
     }
     report.rebuilt = sets_changed;
@@ -463,11 +511,14 @@ StepReport Simulation::step(double time) {
   return report;
 }
 
-std::vector<Eigen::Vector3d> Simulation::remote_positions(const IntermediateRepresentation& ir) const {
+std::vector<Eigen::Vector3d> Simulation::remote_positions(
+    const IntermediateRepresentation& ir) const {
   std::vector<Eigen::Vector3d> positions;
   for (int r = 0; r < remote_count(ir); ++r) {
     const UserState& user = users_[remote_user(ir, r)];
-    positions.push_back(user.known ? user.position : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+    positions.push_back(user.known
+                            ? user.position
+                            : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
   }
   return positions;
 }

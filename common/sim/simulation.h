@@ -77,8 +77,9 @@ class Simulation {
   /// One user per tool (usually the scene's tools). `body` and `columns` (whose rows
   /// must include every node that can be held) must outlive it; the body's surface nodes
   /// collide with `obstacles` (copied into distance queries here).
-  Simulation(const ElasticBody& body, std::span<const Obstacle> obstacles, ComplianceColumns& columns,
-             const std::vector<ToolSpec>& tools, SimulationOptions options);
+  Simulation(const ElasticBody& body, std::span<const Obstacle> obstacles,
+             ComplianceColumns& columns, const std::vector<ToolSpec>& tools,
+             SimulationOptions options);
 
   int user_count() const { return static_cast<int>(users_.size()); }
   void set_tool(int user, const Eigen::Vector3d& position);
@@ -94,7 +95,9 @@ class Simulation {
   void set_step_delay_nodes(int nodes);
 
   /// Latest IR of `user`; null until its tool position is known.
-  std::shared_ptr<const PreparedIR> ir(int user) const { return users_[static_cast<std::size_t>(user)].ir; }
+  std::shared_ptr<const PreparedIR> ir(int user) const {
+    return users_[static_cast<std::size_t>(user)].ir;
+  }
   /// Reaction force on `user`'s tool now (zero if it has no IR).
   ForceSample force(int user) const;
   /// Positions of the remote tools of `ir`, in its remotes' order (NaN where unknown).
@@ -143,8 +146,9 @@ class Simulation {
     /// Sphere contact model: nodes outside its sphere at rest that the state has it push and
     /// that its patch would not hold otherwise; their triangles join the patch.
     std::vector<int> sphere_carried;
-    std::vector<int> sphere_patch_nodes;  ///< its patch's nodes without the carried nodes' triangles
-    std::vector<int> sphere_nodes;        ///< its patch's nodes with them: its candidates
+    std::vector<int>
+        sphere_patch_nodes;         ///< its patch's nodes without the carried nodes' triangles
+    std::vector<int> sphere_nodes;  ///< its patch's nodes with them: its candidates
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
   };
@@ -165,7 +169,8 @@ class Simulation {
   /// beyond the rings) joins that patch, B is updated again, and the state solved again.
   /// Returns whether B changed; counts in `report` the pushed nodes still left out after
   /// kMaxCarryPasses passes.
-  bool carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, std::vector<bool>& in_patch, StepReport& report);
+  bool carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, std::vector<bool>& in_patch,
+                                       StepReport& report);
   std::vector<SphereTool> spheres() const;  ///< every known user's tool
   StateSolution solve_spheres(std::span<const SphereTool> spheres) const;
   /// Sphere model: whether the IRs last built stand: they hold every node a sphere holds or
@@ -175,7 +180,8 @@ class Simulation {
   bool update_obstacle_contacts(const std::vector<bool>& under_tool);
   /// The condensation the IRs are built over: the support's, with B synchronised, or the body's.
   IncrementalCondensation& ir_condensation();
-  std::vector<Eigen::Vector3d> boundary_displacement(const IncrementalCondensation& condensation) const;
+  std::vector<Eigen::Vector3d> boundary_displacement(
+      const IncrementalCondensation& condensation) const;
   void hold(int node, const HeldNode& held);
   void release(int node);
   Eigen::VectorXd boundary_dof_displacement() const;
@@ -183,23 +189,30 @@ class Simulation {
   const ElasticBody& body_;
   ComplianceColumns& columns_;
   SimulationOptions options_;
-  bool step_delay_changed_ = false;  // set_step_delay_nodes() since the last step
+  bool step_delay_changed_ = false;               // set_step_delay_nodes() since the last step
   mutable IncrementalCondensation condensation_;  // its Z cache changes on const queries
   std::vector<ObstacleDistance> obstacles_;
-  NearestTriangleCandidates candidates_;          // the few triangles each tool's nearest-triangle scans visit
-  std::vector<int> surface_candidates_, touchable_candidates_;  // their scratch, reused step to step
-  std::vector<bool> touchable_triangle_;          // per surface triangle
-  ObstacleClearance clearance_;                   // per surface node: where it was last found clear of the obstacles
-  std::vector<NodeDistance> near_obstacles_;      // see nodes_near_obstacles()
+  NearestTriangleCandidates
+      candidates_;  // the few triangles each tool's nearest-triangle scans visit
+  std::vector<int> surface_candidates_,
+      touchable_candidates_;              // their scratch, reused step to step
+  std::vector<bool> touchable_triangle_;  // per surface triangle
+  ObstacleClearance clearance_;  // per surface node: where it was last found clear of the obstacles
+  std::vector<NodeDistance> near_obstacles_;  // see nodes_near_obstacles()
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
-  std::vector<int> built_nearest_;                // nearest triangles the IRs were built for
-  std::vector<char> built_sphere_rows_;             // per node: a row node of the IRs last built (sphere model)
-  std::vector<std::pair<int, Eigen::Vector3d>> built_row_directions_;  // sphere model: those rows' nodes with a slot, ascending, and its direction then
+  std::vector<int> built_nearest_;  // nearest triangles the IRs were built for
+  std::vector<char>
+      built_sphere_rows_;  // per node: a row node of the IRs last built (sphere model)
+  std::vector<std::pair<int, Eigen::Vector3d>>
+      built_row_directions_;  // sphere model: those rows' nodes with a slot, ascending, and its
+                              // direction then
   std::unordered_map<std::int64_t, int> node_of_tag_;  // sphere model: to read the IRs' row nodes
-  std::vector<PressingContact> previous_contacts_;  // the pressing contacts of the previous step
-  std::vector<SphereTool> previous_spheres_;        // the sphere model's: the spheres of the previous step
-  mutable std::unique_ptr<SphereStateSolve> sphere_solve_;  // the sphere model's state solve, kept step to step
+  std::vector<PressingContact> previous_contacts_;     // the pressing contacts of the previous step
+  std::vector<SphereTool>
+      previous_spheres_;  // the sphere model's: the spheres of the previous step
+  mutable std::unique_ptr<SphereStateSolve>
+      sphere_solve_;  // the sphere model's state solve, kept step to step
   mutable std::vector<EvaluationState> p0_states_;  // per user: force()'s evaluation of its IR
   // step()'s scratch: the known tools, their nearest triangles and sphere-held nodes, the
   // nodes under them and in their patches.
@@ -207,11 +220,11 @@ class Simulation {
   std::vector<int> step_nearest_;
   std::vector<bool> under_tool_, in_patch_;
   bool boundary_dirty_ = false;
-  AppliedLoads applied_;                            // see set_applied_loads
-  std::function<void(Simulation&)> coupling_;       // see set_coupling
-  std::unique_ptr<SupportedCompliance> support_;    // see set_support
+  AppliedLoads applied_;                                             // see set_applied_loads
+  std::function<void(Simulation&)> coupling_;                        // see set_coupling
+  std::unique_ptr<SupportedCompliance> support_;                     // see set_support
   std::unique_ptr<IncrementalCondensation> supported_condensation_;  // over *support_
-  bool support_changed_ = false;                    // since the IRs were last built
+  bool support_changed_ = false;  // since the IRs were last built
 };
 
 }  // namespace cohaptic

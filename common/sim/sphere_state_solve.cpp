@@ -25,7 +25,8 @@ std::vector<int> obstacle_nodes_of(std::span<const SphereConstraint> obstacles) 
 // How many nodes can be candidates at once: the touchable ones and the obstacles'.
 Eigen::Index candidate_bound(std::span<const int> touchable, std::span<const int> obstacle_nodes) {
   std::vector<int> all;
-  std::set_union(touchable.begin(), touchable.end(), obstacle_nodes.begin(), obstacle_nodes.end(), std::back_inserter(all));
+  std::set_union(touchable.begin(), touchable.end(), obstacle_nodes.begin(), obstacle_nodes.end(),
+                 std::back_inserter(all));
   return static_cast<Eigen::Index>(all.size());
 }
 
@@ -42,7 +43,8 @@ SphereStateSolve::SphereStateSolve(const ElasticBody& body, ComplianceColumns& c
       normal_(columns, body.dofs, directions_, candidate_bound(touchable_, obstacle_nodes_)),
       contact_(static_cast<int>(normal_.capacity())) {}
 
-void SphereStateSolve::set_candidates(const std::vector<int>& nodes, IncrementalCondensation& condensation,
+void SphereStateSolve::set_candidates(const std::vector<int>& nodes,
+                                      IncrementalCondensation& condensation,
                                       const Eigen::VectorXd& boundary_displacement) {
   std::vector<char> wanted(static_cast<std::size_t>(body_.mesh.node_count()), 0);
   for (int node : nodes) wanted[static_cast<std::size_t>(node)] = 1;
@@ -56,26 +58,32 @@ void SphereStateSolve::set_candidates(const std::vector<int>& nodes, Incremental
   const bool w_changed = normal_.update(nodes, condensation, boundary_displacement);
   if (w_changed || contact_.capacity() < normal_.capacity()) {
     const std::vector<int> kept(contact_.members().begin(), contact_.members().end());
-    if (contact_.capacity() < normal_.capacity()) contact_ = IncrementalContactSolve(static_cast<int>(normal_.capacity()));
+    if (contact_.capacity() < normal_.capacity())
+      contact_ = IncrementalContactSolve(static_cast<int>(normal_.capacity()));
     if (!contact_.start_from(normal_.w(), kept)) contact_.clear();
   }
 }
 
-StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std::span<const int> patch_nodes,
-                                      std::span<const SphereTool> spheres, const Eigen::VectorXd& boundary_displacement) {
+StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation,
+                                      std::span<const int> patch_nodes,
+                                      std::span<const SphereTool> spheres,
+                                      const Eigen::VectorXd& boundary_displacement) {
   const DofMap& dofs = body_.dofs;
   obstacle_rows_.clear();  // until this solve finds them (a solve that throws leaves none)
   obstacle_contacts_.clear();
   const auto constraint_of = [&](int node) {
     return node_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
-                           dofs.fixed_axes[static_cast<std::size_t>(node)], spheres, obstacle_at(obstacle_, node));
+                           dofs.fixed_axes[static_cast<std::size_t>(node)], spheres,
+                           obstacle_at(obstacle_, node));
   };
   std::vector<int> candidates;
-  std::vector<int> index_of(static_cast<std::size_t>(body_.mesh.node_count()), -1);  // among the candidates
+  std::vector<int> index_of(static_cast<std::size_t>(body_.mesh.node_count()),
+                            -1);  // among the candidates
   const auto listed = [&](int node) { return index_of[static_cast<std::size_t>(node)] >= 0; };
   const auto add = [&](int node) {
     if (listed(node) || condensation.in_boundary(node) ||
-        (!holdable(body_.contact_normals.col(node), dofs.fixed_axes[static_cast<std::size_t>(node)]) &&
+        (!holdable(body_.contact_normals.col(node),
+                   dofs.fixed_axes[static_cast<std::size_t>(node)]) &&
          !obstacle_at(obstacle_, node)))
       return false;
     index_of[static_cast<std::size_t>(node)] = static_cast<int>(candidates.size());
@@ -87,8 +95,9 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
     bool added = false;
     for (int node : touchable_)
       if (!listed(node))
-        if (const auto constraint = sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
-                                                      dofs.fixed_axes[static_cast<std::size_t>(node)], spheres);
+        if (const auto constraint =
+                sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
+                                  dofs.fixed_axes[static_cast<std::size_t>(node)], spheres);
             constraint && constraint->gap < band)
           added |= add(node);
     return added;
@@ -100,7 +109,8 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
     obstacle_band_ = std::max(obstacle_band_, band);
     bool added = false;
     for (int node : obstacle_nodes_)
-      if (!listed(node) && obstacle_[static_cast<std::size_t>(node)].gap < obstacle_band_ + kObstacleBandMargin)
+      if (!listed(node) &&
+          obstacle_[static_cast<std::size_t>(node)].gap < obstacle_band_ + kObstacleBandMargin)
         added |= add(node);
     return added;
   };
@@ -113,11 +123,13 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
     std::vector<std::optional<SphereConstraint>> constraints;
     for (int node : candidates) {
       constraints.push_back(constraint_of(node));
-      directions_.col(node) = constraints.back() ? constraints.back()->normal : body_.contact_normals.col(node);
+      directions_.col(node) =
+          constraints.back() ? constraints.back()->normal : body_.contact_normals.col(node);
     }
     set_candidates(candidates, condensation, boundary_displacement);
     const auto constraint_of_slot = [&](int slot) -> const std::optional<SphereConstraint>& {
-      return constraints[static_cast<std::size_t>(index_of[static_cast<std::size_t>(normal_.node_of(slot))])];
+      return constraints[static_cast<std::size_t>(
+          index_of[static_cast<std::size_t>(normal_.node_of(slot))])];
     };
     const Eigen::Index capacity = normal_.capacity();
     clearance_.setConstant(capacity, kNone);
@@ -155,15 +167,18 @@ StateSolution SphereStateSolve::solve(IncrementalCondensation& condensation, std
       deepest = std::max(deepest, normal_.free_clearance()[slot] - clearance_[slot]);
     }
     for (int slot = 0; slot < normal_.slot_count(); ++slot)
-      if (normal_.node_of(slot) >= 0) deepest = std::max(deepest, std::abs(normal_.free_clearance()[slot]));
-    state.contact_forces = Eigen::Map<const Eigen::VectorXd>(forces.data(), static_cast<Eigen::Index>(forces.size()));
+      if (normal_.node_of(slot) >= 0)
+        deepest = std::max(deepest, std::abs(normal_.free_clearance()[slot]));
+    state.contact_forces =
+        Eigen::Map<const Eigen::VectorXd>(forces.data(), static_cast<Eigen::Index>(forces.size()));
     // Every touchable node within twice that of a sphere, and every obstacle node within it
     // of its obstacle, must have been a candidate; else they join and the state is solved again.
     const double band = kBandPerDepth * deepest;
     const bool wider = band > band_;
     band_ = band;
     if (wider) {
-      const bool sphere_candidates_joined = add_band(band);  // both run: each adds its own candidates
+      const bool sphere_candidates_joined =
+          add_band(band);  // both run: each adds its own candidates
       const bool obstacle_candidates_joined = add_obstacle_band(band);
       if (sphere_candidates_joined || obstacle_candidates_joined) continue;
     }
@@ -186,15 +201,18 @@ void SphereStateSolve::find_obstacle_rows(std::span<const int> patch_nodes) {
   obstacle_contacts_.clear();
   for (int slot = 0; slot < normal_.slot_count(); ++slot) {
     const int node = normal_.node_of(slot);
-    if (node < 0 || tool_[static_cast<std::size_t>(slot)] >= 0 || clearance_[slot] == kNone) continue;  // no obstacle's
+    if (node < 0 || tool_[static_cast<std::size_t>(slot)] >= 0 || clearance_[slot] == kNone)
+      continue;  // no obstacle's
     const double clearance =
-        clearance_[slot] + (static_cast<std::size_t>(slot) < w_push.size()
-                                ? w_push[static_cast<std::size_t>(slot)]
-                                : gathered_dot(normal_.w().col(slot).data(), members.data(), pushes.data(),
-                                               static_cast<Eigen::Index>(members.size())));
+        clearance_[slot] +
+        (static_cast<std::size_t>(slot) < w_push.size()
+             ? w_push[static_cast<std::size_t>(slot)]
+             : gathered_dot(normal_.w().col(slot).data(), members.data(), pushes.data(),
+                            static_cast<Eigen::Index>(members.size())));
     const bool pushed = contact_.push(slot) > 0;
     if (pushed || clearance < kObstacleJoin) obstacle_contacts_.push_back(node);
-    if (pushed || clearance < kObstacleReach || in_patch[static_cast<std::size_t>(node)]) obstacle_rows_.push_back(node);
+    if (pushed || clearance < kObstacleReach || in_patch[static_cast<std::size_t>(node)])
+      obstacle_rows_.push_back(node);
   }
   std::sort(obstacle_rows_.begin(), obstacle_rows_.end());
   std::sort(obstacle_contacts_.begin(), obstacle_contacts_.end());

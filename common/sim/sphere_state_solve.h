@@ -61,7 +61,8 @@ class SphereStateSolve {
   /// `body` and `columns` (whose rows include every touchable node, every node an obstacle
   /// may hold and every node B may hold) must outlive it. `obstacles`: per volume node, its
   /// obstacle constraint (obstacle_constraints.h), or empty for none.
-  SphereStateSolve(const ElasticBody& body, ComplianceColumns& columns, std::vector<SphereConstraint> obstacles = {});
+  SphereStateSolve(const ElasticBody& body, ComplianceColumns& columns,
+                   std::vector<SphereConstraint> obstacles = {});
   SphereStateSolve(const SphereStateSolve&) = delete;  // normal_ refers to directions_
   SphereStateSolve& operator=(const SphereStateSolve&) = delete;
 
@@ -71,7 +72,8 @@ class SphereStateSolve {
   /// pushed nodes (by spheres and by obstacles); tool_forces[t] is sphere t's force on the
   /// object. Throws NumericalError if the problem cannot be solved.
   StateSolution solve(IncrementalCondensation& condensation, std::span<const int> patch_nodes,
-                      std::span<const SphereTool> spheres, const Eigen::VectorXd& boundary_displacement);
+                      std::span<const SphereTool> spheres,
+                      const Eigen::VectorXd& boundary_displacement);
 
   /// The normal compliance over the last solve's candidates.
   const NormalCompliance& normal_compliance() const { return normal_; }
@@ -100,16 +102,17 @@ class SphereStateSolve {
   std::vector<int> touchable_;  // the touchable triangles' nodes: all that spheres can push
   std::vector<SphereConstraint> obstacle_;  // per volume node (empty: no obstacles)
   std::vector<int> obstacle_nodes_;         // the nodes with an obstacle constraint, ascending
-  Eigen::Matrix3Xd directions_;             // per volume node: its push's direction as of the last solve
+  Eigen::Matrix3Xd directions_;  // per volume node: its push's direction as of the last solve
   NormalCompliance normal_;
   IncrementalContactSolve contact_;
   /// The band of the candidates: twice the deepest penetration.
   static constexpr double kBandPerDepth = 2;
 
-  double band_ = 0;             // [m], as of the last solve
-  double obstacle_band_ = 0;    // [m], the widest band so far
-  Eigen::VectorXd clearance_;   // per slot, this solve's q
-  std::vector<int> tool_;       // per slot, the sphere holding it (-1: none, or an obstacle: then q is finite)
+  double band_ = 0;            // [m], as of the last solve
+  double obstacle_band_ = 0;   // [m], the widest band so far
+  Eigen::VectorXd clearance_;  // per slot, this solve's q
+  std::vector<int>
+      tool_;  // per slot, the sphere holding it (-1: none, or an obstacle: then q is finite)
   std::vector<int> obstacle_rows_, obstacle_contacts_;
   int obstacle_pushed_ = 0;
 };

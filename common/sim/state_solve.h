@@ -23,7 +23,7 @@
 namespace cohaptic {
 
 struct PressingContact {
-  std::array<int, 3> nodes{};                      ///< volume node indices of the triangle
+  std::array<int, 3> nodes{};  ///< volume node indices of the triangle
   Eigen::Vector3d weights = Eigen::Vector3d::Zero();
   Eigen::Vector3d displacement = Eigen::Vector3d::Zero();  ///< d [m]
 };
@@ -35,27 +35,31 @@ struct AppliedLoads {
 };
 
 struct StateSolution {
-  std::vector<int> contact_dofs;    ///< global free dofs of the pressing triangles
-  Eigen::VectorXd contact_forces;   ///< tools' forces on those dofs [N]
-  std::vector<int> boundary_dofs;   ///< global free dofs of B
-  Eigen::VectorXd boundary_forces;  ///< holding forces on those dofs [N]
+  std::vector<int> contact_dofs;             ///< global free dofs of the pressing triangles
+  Eigen::VectorXd contact_forces;            ///< tools' forces on those dofs [N]
+  std::vector<int> boundary_dofs;            ///< global free dofs of B
+  Eigen::VectorXd boundary_forces;           ///< holding forces on those dofs [N]
   std::vector<Eigen::Vector3d> tool_forces;  ///< force each tool applies to the object [N]
-  AppliedLoads applied;             ///< the loads the solve was given
+  AppliedLoads applied;                      ///< the loads the solve was given
 };
 
 /// At most kMaxUsers contacts, sharing no node. u_B over the free dofs of B in the
-/// condensation's order; `applied` on any row nodes. Throws NumericalError if a system is not positive definite.
-StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& condensation, const DofMap& dofs,
-                          std::span<const PressingContact> contacts, const Eigen::VectorXd& boundary_displacement,
-                          ContactModel contact_model, const AppliedLoads& applied = {});
+/// condensation's order; `applied` on any row nodes. Throws NumericalError if a system is not
+/// positive definite.
+StateSolution solve_state(ComplianceColumns& columns, IncrementalCondensation& condensation,
+                          const DofMap& dofs, std::span<const PressingContact> contacts,
+                          const Eigen::VectorXd& boundary_displacement, ContactModel contact_model,
+                          const AppliedLoads& applied = {});
 
 /// Completes `state` from its contact forces: the holding forces on B, from
 /// L_BB f_B = u_B - L_BZ f_Z - L_BP F_P (F_P: state.applied; sets state.boundary_dofs and
 /// state.boundary_forces).
-void solve_boundary_forces(ComplianceColumns& columns, const IncrementalCondensation& condensation, const DofMap& dofs,
-                           const Eigen::VectorXd& boundary_displacement, StateSolution& state);
+void solve_boundary_forces(ComplianceColumns& columns, const IncrementalCondensation& condensation,
+                           const DofMap& dofs, const Eigen::VectorXd& boundary_displacement,
+                           StateSolution& state);
 
 /// Displacement [m] of `nodes` (row nodes of `columns`) in the solved state, one column each.
-Eigen::Matrix3Xd displacement_of_nodes(ComplianceColumns& columns, const StateSolution& state, std::span<const int> nodes);
+Eigen::Matrix3Xd displacement_of_nodes(ComplianceColumns& columns, const StateSolution& state,
+                                       std::span<const int> nodes);
 
 }  // namespace cohaptic

@@ -7,12 +7,13 @@
 namespace cohaptic {
 
 struct StepReport {
-  bool rebuilt = false;       ///< new IRs were built this step (a set changed, or a dynamic body's IR was due)
-  bool recomputed = false;    ///< M~ was computed this step (rebuilt, or naive_every_step)
-  double rebuild_ms = 0;      ///< time to update B and compute every M~ (or cut every sub-network)
-  std::size_t ir_bytes = 0;   ///< total size of the IRs rebuilt
-  int boundary_nodes = 0;     ///< |B| after the step
-  int obstacle_nodes = 0;     ///< of which held by obstacles
+  bool rebuilt =
+      false;  ///< new IRs were built this step (a set changed, or a dynamic body's IR was due)
+  bool recomputed = false;   ///< M~ was computed this step (rebuilt, or naive_every_step)
+  double rebuild_ms = 0;     ///< time to update B and compute every M~ (or cut every sub-network)
+  std::size_t ir_bytes = 0;  ///< total size of the IRs rebuilt
+  int boundary_nodes = 0;    ///< |B| after the step
+  int obstacle_nodes = 0;    ///< of which held by obstacles
   /// Sphere model: nodes the state has a sphere push that no IR's patch holds (its client
   /// cannot feel them); 0 unless the patches failed to settle in a step.
   int sphere_nodes_outside_patches = 0;

@@ -8,16 +8,19 @@
 
 namespace cohaptic {
 
-SupportedCompliance::SupportedCompliance(ComplianceSource& base, const DofMap& dofs, std::vector<int> nodes,
-                                         const Eigen::Matrix3Xd& normals, const Eigen::MatrixXd& support_compliance,
+SupportedCompliance::SupportedCompliance(ComplianceSource& base, const DofMap& dofs,
+                                         std::vector<int> nodes, const Eigen::Matrix3Xd& normals,
+                                         const Eigen::MatrixXd& support_compliance,
                                          const Eigen::VectorXd& rest_gaps)
     : base_(base), nodes_(std::move(nodes)) {
   const auto count = static_cast<Eigen::Index>(nodes_.size());
-  if (normals.cols() != count || support_compliance.rows() != count || support_compliance.cols() != count ||
-      (rest_gaps.size() != 0 && rest_gaps.size() != count))
-    throw Error(fmt::format("supported compliance: {} support nodes, {} normals, a {}x{} support compliance, {} rest gaps",
-                            count, normals.cols(), support_compliance.rows(), support_compliance.cols(),
-                            rest_gaps.size()));
+  if (normals.cols() != count || support_compliance.rows() != count ||
+      support_compliance.cols() != count || (rest_gaps.size() != 0 && rest_gaps.size() != count))
+    throw Error(
+        fmt::format("supported compliance: {} support nodes, {} normals, a {}x{} support "
+                    "compliance, {} rest gaps",
+                    count, normals.cols(), support_compliance.rows(), support_compliance.cols(),
+                    rest_gaps.size()));
   // A fixed axis of A has no row (its L is zero): the support's spring along it does
   // nothing, as K_ff leaves it out. N keeps the free axes only.
   std::vector<std::pair<Eigen::Index, double>> entries;  // (support, normal component) per free dof
@@ -37,8 +40,11 @@ SupportedCompliance::SupportedCompliance(ComplianceSource& base, const DofMap& d
   const Eigen::MatrixXd coupled = support_compliance + normals_.transpose() * block_times_normals;
   coupled_.compute((coupled + coupled.transpose()) / 2);
   if (coupled_.info() != Eigen::Success)
-    throw Error(fmt::format("supported compliance: the {} supporting nodes' coupled compliance is not positive definite "
-                            "(neither A nor the support gives way along a normal)", count));
+    throw Error(
+        fmt::format("supported compliance: the {} supporting nodes' coupled compliance is not "
+                    "positive definite "
+                    "(neither A nor the support gives way along a normal)",
+                    count));
   if (rest_gaps.size() != 0 && !rest_gaps.isZero(0))
     rest_loads_ = normals_ * Eigen::VectorXd(-coupled_.solve(rest_gaps));
 }
@@ -48,11 +54,16 @@ Eigen::VectorXd SupportedCompliance::rest_displacement(std::span<const int> dofs
   return base_.dof_block(dofs, dofs_) * rest_loads_;
 }
 
-void SupportedCompliance::compute_columns(const std::vector<int>& nodes) { base_.compute_columns(nodes); }
+void SupportedCompliance::compute_columns(const std::vector<int>& nodes) {
+  base_.compute_columns(nodes);
+}
 
-Eigen::MatrixXd SupportedCompliance::dof_block(std::span<const int> row_dofs, std::span<const int> col_dofs) {
-  const Eigen::MatrixXd rows = Eigen::MatrixXd(base_.dof_block(row_dofs, dofs_) * normals_);  // L_XS N
-  const Eigen::MatrixXd cols = Eigen::MatrixXd(base_.dof_block(col_dofs, dofs_) * normals_);  // L_YS N = (N^T L_SY)^T, L symmetric
+Eigen::MatrixXd SupportedCompliance::dof_block(std::span<const int> row_dofs,
+                                               std::span<const int> col_dofs) {
+  const Eigen::MatrixXd rows =
+      Eigen::MatrixXd(base_.dof_block(row_dofs, dofs_) * normals_);  // L_XS N
+  const Eigen::MatrixXd cols = Eigen::MatrixXd(base_.dof_block(col_dofs, dofs_) *
+                                               normals_);  // L_YS N = (N^T L_SY)^T, L symmetric
   return base_.dof_block(row_dofs, col_dofs) - rows * coupled_.solve(cols.transpose());
 }
 

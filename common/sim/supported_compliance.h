@@ -35,8 +35,9 @@ class SupportedCompliance final : public ComplianceSource {
   /// node asked for and for `nodes` (S, one normal each, the columns of `normals`);
   /// `support_compliance` A_S is |S| square; `rest_gaps` g0 per node of S, or empty (all
   /// zero). Throws Error if A_S + N^T L_SS N is not positive definite.
-  SupportedCompliance(ComplianceSource& base, const DofMap& dofs, std::vector<int> nodes, const Eigen::Matrix3Xd& normals,
-                      const Eigen::MatrixXd& support_compliance, const Eigen::VectorXd& rest_gaps = {});
+  SupportedCompliance(ComplianceSource& base, const DofMap& dofs, std::vector<int> nodes,
+                      const Eigen::Matrix3Xd& normals, const Eigen::MatrixXd& support_compliance,
+                      const Eigen::VectorXd& rest_gaps = {});
 
   void compute_columns(const std::vector<int>& nodes) override;
   Eigen::MatrixXd dof_block(std::span<const int> row_dofs, std::span<const int> col_dofs) override;
@@ -50,7 +51,7 @@ class SupportedCompliance final : public ComplianceSource {
  private:
   ComplianceSource& base_;
   std::vector<int> nodes_;
-  std::vector<int> dofs_;            // the support nodes' free dofs
+  std::vector<int> dofs_;                // the support nodes' free dofs
   Eigen::SparseMatrix<double> normals_;  // N over those dofs, |dofs_| x |S|: one entry per dof
   Eigen::LLT<Eigen::MatrixXd> coupled_;  // of A_S + N^T L_SS N
   Eigen::VectorXd rest_loads_;           // N lambda0 over dofs_ [N]; empty when g0 = 0

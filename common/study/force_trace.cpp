@@ -12,14 +12,17 @@ namespace cohaptic {
 void validate(const ForceTrace& trace) {
   const std::size_t n = trace.time_s.size();
   if (trace.force.size() != n || trace.position.size() != n)
-    throw Error(fmt::format("force trace: {} times, {} forces and {} positions; they must be as many", n,
-                            trace.force.size(), trace.position.size()));
+    throw Error(
+        fmt::format("force trace: {} times, {} forces and {} positions; they must be as many", n,
+                    trace.force.size(), trace.position.size()));
   for (std::size_t k = 0; k < n; ++k) {
-    if (!std::isfinite(trace.time_s[k]) || !trace.force[k].allFinite() || !trace.position[k].allFinite())
+    if (!std::isfinite(trace.time_s[k]) || !trace.force[k].allFinite() ||
+        !trace.position[k].allFinite())
       throw Error(fmt::format("force trace: sample {} is not finite", k));
     if (k > 0 && !(trace.time_s[k] > trace.time_s[k - 1]))
-      throw Error(fmt::format("force trace: time must strictly increase, but sample {} is at {} s after {} s", k,
-                              trace.time_s[k], trace.time_s[k - 1]));
+      throw Error(fmt::format(
+          "force trace: time must strictly increase, but sample {} is at {} s after {} s", k,
+          trace.time_s[k], trace.time_s[k - 1]));
   }
 }
 
@@ -31,7 +34,8 @@ double peak_force_n(const ForceTrace& trace) {
 
 std::vector<Stroke> find_strokes(const ForceTrace& trace, double threshold_n) {
   validate(trace);
-  if (!(threshold_n >= 0)) throw Error(fmt::format("stroke threshold must be >= 0 N, got {}", threshold_n));
+  if (!(threshold_n >= 0))
+    throw Error(fmt::format("stroke threshold must be >= 0 N, got {}", threshold_n));
   std::vector<Stroke> strokes;
   const std::size_t n = trace.size();
   std::size_t k = 0;
@@ -43,7 +47,8 @@ std::vector<Stroke> find_strokes(const ForceTrace& trace, double threshold_n) {
     Stroke stroke{k, k};
     while (k < n && trace.force[k].norm() > threshold_n) ++k;
     stroke.end = k;
-    if (!strokes.empty() && trace.time_s[stroke.begin] - trace.time_s[strokes.back().end - 1] < kMinReleaseS)
+    if (!strokes.empty() &&
+        trace.time_s[stroke.begin] - trace.time_s[strokes.back().end - 1] < kMinReleaseS)
       strokes.back().end = stroke.end;  // a dip within one press
     else
       strokes.push_back(stroke);

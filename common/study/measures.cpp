@@ -41,15 +41,18 @@ void validate(const MeasureSettings& s) {
   if (!(s.contact_fraction > 0 && s.contact_fraction < 1))
     throw Error(fmt::format("contact fraction must be in (0, 1), got {}", s.contact_fraction));
   if (!(s.lowpass_hz > 0) || !std::isfinite(s.lowpass_hz))
-    throw Error(fmt::format("low-pass cut-off must be a positive frequency, got {} Hz", s.lowpass_hz));
+    throw Error(
+        fmt::format("low-pass cut-off must be a positive frequency, got {} Hz", s.lowpass_hz));
   if (!(s.min_stroke_s >= 0) || !std::isfinite(s.min_stroke_s))
     throw Error(fmt::format("minimum stroke duration must be >= 0 s, got {}", s.min_stroke_s));
   if (s.oscillation_reversals < 2)
-    throw Error(fmt::format("an oscillation needs at least 2 reversals, got {}", s.oscillation_reversals));
+    throw Error(
+        fmt::format("an oscillation needs at least 2 reversals, got {}", s.oscillation_reversals));
   if (!(s.oscillation_window_s > 0) || !std::isfinite(s.oscillation_window_s))
     throw Error(fmt::format("oscillation window must be > 0 s, got {}", s.oscillation_window_s));
   if (!(s.oscillation_swing_fraction > 0 && s.oscillation_swing_fraction <= 1))
-    throw Error(fmt::format("oscillation swing must be in (0, 1] of the peak, got {}", s.oscillation_swing_fraction));
+    throw Error(fmt::format("oscillation swing must be in (0, 1] of the peak, got {}",
+                            s.oscillation_swing_fraction));
 }
 
 double force_update_rate_hz(const ForceTrace& trace, const MeasureSettings& settings) {
@@ -75,7 +78,8 @@ double p99_force_step_ratio(const ForceTrace& trace, const MeasureSettings& sett
 double roughness(const ForceTrace& trace, const MeasureSettings& settings) {
   const std::vector<Stroke> strokes = contact_strokes(trace, settings);
   if (strokes.empty()) return kNaN;
-  const std::vector<Eigen::Vector3d> smooth = zero_phase_lowpass(trace.time_s, trace.force, settings.lowpass_hz);
+  const std::vector<Eigen::Vector3d> smooth =
+      zero_phase_lowpass(trace.time_s, trace.force, settings.lowpass_hz);
   double sum_sq = 0;
   std::size_t n = 0;
   for (const Stroke& stroke : strokes)
@@ -95,8 +99,8 @@ Eigen::Vector3d press_direction(const ForceTrace& trace, const Stroke& stroke) {
 
 std::vector<double> displacement_m(const ForceTrace& trace, const Stroke& stroke) {
   if (stroke.begin > stroke.end || stroke.end > trace.size())
-    throw Error(
-        fmt::format("stroke [{}, {}) is outside the trace of {} samples", stroke.begin, stroke.end, trace.size()));
+    throw Error(fmt::format("stroke [{}, {}) is outside the trace of {} samples", stroke.begin,
+                            stroke.end, trace.size()));
   const Eigen::Vector3d d = press_direction(trace, stroke);
   std::vector<double> s;
   s.reserve(stroke.size());
@@ -109,7 +113,8 @@ double terminal_force_ratio(const ForceTrace& trace, const Stroke& stroke) {
   const std::vector<double> s = displacement_m(trace, stroke);
   if (s.empty()) return kNaN;
   double peak = 0;
-  for (std::size_t k = stroke.begin; k < stroke.end; ++k) peak = std::max(peak, trace.force[k].norm());
+  for (std::size_t k = stroke.begin; k < stroke.end; ++k)
+    peak = std::max(peak, trace.force[k].norm());
   return peak > 0 ? trace.force[stroke.begin + deepest(s)].norm() / peak : kNaN;
 }
 
@@ -135,12 +140,13 @@ double effective_stiffness(const ForceTrace& trace, const Stroke& stroke) {
 
 double hysteresis_energy(const ForceTrace& trace, const Stroke& stroke) {
   if (stroke.begin > stroke.end || stroke.end > trace.size())
-    throw Error(
-        fmt::format("stroke [{}, {}) is outside the trace of {} samples", stroke.begin, stroke.end, trace.size()));
+    throw Error(fmt::format("stroke [{}, {}) is outside the trace of {} samples", stroke.begin,
+                            stroke.end, trace.size()));
   if (stroke.size() < 2) return kNaN;
   double work = 0;
   for (std::size_t k = stroke.begin; k + 1 < stroke.end; ++k)
-    work -= 0.5 * (trace.force[k] + trace.force[k + 1]).dot(trace.position[k + 1] - trace.position[k]);
+    work -=
+        0.5 * (trace.force[k] + trace.force[k + 1]).dot(trace.position[k + 1] - trace.position[k]);
   return work;
 }
 
@@ -152,7 +158,8 @@ double energy_given_to_hand(const ForceTrace& trace) {
   return work;
 }
 
-std::vector<OscillationEpisode> find_oscillations(const ForceTrace& trace, const MeasureSettings& settings) {
+std::vector<OscillationEpisode> find_oscillations(const ForceTrace& trace,
+                                                  const MeasureSettings& settings) {
   validate(trace);
   validate(settings);
   const double peak = peak_force_n(trace);
@@ -162,9 +169,9 @@ std::vector<OscillationEpisode> find_oscillations(const ForceTrace& trace, const
   if (axis.norm() > 1e-12 * peak) {
     axis.normalize();
   } else {  // forces cancel out: take the direction of the peak
-    const auto it =
-        std::max_element(trace.force.begin(), trace.force.end(),
-                         [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.norm() < b.norm(); });
+    const auto it = std::max_element(
+        trace.force.begin(), trace.force.end(),
+        [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.norm() < b.norm(); });
     axis = it->normalized();
   }
   const double swing = settings.oscillation_swing_fraction * peak;
@@ -276,7 +283,9 @@ void for_each_measure(Measures& m, Visit&& visit) {
 
 std::vector<NamedMeasure> named_measures(const TrialMeasures& m) {
   std::vector<NamedMeasure> named;
-  for_each_measure(m, [&](std::string_view name, const auto& value) { named.push_back({name, static_cast<double>(value)}); });
+  for_each_measure(m, [&](std::string_view name, const auto& value) {
+    named.push_back({name, static_cast<double>(value)});
+  });
   return named;
 }
 

@@ -71,7 +71,7 @@ namespace cohaptic {
 struct MeasureSettings {
   double contact_fraction = kDefaultContactFraction;  ///< stroke threshold as a fraction of P
   double lowpass_hz = 20;                             ///< roughness low-pass cut-off [Hz]
-  double min_stroke_s = 0.05;                ///< shorter strokes are left out of the trial's hardness means [s]
+  double min_stroke_s = 0.05;  ///< shorter strokes are left out of the trial's hardness means [s]
   int oscillation_reversals = 4;             ///< N
   double oscillation_window_s = 0.1;         ///< [s]
   double oscillation_swing_fraction = 0.05;  ///< delta / P
@@ -86,7 +86,8 @@ double p99_force_step_ratio(const ForceTrace& trace, const MeasureSettings& sett
 double roughness(const ForceTrace& trace, const MeasureSettings& settings = {});
 
 // Hardness of one stroke of the trace.
-Eigen::Vector3d press_direction(const ForceTrace& trace, const Stroke& stroke);     ///< d; zero if no force
+Eigen::Vector3d press_direction(const ForceTrace& trace,
+                                const Stroke& stroke);  ///< d; zero if no force
 std::vector<double> displacement_m(const ForceTrace& trace, const Stroke& stroke);  ///< s(b..e-1)
 double terminal_force_ratio(const ForceTrace& trace, const Stroke& stroke);
 double effective_stiffness(const ForceTrace& trace, const Stroke& stroke);  ///< [N/m]
@@ -99,7 +100,8 @@ struct OscillationEpisode {
   double begin_s = 0, end_s = 0;  ///< times of its first and last reversal
   int reversals = 0;
 };
-std::vector<OscillationEpisode> find_oscillations(const ForceTrace& trace, const MeasureSettings& settings = {});
+std::vector<OscillationEpisode> find_oscillations(const ForceTrace& trace,
+                                                  const MeasureSettings& settings = {});
 int oscillation_episodes(const ForceTrace& trace, const MeasureSettings& settings = {});
 
 /// Every measure of one trial (one trace). Hardness values are means over the strokes that

@@ -61,16 +61,19 @@ PairedComparisonAnalysis analyse_paired_comparisons(const PairedComparisonRating
 /// A factor's share of the main effect when the conditions are a full factorial design
 /// (every combination of the factors' levels exactly once).
 struct FactorEffect {
-  std::string name;                ///< the factor's name, or "interaction" for what is left
-  std::vector<double> level_scale; ///< the mean scale value of the conditions at each level (empty for the interaction)
-  VarianceSource source;           ///< its sum of squares, degrees of freedom and F test against the error
+  std::string name;                 ///< the factor's name, or "interaction" for what is left
+  std::vector<double> level_scale;  ///< the mean scale value of the conditions at each level (empty
+                                    ///< for the interaction)
+  VarianceSource source;  ///< its sum of squares, degrees of freedom and F test against the error
 };
 
 /// The main effect split into each factor's (from its levels' mean scale values, weighted
 /// by the conditions at each level) and the interaction left over, each with its F test.
 /// `level_of[i][f]`: condition i's level of factor f, 0 <= level < level_count[f]. Throws
 /// Error when the conditions are not the full factorial of the levels.
-std::vector<FactorEffect> factor_effects(const PairedComparisonAnalysis& analysis, const std::vector<std::string>& factor_names,
-                                         const std::vector<int>& level_count, const std::vector<std::vector<int>>& level_of);
+std::vector<FactorEffect> factor_effects(const PairedComparisonAnalysis& analysis,
+                                         const std::vector<std::string>& factor_names,
+                                         const std::vector<int>& level_count,
+                                         const std::vector<std::vector<int>>& level_of);
 
 }  // namespace cohaptic

@@ -28,9 +28,9 @@ namespace cohaptic {
 
 struct ScaleLineFigure {
   std::string title;
-  std::string question;             ///< e.g. "which felt finer?  positive: felt more"
-  std::vector<std::string> names;   ///< one per condition
-  std::vector<double> scale;        ///< alpha_i per condition, in grades
+  std::string question;                       ///< e.g. "which felt finer?  positive: felt more"
+  std::vector<std::string> names;             ///< one per condition
+  std::vector<double> scale;                  ///< alpha_i per condition, in grades
   double yardstick_05 = 0, yardstick_01 = 0;  ///< in grades, not negative
   double width = 800, height = 260;           ///< SVG user units (pixels)
 };
@@ -38,7 +38,8 @@ struct ScaleLineFigure {
 /// The pixel sizes the figure assumes for a label's box (12 px sans-serif text).
 inline constexpr double kScaleLineFontSize = 12;
 inline constexpr double kScaleLineCharWidth = 7;
-inline constexpr double kScaleLineLabelGap = 6;  ///< least horizontal space between two labels on a row
+inline constexpr double kScaleLineLabelGap =
+    6;  ///< least horizontal space between two labels on a row
 
 /// The width the figure reserves for `text` (kScaleLineCharWidth per UTF-8 character).
 double scale_line_label_width(std::string_view text);
@@ -63,12 +64,14 @@ void write_scale_line_svg(const std::filesystem::path& path, const ScaleLineFigu
 ///                    |difference| > Y at that level, else "no"
 /// Throws Error when the names are not one per condition or a file cannot be written.
 void write_analysis_csv(const std::filesystem::path& dir, const PairedComparisonAnalysis& analysis,
-                        const std::vector<std::string>& condition_names, const std::vector<FactorEffect>& factors);
+                        const std::vector<std::string>& condition_names,
+                        const std::vector<FactorEffect>& factors);
 
 /// A plain-text report for the terminal: scale values from highest to lowest, the analysis of
 /// variance (with the factors' lines) marked ** for p < 0.01 and * for p < 0.05, and the
 /// yardsticks as "Y(0.05) = 0.832". Throws Error when the names are not one per condition.
-std::string format_analysis_table(const PairedComparisonAnalysis& analysis, const std::vector<std::string>& names,
+std::string format_analysis_table(const PairedComparisonAnalysis& analysis,
+                                  const std::vector<std::string>& names,
                                   const std::vector<FactorEffect>& factors);
 
 }  // namespace cohaptic

@@ -33,7 +33,8 @@ double usable_measure(double value, std::string_view measure, std::string_view t
   if (std::isfinite(value) && value >= 0) return value;
   const std::string where = trial.empty() ? std::string() : fmt::format("{} trial: ", trial);
   if (std::isnan(value))
-    throw Error(fmt::format("{}{} is NaN (nothing to measure in the trial), so it cannot be rated", where, measure));
+    throw Error(fmt::format("{}{} is NaN (nothing to measure in the trial), so it cannot be rated",
+                            where, measure));
   throw Error(fmt::format("{}{} must be finite and >= 0, got {}", where, measure, value));
 }
 
@@ -45,7 +46,8 @@ double usable_measure(double value, std::string_view measure, std::string_view t
 // often are no longer felt as steps (vibrotactile sensitivity peaks near 250 Hz and falls
 // steeply above), so 500 Hz and 1 kHz feel equally continuous.
 double perceived_fineness(const TrialMeasures& measures, std::string_view trial) {
-  return std::min(usable_measure(measures.force_update_rate_hz, "force_update_rate_hz", trial), kContinuousForceRateHz);
+  return std::min(usable_measure(measures.force_update_rate_hz, "force_update_rate_hz", trial),
+                  kContinuousForceRateHz);
 }
 
 // Hardness: the terminal force ratio f'/f_max, the paper's own hardness measure. The stiffness
@@ -63,10 +65,13 @@ double perceived_hardness(const TrialMeasures& measures, std::string_view trial)
   return usable_measure(measures.terminal_force_ratio, "terminal_force_ratio", trial);
 }
 
-double magnitude_in_trial(RatedQuality quality, const TrialMeasures& measures, std::string_view trial) {
+double magnitude_in_trial(RatedQuality quality, const TrialMeasures& measures,
+                          std::string_view trial) {
   switch (quality) {
-    case RatedQuality::finer: return perceived_fineness(measures, trial);
-    case RatedQuality::harder: return perceived_hardness(measures, trial);
+    case RatedQuality::finer:
+      return perceived_fineness(measures, trial);
+    case RatedQuality::harder:
+      return perceived_hardness(measures, trial);
   }
   throw Error(fmt::format("unknown rated quality {}", static_cast<int>(quality)));
 }
@@ -88,8 +93,10 @@ RatedQuality parse_rated_quality(std::string_view text) {
 
 const char* to_string(RatedQuality quality) {
   switch (quality) {
-    case RatedQuality::finer: return "finer";
-    case RatedQuality::harder: return "harder";
+    case RatedQuality::finer:
+      return "finer";
+    case RatedQuality::harder:
+      return "harder";
   }
   return "?";
 }
@@ -97,7 +104,8 @@ const char* to_string(RatedQuality quality) {
 SimulatedRaterSettings default_rater_settings(RatedQuality quality, unsigned seed) {
   SimulatedRaterSettings settings;
   settings.quality = quality;
-  settings.just_noticeable_difference = quality == RatedQuality::harder ? kHardnessJnd : kFinenessJnd;
+  settings.just_noticeable_difference =
+      quality == RatedQuality::harder ? kHardnessJnd : kFinenessJnd;
   settings.noise_sd = kNoiseSdJnds;
   settings.seed = seed;
   return settings;
@@ -106,16 +114,22 @@ SimulatedRaterSettings default_rater_settings(RatedQuality quality, unsigned see
 void validate(const SimulatedRaterSettings& settings) {
   if (settings.quality != RatedQuality::finer && settings.quality != RatedQuality::harder)
     throw Error(fmt::format("unknown rated quality {}", static_cast<int>(settings.quality)));
-  if (!(settings.just_noticeable_difference > 0) || !std::isfinite(settings.just_noticeable_difference))
-    throw Error(fmt::format("just-noticeable difference must be a finite Weber fraction > 0, got {}",
-                            settings.just_noticeable_difference));
+  if (!(settings.just_noticeable_difference > 0) ||
+      !std::isfinite(settings.just_noticeable_difference))
+    throw Error(
+        fmt::format("just-noticeable difference must be a finite Weber fraction > 0, got {}",
+                    settings.just_noticeable_difference));
   if (!(settings.noise_sd >= 0) || !std::isfinite(settings.noise_sd))
-    throw Error(fmt::format("rater noise sd must be finite and >= 0 JNDs, got {}", settings.noise_sd));
+    throw Error(
+        fmt::format("rater noise sd must be finite and >= 0 JNDs, got {}", settings.noise_sd));
   if (settings.grades < 1)
-    throw Error(fmt::format("the rating scale needs at least 1 grade each side, got {}", settings.grades));
+    throw Error(
+        fmt::format("the rating scale needs at least 1 grade each side, got {}", settings.grades));
 }
 
-std::mt19937 rater_rng(const SimulatedRaterSettings& settings) { return std::mt19937(settings.seed); }
+std::mt19937 rater_rng(const SimulatedRaterSettings& settings) {
+  return std::mt19937(settings.seed);
+}
 
 double perceived_magnitude(RatedQuality quality, const TrialMeasures& measures) {
   return magnitude_in_trial(quality, measures, "");
@@ -131,8 +145,8 @@ double difference_in_jnds(const SimulatedRaterSettings& settings, const TrialMea
   return std::log(m_first / m_second) / std::log1p(settings.just_noticeable_difference);
 }
 
-int rate_pair(const SimulatedRaterSettings& settings, const TrialMeasures& first, const TrialMeasures& second,
-              std::mt19937& rng) {
+int rate_pair(const SimulatedRaterSettings& settings, const TrialMeasures& first,
+              const TrialMeasures& second, std::mt19937& rng) {
   const double d = difference_in_jnds(settings, first, second);
   // A fresh distribution each call: no draw cached from an earlier call carries over.
   std::normal_distribution<double> standard_normal(0, 1);

@@ -73,7 +73,7 @@ double difference_in_jnds(const SimulatedRaterSettings& settings, const TrialMea
 /// depends only on the settings, the measures and the state of `rng`. Throws Error for bad
 /// settings, or naming the trial ("first"/"second") and the measure when a needed measure is
 /// NaN, infinite or negative.
-int rate_pair(const SimulatedRaterSettings& settings, const TrialMeasures& first, const TrialMeasures& second,
-              std::mt19937& rng);
+int rate_pair(const SimulatedRaterSettings& settings, const TrialMeasures& first,
+              const TrialMeasures& second, std::mt19937& rng);
 
 }  // namespace cohaptic

@@ -34,7 +34,8 @@ Statistics describe(std::span<const double> values) {
 
 ConditionTrial condition_trial(std::string condition, const TrialMeasures& measures) {
   ConditionTrial trial{std::move(condition), {}};
-  for (const NamedMeasure& named : named_measures(measures)) trial.values.push_back({std::string(named.name), named.value});
+  for (const NamedMeasure& named : named_measures(measures))
+    trial.values.push_back({std::string(named.name), named.value});
   return trial;
 }
 
@@ -53,7 +54,8 @@ std::vector<ConditionSummary> summarize(const std::vector<ConditionTrial>& trial
       conditions.push_back(trial.condition);
       values.emplace_back(names.size());
     }
-    for (const TrialValue& value : trial.values) values[it->second][name_index.at(value.name)].push_back(value.value);
+    for (const TrialValue& value : trial.values)
+      values[it->second][name_index.at(value.name)].push_back(value.value);
   }
   std::vector<ConditionSummary> summary;
   summary.reserve(conditions.size() * names.size());
@@ -65,11 +67,13 @@ std::vector<ConditionSummary> summarize(const std::vector<ConditionTrial>& trial
   return summary;
 }
 
-void write_summary_csv(const std::filesystem::path& path, const std::vector<ConditionSummary>& summary) {
+void write_summary_csv(const std::filesystem::path& path,
+                       const std::vector<ConditionSummary>& summary) {
   AtomicFile file(path);
   file.write("condition,measure,mean,sd,n\n");
   for (const ConditionSummary& row : summary)
-    file.print("{},{},{:.9g},{:.9g},{}\n", csv_field(row.condition), csv_field(row.measure), row.mean, row.sd, row.n);
+    file.print("{},{},{:.9g},{:.9g},{}\n", csv_field(row.condition), csv_field(row.measure),
+               row.mean, row.sd, row.n);
   file.commit();
 }
 

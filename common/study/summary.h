@@ -60,6 +60,7 @@ std::vector<ConditionSummary> summarize(const std::vector<ConditionTrial>& trial
 /// The summary as CSV with header "condition,measure,mean,sd,n", written atomically; numbers
 /// with 9 significant digits, NaN as "nan"; a condition containing , " or a line break is quoted.
 /// Throws Error if the file cannot be written.
-void write_summary_csv(const std::filesystem::path& path, const std::vector<ConditionSummary>& summary);
+void write_summary_csv(const std::filesystem::path& path,
+                       const std::vector<ConditionSummary>& summary);
 
 }  // namespace cohaptic

@@ -71,22 +71,27 @@ class Canvas {
       throw Error(fmt::format("a plot must have a positive size, got {} x {}", width, height));
     out_ += fmt::format(
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"{0:g}\" height=\"{1:g}\" "
-        "viewBox=\"0 0 {0:g} {1:g}\" font-family=\"sans-serif\" font-size=\"12\" style=\"background:#ffffff\">\n",
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"{0:g}\" "
+        "height=\"{1:g}\" "
+        "viewBox=\"0 0 {0:g} {1:g}\" font-family=\"sans-serif\" font-size=\"12\" "
+        "style=\"background:#ffffff\">\n",
         width, height);
   }
 
-  void line(double x1, double y1, double x2, double y2, std::string_view colour, double stroke_width = 1) {
+  void line(double x1, double y1, double x2, double y2, std::string_view colour,
+            double stroke_width = 1) {
     out_ += fmt::format(
-        "<line x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\" stroke=\"{}\" stroke-width=\"{:g}\"/>\n", x1, y1,
-        x2, y2, xml_escape(colour), stroke_width);
+        "<line x1=\"{:.2f}\" y1=\"{:.2f}\" x2=\"{:.2f}\" y2=\"{:.2f}\" stroke=\"{}\" "
+        "stroke-width=\"{:g}\"/>\n",
+        x1, y1, x2, y2, xml_escape(colour), stroke_width);
   }
-  void text(double x, double y, std::string_view content, std::string_view anchor, double rotate = 0,
-            std::string_view extra = {}) {
+  void text(double x, double y, std::string_view content, std::string_view anchor,
+            double rotate = 0, std::string_view extra = {}) {
     std::string transform;
-    if (rotate != 0) transform = fmt::format(" transform=\"rotate({:g} {:.2f} {:.2f})\"", rotate, x, y);
-    out_ += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" text-anchor=\"{}\"{}{}>{}</text>\n", x, y, anchor, transform,
-                        extra, xml_escape(content));
+    if (rotate != 0)
+      transform = fmt::format(" transform=\"rotate({:g} {:.2f} {:.2f})\"", rotate, x, y);
+    out_ += fmt::format("<text x=\"{:.2f}\" y=\"{:.2f}\" text-anchor=\"{}\"{}{}>{}</text>\n", x, y,
+                        anchor, transform, extra, xml_escape(content));
   }
   void raw(std::string_view s) { out_ += s; }
   std::string finish() { return out_ + "</svg>\n"; }
@@ -101,7 +106,8 @@ class Canvas {
 
 // Title, axis labels, grid, ticks and axes around the plot area [x0, x1] x [y0, y1] (pixels).
 void draw_frame(Canvas& c, double x0, double x1, double y0, double y1, const std::string& title,
-                const std::string& x_label, const std::string& y_label, const Axis* x_axis, const Axis& y_axis) {
+                const std::string& x_label, const std::string& y_label, const Axis* x_axis,
+                const Axis& y_axis) {
   if (!title.empty()) c.text(c.width() / 2, kTop / 2 + 5, title, "middle", 0, " font-size=\"16\"");
   for (double t : y_axis.ticks) {
     const double y = y1 - y_axis.frac(t) * (y1 - y0);
@@ -136,7 +142,8 @@ std::string render(const LinePlot& plot) {
     legend_chars = std::max(legend_chars, s.label.size());
   }
   const Axis x_axis(xr), y_axis(yr);
-  const double legend_width = legend_chars > 0 ? 40 + kCharWidth * static_cast<double>(legend_chars) : 0;
+  const double legend_width =
+      legend_chars > 0 ? 40 + kCharWidth * static_cast<double>(legend_chars) : 0;
   const double x0 = kLeft, x1 = std::max(x0 + 10, plot.width - kRight - legend_width);
   const double y0 = kTop, y1 = std::max(y0 + 10, plot.height - kBottom);
   draw_frame(c, x0, x1, y0, y1, plot.title, plot.x_label, plot.y_label, &x_axis, y_axis);
@@ -150,7 +157,8 @@ std::string render(const LinePlot& plot) {
     const std::size_t n = std::min(s.x.size(), s.y.size());
     for (std::size_t i = 0; i < n; ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
-      const double px = x0 + x_axis.frac(s.x[i]) * (x1 - x0), py = y1 - y_axis.frac(s.y[i]) * (y1 - y0);
+      const double px = x0 + x_axis.frac(s.x[i]) * (x1 - x0),
+                   py = y1 - y_axis.frac(s.y[i]) * (y1 - y0);
       points += fmt::format("{}{:.2f},{:.2f}", points.empty() ? "" : " ", px, py);
       pixels.emplace_back(px, py);
     }
@@ -161,7 +169,8 @@ std::string render(const LinePlot& plot) {
                       colour, points));
       if (s.markers || pixels.size() == 1)
         for (const auto& [px, py] : pixels)
-          c.raw(fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"3\" fill=\"{}\"/>\n", px, py, colour));
+          c.raw(fmt::format("<circle cx=\"{:.2f}\" cy=\"{:.2f}\" r=\"3\" fill=\"{}\"/>\n", px, py,
+                            colour));
     }
     if (!s.label.empty()) {
       c.line(x1 + 10, legend_y, x1 + 30, legend_y, colour, 2);
@@ -199,12 +208,15 @@ std::string render(const BarChart& chart) {
     if (!std::isfinite(bar.mean)) continue;
     const double top = y1 - y_axis.frac(bar.mean) * (y1 - y0);
     const double half = 0.3 * slot;
-    c.raw(fmt::format(
-        "<rect class=\"bar\" x=\"{:.2f}\" y=\"{:.2f}\" width=\"{:.2f}\" height=\"{:.2f}\" fill=\"{}\"/>\n",
-        centre - half, std::min(top, zero_y), 2 * half, std::abs(zero_y - top), xml_escape(colour_of(bar.colour, i))));
+    c.raw(
+        fmt::format("<rect class=\"bar\" x=\"{:.2f}\" y=\"{:.2f}\" width=\"{:.2f}\" "
+                    "height=\"{:.2f}\" fill=\"{}\"/>\n",
+                    centre - half, std::min(top, zero_y), 2 * half, std::abs(zero_y - top),
+                    xml_escape(colour_of(bar.colour, i))));
     if (std::isfinite(bar.sd) && bar.sd != 0) {
       const double sd = std::abs(bar.sd);
-      const double hi = y1 - y_axis.frac(bar.mean + sd) * (y1 - y0), lo = y1 - y_axis.frac(bar.mean - sd) * (y1 - y0);
+      const double hi = y1 - y_axis.frac(bar.mean + sd) * (y1 - y0),
+                   lo = y1 - y_axis.frac(bar.mean - sd) * (y1 - y0);
       const double cap = 0.25 * half;
       c.line(centre, hi, centre, lo, "#000000", 1.5);
       c.line(centre - cap, hi, centre + cap, hi, "#000000", 1.5);
@@ -217,8 +229,9 @@ std::string render(const BarChart& chart) {
 }  // namespace
 
 std::string palette_colour(std::size_t index) {
-  static constexpr std::array<const char*, 10> kPalette = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
-                                                           "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
+  static constexpr std::array<const char*, 10> kPalette = {
+      "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+      "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
   return kPalette[index % kPalette.size()];
 }
 

@@ -22,7 +22,8 @@ Biquad butterworth_lowpass(double cutoff_hz, double rate_hz) {
   return {b0, 2 * b0, b0, 2 * (k * k - 1) * norm, (1 - std::numbers::sqrt2 * k + k * k) * norm};
 }
 
-// Direct form I, starting from the steady state of x[0] (unit DC gain: past inputs and outputs = x[0]).
+// Direct form I, starting from the steady state of x[0] (unit DC gain: past inputs and outputs =
+// x[0]).
 void run(const Biquad& q, std::vector<Eigen::Vector3d>& x) {
   if (x.empty()) return;
   Eigen::Vector3d x1 = x[0], x2 = x[0], y1 = x[0], y2 = x[0];
@@ -39,7 +40,8 @@ void run(const Biquad& q, std::vector<Eigen::Vector3d>& x) {
 }  // namespace
 
 std::vector<Eigen::Vector3d> zero_phase_lowpass(const std::vector<double>& time_s,
-                                                const std::vector<Eigen::Vector3d>& signal, double cutoff_hz) {
+                                                const std::vector<Eigen::Vector3d>& signal,
+                                                double cutoff_hz) {
   if (time_s.size() != signal.size())
     throw Error(fmt::format("low-pass: {} times for {} samples", time_s.size(), signal.size()));
   if (!(cutoff_hz > 0) || !std::isfinite(cutoff_hz))
@@ -54,7 +56,8 @@ std::vector<Eigen::Vector3d> zero_phase_lowpass(const std::vector<double>& time_
   if (!(median_dt > 0)) throw Error("low-pass: sample times must strictly increase");
   const double rate_hz = 1 / median_dt;
   if (!(cutoff_hz < rate_hz / 2))
-    throw Error(fmt::format("low-pass cut-off {} Hz must be below half the sample rate ({} Hz)", cutoff_hz, rate_hz));
+    throw Error(fmt::format("low-pass cut-off {} Hz must be below half the sample rate ({} Hz)",
+                            cutoff_hz, rate_hz));
 
   // The slowest pole of a 2nd-order Butterworth decays at rate 2 pi fc / sqrt(2).
   const double time_constant_s = std::numbers::sqrt2 / (2 * std::numbers::pi * cutoff_hz);
@@ -72,7 +75,8 @@ std::vector<Eigen::Vector3d> zero_phase_lowpass(const std::vector<double>& time_
   std::reverse(x.begin(), x.end());
   run(q, x);
   std::reverse(x.begin(), x.end());
-  return {x.begin() + static_cast<std::ptrdiff_t>(pad), x.begin() + static_cast<std::ptrdiff_t>(pad + n)};
+  return {x.begin() + static_cast<std::ptrdiff_t>(pad),
+          x.begin() + static_cast<std::ptrdiff_t>(pad + n)};
 }
 
 }  // namespace cohaptic

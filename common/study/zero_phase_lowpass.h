@@ -21,6 +21,7 @@
 namespace cohaptic {
 
 std::vector<Eigen::Vector3d> zero_phase_lowpass(const std::vector<double>& time_s,
-                                                const std::vector<Eigen::Vector3d>& signal, double cutoff_hz);
+                                                const std::vector<Eigen::Vector3d>& signal,
+                                                double cutoff_hz);
 
 }  // namespace cohaptic

@@ -25,8 +25,12 @@ class ClockOffsetEstimator {
   void add(std::int64_t t0, std::int64_t t1, std::int64_t t2, std::int64_t t3);
 
   bool valid() const { return best_ >= 0; }
-  std::int64_t offset_ns() const { return valid() ? samples_[static_cast<std::size_t>(best_)].offset : 0; }
-  std::int64_t round_trip_ns() const { return valid() ? samples_[static_cast<std::size_t>(best_)].round_trip : 0; }
+  std::int64_t offset_ns() const {
+    return valid() ? samples_[static_cast<std::size_t>(best_)].offset : 0;
+  }
+  std::int64_t round_trip_ns() const {
+    return valid() ? samples_[static_cast<std::size_t>(best_)].round_trip : 0;
+  }
   std::int64_t to_server(std::int64_t client_ns) const { return client_ns + offset_ns(); }
   std::int64_t to_client(std::int64_t server_ns) const { return server_ns - offset_ns(); }
 

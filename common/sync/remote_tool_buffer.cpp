@@ -17,14 +17,18 @@ PlayoutPolicy parse_playout_policy(const std::string& text) {
   if (text == "newest") return PlayoutPolicy::newest;
   if (text == "fixed") return PlayoutPolicy::fixed;
   if (text == "adaptive") return PlayoutPolicy::adaptive;
-  throw Error(fmt::format("unknown playout policy '{}' (expected newest, fixed or adaptive)", text));
+  throw Error(
+      fmt::format("unknown playout policy '{}' (expected newest, fixed or adaptive)", text));
 }
 
 const char* to_string(PlayoutPolicy policy) {
   switch (policy) {
-    case PlayoutPolicy::newest: return "newest";
-    case PlayoutPolicy::fixed: return "fixed";
-    case PlayoutPolicy::adaptive: return "adaptive";
+    case PlayoutPolicy::newest:
+      return "newest";
+    case PlayoutPolicy::fixed:
+      return "fixed";
+    case PlayoutPolicy::adaptive:
+      return "adaptive";
   }
   return "?";
 }
@@ -34,8 +38,8 @@ RemoteToolBuffer::RemoteToolBuffer(PlayoutPolicy policy, std::int64_t fixed_dela
   age_bin_of_slot_.fill(-1);
 }
 
-void RemoteToolBuffer::add(std::int64_t sample_time_ns, std::int64_t arrival_ns, const Eigen::Vector3d& position,
-                           bool valid) noexcept {
+void RemoteToolBuffer::add(std::int64_t sample_time_ns, std::int64_t arrival_ns,
+                           const Eigen::Vector3d& position, bool valid) noexcept {
   if (count_ > 0 && sample_time_ns <= sample(0).time) {
     ++dropped_;
     return;
@@ -68,9 +72,12 @@ void RemoteToolBuffer::add(std::int64_t sample_time_ns, std::int64_t arrival_ns,
 
 std::int64_t RemoteToolBuffer::playout_delay_ns() const noexcept {
   switch (policy_) {
-    case PlayoutPolicy::newest: return 0;
-    case PlayoutPolicy::fixed: return fixed_delay_ns_;
-    case PlayoutPolicy::adaptive: return adaptive_delay_ns_;
+    case PlayoutPolicy::newest:
+      return 0;
+    case PlayoutPolicy::fixed:
+      return fixed_delay_ns_;
+    case PlayoutPolicy::adaptive:
+      return adaptive_delay_ns_;
   }
   return 0;
 }
@@ -90,7 +97,8 @@ PlayoutQuery RemoteToolBuffer::at(std::int64_t now_ns) const noexcept {
     const Sample& newer = sample(age - 1);
     if (older.time <= target) {
       if (!older.valid || !newer.valid) return {older.position, false, now_ns - older.time};
-      const double s = static_cast<double>(target - older.time) / static_cast<double>(newer.time - older.time);
+      const double s =
+          static_cast<double>(target - older.time) / static_cast<double>(newer.time - older.time);
       return {older.position + s * (newer.position - older.position), true, now_ns - target};
     }
   }

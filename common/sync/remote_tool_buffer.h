@@ -26,8 +26,8 @@ const char* to_string(PlayoutPolicy policy);
 
 struct PlayoutQuery {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  bool valid = false;      ///< false before the first sample, or after an invalid one
-  std::int64_t age_ns = 0; ///< now minus the time of the position returned
+  bool valid = false;       ///< false before the first sample, or after an invalid one
+  std::int64_t age_ns = 0;  ///< now minus the time of the position returned
 };
 
 class RemoteToolBuffer {
@@ -37,7 +37,8 @@ class RemoteToolBuffer {
   RemoteToolBuffer(PlayoutPolicy policy, std::int64_t fixed_delay_ns) noexcept;
 
   /// A sample read at `sample_time_ns` and received at `arrival_ns` (both local clock).
-  void add(std::int64_t sample_time_ns, std::int64_t arrival_ns, const Eigen::Vector3d& position, bool valid) noexcept;
+  void add(std::int64_t sample_time_ns, std::int64_t arrival_ns, const Eigen::Vector3d& position,
+           bool valid) noexcept;
   PlayoutQuery at(std::int64_t now_ns) const noexcept;
 
   std::int64_t playout_delay_ns() const noexcept;
@@ -49,12 +50,14 @@ class RemoteToolBuffer {
     Eigen::Vector3d position = Eigen::Vector3d::Zero();
     bool valid = false;
   };
-  const Sample& sample(int age) const noexcept { return samples_[static_cast<std::size_t>((head_ - 1 - age + kCapacity) % kCapacity)]; }
+  const Sample& sample(int age) const noexcept {
+    return samples_[static_cast<std::size_t>((head_ - 1 - age + kCapacity) % kCapacity)];
+  }
 
   PlayoutPolicy policy_;
   std::int64_t fixed_delay_ns_;
   std::array<Sample, kCapacity> samples_{};
-  int head_ = 0;   // next slot to write
+  int head_ = 0;  // next slot to write
   int count_ = 0;
   std::uint64_t dropped_ = 0;
   // Adaptive delay: ages at arrival over the last second, in 0.25 ms bins.

@@ -24,8 +24,8 @@ AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
   file_ = std::fopen(temp_path_.c_str(), "wb");
   if (file_ == nullptr) {
     const int error_number = errno;
-    throw Error(fmt::format("cannot write {}: {} (while creating {})", path_.string(), reason(error_number),
-                            temp_path_.string()));
+    throw Error(fmt::format("cannot write {}: {} (while creating {})", path_.string(),
+                            reason(error_number), temp_path_.string()));
   }
 }
 
@@ -45,7 +45,8 @@ void AtomicFile::write(std::string_view text) {
 void AtomicFile::flush_buffer() {
   if (buffer_.size() == 0) return;
   errno = 0;
-  if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) fail("writing", errno);
+  if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size())
+    fail("writing", errno);
   buffer_.clear();
 }
 
@@ -59,16 +60,16 @@ void AtomicFile::commit() {
     const int error_number = errno;
     std::error_code ignored;
     std::filesystem::remove(temp_path_, ignored);
-    throw Error(fmt::format("cannot write {}: {} (while closing {})", path_.string(), reason(error_number),
-                            temp_path_.string()));
+    throw Error(fmt::format("cannot write {}: {} (while closing {})", path_.string(),
+                            reason(error_number), temp_path_.string()));
   }
   std::error_code error;
   std::filesystem::rename(temp_path_, path_, error);
   if (error) {
     std::error_code ignored;
     std::filesystem::remove(temp_path_, ignored);
-    throw Error(fmt::format("cannot write {}: {} (while renaming {} into place)", path_.string(), error.message(),
-                            temp_path_.string()));
+    throw Error(fmt::format("cannot write {}: {} (while renaming {} into place)", path_.string(),
+                            error.message(), temp_path_.string()));
   }
 }
 
@@ -77,8 +78,8 @@ void AtomicFile::fail(std::string_view doing, int error_number) {
   std::error_code ignored;
   std::filesystem::remove(temp_path_, ignored);
   throw Error(fmt::format("cannot write {}: {} (while {} {})", path_.string(),
-                          error_number != 0 ? reason(error_number) : std::string("I/O error"), doing,
-                          temp_path_.string()));
+                          error_number != 0 ? reason(error_number) : std::string("I/O error"),
+                          doing, temp_path_.string()));
 }
 
 }  // namespace cohaptic

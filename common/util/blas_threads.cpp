@@ -8,8 +8,9 @@
 extern "C" void openblas_set_num_threads(int) __attribute__((weak));
 extern "C" int openblas_get_num_threads() __attribute__((weak));
 extern "C" char* openblas_get_corename() __attribute__((weak));
-extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const double* alpha,
-                       const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c,
+extern "C" void dgemm_(const char* transa, const char* transb, const int* m, const int* n,
+                       const int* k, const double* alpha, const double* a, const int* lda,
+                       const double* b, const int* ldb, const double* beta, double* c,
                        const int* ldc);
 
 namespace cohaptic {
@@ -35,7 +36,8 @@ namespace {
 // threads and touching the memory.
 double measure_dense_flop_rate() {
   constexpr int n = 768;
-  const std::vector<double> a(static_cast<std::size_t>(n) * n, 0.5), b(static_cast<std::size_t>(n) * n, 0.25);
+  const std::vector<double> a(static_cast<std::size_t>(n) * n, 0.5),
+      b(static_cast<std::size_t>(n) * n, 0.25);
   std::vector<double> c(static_cast<std::size_t>(n) * n);
   const double one = 1, zero = 0;
   const ScopedBlasThreads blas(kFactorBlasThreads);

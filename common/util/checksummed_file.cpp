@@ -44,7 +44,9 @@ void write_checksummed_file(const std::filesystem::path& file, std::string_view 
   const Digest checksum = digest_of(body.data(), body.size());
   std::error_code ec;
   if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), ec);
-  if (ec) throw Error(fmt::format("{}: cannot create the cache directory: {}", file.parent_path().string(), ec.message()));
+  if (ec)
+    throw Error(fmt::format("{}: cannot create the cache directory: {}",
+                            file.parent_path().string(), ec.message()));
   AtomicFile out(file);
   out.write(body);
   out.write(std::string_view(reinterpret_cast<const char*>(checksum.data()), checksum.size()));

@@ -11,7 +11,8 @@ namespace cohaptic {
 
 struct ChecksummedRead {
   std::vector<char> body;  ///< the file without its checksum, when `problem` is empty
-  std::string problem;     ///< "no cache file", "truncated (N bytes)", "checksum mismatch (...)", a read error
+  std::string
+      problem;  ///< "no cache file", "truncated (N bytes)", "checksum mismatch (...)", a read error
 };
 
 /// Reads `file` whole and checks its checksum; a body shorter than `minimum_body` bytes

@@ -16,7 +16,8 @@ namespace cohaptic {
 class ChildProcess {
  public:
   /// Starts `program` with `arguments`; stdout and stderr go to `log`. Throws Error.
-  ChildProcess(const std::string& program, const std::vector<std::string>& arguments, const std::filesystem::path& log);
+  ChildProcess(const std::string& program, const std::vector<std::string>& arguments,
+               const std::filesystem::path& log);
   ~ChildProcess();  ///< kills it if still running
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;

@@ -28,11 +28,11 @@ class ContentHasher {
   ContentHasher& bytes(const void* data, std::size_t size);
   ContentHasher& text(std::string_view s) { return value(s.size()).bytes(s.data(), s.size()); }
   template <typename T>
-    requires std::is_arithmetic_v<T>
-  ContentHasher& value(T v) { return bytes(&v, sizeof v); }
+  requires std::is_arithmetic_v<T> ContentHasher& value(T v) { return bytes(&v, sizeof v); }
   template <typename T>
-    requires std::is_trivially_copyable_v<T>
-  ContentHasher& values(std::span<const T> v) { return value(v.size()).bytes(v.data(), v.size_bytes()); }
+  requires std::is_trivially_copyable_v<T> ContentHasher& values(std::span<const T> v) {
+    return value(v.size()).bytes(v.data(), v.size_bytes());
+  }
   template <typename Derived>
   ContentHasher& matrix(const Eigen::PlainObjectBase<Derived>& m) {
     value(m.rows()).value(m.cols());

@@ -21,7 +21,8 @@ class Error : public std::runtime_error {
 class ParseError : public Error {
  public:
   ParseError(const std::string& file, long line, const std::string& what)
-      : Error(line > 0 ? fmt::format("{}:{}: {}", file, line, what) : fmt::format("{}: {}", file, what)),
+      : Error(line > 0 ? fmt::format("{}:{}: {}", file, line, what)
+                       : fmt::format("{}: {}", file, what)),
         file_(file),
         line_(line) {}
   const std::string& file() const { return file_; }

@@ -18,12 +18,14 @@ namespace cohaptic {
 class Histogram {
  public:
   /// Bins of `resolution` covering [0, resolution * bins).
-  Histogram(std::int64_t resolution, std::size_t bins) : resolution_(resolution), counts_(bins, 0) {}
+  Histogram(std::int64_t resolution, std::size_t bins)
+      : resolution_(resolution), counts_(bins, 0) {}
 
   /// The recording thread only.
   void record(std::int64_t value) noexcept {
     const std::int64_t clamped = std::max<std::int64_t>(0, value);
-    const auto bin = std::min<std::size_t>(static_cast<std::size_t>(clamped / resolution_), counts_.size() - 1);
+    const auto bin =
+        std::min<std::size_t>(static_cast<std::size_t>(clamped / resolution_), counts_.size() - 1);
     store(counts_[bin], load(counts_[bin]) + 1);
     if (value > load(max_)) store(max_, value);
     store(sum_, load(sum_) + static_cast<double>(value));
@@ -32,7 +34,8 @@ class Histogram {
   }
 
   std::uint64_t count() const {
-    return std::atomic_ref<std::uint64_t>(const_cast<std::uint64_t&>(count_)).load(std::memory_order_acquire);
+    return std::atomic_ref<std::uint64_t>(const_cast<std::uint64_t&>(count_))
+        .load(std::memory_order_acquire);
   }
   std::int64_t max() const { return count() ? load(max_) : 0; }
   double mean() const {
@@ -44,11 +47,13 @@ class Histogram {
     const std::uint64_t n = count();
     if (n == 0) return 0;
     const std::int64_t largest = load(max_);
-    const auto target = std::max<std::uint64_t>(static_cast<std::uint64_t>(q * static_cast<double>(n) + 0.5), 1);
+    const auto target =
+        std::max<std::uint64_t>(static_cast<std::uint64_t>(q * static_cast<double>(n) + 0.5), 1);
     std::uint64_t seen = 0;
     for (std::size_t b = 0; b < counts_.size(); ++b) {
       seen += load(counts_[b]);
-      if (seen >= target) return std::min<std::int64_t>((static_cast<std::int64_t>(b) + 1) * resolution_, largest);
+      if (seen >= target)
+        return std::min<std::int64_t>((static_cast<std::int64_t>(b) + 1) * resolution_, largest);
     }
     return largest;
   }

@@ -18,21 +18,25 @@ std::ifstream open_text_file(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   const int error_number = errno;
   if (!in)
-    throw Error(fmt::format("cannot open {}: {}", path.string(),
-                            error_number != 0 ? std::generic_category().message(error_number) : "unknown error"));
+    throw Error(fmt::format(
+        "cannot open {}: {}", path.string(),
+        error_number != 0 ? std::generic_category().message(error_number) : "unknown error"));
   std::error_code ignored;
   if (std::filesystem::is_directory(path, ignored))
-    throw Error(fmt::format("cannot open {}: {}", path.string(), std::generic_category().message(EISDIR)));
+    throw Error(
+        fmt::format("cannot open {}: {}", path.string(), std::generic_category().message(EISDIR)));
   return in;
 }
 
-LineReader::LineReader(std::istream& in, std::string source_name) : in_(in), source_name_(std::move(source_name)) {}
+LineReader::LineReader(std::istream& in, std::string source_name)
+    : in_(in), source_name_(std::move(source_name)) {}
 
 bool LineReader::next() {
   tokens_.clear();
   if (!std::getline(in_, line_)) {
     line_.clear();
-    if (in_.bad()) throw Error(fmt::format("{}: read error after line {}", source_name_, line_number_));
+    if (in_.bad())
+      throw Error(fmt::format("{}: read error after line {}", source_name_, line_number_));
     return false;
   }
   ++line_number_;
@@ -64,7 +68,8 @@ void LineReader::fail_at(long line, const std::string& what) const {
 namespace {
 
 std::string_view without_plus(std::string_view token) {
-  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') token.remove_prefix(1);
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+')
+    token.remove_prefix(1);
   return token;
 }
 
@@ -85,7 +90,8 @@ double LineReader::real(std::string_view token, std::string_view field) const {
   const std::string_view digits = without_plus(token);
   double value = 0;
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-  if (end != digits.data() + digits.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
+  if (end != digits.data() + digits.size() ||
+      (ec != std::errc() && ec != std::errc::result_out_of_range))
     fail(fmt::format("expected {}, found {}", field, quoted(token)));
   if (ec == std::errc::result_out_of_range) {
     // Overflow is an error; underflow (|x| < 1e-308) is a legitimate tiny or zero value.

@@ -11,7 +11,9 @@ namespace cohaptic {
 
 /// Nanoseconds of std::chrono::steady_clock now.
 inline std::int64_t monotonic_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
 
 }  // namespace cohaptic

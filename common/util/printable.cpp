@@ -17,7 +17,8 @@ std::size_t printable_sequence_at(std::string_view text, std::size_t at) {
     code = (code << 6) | (byte(at + k) & 0x3f);
   }
   const char32_t smallest[] = {0, 0, 0x80, 0x800, 0x10000};
-  if (code < smallest[length] || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff)) return 0;  // overlong, surrogate
+  if (code < smallest[length] || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff))
+    return 0;                                  // overlong, surrogate
   if (code >= 0x80 && code <= 0x9f) return 0;  // C1 controls (U+009B is a terminal's CSI)
   return length;
 }

@@ -38,10 +38,12 @@ class ProgressLog {
 
   /// The work shown as done `part_elapsed_s` [s] into a part of `part_work` that began after
   /// `done`, at `expected_rate`: short of the part's end until it reports it.
-  static double shown_done(double done, double part_work, double expected_rate, double part_elapsed_s);
+  static double shown_done(double done, double part_work, double expected_rate,
+                           double part_elapsed_s);
   /// The line for `done` of `total` after `elapsed_s` [s] in all and `counting_s` [s] since
   /// the total was set: bar, per cent, time spent, and time left at the rate since then.
-  static std::string line(const std::string& what, double done, double total, double elapsed_s, double counting_s);
+  static std::string line(const std::string& what, double done, double total, double elapsed_s,
+                          double counting_s);
 
  private:
   void log_every_second();

@@ -1,6 +1,6 @@
 // SpscRing: a bounded single-producer single-consumer queue of plain values (copying
-// them must not allocate or throw), lock-free and allocation-free after construction. One thread pushes, one thread pops
-// (e.g. the I/O thread hands remote tool samples to the haptic thread).
+// them must not allocate or throw), lock-free and allocation-free after construction. One thread
+// pushes, one thread pops (e.g. the I/O thread hands remote tool samples to the haptic thread).
 #pragma once
 
 #include <array>
@@ -13,9 +13,9 @@ namespace cohaptic {
 
 template <typename T, std::size_t Capacity>
 class SpscRing {
-  static_assert(std::is_trivially_destructible_v<T>,
-                "SpscRing holds plain values");
-  static_assert(Capacity >= 2 && (Capacity & (Capacity - 1)) == 0, "Capacity must be a power of two");
+  static_assert(std::is_trivially_destructible_v<T>, "SpscRing holds plain values");
+  static_assert(Capacity >= 2 && (Capacity & (Capacity - 1)) == 0,
+                "Capacity must be a power of two");
 
  public:
   /// Producer side. False (and the value dropped) when full.

@@ -21,7 +21,8 @@ class TripleBuffer {
   T& back() noexcept { return slots_[back_]; }
   /// Writer: make back() the newest value.
   void publish() noexcept {
-    const std::uint8_t previous = middle_.exchange(static_cast<std::uint8_t>(back_ | kFresh), std::memory_order_acq_rel);
+    const std::uint8_t previous =
+        middle_.exchange(static_cast<std::uint8_t>(back_ | kFresh), std::memory_order_acq_rel);
     back_ = previous & kIndex;
   }
 

@@ -19,13 +19,15 @@ void raise_parse_error(const std::string& file, int line, const std::string& mes
 
 namespace {
 // Raisers must not return; this makes sure the compiler knows it too.
-[[noreturn]] void raise(YamlErrorRaiser raiser, const std::string& file, int line, const std::string& message) {
+[[noreturn]] void raise(YamlErrorRaiser raiser, const std::string& file, int line,
+                        const std::string& message) {
   raiser(file, line, message);
   std::abort();
 }
 }  // namespace
 
-YamlCursor::YamlCursor(YAML::Node node, std::string path, const std::string* file, int line, YamlErrorRaiser raiser)
+YamlCursor::YamlCursor(YAML::Node node, std::string path, const std::string* file, int line,
+                       YamlErrorRaiser raiser)
     : node_(std::move(node)), path_(std::move(path)), file_(file), line_(line), raise_(raiser) {
   if (node_.IsDefined() && node_.Mark().line >= 0) line_ = node_.Mark().line + 1;
 }
@@ -34,11 +36,13 @@ std::string YamlCursor::location() const { return fmt::format("{}:{}: {}", *file
 
 void YamlCursor::fail(const std::string& expected) const {
   raise(raise_, *file_, line_,
-        fmt::format("{}: expected {}, found {}", path_.empty() ? "(top level)" : path_, expected, describe()));
+        fmt::format("{}: expected {}, found {}", path_.empty() ? "(top level)" : path_, expected,
+                    describe()));
 }
 
 void YamlCursor::fail_message(const std::string& message) const {
-  raise(raise_, *file_, line_, fmt::format("{}: {}", path_.empty() ? "(top level)" : path_, message));
+  raise(raise_, *file_, line_,
+        fmt::format("{}: {}", path_.empty() ? "(top level)" : path_, message));
 }
 
 std::optional<YamlCursor> YamlCursor::find(const std::string& key) const {
@@ -61,7 +65,8 @@ void YamlCursor::only_keys(std::initializer_list<const char*> allowed) const {
     if (!known.count(key)) {
       std::string list;
       for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-      YamlCursor(entry.first, join(key), file_, line_, raise_).fail_message(fmt::format("unknown key (allowed here: {})", list));
+      YamlCursor(entry.first, join(key), file_, line_, raise_)
+          .fail_message(fmt::format("unknown key (allowed here: {})", list));
     }
   }
 }
@@ -104,7 +109,8 @@ double YamlCursor::positive(const std::string& expected) const {
   return v;
 }
 
-double YamlCursor::number_in(double low, double high, bool low_open, bool high_open, const std::string& expected) const {
+double YamlCursor::number_in(double low, double high, bool low_open, bool high_open,
+                             const std::string& expected) const {
   const double v = number();
   if ((low_open ? v <= low : v < low) || (high_open ? v >= high : v > high)) fail(expected);
   return v;
@@ -156,11 +162,14 @@ Eigen::Vector3d YamlCursor::direction(const std::string& expected) const {
 }
 
 std::string YamlCursor::key_text(const YAML::Node& key) const {
-  if (!key.IsScalar()) YamlCursor(key, path_, file_, line_, raise_).fail("a map whose keys are names");
+  if (!key.IsScalar())
+    YamlCursor(key, path_, file_, line_, raise_).fail("a map whose keys are names");
   return key.Scalar();
 }
 
-std::string YamlCursor::join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+std::string YamlCursor::join(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
 
 std::string YamlCursor::describe() const {
   if (!node_.IsDefined() || node_.IsNull()) return "nothing";

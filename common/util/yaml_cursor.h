@@ -60,7 +60,8 @@ class YamlCursor {
   /// A finite number > 0; `expected` describes it in the message.
   double positive(const std::string& expected) const;
   /// A finite number in the interval from low to high, each end open or closed.
-  double number_in(double low, double high, bool low_open, bool high_open, const std::string& expected) const;
+  double number_in(double low, double high, bool low_open, bool high_open,
+                   const std::string& expected) const;
   std::int64_t integer() const;
   bool boolean() const;
   /// One of `options`; the message lists them.
@@ -85,7 +86,8 @@ class YamlCursor {
 };
 
 /// Parses `text` as YAML; a syntax error is raised naming `file` and the line.
-YAML::Node load_yaml(const std::string& text, const std::string& file, YamlErrorRaiser raise = raise_parse_error);
+YAML::Node load_yaml(const std::string& text, const std::string& file,
+                     YamlErrorRaiser raise = raise_parse_error);
 
 /// The whole file as text; a file that cannot be opened is raised naming it.
 std::string read_text_file(const std::string& file, YamlErrorRaiser raise = raise_parse_error);

@@ -14,7 +14,8 @@ constexpr std::array<std::array<std::uint32_t, 256>, 4> make_tables() {
     tables[0][i] = c;
   }
   for (std::uint32_t i = 0; i < 256; ++i) {
-    for (std::size_t t = 1; t < 4; ++t) tables[t][i] = (tables[t - 1][i] >> 8) ^ tables[0][tables[t - 1][i] & 0xFFu];
+    for (std::size_t t = 1; t < 4; ++t)
+      tables[t][i] = (tables[t - 1][i] >> 8) ^ tables[0][tables[t - 1][i] & 0xFFu];
   }
   return tables;
 }
@@ -28,8 +29,10 @@ void Crc32::update(std::span<const std::uint8_t> bytes) {
   const std::uint8_t* p = bytes.data();
   std::size_t n = bytes.size();
   while (n >= 4) {
-    c ^= std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) | (std::uint32_t{p[3]} << 24);
-    c = kTables[3][c & 0xFFu] ^ kTables[2][(c >> 8) & 0xFFu] ^ kTables[1][(c >> 16) & 0xFFu] ^ kTables[0][c >> 24];
+    c ^= std::uint32_t{p[0]} | (std::uint32_t{p[1]} << 8) | (std::uint32_t{p[2]} << 16) |
+         (std::uint32_t{p[3]} << 24);
+    c = kTables[3][c & 0xFFu] ^ kTables[2][(c >> 8) & 0xFFu] ^ kTables[1][(c >> 16) & 0xFFu] ^
+        kTables[0][c >> 24];
     p += 4;
     n -= 4;
   }

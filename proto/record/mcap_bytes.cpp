@@ -11,13 +11,15 @@ namespace {
 
 template <typename T>
 void put_le(ByteBuffer& out, T value) {
-  for (std::size_t i = 0; i < sizeof(T); ++i) out.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
+  for (std::size_t i = 0; i < sizeof(T); ++i)
+    out.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
 }
 
 template <typename T>
 T get_le(std::span<const std::uint8_t> bytes) {
   T value = 0;
-  for (std::size_t i = 0; i < sizeof(T); ++i) value = static_cast<T>(value | (static_cast<T>(bytes[i]) << (8 * i)));
+  for (std::size_t i = 0; i < sizeof(T); ++i)
+    value = static_cast<T>(value | (static_cast<T>(bytes[i]) << (8 * i)));
   return value;
 }
 
@@ -35,7 +37,9 @@ void put_u16(ByteBuffer& out, std::uint16_t value) { put_le(out, value); }
 void put_u32(ByteBuffer& out, std::uint32_t value) { put_le(out, value); }
 void put_u64(ByteBuffer& out, std::uint64_t value) { put_le(out, value); }
 
-void put_bytes(ByteBuffer& out, std::span<const std::uint8_t> bytes) { out.insert(out.end(), bytes.begin(), bytes.end()); }
+void put_bytes(ByteBuffer& out, std::span<const std::uint8_t> bytes) {
+  out.insert(out.end(), bytes.begin(), bytes.end());
+}
 
 void put_string(ByteBuffer& out, std::string_view text) {
   put_u32(out, length_u32(text.size(), "string"));
@@ -61,12 +65,14 @@ std::size_t begin_record(ByteBuffer& out, std::uint8_t opcode) {
 
 void end_record(ByteBuffer& out, std::size_t start) {
   const std::uint64_t length = out.size() - start - 9;
-  for (std::size_t i = 0; i < 8; ++i) out[start + 1 + i] = static_cast<std::uint8_t>(length >> (8 * i));
+  for (std::size_t i = 0; i < 8; ++i)
+    out[start + 1 + i] = static_cast<std::uint8_t>(length >> (8 * i));
 }
 
 std::span<const std::uint8_t> ByteCursor::take(std::size_t n, const char* field) {
   if (n > remaining()) {
-    throw Error(fmt::format("field '{}' needs {} bytes but only {} remain in the record", field, n, remaining()));
+    throw Error(fmt::format("field '{}' needs {} bytes but only {} remain in the record", field, n,
+                            remaining()));
   }
   const auto out = bytes_.subspan(position_, n);
   position_ += n;
@@ -84,7 +90,9 @@ std::string ByteCursor::string(const char* field) {
   return {text.begin(), text.end()};
 }
 
-std::span<const std::uint8_t> ByteCursor::bytes(std::size_t n, const char* field) { return take(n, field); }
+std::span<const std::uint8_t> ByteCursor::bytes(std::size_t n, const char* field) {
+  return take(n, field);
+}
 
 ByteCursor ByteCursor::prefixed(const char* field) {
   const std::uint32_t length = u32(field);

@@ -14,7 +14,8 @@
 namespace cohaptic::record {
 
 /// 0x89 "MCAP" '0' "\r\n": the first and last 8 bytes of every MCAP file.
-inline constexpr std::array<std::uint8_t, 8> kMcapMagic = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
+inline constexpr std::array<std::uint8_t, 8> kMcapMagic = {0x89, 'M', 'C',  'A',
+                                                           'P',  '0', '\r', '\n'};
 
 namespace opcode {
 inline constexpr std::uint8_t kHeader = 0x01;

@@ -47,8 +47,8 @@ McapReader::McapReader(std::filesystem::path path) : path_(std::move(path)) {
   if (state_ != State::reading) return;
   if (!read_record()) return;
   if (prefix_[0] != opcode::kHeader) {
-    throw Error(fmt::format("{}: expected a Header record after the magic, found a {} record", path_.string(),
-                            mcap_opcode_name(prefix_[0])));
+    throw Error(fmt::format("{}: expected a Header record after the magic, found a {} record",
+                            path_.string(), mcap_opcode_name(prefix_[0])));
   }
   dispatch_record();
 }
@@ -64,18 +64,20 @@ void McapReader::read_magic() {
   errno = 0;
   const std::size_t got = std::fread(magic, 1, sizeof magic, file_.get());
   if (got < sizeof magic && std::ferror(file_.get())) fail_io("read");
-  const bool prefix_matches = std::equal(magic, magic + std::min<std::size_t>(got, 5), kMcapMagic.begin());
+  const bool prefix_matches =
+      std::equal(magic, magic + std::min<std::size_t>(got, 5), kMcapMagic.begin());
   if (got < sizeof magic && prefix_matches && std::equal(magic, magic + got, kMcapMagic.begin())) {
     end_truncated(fmt::format("file ends after {} of the 8 bytes of the opening magic", got));
     return;
   }
   if (got == sizeof magic && prefix_matches && magic[5] != kMcapMagic[5]) {
-    throw Error(fmt::format("{}: unsupported MCAP major version '{}' (this reader reads version 0)", path_.string(),
-                            static_cast<char>(magic[5])));
+    throw Error(fmt::format("{}: unsupported MCAP major version '{}' (this reader reads version 0)",
+                            path_.string(), static_cast<char>(magic[5])));
   }
   if (got < sizeof magic || !std::equal(magic, magic + sizeof magic, kMcapMagic.begin())) {
-    throw Error(fmt::format("{}: not an MCAP file (it does not start with the MCAP magic \\x89MCAP0\\r\\n)",
-                            path_.string()));
+    throw Error(
+        fmt::format("{}: not an MCAP file (it does not start with the MCAP magic \\x89MCAP0\\r\\n)",
+                    path_.string()));
   }
   data_crc_.update(magic);
   offset_ = sizeof magic;
@@ -93,18 +95,21 @@ bool McapReader::read_record() {
   const std::size_t got = std::fread(prefix_, 1, sizeof prefix_, file_.get());
   if (got < sizeof prefix_) {
     if (std::ferror(file_.get())) fail_io("read");
-    end_truncated(got == 0 ? fmt::format("file ends after the complete record ending at offset {}, without a Footer",
-                                         offset_)
-                           : fmt::format("file ends {} bytes into the 9-byte prefix of a record at offset {}", got,
-                                         offset_));
+    end_truncated(
+        got == 0 ? fmt::format(
+                       "file ends after the complete record ending at offset {}, without a Footer",
+                       offset_)
+                 : fmt::format("file ends {} bytes into the 9-byte prefix of a record at offset {}",
+                               got, offset_));
     return false;
   }
   const std::uint64_t length = le64(prefix_ + 1);
   const std::uint64_t content_start = offset_ + sizeof prefix_;
   const std::uint64_t available = file_size_ > content_start ? file_size_ - content_start : 0;
   const auto truncated_record = [&](std::uint64_t present) {
-    end_truncated(fmt::format("file ends {} bytes into the content of a {}-byte {} record at offset {}", present,
-                              length, mcap_opcode_name(prefix_[0]), offset_));
+    end_truncated(
+        fmt::format("file ends {} bytes into the content of a {}-byte {} record at offset {}",
+                    present, length, mcap_opcode_name(prefix_[0]), offset_));
   };
   if (length > available) {  // checked before allocating: a cut file ends early, it does not lie
     truncated_record(available);
@@ -158,8 +163,8 @@ std::optional<McapMessage> McapReader::dispatch_record() {
   try {
     return dispatch(prefix_[0], content_);
   } catch (const Error& e) {
-    throw Error(fmt::format("{}: {} record at offset {}: {}", path_.string(), mcap_opcode_name(prefix_[0]),
-                            record_offset_, e.what()));
+    throw Error(fmt::format("{}: {} record at offset {}: {}", path_.string(),
+                            mcap_opcode_name(prefix_[0]), record_offset_, e.what()));
   }
 }
 
@@ -172,20 +177,24 @@ void McapReader::open_chunk() {
   const std::string compression = cursor.string("compression");
   const std::uint64_t records_size = cursor.u64("records");
   const std::size_t records_begin = content_.size() - cursor.remaining();
-  const auto records = cursor.bytes(static_cast<std::size_t>(std::min<std::uint64_t>(records_size, SIZE_MAX)), "records");
+  const auto records = cursor.bytes(
+      static_cast<std::size_t>(std::min<std::uint64_t>(records_size, SIZE_MAX)), "records");
   if (!compression.empty()) {
-    throw Error(fmt::format("its records are compressed ('{}'): only uncompressed chunks are read", compression));
+    throw Error(fmt::format("its records are compressed ('{}'): only uncompressed chunks are read",
+                            compression));
   }
   if (uncompressed_size != records.size()) {
-    throw Error(fmt::format("uncompressed_size is {} but its records take {} bytes", uncompressed_size, records.size()));
+    throw Error(fmt::format("uncompressed_size is {} but its records take {} bytes",
+                            uncompressed_size, records.size()));
   }
   chunk_checked_ = recorded_crc != 0;  // 0: no CRC computed, by the spec
   if (chunk_checked_) {
     const std::uint32_t computed = crc32(records);
     if (computed != recorded_crc) {
-      throw Error(fmt::format("the CRC-32 of its records (messages logged from {} to {} ns) is recorded as {:08x} but "
-                              "computes to {:08x}: the chunk is corrupt",
-                              start_time, end_time, recorded_crc, computed));
+      throw Error(fmt::format(
+          "the CRC-32 of its records (messages logged from {} to {} ns) is recorded as {:08x} but "
+          "computes to {:08x}: the chunk is corrupt",
+          start_time, end_time, recorded_crc, computed));
     }
     coverage_.checked_through_offset = offset_;
   }
@@ -198,29 +207,37 @@ void McapReader::open_chunk() {
 std::optional<McapMessage> McapReader::next_in_chunk() {
   const std::size_t at = chunk_next_;
   const auto fail = [&](const std::string& record, const std::string& what) {
-    return Error(fmt::format("{}: {} at offset {} inside the Chunk at offset {}: {}", path_.string(), record,
-                             chunk_offset_ + kRecordPrefixBytes + at, chunk_offset_, what));
+    return Error(fmt::format("{}: {} at offset {} inside the Chunk at offset {}: {}",
+                             path_.string(), record, chunk_offset_ + kRecordPrefixBytes + at,
+                             chunk_offset_, what));
   };
   const std::size_t available = chunk_end_ - at;
   if (available < kRecordPrefixBytes) {
-    throw fail("a record", fmt::format("its 9-byte prefix runs past the end of the chunk's records ({} bytes left)",
-                                       available));
+    throw fail(
+        "a record",
+        fmt::format("its 9-byte prefix runs past the end of the chunk's records ({} bytes left)",
+                    available));
   }
   const std::uint8_t op = chunk_[at];
   const std::uint64_t length = le64(chunk_.data() + at + 1);
   const auto name = [op] { return mcap_opcode_name(op) + " record"; };  // for errors only
   if (length > available - kRecordPrefixBytes) {
-    throw fail(name(), fmt::format("its {} bytes of content run past the end of the chunk's records ({} bytes left)",
-                                 length, available - kRecordPrefixBytes));
+    throw fail(
+        name(),
+        fmt::format(
+            "its {} bytes of content run past the end of the chunk's records ({} bytes left)",
+            length, available - kRecordPrefixBytes));
   }
   chunk_next_ = at + kRecordPrefixBytes + static_cast<std::size_t>(length);
   if (!belongs_in_chunk(op)) {
-    if (defined_by_spec(op)) throw fail(name(), "only Schema, Channel and Message records belong in a Chunk");
+    if (defined_by_spec(op))
+      throw fail(name(), "only Schema, Channel and Message records belong in a Chunk");
     return std::nullopt;  // a record type of a later version of the spec
   }
   std::optional<McapMessage> message;
   try {
-    message = dispatch(op, std::span<const std::uint8_t>(chunk_).subspan(at + kRecordPrefixBytes, length));
+    message = dispatch(
+        op, std::span<const std::uint8_t>(chunk_).subspan(at + kRecordPrefixBytes, length));
   } catch (const Error& e) {
     throw fail(name(), e.what());
   }
@@ -235,10 +252,12 @@ void McapReader::count(const McapMessage& message, bool checked) {
     return;
   }
   ++coverage_.checked_messages;
-  coverage_.checked_end_time_ns = std::max(coverage_.checked_end_time_ns.value_or(0), message.log_time_ns);
+  coverage_.checked_end_time_ns =
+      std::max(coverage_.checked_end_time_ns.value_or(0), message.log_time_ns);
 }
 
-std::optional<McapMessage> McapReader::dispatch(std::uint8_t op, std::span<const std::uint8_t> content) {
+std::optional<McapMessage> McapReader::dispatch(std::uint8_t op,
+                                                std::span<const std::uint8_t> content) {
   ByteCursor cursor(content);
   switch (op) {
     case opcode::kHeader: {
@@ -257,8 +276,8 @@ std::optional<McapMessage> McapReader::dispatch(std::uint8_t op, std::span<const
       if (schema.id == 0) return std::nullopt;  // invalid by the spec: ignored
       const auto [it, inserted] = schemas_.try_emplace(schema.id, schema);
       if (!inserted && it->second != schema) {
-        throw Error(fmt::format("schema {} ('{}') differs from the earlier schema with that id", schema.id,
-                                schema.name));
+        throw Error(fmt::format("schema {} ('{}') differs from the earlier schema with that id",
+                                schema.id, schema.name));
       }
       return std::nullopt;
     }
@@ -270,13 +289,14 @@ std::optional<McapMessage> McapReader::dispatch(std::uint8_t op, std::span<const
       channel.message_encoding = cursor.string("message_encoding");
       channel.metadata = read_string_map(cursor, "metadata");
       if (channel.schema_id != 0 && !schemas_.contains(channel.schema_id)) {
-        throw Error(fmt::format("channel {} ('{}') refers to schema {}, which no earlier record defines", channel.id,
-                                channel.topic, channel.schema_id));
+        throw Error(
+            fmt::format("channel {} ('{}') refers to schema {}, which no earlier record defines",
+                        channel.id, channel.topic, channel.schema_id));
       }
       const auto [it, inserted] = channels_.try_emplace(channel.id, channel);
       if (!inserted && it->second != channel) {
-        throw Error(fmt::format("channel {} ('{}') differs from the earlier channel with that id", channel.id,
-                                channel.topic));
+        throw Error(fmt::format("channel {} ('{}') differs from the earlier channel with that id",
+                                channel.id, channel.topic));
       }
       return std::nullopt;
     }
@@ -300,9 +320,10 @@ std::optional<McapMessage> McapReader::dispatch(std::uint8_t op, std::span<const
     case opcode::kDataEnd: {
       const std::uint32_t recorded = cursor.u32("data_section_crc");
       if (recorded != 0 && recorded != data_crc_.value()) {
-        throw Error(fmt::format("data section CRC-32 is recorded as {:08x} but computes to {:08x}: the file is "
-                                "corrupt",
-                                recorded, data_crc_.value()));
+        throw Error(fmt::format(
+            "data section CRC-32 is recorded as {:08x} but computes to {:08x}: the file is "
+            "corrupt",
+            recorded, data_crc_.value()));
       }
       data_end_seen_ = true;
       summary_begin_ = offset_;
@@ -347,15 +368,17 @@ void McapReader::read_footer() {
   const std::uint32_t summary_crc = cursor.u32("summary_crc");
   if (data_end_seen_) {
     if (summary_start != 0 && summary_start != summary_begin_) {
-      throw Error(fmt::format("summary_start {} does not point just past the Data End record (offset {})",
-                              summary_start, summary_begin_));
+      throw Error(
+          fmt::format("summary_start {} does not point just past the Data End record (offset {})",
+                      summary_start, summary_begin_));
     }
     if (summary_crc != 0) {
       summary_crc_.update(prefix_);
       summary_crc_.update(std::span<const std::uint8_t>(content_).first(16));
       if (summary_crc_.value() != summary_crc) {
-        throw Error(fmt::format("summary CRC-32 is recorded as {:08x} but computes to {:08x}: the file is corrupt",
-                                summary_crc, summary_crc_.value()));
+        throw Error(fmt::format(
+            "summary CRC-32 is recorded as {:08x} but computes to {:08x}: the file is corrupt",
+            summary_crc, summary_crc_.value()));
       }
     }
   }
@@ -368,7 +391,8 @@ void McapReader::read_footer() {
     end_truncated(fmt::format("file ends after {} of the 8 bytes of the closing magic", got));
     return;
   }
-  if (!std::equal(magic, magic + sizeof magic, kMcapMagic.begin())) throw Error("no closing magic after the Footer");
+  if (!std::equal(magic, magic + sizeof magic, kMcapMagic.begin()))
+    throw Error("no closing magic after the Footer");
   if (std::fgetc(file_.get()) != EOF) throw Error("bytes follow the closing magic");
   if (std::ferror(file_.get())) fail_io("read");
   offset_ += sizeof magic;
@@ -393,7 +417,8 @@ bool McapReader::carries_protobuf(const McapMessage& message, std::string_view f
   const auto channel = channels_.find(message.channel_id);
   if (channel == channels_.end() || channel->second.message_encoding != "protobuf") return false;
   const auto schema = schemas_.find(channel->second.schema_id);
-  return schema != schemas_.end() && schema->second.encoding == "protobuf" && schema->second.name == full_name;
+  return schema != schemas_.end() && schema->second.encoding == "protobuf" &&
+         schema->second.name == full_name;
 }
 
 }  // namespace cohaptic::record

@@ -83,7 +83,8 @@ class McapReader {
   std::uint64_t valid_bytes() const { return offset_; }
   /// The file's size when it was opened.
   std::uint64_t file_size() const { return file_size_; }
-  /// Which of the messages returned so far a checked CRC covers (final once next() returned nullopt).
+  /// Which of the messages returned so far a checked CRC covers (final once next() returned
+  /// nullopt).
   const McapCrcCoverage& crc_coverage() const { return coverage_; }
 
   /// The channel and the schema of `message` (nullptr if it has none).
@@ -94,10 +95,12 @@ class McapReader {
   /// with ProtoMessage's schema (by full name) or its bytes do not parse.
   template <typename ProtoMessage>
   std::optional<ProtoMessage> parse(const McapMessage& message) const {
-    if (!carries_protobuf(message, ProtoMessage::default_instance().GetTypeName())) return std::nullopt;
+    if (!carries_protobuf(message, ProtoMessage::default_instance().GetTypeName()))
+      return std::nullopt;
     if (message.data.size() > static_cast<std::size_t>(INT_MAX)) return std::nullopt;
     ProtoMessage out;
-    if (!out.ParseFromArray(message.data.data(), static_cast<int>(message.data.size()))) return std::nullopt;
+    if (!out.ParseFromArray(message.data.data(), static_cast<int>(message.data.size())))
+      return std::nullopt;
     return out;
   }
 
@@ -146,7 +149,8 @@ class McapReader {
   std::uint64_t chunk_offset_ = 0;  ///< of the Chunk record in the file
   bool chunk_checked_ = false;      ///< its CRC matched (a recorded 0 is none)
   McapCrcCoverage coverage_;
-  std::optional<std::uint64_t> messages_end_time_;  ///< the latest log time of every message returned
+  std::optional<std::uint64_t>
+      messages_end_time_;  ///< the latest log time of every message returned
   bool header_seen_ = false;
   bool data_end_seen_ = false;
   std::uint64_t summary_begin_ = 0;  ///< offset just past Data End

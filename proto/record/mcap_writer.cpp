@@ -31,7 +31,8 @@ McapWriter::McapWriter(std::filesystem::path path, McapWriterOptions options)
   file_.reset(std::fopen(path_.c_str(), "wb"));
   if (!file_) {
     const int error = errno;
-    throw Error(fmt::format("cannot open MCAP file {} for writing: {}", path_.string(), reason(error)));
+    throw Error(
+        fmt::format("cannot open MCAP file {} for writing: {}", path_.string(), reason(error)));
   }
   // Our own buffer decides when bytes reach the file; stdio adds no second one.
   std::setvbuf(file_.get(), nullptr, _IONBF, 0);
@@ -58,9 +59,11 @@ McapWriter::~McapWriter() {
 
 void McapWriter::check_usable() const {
   if (state_ == State::failed) {
-    throw Error(fmt::format("MCAP writer for {} is unusable after an earlier error: {}", path_.string(), failure_));
+    throw Error(fmt::format("MCAP writer for {} is unusable after an earlier error: {}",
+                            path_.string(), failure_));
   }
-  if (state_ == State::closed) throw Error(fmt::format("MCAP writer for {} is already closed", path_.string()));
+  if (state_ == State::closed)
+    throw Error(fmt::format("MCAP writer for {} is already closed", path_.string()));
 }
 
 void McapWriter::fail(std::string_view operation) {
@@ -71,7 +74,8 @@ void McapWriter::fail(std::string_view operation) {
   throw Error(failure_);
 }
 
-std::uint16_t McapWriter::add_schema(std::string_view name, std::string_view encoding, std::string_view data) {
+std::uint16_t McapWriter::add_schema(std::string_view name, std::string_view encoding,
+                                     std::string_view data) {
   check_usable();
   if (schema_records_.size() >= std::numeric_limits<std::uint16_t>::max()) {
     throw Error(fmt::format("MCAP file {}: too many schemas (at most 65535)", path_.string()));
@@ -99,7 +103,8 @@ std::uint16_t McapWriter::add_channel(std::uint16_t schema_id, std::string_view 
                                       const std::map<std::string, std::string>& metadata) {
   check_usable();
   if (schema_id > schema_records_.size()) {
-    throw Error(fmt::format("MCAP file {}: channel '{}' refers to unknown schema {}", path_.string(), topic, schema_id));
+    throw Error(fmt::format("MCAP file {}: channel '{}' refers to unknown schema {}",
+                            path_.string(), topic, schema_id));
   }
   if (channel_records_.size() >= std::numeric_limits<std::uint16_t>::max()) {
     throw Error(fmt::format("MCAP file {}: too many channels (at most 65535)", path_.string()));
@@ -125,7 +130,8 @@ void McapWriter::write(std::uint16_t channel_id, std::uint32_t sequence, std::ui
                        std::uint64_t publish_time_ns, std::span<const std::uint8_t> data) {
   check_usable();
   if (channel_id == 0 || channel_id > channel_records_.size()) {
-    throw Error(fmt::format("MCAP file {}: message on unknown channel {}", path_.string(), channel_id));
+    throw Error(
+        fmt::format("MCAP file {}: message on unknown channel {}", path_.string(), channel_id));
   }
   start_chunk();
   const std::size_t start = chunk_.size();
@@ -163,16 +169,18 @@ void McapWriter::write(std::uint16_t channel_id, std::uint32_t sequence, std::ui
 }
 
 void McapWriter::write(std::uint16_t channel_id, std::uint32_t sequence, std::uint64_t log_time_ns,
-                       std::uint64_t publish_time_ns, const google::protobuf::MessageLite& message) {
+                       std::uint64_t publish_time_ns,
+                       const google::protobuf::MessageLite& message) {
   check_usable();
   const std::size_t size = message.ByteSizeLong();
   if (size > static_cast<std::size_t>(INT_MAX)) {
-    throw Error(fmt::format("MCAP file {}: a {} of {} bytes is too large for protobuf", path_.string(),
-                            message.GetTypeName(), size));
+    throw Error(fmt::format("MCAP file {}: a {} of {} bytes is too large for protobuf",
+                            path_.string(), message.GetTypeName(), size));
   }
   scratch_.resize(size);
   if (!message.SerializeToArray(scratch_.data(), static_cast<int>(size))) {
-    throw Error(fmt::format("MCAP file {}: cannot serialize a {}", path_.string(), message.GetTypeName()));
+    throw Error(
+        fmt::format("MCAP file {}: cannot serialize a {}", path_.string(), message.GetTypeName()));
   }
   write(channel_id, sequence, log_time_ns, publish_time_ns, scratch_);
 }
@@ -186,7 +194,9 @@ void McapWriter::start_chunk() {
   if (chunk_.empty()) chunk_.resize(kRecordPrefixBytes + kChunkFieldsBytes);
 }
 
-std::uint64_t McapWriter::buffered_bytes() const { return chunk_.empty() ? 0 : chunk_.size() + index_bytes_; }
+std::uint64_t McapWriter::buffered_bytes() const {
+  return chunk_.empty() ? 0 : chunk_.size() + index_bytes_;
+}
 
 void McapWriter::maybe_flush() {
   if (buffered_bytes() >= options_.flush_bytes ||
@@ -215,14 +225,16 @@ void McapWriter::write_chunk() {
   put_u64(head, chunk_end_time_);
   put_u64(head, records_size);
   put_u32(head, crc32(std::span<const std::uint8_t>(chunk_).subspan(head_bytes)));
-  put_string(head, "");  // compression: none, so that every flush leaves records readable as they are
+  put_string(head,
+             "");  // compression: none, so that every flush leaves records readable as they are
   put_u64(head, records_size);
   std::copy(head.begin(), head.end(), chunk_.begin());
   const std::uint64_t chunk_length = chunk_.size();
 
   // The Message Index records follow the chunk, by channel id.
   std::sort(chunk_channels_.begin(), chunk_channels_.end());
-  std::vector<std::pair<std::uint16_t, std::uint64_t>> index_offsets;  // channel, file offset of its index
+  std::vector<std::pair<std::uint16_t, std::uint64_t>>
+      index_offsets;  // channel, file offset of its index
   for (const std::uint16_t channel : chunk_channels_) {
     index_offsets.emplace_back(channel, chunk_start + chunk_.size());
     std::vector<IndexEntry>& entries = chunk_entries_[channel - 1];
@@ -272,7 +284,8 @@ void McapWriter::flush() {
 void McapWriter::flush_if_due() {
   if (state_ == State::closed) return;
   check_usable();
-  if (!chunk_.empty() && std::chrono::steady_clock::now() - last_flush_ >= options_.flush_interval) flush();
+  if (!chunk_.empty() && std::chrono::steady_clock::now() - last_flush_ >= options_.flush_interval)
+    flush();
 }
 
 void McapWriter::close() {
@@ -298,7 +311,8 @@ void McapWriter::close() {
   const auto add_group = [&](std::uint8_t op, const auto& put_records) {
     const std::size_t group_begin = tail.size();
     put_records();
-    if (tail.size() > group_begin) groups.push_back({op, base + group_begin, tail.size() - group_begin});
+    if (tail.size() > group_begin)
+      groups.push_back({op, base + group_begin, tail.size() - group_begin});
   };
   add_group(opcode::kSchema, [&] {
     for (const auto& record : schema_records_) put_bytes(tail, record);

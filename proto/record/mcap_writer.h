@@ -142,8 +142,9 @@ class McapWriter {
   /// The chunk being filled: empty, or its head (kRecordPrefixBytes + kChunkFieldsBytes,
   /// filled in by write_chunk) followed by its records.
   std::vector<std::uint8_t> chunk_;
-  std::vector<std::vector<IndexEntry>> chunk_entries_;  ///< by channel id - 1, this chunk's messages
-  std::vector<std::uint16_t> chunk_channels_;           ///< channels with messages in this chunk
+  std::vector<std::vector<IndexEntry>>
+      chunk_entries_;                          ///< by channel id - 1, this chunk's messages
+  std::vector<std::uint16_t> chunk_channels_;  ///< channels with messages in this chunk
   std::uint64_t chunk_message_count_ = 0;
   std::uint64_t chunk_start_time_ = 0;
   std::uint64_t chunk_end_time_ = 0;
@@ -155,9 +156,9 @@ class McapWriter {
 
   std::vector<std::vector<std::uint8_t>> schema_records_;   ///< by id - 1, repeated in the summary
   std::vector<std::vector<std::uint8_t>> channel_records_;  ///< by id - 1, repeated in the summary
-  std::vector<std::uint8_t> chunk_indexes_;                 ///< one Chunk Index record per chunk written
+  std::vector<std::uint8_t> chunk_indexes_;  ///< one Chunk Index record per chunk written
   std::uint32_t chunk_count_ = 0;
-  std::vector<std::uint64_t> channel_message_counts_;       ///< by id - 1
+  std::vector<std::uint64_t> channel_message_counts_;  ///< by id - 1
   std::uint64_t message_count_ = 0;
   std::uint64_t message_start_time_ = 0;
   std::uint64_t message_end_time_ = 0;

@@ -11,7 +11,8 @@ namespace cohaptic::record {
 namespace {
 
 // Depth first, dependencies before the file itself: a topological order of the imports.
-void add_file(const google::protobuf::FileDescriptor* file, std::set<const google::protobuf::FileDescriptor*>& seen,
+void add_file(const google::protobuf::FileDescriptor* file,
+              std::set<const google::protobuf::FileDescriptor*>& seen,
               google::protobuf::FileDescriptorSet& set) {
   if (!seen.insert(file).second) return;
   for (int i = 0; i < file->dependency_count(); ++i) add_file(file->dependency(i), seen, set);

@@ -24,12 +24,12 @@ struct Recording {
   std::vector<SimulationStep> steps;
   std::vector<SessionEvent> events;
   std::vector<ReceivedClientStatus> client_statuses;  ///< server: the users' status reports
-  std::vector<view::Scene> view_scenes;               ///< server with --view: its live view's scene (one)
-  std::vector<view::Frame> view_frames;               ///< and every frame
+  std::vector<view::Scene> view_scenes;  ///< server with --view: its live view's scene (one)
+  std::vector<view::Frame> view_frames;  ///< and every frame
   bool truncated = false;
-  std::string truncation;         ///< where, if truncated
-  std::uint64_t file_bytes = 0;   ///< the file's size
-  McapCrcCoverage crc;            ///< which of its messages a checked CRC covers (mcap_records.h)
+  std::string truncation;        ///< where, if truncated
+  std::uint64_t file_bytes = 0;  ///< the file's size
+  McapCrcCoverage crc;           ///< which of its messages a checked CRC covers (mcap_records.h)
   std::size_t unknown_messages = 0;  ///< on channels this build does not know
 };
 

@@ -27,7 +27,8 @@ SessionRecorder::SessionRecorder(const std::filesystem::path& file) : file_(file
 
 SessionRecorder::~SessionRecorder() { close(); }
 
-void SessionRecorder::write(std::uint16_t channel, std::int64_t time_ns, const google::protobuf::MessageLite& message) {
+void SessionRecorder::write(std::uint16_t channel, std::int64_t time_ns,
+                            const google::protobuf::MessageLite& message) {
   std::lock_guard lock(mutex_);
   if (failed_ || !writer_ || writer_->is_closed()) return;
   try {
@@ -52,7 +53,8 @@ void SessionRecorder::datagram_in(std::int64_t receive_ns, const wire::Datagram&
   write(datagrams_, receive_ns, record);
 }
 
-void SessionRecorder::ir(std::int64_t time_ns, const wire::IntermediateRepresentation& ir, bool repeat) {
+void SessionRecorder::ir(std::int64_t time_ns, const wire::IntermediateRepresentation& ir,
+                         bool repeat) {
   RecordedIr record;
   record.set_time_ns(time_ns);
   record.set_repeat(repeat);
@@ -60,7 +62,8 @@ void SessionRecorder::ir(std::int64_t time_ns, const wire::IntermediateRepresent
   write(ir_, time_ns, record);
 }
 
-void SessionRecorder::ir_block(std::int64_t time_ns, std::uint32_t stream, const wire::CompressedIr& block, bool repeat) {
+void SessionRecorder::ir_block(std::int64_t time_ns, std::uint32_t stream,
+                               const wire::CompressedIr& block, bool repeat) {
   RecordedIr record;
   record.set_time_ns(time_ns);
   record.set_repeat(repeat);
@@ -90,9 +93,13 @@ void SessionRecorder::client_status(const ReceivedClientStatus& status) {
   write(client_status_, status.receive_time_ns(), status);
 }
 
-void SessionRecorder::view_scene(std::int64_t time_ns, const view::Scene& scene) { write(view_scene_, time_ns, scene); }
+void SessionRecorder::view_scene(std::int64_t time_ns, const view::Scene& scene) {
+  write(view_scene_, time_ns, scene);
+}
 
-void SessionRecorder::view_frame(std::int64_t time_ns, const view::Frame& frame) { write(view_frames_, time_ns, frame); }
+void SessionRecorder::view_frame(std::int64_t time_ns, const view::Frame& frame) {
+  write(view_frames_, time_ns, frame);
+}
 
 void SessionRecorder::flush_if_due() {
   std::lock_guard lock(mutex_);

@@ -58,7 +58,8 @@ class SessionRecorder {
   void ir(std::int64_t time_ns, const wire::IntermediateRepresentation& ir, bool repeat = false);
   /// An IR as the block of IR stream `stream` it travelled in (recording.proto, RecordedIr):
   /// the blocks of a stream must be recorded in order, none left out.
-  void ir_block(std::int64_t time_ns, std::uint32_t stream, const wire::CompressedIr& block, bool repeat = false);
+  void ir_block(std::int64_t time_ns, std::uint32_t stream, const wire::CompressedIr& block,
+                bool repeat = false);
   void tick(const HapticTick& tick);
   void step(const SimulationStep& step);
   /// An event; joins and leaves name their user and slot, so a user can be found by name.
@@ -76,7 +77,8 @@ class SessionRecorder {
   const std::filesystem::path& file() const { return file_; }
 
  private:
-  void write(std::uint16_t channel, std::int64_t time_ns, const google::protobuf::MessageLite& message);
+  void write(std::uint16_t channel, std::int64_t time_ns,
+             const google::protobuf::MessageLite& message);
 
   std::filesystem::path file_;
   mutable std::mutex mutex_;

@@ -26,20 +26,22 @@ std::uint64_t random_salt() {
   return salt;
 }
 
-void seal_in_place(std::span<std::uint8_t> message, std::size_t clear_bytes, const Nonce& nonce, const TrafficKey& key,
-                   bool encrypt) {
+void seal_in_place(std::span<std::uint8_t> message, std::size_t clear_bytes, const Nonce& nonce,
+                   const TrafficKey& key, bool encrypt) {
   std::uint8_t* tag = message.data() + message.size() - kTagBytes;
   const std::size_t body_bytes = message.size() - kTagBytes - clear_bytes;
   std::uint8_t* body = message.data() + clear_bytes;
   // Encrypted: the clear part is the associated data. In clear: everything before the tag is.
   const std::size_t associated = encrypt ? clear_bytes : clear_bytes + body_bytes;
-  crypto_aead_xchacha20poly1305_ietf_encrypt_detached(body, tag, nullptr, body, encrypt ? body_bytes : 0,
-                                                      message.data(), associated, nullptr, nonce.data(),
-                                                      key.bytes.data());
+  crypto_aead_xchacha20poly1305_ietf_encrypt_detached(
+      body, tag, nullptr, body, encrypt ? body_bytes : 0, message.data(), associated, nullptr,
+      nonce.data(), key.bytes.data());
 }
 
-std::optional<std::span<const std::uint8_t>> open_sealed(std::span<const std::uint8_t> message, std::size_t clear_bytes,
-                                                         const Nonce& nonce, const TrafficKey& key, bool encrypted,
+std::optional<std::span<const std::uint8_t>> open_sealed(std::span<const std::uint8_t> message,
+                                                         std::size_t clear_bytes,
+                                                         const Nonce& nonce, const TrafficKey& key,
+                                                         bool encrypted,
                                                          std::span<std::uint8_t> plaintext) {
   if (message.size() < clear_bytes + kTagBytes) return std::nullopt;
   const std::uint8_t* tag = message.data() + message.size() - kTagBytes;
@@ -47,14 +49,16 @@ std::optional<std::span<const std::uint8_t>> open_sealed(std::span<const std::ui
   const std::uint8_t* body = message.data() + clear_bytes;
   if (!encrypted) {
     // No ciphertext (length 0: `body` is only a valid pointer) and no output: the tag alone.
-    if (crypto_aead_xchacha20poly1305_ietf_decrypt_detached(nullptr, nullptr, body, 0, tag, message.data(),
-                                                            clear_bytes + body_bytes, nonce.data(), key.bytes.data()) != 0)
+    if (crypto_aead_xchacha20poly1305_ietf_decrypt_detached(
+            nullptr, nullptr, body, 0, tag, message.data(), clear_bytes + body_bytes, nonce.data(),
+            key.bytes.data()) != 0)
       return std::nullopt;
     return std::span(body, body_bytes);
   }
   if (plaintext.size() < body_bytes) return std::nullopt;
-  if (crypto_aead_xchacha20poly1305_ietf_decrypt_detached(plaintext.data(), nullptr, body, body_bytes, tag, message.data(),
-                                                          clear_bytes, nonce.data(), key.bytes.data()) != 0)
+  if (crypto_aead_xchacha20poly1305_ietf_decrypt_detached(
+          plaintext.data(), nullptr, body, body_bytes, tag, message.data(), clear_bytes,
+          nonce.data(), key.bytes.data()) != 0)
     return std::nullopt;
   return std::span<const std::uint8_t>(plaintext.data(), body_bytes);
 }

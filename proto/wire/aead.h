@@ -37,14 +37,16 @@ std::uint64_t random_salt();
 
 /// Seals `message` in place: its first `clear_bytes` stay as written, the body after them
 /// is encrypted if `encrypt`, and the tag is written into its last kTagBytes.
-void seal_in_place(std::span<std::uint8_t> message, std::size_t clear_bytes, const Nonce& nonce, const TrafficKey& key,
-                   bool encrypt);
+void seal_in_place(std::span<std::uint8_t> message, std::size_t clear_bytes, const Nonce& nonce,
+                   const TrafficKey& key, bool encrypt);
 
 /// Opens a message sealed that way: its body if the tag verifies, else nullopt. An
 /// encrypted body is decrypted into `plaintext` (at least the body's size; it may be the
 /// body's own bytes); a body in clear is returned where it lies. Never throws.
-std::optional<std::span<const std::uint8_t>> open_sealed(std::span<const std::uint8_t> message, std::size_t clear_bytes,
-                                                         const Nonce& nonce, const TrafficKey& key, bool encrypted,
+std::optional<std::span<const std::uint8_t>> open_sealed(std::span<const std::uint8_t> message,
+                                                         std::size_t clear_bytes,
+                                                         const Nonce& nonce, const TrafficKey& key,
+                                                         bool encrypted,
                                                          std::span<std::uint8_t> plaintext);
 
 }  // namespace cohaptic::wire

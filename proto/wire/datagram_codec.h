@@ -47,13 +47,14 @@ struct SealWith {
 /// Throws cohaptic::Error if they exceed kMaxDatagramBytes.
 std::vector<std::uint8_t> encode_datagram(const Datagram& datagram, const SealWith& seal);
 /// The same into `out`, reusing its capacity (no allocation once it is large enough).
-void encode_datagram(const Datagram& datagram, const SealWith& seal, std::vector<std::uint8_t>& out);
+void encode_datagram(const Datagram& datagram, const SealWith& seal,
+                     std::vector<std::uint8_t>& out);
 
 /// The checks that need no state (all but sender, salt and replay), with `key` for
 /// whichever sender the envelope names.
-std::variant<Datagram, Rejection> decode_datagram(std::span<const std::uint8_t> bytes, const TrafficKey& key,
-                                                  std::optional<std::uint64_t> expected_session = std::nullopt,
-                                                  bool allow_cleartext = false);
+std::variant<Datagram, Rejection> decode_datagram(
+    std::span<const std::uint8_t> bytes, const TrafficKey& key,
+    std::optional<std::uint64_t> expected_session = std::nullopt, bool allow_cleartext = false);
 
 /// The bound of every clock reading a datagram carries (header.sender_time_ns and the
 /// body's times): 2^61 ns, 73 years of a monotonic clock. Within it, the receivers' clock
@@ -72,7 +73,8 @@ std::optional<Rejection> body_rejection(const Datagram& datagram);
 class DatagramInspector {
  public:
   /// `allow_cleartext`: accept datagrams sent in clear (authenticated, not encrypted).
-  explicit DatagramInspector(std::optional<std::uint64_t> expected_session = std::nullopt, bool allow_cleartext = false);
+  explicit DatagramInspector(std::optional<std::uint64_t> expected_session = std::nullopt,
+                             bool allow_cleartext = false);
 
   /// A client learns its session from the Welcome; nullopt accepts any session.
   void set_expected_session(std::optional<std::uint64_t> session) { session_ = session; }
@@ -81,7 +83,8 @@ class DatagramInspector {
   /// Accepts datagrams from `sender` sealed with `key` by the sealer whose salt is `salt`,
   /// with sequences above `last_sequence` (the sender's last one before, as it told us),
   /// in a fresh replay window. Replaces what was allowed for `sender` before.
-  void allow_sender(std::uint32_t sender, const TrafficKey& key, std::uint64_t salt, std::uint64_t last_sequence = 0);
+  void allow_sender(std::uint32_t sender, const TrafficKey& key, std::uint64_t salt,
+                    std::uint64_t last_sequence = 0);
   void forget_sender(std::uint32_t sender);
   bool allows(std::uint32_t sender) const { return find(sender) != nullptr; }
   /// The replay window of `sender`, or null if it is not allowed.
@@ -105,7 +108,9 @@ class DatagramInspector {
     ReplayWindow window;
   };
   const Sender* find(std::uint32_t sender) const;
-  Sender* find(std::uint32_t sender) { return const_cast<Sender*>(std::as_const(*this).find(sender)); }
+  Sender* find(std::uint32_t sender) {
+    return const_cast<Sender*>(std::as_const(*this).find(sender));
+  }
   std::nullopt_t reject(Rejection reason);
 
   std::optional<std::uint64_t> session_;

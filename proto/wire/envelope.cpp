@@ -4,7 +4,9 @@
 
 namespace cohaptic::wire {
 
-bool Envelope::known_format() const { return version == kProtocolVersion && (flags & ~kEncryptedFlag) == 0; }
+bool Envelope::known_format() const {
+  return version == kProtocolVersion && (flags & ~kEncryptedFlag) == 0;
+}
 
 void write_le(std::uint64_t value, std::size_t bytes, std::uint8_t* out) {
   for (std::size_t i = 0; i < bytes; ++i) out[i] = static_cast<std::uint8_t>(value >> (8 * i));

@@ -68,7 +68,8 @@ Challenge random_challenge();
 bool is_challenge(const std::string& bytes, const Challenge& challenge);
 
 struct FrameReaderOptions {
-  bool expect_greeting = false;  ///< the client's side: the stream starts with the server's greeting
+  bool expect_greeting =
+      false;  ///< the client's side: the stream starts with the server's greeting
   bool allow_cleartext = false;  ///< accept frames sent in clear (authenticated, not encrypted)
   std::size_t max_body_bytes = kDefaultMaxFrameBytes;  ///< at most INT_MAX, protobuf's limit
 };

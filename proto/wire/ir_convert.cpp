@@ -19,7 +19,8 @@ using WireIr = IntermediateRepresentation;
 
 template <typename... Args>
 [[noreturn]] void invalid(fmt::format_string<Args...> format, Args&&... args) {
-  throw cohaptic::Error("intermediate representation: " + fmt::format(format, std::forward<Args>(args)...));
+  throw cohaptic::Error("intermediate representation: " +
+                        fmt::format(format, std::forward<Args>(args)...));
 }
 
 template <typename Field>
@@ -43,7 +44,8 @@ void add_triple(const std::array<Eigen::Vector3d, 3>& vectors, Triples* out) {
 // ---- from_wire checks ----
 
 void check_vec3(const Vec3& v, const std::string& what) {
-  if (!is_finite(v)) invalid("{} has a non-finite component ({}, {}, {})", what, v.x(), v.y(), v.z());
+  if (!is_finite(v))
+    invalid("{} has a non-finite component ({}, {}, {})", what, v.x(), v.y(), v.z());
 }
 
 template <typename Triples>
@@ -63,18 +65,20 @@ Eigen::Vector3d read_vec3(const Vec3& v, const std::string& what) {
 }
 
 /// Three node indices, each in [0, limit).
-std::array<int, 3> read_nodes(const google::protobuf::RepeatedField<std::uint32_t>& nodes, std::uint32_t limit,
-                              const std::string& what, const char* range) {
+std::array<int, 3> read_nodes(const google::protobuf::RepeatedField<std::uint32_t>& nodes,
+                              std::uint32_t limit, const std::string& what, const char* range) {
   if (nodes.size() != 3) invalid("{}.nodes has {} entries, expected 3", what, nodes.size());
   std::array<int, 3> out{};
   for (int k = 0; k < 3; ++k) {
-    if (nodes[k] >= limit) invalid("{}.nodes[{}] = {} is outside the {} ({} nodes)", what, k, nodes[k], range, limit);
+    if (nodes[k] >= limit)
+      invalid("{}.nodes[{}] = {} is outside the {} ({} nodes)", what, k, nodes[k], range, limit);
     out[static_cast<std::size_t>(k)] = static_cast<int>(nodes[k]);
   }
   return out;
 }
 
-Eigen::Matrix3Xd read_xyz(const google::protobuf::RepeatedField<double>& values, std::uint32_t count, const char* what) {
+Eigen::Matrix3Xd read_xyz(const google::protobuf::RepeatedField<double>& values,
+                          std::uint32_t count, const char* what) {
   if (static_cast<std::uint64_t>(values.size()) != 3ull * count)
     invalid("{} has {} values, expected 3 x {}", what, values.size(), count);
   Eigen::Matrix3Xd out(3, static_cast<Eigen::Index>(count));
@@ -93,7 +97,8 @@ int to_int(std::uint32_t value, const char* what) {
 std::size_t free_dofs(const std::string& fixed_axes, std::size_t first, std::size_t last) {
   std::size_t count = 0;
   for (std::size_t i = first; i < last; ++i)
-    for (int axis = 0; axis < 3; ++axis) count += ((static_cast<unsigned char>(fixed_axes[i]) >> axis) & 1u) ? 0u : 1u;
+    for (int axis = 0; axis < 3; ++axis)
+      count += ((static_cast<unsigned char>(fixed_axes[i]) >> axis) & 1u) ? 0u : 1u;
   return count;
 }
 
@@ -103,7 +108,9 @@ std::vector<AxisMask> read_fixed_axes(const std::string& bytes, const char* what
   masks.reserve(bytes.size());
   for (std::size_t i = 0; i < bytes.size(); ++i) {
     const auto mask = static_cast<AxisMask>(bytes[i]);
-    if (mask & ~kAllAxes) invalid("{} of node {} is 0x{:02x}, not a mask of x, y, z", what, i, static_cast<unsigned>(mask));
+    if (mask & ~kAllAxes)
+      invalid("{} of node {} is 0x{:02x}, not a mask of x, y, z", what, i,
+              static_cast<unsigned>(mask));
     masks.push_back(mask);
   }
   return masks;
@@ -125,12 +132,15 @@ namespace {
 
 void sphere_to_wire(const SphereContactIr& sphere, IrPrecision precision, SphereContact* out) {
   add_xyz(sphere.normals, out->mutable_normals());
-  add_values<double>(sphere.free_clearance.data(), sphere.free_clearance.size(), out->mutable_free_clearance());
+  add_values<double>(sphere.free_clearance.data(), sphere.free_clearance.size(),
+                     out->mutable_free_clearance());
   const Eigen::MatrixXd& w = sphere.normal_compliance;
   const auto add_upper = [&](auto* field) {
     field->Reserve(static_cast<int>(w.rows() * (w.rows() + 1) / 2));
     for (Eigen::Index j = 0; j < w.cols(); ++j)
-      for (Eigen::Index i = 0; i <= j; ++i) field->AddAlreadyReserved(static_cast<typename std::decay_t<decltype(*field)>::value_type>(w(i, j)));
+      for (Eigen::Index i = 0; i <= j; ++i)
+        field->AddAlreadyReserved(
+            static_cast<typename std::decay_t<decltype(*field)>::value_type>(w(i, j)));
   };
   if (precision == IrPrecision::f32)
     add_upper(out->mutable_normal_compliance_f32());
@@ -148,7 +158,7 @@ void sphere_to_wire(const SphereContactIr& sphere, IrPrecision precision, Sphere
 void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
   out->set_contact_model(ir.contact_model == ContactModel::point_constraint ? CondensedFem::POINT
                          : ir.contact_model == ContactModel::sphere         ? CondensedFem::SPHERE
-                                                                            : CondensedFem::TRANSLATION);
+                                                                    : CondensedFem::TRANSLATION);
   out->mutable_node_ids()->Reserve(static_cast<int>(ir.node_ids.size()));
   for (std::int64_t id : ir.node_ids) out->mutable_node_ids()->AddAlreadyReserved(id);
   out->set_fixed_axes(std::string(ir.fixed_axes.begin(), ir.fixed_axes.end()));
@@ -182,8 +192,10 @@ void fem_to_wire(const CondensedFemIr& ir, CondensedFem* out) {
     const Eigen::MatrixXd& rows = ir.compliance_rows->rows;
     out->set_m_rows(static_cast<std::uint32_t>(ir_dofs(ir, 0, ir.row_node_count).size()));
     out->set_m_cols(static_cast<std::uint32_t>(ir_dofs(ir, 0, ir.node_count()).size()));
-    out->mutable_truncated_node_ids()->Add(ir.truncated_node_ids.begin(), ir.truncated_node_ids.end());
-    out->set_truncated_fixed_axes(std::string(ir.truncated_fixed_axes.begin(), ir.truncated_fixed_axes.end()));
+    out->mutable_truncated_node_ids()->Add(ir.truncated_node_ids.begin(),
+                                           ir.truncated_node_ids.end());
+    out->set_truncated_fixed_axes(
+        std::string(ir.truncated_fixed_axes.begin(), ir.truncated_fixed_axes.end()));
     out->set_rows_generation(ir.compliance_rows->generation);
     out->set_compliance_row_count(static_cast<std::uint32_t>(rows.rows()));
     add_values<double>(rows.data(), rows.size(), out->mutable_compliance_rows());
@@ -241,12 +253,17 @@ void mass_spring_to_wire(const MassSpringIr& ir, MassSpringPatch* out) {
   if (!ir.backing.empty()) {
     NodeBacking* backing = out->mutable_backing();
     for (int node : ir.backing.nodes) backing->add_nodes(static_cast<std::uint32_t>(node));
-    const Eigen::MatrixXd& compliance = ir.backing.compliance;  // symmetric: column-major is row-major
+    const Eigen::MatrixXd& compliance =
+        ir.backing.compliance;  // symmetric: column-major is row-major
     add_values<double>(compliance.data(), compliance.size(), backing->mutable_compliance());
-    add_values<double>(ir.backing.offsets.data(), ir.backing.offsets.size(), backing->mutable_offsets());
-    add_values<double>(ir.backing.damping.data(), ir.backing.damping.size(), backing->mutable_damping());
-    add_values<double>(ir.backing.targets.data(), ir.backing.targets.size(), backing->mutable_targets());
-    add_values<double>(ir.backing.normals.data(), ir.backing.normals.size(), backing->mutable_normals());
+    add_values<double>(ir.backing.offsets.data(), ir.backing.offsets.size(),
+                       backing->mutable_offsets());
+    add_values<double>(ir.backing.damping.data(), ir.backing.damping.size(),
+                       backing->mutable_damping());
+    add_values<double>(ir.backing.targets.data(), ir.backing.targets.size(),
+                       backing->mutable_targets());
+    add_values<double>(ir.backing.normals.data(), ir.backing.normals.size(),
+                       backing->mutable_normals());
   }
 }
 
@@ -257,7 +274,8 @@ void home_spring_to_wire(const cohaptic::HomeSpringPatch& patch, HomeSpringPatch
     for (int vertex : triangle) out->add_triangles(static_cast<std::uint32_t>(vertex));
   for (int offset : patch.ring_offsets) out->add_ring_offsets(static_cast<std::uint32_t>(offset));
   for (int vertex : patch.ring_vertices) out->add_ring_vertices(static_cast<std::uint32_t>(vertex));
-  for (int vertex : patch.surface_vertex) out->add_surface_vertex(static_cast<std::uint32_t>(vertex));
+  for (int vertex : patch.surface_vertex)
+    out->add_surface_vertex(static_cast<std::uint32_t>(vertex));
   out->set_home_stiffness(patch.home_stiffness);
   out->set_neighbour_stiffness(patch.neighbour_stiffness);
   to_wire(patch.trocar_pivot, out->mutable_trocar_pivot());
@@ -271,8 +289,12 @@ void home_spring_to_wire(const cohaptic::HomeSpringPatch& patch, HomeSpringPatch
 struct BodyToWire {
   WireIr* out;
   void operator()(const CondensedFemIr& fem) const { fem_to_wire(fem, out->mutable_fem()); }
-  void operator()(const MassSpringIr& network) const { mass_spring_to_wire(network, out->mutable_mass_spring()); }
-  void operator()(const cohaptic::HomeSpringPatch& patch) const { home_spring_to_wire(patch, out->mutable_home_spring()); }
+  void operator()(const MassSpringIr& network) const {
+    mass_spring_to_wire(network, out->mutable_mass_spring());
+  }
+  void operator()(const cohaptic::HomeSpringPatch& patch) const {
+    home_spring_to_wire(patch, out->mutable_home_spring());
+  }
   void operator()(const cohaptic::SeparationIr& separation) const {
     separation_to_wire(separation, out->mutable_separation());
   }
@@ -300,7 +322,8 @@ WireIr to_wire(const CommonIr& ir) {
 
 namespace {
 
-SphereContactIr sphere_from_wire(const SphereContact& w, std::uint32_t nodes, IrPrecision& precision) {
+SphereContactIr sphere_from_wire(const SphereContact& w, std::uint32_t nodes,
+                                 IrPrecision& precision) {
   SphereContactIr sphere;
   sphere.normals = read_xyz(w.normals(), nodes, "sphere.normals");
   if (static_cast<std::uint32_t>(w.free_clearance_size()) != nodes)
@@ -309,10 +332,13 @@ SphereContactIr sphere_from_wire(const SphereContact& w, std::uint32_t nodes, Ir
   read_values(w.free_clearance(), sphere.free_clearance, "sphere.free_clearance");
   const std::uint64_t upper = std::uint64_t{nodes} * (nodes + 1) / 2;
   const bool f32 = w.normal_compliance_f32_size() > 0;
-  if (f32 && w.normal_compliance_f64_size() > 0) invalid("sphere.normal_compliance in both f64 and f32");
-  if (static_cast<std::uint64_t>(f32 ? w.normal_compliance_f32_size() : w.normal_compliance_f64_size()) != upper)
-    invalid("sphere.normal_compliance has {} values, expected the upper triangle of {} row nodes, {}",
-            f32 ? w.normal_compliance_f32_size() : w.normal_compliance_f64_size(), nodes, upper);
+  if (f32 && w.normal_compliance_f64_size() > 0)
+    invalid("sphere.normal_compliance in both f64 and f32");
+  if (static_cast<std::uint64_t>(f32 ? w.normal_compliance_f32_size()
+                                     : w.normal_compliance_f64_size()) != upper)
+    invalid(
+        "sphere.normal_compliance has {} values, expected the upper triangle of {} row nodes, {}",
+        f32 ? w.normal_compliance_f32_size() : w.normal_compliance_f64_size(), nodes, upper);
   if (f32) precision = IrPrecision::f32;
   const auto n = static_cast<Eigen::Index>(nodes);
   sphere.normal_compliance.resize(n, n);
@@ -335,13 +361,15 @@ SphereContactIr sphere_from_wire(const SphereContact& w, std::uint32_t nodes, Ir
   }
   sphere.held_node_ids.assign(w.held_node_ids().begin(), w.held_node_ids().end());
   if (w.obstacle_rows_size() != w.obstacle_gaps_size())
-    invalid("sphere.obstacle_rows has {} values, sphere.obstacle_gaps {}", w.obstacle_rows_size(), w.obstacle_gaps_size());
+    invalid("sphere.obstacle_rows has {} values, sphere.obstacle_gaps {}", w.obstacle_rows_size(),
+            w.obstacle_gaps_size());
   sphere.obstacle_gaps = Eigen::VectorXd::Constant(n, std::numeric_limits<double>::infinity());
   for (int k = 0; k < w.obstacle_rows_size(); ++k) {
     const std::uint32_t row = w.obstacle_rows(k);
     if (row >= nodes || (k > 0 && row <= w.obstacle_rows(k - 1)))
       invalid("sphere.obstacle_rows[{}] = {} is not an ascending row node of {}", k, row, nodes);
-    if (!std::isfinite(w.obstacle_gaps(k))) invalid("sphere.obstacle_gaps[{}] is not finite ({})", k, w.obstacle_gaps(k));
+    if (!std::isfinite(w.obstacle_gaps(k)))
+      invalid("sphere.obstacle_gaps[{}] is not finite ({})", k, w.obstacle_gaps(k));
     sphere.obstacle_gaps[row] = w.obstacle_gaps(k);
   }
   return sphere;
@@ -350,18 +378,28 @@ SphereContactIr sphere_from_wire(const SphereContact& w, std::uint32_t nodes, Ir
 CondensedFemIr fem_from_wire(const CondensedFem& w) {
   CondensedFemIr ir;
   switch (w.contact_model()) {
-    case CondensedFem::TRANSLATION: ir.contact_model = ContactModel::node_translation; break;
-    case CondensedFem::POINT: ir.contact_model = ContactModel::point_constraint; break;
-    case CondensedFem::SPHERE: ir.contact_model = ContactModel::sphere; break;
-    default: invalid("unknown contact model {}", static_cast<int>(w.contact_model()));
+    case CondensedFem::TRANSLATION:
+      ir.contact_model = ContactModel::node_translation;
+      break;
+    case CondensedFem::POINT:
+      ir.contact_model = ContactModel::point_constraint;
+      break;
+    case CondensedFem::SPHERE:
+      ir.contact_model = ContactModel::sphere;
+      break;
+    default:
+      invalid("unknown contact model {}", static_cast<int>(w.contact_model()));
   }
 
   // Nodes.
   const auto nodes = static_cast<std::uint32_t>(w.node_ids_size());
-  if (w.fixed_axes().size() != nodes) invalid("{} fixed_axes bytes for {} nodes", w.fixed_axes().size(), nodes);
-  if (w.row_node_count() > nodes) invalid("row_node_count {} exceeds the {} nodes", w.row_node_count(), nodes);
+  if (w.fixed_axes().size() != nodes)
+    invalid("{} fixed_axes bytes for {} nodes", w.fixed_axes().size(), nodes);
+  if (w.row_node_count() > nodes)
+    invalid("row_node_count {} exceeds the {} nodes", w.row_node_count(), nodes);
   if (w.patch_node_count() > w.row_node_count())
-    invalid("patch_node_count {} exceeds row_node_count {}", w.patch_node_count(), w.row_node_count());
+    invalid("patch_node_count {} exceeds row_node_count {}", w.patch_node_count(),
+            w.row_node_count());
   ir.node_ids.assign(w.node_ids().begin(), w.node_ids().end());
   ir.fixed_axes = read_fixed_axes(w.fixed_axes(), "fixed_axes");
   ir.row_node_count = static_cast<int>(w.row_node_count());
@@ -375,20 +413,24 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
     const std::string what = fmt::format("patch[{}]", i);
     cohaptic::IrTriangle tri;
     tri.nodes = read_nodes(t.nodes(), w.patch_node_count(), what, "patch");
-    if (t.surface_index() < 0) invalid("{}.surface_index is negative ({})", what, t.surface_index());
+    if (t.surface_index() < 0)
+      invalid("{}.surface_index is negative ({})", what, t.surface_index());
     tri.surface_index = t.surface_index();
     tri.normal = read_vec3(t.normal(), what + ".normal");
-    if (t.neighbours_size() != 3) invalid("{}.neighbours has {} entries, expected 3", what, t.neighbours_size());
+    if (t.neighbours_size() != 3)
+      invalid("{}.neighbours has {} entries, expected 3", what, t.neighbours_size());
     for (int k = 0; k < 3; ++k) {
       const std::int32_t n = t.neighbours(k);
       if (n < -1 || n >= w.patch_size())
-        invalid("{}.neighbours[{}] = {} is neither -1 nor one of the {} patch triangles", what, k, n, w.patch_size());
+        invalid("{}.neighbours[{}] = {} is neither -1 nor one of the {} patch triangles", what, k,
+                n, w.patch_size());
       tri.neighbours[static_cast<std::size_t>(k)] = n;
     }
     tri.edge_normals = read_triple(t.edge_normals(), what + ".edge_normals");
     ir.patch.push_back(tri);
   }
-  ir.patch_vertex_normals = read_xyz(w.patch_vertex_normals(), w.patch_node_count(), "patch_vertex_normals");
+  ir.patch_vertex_normals =
+      read_xyz(w.patch_vertex_normals(), w.patch_node_count(), "patch_vertex_normals");
   for (int i = 0; i < w.guard_size(); ++i) {
     const std::string what = fmt::format("guard[{}]", i);
     cohaptic::IrGuardTriangle guard;
@@ -411,14 +453,19 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
     ir.remotes.push_back(remote);
   }
 
-  if (w.has_sphere() && ir.contact_model != ContactModel::sphere) invalid("a sphere contact part under another contact model");
+  if (w.has_sphere() && ir.contact_model != ContactModel::sphere)
+    invalid("a sphere contact part under another contact model");
   if (ir.contact_model == ContactModel::sphere) {
-    if (!w.has_sphere()) invalid("a sphere body without its normal compliance (format 6 carries it instead of M~)");
-    if (nodes != w.row_node_count() || w.m_rows() != 0 || w.m_cols() != 0 || w.m_tilde_f64_size() > 0 ||
-        w.m_tilde_f32_size() > 0 || w.boundary_displacement_f64_size() > 0 || w.boundary_displacement_f32_size() > 0 ||
+    if (!w.has_sphere())
+      invalid("a sphere body without its normal compliance (format 6 carries it instead of M~)");
+    if (nodes != w.row_node_count() || w.m_rows() != 0 || w.m_cols() != 0 ||
+        w.m_tilde_f64_size() > 0 || w.m_tilde_f32_size() > 0 ||
+        w.boundary_displacement_f64_size() > 0 || w.boundary_displacement_f32_size() > 0 ||
         w.rows_generation() > 0 || w.rest_forces_size() > 0 || w.truncated_node_ids_size() > 0)
-      invalid("a sphere body carries its row nodes and its normal compliance only ({} nodes, {} row nodes, M~ {} x {})",
-              nodes, w.row_node_count(), w.m_rows(), w.m_cols());
+      invalid(
+          "a sphere body carries its row nodes and its normal compliance only ({} nodes, {} row "
+          "nodes, M~ {} x {})",
+          nodes, w.row_node_count(), w.m_rows(), w.m_cols());
     ir.sphere = sphere_from_wire(w.sphere(), nodes, ir.precision);
     return ir;
   }
@@ -430,21 +477,25 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   ir.precision = f32 ? IrPrecision::f32 : IrPrecision::f64;
   const std::size_t row_dofs = free_dofs(w.fixed_axes(), 0, w.row_node_count());
   const std::size_t boundary_dofs = free_dofs(w.fixed_axes(), w.row_node_count(), nodes);
-  if (w.m_rows() != row_dofs) invalid("m_rows {} differs from the {} free dofs of the contact nodes", w.m_rows(), row_dofs);
+  if (w.m_rows() != row_dofs)
+    invalid("m_rows {} differs from the {} free dofs of the contact nodes", w.m_rows(), row_dofs);
   if (w.m_cols() != row_dofs + boundary_dofs)
-    invalid("m_cols {} differs from the {} free dofs of all nodes", w.m_cols(), row_dofs + boundary_dofs);
+    invalid("m_cols {} differs from the {} free dofs of all nodes", w.m_cols(),
+            row_dofs + boundary_dofs);
   const bool rows_form = w.rows_generation() > 0;
   const std::uint64_t entries = rows_form ? 0 : std::uint64_t{w.m_rows()} * w.m_cols();
-  const auto m_length = static_cast<std::uint64_t>(f32 ? w.m_tilde_f32_size() : w.m_tilde_f64_size());
+  const auto m_length =
+      static_cast<std::uint64_t>(f32 ? w.m_tilde_f32_size() : w.m_tilde_f64_size());
   if (m_length != entries)
-    invalid("M~ has {} values, expected {} (m_rows x m_cols = {} x {}, none with compliance rows)", m_length, entries,
-            w.m_rows(), w.m_cols());
+    invalid("M~ has {} values, expected {} (m_rows x m_cols = {} x {}, none with compliance rows)",
+            m_length, entries, w.m_rows(), w.m_cols());
   // B truncation's held nodes left out of M~: the rows' columns cover them too.
   const auto truncated = static_cast<std::uint32_t>(w.truncated_node_ids_size());
   if (!rows_form && (truncated > 0 || !w.truncated_fixed_axes().empty()))
     invalid("truncated held nodes without a rows_generation (only compliance rows carry them)");
   if (w.truncated_fixed_axes().size() != truncated)
-    invalid("{} truncated_fixed_axes bytes for {} truncated held nodes", w.truncated_fixed_axes().size(), truncated);
+    invalid("{} truncated_fixed_axes bytes for {} truncated held nodes",
+            w.truncated_fixed_axes().size(), truncated);
   ir.truncated_node_ids.assign(w.truncated_node_ids().begin(), w.truncated_node_ids().end());
   ir.truncated_fixed_axes = read_fixed_axes(w.truncated_fixed_axes(), "truncated_fixed_axes");
   const std::uint64_t row_cols = w.m_cols() + free_dofs(w.truncated_fixed_axes(), 0, truncated);
@@ -452,20 +503,26 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
   if (!rows_form && (w.compliance_row_count() > 0 || w.compliance_rows_size() > 0))
     invalid("compliance rows without a rows_generation");
   if (static_cast<std::uint64_t>(w.compliance_rows_size()) != row_values)
-    invalid("compliance_rows has {} values, expected compliance_row_count x (m_cols + free dofs of the truncated "
-            "held nodes) = {} x {}",
-            w.compliance_rows_size(), w.compliance_row_count(), row_cols);
-  const auto u_length =
-      static_cast<std::uint64_t>(f32 ? w.boundary_displacement_f32_size() : w.boundary_displacement_f64_size());
-  if (u_length != boundary_dofs) invalid("u_B has {} values, expected {} (free boundary dofs)", u_length, boundary_dofs);
-  ir.m_tilde.resize(rows_form ? 0 : static_cast<Eigen::Index>(w.m_rows()), rows_form ? 0 : static_cast<Eigen::Index>(w.m_cols()));
+    invalid(
+        "compliance_rows has {} values, expected compliance_row_count x (m_cols + free dofs of the "
+        "truncated "
+        "held nodes) = {} x {}",
+        w.compliance_rows_size(), w.compliance_row_count(), row_cols);
+  const auto u_length = static_cast<std::uint64_t>(f32 ? w.boundary_displacement_f32_size()
+                                                       : w.boundary_displacement_f64_size());
+  if (u_length != boundary_dofs)
+    invalid("u_B has {} values, expected {} (free boundary dofs)", u_length, boundary_dofs);
+  ir.m_tilde.resize(rows_form ? 0 : static_cast<Eigen::Index>(w.m_rows()),
+                    rows_form ? 0 : static_cast<Eigen::Index>(w.m_cols()));
   ir.boundary_displacement.resize(static_cast<Eigen::Index>(boundary_dofs));
   if (f32) {
     read_values(w.m_tilde_f32(), ir.m_tilde, "m_tilde_f32");
-    read_values(w.boundary_displacement_f32(), ir.boundary_displacement, "boundary_displacement_f32");
+    read_values(w.boundary_displacement_f32(), ir.boundary_displacement,
+                "boundary_displacement_f32");
   } else {
     read_values(w.m_tilde_f64(), ir.m_tilde, "m_tilde_f64");
-    read_values(w.boundary_displacement_f64(), ir.boundary_displacement, "boundary_displacement_f64");
+    read_values(w.boundary_displacement_f64(), ir.boundary_displacement,
+                "boundary_displacement_f64");
   }
   if (w.rest_forces_size() > 0) {
     if (static_cast<std::uint64_t>(w.rest_forces_size()) != w.m_rows())
@@ -474,8 +531,9 @@ CondensedFemIr fem_from_wire(const CondensedFem& w) {
     read_values(w.rest_forces(), ir.rest_forces, "rest_forces");
   }
   if (rows_form) {
-    ComplianceRows rows{w.rows_generation(), Eigen::MatrixXd(static_cast<Eigen::Index>(w.compliance_row_count()),
-                                                             static_cast<Eigen::Index>(row_cols))};
+    ComplianceRows rows{w.rows_generation(),
+                        Eigen::MatrixXd(static_cast<Eigen::Index>(w.compliance_row_count()),
+                                        static_cast<Eigen::Index>(row_cols))};
     read_values(w.compliance_rows(), rows.rows, "compliance_rows");
     ir.compliance_rows = std::move(rows);
   }
@@ -489,7 +547,8 @@ MassSpringIr mass_spring_from_wire(const MassSpringPatch& w) {
   ir.node_ids.assign(w.node_ids().begin(), w.node_ids().end());
   ir.positions = read_xyz(w.positions(), nodes, "positions");
   ir.velocities = read_xyz(w.velocities(), nodes, "velocities");
-  if (static_cast<std::uint32_t>(w.masses_size()) != nodes) invalid("{} masses for {} nodes", w.masses_size(), nodes);
+  if (static_cast<std::uint32_t>(w.masses_size()) != nodes)
+    invalid("{} masses for {} nodes", w.masses_size(), nodes);
   ir.mass.resize(static_cast<Eigen::Index>(nodes));
   read_values(w.masses(), ir.mass, "masses");
   if (w.held().size() != nodes) invalid("{} held bytes for {} nodes", w.held().size(), nodes);
@@ -498,9 +557,10 @@ MassSpringIr mass_spring_from_wire(const MassSpringPatch& w) {
     ir.held.push_back(static_cast<std::uint8_t>(held));
   }
   const int springs = w.spring_rest_lengths_size();
-  if (w.spring_nodes_size() != 2 * springs || w.spring_stiffness_size() != springs || w.spring_damping_size() != springs)
-    invalid("{} spring node indices, {} rest lengths, {} stiffnesses and {} dampings", w.spring_nodes_size(), springs,
-            w.spring_stiffness_size(), w.spring_damping_size());
+  if (w.spring_nodes_size() != 2 * springs || w.spring_stiffness_size() != springs ||
+      w.spring_damping_size() != springs)
+    invalid("{} spring node indices, {} rest lengths, {} stiffnesses and {} dampings",
+            w.spring_nodes_size(), springs, w.spring_stiffness_size(), w.spring_damping_size());
   for (int i = 0; i < springs; ++i) {
     Spring spring;
     for (int end = 0; end < 2; ++end) {
@@ -513,11 +573,13 @@ MassSpringIr mass_spring_from_wire(const MassSpringPatch& w) {
     spring.damping = w.spring_damping(i);
     ir.springs.push_back(spring);
   }
-  if (w.triangles_size() % 3 != 0) invalid("{} triangle indices, not a multiple of 3", w.triangles_size());
+  if (w.triangles_size() % 3 != 0)
+    invalid("{} triangle indices, not a multiple of 3", w.triangles_size());
   for (int i = 0; i < w.triangles_size(); i += 3) {
     std::array<int, 3> triangle{};
     for (int k = 0; k < 3; ++k) {
-      if (w.triangles(i + k) >= nodes) invalid("triangle {} names node {} of {}", i / 3, w.triangles(i + k), nodes);
+      if (w.triangles(i + k) >= nodes)
+        invalid("triangle {} names node {} of {}", i / 3, w.triangles(i + k), nodes);
       triangle[static_cast<std::size_t>(k)] = static_cast<int>(w.triangles(i + k));
     }
     ir.triangles.push_back(triangle);
@@ -535,26 +597,32 @@ MassSpringIr mass_spring_from_wire(const MassSpringPatch& w) {
     plane.dynamic_friction = w.plane().dynamic_friction();
     p.plane = plane;
   }
-  if (w.remote_radii_size() != w.remote_users_size() || w.presses_size() != w.remote_users_size() + 1)
-    invalid("{} remote users, {} radii and {} presses (expected one more)", w.remote_users_size(), w.remote_radii_size(),
-            w.presses_size());
+  if (w.remote_radii_size() != w.remote_users_size() ||
+      w.presses_size() != w.remote_users_size() + 1)
+    invalid("{} remote users, {} radii and {} presses (expected one more)", w.remote_users_size(),
+            w.remote_radii_size(), w.presses_size());
   for (int i = 0; i < w.remote_users_size(); ++i) {
     ir.remote_users.push_back(to_int(w.remote_users(i), "remote user"));
     ir.remote_radii.push_back(w.remote_radii(i));
   }
   for (int i = 0; i < w.presses_size(); ++i)
-    ir.presses.push_back({w.presses(i).pressing(), read_vec3(w.presses(i).previous(), fmt::format("presses[{}]", i))});
+    ir.presses.push_back({w.presses(i).pressing(),
+                          read_vec3(w.presses(i).previous(), fmt::format("presses[{}]", i))});
   if (w.has_backing()) {
     const NodeBacking& b = w.backing();
     const auto backed = static_cast<std::uint64_t>(b.nodes_size());
     const auto count = static_cast<Eigen::Index>(backed);
     if (static_cast<std::uint64_t>(b.compliance_size()) != backed * backed ||
-        static_cast<std::uint64_t>(b.offsets_size()) != backed || static_cast<std::uint64_t>(b.damping_size()) != backed ||
-        static_cast<std::uint64_t>(b.targets_size()) != 3 * backed || static_cast<std::uint64_t>(b.normals_size()) != 3 * backed)
-      invalid("a backing of {} nodes with {} compliances, {} offsets, {} dampings, {} targets and {} normals (expected {}, "
-              "{}, {}, {}, {})",
-              backed, b.compliance_size(), b.offsets_size(), b.damping_size(), b.targets_size(), b.normals_size(),
-              backed * backed, backed, backed, 3 * backed, 3 * backed);
+        static_cast<std::uint64_t>(b.offsets_size()) != backed ||
+        static_cast<std::uint64_t>(b.damping_size()) != backed ||
+        static_cast<std::uint64_t>(b.targets_size()) != 3 * backed ||
+        static_cast<std::uint64_t>(b.normals_size()) != 3 * backed)
+      invalid(
+          "a backing of {} nodes with {} compliances, {} offsets, {} dampings, {} targets and {} "
+          "normals (expected {}, "
+          "{}, {}, {}, {})",
+          backed, b.compliance_size(), b.offsets_size(), b.damping_size(), b.targets_size(),
+          b.normals_size(), backed * backed, backed, backed, 3 * backed, 3 * backed);
     for (std::uint32_t node : b.nodes()) {
       if (node >= nodes) invalid("the backing names node {} of {}", node, nodes);
       ir.backing.nodes.push_back(static_cast<int>(node));
@@ -588,9 +656,11 @@ cohaptic::HomeSpringPatch home_spring_from_wire(const HomeSpringPatch& w) {
   const auto vertices = static_cast<std::uint32_t>(w.surface_vertex_size());
   patch.rest_positions = read_xyz(w.rest_positions(), vertices, "rest_positions");
   patch.contact_vertex_count = to_int(w.contact_vertex_count(), "contact_vertex_count");
-  if (w.triangles_size() % 3 != 0) invalid("{} triangle indices, not a multiple of 3", w.triangles_size());
+  if (w.triangles_size() % 3 != 0)
+    invalid("{} triangle indices, not a multiple of 3", w.triangles_size());
   const std::vector<int> corners = read_indices(w.triangles(), "triangle corner");
-  for (std::size_t i = 0; i < corners.size(); i += 3) patch.triangles.push_back({corners[i], corners[i + 1], corners[i + 2]});
+  for (std::size_t i = 0; i < corners.size(); i += 3)
+    patch.triangles.push_back({corners[i], corners[i + 1], corners[i + 2]});
   patch.ring_offsets = read_indices(w.ring_offsets(), "ring offset");
   patch.ring_vertices = read_indices(w.ring_vertices(), "ring vertex");
   patch.surface_vertex = read_indices(w.surface_vertex(), "surface vertex");
@@ -612,33 +682,47 @@ cohaptic::HomeSpringPatch home_spring_from_wire(const HomeSpringPatch& w) {
 }  // namespace
 
 CommonIr from_wire(const WireIr& w) {
-  if (w.format_version() < CommonIr::kOldestReadableVersion || w.format_version() > CommonIr::kFormatVersion)
-    invalid("format version {}, expected {} to {}{}", w.format_version(), CommonIr::kOldestReadableVersion,
-            CommonIr::kFormatVersion,
-            w.format_version() == 1 ? " (version 1 is read by cohaptic builds before the body framework)" : "");
+  if (w.format_version() < CommonIr::kOldestReadableVersion ||
+      w.format_version() > CommonIr::kFormatVersion)
+    invalid("format version {}, expected {} to {}{}", w.format_version(),
+            CommonIr::kOldestReadableVersion, CommonIr::kFormatVersion,
+            w.format_version() == 1
+                ? " (version 1 is read by cohaptic builds before the body framework)"
+                : "");
   if (w.format_version() < 3 && w.has_fem() && w.fem().rows_generation() > 0)
     invalid("format version {} cannot carry compliance rows (version 3 can)", w.format_version());
   if (w.format_version() < 4 && w.has_fem() && w.fem().truncated_node_ids_size() > 0)
-    invalid("format version {} cannot carry truncated held nodes (version 4 can)", w.format_version());
-  if (w.format_version() < 6 && w.has_fem() && w.fem().contact_model() == CondensedFem::SPHERE)
-    invalid("format version {} carries a sphere body as M~, which this build no longer evaluates (version 6 carries its "
-            "normal compliance)",
+    invalid("format version {} cannot carry truncated held nodes (version 4 can)",
             w.format_version());
+  if (w.format_version() < 6 && w.has_fem() && w.fem().contact_model() == CondensedFem::SPHERE)
+    invalid(
+        "format version {} carries a sphere body as M~, which this build no longer evaluates "
+        "(version 6 carries its "
+        "normal compliance)",
+        w.format_version());
   CommonIr ir;
   ir.epoch = w.epoch();
-  if (!std::isfinite(w.simulation_time())) invalid("simulation_time is not finite ({})", w.simulation_time());
+  if (!std::isfinite(w.simulation_time()))
+    invalid("simulation_time is not finite ({})", w.simulation_time());
   ir.simulation_time = w.simulation_time();
   ir.user = to_int(w.user(), "user");
   ir.object = to_int(w.object(), "object");
-  if (!(std::isfinite(w.tool_radius()) && w.tool_radius() >= 0)) invalid("tool_radius {} is not a finite length >= 0", w.tool_radius());
+  if (!(std::isfinite(w.tool_radius()) && w.tool_radius() >= 0))
+    invalid("tool_radius {} is not a finite length >= 0", w.tool_radius());
   ir.tool_radius = w.tool_radius();
   // +inf is a legitimate "no limit".
   if (!(w.force_limit() >= 0)) invalid("force_limit {} is not >= 0", w.force_limit());
   ir.force_limit = w.force_limit();
   switch (w.body_case()) {
-    case WireIr::kFem: ir.body = fem_from_wire(w.fem()); break;
-    case WireIr::kMassSpring: ir.body = mass_spring_from_wire(w.mass_spring()); break;
-    case WireIr::kHomeSpring: ir.body = home_spring_from_wire(w.home_spring()); break;
+    case WireIr::kFem:
+      ir.body = fem_from_wire(w.fem());
+      break;
+    case WireIr::kMassSpring:
+      ir.body = mass_spring_from_wire(w.mass_spring());
+      break;
+    case WireIr::kHomeSpring:
+      ir.body = home_spring_from_wire(w.home_spring());
+      break;
     case WireIr::kSeparation:
       try {
         ir.body = separation_from_wire(w.separation());
@@ -646,7 +730,8 @@ CommonIr from_wire(const WireIr& w) {
         invalid("{}", e.what());
       }
       break;
-    case WireIr::BODY_NOT_SET: invalid("no body of a kind this build knows");
+    case WireIr::BODY_NOT_SET:
+      invalid("no body of a kind this build knows");
   }
   return ir;
 }

@@ -14,7 +14,8 @@ namespace {
 constexpr int kIrStreamLevel = 1;  // zstd's fastest: long-distance matching finds the repeats
 
 void check_zstd(std::size_t code, const char* what) {
-  if (ZSTD_isError(code)) throw cohaptic::Error(fmt::format("IR stream: {}: {}", what, ZSTD_getErrorName(code)));
+  if (ZSTD_isError(code))
+    throw cohaptic::Error(fmt::format("IR stream: {}: {}", what, ZSTD_getErrorName(code)));
 }
 
 }  // namespace
@@ -30,7 +31,8 @@ struct IrStreamReader::Context {
 };
 
 IrStreamWriter::IrStreamWriter() : context_(std::make_unique<Context>()) {
-  if (!context_->cctx) throw cohaptic::Error("IR stream: zstd could not make a compression context");
+  if (!context_->cctx)
+    throw cohaptic::Error("IR stream: zstd could not make a compression context");
 }
 IrStreamWriter::~IrStreamWriter() = default;
 IrStreamWriter::IrStreamWriter(IrStreamWriter&&) noexcept = default;
@@ -67,7 +69,8 @@ CompressedIr IrStreamWriter::compress(const IntermediateRepresentation& ir, bool
 }
 
 IrStreamReader::IrStreamReader() : context_(std::make_unique<Context>()) {
-  if (!context_->dctx) throw cohaptic::Error("IR stream: zstd could not make a decompression context");
+  if (!context_->dctx)
+    throw cohaptic::Error("IR stream: zstd could not make a decompression context");
 }
 IrStreamReader::~IrStreamReader() = default;
 IrStreamReader::IrStreamReader(IrStreamReader&&) noexcept = default;
@@ -81,9 +84,10 @@ IntermediateRepresentation IrStreamReader::open(const CompressedIr& block) {
   } else if (index_ == 0 || block.index() != index_ + 1) {
     const std::uint64_t held = index_;
     index_ = 0;
-    throw cohaptic::Error(fmt::format("a compressed IR block {} of its stream, and this client opened block {} last: "
-                                      "refused, until the server starts the stream afresh",
-                                      block.index(), held));
+    throw cohaptic::Error(
+        fmt::format("a compressed IR block {} of its stream, and this client opened block {} last: "
+                    "refused, until the server starts the stream afresh",
+                    block.index(), held));
   }
   index_ = 0;  // until this block is opened whole
   const std::string& zstd = block.zstd();
@@ -94,20 +98,22 @@ IntermediateRepresentation IrStreamReader::open(const CompressedIr& block) {
   while (input.pos < input.size || output.pos == output.size) {
     if (output.pos == output.size) {
       if (out.size() >= kMaxStreamIrBytes)
-        throw cohaptic::Error(fmt::format("compressed IR block {} decompresses to more than {} bytes: refused",
-                                          block.index(), kMaxStreamIrBytes));
+        throw cohaptic::Error(
+            fmt::format("compressed IR block {} decompresses to more than {} bytes: refused",
+                        block.index(), kMaxStreamIrBytes));
       out.resize(std::min(kMaxStreamIrBytes, 2 * out.size()));
       output = {out.data(), out.size(), output.pos};
     }
     const std::size_t code = ZSTD_decompressStream(dctx, &output, &input);
     if (ZSTD_isError(code))
-      throw cohaptic::Error(fmt::format("compressed IR block {}: zstd cannot decompress it: {}", block.index(),
-                                        ZSTD_getErrorName(code)));
+      throw cohaptic::Error(fmt::format("compressed IR block {}: zstd cannot decompress it: {}",
+                                        block.index(), ZSTD_getErrorName(code)));
     if (input.pos == input.size && output.pos < output.size) break;
   }
   IntermediateRepresentation ir;
   if (!ir.ParseFromArray(out.data(), static_cast<int>(output.pos)))
-    throw cohaptic::Error(fmt::format("compressed IR block {}: its {} bytes are not an IR", block.index(), output.pos));
+    throw cohaptic::Error(fmt::format("compressed IR block {}: its {} bytes are not an IR",
+                                      block.index(), output.pos));
   index_ = block.index();
   return ir;
 }

@@ -22,7 +22,8 @@
 
 namespace cohaptic::wire {
 
-constexpr std::size_t kMaxStreamIrBytes = std::size_t{64} << 20;  ///< the frame body limit, frame_codec.h
+constexpr std::size_t kMaxStreamIrBytes = std::size_t{64}
+                                          << 20;  ///< the frame body limit, frame_codec.h
 constexpr int kIrStreamWindowLog = 21;
 
 class IrStreamWriter {

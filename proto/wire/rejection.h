@@ -37,9 +37,10 @@ enum class Rejection : std::uint8_t {
 constexpr std::size_t kRejectionCount = 12;
 
 constexpr std::array<Rejection, kRejectionCount> kAllRejections = {
-    Rejection::oversized,     Rejection::truncated,      Rejection::bad_tag,  Rejection::bad_version,
-    Rejection::wrong_session, Rejection::unknown_sender, Rejection::replayed, Rejection::non_finite,
-    Rejection::empty,         Rejection::cleartext,      Rejection::rate_limited, Rejection::bad_time};
+    Rejection::oversized,   Rejection::truncated,     Rejection::bad_tag,
+    Rejection::bad_version, Rejection::wrong_session, Rejection::unknown_sender,
+    Rejection::replayed,    Rejection::non_finite,    Rejection::empty,
+    Rejection::cleartext,   Rejection::rate_limited,  Rejection::bad_time};
 
 /// "oversized", "truncated", "bad_tag", ...: the enumerator's name.
 std::string_view to_string(Rejection reason);
@@ -53,7 +54,9 @@ class RejectionCounters {
   /// Sum over every reason.
   std::uint64_t rejected() const;
 
-  void record(Rejection reason) { rejected_[static_cast<std::size_t>(reason)].fetch_add(1, std::memory_order_relaxed); }
+  void record(Rejection reason) {
+    rejected_[static_cast<std::size_t>(reason)].fetch_add(1, std::memory_order_relaxed);
+  }
   void record_accepted() { accepted_.fetch_add(1, std::memory_order_relaxed); }
 
   /// {"accepted": n, "bad_tag": n, ...}: every reason, zeros included (ready for JSON).

@@ -51,8 +51,10 @@ class Sealer {
     if (!key_) throw cohaptic::Error("a message to seal, and no key to seal it with yet");
     stamp_.stamp(*message.mutable_header());
     const SealWith with{*key_, salt_, encrypt_};
-    if constexpr (std::is_same_v<Message, Control>) return encode_frame(message, with);
-    else return encode_datagram(message, with);
+    if constexpr (std::is_same_v<Message, Control>)
+      return encode_frame(message, with);
+    else
+      return encode_datagram(message, with);
   }
 
   /// This sealer's salt: a receiver accepts a sender's datagrams from its current sealer only.

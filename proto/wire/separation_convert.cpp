@@ -30,20 +30,25 @@ void add_separation_vectors(const std::vector<Eigen::Vector3d>& vectors, Field* 
 }
 
 int separation_index(std::uint32_t value, const char* what) {
-  if (value > static_cast<std::uint32_t>(INT_MAX)) refuse_separation_wire("{} = {} is out of range", what, value);
+  if (value > static_cast<std::uint32_t>(INT_MAX))
+    refuse_separation_wire("{} = {} is out of range", what, value);
   return static_cast<int>(value);
 }
 
-std::vector<Eigen::Vector3d> read_separation_vectors(const google::protobuf::RepeatedField<double>& values, int count,
-                                                     const char* what) {
-  if (values.size() != 3 * count) refuse_separation_wire("{} has {} values, expected 3 x {}", what, values.size(), count);
+std::vector<Eigen::Vector3d> read_separation_vectors(
+    const google::protobuf::RepeatedField<double>& values, int count, const char* what) {
+  if (values.size() != 3 * count)
+    refuse_separation_wire("{} has {} values, expected 3 x {}", what, values.size(), count);
   std::vector<Eigen::Vector3d> out(static_cast<std::size_t>(count));
-  for (int i = 0; i < count; ++i) out[static_cast<std::size_t>(i)] = {values[3 * i], values[3 * i + 1], values[3 * i + 2]};
+  for (int i = 0; i < count; ++i)
+    out[static_cast<std::size_t>(i)] = {values[3 * i], values[3 * i + 1], values[3 * i + 2]};
   return out;
 }
 
-Eigen::Vector3d read_separation_weights(const google::protobuf::RepeatedField<double>& values, const char* what) {
-  if (values.size() != 3) refuse_separation_wire("{} has {} values, expected 3", what, values.size());
+Eigen::Vector3d read_separation_weights(const google::protobuf::RepeatedField<double>& values,
+                                        const char* what) {
+  if (values.size() != 3)
+    refuse_separation_wire("{} has {} values, expected 3", what, values.size());
   return {values[0], values[1], values[2]};
 }
 
@@ -53,8 +58,11 @@ cohaptic::SeparationContact contact_from_wire(const SeparationContact& w) {
   contact.mode = static_cast<ContactMode>(w.mode());
   contact.point.triangle = separation_index(w.triangle(), "contact triangle");
   contact.point.weights = read_separation_weights(w.weights(), "contact weights");
-  if (w.tool_nodes_size() != 3) refuse_separation_wire("contact tool_nodes has {} entries, expected 3", w.tool_nodes_size());
-  for (int k = 0; k < 3; ++k) contact.point.tool_nodes[static_cast<std::size_t>(k)] = separation_index(w.tool_nodes(k), "contact tool node");
+  if (w.tool_nodes_size() != 3)
+    refuse_separation_wire("contact tool_nodes has {} entries, expected 3", w.tool_nodes_size());
+  for (int k = 0; k < 3; ++k)
+    contact.point.tool_nodes[static_cast<std::size_t>(k)] =
+        separation_index(w.tool_nodes(k), "contact tool node");
   contact.point.tool_weights = read_separation_weights(w.tool_weights(), "contact tool_weights");
   contact.position = from_wire(w.position());
   contact.tool_offset = from_wire(w.tool_offset());
@@ -66,7 +74,8 @@ cohaptic::SeparationContact contact_from_wire(const SeparationContact& w) {
 
 void separation_to_wire(const cohaptic::SeparationIr& ir, SeparationPatch* out) {
   const cohaptic::SeparationPatch& p = *ir.patch;
-  add_separation_doubles(p.positions.data(), static_cast<std::size_t>(p.positions.size()), out->mutable_positions());
+  add_separation_doubles(p.positions.data(), static_cast<std::size_t>(p.positions.size()),
+                         out->mutable_positions());
   for (const Triangle& t : p.triangles)
     for (int node : t) out->add_triangles(static_cast<std::uint32_t>(node));
   for (const std::array<int, 3>& n : p.neighbours)
@@ -94,7 +103,8 @@ void separation_to_wire(const cohaptic::SeparationIr& ir, SeparationPatch* out) 
   out->set_vaporisation_energy(p.vaporisation_energy);
   out->set_vaporisation_speed(p.vaporisation_speed);
   out->set_force_limit(p.force_limit);
-  add_separation_doubles(ir.state.separated.data(), ir.state.separated.size(), out->mutable_separated());
+  add_separation_doubles(ir.state.separated.data(), ir.state.separated.size(),
+                         out->mutable_separated());
   out->set_separated_area(ir.state.separated_area);
   out->set_laser_tool(ir.tool.laser);
   out->set_grasp_reach(ir.tool.grasp_reach);
@@ -117,11 +127,13 @@ void separation_to_wire(const cohaptic::SeparationIr& ir, SeparationPatch* out) 
 
 cohaptic::SeparationIr separation_from_wire(const SeparationPatch& w) {
   auto p = std::make_shared<cohaptic::SeparationPatch>();
-  if (w.positions_size() % 3 != 0) refuse_separation_wire("{} position values, not a multiple of 3", w.positions_size());
+  if (w.positions_size() % 3 != 0)
+    refuse_separation_wire("{} position values, not a multiple of 3", w.positions_size());
   const int nodes = w.positions_size() / 3;
   p->positions.resize(3, nodes);
   for (int i = 0; i < w.positions_size(); ++i) p->positions.data()[i] = w.positions(i);
-  if (w.triangles_size() % 3 != 0) refuse_separation_wire("{} triangle corners, not a multiple of 3", w.triangles_size());
+  if (w.triangles_size() % 3 != 0)
+    refuse_separation_wire("{} triangle corners, not a multiple of 3", w.triangles_size());
   const int triangles = w.triangles_size() / 3;
   if (w.neighbours_size() != 3 * triangles)
     refuse_separation_wire("{} neighbours for {} triangles", w.neighbours_size(), triangles);
@@ -129,15 +141,19 @@ cohaptic::SeparationIr separation_from_wire(const SeparationPatch& w) {
   p->neighbours.resize(static_cast<std::size_t>(triangles));
   for (int t = 0; t < triangles; ++t)
     for (int k = 0; k < 3; ++k) {
-      p->triangles[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)] = separation_index(w.triangles(3 * t + k), "triangle corner");
-      p->neighbours[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)] = w.neighbours(3 * t + k);
+      p->triangles[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)] =
+          separation_index(w.triangles(3 * t + k), "triangle corner");
+      p->neighbours[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)] =
+          w.neighbours(3 * t + k);
     }
   p->open_rim.assign(w.open_rim().begin(), w.open_rim().end());
   p->normals = read_separation_vectors(w.normals(), triangles, "normals");
   p->centroids = read_separation_vectors(w.centroids(), triangles, "centroids");
   p->areas.assign(w.areas().begin(), w.areas().end());
-  for (std::uint32_t offset : w.region_offsets()) p->regions.offsets.push_back(separation_index(offset, "region offset"));
-  for (std::uint32_t t : w.region_triangles()) p->regions.triangles.push_back(separation_index(t, "region triangle"));
+  for (std::uint32_t offset : w.region_offsets())
+    p->regions.offsets.push_back(separation_index(offset, "region offset"));
+  for (std::uint32_t t : w.region_triangles())
+    p->regions.triangles.push_back(separation_index(t, "region triangle"));
   if (p->regions.offsets.empty()) refuse_separation_wire("no region offsets");
   p->region_areas.assign(w.region_areas().begin(), w.region_areas().end());
   p->interface_area = w.interface_area();

@@ -51,8 +51,9 @@ std::variant<SessionKey, ParticipantKey> load_key_file(const std::filesystem::pa
 SessionKey load_session_key(const std::filesystem::path& file);
 
 /// The fixed, publicly known development key: the 32 ASCII bytes
-/// "cohaptic-development-key-public!" (hex 636f6861707469632d646576656c6f706d656e742d6b65792d7075626c696321).
-/// Anyone can forge and read traffic with it; use it only on a trusted network, and warn.
+/// "cohaptic-development-key-public!" (hex
+/// 636f6861707469632d646576656c6f706d656e742d6b65792d7075626c696321). Anyone can forge and read
+/// traffic with it; use it only on a trusted network, and warn.
 SessionKey development_key();
 
 /// Creates `file` (which must not exist) with mode 0600 holding a new random session key
@@ -61,7 +62,8 @@ void write_session_key(const std::filesystem::path& file);
 
 /// Creates `file` (which must not exist) with mode 0600 holding the participant key of
 /// `slot`, derived from `session`. Throws cohaptic::Error naming the file on failure.
-void write_participant_key(const std::filesystem::path& file, const SessionKey& session, std::uint32_t slot);
+void write_participant_key(const std::filesystem::path& file, const SessionKey& session,
+                           std::uint32_t slot);
 
 /// The key as 64 lowercase hex characters (for key files and tests; never log it).
 std::string to_hex(const SecretBytes& key);

@@ -23,7 +23,8 @@ SurfaceMesh surface_mesh_message(const ElasticBody& body) {
     for (int corner : tri) {
       const auto node = static_cast<std::size_t>(corner);
       if (compact[node] < 0)
-        throw cohaptic::Error(fmt::format("surface mesh: triangle node {} is not a surface node", body.mesh.node_tags[node]));
+        throw cohaptic::Error(fmt::format("surface mesh: triangle node {} is not a surface node",
+                                          body.mesh.node_tags[node]));
       message.add_triangles(static_cast<std::uint32_t>(compact[node]));
     }
   return message;
@@ -40,14 +41,16 @@ SurfaceMesh surface_mesh_message(const MassSpringModel& body) {
     message.add_node_ids(node);
   }
   for (const auto& triangle : network.triangles)
-    for (int corner : triangle) message.add_triangles(static_cast<std::uint32_t>(compact[static_cast<std::size_t>(corner)]));
+    for (int corner : triangle)
+      message.add_triangles(static_cast<std::uint32_t>(compact[static_cast<std::size_t>(corner)]));
   return message;
 }
 
 namespace {
 
 // A surface whose vertex i is point i of `vertices`, its node id i.
-SurfaceMesh indexed_surface_message(const Eigen::Matrix3Xd& vertices, const std::vector<Triangle>& triangles) {
+SurfaceMesh indexed_surface_message(const Eigen::Matrix3Xd& vertices,
+                                    const std::vector<Triangle>& triangles) {
   SurfaceMesh message;
   for (int v = 0; v < static_cast<int>(vertices.cols()); ++v) {
     for (int axis = 0; axis < 3; ++axis) message.add_vertices(vertices(axis, v));
@@ -74,14 +77,18 @@ SurfaceMesh surface_mesh_message(const BodyModel& body) {
 
 ReceivedSurface from_wire(const SurfaceMesh& mesh) {
   const auto fail = [](const std::string& what) { throw cohaptic::Error("surface mesh: " + what); };
-  if (mesh.vertices_size() % 3 != 0) fail(fmt::format("{} vertex coordinates, not a multiple of 3", mesh.vertices_size()));
+  if (mesh.vertices_size() % 3 != 0)
+    fail(fmt::format("{} vertex coordinates, not a multiple of 3", mesh.vertices_size()));
   const int vertices = mesh.vertices_size() / 3;
-  if (mesh.node_ids_size() != vertices) fail(fmt::format("{} node ids for {} vertices", mesh.node_ids_size(), vertices));
-  if (mesh.triangles_size() % 3 != 0) fail(fmt::format("{} triangle indices, not a multiple of 3", mesh.triangles_size()));
+  if (mesh.node_ids_size() != vertices)
+    fail(fmt::format("{} node ids for {} vertices", mesh.node_ids_size(), vertices));
+  if (mesh.triangles_size() % 3 != 0)
+    fail(fmt::format("{} triangle indices, not a multiple of 3", mesh.triangles_size()));
   ReceivedSurface received;
   received.surface.vertices.resize(3, vertices);
   for (int i = 0; i < mesh.vertices_size(); ++i) {
-    if (!std::isfinite(mesh.vertices(i))) fail(fmt::format("vertex {} has a non-finite coordinate", i / 3));
+    if (!std::isfinite(mesh.vertices(i)))
+      fail(fmt::format("vertex {} has a non-finite coordinate", i / 3));
     received.surface.vertices.data()[i] = mesh.vertices(i);
   }
   received.node_ids.assign(mesh.node_ids().begin(), mesh.node_ids().end());
@@ -90,7 +97,8 @@ ReceivedSurface from_wire(const SurfaceMesh& mesh) {
     const std::uint32_t v = mesh.triangles(i);
     if (v >= static_cast<std::uint32_t>(vertices))
       fail(fmt::format("triangle {} refers to vertex {}, there are {}", i / 3, v, vertices));
-    received.surface.triangles[static_cast<std::size_t>(i / 3)][static_cast<std::size_t>(i % 3)] = static_cast<int>(v);
+    received.surface.triangles[static_cast<std::size_t>(i / 3)][static_cast<std::size_t>(i % 3)] =
+        static_cast<int>(v);
   }
   return received;
 }

@@ -31,8 +31,8 @@ SurfaceMesh surface_mesh_message(const BodyModel& body);
 
 /// A received surface: its triangles and each vertex's mesh node id.
 struct ReceivedSurface {
-  TriangleSurface surface;            ///< [m]
-  std::vector<std::int64_t> node_ids; ///< per vertex
+  TriangleSurface surface;             ///< [m]
+  std::vector<std::int64_t> node_ids;  ///< per vertex
 };
 
 /// Validated conversion: vertices a multiple of 3 and finite, one node id per vertex,

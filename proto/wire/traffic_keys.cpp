@@ -6,13 +6,15 @@
 
 namespace cohaptic::wire {
 
-static_assert(crypto_kdf_KEYBYTES == sizeof(SessionKey::bytes), "crypto_kdf takes 32-byte master keys");
+static_assert(crypto_kdf_KEYBYTES == sizeof(SessionKey::bytes),
+              "crypto_kdf takes 32-byte master keys");
 static_assert(crypto_kdf_CONTEXTBYTES == 8, "crypto_kdf contexts are 8 bytes");
 
 TrafficKey traffic_key(const SessionKey& session, std::uint32_t sender) {
   ensure_sodium();
   TrafficKey key;
-  crypto_kdf_derive_from_key(key.bytes.data(), key.bytes.size(), sender, "cohaptic", session.bytes.data());
+  crypto_kdf_derive_from_key(key.bytes.data(), key.bytes.size(), sender, "cohaptic",
+                             session.bytes.data());
   return key;
 }
 

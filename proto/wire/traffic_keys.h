@@ -23,7 +23,9 @@ TrafficKey traffic_key(const SessionKey& session, std::uint32_t sender);
 inline TrafficKey participant_key(const SessionKey& session, std::uint32_t slot) {
   return traffic_key(session, sender_of_slot(slot));
 }
-inline TrafficKey joining_key(const SessionKey& session) { return traffic_key(session, kJoiningSender); }
+inline TrafficKey joining_key(const SessionKey& session) {
+  return traffic_key(session, kJoiningSender);
+}
 
 /// What a client holds, from its key file: the session key (it may ask for any slot, and
 /// joins with the joining key) or one participant's key (it joins that slot only, with it).

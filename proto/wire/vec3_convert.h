@@ -24,6 +24,8 @@ inline Vec3 to_wire(const Eigen::Vector3d& v) {
 /// An absent Vec3 reads as zeros (proto3 defaults).
 inline Eigen::Vector3d from_wire(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 
-inline bool is_finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+inline bool is_finite(const Vec3& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
 
 }  // namespace cohaptic::wire

@@ -20,7 +20,8 @@ using namespace cohaptic;
 using fuzz::require;
 
 template <class Packet, class Bytes, std::size_t kSize>
-void check(std::span<const std::uint8_t> bytes, const std::array<std::uint8_t, 4>& magic, std::size_t compared) {
+void check(std::span<const std::uint8_t> bytes, const std::array<std::uint8_t, 4>& magic,
+           std::size_t compared) {
   Packet packet;
   const bridge::PacketStatus status = bridge::decode(bytes, packet);
   if (bytes.size() != kSize) {
@@ -28,7 +29,8 @@ void check(std::span<const std::uint8_t> bytes, const std::array<std::uint8_t, 4
     return;
   }
   if (!std::equal(magic.begin(), magic.end(), bytes.begin())) {
-    require(status == bridge::PacketStatus::bad_magic, "a packet with the wrong magic is bad_magic");
+    require(status == bridge::PacketStatus::bad_magic,
+            "a packet with the wrong magic is bad_magic");
     return;
   }
   if (status == bridge::PacketStatus::non_finite) return;
@@ -36,7 +38,8 @@ void check(std::span<const std::uint8_t> bytes, const std::array<std::uint8_t, 4
   require(std::isfinite(packet.device_time_s), "an accepted packet's time is finite");
   Bytes again{};
   bridge::encode(packet, again);
-  require(std::equal(again.begin(), again.begin() + static_cast<std::ptrdiff_t>(compared), bytes.begin()),
+  require(std::equal(again.begin(), again.begin() + static_cast<std::ptrdiff_t>(compared),
+                     bytes.begin()),
           "an accepted packet encodes back to its bytes");
 }
 
@@ -44,8 +47,9 @@ void check(std::span<const std::uint8_t> bytes, const std::array<std::uint8_t, 4
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::span<const std::uint8_t> bytes(data, size);
-  check<bridge::PosePacket, bridge::PoseBytes, bridge::kPosePacketSize>(bytes, bridge::kPoseMagic, bridge::kPosePacketSize);
-  check<bridge::ForcePacket, bridge::ForceBytes, bridge::kForcePacketSize>(bytes, bridge::kForceMagic,
-                                                                          bridge::kForcePacketSize - 4);
+  check<bridge::PosePacket, bridge::PoseBytes, bridge::kPosePacketSize>(bytes, bridge::kPoseMagic,
+                                                                        bridge::kPosePacketSize);
+  check<bridge::ForcePacket, bridge::ForceBytes, bridge::kForcePacketSize>(
+      bytes, bridge::kForceMagic, bridge::kForcePacketSize - 4);
   return 0;
 }

@@ -52,7 +52,8 @@ struct Outcome {
 // Takes every frame the reader has ready; false once it has failed.
 bool drain(wire::FrameReader& reader, Outcome& outcome) {
   try {
-    while (std::optional<wire::Control> control = reader.next()) outcome.messages.push_back(std::move(*control));
+    while (std::optional<wire::Control> control = reader.next())
+      outcome.messages.push_back(std::move(*control));
     return true;
   } catch (const wire::FrameError& error) {
     outcome.error = error.what();
@@ -66,9 +67,11 @@ bool drain(wire::FrameReader& reader, Outcome& outcome) {
   }
 }
 
-Outcome read_in_chunks(std::span<const std::uint8_t> stream, const std::vector<std::size_t>& chunks) {
+Outcome read_in_chunks(std::span<const std::uint8_t> stream,
+                       const std::vector<std::size_t>& chunks) {
   const auto key_for = [](std::uint32_t sender) -> const wire::TrafficKey* {
-    if (sender <= wire::sender_of_slot(3) || sender == wire::kJoiningSender) return &fuzz::fuzz_key(sender);
+    if (sender <= wire::sender_of_slot(3) || sender == wire::kJoiningSender)
+      return &fuzz::fuzz_key(sender);
     return nullptr;
   };
   wire::FrameReader reader(key_for, {.expect_greeting = true});
@@ -85,7 +88,9 @@ Outcome read_in_chunks(std::span<const std::uint8_t> stream, const std::vector<s
 }
 
 bool same(const Outcome& a, const Outcome& b) {
-  if (a.messages.size() != b.messages.size() || a.error != b.error || a.left_buffered != b.left_buffered) return false;
+  if (a.messages.size() != b.messages.size() || a.error != b.error ||
+      a.left_buffered != b.left_buffered)
+    return false;
   for (std::size_t i = 0; i < a.messages.size(); ++i)
     if (a.messages[i].SerializeAsString() != b.messages[i].SerializeAsString()) return false;
   return true;
@@ -112,11 +117,13 @@ void check_content(const wire::Control& control, wire::IrStreamReader& ir_stream
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::vector<fuzz::Piece> pieces = fuzz::split_pieces({data, size});
   std::vector<std::uint8_t> stream;
-  if (!pieces.empty() && (pieces.front().kind & 1)) stream = wire::encode_greeting(fuzz::fuzz_challenge());
+  if (!pieces.empty() && (pieces.front().kind & 1))
+    stream = wire::encode_greeting(fuzz::fuzz_challenge());
   std::vector<std::size_t> chunks;
   for (const fuzz::Piece& piece : pieces) {
     if (piece.kind & 1) {
-      const std::vector<std::uint8_t> frame = fuzz::sealed_frame(piece.bytes, {.encrypt = (piece.kind & 0x80) == 0});
+      const std::vector<std::uint8_t> frame =
+          fuzz::sealed_frame(piece.bytes, {.encrypt = (piece.kind & 0x80) == 0});
       stream.insert(stream.end(), frame.begin(), frame.end());
     } else {
       stream.insert(stream.end(), piece.bytes.begin(), piece.bytes.end());
@@ -130,8 +137,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // messages, so that streams carrying an IR still run hundreds of times a second.
   constexpr std::size_t kByteByByteLimit = 4096;
   if (stream.size() <= kByteByByteLimit)
-    require(same(whole, read_in_chunks(stream, {1})), "byte by byte reads the same frames as the whole stream");
-  require(same(whole, read_in_chunks(stream, chunks)), "reads of any size read the same frames as the whole stream");
+    require(same(whole, read_in_chunks(stream, {1})),
+            "byte by byte reads the same frames as the whole stream");
+  require(same(whole, read_in_chunks(stream, chunks)),
+          "reads of any size read the same frames as the whole stream");
 
   std::optional<std::uint64_t> previous;
   wire::IrStreamReader ir_stream;
@@ -142,7 +151,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
               "the stream's first message is the greeting, with its challenge");
       continue;
     }
-    require(control.header().protocol_version() == wire::kProtocolVersion, "a frame read has our version");
+    require(control.header().protocol_version() == wire::kProtocolVersion,
+            "a frame read has our version");
     require(control.body_case() != wire::Control::BODY_NOT_SET, "a frame read has a body");
     require(!previous || control.header().sequence() > *previous, "sequence numbers increase");
     previous = control.header().sequence();

@@ -39,8 +39,9 @@ namespace {
 using namespace cohaptic;
 using fuzz::require;
 
-constexpr std::int64_t kLocalStartNs = 1'000'000'000'000;  // the client's clock, about 17 min after boot
-constexpr std::int64_t kArrivalStepNs = 1'000'000;          // one datagram per millisecond
+constexpr std::int64_t kLocalStartNs =
+    1'000'000'000'000;                              // the client's clock, about 17 min after boot
+constexpr std::int64_t kArrivalStepNs = 1'000'000;  // one datagram per millisecond
 
 // The client's receiving side: the clock estimate and a playout buffer per remote user.
 struct Client {
@@ -59,7 +60,8 @@ struct Client {
       for (RemoteToolBuffer* buffer : {&newest, &fixed, &adaptive}) {
         buffer->add(local_time, arrival_ns, wire::from_wire(sample.position()), sample.valid());
         const PlayoutQuery query = buffer->at(arrival_ns);
-        require(!query.valid || query.position.allFinite(), "a valid remote tool position is finite");
+        require(!query.valid || query.position.allFinite(),
+                "a valid remote tool position is finite");
       }
     }
   }
@@ -78,27 +80,33 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   for (const fuzz::Piece& piece : fuzz::split_pieces({data, size})) {
     arrival += kArrivalStepNs;
-    const fuzz::SealOptions seal{.encrypt = (piece.kind & 2) == 0, .wrong_key = (piece.kind & 4) != 0};
-    const std::vector<std::uint8_t> bytes = piece.kind & 1 ? fuzz::sealed_datagram(piece.bytes, seal)
-                                                           : std::vector<std::uint8_t>(piece.bytes.begin(), piece.bytes.end());
+    const fuzz::SealOptions seal{.encrypt = (piece.kind & 2) == 0,
+                                 .wrong_key = (piece.kind & 4) != 0};
+    const std::vector<std::uint8_t> bytes =
+        piece.kind & 1 ? fuzz::sealed_datagram(piece.bytes, seal)
+                       : std::vector<std::uint8_t>(piece.bytes.begin(), piece.bytes.end());
     const std::optional<wire::Envelope> envelope = wire::read_envelope(bytes);
     const wire::TrafficKey& key = fuzz::fuzz_key(envelope ? envelope->sender : wire::kServerSender);
     const auto decoded = wire::decode_datagram(bytes, key);
     const std::optional<wire::Datagram> accepted = inspector.inspect(bytes);
     ++inspected;
-    require(accepted.has_value() != inspector.last_rejection().has_value(), "inspect() either accepts or names a reason");
+    require(accepted.has_value() != inspector.last_rejection().has_value(),
+            "inspect() either accepts or names a reason");
     if (!accepted) {
       const wire::Rejection reason = *inspector.last_rejection();
       if (reason == wire::Rejection::unknown_sender) {
-        require(envelope && !allowed(envelope->sender), "unknown_sender names a sender without a key");
+        require(envelope && !allowed(envelope->sender),
+                "unknown_sender names a sender without a key");
       } else if (reason == wire::Rejection::replayed) {
         // Another sealer's salt (checked after the session, before the body) or the window.
         const auto* decode_reason = std::get_if<wire::Rejection>(&decoded);
         require(!decode_reason || *decode_reason == wire::Rejection::empty ||
-                    *decode_reason == wire::Rejection::non_finite || *decode_reason == wire::Rejection::bad_time,
+                    *decode_reason == wire::Rejection::non_finite ||
+                    *decode_reason == wire::Rejection::bad_time,
                 "a replay decodes, or fails only on its body");
       } else {
-        require(std::holds_alternative<wire::Rejection>(decoded) && std::get<wire::Rejection>(decoded) == reason,
+        require(std::holds_alternative<wire::Rejection>(decoded) &&
+                    std::get<wire::Rejection>(decoded) == reason,
                 "the inspector names decode_datagram()'s reason");
       }
       continue;
@@ -107,11 +115,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const wire::Datagram& datagram = *accepted;
     require(std::get<wire::Datagram>(decoded).SerializeAsString() == datagram.SerializeAsString(),
             "the inspector and decode_datagram() read the same message");
-    require(datagram.header().protocol_version() == wire::kProtocolVersion, "an accepted datagram has our version");
-    require(datagram.body_case() != wire::Datagram::BODY_NOT_SET, "an accepted datagram has a body");
-    require(!wire::body_rejection(datagram).has_value(), "an accepted datagram's values are finite");
-    if (datagram.has_tool()) require(wire::from_wire(datagram.tool().position()).allFinite(), "a tool position is finite");
-    if (datagram.has_force()) require(wire::from_wire(datagram.force().force()).allFinite(), "a force is finite");
+    require(datagram.header().protocol_version() == wire::kProtocolVersion,
+            "an accepted datagram has our version");
+    require(datagram.body_case() != wire::Datagram::BODY_NOT_SET,
+            "an accepted datagram has a body");
+    require(!wire::body_rejection(datagram).has_value(),
+            "an accepted datagram's values are finite");
+    if (datagram.has_tool())
+      require(wire::from_wire(datagram.tool().position()).allFinite(), "a tool position is finite");
+    if (datagram.has_force())
+      require(wire::from_wire(datagram.force().force()).allFinite(), "a force is finite");
 
     const auto other_session = wire::decode_datagram(bytes, key, datagram.header().session() + 1);
     require(std::holds_alternative<wire::Rejection>(other_session) &&
@@ -122,6 +135,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     ++inspected;
     client.take(datagram, arrival);
   }
-  require(inspector.counters().accepted() + inspector.counters().rejected() == inspected, "every datagram is counted once");
+  require(inspector.counters().accepted() + inspector.counters().rejected() == inspected,
+          "every datagram is counted once");
   return 0;
 }

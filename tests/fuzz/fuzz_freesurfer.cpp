@@ -23,7 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     fuzz::require(surface.vertices.allFinite(), "vertex coordinates are finite");
     for (const Triangle& triangle : surface.triangles)
       for (int vertex : triangle)
-        fuzz::require(vertex >= 0 && vertex < surface.vertex_count(), "triangle vertices are in range");
+        fuzz::require(vertex >= 0 && vertex < surface.vertex_count(),
+                      "triangle vertices are in range");
     check_triangle_surface(surface, "fuzz.asc");
   } catch (const Error&) {
   }

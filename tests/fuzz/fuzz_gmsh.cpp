@@ -29,7 +29,8 @@ void require_well_formed(const TetMesh& mesh) {
   require(mesh.tet_tags.size() == mesh.tets.size(), "one tag per tetrahedron");
   require(mesh.nodes.allFinite(), "node coordinates are finite");
   for (const Tet& tet : mesh.tets)
-    for (int node : tet) require(node >= 0 && node < mesh.node_count(), "tetrahedron nodes are in range");
+    for (int node : tet)
+      require(node >= 0 && node < mesh.node_count(), "tetrahedron nodes are in range");
 }
 
 }  // namespace
@@ -43,7 +44,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     require_well_formed(read.mesh);
     const BoundarySurface surface = extract_boundary_surface(read.mesh);
     for (const Triangle& triangle : surface.triangles)
-      for (int node : triangle) require(node >= 0 && node < read.mesh.node_count(), "surface nodes are mesh nodes");
+      for (int node : triangle)
+        require(node >= 0 && node < read.mesh.node_count(), "surface nodes are mesh nodes");
     check_boundary_surface(read.mesh, surface);
   } catch (const Error&) {
   }

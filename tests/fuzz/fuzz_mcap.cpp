@@ -32,11 +32,13 @@ Read read_all(std::span<const std::uint8_t> bytes, const char* extension) {
   try {
     record::McapReader reader(fuzz::scratch_file(bytes, extension));
     while (const auto message = reader.next()) {
-      require(reader.channels().count(message->channel_id) == 1, "a message's channel was declared");
+      require(reader.channels().count(message->channel_id) == 1,
+              "a message's channel was declared");
       reader.schema_of(*message);
       read.messages.push_back(*message);
     }
-    require(!(reader.complete() && reader.truncated()), "a file is complete or truncated, not both");
+    require(!(reader.complete() && reader.truncated()),
+            "a file is complete or truncated, not both");
     require(reader.valid_bytes() <= bytes.size(), "the readable prefix lies within the file");
   } catch (const Error&) {
     read.failed = true;
@@ -44,12 +46,15 @@ Read read_all(std::span<const std::uint8_t> bytes, const char* extension) {
   return read;
 }
 
-void require_prefix_reads(std::span<const std::uint8_t> bytes, std::size_t length, const Read& whole) {
+void require_prefix_reads(std::span<const std::uint8_t> bytes, std::size_t length,
+                          const Read& whole) {
   const Read prefix = read_all(bytes.first(length), ".part.mcap");
   require(!prefix.failed, "a prefix of a readable file reads");
-  require(prefix.messages.size() <= whole.messages.size(), "a prefix yields no more messages than the whole");
+  require(prefix.messages.size() <= whole.messages.size(),
+          "a prefix yields no more messages than the whole");
   for (std::size_t i = 0; i < prefix.messages.size(); ++i)
-    require(prefix.messages[i] == whole.messages[i], "a prefix yields the first messages of the whole");
+    require(prefix.messages[i] == whole.messages[i],
+            "a prefix yields the first messages of the whole");
 }
 
 }  // namespace

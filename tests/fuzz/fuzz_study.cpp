@@ -18,15 +18,18 @@ using namespace cohaptic;
 using fuzz::require;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const std::filesystem::path file = std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes" / "studies" / "fuzzed.yaml";
+  static const std::filesystem::path file =
+      std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes" / "studies" / "fuzzed.yaml";
   try {
     const Study study = parse_study(std::string(reinterpret_cast<const char*>(data), size), file);
     require(!study.participants.empty(), "a study has participants");
     require(!study.conditions.empty(), "a study has conditions");
-    require(study.trials.size() == study.conditions.size() * static_cast<std::size_t>(study.repetitions),
+    require(study.trials.size() ==
+                study.conditions.size() * static_cast<std::size_t>(study.repetitions),
             "every condition runs once per repetition");
     for (const StudyTrial& trial : study.trials)
-      require(trial.repetition >= 1 && trial.repetition <= study.repetitions, "a trial's repetition is in range");
+      require(trial.repetition >= 1 && trial.repetition <= study.repetitions,
+              "a trial's repetition is in range");
   } catch (const Error&) {
   }
   return 0;

@@ -32,7 +32,8 @@ std::vector<Piece> split_pieces(std::span<const std::uint8_t> input) {
   return pieces;
 }
 
-void append_piece(std::vector<std::uint8_t>& input, std::uint8_t kind, std::span<const std::uint8_t> bytes) {
+void append_piece(std::vector<std::uint8_t>& input, std::uint8_t kind,
+                  std::span<const std::uint8_t> bytes) {
   require(bytes.size() <= 0xffff, "a seed piece fits a 16-bit length");
   input.push_back(kind);
   input.push_back(static_cast<std::uint8_t>(bytes.size()));
@@ -43,7 +44,8 @@ void append_piece(std::vector<std::uint8_t>& input, std::uint8_t kind, std::span
 const wire::SessionKey& fuzz_session_key() {
   static const wire::SessionKey key = [] {
     wire::SessionKey k;
-    for (std::size_t i = 0; i < k.bytes.size(); ++i) k.bytes[i] = static_cast<std::uint8_t>(0xa5 ^ (7 * i));
+    for (std::size_t i = 0; i < k.bytes.size(); ++i)
+      k.bytes[i] = static_cast<std::uint8_t>(0xa5 ^ (7 * i));
     return k;
   }();
   return key;
@@ -57,9 +59,11 @@ const wire::TrafficKey& fuzz_key(std::uint32_t sender) {
   static std::map<std::uint32_t, wire::TrafficKey> cached;
   static wire::TrafficKey scratch;
   const std::uint32_t owner = sender == wire::kServerSender ? wire::sender_of_slot(0) : sender;
-  if (owner >= kCached && owner != wire::kJoiningSender) return scratch = wire::traffic_key(fuzz_session_key(), owner);
+  if (owner >= kCached && owner != wire::kJoiningSender)
+    return scratch = wire::traffic_key(fuzz_session_key(), owner);
   auto found = cached.find(owner);
-  if (found == cached.end()) found = cached.emplace(owner, wire::traffic_key(fuzz_session_key(), owner)).first;
+  if (found == cached.end())
+    found = cached.emplace(owner, wire::traffic_key(fuzz_session_key(), owner)).first;
   return found->second;
 }
 
@@ -77,23 +81,26 @@ namespace {
 // Seals out[clear_bytes, end - tag) in place, behind an envelope at out[envelope_at] naming
 // the payload's own sender and sequence.
 template <class Message>
-void seal_payload(std::vector<std::uint8_t>& out, std::size_t envelope_at, std::span<const std::uint8_t> payload,
-                  wire::Channel channel, SealOptions options) {
+void seal_payload(std::vector<std::uint8_t>& out, std::size_t envelope_at,
+                  std::span<const std::uint8_t> payload, wire::Channel channel,
+                  SealOptions options) {
   Message parsed;
   const bool parses = parsed.ParseFromArray(payload.data(), static_cast<int>(payload.size()));
   const std::uint32_t sender = parses ? parsed.header().sender() : wire::kServerSender;
   const wire::Envelope envelope{static_cast<std::uint8_t>(wire::kProtocolVersion),
-                                options.encrypt ? wire::kEncryptedFlag : std::uint8_t{0}, sender, kFuzzSalt,
-                                parses ? parsed.header().sequence() : 0};
+                                options.encrypt ? wire::kEncryptedFlag : std::uint8_t{0}, sender,
+                                kFuzzSalt, parses ? parsed.header().sequence() : 0};
   wire::write_envelope(envelope, out.data() + envelope_at);
-  std::copy(payload.begin(), payload.end(), out.begin() + static_cast<std::ptrdiff_t>(envelope_at + wire::kEnvelopeBytes));
+  std::copy(payload.begin(), payload.end(),
+            out.begin() + static_cast<std::ptrdiff_t>(envelope_at + wire::kEnvelopeBytes));
   wire::seal_in_place(out, envelope_at + wire::kEnvelopeBytes, wire::make_nonce(channel, envelope),
                       fuzz_key(options.wrong_key ? sender + 2 : sender), options.encrypt);
 }
 
 }  // namespace
 
-std::vector<std::uint8_t> sealed_datagram(std::span<const std::uint8_t> payload, SealOptions options) {
+std::vector<std::uint8_t> sealed_datagram(std::span<const std::uint8_t> payload,
+                                          SealOptions options) {
   std::vector<std::uint8_t> out(wire::kDatagramOverheadBytes + payload.size());
   seal_payload<wire::Datagram>(out, 0, payload, wire::Channel::datagram, options);
   return out;
@@ -110,7 +117,8 @@ namespace {
 
 // The process's own directory under the temporary directory, removed at exit.
 struct ScratchDirectory {
-  std::filesystem::path path = std::filesystem::temp_directory_path() / ("cohaptic-fuzz-" + std::to_string(::getpid()));
+  std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("cohaptic-fuzz-" + std::to_string(::getpid()));
   ScratchDirectory() { std::filesystem::create_directories(path); }
   ~ScratchDirectory() {
     std::error_code ignored;
@@ -120,12 +128,14 @@ struct ScratchDirectory {
 
 }  // namespace
 
-std::filesystem::path scratch_file(std::span<const std::uint8_t> bytes, std::string_view extension) {
+std::filesystem::path scratch_file(std::span<const std::uint8_t> bytes,
+                                   std::string_view extension) {
   static const ScratchDirectory directory;
   std::filesystem::path file = directory.path / "input";
   file += extension;
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
   require(out.good(), "the scratch file is written");
   return file;
 }

@@ -36,7 +36,8 @@ struct Piece {
 /// with no bytes. Every input splits; none is refused.
 std::vector<Piece> split_pieces(std::span<const std::uint8_t> input);
 /// Appends a piece in that layout (seeds; at most 65535 bytes).
-void append_piece(std::vector<std::uint8_t>& input, std::uint8_t kind, std::span<const std::uint8_t> bytes);
+void append_piece(std::vector<std::uint8_t>& input, std::uint8_t kind,
+                  std::span<const std::uint8_t> bytes);
 
 /// The session key of the fuzzed session, and the traffic key a peer seals `sender`'s
 /// messages with (traffic_keys.h): its own for a participant and for the joining sender;
@@ -55,9 +56,11 @@ struct SealOptions {
   bool wrong_key = false;  ///< sealed with the next sender's key: another participant forging
 };
 /// `payload` as a datagram its header's sender sends.
-std::vector<std::uint8_t> sealed_datagram(std::span<const std::uint8_t> payload, SealOptions options = {});
+std::vector<std::uint8_t> sealed_datagram(std::span<const std::uint8_t> payload,
+                                          SealOptions options = {});
 /// `payload` as one control frame (length, envelope, body, tag) its header's sender sends.
-std::vector<std::uint8_t> sealed_frame(std::span<const std::uint8_t> payload, SealOptions options = {});
+std::vector<std::uint8_t> sealed_frame(std::span<const std::uint8_t> payload,
+                                       SealOptions options = {});
 
 /// A file of this process holding exactly `bytes` (rewritten on every call), for readers
 /// that take a path. `extension` e.g. ".mcap".

@@ -30,25 +30,32 @@ namespace {
 using namespace cohaptic;
 using fuzz::require;
 
-std::string text_of(std::span<const std::uint8_t> bytes) { return {reinterpret_cast<const char*>(bytes.data()), bytes.size()}; }
+std::string text_of(std::span<const std::uint8_t> bytes) {
+  return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+}
 
 void require_consistent(const view::ReplayPlayer& player) {
   const view::Timeline timeline = player.timeline();
-  if (!std::isfinite(timeline.start()) || !std::isfinite(timeline.end())) return;  // checked where frames are read
-  require(timeline.start() <= timeline.time() && timeline.time() <= timeline.end(), "the position lies in the recording");
-  require(player.frame().time() <= timeline.time() || player.frame_index() == 0, "the frame shown is at or before the position");
+  if (!std::isfinite(timeline.start()) || !std::isfinite(timeline.end()))
+    return;  // checked where frames are read
+  require(timeline.start() <= timeline.time() && timeline.time() <= timeline.end(),
+          "the position lies in the recording");
+  require(player.frame().time() <= timeline.time() || player.frame_index() == 0,
+          "the frame shown is at or before the position");
   require(timeline.speed() > 0 && timeline.speed() <= 100, "the speed is in (0, 100]");
   for (double jump : {timeline.peak_force_time(), timeline.largest_step_time()})
     require(timeline.start() <= jump && jump <= timeline.end(), "a jump lands in the recording");
   const view::Status shown = player.status();
   for (const view::UserStatus& status : shown.users())
-    require(status.received_time() <= timeline.time(), "the status shown was received by the position");
+    require(status.received_time() <= timeline.time(),
+            "the status shown was received by the position");
 }
 
 void check_handshake(const std::string& resource) {
   static const std::string token = "fuzz-token-0123456789";
   const bool accepted = view::handshake_refusal(resource, "", "localhost:8080", token).empty();
-  const bool right = resource.substr(0, resource.find('?')) == "/ws" && view::query_value(resource, "token") == token;
+  const bool right = resource.substr(0, resource.find('?')) == "/ws" &&
+                     view::query_value(resource, "token") == token;
   require(accepted == right, "a handshake is accepted exactly with the path /ws and the token");
   require(!view::handshake_refusal(resource, "http://evil.example", "localhost:8080", "").empty(),
           "a page from another origin is refused");
@@ -69,7 +76,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const fuzz::Piece& piece = pieces[i];
     switch (piece.kind % 3) {
       case 0:
-        if (const std::optional<view::Command> command = view::parse_command(text_of(piece.bytes)); command && player)
+        if (const std::optional<view::Command> command = view::parse_command(text_of(piece.bytes));
+            command && player)
           player->command(*command);
         break;
       case 1:
@@ -79,7 +87,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           player->advance(seconds);
         }
         break;
-      default: check_handshake(text_of(piece.bytes)); break;
+      default:
+        check_handshake(text_of(piece.bytes));
+        break;
     }
     if (player) require_consistent(*player);
   }

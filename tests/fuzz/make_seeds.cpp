@@ -47,10 +47,12 @@ std::vector<std::uint8_t> bytes_of(const google::protobuf::MessageLite& message)
   return {s.begin(), s.end()};
 }
 
-void write_seed(const fs::path& directory, const std::string& name, const std::vector<std::uint8_t>& bytes) {
+void write_seed(const fs::path& directory, const std::string& name,
+                const std::vector<std::uint8_t>& bytes) {
   fs::create_directories(directory);
   std::ofstream out(directory / name, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
   std::printf("%s/%s: %zu bytes\n", directory.string().c_str(), name.c_str(), bytes.size());
 }
 
@@ -61,7 +63,8 @@ std::vector<std::uint8_t> pieces(const std::vector<std::vector<std::uint8_t>>& p
 }
 
 // The first datagram of each body kind in the recordings, in order of appearance.
-std::map<int, wire::Datagram> one_of_each_kind(const std::vector<const record::Recording*>& recordings) {
+std::map<int, wire::Datagram> one_of_each_kind(
+    const std::vector<const record::Recording*>& recordings) {
   std::map<int, wire::Datagram> kinds;
   for (const record::Recording* recording : recordings)
     for (const record::ReceivedDatagram& received : recording->datagrams)
@@ -71,7 +74,8 @@ std::map<int, wire::Datagram> one_of_each_kind(const std::vector<const record::R
 
 // The recorded IRs by size, smallest first, those sent as compliance rows completed as the
 // client did (each stands alone then; rows_seed keeps one as it came).
-std::vector<wire::IntermediateRepresentation> irs_by_size(const std::vector<const record::Recording*>& recordings) {
+std::vector<wire::IntermediateRepresentation> irs_by_size(
+    const std::vector<const record::Recording*>& recordings) {
   std::vector<wire::IntermediateRepresentation> irs;
   for (const record::Recording* recording : recordings) {
     ClientCondensation client;
@@ -81,7 +85,9 @@ std::vector<wire::IntermediateRepresentation> irs_by_size(const std::vector<cons
       irs.push_back(wire::to_wire(ir));
     }
   }
-  std::stable_sort(irs.begin(), irs.end(), [](const auto& a, const auto& b) { return a.ByteSizeLong() < b.ByteSizeLong(); });
+  std::stable_sort(irs.begin(), irs.end(), [](const auto& a, const auto& b) {
+    return a.ByteSizeLong() < b.ByteSizeLong();
+  });
   return irs;
 }
 
@@ -113,7 +119,8 @@ wire::Welcome welcome_for(const record::SessionConfig& config, const fs::path& s
   for (const Triangle& triangle : surface.triangles)
     for (int node : triangle)
       message->add_triangles(static_cast<std::uint32_t>(
-          std::lower_bound(surface.nodes.begin(), surface.nodes.end(), node) - surface.nodes.begin()));
+          std::lower_bound(surface.nodes.begin(), surface.nodes.end(), node) -
+          surface.nodes.begin()));
   return welcome;
 }
 
@@ -145,8 +152,10 @@ void datagram_seeds(const std::vector<const record::Recording*>& recordings, con
   write_seed(out, "replayed", pieces({all.front(), all.front()}));
 }
 
-void control_seeds(const record::Recording& client, const std::vector<wire::IntermediateRepresentation>& irs,
-                   const wire::IntermediateRepresentation& mass_spring_ir, const fs::path& source_dir, const fs::path& out) {
+void control_seeds(const record::Recording& client,
+                   const std::vector<wire::IntermediateRepresentation>& irs,
+                   const wire::IntermediateRepresentation& mass_spring_ir,
+                   const fs::path& source_dir, const fs::path& out) {
   const std::uint64_t session = client.config.session();
   const std::uint32_t server = wire::kServerSender;
 
@@ -176,7 +185,8 @@ void control_seeds(const record::Recording& client, const std::vector<wire::Inte
   std::vector<std::vector<std::uint8_t>> compressed;
   for (std::uint64_t k = 0; k < 3; ++k) {
     wire::Control block = control(session, server, 2 + k);
-    *block.mutable_compressed_ir() = ir_stream.compress(irs[std::min<std::size_t>(k, irs.size() - 1)], k == 0);
+    *block.mutable_compressed_ir() =
+        ir_stream.compress(irs[std::min<std::size_t>(k, irs.size() - 1)], k == 0);
     if (k == 2) block.mutable_compressed_ir()->set_index(7);
     compressed.push_back(bytes_of(block));
   }
@@ -207,12 +217,13 @@ void control_seeds(const record::Recording& client, const std::vector<wire::Inte
 }
 
 void ir_seeds(const std::vector<wire::IntermediateRepresentation>& irs,
-              const wire::IntermediateRepresentation& mass_spring_ir, const wire::IntermediateRepresentation& sphere_ir,
-              const fs::path& out) {
+              const wire::IntermediateRepresentation& mass_spring_ir,
+              const wire::IntermediateRepresentation& sphere_ir, const fs::path& out) {
   write_seed(out, "smallest", bytes_of(irs.front()));
   write_seed(out, "mass_spring", bytes_of(mass_spring_ir));
   write_seed(out, "sphere", bytes_of(sphere_ir));
-  const auto with_remote = std::find_if(irs.begin(), irs.end(), [](const auto& ir) { return ir.fem().remotes_size() > 0; });
+  const auto with_remote = std::find_if(irs.begin(), irs.end(),
+                                        [](const auto& ir) { return ir.fem().remotes_size() > 0; });
   if (with_remote != irs.end()) write_seed(out, "with_remote", bytes_of(*with_remote));
   // The smallest as a server with --ir-precision f32 sends it: M~ and u_B rounded to float.
   wire::IntermediateRepresentation f32 = irs.front();
@@ -220,7 +231,8 @@ void ir_seeds(const std::vector<wire::IntermediateRepresentation>& irs,
   fem.clear_m_tilde_f64();
   fem.clear_boundary_displacement_f64();
   for (double v : irs.front().fem().m_tilde_f64()) fem.add_m_tilde_f32(static_cast<float>(v));
-  for (double v : irs.front().fem().boundary_displacement_f64()) fem.add_boundary_displacement_f32(static_cast<float>(v));
+  for (double v : irs.front().fem().boundary_displacement_f64())
+    fem.add_boundary_displacement_f32(static_cast<float>(v));
   write_seed(out, "smallest_f32", bytes_of(f32));
 }
 
@@ -235,7 +247,8 @@ void rows_seed(const record::Recording& client, const fs::path& out) {
 
 // A complete recording of a few messages of each kind, and the same cut short as a killed
 // writer leaves it.
-void mcap_seeds(const record::Recording& server, const record::Recording& client, const fs::path& out) {
+void mcap_seeds(const record::Recording& server, const record::Recording& client,
+                const fs::path& out) {
   fs::create_directories(out);
   const fs::path file = out / "short_session";
   {
@@ -245,19 +258,23 @@ void mcap_seeds(const record::Recording& server, const record::Recording& client
       recorder.datagram_in(client.datagrams[i].receive_time_ns(), client.datagrams[i].datagram());
     const auto smallest = irs_by_size({&client});
     if (!smallest.empty()) recorder.ir(client.irs.front().time_ns(), smallest.front());
-    for (std::size_t i = 0; i < std::min<std::size_t>(3, client.ticks.size()); ++i) recorder.tick(client.ticks[i]);
-    for (std::size_t i = 0; i < std::min<std::size_t>(2, server.steps.size()); ++i) recorder.step(server.steps[i]);
+    for (std::size_t i = 0; i < std::min<std::size_t>(3, client.ticks.size()); ++i)
+      recorder.tick(client.ticks[i]);
+    for (std::size_t i = 0; i < std::min<std::size_t>(2, server.steps.size()); ++i)
+      recorder.step(server.steps[i]);
     for (std::size_t i = 0; i < std::min<std::size_t>(2, client.events.size()); ++i)
       recorder.event(client.events[i].time_ns(), client.events[i].kind(), client.events[i].text());
     recorder.close();
   }
-  std::printf("%s: %ju bytes\n", file.string().c_str(), static_cast<std::uintmax_t>(fs::file_size(file)));
+  std::printf("%s: %ju bytes\n", file.string().c_str(),
+              static_cast<std::uintmax_t>(fs::file_size(file)));
   // The recorder embeds each channel's whole schema (55 kB of the above); this one names
   // its schema only, so the fuzzer's mutations land on the records around it.
   const fs::path small = out / "events_only";
   {
     record::McapWriter writer(small);
-    const std::uint16_t schema = writer.add_schema(record::SessionEvent::descriptor()->full_name(), "protobuf", "");
+    const std::uint16_t schema =
+        writer.add_schema(record::SessionEvent::descriptor()->full_name(), "protobuf", "");
     const std::uint16_t channel = writer.add_channel(schema, record::topic::kEvents);
     for (std::size_t i = 0; i < std::min<std::size_t>(3, client.events.size()); ++i) {
       const auto time = static_cast<std::uint64_t>(client.events[i].time_ns());
@@ -265,9 +282,11 @@ void mcap_seeds(const record::Recording& server, const record::Recording& client
     }
     writer.close();
   }
-  std::printf("%s: %ju bytes\n", small.string().c_str(), static_cast<std::uintmax_t>(fs::file_size(small)));
+  std::printf("%s: %ju bytes\n", small.string().c_str(),
+              static_cast<std::uintmax_t>(fs::file_size(small)));
   std::ifstream in(file, std::ios::binary);
-  std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  std::vector<std::uint8_t> bytes{std::istreambuf_iterator<char>(in),
+                                  std::istreambuf_iterator<char>()};
   bytes.resize(bytes.size() * 2 / 3);
   write_seed(out, "killed_writer", bytes);
 }
@@ -276,24 +295,29 @@ void mcap_seeds(const record::Recording& server, const record::Recording& client
 // users press, two status reports; schemas named only, as in the mcap seed events_only) as
 // the first piece, then browsers' Commands, wall time passing and a handshake.
 void view_seeds(const record::Recording& server, const fs::path& out) {
-  if (server.view_scenes.empty() || server.view_frames.empty()) throw Error("the server recording has no view frames (--view)");
+  if (server.view_scenes.empty() || server.view_frames.empty())
+    throw Error("the server recording has no view frames (--view)");
   const fs::path file = out / "recording.mcap";
   fs::create_directories(out);
   {
     record::McapWriter writer(file);
-    const auto channel = [&writer](const google::protobuf::Descriptor* descriptor, const char* topic) {
+    const auto channel = [&writer](const google::protobuf::Descriptor* descriptor,
+                                   const char* topic) {
       return writer.add_channel(writer.add_schema(descriptor->full_name(), "protobuf", ""), topic);
     };
-    const std::uint16_t config = channel(record::SessionConfig::descriptor(), record::topic::kConfig);
+    const std::uint16_t config =
+        channel(record::SessionConfig::descriptor(), record::topic::kConfig);
     const std::uint16_t scene = channel(view::Scene::descriptor(), record::topic::kViewScene);
     const std::uint16_t frames = channel(view::Frame::descriptor(), record::topic::kViewFrames);
-    const std::uint16_t statuses = channel(record::ReceivedClientStatus::descriptor(), record::topic::kClientStatus);
+    const std::uint16_t statuses =
+        channel(record::ReceivedClientStatus::descriptor(), record::topic::kClientStatus);
     const auto start = static_cast<std::uint64_t>(server.config.start_time_ns());
     std::uint32_t sequence = 0;
     writer.write(config, ++sequence, start, start, server.config);
     writer.write(scene, ++sequence, start, start, server.view_scenes.front());
     const std::size_t count = std::min<std::size_t>(4, server.view_frames.size());
-    const std::size_t first = (server.view_frames.size() - count) / 2;  // mid-session: while pressing
+    const std::size_t first =
+        (server.view_frames.size() - count) / 2;  // mid-session: while pressing
     for (std::size_t i = first; i < first + count; ++i) {
       const auto time = start + static_cast<std::uint64_t>(server.view_frames[i].time() * 1e9);
       writer.write(frames, ++sequence, time, time, server.view_frames[i]);
@@ -305,7 +329,8 @@ void view_seeds(const record::Recording& server, const fs::path& out) {
     writer.close();
   }
   std::ifstream in(file, std::ios::binary);
-  const std::vector<std::uint8_t> recording{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::vector<std::uint8_t> recording{std::istreambuf_iterator<char>(in),
+                                            std::istreambuf_iterator<char>()};
   fs::remove(file);
   if (recording.size() > 65535) throw Error("the view's seed recording exceeds a piece (64 kB)");
 
@@ -318,20 +343,27 @@ void view_seeds(const record::Recording& server, const fs::path& out) {
   fuzz::append_piece(input, 0, recording);
   fuzz::append_piece(input, 0, command_bytes([](view::Command& c) { c.mutable_play(); }));
   const double half_second = 0.5;
-  fuzz::append_piece(input, 1, {reinterpret_cast<const std::uint8_t*>(&half_second), sizeof half_second});
+  fuzz::append_piece(input, 1,
+                     {reinterpret_cast<const std::uint8_t*>(&half_second), sizeof half_second});
   fuzz::append_piece(input, 0, command_bytes([](view::Command& c) { c.set_speed(4); }));
-  fuzz::append_piece(input, 0, command_bytes([&server](view::Command& c) { c.set_seek(server.view_frames.front().time()); }));
-  fuzz::append_piece(input, 0, command_bytes([](view::Command& c) { c.set_jump(view::Command::PEAK_FORCE); }));
+  fuzz::append_piece(input, 0, command_bytes([&server](view::Command& c) {
+                       c.set_seek(server.view_frames.front().time());
+                     }));
+  fuzz::append_piece(
+      input, 0, command_bytes([](view::Command& c) { c.set_jump(view::Command::PEAK_FORCE); }));
   fuzz::append_piece(input, 0, command_bytes([](view::Command& c) { c.mutable_pause(); }));
   const std::string handshake = "/ws?token=fuzz-token-0123456789";
-  fuzz::append_piece(input, 2, {reinterpret_cast<const std::uint8_t*>(handshake.data()), handshake.size()});
+  fuzz::append_piece(input, 2,
+                     {reinterpret_cast<const std::uint8_t*>(handshake.data()), handshake.size()});
   write_seed(out, "replay_session", input);
 }
 
 void bridge_seeds(const record::Recording& client, const fs::path& out) {
-  const auto pressing = std::find_if(client.ticks.begin(), client.ticks.end(),
-                                     [](const record::HapticTick& tick) { return tick.force().z() != 0; });
-  const record::HapticTick& tick = pressing != client.ticks.end() ? *pressing : client.ticks.front();
+  const auto pressing =
+      std::find_if(client.ticks.begin(), client.ticks.end(),
+                   [](const record::HapticTick& tick) { return tick.force().z() != 0; });
+  const record::HapticTick& tick =
+      pressing != client.ticks.end() ? *pressing : client.ticks.front();
   bridge::PosePacket pose;
   pose.sequence = 1234;
   pose.device_time_s = static_cast<double>(tick.time_ns()) * 1e-9;
@@ -354,8 +386,10 @@ void bridge_seeds(const record::Recording& client, const fs::path& out) {
 
 int main(int argc, char** argv) {
   if (argc != 6) {
-    std::fprintf(stderr, "usage: %s SERVER.mcap CLIENT.mcap MASS_SPRING_CLIENT.mcap SPHERE_CLIENT.mcap OUT_DIR\n",
-                 argv[0]);
+    std::fprintf(
+        stderr,
+        "usage: %s SERVER.mcap CLIENT.mcap MASS_SPRING_CLIENT.mcap SPHERE_CLIENT.mcap OUT_DIR\n",
+        argv[0]);
     return 2;
   }
   const record::Recording server = record::read_recording(argv[1]);
@@ -365,15 +399,19 @@ int main(int argc, char** argv) {
   const fs::path out = argv[5];
   const std::vector<wire::IntermediateRepresentation> irs = irs_by_size({&server, &client});
   const std::vector<wire::IntermediateRepresentation> patches = irs_by_size({&mass_spring_client});
-  const auto patch = std::find_if(patches.begin(), patches.end(), [](const auto& ir) { return ir.has_mass_spring(); });
+  const auto patch = std::find_if(patches.begin(), patches.end(),
+                                  [](const auto& ir) { return ir.has_mass_spring(); });
   // The smallest sphere IR that holds a node: one whose contact solve has work to do.
   const std::vector<wire::IntermediateRepresentation> sphere_irs = irs_by_size({&sphere_client});
   const auto sphere = std::find_if(sphere_irs.begin(), sphere_irs.end(), [](const auto& ir) {
-    return ir.has_fem() && ir.fem().contact_model() == wire::CondensedFem::SPHERE && ir.fem().node_ids_size() > 0;
+    return ir.has_fem() && ir.fem().contact_model() == wire::CondensedFem::SPHERE &&
+           ir.fem().node_ids_size() > 0;
   });
   if (irs.empty() || client.datagrams.empty() || client.ticks.empty() || patch == patches.end() ||
       sphere == sphere_irs.end()) {
-    std::fprintf(stderr, "%s: the recordings hold no IRs of all three kinds, datagrams or haptic ticks\n", argv[0]);
+    std::fprintf(stderr,
+                 "%s: the recordings hold no IRs of all three kinds, datagrams or haptic ticks\n",
+                 argv[0]);
     return 1;
   }
   datagram_seeds({&server, &client}, out / "datagram");

@@ -23,6 +23,7 @@ std::string brain_scene_text(const std::string& mesh);
 Scene brain_scene(const std::string& mesh);
 
 /// The brain scene with `mesh`, written to `directory`/brain.yaml; that file.
-std::filesystem::path write_brain_scene(const std::filesystem::path& directory, const std::string& mesh);
+std::filesystem::path write_brain_scene(const std::filesystem::path& directory,
+                                        const std::string& mesh);
 
 }  // namespace cohaptic::testing

@@ -17,7 +17,8 @@ CubeSceneOptions pressed_cube_options() {
 }
 
 std::string cube_scene_yaml(const CubeSceneOptions& o) {
-  return fmt::format(R"(
+  return fmt::format(
+      R"(
 units: mm
 objects:
   - name: cube
@@ -30,8 +31,9 @@ obstacles: [{4}]
 tools: {5}
 haptic: {{force_limit: {6}{8}}}
 )",
-                     o.divisions, o.youngs_modulus, o.poisson_ratio, o.touchable, o.obstacles, o.tools, o.force_limit,
-                     o.compliance, o.contact_model.empty() ? std::string() : ", contact_model: " + o.contact_model);
+      o.divisions, o.youngs_modulus, o.poisson_ratio, o.touchable, o.obstacles, o.tools,
+      o.force_limit, o.compliance,
+      o.contact_model.empty() ? std::string() : ", contact_model: " + o.contact_model);
 }
 
 CubeRig::CubeRig(const CubeSceneOptions& options) : CubeRig(cube_scene_yaml(options)) {}
@@ -39,6 +41,7 @@ CubeRig::CubeRig(const CubeSceneOptions& options) : CubeRig(cube_scene_yaml(opti
 CubeRig::CubeRig(const std::string& scene_yaml)
     : model(std::make_unique<Model>(build_model(parse_scene(scene_yaml, "cube.yaml")))),
       body(single_elastic_body(*model)),
-      columns(std::make_unique<ComplianceColumns>(body.free_factor, body.dofs, body.surface.nodes)) {}
+      columns(
+          std::make_unique<ComplianceColumns>(body.free_factor, body.dofs, body.surface.nodes)) {}
 
 }  // namespace cohaptic::testing

@@ -14,7 +14,7 @@ struct CubeSceneOptions {
   double youngs_modulus = 1.0e6;
   double poisson_ratio = 0.4;
   std::string touchable = "{plane: {point: [0, 0, 0], normal: [0, 0, 1]}}";
-  std::string obstacles;      ///< YAML list items, e.g. "- {name: wall, plane: {...}}"
+  std::string obstacles;  ///< YAML list items, e.g. "- {name: wall, plane: {...}}"
   std::string tools = "[{name: A}, {name: B}]";
   std::string compliance = "{precompute: on_demand, disk_cache: false}";
   double force_limit = 3.3;

@@ -12,9 +12,11 @@ namespace cohaptic::testing {
 namespace fs = std::filesystem;
 
 void write_cube_scene(const fs::path& dir, const std::string& extra, int tools) {
-  if (tools < 1 || tools > 4) throw std::invalid_argument(fmt::format("write_cube_scene: {} tools, not 1 to 4", tools));
+  if (tools < 1 || tools > 4)
+    throw std::invalid_argument(fmt::format("write_cube_scene: {} tools, not 1 to 4", tools));
   std::string tool_list;
-  for (int k = 0; k < tools; ++k) tool_list += fmt::format("{}{{name: {}}}", k ? ", " : "", static_cast<char>('A' + k));
+  for (int k = 0; k < tools; ++k)
+    tool_list += fmt::format("{}{{name: {}}}", k ? ", " : "", static_cast<char>('A' + k));
   std::ofstream(dir / "cube.yaml") << R"(
 name: soft-cube
 units: mm
@@ -30,7 +32,8 @@ haptic: {rate_hz: 1000, force_limit: 3.3, contact_model: translation, patch_ring
 )" << extra;
 }
 
-fs::path write_press(const fs::path& dir, const std::string& name, double x, double y, double depth, double hold) {
+fs::path write_press(const fs::path& dir, const std::string& name, double x, double y, double depth,
+                     double hold) {
   const fs::path file = dir / (name + ".yaml");
   std::ofstream(file) << fmt::format(R"(
 units: mm
@@ -46,16 +49,19 @@ segments:
 }
 
 double period_p99_allowance_us(const nlohmann::json& client_report) {
-  return std::max(1100.0, client_report.at("timer_floor").at("period_us").at("p99").get<double>() + 150);
+  return std::max(1100.0,
+                  client_report.at("timer_floor").at("period_us").at("p99").get<double>() + 150);
 }
 
 CubeSession::CubeSession(const std::string& name, const std::vector<std::string>& server_arguments,
                          const std::string& scene_extra, int tools)
     : dir(scratch_directory(name)) {
   write_cube_scene(dir, scene_extra, tools);
-  std::vector<std::string> arguments = {"--scene", (dir / "cube.yaml").string(), "--listen", "127.0.0.1:0",
-                                        "--report", (dir / "server.json").string(), "--no-disk-cache"};
-  for (const std::string& argument : server_arguments) {  // paths after --display and --record are the session directory's
+  std::vector<std::string> arguments = {
+      "--scene",  (dir / "cube.yaml").string(),   "--listen",       "127.0.0.1:0",
+      "--report", (dir / "server.json").string(), "--no-disk-cache"};
+  for (const std::string& argument :
+       server_arguments) {  // paths after --display and --record are the session directory's
     const bool in_directory = arguments.back() == "--display" || arguments.back() == "--record";
     arguments.push_back(in_directory ? (dir / argument).string() : argument);
   }
@@ -64,16 +70,20 @@ CubeSession::CubeSession(const std::string& name, const std::vector<std::string>
   port = listening_port(server->log_text());
 }
 
-std::unique_ptr<ChildProcess> CubeSession::client(const std::string& user, int slot, const fs::path& trajectory,
+std::unique_ptr<ChildProcess> CubeSession::client(const std::string& user, int slot,
+                                                  const fs::path& trajectory,
                                                   const std::vector<std::string>& extra) const {
   return scripted_client(dir, port, user, slot, trajectory, extra);
 }
 
-std::unique_ptr<ChildProcess> scripted_client(const fs::path& dir, int port, const std::string& user, int slot,
-                                              const fs::path& trajectory, const std::vector<std::string>& extra) {
-  std::vector<std::string> arguments = {"--server", fmt::format("127.0.0.1:{}", port), "--user", user,
-                                        "--device", "script:" + trajectory.string(),
-                                        "--report", (dir / (user + ".json")).string(), "--record", (dir / (user + ".mcap")).string()};
+std::unique_ptr<ChildProcess> scripted_client(const fs::path& dir, int port,
+                                              const std::string& user, int slot,
+                                              const fs::path& trajectory,
+                                              const std::vector<std::string>& extra) {
+  std::vector<std::string> arguments = {
+      "--server", fmt::format("127.0.0.1:{}", port), "--user",   user,
+      "--device", "script:" + trajectory.string(),   "--report", (dir / (user + ".json")).string(),
+      "--record", (dir / (user + ".mcap")).string()};
   if (slot >= 0) arguments.insert(arguments.end(), {"--slot", std::to_string(slot)});
   arguments.insert(arguments.end(), extra.begin(), extra.end());
   return std::make_unique<ChildProcess>(client_program(), arguments, dir / (user + ".log"));

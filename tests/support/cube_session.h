@@ -16,11 +16,12 @@ namespace cohaptic::testing {
 /// A soft cube (forces well under the 3.3 N limit) with `tools` point tools (A, B, ..., at
 /// most 4), touchable on its top face (z = 0 mm); `extra` is appended to the scene text
 /// (e.g. a network section).
-void write_cube_scene(const std::filesystem::path& dir, const std::string& extra = "", int tools = 2);
+void write_cube_scene(const std::filesystem::path& dir, const std::string& extra = "",
+                      int tools = 2);
 
 /// Press `depth` mm at (x, y) mm, hold, release: about 0.4 + 2 * depth / 5 + hold seconds.
-std::filesystem::path write_press(const std::filesystem::path& dir, const std::string& name, double x, double y,
-                                  double depth, double hold);
+std::filesystem::path write_press(const std::filesystem::path& dir, const std::string& name,
+                                  double x, double y, double depth, double hold);
 
 /// The haptic period p99 [us] a well-behaved client keeps while others misbehave: its own
 /// bare timer floor's p99 (measured beside its loop, so the machine's load is in both) plus
@@ -29,7 +30,8 @@ double period_p99_allowance_us(const nlohmann::json& client_report);
 
 /// A client of the server at 127.0.0.1:`port` with a scripted device, its report, recording
 /// and log in `dir` named after `user`; `slot` -1: the first free one.
-std::unique_ptr<ChildProcess> scripted_client(const std::filesystem::path& dir, int port, const std::string& user, int slot,
+std::unique_ptr<ChildProcess> scripted_client(const std::filesystem::path& dir, int port,
+                                              const std::string& user, int slot,
                                               const std::filesystem::path& trajectory,
                                               const std::vector<std::string>& extra = {});
 
@@ -42,7 +44,8 @@ struct CubeSession {
   CubeSession(const std::string& name, const std::vector<std::string>& server_arguments,
               const std::string& scene_extra = "", int tools = 2);
   /// A client with a scripted device, its report, recording and log in the directory.
-  std::unique_ptr<ChildProcess> client(const std::string& user, int slot, const std::filesystem::path& trajectory,
+  std::unique_ptr<ChildProcess> client(const std::string& user, int slot,
+                                       const std::filesystem::path& trajectory,
                                        const std::vector<std::string>& extra = {}) const;
   /// `name`.json of the directory.
   nlohmann::json report(const std::string& name) const;

@@ -7,7 +7,8 @@
 namespace cohaptic::testing {
 
 inline const TwoLayerSetup& default_two_layers() {
-  static const TwoLayerSetup setup = make_two_layer_setup(TwoLayerBoxes{}, FieldSettings{}, SeparationSettings{});
+  static const TwoLayerSetup setup =
+      make_two_layer_setup(TwoLayerBoxes{}, FieldSettings{}, SeparationSettings{});
   return setup;
 }
 

@@ -29,11 +29,13 @@ struct FreePush {
 
 /// The push to `depth` [m]; `also_held` global dofs of A held at zero (A's back face, for
 /// the fixed condition).
-FreePush push_without_behind(const ElasticBody& front, double depth, const std::vector<int>& also_held = {});
+FreePush push_without_behind(const ElasticBody& front, double depth,
+                             const std::vector<int>& also_held = {});
 
 /// A's back-face nodes at `displacement` against B's rest surface, within kFemPairReach (the
 /// scenes' candidates), each against the polygons around B's nearest surface node.
-std::vector<PolygonCollision> back_face_candidates(const PairedBoxesRig& rig, const Eigen::VectorXd& displacement);
+std::vector<PolygonCollision> back_face_candidates(const PairedBoxesRig& rig,
+                                                   const Eigen::VectorXd& displacement);
 
 /// The push, its candidates and the coupled contact (A's columns over its surface).
 struct CoupledPush {
@@ -60,7 +62,8 @@ std::vector<int> tool_neighbourhood(const CoupledPush& push);
 
 /// K_ff of `a` plus the springs N support^-1 N^T on `nodes` (one normal each, `normals`'
 /// columns): A resting on the support, the naive way.
-SparseMatrix stiffness_with_support(const ElasticBody& a, const std::vector<int>& nodes, const Eigen::Matrix3Xd& normals,
+SparseMatrix stiffness_with_support(const ElasticBody& a, const std::vector<int>& nodes,
+                                    const Eigen::Matrix3Xd& normals,
                                     const Eigen::MatrixXd& support);
 
 }  // namespace cohaptic::testing

@@ -41,18 +41,21 @@ Bytes HostileDatagrams::random_bytes(std::size_t size) {
 Bytes HostileDatagrams::next() {
   Bytes bytes;
   switch (rng_() % 6) {
-    case 0: return random_bytes(rng_() % 1600);  // empty to oversized
-    case 1:                                      // protocol 1 or 2's first byte
+    case 0:
+      return random_bytes(rng_() % 1600);  // empty to oversized
+    case 1:                                // protocol 1 or 2's first byte
       bytes = random_bytes(40 + rng_() % 200);
       bytes[0] = 0x0a;
       return bytes;
     case 2:  // an envelope naming user 0 or 1, and no valid tag
       bytes = random_bytes(60 + rng_() % 100);
-      wire::write_envelope({wire::kProtocolVersion, wire::kEncryptedFlag, 1 + static_cast<std::uint32_t>(rng_() % 2), rng_(), rng_()},
+      wire::write_envelope({wire::kProtocolVersion, wire::kEncryptedFlag,
+                            1 + static_cast<std::uint32_t>(rng_() % 2), rng_(), rng_()},
                            bytes.data());
       return bytes;
-    case 3: return authentic_[rng_() % authentic_.size()];  // another's key, or another sealer
-    default:                                                // one of those with a bit flipped
+    case 3:
+      return authentic_[rng_() % authentic_.size()];  // another's key, or another sealer
+    default:                                          // one of those with a bit flipped
       bytes = authentic_[rng_() % authentic_.size()];
       bytes[rng_() % bytes.size()] ^= static_cast<std::uint8_t>(1u << (rng_() % 8));
       return bytes;

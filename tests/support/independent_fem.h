@@ -12,7 +12,8 @@
 
 namespace cohaptic::testing {
 
-Eigen::Matrix<double, 12, 12> independent_tet_stiffness(const Eigen::Matrix<double, 3, 4>& corners, double youngs_modulus,
+Eigen::Matrix<double, 12, 12> independent_tet_stiffness(const Eigen::Matrix<double, 3, 4>& corners,
+                                                        double youngs_modulus,
                                                         double poisson_ratio);
 
 struct IndependentSolution {
@@ -21,8 +22,9 @@ struct IndependentSolution {
 };
 
 /// Static solve: `fixed` dofs are zero, `prescribed` maps dof -> value, `loads` is 3N or empty.
-IndependentSolution independent_static_solve(const TetMesh& mesh, double youngs_modulus, double poisson_ratio,
-                                             const std::vector<bool>& fixed, const std::map<int, double>& prescribed,
+IndependentSolution independent_static_solve(const TetMesh& mesh, double youngs_modulus,
+                                             double poisson_ratio, const std::vector<bool>& fixed,
+                                             const std::map<int, double>& prescribed,
                                              const Eigen::VectorXd& loads = {});
 
 }  // namespace cohaptic::testing

@@ -16,7 +16,8 @@
 namespace cohaptic::testing {
 
 inline PreparedIR prepared_ir_seed(const std::string& name) {
-  std::ifstream in(std::string(COHAPTIC_SOURCE_DIR) + "/tests/fuzz/corpus/ir/" + name, std::ios::binary);
+  std::ifstream in(std::string(COHAPTIC_SOURCE_DIR) + "/tests/fuzz/corpus/ir/" + name,
+                   std::ios::binary);
   wire::IntermediateRepresentation message;
   EXPECT_TRUE(message.ParseFromIstream(&in)) << name;
   IntermediateRepresentation ir = wire::from_wire(message);

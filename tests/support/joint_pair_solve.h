@@ -20,11 +20,14 @@ struct JointPairSolution {
   Eigen::VectorXd pushes;         ///< per collision, zero outside the set [N]
   Eigen::VectorXd gaps;           ///< per collision [m]
   Eigen::VectorXd front, behind;  ///< displacements, 3 per node of each body [m]
-  Eigen::VectorXd front_reaction; ///< K_A u_A, 3 per node of A: the forces holding A's held dofs [N]
+  Eigen::VectorXd
+      front_reaction;  ///< K_A u_A, 3 per node of A: the forces holding A's held dofs [N]
 };
 
 /// A with `held_dofs` (global free dofs) at `held_values` [m], against B through `collisions`.
-JointPairSolution joint_pair_solve(const ElasticBody& front, const ElasticBody& behind, std::span<const int> held_dofs,
-                                   const Eigen::VectorXd& held_values, const std::vector<PolygonCollision>& collisions);
+JointPairSolution joint_pair_solve(const ElasticBody& front, const ElasticBody& behind,
+                                   std::span<const int> held_dofs,
+                                   const Eigen::VectorXd& held_values,
+                                   const std::vector<PolygonCollision>& collisions);
 
 }  // namespace cohaptic::testing

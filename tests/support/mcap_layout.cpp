@@ -6,15 +6,16 @@
 namespace cohaptic::testing {
 namespace {
 
-constexpr std::uint8_t kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05, kChunk = 0x06,
-                       kMessageIndex = 0x07, kStatistics = 0x0B, kDataEnd = 0x0F;
+constexpr std::uint8_t kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05,
+                       kChunk = 0x06, kMessageIndex = 0x07, kStatistics = 0x0B, kDataEnd = 0x0F;
 
 void put_le(Bytes& out, std::uint64_t value, int width) {
   for (int i = 0; i < width; ++i) out.push_back(static_cast<std::uint8_t>(value >> (8 * i)));
 }
 
 void put_range(Bytes& out, const Bytes& from, std::size_t begin, std::size_t end) {
-  out.insert(out.end(), from.begin() + static_cast<std::ptrdiff_t>(begin), from.begin() + static_cast<std::ptrdiff_t>(end));
+  out.insert(out.end(), from.begin() + static_cast<std::ptrdiff_t>(begin),
+             from.begin() + static_cast<std::ptrdiff_t>(end));
 }
 
 }  // namespace
@@ -28,16 +29,22 @@ Bytes read_bytes(const std::filesystem::path& path) {
 
 void write_bytes(const std::filesystem::path& path, const Bytes& bytes) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
 }
 
 std::uint64_t le(const Bytes& b, std::size_t at, int width) {
   std::uint64_t value = 0;
-  for (int i = width - 1; i >= 0; --i) value = (value << 8) | b.at(at + static_cast<std::size_t>(i));
+  for (int i = width - 1; i >= 0; --i)
+    value = (value << 8) | b.at(at + static_cast<std::size_t>(i));
   return value;
 }
-std::uint16_t le16(const Bytes& b, std::size_t at) { return static_cast<std::uint16_t>(le(b, at, 2)); }
-std::uint32_t le32(const Bytes& b, std::size_t at) { return static_cast<std::uint32_t>(le(b, at, 4)); }
+std::uint16_t le16(const Bytes& b, std::size_t at) {
+  return static_cast<std::uint16_t>(le(b, at, 2));
+}
+std::uint32_t le32(const Bytes& b, std::size_t at) {
+  return static_cast<std::uint32_t>(le(b, at, 4));
+}
 std::uint64_t le64(const Bytes& b, std::size_t at) { return le(b, at, 8); }
 std::string text(const Bytes& b, std::size_t at, std::size_t n) {
   return std::string(reinterpret_cast<const char*>(b.data() + at), n);
@@ -119,7 +126,8 @@ Bytes unchunked(const Bytes& chunked) {
   const std::size_t summary_start = out.size();
   for (++r; r < records.size(); ++r) {
     const RawRecord& record = records[r];
-    if (record.opcode != kSchema && record.opcode != kChannel && record.opcode != kStatistics) continue;
+    if (record.opcode != kSchema && record.opcode != kChannel && record.opcode != kStatistics)
+      continue;
     const std::size_t at = out.size();
     put_range(out, chunked, record.offset, record.end());
     if (record.opcode == kStatistics)

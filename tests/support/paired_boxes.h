@@ -17,8 +17,8 @@
 
 namespace cohaptic::testing {
 
-using cohaptic::PairedBoxesOptions;
 using cohaptic::paired_boxes_scene_yaml;
+using cohaptic::PairedBoxesOptions;
 
 /// Both bodies compiled, their surfaces' adjacency, B's compliance over its surface nodes.
 struct PairedBoxesRig {

@@ -25,7 +25,8 @@ Eigen::VectorXd nodal(const Eigen::VectorXd& global, const std::vector<int>& nod
   return values;
 }
 
-Eigen::VectorXd free_reactions(const ElasticBody& body, const Eigen::VectorXd& reaction, const std::vector<int>& nodes) {
+Eigen::VectorXd free_reactions(const ElasticBody& body, const Eigen::VectorXd& reaction,
+                               const std::vector<int>& nodes) {
   Eigen::VectorXd values = nodal(reaction, nodes);
   for (std::size_t j = 0; j < nodes.size(); ++j)
     for (int axis = 0; axis < 3; ++axis)

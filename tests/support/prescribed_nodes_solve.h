@@ -21,6 +21,7 @@ Eigen::VectorXd nodal(const Eigen::VectorXd& global, const std::vector<int>& nod
 
 /// The full solve's reactions at `nodes` along their free axes (a fixed axis's reaction
 /// is the support's, not the interaction's).
-Eigen::VectorXd free_reactions(const ElasticBody& body, const Eigen::VectorXd& reaction, const std::vector<int>& nodes);
+Eigen::VectorXd free_reactions(const ElasticBody& body, const Eigen::VectorXd& reaction,
+                               const std::vector<int>& nodes);
 
 }  // namespace cohaptic::testing

@@ -56,8 +56,12 @@ std::filesystem::path scratch_directory(const std::string& name) {
   return dir;
 }
 
-std::string server_program() { return std::string(COHAPTIC_BINARY_DIR) + "/server/cohaptic-server"; }
-std::string client_program() { return std::string(COHAPTIC_BINARY_DIR) + "/client/cohaptic-client"; }
+std::string server_program() {
+  return std::string(COHAPTIC_BINARY_DIR) + "/server/cohaptic-server";
+}
+std::string client_program() {
+  return std::string(COHAPTIC_BINARY_DIR) + "/client/cohaptic-client";
+}
 
 ::testing::AssertionResult wait_for_output(ChildProcess& process, const std::string& text,
                                            std::chrono::milliseconds timeout) {
@@ -72,9 +76,10 @@ std::string client_program() { return std::string(COHAPTIC_BINARY_DIR) + "/clien
       "'" + text + "' in a child process's output", timeout);
   if (shown()) return ::testing::AssertionSuccess();
   if (ended)
-    return ::testing::AssertionFailure() << "the child process ended (status " << *process.wait(timeout)
-                                         << ") before its output showed '" << text << "'; its output:\n"
-                                         << process.log_text();
+    return ::testing::AssertionFailure()
+           << "the child process ended (status " << *process.wait(timeout)
+           << ") before its output showed '" << text << "'; its output:\n"
+           << process.log_text();
   return waited << "; its output:\n" << process.log_text();
 }
 
@@ -82,8 +87,10 @@ void run_scripted_session(const std::filesystem::path& dir, const std::filesyste
                           const std::vector<std::string>& server_arguments,
                           const std::vector<std::pair<std::string, std::filesystem::path>>& users,
                           std::chrono::milliseconds load_timeout) {
-  std::vector<std::string> arguments = {"--scene", scene.string(), "--listen", "127.0.0.1:0", "--report",
-                                        (dir / "server.json").string(), "--record", (dir / "server.mcap").string()};
+  std::vector<std::string> arguments = {"--scene",  scene.string(),
+                                        "--listen", "127.0.0.1:0",
+                                        "--report", (dir / "server.json").string(),
+                                        "--record", (dir / "server.mcap").string()};
   arguments.insert(arguments.end(), server_arguments.begin(), server_arguments.end());
   ChildProcess server(server_program(), arguments, dir / "server.log");
   ASSERT_TRUE(wait_for_output(server, "listening on", load_timeout)) << server.log_text();
@@ -93,9 +100,10 @@ void run_scripted_session(const std::filesystem::path& dir, const std::filesyste
     const std::string& user = users[slot].first;
     clients.push_back(std::make_unique<ChildProcess>(
         client_program(),
-        std::vector<std::string>{"--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot",
-                                 std::to_string(slot), "--device", "script:" + users[slot].second.string(), "--report",
-                                 (dir / (user + ".json")).string(), "--record", (dir / (user + ".mcap")).string()},
+        std::vector<std::string>{
+            "--server", fmt::format("127.0.0.1:{}", port), "--user", user, "--slot",
+            std::to_string(slot), "--device", "script:" + users[slot].second.string(), "--report",
+            (dir / (user + ".json")).string(), "--record", (dir / (user + ".mcap")).string()},
         dir / (user + ".log")));
   }
   for (const auto& client : clients) ASSERT_EQ(client->wait(kPatience), 0) << client->log_text();

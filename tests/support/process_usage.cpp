@@ -23,7 +23,8 @@ std::optional<ProcessUsage> usage_of(pid_t pid) {
   }
   if (!found_rss) return std::nullopt;
   std::error_code error;
-  for (std::filesystem::directory_iterator fd(proc / "fd", error), end; !error && fd != end; fd.increment(error))
+  for (std::filesystem::directory_iterator fd(proc / "fd", error), end; !error && fd != end;
+       fd.increment(error))
     ++usage.open_fds;
   if (error) return std::nullopt;
   // stat: "pid (comm) state ..." with utime and stime the 12th and 13th fields after comm,
@@ -36,9 +37,12 @@ std::optional<ProcessUsage> usage_of(pid_t pid) {
   std::string field;
   unsigned long long utime = 0, stime = 0;
   for (int k = 1; k <= 13 && fields >> field; ++k)
-    if (k == 12) utime = std::stoull(field);
-    else if (k == 13) stime = std::stoull(field);
-  usage.cpu_seconds = static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+    if (k == 12)
+      utime = std::stoull(field);
+    else if (k == 13)
+      stime = std::stoull(field);
+  usage.cpu_seconds =
+      static_cast<double>(utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
   return usage;
 }
 

@@ -1,6 +1,6 @@
 // What a running process holds, read from Linux's /proc: its resident set (VmRSS, bytes)
-// its open file descriptors (the entries of /proc/PID/fd) and its CPU time (/proc/PID/stat). The soak samples both for
-// the server and its clients to show that nothing grows with time.
+// its open file descriptors (the entries of /proc/PID/fd) and its CPU time (/proc/PID/stat). The
+// soak samples both for the server and its clients to show that nothing grows with time.
 #pragma once
 
 #include <sys/types.h>

@@ -31,9 +31,11 @@ void RawParticipant::stop() {
 }
 
 bool RawParticipant::read_some(std::chrono::steady_clock::time_point deadline) {
-  const auto left = std::chrono::duration_cast<std::chrono::microseconds>(deadline - std::chrono::steady_clock::now());
+  const auto left = std::chrono::duration_cast<std::chrono::microseconds>(
+      deadline - std::chrono::steady_clock::now());
   if (left.count() <= 0) return false;
-  const timeval timeout{static_cast<time_t>(left.count() / 1'000'000), static_cast<suseconds_t>(left.count() % 1'000'000)};
+  const timeval timeout{static_cast<time_t>(left.count() / 1'000'000),
+                        static_cast<suseconds_t>(left.count() % 1'000'000)};
   ::setsockopt(tcp_.native_handle(), SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
   std::array<std::uint8_t, 65536> buffer{};
   std::error_code error;
@@ -46,10 +48,12 @@ bool RawParticipant::read_some(std::chrono::steady_clock::time_point deadline) {
 wire::Welcome RawParticipant::join(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   tcp_.open(tcp::v4());
-  if (options_.tcp_receive_buffer > 0) tcp_.set_option(asio::socket_base::receive_buffer_size(options_.tcp_receive_buffer));
+  if (options_.tcp_receive_buffer > 0)
+    tcp_.set_option(asio::socket_base::receive_buffer_size(options_.tcp_receive_buffer));
   tcp_.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), options_.server_port));
-  wire::FrameReader reader([this](std::uint32_t sender) { return sender == wire::kServerSender ? &key_ : nullptr; },
-                           {.expect_greeting = true, .allow_cleartext = !options_.encrypt});
+  wire::FrameReader reader(
+      [this](std::uint32_t sender) { return sender == wire::kServerSender ? &key_ : nullptr; },
+      {.expect_greeting = true, .allow_cleartext = !options_.encrypt});
   std::size_t fed = 0;
   const wire::Challenge mine = wire::random_challenge();
   while (true) {
@@ -67,10 +71,12 @@ wire::Welcome RawParticipant::join(std::chrono::milliseconds timeout) {
         join_bytes_ = frames_.seal(join);
         send_raw(join_bytes_);
       } else if (control->has_error()) {
-        throw Error("the server refused: " + control->error().text() + " (" + control->error().code() + ")");
+        throw Error("the server refused: " + control->error().text() + " (" +
+                    control->error().code() + ")");
       } else if (control->has_welcome()) {
         const wire::Welcome& welcome = control->welcome();
-        if (!wire::is_challenge(welcome.client_challenge(), mine)) throw Error("a welcome that does not answer our join");
+        if (!wire::is_challenge(welcome.client_challenge(), mine))
+          throw Error("a welcome that does not answer our join");
         key_ = *keys_.slot_key(welcome.slot());
         frames_.set_key(key_);
         datagrams_.set_key(key_);
@@ -84,7 +90,9 @@ wire::Welcome RawParticipant::join(std::chrono::milliseconds timeout) {
   }
 }
 
-void RawParticipant::send_raw(const std::vector<std::uint8_t>& bytes) { asio::write(tcp_, asio::buffer(bytes)); }
+void RawParticipant::send_raw(const std::vector<std::uint8_t>& bytes) {
+  asio::write(tcp_, asio::buffer(bytes));
+}
 
 void RawParticipant::send_sample(const Eigen::Vector3d& position) {
   wire::Datagram datagram;
@@ -105,7 +113,8 @@ void RawParticipant::press_along(std::function<Eigen::Vector3d(double)> path) {
     const auto start = std::chrono::steady_clock::now();
     auto next = start;
     while (!stop_) {
-      send_sample(path(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
+      send_sample(
+          path(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
       next += std::chrono::milliseconds(1);
       std::this_thread::sleep_until(next);
     }

@@ -11,6 +11,7 @@ struct ProgramRun {
 };
 
 /// Runs `program arguments` through the shell (arguments are not quoted) and waits for it.
-ProgramRun run_program(const std::string& program, const std::string& arguments, bool with_stderr = false);
+ProgramRun run_program(const std::string& program, const std::string& arguments,
+                       bool with_stderr = false);
 
 }  // namespace cohaptic::testing

@@ -13,7 +13,8 @@ TetMesh distorted_box_mesh(double size, int divisions, double jitter, unsigned s
   TetMesh mesh = make_box_mesh(Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(size),
                                Eigen::Vector3i::Constant(divisions));
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> offset(-jitter * size / divisions, jitter * size / divisions);
+  std::uniform_real_distribution<double> offset(-jitter * size / divisions,
+                                                jitter * size / divisions);
   const double tolerance = 1e-12 * size;
   for (int n = 0; n < mesh.node_count(); ++n) {
     for (int axis = 0; axis < 3; ++axis) {
@@ -28,11 +29,13 @@ TetMesh distorted_box_mesh(double size, int divisions, double jitter, unsigned s
 
 TriangleSurface make_icosphere(int level, double radius) {
   const double g = (1 + std::sqrt(5.0)) / 2;
-  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
-                             {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
-  std::vector<Triangle> t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                             {11, 10, 2}, {10, 7, 6}, {7, 1, 8},   {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                             {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                                    {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                                    {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<Triangle> t = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                             {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                             {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                             {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
   for (int l = 0; l < level; ++l) {
     std::map<std::pair<int, int>, int> midpoint;
     const auto middle = [&](int a, int b) {
@@ -50,7 +53,8 @@ TriangleSurface make_icosphere(int level, double radius) {
   }
   TriangleSurface s;
   s.vertices.resize(3, static_cast<Eigen::Index>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i) s.vertices.col(static_cast<Eigen::Index>(i)) = radius * v[i].normalized();
+  for (std::size_t i = 0; i < v.size(); ++i)
+    s.vertices.col(static_cast<Eigen::Index>(i)) = radius * v[i].normalized();
   s.triangles = std::move(t);
   return s;
 }
@@ -63,6 +67,8 @@ Eigen::Vector3d random_direction(std::mt19937& rng) {
   }
 }
 
-std::string source_path(const std::string& relative) { return std::string(COHAPTIC_SOURCE_DIR) + "/" + relative; }
+std::string source_path(const std::string& relative) {
+  return std::string(COHAPTIC_SOURCE_DIR) + "/" + relative;
+}
 
 }  // namespace cohaptic::testing

@@ -13,7 +13,8 @@ TriangleSurface equilateral_sheet(int columns, int rows, double spacing) {
   const Eigen::Vector3d centre(0.5 * (columns + 0.5) * spacing, 0.5 * rows * row_height, 0);
   for (int j = 0; j <= rows; ++j)
     for (int i = 0; i <= columns; ++i)
-      sheet.vertices.col(index(i, j)) = Eigen::Vector3d((i + 0.5 * (j % 2)) * spacing, j * row_height, 0) - centre;
+      sheet.vertices.col(index(i, j)) =
+          Eigen::Vector3d((i + 0.5 * (j % 2)) * spacing, j * row_height, 0) - centre;
   for (int j = 0; j < rows; ++j)
     for (int i = 0; i < columns; ++i) {
       if (j % 2 == 0) {

@@ -10,7 +10,8 @@ using asio::ip::tcp;
 
 asio::ip::address other_loopback(std::uint32_t k) { return asio::ip::address_v4(0x7f000002u + k); }
 
-tcp::socket connect_from(asio::io_context& io, const asio::ip::address& source, const tcp::endpoint& to) {
+tcp::socket connect_from(asio::io_context& io, const asio::ip::address& source,
+                         const tcp::endpoint& to) {
   tcp::socket socket(io);
   std::error_code error;
   socket.open(tcp::v4(), error);
@@ -33,8 +34,11 @@ std::uint64_t hold_connections(const tcp::endpoint& to, int sources, int per_sou
                                std::chrono::steady_clock::time_point until) {
   asio::io_context io;
   std::vector<tcp::socket> held;
-  const auto source_of = [&](std::size_t k) { return other_loopback(static_cast<std::uint32_t>(k) / static_cast<std::uint32_t>(per_source)); };
-  for (std::size_t k = 0; k < static_cast<std::size_t>(sources * per_source); ++k) held.push_back(connect_from(io, source_of(k), to));
+  const auto source_of = [&](std::size_t k) {
+    return other_loopback(static_cast<std::uint32_t>(k) / static_cast<std::uint32_t>(per_source));
+  };
+  for (std::size_t k = 0; k < static_cast<std::size_t>(sources * per_source); ++k)
+    held.push_back(connect_from(io, source_of(k), to));
   std::uint64_t opened = held.size();
   while (std::chrono::steady_clock::now() < until) {
     for (std::size_t k = 0; k < held.size(); ++k)
@@ -42,7 +46,8 @@ std::uint64_t hold_connections(const tcp::endpoint& to, int sources, int per_sou
         held[k] = connect_from(io, source_of(k), to);
         ++opened;
       }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // bounded, yet far faster than a join timer
+    std::this_thread::sleep_for(
+        std::chrono::milliseconds(20));  // bounded, yet far faster than a join timer
   }
   return opened;
 }

@@ -8,7 +8,8 @@
 
 namespace cohaptic::testing {
 
-inline SimulationOptions unlimited_options(ContactModel model, int step_delay_nodes = 0, int patch_rings = 1,
+inline SimulationOptions unlimited_options(ContactModel model, int step_delay_nodes = 0,
+                                           int patch_rings = 1,
                                            IrPrecision precision = IrPrecision::f64) {
   SimulationOptions options;
   options.ir.contact_model = model;

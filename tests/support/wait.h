@@ -19,7 +19,8 @@ inline constexpr std::chrono::milliseconds kPatience{30'000};
 /// Polls `condition` (first at once, then at intervals growing from 0.2 ms to 20 ms) until
 /// it is true: success, or after `timeout` a failure "timed out after T s waiting for
 /// <what>". Use as ASSERT_TRUE(wait_until(...)) << details.
-::testing::AssertionResult wait_until(const std::function<bool()>& condition, const std::string& what,
+::testing::AssertionResult wait_until(const std::function<bool()>& condition,
+                                      const std::string& what,
                                       std::chrono::milliseconds timeout = kPatience);
 
 }  // namespace cohaptic::testing

@@ -36,7 +36,8 @@ struct WebSocketClient::Impl {
   }
 };
 
-WebSocketClient::WebSocketClient(const std::string& url, const std::string& origin) : impl_(std::make_unique<Impl>()) {
+WebSocketClient::WebSocketClient(const std::string& url, const std::string& origin)
+    : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.client.clear_access_channels(websocketpp::log::alevel::all);
   s.client.clear_error_channels(websocketpp::log::elevel::all);
@@ -153,13 +154,15 @@ struct StalledWebSocket::Impl {
   asio::ip::tcp::socket socket{io};
 };
 
-StalledWebSocket::StalledWebSocket(const std::string& host, std::uint16_t port) : impl_(std::make_unique<Impl>()) {
+StalledWebSocket::StalledWebSocket(const std::string& host, std::uint16_t port)
+    : impl_(std::make_unique<Impl>()) {
   impl_->socket.connect({asio::ip::make_address(host), port});
   // The smallest receive buffer, so that the server's sends back up soon.
   impl_->socket.set_option(asio::socket_base::receive_buffer_size(4096));
-  const std::string request = "GET /ws HTTP/1.1\r\nHost: " + host + ":" + std::to_string(port) +
-                              "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
-                              "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
+  const std::string request =
+      "GET /ws HTTP/1.1\r\nHost: " + host + ":" + std::to_string(port) +
+      "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+      "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
   asio::write(impl_->socket, asio::buffer(request));
   std::string response;
   asio::error_code error;
@@ -170,18 +173,22 @@ StalledWebSocket::StalledWebSocket(const std::string& host, std::uint16_t port) 
 StalledWebSocket::~StalledWebSocket() = default;
 
 std::string http_get(const std::string& host, std::uint16_t port, const std::string& path) {
-  return http_exchange(host, port, "GET " + path + " HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n");
+  return http_exchange(
+      host, port, "GET " + path + " HTTP/1.1\r\nHost: " + host + "\r\nConnection: close\r\n\r\n");
 }
 
-std::string http_exchange(const std::string& host, std::uint16_t port, const std::string& request, bool head_only) {
+std::string http_exchange(const std::string& host, std::uint16_t port, const std::string& request,
+                          bool head_only) {
   asio::io_context io;
   asio::ip::tcp::socket socket(io);
   socket.connect({asio::ip::make_address(host), port});
   asio::write(socket, asio::buffer(request));
   std::string response;
   asio::error_code error;
-  if (head_only) asio::read_until(socket, asio::dynamic_buffer(response), "\r\n\r\n", error);
-  else asio::read(socket, asio::dynamic_buffer(response), error);  // to the end: the server closes
+  if (head_only)
+    asio::read_until(socket, asio::dynamic_buffer(response), "\r\n\r\n", error);
+  else
+    asio::read(socket, asio::dynamic_buffer(response), error);  // to the end: the server closes
   return response;
 }
 
