@@ -23,7 +23,7 @@ fi
 if ! report=$(clang-format --dry-run --Werror "${files[@]}" 2>&1); then
   lines=$(grep -c 'clang-format-violations' <<<"$report" || true)
   echo "format_sources: $lines place(s) differ from clang-format's (make format rewrites them); the first:"
-  grep 'clang-format-violations' <<<"$report" | head -n 40 | sed 's/: warning: code should be clang-formatted.*//'
+  grep 'clang-format-violations' <<<"$report" | head -n 40 | sed -E 's/: (warning|error): code should be clang-formatted.*//'
   exit 1
 fi
 echo "format_sources: ${#files[@]} files as clang-format writes them"

@@ -130,7 +130,7 @@ SeparationModel default_separation_model(bool laser) {
   SeparationModel model;
   model.name = "layers";
   model.patch = shared_default_patch();
-  if (laser) model.spec.instruments.push_back({"tool", {true, 1e-3}, "test"});
+  if (laser) model.spec.instruments.push_back({"tool", {true, 1e-3}});
   return model;
 }
 

@@ -10,6 +10,7 @@
 #include "common/util/yaml_cursor.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -33,18 +34,11 @@ double metres_per(const Cursor& units) {
   return u == "m" ? 1.0 : u == "cm" ? 0.01 : 0.001;
 }
 
+// The scene file's names of the tool shapes, in ToolShape's order.
+constexpr std::array<const char*, 4> kToolShapeNames = {"point", "sphere", "probe", "forceps"};
+
 const char* tool_shape_name(ToolShape shape) {
-  switch (shape) {
-    case ToolShape::point:
-      return "point";
-    case ToolShape::sphere:
-      return "sphere";
-    case ToolShape::probe:
-      return "probe";
-    case ToolShape::forceps:
-      return "forceps";
-  }
-  return "?";
+  return kToolShapeNames[static_cast<std::size_t>(shape)];
 }
 
 AxisMask parse_axes(const Cursor& c) {
@@ -228,10 +222,8 @@ ToolSpec parse_tool(const Cursor& c, double scale) {
   tool.name = c.at("name").text();
   if (auto shape = c.find("shape")) {
     const std::string name = shape->choice({"point", "sphere", "probe", "forceps"});
-    tool.shape = name == "point"    ? ToolShape::point
-                 : name == "sphere" ? ToolShape::sphere
-                 : name == "probe"  ? ToolShape::probe
-                                    : ToolShape::forceps;
+    tool.shape = static_cast<ToolShape>(
+        std::find(kToolShapeNames.begin(), kToolShapeNames.end(), name) - kToolShapeNames.begin());
   }
   if (tool.shape == ToolShape::probe || tool.shape == ToolShape::forceps)
     tool.instrument = parse_instrument(c, scale, tool.shape == ToolShape::forceps);

@@ -142,7 +142,6 @@ SeparationObjectSpec parse_separation_object(const YamlCursor& c, double scale) 
       instrument.tool = item.at("tool").text();
       if (!tools.insert(instrument.tool).second)
         item.at("tool").fail("a tool not named by an earlier instrument");
-      instrument.where = item.location();
       instrument.settings.grasp_reach = object.grasp_reach;
       if (auto laser = item.find("laser")) instrument.settings.laser = laser->boolean();
       if (auto reach = item.find("grasp_reach"))

@@ -22,7 +22,6 @@ namespace cohaptic {
 struct SeparationInstrumentSpec {
   std::string tool;  ///< the scene tool's name
   SeparationToolSettings settings;
-  std::string where;  ///< file:line, for messages
 };
 
 struct SeparationObjectSpec {
