@@ -99,8 +99,14 @@ SessionVerdict summarize_session(const nlohmann::json& server,
       problem(user + ": the haptic loop never ran");
       continue;
     }
+    // A tick late past the next deadline is a tick lost: the ticks the bare timer floor beside
+    // the loop lost too are the machine's (a note below), the rest the loop's own.
+    const double due_ticks = rate > 0 ? ticks * rate_setting / rate : ticks;
+    const double floor_missed = number(c, {"timer_floor", "missed_deadlines"});
+    const bool rate_kept = rate >= 0.95 * rate_setting;
     judge(user, "haptic rate", fmt::format("{:.1f} Hz", rate),
-          fmt::format(">= {:.0f} Hz", 0.95 * rate_setting), rate >= 0.95 * rate_setting,
+          fmt::format(">= {:.0f} Hz, the floor's lost ticks aside", 0.95 * rate_setting),
+          rate_kept || ticks + floor_missed >= 0.95 * due_ticks,
           fmt::format("haptic rate {:.1f} Hz, below 95 % of {:g} Hz", rate, rate_setting));
     if (p1 ? number(c, {"ir", "received"}) < 1 : number(c, {"forces_received"}) < 1)
       problem(user + ": nothing to compute forces from (no IR or force received)");
@@ -150,13 +156,17 @@ SessionVerdict summarize_session(const nlohmann::json& server,
     }
     const double p99 = number(c, {"period_us", "p99"});
     const double floor_p99 = number(c, {"timer_floor", "period_us", "p99"});
+    // Beside a floor late by milliseconds (a host that stalls its vCPUs), two p99s of that
+    // tail, each from a few thousand periods, differ by a tenth with no fault of the loop's.
+    const double floor_margin = std::max(100.0, 0.1 * floor_p99);
+    const bool as_late_as_the_floor = p99 <= floor_p99 + floor_margin;
     judge(user, "haptic period p99", fmt::format("{:.0f} us (floor {:.0f} us)", p99, floor_p99),
-          fmt::format("<= {:.0f} us or floor + 100 us", nominal + 100),
-          p99 <= nominal + 100 || p99 <= floor_p99 + 100,
-          fmt::format("haptic period p99 {:.0f} us, more than 100 us above both {:.0f} us and the "
-                      "timer floor ({:.0f} us)",
-                      p99, nominal, floor_p99));
-    if (p99 > nominal + 100 && p99 <= floor_p99 + 100)
+          fmt::format("<= {:.0f} us or floor + {:.0f} us", nominal + 100, floor_margin),
+          p99 <= nominal + 100 || as_late_as_the_floor,
+          fmt::format("haptic period p99 {:.0f} us, more than 100 us above {:.0f} us and more "
+                      "than {:.0f} us above the timer floor ({:.0f} us)",
+                      p99, nominal, floor_margin, floor_p99));
+    if (p99 > nominal + 100 && as_late_as_the_floor)
       verdict.notes.push_back(fmt::format(
           "{}: period p99 {:.0f} us exceeds {:.0f} + 100 us, but so does this machine's "
           "bare timer (p99 {:.0f} us)",
@@ -164,7 +174,6 @@ SessionVerdict summarize_session(const nlohmann::json& server,
     // A stall of the whole machine makes the bare timer miss the same deadlines: only the
     // misses beyond the floor's are the loop's own.
     const double missed = number(c, {"missed_deadlines"});
-    const double floor_missed = number(c, {"timer_floor", "missed_deadlines"});
     // The timer floor is the worst of one per CPU; each also says how long the host held its
     // CPU back (steal time, in a virtual machine), which names a stall the host made.
     std::string steal;
@@ -179,9 +188,11 @@ SessionVerdict summarize_session(const nlohmann::json& server,
           fmt::format("{:.0f} missed deadlines ({:.2f} %), the bare timer floor {:.0f}{}", missed,
                       100 * missed / ticks, floor_missed, steal));
     if (!own_misses && missed > 0)
-      verdict.notes.push_back(
-          fmt::format("{}: {:.0f} missed deadlines (timer floor missed {:.0f}{})", user, missed,
-                      floor_missed, steal));
+      verdict.notes.push_back(fmt::format(
+          "{}: {:.0f} missed deadlines{} (timer floor missed {:.0f}{})", user, missed,
+          rate_kept ? std::string()
+                    : fmt::format(", so a haptic rate of {:.1f} Hz, the machine's", rate),
+          floor_missed, steal));
     // How much users feel of each other is the experiment's design (two tools far apart
     // feel little), not the session's health: a note. A dynamic body's client does not
     // measure it (reports before that flag always did).

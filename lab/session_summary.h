@@ -5,17 +5,20 @@
 //   - server: no datagram or control frame rejected (nobody else is on the demo's
 //     loopback); no simulation step failed; the step rate at least 90 % of its target (the
 //     --sim-rate-hz asked for, else the scene's haptic.min_sim_rate_hz);
-//   - each client: the haptic loop ran at >= 95 % of its rate, received IRs (P1) or forces
+//   - each client: the haptic loop ran at >= 95 % of its rate (or lost no more ticks than the
+//     bare timer beside it missed deadlines: the machine's stall), received IRs (P1) or forces
 //     (P0), touched the object, never output a non-finite force, rejected no datagram;
 //     its force never faded while pushing; at most 0.1 % of its ticks at the force limit;
 //     the age of its IR (P1) or force (P0): p99 within 4 steps at the target rate plus the
 //     injected delay (50 ms at least, the fade age at most), max below the fade age;
 //   - the haptic period's p99 within 100 us of the period, or, on a machine whose bare
-//     timer cannot do that, within 100 us of that timer floor measured at the same time;
+//     timer cannot do that, within 100 us (or a tenth, if more) of that timer floor
+//     measured at the same time;
 //     at most 0.1 % of the ticks missed their deadline beyond what the bare timer missed.
 // A failed criterion is a problem naming its cause. Notes are worth knowing and judge
 // nothing: how much the users felt of each other (the experiment's design), a machine
-// whose bare timer was as late as the loop.
+// whose bare timer was as late as the loop or missed as many deadlines (its host's steal time
+// named, in a virtual machine).
 #pragma once
 
 #include <filesystem>

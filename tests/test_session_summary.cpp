@@ -87,6 +87,26 @@ TEST(SessionSummary, MissedDeadlinesNameTheHostsStealTimePerCpu) {
       << verdict.report["problems"].dump();
 }
 
+// 2,000 ticks lost of 16,000 (a rate of 889 Hz): the loop's own when the bare timer floor
+// kept its deadlines, the machine's (a note naming the host's steal) when it missed as many.
+TEST(SessionSummary, ALowHapticRateIsAProblemUnlessTheTimerFloorLostAsManyTicks) {
+  nlohmann::json slow = healthy_client("a");
+  slow["haptic_rate_hz"] = 888.9;
+  slow["missed_deadlines"] = 2000;
+  SessionVerdict verdict = summarize_session(healthy_server(), {slow, healthy_client("b")});
+  EXPECT_TRUE(mentions(verdict.problems, "a: haptic rate 888.9 Hz, below 95 % of 1000 Hz"))
+      << verdict.report["problems"].dump();
+  slow["timer_floor"]["missed_deadlines"] = 1990;
+  slow["timer_floor"]["cpus"] = {
+      {{"cpu", 0}, {"missed_deadlines", 1990}, {"host_steal_ms", 1800.0}}};
+  verdict = summarize_session(healthy_server(), {slow, healthy_client("b")});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
+  EXPECT_TRUE(mentions(verdict.notes,
+                       "a: 2000 missed deadlines, so a haptic rate of 888.9 Hz, the machine's "
+                       "(timer floor missed 1990; host steal time: CPU 0 1800 ms)"))
+      << verdict.report["notes"].dump();
+}
+
 TEST(SessionSummary, SlowPeriodIsAProblemUnlessTheTimerFloorIsAsSlow) {
   nlohmann::json slow = healthy_client("a");
   slow["period_us"]["p99"] = 1300.0;
@@ -96,6 +116,15 @@ TEST(SessionSummary, SlowPeriodIsAProblemUnlessTheTimerFloorIsAsSlow) {
   verdict = summarize_session(healthy_server(), {slow, healthy_client("b")});
   EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
   EXPECT_TRUE(mentions(verdict.notes, "bare timer"));
+  // A floor late by milliseconds (a host stalling its vCPUs): within a tenth of it.
+  slow["timer_floor"]["period_us"]["p99"] = 7000.0;
+  slow["period_us"]["p99"] = 7650.0;
+  verdict = summarize_session(healthy_server(), {slow, healthy_client("b")});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
+  slow["period_us"]["p99"] = 7750.0;
+  verdict = summarize_session(healthy_server(), {slow, healthy_client("b")});
+  EXPECT_TRUE(mentions(verdict.problems, "more than 700 us above the timer floor (7000 us)"))
+      << verdict.report["problems"].dump();
 }
 
 TEST(SessionSummary, EachFailedCriterionIsNamed) {

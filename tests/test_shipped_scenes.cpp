@@ -7,7 +7,9 @@
 // by what the surgeons felt: no force faded while either pushed, each touched its body,
 // and each client's recording verifies bit for bit. The verdict itself is printed, not
 // asserted: the unit tests beside this one on a 2-core machine make missed deadlines,
-// which a verdict rightly reports.
+// which a verdict rightly reports. A session in which a force faded while the host of a
+// virtual machine held a client's CPU back (steal time) for more than a twentieth of it
+// runs once more: that fade is the host's.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -88,10 +90,48 @@ std::string run_demo(const std::string& scene, const fs::path& out, bool watched
 
 class ShippedScene : public ::testing::TestWithParam<std::string> {};
 
+// The largest share of the session [0, 1] the host held one of the client's CPUs back (steal
+// time, as its timer floors report it: client/timer_floors.h).
+double host_steal_share(const json& client_report) {
+  const double session_ms =
+      1e3 * client_report.value("ticks", 0.0) / client_report.value("haptic_rate_hz", 1.0);
+  double share = 0;
+  const json floors = client_report.value("timer_floor", json::object());
+  for (const json& cpu : floors.value("cpus", json::array()))
+    share = std::max(share, cpu.value("host_steal_ms", 0.0) / std::max(session_ms, 1.0));
+  return share;
+}
+
+// Whether the session in `out` lost a push to the host: a force faded while the host held a
+// client's CPU back for more than a twentieth of the session (a virtual machine's host
+// descheduling it; then the fade says how busy the host was, not what cohaptic did).
+bool faded_while_the_host_stole(const fs::path& out) {
+  bool faded = false;
+  double steal = 0;
+  for (const char* client : {"client_a", "client_b"}) {
+    const fs::path file = out / (std::string(client) + ".json");
+    if (!fs::exists(file)) return false;
+    const json report = json::parse(std::ifstream(file));
+    faded = faded || report["fades"]["count"] != 0;
+    steal = std::max(steal, host_steal_share(report));
+  }
+  if (faded && steal > 0.05)
+    std::printf(
+        "  a force faded while the host held a CPU back for %.0f %% of the session: "
+        "the session runs again\n",
+        100 * steal);
+  return faded && steal > 0.05;
+}
+
 void expect_felt_without_fades(const std::string& scene, bool watched) {
-  const fs::path out = testing::scratch_directory(std::regex_replace(scene, std::regex("/"), "-") +
-                                                  (watched ? "-watched" : ""));
-  const std::string output = run_demo(scene, out, watched);
+  const std::string name =
+      std::regex_replace(scene, std::regex("/"), "-") + (watched ? "-watched" : "");
+  fs::path out = testing::scratch_directory(name);
+  std::string output = run_demo(scene, out, watched);
+  if (faded_while_the_host_stole(out)) {
+    out = testing::scratch_directory(name + "-again");
+    output = run_demo(scene, out, watched);
+  }
   std::printf("%s",
               output.substr(output.find("\nwho ") == std::string::npos ? 0 : output.find("\nwho "))
                   .c_str());
@@ -102,7 +142,8 @@ void expect_felt_without_fades(const std::string& scene, bool watched) {
     const json report = json::parse(std::ifstream(out / (std::string(client) + ".json")));
     EXPECT_EQ(report["fades"]["count"], 0)
         << "the force faded while the surgeon pushed: " << report["fades"].dump() << "; IR age "
-        << report["ir_age_ms"].dump();
+        << report["ir_age_ms"].dump() << "; the host held a CPU back for "
+        << 100 * host_steal_share(report) << " % of the session";
     EXPECT_GT(report["force_n"]["peak"].get<double>(), 1e-4)
         << "the surgeon never touched the body";
   }

@@ -49,8 +49,8 @@ segments:
 }
 
 double period_p99_allowance_us(const nlohmann::json& client_report) {
-  return std::max(1100.0,
-                  client_report.at("timer_floor").at("period_us").at("p99").get<double>() + 150);
+  const double floor_p99 = client_report.at("timer_floor").at("period_us").at("p99").get<double>();
+  return std::max(1100.0, 1.1 * floor_p99 + 150);
 }
 
 CubeSession::CubeSession(const std::string& name, const std::vector<std::string>& server_arguments,

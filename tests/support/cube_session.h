@@ -24,8 +24,10 @@ std::filesystem::path write_press(const std::filesystem::path& dir, const std::s
                                   double x, double y, double depth, double hold);
 
 /// The haptic period p99 [us] a well-behaved client keeps while others misbehave: its own
-/// bare timer floor's p99 (measured beside its loop, so the machine's load is in both) plus
-/// 150 us, and never less than 1.1 ms (a 1 kHz period and a tenth).
+/// bare timer floor's p99 (measured beside its loop, so the machine's load is in both) and a
+/// tenth, plus 150 us, and never less than 1.1 ms (a 1 kHz period and a tenth). The tenth is
+/// for a host that stalls its vCPUs for milliseconds: two p99s of such a tail, each from a few
+/// thousand periods, differ by that much with no fault of the loop's.
 double period_p99_allowance_us(const nlohmann::json& client_report);
 
 /// A client of the server at 127.0.0.1:`port` with a scripted device, its report, recording
