@@ -145,8 +145,7 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       // The coupling figure (the force without the remote tools) needs a second evaluation,
       // which would advance a dynamic body's state a second time: static bodies only. A sphere
       // body's contact solve is no body state: the second evaluation keeps one of its own.
-      const bool static_body = std::holds_alternative<std::monostate>(slot.state->body) ||
-                               std::holds_alternative<SphereContactState>(slot.state->body);
+      const bool static_body = !evaluation_moves_the_body(*slot.state);
       // Measured only in contact: a user that passed by a static body without touching it
       // (e.g. on its way to a mass-spring object lying on it) measured nothing. A home-spring
       // body's users never couple (each feels its own vertex's springs): nothing to measure.

@@ -74,7 +74,8 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
       for (std::size_t u = 0; u < users; ++u) {
         if (!published[u]) continue;
         const Stopwatch evaluation;
-        EvaluationState stateless;  // the home-spring body keeps none and ignores dt
+        EvaluationState stateless =
+            make_evaluation_state(*published[u]);  // the home-spring body keeps none
         held[u] = evaluate_force(*published[u], stateless, positions[u], {}, 0).force;
         tally.evaluation(1000 * evaluation.elapsed_ms());
       }

@@ -281,7 +281,7 @@ struct TickRig {
 // Both methods at every 20th tick of the path's first half (each is exact from any start).
 std::string compare_ticks(const TickRig& rig, int& contacts, double& difference) {
   EvaluationState state = make_evaluation_state(*rig.prepared);
-  std::get<SphereContactState>(state.body).work_budget = kInfinity;
+  std::get<FemEvaluation>(state.body).sphere->work_budget = kInfinity;
   DenseTick dense(rig.prepared->ir, rig.compliance);
   for (std::size_t tick = 0; tick <= 100; tick += 20) {
     const Eigen::Vector3d tool = along_path(rig.start, tick);

@@ -7,6 +7,7 @@
 // IR leaves held nodes out, the client condenses over them all the same and drops their
 // columns). A stale, skipped or hostile update is refused with its reason and loses
 // nothing: the next right one is exact.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -20,6 +21,7 @@
 #include "common/ir/client_condensation.h"
 #include "common/ir/compliance_rows_sender.h"
 #include "common/ir/evaluate_force.h"
+#include "common/util/error.h"
 #include "proto/wire/ir_convert.h"
 #include "support/cube_scene.h"
 #include "support/ir_seed.h"

@@ -357,7 +357,7 @@ TEST(ForceEvaluator, AllocatesNothingUnderTheSphereModel) {
   const PreparedIR& prepared = *simulation.ir(0);
   const std::vector<Eigen::Vector3d> remotes = simulation.remote_positions(prepared.ir);
   EvaluationState state = make_evaluation_state(prepared);  // its contact solve, sized here
-  ASSERT_TRUE(std::holds_alternative<SphereContactState>(state.body));
+  ASSERT_TRUE(std::get<FemEvaluation>(state.body).sphere.has_value());
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   allocations = 0;
   counting = true;

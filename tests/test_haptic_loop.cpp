@@ -318,7 +318,7 @@ TEST(HapticLoop, ASphereSolvePastItsBudgetHoldsTheLastResolvedForceAndCatchesUp)
   auto channels = std::make_unique<HapticChannels>();
   channels->tracing = true;
   channels->ir.back() = make_ir_slot(std::make_unique<const PreparedIR>(*ir), clock.now);
-  std::get<SphereContactState>(channels->ir.back().state->body).work_budget = 200;
+  std::get<FemEvaluation>(channels->ir.back().state->body).sphere->work_budget = 200;
   channels->ir.publish();
   ScriptedDevice device(
       parse_trajectory(

@@ -17,8 +17,7 @@
 #include "common/contact/incremental_contact_solve.h"
 #include "common/contact/unilateral_contact_solve.h"
 
-namespace cohaptic {
-namespace {
+namespace cohaptic::incremental_contact_solve_test {
 
 constexpr double kUnlimited = std::numeric_limits<double>::infinity();
 
@@ -238,5 +237,4 @@ TEST(IncrementalContactSolve, AMatrixThatIsNotPositiveDefiniteGivesNoAnswerAndAn
   EXPECT_FALSE(solve.start_from(w, std::vector<int>{3})) << "beyond the capacity";
 }
 
-}  // namespace
-}  // namespace cohaptic
+}  // namespace cohaptic::incremental_contact_solve_test

@@ -291,7 +291,7 @@ std::vector<std::int64_t> ir_contact_tags(const PreparedIR& prepared,
                                           const EvaluationState& state) {
   std::vector<std::int64_t> tags;
   for (int i = 0; i < condensed_fem(prepared.ir).row_node_count; ++i)
-    if (std::get<SphereContactState>(state.body).solve.push(i) > 0)
+    if (std::get<FemEvaluation>(state.body).sphere->solve.push(i) > 0)
       tags.push_back(condensed_fem(prepared.ir).node_ids[static_cast<std::size_t>(i)]);
   std::sort(tags.begin(), tags.end());
   return tags;
@@ -323,7 +323,7 @@ void compare(const ElasticBody& body, const Simulation& simulation,
   for (int r = 0; r < remote_count(prepared.ir); ++r)
     remotes.push_back(tools[static_cast<std::size_t>(remote_user(prepared.ir, r))]);
   EvaluationState state = make_evaluation_state(prepared);
-  std::get<SphereContactState>(state.body).work_budget = std::numeric_limits<double>::infinity();
+  std::get<FemEvaluation>(state.body).sphere->work_budget = std::numeric_limits<double>::infinity();
   const ForceSample sample =
       evaluate_force(prepared, state, tools[static_cast<std::size_t>(user)], remotes, 1e-3);
   std::vector<PressedTool> pressed;

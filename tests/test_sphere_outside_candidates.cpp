@@ -176,7 +176,7 @@ std::vector<std::int64_t> column_ir_contact_tags(const PreparedIR& prepared,
   const CondensedFemIr& fem = condensed_fem(prepared.ir);
   std::vector<std::int64_t> tags;
   for (int i = 0; i < fem.row_node_count; ++i)
-    if (std::get<SphereContactState>(state.body).solve.push(i) > 0)
+    if (std::get<FemEvaluation>(state.body).sphere->solve.push(i) > 0)
       tags.push_back(fem.node_ids[static_cast<std::size_t>(i)]);
   std::sort(tags.begin(), tags.end());
   return tags;

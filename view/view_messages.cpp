@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 
 #include "common/model/body_model_name.h"
+#include "common/util/overloaded.h"
 
 namespace cohaptic::view {
 namespace {
@@ -105,22 +106,29 @@ void add_ir_nodes(UserFrame& out, const UserFrameState& user, const ShownScene& 
   const auto add = [](google::protobuf::RepeatedField<std::uint32_t>& to, int index) {
     if (index >= 0) to.Add(static_cast<std::uint32_t>(index));
   };
-  if (const auto* fem = std::get_if<CondensedFemIr>(&user.ir->ir.body)) {
-    const auto tag_of = [&](int node) { return fem->node_ids[static_cast<std::size_t>(node)]; };
-    for (int node = 0; node < fem->patch_node_count; ++node)
-      add(*out.mutable_patch_nodes(), shown.of_tag(body, tag_of(node)));
-    if (user.pressing && !fem->patch.empty())
-      for (int node : fem->patch.front().nodes)
-        add(*out.mutable_contact_nodes(), shown.of_tag(body, tag_of(node)));
-  } else if (const auto* network = std::get_if<MassSpringIr>(&user.ir->ir.body)) {
-    for (std::int32_t node : network->node_ids)
-      add(*out.mutable_patch_nodes(), shown.of_node(body, node));
-    if (user.contact_node >= 0 && user.body == body)
-      add(*out.mutable_contact_nodes(), shown.of_node(body, user.contact_node));
-  } else if (const auto* tissue = std::get_if<HomeSpringPatch>(&user.ir->ir.body)) {
-    for (int vertex : tissue->surface_vertex)
-      add(*out.mutable_patch_nodes(), shown.of_node(body, vertex));
-  }
+  std::visit(Overloaded{[&](const CondensedFemIr& fem) {
+                          const auto tag_of = [&](int node) {
+                            return fem.node_ids[static_cast<std::size_t>(node)];
+                          };
+                          for (int node = 0; node < fem.patch_node_count; ++node)
+                            add(*out.mutable_patch_nodes(), shown.of_tag(body, tag_of(node)));
+                          if (user.pressing && !fem.patch.empty())
+                            for (int node : fem.patch.front().nodes)
+                              add(*out.mutable_contact_nodes(), shown.of_tag(body, tag_of(node)));
+                        },
+                        [&](const MassSpringIr& network) {
+                          for (std::int32_t node : network.node_ids)
+                            add(*out.mutable_patch_nodes(), shown.of_node(body, node));
+                          if (user.contact_node >= 0 && user.body == body)
+                            add(*out.mutable_contact_nodes(),
+                                shown.of_node(body, user.contact_node));
+                        },
+                        [&](const HomeSpringPatch& tissue) {
+                          for (int vertex : tissue.surface_vertex)
+                            add(*out.mutable_patch_nodes(), shown.of_node(body, vertex));
+                        },
+                        [](const SeparationIr&) {}},  // separating layers have no IR nodes marked
+             user.ir->ir.body);
 }
 
 }  // namespace

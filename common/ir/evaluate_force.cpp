@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <utility>
 
 #include "common/condense/naive_condensation.h"
 #include "common/contact/closest_point_on_triangle.h"
@@ -14,6 +15,7 @@
 #include "common/ir/evaluate_sphere_contact.h"
 #include "common/ir/separation_evaluation.h"
 #include "common/util/error.h"
+#include "common/util/overloaded.h"
 
 namespace cohaptic {
 namespace {
@@ -334,47 +336,106 @@ PreparedIR prepare_ir(IntermediateRepresentation ir) {
 }
 
 EvaluationState make_evaluation_state(const PreparedIR& prepared) {
-  EvaluationState state;
-  if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
-    state.body = make_mass_spring_state(*network, std::get<PreparedMassSpring>(prepared.body));
-  else if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body);
-           fem && fem->contact_model == ContactModel::sphere)
-    state.body =
-        make_sphere_contact_state(std::get<PreparedFem>(prepared.body).sphere, fem->row_node_count);
-  else if (const auto* separation = std::get_if<SeparationIr>(&prepared.ir.body))
-    state.body = SeparationEvaluation{separation->state, separation->tool_state};
-  return state;
+  // prepare_ir made prepared.body of the IR body's kind: std::get cannot throw here.
+  return {std::visit(
+      Overloaded{[&](const CondensedFemIr& fem) -> EvaluationBody {
+                   FemEvaluation evaluation;
+                   if (fem.contact_model == ContactModel::sphere)
+                     evaluation.sphere = make_sphere_contact_state(
+                         std::get<PreparedFem>(prepared.body).sphere, fem.row_node_count);
+                   return evaluation;
+                 },
+                 [&](const MassSpringIr& network) -> EvaluationBody {
+                   return make_mass_spring_state(network,
+                                                 std::get<PreparedMassSpring>(prepared.body));
+                 },
+                 [](const HomeSpringPatch&) -> EvaluationBody { return HomeSpringEvaluation{}; },
+                 [](const SeparationIr& separation) -> EvaluationBody {
+                   return SeparationEvaluation{separation.state, separation.tool_state};
+                 }},
+      prepared.ir.body)};
 }
+
+bool evaluation_moves_the_body(const EvaluationState& state) {
+  return std::visit(Overloaded{[](const FemEvaluation&) { return false; },
+                               [](const MassSpringPatchState&) { return true; },
+                               [](const HomeSpringEvaluation&) { return false; },
+                               [](const SeparationEvaluation&) { return true; }},
+                    state.body);
+}
+
+namespace {
+
+// What one evaluation is given besides the body.
+struct Tick {
+  const IntermediateRepresentation& envelope;
+  const Eigen::Vector3d& own_tool;
+  std::span<const Eigen::Vector3d> remote_tools;
+  double dt;
+  std::uint32_t buttons;
+};
+
+// One evaluation per body kind: a kind without its overload fails to compile in
+// evaluate_if_of_kind below.
+ForceSample evaluate_body(const CondensedFemIr& fem, const PreparedFem& prepared,
+                          FemEvaluation& evaluation, const Tick& tick) noexcept {
+  if (fem.contact_model == ContactModel::sphere)
+    return evaluate_sphere_contact(tick.envelope, fem, prepared,
+                                   evaluation.sphere ? &*evaluation.sphere : nullptr, tick.own_tool,
+                                   tick.remote_tools);
+  return evaluate_condensed_fem(tick.envelope, fem, prepared, tick.own_tool, tick.remote_tools);
+}
+
+ForceSample evaluate_body(const MassSpringIr& network, const PreparedMassSpring& prepared,
+                          MassSpringPatchState& state, const Tick& tick) noexcept {
+  return evaluate_mass_spring(tick.envelope, network, prepared, state, tick.own_tool,
+                              tick.remote_tools, tick.dt);
+}
+
+ForceSample evaluate_body(const HomeSpringPatch&, const PreparedHomeSpringPatch& prepared,
+                          HomeSpringEvaluation&, const Tick& tick) noexcept {
+  return evaluate_home_spring_body(tick.envelope, prepared, tick.own_tool);
+}
+
+ForceSample evaluate_body(const SeparationIr& separation, const PreparedSeparation&,
+                          SeparationEvaluation& evaluation, const Tick& tick) noexcept {
+  return step_separation_force(*separation.patch, evaluation.state, evaluation.tool,
+                               separation.tool, tick.own_tool, tick.buttons, tick.dt,
+                               tick.envelope.force_limit);
+}
+
+// Whether the IR's body is of kind `Kind`; if so, and the prepared body and the state are of
+// that kind too, `sample` is its evaluation (left as it was otherwise).
+template <std::size_t Kind>
+bool evaluate_if_of_kind(const PreparedIR& prepared, EvaluationState& state, const Tick& tick,
+                         ForceSample& sample) noexcept {
+  const auto* body = std::get_if<Kind>(&prepared.ir.body);
+  if (!body) return false;
+  const auto* derived = std::get_if<Kind>(&prepared.body);
+  auto* evaluation = std::get_if<Kind>(&state.body);
+  if (derived && evaluation) sample = evaluate_body(*body, *derived, *evaluation, tick);
+  return true;
+}
+
+// get_if by index, not std::visit: nothing on the haptic path may throw.
+template <std::size_t... Kinds>
+ForceSample evaluate_by_kind(const PreparedIR& prepared, EvaluationState& state, const Tick& tick,
+                             std::index_sequence<Kinds...>) noexcept {
+  ForceSample sample;
+  sample.flags = kNonFinite;  // unless a prepared body and a state of the IR body's kind
+  (evaluate_if_of_kind<Kinds>(prepared, state, tick, sample) || ...);
+  return sample;
+}
+
+}  // namespace
 
 ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state,
                            const Eigen::Vector3d& own_tool,
                            std::span<const Eigen::Vector3d> remote_tools, double dt,
                            std::uint32_t buttons) noexcept {
-  // get_if, not visit: nothing on this path may throw. prepare_ir made the kinds match.
-  if (const auto* fem = std::get_if<CondensedFemIr>(&prepared.ir.body))
-    if (const auto* prepared_fem = std::get_if<PreparedFem>(&prepared.body)) {
-      if (fem->contact_model == ContactModel::sphere)
-        return evaluate_sphere_contact(prepared.ir, *fem, *prepared_fem,
-                                       std::get_if<SphereContactState>(&state.body), own_tool,
-                                       remote_tools);
-      return evaluate_condensed_fem(prepared.ir, *fem, *prepared_fem, own_tool, remote_tools);
-    }
-  if (const auto* network = std::get_if<MassSpringIr>(&prepared.ir.body))
-    if (const auto* prepared_network = std::get_if<PreparedMassSpring>(&prepared.body))
-      if (auto* network_state = std::get_if<MassSpringPatchState>(&state.body))
-        return evaluate_mass_spring(prepared.ir, *network, *prepared_network, *network_state,
-                                    own_tool, remote_tools, dt);
-  if (std::holds_alternative<HomeSpringPatch>(prepared.ir.body))
-    if (const auto* prepared_patch = std::get_if<PreparedHomeSpringPatch>(&prepared.body))
-      return evaluate_home_spring_body(prepared.ir, *prepared_patch, own_tool);
-  if (const auto* separation = std::get_if<SeparationIr>(&prepared.ir.body))
-    if (auto* separation_state = std::get_if<SeparationEvaluation>(&state.body))
-      return step_separation_force(*separation->patch, separation_state->state,
-                                   separation_state->tool, separation->tool, own_tool, buttons, dt,
-                                   prepared.ir.force_limit);
-  ForceSample unknown;
-  unknown.flags = kNonFinite;
-  return unknown;
+  static_assert(std::variant_size_v<IrBody> == kBodyKindCount);
+  return evaluate_by_kind(prepared, state, Tick{prepared.ir, own_tool, remote_tools, dt, buttons},
+                          std::make_index_sequence<kBodyKindCount>{});
 }
 
 }  // namespace cohaptic

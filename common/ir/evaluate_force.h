@@ -40,6 +40,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <variant>
 #include <vector>
@@ -48,6 +49,7 @@
 #include "common/ir/intermediate_representation.h"
 #include "common/ir/mass_spring_evaluation.h"
 #include "common/ir/prepared_sphere_contact.h"
+#include "common/kinds/body_kinds.h"
 #include "common/laparoscopy/home_spring_contact.h"
 
 namespace cohaptic {
@@ -66,9 +68,12 @@ struct PreparedFem {
 /// The separation body needs nothing derived: prepare_ir validates it.
 struct PreparedSeparation {};
 
-/// One alternative per IrBody alternative, in the same order.
+/// What prepare_ir derives from an IR body: one alternative per body kind
+/// (common/kinds/body_kinds.h), the IR body's own.
 using PreparedBody =
-    std::variant<PreparedFem, PreparedMassSpring, PreparedHomeSpringPatch, PreparedSeparation>;
+    PerKind<ForKind<LinearElasticKind, PreparedFem>, ForKind<MassSpringKind, PreparedMassSpring>,
+            ForKind<HomeSpringKind, PreparedHomeSpringPatch>,
+            ForKind<SeparationKind, PreparedSeparation>>::variant;
 
 /// An IR and what its evaluation needs, computed once: `body` holds the alternative that
 /// matches ir.body's kind (PreparedFem for CondensedFemIr, PreparedMassSpring for
@@ -84,21 +89,40 @@ struct PreparedIR {
 /// definiteness of M_CC; throws Error naming the problem.
 PreparedIR prepare_ir(IntermediateRepresentation ir);
 
-/// The mutable side of one evaluator of one prepared IR: nothing for a static body (FEM),
-/// its contact solve for an FEM body under the sphere contact model (whose evaluation needs
-/// it), the sub-network's state for a mass-spring body, the separated state and the
-/// instrument for a separation body. Made off the haptic thread, sized there.
+/// An FEM body's evaluator: under the sphere contact model its contact solve (warm-started
+/// from tick to tick), under the paper's two models nothing (the body is static).
+struct FemEvaluation {
+  std::optional<SphereContactState> sphere;
+};
+
+/// A home-spring body's evaluator keeps nothing: its grasp travels in the IR.
+struct HomeSpringEvaluation {};
+
+/// A separation body's evaluator: the separated state and the instrument, stepped per tick.
 struct SeparationEvaluation {
   SeparationState state;
   SeparationToolState tool;
 };
 
+/// The mutable side of one evaluator of one prepared IR: one alternative per body kind
+/// (common/kinds/body_kinds.h), the IR body's own (a mass-spring body's is its sub-network's
+/// state). Made off the haptic thread, sized there.
+using EvaluationBody = PerKind<ForKind<LinearElasticKind, FemEvaluation>,
+                               ForKind<MassSpringKind, MassSpringPatchState>,
+                               ForKind<HomeSpringKind, HomeSpringEvaluation>,
+                               ForKind<SeparationKind, SeparationEvaluation>>::variant;
+
 struct EvaluationState {
-  std::variant<std::monostate, MassSpringPatchState, SphereContactState, SeparationEvaluation> body;
+  EvaluationBody body;
 };
 
 /// The state an evaluator of `prepared` starts from (the server's state at the IR's time).
 EvaluationState make_evaluation_state(const PreparedIR& prepared);
+
+/// Whether evaluating moves the body itself: a mass-spring sub-network or a separation steps
+/// with every call, so a second evaluation in the same tick would step it twice. An FEM or
+/// home-spring body is static (a sphere contact solve is the evaluator's, not the body's).
+bool evaluation_moves_the_body(const EvaluationState& state);
 
 enum ForceFlag : std::uint8_t {
   kInContact = 1,        ///< the own tool presses the surface

@@ -31,6 +31,7 @@
 #include "common/ir/compliance_rows.h"
 #include "common/ir/mass_spring_ir.h"
 #include "common/ir/separation_ir.h"
+#include "common/kinds/body_kinds.h"
 #include "common/kinds/contact_model.h"
 #include "common/laparoscopy/home_spring_patch.h"
 #include "common/mesh/tet_mesh.h"
@@ -140,8 +141,12 @@ struct CondensedFemIr {
   std::size_t size_bytes() const;
 };
 
-/// One alternative per body kind; the wire's `oneof body` mirrors it.
-using IrBody = std::variant<CondensedFemIr, MassSpringIr, HomeSpringPatch, SeparationIr>;
+/// What a client is sent of a body: one alternative per body kind
+/// (common/kinds/body_kinds.h); the wire's `oneof body` mirrors it.
+using IrBody =
+    PerKind<ForKind<LinearElasticKind, CondensedFemIr>, ForKind<MassSpringKind, MassSpringIr>,
+            ForKind<HomeSpringKind, HomeSpringPatch>,
+            ForKind<SeparationKind, SeparationIr>>::variant;
 
 struct IntermediateRepresentation {
   /// 2: the envelope and a body of one kind (1 was the condensed FEM body's fields alone);

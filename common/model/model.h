@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/contact/obstacle.h"
+#include "common/kinds/body_kinds.h"
 #include "common/model/elastic_body.h"
 #include "common/model/home_spring_body.h"
 #include "common/model/mass_spring_body.h"
@@ -18,8 +19,11 @@
 
 namespace cohaptic {
 
-/// A compiled scene object: one alternative per BodySpec alternative, in the same order.
-using BodyModel = std::variant<ElasticBody, MassSpringModel, HomeSpringBody, SeparationModel>;
+/// A compiled scene object: one alternative per body kind (common/kinds/body_kinds.h).
+using BodyModel =
+    PerKind<ForKind<LinearElasticKind, ElasticBody>, ForKind<MassSpringKind, MassSpringModel>,
+            ForKind<HomeSpringKind, HomeSpringBody>,
+            ForKind<SeparationKind, SeparationModel>>::variant;
 
 struct Model {
   Scene scene;

@@ -16,6 +16,7 @@
 
 #include "common/fem/dof_map.h"
 #include "common/fem/linear_elastic_material.h"
+#include "common/kinds/body_kinds.h"
 #include "common/kinds/contact_model.h"
 #include "common/laparoscopy/home_spring_spec.h"
 #include "common/mass_spring/mass_spring_spec.h"
@@ -69,11 +70,12 @@ struct ElasticObjectSpec {
   ComplianceSettings compliance;
 };
 
-/// One alternative per body model a scene may ask for (`model:` in the file). Adding a
-/// model adds an alternative here, and the compiler then names every place that must
-/// learn it (the compiled body, its simulation, its IR body).
-using BodySpec = std::variant<ElasticObjectSpec, MassSpringObjectSpec, HomeSpringObjectSpec,
-                              SeparationObjectSpec>;
+/// What the scene file says of a body (`model:` names its kind): one alternative per body
+/// kind (common/kinds/body_kinds.h).
+using BodySpec = PerKind<ForKind<LinearElasticKind, ElasticObjectSpec>,
+                         ForKind<MassSpringKind, MassSpringObjectSpec>,
+                         ForKind<HomeSpringKind, HomeSpringObjectSpec>,
+                         ForKind<SeparationKind, SeparationObjectSpec>>::variant;
 
 /// A deformable object of the scene: its name (unique in the scene) and its model's spec.
 struct ObjectSpec {

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "common/util/error.h"
+#include "common/util/overloaded.h"
 
 namespace cohaptic {
 namespace {
@@ -140,18 +141,20 @@ bool SceneSimulation::pressing(int user) const {
 }
 
 double SceneSimulation::distance_to_body(int body_index, const Eigen::Vector3d& point) const {
-  if (const auto* network = std::get_if<MassSpringSimulation>(&body(body_index)))
-    return network->distance_to_surface(point);
-  if (const auto* tissue = std::get_if<HomeSpringSimulation>(&body(body_index)))
-    return tissue->distance_to_surface(point);
-  if (const auto* layers = std::get_if<SeparationSimulation>(&body(body_index)))
-    return layers->distance_to_interface(point);
-  const ElasticBody& elastic =
-      std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(body_index)]);
-  double nearest = std::numeric_limits<double>::infinity();
-  for (int node : elastic.touchable_nodes)
-    nearest = std::min(nearest, (elastic.mesh.nodes.col(node) - point).norm());
-  return nearest;
+  return std::visit(
+      Overloaded{
+          [&](const Simulation&) {
+            const ElasticBody& elastic =
+                std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(body_index)]);
+            double nearest = std::numeric_limits<double>::infinity();
+            for (int node : elastic.touchable_nodes)
+              nearest = std::min(nearest, (elastic.mesh.nodes.col(node) - point).norm());
+            return nearest;
+          },
+          [&](const MassSpringSimulation& network) { return network.distance_to_surface(point); },
+          [&](const HomeSpringSimulation& tissue) { return tissue.distance_to_surface(point); },
+          [&](const SeparationSimulation& layers) { return layers.distance_to_interface(point); }},
+      body(body_index));
 }
 
 void SceneSimulation::assign_bodies() {
@@ -219,12 +222,12 @@ StepReport SceneSimulation::step(double time) {
 }
 
 ForceSample SceneSimulation::force(int user) {
-  BodySimulation& simulation = *bodies_[static_cast<std::size_t>(body_of(user))];
-  if (auto* network = std::get_if<MassSpringSimulation>(&simulation))
-    return network->force(user, period_);
-  if (auto* tissue = std::get_if<HomeSpringSimulation>(&simulation)) return tissue->force(user);
-  if (auto* layers = std::get_if<SeparationSimulation>(&simulation)) return layers->force(user);
-  return std::get<Simulation>(simulation).force(user);
+  return std::visit(
+      Overloaded{[&](Simulation& fem) { return fem.force(user); },
+                 [&](MassSpringSimulation& network) { return network.force(user, period_); },
+                 [&](HomeSpringSimulation& tissue) { return tissue.force(user); },
+                 [&](SeparationSimulation& layers) { return layers.force(user); }},
+      *bodies_[static_cast<std::size_t>(body_of(user))]);
 }
 
 const Simulation& SceneSimulation::single_elastic() const {

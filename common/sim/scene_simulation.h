@@ -25,6 +25,7 @@
 #include <variant>
 #include <vector>
 
+#include "common/kinds/body_kinds.h"
 #include "common/model/model.h"
 #include "common/sim/body_interaction.h"
 #include "common/sim/fem_pair_interaction.h"
@@ -35,9 +36,11 @@
 
 namespace cohaptic {
 
-/// One alternative per BodyModel alternative, in the same order.
+/// What a body's step changes: one alternative per body kind (common/kinds/body_kinds.h).
 using BodySimulation =
-    std::variant<Simulation, MassSpringSimulation, HomeSpringSimulation, SeparationSimulation>;
+    PerKind<ForKind<LinearElasticKind, Simulation>, ForKind<MassSpringKind, MassSpringSimulation>,
+            ForKind<HomeSpringKind, HomeSpringSimulation>,
+            ForKind<SeparationKind, SeparationSimulation>>::variant;
 
 class SceneSimulation {
  public:

@@ -14,8 +14,8 @@ namespace cohaptic::testing {
 inline ForceSample evaluate_static(const PreparedIR& prepared, const Eigen::Vector3d& own_tool,
                                    std::span<const Eigen::Vector3d> remote_tools) {
   EvaluationState fresh = make_evaluation_state(prepared);
-  if (auto* sphere = std::get_if<SphereContactState>(&fresh.body))
-    sphere->work_budget = std::numeric_limits<double>::infinity();
+  if (auto* fem = std::get_if<FemEvaluation>(&fresh.body); fem && fem->sphere)
+    fem->sphere->work_budget = std::numeric_limits<double>::infinity();
   return evaluate_force(prepared, fresh, own_tool, remote_tools, 0);
 }
 
