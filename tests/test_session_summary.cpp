@@ -105,6 +105,15 @@ TEST(SessionSummary, ALowHapticRateIsAProblemUnlessTheTimerFloorLostAsManyTicks)
                        "a: 2000 missed deadlines, so a haptic rate of 888.9 Hz, the machine's "
                        "(timer floor missed 1990; host steal time: CPU 0 1800 ms)"))
       << verdict.report["notes"].dump();
+  // A host that stole half the session: the loop missed 1.0 % more than the floor (noise);
+  // missing a tenth more is its own.
+  slow["missed_deadlines"] = 2010;
+  verdict = summarize_session(healthy_server(), {slow, healthy_client("b")});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
+  slow["missed_deadlines"] = 2190;
+  verdict = summarize_session(healthy_server(), {slow, healthy_client("b")});
+  EXPECT_TRUE(mentions(verdict.problems, "a: 2190 missed deadlines"))
+      << verdict.report["problems"].dump();
 }
 
 TEST(SessionSummary, SlowPeriodIsAProblemUnlessTheTimerFloorIsAsSlow) {
