@@ -12,7 +12,6 @@
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
 #include "common/util/log_to_stderr.h"
-#include "server/raise_priority.h"
 #include "server/simulation_server.h"
 
 int main(int argc, char** argv) {
@@ -140,11 +139,6 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--no-disk-cache", serve_no_disk_cache,
                "Neither read nor write the on-disk compliance cache");
-  bool normal_priority = false;
-  app.add_flag("--normal-priority", normal_priority,
-               "Keep the priority it was started with; by default it raises its own to nice -10 "
-               "where permitted (root, CAP_SYS_NICE), so that the machine's other programs, a "
-               "browser drawing the live view among them, do not starve the simulation");
 
   // The offline tools are cohaptic-lab subcommands: naming one here fails, with the cohaptic-lab
   // spelling. Parsing stops at the first argument it does not know, which is then checked.
@@ -165,17 +159,6 @@ int main(int argc, char** argv) {
   }
   spdlog::set_level(spdlog::level::from_str(log_level));
   cohaptic::use_single_blas_thread();
-  // Before any thread starts: they inherit it.
-  if (!normal_priority) {
-    if (cohaptic::raise_priority(cohaptic::kServerNice))
-      spdlog::info("scheduling: nice {}, ahead of the machine's other programs",
-                   cohaptic::kServerNice);
-    else
-      spdlog::info(
-          "scheduling: nice {} not permitted (needs root or CAP_SYS_NICE): the "
-          "priority it was started with",
-          cohaptic::kServerNice);
-  }
 
   try {
     if (serve.scene.empty()) {

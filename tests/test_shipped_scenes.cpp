@@ -1,15 +1,15 @@
 // Every shipped scene with two surgeons' scripts (scenes/<scene>/surgeon_a.yaml and
 // surgeon_b.yaml beside scenes/<scene>.yaml) served as `make demo SCENE=...` serves it
 // (deploy/run-demo.sh, the real programs on loopback, the user's compliance cache), for a
-// few seconds of the scripted surgeons, with headless Chromium watching the live view at
-// normal priority, as a user's browser would (without a browser where none is installed:
+// few seconds of the scripted surgeons, with headless Chromium watching the live view below
+// the session's priority, as a user's browser on one small machine would (kBrowserNice; without
+// a browser where none is installed:
 // the watched session is the harder of the two, the view's work beside the surgeons'). Judged
 // by what the surgeons felt: no force faded while either pushed, each touched its body,
 // and each client's recording verifies bit for bit. The verdict itself is printed, not
 // asserted: the unit tests beside this one on a 2-core machine make missed deadlines,
-// which a verdict rightly reports. A session in which a force faded while the host of a
-// virtual machine held a client's CPU back (steal time) for more than a twentieth of it
-// runs once more: that fade is the host's.
+// which a verdict rightly reports. A fade's message gives the share of the session the host
+// of a virtual machine held a client's CPU back (steal time).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -35,6 +35,10 @@ constexpr int kSessionSeconds = 8;
 // press.
 constexpr int kWatchedSessionSeconds = 12;
 constexpr std::chrono::milliseconds kDemoPatience{300'000};
+// The watching browser's nice value: below the session, as a user on one small machine runs
+// it (the demo's own runs at 19). At 0 on two cores, Chromium drawing in software takes as
+// much CPU as the server, whose IRs then come late enough for a force to fade.
+constexpr int kBrowserNice = 10;
 
 // The shipped scenes that have both surgeons' scripts, as paths under scenes/ without ".yaml".
 std::vector<std::string> scenes_with_surgeons() {
@@ -72,8 +76,9 @@ std::string run_demo(const std::string& scene, const fs::path& out, bool watched
     const std::string text = demo.log_text();
     if (std::regex_search(text, url, std::regex(R"(live view at (http://\S+))")))
       browser = std::make_unique<ChildProcess>(
-          testing::node_program(),
-          std::vector<std::string>{(kSource / "tests/support/view_check.mjs").string(), "--url",
+          "/usr/bin/nice",
+          std::vector<std::string>{"-n", std::to_string(kBrowserNice), testing::node_program(),
+                                   (kSource / "tests/support/view_check.mjs").string(), "--url",
                                    url[1].str(), "--screenshot", (out / "view.png").string(),
                                    "--min-force", "0", "--stay", std::to_string(seconds + 2)},
           out / "view_check.log");
@@ -102,36 +107,10 @@ double host_steal_share(const json& client_report) {
   return share;
 }
 
-// Whether the session in `out` lost a push to the host: a force faded while the host held a
-// client's CPU back for more than a twentieth of the session (a virtual machine's host
-// descheduling it; then the fade says how busy the host was, not what cohaptic did).
-bool faded_while_the_host_stole(const fs::path& out) {
-  bool faded = false;
-  double steal = 0;
-  for (const char* client : {"client_a", "client_b"}) {
-    const fs::path file = out / (std::string(client) + ".json");
-    if (!fs::exists(file)) return false;
-    const json report = json::parse(std::ifstream(file));
-    faded = faded || report["fades"]["count"] != 0;
-    steal = std::max(steal, host_steal_share(report));
-  }
-  if (faded && steal > 0.05)
-    std::printf(
-        "  a force faded while the host held a CPU back for %.0f %% of the session: "
-        "the session runs again\n",
-        100 * steal);
-  return faded && steal > 0.05;
-}
-
 void expect_felt_without_fades(const std::string& scene, bool watched) {
-  const std::string name =
-      std::regex_replace(scene, std::regex("/"), "-") + (watched ? "-watched" : "");
-  fs::path out = testing::scratch_directory(name);
-  std::string output = run_demo(scene, out, watched);
-  if (faded_while_the_host_stole(out)) {
-    out = testing::scratch_directory(name + "-again");
-    output = run_demo(scene, out, watched);
-  }
+  const fs::path out = testing::scratch_directory(std::regex_replace(scene, std::regex("/"), "-") +
+                                                  (watched ? "-watched" : ""));
+  const std::string output = run_demo(scene, out, watched);
   std::printf("%s",
               output.substr(output.find("\nwho ") == std::string::npos ? 0 : output.find("\nwho "))
                   .c_str());
