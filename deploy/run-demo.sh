@@ -98,7 +98,8 @@ elif [[ ${#view[@]} -gt 0 ]]; then
   echo "demo: live view at $url (open it in a browser; replay it afterwards with: $lab_bin replay $out/server.mcap --view 127.0.0.1:$(sed 's#.*:\([0-9]*\)/.*#\1#' <<<"$url"))"
   if [[ -n "$screenshot" ]]; then
     # Chromium draws in software here; at the lowest priority it takes what the haptic
-    # loops leave, as a browser on another machine would take nothing.
+    # loops leave, as a browser on another machine would take nothing (view_check.mjs keeps
+    # the Chromium it starts at its own nice value).
     nice -n 19 node tests/support/view_check.mjs --url "$url" --screenshot "$screenshot" --min-force 0.01 --focus-tools 1 --stay "$duration" \
       >"$out/view_check.json" 2>"$out/view_check.log" &
     pids+=($!)

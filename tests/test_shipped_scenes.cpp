@@ -17,6 +17,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <sstream>
 
 #include "support/browser.h"
 #include "support/process.h"
@@ -36,8 +37,9 @@ constexpr int kSessionSeconds = 8;
 constexpr int kWatchedSessionSeconds = 12;
 constexpr std::chrono::milliseconds kDemoPatience{300'000};
 // The watching browser's nice value: below the session, as a user on one small machine runs
-// it (the demo's own runs at 19). At 0 on two cores, Chromium drawing in software takes as
-// much CPU as the server, whose IRs then come late enough for a force to fade.
+// it (the demo's own runs at 19; view_check.mjs gives it to Chromium's whole autogroup). At 0
+// on two cores, Chromium drawing in software takes as much CPU as the server, whose IRs then
+// come late enough for a force to fade.
 constexpr int kBrowserNice = 10;
 
 // The shipped scenes that have both surgeons' scripts, as paths under scenes/ without ".yaml".
@@ -111,13 +113,16 @@ void expect_felt_without_fades(const std::string& scene, bool watched) {
   const fs::path out = testing::scratch_directory(std::regex_replace(scene, std::regex("/"), "-") +
                                                   (watched ? "-watched" : ""));
   const std::string output = run_demo(scene, out, watched);
-  std::printf("%s",
-              output.substr(output.find("\nwho ") == std::string::npos ? 0 : output.find("\nwho "))
-                  .c_str());
-  ASSERT_TRUE(fs::exists(out / "report.json")) << output;
+  // The summary after the judgement, so that a failure's message comes first in a long log.
+  const auto print_summary = [&] {
+    const std::size_t table = output.find("\nwho ");
+    std::printf("%s", output.substr(table == std::string::npos ? 0 : table).c_str());
+  };
+  if (!fs::exists(out / "report.json")) print_summary();
+  ASSERT_TRUE(fs::exists(out / "report.json")) << "the demo wrote no report (its output above)";
   for (const char* client : {"client_a", "client_b"}) {
     SCOPED_TRACE(client);
-    ASSERT_TRUE(fs::exists(out / (std::string(client) + ".json"))) << output;
+    ASSERT_TRUE(fs::exists(out / (std::string(client) + ".json"))) << "no report of " << client;
     const json report = json::parse(std::ifstream(out / (std::string(client) + ".json")));
     EXPECT_EQ(report["fades"]["count"], 0)
         << "the force faded while the surgeon pushed: " << report["fades"].dump() << "; IR age "
@@ -127,10 +132,15 @@ void expect_felt_without_fades(const std::string& scene, bool watched) {
         << "the surgeon never touched the body";
   }
   std::size_t verified = 0;
-  for (std::size_t at = output.find("verify: identical"); at != std::string::npos;
-       at = output.find("verify: identical", at + 1))
-    ++verified;
-  EXPECT_EQ(verified, 2u) << "both clients' recordings verify bit for bit:\n" << output;
+  std::string verify_lines;
+  std::istringstream lines(output);
+  for (std::string line; std::getline(lines, line);)
+    if (line.find("verify:") != std::string::npos) {
+      verified += line.find("verify: identical") != std::string::npos;
+      verify_lines += line + "\n";
+    }
+  EXPECT_EQ(verified, 2u) << "both clients' recordings verify bit for bit:\n" << verify_lines;
+  print_summary();
 }
 
 TEST_P(ShippedScene, TwoSurgeonsFeelItWithoutAFadeWhileABrowserWatches) {

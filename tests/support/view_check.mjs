@@ -27,7 +27,27 @@
 // Exit status 0 with {"skipped": reason} when no Chromium can be started; 1 on a timeout,
 // naming what was awaited (the screenshot is still taken, of whatever the page shows).
 import { chromium } from '../../deploy/node/node_modules/playwright-core/index.mjs';
-import { existsSync, writeFileSync } from 'node:fs';
+import { existsSync, readdirSync, readFileSync, writeFileSync } from 'node:fs';
+import { getPriority } from 'node:os';
+
+// playwright starts Chromium in a session of its own (setsid), and Linux shares the CPUs
+// between sessions' autogroups before it looks at any process's nice value: `nice -n 19 node
+// view_check.mjs` would leave Chromium an equal share beside the session it watches. So its
+// autogroup is given this process's nice value (sched(7), "The autogroup feature").
+function keepBrowserAtOurPriority() {
+  const nice = getPriority();
+  for (const entry of readdirSync('/proc')) {
+    if (!/^\d+$/.test(entry)) continue;
+    try {
+      const stat = readFileSync(`/proc/${entry}/stat`, 'utf8');
+      const parent = Number(stat.slice(stat.lastIndexOf(')') + 2).split(' ')[1]);
+      if (parent === process.pid) writeFileSync(`/proc/${entry}/autogroup`, String(nice));
+    } catch (e) {
+      if (e.code !== 'ENOENT' && e.code !== 'ESRCH')
+        console.error(`view_check: the browser's priority stays its own (${e.message})`);
+    }
+  }
+}
 
 const args = Object.fromEntries(
   process.argv.slice(2).reduce((pairs, a, i, all) => (a.startsWith('--') ? [...pairs, [a.slice(2), all[i + 1]]] : pairs), []));
@@ -43,6 +63,7 @@ const browser = await chromium.launch({
   executablePath: executable,
   args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
 });
+keepBrowserAtOurPriority();
 const started = Date.now();
 const result = { errors: [] };
 let page = null, pictured = false;
