@@ -36,7 +36,8 @@ std::uint64_t skip_missed_deadlines(std::int64_t& deadline, std::int64_t woke,
 IrSlot make_ir_slot(std::unique_ptr<const PreparedIR> ir, std::int64_t arrival_ns) {
   auto state = std::make_unique<EvaluationState>(make_evaluation_state(*ir));
   auto alone_state = std::make_unique<EvaluationState>(*state);
-  return IrSlot{std::move(ir), std::move(state), std::move(alone_state), arrival_ns};
+  const bool body_moves = evaluation_moves_the_body(*state);
+  return IrSlot{std::move(ir), std::move(state), std::move(alone_state), arrival_ns, body_moves};
 }
 
 HapticClock HapticClock::monotonic() {
@@ -145,7 +146,7 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
       // The coupling figure (the force without the remote tools) needs a second evaluation,
       // which would advance a dynamic body's state a second time: static bodies only. A sphere
       // body's contact solve is no body state: the second evaluation keeps one of its own.
-      const bool static_body = !evaluation_moves_the_body(*slot.state);
+      const bool static_body = !slot.body_moves;
       // Measured only in contact: a user that passed by a static body without touching it
       // (e.g. on its way to a mass-spring object lying on it) measured nothing. A home-spring
       // body's users never couple (each feels its own vertex's springs): nothing to measure.

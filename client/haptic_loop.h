@@ -60,6 +60,8 @@ struct IrSlot {
   /// neither evaluation disturbs the other's (a sphere body's contact solve is kept).
   std::unique_ptr<EvaluationState> alone_state;
   std::int64_t arrival_ns = 0;
+  /// evaluation_moves_the_body(*state), decided here once rather than on every tick.
+  bool body_moves = false;
 };
 
 /// The slot for `ir` with the state its evaluation starts from (off the haptic thread).

@@ -3,9 +3,11 @@
 // body, the prepared body and the evaluator's state is one kind. Checked at compile time for
 // the types, and at run time on an IR of each kind from the fuzzer's seeds: the prepared body
 // and the state made for it are of the IR's kind, and an evaluation handed a state of another
-// kind gives a zero force flagged non-finite, never another kind's answer.
+// kind gives a zero force flagged non-finite, never another kind's answer. The haptic path's
+// visit by index (common/util/visit_held.h) on a variant of each state.
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -14,6 +16,8 @@
 #include "common/ir/evaluate_force.h"
 #include "common/model/model.h"
 #include "common/sim/scene_simulation.h"
+#include "common/util/overloaded.h"
+#include "common/util/visit_held.h"
 #include "support/ir_seed.h"
 
 namespace cohaptic::body_kinds_test {
@@ -81,6 +85,29 @@ TEST(BodyKinds, AStateOfAnotherKindGivesAZeroForceFlaggedNonFinite) {
       EXPECT_TRUE(sample.force.isZero());
       EXPECT_EQ((sample.flags & kNonFinite) != 0, kSeeds[i].kind != kSeeds[j].kind);
     }
+}
+
+// An alternative whose construction throws: emplacing it leaves the variant valueless (its
+// own copy makes it not trivially copyable, so the library cannot build it aside first).
+struct RefusesConstruction {
+  RefusesConstruction() { throw std::runtime_error("refused"); }
+  RefusesConstruction(const RefusesConstruction&) {}
+  RefusesConstruction& operator=(const RefusesConstruction&) = default;
+};
+
+// The haptic path's visit (remote_count, remote_user) finds the held alternative by its
+// index, and a valueless variant, where std::visit would throw, gives the fallback.
+TEST(VisitHeld, CallsTheHeldAlternativesHandlerAndGivesTheFallbackForAValuelessVariant) {
+  using Held = std::variant<int, double, RefusesConstruction>;
+  const auto which = Overloaded{[](int) { return 1; }, [](double) { return 2; },
+                                [](const RefusesConstruction&) { return 3; }};
+  Held held = 5;
+  EXPECT_EQ(visit_held(held, which, -1), 1);
+  held = 2.5;
+  EXPECT_EQ(visit_held(held, which, -1), 2);
+  EXPECT_THROW(held.emplace<RefusesConstruction>(), std::runtime_error);
+  ASSERT_TRUE(held.valueless_by_exception());
+  EXPECT_EQ(visit_held(held, which, -1), -1);
 }
 
 }  // namespace cohaptic::body_kinds_test

@@ -433,7 +433,6 @@ ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state,
                            const Eigen::Vector3d& own_tool,
                            std::span<const Eigen::Vector3d> remote_tools, double dt,
                            std::uint32_t buttons) noexcept {
-  static_assert(std::variant_size_v<IrBody> == kBodyKindCount);
   return evaluate_by_kind(prepared, state, Tick{prepared.ir, own_tool, remote_tools, dt, buttons},
                           std::make_index_sequence<kBodyKindCount>{});
 }

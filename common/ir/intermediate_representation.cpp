@@ -5,6 +5,8 @@
 #include <limits>
 
 #include "common/util/error.h"
+#include "common/util/overloaded.h"
+#include "common/util/visit_held.h"
 
 namespace cohaptic {
 
@@ -80,19 +82,23 @@ std::size_t MassSpringIr::size_bytes() const {
 }
 
 int remote_count(const IntermediateRepresentation& ir) noexcept {
-  if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body))
-    return static_cast<int>(fem->remotes.size());
-  if (const auto* network = std::get_if<MassSpringIr>(&ir.body))
-    return static_cast<int>(network->remote_users.size());
-  return 0;
+  return visit_held(
+      ir.body,
+      Overloaded{
+          [](const CondensedFemIr& fem) { return static_cast<int>(fem.remotes.size()); },
+          [](const MassSpringIr& network) { return static_cast<int>(network.remote_users.size()); },
+          [](const HomeSpringPatch&) { return 0; }, [](const SeparationIr&) { return 0; }},
+      0);
 }
 
 int remote_user(const IntermediateRepresentation& ir, int i) noexcept {
-  if (const auto* fem = std::get_if<CondensedFemIr>(&ir.body))
-    return fem->remotes[static_cast<std::size_t>(i)].user;
-  if (const auto* network = std::get_if<MassSpringIr>(&ir.body))
-    return network->remote_users[static_cast<std::size_t>(i)];
-  return -1;
+  const auto at = static_cast<std::size_t>(i);
+  return visit_held(
+      ir.body,
+      Overloaded{[at](const CondensedFemIr& fem) { return fem.remotes[at].user; },
+                 [at](const MassSpringIr& network) { return network.remote_users[at]; },
+                 [](const HomeSpringPatch&) { return -1; }, [](const SeparationIr&) { return -1; }},
+      -1);
 }
 
 std::vector<int> ir_dofs(const CondensedFemIr& ir, int first_node, int last_node) {
