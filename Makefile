@@ -137,16 +137,17 @@ results:
 	BUILD_DIR=$(BUILD_DIR) deploy/sphere-contact-bytes.sh > docs/results/sphere-contact-bytes.md
 	$(MAKE) --no-print-directory bench-compliance > docs/results/compliance-speed.md
 	$(MAKE) --no-print-directory bench-thin > docs/results/mass-spring-speed.md
-	$(LAB) hertz --out docs/results/hertz-nu030 && tests/results_stamp.sh >> docs/results/hertz-nu030/hertz.md
-	$(LAB) hertz --element nodal_pressure_tet --poisson-ratio 0.45 --out docs/results/hertz-nu045 \
-	  && tests/results_stamp.sh >> docs/results/hertz-nu045/hertz.md
-	$(MAKE) --no-print-directory tradeoff TRADEOFF_OUT=docs/results/tradeoff-cube \
-	  && tests/results_stamp.sh >> docs/results/tradeoff-cube/tradeoff.md
-	$(LAB) stability --out docs/results/stability && tests/results_stamp.sh >> docs/results/stability/stability.md
-	$(LAB) objects-push --out docs/results/objects-push && tests/results_stamp.sh >> docs/results/objects-push/objects_push.md
-	$(LAB) objects-push --in-time --out docs/results/objects-push \
-	  && tests/results_stamp.sh >> docs/results/objects-push/objects_push_in_time.md \
-	  && rm docs/results/objects-push/objects_push_in_time.csv  # every step of every curve: megabytes
+	tests/results_page.sh docs/results/hertz-nu030/hertz.md $(LAB) hertz --out docs/results/hertz-nu030
+	tests/results_page.sh docs/results/hertz-nu045/hertz.md \
+	  $(LAB) hertz --element nodal_pressure_tet --poisson-ratio 0.45 --out docs/results/hertz-nu045
+	tests/results_page.sh docs/results/tradeoff-cube/tradeoff.md \
+	  $(MAKE) --no-print-directory tradeoff TRADEOFF_OUT=docs/results/tradeoff-cube
+	tests/results_page.sh docs/results/stability/stability.md $(LAB) stability --out docs/results/stability
+	tests/results_page.sh docs/results/objects-push/objects_push.md \
+	  $(LAB) objects-push --out docs/results/objects-push
+	tests/results_page.sh docs/results/objects-push/objects_push_in_time.md \
+	  $(LAB) objects-push --in-time --out docs/results/objects-push
+	rm docs/results/objects-push/objects_push_in_time.csv  # every step of every curve: megabytes
 	rm -rf out/paired && $(MAKE) --no-print-directory paired-rehearsal > docs/results/paired-comparisons.md
 	$(MAKE) --no-print-directory brain-convergence > docs/results/brain-convergence.md
 

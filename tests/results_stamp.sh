@@ -5,7 +5,13 @@
 #   usage: tests/results_stamp.sh
 set -euo pipefail
 source_dir=$(cd "$(dirname "$0")/.." && pwd)
-commit=$(git -C "$source_dir" describe --always --dirty=' with uncommitted changes' 2>/dev/null || echo "no git checkout")
+# Dirty only for changes outside docs/results/: `make results` rewrites those pages as it goes.
+if commit=$(git -C "$source_dir" describe --always 2>/dev/null); then
+  [[ -z $(git -C "$source_dir" status --porcelain -- . ':!docs/results') ]] ||
+    commit+=" with uncommitted changes"
+else
+  commit="no git checkout"
+fi
 cpu=$(grep -m1 'model name' /proc/cpuinfo 2>/dev/null | cut -d: -f2 | sed 's/^ *//' || true)
 echo
 echo "_Measured at commit ${commit} on $(date -u +%Y-%m-%d), ${cpu:-an unknown CPU}, $(nproc) cores, $(uname -sr)._"
