@@ -351,7 +351,7 @@ struct PressedBrain {
   BrainRig& rig = BrainRig::get();
   std::array<ComplianceColumns*, 1> columns{rig.columns.get()};
   SceneSimulation scene;
-  const Simulation& simulation;
+  Simulation& simulation;
   view::ShownScene shown;
   std::vector<view::ToolState> tools;
   std::vector<Eigen::Vector3d> forces;

@@ -88,7 +88,7 @@ struct FemPairRun {
     }
     return simulation.force(0);
   }
-  const Simulation& fem(int body) const { return std::get<Simulation>(simulation.body(body)); }
+  Simulation& fem(int body) { return std::get<Simulation>(simulation.body(body)); }
 };
 
 // The tool `depth` [m] into A's front face near its centre, a quarter and a half into a cell
@@ -147,7 +147,7 @@ ExpectedPress expected_press(const testing::PairedBoxesRig& rig, const Eigen::Ve
 
 // The largest difference of `simulation`'s displacement at `body`'s surface from `expected`
 // (3 per node), and the largest expected displacement there [m].
-std::pair<double, double> surface_difference(const Simulation& simulation, const ElasticBody& body,
+std::pair<double, double> surface_difference(Simulation& simulation, const ElasticBody& body,
                                              const Eigen::VectorXd& expected) {
   const Eigen::Matrix3Xd u = simulation.displacement_of(body.surface.nodes);
   double error = 0, largest = 0;
@@ -294,6 +294,19 @@ TEST(FemPairScene, TheServersForceAndBothBodiesShapesAreTheJointSparseSolves) {
     EXPECT_GT(behind_largest, 0);
     EXPECT_LE(behind_error, 1e-9 * behind_largest);
   }
+}
+
+// The pair acts between A's stages, after its tools' contacts and before its IRs: the IR of
+// the very step in which A starts pushing B condenses over B, not one a step later.
+TEST(FemPairScene, TheStepInWhichAStartsPushingBuildsItsIrOverB) {
+  FemPairRun run(fem_pair_scene(0.5, kFemPairInteraction));
+  run.simulation.set_tool(0, fem_pair_tool(0.5, 4e-3));
+  run.simulation.step(0);
+  ASSERT_TRUE(run.simulation.condenses_over_support(0));
+  const auto ir = run.simulation.ir(0);
+  ASSERT_TRUE(ir);
+  EXPECT_GT(condensed_fem(ir->ir).rest_forces.size(), 0)
+      << "the first step's IR was built before B was folded in";
 }
 
 TEST(FemPairScene, TheClientFeelsBThroughAsIrAsTheServerDoes) {

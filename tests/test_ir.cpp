@@ -135,6 +135,22 @@ TEST(IntermediateRepresentation, TwoUsersEqualTheFullSolveWithHeldBoundaryNodes)
 // the untruncated one bit for bit; above it the kept columns are the same numbers, the
 // dropped nodes are exactly those below the threshold, and the force changes by exactly
 // the dropped columns times their displacements.
+// The step's stages run in order: the IRs are built from a held set updated for them, once.
+TEST(IntermediateRepresentation, AreBuiltOnlyFromAHeldSetUpdatedForThem) {
+  Rig& rig = shared_cube();
+  const Model& model = *rig.model;
+  Simulation simulation(single_elastic_body(model), model.obstacles, *rig.columns,
+                        std::vector<ToolSpec>(1),
+                        unlimited_options(ContactModel::node_translation, 0));
+  simulation.set_tool(0, mm(-20, 5, -4));
+  EXPECT_THROW(simulation.build_irs(0), Error);
+  simulation.update_held_set();
+  EXPECT_TRUE(simulation.build_irs(0).rebuilt);
+  ASSERT_TRUE(simulation.ir(0));
+  EXPECT_THROW(simulation.build_irs(0.001), Error);
+  EXPECT_FALSE(simulation.step(0.001).rebuilt) << "nothing moved: the IR stands";
+}
+
 TEST(IntermediateRepresentation, BoundaryTruncationDropsOnlyWeakColumns) {
   Rig& rig = shared_cube();
   const Model& model = *rig.model;

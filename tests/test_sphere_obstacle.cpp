@@ -52,7 +52,7 @@ struct PathResult {
   int obstacle_nodes = 0;  ///< the obstacles push in the state
 };
 
-PathResult result_of(const Simulation& simulation, const std::vector<Eigen::Vector3d>& tools) {
+PathResult result_of(Simulation& simulation, const std::vector<Eigen::Vector3d>& tools) {
   PathResult result;
   const StateSolution state = simulation.solve();
   result.server = state.tool_forces;

@@ -502,7 +502,7 @@ TEST(ViewFrame, CarriesTheSimulationsDisplacementForcesPatchContactAndHeldNodes)
   scene.set_tool(0, pressing);
   scene.step(0);
   scene.step(0.001);
-  const Simulation& simulation = scene.single_elastic();
+  Simulation& simulation = scene.single_elastic();
   ASSERT_TRUE(simulation.pressing(0));
 
   const view::ShownScene shown_scene = view::shown_scene(*cube.model, columns);

@@ -150,7 +150,7 @@ TEST(ViewBodies, ThePairedBoxesShowTheNetworkAndTheElasticBoxEachFromItsOwnState
   ViewedShippedScene boxes(load_shipped_view_scene("scenes/objects/paired_boxes.yaml"));
   ASSERT_EQ(boxes.shown.parts.size(), 2u);
   const auto& front = std::get<MassSpringSimulation>(boxes.simulation.body(0));
-  const auto& behind = std::get<Simulation>(boxes.simulation.body(1));
+  auto& behind = std::get<Simulation>(boxes.simulation.body(1));
   const view::ShownPart& box = boxes.shown.parts[1];
   EXPECT_EQ(box.offset, static_cast<int>(front.body().network.surface_nodes.size()));
   EXPECT_EQ(box.offset + box.size(), boxes.shown.node_count());

@@ -12,6 +12,6 @@
 namespace cohaptic {
 
 /// Per body of `simulation`: its StateSolution when it is linear elastic, nullopt otherwise.
-std::vector<std::optional<StateSolution>> solve_elastic_states(const SceneSimulation& simulation);
+std::vector<std::optional<StateSolution>> solve_elastic_states(SceneSimulation& simulation);
 
 }  // namespace cohaptic

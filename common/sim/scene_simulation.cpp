@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <type_traits>
 
 #include "common/util/error.h"
 #include "common/util/overloaded.h"
@@ -86,9 +87,9 @@ void SceneSimulation::add_fem_pair(const InteractionSpec& spec, int front, int b
         "only, and this scene's is '{}' (haptic: {{contact_model: translation}})",
         spec.where, contact_model_name(options.ir.contact_model)));
   // Each pair sets both bodies' applied loads: a body in two pairs would lose one's.
-  for (const auto& pair : fem_pairs_)
+  for (const FemPairInteraction& pair : fem_pairs_)
     for (const int body : {front, behind})
-      if (body == pair->front || body == pair->behind)
+      if (body == pair.front || body == pair.behind)
         throw Error(
             fmt::format("{}: object '{}' is in an earlier pair of linear elastic objects already "
                         "(one such pair "
@@ -96,17 +97,24 @@ void SceneSimulation::add_fem_pair(const InteractionSpec& spec, int front, int b
                         spec.where, body_name(model_, body)));
   const auto& front_body = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(front)]);
   const auto& behind_body = std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(behind)]);
-  auto& pair = *fem_pairs_.emplace_back(std::make_unique<FemPairInteraction>(
-      make_fem_pair_interaction(front, front_body, behind, behind_body)));
-  Simulation& behind_simulation = std::get<Simulation>(*bodies_[static_cast<std::size_t>(behind)]);
-  ComplianceColumns* front_columns = columns_[static_cast<std::size_t>(front)];
-  ComplianceColumns* behind_columns = columns_[static_cast<std::size_t>(behind)];
-  std::get<Simulation>(*bodies_[static_cast<std::size_t>(front)])
-      .set_coupling([&pair, &front_body, front_columns, &behind_simulation, &behind_body,
-                     behind_columns](Simulation& simulation) {
-        couple_fem_pair(pair, simulation, front_body, *front_columns, behind_simulation,
-                        behind_body, *behind_columns);
-      });
+  fem_pairs_.push_back(make_fem_pair_interaction(front, front_body, behind, behind_body));
+}
+
+void SceneSimulation::couple(FemPairInteraction& pair) {
+  const auto front = static_cast<std::size_t>(pair.front);
+  const auto behind = static_cast<std::size_t>(pair.behind);
+  couple_fem_pair(pair, std::get<Simulation>(*bodies_[front]),
+                  std::get<ElasticBody>(model_.bodies[front]), *columns_[front],
+                  std::get<Simulation>(*bodies_[behind]),
+                  std::get<ElasticBody>(model_.bodies[behind]), *columns_[behind]);
+}
+
+StepReport SceneSimulation::step_fem_body(int body, Simulation& simulation, double time) {
+  simulation.update_held_set();
+  // The front of a pair pushes with its tools' contacts and held set known, before its IRs.
+  for (FemPairInteraction& pair : fem_pairs_)
+    if (pair.front == body) couple(pair);
+  return simulation.build_irs(time);
 }
 
 bool SceneSimulation::condenses_over_support(int body_index) const {
@@ -205,7 +213,10 @@ StepReport SceneSimulation::step(double time) {
             else
               body_simulation.set_tool(u, user.position);
           }
-          report += body_simulation.step(time);
+          if constexpr (std::is_same_v<std::remove_cvref_t<decltype(body_simulation)>, Simulation>)
+            report += step_fem_body(b, body_simulation, time);
+          else
+            report += body_simulation.step(time);
         },
         simulation);
   }
@@ -232,6 +243,11 @@ ForceSample SceneSimulation::force(int user) {
 
 const Simulation& SceneSimulation::single_elastic() const {
   single_elastic_body(model_);  // throws naming the scene when it is not one linear elastic object
+  return std::get<Simulation>(*bodies_.front());
+}
+
+Simulation& SceneSimulation::single_elastic() {
+  single_elastic_body(model_);
   return std::get<Simulation>(*bodies_.front());
 }
 

@@ -13,8 +13,9 @@
 // body_interaction.h) run at the start of each step, before the bodies advance: the
 // front body then integrates the behind body's reaction as a backing (node_backing.h).
 // A linear elastic body pressing on another (an FEM pair, fem_pair_interaction.h) runs
-// within the front body's step, once its tools are known: both bodies are loaded by the
-// pushes and the front body's IRs condense over B folded in as a support.
+// between the front body's stages, once its tools' contacts and held set are known and
+// before its IRs are built (Simulation::update_held_set, build_irs): both bodies are loaded
+// by the pushes and the front body's IRs condense over B folded in as a support.
 // Units: SI; times in s of the simulation's clock.
 #pragma once
 
@@ -77,15 +78,17 @@ class SceneSimulation {
   int body_of(int user) const { return users_[static_cast<std::size_t>(user)].body; }
 
   const BodySimulation& body(int i) const { return *bodies_[static_cast<std::size_t>(i)]; }
+  BodySimulation& body(int i) { return *bodies_[static_cast<std::size_t>(i)]; }
   /// The FEM simulation of a scene whose only object is linear elastic (the display and the
   /// live view show that body); throws Error (single_elastic_body's) otherwise.
   const Simulation& single_elastic() const;
+  Simulation& single_elastic();
   /// The scene's interactions in scene order, as of the latest step.
   const std::vector<BodyInteraction>& interactions() const { return interactions_; }
   /// The scene's FEM pairs in scene order, as of the latest step.
   int fem_pair_count() const { return static_cast<int>(fem_pairs_.size()); }
   const FemPairInteraction& fem_pair(int i) const {
-    return *fem_pairs_[static_cast<std::size_t>(i)];
+    return fem_pairs_[static_cast<std::size_t>(i)];
   }
   /// True when `body`'s IRs condense over a support (the front of an FEM pair that pushes):
   /// their M~ is not of the body's own compliance.
@@ -104,6 +107,11 @@ class SceneSimulation {
                     const SimulationOptions& options);
   void assign_bodies();
   void run_interactions();
+  /// The FEM pair's step between its front body's stages: the pushes as loads on both
+  /// bodies, and the front's support.
+  void couple(FemPairInteraction& pair);
+  /// An FEM body's step, with the pairs it is the front of acting between its stages.
+  StepReport step_fem_body(int body, Simulation& simulation, double time);
   double distance_to_body(int body, const Eigen::Vector3d& point) const;
 
   const Model& model_;
@@ -111,8 +119,7 @@ class SceneSimulation {
   std::vector<UserState> users_;
   std::vector<ComplianceColumns*> columns_;  // per body, null unless linear elastic
   std::vector<BodyInteraction> interactions_;
-  std::vector<std::unique_ptr<FemPairInteraction>>
-      fem_pairs_;  // at fixed addresses: the front's coupling holds one
+  std::vector<FemPairInteraction> fem_pairs_;
   bool started_ = false;
   double time_ = 0;    // of the latest step [s]
   double period_ = 0;  // of the latest step [s]

@@ -133,16 +133,16 @@ std::vector<PressingContact> Simulation::pressing_contacts() const {
   return contacts;
 }
 
-StateSolution Simulation::solve(std::span<const PressingContact> contacts) const {
+StateSolution Simulation::solve(std::span<const PressingContact> contacts) {
   return solve_state(columns_, condensation_, body_.dofs, contacts, boundary_dof_displacement(),
                      options_.ir.contact_model, applied_);
 }
 
-StateSolution Simulation::solve() const {
+StateSolution Simulation::solve() {
   return sphere_model() ? solve_spheres(spheres()) : solve(pressing_contacts());
 }
 
-StateSolution Simulation::solve_unloaded() const {
+StateSolution Simulation::solve_unloaded() {
   if (sphere_model()) return solve_spheres(spheres());  // in no FEM pair (refused), so never loaded
   return solve_state(columns_, condensation_, body_.dofs, pressing_contacts(),
                      boundary_dof_displacement(), options_.ir.contact_model);
@@ -155,7 +155,7 @@ std::vector<SphereTool> Simulation::spheres() const {
   return out;
 }
 
-StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) const {
+StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) {
   std::vector<int> candidates;
   for (const UserState& user : users_)
     if (user.known)
@@ -213,7 +213,8 @@ void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool,
 }
 
 bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool,
-                                                 std::vector<bool>& in_patch, StepReport& report) {
+                                                 std::vector<bool>& in_patch,
+                                                 HeldSetUpdate& update) {
   constexpr int kMaxCarryPasses = 4;  // each pass only adds nodes; in practice one settles it
   std::vector<int> user_of_sphere;    // spheres() lists the known users in order
   for (std::size_t u = 0; u < users_.size(); ++u)
@@ -250,7 +251,7 @@ bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool,
       return boundary_changed;
     }
     if (pass == kMaxCarryPasses) {
-      report.sphere_nodes_outside_patches = static_cast<int>(left_out.size());
+      update.nodes_outside_patches = static_cast<int>(left_out.size());
       return boundary_changed;
     }
     for (const auto& [node, user] : left_out)
@@ -262,7 +263,7 @@ bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool,
   }
 }
 
-Eigen::Matrix3Xd Simulation::displacement_of(std::span<const int> nodes) const {
+Eigen::Matrix3Xd Simulation::displacement_of(std::span<const int> nodes) {
   return displacement_of_nodes(columns_, solve(), nodes);
 }
 
@@ -368,13 +369,15 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool,
 }
 
 StepReport Simulation::step(double time) {
-  StepReport report;
+  update_held_set();
+  return build_irs(time);
+}
+
+void Simulation::find_contacts() {
   // The step's scratch lives in the simulation, so that a step allocates no more than its
   // mathematics does.
-  std::vector<UserTool>& tools = step_tools_;
   std::vector<bool>& under_tool = under_tool_;
   std::vector<bool>& in_patch = in_patch_;
-  tools.clear();
   under_tool.assign(static_cast<std::size_t>(body_.mesh.node_count()), false);
   in_patch.assign(under_tool.size(), false);
   for (std::size_t u = 0; u < users_.size(); ++u) {
@@ -403,12 +406,28 @@ StepReport Simulation::step(double time) {
         for (int node : body_.surface.triangles[t]) in_patch[node] = true;
     if (sphere_model()) mark_sphere(user, under_tool, in_patch, touchable_triangle_);
   }
+}
 
+void Simulation::update_held_set() {
+  find_contacts();
   Stopwatch watch;
-  bool boundary_changed = update_boundary(under_tool, in_patch);
+  HeldSetUpdate update;
+  update.changed = update_boundary(under_tool_, in_patch_);
   if (sphere_model())
-    boundary_changed |= carry_pushed_nodes_into_patches(under_tool, in_patch, report);
-  if (coupling_) coupling_(*this);
+    update.changed |= carry_pushed_nodes_into_patches(under_tool_, in_patch_, update);
+  update.elapsed_ms = watch.elapsed_ms();
+  held_set_update_ = update;
+}
+
+StepReport Simulation::build_irs(double time) {
+  if (!held_set_update_)
+    throw Error("Simulation::build_irs: the held set was not updated since the IRs were built");
+  const HeldSetUpdate update = *std::exchange(held_set_update_, std::nullopt);
+  StepReport report;
+  report.sphere_nodes_outside_patches = update.nodes_outside_patches;
+  Stopwatch watch;
+  std::vector<UserTool>& tools = step_tools_;
+  tools.clear();
   std::vector<int>& nearest = step_nearest_;
   nearest.clear();
   for (std::size_t u = 0; u < users_.size(); ++u) {
@@ -431,7 +450,7 @@ StepReport Simulation::step(double time) {
   // pushed along the direction it had at the build (its normal compliance does not depend
   // on where they are): it is rebuilt when one is not, or when a sphere holding nothing
   // comes nearest another triangle.
-  const bool sets_changed = boundary_changed || support_changed || nearest != built_nearest_ ||
+  const bool sets_changed = update.changed || support_changed || nearest != built_nearest_ ||
                             (sphere_model() && !sphere_irs_stand());
   if (sets_changed || options_.naive_every_step) {
     IncrementalCondensation& condensation = ir_condensation();
@@ -502,7 +521,7 @@ StepReport Simulation::step(double time) {
     report.rebuilt = sets_changed;
     report.recomputed = true;
   }
-  report.rebuild_ms = watch.elapsed_ms();
+  report.rebuild_ms = update.elapsed_ms + watch.elapsed_ms();
   previous_contacts_ = pressing_contacts();
   previous_spheres_ = spheres();
   report.boundary_nodes = static_cast<int>(condensation_.boundary_nodes().size());
@@ -523,7 +542,7 @@ std::vector<Eigen::Vector3d> Simulation::remote_positions(
   return positions;
 }
 
-ForceSample Simulation::force(int user) const {
+ForceSample Simulation::force(int user) {
   const UserState& state = users_[user];
   if (!state.ir) return {};
   // The condensed FEM body ignores dt; the sphere model's state keeps its contact solve.

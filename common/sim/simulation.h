@@ -1,8 +1,9 @@
 // Simulation: the body of the server's simulation loop, with no threads or sockets.
 //
-// Each step takes the users' latest tool positions and
-//   1. finds every tool's nearest touchable triangle and whether it presses;
-//   2. updates the colliding boundary set B, the nodes held at a prescribed displacement:
+// Each step takes the users' latest tool positions and, in named stages,
+//   1. contacts: finds every tool's nearest touchable triangle and whether it presses;
+//   2. held set: updates the colliding boundary set B, the nodes held at a prescribed
+//      displacement:
 //      - step delay (the paper's T150/T300): with `step_delay_nodes` = N, the N surface
 //        nodes nearest the pressing tools, outside every user's patch, join B when contact
 //        begins, held where they were at the previous step (before the touch), and leave
@@ -16,22 +17,22 @@
 //        nodes slide along them, and the IRs carry them as rows of their own;
 //      - a node of a tool's nearest triangle is never held: the tool wins (under the
 //        sphere contact model, no node of the sphere's patch);
-//   3. rebuilds every user's IR when a set changed (nearest triangles, the nodes each
+//   3. IRs: rebuilds every user's IR when a set changed (nearest triangles, the nodes each
 //      sphere holds under the sphere contact model, or B): M~ depends
 //      only on the sets, so it is not rebuilt otherwise (`naive_every_step` computes it
 //      every step all the same, for its cost, and publishes it only when a set changed).
 // force() evaluates a user's force from its IR and the current tool positions: the P0
 // protocol's server-side force, the same function the P1 client runs. surface
 // displacement() solves the whole state for display.
-// Another body pressing on this one (an FEM pair, fem_pair_interaction.h) acts through a
-// coupling called in each step before the IRs are built: it sets loads applied in every
-// state solve, and may set a support (this body's compliance with the other body folded in
-// on the nodes that push on it, supported_compliance.h) that the IRs condense over from then
-// on; a change of support rebuilds them, as a change of the sets does. Units: SI.
+// step() runs the three; update_held_set() and build_irs() split them for another body
+// pressing on this one (an FEM pair, fem_pair_interaction.h), which acts in between: it sets
+// loads applied in every state solve, and may set a support (this body's compliance with the
+// other body folded in on the nodes that push on it, supported_compliance.h) that the IRs
+// condense over from then on; a change of support rebuilds them, as a change of the sets
+// does. Units: SI.
 #pragma once
 
 #include <Eigen/Core>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -88,7 +89,16 @@ class Simulation {
   /// The user's next IR gets an epoch above `epoch` (a user coming from another body).
   void continue_epochs(int user, std::uint64_t epoch);
 
+  /// One step: update_held_set(), then build_irs(time).
   StepReport step(double time);
+  /// A step's first two stages: each known tool's contact (its nearest triangle, whether it
+  /// presses, a sphere's patch), then the held set B (the tools' triangles freed, the step
+  /// delay's nodes, the obstacles' active set, the nodes a sphere's state carries).
+  void update_held_set();
+  /// A step's last stage, after update_held_set(): every user's IR, built again if a set
+  /// changed since the IRs were last built. The step's report. Throws Error if the held set
+  /// was not updated since the last build_irs().
+  StepReport build_irs(double time);
 
   /// Step delay from the next step on: hold `nodes` surface nodes while any tool presses (0:
   /// none). The nodes held now are released there and, if a tool presses, chosen afresh.
@@ -98,22 +108,22 @@ class Simulation {
   std::shared_ptr<const PreparedIR> ir(int user) const {
     return users_[static_cast<std::size_t>(user)].ir;
   }
-  /// Reaction force on `user`'s tool now (zero if it has no IR).
-  ForceSample force(int user) const;
+  /// Reaction force on `user`'s tool now (zero if it has no IR). It advances the user's
+  /// evaluation of its IR (a sphere's contact solve is kept from call to call).
+  ForceSample force(int user);
   /// Positions of the remote tools of `ir`, in its remotes' order (NaN where unknown).
   std::vector<Eigen::Vector3d> remote_positions(const IntermediateRepresentation& ir) const;
   bool pressing(int user) const { return users_[static_cast<std::size_t>(user)].pressing; }
 
-  /// The whole state solved at the current tool positions, with the applied loads.
-  StateSolution solve() const;
+  /// The whole state solved at the current tool positions, with the applied loads. Not
+  /// const, as no solve is: it computes compliance columns and the condensation's cached
+  /// rows as it needs them.
+  StateSolution solve();
   /// The same without the applied loads: the body as it would be alone.
-  StateSolution solve_unloaded() const;
+  StateSolution solve_unloaded();
 
   /// Loads another body applies to this one, in every state solve from now on.
   void set_applied_loads(AppliedLoads loads) { applied_ = std::move(loads); }
-  /// Called in each step once the tools' contacts and the held set B are known, before the
-  /// IRs are built (SceneSimulation's FEM pairs). Not under the sphere contact model.
-  void set_coupling(std::function<void(Simulation&)> coupling) { coupling_ = std::move(coupling); }
   /// The IRs condense over `support` (built over this body's columns) from the next build on;
   /// null: over the body's own compliance again. Either way they are rebuilt at this step.
   void set_support(std::unique_ptr<SupportedCompliance> support);
@@ -121,7 +131,7 @@ class Simulation {
   /// body's own L (compliance rows of L would not give it).
   const SupportedCompliance* support() const { return support_.get(); }
   /// Displacement of `nodes` (row nodes) in the current state [m].
-  Eigen::Matrix3Xd displacement_of(std::span<const int> nodes) const;
+  Eigen::Matrix3Xd displacement_of(std::span<const int> nodes);
 
   /// Free surface nodes without compliance columns yet that were about (to first order,
   /// ObstacleClearance::estimate) options.near_obstacle_distance or less from an obstacle
@@ -152,12 +162,21 @@ class Simulation {
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
   };
+  /// What update_held_set() leaves for build_irs().
+  struct HeldSetUpdate {
+    bool changed = false;           ///< B changed
+    double elapsed_ms = 0;          ///< updating B took
+    int nodes_outside_patches = 0;  ///< StepReport::sphere_nodes_outside_patches
+  };
   struct HeldNode {
     Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
     int obstacle = -1;  ///< the obstacle holding it, or -1 for a step-delay node
   };
+  /// The contacts stage: each known tool's nearest triangle, whether it presses, a sphere's
+  /// patch; the nodes under the tools and in their patches (under_tool_, in_patch_).
+  void find_contacts();
   std::vector<PressingContact> pressing_contacts() const;
-  StateSolution solve(std::span<const PressingContact> contacts) const;
+  StateSolution solve(std::span<const PressingContact> contacts);
   bool sphere_model() const { return options_.ir.contact_model == ContactModel::sphere; }
   void release_step_delay_nodes();
   /// The sphere contact model's part of a user's step: its patch's nodes are under the tool
@@ -167,12 +186,12 @@ class Simulation {
   /// The sphere model's check of the patches against the solved state: a node that the
   /// state has a sphere push and that its user's patch leaves out (a bulge carried it in,
   /// beyond the rings) joins that patch, B is updated again, and the state solved again.
-  /// Returns whether B changed; counts in `report` the pushed nodes still left out after
+  /// Returns whether B changed; counts in `update` the pushed nodes still left out after
   /// kMaxCarryPasses passes.
   bool carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, std::vector<bool>& in_patch,
-                                       StepReport& report);
+                                       HeldSetUpdate& update);
   std::vector<SphereTool> spheres() const;  ///< every known user's tool
-  StateSolution solve_spheres(std::span<const SphereTool> spheres) const;
+  StateSolution solve_spheres(std::span<const SphereTool> spheres);
   /// Sphere model: whether the IRs last built stand: they hold every node a sphere holds or
   /// carries now and every obstacle contact, each pushed along its direction at the build.
   bool sphere_irs_stand() const;
@@ -189,8 +208,8 @@ class Simulation {
   const ElasticBody& body_;
   ComplianceColumns& columns_;
   SimulationOptions options_;
-  bool step_delay_changed_ = false;               // set_step_delay_nodes() since the last step
-  mutable IncrementalCondensation condensation_;  // its Z cache changes on const queries
+  bool step_delay_changed_ = false;  // set_step_delay_nodes() since the last step
+  IncrementalCondensation condensation_;
   std::vector<ObstacleDistance> obstacles_;
   NearestTriangleCandidates
       candidates_;  // the few triangles each tool's nearest-triangle scans visit
@@ -211,9 +230,9 @@ class Simulation {
   std::vector<PressingContact> previous_contacts_;     // the pressing contacts of the previous step
   std::vector<SphereTool>
       previous_spheres_;  // the sphere model's: the spheres of the previous step
-  mutable std::unique_ptr<SphereStateSolve>
-      sphere_solve_;  // the sphere model's state solve, kept step to step
-  mutable std::vector<EvaluationState> p0_states_;  // per user: force()'s evaluation of its IR
+  std::unique_ptr<SphereStateSolve>
+      sphere_solve_;                        // the sphere model's state solve, kept step to step
+  std::vector<EvaluationState> p0_states_;  // per user: force()'s evaluation of its IR
   // step()'s scratch: the known tools, their nearest triangles and sphere-held nodes, the
   // nodes under them and in their patches.
   std::vector<UserTool> step_tools_;
@@ -221,7 +240,7 @@ class Simulation {
   std::vector<bool> under_tool_, in_patch_;
   bool boundary_dirty_ = false;
   AppliedLoads applied_;                                             // see set_applied_loads
-  std::function<void(Simulation&)> coupling_;                        // see set_coupling
+  std::optional<HeldSetUpdate> held_set_update_;                     // until build_irs()
   std::unique_ptr<SupportedCompliance> support_;                     // see set_support
   std::unique_ptr<IncrementalCondensation> supported_condensation_;  // over *support_
   bool support_changed_ = false;  // since the IRs were last built
