@@ -14,9 +14,10 @@ namespace visit_held_detail {
 template <class Result, class Variant, class Handlers, std::size_t... Index>
 Result visit_by_index(Variant& variant, Handlers& handlers, Result otherwise,
                       std::index_sequence<Index...>) noexcept {
-  ((variant.index() == Index ? (otherwise = handlers(*std::get_if<Index>(&variant)), true)
-                             : false) ||
-   ...);
+  static_cast<void>(
+      ((variant.index() == Index ? (otherwise = handlers(*std::get_if<Index>(&variant)), true)
+                                 : false) ||
+       ...));
   return otherwise;
 }
 }  // namespace visit_held_detail
