@@ -118,11 +118,13 @@ void expect_felt_without_fades(const std::string& scene, bool watched) {
     const std::size_t table = output.find("\nwho ");
     std::printf("%s", output.substr(table == std::string::npos ? 0 : table).c_str());
   };
-  if (!fs::exists(out / "report.json")) print_summary();
-  ASSERT_TRUE(fs::exists(out / "report.json")) << "the demo wrote no report (its output above)";
+  const bool reported = fs::exists(out / "report.json") && fs::exists(out / "client_a.json") &&
+                        fs::exists(out / "client_b.json");
+  if (!reported) print_summary();
+  ASSERT_TRUE(reported) << "the demo did not write report.json, client_a.json and client_b.json "
+                           "(its output above)";
   for (const char* client : {"client_a", "client_b"}) {
     SCOPED_TRACE(client);
-    ASSERT_TRUE(fs::exists(out / (std::string(client) + ".json"))) << "no report of " << client;
     const json report = json::parse(std::ifstream(out / (std::string(client) + ".json")));
     EXPECT_EQ(report["fades"]["count"], 0)
         << "the force faded while the surgeon pushed: " << report["fades"].dump() << "; IR age "
