@@ -405,6 +405,11 @@ TEST(ReplayPlayer, FindsThePeakAndTheLargestStepSeeksToTheFrameAtATimeAndPlaysAt
   EXPECT_NEAR(player.time(), 2.2, 1e-9);
   EXPECT_EQ(player.timeline().speed(), 2);
   EXPECT_TRUE(player.timeline().playing());
+  for (double wall : {std::nan(""), -1.0, 0.0}) {  // ignored: the position stays in the recording
+    player.advance(wall);
+    player.seek(std::nan(""));
+    EXPECT_NEAR(player.time(), 2.2, 1e-9) << wall;
+  }
   player.advance(10);  // past the end: it stops there
   EXPECT_NEAR(player.time(), 3.0, 1e-12);
   EXPECT_FALSE(player.playing());

@@ -131,12 +131,13 @@ void ReplayPlayer::command(const Command& command) {
 }
 
 void ReplayPlayer::advance(double wall_seconds) {
-  if (!playing_) return;
+  if (!playing_ || !(wall_seconds > 0)) return;  // time never runs back, nor by NaN
   seek(time_ + wall_seconds * speed_);
   if (time_ >= frames_.back().time()) playing_ = false;
 }
 
 void ReplayPlayer::seek(double time) {
+  if (std::isnan(time)) return;  // std::clamp would pass it through
   time_ = std::clamp(time, frames_.front().time(), frames_.back().time());
   const auto after =
       std::upper_bound(frames_.begin(), frames_.end(), time_,

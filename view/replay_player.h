@@ -36,8 +36,10 @@ class ReplayPlayer {
 
   /// Play, pause, speed (> 0, else ignored), seek (clamped to the recording), jump.
   void command(const Command& command);
-  /// Moves the position on by `wall_seconds` times the speed while playing; pauses at the end.
+  /// Moves the position on by `wall_seconds` (> 0, else ignored) times the speed while playing;
+  /// pauses at the end.
   void advance(double wall_seconds);
+  /// Moves the position to `time`, clamped to the recording; NaN is ignored.
   void seek(double time);
 
  private:
