@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <memory>
 
@@ -39,8 +40,10 @@ bool misses_deadlines_of_its_own(const nlohmann::json& client_report) {
   const double missed = number(client_report, {"missed_deadlines"});
   const double floor_missed = number(client_report, {"timer_floor", "missed_deadlines"});
   // Two threads stalled by the same host miss about as many deadlines, not exactly as many:
-  // beyond a twentieth of the floor's misses, or 0.1 % of the ticks if more.
-  const double margin = std::max(0.001 * ticks, 0.05 * floor_missed);
+  // their counts differ by a few times the square root of the floor's (counting noise, which
+  // rules a short session), by a twentieth of it (a long one), or by 0.1 % of the ticks,
+  // whichever is most.
+  const double margin = std::max({0.001 * ticks, 0.05 * floor_missed, 3 * std::sqrt(floor_missed)});
   return missed > 0.001 * ticks && missed - floor_missed > margin;
 }
 

@@ -14,8 +14,8 @@
 //   - the haptic period's p99 within 100 us of the period, or, on a machine whose bare
 //     timer cannot do that, within 100 us (or a tenth, if more) of that timer floor
 //     measured at the same time;
-//     at most 0.1 % of the ticks (or a twentieth of the bare timer's misses, if more) missed
-//     their deadline beyond what the bare timer missed.
+//     at most 0.1 % of the ticks (or a twentieth of the bare timer's misses, or three times
+//     their square root, if more) missed their deadline beyond what the bare timer missed.
 // A failed criterion is a problem naming its cause. Notes are worth knowing and judge
 // nothing: how much the users felt of each other (the experiment's design), a machine
 // whose bare timer was as late as the loop or missed as many deadlines (its host's steal time
@@ -48,7 +48,8 @@ SessionVerdict summarize_session(const nlohmann::json& server,
                                  const std::vector<nlohmann::json>& clients);
 
 /// Whether a client's report shows missed deadlines of its own haptic loop: more than 0.1 % of
-/// its ticks (or a twentieth of the floor's misses, if more) beyond those the bare timer floor
+/// its ticks (or a twentieth of the floor's misses, or three times their square root, if more)
+/// beyond those the bare timer floor
 /// beside it missed (a stall of the whole machine, the host's steal time in a virtual machine,
 /// makes the floor miss about the same deadlines).
 bool misses_deadlines_of_its_own(const nlohmann::json& client_report);

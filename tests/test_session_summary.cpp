@@ -63,6 +63,18 @@ TEST(SessionSummary, MissedDeadlinesAreTheLoopsOnlyBeyondWhatTheBareTimerMissed)
   late["missed_deadlines"] = 60;
   verdict = summarize_session(healthy_server(), {late, healthy_client("b")});
   EXPECT_TRUE(mentions(verdict.problems, "a: 60 missed deadlines"));
+
+  // A session of 2,300 ticks on a stalling machine: 38 against the floor's 35 is counting
+  // noise (three times the root of 35 is 17.7), though over 0.1 % of the ticks; 60 is not.
+  late["ticks"] = 2300;
+  late["timer_floor"]["missed_deadlines"] = 35;
+  late["missed_deadlines"] = 38;
+  verdict = summarize_session(healthy_server(), {late, healthy_client("b")});
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
+  late["missed_deadlines"] = 60;
+  verdict = summarize_session(healthy_server(), {late, healthy_client("b")});
+  EXPECT_TRUE(mentions(verdict.problems, "a: 60 missed deadlines"))
+      << verdict.report["problems"].dump();
 }
 
 // A client's floors, one per CPU, as cohaptic-client reports them (client/timer_floors.h): the
