@@ -49,9 +49,8 @@ SessionVerdict summarize_session(const nlohmann::json& server,
 
 /// Whether a client's report shows missed deadlines of its own haptic loop: more than 0.1 % of
 /// its ticks (or a twentieth of the floor's misses, or three times their square root, if more)
-/// beyond those the bare timer floor
-/// beside it missed (a stall of the whole machine, the host's steal time in a virtual machine,
-/// makes the floor miss about the same deadlines).
+/// beyond those the bare timer floor beside it missed (a stall of the whole machine, the host's
+/// steal time in a virtual machine, makes the floor miss about the same deadlines).
 bool misses_deadlines_of_its_own(const nlohmann::json& client_report);
 
 /// Reads the reports, prints the table, writes `out` (if not empty); exit code 0 if healthy.
