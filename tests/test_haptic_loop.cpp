@@ -17,12 +17,14 @@
 #include "common/sim/simulation.h"
 #include "common/util/monotonic_clock.h"
 #include "support/cube_scene.h"
+#include "support/driven_clock.h"
 #include "support/evaluate_static.h"
 
 namespace cohaptic {
 namespace {
 
 using namespace std::chrono_literals;
+using testing::DrivenClock;
 
 // A device whose pose becomes NaN after `nan_after_s`.
 class NanDevice final : public HapticDevice {
@@ -94,23 +96,6 @@ std::vector<TickRecord> run_to_end(HapticLoop& loop, HapticChannels& channels) {
 }
 
 constexpr std::int64_t kMs = 1'000'000;  // [ns]
-
-// A clock the test drives: a sleep returns at once with the time set to its deadline (or
-// left where it is, if a stall already took it past), then calls `at` with the new time,
-// so a stimulus (a confirmation arriving) happens at an exact time on the loop's thread.
-struct DrivenClock {
-  std::int64_t now = 1'000'000'000;  // [ns]
-  std::function<void(std::int64_t now)> at;
-  HapticClock haptic() {
-    return {[](void* self) { return static_cast<DrivenClock*>(self)->now; },
-            [](void* self, std::int64_t deadline_ns) {
-              DrivenClock& clock = *static_cast<DrivenClock*>(self);
-              clock.now = std::max(clock.now, deadline_ns);
-              if (clock.at) clock.at(clock.now);
-            },
-            this};
-  }
-};
 
 // On a driven clock: confirmations every 10 ms until 200 ms, then none. The force is the
 // evaluator's times a fade of exactly 1 up to an age of max_age (100 ms), then falling on a

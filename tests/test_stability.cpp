@@ -9,9 +9,9 @@
 #include "common/haptics/passivity_controller.h"
 #include "common/haptics/scripted_device.h"
 #include "common/study/measures.h"
-#include "common/util/monotonic_clock.h"
 #include "lab/stability.h"
 #include "proto/wire/header.h"
+#include "support/driven_clock.h"
 
 namespace cohaptic {
 namespace {
@@ -130,11 +130,14 @@ TEST(WallLoop, ThePassivityControllerTurnsADivergingLoopPassiveAndCostsNothingWh
 TEST(HapticLoop, PassivityControlStopsAnActiveForceFromFeedingTheHand) {
   // P0: the server's force pushes along the tool's steady motion (as a delayed force on
   // release does). The work it does on the moving tool grows without the controller and
-  // stays at the controller's tolerance with it.
+  // stays at the controller's tolerance with it. The loop runs on a driven clock: on the
+  // real one, a stalled tick moves the tool a long step under the force before the
+  // controller can answer, and the work it books then depends on the machine's load.
   const auto work_done = [](bool passivity_control) {
+    testing::DrivenClock clock;
     auto channels = std::make_unique<HapticChannels>();
     channels->tracing = true;
-    channels->force.back() = ForceSlot{Eigen::Vector3d(0.5, 0, 0), monotonic_now_ns(), 1, true};
+    channels->force.back() = ForceSlot{Eigen::Vector3d(0.5, 0, 0), clock.now, 1, true};
     channels->force.publish();
     ScriptedDevice device(
         Trajectory({0.0, 1.0}, {Eigen::Vector3d::Zero(), Eigen::Vector3d(0.02, 0, 0)}, "slide"),
@@ -145,7 +148,7 @@ TEST(HapticLoop, PassivityControlStopsAnActiveForceFromFeedingTheHand) {
     settings.realtime = false;
     settings.max_age_s = 10;
     settings.passivity_control = passivity_control;
-    HapticLoop loop(device, *channels, settings);
+    HapticLoop loop(device, *channels, settings, clock.haptic());
     std::atomic<bool> stop{false};
     loop.run(stop);
     ForceTrace trace;
