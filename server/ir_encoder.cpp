@@ -27,7 +27,11 @@ bool travels_whole(const BuiltIr& built) { return built.send && !built.as_sent; 
 }  // namespace
 
 void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
-  if (irs.empty()) return;
+  record(irs, frame(irs, outbox));
+}
+
+std::vector<IrEncoder::ToRecord> IrEncoder::frame(std::vector<BuiltIr>& irs, Outbox& outbox) {
+  if (irs.empty()) return {};
   const std::int64_t start_ns = monotonic_now_ns();
   // An IR that travels whole and is followed by another of its user's that does too is
   // superseded: it is recorded, not sent; a fresh start of the stream passes to the next.
@@ -49,25 +53,27 @@ void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
   std::uint64_t sent = 0, bytes = 0, skipped = 0;
   if (std::any_of(irs.begin(), irs.end(), [](const BuiltIr& built) { return built.announces_p1; }))
     outbox.protocol_switch = wire::P1;
+  std::vector<ToRecord> to_record(recorder_ ? irs.size() : 0);
   for (std::size_t i = 0; i < irs.size(); ++i) {
     const BuiltIr& built = irs[i];
-    const wire::IntermediateRepresentation whole = wire::to_wire(built.built->ir);
     if (!built.send || superseded[i]) {
       if (superseded[i]) ++skipped;
-      if (recorder_) recorder_->ir(built.time_ns, whole, built.repeat);
       continue;
     }
+    // What travels: the compliance rows, or the IR whole (kept for the recording).
+    std::optional<wire::IntermediateRepresentation> whole;
+    if (!built.as_sent) whole = wire::to_wire(built.built->ir);
     wire::Control control;
     try {
       if (built.streamed)
         *control.mutable_compressed_ir() = streams_[static_cast<std::size_t>(built.user)].compress(
-            built.as_sent ? wire::to_wire(*built.as_sent) : whole, built.fresh);
+            built.as_sent ? wire::to_wire(*built.as_sent) : *whole, built.fresh);
       else
-        *control.mutable_ir() = built.as_sent ? wire::to_wire(*built.as_sent) : whole;
+        *control.mutable_ir() = built.as_sent ? wire::to_wire(*built.as_sent) : *whole;
     } catch (const std::exception& e) {
       spdlog::error("user {}'s IR (epoch {}) not sent: {}; the next starts its stream afresh",
                     built.user, built.built->ir.epoch, e.what());
-      if (recorder_) recorder_->ir(built.time_ns, whole, built.repeat);
+      if (recorder_) to_record[i].whole = std::move(whole);
       std::lock_guard lock(mutex_);
       restarts_.push_back(built.user);
       continue;
@@ -77,16 +83,30 @@ void IrEncoder::encode(std::vector<BuiltIr>& irs, Outbox& outbox) {
     // client's do), else the IR.
     if (recorder_) {
       if (built.streamed && !built.as_sent)
-        recorder_->ir_block(built.time_ns, static_cast<std::uint32_t>(built.user),
-                            control.compressed_ir(), built.repeat);
+        to_record[i].block = control.compressed_ir();
       else
-        recorder_->ir(built.time_ns, whole, built.repeat);
+        to_record[i].whole = std::move(whole);
     }
     bytes += built.streamed ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
     outbox.irs.push_back({built.user, std::move(control), built.streamed});
     ++sent;
   }
   statistics_.record_irs_encoded(monotonic_now_ns() - start_ns, sent, bytes, skipped);
+  return to_record;
+}
+
+void IrEncoder::record(const std::vector<BuiltIr>& irs, std::vector<ToRecord> to_record) {
+  if (!recorder_) return;
+  for (std::size_t i = 0; i < irs.size(); ++i) {
+    const BuiltIr& built = irs[i];
+    ToRecord& kept = to_record[i];
+    if (kept.block)
+      recorder_->ir_block(built.time_ns, static_cast<std::uint32_t>(built.user), *kept.block,
+                          built.repeat);
+    else
+      recorder_->ir(built.time_ns, kept.whole ? *kept.whole : wire::to_wire(built.built->ir),
+                    built.repeat);
+  }
 }
 
 void IrEncoder::start(std::function<void(Outbox&&)> send) {
@@ -131,9 +151,12 @@ void IrEncoder::run() {
       queue_.clear();
     }
     changed_.notify_all();  // room for post()
+    // The frames leave before the recording is written: recording a burst of large IRs
+    // takes longer than sending the newest, which would otherwise wait for it.
     Outbox outbox;
-    encode(irs, outbox);
+    std::vector<ToRecord> to_record = frame(irs, outbox);
     if (!outbox.empty()) send_(std::move(outbox));
+    record(irs, std::move(to_record));
   }
 }
 

@@ -11,7 +11,9 @@
 // recording keep the simulation's order. It takes every step waiting at once, and of a
 // user's IRs that travel whole (not as compliance rows) sends only the newest: one that a
 // newer one replaced before it could leave is recorded, not sent (superseded in the
-// report), so that a burst of rebuilds does not queue IRs that are stale on arrival.
+// report), so that a burst of rebuilds does not queue IRs that are stale on arrival. The
+// batch's frames are handed over before its IRs are recorded, so the newest IR never
+// waits for the recording of those before it.
 // Backpressure: post() blocks while
 // kMaxQueuedSteps steps' IRs wait, so a slow encoder slows the simulation (visible in its
 // step rate) instead of growing a queue. A block that fails to encode (zstd) is logged and
@@ -80,6 +82,17 @@ class IrEncoder {
   std::vector<int> take_restarts();
 
  private:
+  /// What the recording keeps of one IR once its frame is made: the stream block that held
+  /// it whole, or its wire form if framing made it (else it is made when recorded).
+  struct ToRecord {
+    std::optional<wire::CompressedIr> block;
+    std::optional<wire::IntermediateRepresentation> whole;
+  };
+  /// The frames of `irs` into `outbox`; what the recording needs of them (empty without a
+  /// recorder).
+  std::vector<ToRecord> frame(std::vector<BuiltIr>& irs, Outbox& outbox);
+  /// Records every IR of `irs`, in order.
+  void record(const std::vector<BuiltIr>& irs, std::vector<ToRecord> to_record);
   void run();
 
   record::SessionRecorder* recorder_;
