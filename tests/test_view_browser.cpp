@@ -329,17 +329,18 @@ TEST(ViewInBrowser, TheBrainIsDrawnWithBothSurgeonsToolsAndForceArrows) {
   EXPECT_GT(frame["maxDeformationMm"].get<double>(), 0.5) << frame.dump();
 
   // A screenshot whose condition is never met (no surgeon presses with 100 N): the script
-  // gives up in its time (30 s by default; 10 s here), still writes the picture and says
+  // gives up in its time (30 s by default; 20 s here, as a loaded 2-core machine may take
+  // 10 s to load the page and draw its first frames), still writes the picture and says
   // which condition failed.
   const auto asked = std::chrono::steady_clock::now();
   const json unmet = check_page(dir, "unmet",
                                 {"--url", session.url, "--screenshot", (dir / "unmet.png").string(),
-                                 "--min-force", "100", "--give-up", "10"},
+                                 "--min-force", "100", "--give-up", "20"},
                                 1);
-  EXPECT_LT(std::chrono::steady_clock::now() - asked, std::chrono::seconds(25));
+  EXPECT_LT(std::chrono::steady_clock::now() - asked, std::chrono::seconds(35));
   EXPECT_TRUE(fs::exists(dir / "unmet.png"));
   ASSERT_TRUE(unmet.contains("error")) << unmet.dump();
-  EXPECT_NE(unmet["error"].get<std::string>().find("gave up after 10 s: "), std::string::npos)
+  EXPECT_NE(unmet["error"].get<std::string>().find("gave up after 20 s: "), std::string::npos)
       << unmet["error"];
   EXPECT_NE(unmet["error"].get<std::string>().find("pressing with at least 100 N"),
             std::string::npos)

@@ -24,6 +24,8 @@
 // "screen": what the page shows, in CSS pixels: per user the arrow's length, its tip's
 // distance from its tool's centre and the tool's radius on the screen; the legend's title,
 // the arrow scale, the rigid-motion checkbox, the scale bar's text and length.
+// Timings, in ms: "launchMs" Chromium's start; from then, "gotoMs" the page loaded,
+// "connectedMs" and "firstFrameMs" first seen connected and drawing (a slow machine's).
 // Exit status 0 with {"skipped": reason} when no Chromium can be started; 1 on a timeout,
 // naming what was awaited (the screenshot is still taken, of whatever the page shows).
 import { chromium } from '../../deploy/node/node_modules/playwright-core/index.mjs';
@@ -59,6 +61,7 @@ if (!executable) {
   process.exit(0);
 }
 
+const launching = Date.now();
 const browser = await chromium.launch({
   executablePath: executable,
   args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
@@ -71,12 +74,16 @@ try {
   page = await browser.newPage({ viewport: { width, height } });
   page.on('pageerror', (e) => result.errors.push(e.message));
   page.on('console', (m) => { if (m.type() === 'error') result.errors.push(m.text()); });
+  result.launchMs = started - launching;
   await page.goto(args.url, { timeout: GIVE_UP_S * 1000 });
+  result.gotoMs = Date.now() - started;
   const snapshot = () => page.evaluate(() => window.cohapticView.snapshot());
   // The page's last state, and whether it passed `test` before `until` (a time in ms).
   const poll = async (test, until) => {
     for (;;) {
       const s = await page.evaluate(() => (window.cohapticView ? window.cohapticView.snapshot() : null));
+      if (s && s.connected && result.connectedMs === undefined) result.connectedMs = Date.now() - started;
+      if (s && s.framesDrawn > 0 && result.firstFrameMs === undefined) result.firstFrameMs = Date.now() - started;
       if (s && test(s)) return { s, met: true };
       if (Date.now() > until) return { s, met: false };
       await page.waitForTimeout(100);
