@@ -151,8 +151,8 @@ void IrEncoder::run() {
       queue_.clear();
     }
     changed_.notify_all();  // room for post()
-    // The frames leave before the recording is written: recording a burst of large IRs
-    // takes longer than sending the newest, which would otherwise wait for it.
+    // The frames leave before the recording is written, so that no IR of the batch waits
+    // for the recording of those before it.
     Outbox outbox;
     std::vector<ToRecord> to_record = frame(irs, outbox);
     if (!outbox.empty()) send_(std::move(outbox));
