@@ -3,8 +3,7 @@
 // gmsh grades to 0.6 mm under each of two 10 mm spheres) and two cohaptic-client processes
 // pressing it 1 mm with scripted tools. Each IR carries the normal compliance of a few
 // hundred candidate nodes (no cap), the clients push more than 100 nodes each at the
-// deepest, the session is healthy by the demo's own verdict (but for its IR-age p99 bound,
-// which two cores cannot hold for IRs this large: see the test), and the three recordings
+// deepest, the session is healthy by the demo's own verdict, and the three recordings
 // verify bit for bit: each client's forces re-run, tick by tick in the order it used them,
 // from the IRs it received (the offline evaluation of what it held), the server's steps
 // from the tools it was given.
@@ -88,21 +87,8 @@ TEST(BlockSession, TwoUsersPushHundredsOfNodesHealthyAndTheirRecordingsVerify) {
     EXPECT_GT(most_rows, 200u);
     EXPECT_GT(most_contacts, 100u);
   }
-  // The demo's verdict, but for one bound: on two cores that the server and both clients
-  // share, an IR of hundreds of row nodes may come later than four simulation steps at
-  // 20 Hz (the IR-age p99 bound), the known cost of such IRs on a machine without cores to
-  // spare (docs/sphere-contact.md, "On two cores"). What the users feel still holds: no
-  // force faded, no IR reached the fade age, and every other criterion.
   const SessionVerdict verdict = summarize_session(server_report, client_reports);
-  for (const HealthCriterion& criterion : verdict.criteria) {
-    if (criterion.what == "IR age p99") {
-      std::printf("  %s: IR age p99 %s (the demo's verdict: %s)\n", criterion.who.c_str(),
-                  criterion.value.c_str(), criterion.threshold.c_str());
-      continue;
-    }
-    EXPECT_TRUE(criterion.ok) << criterion.who << ": " << criterion.what << " " << criterion.value
-                              << ", healthy if " << criterion.threshold;
-  }
+  EXPECT_TRUE(verdict.problems.empty()) << verdict.report["problems"].dump();
   for (const auto& [file, least] :
        {std::pair{"server.mcap", 3u}, {"a.mcap", 1000u}, {"b.mcap", 1000u}}) {
     const VerifyResult result = verify_recording(dir / file, SceneFileAccess{});
