@@ -16,11 +16,13 @@
 #include "common/util/atomic_file.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
+#include "common/util/keep_freed_memory.h"
 #include "common/util/log_to_stderr.h"
 #include "proto/wire/user_name.h"
 
 int main(int argc, char** argv) {
   cohaptic::log_to_stderr();
+  cohaptic::keep_freed_memory();
 
   CLI::App app{"cohaptic-client: a haptic client of a cohaptic-server session"};
   std::string server = "127.0.0.1:7400", device_spec, log_level = "info", playout = "fixed";

@@ -11,11 +11,13 @@
 #include "common/util/host_port.h"
 #include "common/util/blas_threads.h"
 #include "common/util/error.h"
+#include "common/util/keep_freed_memory.h"
 #include "common/util/log_to_stderr.h"
 #include "server/simulation_server.h"
 
 int main(int argc, char** argv) {
   cohaptic::log_to_stderr();
+  cohaptic::keep_freed_memory();
 
   CLI::App app{
       "cohaptic-server: FEM simulation server for networked haptic collaboration. Serves a scene "
