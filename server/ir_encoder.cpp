@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <future>
 #include <iterator>
 #include <map>
 #include <utility>
@@ -50,16 +51,48 @@ std::vector<IrEncoder::ToRecord> IrEncoder::frame(std::vector<BuiltIr>& irs, Out
     else
       irs[i].fresh = std::exchange(carried, false) || irs[i].fresh;
   }
-  std::uint64_t sent = 0, bytes = 0, skipped = 0;
   if (std::any_of(irs.begin(), irs.end(), [](const BuiltIr& built) { return built.announces_p1; }))
     outbox.protocol_switch = wire::P1;
-  std::vector<ToRecord> to_record(recorder_ ? irs.size() : 0);
+  // Each user's IRs to send, in order, grouped by user in the order they first appear.
+  std::vector<std::vector<std::size_t>> by_user;
+  std::map<int, std::size_t> group_of_user;
+  std::uint64_t skipped = 0;
   for (std::size_t i = 0; i < irs.size(); ++i) {
+    if (superseded[i]) ++skipped;
+    if (!irs[i].send || superseded[i]) continue;
+    const auto [group, added] = group_of_user.try_emplace(irs[i].user, by_user.size());
+    if (added) by_user.emplace_back();
+    by_user[group->second].push_back(i);
+  }
+  // The users' streams are independent: each user's IRs are framed on a thread of its own
+  // (the first user's on this one), so that one user's compression does not hold back the
+  // IR of another.
+  std::vector<ToRecord> to_record(recorder_ ? irs.size() : 0);
+  std::vector<UserFrames> frames(by_user.size());
+  {
+    std::vector<std::future<void>> others;
+    for (std::size_t g = 1; g < by_user.size(); ++g)
+      others.push_back(std::async(std::launch::async,
+                                  [&, g] { frames[g] = frame_user(irs, by_user[g], to_record); }));
+    if (!by_user.empty()) frames[0] = frame_user(irs, by_user[0], to_record);
+    for (std::future<void>& other : others) other.get();
+  }
+  std::uint64_t sent = 0, bytes = 0;
+  for (UserFrames& user : frames) {
+    sent += user.frames.size();
+    bytes += user.bytes;
+    std::move(user.frames.begin(), user.frames.end(), std::back_inserter(outbox.irs));
+  }
+  statistics_.record_irs_encoded(monotonic_now_ns() - start_ns, sent, bytes, skipped);
+  return to_record;
+}
+
+IrEncoder::UserFrames IrEncoder::frame_user(const std::vector<BuiltIr>& irs,
+                                            std::span<const std::size_t> indices,
+                                            std::vector<ToRecord>& to_record) {
+  UserFrames user;
+  for (const std::size_t i : indices) {
     const BuiltIr& built = irs[i];
-    if (!built.send || superseded[i]) {
-      if (superseded[i]) ++skipped;
-      continue;
-    }
     // What travels: the compliance rows, or the IR whole (kept for the recording).
     std::optional<wire::IntermediateRepresentation> whole;
     if (!built.as_sent) whole = wire::to_wire(built.built->ir);
@@ -87,12 +120,11 @@ std::vector<IrEncoder::ToRecord> IrEncoder::frame(std::vector<BuiltIr>& irs, Out
       else
         to_record[i].whole = std::move(whole);
     }
-    bytes += built.streamed ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
-    outbox.irs.push_back({built.user, std::move(control), built.streamed});
-    ++sent;
+    user.bytes +=
+        built.streamed ? control.compressed_ir().ByteSizeLong() : control.ir().ByteSizeLong();
+    user.frames.push_back({built.user, std::move(control), built.streamed});
   }
-  statistics_.record_irs_encoded(monotonic_now_ns() - start_ns, sent, bytes, skipped);
-  return to_record;
+  return user;
 }
 
 void IrEncoder::record(const std::vector<BuiltIr>& irs, std::vector<ToRecord> to_record) {

@@ -7,8 +7,10 @@
 // not the steps (and keep-alives) after it. encode() does the same work on the caller's
 // thread (SimulationLoop::step, for callers that step the loop themselves).
 //
-// Order: one thread encodes every IR in the order posted, so each user's stream and the
-// recording keep the simulation's order. It takes every step waiting at once, and of a
+// Order: one thread takes the IRs in the order posted, so each user's stream and the
+// recording keep the simulation's order; within a batch, each user's IRs are framed in order
+// on a thread of their own (the users' streams are independent), so one user's compression
+// does not delay another's IR. It takes every step waiting at once, and of a
 // user's IRs that travel whole (not as compliance rows) sends only the newest: one that a
 // newer one replaced before it could leave is recorded, not sent (superseded in the
 // report), so that a burst of rebuilds does not queue IRs that are stale on arrival. The
@@ -28,6 +30,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -88,9 +91,18 @@ class IrEncoder {
     std::optional<wire::CompressedIr> block;
     std::optional<wire::IntermediateRepresentation> whole;
   };
+  /// One user's frames, in order, and their bytes.
+  struct UserFrames {
+    std::vector<ToSlot<wire::Control>> frames;
+    std::uint64_t bytes = 0;
+  };
   /// The frames of `irs` into `outbox`; what the recording needs of them (empty without a
   /// recorder).
   std::vector<ToRecord> frame(std::vector<BuiltIr>& irs, Outbox& outbox);
+  /// The frames of irs[i] for i in `indices` (one user's, in order), filling their
+  /// to_record[i]; called for different users at once.
+  UserFrames frame_user(const std::vector<BuiltIr>& irs, std::span<const std::size_t> indices,
+                        std::vector<ToRecord>& to_record);
   /// Records every IR of `irs`, in order.
   void record(const std::vector<BuiltIr>& irs, std::vector<ToRecord> to_record);
   void run();

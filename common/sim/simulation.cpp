@@ -467,10 +467,9 @@ StepReport Simulation::build_irs(double time) {
       if (sets_changed)
         built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
     }
-    // One user's IR, and (when the sets changed) prepared for the server's own evaluation.
+    // One user's IR, prepared (and so checked) when the sets changed.
     struct BuiltIr {
       std::shared_ptr<const PreparedIR> ir;
-      EvaluationState state;
       std::size_t bytes = 0;
     };
     const auto build = [&](std::size_t i) {
@@ -481,7 +480,6 @@ StepReport Simulation::build_irs(double time) {
       if (!sets_changed) return built;
       built.bytes = ir.size_bytes();
       built.ir = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
-      built.state = make_evaluation_state(*built.ir);
       return built;
     };
     std::vector<BuiltIr> built(tools.size());
@@ -506,7 +504,9 @@ StepReport Simulation::build_irs(double time) {
         for (const std::int64_t tag : condensed_fem(built[i].ir->ir).node_ids)
           built_sphere_rows_[static_cast<std::size_t>(node_of_tag_.at(tag))] = 1;
       user.ir = std::move(built[i].ir);
-      p0_states_[static_cast<std::size_t>(tools[i].user)] = std::move(built[i].state);
+      // force() makes its evaluation state when first asked: a P1 session without a view
+      // never asks, and the IR leaves for its client without waiting for one.
+      p0_states_[static_cast<std::size_t>(tools[i].user)].reset();
     }
     built_nearest_ = nearest;
     if (sphere_model() && sets_changed) {
@@ -546,8 +546,9 @@ ForceSample Simulation::force(int user) {
   const UserState& state = users_[user];
   if (!state.ir) return {};
   // The condensed FEM body ignores dt; the sphere model's state keeps its contact solve.
-  return evaluate_force(*state.ir, p0_states_[static_cast<std::size_t>(user)], state.position,
-                        remote_positions(state.ir->ir), 0);
+  std::optional<EvaluationState>& evaluation = p0_states_[static_cast<std::size_t>(user)];
+  if (!evaluation) evaluation = make_evaluation_state(*state.ir);
+  return evaluate_force(*state.ir, *evaluation, state.position, remote_positions(state.ir->ir), 0);
 }
 
 }  // namespace cohaptic

@@ -231,8 +231,9 @@ class Simulation {
   std::vector<SphereTool>
       previous_spheres_;  // the sphere model's: the spheres of the previous step
   std::unique_ptr<SphereStateSolve>
-      sphere_solve_;                        // the sphere model's state solve, kept step to step
-  std::vector<EvaluationState> p0_states_;  // per user: force()'s evaluation of its IR
+      sphere_solve_;  // the sphere model's state solve, kept step to step
+  std::vector<std::optional<EvaluationState>>
+      p0_states_;  // per user: force()'s evaluation of its IR, made at its first call
   // step()'s scratch: the known tools, their nearest triangles and sphere-held nodes, the
   // nodes under them and in their patches.
   std::vector<UserTool> step_tools_;
