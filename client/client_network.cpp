@@ -160,12 +160,12 @@ struct ClientNetwork::Impl {
     } else if (control.has_ir()) {
       const std::int64_t arrival = now_ns();
       if (irs.receive(control.ir(), control.ByteSizeLong(), arrival) && recorder)
-        recorder->ir(arrival, control.ir());
+        recorder->ir(arrival, control.ir(), false, irs.warmed());
     } else if (control.has_compressed_ir()) {  // recorded as the block it came in
       const std::int64_t arrival = now_ns();
       if (irs.receive_compressed(control.compressed_ir(), control.ByteSizeLong(), arrival) &&
           recorder)
-        recorder->ir_block(arrival, 0, control.compressed_ir());
+        recorder->ir_block(arrival, 0, control.compressed_ir(), false, irs.warmed());
     } else if (control.has_protocol_switch()) {
       const wire::Protocol protocol = control.protocol_switch().protocol();
       if (protocol != wire::P0 && protocol != wire::P1) {
@@ -253,6 +253,7 @@ struct ClientNetwork::Impl {
       remote.arrival_ns = arrival;
       remote.position = wire::from_wire(sample.position());
       remote.valid = sample.valid();
+      irs.see_remote_tool(remote.user, remote.position, remote.valid);
       channels.remote_samples.push(remote);
       ++remote_samples;
     } else if (datagram.has_keep_alive()) {
@@ -278,6 +279,7 @@ struct ClientNetwork::Impl {
 
   void drain() {
     while (const auto own = channels.own_samples.pop()) {
+      irs.see_own_tool(own->position, own->valid);
       wire::Datagram datagram;
       auto* sample = datagram.mutable_tool();
       const std::uint32_t sender = udp_sealer.stamp().sender();

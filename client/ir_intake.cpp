@@ -3,15 +3,20 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include "common/util/error.h"
 #include "common/util/stopwatch.h"
+#include "common/ir/warm_start_sphere_contact.h"
 #include "proto/wire/ir_convert.h"
+#include "proto/wire/vec3_convert.h"
 
 namespace cohaptic {
 
 bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::size_t bytes,
                        std::int64_t arrival_ns) {
+  warmed_.reset();
   try {
     IntermediateRepresentation ir = wire::from_wire(message);
     if (auto* fem = std::get_if<CondensedFemIr>(&ir.body); fem && fem->compliance_rows) {
@@ -19,7 +24,9 @@ bool IrIntake::receive(const wire::IntermediateRepresentation& message, std::siz
       condensation_.complete(*fem);
       condense_us_.record(std::llround(thread_cpu_us() - start_us));
     }
-    auto prepared = std::make_unique<const PreparedIR>(prepare_ir(std::move(ir)));
+    PreparedIR prepared_ir = prepare_ir(std::move(ir));
+    warm(prepared_ir);
+    auto prepared = std::make_unique<const PreparedIR>(std::move(prepared_ir));
     to_haptic_.back() = make_ir_slot(std::move(prepared), arrival_ns);
     to_haptic_.publish();
   } catch (const Error& e) {
@@ -48,6 +55,29 @@ bool IrIntake::receive_compressed(const wire::CompressedIr& block, std::size_t b
   }
   receive(message, bytes, arrival_ns);
   return true;
+}
+
+void IrIntake::see_own_tool(const Eigen::Vector3d& position, bool valid) {
+  own_ = valid ? std::optional(position) : std::nullopt;
+}
+
+void IrIntake::see_remote_tool(std::uint32_t user, const Eigen::Vector3d& position, bool valid) {
+  if (user < remotes_.size()) remotes_[user] = valid ? std::optional(position) : std::nullopt;
+}
+
+void IrIntake::warm(PreparedIR& prepared) {
+  if (!own_) return;
+  std::vector<Eigen::Vector3d> remotes;
+  for (int r = 0; r < remote_count(prepared.ir); ++r) {
+    const auto user = static_cast<std::size_t>(remote_user(prepared.ir, r));
+    remotes.push_back(user < remotes_.size() && remotes_[user]
+                          ? *remotes_[user]
+                          : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  }
+  if (!warm_start_sphere_contact(prepared, *own_, remotes)) return;
+  record::WarmStart& warmed = warmed_.emplace();
+  *warmed.mutable_own() = wire::to_wire(*own_);
+  for (const Eigen::Vector3d& remote : remotes) *warmed.add_remotes() = wire::to_wire(remote);
 }
 
 nlohmann::json IrIntake::report() const {

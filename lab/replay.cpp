@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/ir/client_condensation.h"
+#include "common/ir/warm_start_sphere_contact.h"
 #include "common/model/model.h"
 #include "common/model/scene_compliance.h"
 #include "common/sim/ir_build_options.h"
@@ -68,9 +69,16 @@ VerifyResult verify_client(const Recording& rec) {
   for (const record::RecordedIr& recorded : rec.irs) {
     IntermediateRepresentation ir = wire::from_wire(recorded.ir());
     if (auto* fem = std::get_if<CondensedFemIr>(&ir.body)) condensation.complete(*fem);
+    PreparedIR prepared = prepare_ir(std::move(ir));
+    if (recorded.has_warm_start()) {  // warmed again, as the client warmed it on arrival
+      std::vector<Eigen::Vector3d> remotes;
+      for (const wire::Vec3& remote : recorded.warm_start().remotes())
+        remotes.push_back(wire::from_wire(remote));
+      warm_start_sphere_contact(prepared, wire::from_wire(recorded.warm_start().own()), remotes);
+    }
     irs.emplace(recorded.ir().epoch(),
                 std::make_pair(recorded.time_ns(),
-                               std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)))));
+                               std::make_shared<const PreparedIR>(std::move(prepared))));
   }
   std::vector<std::tuple<std::int64_t, std::uint64_t, Eigen::Vector3d>>
       forces;  // P0: arrival, epoch, force

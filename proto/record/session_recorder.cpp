@@ -54,20 +54,23 @@ void SessionRecorder::datagram_in(std::int64_t receive_ns, const wire::Datagram&
 }
 
 void SessionRecorder::ir(std::int64_t time_ns, const wire::IntermediateRepresentation& ir,
-                         bool repeat) {
+                         bool repeat, const WarmStart* warm_start) {
   RecordedIr record;
   record.set_time_ns(time_ns);
   record.set_repeat(repeat);
   *record.mutable_ir() = ir;
+  if (warm_start) *record.mutable_warm_start() = *warm_start;
   write(ir_, time_ns, record);
 }
 
 void SessionRecorder::ir_block(std::int64_t time_ns, std::uint32_t stream,
-                               const wire::CompressedIr& block, bool repeat) {
+                               const wire::CompressedIr& block, bool repeat,
+                               const WarmStart* warm_start) {
   RecordedIr record;
   record.set_time_ns(time_ns);
   record.set_repeat(repeat);
   *record.mutable_compressed_ir() = block;
+  if (warm_start) *record.mutable_warm_start() = *warm_start;
   record.set_stream(stream);
   write(ir_, time_ns, record);
 }

@@ -55,11 +55,13 @@ class SessionRecorder {
   void config(const SessionConfig& config);
   void datagram_in(std::int64_t receive_ns, const wire::Datagram& datagram);
   /// `repeat`: built by an earlier step, sent again (RecordedIr.repeat).
-  void ir(std::int64_t time_ns, const wire::IntermediateRepresentation& ir, bool repeat = false);
+  /// `warm_start`: a client's, if it warmed the IR's contact solve (recording.proto).
+  void ir(std::int64_t time_ns, const wire::IntermediateRepresentation& ir, bool repeat = false,
+          const WarmStart* warm_start = nullptr);
   /// An IR as the block of IR stream `stream` it travelled in (recording.proto, RecordedIr):
   /// the blocks of a stream must be recorded in order, none left out.
   void ir_block(std::int64_t time_ns, std::uint32_t stream, const wire::CompressedIr& block,
-                bool repeat = false);
+                bool repeat = false, const WarmStart* warm_start = nullptr);
   void tick(const HapticTick& tick);
   void step(const SimulationStep& step);
   /// An event; joins and leaves name their user and slot, so a user can be found by name.
