@@ -34,6 +34,9 @@ struct ConnectionHandler::Participant {
   LinkDelay to_client_udp, to_client_tcp, from_client_udp;
   asio::steady_timer join_timer;
   net::TokenBucket datagram_budget;  // set at the join, from the user's haptic rate
+  // A datagram came from it: it has taken in the welcome, and knows the server's datagrams.
+  // Until then none are sent to it (it would refuse them as from an unknown sender).
+  bool heard_over_udp = false;
   bool gone = false;
   Participant(asio::io_context& io, std::uint64_t session, const LinkDelaySettings& shift,
               bool encrypt)
@@ -491,6 +494,7 @@ void ConnectionHandler::send(Outbox outbox) {
 // ---- datagrams ----
 
 void ConnectionHandler::send_datagram(Participant& participant, wire::Datagram& datagram) {
+  if (!participant.heard_over_udp) return;
   const udp::endpoint to = participant.udp_endpoint;
   const bool delivered =
       net::deliver_over(participant.to_client_udp, io_, monotonic_now_ns(),
@@ -504,6 +508,7 @@ void ConnectionHandler::receive_datagram(wire::Datagram&& datagram, std::int64_t
   const int slot = static_cast<int>(datagram.header().sender()) - 1;
   if (slot < 0 || slot >= slots() || !slots_[static_cast<std::size_t>(slot)]) return;
   Participant& user = *slots_[static_cast<std::size_t>(slot)];
+  user.heard_over_udp = true;
   if (!user.datagram_budget.try_take(arrival_ns)) {
     ++counters_.datagrams_over_budget;
     warn_throttled(fmt::format("datagrams of '{}' (slot {}) dropped: more than {:.0f} a second",

@@ -5,6 +5,8 @@
 //   - the UDP endpoint (net::DatagramEndpoint): tool samples in (the newest of each slot
 //     to ToolInputs, and relayed to the other users), clock pings answered with pongs;
 //   - the sending of each step's Outbox (IRs over TCP, keep-alives and forces over UDP);
+//     nothing goes to a user over UDP before a datagram has come from it (its first is sent
+//     once it has the welcome, and with it the key the server's datagrams are opened with);
 //   - the injected shift delay: per participant, one LinkDelay per link and direction (to
 //     the client over UDP and over TCP, from the client over UDP), applied where a message
 //     leaves or enters the process;
