@@ -16,6 +16,7 @@
 //     of the rate just before it, measured from the server's recording, and every datagram
 //     the real clients sent is accepted;
 //   - a participant's samples past twice its haptic rate are neither relayed nor recorded;
+//     a user gets no datagram before it has sent one (it may not have its Welcome yet);
 //     connections that never join, from many addresses, lock no client out; out of file
 //     descriptors, neither listener spins, and both accept again once they are free;
 //   - a recording's scene, built by replay --verify, reads nothing outside the recording's
@@ -592,6 +593,28 @@ TEST(Robustness, AParticipantsSamplesBeyondTwiceItsHapticRateAreNeitherRelayedNo
   EXPECT_LE(static_cast<double>(recorded), budget);
   EXPECT_LE(static_cast<double>(b["remote_samples_received"].get<std::uint64_t>()), budget);
   EXPECT_LE(b["period_us"]["p99"].get<double>(), testing::period_p99_allowance_us(b));
+}
+
+// A user joining a session already running gets no datagram before it has sent one: until
+// then it may not have taken in its Welcome, and would refuse the server's datagrams (the
+// other user's relayed samples, its IR keep-alives) as from an unknown sender.
+TEST(Robustness, TheServerSendsAUserNoDatagramBeforeOneCameFromIt) {
+  CubeSession session("udp-after-heard", {"--duration", "120"});
+  const auto bob = session.client("bob", 1, write_press(session.dir, "b", 3, 2, 2, 100.0));
+  ASSERT_TRUE(testing::wait_for_output(*bob, "haptic loop at")) << bob->log_text();
+  RawParticipant late({.server_port = static_cast<std::uint16_t>(session.port), .slot = 0},
+                      wire::ClientKeys(wire::development_key()));
+  late.join();
+  const std::size_t before = late.datagrams_within(500ms);
+  late.send_sample({0.003, 0.002, 0.05});  // above the cube: nothing pressed
+  const std::size_t after = late.datagrams_within(500ms);
+  std::printf("  datagrams to a joined user: %zu in 500 ms before it sent one, %zu after\n", before,
+              after);
+  EXPECT_EQ(before, 0u);
+  EXPECT_GT(after, 100u) << "bob's samples are relayed to it once it has been heard";
+  bob->signal(SIGINT);
+  ASSERT_EQ(bob->wait(testing::kPatience), 0) << bob->log_text();
+  session.stop_server();
 }
 
 // Connections that never join, from 8 source addresses (127.0.0.2 to 127.0.0.9), 8 from

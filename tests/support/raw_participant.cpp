@@ -4,6 +4,8 @@
 #include <sys/socket.h>
 #include <sys/time.h>
 
+#include <array>
+
 #include "common/util/error.h"
 #include "proto/wire/header.h"
 #include "proto/wire/vec3_convert.h"
@@ -104,6 +106,24 @@ void RawParticipant::send_sample(const Eigen::Vector3d& position) {
   std::error_code ignored;
   udp_.send_to(asio::buffer(datagrams_.seal(datagram)), server_udp_, 0, ignored);
   ++samples_sent_;
+}
+
+std::size_t RawParticipant::datagrams_within(std::chrono::milliseconds span) {
+  const auto until = std::chrono::steady_clock::now() + span;
+  std::array<std::uint8_t, 2048> buffer;
+  std::size_t count = 0;
+  udp_.non_blocking(true);
+  while (std::chrono::steady_clock::now() < until) {
+    std::error_code error;
+    udp::endpoint from;
+    udp_.receive_from(asio::buffer(buffer), from, 0, error);
+    if (!error)
+      ++count;
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  udp_.non_blocking(false);
+  return count;
 }
 
 void RawParticipant::press_along(std::function<Eigen::Vector3d(double)> path) {

@@ -53,6 +53,8 @@ class RawParticipant {
   void press_along(std::function<Eigen::Vector3d(double)> path);
   void stop();
   std::uint64_t samples_sent() const { return samples_sent_; }
+  /// How many datagrams reach this participant's UDP socket within `span` (read and dropped).
+  std::size_t datagrams_within(std::chrono::milliseconds span);
 
  private:
   bool read_some(std::chrono::steady_clock::time_point deadline);
