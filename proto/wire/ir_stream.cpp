@@ -91,7 +91,12 @@ IntermediateRepresentation IrStreamReader::open(const CompressedIr& block) {
   }
   index_ = 0;  // until this block is opened whole
   const std::string& zstd = block.zstd();
-  std::string out(std::min(kMaxStreamIrBytes, std::max<std::size_t>(4096, 4 * zstd.size())), '\0');
+  // The buffer is kept from block to block: it grows to the largest IR once, instead of a
+  // block of several times the frame's size being allocated and zeroed for every IR.
+  std::string& out = buffer_;
+  const std::size_t first_guess =
+      std::min(kMaxStreamIrBytes, std::max<std::size_t>(4096, 4 * zstd.size()));
+  if (out.size() < first_guess) out.resize(first_guess);
   ZSTD_inBuffer input{zstd.data(), zstd.size(), 0};
   ZSTD_outBuffer output{out.data(), out.size(), 0};
   // A flushed block is whole once its input is consumed and the output was not filled.

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 
 #include "cohaptic/messages.pb.h"
 
@@ -59,6 +60,8 @@ class IrStreamReader {
   struct Context;
   std::unique_ptr<Context> context_;
   std::uint64_t index_ = 0;  ///< the last block opened; 0: none, only a fresh start is accepted
+  std::string buffer_;       ///< where blocks decompress, kept at the largest IR's size (at most
+                             ///< kMaxStreamIrBytes)
 };
 
 }  // namespace cohaptic::wire
