@@ -21,6 +21,7 @@
 
 #include "support/browser.h"
 #include "support/process.h"
+#include "support/shipped_scenes.h"
 
 namespace cohaptic {
 namespace {
@@ -41,20 +42,6 @@ constexpr std::chrono::milliseconds kDemoPatience{300'000};
 // on two cores, Chromium drawing in software takes as much CPU as the server, whose IRs then
 // come late enough for a force to fade.
 constexpr int kBrowserNice = 10;
-
-// The shipped scenes that have both surgeons' scripts, as paths under scenes/ without ".yaml".
-std::vector<std::string> scenes_with_surgeons() {
-  std::vector<std::string> scenes;
-  for (const fs::directory_entry& entry : fs::recursive_directory_iterator(kSource / "scenes")) {
-    if (entry.path().filename() != "surgeon_a.yaml") continue;
-    const fs::path scene_dir = entry.path().parent_path();
-    if (fs::exists(scene_dir / "surgeon_b.yaml") &&
-        fs::exists(fs::path(scene_dir.string() + ".yaml")))
-      scenes.push_back(fs::relative(scene_dir, kSource / "scenes").generic_string());
-  }
-  std::sort(scenes.begin(), scenes.end());
-  return scenes;
-}
 
 // deploy/run-demo.sh on `scene` in `out`, for kSessionSeconds; with a browser watching its
 // live view if `watched` (for kWatchedSessionSeconds). Its output.
@@ -151,9 +138,9 @@ TEST_P(ShippedScene, TwoSurgeonsFeelItWithoutAFadeWhileABrowserWatches) {
   expect_felt_without_fades(GetParam(), no_browser.empty());
 }
 
-INSTANTIATE_TEST_SUITE_P(Scenes, ShippedScene, ::testing::ValuesIn(scenes_with_surgeons()),
+INSTANTIATE_TEST_SUITE_P(Scenes, ShippedScene, ::testing::ValuesIn(testing::scenes_with_surgeons()),
                          [](const ::testing::TestParamInfo<std::string>& scene) {
-                           return std::regex_replace(scene.param, std::regex("[^A-Za-z0-9]"), "_");
+                           return testing::scene_test_name(scene.param);
                          });
 
 }  // namespace
