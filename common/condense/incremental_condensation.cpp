@@ -50,7 +50,7 @@ double symmetric_frobenius_norm(const Eigen::Ref<const Eigen::MatrixXd>& lower) 
 
 IncrementalCondensation::IncrementalCondensation(ComplianceSource& columns, const DofMap& dofs,
                                                  Options options)
-    : columns_(columns), dofs_(dofs), options_(options) {}
+    : columns_(&columns), dofs_(dofs), options_(options) {}
 
 bool IncrementalCondensation::in_boundary(int node) const {
   return std::find(b_nodes_.begin(), b_nodes_.end(), node) != b_nodes_.end();
@@ -82,7 +82,7 @@ int IncrementalCondensation::slot_of(int node) const {
 }
 
 Eigen::MatrixXd IncrementalCondensation::column_rows_at_boundary(int node) {
-  return gather_compliance(columns_, b_dofs_,
+  return gather_compliance(*columns_, b_dofs_,
                            free_dofs_of_nodes(dofs_, std::span<const int>(&node, 1)));
 }
 
@@ -99,7 +99,7 @@ Eigen::MatrixXd IncrementalCondensation::compliance_to_slots(std::span<const int
                           static_cast<Eigen::Index>(axis));
     }
   }
-  const Eigen::MatrixXd gathered = gather_compliance(columns_, row_dofs, dofs);
+  const Eigen::MatrixXd gathered = gather_compliance(*columns_, row_dofs, dofs);
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(
       gathered.rows(), 3 * static_cast<Eigen::Index>(cached_.size() - first_slot));
   for (std::size_t j = 0; j < column_of.size(); ++j)
@@ -115,8 +115,8 @@ void IncrementalCondensation::add_boundary_node(int node) {
 
   Stopwatch watch;
   const int n = n_;
-  const Eigen::MatrixXd l = column_rows_at_boundary(node);                   // n x k
-  Eigen::MatrixXd lambda = gather_compliance(columns_, new_dofs, new_dofs);  // k x k
+  const Eigen::MatrixXd l = column_rows_at_boundary(node);                    // n x k
+  Eigen::MatrixXd lambda = gather_compliance(*columns_, new_dofs, new_dofs);  // k x k
   lambda = 0.5 * (lambda + lambda.transpose()).eval();
   ensure_row_capacity(n + k);
   const auto g_old = g_.topLeftCorner(n, n);
@@ -240,7 +240,7 @@ void IncrementalCondensation::set_boundary_nodes(std::span<const int> nodes) {
   for (int node : nodes)
     if (!in_boundary(node) && std::find(joining.begin(), joining.end(), node) == joining.end())
       joining.push_back(node);
-  columns_.compute_columns(joining);  // one multi-right-hand-side solve for them all
+  columns_->compute_columns(joining);  // one multi-right-hand-side solve for them all
   // Many at once (a step-delay set): append them to L_BB and factor once, O(|B|^3 / 3),
   // cheaper than as many bordering steps.
   if (joining.size() <= kBulkJoin) {
@@ -258,8 +258,8 @@ void IncrementalCondensation::set_boundary_nodes(std::span<const int> nodes) {
   }
   const auto k = static_cast<int>(new_dofs.size());
   ensure_row_capacity(n_ + k);
-  const Eigen::MatrixXd l_new = gather_compliance(columns_, b_dofs_, new_dofs);
-  const Eigen::MatrixXd lambda = gather_compliance(columns_, new_dofs, new_dofs);
+  const Eigen::MatrixXd l_new = gather_compliance(*columns_, b_dofs_, new_dofs);
+  const Eigen::MatrixXd lambda = gather_compliance(*columns_, new_dofs, new_dofs);
   l_bb_.block(n_, 0, k, n_) = l_new.transpose();
   l_bb_.block(n_, n_, k, k) = 0.5 * (lambda + lambda.transpose());
   b_dofs_.insert(b_dofs_.end(), new_dofs.begin(), new_dofs.end());
@@ -295,7 +295,7 @@ CondensedOperator IncrementalCondensation::condense(std::span<const int> contact
   for (int node : contact_nodes)
     if (in_boundary(node))
       throw Error(fmt::format("node {} is both a contact and a boundary node", node));
-  if (options_.naive) return naive_condensation(columns_, dofs_, contact_nodes, b_nodes_);
+  if (options_.naive) return naive_condensation(*columns_, dofs_, contact_nodes, b_nodes_);
   Stopwatch watch;
   compute_z(contact_nodes);
   stats_.z_ms += watch.lap_ms();
@@ -314,7 +314,7 @@ CondensedOperator IncrementalCondensation::condense(std::span<const int> contact
     l_bc.middleCols(col, cached.width) = l_bz_.block(0, 3 * slot, n_, cached.width);
     col += cached.width;
   }
-  Eigen::MatrixXd s = gather_compliance(columns_, op.contact_dofs, op.contact_dofs);
+  Eigen::MatrixXd s = gather_compliance(*columns_, op.contact_dofs, op.contact_dofs);
   multiply(-1, l_bc, Transposed::yes, z_c, Transposed::no, 1, s);
   s = 0.5 * (s + s.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(s);

@@ -48,9 +48,16 @@ class IncrementalCondensation {
   };
 
   /// `columns` and `dofs` must outlive this object; B and C nodes must be row nodes of `columns`.
+  /// A copy reads the same `columns` (a cache of what does not change).
   IncrementalCondensation(ComplianceSource& columns, const DofMap& dofs, Options options);
   IncrementalCondensation(ComplianceSource& columns, const DofMap& dofs)
       : IncrementalCondensation(columns, dofs, Options{}) {}
+  /// A copy of `other` that reads `columns` instead: a copy of other's source, which has
+  /// state of its own (supported_compliance.h).
+  IncrementalCondensation(const IncrementalCondensation& other, ComplianceSource& columns)
+      : IncrementalCondensation(other) {
+    columns_ = &columns;
+  }
 
   const std::vector<int>& boundary_nodes() const { return b_nodes_; }
   int boundary_dof_count() const { return n_; }
@@ -106,7 +113,7 @@ class IncrementalCondensation {
   void compute_z(std::span<const int> nodes);
   Eigen::MatrixXd column_rows_at_boundary(int node);  // L[B dofs, free dofs of node]
 
-  ComplianceSource& columns_;
+  ComplianceSource* columns_;  // never null
   const DofMap& dofs_;
   Options options_;
   std::vector<int> b_nodes_;

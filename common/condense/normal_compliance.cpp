@@ -15,12 +15,10 @@ constexpr Eigen::Index kFirstCapacity = 64;
 }  // namespace
 
 NormalCompliance::NormalCompliance(ComplianceColumns& columns, const DofMap& dofs,
-                                   const Eigen::Matrix3Xd& directions,
                                    Eigen::Index expected_candidates)
     : columns_(columns),
       dofs_(dofs),
-      directions_(directions),
-      slot_of_node_(static_cast<std::size_t>(directions.cols()), -1) {
+      slot_of_node_(static_cast<std::size_t>(dofs.node_count()), -1) {
   grow(std::clamp(expected_candidates, kFirstCapacity, kMaxInitialCapacity));
 }
 
@@ -30,9 +28,9 @@ int NormalCompliance::slot_of(int node) const {
              : -1;
 }
 
-bool NormalCompliance::current(int node) const {
+bool NormalCompliance::current(int node, const Eigen::Vector3d& direction) const {
   const int slot = slot_of(node);
-  return slot >= 0 && slot_direction_.col(slot) == directions_.col(node);
+  return slot >= 0 && slot_direction_.col(slot) == direction;
 }
 
 void NormalCompliance::grow(Eigen::Index capacity) {
@@ -58,10 +56,9 @@ void NormalCompliance::grow(Eigen::Index capacity) {
   nonnegative_.resize(static_cast<std::size_t>(capacity), 1);
 }
 
-bool NormalCompliance::update(std::span<const int> nodes,
+bool NormalCompliance::update(std::span<const int> nodes, const Eigen::Matrix3Xd& directions,
                               const IncrementalCondensation& condensation,
                               const Eigen::VectorXd& boundary_displacement) {
-  condensation_ = &condensation;
   std::vector<char> wanted(slot_of_node_.size(), 0);
   for (int node : nodes) {
     if (node < 0 || node >= static_cast<int>(wanted.size()) ||
@@ -77,7 +74,8 @@ bool NormalCompliance::update(std::span<const int> nodes,
   // lowest free slot, or a new one.
   for (int slot = 0; slot < slot_count(); ++slot) {
     const int node = node_of_slot_[static_cast<std::size_t>(slot)];
-    if (node < 0 || (wanted[static_cast<std::size_t>(node)] && current(node))) continue;
+    if (node < 0 || (wanted[static_cast<std::size_t>(node)] && current(node, directions.col(node))))
+      continue;
     node_of_slot_[static_cast<std::size_t>(slot)] = -1;
     slot_of_node_[static_cast<std::size_t>(node)] = -1;
     free_slots_.push_back(slot);
@@ -103,7 +101,7 @@ bool NormalCompliance::update(std::span<const int> nodes,
     }
     node_of_slot_[static_cast<std::size_t>(slot)] = node;
     slot_of_node_[static_cast<std::size_t>(node)] = slot;
-    slot_direction_.col(slot) = directions_.col(node);
+    slot_direction_.col(slot) = directions.col(node);
     joined.push_back(slot);
   }
   std::sort(joined.begin(), joined.end());
@@ -124,7 +122,8 @@ bool NormalCompliance::update(std::span<const int> nodes,
   // A joining slot's W0 and P; with a new B, every slot's P (W0 is kept).
   add_columns(boundary_changed ? std::span<const int>(every_slot) : std::span<const int>(joined),
               joined);
-  condense(boundary_changed ? std::span<const int>(every_slot) : std::span<const int>(joined));
+  condense(boundary_changed ? std::span<const int>(every_slot) : std::span<const int>(joined),
+           condensation);
   free_clearance_.setZero();
   if (!boundary_dofs_.empty())
     for (int slot : every_slot) free_clearance_[slot] = q_.col(slot).dot(boundary_displacement);
@@ -163,13 +162,14 @@ void NormalCompliance::add_columns(std::span<const int> slots, std::span<const i
   }
 }
 
-void NormalCompliance::condense(std::span<const int> slots) {
+void NormalCompliance::condense(std::span<const int> slots,
+                                const IncrementalCondensation& condensation) {
   if (slots.empty()) return;
   Eigen::MatrixXd p_listed(p_.rows(), static_cast<Eigen::Index>(slots.size()));
   for (std::size_t i = 0; i < slots.size(); ++i)
     p_listed.col(static_cast<Eigen::Index>(i)) = p_.col(slots[i]);
   if (p_.rows() > 0) {
-    const Eigen::MatrixXd q_listed = condensation_->solve_boundary(p_listed);
+    const Eigen::MatrixXd q_listed = condensation.solve_boundary(p_listed);
     for (std::size_t i = 0; i < slots.size(); ++i)
       q_.col(slots[i]) = q_listed.col(static_cast<Eigen::Index>(i));
   }

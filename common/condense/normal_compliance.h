@@ -40,18 +40,20 @@ class NormalCompliance {
   /// many squared doubles (134 MB at 4096).
   static constexpr Eigen::Index kMaxInitialCapacity = 4096;
 
-  /// `columns`, `dofs` and `directions` (per volume node: the direction it is pushed along)
-  /// must outlive it; every candidate and every node of B must be a row node of `columns`.
-  /// `expected_candidates`: how many candidates there may be at once (the capacity made
-  /// now: at least 64, at most kMaxInitialCapacity).
+  /// `columns` and `dofs` must outlive it (a copy shares them: they do not change); every
+  /// candidate and every node of B must be a row node of `columns`. `expected_candidates`:
+  /// how many candidates there may be at once (the capacity made now: at least 64, at most
+  /// kMaxInitialCapacity).
   NormalCompliance(ComplianceColumns& columns, const DofMap& dofs,
-                   const Eigen::Matrix3Xd& directions, Eigen::Index expected_candidates = 0);
+                   Eigen::Index expected_candidates = 0);
 
-  /// The candidates become `nodes` (each once, none in B), under the held set of
-  /// `condensation` held at `boundary_displacement` (free dofs of B in its order). A node
-  /// whose direction changed since it took its slot leaves it and joins again. Returns
-  /// whether W changed between slots that stay (B changed): a factor kept over them is void.
-  bool update(std::span<const int> nodes, const IncrementalCondensation& condensation,
+  /// The candidates become `nodes` (each once, none in B), each pushed along its column of
+  /// `directions` (per volume node), under the held set of `condensation` held at
+  /// `boundary_displacement` (free dofs of B in its order). A node whose direction changed
+  /// since it took its slot leaves it and joins again. Returns whether W changed between
+  /// slots that stay (B changed): a factor kept over them is void.
+  bool update(std::span<const int> nodes, const Eigen::Matrix3Xd& directions,
+              const IncrementalCondensation& condensation,
               const Eigen::VectorXd& boundary_displacement);
 
   /// Slots [0, slot_count()) hold a candidate or are free; W is slot_count() square.
@@ -64,9 +66,9 @@ class NormalCompliance {
   int slot_of(int node) const;  ///< -1 if not a candidate
   /// The direction the slot's node was taken with.
   Eigen::Vector3d normal(int slot) const { return slot_direction_.col(slot); }
-  /// Whether `node` is a candidate taken along its current direction (false: it is none, or
-  /// the next update moves it to a new slot).
-  bool current(int node) const;
+  /// Whether `node` is a candidate taken along `direction` (false: it is none, or an update
+  /// with that direction moves it to a new slot).
+  bool current(int node, const Eigen::Vector3d& direction) const;
 
   /// W over the slots (capacity() square; free slots' rows and columns are zero but for a
   /// unit diagonal) [m/N].
@@ -81,21 +83,20 @@ class NormalCompliance {
   void grow(Eigen::Index capacity);
   /// P for the nodes in `slots`, and the rows and columns of W0 of those in `joined`.
   void add_columns(std::span<const int> slots, std::span<const int> joined);
-  /// W and Q for the pairs with a slot of `slots` (all pairs: every slot), from W0 and P.
-  void condense(std::span<const int> slots);
+  /// W and Q for the pairs with a slot of `slots` (all pairs: every slot), from W0 and P,
+  /// Q over B of `condensation`.
+  void condense(std::span<const int> slots, const IncrementalCondensation& condensation);
   /// The rows without a negative entry: all of them anew (`all`), or after `joined` slots.
   void find_nonnegative_rows(std::span<const int> joined, bool all);
 
   ComplianceColumns& columns_;
   const DofMap& dofs_;
-  const Eigen::Matrix3Xd& directions_;
   Eigen::Matrix3Xd slot_direction_;  // per slot: its node's direction when it joined
   std::vector<int> node_of_slot_;
   std::vector<int> slot_of_node_;  // per volume node
   std::vector<int> free_slots_;
   std::vector<int> boundary_;  // B as of the last update
   std::vector<int> boundary_dofs_;
-  const IncrementalCondensation* condensation_ = nullptr;
   Eigen::MatrixXd w0_, w_;  // capacity square
   Eigen::MatrixXd p_, q_;   // B's free dofs x capacity
   Eigen::VectorXd free_clearance_;

@@ -19,25 +19,24 @@ struct SimulationMaker {
   const std::vector<ToolSpec>& tools;
   const SimulationOptions& options;
   int object;
-  std::unique_ptr<BodySimulation> operator()(const ElasticBody& body) const {
+  BodySimulation operator()(const ElasticBody& body) const {
     if (!columns)
       throw Error(fmt::format(
           "scene simulation: no compliance columns for the linear elastic object '{}'", body.name));
-    return std::make_unique<BodySimulation>(std::in_place_type<Simulation>, body, model.obstacles,
-                                            *columns, tools, options);
+    return BodySimulation(std::in_place_type<Simulation>, body, model.obstacles, *columns, tools,
+                          options);
   }
-  std::unique_ptr<BodySimulation> operator()(const MassSpringModel& body) const {
-    return std::make_unique<BodySimulation>(std::in_place_type<MassSpringSimulation>, body, object,
-                                            tools, model.scene.haptic.force_limit_n,
-                                            1 / model.scene.haptic.rate_hz);
+  BodySimulation operator()(const MassSpringModel& body) const {
+    return BodySimulation(std::in_place_type<MassSpringSimulation>, body, object, tools,
+                          model.scene.haptic.force_limit_n, 1 / model.scene.haptic.rate_hz);
   }
-  std::unique_ptr<BodySimulation> operator()(const HomeSpringBody& body) const {
-    return std::make_unique<BodySimulation>(std::in_place_type<HomeSpringSimulation>, body, object,
-                                            tools, model.scene.haptic.force_limit_n);
+  BodySimulation operator()(const HomeSpringBody& body) const {
+    return BodySimulation(std::in_place_type<HomeSpringSimulation>, body, object, tools,
+                          model.scene.haptic.force_limit_n);
   }
-  std::unique_ptr<BodySimulation> operator()(const SeparationModel& body) const {
-    return std::make_unique<BodySimulation>(std::in_place_type<SeparationSimulation>, body, object,
-                                            tools, model.scene.haptic.force_limit_n);
+  BodySimulation operator()(const SeparationModel& body) const {
+    return BodySimulation(std::in_place_type<SeparationSimulation>, body, object, tools,
+                          model.scene.haptic.force_limit_n);
   }
 };
 
@@ -57,6 +56,7 @@ SceneSimulation::SceneSimulation(const Model& model, std::span<ComplianceColumns
   if (columns.size() != model.bodies.size())
     throw Error(fmt::format("scene simulation: {} compliance column sets for {} bodies",
                             columns.size(), model.bodies.size()));
+  bodies_.reserve(model.bodies.size());
   for (std::size_t i = 0; i < model.bodies.size(); ++i)
     bodies_.push_back(std::visit(
         SimulationMaker{model, columns[i], tools, options, static_cast<int>(i)}, model.bodies[i]));
@@ -103,9 +103,9 @@ void SceneSimulation::add_fem_pair(const InteractionSpec& spec, int front, int b
 void SceneSimulation::couple(FemPairInteraction& pair) {
   const auto front = static_cast<std::size_t>(pair.front);
   const auto behind = static_cast<std::size_t>(pair.behind);
-  couple_fem_pair(pair, std::get<Simulation>(*bodies_[front]),
+  couple_fem_pair(pair, std::get<Simulation>(bodies_[front]),
                   std::get<ElasticBody>(model_.bodies[front]), *columns_[front],
-                  std::get<Simulation>(*bodies_[behind]),
+                  std::get<Simulation>(bodies_[behind]),
                   std::get<ElasticBody>(model_.bodies[behind]), *columns_[behind]);
 }
 
@@ -125,7 +125,7 @@ bool SceneSimulation::condenses_over_support(int body_index) const {
 void SceneSimulation::run_interactions() {
   for (BodyInteraction& interaction : interactions_) {
     auto& front =
-        std::get<MassSpringSimulation>(*bodies_[static_cast<std::size_t>(interaction.front)]);
+        std::get<MassSpringSimulation>(bodies_[static_cast<std::size_t>(interaction.front)]);
     const auto& behind =
         std::get<ElasticBody>(model_.bodies[static_cast<std::size_t>(interaction.behind)]);
     front.set_backing(
@@ -181,13 +181,13 @@ void SceneSimulation::assign_bodies() {
     user.body = nearest;
     const std::uint64_t epoch = user.ir ? user.ir->ir.epoch : 0;
     std::visit([&](auto& simulation) { simulation.continue_epochs(u, epoch); },
-               *bodies_[static_cast<std::size_t>(nearest)]);
+               bodies_[static_cast<std::size_t>(nearest)]);
   }
 }
 
 void SceneSimulation::set_step_delay_nodes(int nodes) {
-  for (const std::unique_ptr<BodySimulation>& body : bodies_)
-    if (auto* fem = std::get_if<Simulation>(body.get())) fem->set_step_delay_nodes(nodes);
+  for (BodySimulation& body : bodies_)
+    if (auto* fem = std::get_if<Simulation>(&body)) fem->set_step_delay_nodes(nodes);
 }
 
 StepReport SceneSimulation::step(double time) {
@@ -198,7 +198,7 @@ StepReport SceneSimulation::step(double time) {
   run_interactions();
   StepReport report;
   for (int b = 0; b < body_count(); ++b) {
-    BodySimulation& simulation = *bodies_[static_cast<std::size_t>(b)];
+    BodySimulation& simulation = bodies_[static_cast<std::size_t>(b)];
     std::visit(
         [&](auto& body_simulation) {
           for (int u = 0; u < user_count(); ++u) {
@@ -238,17 +238,17 @@ ForceSample SceneSimulation::force(int user) {
                  [&](MassSpringSimulation& network) { return network.force(user, period_); },
                  [&](HomeSpringSimulation& tissue) { return tissue.force(user); },
                  [&](SeparationSimulation& layers) { return layers.force(user); }},
-      *bodies_[static_cast<std::size_t>(body_of(user))]);
+      bodies_[static_cast<std::size_t>(body_of(user))]);
 }
 
 const Simulation& SceneSimulation::single_elastic() const {
   single_elastic_body(model_);  // throws naming the scene when it is not one linear elastic object
-  return std::get<Simulation>(*bodies_.front());
+  return std::get<Simulation>(bodies_.front());
 }
 
 Simulation& SceneSimulation::single_elastic() {
   single_elastic_body(model_);
-  return std::get<Simulation>(*bodies_.front());
+  return std::get<Simulation>(bodies_.front());
 }
 
 }  // namespace cohaptic

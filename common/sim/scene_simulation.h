@@ -1,7 +1,9 @@
 // SceneSimulation: the server's simulation of a whole scene, one body simulation per scene
 // object (BodySimulation: the condensed FEM body's Simulation, a MassSpringSimulation, a
 // HomeSpringSimulation or a SeparationSimulation),
-// with no threads or sockets. It is what the server loop and the replay step.
+// with no threads or sockets. It is what the server loop and the replay step. A copy shares
+// the model and the compliance columns and owns every body's state: it steps bit for bit as
+// the original would, whichever runs first.
 //
 // Each user is on one body at a time: the body whose touchable surface is nearest its tool
 // (the FEM body's at rest, a dynamic body's in its current state). A user changes body only
@@ -77,8 +79,8 @@ class SceneSimulation {
   /// The body `user` is on.
   int body_of(int user) const { return users_[static_cast<std::size_t>(user)].body; }
 
-  const BodySimulation& body(int i) const { return *bodies_[static_cast<std::size_t>(i)]; }
-  BodySimulation& body(int i) { return *bodies_[static_cast<std::size_t>(i)]; }
+  const BodySimulation& body(int i) const { return bodies_[static_cast<std::size_t>(i)]; }
+  BodySimulation& body(int i) { return bodies_[static_cast<std::size_t>(i)]; }
   /// The FEM simulation of a scene whose only object is linear elastic (the display and the
   /// live view show that body); throws Error (single_elastic_body's) otherwise.
   const Simulation& single_elastic() const;
@@ -115,7 +117,7 @@ class SceneSimulation {
   double distance_to_body(int body, const Eigen::Vector3d& point) const;
 
   const Model& model_;
-  std::vector<std::unique_ptr<BodySimulation>> bodies_;
+  std::vector<BodySimulation> bodies_;
   std::vector<UserState> users_;
   std::vector<ComplianceColumns*> columns_;  // per body, null unless linear elastic
   std::vector<BodyInteraction> interactions_;

@@ -47,7 +47,7 @@ Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstac
     if (!sphere_model()) clearance_ = ObstacleClearance(obstacles_, surface_points);
   }
   if (sphere_model()) {
-    sphere_solve_ = std::make_unique<SphereStateSolve>(
+    sphere_solve_.emplace(
         body, columns,
         obstacles_.empty() ? std::vector<SphereConstraint>{}
                            : obstacle_constraints(body.mesh, body.surface, body.dofs, obstacles_));
@@ -90,21 +90,19 @@ std::vector<Eigen::Vector3d> Simulation::boundary_displacement(
 }
 
 void Simulation::set_support(std::unique_ptr<SupportedCompliance> support) {
-  supported_condensation_.reset();  // it reads the old support
-  support_ = std::move(support);
-  if (support_) {
+  supported_.reset();
+  if (support) {
     IncrementalCondensation::Options options;
     options.naive = options_.naive_every_step;
-    supported_condensation_ =
-        std::make_unique<IncrementalCondensation>(*support_, body_.dofs, options);
+    supported_.emplace(std::move(support), body_.dofs, options);
   }
   support_changed_ = true;
 }
 
 IncrementalCondensation& Simulation::ir_condensation() {
-  if (!supported_condensation_) return condensation_;
-  supported_condensation_->set_boundary_nodes(condensation_.boundary_nodes());
-  return *supported_condensation_;
+  if (!supported_) return condensation_;
+  supported_->condensation().set_boundary_nodes(condensation_.boundary_nodes());
+  return supported_->condensation();
 }
 
 Eigen::VectorXd Simulation::boundary_dof_displacement() const {
@@ -456,8 +454,8 @@ StepReport Simulation::build_irs(double time) {
     IncrementalCondensation& condensation = ir_condensation();
     const std::vector<Eigen::Vector3d> held = boundary_displacement(condensation);
     RestDisplacement rest_displacement;  // the support's load at rest, if any
-    if (support_ && support_->loads_at_rest())
-      rest_displacement = [support = support_.get()](std::span<const int> dofs) {
+    if (supported_ && supported_->support().loads_at_rest())
+      rest_displacement = [support = &supported_->support()](std::span<const int> dofs) {
         return support->rest_displacement(dofs);
       };
     SphereIrSource sphere;

@@ -29,7 +29,9 @@
 // loads applied in every state solve, and may set a support (this body's compliance with the
 // other body folded in on the nodes that push on it, supported_compliance.h) that the IRs
 // condense over from then on; a change of support rebuilds them, as a change of the sets
-// does. Units: SI.
+// does. A copy shares the body and the compliance columns (a cache of what does not change)
+// and owns the rest, a support and its condensation included: it steps bit for bit as the
+// original would, apart from it (tests/test_simulation_copy.cpp). Units: SI.
 #pragma once
 
 #include <Eigen/Core>
@@ -129,7 +131,9 @@ class Simulation {
   void set_support(std::unique_ptr<SupportedCompliance> support);
   /// The support the IRs condense over, or null: while there is one, their M~ is not of the
   /// body's own L (compliance rows of L would not give it).
-  const SupportedCompliance* support() const { return support_.get(); }
+  const SupportedCompliance* support() const {
+    return supported_ ? &supported_->support() : nullptr;
+  }
   /// Displacement of `nodes` (row nodes) in the current state [m].
   Eigen::Matrix3Xd displacement_of(std::span<const int> nodes);
 
@@ -167,6 +171,25 @@ class Simulation {
     bool changed = false;           ///< B changed
     double elapsed_ms = 0;          ///< updating B took
     int nodes_outside_patches = 0;  ///< StepReport::sphere_nodes_outside_patches
+  };
+  /// The support the IRs condense over (set_support) and their condensation over it; a copy
+  /// condenses over a copy of the support.
+  class CondensationOverSupport {
+   public:
+    CondensationOverSupport(std::unique_ptr<SupportedCompliance> support, const DofMap& dofs,
+                            IncrementalCondensation::Options options)
+        : support_(std::move(support)), condensation_(*support_, dofs, options) {}
+    CondensationOverSupport(const CondensationOverSupport& other)
+        : support_(std::make_unique<SupportedCompliance>(*other.support_)),
+          condensation_(other.condensation_, *support_) {}
+    CondensationOverSupport& operator=(const CondensationOverSupport&) = delete;
+
+    SupportedCompliance& support() const { return *support_; }
+    IncrementalCondensation& condensation() { return condensation_; }
+
+   private:
+    std::unique_ptr<SupportedCompliance> support_;  // never null; where condensation_ reads
+    IncrementalCondensation condensation_;
   };
   struct HeldNode {
     Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
@@ -230,8 +253,7 @@ class Simulation {
   std::vector<PressingContact> previous_contacts_;     // the pressing contacts of the previous step
   std::vector<SphereTool>
       previous_spheres_;  // the sphere model's: the spheres of the previous step
-  std::unique_ptr<SphereStateSolve>
-      sphere_solve_;  // the sphere model's state solve, kept step to step
+  std::optional<SphereStateSolve> sphere_solve_;  // the sphere model's, kept step to step
   std::vector<std::optional<EvaluationState>>
       p0_states_;  // per user: force()'s evaluation of its IR, made at its first call
   // step()'s scratch: the known tools, their nearest triangles and sphere-held nodes, the
@@ -240,11 +262,10 @@ class Simulation {
   std::vector<int> step_nearest_;
   std::vector<bool> under_tool_, in_patch_;
   bool boundary_dirty_ = false;
-  AppliedLoads applied_;                                             // see set_applied_loads
-  std::optional<HeldSetUpdate> held_set_update_;                     // until build_irs()
-  std::unique_ptr<SupportedCompliance> support_;                     // see set_support
-  std::unique_ptr<IncrementalCondensation> supported_condensation_;  // over *support_
-  bool support_changed_ = false;  // since the IRs were last built
+  AppliedLoads applied_;                              // see set_applied_loads
+  std::optional<HeldSetUpdate> held_set_update_;      // until build_irs()
+  std::optional<CondensationOverSupport> supported_;  // see set_support
+  bool support_changed_ = false;                      // since the IRs were last built
 };
 
 }  // namespace cohaptic

@@ -40,7 +40,7 @@ SphereStateSolve::SphereStateSolve(const ElasticBody& body, ComplianceColumns& c
       obstacle_(std::move(obstacles)),
       obstacle_nodes_(obstacle_nodes_of(obstacle_)),
       directions_(body.contact_normals),
-      normal_(columns, body.dofs, directions_, candidate_bound(touchable_, obstacle_nodes_)),
+      normal_(columns, body.dofs, candidate_bound(touchable_, obstacle_nodes_)),
       contact_(static_cast<int>(normal_.capacity())) {}
 
 void SphereStateSolve::set_candidates(const std::vector<int>& nodes,
@@ -53,9 +53,10 @@ void SphereStateSolve::set_candidates(const std::vector<int>& nodes,
   const std::vector<int> members(contact_.members().begin(), contact_.members().end());
   for (int slot : members) {
     const int node = normal_.node_of(slot);
-    if (!wanted[static_cast<std::size_t>(node)] || !normal_.current(node)) contact_.remove(slot);
+    if (!wanted[static_cast<std::size_t>(node)] || !normal_.current(node, directions_.col(node)))
+      contact_.remove(slot);
   }
-  const bool w_changed = normal_.update(nodes, condensation, boundary_displacement);
+  const bool w_changed = normal_.update(nodes, directions_, condensation, boundary_displacement);
   if (w_changed || contact_.capacity() < normal_.capacity()) {
     const std::vector<int> kept(contact_.members().begin(), contact_.members().end());
     if (contact_.capacity() < normal_.capacity())

@@ -63,8 +63,6 @@ class SphereStateSolve {
   /// obstacle constraint (obstacle_constraints.h), or empty for none.
   SphereStateSolve(const ElasticBody& body, ComplianceColumns& columns,
                    std::vector<SphereConstraint> obstacles = {});
-  SphereStateSolve(const SphereStateSolve&) = delete;  // normal_ refers to directions_
-  SphereStateSolve& operator=(const SphereStateSolve&) = delete;
 
   /// The state with `spheres` pressing, over the candidates `patch_nodes` (any order,
   /// repeats allowed; nodes in B or that the model cannot hold are left out), u_B over the
