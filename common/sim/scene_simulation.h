@@ -3,7 +3,7 @@
 // HomeSpringSimulation or a SeparationSimulation),
 // with no threads or sockets. It is what the server loop and the replay step. A copy shares
 // the model and the compliance columns and owns every body's state: it steps bit for bit as
-// the original would, whichever runs first.
+// the original would, whichever runs first (one at a time: steps fill the shared columns).
 //
 // Each user is on one body at a time: the body whose touchable surface is nearest its tool
 // (the FEM body's at rest, a dynamic body's in its current state). A user changes body only

@@ -31,7 +31,8 @@
 // condense over from then on; a change of support rebuilds them, as a change of the sets
 // does. A copy shares the body and the compliance columns (a cache of what does not change)
 // and owns the rest, a support and its condensation included: it steps bit for bit as the
-// original would, apart from it (tests/test_simulation_copy.cpp). Units: SI.
+// original would, apart from it (tests/test_simulation_copy.cpp), though not at the same time
+// on another thread, as steps fill the shared columns. Units: SI.
 #pragma once
 
 #include <Eigen/Core>
