@@ -291,6 +291,27 @@ TEST(ViewServer, AStalledBrowserGetsNothingNewWhileItsQueueIsFullAndTheOthersGet
   EXPECT_GT(counters.dropped, static_cast<std::uint64_t>(kFrames / 2));
 }
 
+// A browser skipped while its queue is full gets the newest frame once it reads again, though
+// nothing more is published.
+TEST(ViewServer, ABrowserThatFellBehindGetsTheNewestOnceItReadsAgain) {
+  view::ViewServerOptions options = local_options();
+  options.max_buffered_bytes = 64 * 1024;
+  view::ViewServer server(options);
+  server.publish(view::Channel::scene, "scene");
+  server.start();
+  testing::StalledWebSocket browser("127.0.0.1", server.port());
+  ASSERT_TRUE(browser.upgraded());
+  const std::string payload(100 * 1024, 'x');  // 3 MB in all: more than its socket holds
+  for (int k = 1; k <= 30; ++k) {
+    server.publish(view::Channel::frame, std::to_string(k) + payload);
+    std::this_thread::sleep_for(1ms);
+  }
+  server.publish(view::Channel::frame, "last");
+  std::this_thread::sleep_for(100ms);  // "last" finds the browser busy
+  EXPECT_TRUE(browser.read_until_message("last", 10s));
+  EXPECT_GT(server.counters().dropped, 0u);  // it was skipped: frames were dropped for it
+}
+
 // As many browsers as the server takes, none reading, while 1 MB frames are published: each
 // frame is held once for all of them, so the server's memory grows by a few frames, not by
 // a queue per browser (64 queues of 2 MB and more, were each frame copied per browser).

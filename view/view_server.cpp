@@ -29,6 +29,9 @@ using websocketpp::connection_hdl;
 constexpr auto kCloseGrace = std::chrono::milliseconds(200);
 /// After an accept() that failed (out of file descriptors, say), the wait before the next.
 constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
+/// While a browser is too busy for the newest messages, the wait before offering them again:
+/// nothing else would, were nothing more published.
+constexpr auto kCatchUpRetry = std::chrono::milliseconds(5);
 /// The kernel's send buffer of a browser's socket: a browser that stops reading holds at
 /// most this in the kernel (and max_buffered_bytes, shared with the others, in the server).
 constexpr int kBrowserSendBufferBytes = 256 << 10;
@@ -62,6 +65,7 @@ struct ViewServer::Impl {
   asio::io_context io;
   WsServer server;
   asio::steady_timer accept_retry{io};
+  asio::steady_timer catch_up{io};
   std::int64_t last_accept_warning_ns = 0;
   std::uint16_t port = 0;
   std::thread thread;
@@ -75,6 +79,8 @@ struct ViewServer::Impl {
   std::atomic<int> connected{0};  // browsers, for watched()
 
   // The server's thread only.
+  bool stopped_serving = false;  // stop() has begun closing the browsers
+  bool catch_up_armed = false;
   std::map<connection_hdl, Browser, std::owner_less<connection_hdl>> browsers;
 
   mutable std::mutex counters_mutex;
@@ -234,7 +240,8 @@ struct ViewServer::Impl {
   }
 
   // Each browser gets the newest message of each channel it has not had, scene first;
-  // one still busy with earlier messages gets nothing new.
+  // one still busy with earlier messages gets nothing new until it has caught up, when the
+  // catch-up timer offers it whatever is newest then.
   void flush() {
     flush_pending = false;
     std::array<std::shared_ptr<const std::string>, kChannels> messages;
@@ -246,6 +253,7 @@ struct ViewServer::Impl {
     }
     if (!messages[static_cast<std::size_t>(Channel::scene)]) return;
     std::uint64_t sent = 0, bytes = 0, dropped = 0;
+    bool someone_busy = false;
     std::array<WsServer::message_ptr, kChannels>
         frames;  // framed on first use, shared by every browser
     for (auto& [hdl, browser] : browsers) {
@@ -260,8 +268,10 @@ struct ViewServer::Impl {
           browser.accounted[channel] = sequences[channel] - 1;
         }
         if (channel != static_cast<std::size_t>(Channel::scene) &&
-            connection->get_buffered_amount() > options.max_buffered_bytes)
-          continue;  // caught up later, with whatever is newest then
+            connection->get_buffered_amount() > options.max_buffered_bytes) {
+          someone_busy = true;
+          continue;
+        }
         if (!frames[channel]) frames[channel] = prepared_frame(connection, *messages[channel]);
         error = connection->send(frames[channel]);
         if (error) break;
@@ -275,6 +285,14 @@ struct ViewServer::Impl {
       c.bytes_sent += bytes;
       c.dropped += dropped;
     });
+    if (someone_busy && !catch_up_armed && !stopped_serving) {
+      catch_up_armed = true;
+      catch_up.expires_after(kCatchUpRetry);
+      catch_up.async_wait([this](const asio::error_code& error) {
+        catch_up_armed = false;
+        if (!error) flush();
+      });
+    }
   }
 };
 
@@ -295,6 +313,8 @@ void ViewServer::stop() {
     websocketpp::lib::error_code error;
     s.server.stop_listening(error);
     s.accept_retry.cancel();
+    s.stopped_serving = true;
+    s.catch_up.cancel();
     for (const auto& [hdl, browser] : s.browsers)
       s.server.close(hdl, websocketpp::close::status::going_away, "server stopped", error);
     auto timer = std::make_shared<asio::steady_timer>(s.io, kCloseGrace);

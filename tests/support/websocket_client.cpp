@@ -4,6 +4,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <websocketpp/client.hpp>
 #include <websocketpp/config/asio_no_tls_client.hpp>
@@ -152,13 +153,18 @@ void WebSocketClient::count_only() {
 struct StalledWebSocket::Impl {
   asio::io_context io;
   asio::ip::tcp::socket socket{io};
+  std::string unread;  // received, not yet parsed into frames
 };
 
 StalledWebSocket::StalledWebSocket(const std::string& host, std::uint16_t port)
     : impl_(std::make_unique<Impl>()) {
-  impl_->socket.connect({asio::ip::make_address(host), port});
-  // The smallest receive buffer, so that the server's sends back up soon.
+  const asio::ip::tcp::endpoint server(asio::ip::make_address(host), port);
+  // The smallest receive buffer, so that the server's sends back up soon; set before the
+  // connection, whose window it bounds: shrunk after, the kernel drops what the window let in
+  // beyond it, and the server's retransmissions back off for seconds once it reads again.
+  impl_->socket.open(server.protocol());
   impl_->socket.set_option(asio::socket_base::receive_buffer_size(4096));
+  impl_->socket.connect(server);
   const std::string request =
       "GET /ws HTTP/1.1\r\nHost: " + host + ":" + std::to_string(port) +
       "\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
@@ -166,11 +172,67 @@ StalledWebSocket::StalledWebSocket(const std::string& host, std::uint16_t port)
   asio::write(impl_->socket, asio::buffer(request));
   std::string response;
   asio::error_code error;
-  asio::read_until(impl_->socket, asio::dynamic_buffer(response), "\r\n\r\n", error);
+  const std::size_t head =
+      asio::read_until(impl_->socket, asio::dynamic_buffer(response), "\r\n\r\n", error);
   upgraded_ = !error && response.rfind("HTTP/1.1 101", 0) == 0;
+  if (upgraded_) impl_->unread = response.substr(head);  // frames read with the response
 }
 
 StalledWebSocket::~StalledWebSocket() = default;
+
+namespace {
+
+// The payload of the first whole frame at the front of `bytes` (a server's frames are not
+// masked), removed from it; nullopt while the frame is incomplete.
+std::optional<std::string> take_frame(std::string& bytes) {
+  if (bytes.size() < 2) return std::nullopt;
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(bytes[k]); };
+  std::size_t header = 2;
+  std::uint64_t length = byte(1) & 0x7f;
+  if (length >= 126) {
+    header = length == 126 ? 4 : 10;
+    if (bytes.size() < header) return std::nullopt;
+    length = 0;
+    for (std::size_t k = 2; k < header; ++k) length = length << 8 | byte(k);
+  }
+  if (bytes.size() - header < length) return std::nullopt;
+  std::string payload = bytes.substr(header, length);
+  bytes.erase(0, header + length);
+  return payload;
+}
+
+}  // namespace
+
+bool StalledWebSocket::read_until_message(const std::string& wanted,
+                                          std::chrono::milliseconds timeout) {
+  Impl& s = *impl_;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  std::vector<char> chunk(64 * 1024);
+  for (;;) {
+    while (const std::optional<std::string> payload = take_frame(s.unread))
+      if (*payload == wanted) return true;
+    const auto left = deadline - std::chrono::steady_clock::now();
+    if (left <= std::chrono::steady_clock::duration::zero()) return false;
+    asio::error_code error;
+    std::size_t received = 0;
+    bool done = false;
+    s.socket.async_read_some(asio::buffer(chunk), [&](const asio::error_code& e, std::size_t n) {
+      error = e;
+      received = n;
+      done = true;
+    });
+    s.io.restart();
+    s.io.run_for(left);
+    if (!done) {  // timed out: cancel the read and let its handler run before returning
+      s.socket.cancel();
+      s.io.restart();
+      s.io.run();
+      return false;
+    }
+    if (error) return false;
+    s.unread.append(chunk.data(), received);
+  }
+}
 
 std::string http_get(const std::string& host, std::uint16_t port, const std::string& path) {
   return http_exchange(

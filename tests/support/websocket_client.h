@@ -51,14 +51,17 @@ class WebSocketClient {
   std::unique_ptr<Impl> impl_;
 };
 
-/// A browser that completes the WebSocket handshake on `host`:`port` at /ws and then never
-/// reads: the server's sends pile up in the socket until it stops sending to it.
+/// A browser that completes the WebSocket handshake on `host`:`port` at /ws and then does not
+/// read until told to: the server's sends pile up in the socket until it stops sending to it.
 class StalledWebSocket {
  public:
   StalledWebSocket(const std::string& host, std::uint16_t port);
   ~StalledWebSocket();
   /// Whether the server answered the handshake with 101.
   bool upgraded() const { return upgraded_; }
+  /// Reads at last: the server's frames, until one whose payload is `wanted` (true), or the
+  /// connection ends or `timeout` passes first (false).
+  bool read_until_message(const std::string& wanted, std::chrono::milliseconds timeout);
 
  private:
   struct Impl;
