@@ -41,18 +41,15 @@ Simulation::Simulation(const ElasticBody& body, std::span<const Obstacle> obstac
   users_.resize(tools.size());
   for (std::size_t u = 0; u < users_.size(); ++u) users_[u].radius = tools[u].radius;
   p0_states_.resize(users_.size());
+  Eigen::Matrix3Xd surface_points;
   if (!obstacles.empty()) {
-    const Eigen::Matrix3Xd surface_points = surface_rest_points(body.mesh, body.surface);
+    surface_points = surface_rest_points(body.mesh, body.surface);
     for (const Obstacle& obstacle : obstacles) obstacles_.emplace_back(obstacle, surface_points);
-    if (!sphere_model()) clearance_ = ObstacleClearance(obstacles_, surface_points);
   }
-  if (sphere_model()) {
-    sphere_solve_.emplace(
-        body, columns,
-        obstacles_.empty() ? std::vector<SphereConstraint>{}
-                           : obstacle_constraints(body.mesh, body.surface, body.dofs, obstacles_));
-    node_of_tag_ = node_indices_by_tag(body.mesh);
-  }
+  if (options.ir.contact_model == ContactModel::sphere)
+    contacts_.emplace<SphereContacts>(body, columns, obstacles_, users_.size());
+  else if (!obstacles_.empty())
+    contacts_.emplace<TriangleContacts>(obstacles_, surface_points);
 }
 
 void Simulation::set_tool(int user, const Eigen::Vector3d& position) {
@@ -137,13 +134,17 @@ StateSolution Simulation::solve(std::span<const PressingContact> contacts) {
 }
 
 StateSolution Simulation::solve() {
-  return sphere_model() ? solve_spheres(spheres()) : solve(pressing_contacts());
+  return with_contacts([&](auto& contacts) { return contacts.solve(*this); });
 }
 
 StateSolution Simulation::solve_unloaded() {
-  if (sphere_model()) return solve_spheres(spheres());  // in no FEM pair (refused), so never loaded
-  return solve_state(columns_, condensation_, body_.dofs, pressing_contacts(),
-                     boundary_dof_displacement(), options_.ir.contact_model);
+  return with_contacts([&](auto& contacts) { return contacts.solve_unloaded(*this); });
+}
+
+const std::vector<NodeDistance>& Simulation::nodes_near_obstacles() const {
+  return with_contacts([](const auto& contacts) -> const std::vector<NodeDistance>& {
+    return contacts.near_obstacles();
+  });
 }
 
 std::vector<SphereTool> Simulation::spheres() const {
@@ -153,164 +154,8 @@ std::vector<SphereTool> Simulation::spheres() const {
   return out;
 }
 
-StateSolution Simulation::solve_spheres(std::span<const SphereTool> spheres) {
-  std::vector<int> candidates;
-  for (const UserState& user : users_)
-    if (user.known)
-      candidates.insert(candidates.end(), user.sphere_nodes.begin(), user.sphere_nodes.end());
-  return sphere_solve_->solve(condensation_, candidates, spheres, boundary_dof_displacement());
-}
-
-bool Simulation::sphere_irs_stand() const {
-  if (built_sphere_rows_.empty()) return false;
-  // A node must be a row of the IRs, pushed along the direction its slot had then: only
-  // where it is held or pushed does the direction matter (elsewhere it pushes nothing).
-  const NormalCompliance& normal = sphere_solve_->normal_compliance();
-  const auto stands = [&](int node) {
-    if (!built_sphere_rows_[static_cast<std::size_t>(node)]) return false;
-    const int slot = normal.slot_of(node);
-    const auto built =
-        std::lower_bound(built_row_directions_.begin(), built_row_directions_.end(), node,
-                         [](const auto& entry, int n) { return entry.first < n; });
-    return slot < 0 || built == built_row_directions_.end() || built->first != node ||
-           normal.normal(slot) == built->second;
-  };
-  for (const UserState& user : users_) {
-    if (!user.known) continue;
-    for (const std::vector<int>* nodes : {&user.sphere_holds, &user.sphere_carried})
-      if (!std::ranges::all_of(*nodes, stands)) return false;
-  }
-  return std::ranges::all_of(sphere_solve_->obstacle_contacts(), stands);
-}
-
-void Simulation::mark_sphere(UserState& user, std::vector<bool>& under_tool,
-                             std::vector<bool>& in_patch,
-                             const std::vector<bool>& touchable) const {
-  const SphereTool sphere{user.position, user.radius};
-  const int rings = options_.ir.patch_rings;
-  user.sphere_patch_nodes =
-      triangle_nodes(body_.surface, sphere_patch(body_.mesh, body_.surface, body_.surface_tree,
-                                                 user.nearest, sphere, rings, touchable));
-  // Carried nodes the patch now holds anyway are no longer carried.
-  std::erase_if(user.sphere_carried, [&](int node) {
-    return std::find(user.sphere_patch_nodes.begin(), user.sphere_patch_nodes.end(), node) !=
-           user.sphere_patch_nodes.end();
-  });
-  const std::vector<int> nodes =
-      user.sphere_carried.empty()
-          ? user.sphere_patch_nodes
-          : triangle_nodes(body_.surface,
-                           sphere_patch(body_.mesh, body_.surface, body_.surface_tree, user.nearest,
-                                        sphere, rings, touchable, user.sphere_carried));
-  for (int node : nodes) under_tool[node] = in_patch[node] = true;
-  user.sphere_nodes = nodes;
-  user.sphere_holds = nodes_held_by_spheres(body_.mesh, body_.dofs, body_.contact_normals, nodes,
-                                            std::span(&sphere, 1))
-                          .nodes;
-  user.pressing = !user.sphere_holds.empty() || !user.sphere_carried.empty();
-}
-
-bool Simulation::carry_pushed_nodes_into_patches(std::vector<bool>& under_tool,
-                                                 std::vector<bool>& in_patch,
-                                                 HeldSetUpdate& update) {
-  constexpr int kMaxCarryPasses = 4;  // each pass only adds nodes; in practice one settles it
-  std::vector<int> user_of_sphere;    // spheres() lists the known users in order
-  for (std::size_t u = 0; u < users_.size(); ++u)
-    if (users_[u].known) user_of_sphere.push_back(static_cast<int>(u));
-  const std::vector<SphereTool> tools = spheres();
-  bool boundary_changed = false;
-  for (int pass = 0;; ++pass) {
-    const StateSolution state = solve();
-    // The pushed nodes of this state, each with the user whose sphere pushes it, that no
-    // patch holds (a node in another user's patch is a contact node of this user's IR too).
-    std::vector<int> pushed;
-    std::vector<std::pair<int, int>> left_out;
-    const std::span<const int> obstacle_rows = sphere_solve_->obstacle_rows();
-    for (std::size_t i = 0; i < state.contact_dofs.size(); ++i) {
-      const int node = state.contact_dofs[i] / 3;
-      if (state.contact_forces[static_cast<Eigen::Index>(i)] == 0.0 ||
-          (!pushed.empty() && pushed.back() == node))
-        continue;  // not pushed, or its other axes
-      pushed.push_back(node);
-      if (in_patch[node] || std::binary_search(obstacle_rows.begin(), obstacle_rows.end(), node))
-        continue;
-      const SphereConstraint constraint =
-          sphere_constraint(body_.mesh.nodes.col(node), body_.contact_normals.col(node),
-                            body_.dofs.fixed_axes[node], tools)
-              .value();
-      left_out.emplace_back(node, user_of_sphere[static_cast<std::size_t>(constraint.tool)]);
-    }
-    if (left_out.empty()) {
-      // A carried node the state no longer pushes leaves its patch from the next step on.
-      for (UserState& user : users_)
-        std::erase_if(user.sphere_carried, [&](int node) {
-          return std::find(pushed.begin(), pushed.end(), node) == pushed.end();
-        });
-      return boundary_changed;
-    }
-    if (pass == kMaxCarryPasses) {
-      update.nodes_outside_patches = static_cast<int>(left_out.size());
-      return boundary_changed;
-    }
-    for (const auto& [node, user] : left_out)
-      users_[static_cast<std::size_t>(user)].sphere_carried.push_back(node);
-    for (const auto& [node, user] : left_out)
-      mark_sphere(users_[static_cast<std::size_t>(user)], under_tool, in_patch,
-                  touchable_triangle_);
-    boundary_changed |= update_boundary(under_tool, in_patch);
-  }
-}
-
 Eigen::Matrix3Xd Simulation::displacement_of(std::span<const int> nodes) {
   return displacement_of_nodes(columns_, solve(), nodes);
-}
-
-bool Simulation::update_obstacle_contacts(const std::vector<bool>& under_tool) {
-  const StateSolution state = solve();
-  // Held nodes whose obstacle would have to pull (holding force into the obstacle) go free.
-  std::vector<int> pulling;
-  for (std::size_t b = 0, dof = 0; b < condensation_.boundary_nodes().size(); ++b) {
-    const int node = condensation_.boundary_nodes()[b];
-    Eigen::Vector3d force = Eigen::Vector3d::Zero();
-    for (int axis = 0; axis < 3; ++axis)
-      if (!body_.dofs.is_fixed(node, axis))
-        force[axis] = state.boundary_forces[static_cast<Eigen::Index>(dof++)];
-    const HeldNode& held = held_.at(node);
-    if (held.obstacle < 0) continue;
-    const Eigen::Vector3d at = body_.mesh.nodes.col(node) + held.displacement;
-    if (force.dot(obstacles_[held.obstacle].closest_point(at).normal) < 0) pulling.push_back(node);
-  }
-  // Free nodes whose displaced position penetrates an obstacle are held on it. Only nodes
-  // that may have reached one since their last query are queried (ObstacleClearance).
-  const Eigen::Matrix3Xd u = displacement_of_nodes(columns_, state, body_.surface.nodes);
-  near_obstacles_.clear();  // as of this pass's state
-  std::vector<std::pair<int, HeldNode>> penetrating;
-  for (std::size_t i = 0; i < body_.surface.nodes.size(); ++i) {
-    const int node = body_.surface.nodes[i];
-    if (held_.count(node) || under_tool[node] || body_.dofs.fixed_axes[node] == kAllAxes) continue;
-    const Eigen::Vector3d rest = body_.mesh.nodes.col(node);
-    const Eigen::Vector3d moved = rest + u.col(static_cast<Eigen::Index>(i));
-    if (const double estimate = clearance_.estimate(i, moved);
-        estimate < options_.near_obstacle_distance && !columns_.has_column(node))
-      near_obstacles_.push_back({node, estimate});
-    if (clearance_.certainly_clear(i, moved)) continue;
-    ObstaclePoint nearest{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
-                          std::numeric_limits<double>::infinity(), -1};
-    for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
-      const ObstaclePoint hit = obstacles_[o].closest_point(moved);
-      if (hit.signed_distance < nearest.signed_distance) nearest = hit;
-      if (hit.signed_distance >= 0) continue;
-      penetrating.push_back({node, {hit.point - rest, o}});
-      break;
-    }
-    clearance_.record(i, moved, nearest.signed_distance, nearest.normal);
-  }
-  for (int node : pulling) release(node);
-  std::vector<int> joining;
-  for (const auto& entry : penetrating) joining.push_back(entry.first);
-  columns_.compute_columns(joining);  // one multi-right-hand-side solve for all that join
-  for (const auto& [node, held] : penetrating) hold(node, held);
-  return !pulling.empty() || !penetrating.empty();
 }
 
 void Simulation::set_step_delay_nodes(int nodes) {
@@ -327,8 +172,9 @@ void Simulation::release_step_delay_nodes() {
   for (int node : step_nodes) release(node);
 }
 
-bool Simulation::update_boundary(const std::vector<bool>& under_tool,
-                                 const std::vector<bool>& in_patch) {
+bool Simulation::update_boundary() {
+  const std::vector<bool>& under_tool = under_tool_;
+  const std::vector<bool>& in_patch = in_patch_;
   boundary_dirty_ = false;
   const std::vector<int> current = condensation_.boundary_nodes();
   for (int node : current)
@@ -351,18 +197,13 @@ bool Simulation::update_boundary(const std::vector<bool>& under_tool,
       if (!held_.count(node)) fresh.push_back(node);
     // Held where they were before the touch: the previous step's state.
     const Eigen::Matrix3Xd u = displacement_of_nodes(
-        columns_, sphere_model() ? solve_spheres(previous_spheres_) : solve(previous_contacts_),
+        columns_, with_contacts([&](auto& contacts) { return contacts.solve_previous(*this); }),
         fresh);
     for (std::size_t i = 0; i < fresh.size(); ++i)
       hold(fresh[i], {u.col(static_cast<Eigen::Index>(i)), -1});
   } else if (contact_points.empty() && step_delay_held) {
     release_step_delay_nodes();
   }
-
-  // Under the sphere contact model the state solve holds the obstacles' nodes itself.
-  for (int pass = 0; pass < options_.obstacle_iterations && !obstacles_.empty() && !sphere_model();
-       ++pass)
-    if (!update_obstacle_contacts(under_tool)) break;
   return boundary_dirty_;
 }
 
@@ -382,7 +223,7 @@ void Simulation::find_contacts() {
     UserState& user = users_[u];
     if (!user.known) {
       user.pressing = false;
-      user.sphere_carried.clear();
+      with_contacts([&](auto& contacts) { contacts.forget(static_cast<int>(u)); });
       user.contact.reset();
       user.ir.reset();
       continue;
@@ -402,7 +243,7 @@ void Simulation::find_contacts() {
       for (int t :
            contact_patch(body_.surface, user.nearest, options_.ir.patch_rings, touchable_triangle_))
         for (int node : body_.surface.triangles[t]) in_patch[node] = true;
-    if (sphere_model()) mark_sphere(user, under_tool, in_patch, touchable_triangle_);
+    with_contacts([&](auto& contacts) { contacts.mark(*this, static_cast<int>(u)); });
   }
 }
 
@@ -410,9 +251,8 @@ void Simulation::update_held_set() {
   find_contacts();
   Stopwatch watch;
   HeldSetUpdate update;
-  update.changed = update_boundary(under_tool_, in_patch_);
-  if (sphere_model())
-    update.changed |= carry_pushed_nodes_into_patches(under_tool_, in_patch_, update);
+  update.changed = update_boundary();
+  update.changed |= with_contacts([&](auto& contacts) { return contacts.settle(*this, update); });
   update.elapsed_ms = watch.elapsed_ms();
   held_set_update_ = update;
 }
@@ -430,14 +270,14 @@ StepReport Simulation::build_irs(double time) {
   nearest.clear();
   for (std::size_t u = 0; u < users_.size(); ++u) {
     const UserState& user = users_[u];
-    // A sphere that holds nothing follows its nearest triangle, so that its IR is there when
-    // it touches; once it holds nodes, their being row nodes is what counts (below).
+    const int slot = static_cast<int>(u);
     const bool follows_nearest =
-        !sphere_model() || (user.sphere_holds.empty() && user.sphere_carried.empty());
+        with_contacts([&](const auto& contacts) { return contacts.follows_nearest(slot); });
     nearest.push_back(!user.known ? -1 : follows_nearest ? user.nearest : kHoldingSphere);
     if (user.known)
       tools.push_back(
-          {static_cast<int>(u), user.position, user.radius, user.nearest, user.sphere_carried});
+          {slot, user.position, user.radius, user.nearest,
+           with_contacts([&](const auto& contacts) { return contacts.carried(slot); })});
   }
   // Under naive_every_step M~ is computed again every step, as the paper's conventional loop
   // did (that cost is the step delay), but with unchanged sets it is the same IR: a new one
@@ -448,8 +288,9 @@ StepReport Simulation::build_irs(double time) {
   // pushed along the direction it had at the build (its normal compliance does not depend
   // on where they are): it is rebuilt when one is not, or when a sphere holding nothing
   // comes nearest another triangle.
-  const bool sets_changed = update.changed || support_changed || nearest != built_nearest_ ||
-                            (sphere_model() && !sphere_irs_stand());
+  const bool sets_changed =
+      update.changed || support_changed || nearest != built_nearest_ ||
+      !with_contacts([&](const auto& contacts) { return contacts.irs_stand(*this); });
   if (sets_changed || options_.naive_every_step) {
     IncrementalCondensation& condensation = ir_condensation();
     const std::vector<Eigen::Vector3d> held = boundary_displacement(condensation);
@@ -458,13 +299,8 @@ StepReport Simulation::build_irs(double time) {
       rest_displacement = [support = &supported_->support()](std::span<const int> dofs) {
         return support->rest_displacement(dofs);
       };
-    SphereIrSource sphere;
-    if (sphere_model()) {
-      sphere = {&sphere_solve_->normal_compliance(), sphere_solve_->contact_slots(),
-                sphere_solve_->obstacle_rows(), sphere_solve_->obstacle_constraints()};
-      if (sets_changed)
-        built_sphere_rows_.assign(static_cast<std::size_t>(body_.mesh.node_count()), 0);
-    }
+    const SphereIrSource sphere =
+        with_contacts([&](auto& contacts) { return contacts.ir_source(*this, sets_changed); });
     // One user's IR, prepared (and so checked) when the sets changed.
     struct BuiltIr {
       std::shared_ptr<const PreparedIR> ir;
@@ -481,10 +317,10 @@ StepReport Simulation::build_irs(double time) {
       return built;
     };
     std::vector<BuiltIr> built(tools.size());
-    if (sphere_model() && tools.size() > 1) {
-      // A sphere IR is cut from W and the body alone (neither the condensation nor a
-      // support's load is touched), so the users' IRs are built side by side, one thread per
-      // further user, joined here: a rebuild that changes every IR costs about one build.
+    if (with_contacts(
+            [&](const auto& contacts) { return contacts.builds_side_by_side(tools.size()); })) {
+      // One thread per further user, joined here: a rebuild that changes every IR costs about
+      // one build.
       std::vector<std::future<BuiltIr>> others;
       for (std::size_t i = 1; i < tools.size(); ++i)
         others.push_back(std::async(std::launch::async, build, i));
@@ -498,33 +334,22 @@ StepReport Simulation::build_irs(double time) {
       UserState& user = users_[tools[i].user];
       ++user.epoch;
       report.ir_bytes += built[i].bytes;
-      if (sphere_model())
-        for (const std::int64_t tag : condensed_fem(built[i].ir->ir).node_ids)
-          built_sphere_rows_[static_cast<std::size_t>(node_of_tag_.at(tag))] = 1;
+      with_contacts([&](auto& contacts) { contacts.built(*this, *built[i].ir); });
       user.ir = std::move(built[i].ir);
       // force() makes its evaluation state when first asked: a P1 session without a view
       // never asks, and the IR leaves for its client without waiting for one.
       p0_states_[static_cast<std::size_t>(tools[i].user)].reset();
     }
     built_nearest_ = nearest;
-    if (sphere_model() && sets_changed) {
-      built_row_directions_.clear();
-      const NormalCompliance& normal = sphere_solve_->normal_compliance();
-      for (int node = 0; node < body_.mesh.node_count(); ++node)
-        if (const int slot =
-                built_sphere_rows_[static_cast<std::size_t>(node)] ? normal.slot_of(node) : -1;
-            slot >= 0)
-          built_row_directions_.emplace_back(node, normal.normal(slot));
-    }
+    if (sets_changed) with_contacts([&](auto& contacts) { contacts.built_all(*this); });
     report.rebuilt = sets_changed;
     report.recomputed = true;
   }
   report.rebuild_ms = update.elapsed_ms + watch.elapsed_ms();
-  previous_contacts_ = pressing_contacts();
-  previous_spheres_ = spheres();
+  with_contacts([&](auto& contacts) { contacts.remember_step(*this); });
   report.boundary_nodes = static_cast<int>(condensation_.boundary_nodes().size());
-  for (const auto& [node, held] : held_) report.obstacle_nodes += held.obstacle >= 0;
-  if (sphere_model()) report.obstacle_nodes = sphere_solve_->obstacle_pushed();
+  report.obstacle_nodes =
+      with_contacts([&](const auto& contacts) { return contacts.obstacle_nodes(*this); });
   return report;
 }
 

@@ -21,6 +21,11 @@
 //      sphere holds under the sphere contact model, or B): M~ depends
 //      only on the sets, so it is not rebuilt otherwise (`naive_every_step` computes it
 //      every step all the same, for its cost, and publishes it only when a set changed).
+// The contact model is chosen once, at construction: the triangle models' part of a step
+// (the obstacles' active set) or the sphere model's (its state solve, the nodes its spheres
+// hold and carry, what its IRs hold) is one alternative of `contacts_`, and every place a
+// step differs between them is a member both alternatives have, reached by std::visit, so
+// that a model without one does not compile.
 // force() evaluates a user's force from its IR and the current tool positions: the P0
 // protocol's server-side force, the same function the P1 client runs. surface
 // displacement() solves the whole state for display.
@@ -40,6 +45,7 @@
 #include <optional>
 #include <span>
 #include <unordered_map>
+#include <variant>
 #include <vector>
 
 #include "common/condense/incremental_condensation.h"
@@ -143,7 +149,7 @@ class Simulation {
   /// in the last step's last obstacle pass, with that estimate: should one reach the
   /// obstacle, the step that holds it solves its columns first. A caller may have them
   /// solved ahead (the server's CompliancePrefetch). Empty under the sphere contact model.
-  const std::vector<NodeDistance>& nodes_near_obstacles() const { return near_obstacles_; }
+  const std::vector<NodeDistance>& nodes_near_obstacles() const;
 
   const IncrementalCondensation& condensation() const { return condensation_; }
   /// u of each node of condensation().boundary_nodes(), in that order [m].
@@ -157,13 +163,6 @@ class Simulation {
     int nearest = -1;
     std::optional<ToolContact> contact;
     bool pressing = false;
-    std::vector<int> sphere_holds;  ///< sphere contact model: the nodes its sphere holds at rest
-    /// Sphere contact model: nodes outside its sphere at rest that the state has it push and
-    /// that its patch would not hold otherwise; their triangles join the patch.
-    std::vector<int> sphere_carried;
-    std::vector<int>
-        sphere_patch_nodes;         ///< its patch's nodes without the carried nodes' triangles
-    std::vector<int> sphere_nodes;  ///< its patch's nodes with them: its candidates
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
   };
@@ -196,31 +195,127 @@ class Simulation {
     Eigen::Vector3d displacement = Eigen::Vector3d::Zero();
     int obstacle = -1;  ///< the obstacle holding it, or -1 for a step-delay node
   };
+
+  /// The node translation and point contact models' own part of a step: a tool presses its
+  /// nearest triangle, rigid obstacles hold the nodes that reach them in B (an active set),
+  /// and the step delay's nodes are held in the previous step's state of pressing contacts.
+  /// Each member takes the simulation it is part of (it keeps no pointer to it, so that a
+  /// copied simulation's copy is its own).
+  class TriangleContacts {
+   public:
+    TriangleContacts() = default;
+    TriangleContacts(std::span<const ObstacleDistance> obstacles,
+                     const Eigen::Matrix3Xd& surface_points);
+    void forget(int /*user*/) {}
+    void mark(Simulation& /*s*/, int /*user*/) {}
+    /// After B's update: the obstacles' active-set passes. Whether B changed.
+    bool settle(Simulation& s, HeldSetUpdate& update);
+    StateSolution solve(Simulation& s) const;
+    StateSolution solve_unloaded(Simulation& s) const;
+    StateSolution solve_previous(Simulation& s) const;  ///< the previous step's state
+    bool follows_nearest(int /*user*/) const { return true; }
+    std::vector<int> carried(int /*user*/) const { return {}; }
+    bool irs_stand(const Simulation& /*s*/) const { return true; }
+    SphereIrSource ir_source(const Simulation& /*s*/, bool /*sets_changed*/) { return {}; }
+    bool builds_side_by_side(std::size_t /*tools*/) const { return false; }
+    void built(const Simulation& /*s*/, const PreparedIR& /*ir*/) {}
+    void built_all(const Simulation& /*s*/) {}
+    void remember_step(const Simulation& s);
+    int obstacle_nodes(const Simulation& s) const;
+    const std::vector<NodeDistance>& near_obstacles() const { return near_obstacles_; }
+
+   private:
+    /// One active-set pass: held nodes whose obstacle would pull go free, free nodes that
+    /// penetrate one are held on it. Whether B changed.
+    bool update_obstacle_contacts(Simulation& s);
+
+    ObstacleClearance clearance_;  // per surface node: where it was last found clear of them
+    std::vector<NodeDistance> near_obstacles_;  // see nodes_near_obstacles()
+    std::vector<PressingContact> previous_contacts_;
+  };
+
+  /// The sphere contact model's own part of a step: each sphere holds the nodes of its patch
+  /// it pushes, the obstacles are unilateral constraints of its state solve (kept from step
+  /// to step), and an IR stands while it holds every node held, carried or pushed by an
+  /// obstacle along the direction it had at the build. Takes its simulation as
+  /// TriangleContacts does.
+  class SphereContacts {
+   public:
+    SphereContacts(const ElasticBody& body, ComplianceColumns& columns,
+                   std::span<const ObstacleDistance> obstacles, std::size_t users);
+    /// The user's tool is not known: it carries nothing.
+    void forget(int user) { users_[static_cast<std::size_t>(user)].carried.clear(); }
+    /// The user's patch's nodes are under its tool and in its patch (its candidates); it
+    /// presses when its sphere holds or carries a node.
+    void mark(Simulation& s, int user);
+    /// After B's update: nodes the state has a sphere push that its user's patch leaves out
+    /// (a bulge carried them in, beyond the rings) join that patch, B is updated again and the
+    /// state solved again. Whether B changed; counts in `update` the pushed nodes still left
+    /// out after kMaxCarryPasses passes.
+    bool settle(Simulation& s, HeldSetUpdate& update);
+    StateSolution solve(Simulation& s) { return solve(s, s.spheres()); }
+    /// In no FEM pair (refused), so never loaded.
+    StateSolution solve_unloaded(Simulation& s) { return solve(s); }
+    StateSolution solve_previous(Simulation& s) { return solve(s, previous_spheres_); }
+    /// A sphere that holds nothing follows its nearest triangle, so that its IR is there when
+    /// it touches; once it holds nodes, their being row nodes is what counts (irs_stand).
+    bool follows_nearest(int user) const;
+    std::vector<int> carried(int user) const {
+      return users_[static_cast<std::size_t>(user)].carried;
+    }
+    /// Whether the IRs last built stand: they hold every node a sphere holds or carries now
+    /// and every obstacle contact, each pushed along its direction at the build.
+    bool irs_stand(const Simulation& s) const;
+    SphereIrSource ir_source(const Simulation& s, bool sets_changed);
+    /// A sphere IR is cut from W and the body alone (neither the condensation nor a support's
+    /// load is touched), so the users' IRs are built side by side.
+    bool builds_side_by_side(std::size_t tools) const { return tools > 1; }
+    void built(const Simulation& s, const PreparedIR& ir);
+    void built_all(const Simulation& s);
+    void remember_step(const Simulation& s) { previous_spheres_ = s.spheres(); }
+    int obstacle_nodes(const Simulation& /*s*/) const { return solve_.obstacle_pushed(); }
+    const std::vector<NodeDistance>& near_obstacles() const;
+
+   private:
+    struct User {
+      std::vector<int> holds;  ///< the nodes its sphere holds at rest
+      /// Nodes outside its sphere at rest that the state has it push and that its patch
+      /// would not hold otherwise; their triangles join the patch.
+      std::vector<int> carried;
+      std::vector<int> patch_nodes;  ///< its patch's nodes without the carried nodes' triangles
+      std::vector<int> nodes;        ///< its patch's nodes with them: its candidates
+    };
+    StateSolution solve(Simulation& s, std::span<const SphereTool> spheres);
+
+    SphereStateSolve solve_;                             // kept step to step
+    std::unordered_map<std::int64_t, int> node_of_tag_;  // to read the IRs' row nodes
+    std::vector<User> users_;
+    std::vector<char> built_rows_;  // per node: a row node of the IRs last built
+    /// Those rows' nodes with a slot, ascending, and its direction then.
+    std::vector<std::pair<int, Eigen::Vector3d>> built_row_directions_;
+    std::vector<SphereTool> previous_spheres_;  // the spheres of the previous step
+  };
+
+  /// Runs `f` on the contact model's part of the step.
+  template <class F>
+  decltype(auto) with_contacts(F&& f) {
+    return std::visit(std::forward<F>(f), contacts_);
+  }
+  template <class F>
+  decltype(auto) with_contacts(F&& f) const {
+    return std::visit(std::forward<F>(f), contacts_);
+  }
+
   /// The contacts stage: each known tool's nearest triangle, whether it presses, a sphere's
   /// patch; the nodes under the tools and in their patches (under_tool_, in_patch_).
   void find_contacts();
   std::vector<PressingContact> pressing_contacts() const;
   StateSolution solve(std::span<const PressingContact> contacts);
-  bool sphere_model() const { return options_.ir.contact_model == ContactModel::sphere; }
   void release_step_delay_nodes();
-  /// The sphere contact model's part of a user's step: its patch's nodes are under the tool
-  /// and in the patch (its candidates), and it presses when its sphere holds a node.
-  void mark_sphere(UserState& user, std::vector<bool>& under_tool, std::vector<bool>& in_patch,
-                   const std::vector<bool>& touchable) const;
-  /// The sphere model's check of the patches against the solved state: a node that the
-  /// state has a sphere push and that its user's patch leaves out (a bulge carried it in,
-  /// beyond the rings) joins that patch, B is updated again, and the state solved again.
-  /// Returns whether B changed; counts in `update` the pushed nodes still left out after
-  /// kMaxCarryPasses passes.
-  bool carry_pushed_nodes_into_patches(std::vector<bool>& under_tool, std::vector<bool>& in_patch,
-                                       HeldSetUpdate& update);
   std::vector<SphereTool> spheres() const;  ///< every known user's tool
-  StateSolution solve_spheres(std::span<const SphereTool> spheres);
-  /// Sphere model: whether the IRs last built stand: they hold every node a sphere holds or
-  /// carries now and every obstacle contact, each pushed along its direction at the build.
-  bool sphere_irs_stand() const;
-  bool update_boundary(const std::vector<bool>& under_tool, const std::vector<bool>& in_patch);
-  bool update_obstacle_contacts(const std::vector<bool>& under_tool);
+  /// B after the tools' contacts: their triangles' nodes freed, the step delay's nodes held
+  /// or released. Whether B changed.
+  bool update_boundary();
   /// The condensation the IRs are built over: the support's, with B synchronised, or the body's.
   IncrementalCondensation& ir_condensation();
   std::vector<Eigen::Vector3d> boundary_displacement(
@@ -240,21 +335,10 @@ class Simulation {
   std::vector<int> surface_candidates_,
       touchable_candidates_;              // their scratch, reused step to step
   std::vector<bool> touchable_triangle_;  // per surface triangle
-  ObstacleClearance clearance_;  // per surface node: where it was last found clear of the obstacles
-  std::vector<NodeDistance> near_obstacles_;  // see nodes_near_obstacles()
   std::unordered_map<int, HeldNode> held_;
   std::vector<UserState> users_;
   std::vector<int> built_nearest_;  // nearest triangles the IRs were built for
-  std::vector<char>
-      built_sphere_rows_;  // per node: a row node of the IRs last built (sphere model)
-  std::vector<std::pair<int, Eigen::Vector3d>>
-      built_row_directions_;  // sphere model: those rows' nodes with a slot, ascending, and its
-                              // direction then
-  std::unordered_map<std::int64_t, int> node_of_tag_;  // sphere model: to read the IRs' row nodes
-  std::vector<PressingContact> previous_contacts_;     // the pressing contacts of the previous step
-  std::vector<SphereTool>
-      previous_spheres_;  // the sphere model's: the spheres of the previous step
-  std::optional<SphereStateSolve> sphere_solve_;  // the sphere model's, kept step to step
+  std::variant<TriangleContacts, SphereContacts> contacts_;  // the contact model's part
   std::vector<std::optional<EvaluationState>>
       p0_states_;  // per user: force()'s evaluation of its IR, made at its first call
   // step()'s scratch: the known tools, their nearest triangles and sphere-held nodes, the
