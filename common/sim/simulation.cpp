@@ -11,7 +11,6 @@
 #include "common/contact/find_contact.h"
 #include "common/contact/nearest_surface_nodes.h"
 #include "common/contact/obstacle_constraints.h"
-#include "common/sim/sphere_state_solve.h"
 #include "common/util/error.h"
 #include "common/util/stopwatch.h"
 

@@ -21,11 +21,12 @@
 //      sphere holds under the sphere contact model, or B): M~ depends
 //      only on the sets, so it is not rebuilt otherwise (`naive_every_step` computes it
 //      every step all the same, for its cost, and publishes it only when a set changed).
-// The contact model is chosen once, at construction: the triangle models' part of a step
-// (the obstacles' active set) or the sphere model's (its state solve, the nodes its spheres
-// hold and carry, what its IRs hold) is one alternative of `contacts_`, and every place a
-// step differs between them is a member both alternatives have, reached by std::visit, so
-// that a model without one does not compile.
+// The contact model is chosen once, at construction: the triangle models' state (the
+// obstacles' active set, the previous step's contacts) or the sphere model's (its state
+// solve, the nodes its spheres hold and carry, what its IRs hold) is one alternative of
+// `contacts_`, and every place a step differs between them is a member both alternatives
+// have, reached by std::visit, so that a model without one does not compile. What both
+// models read (the tools' nearest triangles, B) stays in Simulation.
 // force() evaluates a user's force from its IR and the current tool positions: the P0
 // protocol's server-side force, the same function the P1 client runs. surface
 // displacement() solves the whole state for display.
@@ -247,7 +248,7 @@ class Simulation {
     void forget(int user) { users_[static_cast<std::size_t>(user)].carried.clear(); }
     /// The user's patch's nodes are under its tool and in its patch (its candidates); it
     /// presses when its sphere holds or carries a node.
-    void mark(Simulation& s, int user);
+    void mark(Simulation& s, int user_slot);
     /// After B's update: nodes the state has a sphere push that its user's patch leaves out
     /// (a bulge carried them in, beyond the rings) join that patch, B is updated again and the
     /// state solved again. Whether B changed; counts in `update` the pushed nodes still left
@@ -341,8 +342,8 @@ class Simulation {
   std::variant<TriangleContacts, SphereContacts> contacts_;  // the contact model's part
   std::vector<std::optional<EvaluationState>>
       p0_states_;  // per user: force()'s evaluation of its IR, made at its first call
-  // step()'s scratch: the known tools, their nearest triangles and sphere-held nodes, the
-  // nodes under them and in their patches.
+  // step()'s scratch: the known tools, their nearest triangles (kHoldingSphere for a sphere
+  // holding nodes), the nodes under them and in their patches.
   std::vector<UserTool> step_tools_;
   std::vector<int> step_nearest_;
   std::vector<bool> under_tool_, in_patch_;

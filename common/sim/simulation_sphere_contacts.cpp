@@ -1,9 +1,9 @@
 // The sphere contact model's part of Simulation's step (simulation.h).
+#include "common/sim/simulation.h"
+
 #include <algorithm>
 
-#include "common/contact/contact_patch.h"
 #include "common/contact/obstacle_constraints.h"
-#include "common/sim/simulation.h"
 
 namespace cohaptic {
 
@@ -150,7 +150,9 @@ void Simulation::SphereContacts::built_all(const Simulation& s) {
 }
 
 const std::vector<NodeDistance>& Simulation::SphereContacts::near_obstacles() const {
-  static const std::vector<NodeDistance> none;  // its state solve holds the obstacles' nodes
+  // Its state solve holds the obstacles' nodes, so none is ever near: one empty list, const,
+  // shared by every simulation.
+  static const std::vector<NodeDistance> none;
   return none;
 }
 

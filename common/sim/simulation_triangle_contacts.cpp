@@ -1,7 +1,7 @@
 // The node translation and point contact models' part of Simulation's step (simulation.h).
-#include <limits>
-
 #include "common/sim/simulation.h"
+
+#include <limits>
 
 namespace cohaptic {
 

@@ -29,7 +29,7 @@
 //
 // The nodal forces lambda n then give f_B and any node's displacement as for the other models
 // (state_solve.h). A node a sphere pushes outside the patches makes the simulation widen
-// that user's patch (Simulation::carry_pushed_nodes_into_patches). Units: m, N. Not
+// that user's patch (Simulation::SphereContacts::settle). Units: m, N. Not
 // thread-safe.
 #pragma once
 
