@@ -12,6 +12,7 @@
 #include <cmath>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 #include "common/model/shown_surface.h"
@@ -258,14 +259,27 @@ TEST(ViewServer, AMalformedOrOversizedMessageClosesThatBrowserAndNothingElse) {
             3u);  // the oversized one websocketpp closes itself
 }
 
-TEST(ViewServer, AStalledBrowserGetsNothingNewWhileItsQueueIsFullAndTheOthersGetTheNewest) {
-  view::ViewServerOptions options = local_options();
-  options.max_buffered_bytes = 64 * 1024;
-  view::ViewServer server(options);
-  server.publish(view::Channel::scene, "scene");
-  server.start();
-  testing::StalledWebSocket stalled("127.0.0.1", server.port());
-  ASSERT_TRUE(stalled.upgraded());
+// A view server that skips a browser with more than 64 kB waiting for it, its scene
+// published, and a browser connected to it that does not read (until told to).
+class ViewServerWithAStalledBrowser : public ::testing::Test {
+ protected:
+  static view::ViewServerOptions small_queue_options() {
+    view::ViewServerOptions options = local_options();
+    options.max_buffered_bytes = 64 * 1024;
+    return options;
+  }
+  void SetUp() override {
+    server.publish(view::Channel::scene, "scene");
+    server.start();
+    stalled.emplace("127.0.0.1", server.port());
+    ASSERT_TRUE(stalled->upgraded());
+  }
+
+  view::ViewServer server{small_queue_options()};
+  std::optional<testing::StalledWebSocket> stalled;
+};
+
+TEST_F(ViewServerWithAStalledBrowser, ItGetsNothingNewWhileItsQueueIsFullAndTheOthersGetTheNewest) {
   WebSocketClient reader(data_url(server));
   ASSERT_TRUE(reader.wait_open(10s));
   reader.count_only();  // 40 MB
@@ -293,14 +307,7 @@ TEST(ViewServer, AStalledBrowserGetsNothingNewWhileItsQueueIsFullAndTheOthersGet
 
 // A browser skipped while its queue is full gets the newest frame once it reads again, though
 // nothing more is published.
-TEST(ViewServer, ABrowserThatFellBehindGetsTheNewestOnceItReadsAgain) {
-  view::ViewServerOptions options = local_options();
-  options.max_buffered_bytes = 64 * 1024;
-  view::ViewServer server(options);
-  server.publish(view::Channel::scene, "scene");
-  server.start();
-  testing::StalledWebSocket browser("127.0.0.1", server.port());
-  ASSERT_TRUE(browser.upgraded());
+TEST_F(ViewServerWithAStalledBrowser, OnceItReadsAgainItGetsTheNewest) {
   const std::string payload(100 * 1024, 'x');  // 3 MB in all: more than its socket holds
   for (int k = 1; k <= 30; ++k) {
     server.publish(view::Channel::frame, std::to_string(k) + payload);
@@ -308,7 +315,7 @@ TEST(ViewServer, ABrowserThatFellBehindGetsTheNewestOnceItReadsAgain) {
   }
   server.publish(view::Channel::frame, "last");
   std::this_thread::sleep_for(100ms);  // "last" finds the browser busy
-  EXPECT_TRUE(browser.read_until_message("last", 10s));
+  EXPECT_TRUE(stalled->read_until_message("last", 10s));
   EXPECT_GT(server.counters().dropped, 0u);  // it was skipped: frames were dropped for it
 }
 
