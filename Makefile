@@ -142,6 +142,10 @@ results:
 	  $(LAB) hertz --element nodal_pressure_tet --poisson-ratio 0.45 --out docs/results/hertz-nu045
 	tests/results_page.sh docs/results/tradeoff-cube/tradeoff.md \
 	  $(MAKE) --no-print-directory tradeoff TRADEOFF_OUT=docs/results/tradeoff-cube
+	tests/results_page.sh docs/results/tradeoff-brain/tradeoff.md \
+	  $(LAB) tradeoff --scene scenes/tradeoff/brain.yaml --reference-scene scenes/tradeoff/brain_fine.yaml \
+	  --motion scenes/tradeoff/brain_press_slide.yaml --motion scenes/tradeoff/brain_press_hold.yaml \
+	  --sample-rate-hz 1000 --out docs/results/tradeoff-brain
 	tests/results_page.sh docs/results/stability/stability.md $(LAB) stability --out docs/results/stability
 	tests/results_page.sh docs/results/objects-push/objects_push_in_time.md \
 	  $(LAB) objects-push --in-time --out docs/results/objects-push

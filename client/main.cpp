@@ -1,5 +1,5 @@
 // cohaptic-client: a haptic client. Joins a cohaptic-server session, runs the haptic loop
-// against a device at its rate, and writes a report at the end. See README.md.
+// against a device at its rate, and writes a report at the end. See docs/client.md.
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 

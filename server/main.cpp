@@ -1,6 +1,7 @@
 // cohaptic-server: the networked simulation server.
 //   cohaptic-server --scene FILE --listen HOST:PORT [...]   serve a scene to haptic clients
-// The offline tools (probe, replay, study, ...) are cohaptic-lab's. See README.md for every option.
+// The offline tools (probe, replay, study, ...) are cohaptic-lab's. Every option:
+// docs/server.md.
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 

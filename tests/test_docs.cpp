@@ -4,6 +4,8 @@
 //   - every heading cited on the README (README and the heading in quotes) is one of its headings;
 //   - every relative Markdown link of a page lands on a file, and on a heading of it when it
 //     names an anchor.
+// Every page of docs/results/ says which command writes it, is stamped, and is made again by
+// `make results`.
 // And the tree describes what is built, not how it came to be: no line dates itself by a
 // numbered stage of the project's development, names another engineer's build or speaks of
 // the code as it was before a change (what changed and when goes in CHANGELOG.md, the one
@@ -120,6 +122,15 @@ std::string line_at(const TextFile& file, std::size_t index) {
   return file.relative.generic_string() + ":" + std::to_string(index + 1);
 }
 
+// Line `index` of a file as the sentence before it reads on: without its comment marker
+// (`//`, `#`, `*`) and the blanks around it; empty past the end.
+std::string continued_text(const TextFile& file, std::size_t index) {
+  if (index >= file.lines.size()) return "";
+  static const std::regex kCommentMarker(R"(^\s*(//+|#+|\*+)?\s*)");
+  return std::regex_replace(file.lines[index], kCommentMarker, "",
+                            std::regex_constants::format_first_only);
+}
+
 TEST(Docs, AnchorsAreGitHubsForHeadingsWithCodePunctuationAndDashes) {
   EXPECT_EQ(anchor_of("Study files"), "study-files");
   EXPECT_EQ(anchor_of("`cohaptic-lab probe`"), "cohaptic-lab-probe");
@@ -150,8 +161,16 @@ TEST(Docs, EveryCitedPageHeadingAndLinkExists) {
     const bool markdown = file.relative.extension() == ".md";
     for (std::size_t i = 0; i < file.lines.size(); ++i) {
       const std::string& line = file.lines[i];
+      // A citation may wrap: its heading read on with the next line, and counted on the
+      // line where it starts.
+      const std::string read_on = line + " " + continued_text(file, i + 1);
+      const auto starts_on_line = [&](const std::smatch& m) {
+        return static_cast<std::size_t>(m.position(0)) < line.size();
+      };
       if (line.find("docs/") != std::string::npos) {
-        for (std::sregex_iterator m(line.begin(), line.end(), kPageCitation), end; m != end; ++m) {
+        for (std::sregex_iterator m(read_on.begin(), read_on.end(), kPageCitation), end; m != end;
+             ++m) {
+          if (!starts_on_line(*m)) continue;
           ++citations;
           const fs::path page = kTreeRoot / (*m)[1].str();
           if (!fs::exists(page))
@@ -161,8 +180,9 @@ TEST(Docs, EveryCitedPageHeadingAndLinkExists) {
         }
       }
       if (line.find("README") != std::string::npos) {
-        for (std::sregex_iterator m(line.begin(), line.end(), kReadmeCitation), end; m != end;
-             ++m) {
+        for (std::sregex_iterator m(read_on.begin(), read_on.end(), kReadmeCitation), end;
+             m != end; ++m) {
+          if (!starts_on_line(*m)) continue;
           ++citations;
           check_heading(kTreeRoot / "README.md", (*m)[1], "", line_at(file, i));
         }
@@ -186,6 +206,42 @@ TEST(Docs, EveryCitedPageHeadingAndLinkExists) {
   }
   EXPECT_GT(citations, 100u) << "the walk found too few citations to be reading the tree";
   EXPECT_TRUE(broken.empty()) << ::testing::PrintToString(broken);
+}
+
+// A measured figure in the manual stands on a page of docs/results/ that a command makes:
+// each page names its command near its top, ends with the stamp tests/results_stamp.sh
+// writes (commit, date, machine), and is one that `make results` makes again.
+TEST(Docs, EveryResultsPageNamesItsCommandIsStampedAndIsMadeAgainByMakeResults) {
+  std::ifstream makefile_in(kTreeRoot / "Makefile");
+  std::stringstream makefile;
+  makefile << makefile_in.rdbuf();
+  const std::string recipes = makefile.str();
+  const std::size_t recipe_start = recipes.find("\nresults:");
+  ASSERT_NE(recipe_start, std::string::npos) << "the Makefile has no results target";
+  // The recipe ends at the first empty line.
+  const std::string results_recipe =
+      recipes.substr(recipe_start, recipes.find("\n\n", recipe_start) - recipe_start);
+  std::size_t pages = 0;
+  std::vector<std::string> faults;
+  for (const TextFile& file : project_text_files()) {
+    const std::string path = file.relative.generic_string();
+    if (path.rfind("docs/results/", 0) != 0 || file.relative.extension() != ".md") continue;
+    ++pages;
+    const std::size_t top = std::min<std::size_t>(file.lines.size(), 5);
+    if (std::none_of(file.lines.begin(), file.lines.begin() + static_cast<std::ptrdiff_t>(top),
+                     [](const std::string& line) {
+                       return line.find("writes this page") != std::string::npos;
+                     }))
+      faults.push_back(path + ": its first lines do not say which command writes this page");
+    const auto last = std::find_if(file.lines.rbegin(), file.lines.rend(),
+                                   [](const std::string& line) { return !line.empty(); });
+    if (last == file.lines.rend() || last->rfind("_Measured at commit ", 0) != 0)
+      faults.push_back(path + ": it does not end with tests/results_stamp.sh's stamp");
+    if (results_recipe.find(path) == std::string::npos)
+      faults.push_back(path + ": `make results` does not make it again");
+  }
+  EXPECT_GE(pages, 10u) << "the walk found too few results pages to be reading docs/results/";
+  EXPECT_TRUE(faults.empty()) << ::testing::PrintToString(faults);
 }
 
 TEST(Docs, NoLineDatesItselfByTheProjectsDevelopment) {

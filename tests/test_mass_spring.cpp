@@ -29,7 +29,8 @@
 namespace cohaptic {
 namespace {
 
-constexpr double kRadius = 0.005;  // the paper's geometry, as Table 1 implies (README)
+// Eq. 1 fixes only E r: with the paper's E, this radius gives its Table 1's springs.
+constexpr double kRadius = 0.005;
 constexpr double kSpacing = 0.0022245;
 constexpr double kYoungsModulus = 737.4;  // [Pa]
 constexpr double kG = 9.81;
@@ -564,8 +565,8 @@ TEST(MassSpringStatics, BentTubeKeepsItsVolumeWithinTwoPercent) {
 // holds the rest back, so the tube bends around the tool (the driven node follows the tool,
 // tool_coupling.h). The tube is 10 times stiffer than the paper's and its springs damped at
 // alpha = 1e-4 s: the paper's E = 737 Pa tube, flattened to half its height by its own
-// weight, is crushed by the tool (its volume falls to about a quarter; README, "What to set
-// for a drag by a tool"). At the paper's alpha = 1e-6 s the stiffer tube bends alike (middle
+// weight, is crushed by the tool (its volume falls to about a quarter; docs/mass-spring.md,
+// what to set for a drag by a tool). At the paper's alpha = 1e-6 s the stiffer tube bends alike (middle
 // 10.15 mm, ends 5.95 mm, volume ratio 0.9961, measured once).
 TEST(MassSpringStatics, TubeBentByAToolKeepsItsVolumeWithinTwoPercent) {
   const int sections = 20;

@@ -1,5 +1,5 @@
-// The scene's description of a laparoscopy tissue (`model: home_spring`, README.md,
-// "Laparoscopic instruments") and of an instrument tool (`shape: probe` or `shape:
+// The scene's description of a laparoscopy tissue (`model: home_spring`,
+// docs/laparoscopy.md) and of an instrument tool (`shape: probe` or `shape:
 // forceps`), as loaded: plain data, validated by the scene loader (parse_home_spring.h).
 //
 // The tissue is a triangle surface (a FreeSurfer .asc file, or a generated horizontal grid

@@ -1,5 +1,5 @@
-// NodeSelector: which nodes of a body a scene means, as the scene file says it (README.md,
-// "Scene files"): its whole surface, the nodes inside a box, on a plane, or by tag. Plain
+// NodeSelector: which nodes of a body a scene means, as the scene file says it
+// (docs/scene-reference.md, "Node selectors"): its whole surface, the nodes inside a box, on a plane, or by tag. Plain
 // data; it is resolved against a body's nodes when the body is built (select_nodes,
 // common/model/elastic_body.h). Units: m.
 #pragma once
