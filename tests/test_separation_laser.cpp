@@ -3,7 +3,9 @@
 // below that speed and nothing above it, and the strip geometry against exact areas.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "common/separation/laser_groove.h"
 #include "common/separation/two_layer_setup.h"
@@ -79,12 +81,80 @@ TEST(SeparationLaser, HalfSpeedVaporisesTheStripOneAndAHalfNothing) {
   LaserFibre fibre;
   for (int i = 0; i < 100; ++i) step_laser(patch, held, fibre, from, true, 1e-3);
   EXPECT_EQ(held.separated_area, 0);
-  // A second pass over the groove adds nothing new where the first took everything.
-  SeparationState twice = make_separation_state(patch);
-  sweep(patch, twice, from, to, 0.5 * v_s);
-  const double first = twice.separated_area;
-  sweep(patch, twice, from, to, 0.5 * v_s);
-  EXPECT_LE(twice.separated_area, 2 * first + 1e-18);
+}
+
+// Tissue is vaporised once: three passes over one line separate what the first did (l_f L),
+// and two crossing grooves l_f (L1 + L2) less the square where they cross.
+TEST(SeparationLaser, RepeatedAndCrossingPassesSeparateTheGrooveOnce) {
+  const SeparationPatch& patch = default_two_layers().patch;
+  const double v_s = patch.vaporisation_speed, l_f = patch.spot_diameter;
+  const Eigen::Vector3d from(0.0113, 0.0087, 0), to(0.0261, 0.0171, 0);
+  SeparationState thrice = make_separation_state(patch);
+  double length = 0;
+  const double first = sweep(patch, thrice, from, to, 0.5 * v_s, true, &length);
+  EXPECT_NEAR(first, l_f * length, 1e-9 * l_f * length);
+  EXPECT_EQ(sweep(patch, thrice, from, to, 0.5 * v_s), 0);
+  // Back from where the first pass ended (short of `to`), at another speed.
+  const Eigen::Vector3d end = from + length * (to - from).normalized();
+  EXPECT_EQ(sweep(patch, thrice, end, from, 0.3 * v_s), 0);
+  EXPECT_NEAR(thrice.separated_area, l_f * length, 1e-9 * l_f * length);
+  EXPECT_EQ(thrice.groove.count, 1u) << "a straight stroke is one segment, and passes that "
+                                        "vaporise nothing are not remembered";
+
+  SeparationState crossed = make_separation_state(patch);
+  double along_x = 0, along_y = 0;
+  sweep(patch, crossed, Eigen::Vector3d(0.012, 0.013, 0), Eigen::Vector3d(0.026, 0.013, 0),
+        0.5 * v_s, true, &along_x);
+  sweep(patch, crossed, Eigen::Vector3d(0.019, 0.008, 0), Eigen::Vector3d(0.019, 0.018, 0),
+        0.5 * v_s, true, &along_y);
+  EXPECT_NEAR(crossed.separated_area, l_f * (along_x + along_y) - l_f * l_f, 0.03 * l_f * l_f);
+}
+
+// The record merges a stroke's ticks while they stay on one line, within 2 % of the width
+// for every tick merged, starts a segment where the stroke turns, and says when it is full.
+TEST(SeparationLaser, TheGrooveRecordMergesAStrokesTicksAndSaysWhenItIsFull) {
+  const double width = 5e-4;
+  GrooveRecord record;
+  record.segments.resize(64);
+  // An arc of radius 10 mm, 1 ms ticks at 26 mm/s: every tick end stays within the
+  // tolerance of its segment's line.
+  const double radius = 0.01, step = 2.6e-5;
+  std::vector<Eigen::Vector3d> ticks;
+  for (int i = 0; i <= 400; ++i)
+    ticks.emplace_back(radius * std::cos(i * step / radius), radius * std::sin(i * step / radius),
+                       0);
+  for (std::size_t i = 1; i < ticks.size(); ++i)
+    remember_groove(record, ticks[i - 1], ticks[i], width);
+  EXPECT_GT(record.count, 3u) << "a 10 mm arc is not one straight segment";
+  EXPECT_LT(record.count, 40u) << "ticks on a gentle arc merge";
+  EXPECT_FALSE(record.full);
+  for (const Eigen::Vector3d& p : ticks) {
+    double nearest = 1;
+    for (std::size_t k = 0; k < record.count; ++k) {
+      const GrooveSegment& s = record.segments[k];
+      const Eigen::Vector3d d = (s.b - s.a).normalized();
+      const double along = (p - s.a).dot(d);
+      if (along < -1e-12 || along > (s.b - s.a).norm() + 1e-12) continue;
+      nearest = std::min(nearest, (p - s.a - along * d).norm());
+    }
+    EXPECT_LE(nearest, 0.02 * width + 1e-15);
+  }
+  // A right-angle turn starts a segment; a record with no room left says so.
+  GrooveRecord small;
+  small.segments.resize(2);
+  const Eigen::Vector3d o(0, 0, 0), x(0.001, 0, 0), xy(0.001, 0.001, 0), y(0, 0.001, 0);
+  remember_groove(small, o, x, width);
+  remember_groove(small, x, xy, width);
+  EXPECT_EQ(small.count, 2u);
+  EXPECT_FALSE(small.full);
+  remember_groove(small, xy, y, width);
+  EXPECT_EQ(small.count, 2u);
+  EXPECT_TRUE(small.full);
+  // A state read from the wire has no buffer: it remembers nothing and vaporises as before.
+  GrooveRecord none;
+  remember_groove(none, o, x, width);
+  EXPECT_EQ(none.count, 0u);
+  EXPECT_EQ(uncovered_share(none, o, x, width, Eigen::Vector3d::UnitZ()), 1.0);
 }
 
 TEST(SeparationLaser, StripAreaIsTheExactIntersection) {

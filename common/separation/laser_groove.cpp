@@ -40,7 +40,79 @@ double polygon_area(const Polygon& polygon) noexcept {
   return 0.5 * std::abs(twice);
 }
 
+// Whether `p` lies on segment s's strip: within its length and its half width of its line.
+bool on_segment_strip(const GrooveSegment& s, const Eigen::Vector3d& p) noexcept {
+  const Eigen::Vector3d d = s.b - s.a;
+  const double length_squared = d.squaredNorm();
+  if (!(length_squared > 0)) return false;
+  const double along = (p - s.a).dot(d) / length_squared;
+  if (along < 0 || along > 1) return false;
+  return (p - s.a - along * d).squaredNorm() <= 0.25 * s.width * s.width;
+}
+
 }  // namespace
+
+double uncovered_share(const GrooveRecord& groove, const Eigen::Vector3d& a,
+                       const Eigen::Vector3d& b, double width,
+                       const Eigen::Vector3d& normal) noexcept {
+  constexpr int kAlong = 4, kAcross = 16;
+  const Eigen::Vector3d d = b - a;
+  Eigen::Vector3d across = normal.cross(d);
+  if (groove.count == 0 || !(across.norm() > 0)) return 1;
+  across.normalize();
+  // Only the segments whose box, widened by half their width, meets the strip's.
+  const double reach = 0.5 * width;
+  const Eigen::Vector3d lo = a.cwiseMin(b).array() - reach, hi = a.cwiseMax(b).array() + reach;
+  int covered = 0;
+  for (int i = 0; i < kAlong; ++i) {
+    for (int j = 0; j < kAcross; ++j) {
+      const Eigen::Vector3d p =
+          a + (i + 0.5) / kAlong * d + ((j + 0.5) / kAcross - 0.5) * width * across;
+      for (std::size_t k = 0; k < groove.count; ++k) {
+        const GrooveSegment& s = groove.segments[k];
+        const double half = 0.5 * s.width;
+        const Eigen::Vector3d s_lo = s.a.cwiseMin(s.b).array() - half,
+                              s_hi = s.a.cwiseMax(s.b).array() + half;
+        if ((s_hi.array() < lo.array()).any() || (s_lo.array() > hi.array()).any()) continue;
+        if (on_segment_strip(s, p)) {
+          ++covered;
+          break;
+        }
+      }
+    }
+  }
+  return 1.0 - static_cast<double>(covered) / (kAlong * kAcross);
+}
+
+void remember_groove(GrooveRecord& groove, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                     double width) noexcept {
+  constexpr double kMergeTolerance = 0.02;  // of the width
+  if (groove.count > 0) {
+    GrooveSegment& last = groove.segments[groove.count - 1];
+    if (last.b == a && last.width == width) {
+      // The strip continues the last segment: merge if the line a0-b still passes within
+      // the tolerance of every tick merged so far (the old end's distance from the new
+      // line, added to what earlier merges strayed, bounds it).
+      const Eigen::Vector3d line = b - last.a;
+      const double length = line.norm();
+      if (length > 0 && (a - last.a).dot(line) < length * length) {
+        const Eigen::Vector3d u = line / length;
+        const Eigen::Vector3d off = (a - last.a) - (a - last.a).dot(u) * u;
+        const double slack = last.slack + off.norm();
+        if (slack <= kMergeTolerance * width) {
+          last.b = b;
+          last.slack = slack;
+          return;
+        }
+      }
+    }
+  }
+  if (groove.count >= groove.segments.size()) {
+    groove.full = true;
+    return;
+  }
+  groove.segments[groove.count++] = GrooveSegment{a, b, width, 0.0};
+}
 
 double strip_area_in_triangle(const SeparationPatch& patch, int t, const Eigen::Vector3d& a,
                               const Eigen::Vector3d& b, double width) noexcept {
@@ -101,9 +173,12 @@ LaserSample step_laser(const SeparationPatch& patch, SeparationState& state, Las
     if (std::abs((from - corner).dot(n)) > patch.laser_reach ||
         std::abs((tip - corner).dot(n)) > patch.laser_reach)
       continue;
-    sample.vaporised +=
-        separate_in_triangle(patch, state, t, strip_area_in_triangle(patch, t, from, tip, width));
+    const double fresh = uncovered_share(state.groove, from, tip, width, n);
+    if (fresh <= 0) continue;
+    sample.vaporised += separate_in_triangle(
+        patch, state, t, fresh * strip_area_in_triangle(patch, t, from, tip, width));
   }
+  if (sample.vaporised > 0) remember_groove(state.groove, from, tip, width);
   sample.vaporising = sample.vaporised > 0;
   return sample;
 }

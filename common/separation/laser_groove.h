@@ -7,10 +7,13 @@
 // so consecutive ticks tile it): the area l_f |b - a| (Eqs. 15–17). Faster than v_s the
 // absorbed energy per length cannot vaporise the volume l_f^2 dx and nothing is removed.
 // A held fibre does not extend the groove. Only triangles whose plane both ends of the
-// segment are within `reach` of take part; each gains at most its connected area (a
-// strip over already separated tissue adds nothing once a triangle is full). Heat
-// conduction is neglected, as in the paper. The groove's triangles are open: a crack
-// edge a tool can then open (Sec. VI.C). noexcept, no allocation. Units: m, m^2, s, m/s.
+// segment are within `reach` of take part; each gains at most its connected area. Tissue
+// is vaporised once: the part of a tick's strip that lies in the groove record
+// (separation_state.h) adds nothing, so passes over a groove, or across one, separate
+// only what no pass took before (a tick that vaporises something is remembered) (the share of the
+// strip already taken is read at 64 points spread over it). Heat conduction is neglected, as in the
+// paper. The groove's triangles are open: a crack edge a tool can then open (Sec. VI.C). noexcept,
+// no allocation. Units: m, m^2, s, m/s.
 #pragma once
 
 #include <Eigen/Core>
@@ -33,6 +36,19 @@ struct LaserSample {
 /// One tick of length dt [s] with the fibre's tip at `tip` and the laser `on`.
 LaserSample step_laser(const SeparationPatch& patch, SeparationState& state, LaserFibre& fibre,
                        const Eigen::Vector3d& tip, bool on, double dt) noexcept;
+
+/// The share of the strip of `width` along a-b, in the plane whose normal is `normal`,
+/// that no segment of `groove` covers: 1 on fresh tissue, 0 on a groove's repeat.
+double uncovered_share(const GrooveRecord& groove, const Eigen::Vector3d& a,
+                       const Eigen::Vector3d& b, double width,
+                       const Eigen::Vector3d& normal) noexcept;
+
+/// Adds the strip of `width` along a-b to the record: it lengthens the last segment when
+/// the strip continues it (starts at its end, same width, within 2 % of the width of its
+/// line, counting what earlier merges strayed), else it takes a segment of its own, or
+/// sets `full` when there is none left.
+void remember_groove(GrooveRecord& groove, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                     double width) noexcept;
 
 /// The area of triangle t covered by the strip of `width` along segment a-b, both
 /// projected on the triangle's plane [m^2].

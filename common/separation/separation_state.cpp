@@ -10,6 +10,7 @@ namespace cohaptic {
 SeparationState make_separation_state(const SeparationPatch& patch) {
   SeparationState state;
   state.separated.assign(static_cast<std::size_t>(patch.triangle_count()), 0.0);
+  state.groove.segments.resize(kGrooveSegmentCapacity);
   return state;
 }
 

@@ -9,8 +9,16 @@
 // complements (Eq. 3). A triangle is open when any of it is separated. A crack may grow
 // into a triangle that is not fully separated and is open, has an open rim edge, or has
 // an edge neighbour that is fully separated: cracks grow only from crack edges.
+//
+// The groove record remembers where lasers have vaporised (laser_groove.h), so that a pass
+// over an existing groove separates nothing twice: strips of the spot's width along
+// segments, a stroke's consecutive near-collinear ticks merged into one segment. It holds
+// at most its buffer's size (make_separation_state's is kGrooveSegmentCapacity; a state
+// read from the wire has none, so a client's prediction within one IR remembers nothing);
+// once full, further grooves are vaporised but not remembered, and `full` says so.
 #pragma once
 
+#include <Eigen/Core>
 #include <span>
 #include <vector>
 
@@ -18,9 +26,26 @@
 
 namespace cohaptic {
 
+/// A vaporised strip: width `width` along a-b, flat ends [m]. The ticks merged into it lie
+/// within `slack` of the line a-b [m].
+struct GrooveSegment {
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
+  double width = 0;
+  double slack = 0;
+};
+
+inline constexpr std::size_t kGrooveSegmentCapacity = 1024;
+
+struct GrooveRecord {
+  std::vector<GrooveSegment> segments;  ///< the buffer; the first `count` are the record
+  std::size_t count = 0;
+  bool full = false;  ///< a groove was vaporised that the buffer had no room for
+};
+
 struct SeparationState {
   std::vector<double> separated;  ///< per patch triangle, in [0, 1]
   double separated_area = 0;      ///< Lambda [m^2]
+  GrooveRecord groove;
 };
 
 /// Everything connected.
