@@ -180,8 +180,8 @@ TEST(Docs, EveryCitedPageHeadingAndLinkExists) {
         }
       }
       if (line.find("README") != std::string::npos) {
-        for (std::sregex_iterator m(read_on.begin(), read_on.end(), kReadmeCitation), end;
-             m != end; ++m) {
+        for (std::sregex_iterator m(read_on.begin(), read_on.end(), kReadmeCitation), end; m != end;
+             ++m) {
           if (!starts_on_line(*m)) continue;
           ++citations;
           check_heading(kTreeRoot / "README.md", (*m)[1], "", line_at(file, i));

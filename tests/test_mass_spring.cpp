@@ -566,8 +566,8 @@ TEST(MassSpringStatics, BentTubeKeepsItsVolumeWithinTwoPercent) {
 // tool_coupling.h). The tube is 10 times stiffer than the paper's and its springs damped at
 // alpha = 1e-4 s: the paper's E = 737 Pa tube, flattened to half its height by its own
 // weight, is crushed by the tool (its volume falls to about a quarter; docs/mass-spring.md,
-// what to set for a drag by a tool). At the paper's alpha = 1e-6 s the stiffer tube bends alike (middle
-// 10.15 mm, ends 5.95 mm, volume ratio 0.9961, measured once).
+// what to set for a drag by a tool). At the paper's alpha = 1e-6 s the stiffer tube bends alike
+// (middle 10.15 mm, ends 5.95 mm, volume ratio 0.9961, measured once).
 TEST(MassSpringStatics, TubeBentByAToolKeepsItsVolumeWithinTwoPercent) {
   const int sections = 20;
   MassSpringNetwork network =

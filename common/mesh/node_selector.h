@@ -1,7 +1,7 @@
 // NodeSelector: which nodes of a body a scene means, as the scene file says it
-// (docs/scene-reference.md, "Node selectors"): its whole surface, the nodes inside a box, on a plane, or by tag. Plain
-// data; it is resolved against a body's nodes when the body is built (select_nodes,
-// common/model/elastic_body.h). Units: m.
+// (docs/scene-reference.md, "Node selectors"): its whole surface, the nodes inside a box, on a
+// plane, or by tag. Plain data; it is resolved against a body's nodes when the body is built
+// (select_nodes, common/model/elastic_body.h). Units: m.
 #pragma once
 
 #include <Eigen/Core>
