@@ -10,8 +10,8 @@
 // 6 mm, our choice — the tip of a 5 mm laparoscopic dissector and the flap it lifts on
 // either side. So F_n = J_c l_n = F_t = J_c l_t = 0.45 N by default (Eqs. 11, 14).
 // Fracture holds the force at F_n only when l_n is long enough for the fields
-// (holding_normal_length in normal_fracture.h: 5.1 mm at the rim of the default two-layer
-// scene); shorter, the force rises above F_n while the crack grows.
+// (holding_normal_length in fracture_step.h: 5.1 mm at the rim of the default two-layer
+// scene, longer inside it); shorter, the force rises above F_n while the crack grows.
 // Friction between the tool and an exposed layer, mu = 0.2: our choice for wet tissue on
 // steel (a setting; the paper's sliding follows Hayward & Armstrong's model [28]).
 //
