@@ -3,7 +3,9 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 namespace cohaptic {
 namespace {
@@ -55,33 +57,30 @@ bool on_segment_strip(const GrooveSegment& s, const Eigen::Vector3d& p) noexcept
 double uncovered_share(const GrooveRecord& groove, const Eigen::Vector3d& a,
                        const Eigen::Vector3d& b, double width,
                        const Eigen::Vector3d& normal) noexcept {
-  constexpr int kAlong = 4, kAcross = 16;
+  constexpr int kAlong = 4, kAcross = 16;  // 64 samples: one bit each of `covered`
   const Eigen::Vector3d d = b - a;
   Eigen::Vector3d across = normal.cross(d);
   if (groove.count == 0 || !(across.norm() > 0)) return 1;
   across.normalize();
-  // Only the segments whose box, widened by half their width, meets the strip's.
-  const double reach = 0.5 * width;
-  const Eigen::Vector3d lo = a.cwiseMin(b).array() - reach, hi = a.cwiseMax(b).array() + reach;
-  int covered = 0;
-  for (int i = 0; i < kAlong; ++i) {
-    for (int j = 0; j < kAcross; ++j) {
-      const Eigen::Vector3d p =
+  std::array<Eigen::Vector3d, kAlong * kAcross> samples;
+  for (int i = 0; i < kAlong; ++i)
+    for (int j = 0; j < kAcross; ++j)
+      samples[static_cast<std::size_t>(i * kAcross + j)] =
           a + (i + 0.5) / kAlong * d + ((j + 0.5) / kAcross - 0.5) * width * across;
-      for (std::size_t k = 0; k < groove.count; ++k) {
-        const GrooveSegment& s = groove.segments[k];
-        const double half = 0.5 * s.width;
-        const Eigen::Vector3d s_lo = s.a.cwiseMin(s.b).array() - half,
-                              s_hi = s.a.cwiseMax(s.b).array() + half;
-        if ((s_hi.array() < lo.array()).any() || (s_lo.array() > hi.array()).any()) continue;
-        if (on_segment_strip(s, p)) {
-          ++covered;
-          break;
-        }
-      }
-    }
+  // Only the segments whose box, widened by half their width, meets the strip's.
+  const Eigen::Vector3d lo = a.cwiseMin(b).array() - 0.5 * width,
+                        hi = a.cwiseMax(b).array() + 0.5 * width;
+  constexpr std::uint64_t kAll = ~std::uint64_t{0};
+  std::uint64_t covered = 0;
+  for (std::size_t k = 0; k < groove.count && covered != kAll; ++k) {
+    const GrooveSegment& s = groove.segments[k];
+    const Eigen::Vector3d s_lo = s.a.cwiseMin(s.b).array() - 0.5 * s.width,
+                          s_hi = s.a.cwiseMax(s.b).array() + 0.5 * s.width;
+    if ((s_hi.array() < lo.array()).any() || (s_lo.array() > hi.array()).any()) continue;
+    for (std::size_t p = 0; p < samples.size(); ++p)
+      if (!(covered >> p & 1u) && on_segment_strip(s, samples[p])) covered |= std::uint64_t{1} << p;
   }
-  return 1.0 - static_cast<double>(covered) / (kAlong * kAcross);
+  return 1.0 - static_cast<double>(std::popcount(covered)) / (kAlong * kAcross);
 }
 
 void remember_groove(GrooveRecord& groove, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
