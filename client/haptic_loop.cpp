@@ -37,7 +37,9 @@ IrSlot make_ir_slot(std::unique_ptr<const PreparedIR> ir, std::int64_t arrival_n
   auto state = std::make_unique<EvaluationState>(make_evaluation_state(*ir));
   auto alone_state = std::make_unique<EvaluationState>(*state);
   const bool body_moves = evaluation_moves_the_body(*state);
-  return IrSlot{std::move(ir), std::move(state), std::move(alone_state), arrival_ns, body_moves};
+  const bool measures_elapsed = evaluation_measures_elapsed_time(*state);
+  return IrSlot{std::move(ir), std::move(state), std::move(alone_state),
+                arrival_ns,    body_moves,       measures_elapsed};
 }
 
 HapticClock HapticClock::monotonic() {
@@ -127,10 +129,16 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
         record.remotes[r] = remotes[r];
       }
       record.remote_count = static_cast<std::uint8_t>(count);
-      // dt: the nominal period, so that a replay reproduces the force bit for bit.
-      const double dt = 1 / settings_.rate_hz;
+      // dt: the nominal period, or for a body whose force is a velocity the time since the
+      // last evaluation's tick; recorded, so that a replay reproduces the force bit for bit.
+      const double dt = slot.measures_elapsed && last_evaluated_ns_ > 0 && now > last_evaluated_ns_
+                            ? 1e-9 * static_cast<double>(now - last_evaluated_ns_)
+                            : 1 / settings_.rate_hz;
+      last_evaluated_ns_ = now;
+      continue_evaluation(carry_, *slot.ir, *slot.state);  // a new IR goes on from the last
       const ForceSample sample = evaluate_force(
           *slot.ir, *slot.state, own, std::span(remotes.data(), count), dt, record.buttons);
+      carry_ = take_evaluation_carry(*slot.ir, *slot.state);
       // A sphere contact solve that could not finish inside the tick has no answer: hold the
       // last one and count the tick.
       if (sample.flags & kContactUnresolved) {

@@ -62,6 +62,8 @@ struct IrSlot {
   std::int64_t arrival_ns = 0;
   /// evaluation_moves_the_body(*state), decided here once rather than on every tick.
   bool body_moves = false;
+  /// evaluation_measures_elapsed_time(*state), likewise.
+  bool measures_elapsed = false;
 };
 
 /// The slot for `ir` with the state its evaluation starts from (off the haptic thread).
@@ -218,6 +220,8 @@ class HapticLoop {
   std::array<RemoteToolBuffer, kMaxUsers> remote_buffers_;
   Eigen::Vector3d last_force_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d last_evaluated_ = Eigen::Vector3d::Zero();  // the IR's last resolved force
+  EvaluationCarry carry_;               // what the evaluator in use hands on to the next IR's
+  std::int64_t last_evaluated_ns_ = 0;  // when the last IR evaluation's tick woke
   const PreparedIR* confirmed_ir_ =
       nullptr;  // the IR in use, and when the server last confirmed it
   std::int64_t confirmed_ns_ = 0;

@@ -90,6 +90,7 @@ VerifyResult verify_client(const Recording& rec) {
   // Each IR's evaluation state, made when a tick first uses the IR and advanced by every
   // tick that uses it, as the haptic loop did (a dynamic body's force depends on it).
   std::map<const PreparedIR*, EvaluationState> states;
+  EvaluationCarry carry;  // what each IR's evaluator hands on to the next
   Eigen::Vector3d last_resolved =
       Eigen::Vector3d::Zero();  // held over unresolved sphere solves, as the loop does
   const auto fail = [&](std::size_t i, const record::HapticTick& tick, const std::string& what) {
@@ -120,8 +121,10 @@ VerifyResult verify_client(const Recording& rec) {
         auto state = states.find(ir.get());
         if (state == states.end())
           state = states.emplace(ir.get(), make_evaluation_state(*ir)).first;
+        continue_evaluation(carry, *ir, state->second);  // as the haptic loop does
         const ForceSample sample = evaluate_force(*ir, state->second, wire::from_wire(tick.own()),
                                                   remotes, tick.dt(), tick.buttons());
+        carry = take_evaluation_carry(*ir, state->second);
         expected = (sample.flags & kContactUnresolved) ? last_resolved : sample.force;
         last_resolved = expected;
       } else {

@@ -53,6 +53,9 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
   HomeSpringSimulation server(body, 0, scene.tools, kUnlimited);
   HomeSpringSimulation every_sample(body, 0, scene.tools, kUnlimited);
   std::vector<std::shared_ptr<const PreparedIR>> published(users);
+  std::vector<EvaluationState> client(users);  // a viscous tissue's vertex moves in it
+  std::vector<EvaluationCarry> carry(users);
+  const double tick_s = per_tick / reference.sample_rate_hz;
   std::vector<Eigen::Vector3d> held(users, Eigen::Vector3d::Zero());
   TradeoffTally tally;
   const std::size_t samples = reference.positions.size();
@@ -67,6 +70,7 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
       for (std::size_t u = 0; u < users; ++u)
         if (const auto ir = server.ir(static_cast<int>(u)); ir && ir != published[u]) {
           published[u] = ir;
+          client[u] = make_evaluation_state(*ir);
           tally.published(ir->ir.size_bytes());
         }
     }
@@ -74,9 +78,9 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
       for (std::size_t u = 0; u < users; ++u) {
         if (!published[u]) continue;
         const Stopwatch evaluation;
-        EvaluationState stateless =
-            make_evaluation_state(*published[u]);  // the home-spring body keeps none
-        held[u] = evaluate_force(*published[u], stateless, positions[u], {}, 0).force;
+        continue_evaluation(carry[u], *published[u], client[u]);
+        held[u] = evaluate_force(*published[u], client[u], positions[u], {}, tick_s).force;
+        carry[u] = take_evaluation_carry(*published[u], client[u]);
         tally.evaluation(1000 * evaluation.elapsed_ms());
       }
     for (std::size_t u = 0; u < users; ++u)

@@ -49,7 +49,7 @@ const std::vector<Seed> kSeeds = {
     {"smallest", body_kind_index<LinearElasticKind>, false},
     {"sphere", body_kind_index<LinearElasticKind>, false},
     {"mass_spring", body_kind_index<MassSpringKind>, true},
-    {"home_spring", body_kind_index<HomeSpringKind>, false},
+    {"home_spring", body_kind_index<HomeSpringKind>, true},  // viscous: its vertex moves
     {"separation", body_kind_index<SeparationKind>, true},
 };
 

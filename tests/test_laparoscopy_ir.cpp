@@ -57,6 +57,7 @@ void expect_same_patch(const HomeSpringPatch& a, const HomeSpringPatch& b) {
   EXPECT_EQ(a.surface_vertex, b.surface_vertex);
   EXPECT_EQ(a.home_stiffness, b.home_stiffness);
   EXPECT_EQ(a.neighbour_stiffness, b.neighbour_stiffness);
+  EXPECT_EQ(a.damping, b.damping);
   EXPECT_EQ(a.trocar_pivot, b.trocar_pivot);
   EXPECT_EQ(a.grasp.vertex, b.grasp.vertex);
   EXPECT_EQ(a.grasp.tool_at_grasp, b.grasp.tool_at_grasp);
@@ -64,6 +65,8 @@ void expect_same_patch(const HomeSpringPatch& a, const HomeSpringPatch& b) {
 
 TEST(LaparoscopyIr, WireRoundTripIsBitExact) {
   HomeSpringPatch patch = sheet_patch();
+  expect_same_patch(received(envelope_of(patch, 5)), patch);
+  patch.damping = 45;
   expect_same_patch(received(envelope_of(patch, 5)), patch);
   patch.grasp = {nearest_touchable_vertex(patch, Vector3d::Zero()),
                  Vector3d(0.0004, 0.0002, -0.001)};

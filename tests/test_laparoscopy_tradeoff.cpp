@@ -19,7 +19,11 @@ const std::filesystem::path kLaparoscopy =
     std::filesystem::path(COHAPTIC_SOURCE_DIR) / "scenes/laparoscopy";
 
 TEST(LaparoscopyTradeoff, HomeSpringRowIsMeasuredAgainstTheReferenceItIsGiven) {
-  const Scene tissue = load_scene(kLaparoscopy / "tissue.yaml");
+  // The shipped tissue without its dashpot: a dashpot's force steps with the velocity at
+  // each corner of the motion below, and the haptic loop's hold between ticks would turn
+  // those steps into an own-model error far above the elastic tissue's bound here.
+  Scene tissue = load_scene(kLaparoscopy / "tissue.yaml");
+  std::get<HomeSpringObjectSpec>(tissue.objects.front().body).damping = 0;
   const Scene fem = load_scene(kLaparoscopy / "tissue_fem.yaml");
   // Press, slide across a few vertices, release; the second tool pokes beside it.
   const std::vector<Trajectory> motions = {

@@ -282,9 +282,9 @@ ForceSample evaluate_mass_spring(const IntermediateRepresentation& envelope, con
 }
 
 ForceSample evaluate_home_spring_body(const IntermediateRepresentation& envelope,
-                                      const PreparedHomeSpringPatch& prepared,
-                                      const Eigen::Vector3d& own_tool) noexcept {
-  const HomeSpringContact contact = evaluate_home_spring(prepared, own_tool);
+                                      const PreparedHomeSpringPatch& prepared, MovingVertex& moving,
+                                      const Eigen::Vector3d& own_tool, double dt) noexcept {
+  const HomeSpringContact contact = evaluate_viscous_home_spring(prepared, moving, own_tool, dt);
   ForceSample sample;
   sample.force = contact.force;
   if (contact.touching) {
@@ -349,17 +349,42 @@ EvaluationState make_evaluation_state(const PreparedIR& prepared) {
                    return make_mass_spring_state(network,
                                                  std::get<PreparedMassSpring>(prepared.body));
                  },
-                 [](const HomeSpringPatch&) -> EvaluationBody { return HomeSpringEvaluation{}; },
+                 [](const HomeSpringPatch& patch) -> EvaluationBody {
+                   return HomeSpringEvaluation{patch.damping > 0, false, {}};
+                 },
                  [](const SeparationIr& separation) -> EvaluationBody {
                    return SeparationEvaluation{separation.state, separation.tool_state};
                  }},
       prepared.ir.body)};
 }
 
+EvaluationCarry take_evaluation_carry(const PreparedIR& prepared,
+                                      const EvaluationState& state) noexcept {
+  const auto* tissue = std::get_if<HomeSpringEvaluation>(&state.body);
+  if (!tissue || !tissue->viscous) return {};
+  return {prepared.ir.object, tissue->moving};
+}
+
+void continue_evaluation(const EvaluationCarry& carry, const PreparedIR& prepared,
+                         EvaluationState& state) noexcept {
+  auto* tissue = std::get_if<HomeSpringEvaluation>(&state.body);
+  const auto* patch = std::get_if<HomeSpringPatch>(&prepared.ir.body);
+  if (!tissue || !patch || !tissue->viscous || tissue->started ||
+      carry.object != prepared.ir.object)
+    return;
+  tissue->moving = carry.moving;
+  carry_moving_vertex(*patch, tissue->moving);
+}
+
+bool evaluation_measures_elapsed_time(const EvaluationState& state) {
+  const auto* tissue = std::get_if<HomeSpringEvaluation>(&state.body);
+  return tissue && tissue->viscous;
+}
+
 bool evaluation_moves_the_body(const EvaluationState& state) {
   return std::visit(Overloaded{[](const FemEvaluation&) { return false; },
                                [](const MassSpringPatchState&) { return true; },
-                               [](const HomeSpringEvaluation&) { return false; },
+                               [](const HomeSpringEvaluation& tissue) { return tissue.viscous; },
                                [](const SeparationEvaluation&) { return true; }},
                     state.body);
 }
@@ -393,8 +418,10 @@ ForceSample evaluate_body(const MassSpringIr& network, const PreparedMassSpring&
 }
 
 ForceSample evaluate_body(const HomeSpringPatch&, const PreparedHomeSpringPatch& prepared,
-                          HomeSpringEvaluation&, const Tick& tick) noexcept {
-  return evaluate_home_spring_body(tick.envelope, prepared, tick.own_tool);
+                          HomeSpringEvaluation& evaluation, const Tick& tick) noexcept {
+  evaluation.started = true;
+  return evaluate_home_spring_body(tick.envelope, prepared, evaluation.moving, tick.own_tool,
+                                   tick.dt);
 }
 
 ForceSample evaluate_body(const SeparationIr& separation, const PreparedSeparation&,

@@ -5,15 +5,17 @@
 // noexcept, takes no lock and allocates nothing: all working storage has a fixed maximum
 // size (kMaxUsers users, each contributing at most 3 contact nodes), and what a dynamic
 // body changes from tick to tick lives in the caller's EvaluationState, made with the
-// prepared IR (make_evaluation_state) and advanced by dt, the loop's nominal period, at
-// every call. The condensed FEM body is static: it ignores dt, and its state is at most the
-// sphere contact model's warm start. The mass-spring body (mass_spring_evaluation.h)
-// integrates its sub-network over dt. The home-spring body is static too (its grasp
-// travels in the IR): home_spring_contact.h's tick, from the shaft through the patch's
-// trocar pivot; the sample's depth is then |u|, the contact vertex's displacement, and
-// its triangle -1. The separation body (separation_ir.h) steps the user's instrument on
-// the state that make_evaluation_state copied from the IR: grasp, fracture and the laser
-// (its buttons), exactly as the server's step does; depth is then the deflection's length.
+// prepared IR (make_evaluation_state) and advanced by dt, the loop's nominal period (or the
+// time measured since the last call, evaluation_measures_elapsed_time), at every call. The
+// condensed FEM body is static: it ignores dt, and its state is at most the sphere contact model's
+// warm start. The mass-spring body (mass_spring_evaluation.h) integrates its sub-network over dt.
+// The home-spring body is static too (its grasp travels in the IR) unless it is viscous:
+// home_spring_contact.h's tick, from the shaft through the patch's trocar pivot, with a damping the
+// vertex the tool holds or let go of moving over dt (viscous_home_spring.h); the sample's depth is
+// then |u|, the contact vertex's displacement, and its triangle -1. The separation body
+// (separation_ir.h) steps the user's instrument on the state that make_evaluation_state copied from
+// the IR: grasp, fracture and the laser (its buttons), exactly as the server's step does; depth is
+// then the deflection's length.
 //
 // The condensed FEM body:
 // prepare_ir() runs once per IR, off the haptic thread: it checks the IR and inverts the
@@ -51,6 +53,7 @@
 #include "common/ir/prepared_sphere_contact.h"
 #include "common/kinds/body_kinds.h"
 #include "common/laparoscopy/home_spring_contact.h"
+#include "common/laparoscopy/viscous_home_spring.h"
 
 namespace cohaptic {
 
@@ -95,8 +98,13 @@ struct FemEvaluation {
   std::optional<SphereContactState> sphere;
 };
 
-/// A home-spring body's evaluator keeps nothing: its grasp travels in the IR.
-struct HomeSpringEvaluation {};
+/// A home-spring body's evaluator: the vertex that moves (its grasp travels in the IR). Only a
+/// viscous body's (damping > 0) carries from tick to tick; it starts at rest.
+struct HomeSpringEvaluation {
+  bool viscous = false;
+  bool started = false;  ///< evaluated at least once (continue_evaluation no longer applies)
+  MovingVertex moving;
+};
 
 /// A separation body's evaluator: the separated state and the instrument, stepped per tick.
 struct SeparationEvaluation {
@@ -119,10 +127,36 @@ struct EvaluationState {
 /// The state an evaluator of `prepared` starts from (the server's state at the IR's time).
 EvaluationState make_evaluation_state(const PreparedIR& prepared);
 
+/// What an evaluator hands on to the evaluator of the user's next IR of the same body: a
+/// viscous tissue's moving vertex (viscous_home_spring.h), named by its surface index so the
+/// previous IR need not outlive it. Small and copied; nothing for the other kinds.
+struct EvaluationCarry {
+  int object = -1;  ///< the scene object it was taken on; -1: nothing to carry
+  MovingVertex moving;
+};
+
+/// The carry of `state`, an evaluator of `prepared` (noexcept, allocation-free).
+EvaluationCarry take_evaluation_carry(const PreparedIR& prepared,
+                                      const EvaluationState& state) noexcept;
+
+/// `state`, made for `prepared`, goes on from `carry` if it was taken on the same object and
+/// `state` has not been evaluated yet; otherwise nothing. The haptic loop, a replay and the
+/// server call it before every evaluation and take the carry after it, so each new IR's
+/// evaluator goes on from the last one's. noexcept, allocation-free.
+void continue_evaluation(const EvaluationCarry& carry, const PreparedIR& prepared,
+                         EvaluationState& state) noexcept;
+
 /// Whether evaluating moves the body itself: a mass-spring sub-network or a separation steps
-/// with every call, so a second evaluation in the same tick would step it twice. An FEM or
-/// home-spring body is static (a sphere contact solve is the evaluator's, not the body's).
+/// with every call, so a second evaluation in the same tick would step it twice, and so does a
+/// viscous home-spring body's vertex. An FEM or elastic home-spring body is static (a sphere
+/// contact solve is the evaluator's, not the body's).
 bool evaluation_moves_the_body(const EvaluationState& state);
+
+/// Whether the evaluator's dt should be the time measured since its previous evaluation
+/// rather than the loop's nominal period: a viscous home-spring body's force is the vertex's
+/// velocity, and a tick that comes late must not read as a fast tool. The other bodies step
+/// by the nominal period (an integrator's step, kept stable).
+bool evaluation_measures_elapsed_time(const EvaluationState& state);
 
 enum ForceFlag : std::uint8_t {
   kInContact = 1,        ///< the own tool presses the surface
@@ -151,7 +185,8 @@ void limit_force(ForceSample& sample, bool evaluated, double force_limit) noexce
 /// evaluate_sphere_contact()). remote_tools[i] is the position of the tool of the body's
 /// i-th remote contact [m] (NaN: unknown, ignored). `state` must come from
 /// make_evaluation_state(prepared) and be advanced by no other IR; dt [s] is the period
-/// since the previous call (the haptic loop's nominal period). A state of another kind
+/// since the previous call (the haptic loop's nominal period, or the measured time where
+/// evaluation_measures_elapsed_time says so). A state of another kind
 /// than the body's gives a zero force flagged kNonFinite. `buttons` are the own tool's
 /// (bit i = button i held); only the separation body reads them.
 ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state,

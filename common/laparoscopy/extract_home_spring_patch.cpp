@@ -9,7 +9,7 @@ namespace cohaptic {
 
 HomeSpringPatch extract_home_spring_patch(const HomeSpringSurface& surface,
                                           const Eigen::Vector3d& centre, double radius,
-                                          const HomeSpringStiffness& stiffness,
+                                          const HomeSpringConstants& constants,
                                           const Eigen::Vector3d& trocar_pivot) {
   const int surface_vertices = static_cast<int>(surface.rest_positions.cols());
   if (surface.rings.offsets.size() != static_cast<std::size_t>(surface_vertices) + 1)
@@ -55,8 +55,9 @@ HomeSpringPatch extract_home_spring_patch(const HomeSpringSurface& surface,
   patch.triangles.reserve(region.size());
   for (const Triangle& tri : region)
     patch.triangles.push_back({local.at(tri[0]), local.at(tri[1]), local.at(tri[2])});
-  patch.home_stiffness = stiffness.home;
-  patch.neighbour_stiffness = stiffness.neighbour;
+  patch.home_stiffness = constants.home;
+  patch.neighbour_stiffness = constants.neighbour;
+  patch.damping = constants.damping;
   patch.trocar_pivot = trocar_pivot;
   validate_home_spring_patch(patch);
   return patch;

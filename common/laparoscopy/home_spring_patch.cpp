@@ -93,6 +93,8 @@ void validate_home_spring_patch(const HomeSpringPatch& patch) {
   if (!(patch.neighbour_stiffness >= 0) || !std::isfinite(patch.neighbour_stiffness))
     fail(fmt::format("neighbour_stiffness (k2) is {} N/m, expected >= 0 and finite",
                      patch.neighbour_stiffness));
+  if (!(patch.damping >= 0) || !std::isfinite(patch.damping))
+    fail(fmt::format("damping (c) is {} N s/m, expected >= 0 and finite", patch.damping));
   if (!patch.trocar_pivot.allFinite()) fail("trocar_pivot is not finite");
   if (patch.grasp.vertex < -1 || patch.grasp.vertex >= patch.contact_vertex_count)
     fail(fmt::format("grasp names vertex {}, expected -1 (none) or a touchable vertex 0..{}",
@@ -102,7 +104,7 @@ void validate_home_spring_patch(const HomeSpringPatch& patch) {
 
 std::size_t HomeSpringPatch::size_bytes() const {
   constexpr std::size_t kScalars =
-      (2 + 3 + 3) * sizeof(double) + 2 * sizeof(std::int32_t);  // k1, k2, pivot, grasp
+      (3 + 3 + 3) * sizeof(double) + 2 * sizeof(std::int32_t);  // k1, k2, c, pivot, grasp
   const auto vertices = static_cast<std::size_t>(vertex_count());
   return kScalars + vertices * (3 * sizeof(double) + sizeof(std::int32_t)) +
          (triangles.size() * 3 + ring_offsets.size() + ring_vertices.size()) * sizeof(std::int32_t);

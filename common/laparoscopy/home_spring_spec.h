@@ -5,7 +5,7 @@
 // The tissue is a triangle surface (a FreeSurfer .asc file, or a generated horizontal grid
 // facing +z) whose vertices are held by the paper's home springs (k1) and 1-ring springs
 // (k2); the display deforms it by Eq. 1 or by FFD (tissue_display.h). An instrument's shaft
-// passes through its trocar pivot. Units: m, N/m, rad.
+// passes through its trocar pivot. Units: m, N/m, N s/m, rad.
 #pragma once
 
 #include <Eigen/Core>
@@ -30,6 +30,7 @@ struct HomeSpringObjectSpec {
   std::optional<TissueGridSpec> grid;  ///< a generated sheet: exactly one of the two
   double home_stiffness = 0;           ///< k1 [N/m], > 0
   double neighbour_stiffness = 0;      ///< k2 [N/m], >= 0
+  double damping = 0;       ///< c [N s/m], >= 0: the dashpot beside each home spring (0: none)
   double patch_radius = 0;  ///< the IR's patch: triangles within it of the contact vertex [m]
   TissueDisplayKind display = TissueDisplayKind::polynomial;
   double display_radius = 0;  ///< R of Eq. 1 (and the FFD lattice's margin) [m]

@@ -83,9 +83,10 @@ HomeSpringBody build_home_spring_body(const std::string& name, const HomeSpringO
         where, spec.patch_radius, body.longest_edge));
   spdlog::info(
       "object '{}' (home spring): {} vertices, {} triangles, longest edge {:.3g} mm, k1 {:g} N/m, "
-      "k2 {:g} N/m",
+      "k2 {:g} N/m{}",
       name, body.surface.vertex_count(), body.surface.triangle_count(), 1000 * body.longest_edge,
-      spec.home_stiffness, spec.neighbour_stiffness);
+      spec.home_stiffness, spec.neighbour_stiffness,
+      spec.damping > 0 ? fmt::format(", damping c {:g} N s/m", spec.damping) : "");
   return body;
 }
 

@@ -40,7 +40,7 @@ TissueGridSpec parse_tissue_grid(const YamlCursor& c, double scale) {
 
 HomeSpringObjectSpec parse_home_spring_object(const YamlCursor& c, double scale,
                                               const SceneFiles& files) {
-  c.only_keys({"name", "model", "surface", "stiffness", "patch_radius", "display"});
+  c.only_keys({"name", "model", "surface", "stiffness", "damping", "patch_radius", "display"});
   HomeSpringObjectSpec object;
 
   const YamlCursor surface = c.at("surface");
@@ -60,6 +60,9 @@ HomeSpringObjectSpec parse_home_spring_object(const YamlCursor& c, double scale,
   object.home_stiffness = stiffness.at("home").positive("a positive stiffness k1 in N/m");
   object.neighbour_stiffness =
       stiffness.at("neighbour").number_in(0, INFINITY, false, true, "a stiffness k2 >= 0 in N/m");
+  if (const auto damping = c.find("damping"))
+    object.damping = damping->number_in(0, INFINITY, false, true,
+                                        "a damping c >= 0 in N s/m (0: no viscous element)");
   object.patch_radius = c.at("patch_radius").positive("a positive length") * scale;
 
   const YamlCursor display = c.at("display");

@@ -1,5 +1,7 @@
 #include "common/sim/home_spring_simulation.h"
 
+#include <limits>
+
 #include "common/laparoscopy/extract_home_spring_patch.h"
 #include "common/util/stopwatch.h"
 
@@ -80,21 +82,26 @@ double HomeSpringSimulation::distance_to_surface(const Eigen::Vector3d& point) c
 StepReport HomeSpringSimulation::step(double time) {
   StepReport report;
   const Stopwatch watch;
-  for (int u = 0; u < user_count(); ++u) step_user(u, time, report);
+  const double dt = previous_time_ ? std::max(0.0, time - *previous_time_) : 0;
+  previous_time_ = time;
+  for (int u = 0; u < user_count(); ++u) step_user(u, time, dt, report);
   if (report.rebuilt) report.rebuild_ms = watch.elapsed_ms();
   return report;
 }
 
-void HomeSpringSimulation::step_user(int u, double time, StepReport& report) {
+void HomeSpringSimulation::step_user(int u, double time, double dt, StepReport& report) {
   UserState& user = users_[static_cast<std::size_t>(u)];
-  user.pressing = false;
   if (!user.instrument) return;
   if (!user.known) {
     if (user.forceps) user.jaws = open_forceps(jaw_geometry(*user.instrument));
+    evaluate_user(user, dt);  // a viscous tissue's vertex goes on home
     return;
   }
   const auto shaft = shaft_frame(user.instrument->trocar, user.position, user.instrument->opening);
-  if (!shaft) return;
+  if (!shaft) {
+    evaluate_user(user, dt);
+    return;
+  }
   if (user.forceps)
     step_forceps(jaw_geometry(*user.instrument), *shaft, (user.buttons & 1u) != 0, body_.tree,
                  user.jaws);
@@ -117,16 +124,27 @@ void HomeSpringSimulation::step_user(int u, double time, StepReport& report) {
   }
   if (centre >= 0 && (!user.ir || centre != user.centre || user.jaws.grasping != user.grasped))
     publish_ir(u, centre, time, report);
-  if (!user.ir) return;
+  evaluate_user(user, dt);
+}
 
-  const HomeSpringContact contact =
-      evaluate_home_spring(std::get<PreparedHomeSpringPatch>(user.ir->body), user.position);
-  user.pressing = contact.touching;
+void HomeSpringSimulation::evaluate_user(UserState& user, double dt) {
+  user.pressing = false;
+  user.dent.reset();
+  user.force = {};
+  if (!user.ir) return;
+  const Eigen::Vector3d tool =
+      user.known ? user.position
+                 : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  const ForceSample sample = evaluate_force(*user.ir, user.evaluation, tool, {}, dt);
+  if (user.known) user.force = sample;
+  user.pressing = (sample.flags & kInContact) != 0;
+  const MovingVertex& moving = std::get<HomeSpringEvaluation>(user.evaluation.body).moving;
+  if (moving.vertex < 0) return;
   const bool grasping = user.jaws.grasping;
-  user.dent_from = grasping ? user.jaws.grasp_point : contact.contact_point;
-  user.dent_to = grasping
-                     ? Eigen::Vector3d(user.dent_from + (user.position - user.jaws.tool_at_grasp))
-                     : user.position;
+  const Eigen::Vector3d from = grasping ? user.jaws.grasp_point : moving.contact_point;
+  // A probe holding its vertex dents the surface to the tip itself.
+  user.dent = TissueDent{
+      from, moving.held && !grasping ? user.position : Eigen::Vector3d(from + moving.displacement)};
 }
 
 void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport& report) {
@@ -135,7 +153,7 @@ void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport
   HomeSpringPatch patch = extract_home_spring_patch(
       {body_.surface.vertices, body_.surface.triangles, body_.rings},
       body_.surface.vertices.col(centre), spec.patch_radius,
-      {spec.home_stiffness, spec.neighbour_stiffness}, user.instrument->trocar);
+      {spec.home_stiffness, spec.neighbour_stiffness, spec.damping}, user.instrument->trocar);
   if (user.jaws.grasping)
     patch.grasp = {nearest_touchable_vertex(patch, user.jaws.grasp_point), user.jaws.tool_at_grasp};
   IntermediateRepresentation ir;
@@ -145,8 +163,11 @@ void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport
   ir.object = object_;
   ir.force_limit = force_limit_;
   ir.body = std::move(patch);
+  const EvaluationCarry carry =
+      user.ir ? take_evaluation_carry(*user.ir, user.evaluation) : EvaluationCarry{};
   user.ir = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
   user.evaluation = make_evaluation_state(*user.ir);
+  continue_evaluation(carry, *user.ir, user.evaluation);  // the moving vertex goes on
   user.centre = centre;
   user.grasped = user.jaws.grasping;
   report.rebuilt = true;
@@ -157,14 +178,12 @@ void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport
 std::vector<TissueDent> HomeSpringSimulation::dents() const {
   std::vector<TissueDent> dents;
   for (const UserState& user : users_)
-    if (user.pressing) dents.push_back({user.dent_from, user.dent_to});
+    if (user.dent) dents.push_back(*user.dent);
   return dents;
 }
 
-ForceSample HomeSpringSimulation::force(int u) {
-  UserState& user = users_[static_cast<std::size_t>(u)];
-  if (!user.ir || !user.known) return {};
-  return evaluate_force(*user.ir, user.evaluation, user.position, {}, 0);
+ForceSample HomeSpringSimulation::force(int u) const {
+  return users_[static_cast<std::size_t>(u)].force;
 }
 
 }  // namespace cohaptic

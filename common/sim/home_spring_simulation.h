@@ -14,11 +14,14 @@
 // the grasp changes (not otherwise: the patch is static, the client evaluates it exactly);
 // a shaft whose line misses the surface keeps its last IR.
 //
-// force() is the P0 force: the client's evaluate_force on the user's IR. The display
-// deformation (displayed(), computed when asked, not every step) dents the rest surface per
-// pressing user: P the contact point and A the tip for a probe; P the grasp point, fixed,
-// and A it moved by the pull for grasping forceps; the users' dents add. Units: SI; times in s of
-// the simulation's clock.
+// force() is the P0 force: the client's evaluate_force on the user's IR at the step's tool
+// position, advanced by the time since the previous step (a viscous tissue's vertex moves,
+// viscous_home_spring.h, and goes on to a new IR's patch). The display deformation
+// (displayed(), computed when asked, not every step) dents the rest surface per user whose
+// vertex is displaced: P the contact point and A = P + u (the tip, for a probe that holds
+// it); P the grasp point, fixed, and A it moved by the pull for grasping forceps; a vertex let
+// go of on a viscous tissue goes on denting it while it returns home. The users' dents add.
+// Units: SI; times in s of the simulation's clock.
 #pragma once
 
 #include <Eigen/Core>
@@ -63,15 +66,17 @@ class HomeSpringSimulation {
   std::shared_ptr<const PreparedIR> ir(int user) const {
     return users_[static_cast<std::size_t>(user)].ir;
   }
-  /// The shaft crosses the rest surface, or the forceps grasp.
+  /// The tool holds its vertex: the shaft crosses the rest surface (a viscous tissue's vertex
+  /// not left deeper), or the forceps grasp.
   bool pressing(int user) const { return users_[static_cast<std::size_t>(user)].pressing; }
-  /// P0: the user's IR evaluated at its tool's position now (zero without an IR).
-  ForceSample force(int user);
+  /// P0: the user's IR evaluated at its tool's position in the latest step (zero without an
+  /// IR or a tool).
+  ForceSample force(int user) const;
   /// The forceps' jaws of `user` as of the latest step (open, for a probe).
   const ForcepsJaws& jaws(int user) const { return users_[static_cast<std::size_t>(user)].jaws; }
-  /// The rest surface dented by the pressing users, as of the latest step [m].
+  /// The rest surface dented by the users' displaced vertices, as of the latest step [m].
   Eigen::Matrix3Xd displayed() const { return dented_surface(body_.display, dents()); }
-  /// The pressing users' dents as of the latest step: what displayed() draws, small to hand
+  /// The users' dents as of the latest step: what displayed() draws, small to hand
   /// to another thread (the live view dents the surface on its own).
   std::vector<TissueDent> dents() const;
   /// Distance from `point` to the rest surface [m].
@@ -88,15 +93,16 @@ class HomeSpringSimulation {
     std::uint32_t buttons = 0;
     ForcepsJaws jaws;
     bool pressing = false;
-    Eigen::Vector3d dent_from = Eigen::Vector3d::Zero(),
-                    dent_to = Eigen::Vector3d::Zero();  // P -> A while pressing
-    int centre = -1;       // surface vertex the IR's patch is built around
-    bool grasped = false;  // the IR's grasp
+    std::optional<TissueDent> dent;  // P -> A while its vertex is displaced
+    int centre = -1;                 // surface vertex the IR's patch is built around
+    bool grasped = false;            // the IR's grasp
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
     EvaluationState evaluation;  // P0
+    ForceSample force;           // P0 at the latest step
   };
-  void step_user(int user, double time, StepReport& report);
+  void step_user(int user, double time, double dt, StepReport& report);
+  void evaluate_user(UserState& user, double dt);
   void publish_ir(int user, int centre, double time, StepReport& report);
 
   const HomeSpringBody& body_;
@@ -105,6 +111,7 @@ class HomeSpringSimulation {
   double beyond_tip_;  // how far past the tip the shaft's line is followed: across the tissue's
                        // bounds [m]
   std::vector<UserState> users_;
+  std::optional<double> previous_time_;  // of the latest step [s]
 };
 
 }  // namespace cohaptic

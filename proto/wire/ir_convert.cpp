@@ -278,6 +278,7 @@ void home_spring_to_wire(const cohaptic::HomeSpringPatch& patch, HomeSpringPatch
     out->add_surface_vertex(static_cast<std::uint32_t>(vertex));
   out->set_home_stiffness(patch.home_stiffness);
   out->set_neighbour_stiffness(patch.neighbour_stiffness);
+  out->set_damping(patch.damping);
   to_wire(patch.trocar_pivot, out->mutable_trocar_pivot());
   if (patch.grasp.active()) {
     out->mutable_grasp()->set_vertex(static_cast<std::uint32_t>(patch.grasp.vertex));
@@ -666,6 +667,7 @@ cohaptic::HomeSpringPatch home_spring_from_wire(const HomeSpringPatch& w) {
   patch.surface_vertex = read_indices(w.surface_vertex(), "surface vertex");
   patch.home_stiffness = w.home_stiffness();
   patch.neighbour_stiffness = w.neighbour_stiffness();
+  patch.damping = w.damping();
   patch.trocar_pivot = read_vec3(w.trocar_pivot(), "trocar_pivot");
   if (w.has_grasp()) {
     patch.grasp.vertex = to_int(w.grasp().vertex(), "grasp vertex");
