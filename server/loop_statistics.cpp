@@ -21,6 +21,10 @@ void LoopStatistics::record_step(const StepFigures& step, double elapsed_s) {
   totals_.max_obstacle_nodes = std::max(totals_.max_obstacle_nodes, step.report.obstacle_nodes);
   totals_.sphere_nodes_outside_patches +=
       static_cast<std::uint64_t>(step.report.sphere_nodes_outside_patches);
+  totals_.separates = step.report.separates;
+  totals_.fractured_m2 = step.report.fractured_m2;
+  totals_.vaporised_m2 = step.report.vaporised_m2;
+  totals_.groove_record_full = step.report.groove_record_full;
   totals_.elapsed_s = elapsed_s;
 }
 

@@ -34,7 +34,10 @@ struct LoopSummary {
   int max_boundary_nodes = 0, max_obstacle_nodes = 0;
   /// Sphere model: over all steps, nodes the state had a sphere push that no IR's patch held
   std::uint64_t sphere_nodes_outside_patches = 0;
-  double max_surface_displacement_m = 0;  ///< in the display frames
+  double max_surface_displacement_m = 0;      ///< in the display frames
+  bool separates = false;                     ///< the scene has a separation body
+  double fractured_m2 = 0, vaporised_m2 = 0;  ///< separated so far, as of the latest step
+  bool groove_record_full = false;
   std::uint64_t failed_steps = 0;
   int max_consecutive_failures = 0;
   std::string last_failure;

@@ -43,6 +43,10 @@ nlohmann::json server_report(const ServerFigures& figures) {
   server["sphere_nodes_outside_patches"] = loop.sphere_nodes_outside_patches;
   server["forces_sent"] = loop.forces_sent;
   server["max_surface_displacement_mm"] = loop.max_surface_displacement_m * 1e3;
+  if (loop.separates)
+    server["separated_area_mm2"] = {{"fractured", loop.fractured_m2 * 1e6},
+                                    {"vaporised", loop.vaporised_m2 * 1e6},
+                                    {"groove_record_full", loop.groove_record_full}};
   server["failed_steps"] = {{"count", loop.failed_steps},
                             {"max_in_a_row", loop.max_consecutive_failures},
                             {"last_error", loop.last_failure}};
@@ -95,6 +99,10 @@ std::string status_line(const ServerFigures& figures, int users, int slots) {
       loop.elapsed_s, users, slots, loop.rate_hz(), loop.step_p99_ms, loop.max_boundary_nodes,
       loop.rebuilds, figures.datagrams.accepted(), figures.datagrams.rejected(),
       figures.connections.datagrams_sent);
+  if (loop.separates)
+    line += fmt::format(" | separated {:.1f} mm² (fractured {:.1f}, vaporised {:.1f})",
+                        (loop.fractured_m2 + loop.vaporised_m2) * 1e6, loop.fractured_m2 * 1e6,
+                        loop.vaporised_m2 * 1e6);
   if (loop.failed_steps > 0) line += fmt::format(" | failed steps {}", loop.failed_steps);
   return line;
 }

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "common/mesh/tet_mesh.h"
+#include "common/separation/separation_state.h"
 #include "common/sim/elastic_states.h"
 #include "common/sim/ir_build_options.h"
 #include "common/sim/loaded_columns.h"
@@ -113,6 +114,13 @@ SimulationLoop::StepOutput SimulationLoop::advance(std::int64_t now_ns) {
   const std::optional<record::ConditionSwitch> switched = apply_condition_switch(outbox);
   take_tools(now_ns);
   const StepReport report = simulation_.step(seconds_since_start(now_ns));
+  if (report.groove_record_full && !told_groove_record_full_) {
+    told_groove_record_full_ = true;
+    spdlog::warn(
+        "a separation body's groove record is full ({} segments): a laser pass over a groove cut "
+        "from now on separates its area again",
+        kGrooveSegmentCapacity);
+  }
   const bool to_p1 = resend_irs_;
   if (report.rebuilt || resend_irs_) output.irs = new_irs(now_ns);
   if (to_p1) {  // told before the IRs on the same connection, or at once if there are none yet

@@ -153,6 +153,7 @@ class SimulationLoop {
   std::vector<BodyPrefetch> prefetch_;
   std::int64_t last_keep_alive_ns_ = 0, last_display_ns_ = 0;
   std::uint64_t steps_ = 0;                   // successful steps so far
+  bool told_groove_record_full_ = false;      // the warning is logged once
   std::vector<view::ToolState> view_tools_;   // this step's tools, for the view
   std::vector<Eigen::Vector3d> view_forces_;  // per user, for the view [N]
   // Compliance rows: what each user's client holds (restarted when a new user takes the

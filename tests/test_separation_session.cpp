@@ -151,6 +151,20 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
   EXPECT_GT(groove, 0.9 * cut_alone) << "no laser groove";
   EXPECT_GT(last.state.separated_area, rim + cut_alone + 1e-6)
       << "the push did not open the groove";
+
+  // The server's report gives the area separated by fracture and by the laser: together at
+  // least what the last IR carried (the session may have gone on a few steps past it), the
+  // laser's about the groove (the cut's strip, l_f L).
+  const nlohmann::json separated =
+      nlohmann::json::parse(std::ifstream(dir / "server.json"))["server"]["separated_area_mm2"];
+  const double fractured = separated["fractured"].get<double>(),
+               vaporised = separated["vaporised"].get<double>();
+  std::printf("  server's report: fractured %.2f mm^2, vaporised %.2f mm^2\n", fractured,
+              vaporised);
+  EXPECT_GE(fractured + vaporised, last.state.separated_area * 1e6 - 1e-9);
+  EXPECT_GT(fractured, rim * 1e6);
+  EXPECT_NEAR(vaporised, cut_alone * 1e6, 0.25 * cut_alone * 1e6);
+  EXPECT_FALSE(separated["groove_record_full"].get<bool>());
 }
 
 }  // namespace

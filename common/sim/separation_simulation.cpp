@@ -67,6 +67,10 @@ StepReport SeparationSimulation::step(double time) {
   }
 
   StepReport report;
+  report.separates = true;
+  report.fractured_m2 = fractured_;
+  report.vaporised_m2 = vaporised_;
+  report.groove_record_full = state_.groove.full;
   const Stopwatch rebuild;
   for (std::size_t u = 0; u < users_.size(); ++u) {
     const UserState& user = users_[u];

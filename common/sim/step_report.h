@@ -17,6 +17,12 @@ struct StepReport {
   /// Sphere model: nodes the state has a sphere push that no IR's patch holds (its client
   /// cannot feel them); 0 unless the patches failed to settle in a step.
   int sphere_nodes_outside_patches = 0;
+  /// Separation bodies: whether there is one, the area they have separated so far by
+  /// fracture and by the laser [m^2], and whether a groove record is full (a groove it could
+  /// not remember would be separated again by a later pass over it).
+  bool separates = false;
+  double fractured_m2 = 0, vaporised_m2 = 0;
+  bool groove_record_full = false;
 
   /// Adds another body's report to this one.
   StepReport& operator+=(const StepReport& other) {
@@ -27,6 +33,10 @@ struct StepReport {
     boundary_nodes += other.boundary_nodes;
     obstacle_nodes += other.obstacle_nodes;
     sphere_nodes_outside_patches += other.sphere_nodes_outside_patches;
+    separates = separates || other.separates;
+    fractured_m2 += other.fractured_m2;
+    vaporised_m2 += other.vaporised_m2;
+    groove_record_full = groove_record_full || other.groove_record_full;
     return *this;
   }
 };
