@@ -6,6 +6,8 @@
 // from the forces) against J_c times the separated area, and passivity.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <numbers>
 
@@ -26,6 +28,33 @@ int rim_node() {
 }
 int centre_node() {
   return nearest_patch_node(default_two_layers().patch, Eigen::Vector3d(0.02, 0.02, 0));
+}
+
+TEST(SeparationFracture, ThePlateauReachSaysWhereLnHoldsThePullAndNamesTheBound) {
+  SeparationPatch patch = default_two_layers().patch;
+  const PlateauReach reach = plateau_reach(patch);
+  // The rim holds with the default l_n, the centre needs more (docs/separation.md).
+  EXPECT_EQ(reach.nodes, patch.node_count());
+  EXPECT_GT(reach.held, 0);
+  EXPECT_LT(reach.held, reach.nodes);
+  EXPECT_GE(reach.longest, holding_normal_length(patch, centre_node()));
+  EXPECT_GT(reach.longest, patch.normal_length);
+  int independent = 0;  // counted again here
+  for (int node = 0; node < patch.node_count(); ++node)
+    independent += holding_normal_length(patch, node) <= patch.normal_length;
+  EXPECT_EQ(reach.held, independent);
+  const std::string warning = plateau_warning(reach, patch.normal_length);
+  EXPECT_NE(warning.find(fmt::format("at {} of {} interface nodes", reach.held, reach.nodes)),
+            std::string::npos)
+      << warning;
+  EXPECT_NE(warning.find(fmt::format("{:.2f} mm", 1e3 * reach.longest)), std::string::npos)
+      << warning;
+  std::printf("  %s\n", warning.c_str());
+  // At the bound it holds everywhere, and nothing is said.
+  patch.normal_length = reach.longest;
+  const PlateauReach everywhere = plateau_reach(patch);
+  EXPECT_EQ(everywhere.held, everywhere.nodes);
+  EXPECT_EQ(plateau_warning(everywhere, patch.normal_length), "");
 }
 
 TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {

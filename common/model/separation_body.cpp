@@ -48,6 +48,10 @@ SeparationModel build_separation_body(const std::string& name, const SeparationO
       "separation body '{}': {} interface nodes, {} triangles, fields of degree {} {} ({:.2f} s)",
       name, body.patch->node_count(), body.patch->triangle_count(), body.patch->degree,
       body.fields_from_cache ? "from the cache" : "fitted to the FEM", body.report.total_seconds());
+  body.plateau = plateau_reach(*body.patch);
+  if (const std::string warning = plateau_warning(body.plateau, body.patch->normal_length);
+      !warning.empty())
+    spdlog::warn("{}: {}", where, warning);
   return body;
 }
 

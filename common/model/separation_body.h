@@ -10,6 +10,7 @@
 #include <string>
 
 #include "common/scene/scene.h"
+#include "common/separation/fracture_step.h"
 #include "common/separation/separation_object_spec.h"
 #include "common/separation/two_layer_setup.h"
 
@@ -23,6 +24,7 @@ struct SeparationModel {
   std::shared_ptr<const SeparationPatch> patch;
   FieldPrecomputeReport report;  ///< zero when the fields came from the cache
   bool fields_from_cache = false;
+  PlateauReach plateau;  ///< where the patch's l_n holds a pull at F_n (warned about if not all)
 };
 
 /// The program's cache for every separation object of `scene`: `directory`, or none at all.

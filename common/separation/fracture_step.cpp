@@ -1,5 +1,7 @@
 #include "common/separation/fracture_step.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -111,6 +113,31 @@ double holding_normal_length(const SeparationPatch& patch, int node, int tool_no
   const double k_bar = normal_stiffness(FieldState::locally_separated);
   if (!(k > k_bar)) return std::numeric_limits<double>::infinity();
   return k * std::sqrt(patch.region_areas[node] / ((k - k_bar) * patch.toughness));
+}
+
+PlateauReach plateau_reach(const SeparationPatch& patch) {
+  PlateauReach reach;
+  reach.nodes = patch.node_count();
+  for (int node = 0; node < reach.nodes; ++node) {
+    const double length = holding_normal_length(patch, node);
+    if (length <= patch.normal_length) ++reach.held;
+    if (node == 0 || !(length <= reach.longest)) {
+      reach.longest = length;
+      reach.where = patch.positions.col(node);
+    }
+  }
+  return reach;
+}
+
+std::string plateau_warning(const PlateauReach& reach, double normal_length) {
+  if (reach.held == reach.nodes) return {};
+  return fmt::format(
+      "fracture holds the pull at F_n = J_c l_n at {} of {} interface nodes only: with "
+      "normal_length {:.2f} mm a crack front at the others lets the force rise above F_n as it "
+      "grows (the longest length needed is {:.2f} mm, at ({:.1f}, {:.1f}, {:.1f}) mm; "
+      "normal_length at least that holds it everywhere)",
+      reach.held, reach.nodes, 1e3 * normal_length, 1e3 * reach.longest, 1e3 * reach.where.x(),
+      1e3 * reach.where.y(), 1e3 * reach.where.z());
 }
 
 }  // namespace cohaptic

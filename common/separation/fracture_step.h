@@ -29,6 +29,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 
 #include "common/separation/separation_force.h"
 
@@ -63,5 +64,20 @@ FractureStep fracture_step(const SeparationPatch& patch, SeparationState& state,
 /// (the rate l_n at which area may separate must at least match the rate that keeps the
 /// force flat where fracture starts, which is where it is highest). Infinite if k <= k-bar.
 double holding_normal_length(const SeparationPatch& patch, int node, int tool_node = 0);
+
+/// Where over the interface a pull can hold F_n = J_c l_n: holding_normal_length at every
+/// node (the tool's own node), against the patch's l_n.
+struct PlateauReach {
+  int nodes = 0;       ///< interface nodes
+  int held = 0;        ///< of which l_n reaches their holding length
+  double longest = 0;  ///< the longest holding length [m] (infinite: a node no l_n holds)
+  Eigen::Vector3d where = Eigen::Vector3d::Zero();  ///< its node, at rest [m]
+};
+
+PlateauReach plateau_reach(const SeparationPatch& patch);
+
+/// Empty if l_n holds the plateau at every node; otherwise a sentence naming how many nodes
+/// it does not hold at, the bound (the longest holding length) and where it is needed.
+std::string plateau_warning(const PlateauReach& reach, double normal_length);
 
 }  // namespace cohaptic
