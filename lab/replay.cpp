@@ -198,6 +198,13 @@ VerifyResult verify_server(const Recording& rec, const SceneFileAccess& scene_fi
                        report.rebuilt ? "rebuilt them" : "kept them"));
       break;
     }
+    if (report.fractured_m2 != step.fractured_m2() || report.vaporised_m2 != step.vaporised_m2()) {
+      fail(fmt::format(
+          "recorded {:.9g} mm^2 fractured and {:.9g} mm^2 vaporised, the replay {:.9g} and {:.9g}",
+          1e6 * step.fractured_m2(), 1e6 * step.vaporised_m2(), 1e6 * report.fractured_m2,
+          1e6 * report.vaporised_m2));
+      break;
+    }
     std::vector<std::uint32_t> pressing;
     for (int user = 0; user < simulation.user_count(); ++user)
       if (simulation.pressing(user)) pressing.push_back(static_cast<std::uint32_t>(user));
@@ -275,6 +282,11 @@ void print_summary(const Recording& rec) {
   fmt::print("records     {} haptic ticks, {} simulation steps, {} IRs, {} datagrams, {} events\n",
              rec.ticks.size(), rec.steps.size(), rec.irs.size(), rec.datagrams.size(),
              rec.events.size());
+  if (!rec.steps.empty() &&
+      (rec.steps.back().fractured_m2() > 0 || rec.steps.back().vaporised_m2() > 0))
+    fmt::print("separated   {:.2f} mm^2 by the last step: {:.2f} fractured, {:.2f} vaporised\n",
+               1e6 * (rec.steps.back().fractured_m2() + rec.steps.back().vaporised_m2()),
+               1e6 * rec.steps.back().fractured_m2(), 1e6 * rec.steps.back().vaporised_m2());
   if (c.role() == "server")
     fmt::print("view        {} frames, {} client status reports{}\n", rec.view_frames.size(),
                rec.client_statuses.size(),
@@ -352,14 +364,15 @@ void export_csv(const Recording& rec, const std::filesystem::path& dir) {
     AtomicFile out(dir / "steps.csv");
     out.write(
         "time_s,simulation_time_s,slot,known,x,y,z,buttons,rebuilt,boundary_nodes,condition_"
-        "switch\n");
+        "switch,fractured_mm2,vaporised_mm2\n");
     for (const auto& s : rec.steps)
       for (const auto& tool : s.tools()) {
         const Eigen::Vector3d p = wire::from_wire(tool.position());
-        out.print("{:.9f},{:.9f},{},{},{:.17g},{:.17g},{:.17g},{},{},{},{}\n",
+        out.print("{:.9f},{:.9f},{},{},{:.17g},{:.17g},{:.17g},{},{},{},{},{:.9g},{:.9g}\n",
                   seconds(s.time_ns(), start), s.simulation_time(), tool.slot(),
                   tool.known() ? 1 : 0, p.x(), p.y(), p.z(), tool.buttons(), s.rebuilt() ? 1 : 0,
-                  s.boundary_nodes(), csv_field(s.condition_switch().name()));
+                  s.boundary_nodes(), csv_field(s.condition_switch().name()),
+                  1e6 * s.fractured_m2(), 1e6 * s.vaporised_m2());
       }
     out.commit();
   }

@@ -63,6 +63,8 @@ record::SimulationStep simulation_step_record(std::int64_t time_ns, double simul
     if (simulation.pressing(user)) step.add_pressing_slots(static_cast<std::uint32_t>(user));
   step.set_display_frame(display_frame);
   step.set_boundary_nodes(static_cast<std::uint32_t>(report.boundary_nodes));
+  step.set_fractured_m2(report.fractured_m2);
+  step.set_vaporised_m2(report.vaporised_m2);
   for (const record::ServerForce& force : forces) *step.add_forces() = force;
   return step;
 }

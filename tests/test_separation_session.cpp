@@ -8,7 +8,10 @@
 //     positions and buttons it used, bit for bit (its own prediction of fracture and
 //     vaporisation included);
 //   - the server's separated state, as its IRs carried it, grew during the session: the
-//     flap torn at its rim (fracture), the groove cut (the laser) and opened by the push.
+//     flap torn at its rim (fracture), the groove cut (the laser) and opened by the push;
+//   - the server's report gives that area, fractured and vaporised (the laser's about the
+//     groove, l_f L); its recording re-runs to the same area at every step, and replay's
+//     summary and steps.csv give it.
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -21,7 +24,9 @@
 #include "common/ir/evaluate_force.h"
 #include "proto/record/recording.h"
 #include "proto/wire/ir_convert.h"
+#include "support/csv_table.h"
 #include "support/process.h"
+#include "support/run_program.h"
 
 namespace cohaptic {
 namespace {
@@ -86,10 +91,10 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
   const fs::path dir = testing::scratch_directory("separation-session");
   auto server = std::make_unique<ChildProcess>(
       testing::server_program(),
-      std::vector<std::string>{"--scene", (kSeparationScenes / "two_layers.yaml").string(),
-                               "--listen", "127.0.0.1:0", "--duration", "60", "--report",
-                               (dir / "server.json").string(), "--cache-dir",
-                               (dir / "cache").string()},
+      std::vector<std::string>{
+          "--scene", (kSeparationScenes / "two_layers.yaml").string(), "--listen", "127.0.0.1:0",
+          "--duration", "60", "--report", (dir / "server.json").string(), "--record",
+          (dir / "server.mcap").string(), "--cache-dir", (dir / "cache").string()},
       dir / "server.log");
   ASSERT_TRUE(testing::wait_for_output(*server, "listening on")) << server->log_text();
   const int port = testing::listening_port(server->log_text());
@@ -165,6 +170,27 @@ TEST(SeparationSession, TwoUsersFeelTheTissueTearAndCutItAndEachClientEqualsItsI
   EXPECT_GT(fractured, rim * 1e6);
   EXPECT_NEAR(vaporised, cut_alone * 1e6, 0.25 * cut_alone * 1e6);
   EXPECT_FALSE(separated["groove_record_full"].get<bool>());
+
+  // The server's recording re-runs to the same area at every step; its summary and its
+  // steps.csv give it.
+  const fs::path recording = dir / "server.mcap";
+  const testing::ProgramRun verify =
+      testing::run_program(COHAPTIC_LAB_EXE, "replay '" + recording.string() + "' --verify", true);
+  EXPECT_EQ(verify.exit_code, 0) << verify.out;
+  EXPECT_NE(verify.out.find("verify: identical"), std::string::npos) << verify.out;
+  const testing::ProgramRun summary = testing::run_program(
+      COHAPTIC_LAB_EXE,
+      "replay '" + recording.string() + "' --export-csv '" + (dir / "csv").string() + "' --summary",
+      true);
+  EXPECT_NE(
+      summary.out.find(fmt::format("{:.2f} fractured, {:.2f} vaporised", fractured, vaporised)),
+      std::string::npos)
+      << summary.out;
+  const std::vector<testing::CsvRow> steps = testing::read_csv_table(dir / "csv" / "steps.csv");
+  ASSERT_FALSE(steps.empty());
+  EXPECT_NEAR(std::stod(steps.back().at("fractured_mm2")), fractured, 1e-6 * fractured);
+  EXPECT_NEAR(std::stod(steps.back().at("vaporised_mm2")), vaporised, 1e-6 * vaporised);
+  EXPECT_EQ(std::stod(steps.front().at("fractured_mm2")), 0);
 }
 
 }  // namespace
