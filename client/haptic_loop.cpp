@@ -135,10 +135,8 @@ Eigen::Vector3d HapticLoop::compute_force(std::int64_t now, const Eigen::Vector3
                             ? 1e-9 * static_cast<double>(now - last_evaluated_ns_)
                             : 1 / settings_.rate_hz;
       last_evaluated_ns_ = now;
-      continue_evaluation(carry_, *slot.ir, *slot.state);  // a new IR goes on from the last
-      const ForceSample sample = evaluate_force(
-          *slot.ir, *slot.state, own, std::span(remotes.data(), count), dt, record.buttons);
-      carry_ = take_evaluation_carry(*slot.ir, *slot.state);
+      const ForceSample sample = evaluate_force_in_turn(
+          *slot.ir, *slot.state, carry_, own, std::span(remotes.data(), count), dt, record.buttons);
       // A sphere contact solve that could not finish inside the tick has no answer: hold the
       // last one and count the tick.
       if (sample.flags & kContactUnresolved) {

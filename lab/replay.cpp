@@ -121,10 +121,9 @@ VerifyResult verify_client(const Recording& rec) {
         auto state = states.find(ir.get());
         if (state == states.end())
           state = states.emplace(ir.get(), make_evaluation_state(*ir)).first;
-        continue_evaluation(carry, *ir, state->second);  // as the haptic loop does
-        const ForceSample sample = evaluate_force(*ir, state->second, wire::from_wire(tick.own()),
-                                                  remotes, tick.dt(), tick.buttons());
-        carry = take_evaluation_carry(*ir, state->second);
+        const ForceSample sample =
+            evaluate_force_in_turn(*ir, state->second, carry, wire::from_wire(tick.own()), remotes,
+                                   tick.dt(), tick.buttons());
         expected = (sample.flags & kContactUnresolved) ? last_resolved : sample.force;
         last_resolved = expected;
       } else {

@@ -78,9 +78,9 @@ TradeoffRow run_home_spring_setting(const Scene& scene, const std::vector<Trajec
       for (std::size_t u = 0; u < users; ++u) {
         if (!published[u]) continue;
         const Stopwatch evaluation;
-        continue_evaluation(carry[u], *published[u], client[u]);
-        held[u] = evaluate_force(*published[u], client[u], positions[u], {}, tick_s).force;
-        carry[u] = take_evaluation_carry(*published[u], client[u]);
+        held[u] =
+            evaluate_force_in_turn(*published[u], client[u], carry[u], positions[u], {}, tick_s)
+                .force;
         tally.evaluation(1000 * evaluation.elapsed_ms());
       }
     for (std::size_t u = 0; u < users; ++u)

@@ -358,24 +358,6 @@ EvaluationState make_evaluation_state(const PreparedIR& prepared) {
       prepared.ir.body)};
 }
 
-EvaluationCarry take_evaluation_carry(const PreparedIR& prepared,
-                                      const EvaluationState& state) noexcept {
-  const auto* tissue = std::get_if<HomeSpringEvaluation>(&state.body);
-  if (!tissue || !tissue->viscous) return {};
-  return {prepared.ir.object, tissue->moving};
-}
-
-void continue_evaluation(const EvaluationCarry& carry, const PreparedIR& prepared,
-                         EvaluationState& state) noexcept {
-  auto* tissue = std::get_if<HomeSpringEvaluation>(&state.body);
-  const auto* patch = std::get_if<HomeSpringPatch>(&prepared.ir.body);
-  if (!tissue || !patch || !tissue->viscous || tissue->started ||
-      carry.object != prepared.ir.object)
-    return;
-  tissue->moving = carry.moving;
-  carry_moving_vertex(*patch, tissue->moving);
-}
-
 bool evaluation_measures_elapsed_time(const EvaluationState& state) {
   const auto* tissue = std::get_if<HomeSpringEvaluation>(&state.body);
   return tissue && tissue->viscous;
@@ -462,6 +444,23 @@ ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state,
                            std::uint32_t buttons) noexcept {
   return evaluate_by_kind(prepared, state, Tick{prepared.ir, own_tool, remote_tools, dt, buttons},
                           std::make_index_sequence<kBodyKindCount>{});
+}
+
+ForceSample evaluate_force_in_turn(const PreparedIR& prepared, EvaluationState& state,
+                                   EvaluationCarry& carry, const Eigen::Vector3d& own_tool,
+                                   std::span<const Eigen::Vector3d> remote_tools, double dt,
+                                   std::uint32_t buttons) noexcept {
+  auto* tissue = std::get_if<HomeSpringEvaluation>(&state.body);
+  const auto* patch = std::get_if<HomeSpringPatch>(&prepared.ir.body);
+  if (tissue && patch && tissue->viscous && !tissue->started &&
+      carry.object == prepared.ir.object) {
+    tissue->moving = carry.moving;
+    carry_moving_vertex(*patch, tissue->moving);
+  }
+  const ForceSample sample = evaluate_force(prepared, state, own_tool, remote_tools, dt, buttons);
+  carry = tissue && tissue->viscous ? EvaluationCarry{prepared.ir.object, tissue->moving}
+                                    : EvaluationCarry{};
+  return sample;
 }
 
 }  // namespace cohaptic

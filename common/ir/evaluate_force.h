@@ -102,7 +102,7 @@ struct FemEvaluation {
 /// viscous body's (damping > 0) carries from tick to tick; it starts at rest.
 struct HomeSpringEvaluation {
   bool viscous = false;
-  bool started = false;  ///< evaluated at least once (continue_evaluation no longer applies)
+  bool started = false;  ///< evaluated at least once: evaluate_force_in_turn carries nothing in
   MovingVertex moving;
 };
 
@@ -127,24 +127,14 @@ struct EvaluationState {
 /// The state an evaluator of `prepared` starts from (the server's state at the IR's time).
 EvaluationState make_evaluation_state(const PreparedIR& prepared);
 
-/// What an evaluator hands on to the evaluator of the user's next IR of the same body: a
+/// What an evaluator hands on to the evaluator of the user's next IR of the same body
+/// (evaluate_force_in_turn): a
 /// viscous tissue's moving vertex (viscous_home_spring.h), named by its surface index so the
 /// previous IR need not outlive it. Small and copied; nothing for the other kinds.
 struct EvaluationCarry {
   int object = -1;  ///< the scene object it was taken on; -1: nothing to carry
   MovingVertex moving;
 };
-
-/// The carry of `state`, an evaluator of `prepared` (noexcept, allocation-free).
-EvaluationCarry take_evaluation_carry(const PreparedIR& prepared,
-                                      const EvaluationState& state) noexcept;
-
-/// `state`, made for `prepared`, goes on from `carry` if it was taken on the same object and
-/// `state` has not been evaluated yet; otherwise nothing. The haptic loop, a replay and the
-/// server call it before every evaluation and take the carry after it, so each new IR's
-/// evaluator goes on from the last one's. noexcept, allocation-free.
-void continue_evaluation(const EvaluationCarry& carry, const PreparedIR& prepared,
-                         EvaluationState& state) noexcept;
 
 /// Whether evaluating moves the body itself: a mass-spring sub-network or a separation steps
 /// with every call, so a second evaluation in the same tick would step it twice, and so does a
@@ -193,5 +183,13 @@ ForceSample evaluate_force(const PreparedIR& prepared, EvaluationState& state,
                            const Eigen::Vector3d& own_tool,
                            std::span<const Eigen::Vector3d> remote_tools, double dt,
                            std::uint32_t buttons = 0) noexcept;
+
+/// evaluate_force for a caller that evaluates one user's IRs in turn (the haptic loop, a
+/// replay, the server's P0): a `state` not evaluated yet first goes on from `carry` if that
+/// was taken on the same object, and `carry` becomes what `state` hands on to the next IR's.
+ForceSample evaluate_force_in_turn(const PreparedIR& prepared, EvaluationState& state,
+                                   EvaluationCarry& carry, const Eigen::Vector3d& own_tool,
+                                   std::span<const Eigen::Vector3d> remote_tools, double dt,
+                                   std::uint32_t buttons = 0) noexcept;
 
 }  // namespace cohaptic

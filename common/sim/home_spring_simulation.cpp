@@ -135,7 +135,8 @@ void HomeSpringSimulation::evaluate_user(UserState& user, double dt) {
   const Eigen::Vector3d tool =
       user.known ? user.position
                  : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-  const ForceSample sample = evaluate_force(*user.ir, user.evaluation, tool, {}, dt);
+  const ForceSample sample =
+      evaluate_force_in_turn(*user.ir, user.evaluation, user.carry, tool, {}, dt);
   if (user.known) user.force = sample;
   user.pressing = (sample.flags & kInContact) != 0;
   const MovingVertex& moving = std::get<HomeSpringEvaluation>(user.evaluation.body).moving;
@@ -163,11 +164,8 @@ void HomeSpringSimulation::publish_ir(int u, int centre, double time, StepReport
   ir.object = object_;
   ir.force_limit = force_limit_;
   ir.body = std::move(patch);
-  const EvaluationCarry carry =
-      user.ir ? take_evaluation_carry(*user.ir, user.evaluation) : EvaluationCarry{};
   user.ir = std::make_shared<const PreparedIR>(prepare_ir(std::move(ir)));
-  user.evaluation = make_evaluation_state(*user.ir);
-  continue_evaluation(carry, *user.ir, user.evaluation);  // the moving vertex goes on
+  user.evaluation = make_evaluation_state(*user.ir);  // goes on from user.carry when evaluated
   user.centre = centre;
   user.grasped = user.jaws.grasping;
   report.rebuilt = true;

@@ -99,6 +99,7 @@ class HomeSpringSimulation {
     std::uint64_t epoch = 0;
     std::shared_ptr<const PreparedIR> ir;
     EvaluationState evaluation;  // P0
+    EvaluationCarry carry;       // what it hands on to the next IR's (the moving vertex)
     ForceSample force;           // P0 at the latest step
   };
   void step_user(int user, double time, double dt, StepReport& report);
