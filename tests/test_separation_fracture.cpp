@@ -22,7 +22,7 @@ namespace {
 
 using testing::default_two_layers;
 
-// On the default layers the interface has J_c = 75 J/m^2 and l_n = l_t = 5 mm.
+// On the default layers the interface has J_c = 75 J/m^2, l_n = 12 mm and l_t = 6 mm.
 int rim_node() {
   return nearest_patch_node(default_two_layers().patch, Eigen::Vector3d(0, 0.02, 0));
 }
@@ -32,13 +32,20 @@ int centre_node() {
 
 TEST(SeparationFracture, ThePlateauReachSaysWhereLnHoldsThePullAndNamesTheBound) {
   SeparationPatch patch = default_two_layers().patch;
+  // The default l_n holds everywhere, and nothing is said.
+  const PlateauReach everywhere = plateau_reach(patch);
+  EXPECT_EQ(everywhere.nodes, patch.node_count());
+  EXPECT_EQ(everywhere.held, everywhere.nodes);
+  EXPECT_EQ(plateau_warning(everywhere, patch.normal_length), "");
+  // Half of it holds at the rim but not at the centre (docs/separation.md).
+  patch.normal_length *= 0.5;
   const PlateauReach reach = plateau_reach(patch);
-  // The rim holds with the default l_n, the centre needs more (docs/separation.md).
-  EXPECT_EQ(reach.nodes, patch.node_count());
   EXPECT_GT(reach.held, 0);
   EXPECT_LT(reach.held, reach.nodes);
+  EXPECT_LE(holding_normal_length(patch, rim_node()), patch.normal_length);
+  EXPECT_GT(holding_normal_length(patch, centre_node()), patch.normal_length);
   EXPECT_GE(reach.longest, holding_normal_length(patch, centre_node()));
-  EXPECT_GT(reach.longest, patch.normal_length);
+  EXPECT_EQ(reach.longest, everywhere.longest);
   int independent = 0;  // counted again here
   for (int node = 0; node < patch.node_count(); ++node)
     independent += holding_normal_length(patch, node) <= patch.normal_length;
@@ -50,11 +57,9 @@ TEST(SeparationFracture, ThePlateauReachSaysWhereLnHoldsThePullAndNamesTheBound)
   EXPECT_NE(warning.find(fmt::format("{:.2f} mm", 1e3 * reach.longest)), std::string::npos)
       << warning;
   std::printf("  %s\n", warning.c_str());
-  // At the bound it holds everywhere, and nothing is said.
+  // At the bound it holds everywhere.
   patch.normal_length = reach.longest;
-  const PlateauReach everywhere = plateau_reach(patch);
-  EXPECT_EQ(everywhere.held, everywhere.nodes);
-  EXPECT_EQ(plateau_warning(everywhere, patch.normal_length), "");
+  EXPECT_EQ(plateau_reach(patch).held, reach.nodes);
 }
 
 TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
@@ -95,7 +100,8 @@ TEST(SeparationFracture, NormalPullShowsThePapersThreePhases) {
         const double f_e = field_value(patch, node, 0, FieldState::separated, delta).force.dot(n);
         const double global = s.separated_area / patch.interface_area;
         EXPECT_NEAR(s.force, (1 - global) * f_bar + global * f_e, 1e-12 * f_n);
-        EXPECT_NEAR(s.force, f_bar, 0.01 * f_bar) << "at " << s.travel * 1e3 << " mm";
+        // Mostly F-bar: the global share's F^e takes a few per cent.
+        EXPECT_NEAR(s.force, f_bar, 0.05 * f_bar) << "at " << s.travel * 1e3 << " mm";
         break;
       }
     }
@@ -173,6 +179,59 @@ TEST(SeparationFracture, EnergyBalanceAtOtherSpeedsAndAngles) {
         EXPECT_GE(loop.net_work - loop.final_energy, 0) << where;
         EXPECT_GE(loop.final_energy, 0) << where;
       }
+}
+
+// A groove across the interface at x = 20.5 mm from y = 12 to 28 mm, cut at half v_s.
+SeparationState grooved_across_the_middle(const SeparationPatch& patch) {
+  SeparationState grooved = make_separation_state(patch);
+  LaserFibre fibre;
+  const double dt = 1e-3, speed = 0.5 * patch.vaporisation_speed;
+  const Eigen::Vector3d from(0.0205, 0.012, 0), to(0.0205, 0.028, 0);
+  const int ticks = static_cast<int>(std::ceil((to - from).norm() / (speed * dt)));
+  for (int i = 0; i <= ticks; ++i)
+    step_laser(patch, grooved, fibre, from + (to - from) * std::min(1.0, double(i) / ticks), true,
+               dt);
+  return grooved;
+}
+
+// The paper's scenario (Sec. VI.C): a laser groove, then a pull beside it. The crack grows
+// from the groove's edge inside the interface, where the fields need a longer l_n than at
+// the free rim; with the default l_n, which clears every node, BC holds at J_c l_n there
+// too and the hand's work over it is J_c times the area. With an l_n below the node's
+// holding length the plateau is lost as soon as the crack starts (the loop turns at once).
+TEST(SeparationFracture, AGrooveThenAPullBesideItHoldsJcLnWhileTheCrackGrowsInside) {
+  SeparationPatch patch = default_two_layers().patch;
+  const SeparationState grooved = grooved_across_the_middle(patch);
+  ASSERT_EQ(plateau_reach(patch).held, patch.node_count());
+  for (double x : {0.020, 0.022})
+    for (double y : {0.016, 0.020, 0.024}) {
+      const int node = nearest_patch_node(patch, Eigen::Vector3d(x, y, 0));
+      const std::string where = fmt::format("beside the groove at ({}, {}) mm", 1e3 * x, 1e3 * y);
+      ASSERT_LT(holding_normal_length(patch, node), patch.normal_length) << where;
+      PullLoopSettings settings;
+      settings.node = node;
+      const PullLoop loop = run_pull_loop(patch, grooved, settings);
+      int fracture = 0;
+      for (const PullLoopSample& s : loop.samples)
+        if (s.phase == PullPhase::fracture) {
+          ++fracture;
+          EXPECT_NEAR(s.force, loop.threshold, 0.02 * loop.threshold)
+              << where << " at " << s.travel * 1e3 << " mm";
+        }
+      EXPECT_GT(fracture, 100) << where;
+      // The crack grew over the whole of the node's region (the loop's point C), at J_c.
+      EXPECT_GE(loop.fracture_area, patch.region_areas[node]) << where;
+      EXPECT_NEAR(loop.fracture_work, patch.toughness * loop.fracture_area,
+                  0.01 * patch.toughness * loop.fracture_area)
+          << where;
+      EXPECT_GE(loop.net_work - loop.final_energy, 0) << where;
+
+      SeparationPatch short_length = patch;
+      short_length.normal_length = 0.5 * holding_normal_length(patch, node);
+      short_length.normal_threshold = short_length.toughness * short_length.normal_length;
+      const PullLoop lost = run_pull_loop(short_length, grooved, settings);
+      EXPECT_LT(lost.fracture_area, 0.1 * patch.region_areas[node]) << where;
+    }
 }
 
 // Drives a grasp at `node` along `direction` by `step` per tick until `stop` says so.
@@ -259,15 +318,7 @@ TEST(SeparationFracture, NoCrackNoFractureUntilALaserGroove) {
   ASSERT_GE(pulled.samples.back().body_force.dot(n), 10 * patch.normal_threshold);
   EXPECT_EQ(pulled.state.separated_area, 0);
 
-  // A groove across the interface at x = 20.5 mm, through the node's region, at half v_s.
-  SeparationState grooved = make_separation_state(patch);
-  LaserFibre fibre;
-  const double dt = 1e-3, speed = 0.5 * patch.vaporisation_speed;
-  const Eigen::Vector3d from(0.0205, 0.012, 0), to(0.0205, 0.028, 0);
-  const int ticks = static_cast<int>(std::ceil((to - from).norm() / (speed * dt)));
-  for (int i = 0; i <= ticks; ++i)
-    step_laser(patch, grooved, fibre, from + (to - from) * std::min(1.0, double(i) / ticks), true,
-               dt);
+  const SeparationState grooved = grooved_across_the_middle(patch);
   const double groove = grooved.separated_area;
   ASSERT_GT(groove, 0);
   // The same push, 6 mm on from the node: it tears at F_t and goes on tearing, the

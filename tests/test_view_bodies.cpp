@@ -227,7 +227,9 @@ TEST(ViewBodies, TheTissuesFrameIsItsDisplayedDent) {
   EXPECT_GT(frame.users(0).patch_nodes_size(), 0);
 }
 
-TEST(ViewBodies, TheSeparatingTissuesSceneHasBothLayersSurfacesDrawnAtRest) {
+// The layers are drawn at rest; their interface goes with the scene and its separated shares
+// and grooves with every frame, as the simulation holds them.
+TEST(ViewBodies, TheSeparatingTissuesSceneHasBothLayersSurfacesDrawnAtRestAndItsInterface) {
   Scene scene = load_shipped_view_scene("scenes/separation/two_layers.yaml");
   std::get<SeparationObjectSpec>(scene.objects[0].body).disk_cache =
       false;  // no cache written by a test
@@ -253,6 +255,48 @@ TEST(ViewBodies, TheSeparatingTissuesSceneHasBothLayersSurfacesDrawnAtRest) {
   EXPECT_TRUE(std::all_of(frame.displacement().begin(), frame.displacement().end(),
                           [](float u) { return u == 0; }));
   EXPECT_TRUE(frame.users(0).present());
+
+  const SeparationPatch& patch = *body.patch;
+  ASSERT_EQ(message.interfaces_size(), 1);
+  const view::Interface& face = message.interfaces(0);
+  EXPECT_EQ(face.object(), 0u);
+  ASSERT_EQ(face.vertices_size(), 3 * patch.node_count());
+  for (int node = 0; node < patch.node_count(); ++node)
+    for (int axis = 0; axis < 3; ++axis)
+      EXPECT_EQ(face.vertices(3 * node + axis), static_cast<float>(patch.positions(axis, node)));
+  ASSERT_EQ(face.triangles_size(), 3 * patch.triangle_count());
+  for (int t = 0; t < patch.triangle_count(); ++t)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(face.triangles(3 * t + k),
+                static_cast<std::uint32_t>(patch.triangles[static_cast<std::size_t>(t)][k]));
+  ASSERT_EQ(frame.interfaces_size(), 1);
+  EXPECT_EQ(frame.interfaces(0).separated_area(), 0);
+  EXPECT_EQ(frame.interfaces(0).groove_widths_size(), 0);
+
+  // The fibre (user 1) fires along a 10 mm groove at 20 mm/s.
+  for (int k = 0; k <= 500; ++k) {
+    layers.simulation.set_tool(1, Eigen::Vector3d(0.0205, 0.015 + 2e-5 * k, 0.0002), 1u);
+    layers.simulation.step(layers.time += 0.001);
+  }
+  const SeparationState& state = std::get<SeparationSimulation>(layers.simulation.body(0)).state();
+  ASSERT_GT(state.groove.count, 0u);
+  const view::Frame grooved = layers.frame();
+  ASSERT_EQ(grooved.interfaces_size(), 1);
+  const view::InterfaceFrame& shown = grooved.interfaces(0);
+  EXPECT_EQ(shown.separated_area(), state.separated_area);
+  ASSERT_EQ(shown.separated_size(), patch.triangle_count());
+  for (int t = 0; t < patch.triangle_count(); ++t)
+    EXPECT_EQ(shown.separated(t), static_cast<float>(state.separated[static_cast<std::size_t>(t)]));
+  ASSERT_EQ(shown.groove_widths_size(), static_cast<int>(state.groove.count));
+  ASSERT_EQ(shown.grooves_size(), 6 * shown.groove_widths_size());
+  for (int g = 0; g < shown.groove_widths_size(); ++g) {
+    const GrooveSegment& segment = state.groove.segments[static_cast<std::size_t>(g)];
+    EXPECT_EQ(shown.groove_widths(g), static_cast<float>(segment.width));
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_EQ(shown.grooves(6 * g + axis), static_cast<float>(segment.a[axis]));
+      EXPECT_EQ(shown.grooves(6 * g + 3 + axis), static_cast<float>(segment.b[axis]));
+    }
+  }
 }
 
 }  // namespace

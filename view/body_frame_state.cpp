@@ -21,7 +21,14 @@ struct BodyFrameStateTaker {
   BodyFrameState operator()(const HomeSpringSimulation& body) const {
     return TissueFrameState{body.dents()};
   }
-  BodyFrameState operator()(const SeparationSimulation&) const { return RestFrameState{}; }
+  BodyFrameState operator()(const SeparationSimulation& body) const {
+    const SeparationState& separation = body.state();
+    const auto grooves = separation.groove.segments.begin();
+    return SeparationFrameState{
+        separation.separated,
+        {grooves, grooves + static_cast<std::ptrdiff_t>(separation.groove.count)},
+        separation.separated_area};
+  }
 };
 
 struct PartDisplacement {
@@ -42,7 +49,7 @@ struct PartDisplacement {
     return dented_surface(*part.display, state.dents) -
            part.display->rest;  // every vertex is shown, in order
   }
-  Eigen::Matrix3Xd operator()(const RestFrameState&) const {
+  Eigen::Matrix3Xd operator()(const SeparationFrameState&) const {
     return Eigen::Matrix3Xd::Zero(3, part.size());
   }
 };

@@ -43,6 +43,15 @@ Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol pro
     object->set_model(body_model_name(model.bodies[body]));
     object->set_first_node(static_cast<std::uint32_t>(shown.parts[body].offset));
     object->set_node_count(static_cast<std::uint32_t>(shown.parts[body].size()));
+    if (const auto* layers = std::get_if<SeparationModel>(&model.bodies[body])) {
+      Interface* out = scene.add_interfaces();
+      out->set_object(static_cast<std::uint32_t>(body));
+      const SeparationPatch& patch = *layers->patch;
+      for (Eigen::Index node = 0; node < patch.positions.cols(); ++node)
+        add_point(*out->mutable_vertices(), patch.positions.col(node));
+      for (const Triangle& tri : patch.triangles)
+        for (int corner : tri) out->add_triangles(static_cast<std::uint32_t>(corner));
+    }
   }
   for (std::size_t slot = 0; slot < model.scene.tools.size(); ++slot) {
     Tool* tool = scene.add_tools();
@@ -170,6 +179,19 @@ Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t
         frame.add_held_nodes(static_cast<std::uint32_t>(index));
   }
   frame.set_boundary_nodes(boundary_nodes);
+  for (std::size_t body = 0; body < state.bodies.size(); ++body) {
+    const auto* layers = std::get_if<SeparationFrameState>(&state.bodies[body]);
+    if (!layers) continue;
+    InterfaceFrame* out = frame.add_interfaces();
+    out->set_object(static_cast<std::uint32_t>(body));
+    for (double share : layers->separated) out->add_separated(static_cast<float>(share));
+    for (const GrooveSegment& segment : layers->grooves) {
+      add_point(*out->mutable_grooves(), segment.a);
+      add_point(*out->mutable_grooves(), segment.b);
+      out->add_groove_widths(static_cast<float>(segment.width));
+    }
+    out->set_separated_area(layers->separated_area);
+  }
   return frame;
 }
 

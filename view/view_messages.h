@@ -30,9 +30,9 @@ struct ToolState {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< [m]
 };
 
-/// The scene: `shown` (model's, at rest, with each object's name, model and shown nodes), the
-/// tools, the obstacles (a plane as a square of twice the shown surface's size around its
-/// projection), and the session's settings.
+/// The scene: `shown` (model's, at rest, with each object's name, model and shown nodes, and
+/// each separating object's interface), the tools, the obstacles (a plane as a square of
+/// twice the shown surface's size around its projection), and the session's settings.
 Scene view_scene(const Model& model, const ShownScene& shown, wire::Protocol protocol,
                  const record::InjectedDelays& injected, double frame_rate_hz,
                  const std::string& source);
@@ -65,7 +65,8 @@ FrameState frame_state(const SceneSimulation& simulation,
 /// A frame at simulation time `time` [s] (any thread): the displacement of the shown nodes,
 /// each user's tool, its force, its IR patch (linear elastic, mass-spring and tissue IRs) and,
 /// while it presses, its contact (a linear elastic body's contact triangle, the mass-spring
-/// node its tool drives); the held nodes and |B| of the linear elastic bodies.
+/// node its tool drives); the held nodes and |B| of the linear elastic bodies; each separating
+/// body's separated shares and grooves.
 Frame view_frame(const FrameState& state, const ShownScene& shown, std::uint64_t sequence,
                  double time, double sim_rate_hz);
 

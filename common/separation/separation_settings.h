@@ -6,12 +6,14 @@
 // Sommer, Gasser, Regitnig, Auer & Holzapfel, "Dissection properties of the human aortic
 // media: an experimental study", J. Biomech. Eng. 130(2):021007 (2008), report about
 // 5 mJ/cm^2 circumferentially and 7.6 mJ/cm^2 axially (50 and 76 J/m^2). l_n and l_t [m],
-// the crack front a blunt tool opens per unit travel normal to and along the interface:
-// 6 mm, our choice — the tip of a 5 mm laparoscopic dissector and the flap it lifts on
-// either side. So F_n = J_c l_n = F_t = J_c l_t = 0.45 N by default (Eqs. 11, 14).
-// Fracture holds the force at F_n only when l_n is long enough for the fields
-// (holding_normal_length in fracture_step.h: 5.1 mm at the rim of the default two-layer
-// scene, longer inside it); shorter, the force rises above F_n while the crack grows.
+// the crack front a blunt tool opens per unit travel normal to and along the interface.
+// l_t = 6 mm, our choice: the tip of a 5 mm laparoscopic dissector and the flap it lifts on
+// either side. l_n = 12 mm: fracture holds a pull at F_n only where l_n is at least the
+// length the fields need at the crack front (holding_normal_length in fracture_step.h),
+// which is shortest at the free rim and longest inside the interface; 12 mm is the round
+// length that clears every node of the default two-layer scene, so a pull beside a groove
+// holds as one at the rim does. So F_n = J_c l_n = 0.9 N and F_t = J_c l_t = 0.45 N by
+// default (Eqs. 11, 14).
 // Friction between the tool and an exposed layer, mu = 0.2: our choice for wet tissue on
 // steel (a setting; the paper's sliding follows Hayward & Armstrong's model [28]).
 //
@@ -33,7 +35,7 @@ namespace cohaptic {
 
 struct FractureSettings {
   double toughness = 75;             ///< J_c [J/m^2]
-  double normal_length = 0.006;      ///< l_n [m]
+  double normal_length = 0.012;      ///< l_n [m]
   double tangential_length = 0.006;  ///< l_t [m]
   double friction = 0.2;             ///< mu, tool on an exposed layer
 };

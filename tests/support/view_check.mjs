@@ -20,7 +20,8 @@
 // final report (its client has finished).
 // Pixels: the screenshot is decoded by the browser itself (an <img> drawn on a 2-D canvas)
 // and counted: non-background pixels inside the projected box of the mesh, pixels of each
-// user's colour on its tool's outline and along its force arrow, and of the scale bar's line.
+// user's colour on its tool's outline and along its force arrow, of the scale bar's line,
+// and in each separating interface's box those of its separated faces, grooves and crack front.
 // "screen": what the page shows, in CSS pixels: per user the arrow's length, its tip's
 // distance from its tool's centre and the tool's radius on the screen; the legend's title,
 // the arrow scale, the rigid-motion checkbox, the scale bar's text and length.
@@ -175,10 +176,10 @@ try {
     const background = [0x15, 0x17, 0x1c];
     const clip = (b) => ({ x0: Math.max(b.x0, shown.canvas.x), y0: Math.max(b.y0, shown.canvas.y),
       x1: Math.min(b.x1, shown.canvas.x + shown.canvas.width - 1), y1: Math.min(b.y1, shown.canvas.y + shown.canvas.height - 1) });
-    const count = (box, test) => {
+    const count = (box, test, step = 2) => {
       let n = 0, all = 0;
-      for (let y = Math.ceil(box.y0); y <= box.y1; y += 2)
-        for (let x = Math.ceil(box.x0); x <= box.x1; x += 2) { ++all; if (test(at(x, y))) ++n; }
+      for (let y = Math.ceil(box.y0); y <= box.y1; y += step)
+        for (let x = Math.ceil(box.x0); x <= box.x1; x += step) { ++all; if (test(at(x, y))) ++n; }
       return { matching: n, sampled: all };
     };
     const hex = (c) => [1, 3, 5].map((k) => parseInt(c.slice(k, k + 2), 16));
@@ -223,7 +224,17 @@ try {
     const row = Math.floor(bar.y + bar.height) - 1;
     const scaleBar = count({ x0: bar.x + 1, y0: row, x1: bar.x + bar.width - 2, y1: row },
       (p) => distance(p, [0xe6, 0xe6, 0xe6]) < 40);
-    return { mesh, corner: outside, users, scaleBar };
+    // A separating interface's overlay, every pixel of its box: separated faces (drawn fully
+    // separated in exactly this colour), grooves and the crack front (thin lines).
+    const interfaces = (shown.interfaceScreenBoxes || []).map((box) => {
+      const within = (colour, most) => (p) => distance(p, hex(colour)) < most;
+      return {
+        separated: count(clip(box), within('#ff8a65', 12), 1),
+        groove: count(clip(box), within('#ffffff', 12), 1),
+        front: count(clip(box), within('#00e5ff', 40), 1),
+      };
+    });
+    return { mesh, corner: outside, users, scaleBar, interfaces };
   }, { data: png.toString('base64'), shown: result.shown, screen: result.screen });
   if (args.stay !== undefined && !result.error) {
     // Watching on, drawing every frame, for as long as asked (the demo's browser).

@@ -1,7 +1,8 @@
 // cohaptic's live view: decodes the view server's messages (proto/cohaptic/view.proto, with
 // protobufjs) and draws them with three.js: the deformed surface coloured by |u| (or by the
 // deformation, the best-fit rigid motion removed), each user's translucent tool, force arrow,
-// patch and contact nodes, the held nodes, the obstacles, a scale bar; a strip chart and a
+// patch and contact nodes, the held nodes, the obstacles, a separating object's interface
+// (its separated faces, the crack front and the laser's grooves), a scale bar; a strip chart and a
 // status table per user; for a recording, a timeline whose controls send Commands back.
 // Lengths arrive in m and are drawn in the scene's unit; forces in N.
 // window.cohapticView exposes the page's state (the browser test reads it).
@@ -16,8 +17,17 @@ const COLOUR_STOPS = [[0x44, 0x01, 0x54], [0x3b, 0x52, 0x8b], [0x21, 0x91, 0x8c]
 // tool's radius), so that a small force still shows well outside its tool.
 const ARROW_MIN_FRACTION = 0.25;
 const SCALE_BAR_PX = 120;  // the scale bar's longest length
+// A separating interface, drawn over the layers that hide it (opaque, after the surface,
+// before the translucent tools): separated faces (darker where a face is only partly
+// separated), the crack front (where open faces meet connected ones) and the laser's grooves.
+const SEPARATED_COLOUR = new THREE.Color('#ff8a65');
+const CRACK_COLOUR = new THREE.Color('#00e5ff');
+const GROOVE_COLOUR = new THREE.Color('#ffffff');
 
 const $ = (id) => document.getElementById(id);
+// The eight corners of a THREE.Box3.
+const boxCorners = (box) => [0, 1, 2, 3, 4, 5, 6, 7].map((k) => new THREE.Vector3(
+  k & 1 ? box.max.x : box.min.x, k & 2 ? box.max.y : box.min.y, k & 4 ? box.max.z : box.min.z));
 
 // ---- the schema ----
 
@@ -298,6 +308,8 @@ class View {
     }
     this.obstacleGroup.visible = this.showObstacles;
     this.root.add(this.obstacleGroup);
+    this.interfaces = scene.interfaces.map((face) => this.makeInterface(face, unit));
+    this.state.interfaces = [];
 
     const pointSize = Math.max(this.size / 160, 0.5);
     const points = (colour, size) => {
@@ -350,6 +362,102 @@ class View {
 
   // An arrow along +y from its origin, of unit length until placed: a shaft and a head, drawn
   // over everything (after the translucent tools) in the user's own colour.
+  // ---- a separating interface ----
+
+  makeInterface(face, unit) {
+    const vertices = Float32Array.from(face.vertices, (x) => x * unit);
+    const triangles = face.triangles;
+    const count = triangles.length / 3;
+    // Each edge with the faces on either side (-1: the interface's rim).
+    const edges = new Map();
+    for (let t = 0; t < count; ++t)
+      for (let k = 0; k < 3; ++k) {
+        const a = triangles[3 * t + k], b = triangles[3 * t + (k + 1) % 3];
+        const key = a < b ? `${a},${b}` : `${b},${a}`;
+        const edge = edges.get(key);
+        if (edge) edge.faces[1] = t;
+        else edges.set(key, { a, b, faces: [t, -1] });
+      }
+    const overlay = (geometry, material, order) => {
+      const object = material.isLineBasicMaterial ? new THREE.LineSegments(geometry, material) : new THREE.Mesh(geometry, material);
+      geometry.setDrawRange(0, 0);
+      object.renderOrder = order;
+      object.frustumCulled = false;
+      this.root.add(object);
+      return object;
+    };
+    const faces = new THREE.BufferGeometry();
+    faces.setAttribute('position', new THREE.BufferAttribute(new Float32Array(9 * count), 3));
+    faces.setAttribute('color', new THREE.BufferAttribute(new Float32Array(9 * count), 3));
+    const front = new THREE.BufferGeometry();
+    front.setAttribute('position', new THREE.BufferAttribute(new Float32Array(6 * edges.size), 3));
+    const normal = new THREE.Vector3();
+    if (count > 0) {
+      const corner = (k) => new THREE.Vector3().fromArray(vertices, 3 * triangles[k]);
+      normal.crossVectors(corner(1).sub(corner(0)), corner(2).sub(corner(0))).normalize();
+    }
+    return {
+      object: face.object, vertices, triangles, count, edges: [...edges.values()], normal,
+      faces: overlay(faces, new THREE.MeshBasicMaterial({ vertexColors: true, depthTest: false, depthWrite: false, side: THREE.DoubleSide }), 3),
+      front: overlay(front, new THREE.LineBasicMaterial({ color: CRACK_COLOUR, depthTest: false, depthWrite: false }), 5),
+      grooves: overlay(new THREE.BufferGeometry(), new THREE.MeshBasicMaterial({ color: GROOVE_COLOUR, depthTest: false, depthWrite: false, side: THREE.DoubleSide }), 4),
+    };
+  }
+
+  applyInterface(face, data) {
+    const share = data.separated;
+    const open = (t) => t >= 0 && t < share.length && share[t] > 0;
+    const positions = face.faces.geometry.attributes.position.array;
+    const colours = face.faces.geometry.attributes.color.array;
+    let shown = 0, separated = 0;
+    for (let t = 0; t < face.count; ++t) {
+      if (!open(t)) continue;
+      if (share[t] >= 1) ++separated;
+      const shade = 0.45 + 0.55 * Math.min(share[t], 1);
+      for (let k = 0; k < 3; ++k) {
+        const at = 9 * shown + 3 * k;
+        for (let c = 0; c < 3; ++c) positions[at + c] = face.vertices[3 * face.triangles[3 * t + k] + c];
+        colours[at] = SEPARATED_COLOUR.r * shade;
+        colours[at + 1] = SEPARATED_COLOUR.g * shade;
+        colours[at + 2] = SEPARATED_COLOUR.b * shade;
+      }
+      ++shown;
+    }
+    face.faces.geometry.attributes.position.needsUpdate = true;
+    face.faces.geometry.attributes.color.needsUpdate = true;
+    face.faces.geometry.setDrawRange(0, 3 * shown);
+
+    const line = face.front.geometry.attributes.position.array;
+    let fronts = 0;
+    for (const edge of face.edges) {
+      const [left, right] = edge.faces;
+      if (right < 0 || open(left) === open(right)) continue;
+      line.set(face.vertices.subarray(3 * edge.a, 3 * edge.a + 3), 6 * fronts);
+      line.set(face.vertices.subarray(3 * edge.b, 3 * edge.b + 3), 6 * fronts + 3);
+      ++fronts;
+    }
+    face.front.geometry.attributes.position.needsUpdate = true;
+    face.front.geometry.setDrawRange(0, 2 * fronts);
+
+    // A groove: a flat strip of its width along its segment, in the interface's plane.
+    const segments = data.groove_widths.length;
+    const strips = new Float32Array(18 * segments);
+    const a = new THREE.Vector3(), b = new THREE.Vector3(), across = new THREE.Vector3();
+    for (let g = 0; g < segments; ++g) {
+      a.fromArray(data.grooves, 6 * g).multiplyScalar(this.unit);
+      b.fromArray(data.grooves, 6 * g + 3).multiplyScalar(this.unit);
+      across.subVectors(b, a).cross(face.normal).normalize().multiplyScalar(0.5 * data.groove_widths[g] * this.unit);
+      const corners = [a.clone().sub(across), a.clone().add(across), b.clone().add(across), b.clone().sub(across)];
+      [0, 1, 2, 0, 2, 3].forEach((k, i) => corners[k].toArray(strips, 18 * g + 3 * i));
+    }
+    face.grooves.geometry.setAttribute('position', new THREE.BufferAttribute(strips, 3));
+    face.grooves.geometry.setDrawRange(0, 6 * segments);
+    return {
+      object: face.object, triangles: face.count, openTriangles: shown, separatedTriangles: separated, frontEdges: fronts,
+      grooveSegments: segments, separatedAreaMm2: data.separated_area * 1e6,
+    };
+  }
+
   makeArrow(colour) {
     const material = new THREE.MeshBasicMaterial({ color: colour, depthTest: false, transparent: true });
     const shaft = new THREE.Mesh(new THREE.CylinderGeometry(1, 1, 1, 12).translate(0, 0.5, 0), material);
@@ -580,6 +688,10 @@ class View {
       placeNodes(user.contact, data.contact_nodes);
       user.card.querySelector('.force').textContent = `${fmt(magnitude, 3)} N`;
     }
+    this.state.interfaces = frame.interfaces.map((data) => {
+      const face = this.interfaces.find((f) => f.object === data.object);
+      return face ? this.applyInterface(face, data) : null;
+    }).filter((shown) => shown);
     const boundary = frame.boundary_nodes;
     $('frame-info').textContent = `t = ${fmt(frame.time, 2)} s · simulation ${fmt(frame.sim_rate_hz, 0)} steps/s · |B| = ${boundary}`;
     this.state.frame = {
@@ -733,15 +845,14 @@ class View {
 
   snapshot() {
     const box = this.surface ? new THREE.Box3().setFromBufferAttribute(this.surface.geometry.attributes.position) : null;
-    const corners = box ? [0, 1, 2, 3, 4, 5, 6, 7].map((k) => new THREE.Vector3(
-      k & 1 ? box.max.x : box.min.x, k & 2 ? box.max.y : box.min.y, k & 4 ? box.max.z : box.min.z)) : [];
     const rect = this.canvas.getBoundingClientRect();
     return {
       ...this.state,
       frozen: !!this.frozen,
       canvas: { x: rect.left, y: rect.top, width: rect.width, height: rect.height },
-      meshScreenBox: box ? this.screenBox(corners) : null,
+      meshScreenBox: box ? this.screenBox(boxCorners(box)) : null,
       meshTriangles: this.surface ? this.surface.geometry.index.count / 3 : 0,
+      interfaceScreenBoxes: (this.interfaces || []).map((face) => this.screenBox(boxCorners(new THREE.Box3().setFromArray(face.vertices)))),
       users: (this.users || []).map((u) => ({
         slot: u.slot, tool: u.tool, colour: u.colour, present: u.present, pressing: u.pressing, force: u.force,
         forceMagnitude: norm3(u.force), arrowVisible: u.arrow.visible, arrowLength: u.arrowLength || 0,
