@@ -59,6 +59,25 @@ std::string url_in(const std::string& log, const std::string& before) {
   return std::regex_search(log, match, line) ? match[1].str() : "";
 }
 
+// The replay of dir/server.mcap in the page (`cohaptic-lab replay --view`), sought to `time`
+// [s]: view_check's result, its screenshot dir/<name>.png.
+json check_replay_at(const fs::path& dir, const std::string& name, double time) {
+  ChildProcess replay(COHAPTIC_LAB_EXE,
+                      {"replay", (dir / "server.mcap").string(), "--view", "127.0.0.1:0"},
+                      dir / "replay.log");
+  if (!testing::wait_for_output(replay, "in the live view at")) {
+    ADD_FAILURE() << replay.log_text();
+    return json::object();
+  }
+  const json page =
+      check_page(dir, name,
+                 {"--url", url_in(replay.log_text(), "in the live view at"), "--screenshot",
+                  (dir / (name + ".png")).string(), "--seek", fmt::format("{:.9f}", time)});
+  replay.signal(SIGTERM);
+  EXPECT_EQ(replay.wait(testing::kPatience), 0) << replay.log_text();
+  return page;
+}
+
 // A soft cube, two sphere tools, each user pressing its side of the top face: a directory
 // holding the scene (cube.yaml) and a script for each user (a.yaml, b.yaml) that presses
 // `depth_mm` and holds for `hold_s`.
@@ -510,22 +529,13 @@ segments:
   const std::size_t late = recording.view_frames.size() - 3;
   const view::Frame& expected = recording.view_frames[late];
   const double target = 0.5 * (expected.time() + recording.view_frames[late + 1].time());
-  ChildProcess replay(COHAPTIC_LAB_EXE,
-                      {"replay", (dir / "server.mcap").string(), "--view", "127.0.0.1:0"},
-                      dir / "replay.log");
-  ASSERT_TRUE(testing::wait_for_output(replay, "in the live view at"));
-  const json scrubbed =
-      check_page(dir, "scrub",
-                 {"--url", url_in(replay.log_text(), "in the live view at"), "--screenshot",
-                  (dir / "scrub.png").string(), "--seek", fmt::format("{:.9f}", target)});
+  const json scrubbed = check_replay_at(dir, "scrub", target);
   ASSERT_FALSE(scrubbed.contains("error")) << scrubbed.dump();
   EXPECT_DOUBLE_EQ(scrubbed["shown"]["frame"]["time"].get<double>(), expected.time());
   EXPECT_NEAR(scrubbed["shown"]["frame"]["maxDisplacementMm"].get<double>(),
               largest_frame_displacement(expected) * 1e3, 1e-6);
   EXPECT_GT(scrubbed["pixels"]["mesh"]["matching"].get<double>(),
             0.15 * scrubbed["pixels"]["mesh"]["sampled"].get<double>());
-  replay.signal(SIGTERM);
-  EXPECT_EQ(replay.wait(testing::kPatience), 0) << replay.log_text();
 }
 
 // The edges of `face` with a separated (open) triangle on one side and a connected one on
@@ -584,16 +594,7 @@ TEST(ViewInBrowser, TheSeparatingLayersShowTheGrooveTheCrackAndTheSeparatedFaces
   ASSERT_GT(expected.groove_widths_size(), 0) << "the fibre cut a groove";
   ASSERT_GT(front, 0);
 
-  ChildProcess replay(COHAPTIC_LAB_EXE,
-                      {"replay", (dir / "server.mcap").string(), "--view", "127.0.0.1:0"},
-                      dir / "replay.log");
-  ASSERT_TRUE(testing::wait_for_output(replay, "in the live view at"));
-  const json page =
-      check_page(dir, "separation",
-                 {"--url", url_in(replay.log_text(), "in the live view at"), "--screenshot",
-                  (dir / "separation.png").string(), "--seek", fmt::format("{:.9f}", last.time())});
-  replay.signal(SIGTERM);
-  EXPECT_EQ(replay.wait(testing::kPatience), 0) << replay.log_text();
+  const json page = check_replay_at(dir, "separation", last.time());
   ASSERT_FALSE(page.contains("error")) << page.dump();
   EXPECT_TRUE(page["errors"].empty()) << page["errors"].dump();
   ASSERT_EQ(page["shown"]["interfaces"].size(), 1u) << page["shown"].dump();
