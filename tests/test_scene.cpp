@@ -931,6 +931,7 @@ objects:
         laser: true
       - laser: false
         tool: forceps
+        contact: push
 tools:
   - name: forceps
   - name: fibre
@@ -941,6 +942,8 @@ TEST(SeparationSceneErrors, AnInstrumentNamesAToolOfTheSceneOnceAtItsToolKey) {
   const auto& spec = std::get<SeparationObjectSpec>(scene.objects.at(0).body);
   ASSERT_EQ(spec.instruments.size(), 2u);
   EXPECT_EQ(spec.instruments[1].tool, "forceps");
+  EXPECT_EQ(spec.instruments[0].settings.contact, ContactMode::grasp);
+  EXPECT_EQ(spec.instruments[1].settings.contact, ContactMode::push);
   const BadScene cases[] = {
       // The item starts on its `laser:` line; the message names the line of `tool:`.
       {"unknown tool",
@@ -952,6 +955,10 @@ TEST(SeparationSceneErrors, AnInstrumentNamesAToolOfTheSceneOnceAtItsToolKey) {
        "tool: fibre  # again",
        {"objects[0].instruments[1].tool", "expected a tool not named by an earlier instrument",
         "found 'fibre'"}},
+      {"a contact of no kind",
+       replaced(kLayersSceneOfSceneTests, "contact: push", "contact: poke"),
+       "contact: poke",
+       {"objects[0].instruments[1].contact", "grasp | push", "found 'poke'"}},
   };
   for (const BadScene& bad : cases) expect_scene_error(bad);
 }

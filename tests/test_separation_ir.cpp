@@ -126,11 +126,11 @@ struct SeparationDrive {
   std::uint32_t buttons;
 };
 
-SeparationModel default_separation_model(bool laser) {
+SeparationModel default_separation_model(const SeparationToolSettings& tool) {
   SeparationModel model;
   model.name = "layers";
   model.patch = shared_default_patch();
-  if (laser) model.spec.instruments.push_back({"tool", {true, 1e-3}});
+  model.spec.instruments.push_back({"tool", tool});
   return model;
 }
 
@@ -140,11 +140,14 @@ struct ClientServerRun {
   double largest_force = 0;
   double server_area = 0, client_area = 0;
   double fractured = 0, vaporised = 0;
+  int pushing = 0;           // ticks the client's tool held a push contact
+  double furthest_slip = 0;  // the furthest c went from where a contact began [m]
 };
 
 template <typename Script>
-ClientServerRun run_client_and_server(bool laser, int ticks, const Script& script) {
-  const SeparationModel model = default_separation_model(laser);
+ClientServerRun run_client_and_server(const SeparationToolSettings& tool, int ticks,
+                                      const Script& script) {
+  const SeparationModel model = default_separation_model(tool);
   SeparationSimulation server(model, 0, {ToolSpec{"tool", ToolShape::point, 0, {}}}, 3.3);
   const double dt = 1e-3;
   SeparationDrive first = script(0);
@@ -153,6 +156,8 @@ ClientServerRun run_client_and_server(bool laser, int ticks, const Script& scrip
   const PreparedIR client_ir = prepare_ir(over_the_wire(server.ir(0)->ir));
   EvaluationState client = make_evaluation_state(client_ir);
   ClientServerRun run;
+  bool touching = false;
+  Vector3d began = Vector3d::Zero();  // c when the client's contact began
   for (int i = 1; i <= ticks; ++i) {
     const SeparationDrive drive = script(i);
     server.set_tool(0, drive.tip, drive.buttons);
@@ -163,6 +168,13 @@ ClientServerRun run_client_and_server(bool laser, int ticks, const Script& scrip
     run.largest_force = std::max(run.largest_force, expected.force.norm());
     EXPECT_EQ(got.flags, expected.flags) << "tick " << i;
     run.in_contact += (expected.flags & kInContact) ? 1 : 0;
+    const SeparationContact& contact = std::get<SeparationEvaluation>(client.body).tool.contact;
+    if (contact.mode != ContactMode::none && !touching) began = contact.position;
+    touching = contact.mode != ContactMode::none;
+    if (touching) {
+      run.furthest_slip = std::max(run.furthest_slip, (contact.position - began).norm());
+      run.pushing += contact.mode == ContactMode::push;
+    }
     ++run.ticks;
   }
   run.server_area = server.state().separated_area;
@@ -177,7 +189,7 @@ TEST(SeparationIr, ClientForceEqualsTheServersThroughAPullThatTears) {
   // paper's Fig. 10 loading and fracture phases (F_n is reached near 6 mm), then back down.
   const Vector3d rim = default_two_layers().patch.positions.col(
       nearest_patch_node(default_two_layers().patch, Vector3d(0, 0.02, 0)));
-  const ClientServerRun run = run_client_and_server(false, 1600, [&](int i) {
+  const ClientServerRun run = run_client_and_server({}, 1600, [&](int i) {
     const double up = i <= 800 ? 1e-5 * i : 1e-5 * (1600 - i);
     return SeparationDrive{rim + Vector3d(0, 0, up), i >= 5 ? 1u : 0u};
   });
@@ -198,7 +210,7 @@ TEST(SeparationIr, ClientForceEqualsTheServersThroughALaserGrooveAndAPushThatOpe
   const Vector3d from(0.0205, 0.012, 0), to(0.0205, 0.028, 0);
   const int cut = static_cast<int>(std::ceil((to - from).norm() / (speed * dt)));
   const Vector3d grip(0.02, 0.02, 0);
-  const ClientServerRun run = run_client_and_server(true, cut + 400, [&](int i) {
+  const ClientServerRun run = run_client_and_server({.laser = true}, cut + 400, [&](int i) {
     if (i <= cut) return SeparationDrive{from + (to - from) * (double(i) / cut), 1u};
     const int k = i - cut;
     if (k <= 50) return SeparationDrive{to + (grip - to) * (k / 50.0), 0u};  // laser off, jaws open
@@ -206,6 +218,40 @@ TEST(SeparationIr, ClientForceEqualsTheServersThroughALaserGrooveAndAPushThatOpe
                            2u};  // jaws closed, pushing along x
   });
   EXPECT_GT(run.vaporised, 0.9 * patch.spot_diameter * (to - from).norm()) << "no groove";
+  EXPECT_GT(run.fractured, 0) << "the push did not open the groove";
+  EXPECT_LE(run.largest_difference, 1e-9 * run.largest_force);
+  EXPECT_EQ(run.client_area, run.server_area);
+}
+
+TEST(SeparationIr, ClientForceEqualsTheServersThroughAPushingToolThatSlidesToTheGrooveAndOpensIt) {
+  // A blunt laser tool (contact: push): the fibre cuts the groove, goes down out of reach and
+  // over to 1.5 mm before the groove, comes up under the flap (it touches 1 mm below the
+  // interface), presses it up by 1 mm and drags it along x: c slides by friction to the
+  // groove's edge and stops there, and the push tears the interface on from it.
+  const SeparationPatch& patch = default_two_layers().patch;
+  const double speed = 0.5 * patch.vaporisation_speed, dt = 1e-3;
+  const Vector3d from(0.0205, 0.012, 0), to(0.0205, 0.028, 0), below(0, 0, -0.002);
+  const int cut = static_cast<int>(std::ceil((to - from).norm() / (speed * dt)));
+  const Vector3d start(0.019, 0.0203, 0);
+  const auto along = [](const Vector3d& a, const Vector3d& b, int k, int of) {
+    return a + (b - a) * (static_cast<double>(k) / of);
+  };
+  const ClientServerRun run =
+      run_client_and_server({.laser = true, .contact = ContactMode::push}, cut + 1000, [&](int i) {
+        if (i <= cut) return SeparationDrive{along(from, to, i, cut), 1u};
+        const int k = i - cut;
+        if (k <= 50) return SeparationDrive{along(to, to + below, k, 50), 1u};  // firing: off it
+        if (k <= 150) return SeparationDrive{along(to + below, start + below, k - 50, 100), 0u};
+        if (k <= 350)  // up under the flap: touches at 1 mm below, presses 1 mm up
+          return SeparationDrive{along(start + below, start + Vector3d(0, 0, 1e-3), k - 150, 200),
+                                 0u};
+        return SeparationDrive{start + Vector3d(2e-5 * (k - 350), 0, 1e-3), 0u};  // drag along x
+      });
+  EXPECT_GT(run.vaporised, 0.9 * patch.spot_diameter * (to - from).norm()) << "no groove";
+  EXPECT_GT(run.in_contact, 500);
+  EXPECT_EQ(run.pushing, run.in_contact) << "the tool pushes, it never grasps";
+  // c slid from x = 19 mm to the crack edge the groove opened (the cell edge x = 20 mm).
+  EXPECT_GE(run.furthest_slip, 0.9e-3);
   EXPECT_GT(run.fractured, 0) << "the push did not open the groove";
   EXPECT_LE(run.largest_difference, 1e-9 * run.largest_force);
   EXPECT_EQ(run.client_area, run.server_area);
@@ -272,6 +318,12 @@ TEST(SeparationIr, LyingMessagesAreRefusedByName) {
   w = good;
   w.mutable_separation()->mutable_contact()->set_triangle(1u << 31);
   expect_separation_refused(w, "contact triangle = 2147483648 is out of range");
+  w = good;
+  w.mutable_separation()->set_tool_contact(3);
+  expect_separation_refused(w, "tool_contact 3 is neither grasp (1) nor push (2)");
+  w = good;
+  w.mutable_separation()->set_tool_contact(257);
+  expect_separation_refused(w, "tool_contact 257");
   w = good;
   w.mutable_separation()->set_toughness(-75);
   expect_separation_refused(w, "toughness (J_c) must be a positive finite number");

@@ -116,6 +116,9 @@ bool separation_weights_valid(const Eigen::Vector3d& w) {
 void check_separation_tool(const SeparationPatch& p, const SeparationIr& ir) {
   if (!(std::isfinite(ir.tool.grasp_reach) && ir.tool.grasp_reach >= 0))
     refuse_separation("grasp_reach {} is not a finite length >= 0", ir.tool.grasp_reach);
+  if (ir.tool.contact != ContactMode::grasp && ir.tool.contact != ContactMode::push)
+    refuse_separation("the tool's contact {} is not grasp or push",
+                      static_cast<int>(ir.tool.contact));
   const SeparationContact& c = ir.tool_state.contact;
   if (c.mode != ContactMode::none && c.mode != ContactMode::grasp && c.mode != ContactMode::push)
     refuse_separation("contact mode {} is not none, grasp or push", static_cast<int>(c.mode));

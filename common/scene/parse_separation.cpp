@@ -137,13 +137,16 @@ SeparationObjectSpec parse_separation_object(const YamlCursor& c, double scale) 
   if (auto instruments = c.find("instruments")) {
     std::set<std::string> tools;
     for (const YamlCursor& item : instruments->items()) {
-      item.only_keys({"tool", "laser", "grasp_reach"});
+      item.only_keys({"tool", "laser", "contact", "grasp_reach"});
       SeparationInstrumentSpec instrument;
       instrument.tool = item.at("tool").text();
       if (!tools.insert(instrument.tool).second)
         item.at("tool").fail("a tool not named by an earlier instrument");
       instrument.settings.grasp_reach = object.grasp_reach;
       if (auto laser = item.find("laser")) instrument.settings.laser = laser->boolean();
+      if (auto contact = item.find("contact"))
+        instrument.settings.contact =
+            contact->choice({"grasp", "push"}) == "push" ? ContactMode::push : ContactMode::grasp;
       if (auto reach = item.find("grasp_reach"))
         instrument.settings.grasp_reach = separation_reach(*reach, scale);
       object.instruments.push_back(instrument);

@@ -33,13 +33,16 @@ SeparationToolSample step_separation_tool(const SeparationPatch& patch, Separati
                                           double dt) noexcept {
   SeparationToolSample sample;
   const bool firing = settings.laser && (buttons & kLaserFireButton) != 0;
-  const bool jaws = (buttons & jaw_button(settings)) != 0 && !firing;
-  if (!jaws) tool.contact.mode = ContactMode::none;
+  const bool pushes = settings.contact == ContactMode::push;
+  const bool jaws = !pushes && (buttons & jaw_button(settings)) != 0 && !firing;
+  const bool engaged = pushes ? !firing : jaws;
+  if (!engaged) tool.contact.mode = ContactMode::none;
   sample.laser = step_laser(patch, state, tool.fibre, tip, firing, dt);
-  if (jaws && !tool.jaws_closed && tool.contact.mode == ContactMode::none && tip.allFinite()) {
+  const bool may_touch = pushes || !tool.jaws_closed;  // jaws grasp only as they close
+  if (engaged && may_touch && tool.contact.mode == ContactMode::none && tip.allFinite()) {
     const ContactPoint point = nearest_patch_point(patch, tip, sample.distance);
     if (sample.distance <= settings.grasp_reach)
-      tool.contact = begin_contact(patch, ContactMode::grasp, point, tip);
+      tool.contact = begin_contact(patch, settings.contact, point, tip);
   }
   tool.jaws_closed = jaws;
   if (tool.contact.mode != ContactMode::none)

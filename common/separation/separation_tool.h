@@ -1,5 +1,6 @@
 // One user's instrument on a separating interface, one tick: forceps that grasp the flap
-// while their jaws are closed, and optionally a laser fibre at the same tip. The same
+// while their jaws are closed, or a blunt tool that pushes on it, and optionally a laser
+// fibre at the same tip. The same
 // function runs on the server (the authoritative state) and on the client (its prediction
 // within the current IR), each on its own copy of the state.
 //
@@ -9,6 +10,10 @@
 // Jaws that close with the tip within `grasp_reach` of the interface grasp it at the
 // nearest point (a grasp contact, separation_contact.h); opening them, or firing the
 // laser, lets go. Jaws closed out of reach hold nothing until they open and close again.
+// A pushing tool (contact push) has no jaws: whenever its tip is within `grasp_reach` of
+// the interface and it holds no contact, it touches at the nearest point (a push contact:
+// it slides by friction, stops at crack edges and lets go when it would pull); firing its
+// laser lifts it off.
 // The fibre vaporises along the tip's path while firing (laser_groove.h).
 // The force on the hand is the contact's (zero while firing or not grasping).
 // noexcept, no allocation. Units: m, s, N.
@@ -23,8 +28,10 @@
 namespace cohaptic {
 
 struct SeparationToolSettings {
-  bool laser = false;         ///< the tool carries a fibre
-  double grasp_reach = 1e-3;  ///< jaws closing this close to the interface grasp it [m]
+  bool laser = false;  ///< the tool carries a fibre
+  double grasp_reach =
+      1e-3;  ///< jaws closing (a pusher's tip) this close to the interface hold it [m]
+  ContactMode contact = ContactMode::grasp;  ///< grasp (forceps) or push (a blunt tool)
 };
 
 inline constexpr std::uint32_t kLaserFireButton = 1u;  ///< button 0 of a laser tool

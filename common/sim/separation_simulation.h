@@ -42,7 +42,7 @@ class SeparationSimulation {
   std::shared_ptr<const PreparedIR> ir(int user) const {
     return users_[static_cast<std::size_t>(user)].ir;
   }
-  /// The user's instrument grasps the tissue.
+  /// The user's instrument holds the tissue (a grasp, or a pushing tool's push).
   bool pressing(int user) const;
   /// P0: the latest step's force on the user's tool (zero before its first).
   ForceSample force(int user) const { return users_[static_cast<std::size_t>(user)].force; }

@@ -108,6 +108,7 @@ void separation_to_wire(const cohaptic::SeparationIr& ir, SeparationPatch* out) 
   out->set_separated_area(ir.state.separated_area);
   out->set_laser_tool(ir.tool.laser);
   out->set_grasp_reach(ir.tool.grasp_reach);
+  out->set_tool_contact(static_cast<std::uint32_t>(ir.tool.contact));
   const cohaptic::SeparationContact& c = ir.tool_state.contact;
   if (c.mode != ContactMode::none) {
     SeparationContact* w = out->mutable_contact();
@@ -178,6 +179,11 @@ cohaptic::SeparationIr separation_from_wire(const SeparationPatch& w) {
   ir.state.separated_area = w.separated_area();
   ir.tool.laser = w.laser_tool();
   ir.tool.grasp_reach = w.grasp_reach();
+  if (w.tool_contact() > static_cast<std::uint32_t>(ContactMode::push))
+    refuse_separation_wire("tool_contact {} is neither grasp (1) nor push (2)", w.tool_contact());
+  // 0: written before tools could push, forceps.
+  ir.tool.contact =
+      w.tool_contact() == 0 ? ContactMode::grasp : static_cast<ContactMode>(w.tool_contact());
   if (w.has_contact()) ir.tool_state.contact = contact_from_wire(w.contact());
   ir.tool_state.fibre.firing = w.fibre_firing();
   ir.tool_state.fibre.last_tip = from_wire(w.fibre_last_tip());
