@@ -212,9 +212,12 @@ TEST(SeparationFracture, AGrooveThenAPullBesideItHoldsJcLnWhileTheCrackGrowsInsi
       settings.node = node;
       const PullLoop loop = run_pull_loop(patch, grooved, settings);
       int fracture = 0;
+      double lowest = loop.threshold, highest = loop.threshold;
       for (const PullLoopSample& s : loop.samples)
         if (s.phase == PullPhase::fracture) {
           ++fracture;
+          lowest = std::min(lowest, s.force);
+          highest = std::max(highest, s.force);
           EXPECT_NEAR(s.force, loop.threshold, 0.02 * loop.threshold)
               << where << " at " << s.travel * 1e3 << " mm";
         }
@@ -231,6 +234,12 @@ TEST(SeparationFracture, AGrooveThenAPullBesideItHoldsJcLnWhileTheCrackGrowsInsi
       short_length.normal_threshold = short_length.toughness * short_length.normal_length;
       const PullLoop lost = run_pull_loop(short_length, grooved, settings);
       EXPECT_LT(lost.fracture_area, 0.1 * patch.region_areas[node]) << where;
+      std::printf(
+          "  %s: BC %d samples, %.4f..%.4f N against J_c l_n = %.4f N, %.2f mm^2 separated, "
+          "work %.4e J against J_c dLambda %.4e J; at l_n = %.2f mm, %.3f mm^2\n",
+          where.c_str(), fracture, lowest, highest, loop.threshold, 1e6 * loop.fracture_area,
+          loop.fracture_work, patch.toughness * loop.fracture_area,
+          1e3 * short_length.normal_length, 1e6 * lost.fracture_area);
     }
 }
 
