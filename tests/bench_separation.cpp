@@ -1,5 +1,6 @@
 // Benchmarks of the separation body: the haptic tick against the
-// number of patch nodes — elastic, tearing, sliding and laser ticks — beside the
+// number of patch nodes — elastic, tearing, sliding and laser ticks, and a pushing tool
+// hovering out of reach (its search for the nearest interface point) — beside the
 // naive way (a live sparse FEM solve of the two layers per tick), and the precomputation
 // per field. The argument is the divisions of the 40 mm square interface: 10, 20 and 30
 // give 121, 441 and 961 patch nodes.
@@ -11,6 +12,7 @@
 
 #include "common/separation/laser_groove.h"
 #include "common/separation/pull_loop.h"
+#include "common/separation/separation_tool.h"
 #include "common/separation/tied_system.h"
 #include "common/separation/two_layer_setup.h"
 
@@ -132,6 +134,24 @@ void BM_SeparationTick_laser(benchmark::State& state) {
   set_counters(state, patch);
 }
 
+// A pushing tool (contact: push) 2 mm above the middle of the interface, out of its 1 mm
+// reach, moving in small circles: every tick looks for the nearest interface point over all
+// the patch's triangles, to touch as soon as it comes within reach.
+void BM_SeparationTick_pusher_hovering(benchmark::State& state) {
+  const SeparationPatch& patch = layers(static_cast<int>(state.range(0))).patch;
+  SeparationState separation = make_separation_state(patch);
+  SeparationToolState tool;
+  const SeparationToolSettings pusher{.contact = ContactMode::push};
+  int i = 0;
+  for (auto _ : state) {
+    const double t = 1e-3 * (i++ % 6283);
+    const Eigen::Vector3d tip(0.02 + 1e-3 * std::cos(t), 0.02 + 1e-3 * std::sin(t), 0.002);
+    benchmark::DoNotOptimize(
+        step_separation_tool(patch, separation, tool, pusher, tip, 0, 1e-3).distance);
+  }
+  set_counters(state, patch);
+}
+
 // The naive way: the force from a live sparse FEM solve of both layers, with the pairs
 // that are still connected merged, factorised for the tool's node: every tick.
 void BM_SeparationTick_naive_full_solve(benchmark::State& state) {
@@ -177,6 +197,11 @@ BENCHMARK(BM_SeparationTick_tearing)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeparationTick_sliding)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeparationTick_laser)->Arg(10)->Arg(20)->Arg(30)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SeparationTick_pusher_hovering)
+    ->Arg(10)
+    ->Arg(20)
+    ->Arg(30)
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_SeparationTick_naive_full_solve)->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SeparationPrecompute)
     ->Arg(10)
