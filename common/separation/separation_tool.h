@@ -28,9 +28,8 @@
 namespace cohaptic {
 
 struct SeparationToolSettings {
-  bool laser = false;  ///< the tool carries a fibre
-  double grasp_reach =
-      1e-3;  ///< jaws closing (a pusher's tip) this close to the interface hold it [m]
+  bool laser = false;         ///< the tool carries a fibre
+  double grasp_reach = 1e-3;  ///< jaws closing (a pusher's tip) this near hold it [m]
   ContactMode contact = ContactMode::grasp;  ///< grasp (forceps) or push (a blunt tool)
 };
 
