@@ -5,22 +5,36 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <utility>
 #include <fstream>
 #include <numbers>
 
 #include "common/model/model.h"
 #include "common/scene/load_scene.h"
 #include "common/separation/pull_loop_figure.h"
-#include "common/separation/two_layer_setup.h"
+#include "common/separation/separation_setup.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
 namespace {
 
-const SeparationModel& first_separation_body(const Model& model) {
+// The separation body whose interface has the node nearest `point` [m], and that node.
+std::pair<const SeparationModel*, int> nearest_separation_node(const Model& model,
+                                                               const Eigen::Vector3d& point) {
+  std::pair<const SeparationModel*, int> nearest{nullptr, -1};
+  double best = INFINITY;
   for (const BodyModel& body : model.bodies)
-    if (const auto* separation = std::get_if<SeparationModel>(&body)) return *separation;
-  throw Error(fmt::format("scene '{}' has no object of model: separation", model.scene.name));
+    if (const auto* separation = std::get_if<SeparationModel>(&body)) {
+      const int node = nearest_patch_node(*separation->patch, point);
+      if (const double distance = (separation->patch->positions.col(node) - point).norm();
+          distance < best) {
+        best = distance;
+        nearest = {separation, node};
+      }
+    }
+  if (!nearest.first)
+    throw Error(fmt::format("scene '{}' has no object of model: separation", model.scene.name));
+  return nearest;
 }
 
 void write_separation_pull_csv(const std::filesystem::path& file, const PullLoop& loop) {
@@ -39,11 +53,12 @@ int run_separation_pull(const SeparationPullOptions& options) {
   Scene scene = load_scene(options.scene);
   if (!options.disk_cache) use_separation_field_cache(scene, std::nullopt);
   const Model model = build_model(scene);
-  const SeparationPatch& patch = *first_separation_body(model).patch;
+  const auto [body, node_index] = nearest_separation_node(
+      model, Eigen::Vector3d(1e-3 * options.at_mm.at(0), 1e-3 * options.at_mm.at(1), 0));
+  const SeparationPatch& patch = *body->patch;
 
   PullLoopSettings settings;
-  settings.node = nearest_patch_node(
-      patch, Eigen::Vector3d(1e-3 * options.at_mm.at(0), 1e-3 * options.at_mm.at(1), 0));
+  settings.node = node_index;
   const double tilt = options.tilt_deg * std::numbers::pi / 180;
   const Eigen::Vector3d n =
       patch.normals[static_cast<std::size_t>(patch.regions.of(settings.node).front())];
@@ -65,8 +80,10 @@ int run_separation_pull(const SeparationPullOptions& options) {
   }
   const Eigen::Vector3d node = patch.positions.col(settings.node);
   fmt::print(
-      "Fig. 10 pull at node {} ({:.1f}, {:.1f}) mm, {:.1f} mm/s, {:.0f} deg from the normal:\n",
-      settings.node, 1e3 * node.x(), 1e3 * node.y(), options.speed_mm_s, options.tilt_deg);
+      "Fig. 10 pull on '{}' at node {} ({:.1f}, {:.1f}) mm, {:.1f} mm/s, {:.0f} deg from the "
+      "normal:\n",
+      body->name, settings.node, 1e3 * node.x(), 1e3 * node.y(), options.speed_mm_s,
+      options.tilt_deg);
   fmt::print(
       "  threshold J_c l = {:.4f} N; BC held between {:.4f} and {:.4f} N ({:+.2f} % .. {:+.2f} "
       "%)\n",
@@ -103,7 +120,10 @@ LabCommand add_separation_pull_command(CLI::App& lab) {
       "away and back; prints the thresholds and the energy balance, writes the figures to --out");
   command->add_option("--scene", options->scene, "A scene with an object of model: separation")
       ->capture_default_str();
-  command->add_option("--at", options->at_mm, "Hold the interface node nearest (x, y) [mm]")
+  command
+      ->add_option(
+          "--at", options->at_mm,
+          "Hold the interface node nearest (x, y, 0) [mm], on whichever separation object has it")
       ->expected(2)
       ->capture_default_str();
   command->add_option("--speed", options->speed_mm_s, "Pull speed [mm/s]")

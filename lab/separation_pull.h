@@ -18,7 +18,9 @@ namespace cohaptic {
 
 struct SeparationPullOptions {
   std::filesystem::path scene = "scenes/separation/two_layers.yaml";
-  std::vector<double> at_mm{0, 20};  ///< the held node: the interface node nearest (x, y, 0) [mm]
+  std::vector<double> at_mm{
+      0,
+      20};  ///< the held node: the interface node nearest (x, y, 0) [mm], of any separation object
   double speed_mm_s = 10;
   double tilt_deg = 0;        ///< from the normal towards +x
   std::filesystem::path out;  ///< empty: the summary only

@@ -14,7 +14,7 @@
 #include "common/separation/pull_loop.h"
 #include "common/separation/separation_tool.h"
 #include "common/separation/tied_system.h"
-#include "common/separation/two_layer_setup.h"
+#include "common/separation/separation_setup.h"
 
 namespace cohaptic {
 namespace {
@@ -25,11 +25,11 @@ TwoLayerBoxes boxes(int divisions) {
   return b;
 }
 
-const TwoLayerSetup& layers(int divisions) {
-  static std::map<int, std::unique_ptr<TwoLayerSetup>> setups;
+const SeparationSetup& layers(int divisions) {
+  static std::map<int, std::unique_ptr<SeparationSetup>> setups;
   auto& slot = setups[divisions];
   if (!slot)
-    slot = std::make_unique<TwoLayerSetup>(
+    slot = std::make_unique<SeparationSetup>(
         make_two_layer_setup(boxes(divisions), FieldSettings{}, SeparationSettings{}));
   return *slot;
 }
@@ -155,7 +155,7 @@ void BM_SeparationTick_pusher_hovering(benchmark::State& state) {
 // The naive way: the force from a live sparse FEM solve of both layers, with the pairs
 // that are still connected merged, factorised for the tool's node: every tick.
 void BM_SeparationTick_naive_full_solve(benchmark::State& state) {
-  const TwoLayerSetup& setup = layers(static_cast<int>(state.range(0)));
+  const SeparationSetup& setup = layers(static_cast<int>(state.range(0)));
   const int node = nearest_patch_node(setup.patch, Eigen::Vector3d(0.0203, 0.0197, 0));
   const std::vector<bool> tied(static_cast<std::size_t>(setup.interface.node_count()), true);
   const std::vector<int> footprint{node};

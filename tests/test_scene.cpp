@@ -963,6 +963,63 @@ TEST(SeparationSceneErrors, AnInstrumentNamesAToolOfTheSceneOnceAtItsToolKey) {
   for (const BadScene& bad : cases) expect_scene_error(bad);
 }
 
+// A separation body is either the generated layers or two meshes of the user's own, never
+// both; the meshes' keys are checked where they stand.
+TEST(SeparationSceneErrors, OwnMeshesComeInsteadOfTheLayersNotBesideThem) {
+  const std::string own_meshes = replaced(kLayersSceneOfSceneTests, R"(    layers:
+      size: [40, 40]
+      flap_thickness: 4
+      base_thickness: 10
+      divisions: [20, 20]
+      flap_layers: 2
+      base_layers: 3
+)",
+                                          R"(    pulled:
+      mesh: {box: {min: [0, 0, 0], size: [40, 40, 4], divisions: [4, 4, 1]}}
+      material: {youngs_modulus: 60000, poisson_ratio: 0.45}
+      fixed: [{plane: {point: [40, 0, 0], normal: [1, 0, 0]}}]
+    base:
+      mesh: {box: {min: [0, 0, -10], size: [40, 40, 10], divisions: [4, 4, 1]}}
+      material: {youngs_modulus: 60000, poisson_ratio: 0.45}
+      fixed: [{plane: {point: [0, 0, -10], normal: [0, 0, 1]}}]
+    interface: {sealed: [{plane: {point: [40, 0, 0], normal: [1, 0, 0]}}]}
+)");
+  const auto& spec =
+      std::get<SeparationObjectSpec>(parse_scene(own_meshes, kSceneFile).objects.at(0).body);
+  const auto& meshes = std::get<SeparationMeshesSpec>(spec.bodies);
+  EXPECT_EQ(meshes.pulled.mesh.box->size, Eigen::Vector3d(0.04, 0.04, 0.004));
+  EXPECT_EQ(meshes.base.fixed.at(0).nodes.plane_point.z(), -0.01);
+  ASSERT_EQ(meshes.sealed.size(), 1u);
+  EXPECT_EQ(meshes.sealed[0].plane_point.x(), 0.04);
+  const BadScene cases[] = {
+      {"layers beside own meshes",
+       replaced(own_meshes, "    pulled:\n",
+                "    layers: {size: [40, 40], flap_thickness: 4, "
+                "base_thickness: 10, divisions: [4, 4]}\n    pulled:\n"),
+       "      mesh: {box: {min: [0, 0, 0]",  // the map under `pulled:` starts here
+       {"objects[0].pulled", "give either layers or pulled and base"}},
+      {"neither layers nor meshes",
+       replaced(
+           own_meshes,
+           own_meshes.substr(own_meshes.find("    pulled:"),
+                             own_meshes.find("    instruments:") - own_meshes.find("    pulled:")),
+           ""),
+       "  - name: layers",
+       {"objects[0]", "expected layers (two generated boxes), or pulled and base"}},
+      {"a base without supports",
+       replaced(own_meshes, "      fixed: [{plane: {point: [0, 0, -10], normal: [0, 0, 1]}}]",
+                "      fixed: []"),
+       "      fixed: []",
+       {"objects[0].base.fixed",
+        "at least one fixed region (an unfixed body has no static solution)"}},
+      {"a sealed region with axes",
+       replaced(own_meshes, "normal: [1, 0, 0]}}]}", "normal: [1, 0, 0]}, axes: z}]}"),
+       "    interface:",
+       {"objects[0].interface.sealed[0]", "axes"}},
+  };
+  for (const BadScene& bad : cases) expect_scene_error(bad);
+}
+
 // make_two_layer_boxes meshes each layer as a box: (nx + 1)(ny + 1)(layers + 1) nodes, the
 // two layers together the body's nodes. The most a body may have are parsed, more are refused.
 // Parsed only: building them would fit the fields on a quarter of a million nodes.
@@ -983,8 +1040,10 @@ TEST(SeparationSceneErrors, LayersOfMoreNodesThanABodyMayHaveAreRefused) {
                "base_layers: 3", "base_layers: 4");
   const std::string at_limit = replaced(four_and_four, "divisions: [20, 20]",
                                         "divisions: [199, " + std::to_string(rows - 1) + "]");
-  EXPECT_EQ(std::get<SeparationObjectSpec>(parse_scene(at_limit, kSceneFile).objects.at(0).body)
-                .layers.divisions.y(),
+  EXPECT_EQ(std::get<TwoLayerBoxes>(
+                std::get<SeparationObjectSpec>(parse_scene(at_limit, kSceneFile).objects.at(0).body)
+                    .bodies)
+                .divisions.y(),
             rows - 1);
   const std::string over = replaced(four_and_four, "divisions: [20, 20]",
                                     "divisions: [199, " + std::to_string(rows) + "]");

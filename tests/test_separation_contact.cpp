@@ -12,7 +12,7 @@
 
 #include "common/separation/laser_groove.h"
 #include "common/separation/pull_loop.h"
-#include "common/separation/two_layer_setup.h"
+#include "common/separation/separation_setup.h"
 #include "support/default_two_layers.h"
 #include "support/sanitizer_owns_malloc.h"
 
@@ -204,7 +204,7 @@ TEST(SeparationContact, EvaluationAllocatesNothingAndStaysBounded) {
 // patch (here one rebuilt from its parts, as a receiver would) and the same tool samples,
 // every force and every separated share agree to the bit.
 TEST(SeparationContact, TwoCopiesAgreeBitForBit) {
-  const TwoLayerSetup& setup = default_two_layers();
+  const SeparationSetup& setup = default_two_layers();
   const SeparationPatch server = setup.patch;
   const SeparationPatch client =
       make_separation_patch(setup.interface, setup.fields, SeparationSettings{});

@@ -16,7 +16,7 @@
 #include "common/separation/separation_field_cache.h"
 #include "common/separation/separation_force.h"
 #include "common/separation/tied_system.h"
-#include "common/separation/two_layer_setup.h"
+#include "common/separation/separation_setup.h"
 #include "common/util/error.h"
 #include "support/scratch_directory.h"
 
@@ -65,7 +65,7 @@ TEST(SeparationInterface, TwoBoxesShareTheirConformingFace) {
     EXPECT_EQ(bodies.pulled.mesh.nodes.col(interface.pulled_nodes[k]),
               bodies.base.mesh.nodes.col(interface.base_nodes[k]));
   seal_rim_edges(interface,
-                 [&](const Eigen::Vector3d& m) { return m.x() > boxes.size.x() - 1e-9; });
+                 [&](int node) { return interface.positions(0, node) > boxes.size.x() - 1e-9; });
   rim_edges = 0;
   for (int t = 0; t < interface.triangle_count(); ++t)
     for (int k = 0; k < 3; ++k) rim_edges += interface.open_rim[t] >> k & 1;
@@ -155,7 +155,7 @@ TEST(SeparationFields, ReproduceTheFullSparseSolveInEveryState) {
 // energies are ordered U(F) >= U(F-bar) >= U(F^e), which is what makes fracture passive.
 TEST(SeparationFields, MoreConnectionStoresMoreEnergy) {
   const TwoLayerBoxes boxes = small_boxes();
-  const TwoLayerSetup setup = make_two_layer_setup(boxes, FieldSettings{}, SeparationSettings{});
+  const SeparationSetup setup = make_two_layer_setup(boxes, FieldSettings{}, SeparationSettings{});
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> uniform(-0.004, 0.004);
   for (int node = 0; node < setup.patch.node_count(); ++node)
@@ -235,11 +235,11 @@ TEST(SeparationFieldCache, RoundTripsBitForBitAndRebuildsWhenCorrupt) {
   FieldSettings settings;
   settings.degree = 5;
   settings.samples_per_axis = 10;
-  const TwoLayerSetup first =
+  const SeparationSetup first =
       make_two_layer_setup(boxes, settings, SeparationSettings{}, scratch.path);
   EXPECT_FALSE(first.fields_from_cache);
   EXPECT_GT(first.report.total_seconds(), 0);
-  const TwoLayerSetup second =
+  const SeparationSetup second =
       make_two_layer_setup(boxes, settings, SeparationSettings{}, scratch.path);
   ASSERT_TRUE(second.fields_from_cache);
   EXPECT_EQ(second.fields.values, first.fields.values);  // bit for bit
@@ -282,7 +282,7 @@ TEST(SeparationFieldCache, RoundTripsBitForBitAndRebuildsWhenCorrupt) {
 // three weights sum to one (a patch whose three fields are equal gives that field for any
 // areas). Algorithm V.2: at a vertex the nodal field, inside the triangles the weighted sum.
 TEST(SeparationBlend, PureStatesWeightsAndInterpolation) {
-  const TwoLayerSetup setup =
+  const SeparationSetup setup =
       make_two_layer_setup(small_boxes(), FieldSettings{}, SeparationSettings{});
   const SeparationPatch& patch = setup.patch;
   const Eigen::Vector3d delta(0.0012, -0.0007, 0.0021);
@@ -347,7 +347,7 @@ TEST(SeparationBlend, PureStatesWeightsAndInterpolation) {
 TEST(SeparationBlend, InterpolatesOverTheToolTriangle) {
   FieldSettings settings;
   settings.footprint_radii = {0.0, 0.0051, 0.0072};  // the node; with 4 neighbours; with 8
-  const TwoLayerSetup setup = make_two_layer_setup(small_boxes(), settings, SeparationSettings{});
+  const SeparationSetup setup = make_two_layer_setup(small_boxes(), settings, SeparationSettings{});
   const SeparationPatch& patch = setup.patch;
   const Eigen::Vector3d delta(0.0005, 0.0003, 0.002);
   const int node = 40;

@@ -14,7 +14,7 @@
 #include "common/separation/laser_groove.h"
 #include "common/separation/fracture_step.h"
 #include "common/separation/pull_loop_figure.h"
-#include "common/separation/two_layer_setup.h"
+#include "common/separation/separation_setup.h"
 #include "support/default_two_layers.h"
 
 namespace cohaptic {

@@ -16,12 +16,14 @@
 #include "proto/wire/ir_convert.h"
 #include "support/ir_seed.h"
 #include "support/default_two_layers.h"
+#include "support/wire_round_trip.h"
 
 namespace cohaptic {
 namespace {
 
 using Eigen::Vector3d;
 using testing::default_two_layers;
+using testing::over_the_wire;
 
 std::shared_ptr<const SeparationPatch> shared_default_patch() {
   static const auto patch = std::make_shared<const SeparationPatch>(default_two_layers().patch);
@@ -54,14 +56,6 @@ IntermediateRepresentation busy_ir() {
   ir.force_limit = 3.3;
   ir.body = std::move(body);
   return ir;
-}
-
-IntermediateRepresentation over_the_wire(const IntermediateRepresentation& ir) {
-  std::string bytes;
-  EXPECT_TRUE(wire::to_wire(ir).SerializeToString(&bytes));
-  wire::IntermediateRepresentation parsed;
-  EXPECT_TRUE(parsed.ParseFromString(bytes));
-  return wire::from_wire(parsed);
 }
 
 TEST(SeparationIr, WireRoundTripIsBitExact) {

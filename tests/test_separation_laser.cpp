@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "common/separation/laser_groove.h"
-#include "common/separation/two_layer_setup.h"
+#include "common/separation/separation_setup.h"
 #include "common/util/error.h"
 #include "support/default_two_layers.h"
 

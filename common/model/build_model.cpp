@@ -35,7 +35,7 @@ struct BodyBuilder {
     return build_home_spring_body(object.name, spec, object.where, metres_per_unit);
   }
   BodyModel operator()(const SeparationObjectSpec& spec) const {
-    return build_separation_body(object.name, spec, force_limit, object.where);
+    return build_separation_body(object.name, spec, force_limit, metres_per_unit, object.where);
   }
 };
 

@@ -6,6 +6,8 @@
 #include <set>
 
 #include "common/mesh/mesh_limits.h"
+#include "common/scene/parse_mesh.h"
+#include "common/scene/parse_node_selector.h"
 #include "common/util/error.h"
 
 namespace cohaptic {
@@ -41,9 +43,13 @@ LinearElasticMaterial parse_separation_layer_material(const YamlCursor& c) {
 }
 
 TwoLayerBoxes parse_separation_layers(const YamlCursor& c, double scale) {
-  c.only_keys({"size", "flap_thickness", "base_thickness", "divisions", "flap_layers",
+  c.only_keys({"origin", "size", "flap_thickness", "base_thickness", "divisions", "flap_layers",
                "base_layers", "flap_material", "base_material"});
   TwoLayerBoxes layers;
+  if (auto origin = c.find("origin")) {
+    layers.origin = origin->vec3() * scale;
+    if (!layers.origin.allFinite()) origin->fail("three finite lengths");
+  }
   const std::vector<YamlCursor> size = c.at("size").items();
   if (size.size() != 2) c.at("size").fail("a list of two lengths [a, b]");
   layers.size =
@@ -72,6 +78,34 @@ TwoLayerBoxes parse_separation_layers(const YamlCursor& c, double scale) {
   if (auto material = c.find("base_material"))
     layers.base_material = parse_separation_layer_material(*material);
   return layers;
+}
+
+SeparationBodySpec parse_separating_body(const YamlCursor& c, double scale,
+                                         const SceneFiles& files) {
+  c.only_keys({"mesh", "material", "fixed"});
+  SeparationBodySpec body;
+  body.mesh = parse_mesh(c.at("mesh"), scale, files);
+  body.material = parse_separation_layer_material(c.at("material"));
+  body.fixed = parse_fixed_regions(c.at("fixed"), scale);
+  return body;
+}
+
+SeparationMeshesSpec parse_separation_meshes(const YamlCursor& c, double scale,
+                                             const SceneFiles& files) {
+  SeparationMeshesSpec meshes;
+  meshes.pulled = parse_separating_body(c.at("pulled"), scale, files);
+  meshes.base = parse_separating_body(c.at("base"), scale, files);
+  if (auto interface = c.find("interface")) {
+    interface->only_keys({"tolerance", "sealed"});
+    if (auto tolerance = interface->find("tolerance"))
+      meshes.interface_tolerance = separation_length(*tolerance, scale);
+    if (auto sealed = interface->find("sealed"))
+      for (const YamlCursor& item : sealed->items()) {
+        item.only_keys({"surface", "box", "plane", "nodes"});
+        meshes.sealed.push_back(parse_node_selector(item, scale));
+      }
+  }
+  return meshes;
 }
 
 FieldSettings parse_separation_fields(const YamlCursor& c, double scale) {
@@ -121,11 +155,24 @@ void parse_separation_tissue(const YamlCursor& c, TissueThermal& tissue) {
 
 }  // namespace
 
-SeparationObjectSpec parse_separation_object(const YamlCursor& c, double scale) {
-  c.only_keys({"name", "model", "layers", "fields", "fracture", "laser", "tissue", "force_limit",
-               "instruments", "grasp_reach", "ir_rate_hz", "disk_cache"});
+SeparationObjectSpec parse_separation_object(const YamlCursor& c, double scale,
+                                             const SceneFiles& files) {
+  c.only_keys({"name", "model", "layers", "pulled", "base", "interface", "fields", "fracture",
+               "laser", "tissue", "force_limit", "instruments", "grasp_reach", "ir_rate_hz",
+               "disk_cache"});
   SeparationObjectSpec object;
-  object.layers = parse_separation_layers(c.at("layers"), scale);
+  if (auto layers = c.find("layers")) {
+    for (const char* key : {"pulled", "base", "interface"})
+      if (auto own = c.find(key))
+        own->fail_message(
+            "the generated layers have their own bodies and interface: give "
+            "either layers or pulled and base (with an optional interface)");
+    object.bodies = parse_separation_layers(*layers, scale);
+  } else if (c.find("pulled") || c.find("base")) {
+    object.bodies = parse_separation_meshes(c, scale, files);
+  } else {
+    c.fail("layers (two generated boxes), or pulled and base (each a mesh, material and fixed)");
+  }
   if (auto fields = c.find("fields")) object.fields = parse_separation_fields(*fields, scale);
   if (auto fracture = c.find("fracture"))
     parse_separation_fracture(*fracture, scale, object.settings.fracture);

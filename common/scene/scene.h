@@ -20,8 +20,8 @@
 #include "common/kinds/contact_model.h"
 #include "common/laparoscopy/home_spring_spec.h"
 #include "common/mass_spring/mass_spring_spec.h"
-#include "common/mesh/mesh_with_gmsh.h"
 #include "common/mesh/node_selector.h"
+#include "common/fem/mesh_spec.h"
 #include "common/separation/separation_object_spec.h"
 
 namespace cohaptic {
@@ -29,29 +29,6 @@ namespace cohaptic {
 /// probe and forceps are laparoscopic instruments (home_spring_spec.h): a shaft through a
 /// trocar; on any other body kind their tip is a point.
 enum class ToolShape { point, sphere, probe, forceps };
-
-struct BoxMeshSpec {
-  Eigen::Vector3d min_corner = Eigen::Vector3d::Zero();  ///< [m]
-  Eigen::Vector3d size = Eigen::Vector3d::Zero();        ///< [m]
-  Eigen::Vector3i divisions = Eigen::Vector3i::Ones();
-  Eigen::Vector3d grading =
-      Eigen::Vector3d::Ones();  ///< per axis: each cell / the one before (box_mesher.h)
-  Eigen::Vector3i uniform_cells =
-      Eigen::Vector3i::Zero();  ///< per axis: equal cells on the fine side first
-};
-
-/// Exactly one of a mesh file (.msh 2.2/4.1, resolved against the scene's directory), a
-/// Gmsh script that gmsh meshes when the scene is built (mesh_with_gmsh.h), or a box.
-struct MeshSpec {
-  std::filesystem::path file;
-  std::optional<GmshScript> gmsh;
-  std::optional<BoxMeshSpec> box;
-};
-
-struct FixedRegion {
-  NodeSelector nodes;
-  AxisMask axes = kAllAxes;  ///< fixing only some axes expresses a sliding boundary
-};
 
 struct ComplianceSettings {
   bool precompute_touchable =

@@ -80,15 +80,13 @@ SeparationInterface find_interface(const SeparationBodies& bodies, double tolera
   return interface;
 }
 
-void seal_rim_edges(SeparationInterface& interface,
-                    const std::function<bool(const Eigen::Vector3d&)>& sealed) {
+void seal_rim_edges(SeparationInterface& interface, const std::function<bool(int)>& sealed_node) {
   for (int t = 0; t < interface.triangle_count(); ++t)
     for (int k = 0; k < 3; ++k) {
       if ((interface.open_rim[t] >> k & 1u) == 0) continue;
       const Triangle& tri = interface.triangles[t];
-      const Eigen::Vector3d midpoint =
-          0.5 * (interface.positions.col(tri[k]) + interface.positions.col(tri[(k + 1) % 3]));
-      if (sealed(midpoint)) interface.open_rim[t] &= static_cast<std::uint8_t>(~(1u << k));
+      if (sealed_node(tri[k]) && sealed_node(tri[(k + 1) % 3]))
+        interface.open_rim[t] &= static_cast<std::uint8_t>(~(1u << k));
     }
 }
 
@@ -123,6 +121,8 @@ SeparationBodies make_two_layer_boxes(const TwoLayerBoxes& boxes) {
   for (int n = 0; n < bodies.base.mesh.node_count(); ++n)
     if (bodies.base.mesh.nodes(2, n) < -boxes.base_thickness + on_face)
       bodies.base.fixed_axes[n] = kAllAxes;
+  bodies.pulled.mesh.nodes.colwise() += boxes.origin;
+  bodies.base.mesh.nodes.colwise() += boxes.origin;
   return bodies;
 }
 

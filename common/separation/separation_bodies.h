@@ -53,17 +53,18 @@ struct SeparationInterface {
 /// the bodies share no triangle, or a pulled node has two base nodes within tolerance.
 SeparationInterface find_interface(const SeparationBodies& bodies, double tolerance);
 
-/// Closes the rim edges whose midpoint satisfies `sealed` (where the layers go on).
-void seal_rim_edges(SeparationInterface& interface,
-                    const std::function<bool(const Eigen::Vector3d&)>& sealed);
+/// Closes the rim edges both of whose nodes satisfy `sealed_node` (an interface node index):
+/// where the layers go on beyond the model.
+void seal_rim_edges(SeparationInterface& interface, const std::function<bool(int)>& sealed_node);
 
-/// Two stacked boxes: the base [0, a] x [0, b] x [-base_thickness, 0] and the pulled
-/// layer [0, a] x [0, b] x [0, pulled_thickness], with the same divisions in x and y so
-/// that their nodes conform on z = 0.
+/// Two stacked boxes, relative to `origin`: the base [0, a] x [0, b] x [-base_thickness, 0]
+/// and the pulled layer [0, a] x [0, b] x [0, pulled_thickness], with the same divisions in
+/// x and y so that their nodes conform on the interface z = 0.
 struct TwoLayerBoxes {
-  Eigen::Vector2d size{0.04, 0.04};  ///< a, b [m]
-  double pulled_thickness = 0.004;   ///< [m]
-  double base_thickness = 0.01;      ///< [m]
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< the interface's corner [m]
+  Eigen::Vector2d size{0.04, 0.04};                  ///< a, b [m]
+  double pulled_thickness = 0.004;                   ///< [m]
+  double base_thickness = 0.01;                      ///< [m]
   Eigen::Vector2i divisions{20, 20};
   int pulled_layers = 2;
   int base_layers = 3;
@@ -72,8 +73,8 @@ struct TwoLayerBoxes {
 };
 
 /// The two layers with their supports: the base held on its bottom face, the pulled layer
-/// on its end face x = a above the interface (the flap goes on into tissue there; its
-/// interface nodes stay free). Seal the rim at x = a on the found interface.
+/// on its end face x = origin.x + a above the interface (the flap goes on into tissue there; its
+/// interface nodes stay free). Seal the rim at that end on the found interface.
 SeparationBodies make_two_layer_boxes(const TwoLayerBoxes& boxes);
 
 }  // namespace cohaptic

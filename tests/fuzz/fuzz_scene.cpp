@@ -91,8 +91,8 @@ void require_valid(const HomeSpringObjectSpec& object) {
           "the display radius is positive");
 }
 
-void require_valid(const SeparationObjectSpec& object) {
-  const TwoLayerBoxes& layers = object.layers;
+void require_valid(const TwoLayerBoxes& layers) {
+  require(layers.origin.allFinite(), "the layers' origin is finite");
   require(layers.size.allFinite() && (layers.size.array() > 0).all(),
           "the layers have a finite positive size");
   require(std::isfinite(layers.pulled_thickness) && layers.pulled_thickness > 0 &&
@@ -101,6 +101,21 @@ void require_valid(const SeparationObjectSpec& object) {
   require(
       (layers.divisions.array() >= 1).all() && layers.pulled_layers >= 1 && layers.base_layers >= 1,
       "the layers have cells");
+}
+
+void require_valid(const SeparationMeshesSpec& meshes) {
+  for (const SeparationBodySpec* body : {&meshes.pulled, &meshes.base}) {
+    require(!body->fixed.empty(), "each separating body has supports");
+    require(std::isfinite(body->material.youngs_modulus) && body->material.youngs_modulus > 0,
+            "each separating body's modulus is positive");
+  }
+  require(!meshes.interface_tolerance ||
+              (std::isfinite(*meshes.interface_tolerance) && *meshes.interface_tolerance > 0),
+          "the interface tolerance is a positive length");
+}
+
+void require_valid(const SeparationObjectSpec& object) {
+  std::visit([](const auto& bodies) { require_valid(bodies); }, object.bodies);
   bool settings_valid = true;
   try {
     validate(object.settings);

@@ -2,12 +2,12 @@
 // (a 4 mm flap on a 10 mm bed), 2 mm cells, every field and separation setting at its default.
 #pragma once
 
-#include "common/separation/two_layer_setup.h"
+#include "common/separation/separation_setup.h"
 
 namespace cohaptic::testing {
 
-inline const TwoLayerSetup& default_two_layers() {
-  static const TwoLayerSetup setup =
+inline const SeparationSetup& default_two_layers() {
+  static const SeparationSetup setup =
       make_two_layer_setup(TwoLayerBoxes{}, FieldSettings{}, SeparationSettings{});
   return setup;
 }
