@@ -966,15 +966,14 @@ TEST(SeparationSceneErrors, AnInstrumentNamesAToolOfTheSceneOnceAtItsToolKey) {
 // A separation body is either the generated layers or two meshes of the user's own, never
 // both; the meshes' keys are checked where they stand.
 TEST(SeparationSceneErrors, OwnMeshesComeInsteadOfTheLayersNotBesideThem) {
-  const std::string own_meshes = replaced(kLayersSceneOfSceneTests, R"(    layers:
-      size: [40, 40]
-      flap_thickness: 4
-      base_thickness: 10
-      divisions: [20, 20]
-      flap_layers: 2
-      base_layers: 3
-)",
-                                          R"(    pulled:
+  // The lines from `key:` up to `instruments:`: the object's bodies.
+  const auto bodies_of = [](const std::string& scene, const std::string& key) {
+    const std::size_t from = scene.find("    " + key + ":");
+    return scene.substr(from, scene.find("    instruments:") - from);
+  };
+  const std::string own_meshes =
+      replaced(kLayersSceneOfSceneTests, bodies_of(kLayersSceneOfSceneTests, "layers"),
+               R"(    pulled:
       mesh: {box: {min: [0, 0, 0], size: [40, 40, 4], divisions: [4, 4, 1]}}
       material: {youngs_modulus: 60000, poisson_ratio: 0.45}
       fixed: [{plane: {point: [40, 0, 0], normal: [1, 0, 0]}}]
@@ -999,11 +998,7 @@ TEST(SeparationSceneErrors, OwnMeshesComeInsteadOfTheLayersNotBesideThem) {
        "      mesh: {box: {min: [0, 0, 0]",  // the map under `pulled:` starts here
        {"objects[0].pulled", "give either layers or pulled and base"}},
       {"neither layers nor meshes",
-       replaced(
-           own_meshes,
-           own_meshes.substr(own_meshes.find("    pulled:"),
-                             own_meshes.find("    instruments:") - own_meshes.find("    pulled:")),
-           ""),
+       replaced(own_meshes, bodies_of(own_meshes, "pulled"), ""),
        "  - name: layers",
        {"objects[0]", "expected layers (two generated boxes), or pulled and base"}},
       {"a base without supports",
