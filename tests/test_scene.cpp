@@ -983,8 +983,8 @@ TEST(SeparationSceneErrors, OwnMeshesComeInsteadOfTheLayersNotBesideThem) {
       fixed: [{plane: {point: [0, 0, -10], normal: [0, 0, 1]}}]
     interface: {sealed: [{plane: {point: [40, 0, 0], normal: [1, 0, 0]}}]}
 )");
-  const auto& spec =
-      std::get<SeparationObjectSpec>(parse_scene(own_meshes, kSceneFile).objects.at(0).body);
+  const Scene scene = parse_scene(own_meshes, kSceneFile);
+  const auto& spec = std::get<SeparationObjectSpec>(scene.objects.at(0).body);
   const auto& meshes = std::get<SeparationMeshesSpec>(spec.bodies);
   EXPECT_EQ(meshes.pulled.mesh.box->size, Eigen::Vector3d(0.04, 0.04, 0.004));
   EXPECT_EQ(meshes.base.fixed.at(0).nodes.plane_point.z(), -0.01);
